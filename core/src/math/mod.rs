@@ -1,0 +1,79 @@
+//! Fixed-point numbers and vectors: the only arithmetic the tracer does per ray.
+//!
+//! Invariants:
+//! - A loaded scene lives in *normalised* space (see [`crate::scene::Normalization`]):
+//!   every point the tracer meets has coordinates within ±2^13 = ±8192, so a
+//!   difference of two points is within ±2^14 per axis and any distance along
+//!   a ray is below 2^15. [`Scalar`] (Q16.16) holds all of them.
+//! - Directions are unit vectors in Q2.30 ([`Dir`]); a product of a Q16.16
+//!   component and a Q2.30 component fits an `i64` with room for a sum of three.
+//! - Products are computed exactly in `i64` and rounded by an arithmetic shift,
+//!   so every result is the same bits on every target.
+//! - No function here panics on any input except through an overflow that the
+//!   invariants above rule out; debug builds (and the test suite) check that.
+
+mod exp_log;
+mod vector;
+
+pub use exp_log::{exp2_q32, log2_q32, pow_q30, pow_unit};
+pub use vector::{Dir, Vec3};
+
+pub use fixed::types::{I16F16, I2F30, I32F32};
+
+/// Positions, lengths, ray parameters and colours: Q16.16.
+pub type Scalar = I16F16;
+/// Components of unit vectors and cosines: Q2.30.
+pub type Unit = I2F30;
+/// Wide values (world coordinates as parsed, products of two [`Scalar`]s): Q32.32.
+pub type Wide = I32F32;
+
+/// Normalised scene coordinates lie within ±2^`SCENE_RANGE_LOG2`.
+pub const SCENE_RANGE_LOG2: u32 = 13;
+
+/// One in Q2.30.
+pub const UNIT_ONE: i64 = 1 << 30;
+/// One in Q16.16.
+pub const SCALAR_ONE: i32 = 1 << 16;
+
+/// Floor of the square root of a `u64`.
+#[inline]
+pub fn isqrt(n: u64) -> u64 {
+    n.isqrt()
+}
+
+/// `a * b >> shift` for signed operands whose exact product fits an `i64`.
+#[inline]
+pub fn mul_shift(a: i64, b: i64, shift: u32) -> i64 {
+    (a * b) >> shift
+}
+
+/// Divides `num` by `den` (> 0) after scaling `num` by 2^`shift`, saturating
+/// the quotient to `i32`. Used where a ratio may be huge (a ray almost parallel
+/// to a plane) and only its comparison with a bound matters.
+#[inline]
+pub fn div_scaled_saturating(num: i64, den: i64, shift: u32) -> i32 {
+    debug_assert!(den > 0);
+    let wide = ((num as i128) << shift) / den as i128;
+    wide.clamp(i32::MIN as i128, i32::MAX as i128) as i32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn isqrt_is_floor() {
+        for n in [0u64, 1, 2, 3, 4, 15, 16, 17, u64::MAX, (1 << 62) - 1, 1 << 62] {
+            let r = isqrt(n);
+            assert!(r * r <= n);
+            assert!((r + 1).checked_mul(r + 1).is_none_or(|s| s > n));
+        }
+    }
+
+    #[test]
+    fn saturating_division_clamps() {
+        assert_eq!(div_scaled_saturating(1, 1, 40), i32::MAX);
+        assert_eq!(div_scaled_saturating(-1, 1, 40), i32::MIN);
+        assert_eq!(div_scaled_saturating(3 << 16, 2, 0), 3 << 15);
+    }
+}

@@ -1,0 +1,313 @@
+//! Three-component vectors: [`Vec3`] for points and offsets (Q16.16), [`Dir`]
+//! for unit directions (Q2.30).
+//!
+//! Invariant: a [`Dir`] built by [`Dir::normalize`] has length 1 within 2^-29.
+//! Arithmetic on [`Vec3`] uses `fixed`'s operators, which panic on overflow in
+//! debug builds; the scene normalisation keeps every value in range.
+
+use super::{Scalar, Unit, UNIT_ONE};
+use core::ops::{Add, Neg, Sub};
+
+/// A point or an offset in normalised scene space.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Vec3 {
+    pub x: Scalar,
+    pub y: Scalar,
+    pub z: Scalar,
+}
+
+/// A unit vector.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Dir {
+    pub x: Unit,
+    pub y: Unit,
+    pub z: Unit,
+}
+
+impl Vec3 {
+    pub const ZERO: Vec3 = Vec3::from_bits([0; 3]);
+
+    #[inline]
+    pub const fn from_bits(b: [i32; 3]) -> Self {
+        Vec3 {
+            x: Scalar::from_bits(b[0]),
+            y: Scalar::from_bits(b[1]),
+            z: Scalar::from_bits(b[2]),
+        }
+    }
+
+    #[inline]
+    pub const fn bits(self) -> [i32; 3] {
+        [self.x.to_bits(), self.y.to_bits(), self.z.to_bits()]
+    }
+
+    /// Components widened to `i64` (still Q16.16).
+    #[inline]
+    pub const fn wide(self) -> [i64; 3] {
+        let b = self.bits();
+        [b[0] as i64, b[1] as i64, b[2] as i64]
+    }
+
+    #[inline]
+    pub fn axis(self, axis: usize) -> Scalar {
+        match axis {
+            0 => self.x,
+            1 => self.y,
+            _ => self.z,
+        }
+    }
+
+    /// `self · d` in Q16.16, rounded towards minus infinity.
+    #[inline]
+    pub fn dot_dir(self, d: Dir) -> Scalar {
+        Scalar::from_bits((self.dot_dir_q46(d) >> 30) as i32)
+    }
+
+    /// `self · d` exactly, in Q18.46.
+    #[inline]
+    pub fn dot_dir_q46(self, d: Dir) -> i64 {
+        let v = self.wide();
+        let e = d.wide();
+        v[0] * e[0] + v[1] * e[1] + v[2] * e[2]
+    }
+
+    /// `|self|²` exactly, in Q32.32. Components must be within ±2^15.
+    #[inline]
+    pub fn length_squared_q32(self) -> i64 {
+        let v = self.wide();
+        v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+    }
+
+    /// `|self|` in Q16.16, rounded down.
+    #[inline]
+    pub fn length(self) -> Scalar {
+        Scalar::from_bits(super::isqrt(self.length_squared_q32() as u64) as i32)
+    }
+
+    /// The unit vector along `self`, or `None` for the zero vector.
+    #[inline]
+    pub fn direction(self) -> Option<Dir> {
+        Dir::normalize(self.wide())
+    }
+}
+
+impl Add for Vec3 {
+    type Output = Vec3;
+    #[inline]
+    fn add(self, o: Vec3) -> Vec3 {
+        Vec3 {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
+    }
+}
+
+impl Sub for Vec3 {
+    type Output = Vec3;
+    #[inline]
+    fn sub(self, o: Vec3) -> Vec3 {
+        Vec3 {
+            x: self.x - o.x,
+            y: self.y - o.y,
+            z: self.z - o.z,
+        }
+    }
+}
+
+impl Neg for Vec3 {
+    type Output = Vec3;
+    #[inline]
+    fn neg(self) -> Vec3 {
+        Vec3 {
+            x: -self.x,
+            y: -self.y,
+            z: -self.z,
+        }
+    }
+}
+
+impl Dir {
+    pub const X: Dir = Dir::from_bits([1 << 30, 0, 0]);
+    pub const Y: Dir = Dir::from_bits([0, 1 << 30, 0]);
+    pub const Z: Dir = Dir::from_bits([0, 0, 1 << 30]);
+
+    #[inline]
+    pub const fn from_bits(b: [i32; 3]) -> Self {
+        Dir {
+            x: Unit::from_bits(b[0]),
+            y: Unit::from_bits(b[1]),
+            z: Unit::from_bits(b[2]),
+        }
+    }
+
+    #[inline]
+    pub const fn bits(self) -> [i32; 3] {
+        [self.x.to_bits(), self.y.to_bits(), self.z.to_bits()]
+    }
+
+    #[inline]
+    pub const fn wide(self) -> [i64; 3] {
+        let b = self.bits();
+        [b[0] as i64, b[1] as i64, b[2] as i64]
+    }
+
+    /// The unit vector along the axis `axis` (0, 1, 2), negated if `negative`.
+    #[inline]
+    pub fn axis_unit(axis: usize, negative: bool) -> Dir {
+        let one = if negative { -(1 << 30) } else { 1 << 30 };
+        let mut b = [0; 3];
+        b[axis.min(2)] = one;
+        Dir::from_bits(b)
+    }
+
+    #[inline]
+    pub fn axis(self, axis: usize) -> Unit {
+        match axis {
+            0 => self.x,
+            1 => self.y,
+            _ => self.z,
+        }
+    }
+
+    /// `self · o` exactly, in Q4.60.
+    #[inline]
+    pub fn dot_q60(self, o: Dir) -> i64 {
+        let a = self.wide();
+        let b = o.wide();
+        a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    }
+
+    /// `self · o` in Q2.30, rounded towards minus infinity.
+    #[inline]
+    pub fn dot(self, o: Dir) -> Unit {
+        Unit::from_bits((self.dot_q60(o) >> 30) as i32)
+    }
+
+    /// `t · self` in Q16.16; `|t|` below 2^15.
+    #[inline]
+    pub fn scale(self, t: Scalar) -> Vec3 {
+        let t = t.to_bits() as i64;
+        let d = self.wide();
+        Vec3::from_bits([
+            ((d[0] * t) >> 30) as i32,
+            ((d[1] * t) >> 30) as i32,
+            ((d[2] * t) >> 30) as i32,
+        ])
+    }
+
+    /// The unit vector along the integer vector `v` (any common scale), or
+    /// `None` when `v` is zero. Rounding is symmetric: `normalize(-v) ==
+    /// -normalize(v)`.
+    pub fn normalize(v: [i64; 3]) -> Option<Dir> {
+        let mag = |c: i64| c.unsigned_abs();
+        let largest = mag(v[0]).max(mag(v[1])).max(mag(v[2]));
+        if largest == 0 {
+            return None;
+        }
+        // Bring the largest magnitude to [2^29, 2^30): the squared length then
+        // fits a u64 and keeps 29 bits of precision whatever the input scale.
+        let bits = 64 - largest.leading_zeros() as i32;
+        let shift = bits - 30;
+        let scaled = v.map(|c| {
+            let m = mag(c);
+            let m = if shift > 0 { m >> shift } else { m << -shift } as i64;
+            if c < 0 {
+                -m
+            } else {
+                m
+            }
+        });
+        let len2 = scaled.iter().map(|&c| (c * c) as u64).sum::<u64>();
+        let len = super::isqrt(len2) as i64;
+        Some(Dir::from_bits(
+            scaled.map(|c| ((c << 30) / len) as i32),
+        ))
+    }
+
+    /// Cross product, renormalised; `None` for parallel inputs.
+    pub fn cross(self, o: Dir) -> Option<Dir> {
+        let a = self.wide();
+        let b = o.wide();
+        Dir::normalize([
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ])
+    }
+
+    /// The mirror image of `self` about the unit normal `n`: `2(n·self)n − self`.
+    /// The result stays unit length to rounding, so it is not renormalised.
+    #[inline]
+    pub fn reflect_about(self, n: Dir) -> Dir {
+        let d = self.dot_q60(n) >> 29; // 2(n·self) in Q2.30
+        let nb = n.wide();
+        let s = self.wide();
+        Dir::from_bits([0, 1, 2].map(|i| (((d * nb[i]) >> 30) - s[i]).clamp(-UNIT_ONE, UNIT_ONE) as i32))
+    }
+}
+
+impl Neg for Dir {
+    type Output = Dir;
+    #[inline]
+    fn neg(self) -> Dir {
+        Dir::from_bits(self.bits().map(|c| -c))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn len2(d: Dir) -> i64 {
+        d.dot_q60(d)
+    }
+
+    #[test]
+    fn normalize_gives_unit_length_at_any_scale() {
+        for v in [
+            [1i64, 0, 0],
+            [3, 4, 0],
+            [-7, 2, 9],
+            [1 << 50, -(1 << 49), 12345],
+            [i64::MAX / 4, i64::MIN / 4, 0],
+            [0, 0, -1],
+        ] {
+            let d = Dir::normalize(v).unwrap();
+            let err = (len2(d) - (1i64 << 60)).abs();
+            assert!(err < 1 << 32, "{v:?} -> {d:?} off by {err}");
+            // Same direction: the cross product with the input is tiny.
+            let n = Dir::normalize(v.map(|c| -c)).unwrap();
+            assert_eq!(n, -d, "symmetric rounding");
+        }
+        assert_eq!(Dir::normalize([0, 0, 0]), None);
+    }
+
+    #[test]
+    fn normalize_three_four_five() {
+        let d = Dir::normalize([3, 4, 0]).unwrap();
+        assert_eq!(d.bits()[2], 0);
+        assert!((d.bits()[0] as i64 - (3i64 << 30) / 5).abs() <= 2);
+        assert!((d.bits()[1] as i64 - (4i64 << 30) / 5).abs() <= 2);
+    }
+
+    #[test]
+    fn reflection_about_axis_flips_one_component() {
+        let d = Dir::normalize([1, -1, 0]).unwrap();
+        let r = (-d).reflect_about(Dir::Y);
+        let b = r.bits();
+        let e = d.bits();
+        assert!((b[0] - e[0]).abs() <= 1 && (b[1] + e[1]).abs() <= 1, "{r:?}");
+    }
+
+    #[test]
+    fn dot_and_scale() {
+        let v = Vec3::from_bits([3 << 16, 4 << 16, 0]);
+        assert_eq!(v.length().to_bits(), 5 << 16);
+        assert_eq!(v.dot_dir(Dir::X).to_bits(), 3 << 16);
+        let s = Dir::Y.scale(Scalar::from_bits(-(5 << 16)));
+        assert_eq!(s.bits(), [0, -(5 << 16), 0]);
+        let c = Dir::X.cross(Dir::Y).unwrap();
+        assert_eq!(c, Dir::Z);
+    }
+}

@@ -1,0 +1,171 @@
+//! `BOX s xc yc zc xs ys zs`: an axis-aligned box given by its centre and
+//! half-sizes.
+//!
+//! The slab test orders the crossings as exact ratios (cross multiplication)
+//! and divides once, for the crossing it returns: a ray parallel to a face, or
+//! nearly so, needs no special case and cannot overflow.
+
+use super::{Aabb, Leaving, Ratio, Ray};
+use crate::math::{Dir, Scalar, Vec3};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AxisAlignedBox {
+    pub min: Vec3,
+    pub max: Vec3,
+    pub surface: u16,
+}
+
+/// The parameter interval in which a ray is inside an axis-aligned box, as
+/// exact ratios; `None` bounds are unbounded.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SlabSpan {
+    pub enter: Option<Ratio>,
+    pub exit: Option<Ratio>,
+}
+
+/// Clips `ray` against the box `[min, max]`; `None` when the ray's line misses
+/// it. The span may lie partly or wholly behind the origin.
+pub(crate) fn slab_span(ray: &Ray, min: Vec3, max: Vec3) -> Option<SlabSpan> {
+    let mut enter: Option<Ratio> = None;
+    let mut exit: Option<Ratio> = None;
+    let o = ray.origin.wide();
+    let d = ray.dir.wide();
+    let lo = min.wide();
+    let hi = max.wide();
+    for axis in 0..3 {
+        let (near, far) = match d[axis] {
+            0 => {
+                if o[axis] < lo[axis] || o[axis] > hi[axis] {
+                    return None;
+                }
+                continue;
+            }
+            dv if dv > 0 => (lo[axis] - o[axis], hi[axis] - o[axis]),
+            _ => (o[axis] - hi[axis], o[axis] - lo[axis]),
+        };
+        let den = d[axis].abs();
+        let near = Ratio { num: near, den };
+        let far = Ratio { num: far, den };
+        if enter.is_none_or(|e| e.lt(near)) {
+            enter = Some(near);
+        }
+        if exit.is_none_or(|x| far.lt(x)) {
+            exit = Some(far);
+        }
+    }
+    if let (Some(e), Some(x)) = (enter, exit) {
+        if x.lt(e) {
+            return None;
+        }
+    }
+    Some(SlabSpan { enter, exit })
+}
+
+impl AxisAlignedBox {
+    pub fn new(center: Vec3, half: Vec3, surface: u16) -> AxisAlignedBox {
+        AxisAlignedBox {
+            min: center - half,
+            max: center + half,
+            surface,
+        }
+    }
+
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
+        if leaving == Leaving::Outward {
+            return None;
+        }
+        let span = slab_span(ray, self.min, self.max)?;
+        let positive = |r: Ratio| r.num > 0;
+        let chosen = match (leaving, span.enter) {
+            (Leaving::No, Some(e)) if positive(e) => e,
+            _ => span.exit?,
+        };
+        if !positive(chosen) || !chosen.le_scalar(t_max) {
+            return None;
+        }
+        let t = chosen.to_scalar();
+        (t.to_bits() > 0).then_some(t)
+    }
+
+    /// Outward normal of the face nearest to `p` (relative to each half-size);
+    /// on an edge or corner the lowest axis wins.
+    pub fn normal_at(&self, p: Vec3) -> Dir {
+        let c = [0, 1, 2].map(|a| (self.min.axis(a).to_bits() as i64 + self.max.axis(a).to_bits() as i64) / 2);
+        let h = [0, 1, 2].map(|a| (self.max.axis(a).to_bits() as i64 - self.min.axis(a).to_bits() as i64).max(1));
+        let off = [0, 1, 2].map(|a| p.axis(a).to_bits() as i64 - c[a]);
+        // Largest |off_a| / h_a by cross multiplication.
+        let mut best = 0;
+        for a in 1..3 {
+            if off[a].abs() * h[best] > off[best].abs() * h[a] {
+                best = a;
+            }
+        }
+        Dir::axis_unit(best, off[best] < 0)
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        Aabb {
+            min: self.min,
+            max: self.max,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_util::*;
+    use super::*;
+
+    fn cube() -> AxisAlignedBox {
+        AxisAlignedBox::new(p(0, 0, -10), p(1, 2, 3), 0)
+    }
+
+    #[test]
+    fn hits_the_near_face_then_the_far_one() {
+        let r = ray(p(0, 0, 0), [0, 0, -1]);
+        assert_eq!(cube().intersect(&r, far(), Leaving::No), Some(s(7)));
+        assert_eq!(cube().intersect(&r, far(), Leaving::Inward), Some(s(13)));
+        assert_eq!(cube().intersect(&r, far(), Leaving::Outward), None);
+        assert_eq!(cube().normal_at(r.at(s(7))), Dir::Z);
+        assert_eq!(cube().normal_at(r.at(s(13))), -Dir::Z);
+    }
+
+    #[test]
+    fn misses_and_parallel_rays() {
+        assert_eq!(cube().intersect(&ray(p(2, 0, 0), [0, 0, -1]), far(), Leaving::No), None);
+        // Parallel to the x faces, inside the x slab: hits.
+        assert_eq!(cube().intersect(&ray(p(1, 0, 0), [0, 0, -1]), far(), Leaving::No), Some(s(7)));
+        // Pointing away.
+        assert_eq!(cube().intersect(&ray(p(0, 0, 0), [0, 0, 1]), far(), Leaving::No), None);
+    }
+
+    #[test]
+    fn oblique_hit_and_side_normal() {
+        let r = ray(p(-5, 0, -10), [1, 0, 0]);
+        assert_eq!(cube().intersect(&r, far(), Leaving::No), Some(s(4)));
+        assert_eq!(cube().normal_at(r.at(s(4))), -Dir::X);
+        let r = ray(p(0, 10, -10), [0, -1, 0]);
+        assert_eq!(cube().normal_at(r.at(cube().intersect(&r, far(), Leaving::No).unwrap())), Dir::Y);
+    }
+
+    #[test]
+    fn from_inside_exits() {
+        let r = ray(p(0, 0, -10), [1, 0, 0]);
+        assert_eq!(cube().intersect(&r, far(), Leaving::No), Some(s(1)));
+    }
+
+    #[test]
+    fn nearly_parallel_ray_has_no_overflow() {
+        let r = Ray {
+            origin: p(0, 0, 0),
+            dir: Dir::from_bits([1, 0, -(1 << 30)]),
+        };
+        assert_eq!(cube().intersect(&r, far(), Leaving::No), Some(s(7)));
+        let r = Ray {
+            origin: p(5, 0, -10),
+            dir: Dir::from_bits([-1, 0, 1 << 30]),
+        };
+        assert_eq!(cube().intersect(&r, far(), Leaving::No), None);
+    }
+}

@@ -1,0 +1,286 @@
+//! The closed set of primitives, one file each, dispatched through [`ShapeRef`]
+//! without virtual calls.
+//!
+//! Every primitive answers three questions, as pbrt splits them: a cheap hit
+//! test that returns only the ray parameter ([`ShapeRef::intersect`]), the
+//! surface normal at a point found by that test ([`ShapeRef::normal_at`]), and
+//! its bounds for the acceleration structures ([`ShapeRef::bounds`]).
+//!
+//! Invariants: a hit test returns `Some(t)` only for `0 < t ≤ t_max`; the
+//! object a ray leaves is never hit again at the spot it left
+//! ([`Leaving`]); no test divides by zero or overflows for rays whose origin
+//! lies in the normalised scene range.
+
+mod axis_aligned_box;
+mod polygon;
+mod rectangle;
+mod sphere;
+mod superquadric;
+mod triangle;
+
+pub use axis_aligned_box::AxisAlignedBox;
+pub use polygon::Polygon;
+pub use rectangle::Rectangle;
+pub use sphere::Sphere;
+pub use superquadric::Superquadric;
+pub use triangle::Triangle;
+
+use crate::math::{Dir, Scalar, Vec3};
+
+/// A ray `origin + t·dir`, `t > 0`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Ray {
+    pub origin: Vec3,
+    pub dir: Dir,
+}
+
+impl Ray {
+    /// The point at parameter `t`.
+    #[inline]
+    pub fn at(&self, t: Scalar) -> Vec3 {
+        self.origin + self.dir.scale(t)
+    }
+}
+
+/// How a ray relates to the object it starts on, so that the object is not hit
+/// again at the spot the ray leaves (no self-intersection acne, no epsilon).
+///
+/// Every primitive is convex or flat, so a ray leaving its surface outwards can
+/// never meet it again, and one leaving inwards meets it once more, on the far
+/// side.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Leaving {
+    /// The ray does not start on this object.
+    No,
+    /// The ray starts on this object and points away from its interior.
+    Outward,
+    /// The ray starts on this object and points into its interior: only the
+    /// far side counts.
+    Inward,
+}
+
+/// An axis-aligned bounding box in normalised space, inclusive.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Aabb {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl Aabb {
+    /// The smallest box holding both.
+    pub fn union(self, o: Aabb) -> Aabb {
+        Aabb {
+            min: Vec3 {
+                x: self.min.x.min(o.min.x),
+                y: self.min.y.min(o.min.y),
+                z: self.min.z.min(o.min.z),
+            },
+            max: Vec3 {
+                x: self.max.x.max(o.max.x),
+                y: self.max.y.max(o.max.y),
+                z: self.max.z.max(o.max.z),
+            },
+        }
+    }
+
+    /// Whether the two boxes share any point.
+    pub fn overlaps(&self, o: &Aabb) -> bool {
+        (0..3).all(|a| self.min.axis(a) <= o.max.axis(a) && o.min.axis(a) <= self.max.axis(a))
+    }
+}
+
+/// Which primitive an object is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum ShapeKind {
+    Sphere = 0,
+    Box = 1,
+    Superquadric = 2,
+    Triangle = 3,
+    Rectangle = 4,
+}
+
+impl ShapeKind {
+    pub const ALL: [ShapeKind; 5] = [
+        ShapeKind::Sphere,
+        ShapeKind::Box,
+        ShapeKind::Superquadric,
+        ShapeKind::Triangle,
+        ShapeKind::Rectangle,
+    ];
+
+    /// The scene-file keyword.
+    pub const fn keyword(self) -> &'static str {
+        match self {
+            ShapeKind::Sphere => "SPHERE",
+            ShapeKind::Box => "BOX",
+            ShapeKind::Superquadric => "SUPERQUADRIC",
+            ShapeKind::Triangle => "TRIANGLE",
+            ShapeKind::Rectangle => "RECTANGLE",
+        }
+    }
+
+    /// Flat shapes are seen from both sides; the others are closed.
+    pub const fn is_flat(self) -> bool {
+        matches!(self, ShapeKind::Triangle | ShapeKind::Rectangle)
+    }
+
+    const fn from_u8(v: u8) -> ShapeKind {
+        match v {
+            0 => ShapeKind::Sphere,
+            1 => ShapeKind::Box,
+            2 => ShapeKind::Superquadric,
+            3 => ShapeKind::Triangle,
+            _ => ShapeKind::Rectangle,
+        }
+    }
+}
+
+/// An object's primitive kind and its index in that kind's arena, packed in
+/// 32 bits (3 for the kind, 29 for the index).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ShapeHandle(u32);
+
+impl ShapeHandle {
+    /// Largest index a handle can carry.
+    pub const MAX_INDEX: usize = (1 << 29) - 1;
+
+    pub const fn new(kind: ShapeKind, index: usize) -> ShapeHandle {
+        ShapeHandle(((kind as u32) << 29) | (index as u32 & Self::MAX_INDEX as u32))
+    }
+
+    pub const fn kind(self) -> ShapeKind {
+        ShapeKind::from_u8((self.0 >> 29) as u8)
+    }
+
+    pub const fn index(self) -> usize {
+        (self.0 & Self::MAX_INDEX as u32) as usize
+    }
+}
+
+/// A borrowed primitive: the closed set every caller matches on.
+#[derive(Clone, Copy, Debug)]
+pub enum ShapeRef<'a> {
+    Sphere(&'a Sphere),
+    Box(&'a AxisAlignedBox),
+    Superquadric(&'a Superquadric),
+    Triangle(&'a Triangle),
+    Rectangle(&'a Rectangle),
+}
+
+impl ShapeRef<'_> {
+    /// The parameter of the nearest hit with `0 < t ≤ t_max`, if any.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
+        match self {
+            ShapeRef::Sphere(s) => s.intersect(ray, t_max, leaving),
+            ShapeRef::Box(s) => s.intersect(ray, t_max, leaving),
+            ShapeRef::Superquadric(s) => s.intersect(ray, t_max, leaving),
+            ShapeRef::Triangle(s) => s.intersect(ray, t_max, leaving),
+            ShapeRef::Rectangle(s) => s.intersect(ray, t_max, leaving),
+        }
+    }
+
+    /// The geometric normal at a point on the surface: outward for closed
+    /// shapes, the front side (counter-clockwise corners) for flat ones.
+    pub fn normal_at(&self, p: Vec3) -> Dir {
+        match self {
+            ShapeRef::Sphere(s) => s.normal_at(p),
+            ShapeRef::Box(s) => s.normal_at(p),
+            ShapeRef::Superquadric(s) => s.normal_at(p),
+            ShapeRef::Triangle(s) => s.normal(),
+            ShapeRef::Rectangle(s) => s.normal(),
+        }
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        match self {
+            ShapeRef::Sphere(s) => s.bounds(),
+            ShapeRef::Box(s) => s.bounds(),
+            ShapeRef::Superquadric(s) => s.bounds(),
+            ShapeRef::Triangle(s) => s.bounds(),
+            ShapeRef::Rectangle(s) => s.bounds(),
+        }
+    }
+
+    pub fn surface(&self) -> u16 {
+        match self {
+            ShapeRef::Sphere(s) => s.surface,
+            ShapeRef::Box(s) => s.surface,
+            ShapeRef::Superquadric(s) => s.surface,
+            ShapeRef::Triangle(s) => s.surface,
+            ShapeRef::Rectangle(s) => s.surface,
+        }
+    }
+
+    pub fn kind(&self) -> ShapeKind {
+        match self {
+            ShapeRef::Sphere(_) => ShapeKind::Sphere,
+            ShapeRef::Box(_) => ShapeKind::Box,
+            ShapeRef::Superquadric(_) => ShapeKind::Superquadric,
+            ShapeRef::Triangle(_) => ShapeKind::Triangle,
+            ShapeRef::Rectangle(_) => ShapeKind::Rectangle,
+        }
+    }
+}
+
+/// A ratio `num / den` with `den > 0`, compared exactly by cross
+/// multiplication: the slab tests use it to order crossings without dividing.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Ratio {
+    pub num: i64,
+    pub den: i64,
+}
+
+impl Ratio {
+    /// `self < o`; numerators within ±2^32 and denominators within 2^30.
+    #[inline]
+    pub fn lt(self, o: Ratio) -> bool {
+        self.num * o.den < o.num * self.den
+    }
+
+    /// The ratio of a Q16.16 numerator to a Q2.30 denominator, as Q16.16.
+    #[inline]
+    pub fn to_scalar(self) -> Scalar {
+        Scalar::from_bits(((self.num << 30) / self.den) as i32)
+    }
+
+    /// `self ≤ t` for a Q16.16 `t` (same units as [`Ratio::to_scalar`]).
+    #[inline]
+    pub fn le_scalar(self, t: Scalar) -> bool {
+        (self.num << 30) <= t.to_bits() as i64 * self.den
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod test_util {
+    use super::*;
+
+    pub fn s(v: i32) -> Scalar {
+        Scalar::from_num(v)
+    }
+
+    pub fn p(x: i32, y: i32, z: i32) -> Vec3 {
+        Vec3 {
+            x: s(x),
+            y: s(y),
+            z: s(z),
+        }
+    }
+
+    pub fn ray(o: Vec3, d: [i64; 3]) -> Ray {
+        Ray {
+            origin: o,
+            dir: Dir::normalize(d).unwrap(),
+        }
+    }
+
+    pub fn far() -> Scalar {
+        Scalar::from_num(30000)
+    }
+
+    /// `|a − b|` below `tol` raw units on every axis.
+    pub fn close(a: Vec3, b: Vec3, tol: i32) -> bool {
+        a.bits().iter().zip(b.bits()).all(|(x, y)| (x - y).abs() <= tol)
+    }
+}

@@ -1,0 +1,129 @@
+//! The plane-and-edges test shared by triangles and rectangles: a convex
+//! polygon with `N` corners, counter-clockwise seen from its front.
+//!
+//! The hit point is found on the plane, then tested against the edges in the
+//! 2-D projection that drops the normal's largest axis. Edge functions are
+//! exact integer products, so two polygons sharing an edge classify a point on
+//! it consistently; each edge is widened by [`EDGE_TOLERANCE`] so that
+//! neighbours whose planes round differently still leave no crack.
+
+use super::{Aabb, Leaving, Ray};
+use crate::math::{Dir, Scalar, Vec3};
+
+/// How far (in Q16.16 raw units, normalised space) a hit may lie outside an
+/// edge and still count: four units, about 6·10^-5, far below a pixel.
+pub const EDGE_TOLERANCE: i64 = 4;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Polygon<const N: usize> {
+    pub corners: [Vec3; N],
+    /// Front normal.
+    pub normal: Dir,
+    /// `normal · corners[0]`.
+    pub offset: Scalar,
+    /// The axis dropped for the 2-D edge test (the normal's largest).
+    drop_axis: u8,
+}
+
+impl<const N: usize> Polygon<N> {
+    /// A polygon with the given front normal; `None` if the normal is zero.
+    pub fn with_normal(corners: [Vec3; N], normal: [i64; 3]) -> Option<Self> {
+        let normal = Dir::normalize(normal)?;
+        let nb = normal.bits().map(|c| c.unsigned_abs());
+        let drop_axis = if nb[0] >= nb[1] && nb[0] >= nb[2] {
+            0
+        } else if nb[1] >= nb[2] {
+            1
+        } else {
+            2
+        };
+        Some(Polygon {
+            corners,
+            normal,
+            offset: corners[0].dot_dir(normal),
+            drop_axis,
+        })
+    }
+
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
+        // A flat shape cannot be met again by a ray leaving it.
+        if leaving != Leaving::No {
+            return None;
+        }
+        let den = self.normal.dot(ray.dir).to_bits() as i64; // Q2.30
+        if den == 0 {
+            return None;
+        }
+        // (offset − n·o) in Q18.46; t = num / den is then Q16.16.
+        let num = ((self.offset.to_bits() as i64) << 30) - ray.origin.dot_dir_q46(self.normal);
+        let (num, den) = if den < 0 { (-num, -den) } else { (num, den) };
+        if num <= 0 || num > t_max.to_bits() as i64 * den {
+            return None;
+        }
+        let t = Scalar::from_bits((num / den) as i32);
+        if t.to_bits() <= 0 {
+            return None;
+        }
+        self.contains(ray.at(t)).then_some(t)
+    }
+
+    /// Whether `p` (on the plane) lies inside the polygon, edges included.
+    #[inline]
+    pub fn contains(&self, p: Vec3) -> bool {
+        let (u, v) = self.project(p);
+        let sign = self.normal.axis(self.drop_axis as usize).to_bits().signum() as i64;
+        let mut prev = self.project(self.corners[N - 1]);
+        for corner in &self.corners {
+            let cur = self.project(*corner);
+            let (du, dv) = (cur.0 - prev.0, cur.1 - prev.1);
+            let edge = (du * (v - prev.1) - dv * (u - prev.0)) * sign;
+            if edge < -EDGE_TOLERANCE * du.abs().max(dv.abs()) {
+                return false;
+            }
+            prev = cur;
+        }
+        true
+    }
+
+    /// Edge function values of `p` against each edge (`i` from corner `i` to
+    /// `i + 1`), positive inside; used for barycentric weights.
+    pub fn edge_values(&self, p: Vec3) -> [i64; N] {
+        let (u, v) = self.project(p);
+        let sign = self.normal.axis(self.drop_axis as usize).to_bits().signum() as i64;
+        core::array::from_fn(|i| {
+            let a = self.project(self.corners[i]);
+            let b = self.project(self.corners[(i + 1) % N]);
+            ((b.0 - a.0) * (v - a.1) - (b.1 - a.1) * (u - a.0)) * sign
+        })
+    }
+
+    #[inline]
+    fn project(&self, p: Vec3) -> (i64, i64) {
+        let b = p.wide();
+        match self.drop_axis {
+            0 => (b[1], b[2]),
+            1 => (b[2], b[0]),
+            _ => (b[0], b[1]),
+        }
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        let first = Aabb {
+            min: self.corners[0],
+            max: self.corners[0],
+        };
+        self.corners.iter().fold(first, |b, &c| b.union(Aabb { min: c, max: c }))
+    }
+}
+
+/// `(b − a) × (c − a)` exactly, in Q32.32, for points within the scene range.
+pub fn cross_of_edges(a: Vec3, b: Vec3, c: Vec3) -> [i64; 3] {
+    let e1 = (b - a).wide();
+    let e2 = (c - a).wide();
+    [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ]
+}
