@@ -39,7 +39,8 @@ const fn log2_table() -> [u64; 257] {
     t
 }
 
-const fn isqrt_u128(n: u128) -> u128 {
+/// Floor of the square root of a `u128` (also usable in constants).
+pub const fn isqrt_u128(n: u128) -> u128 {
     if n < 2 {
         return n;
     }
@@ -114,9 +115,9 @@ pub fn exp2_q32(y: i64) -> u64 {
     }
 }
 
-/// `x^p` for `x` ≥ 0 in Q2.30 (so below 4) and `p` ≥ 0 in Q16.16, as Q2.30
+/// `x^p` for `x` ≥ 0 in Q2.30 (so below 4) and `p` ≥ 0 in Q32.32, as Q2.30
 /// in a `u64`, saturating at 2^10. `0^0` is 1.
-pub fn pow_q30(x: u32, p: i32) -> u64 {
+pub fn pow_q30(x: u32, p: i64) -> u64 {
     if p <= 0 {
         return 1 << 30;
     }
@@ -124,7 +125,7 @@ pub fn pow_q30(x: u32, p: i32) -> u64 {
         return 0;
     }
     let l = log2_q32(x as u64, 30);
-    let y = (l as i128 * p as i128) >> 16;
+    let y = (l as i128 * p as i128) >> 32;
     if y < -(40i128 << 32) {
         return 0;
     }
@@ -135,9 +136,9 @@ pub fn pow_q30(x: u32, p: i32) -> u64 {
 }
 
 /// `x^p` for `x` in [0, 1] given in Q2.30 (values outside are clamped) and
-/// `p` ≥ 0 in Q16.16; result in Q2.30. `0^0` is 1, as the shading model's
+/// `p` ≥ 0 in Q32.32; result in Q2.30. `0^0` is 1, as the shading model's
 /// constant specular term needs.
-pub fn pow_unit(x: i32, p: i32) -> i32 {
+pub fn pow_unit(x: i32, p: i64) -> i32 {
     pow_q30(x.clamp(0, 1 << 30) as u32, p).min(1 << 30) as i32
 }
 
@@ -182,12 +183,12 @@ mod tests {
     #[test]
     fn pow_unit_special_cases() {
         let one = 1 << 30;
-        let sixteen = 16 << 16;
+        let sixteen = 16 << 32;
         assert_eq!(pow_unit(one, sixteen), one);
         assert_eq!(pow_unit(0, sixteen), 0);
         assert_eq!(pow_unit(0, 0), one);
         assert_eq!(pow_unit(one / 2, 0), one);
-        let quarter = pow_unit(one / 2, 2 << 16);
+        let quarter = pow_unit(one / 2, 2 << 32);
         assert!((quarter - one / 4).abs() < 64, "{quarter}");
     }
 }

@@ -15,7 +15,7 @@
 mod exp_log;
 mod vector;
 
-pub use exp_log::{exp2_q32, log2_q32, pow_q30, pow_unit};
+pub use exp_log::{exp2_q32, isqrt_u128, log2_q32, pow_q30, pow_unit};
 pub use vector::{Dir, Vec3};
 
 pub use fixed::types::{I16F16, I2F30, I32F32};

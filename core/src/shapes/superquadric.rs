@@ -65,7 +65,7 @@ impl Superquadric {
     /// clamped to ±1.5 and powers to 2: every point evaluated lies on the
     /// bounding box's segment, so only rounding can push it past ±1.
     fn evaluate(&self, x: [i64; 3], delta: [i64; 3]) -> (i64, i64) {
-        let pm1 = self.power.to_bits() - (1 << 16);
+        let pm1 = ((self.power.to_bits() - (1 << 16)) as i64) << 16;
         let mut f = 0;
         let mut g = 0;
         for i in 0..3 {
@@ -164,7 +164,7 @@ impl Superquadric {
         let x = self.local(p);
         let h = self.half.wide();
         let h_min = h[0].min(h[1]).min(h[2]).max(1);
-        let pm1 = self.power.to_bits() - (1 << 16);
+        let pm1 = ((self.power.to_bits() - (1 << 16)) as i64) << 16;
         let g = [0, 1, 2].map(|i| {
             let (_, pow) = clamped_power(x[i], pm1);
             // Scaled by h_min / h_i ≤ 1 so that no component overflows.
@@ -188,7 +188,7 @@ impl Superquadric {
 
 /// `|x|` clamped to 1.5 and `|x|^e` clamped to 2, both Q2.30.
 #[inline]
-fn clamped_power(x: i64, e: i32) -> (i64, i64) {
+fn clamped_power(x: i64, e: i64) -> (i64, i64) {
     let a = x.unsigned_abs().min(3 << 29);
     (a as i64, pow_q30(a as u32, e).min(2 << 30) as i64)
 }

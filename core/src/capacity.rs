@@ -1,0 +1,143 @@
+//! Every capacity octrace has, in one place: the arenas a scene is stored in
+//! and the profiles that size them.
+//!
+//! A profile is a type implementing [`Capacities`]; each associated type is an
+//! arena of fixed capacity. On a board the arenas are `heapless::Vec`s that
+//! live in a `static` (no heap, the linker checks the RAM); on a host they may
+//! be [`HeapArena`]s (feature `alloc`): the same fixed limits, but memory is
+//! taken only as the scene fills them. Exceeding a capacity is a scene error
+//! that names it ([`crate::parse::ErrorKind::Capacity`]).
+//!
+//! To raise a limit, define your own profile (copy one below and change the
+//! numbers); nothing else changes.
+
+use crate::scene::{Light, SurfaceEntry};
+use crate::shapes::{AxisAlignedBox, Rectangle, ShapeHandle, Sphere, Superquadric, Triangle};
+
+/// A fixed-capacity, append-only store: `heapless::Vec` on boards.
+pub trait Arena<T>: Sized {
+    /// An empty arena (a constant, so a scene can be built in a `static`).
+    const EMPTY: Self;
+    /// The most items it holds.
+    const CAPACITY: usize;
+    /// Appends `item`, or gives it back when the arena is full.
+    fn push(&mut self, item: T) -> Result<(), T>;
+    fn as_slice(&self) -> &[T];
+    fn as_mut_slice(&mut self) -> &mut [T];
+    fn clear(&mut self);
+}
+
+impl<T, const N: usize> Arena<T> for heapless::Vec<T, N> {
+    const EMPTY: Self = heapless::Vec::new();
+    const CAPACITY: usize = N;
+
+    fn push(&mut self, item: T) -> Result<(), T> {
+        heapless::Vec::push(self, item)
+    }
+
+    fn as_slice(&self) -> &[T] {
+        self
+    }
+
+    fn as_mut_slice(&mut self) -> &mut [T] {
+        self
+    }
+
+    fn clear(&mut self) {
+        heapless::Vec::clear(self)
+    }
+}
+
+/// A heap-backed arena with the fixed capacity `N` (feature `alloc`): for
+/// hosts, where a million-object limit should not cost memory up front.
+#[cfg(feature = "alloc")]
+pub struct HeapArena<T, const N: usize>(alloc::vec::Vec<T>);
+
+#[cfg(feature = "alloc")]
+impl<T, const N: usize> Arena<T> for HeapArena<T, N> {
+    const EMPTY: Self = HeapArena(alloc::vec::Vec::new());
+    const CAPACITY: usize = N;
+
+    fn push(&mut self, item: T) -> Result<(), T> {
+        if self.0.len() >= N {
+            return Err(item);
+        }
+        self.0.push(item);
+        Ok(())
+    }
+
+    fn as_slice(&self) -> &[T] {
+        &self.0
+    }
+
+    fn as_mut_slice(&mut self) -> &mut [T] {
+        &mut self.0
+    }
+
+    fn clear(&mut self) {
+        self.0.clear()
+    }
+}
+
+/// The capacities of one build: how many of each thing a scene may hold.
+pub trait Capacities {
+    /// The profile's name, shown in capacity errors.
+    const NAME: &'static str;
+    /// All objects, in file order.
+    type Objects: Arena<ShapeHandle>;
+    type Spheres: Arena<Sphere>;
+    type Boxes: Arena<AxisAlignedBox>;
+    type Superquadrics: Arena<Superquadric>;
+    type Triangles: Arena<Triangle>;
+    type Rectangles: Arena<Rectangle>;
+    /// Surface definitions; at most 65,535 (objects refer to them by `u16`).
+    type Surfaces: Arena<SurfaceEntry>;
+    type Lights: Arena<Light>;
+}
+
+/// The host build: a million objects of any mix (heap-backed arenas).
+#[cfg(feature = "alloc")]
+pub struct Host;
+
+#[cfg(feature = "alloc")]
+impl Capacities for Host {
+    const NAME: &'static str = "Host";
+    type Objects = HeapArena<ShapeHandle, 1_000_000>;
+    type Spheres = HeapArena<Sphere, 1_000_000>;
+    type Boxes = HeapArena<AxisAlignedBox, 1_000_000>;
+    type Superquadrics = HeapArena<Superquadric, 1_000_000>;
+    type Triangles = HeapArena<Triangle, 1_000_000>;
+    type Rectangles = HeapArena<Rectangle, 1_000_000>;
+    type Surfaces = HeapArena<SurfaceEntry, 65_535>;
+    type Lights = HeapArena<Light, 4_096>;
+}
+
+/// A board with 16 KiB of RAM (BBC micro:bit v1): about 6 KiB of scene.
+pub struct Board16K;
+
+impl Capacities for Board16K {
+    const NAME: &'static str = "Board16K";
+    type Objects = heapless::Vec<ShapeHandle, 224>;
+    type Spheres = heapless::Vec<Sphere, 208>;
+    type Boxes = heapless::Vec<AxisAlignedBox, 4>;
+    type Superquadrics = heapless::Vec<Superquadric, 4>;
+    type Triangles = heapless::Vec<Triangle, 4>;
+    type Rectangles = heapless::Vec<Rectangle, 4>;
+    type Surfaces = heapless::Vec<SurfaceEntry, 16>;
+    type Lights = heapless::Vec<Light, 4>;
+}
+
+/// A board with 64 KiB of RAM or more (Cortex-M3/M4 class).
+pub struct Board64K;
+
+impl Capacities for Board64K {
+    const NAME: &'static str = "Board64K";
+    type Objects = heapless::Vec<ShapeHandle, 512>;
+    type Spheres = heapless::Vec<Sphere, 320>;
+    type Boxes = heapless::Vec<AxisAlignedBox, 32>;
+    type Superquadrics = heapless::Vec<Superquadric, 32>;
+    type Triangles = heapless::Vec<Triangle, 96>;
+    type Rectangles = heapless::Vec<Rectangle, 96>;
+    type Surfaces = heapless::Vec<SurfaceEntry, 64>;
+    type Lights = heapless::Vec<Light, 8>;
+}

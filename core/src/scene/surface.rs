@@ -1,0 +1,113 @@
+//! Colours and `SURFACE` materials.
+//!
+//! Invariant: colour arithmetic saturates (a colour channel is at most
+//! 32767.99); it never wraps, so an over-bright light clamps to white as the
+//! shading model's final `min(1, …)` says.
+
+use crate::math::{Scalar, Unit};
+use fixed::types::I48F16;
+
+/// A linear RGB colour, Q16.16 per channel (1.0 is full intensity; values
+/// above 1 are kept until the final clamp).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Color {
+    pub r: Scalar,
+    pub g: Scalar,
+    pub b: Scalar,
+}
+
+impl Color {
+    pub const BLACK: Color = Color::from_bits([0; 3]);
+
+    pub const fn from_bits(c: [i32; 3]) -> Color {
+        Color {
+            r: Scalar::from_bits(c[0]),
+            g: Scalar::from_bits(c[1]),
+            b: Scalar::from_bits(c[2]),
+        }
+    }
+
+    pub const fn bits(self) -> [i32; 3] {
+        [self.r.to_bits(), self.g.to_bits(), self.b.to_bits()]
+    }
+
+    #[inline]
+    pub fn saturating_add(self, o: Color) -> Color {
+        Color {
+            r: self.r.saturating_add(o.r),
+            g: self.g.saturating_add(o.g),
+            b: self.b.saturating_add(o.b),
+        }
+    }
+
+    /// Each channel times `k` (Q16.16), saturating.
+    #[inline]
+    pub fn scale(self, k: Scalar) -> Color {
+        let k = k.to_bits() as i64;
+        Color::from_bits(self.bits().map(|c| sat(((c as i64) * k) >> 16)))
+    }
+
+    /// Each channel times a cosine in Q2.30.
+    #[inline]
+    pub fn scale_unit(self, k: Unit) -> Color {
+        let k = k.to_bits() as i64;
+        Color::from_bits(self.bits().map(|c| sat(((c as i64) * k) >> 30)))
+    }
+
+    /// Channel-wise product (filtering one colour by another).
+    #[inline]
+    pub fn modulate(self, o: Color) -> Color {
+        let o = o.bits();
+        let s = self.bits();
+        Color::from_bits([0, 1, 2].map(|i| sat(((s[i] as i64) * o[i] as i64) >> 16)))
+    }
+
+    pub fn is_black(self) -> bool {
+        self == Color::BLACK
+    }
+}
+
+#[inline]
+fn sat(v: i64) -> i32 {
+    v.clamp(i32::MIN as i64, i32::MAX as i64) as i32
+}
+
+/// A `SURFACE` definition: the material of every object that names it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Surface {
+    pub ambient: Color,
+    pub diffuse: Color,
+    pub specular: Color,
+    /// The Phong exponent k ≥ 0 (0: a constant specular term).
+    pub exponent: I48F16,
+    /// Reflectivity r, 0 to 1.
+    pub reflectivity: Scalar,
+    /// Transparency t, 0 to 1.
+    pub transparency: Scalar,
+}
+
+/// A surface with the number the scene gave it and the line it was defined
+/// on (for "defined twice" errors).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SurfaceEntry {
+    pub number: u32,
+    pub line: u32,
+    pub surface: Surface,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn saturating_colour_arithmetic() {
+        let big = Color::from_bits([i32::MAX - 5, 1 << 16, 0]);
+        let sum = big.saturating_add(Color::from_bits([100, 1 << 16, -5]));
+        assert_eq!(sum.bits(), [i32::MAX, 2 << 16, -5]);
+        assert_eq!(big.scale(Scalar::from_num(4)).bits()[0], i32::MAX);
+        let half = Color::from_bits([1 << 16; 3]).scale_unit(Unit::from_num(0.5));
+        assert_eq!(half.bits(), [1 << 15; 3]);
+        let m = Color::from_bits([1 << 16, 1 << 15, 0]).modulate(Color::from_bits([1 << 15; 3]));
+        assert_eq!(m.bits(), [1 << 15, 1 << 14, 0]);
+    }
+}
