@@ -4,7 +4,11 @@
 #[cfg(feature = "alloc")]
 extern crate alloc;
 
+pub mod accel;
 pub mod capacity;
 pub mod math;
+pub mod parse;
+pub mod render;
 pub mod scene;
+pub mod shade;
 pub mod shapes;

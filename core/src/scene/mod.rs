@@ -254,7 +254,7 @@ impl<C: Capacities> Scene<C> {
     pub fn sort_surfaces(&mut self) {
         self.surfaces
             .as_mut_slice()
-            .sort_unstable_by_key(|s| (s.number, s.line));
+            .sort_unstable_by_key(|s| (s.number, s.line, s.column));
     }
 
     /// Drops the objects and lights but keeps the surfaces (the parser's

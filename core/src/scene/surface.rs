@@ -86,12 +86,13 @@ pub struct Surface {
     pub transparency: Scalar,
 }
 
-/// A surface with the number the scene gave it and the line it was defined
-/// on (for "defined twice" errors).
+/// A surface with the number the scene gave it and where it was defined (for
+/// "defined twice" errors).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SurfaceEntry {
     pub number: u32,
     pub line: u32,
+    pub column: u32,
     pub surface: Surface,
 }
 

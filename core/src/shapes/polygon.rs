@@ -61,10 +61,22 @@ impl<const N: usize> Polygon<N> {
         if num <= 0 || num > t_max.to_bits() as i64 * den {
             return None;
         }
-        let t = Scalar::from_bits((num / den) as i32);
-        if t.to_bits() <= 0 {
+        let t = num / den;
+        if t <= 0 {
             return None;
         }
+        // The plane may be met far outside the scene range; only a point
+        // inside the polygon's bounds is representable and worth testing.
+        let o = ray.origin.wide();
+        let d = ray.dir.wide();
+        let p = [0, 1, 2].map(|a| o[a] + ((d[a] * t) >> 30));
+        let b = self.bounds();
+        let (lo, hi) = (b.min.wide(), b.max.wide());
+        let slack = EDGE_TOLERANCE;
+        if (0..3).any(|a| p[a] < lo[a] - slack || p[a] > hi[a] + slack) {
+            return None;
+        }
+        let t = Scalar::from_bits(t as i32);
         self.contains(ray.at(t)).then_some(t)
     }
 

@@ -1,0 +1,37 @@
+//! The naive mode: every object tested for every ray, as the thesis's first
+//! version did. It is the reference the other modes must match bit for bit.
+
+use super::{Accelerator, Hit, RayStart};
+use crate::math::Scalar;
+use crate::scene::{ObjectId, SceneView};
+use crate::shapes::Ray;
+
+/// Tests every object, in file order.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Naive;
+
+impl Accelerator for Naive {
+    fn nearest(&self, scene: &SceneView<'_>, ray: &Ray, start: Option<RayStart>) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        let mut t_max = Scalar::MAX;
+        for (i, &handle) in scene.objects.iter().enumerate() {
+            let object = ObjectId(i as u32);
+            let leaving = RayStart::leaving(start, object);
+            if let Some(t) = scene.shape_of(handle).intersect(ray, t_max, leaving) {
+                // File order: a later object wins only when strictly nearer.
+                if best.is_none_or(|b| t < b.t) {
+                    best = Some(Hit { t, object });
+                    t_max = t;
+                }
+            }
+        }
+        best
+    }
+
+    fn occluded(&self, scene: &SceneView<'_>, ray: &Ray, t_max: Scalar, start: Option<RayStart>) -> bool {
+        scene.objects.iter().enumerate().any(|(i, &handle)| {
+            let leaving = RayStart::leaving(start, ObjectId(i as u32));
+            scene.shape_of(handle).intersect(ray, t_max, leaving).is_some()
+        })
+    }
+}

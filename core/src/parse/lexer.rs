@@ -1,0 +1,186 @@
+//! Tokens with their line and column, straight from the scene text (no
+//! allocation: a token borrows its text).
+//!
+//! A token is a run of non-whitespace characters; a `/*` or `//` ends it and
+//! starts a comment. A token that starts with `"` runs to the next `"` (a
+//! quoted file name). Columns count characters, not bytes, from 1.
+
+use super::error::{ErrorKind, ParseError, Pos};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Token<'a> {
+    /// The token's text (without the quotes of a quoted string).
+    pub text: &'a str,
+    pub pos: Pos,
+    pub quoted: bool,
+}
+
+pub struct Lexer<'a> {
+    src: &'a str,
+    offset: usize,
+    pos: Pos,
+}
+
+impl<'a> Lexer<'a> {
+    pub fn new(src: &'a str) -> Lexer<'a> {
+        Lexer {
+            src,
+            offset: 0,
+            pos: Pos { line: 1, column: 1 },
+        }
+    }
+
+    /// Where the lexer stands: after the last token, or the end of the text.
+    pub fn pos(&self) -> Pos {
+        self.pos
+    }
+
+    fn rest(&self) -> &'a str {
+        &self.src[self.offset..]
+    }
+
+    fn bump(&mut self) -> Option<char> {
+        let c = self.rest().chars().next()?;
+        self.offset += c.len_utf8();
+        if c == '\n' {
+            self.pos.line += 1;
+            self.pos.column = 1;
+        } else {
+            self.pos.column += 1;
+        }
+        Some(c)
+    }
+
+    /// Skips whitespace and comments. An unterminated block comment is an
+    /// error at the `/*` that opened it; the rest of the text is consumed.
+    fn skip_trivia(&mut self) -> Result<(), ParseError<'a>> {
+        loop {
+            let rest = self.rest();
+            if rest.starts_with("//") {
+                while let Some(c) = self.bump() {
+                    if c == '\n' {
+                        break;
+                    }
+                }
+            } else if rest.starts_with("/*") {
+                let open = self.pos;
+                self.bump();
+                self.bump();
+                loop {
+                    if self.rest().starts_with("*/") {
+                        self.bump();
+                        self.bump();
+                        break;
+                    }
+                    if self.bump().is_none() {
+                        return Err(ParseError::new(open, ErrorKind::UnterminatedComment));
+                    }
+                }
+            } else if rest.chars().next().is_some_and(char::is_whitespace) {
+                self.bump();
+            } else {
+                return Ok(());
+            }
+        }
+    }
+
+    /// The next token, `None` at the end of the text.
+    pub fn next_token(&mut self) -> Result<Option<Token<'a>>, ParseError<'a>> {
+        self.skip_trivia()?;
+        let pos = self.pos;
+        let start = self.offset;
+        match self.rest().chars().next() {
+            None => Ok(None),
+            Some('"') => {
+                self.bump();
+                let inner = self.offset;
+                loop {
+                    match self.bump() {
+                        Some('"') => {
+                            return Ok(Some(Token {
+                                text: &self.src[inner..self.offset - 1],
+                                pos,
+                                quoted: true,
+                            }))
+                        }
+                        Some(_) => {}
+                        None => return Err(ParseError::new(pos, ErrorKind::UnterminatedString)),
+                    }
+                }
+            }
+            Some(_) => {
+                loop {
+                    let rest = self.rest();
+                    match rest.chars().next() {
+                        Some(c) if !c.is_whitespace() && !rest.starts_with("/*") && !rest.starts_with("//") => {
+                            self.bump();
+                        }
+                        _ => break,
+                    }
+                }
+                Ok(Some(Token {
+                    text: &self.src[start..self.offset],
+                    pos,
+                    quoted: false,
+                }))
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tokens(src: &str) -> heapless::Vec<(&str, u32, u32), 32> {
+        let mut lx = Lexer::new(src);
+        let mut out = heapless::Vec::new();
+        while let Some(t) = lx.next_token().unwrap() {
+            out.push((t.text, t.pos.line, t.pos.column)).unwrap();
+        }
+        out
+    }
+
+    #[test]
+    fn tokens_carry_line_and_column() {
+        let t = tokens("LIGHT 1.0\n  2 3 4\n");
+        assert_eq!(&t[..], &[("LIGHT", 1, 1), ("1.0", 1, 7), ("2", 2, 3), ("3", 2, 5), ("4", 2, 7)]);
+    }
+
+    #[test]
+    fn comments_of_both_kinds_end_tokens() {
+        let t = tokens("A/*x\ny*/B // c\n C//d\nD");
+        assert_eq!(&t[..], &[("A", 1, 1), ("B", 2, 4), ("C", 3, 2), ("D", 4, 1)]);
+    }
+
+    #[test]
+    fn columns_count_characters() {
+        let t = tokens("/* é */ X");
+        assert_eq!(&t[..], &[("X", 1, 9)]);
+    }
+
+    #[test]
+    fn quoted_strings() {
+        let mut lx = Lexer::new("IMAGEFILE \"my file.png\" x");
+        lx.next_token().unwrap();
+        let t = lx.next_token().unwrap().unwrap();
+        assert_eq!((t.text, t.quoted, t.pos.column), ("my file.png", true, 11));
+        assert_eq!(lx.next_token().unwrap().unwrap().text, "x");
+    }
+
+    #[test]
+    fn unterminated_comment_names_where_it_opened() {
+        let mut lx = Lexer::new("A\n  /* never\nclosed");
+        lx.next_token().unwrap();
+        let e = lx.next_token().unwrap_err();
+        assert_eq!(e.pos, Pos { line: 2, column: 3 });
+        assert_eq!(e.kind, ErrorKind::UnterminatedComment);
+        assert_eq!(lx.next_token().unwrap(), None);
+    }
+
+    #[test]
+    fn unterminated_string() {
+        let mut lx = Lexer::new("\"abc");
+        assert_eq!(lx.next_token().unwrap_err().kind, ErrorKind::UnterminatedString);
+    }
+}

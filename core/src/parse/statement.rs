@@ -1,0 +1,410 @@
+//! One statement of the scene format, read into world units (Q32.32) and
+//! checked for everything that needs no other statement: syntax, ranges and
+//! degenerate shapes.
+
+use super::error::{ErrorKind, Field, Found, ParseError, Pos, Rule};
+use super::lexer::{Lexer, Token};
+use super::number::{parse_integer, Decimal};
+use crate::math::isqrt_u128;
+use crate::scene::{Color, Surface, WorldPoint, WorldValue};
+use fixed::types::{I32F32, I48F16};
+
+/// A statement's content, in world units.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Statement<'a> {
+    Viewpoint(WorldPoint),
+    Origin(WorldPoint),
+    Upvector(WorldPoint),
+    Raster([u32; 2]),
+    Viewport([WorldValue; 2]),
+    Rdepth(u32),
+    Imagefile(&'a str),
+    Light { brightness: I32F32, position: WorldPoint },
+    Background(Color),
+    Gamma(I32F32),
+    Attenuation(I32F32),
+    Samples(u32),
+    Sphere { surface: u32, radius: WorldValue, center: WorldPoint },
+    Box { surface: u32, center: WorldPoint, half: WorldPoint },
+    Superquadric { surface: u32, power: I32F32, center: WorldPoint, half: WorldPoint },
+    Triangle { surface: u32, corners: [WorldPoint; 3] },
+    Rectangle { surface: u32, corners: [WorldPoint; 4] },
+    Surface { number: u32, surface: Surface },
+}
+
+impl Statement<'_> {
+    /// The world-space box holding an object statement, if it is one.
+    pub fn object_bounds(&self) -> Option<(WorldPoint, WorldPoint)> {
+        let spread = |c: WorldPoint, h: WorldPoint| {
+            (
+                [0, 1, 2].map(|a| c[a] - h[a]),
+                [0, 1, 2].map(|a| c[a] + h[a]),
+            )
+        };
+        let corners = |cs: &[WorldPoint]| {
+            let mut lo = cs[0];
+            let mut hi = cs[0];
+            for c in cs {
+                for a in 0..3 {
+                    lo[a] = lo[a].min(c[a]);
+                    hi[a] = hi[a].max(c[a]);
+                }
+            }
+            (lo, hi)
+        };
+        match self {
+            Statement::Sphere { radius, center, .. } => Some(spread(*center, [*radius; 3])),
+            Statement::Box { center, half, .. } | Statement::Superquadric { center, half, .. } => {
+                Some(spread(*center, *half))
+            }
+            Statement::Triangle { corners: c, .. } => Some(corners(c)),
+            Statement::Rectangle { corners: c, .. } => Some(corners(c)),
+            _ => None,
+        }
+    }
+}
+
+/// Every statement keyword, in the case the format writes them.
+pub const KEYWORDS: [&str; 19] = [
+    "VIEWPOINT",
+    "ORIGIN",
+    "UPVECTOR",
+    "RASTER",
+    "VIEWPORT",
+    "RDEPTH",
+    "IMAGEFILE",
+    "LIGHT",
+    "BACKGROUND",
+    "GAMMA",
+    "ATTENUATION",
+    "SAMPLES",
+    "SPHERE",
+    "BOX",
+    "SUPERQUADRIC",
+    "TRIANGLE",
+    "RECTANGLE",
+    "BSPLINE",
+    "SURFACE",
+];
+
+/// The keyword `text` names (case-insensitively), if any.
+pub fn keyword(text: &str) -> Option<&'static str> {
+    KEYWORDS.iter().copied().find(|k| k.eq_ignore_ascii_case(text))
+}
+
+/// Tokens with one token of look-ahead.
+pub struct Cursor<'a> {
+    lexer: Lexer<'a>,
+    peeked: Option<Option<Token<'a>>>,
+}
+
+impl<'a> Cursor<'a> {
+    pub fn new(text: &'a str) -> Cursor<'a> {
+        Cursor {
+            lexer: Lexer::new(text),
+            peeked: None,
+        }
+    }
+
+    pub fn peek(&mut self) -> Result<Option<Token<'a>>, ParseError<'a>> {
+        if let Some(t) = self.peeked {
+            return Ok(t);
+        }
+        let t = self.lexer.next_token()?;
+        self.peeked = Some(t);
+        Ok(t)
+    }
+
+    pub fn next(&mut self) -> Result<Option<Token<'a>>, ParseError<'a>> {
+        let t = self.peek()?;
+        self.peeked = None;
+        Ok(t)
+    }
+
+    /// The position of the end of the text (for "found the end of the file").
+    fn end_pos(&self) -> Pos {
+        self.lexer.pos()
+    }
+
+    /// The next token if it is a number (consumed), else the error for
+    /// `field` (the token is left for error recovery).
+    fn number(&mut self, field: Field) -> Result<(Decimal, Token<'a>), ParseError<'a>> {
+        match self.peek()? {
+            None => Err(ParseError::new(
+                self.end_pos(),
+                ErrorKind::ExpectedNumber {
+                    field,
+                    found: Found::EndOfFile,
+                },
+            )),
+            Some(t) => match Decimal::parse(t.text).filter(|_| !t.quoted) {
+                None => Err(ParseError::new(
+                    t.pos,
+                    ErrorKind::ExpectedNumber {
+                        field,
+                        found: Found::Token(t.text),
+                    },
+                )),
+                Some(d) if d.out_of_range() => Err(out_of_range(t, field, Rule::Magnitude)),
+                Some(d) => {
+                    self.peeked = None;
+                    Ok((d, t))
+                }
+            },
+        }
+    }
+
+    /// A real number in Q32.32 satisfying `rule`.
+    fn real(&mut self, field: Field, rule: Rule) -> Result<i64, ParseError<'a>> {
+        let (d, t) = self.number(field)?;
+        let v = d.to_q32();
+        let ok = match rule {
+            Rule::Positive => v > 0,
+            Rule::NonNegative => !d.negative || d.is_zero(),
+            Rule::UnitInterval => (!d.negative || d.is_zero()) && v <= 1 << 32,
+            Rule::BetweenReal(lo, hi) => v >= lo << 32 && v <= hi << 32,
+            Rule::Between(..) | Rule::Magnitude => true,
+        };
+        if ok {
+            Ok(v)
+        } else {
+            Err(out_of_range(t, field, rule))
+        }
+    }
+
+    /// An integer from `lo` to `hi`.
+    fn integer(&mut self, field: Field, lo: i64, hi: i64) -> Result<i64, ParseError<'a>> {
+        let t = match self.peek()? {
+            None => {
+                return Err(ParseError::new(
+                    self.end_pos(),
+                    ErrorKind::ExpectedInteger {
+                        field,
+                        found: Found::EndOfFile,
+                    },
+                ))
+            }
+            Some(t) => t,
+        };
+        let v = parse_integer(t.text).filter(|_| !t.quoted).ok_or(ParseError::new(
+            t.pos,
+            ErrorKind::ExpectedInteger {
+                field,
+                found: Found::Token(t.text),
+            },
+        ))?;
+        if v < lo || v > hi {
+            return Err(out_of_range(t, field, Rule::Between(lo, hi)));
+        }
+        self.peeked = None;
+        Ok(v)
+    }
+
+    fn point(&mut self, statement: &'static str, names: [&'static str; 3]) -> Result<WorldPoint, ParseError<'a>> {
+        let mut p = [0; 3];
+        for (v, name) in p.iter_mut().zip(names) {
+            *v = self.real(Field { statement, name }, Rule::Magnitude)?;
+        }
+        Ok(p)
+    }
+
+    fn positive_triple(&mut self, statement: &'static str, names: [&'static str; 3]) -> Result<WorldPoint, ParseError<'a>> {
+        let mut p = [0; 3];
+        for (v, name) in p.iter_mut().zip(names) {
+            *v = self.real(Field { statement, name }, Rule::Positive)?;
+        }
+        Ok(p)
+    }
+
+    fn color(&mut self, statement: &'static str, names: [&'static str; 3]) -> Result<Color, ParseError<'a>> {
+        let mut c = [0; 3];
+        for (v, name) in c.iter_mut().zip(names) {
+            *v = q32_to_q16(self.real(Field { statement, name }, Rule::UnitInterval)?) as i32;
+        }
+        Ok(Color::from_bits(c))
+    }
+
+    fn surface_number(&mut self, statement: &'static str) -> Result<u32, ParseError<'a>> {
+        let field = Field {
+            statement,
+            name: "surface number",
+        };
+        Ok(self.integer(field, 0, super::number::LIMIT as i64)? as u32)
+    }
+}
+
+fn out_of_range<'a>(t: Token<'a>, field: Field, rule: Rule) -> ParseError<'a> {
+    ParseError::new(
+        t.pos,
+        ErrorKind::OutOfRange {
+            field,
+            rule,
+            found: t.text,
+        },
+    )
+}
+
+/// Q32.32 to Q16.16, rounded to nearest.
+pub fn q32_to_q16(v: i64) -> i64 {
+    (v + (1 << 15)) >> 16
+}
+
+/// Reads the statement that `keyword` (already consumed) begins.
+pub fn statement<'a>(cur: &mut Cursor<'a>, kw: &'static str, at: Pos) -> Result<Statement<'a>, ParseError<'a>> {
+    let f = |name| Field { statement: kw, name };
+    let xyz = ["x", "y", "z"];
+    Ok(match kw {
+        "VIEWPOINT" => Statement::Viewpoint(cur.point(kw, xyz)?),
+        "ORIGIN" => Statement::Origin(cur.point(kw, xyz)?),
+        "UPVECTOR" => Statement::Upvector(cur.point(kw, xyz)?),
+        "RASTER" => Statement::Raster([
+            cur.integer(f("width"), 1, 16384)? as u32,
+            cur.integer(f("height"), 1, 16384)? as u32,
+        ]),
+        "VIEWPORT" => Statement::Viewport([cur.real(f("width"), Rule::Positive)?, cur.real(f("height"), Rule::Positive)?]),
+        "RDEPTH" => Statement::Rdepth(cur.integer(f("depth"), 0, super::number::LIMIT as i64)? as u32),
+        "IMAGEFILE" => match cur.next()? {
+            Some(t) => Statement::Imagefile(t.text),
+            None => {
+                return Err(ParseError::new(
+                    cur.end_pos(),
+                    ErrorKind::ExpectedName { field: f("file name") },
+                ))
+            }
+        },
+        "LIGHT" => Statement::Light {
+            brightness: I32F32::from_bits(cur.real(f("brightness"), Rule::NonNegative)?),
+            position: cur.point(kw, xyz)?,
+        },
+        "BACKGROUND" => Statement::Background(cur.color(kw, ["red", "green", "blue"])?),
+        "GAMMA" => Statement::Gamma(I32F32::from_bits(cur.real(f("value"), Rule::Positive)?)),
+        "ATTENUATION" => Statement::Attenuation(I32F32::from_bits(cur.real(f("d0"), Rule::Positive)?)),
+        "SAMPLES" => Statement::Samples(cur.integer(f("count"), 1, 16)? as u32),
+        "SPHERE" => Statement::Sphere {
+            surface: cur.surface_number(kw)?,
+            radius: cur.real(f("radius"), Rule::Positive)?,
+            center: cur.point(kw, xyz)?,
+        },
+        "BOX" => Statement::Box {
+            surface: cur.surface_number(kw)?,
+            center: cur.point(kw, ["xc", "yc", "zc"])?,
+            half: cur.positive_triple(kw, ["xs", "ys", "zs"])?,
+        },
+        "SUPERQUADRIC" => Statement::Superquadric {
+            surface: cur.surface_number(kw)?,
+            power: I32F32::from_bits(cur.real(f("power"), Rule::BetweenReal(2, 64))?),
+            center: cur.point(kw, ["xc", "yc", "zc"])?,
+            half: cur.positive_triple(kw, ["xs", "ys", "zs"])?,
+        },
+        "TRIANGLE" => {
+            let surface = cur.surface_number(kw)?;
+            let corners = [
+                cur.point(kw, ["x1", "y1", "z1"])?,
+                cur.point(kw, ["x2", "y2", "z2"])?,
+                cur.point(kw, ["x3", "y3", "z3"])?,
+            ];
+            if cross(sub(corners[1], corners[0]), sub(corners[2], corners[0])) == [0; 3] {
+                return Err(ParseError::new(
+                    at,
+                    ErrorKind::Degenerate {
+                        keyword: kw,
+                        why: "its corners are collinear (zero area)",
+                    },
+                ));
+            }
+            Statement::Triangle { surface, corners }
+        }
+        "RECTANGLE" => {
+            let surface = cur.surface_number(kw)?;
+            let corners = [
+                cur.point(kw, ["x1", "y1", "z1"])?,
+                cur.point(kw, ["x2", "y2", "z2"])?,
+                cur.point(kw, ["x3", "y3", "z3"])?,
+                cur.point(kw, ["x4", "y4", "z4"])?,
+            ];
+            check_quadrilateral(&corners).map_err(|k| ParseError::new(at, k))?;
+            Statement::Rectangle { surface, corners }
+        }
+        "SURFACE" => {
+            let number = cur.surface_number(kw)?;
+            let ambient = cur.color(kw, ["ambient red", "ambient green", "ambient blue"])?;
+            let diffuse = cur.color(kw, ["diffuse red", "diffuse green", "diffuse blue"])?;
+            let specular = cur.color(kw, ["specular red", "specular green", "specular blue"])?;
+            let exponent = I48F16::from_bits(q32_to_q16(cur.real(f("specular exponent"), Rule::NonNegative)?));
+            let reflectivity = q32_to_q16(cur.real(f("reflectivity"), Rule::UnitInterval)?) as i32;
+            let transparency = q32_to_q16(cur.real(f("transparency"), Rule::UnitInterval)?) as i32;
+            Statement::Surface {
+                number,
+                surface: Surface {
+                    ambient,
+                    diffuse,
+                    specular,
+                    exponent,
+                    reflectivity: fixed::types::I16F16::from_bits(reflectivity),
+                    transparency: fixed::types::I16F16::from_bits(transparency),
+                },
+            }
+        }
+        _ => return Err(ParseError::new(at, ErrorKind::Unsupported(kw))),
+    })
+}
+
+fn sub(a: WorldPoint, b: WorldPoint) -> [i128; 3] {
+    [0, 1, 2].map(|i| a[i] as i128 - b[i] as i128)
+}
+
+fn cross(a: [i128; 3], b: [i128; 3]) -> [i128; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot(a: [i128; 3], b: [i128; 3]) -> i128 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// A rectangle must have area, be planar (its fourth corner within 2^-10 of
+/// its size from the plane of the others) and be strictly convex.
+fn check_quadrilateral(c: &[WorldPoint; 4]) -> Result<(), ErrorKind<'static>> {
+    // Work on edge vectors reduced to 24 significant bits: exact enough for
+    // tolerance checks, and every product below fits an i128.
+    let mut v = [[0i128; 3]; 4];
+    for (i, e) in v.iter_mut().enumerate() {
+        *e = sub(c[(i + 1) % 4], c[i]);
+    }
+    let largest = v.iter().flatten().map(|x| x.unsigned_abs()).max().unwrap_or(0);
+    if largest == 0 {
+        return Err(ErrorKind::Degenerate {
+            keyword: "RECTANGLE",
+            why: "its corners coincide",
+        });
+    }
+    let shift = (128 - largest.leading_zeros()).saturating_sub(24);
+    let v = v.map(|e| e.map(|x| x >> shift));
+    let d1 = [0, 1, 2].map(|a| v[0][a] + v[1][a]); // p3 − p1
+    let d2 = [0, 1, 2].map(|a| v[1][a] + v[2][a]); // p4 − p2
+    let n = cross(d1, d2);
+    if n == [0; 3] {
+        return Err(ErrorKind::Degenerate {
+            keyword: "RECTANGLE",
+            why: "its corners are collinear (zero area)",
+        });
+    }
+    // Distance of p4 from the plane through p1 with normal n, against the
+    // longest edge L: |(p4 − p1)·n| / |n| ≤ 2^-10 · L.
+    let to4 = [0, 1, 2].map(|a| -v[3][a]); // p4 − p1 = −(p1 − p4)
+    let off = dot(to4, n).unsigned_abs();
+    let longest = isqrt_u128(v.iter().map(|e| dot(*e, *e) as u128).max().unwrap_or(0));
+    if off << 10 > longest * isqrt_u128(dot(n, n) as u128) {
+        return Err(ErrorKind::NotPlanar);
+    }
+    // Every corner turns the same way as the normal.
+    for i in 0..4 {
+        if dot(cross(v[i], v[(i + 1) % 4]), n) <= 0 {
+            return Err(ErrorKind::NotConvex);
+        }
+    }
+    Ok(())
+}

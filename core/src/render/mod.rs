@@ -1,0 +1,152 @@
+//! Pixels out: a whole image, a band of rows or a rectangle, streamed into any
+//! embedded-graphics [`DrawTarget`] one scanline per `fill_contiguous`.
+//!
+//! There is no framebuffer: each pixel is traced as the target pulls it from
+//! the row iterator, so the memory cost is the same for 8×8 and 16384×16384.
+//! Every pixel depends only on its coordinates, so any split of the image
+//! into rows, tiles or threads gives the same bits.
+//!
+//! A pixel with SAMPLES n is the mean of its n² sample colours, each clamped
+//! to [0, 1] first (an over-bright highlight does not bleed into its
+//! neighbours), then gamma-corrected and rounded. Its object is the one hit
+//! by sample (n/2, n/2), the centre sample for odd n.
+
+mod gamma;
+
+pub use gamma::GammaTable;
+
+use crate::accel::Accelerator;
+use crate::scene::{Camera, CameraError, Color, ObjectId, SceneView};
+use crate::shade::{Stats, Tracer};
+use core::cell::Cell;
+use core::ops::Range;
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::pixelcolor::Rgb888;
+use embedded_graphics_core::primitives::Rectangle;
+
+/// A finished pixel: its display colour and the object seen through it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PixelSample {
+    pub color: Rgb888,
+    /// The object the pixel's (centre) primary ray hits; `None` for background.
+    pub object: Option<ObjectId>,
+}
+
+/// Renders one scene through one accelerator.
+pub struct Renderer<'a, A> {
+    tracer: Tracer<'a, A>,
+    camera: Camera,
+    gamma: GammaTable,
+}
+
+impl<'a, A: Accelerator> Renderer<'a, A> {
+    /// A renderer at the scene's RASTER size.
+    pub fn new(scene: SceneView<'a>, accel: &'a A) -> Result<Self, CameraError> {
+        let [w, h] = scene.settings.raster;
+        Self::with_size(scene, accel, w, h)
+    }
+
+    /// A renderer at another size (the default VIEWPORT follows its aspect).
+    pub fn with_size(scene: SceneView<'a>, accel: &'a A, width: u32, height: u32) -> Result<Self, CameraError> {
+        let s = scene.settings;
+        let camera = Camera::new(&s.view, &scene.normalization, width, height, s.samples)?;
+        Ok(Renderer {
+            tracer: Tracer::new(scene, accel),
+            camera,
+            gamma: GammaTable::new(s.gamma),
+        })
+    }
+
+    pub fn size(&self) -> Size {
+        Size::new(self.camera.width(), self.camera.height())
+    }
+
+    pub fn tracer(&self) -> &Tracer<'a, A> {
+        &self.tracer
+    }
+
+    /// The pixel at (`x`, `y`), `x` to the right and `y` down.
+    pub fn pixel(&self, x: u32, y: u32, stats: &mut Stats) -> PixelSample {
+        let n = self.camera.samples();
+        let mut object = None;
+        let mut sum = [0i64; 3];
+        for sy in 0..n {
+            for sx in 0..n {
+                let (c, o) = self.tracer.trace(self.camera.ray(x, y, sx, sy), stats);
+                if sx == n / 2 && sy == n / 2 {
+                    object = o;
+                }
+                for (s, v) in sum.iter_mut().zip(c.bits()) {
+                    *s += v.clamp(0, 1 << 16) as i64;
+                }
+            }
+        }
+        let count = (n * n) as i64;
+        let mean = Color::from_bits(sum.map(|s| ((s + count / 2) / count) as i32));
+        PixelSample {
+            color: Rgb888::new(
+                self.gamma.encode(mean.r),
+                self.gamma.encode(mean.g),
+                self.gamma.encode(mean.b),
+            ),
+            object,
+        }
+    }
+
+    /// The pixels of row `y` for the columns `xs`, traced lazily.
+    pub fn row<'s>(&'s self, y: u32, xs: Range<u32>, stats: &'s Cell<Stats>) -> impl Iterator<Item = PixelSample> + 's {
+        xs.map(move |x| {
+            let mut s = stats.get();
+            let p = self.pixel(x, y, &mut s);
+            stats.set(s);
+            p
+        })
+    }
+
+    /// Renders the whole image.
+    pub fn render<D>(&self, target: &mut D) -> Result<Stats, D::Error>
+    where
+        D: DrawTarget,
+        D::Color: From<Rgb888>,
+    {
+        self.render_rect(&Rectangle::new(Point::zero(), self.size()), target)
+    }
+
+    /// Renders the rows `rows` (clipped to the image).
+    pub fn render_rows<D>(&self, rows: Range<u32>, target: &mut D) -> Result<Stats, D::Error>
+    where
+        D: DrawTarget,
+        D::Color: From<Rgb888>,
+    {
+        let h = self.camera.height();
+        let (start, end) = (rows.start.min(h), rows.end.min(h));
+        let rect = Rectangle::new(
+            Point::new(0, start as i32),
+            Size::new(self.camera.width(), end.saturating_sub(start)),
+        );
+        self.render_rect(&rect, target)
+    }
+
+    /// Renders the pixels of `rect` (clipped to the image), one
+    /// `fill_contiguous` per row.
+    pub fn render_rect<D>(&self, rect: &Rectangle, target: &mut D) -> Result<Stats, D::Error>
+    where
+        D: DrawTarget,
+        D::Color: From<Rgb888>,
+    {
+        let image = Rectangle::new(Point::zero(), self.size());
+        let r = rect.intersection(&image);
+        let stats = Cell::new(Stats::default());
+        if r.size.width == 0 || r.size.height == 0 {
+            return Ok(stats.get());
+        }
+        let x0 = r.top_left.x as u32;
+        for y in r.top_left.y as u32..r.top_left.y as u32 + r.size.height {
+            let line = Rectangle::new(Point::new(x0 as i32, y as i32), Size::new(r.size.width, 1));
+            let pixels = self.row(y, x0..x0 + r.size.width, &stats);
+            target.fill_contiguous(&line, pixels.map(|p| p.color.into()))?;
+        }
+        Ok(stats.get())
+    }
+}

@@ -1,0 +1,200 @@
+//! The `host-sim` command line.
+
+use crate::{load_file, new_scene, render_with_progress, LoadError};
+use clap::Parser;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Exit code for a bad scene or bad arguments.
+pub const EXIT_SCENE: i32 = 2;
+/// Exit code for a file that cannot be read or written.
+pub const EXIT_IO: i32 = 1;
+
+/// Render an octrace scene file to a PNG image.
+///
+/// Exit codes: 0 success, 1 a file could not be read or written, 2 the scene
+/// or the arguments are invalid (every error is printed as file:line:col).
+/// Nothing is written unless the whole image renders: the image goes to a
+/// temporary file that is renamed into place at the end.
+#[derive(Parser, Debug)]
+#[command(name = "host-sim", version, about, long_about)]
+pub struct Args {
+    /// The scene file (octrace scene format, see the README).
+    pub scene: PathBuf,
+    /// Where to write the PNG; defaults to the scene's IMAGEFILE (relative to
+    /// the current directory).
+    pub out: Option<PathBuf>,
+    /// Render at WxH pixels instead of the scene's RASTER (for a quick
+    /// preview; a default VIEWPORT follows the new aspect ratio).
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WxH (for example 160x128), found `{s}`"))?;
+    let dim = |v: &str| -> Result<u32, String> {
+        let n: u32 = v.parse().map_err(|_| format!("`{v}` is not a whole number"))?;
+        if (1..=16384).contains(&n) {
+            Ok(n)
+        } else {
+            Err(format!("{n} is outside 1 to 16384"))
+        }
+    };
+    Ok((dim(w)?, dim(h)?))
+}
+
+pub fn run<I, T>(args: I, stderr: &mut dyn Write) -> i32
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let args = match Args::try_parse_from(args) {
+        Ok(a) => a,
+        Err(e) => {
+            let _ = write!(stderr, "{}", e.render().ansi());
+            return if e.use_stderr() { EXIT_SCENE } else { 0 };
+        }
+    };
+    match execute(&args, stderr) {
+        Ok(()) => 0,
+        Err(code) => code,
+    }
+}
+
+fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
+    let mut scene = new_scene();
+    let loaded = match load_file(&args.scene, &mut scene) {
+        Ok(l) => l,
+        Err(LoadError::Io(e)) => {
+            let _ = writeln!(stderr, "host-sim: cannot read {}: {e}", args.scene.display());
+            return Err(EXIT_IO);
+        }
+        Err(LoadError::Scene(errors)) => {
+            for e in &errors {
+                let _ = writeln!(stderr, "{e}");
+            }
+            let _ = writeln!(stderr, "host-sim: {} error(s) in {}; nothing rendered", errors.len(), args.scene.display());
+            return Err(EXIT_SCENE);
+        }
+    };
+    let out = match (&args.out, &loaded.imagefile) {
+        (Some(o), _) => o.clone(),
+        (None, Some(f)) => PathBuf::from(f),
+        (None, None) => {
+            let _ = writeln!(
+                stderr,
+                "host-sim: no output file: give OUT on the command line or IMAGEFILE in {}",
+                args.scene.display()
+            );
+            return Err(EXIT_SCENE);
+        }
+    };
+    if same_file(&args.scene, &out) {
+        let _ = writeln!(stderr, "host-sim: refusing to overwrite the scene file {} with the image", out.display());
+        return Err(EXIT_SCENE);
+    }
+    let view = scene.view();
+    let (w, h) = args.size.unwrap_or((view.settings.raster[0], view.settings.raster[1]));
+    let bar = if !args.quiet && std::io::stderr().is_terminal() {
+        let bar = ProgressBar::new(h as u64);
+        bar.set_style(
+            ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} rows, eta {eta}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        Some(bar)
+    } else {
+        None
+    };
+    let started = Instant::now();
+    let rendered = render_with_progress(&scene, Some((w, h)), |_| {
+        if let Some(b) = &bar {
+            b.inc(1);
+        }
+    });
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let (image, stats) = match rendered {
+        Ok(r) => r,
+        Err(e) => {
+            // The parser rejects these; a scene built by hand may not.
+            let _ = writeln!(stderr, "host-sim: cannot set up the camera: {e:?}");
+            return Err(EXIT_SCENE);
+        }
+    };
+    let elapsed = started.elapsed();
+    if let Err(e) = write_atomically(&out, |f| image.write_png(f).map_err(std::io::Error::other)) {
+        let _ = writeln!(stderr, "host-sim: cannot write {}: {e}", out.display());
+        return Err(EXIT_IO);
+    }
+    if !args.quiet {
+        let _ = writeln!(
+            stderr,
+            "{w}x{h} in {:.3} s: {} rays, {} shadow rays{} -> {}",
+            elapsed.as_secs_f64(),
+            stats.rays,
+            stats.shadow_rays,
+            if stats.truncated > 0 {
+                format!(" ({} ray-tree branches cut at the per-sample limits)", stats.truncated)
+            } else {
+                String::new()
+            },
+            out.display()
+        );
+    }
+    Ok(())
+}
+
+/// Whether two paths name the same existing file.
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
+}
+
+/// Writes `path` through a temporary file in the same directory, renamed into
+/// place only when `write` succeeds; on failure no file is left behind.
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::InvalidInput, "the output path names no file"))?;
+    let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
+    let result = (|| {
+        let file = std::fs::File::create(&tmp)?;
+        let mut w = std::io::BufWriter::new(file);
+        write(&mut w)?;
+        w.flush()?;
+        w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes() {
+        assert_eq!(parse_size("160x128"), Ok((160, 128)));
+        assert_eq!(parse_size("8X8"), Ok((8, 8)));
+        assert!(parse_size("0x5").is_err());
+        assert!(parse_size("12").is_err());
+        assert!(parse_size("20000x5").is_err());
+    }
+}
