@@ -62,15 +62,19 @@ fn for_each_statement<'a>(
         let failed = result.is_err();
         each(token.pos, result);
         if failed {
-            // Recover: skip to the next keyword.
+            // Recover: drop the offending token unless it starts a statement,
+            // then the numbers that follow; resume at the next word, so an
+            // unknown word right after a bad statement is still reported.
+            let mut first = true;
             loop {
                 match cur.peek() {
-                    Ok(Some(t)) if keyword(t.text).is_none() || t.quoted => {
+                    Ok(Some(t)) if (first && keyword(t.text).is_none()) || Decimal::parse(t.text).is_some() => {
                         let _ = cur.next();
                     }
                     Ok(_) => break,
                     Err(e) => each(e.pos, Err(e)),
                 }
+                first = false;
             }
         }
     }
@@ -226,8 +230,6 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
         if self.reported_capacity & bit == 0 {
             self.reported_capacity |= bit;
             self.report(ParseError::new(pos, ErrorKind::Capacity(e)));
-        } else {
-            self.errors += 1;
         }
     }
 
@@ -424,5 +426,239 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
                 self.report(ParseError::new(pos, ErrorKind::UpParallel))
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::capacity::Board64K;
+    use crate::math::{Scalar, Vec3};
+    use crate::shapes::ShapeKind;
+    use std::format;
+    use std::string::{String, ToString};
+    use std::vec::Vec;
+
+    type TestScene = Scene<Board64K>;
+
+    fn load(text: &str) -> (std::boxed::Box<TestScene>, Result<Parsed<'_>, usize>, Vec<String>) {
+        let mut scene = std::boxed::Box::new(TestScene::new());
+        let mut errors = Vec::new();
+        let r = parse(text, &mut scene, &mut |e| errors.push(e.to_string()));
+        (scene, r, errors)
+    }
+
+    fn ok(text: &str) -> std::boxed::Box<TestScene> {
+        let (scene, r, errors) = load(text);
+        assert!(r.is_ok(), "{errors:?}");
+        scene
+    }
+
+    fn errs(text: &str) -> Vec<String> {
+        let (scene, r, errors) = load(text);
+        assert_eq!(r, Err(errors.len()), "{errors:?}");
+        assert_eq!(scene.view().object_count(), 0, "a failed scene is cleared");
+        errors
+    }
+
+    fn one_err(text: &str) -> String {
+        let e = errs(text);
+        assert_eq!(e.len(), 1, "{e:?}");
+        e.into_iter().next().unwrap_or_default()
+    }
+
+    const SURF: &str = "SURFACE 1 0.1 0.1 0.1 0.5 0.5 0.5 1 1 1 10 0.2 0.3\n";
+
+    #[test]
+    fn empty_and_comment_only_files_are_valid() {
+        for text in ["", "   \n\t", "/* nothing */ // at all\n"] {
+            let s = ok(text);
+            assert_eq!(s.view().object_count(), 0);
+            assert_eq!(s.settings, crate::scene::Settings::default());
+        }
+    }
+
+    #[test]
+    fn every_scene_parameter() {
+        let s = ok("VIEWPOINT 1 2 3 ORIGIN 4 5 6 UPVECTOR 0 0 1 RASTER 64 48 VIEWPORT 3 2 RDEPTH 7 \
+                    IMAGEFILE out.png LIGHT 0.5 1 1 1 LIGHT 2 -1 -1 -1 BACKGROUND 0.5 0 1 GAMMA 1.8 \
+                    ATTENUATION 2.5 SAMPLES 3");
+        let st = &s.settings;
+        let one = 1i64 << 32;
+        assert_eq!(st.view.eye, [one, 2 * one, 3 * one]);
+        assert_eq!(st.view.look_at, [4 * one, 5 * one, 6 * one]);
+        assert_eq!(st.view.up, [0, 0, one]);
+        assert_eq!(st.raster, [64, 48]);
+        assert_eq!(st.view.viewport, Some([3 * one, 2 * one]));
+        assert_eq!(st.rdepth, 7);
+        assert_eq!(st.background.bits(), [1 << 15, 0, 1 << 16]);
+        assert_eq!(st.gamma.to_bits(), (18 * one + 5) / 10);
+        assert_eq!(st.attenuation.to_bits(), 5 * one / 2);
+        assert_eq!(st.samples, 3);
+        assert_eq!(s.view().lights.len(), 2);
+        assert_eq!(s.view().lights[1].brightness.to_bits(), 2 * one);
+        let (_, r, _) = load("IMAGEFILE \"a b.png\"");
+        assert_eq!(r.unwrap().imagefile, Some("a b.png"));
+    }
+
+    #[test]
+    fn keywords_ignore_case_and_line_breaks_do_not_matter() {
+        let a = ok("sphere 1 2 0 0 0 Surface 1 0 0 0 1 1 1 0 0 0 0 0 0");
+        let b = ok("SPHERE\n1\n2\n0 0\n0\nSURFACE 1\n0 0 0\n1 1 1\n0 0 0\n0\n0\n0");
+        assert_eq!(a.view().spheres, b.view().spheres);
+        assert_eq!(a.view().object_count(), 1);
+    }
+
+    #[test]
+    fn every_object_kind_with_a_surface_defined_later() {
+        let text = format!(
+            "SPHERE 1 1 0 0 0 BOX 1 0 0 0 1 2 3 SUPERQUADRIC 1 4.5 0 0 0 1 1 1 \
+             TRIANGLE 1 0 0 0 1 0 0 0 1 0 RECTANGLE 1 0 0 0 1 0 0 1 1 0 0 1 0 {SURF}"
+        );
+        let s = ok(&text);
+        let v = s.view();
+        let kinds: Vec<ShapeKind> = v.objects.iter().map(|h| h.kind()).collect();
+        assert_eq!(
+            kinds,
+            [ShapeKind::Sphere, ShapeKind::Box, ShapeKind::Superquadric, ShapeKind::Triangle, ShapeKind::Rectangle]
+        );
+        let surf = v.surface(v.spheres[0].surface);
+        assert_eq!(surf.transparency, Scalar::from_num(0.3));
+        assert_eq!(surf.exponent.to_num::<i32>(), 10);
+        assert_eq!(v.superquadrics[0].power, Scalar::from_num(4.5));
+    }
+
+    #[test]
+    fn the_scene_is_normalised_into_range_at_any_scale() {
+        for (scale, ten) in [("0.001", "0.01"), ("1", "10"), ("1000", "10000"), ("100000", "1000000")] {
+            let text = format!("VIEWPOINT 0 0 {ten} SPHERE 1 {scale} 0 0 0 LIGHT 1 {ten} {ten} 0 {SURF}");
+            let s = ok(&text);
+            let v = s.view();
+            assert!(crate::scene::Normalization::in_range(v.spheres[0].center));
+            assert!(crate::scene::Normalization::in_range(v.lights[0].position));
+            // The same proportions whatever the scale, to 10^-6 (decimal
+            // fractions such as 0.001 round in Q32.32 when read).
+            let r = v.spheres[0].radius.to_bits() as i64;
+            let lx = (v.lights[0].position - v.spheres[0].center).x.to_bits() as i64;
+            assert!((lx - 10 * r).abs() * 1_000_000 <= lx, "{scale}: {lx} vs {r}");
+            assert!(r > 1 << 24, "{scale}: radius keeps precision ({r})");
+        }
+    }
+
+    fn check(text: &str, want: &str) {
+        let e = one_err(text);
+        assert!(e.contains(want), "{text:?}: got {e:?}, want {want:?}");
+    }
+
+    #[test]
+    fn lexical_and_number_errors() {
+        check("SPHERE 1 nan 0 0 0", "1:10: expected a number for SPHERE radius, found `nan`");
+        check("SPHERE 1 1 inf 0 0", "expected a number for SPHERE x, found `inf`");
+        check("SPHERE 1 1 0x10 0 0", "found `0x10`");
+        check("SPHERE 1 1 0 0", "1:15: expected a number for SPHERE z, found the end of the file");
+        check("RASTER 3.5 2", "expected an integer for RASTER width, found `3.5`");
+        check("SPHERE 1.5 1 0 0 0", "expected an integer for SPHERE surface number");
+        check("\n\n  /* open", "3:3: unterminated comment");
+        check("IMAGEFILE \"abc", "unterminated string");
+        check("SPHERE 1 1e400 0 0 0", "SPHERE radius must be at most 1e6 in magnitude, found 1e400");
+        check("VIEWPOINT 1000000.5 0 0", "VIEWPOINT x must be at most 1e6 in magnitude");
+        check("SPHER 1 1 0 0 0", "unknown keyword `SPHER`");
+    }
+
+    #[test]
+    fn range_errors() {
+        check("SPHERE 1 -1 0 0 0", "SPHERE radius must be > 0, found -1");
+        check("SPHERE 1 0 0 0 0", "SPHERE radius must be > 0, found 0");
+        check("BOX 1 0 0 0 1 0 1", "BOX ys must be > 0, found 0");
+        check("SUPERQUADRIC 1 1.5 0 0 0 1 1 1", "SUPERQUADRIC power must be between 2 and 64, found 1.5");
+        check("SUPERQUADRIC 1 65 0 0 0 1 1 1", "between 2 and 64");
+        check("RASTER 0 10", "RASTER width must be an integer from 1 to 16384, found 0");
+        check("RASTER 10 16385", "RASTER height must be an integer from 1 to 16384");
+        check("SAMPLES 17", "SAMPLES count must be an integer from 1 to 16");
+        check("RDEPTH -1", "RDEPTH depth must be an integer from 0 to 1000000");
+        check("GAMMA 0", "GAMMA value must be > 0");
+        check("ATTENUATION -2", "ATTENUATION d0 must be > 0");
+        check("LIGHT -0.5 0 0 0", "LIGHT brightness must be >= 0");
+        check("BACKGROUND 0 1.5 0", "BACKGROUND green must be between 0 and 1, found 1.5");
+        check("VIEWPORT 0 1", "VIEWPORT width must be > 0");
+        check("SURFACE -1 0 0 0 0 0 0 0 0 0 0 0 0", "SURFACE surface number must be an integer from 0 to 1000000");
+        check("SURFACE 1 0 0 0 0 0 0 0 0 0 -1 0 0", "SURFACE specular exponent must be >= 0");
+        check("SURFACE 1 0 0 0 0 0 0 0 0 0 0 2 0", "SURFACE reflectivity must be between 0 and 1");
+    }
+
+    #[test]
+    fn context_errors() {
+        check("RDEPTH 2\nRDEPTH 3", "2:1: RDEPTH is given twice (first on line 1)");
+        check(&format!("{SURF}{SURF}"), "2:1: SURFACE 1 is defined twice (first on line 1)");
+        check("SURFACE 1 0 0 0 0 0 0 0 0 0 0 0 0 SURFACE 1 0 0 0 0 0 0 0 0 0 0 0 0", "1:35: SURFACE 1 is defined twice");
+        check("\nSPHERE 7 1 0 0 0", "2:1: SPHERE uses surface 7, which is never defined");
+        check(&format!("TRIANGLE 1 0 0 0 1 1 1 2 2 2 {SURF}"), "1:1: TRIANGLE is degenerate: its corners are collinear");
+        check(&format!("RECTANGLE 1 0 0 0 1 0 0 1 1 0.5 0 1 0 {SURF}"), "RECTANGLE is not planar");
+        check(&format!("RECTANGLE 1 0 0 0 1 1 0 1 0 0 0 1 0 {SURF}"), "RECTANGLE is not convex");
+        check(&format!("RECTANGLE 1 0 0 0 0 0 0 0 0 0 0 0 0 {SURF}"), "RECTANGLE is degenerate");
+        check("VIEWPOINT 1 2 3 ORIGIN 1 2 3", "1:17: VIEWPOINT equals ORIGIN");
+        check("UPVECTOR 0 0 5", "1:1: UPVECTOR is zero or parallel to the view direction");
+        check("UPVECTOR 0 0 0", "UPVECTOR is zero or parallel");
+    }
+
+    #[test]
+    fn clockwise_rectangles_are_convex_too() {
+        ok(&format!("RECTANGLE 1 0 0 0 0 1 0 1 1 0 1 0 0 {SURF}"));
+    }
+
+    #[test]
+    fn all_errors_are_reported_in_order() {
+        let e = errs("SPHERE 1 -1 0 0 0\nFOO 1 2 3\nRASTER 1 1\nRASTER 2 2 BOX 1 0 0 0 0 1 1\n/* open");
+        assert_eq!(e.len(), 5, "{e:?}");
+        assert!(e[0].starts_with("1:10:") && e[1].starts_with("2:1:") && e[2].starts_with("4:1:"));
+        assert!(e[3].starts_with("4:24:") && e[4].starts_with("5:1:"), "{e:?}");
+    }
+
+    #[test]
+    fn recovery_resumes_at_the_next_keyword() {
+        // The missing z is reported at the keyword that follows, which is
+        // then read normally.
+        let e = errs(&format!("SPHERE 1 1 0 0\n{SURF}RDEPTH 2 RDEPTH 3"));
+        assert_eq!(e.len(), 2, "{e:?}");
+        assert!(e[0].contains("2:1: expected a number for SPHERE z, found `SURFACE`"), "{e:?}");
+        assert!(e[1].contains("RDEPTH is given twice"), "{e:?}");
+    }
+
+    #[test]
+    fn capacity_errors_name_the_limit_once() {
+        let mut text = String::from(SURF);
+        for _ in 0..40 {
+            text.push_str("BOX 1 0 0 0 1 1 1\n");
+        }
+        let e = errs(&text);
+        assert_eq!(e.len(), 1, "{e:?}");
+        assert_eq!(
+            e.iter().filter(|m| m.contains("boxes than this build holds (32, capacity profile Board64K)")).count(),
+            1,
+            "{e:?}"
+        );
+    }
+
+    #[test]
+    fn invalid_utf8_is_located() {
+        let mut scene = std::boxed::Box::new(TestScene::new());
+        let mut errors = Vec::new();
+        let bytes = b"RDEPTH 2\nLIGHT 1 \xff 0 0";
+        let r = parse_bytes(bytes, &mut scene, &mut |e| errors.push(e.to_string()));
+        assert_eq!(r, Err(1));
+        assert_eq!(errors, ["2:9: the file is not valid UTF-8 (invalid byte here)"]);
+    }
+
+    #[test]
+    fn objects_keep_file_order_and_positions() {
+        let s = ok(&format!("SPHERE 1 1 0 0 0 SPHERE 1 2 5 0 0 {SURF} LIGHT 1 -5 0 0"));
+        let v = s.view();
+        let a = v.spheres[0];
+        let b = v.spheres[1];
+        assert_eq!(b.radius.to_bits(), 2 * a.radius.to_bits());
+        assert_eq!((b.center - a.center).x.to_bits(), 5 * a.radius.to_bits());
+        assert_eq!(v.lights[0].position.y, a.center.y);
+        assert_eq!(a.center.y, Vec3::ZERO.y + a.center.y);
     }
 }

@@ -383,28 +383,29 @@ fn check_quadrilateral(c: &[WorldPoint; 4]) -> Result<(), ErrorKind<'static>> {
     }
     let shift = (128 - largest.leading_zeros()).saturating_sub(24);
     let v = v.map(|e| e.map(|x| x >> shift));
-    let d1 = [0, 1, 2].map(|a| v[0][a] + v[1][a]); // p3 − p1
-    let d2 = [0, 1, 2].map(|a| v[1][a] + v[2][a]); // p4 − p2
-    let n = cross(d1, d2);
-    if n == [0; 3] {
+    // The turn at each corner; for a strictly convex quadrilateral all four
+    // point the same way (counter-clockwise: along the front normal).
+    let turns: [[i128; 3]; 4] = core::array::from_fn(|i| cross(v[i], v[(i + 1) % 4]));
+    let reference = turns.iter().copied().max_by_key(|c| dot(*c, *c)).unwrap_or([0; 3]);
+    if reference == [0; 3] {
         return Err(ErrorKind::Degenerate {
             keyword: "RECTANGLE",
             why: "its corners are collinear (zero area)",
         });
     }
-    // Distance of p4 from the plane through p1 with normal n, against the
-    // longest edge L: |(p4 − p1)·n| / |n| ≤ 2^-10 · L.
+    if turns.iter().any(|c| dot(*c, reference) <= 0) {
+        return Err(ErrorKind::NotConvex);
+    }
+    // Distance of p4 from the plane through p1 with the diagonals' normal n,
+    // against the longest edge L: |(p4 − p1)·n| / |n| ≤ 2^-10 · L.
+    let d1 = [0, 1, 2].map(|a| v[0][a] + v[1][a]); // p3 − p1
+    let d2 = [0, 1, 2].map(|a| v[1][a] + v[2][a]); // p4 − p2
+    let n = cross(d1, d2);
     let to4 = [0, 1, 2].map(|a| -v[3][a]); // p4 − p1 = −(p1 − p4)
     let off = dot(to4, n).unsigned_abs();
     let longest = isqrt_u128(v.iter().map(|e| dot(*e, *e) as u128).max().unwrap_or(0));
     if off << 10 > longest * isqrt_u128(dot(n, n) as u128) {
         return Err(ErrorKind::NotPlanar);
-    }
-    // Every corner turns the same way as the normal.
-    for i in 0..4 {
-        if dot(cross(v[i], v[(i + 1) % 4]), n) <= 0 {
-            return Err(ErrorKind::NotConvex);
-        }
     }
     Ok(())
 }
