@@ -231,3 +231,155 @@ mod tests {
         assert_eq!(ratio_q16(3 * one, 4 * one), 3 << 14);
     }
 }
+
+#[cfg(test)]
+mod shading_tests {
+    extern crate std;
+    use super::*;
+    use crate::accel::Naive;
+    use crate::capacity::Board64K;
+    use crate::parse::parse;
+    use crate::scene::Scene;
+    use std::boxed::Box;
+    use std::format;
+
+    /// The colour seen from the eye (0, 0, 10) straight down −z.
+    fn look(text: &str) -> (Color, Option<ObjectId>, Stats) {
+        let mut scene: Box<Scene<Board64K>> = Box::new(Scene::new());
+        parse(text, &mut scene, &mut |e| panic!("{e}")).unwrap();
+        let view = scene.view();
+        let eye = view.normalization.point(view.settings.view.eye);
+        let tracer = Tracer::new(view, &Naive);
+        let mut stats = Stats::default();
+        let (c, o) = tracer.trace(Ray { origin: eye, dir: -Dir::Z }, &mut stats);
+        (c, o, stats)
+    }
+
+    fn approx(c: Color, rgb: [i32; 3]) {
+        for (got, w) in c.bits().iter().zip(rgb) {
+            assert!((got - w).abs() <= 24, "{:?} vs {rgb:?}", c.bits());
+        }
+    }
+
+    /// Q16.16 of a decimal given in thousandths.
+    fn m(thousandths: i64) -> i32 {
+        ((thousandths << 16) / 1000) as i32
+    }
+
+    const SPHERE: &str = "SPHERE 1 1 0 0 0\n";
+
+    fn surface(amb: &str, dif: &str, spec: &str, k: &str, r: &str, t: &str) -> std::string::String {
+        format!("SURFACE 1 {amb} {amb} {amb} {dif} {dif} {dif} {spec} {spec} {spec} {k} {r} {t}\n")
+    }
+
+    #[test]
+    fn ambient_diffuse_and_specular_add_up() {
+        // Light at the eye, 9 units from the hit point: B/(d + d0) = 10/10.
+        let text = format!("{SPHERE}LIGHT 10 0 0 10\n{}", surface("0.1", "0.5", "0.25", "10", "0", "0"));
+        let (c, o, stats) = look(&text);
+        approx(c, [m(850); 3]);
+        assert_eq!(o, Some(ObjectId(0)));
+        assert_eq!((stats.rays, stats.shadow_rays), (1, 1));
+    }
+
+    #[test]
+    fn attenuation_uses_world_distance_and_d0() {
+        // d = 9, d0 = 3: factor 10 / 12; diffuse only.
+        let text = format!("{SPHERE}ATTENUATION 3 LIGHT 10 0 0 10\n{}", surface("0", "0.6", "0", "0", "0", "0"));
+        approx(look(&text).0, [m(500); 3]);
+        // The same scene 1000 times larger, with d0 scaled too: same colour.
+        let big = format!(
+            "VIEWPOINT 0 0 10000 SPHERE 1 1000 0 0 0 ATTENUATION 3000 LIGHT 10000 0 0 10000\n{}",
+            surface("0", "0.6", "0", "0", "0", "0")
+        );
+        approx(look(&big).0, [m(500); 3]);
+    }
+
+    #[test]
+    fn specular_exponent_zero_is_constant() {
+        // Light off to the side: R·V < 1, but k = 0 makes the term constant.
+        let text = format!("{SPHERE}LIGHT 9 7 0 8\n{}", surface("0", "0", "0.5", "0", "0", "0"));
+        let (c, _, _) = look(&text);
+        // d = |(7, 0, 7)| = 9.8995 from P = (0, 0, 1): 9 / 10.8995 · 0.5.
+        approx(c, [m(413); 3]);
+    }
+
+    #[test]
+    fn light_behind_the_surface_gives_ambient_only() {
+        let text = format!("{SPHERE}LIGHT 10 0 0 -10\n{}", surface("0.2", "0.5", "0.5", "10", "0", "0"));
+        let (c, _, stats) = look(&text);
+        assert_eq!(c.bits(), [m(200); 3]);
+        assert_eq!(stats.shadow_rays, 0);
+    }
+
+    #[test]
+    fn any_object_casts_a_shadow_even_a_transparent_one() {
+        let text = format!(
+            "{SPHERE}SPHERE 2 0.5 0 0 5\nLIGHT 10 0 0 10\n{}SURFACE 2 0 0 0 0 0 0 0 0 0 0 0 1",
+            surface("0.2", "0.5", "0", "0", "0", "0")
+        );
+        // The small sphere is between the eye and the big one, so look past
+        // it: a ray from the side, hitting the big sphere at (1, 0, 0)… use
+        // the eye ray but with the small sphere fully transparent.
+        let (c, o, _) = look(&text);
+        assert_eq!(o, Some(ObjectId(1)));
+        // Seen through the transparent sphere: the big sphere in its shadow.
+        approx(c, [m(200); 3]);
+    }
+
+    #[test]
+    fn reflection_adds_r_times_what_the_mirror_sees() {
+        let text = format!("{SPHERE}BACKGROUND 0.5 0.5 0.5\n{}", surface("0.1", "0", "0", "0", "0.4", "0"));
+        // The mirror direction at the pole is straight back to the eye:
+        // background. C = 0.1 + 0.4 · 0.5.
+        let (c, _, stats) = look(&text);
+        approx(c, [m(300); 3]);
+        assert_eq!(stats.rays, 2);
+    }
+
+    #[test]
+    fn transparency_mixes_local_and_behind() {
+        // t = 0.5: C = 0.5 · 0.2 + 0.5 · background (the ray passes the
+        // sphere: its far side, then nothing). The far side's own colour
+        // counts too (it is the same transparent surface).
+        let text = format!("{SPHERE}BACKGROUND 1 1 1 RDEPTH 1\n{}", surface("0.2", "0", "0", "0", "0", "0.5"));
+        // Depth 1: the far side is reached but not passed: 0.5·0.2 + 0.5·(0.5·0.2).
+        approx(look(&text).0, [m(150); 3]);
+        let text = format!("{SPHERE}BACKGROUND 1 1 1 RDEPTH 2\n{}", surface("0.2", "0", "0", "0", "0", "0.5"));
+        // Depth 2: … + 0.25 · background.
+        approx(look(&text).0, [m(400); 3]);
+    }
+
+    #[test]
+    fn rdepth_zero_traces_primary_rays_only() {
+        let text = format!("{SPHERE}BACKGROUND 1 1 1 RDEPTH 0\n{}", surface("0.2", "0", "0", "0", "1", "1"));
+        let (c, _, stats) = look(&text);
+        assert_eq!(c.bits(), [0; 3]); // (1 − t) · local = 0
+        assert_eq!(stats.rays, 1);
+    }
+
+    #[test]
+    fn two_facing_mirrors_are_bounded() {
+        // Perfect mirrors facing each other with the eye between them: the
+        // ray bounces RDEPTH times at most, then the per-sample limit.
+        let text = "VIEWPOINT 0 0 0 ORIGIN 0 0 -1 RDEPTH 100000 \
+                    RECTANGLE 1 -5 -5 -3  5 -5 -3  5 5 -3  -5 5 -3 \
+                    RECTANGLE 1 -5 -5 3  -5 5 3  5 5 3  5 -5 3 \
+                    SURFACE 1 0.01 0.01 0.01 0 0 0 0 0 0 0 1 0";
+        let (c, _, stats) = look(text);
+        assert_eq!(stats.rays, MAX_RAYS_PER_SAMPLE as u64);
+        assert_eq!(stats.truncated, 1);
+        assert_eq!(c.bits(), [i32::MAX; 3].map(|_| c.bits()[0]));
+    }
+
+    #[test]
+    fn the_back_of_a_triangle_is_lit_from_behind() {
+        // Clockwise seen from the eye: its front faces −z, the eye sees its
+        // back, lit from the eye's side at d = 10: 10/11 · 0.5.
+        let text = format!(
+            "TRIANGLE 1 -2 -2 0  0 2 0  2 -2 0\nLIGHT 10 0 0 10\n{}",
+            surface("0", "0.5", "0", "0", "0", "0")
+        );
+        approx(look(&text).0, [(5 << 16) / 11; 3]);
+    }
+}
