@@ -50,16 +50,21 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((dim(w)?, dim(h)?))
 }
 
-pub fn run<I, T>(args: I, stderr: &mut dyn Write) -> i32
+pub fn run<I, T>(args: I, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i32
 where
     I: IntoIterator<Item = T>,
     T: Into<std::ffi::OsString> + Clone,
 {
     let args = match Args::try_parse_from(args) {
         Ok(a) => a,
+        Err(e) if e.use_stderr() => {
+            let _ = write!(stderr, "{}", e.render());
+            return EXIT_SCENE;
+        }
         Err(e) => {
-            let _ = write!(stderr, "{}", e.render().ansi());
-            return if e.use_stderr() { EXIT_SCENE } else { 0 };
+            // --help and --version.
+            let _ = write!(stdout, "{}", e.render());
+            return 0;
         }
     };
     match execute(&args, stderr) {

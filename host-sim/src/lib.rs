@@ -93,12 +93,12 @@ pub fn render_with_progress(
     Ok((image, stats))
 }
 
-/// Runs the command line `args` (including the program name); diagnostics go
-/// to `stderr`. Returns the process exit code.
-pub fn run<I, T>(args: I, stderr: &mut dyn std::io::Write) -> i32
+/// Runs the command line `args` (including the program name); help goes to
+/// `stdout`, diagnostics to `stderr`. Returns the process exit code.
+pub fn run<I, T>(args: I, stdout: &mut dyn std::io::Write, stderr: &mut dyn std::io::Write) -> i32
 where
     I: IntoIterator<Item = T>,
     T: Into<std::ffi::OsString> + Clone,
 {
-    cli::run(args, stderr)
+    cli::run(args, stdout, stderr)
 }

@@ -126,8 +126,9 @@ impl<'a> Cursor<'a> {
         self.lexer.pos()
     }
 
-    /// The next token if it is a number (consumed), else the error for
-    /// `field` (the token is left for error recovery).
+    /// The next token if it is a number, else the error for `field`. The
+    /// token is not consumed: the caller consumes it once it is accepted,
+    /// so error recovery always starts at the offending token.
     fn number(&mut self, field: Field) -> Result<(Decimal, Token<'a>), ParseError<'a>> {
         match self.peek()? {
             None => Err(ParseError::new(
@@ -146,10 +147,7 @@ impl<'a> Cursor<'a> {
                     },
                 )),
                 Some(d) if d.out_of_range() => Err(out_of_range(t, field, Rule::Magnitude)),
-                Some(d) => {
-                    self.peeked = None;
-                    Ok((d, t))
-                }
+                Some(d) => Ok((d, t)),
             },
         }
     }
@@ -166,6 +164,7 @@ impl<'a> Cursor<'a> {
             Rule::Between(..) | Rule::Magnitude => true,
         };
         if ok {
+            self.peeked = None;
             Ok(v)
         } else {
             Err(out_of_range(t, field, rule))

@@ -1,0 +1,45 @@
+//! Golden images: every scene in `scenes/`, rendered at its RASTER size, must
+//! equal `docs/gallery/<scene>.png` bit for bit (the output is
+//! deterministic). These are also the README's gallery, so the gallery is
+//! always what the code produces.
+//!
+//! Re-bless after an intended change of the images:
+//!
+//!     OCTRACE_BLESS=1 cargo test -p octrace-tests --test golden
+
+use host_sim::{load_file, new_scene, render, RgbImage};
+use octrace_tests::{blessing, repo, scenes};
+
+#[test]
+fn every_scene_matches_its_golden_image() {
+    let gallery = repo().join("docs/gallery");
+    let mut failures = Vec::new();
+    for (name, path) in scenes() {
+        let mut scene = new_scene();
+        load_file(&path, &mut scene).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let (image, _) = render(&scene, None).unwrap_or_else(|e| panic!("{name}: {e:?}"));
+        let golden = gallery.join(format!("{name}.png"));
+        if blessing() {
+            std::fs::create_dir_all(&gallery).unwrap();
+            image.write_png(std::fs::File::create(&golden).unwrap()).unwrap();
+            println!("blessed {}", golden.display());
+            continue;
+        }
+        let expected = std::fs::read(&golden)
+            .map_err(|e| e.to_string())
+            .and_then(|b| RgbImage::read_png(std::io::Cursor::new(b)));
+        match expected {
+            Err(e) => failures.push(format!("{name}: cannot read {}: {e}", golden.display())),
+            Ok(expected) if expected != image => {
+                let differing = expected.data.chunks(3).zip(image.data.chunks(3)).filter(|(a, b)| a != b).count();
+                failures.push(format!("{name}: {differing} pixels differ from {}", golden.display()));
+            }
+            Ok(_) => println!("{name}: identical"),
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{}\n(re-bless with OCTRACE_BLESS=1 cargo test -p octrace-tests --test golden)",
+        failures.join("\n")
+    );
+}
