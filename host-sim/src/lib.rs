@@ -68,7 +68,10 @@ pub fn load_file(path: &Path, scene: &mut HostScene) -> Result<Loaded, LoadError
 }
 
 /// Renders a loaded scene into a new image (`size` overrides RASTER).
-pub fn render(scene: &HostScene, size: Option<(u32, u32)>) -> Result<(RgbImage, Stats), CameraError> {
+pub fn render(
+    scene: &HostScene,
+    size: Option<(u32, u32)>,
+) -> Result<(RgbImage, Stats), CameraError> {
     render_with_progress(scene, size, |_| {})
 }
 

@@ -262,7 +262,11 @@ fn tokenize(text: &str) -> Result<Vec<Token>, String> {
                 s.push(chars[i]);
                 step(&mut i, &mut line, &mut col);
             }
-            tokens.push(Token { text: s, line: tl, col: tc });
+            tokens.push(Token {
+                text: s,
+                line: tl,
+                col: tc,
+            });
         } else {
             let (tl, tc) = (line, col);
             let mut s = String::new();
@@ -270,7 +274,11 @@ fn tokenize(text: &str) -> Result<Vec<Token>, String> {
                 s.push(chars[i]);
                 step(&mut i, &mut line, &mut col);
             }
-            tokens.push(Token { text: s, line: tl, col: tc });
+            tokens.push(Token {
+                text: s,
+                line: tl,
+                col: tc,
+            });
         }
     }
     Ok(tokens)
@@ -397,7 +405,11 @@ impl Parser {
     }
 
     fn vec3(&mut self, what: &str) -> Result<V3, String> {
-        Ok(V3::new(self.number(what)?, self.number(what)?, self.number(what)?))
+        Ok(V3::new(
+            self.number(what)?,
+            self.number(what)?,
+            self.number(what)?,
+        ))
     }
 
     fn colour(&mut self, what: &str) -> Result<Rgb, String> {
@@ -413,7 +425,11 @@ pub fn parse(text: &str) -> Result<RefScene, String> {
         let last_col = text.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
         (lines, last_col)
     };
-    let mut p = Parser { tokens, pos: 0, end };
+    let mut p = Parser {
+        tokens,
+        pos: 0,
+        end,
+    };
 
     let mut scene = RefScene {
         viewpoint: V3::new(0.0, 0.0, 10.0),
@@ -482,7 +498,10 @@ pub fn parse(text: &str) -> Result<RefScene, String> {
             "LIGHT" => {
                 let brightness = p.checked("LIGHT brightness", ">= 0", |v| v >= 0.0)?;
                 let position = p.vec3("LIGHT coordinate")?;
-                scene.lights.push(Light { brightness, position });
+                scene.lights.push(Light {
+                    brightness,
+                    position,
+                });
             }
             "BACKGROUND" => scene.background = p.colour("BACKGROUND component")?,
             "GAMMA" => scene.gamma = p.checked("GAMMA", "> 0", |v| v > 0.0)?,
@@ -545,7 +564,10 @@ fn parse_shape(p: &mut Parser, keyword: &str, line: usize, col: usize) -> Result
     Ok(match keyword {
         "SPHERE" => {
             let radius = p.checked("SPHERE radius", "> 0", positive)?;
-            Shape::Sphere { centre: p.vec3("SPHERE centre")?, radius }
+            Shape::Sphere {
+                centre: p.vec3("SPHERE centre")?,
+                radius,
+            }
         }
         "BOX" => {
             let centre = p.vec3("BOX centre")?;
@@ -557,22 +579,35 @@ fn parse_shape(p: &mut Parser, keyword: &str, line: usize, col: usize) -> Result
             Shape::Box { centre, half }
         }
         "SUPERQUADRIC" => {
-            let power = p.checked("SUPERQUADRIC power", "in 2..=64", |v| (2.0..=64.0).contains(&v))?;
+            let power = p.checked("SUPERQUADRIC power", "in 2..=64", |v| {
+                (2.0..=64.0).contains(&v)
+            })?;
             let centre = p.vec3("SUPERQUADRIC centre")?;
             let half = V3::new(
                 p.checked("SUPERQUADRIC size", "> 0", positive)?,
                 p.checked("SUPERQUADRIC size", "> 0", positive)?,
                 p.checked("SUPERQUADRIC size", "> 0", positive)?,
             );
-            Shape::Superquadric { power, centre, half }
+            Shape::Superquadric {
+                power,
+                centre,
+                half,
+            }
         }
         "TRIANGLE" => {
-            let pts = [p.vec3("TRIANGLE corner")?, p.vec3("TRIANGLE corner")?, p.vec3("TRIANGLE corner")?];
+            let pts = [
+                p.vec3("TRIANGLE corner")?,
+                p.vec3("TRIANGLE corner")?,
+                p.vec3("TRIANGLE corner")?,
+            ];
             let n = (pts[1] - pts[0]).cross(pts[2] - pts[0]);
             if n.length() == 0.0 {
                 return degenerate();
             }
-            Shape::Triangle { p: pts, normal: n.normalised() }
+            Shape::Triangle {
+                p: pts,
+                normal: n.normalised(),
+            }
         }
         _ => {
             let pts = [
@@ -587,7 +622,10 @@ fn parse_shape(p: &mut Parser, keyword: &str, line: usize, col: usize) -> Result
             if n.length() == 0.0 {
                 return degenerate();
             }
-            Shape::Rectangle { p: pts, normal: n.normalised() }
+            Shape::Rectangle {
+                p: pts,
+                normal: n.normalised(),
+            }
         }
     })
 }
@@ -775,9 +813,11 @@ impl Object {
         match self.shape {
             Shape::Sphere { centre, radius } => sphere_hit(centre, radius, o, d, roots),
             Shape::Box { centre, half } => box_hit(centre, half, o, d, roots),
-            Shape::Superquadric { power, centre, half } => {
-                superquadric_hit(power, centre, half, o, d, roots)
-            }
+            Shape::Superquadric {
+                power,
+                centre,
+                half,
+            } => superquadric_hit(power, centre, half, o, d, roots),
             Shape::Triangle { ref p, .. } => triangle_hit(p, o, d),
             Shape::Rectangle { ref p, normal } => rectangle_hit(p, normal, o, d),
         }
@@ -799,7 +839,11 @@ impl Object {
                 let sign = if rel(axis) < 0.0 { -1.0 } else { 1.0 };
                 V3::from_fn(|i| if i == axis { sign } else { 0.0 })
             }
-            Shape::Superquadric { power, centre, half } => {
+            Shape::Superquadric {
+                power,
+                centre,
+                half,
+            } => {
                 let g = V3::from_fn(|i| {
                     let x = (at.get(i) - centre.get(i)) / half.get(i);
                     x.signum() * x.abs().powf(power - 1.0) / half.get(i)
@@ -916,7 +960,10 @@ impl RefScene {
         let ng = object.normal(p);
         let n = if ng.dot(d) < 0.0 { ng } else { -ng };
         let v = -d;
-        let here = Start { object: index, normal: ng };
+        let here = Start {
+            object: index,
+            normal: ng,
+        };
 
         let mut local = surface.ambient;
         for light in &self.lights {
@@ -1035,7 +1082,11 @@ mod tests {
         // 127.5 and 63.75 round half up.
         assert!(image.iter().all(|&p| p == [128, 64, 255]));
         // An empty file renders black.
-        assert!(parse("").unwrap().render(4, 4).iter().all(|&p| p == [0, 0, 0]));
+        assert!(parse("")
+            .unwrap()
+            .render(4, 4)
+            .iter()
+            .all(|&p| p == [0, 0, 0]));
     }
 
     #[test]
@@ -1096,8 +1147,10 @@ mod tests {
                     RECTANGLE 1 -9 -9 0  9 -9 0  9 9 0  -9 9 0
                     SURFACE 1 0.1 0.1 0.1  0.5 0.5 0.5  0 0 0  0 0 0";
         let shadowed = |t: &str| {
-            let s = parse(&format!("{base} SPHERE 2 0.5 2.5 0 2.5 SURFACE 2 1 1 1 1 1 1 0 0 0 0 0 {t}"))
-                .unwrap();
+            let s = parse(&format!(
+                "{base} SPHERE 2 0.5 2.5 0 2.5 SURFACE 2 1 1 1 1 1 1 0 0 0 0 0 {t}"
+            ))
+            .unwrap();
             s.sample(3, 3, 1, 1, 0, 0)
         };
         assert!(close(shadowed("0"), [0.1; 3]));
@@ -1160,7 +1213,11 @@ mod tests {
         assert_eq!(s.render(4, 2).len(), 8);
 
         let err = |text: &str| parse(text).unwrap_err();
-        assert!(err("SPHERE 1 1 0 0 0\n  FOO").starts_with("2:3:"), "{}", err("\n  FOO"));
+        assert!(
+            err("SPHERE 1 1 0 0 0\n  FOO").starts_with("2:3:"),
+            "{}",
+            err("\n  FOO")
+        );
         assert!(err("RASTER 3 nan").starts_with("1:10:"));
         assert!(err("GAMMA 0x10").starts_with("1:7:"));
         assert!(err("RASTER 3.5 2").starts_with("1:8:"));

@@ -21,7 +21,9 @@ fn every_scene_matches_its_golden_image() {
         let golden = gallery.join(format!("{name}.png"));
         if blessing() {
             std::fs::create_dir_all(&gallery).unwrap();
-            image.write_png(std::fs::File::create(&golden).unwrap()).unwrap();
+            image
+                .write_png(std::fs::File::create(&golden).unwrap())
+                .unwrap();
             println!("blessed {}", golden.display());
             continue;
         }
@@ -31,8 +33,16 @@ fn every_scene_matches_its_golden_image() {
         match expected {
             Err(e) => failures.push(format!("{name}: cannot read {}: {e}", golden.display())),
             Ok(expected) if expected != image => {
-                let differing = expected.data.chunks(3).zip(image.data.chunks(3)).filter(|(a, b)| a != b).count();
-                failures.push(format!("{name}: {differing} pixels differ from {}", golden.display()));
+                let differing = expected
+                    .data
+                    .chunks(3)
+                    .zip(image.data.chunks(3))
+                    .filter(|(a, b)| a != b)
+                    .count();
+                failures.push(format!(
+                    "{name}: {differing} pixels differ from {}",
+                    golden.display()
+                ));
             }
             Ok(_) => println!("{name}: identical"),
         }

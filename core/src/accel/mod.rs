@@ -48,5 +48,11 @@ pub trait Accelerator {
     fn nearest(&self, scene: &SceneView<'_>, ray: &Ray, start: Option<RayStart>) -> Option<Hit>;
 
     /// Whether anything is hit with `0 < t ≤ t_max`.
-    fn occluded(&self, scene: &SceneView<'_>, ray: &Ray, t_max: Scalar, start: Option<RayStart>) -> bool;
+    fn occluded(
+        &self,
+        scene: &SceneView<'_>,
+        ray: &Ray,
+        t_max: Scalar,
+        start: Option<RayStart>,
+    ) -> bool;
 }

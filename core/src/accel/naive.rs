@@ -28,10 +28,19 @@ impl Accelerator for Naive {
         best
     }
 
-    fn occluded(&self, scene: &SceneView<'_>, ray: &Ray, t_max: Scalar, start: Option<RayStart>) -> bool {
+    fn occluded(
+        &self,
+        scene: &SceneView<'_>,
+        ray: &Ray,
+        t_max: Scalar,
+        start: Option<RayStart>,
+    ) -> bool {
         scene.objects.iter().enumerate().any(|(i, &handle)| {
             let leaving = RayStart::leaving(start, ObjectId(i as u32));
-            scene.shape_of(handle).intersect(ray, t_max, leaving).is_some()
+            scene
+                .shape_of(handle)
+                .intersect(ray, t_max, leaving)
+                .is_some()
         })
     }
 }

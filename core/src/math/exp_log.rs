@@ -102,7 +102,7 @@ pub fn exp2_q32(y: i64) -> u64 {
     let lo = EXP2_TABLE[index];
     let hi = EXP2_TABLE[index + 1];
     let mant = lo + ((((hi - lo) >> 20) * rest) >> 4); // Q2.62 in [1, 2]
-    // result = mant * 2^int in Q32: shift right by 30 - int.
+                                                       // result = mant * 2^int in Q32: shift right by 30 - int.
     let shift = 30 - int;
     if shift >= 64 {
         0
@@ -176,7 +176,10 @@ mod tests {
         for raw in [1u64, 3, 1000, 65_535, 65_536, 99_999, 1 << 40] {
             let back = exp2_q32(log2_q32(raw, 16)) as i128; // Q32
             let want = (raw as i128) << 16;
-            assert!((back - want).abs() * 100_000 <= want + 100_000, "{raw}: {back} vs {want}");
+            assert!(
+                (back - want).abs() * 100_000 <= want + 100_000,
+                "{raw}: {back} vs {want}"
+            );
         }
     }
 

@@ -220,9 +220,7 @@ impl Dir {
         });
         let len2 = scaled.iter().map(|&c| (c * c) as u64).sum::<u64>();
         let len = super::isqrt(len2) as i64;
-        Some(Dir::from_bits(
-            scaled.map(|c| ((c << 30) / len) as i32),
-        ))
+        Some(Dir::from_bits(scaled.map(|c| ((c << 30) / len) as i32)))
     }
 
     /// Cross product, renormalised; `None` for parallel inputs.
@@ -243,7 +241,9 @@ impl Dir {
         let d = self.dot_q60(n) >> 29; // 2(n·self) in Q2.30
         let nb = n.wide();
         let s = self.wide();
-        Dir::from_bits([0, 1, 2].map(|i| (((d * nb[i]) >> 30) - s[i]).clamp(-UNIT_ONE, UNIT_ONE) as i32))
+        Dir::from_bits(
+            [0, 1, 2].map(|i| (((d * nb[i]) >> 30) - s[i]).clamp(-UNIT_ONE, UNIT_ONE) as i32),
+        )
     }
 }
 
@@ -297,7 +297,10 @@ mod tests {
         let r = (-d).reflect_about(Dir::Y);
         let b = r.bits();
         let e = d.bits();
-        assert!((b[0] - e[0]).abs() <= 1 && (b[1] + e[1]).abs() <= 1, "{r:?}");
+        assert!(
+            (b[0] - e[0]).abs() <= 1 && (b[1] + e[1]).abs() <= 1,
+            "{r:?}"
+        );
     }
 
     #[test]

@@ -84,20 +84,46 @@ pub enum ErrorKind<'a> {
     UnknownKeyword(&'a str),
     /// A keyword the format reserves but this build does not implement.
     Unsupported(&'static str),
-    ExpectedNumber { field: Field, found: Found<'a> },
-    ExpectedInteger { field: Field, found: Found<'a> },
-    ExpectedName { field: Field },
-    OutOfRange { field: Field, rule: Rule, found: &'a str },
+    ExpectedNumber {
+        field: Field,
+        found: Found<'a>,
+    },
+    ExpectedInteger {
+        field: Field,
+        found: Found<'a>,
+    },
+    ExpectedName {
+        field: Field,
+    },
+    OutOfRange {
+        field: Field,
+        rule: Rule,
+        found: &'a str,
+    },
     /// A scene parameter given twice.
-    Repeated { keyword: &'static str, first_line: u32 },
-    SurfaceRepeated { number: u32, first_line: u32 },
-    UndefinedSurface { keyword: &'static str, number: u32 },
+    Repeated {
+        keyword: &'static str,
+        first_line: u32,
+    },
+    SurfaceRepeated {
+        number: u32,
+        first_line: u32,
+    },
+    UndefinedSurface {
+        keyword: &'static str,
+        number: u32,
+    },
     /// A shape with no area or volume: `why` says how.
-    Degenerate { keyword: &'static str, why: &'static str },
+    Degenerate {
+        keyword: &'static str,
+        why: &'static str,
+    },
     NotPlanar,
     NotConvex,
     /// A shape that rounds to nothing at the scale the whole scene needs.
-    TooSmall { keyword: &'static str },
+    TooSmall {
+        keyword: &'static str,
+    },
     EyeAtOrigin,
     UpParallel,
     Capacity(CapacityError),

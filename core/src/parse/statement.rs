@@ -19,17 +19,42 @@ pub enum Statement<'a> {
     Viewport([WorldValue; 2]),
     Rdepth(u32),
     Imagefile(&'a str),
-    Light { brightness: I32F32, position: WorldPoint },
+    Light {
+        brightness: I32F32,
+        position: WorldPoint,
+    },
     Background(Color),
     Gamma(I32F32),
     Attenuation(I32F32),
     Samples(u32),
-    Sphere { surface: u32, radius: WorldValue, center: WorldPoint },
-    Box { surface: u32, center: WorldPoint, half: WorldPoint },
-    Superquadric { surface: u32, power: I32F32, center: WorldPoint, half: WorldPoint },
-    Triangle { surface: u32, corners: [WorldPoint; 3] },
-    Rectangle { surface: u32, corners: [WorldPoint; 4] },
-    Surface { number: u32, surface: Surface },
+    Sphere {
+        surface: u32,
+        radius: WorldValue,
+        center: WorldPoint,
+    },
+    Box {
+        surface: u32,
+        center: WorldPoint,
+        half: WorldPoint,
+    },
+    Superquadric {
+        surface: u32,
+        power: I32F32,
+        center: WorldPoint,
+        half: WorldPoint,
+    },
+    Triangle {
+        surface: u32,
+        corners: [WorldPoint; 3],
+    },
+    Rectangle {
+        surface: u32,
+        corners: [WorldPoint; 4],
+    },
+    Surface {
+        number: u32,
+        surface: Surface,
+    },
 }
 
 impl Statement<'_> {
@@ -89,7 +114,10 @@ pub const KEYWORDS: [&str; 19] = [
 
 /// The keyword `text` names (case-insensitively), if any.
 pub fn keyword(text: &str) -> Option<&'static str> {
-    KEYWORDS.iter().copied().find(|k| k.eq_ignore_ascii_case(text))
+    KEYWORDS
+        .iter()
+        .copied()
+        .find(|k| k.eq_ignore_ascii_case(text))
 }
 
 /// Tokens with one token of look-ahead.
@@ -185,13 +213,15 @@ impl<'a> Cursor<'a> {
             }
             Some(t) => t,
         };
-        let v = parse_integer(t.text).filter(|_| !t.quoted).ok_or(ParseError::new(
-            t.pos,
-            ErrorKind::ExpectedInteger {
-                field,
-                found: Found::Token(t.text),
-            },
-        ))?;
+        let v = parse_integer(t.text)
+            .filter(|_| !t.quoted)
+            .ok_or(ParseError::new(
+                t.pos,
+                ErrorKind::ExpectedInteger {
+                    field,
+                    found: Found::Token(t.text),
+                },
+            ))?;
         if v < lo || v > hi {
             return Err(out_of_range(t, field, Rule::Between(lo, hi)));
         }
@@ -199,7 +229,11 @@ impl<'a> Cursor<'a> {
         Ok(v)
     }
 
-    fn point(&mut self, statement: &'static str, names: [&'static str; 3]) -> Result<WorldPoint, ParseError<'a>> {
+    fn point(
+        &mut self,
+        statement: &'static str,
+        names: [&'static str; 3],
+    ) -> Result<WorldPoint, ParseError<'a>> {
         let mut p = [0; 3];
         for (v, name) in p.iter_mut().zip(names) {
             *v = self.real(Field { statement, name }, Rule::Magnitude)?;
@@ -207,7 +241,11 @@ impl<'a> Cursor<'a> {
         Ok(p)
     }
 
-    fn positive_triple(&mut self, statement: &'static str, names: [&'static str; 3]) -> Result<WorldPoint, ParseError<'a>> {
+    fn positive_triple(
+        &mut self,
+        statement: &'static str,
+        names: [&'static str; 3],
+    ) -> Result<WorldPoint, ParseError<'a>> {
         let mut p = [0; 3];
         for (v, name) in p.iter_mut().zip(names) {
             *v = self.real(Field { statement, name }, Rule::Positive)?;
@@ -215,7 +253,11 @@ impl<'a> Cursor<'a> {
         Ok(p)
     }
 
-    fn color(&mut self, statement: &'static str, names: [&'static str; 3]) -> Result<Color, ParseError<'a>> {
+    fn color(
+        &mut self,
+        statement: &'static str,
+        names: [&'static str; 3],
+    ) -> Result<Color, ParseError<'a>> {
         let mut c = [0; 3];
         for (v, name) in c.iter_mut().zip(names) {
             *v = q32_to_q16(self.real(Field { statement, name }, Rule::UnitInterval)?) as i32;
@@ -249,8 +291,15 @@ pub fn q32_to_q16(v: i64) -> i64 {
 }
 
 /// Reads the statement that `keyword` (already consumed) begins.
-pub fn statement<'a>(cur: &mut Cursor<'a>, kw: &'static str, at: Pos) -> Result<Statement<'a>, ParseError<'a>> {
-    let f = |name| Field { statement: kw, name };
+pub fn statement<'a>(
+    cur: &mut Cursor<'a>,
+    kw: &'static str,
+    at: Pos,
+) -> Result<Statement<'a>, ParseError<'a>> {
+    let f = |name| Field {
+        statement: kw,
+        name,
+    };
     let xyz = ["x", "y", "z"];
     Ok(match kw {
         "VIEWPOINT" => Statement::Viewpoint(cur.point(kw, xyz)?),
@@ -260,14 +309,21 @@ pub fn statement<'a>(cur: &mut Cursor<'a>, kw: &'static str, at: Pos) -> Result<
             cur.integer(f("width"), 1, 16384)? as u32,
             cur.integer(f("height"), 1, 16384)? as u32,
         ]),
-        "VIEWPORT" => Statement::Viewport([cur.real(f("width"), Rule::Positive)?, cur.real(f("height"), Rule::Positive)?]),
-        "RDEPTH" => Statement::Rdepth(cur.integer(f("depth"), 0, super::number::LIMIT as i64)? as u32),
+        "VIEWPORT" => Statement::Viewport([
+            cur.real(f("width"), Rule::Positive)?,
+            cur.real(f("height"), Rule::Positive)?,
+        ]),
+        "RDEPTH" => {
+            Statement::Rdepth(cur.integer(f("depth"), 0, super::number::LIMIT as i64)? as u32)
+        }
         "IMAGEFILE" => match cur.next()? {
             Some(t) => Statement::Imagefile(t.text),
             None => {
                 return Err(ParseError::new(
                     cur.end_pos(),
-                    ErrorKind::ExpectedName { field: f("file name") },
+                    ErrorKind::ExpectedName {
+                        field: f("file name"),
+                    },
                 ))
             }
         },
@@ -277,7 +333,9 @@ pub fn statement<'a>(cur: &mut Cursor<'a>, kw: &'static str, at: Pos) -> Result<
         },
         "BACKGROUND" => Statement::Background(cur.color(kw, ["red", "green", "blue"])?),
         "GAMMA" => Statement::Gamma(I32F32::from_bits(cur.real(f("value"), Rule::Positive)?)),
-        "ATTENUATION" => Statement::Attenuation(I32F32::from_bits(cur.real(f("d0"), Rule::Positive)?)),
+        "ATTENUATION" => {
+            Statement::Attenuation(I32F32::from_bits(cur.real(f("d0"), Rule::Positive)?))
+        }
         "SAMPLES" => Statement::Samples(cur.integer(f("count"), 1, 16)? as u32),
         "SPHERE" => Statement::Sphere {
             surface: cur.surface_number(kw)?,
@@ -329,7 +387,9 @@ pub fn statement<'a>(cur: &mut Cursor<'a>, kw: &'static str, at: Pos) -> Result<
             let ambient = cur.color(kw, ["ambient red", "ambient green", "ambient blue"])?;
             let diffuse = cur.color(kw, ["diffuse red", "diffuse green", "diffuse blue"])?;
             let specular = cur.color(kw, ["specular red", "specular green", "specular blue"])?;
-            let exponent = I48F16::from_bits(q32_to_q16(cur.real(f("specular exponent"), Rule::NonNegative)?));
+            let exponent = I48F16::from_bits(q32_to_q16(
+                cur.real(f("specular exponent"), Rule::NonNegative)?,
+            ));
             let reflectivity = q32_to_q16(cur.real(f("reflectivity"), Rule::UnitInterval)?) as i32;
             let transparency = q32_to_q16(cur.real(f("transparency"), Rule::UnitInterval)?) as i32;
             Statement::Surface {
@@ -373,7 +433,12 @@ fn check_quadrilateral(c: &[WorldPoint; 4]) -> Result<(), ErrorKind<'static>> {
     for (i, e) in v.iter_mut().enumerate() {
         *e = sub(c[(i + 1) % 4], c[i]);
     }
-    let largest = v.iter().flatten().map(|x| x.unsigned_abs()).max().unwrap_or(0);
+    let largest = v
+        .iter()
+        .flatten()
+        .map(|x| x.unsigned_abs())
+        .max()
+        .unwrap_or(0);
     if largest == 0 {
         return Err(ErrorKind::Degenerate {
             keyword: "RECTANGLE",
@@ -385,7 +450,11 @@ fn check_quadrilateral(c: &[WorldPoint; 4]) -> Result<(), ErrorKind<'static>> {
     // The turn at each corner; for a strictly convex quadrilateral all four
     // point the same way (counter-clockwise: along the front normal).
     let turns: [[i128; 3]; 4] = core::array::from_fn(|i| cross(v[i], v[(i + 1) % 4]));
-    let reference = turns.iter().copied().max_by_key(|c| dot(*c, *c)).unwrap_or([0; 3]);
+    let reference = turns
+        .iter()
+        .copied()
+        .max_by_key(|c| dot(*c, *c))
+        .unwrap_or([0; 3]);
     if reference == [0; 3] {
         return Err(ErrorKind::Degenerate {
             keyword: "RECTANGLE",

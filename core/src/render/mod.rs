@@ -48,7 +48,12 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     }
 
     /// A renderer at another size (the default VIEWPORT follows its aspect).
-    pub fn with_size(scene: SceneView<'a>, accel: &'a A, width: u32, height: u32) -> Result<Self, CameraError> {
+    pub fn with_size(
+        scene: SceneView<'a>,
+        accel: &'a A,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, CameraError> {
         let s = scene.settings;
         let camera = Camera::new(&s.view, &scene.normalization, width, height, s.samples)?;
         Ok(Renderer {
@@ -95,7 +100,12 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     }
 
     /// The pixels of row `y` for the columns `xs`, traced lazily.
-    pub fn row<'s>(&'s self, y: u32, xs: Range<u32>, stats: &'s Cell<Stats>) -> impl Iterator<Item = PixelSample> + 's {
+    pub fn row<'s>(
+        &'s self,
+        y: u32,
+        xs: Range<u32>,
+        stats: &'s Cell<Stats>,
+    ) -> impl Iterator<Item = PixelSample> + 's {
         xs.map(move |x| {
             let mut s = stats.get();
             let p = self.pixel(x, y, &mut s);

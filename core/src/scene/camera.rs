@@ -102,7 +102,11 @@ impl Camera {
         samples: u32,
     ) -> Result<Camera, CameraError> {
         let (f, r, u, dist) = Self::basis(view)?;
-        let (w, h, n) = (width.max(1) as i128, height.max(1) as i128, samples.max(1) as i128);
+        let (w, h, n) = (
+            width.max(1) as i128,
+            height.max(1) as i128,
+            samples.max(1) as i128,
+        );
         let dist = dist.max(1) as i128;
         // Tangent-like ratios vw/d and vh/d in Q32.32.
         let (ax, ay) = match view.viewport {
@@ -127,7 +131,13 @@ impl Camera {
         };
         Ok(Camera {
             eye: norm.point(view.eye),
-            forward: f.wide().map(|c| if frac >= 30 { c << (frac - 30) } else { c >> (30 - frac) }),
+            forward: f.wide().map(|c| {
+                if frac >= 30 {
+                    c << (frac - 30)
+                } else {
+                    c >> (30 - frac)
+                }
+            }),
             step_x: scale(r, ax, 2 * n * w),
             step_y: scale(u, ay, 2 * n * h),
             width: width.max(1),
@@ -240,7 +250,10 @@ mod tests {
             eye: [0; 3],
             ..View::default()
         };
-        assert_eq!(Camera::new(&at_origin, &norm, 4, 4, 1), Err(CameraError::EyeAtOrigin));
+        assert_eq!(
+            Camera::new(&at_origin, &norm, 4, 4, 1),
+            Err(CameraError::EyeAtOrigin)
+        );
         let parallel = View {
             up: [0, 0, -3 * ONE],
             ..View::default()

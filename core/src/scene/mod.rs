@@ -91,7 +91,12 @@ impl<C: Capacities> Default for Scene<C> {
     }
 }
 
-fn push<T, A: Arena<T>>(arena: &mut A, item: T, what: &'static str, profile: &'static str) -> Result<usize, CapacityError> {
+fn push<T, A: Arena<T>>(
+    arena: &mut A,
+    item: T,
+    what: &'static str,
+    profile: &'static str,
+) -> Result<usize, CapacityError> {
     let index = arena.as_slice().len();
     arena.push(item).map_err(|_| CapacityError {
         what,
@@ -178,7 +183,13 @@ impl<C: Capacities> Scene<C> {
                 profile: C::NAME,
             });
         }
-        push(&mut self.objects, ShapeHandle::new(kind, index), "objects", C::NAME).map(|_| ())
+        push(
+            &mut self.objects,
+            ShapeHandle::new(kind, index),
+            "objects",
+            C::NAME,
+        )
+        .map(|_| ())
     }
 
     /// Checks that one more object of `kind` fits, before it is built.
@@ -192,7 +203,11 @@ impl<C: Capacities> Scene<C> {
         };
         let capacity = Self::capacity_of(kind).min(ShapeHandle::MAX_INDEX);
         if len >= capacity {
-            return Err(CapacityError { what, capacity, profile: C::NAME });
+            return Err(CapacityError {
+                what,
+                capacity,
+                profile: C::NAME,
+            });
         }
         if self.objects.as_slice().len() >= Self::object_capacity() {
             return Err(CapacityError {

@@ -134,9 +134,15 @@ mod tests {
     fn scaled_scenes_normalise_to_the_same_numbers() {
         // The same scene at unit scale and at 1024 times: identical.
         let a = Normalization::fit([-3 * ONE, -ONE, 0], [5 * ONE, ONE, 2 * ONE]);
-        let b = Normalization::fit([-3 * ONE * 1024, -ONE * 1024, 0], [5 * ONE * 1024, ONE * 1024, 2 * ONE * 1024]);
+        let b = Normalization::fit(
+            [-3 * ONE * 1024, -ONE * 1024, 0],
+            [5 * ONE * 1024, ONE * 1024, 2 * ONE * 1024],
+        );
         assert_eq!(a.shift, b.shift + 10);
-        assert_eq!(a.point([ONE, ONE / 2, ONE]), b.point([ONE * 1024, ONE * 512, ONE * 1024]));
+        assert_eq!(
+            a.point([ONE, ONE / 2, ONE]),
+            b.point([ONE * 1024, ONE * 512, ONE * 1024])
+        );
         assert_eq!(a.length(3 * ONE), b.length(3 * ONE * 1024));
     }
 

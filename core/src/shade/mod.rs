@@ -143,18 +143,30 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
 
     /// Adds the weighted local colour at `hit` to `color` and returns the
     /// transmitted and reflected rays to trace.
-    fn shade(&self, p: &Pending, hit: Hit, color: &mut Color, stats: &mut Stats) -> [Option<Pending>; 2] {
+    fn shade(
+        &self,
+        p: &Pending,
+        hit: Hit,
+        color: &mut Color,
+        stats: &mut Stats,
+    ) -> [Option<Pending>; 2] {
         let shape = self.scene.shape(hit.object);
         let point = p.ray.at(hit.t);
         let geometric = shape.normal_at(point);
         // Two-sided: shade with the normal facing the incoming ray.
-        let normal = if geometric.dot_q60(p.ray.dir) > 0 { -geometric } else { geometric };
+        let normal = if geometric.dot_q60(p.ray.dir) > 0 {
+            -geometric
+        } else {
+            geometric
+        };
         let to_eye = -p.ray.dir;
         let surface = self.scene.surface(shape.surface());
         let mut local = surface.ambient;
         for light in self.scene.lights {
             let to_light = light.position - point;
-            let Some(light_dir) = to_light.direction() else { continue };
+            let Some(light_dir) = to_light.direction() else {
+                continue;
+            };
             let cos = normal.dot(light_dir);
             if cos.to_bits() <= 0 {
                 continue;
@@ -170,7 +182,10 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
                 leaving: leaving_along(geometric, light_dir),
             };
             let t_max = Scalar::from_bits((distance.to_bits() - 1).max(0));
-            if self.accel.occluded(&self.scene, &shadow, t_max, Some(start)) {
+            if self
+                .accel
+                .occluded(&self.scene, &shadow, t_max, Some(start))
+            {
                 continue;
             }
             let attenuation = self.attenuation(light.brightness.to_bits(), distance);
@@ -245,13 +260,19 @@ mod shading_tests {
 
     /// The colour seen from the eye (0, 0, 10) straight down −z.
     fn look(text: &str) -> (Color, Option<ObjectId>, Stats) {
-        let mut scene: Box<Scene<Board64K>> = Box::new(Scene::new());
+        let mut scene: Box<Scene<Board64K>> = Box::default();
         parse(text, &mut scene, &mut |e| panic!("{e}")).unwrap();
         let view = scene.view();
         let eye = view.normalization.point(view.settings.view.eye);
         let tracer = Tracer::new(view, &Naive);
         let mut stats = Stats::default();
-        let (c, o) = tracer.trace(Ray { origin: eye, dir: -Dir::Z }, &mut stats);
+        let (c, o) = tracer.trace(
+            Ray {
+                origin: eye,
+                dir: -Dir::Z,
+            },
+            &mut stats,
+        );
         (c, o, stats)
     }
 
@@ -275,7 +296,10 @@ mod shading_tests {
     #[test]
     fn ambient_diffuse_and_specular_add_up() {
         // Light at the eye, 9 units from the hit point: B/(d + d0) = 10/10.
-        let text = format!("{SPHERE}LIGHT 10 0 0 10\n{}", surface("0.1", "0.5", "0.25", "10", "0", "0"));
+        let text = format!(
+            "{SPHERE}LIGHT 10 0 0 10\n{}",
+            surface("0.1", "0.5", "0.25", "10", "0", "0")
+        );
         let (c, o, stats) = look(&text);
         approx(c, [m(850); 3]);
         assert_eq!(o, Some(ObjectId(0)));
@@ -285,7 +309,10 @@ mod shading_tests {
     #[test]
     fn attenuation_uses_world_distance_and_d0() {
         // d = 9, d0 = 3: factor 10 / 12; diffuse only.
-        let text = format!("{SPHERE}ATTENUATION 3 LIGHT 10 0 0 10\n{}", surface("0", "0.6", "0", "0", "0", "0"));
+        let text = format!(
+            "{SPHERE}ATTENUATION 3 LIGHT 10 0 0 10\n{}",
+            surface("0", "0.6", "0", "0", "0", "0")
+        );
         approx(look(&text).0, [m(500); 3]);
         // The same scene 1000 times larger, with d0 scaled too: same colour.
         let big = format!(
@@ -298,7 +325,10 @@ mod shading_tests {
     #[test]
     fn specular_exponent_zero_is_constant() {
         // Light off to the side: R·V < 1, but k = 0 makes the term constant.
-        let text = format!("{SPHERE}LIGHT 9 7 0 8\n{}", surface("0", "0", "0.5", "0", "0", "0"));
+        let text = format!(
+            "{SPHERE}LIGHT 9 7 0 8\n{}",
+            surface("0", "0", "0.5", "0", "0", "0")
+        );
         let (c, _, _) = look(&text);
         // d = |(7, 0, 7)| = 9.8995 from P = (0, 0, 1): 9 / 10.8995 · 0.5.
         approx(c, [m(413); 3]);
@@ -306,7 +336,10 @@ mod shading_tests {
 
     #[test]
     fn light_behind_the_surface_gives_ambient_only() {
-        let text = format!("{SPHERE}LIGHT 10 0 0 -10\n{}", surface("0.2", "0.5", "0.5", "10", "0", "0"));
+        let text = format!(
+            "{SPHERE}LIGHT 10 0 0 -10\n{}",
+            surface("0.2", "0.5", "0.5", "10", "0", "0")
+        );
         let (c, _, stats) = look(&text);
         assert_eq!(c.bits(), [m(200); 3]);
         assert_eq!(stats.shadow_rays, 0);
@@ -329,7 +362,10 @@ mod shading_tests {
 
     #[test]
     fn reflection_adds_r_times_what_the_mirror_sees() {
-        let text = format!("{SPHERE}BACKGROUND 0.5 0.5 0.5\n{}", surface("0.1", "0", "0", "0", "0.4", "0"));
+        let text = format!(
+            "{SPHERE}BACKGROUND 0.5 0.5 0.5\n{}",
+            surface("0.1", "0", "0", "0", "0.4", "0")
+        );
         // The mirror direction at the pole is straight back to the eye:
         // background. C = 0.1 + 0.4 · 0.5.
         let (c, _, stats) = look(&text);
@@ -342,17 +378,26 @@ mod shading_tests {
         // t = 0.5: C = 0.5 · 0.2 + 0.5 · background (the ray passes the
         // sphere: its far side, then nothing). The far side's own colour
         // counts too (it is the same transparent surface).
-        let text = format!("{SPHERE}BACKGROUND 1 1 1 RDEPTH 1\n{}", surface("0.2", "0", "0", "0", "0", "0.5"));
+        let text = format!(
+            "{SPHERE}BACKGROUND 1 1 1 RDEPTH 1\n{}",
+            surface("0.2", "0", "0", "0", "0", "0.5")
+        );
         // Depth 1: the far side is reached but not passed: 0.5·0.2 + 0.5·(0.5·0.2).
         approx(look(&text).0, [m(150); 3]);
-        let text = format!("{SPHERE}BACKGROUND 1 1 1 RDEPTH 2\n{}", surface("0.2", "0", "0", "0", "0", "0.5"));
+        let text = format!(
+            "{SPHERE}BACKGROUND 1 1 1 RDEPTH 2\n{}",
+            surface("0.2", "0", "0", "0", "0", "0.5")
+        );
         // Depth 2: … + 0.25 · background.
         approx(look(&text).0, [m(400); 3]);
     }
 
     #[test]
     fn rdepth_zero_traces_primary_rays_only() {
-        let text = format!("{SPHERE}BACKGROUND 1 1 1 RDEPTH 0\n{}", surface("0.2", "0", "0", "0", "1", "1"));
+        let text = format!(
+            "{SPHERE}BACKGROUND 1 1 1 RDEPTH 0\n{}",
+            surface("0.2", "0", "0", "0", "1", "1")
+        );
         let (c, _, stats) = look(&text);
         assert_eq!(c.bits(), [0; 3]); // (1 − t) · local = 0
         assert_eq!(stats.rays, 1);

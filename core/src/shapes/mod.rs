@@ -281,6 +281,9 @@ pub(crate) mod test_util {
 
     /// `|a − b|` below `tol` raw units on every axis.
     pub fn close(a: Vec3, b: Vec3, tol: i32) -> bool {
-        a.bits().iter().zip(b.bits()).all(|(x, y)| (x - y).abs() <= tol)
+        a.bits()
+            .iter()
+            .zip(b.bits())
+            .all(|(x, y)| (x - y).abs() <= tol)
     }
 }

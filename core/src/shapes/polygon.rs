@@ -125,7 +125,9 @@ impl<const N: usize> Polygon<N> {
             min: self.corners[0],
             max: self.corners[0],
         };
-        self.corners.iter().fold(first, |b, &c| b.union(Aabb { min: c, max: c }))
+        self.corners
+            .iter()
+            .fold(first, |b, &c| b.union(Aabb { min: c, max: c }))
     }
 }
 

@@ -58,16 +58,31 @@ mod tests {
     fn front_normal_and_hits() {
         let f = floor();
         assert_eq!(f.normal(), Dir::Y);
-        assert_eq!(f.intersect(&ray(p(0, 3, 0), [0, -1, 0]), far(), Leaving::No), Some(s(4)));
-        assert_eq!(f.intersect(&ray(p(1, -5, 1), [0, 1, 0]), far(), Leaving::No), Some(s(4)));
-        assert_eq!(f.intersect(&ray(p(2, 3, -2), [0, -1, 0]), far(), Leaving::No), Some(s(4)));
+        assert_eq!(
+            f.intersect(&ray(p(0, 3, 0), [0, -1, 0]), far(), Leaving::No),
+            Some(s(4))
+        );
+        assert_eq!(
+            f.intersect(&ray(p(1, -5, 1), [0, 1, 0]), far(), Leaving::No),
+            Some(s(4))
+        );
+        assert_eq!(
+            f.intersect(&ray(p(2, 3, -2), [0, -1, 0]), far(), Leaving::No),
+            Some(s(4))
+        );
     }
 
     #[test]
     fn misses_outside_the_corners() {
         let f = floor();
-        assert_eq!(f.intersect(&ray(p(3, 3, 0), [0, -1, 0]), far(), Leaving::No), None);
-        assert_eq!(f.intersect(&ray(p(0, 3, 3), [0, -1, 0]), far(), Leaving::No), None);
+        assert_eq!(
+            f.intersect(&ray(p(3, 3, 0), [0, -1, 0]), far(), Leaving::No),
+            None
+        );
+        assert_eq!(
+            f.intersect(&ray(p(0, 3, 3), [0, -1, 0]), far(), Leaving::No),
+            None
+        );
     }
 
     #[test]
@@ -89,7 +104,9 @@ mod tests {
                 ..p(0, 5, 0)
             };
             let r = ray(origin, [1, -1000, 3]);
-            let hit = a.intersect(&r, far(), Leaving::No).or(b.intersect(&r, far(), Leaving::No));
+            let hit = a
+                .intersect(&r, far(), Leaving::No)
+                .or(b.intersect(&r, far(), Leaving::No));
             assert!(hit.is_some(), "crack at k = {k}");
         }
     }

@@ -97,9 +97,18 @@ mod tests {
     #[test]
     fn misses_beside_and_behind() {
         let sph = unit_sphere_at(-5);
-        assert_eq!(sph.intersect(&ray(p(2, 0, 0), [0, 0, -1]), far(), Leaving::No), None);
-        assert_eq!(sph.intersect(&ray(p(0, 0, 0), [0, 0, 1]), far(), Leaving::No), None);
-        assert_eq!(sph.intersect(&ray(p(0, 0, 0), [0, 1, 0]), far(), Leaving::No), None);
+        assert_eq!(
+            sph.intersect(&ray(p(2, 0, 0), [0, 0, -1]), far(), Leaving::No),
+            None
+        );
+        assert_eq!(
+            sph.intersect(&ray(p(0, 0, 0), [0, 0, 1]), far(), Leaving::No),
+            None
+        );
+        assert_eq!(
+            sph.intersect(&ray(p(0, 0, 0), [0, 1, 0]), far(), Leaving::No),
+            None
+        );
     }
 
     #[test]
@@ -136,10 +145,14 @@ mod tests {
     #[test]
     fn tiny_and_huge_spheres() {
         let tiny = Sphere::new(p(0, 0, -100), Scalar::from_bits(64), 0);
-        let t = tiny.intersect(&ray(p(0, 0, 0), [0, 0, -1]), far(), Leaving::No).unwrap();
+        let t = tiny
+            .intersect(&ray(p(0, 0, 0), [0, 0, -1]), far(), Leaving::No)
+            .unwrap();
         assert_eq!(t.to_bits(), (100 << 16) - 64);
         let huge = Sphere::new(p(0, 0, -8000), s(4000), 0);
-        let t = huge.intersect(&ray(p(0, 0, 8000), [0, 0, -1]), far(), Leaving::No).unwrap();
+        let t = huge
+            .intersect(&ray(p(0, 0, 8000), [0, 0, -1]), far(), Leaving::No)
+            .unwrap();
         assert_eq!(t, s(12000));
     }
 }
