@@ -36,13 +36,9 @@ pub struct Args {
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("expected WxH (for example 160x128), found `{s}`"))?;
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WxH (for example 160x128), found `{s}`"))?;
     let dim = |v: &str| -> Result<u32, String> {
-        let n: u32 = v
-            .parse()
-            .map_err(|_| format!("`{v}` is not a whole number"))?;
+        let n: u32 = v.parse().map_err(|_| format!("`{v}` is not a whole number"))?;
         if (1..=16384).contains(&n) {
             Ok(n)
         } else {
@@ -80,23 +76,15 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
     let loaded = match load_file(&args.scene, &mut scene) {
         Ok(l) => l,
         Err(LoadError::Io(e)) => {
-            let _ = writeln!(
-                stderr,
-                "host-sim: cannot read {}: {e}",
-                args.scene.display()
-            );
+            let _ = writeln!(stderr, "host-sim: cannot read {}: {e}", args.scene.display());
             return Err(EXIT_IO);
         }
         Err(LoadError::Scene(errors)) => {
             for e in &errors {
                 let _ = writeln!(stderr, "{e}");
             }
-            let _ = writeln!(
-                stderr,
-                "host-sim: {} error(s) in {}; nothing rendered",
-                errors.len(),
-                args.scene.display()
-            );
+            let _ =
+                writeln!(stderr, "host-sim: {} error(s) in {}; nothing rendered", errors.len(), args.scene.display());
             return Err(EXIT_SCENE);
         }
     };
@@ -113,24 +101,16 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
         }
     };
     if same_file(&args.scene, &out) {
-        let _ = writeln!(
-            stderr,
-            "host-sim: refusing to overwrite the scene file {} with the image",
-            out.display()
-        );
+        let _ = writeln!(stderr, "host-sim: refusing to overwrite the scene file {} with the image", out.display());
         return Err(EXIT_SCENE);
     }
     let view = scene.view();
-    let (w, h) = args
-        .size
-        .unwrap_or((view.settings.raster[0], view.settings.raster[1]));
+    let (w, h) = args.size.unwrap_or((view.settings.raster[0], view.settings.raster[1]));
     let bar = if !args.quiet && std::io::stderr().is_terminal() {
         let bar = ProgressBar::new(h as u64);
         bar.set_style(
-            ProgressStyle::with_template(
-                "{elapsed_precise} [{bar:40}] {pos}/{len} rows, eta {eta}",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+            ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} rows, eta {eta}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
         Some(bar)
     } else {
@@ -166,10 +146,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
             stats.rays,
             stats.shadow_rays,
             if stats.truncated > 0 {
-                format!(
-                    " ({} ray-tree branches cut at the per-sample limits)",
-                    stats.truncated
-                )
+                format!(" ({} ray-tree branches cut at the per-sample limits)", stats.truncated)
             } else {
                 String::new()
             },
@@ -193,21 +170,11 @@ pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path.file_name().ok_or_else(|| {
-        std::io::Error::new(
-            std::io::ErrorKind::InvalidInput,
-            "the output path names no file",
-        )
-    })?;
-    let tmp = dir.join(format!(
-        ".{}.{}.tmp",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::InvalidInput, "the output path names no file"))?;
+    let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
     let result = (|| {
         let file = std::fs::File::create(&tmp)?;
         let mut w = std::io::BufWriter::new(file);

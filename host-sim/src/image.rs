@@ -19,11 +19,7 @@ pub struct RgbImage {
 
 impl RgbImage {
     pub fn new(width: u32, height: u32) -> RgbImage {
-        RgbImage {
-            width,
-            height,
-            data: vec![0; width as usize * height as usize * 3],
-        }
+        RgbImage { width, height, data: vec![0; width as usize * height as usize * 3] }
     }
 
     pub fn pixel(&self, x: u32, y: u32) -> [u8; 3] {
@@ -55,17 +51,10 @@ impl RgbImage {
         let mut buf = vec![0; reader.output_buffer_size().ok_or("image too large")?];
         let info = reader.next_frame(&mut buf).map_err(|e| e.to_string())?;
         if info.color_type != png::ColorType::Rgb || info.bit_depth != png::BitDepth::Eight {
-            return Err(format!(
-                "expected 8-bit RGB, found {:?} {:?}",
-                info.color_type, info.bit_depth
-            ));
+            return Err(format!("expected 8-bit RGB, found {:?} {:?}", info.color_type, info.bit_depth));
         }
         buf.truncate(info.buffer_size());
-        Ok(RgbImage {
-            width: info.width,
-            height: info.height,
-            data: buf,
-        })
+        Ok(RgbImage { width: info.width, height: info.height, data: buf })
     }
 }
 
@@ -116,11 +105,7 @@ mod tests {
         let mut img = RgbImage::new(3, 2);
         img.fill_contiguous(
             &Rectangle::new(Point::new(0, 1), Size::new(3, 1)),
-            [
-                Rgb888::new(1, 2, 3),
-                Rgb888::new(4, 5, 6),
-                Rgb888::new(255, 0, 7),
-            ],
+            [Rgb888::new(1, 2, 3), Rgb888::new(4, 5, 6), Rgb888::new(255, 0, 7)],
         )
         .unwrap();
         let mut bytes = Vec::new();

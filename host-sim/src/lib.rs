@@ -54,9 +54,7 @@ pub fn load_bytes(name: &str, bytes: &[u8], scene: &mut HostScene) -> Result<Loa
     let mut errors = Vec::new();
     let mut on_error = |e: ParseError<'_>| errors.push(format!("{name}:{e}"));
     match parse_bytes(bytes, scene, &mut on_error) {
-        Ok(parsed) => Ok(Loaded {
-            imagefile: parsed.imagefile.map(str::to_owned),
-        }),
+        Ok(parsed) => Ok(Loaded { imagefile: parsed.imagefile.map(str::to_owned) }),
         Err(_) => Err(LoadError::Scene(errors)),
     }
 }
@@ -68,10 +66,7 @@ pub fn load_file(path: &Path, scene: &mut HostScene) -> Result<Loaded, LoadError
 }
 
 /// Renders a loaded scene into a new image (`size` overrides RASTER).
-pub fn render(
-    scene: &HostScene,
-    size: Option<(u32, u32)>,
-) -> Result<(RgbImage, Stats), CameraError> {
+pub fn render(scene: &HostScene, size: Option<(u32, u32)>) -> Result<(RgbImage, Stats), CameraError> {
     render_with_progress(scene, size, |_| {})
 }
 
@@ -83,7 +78,7 @@ pub fn render_with_progress(
 ) -> Result<(RgbImage, Stats), CameraError> {
     let view = scene.view();
     let [w, h] = size.map_or(view.settings.raster, |(w, h)| [w, h]);
-    let renderer = Renderer::with_size(view, &Naive, w, h)?;
+    let mut renderer = Renderer::with_size(view, &Naive, w, h)?;
     let mut image = RgbImage::new(w, h);
     let mut stats = Stats::default();
     for y in 0..h {

@@ -16,15 +16,7 @@ pub fn scenes() -> Vec<(String, PathBuf)> {
         .expect("scenes/ exists")
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "txt"))
-        .map(|p| {
-            (
-                p.file_stem()
-                    .unwrap_or_default()
-                    .to_string_lossy()
-                    .into_owned(),
-                p,
-            )
-        })
+        .map(|p| (p.file_stem().unwrap_or_default().to_string_lossy().into_owned(), p))
         .collect();
     v.sort();
     v

@@ -20,17 +20,9 @@ fn run_bytes(scene: &[u8]) -> Run {
     std::fs::write(&path, scene).unwrap();
     let out = dir.path().join("out.png");
     let mut stderr = Vec::new();
-    let code = host_sim::run(
-        ["host-sim".as_ref(), path.as_os_str(), out.as_os_str()],
-        &mut std::io::sink(),
-        &mut stderr,
-    );
-    Run {
-        code,
-        stderr: String::from_utf8_lossy(&stderr).into_owned(),
-        out,
-        _dir: dir,
-    }
+    let code =
+        host_sim::run(["host-sim".as_ref(), path.as_os_str(), out.as_os_str()], &mut std::io::sink(), &mut stderr);
+    Run { code, stderr: String::from_utf8_lossy(&stderr).into_owned(), out, _dir: dir }
 }
 
 fn no_files_but_the_scene(dir: &Path) -> bool {
@@ -49,156 +41,69 @@ fn rejected_bytes(scene: &[u8], at: &str, message: &str) {
     let want = format!("scene.txt:{at}: {message}");
     assert!(r.stderr.contains(&want), "want {want:?} in:\n{}", r.stderr);
     assert!(!r.out.exists(), "an output file was written");
-    assert!(
-        no_files_but_the_scene(r._dir.path()),
-        "a temporary file was left behind"
-    );
+    assert!(no_files_but_the_scene(r._dir.path()), "a temporary file was left behind");
 }
 
 #[test]
 fn unknown_keyword() {
-    rejected(
-        "SPHERE 1 1 0 0 0\nCUBE 1 2",
-        "2:1",
-        "unknown keyword `CUBE`",
-    );
+    rejected("SPHERE 1 1 0 0 0\nCUBE 1 2", "2:1", "unknown keyword `CUBE`");
 }
 
 #[test]
 fn missing_and_malformed_numbers() {
-    rejected(
-        "LIGHT 1 0 0",
-        "1:12",
-        "expected a number for LIGHT z, found the end of the file",
-    );
-    rejected(
-        "GAMMA nan",
-        "1:7",
-        "expected a number for GAMMA value, found `nan`",
-    );
-    rejected(
-        "GAMMA inf",
-        "1:7",
-        "expected a number for GAMMA value, found `inf`",
-    );
-    rejected(
-        "GAMMA 0x10",
-        "1:7",
-        "expected a number for GAMMA value, found `0x10`",
-    );
-    rejected(
-        "VIEWPOINT 1 2 three",
-        "1:15",
-        "expected a number for VIEWPOINT z, found `three`",
-    );
+    rejected("LIGHT 1 0 0", "1:12", "expected a number for LIGHT z, found the end of the file");
+    rejected("GAMMA nan", "1:7", "expected a number for GAMMA value, found `nan`");
+    rejected("GAMMA inf", "1:7", "expected a number for GAMMA value, found `inf`");
+    rejected("GAMMA 0x10", "1:7", "expected a number for GAMMA value, found `0x10`");
+    rejected("VIEWPOINT 1 2 three", "1:15", "expected a number for VIEWPOINT z, found `three`");
 }
 
 #[test]
 fn non_integer_where_an_integer_is_required() {
-    rejected(
-        "RDEPTH 2.5",
-        "1:8",
-        "expected an integer for RDEPTH depth, found `2.5`",
-    );
-    rejected(
-        "RASTER 64 4e1",
-        "1:11",
-        "expected an integer for RASTER height, found `4e1`",
-    );
+    rejected("RDEPTH 2.5", "1:8", "expected an integer for RDEPTH depth, found `2.5`");
+    rejected("RASTER 64 4e1", "1:11", "expected an integer for RASTER height, found `4e1`");
 }
 
 #[test]
 fn values_out_of_range() {
-    rejected(
-        &format!("{SURF}SPHERE 1 -1 0 0 0"),
-        "2:10",
-        "SPHERE radius must be > 0, found -1",
-    );
-    rejected(
-        "VIEWPOINT 0 0 2e6",
-        "1:15",
-        "VIEWPOINT z must be at most 1e6 in magnitude, found 2e6",
-    );
-    rejected(
-        "SAMPLES 0",
-        "1:9",
-        "SAMPLES count must be an integer from 1 to 16, found 0",
-    );
-    rejected(
-        "BACKGROUND 0 0 -0.1",
-        "1:16",
-        "BACKGROUND blue must be between 0 and 1, found -0.1",
-    );
+    rejected(&format!("{SURF}SPHERE 1 -1 0 0 0"), "2:10", "SPHERE radius must be > 0, found -1");
+    rejected("VIEWPOINT 0 0 2e6", "1:15", "VIEWPOINT z must be at most 1e6 in magnitude, found 2e6");
+    rejected("SAMPLES 0", "1:9", "SAMPLES count must be an integer from 1 to 16, found 0");
+    rejected("BACKGROUND 0 0 -0.1", "1:16", "BACKGROUND blue must be between 0 and 1, found -0.1");
 }
 
 #[test]
 fn repeated_parameter_names_both_lines() {
-    rejected(
-        "RASTER 10 10\n\nRASTER 20 20",
-        "3:1",
-        "RASTER is given twice (first on line 1)",
-    );
+    rejected("RASTER 10 10\n\nRASTER 20 20", "3:1", "RASTER is given twice (first on line 1)");
 }
 
 #[test]
 fn undefined_and_repeated_surfaces() {
-    rejected(
-        "SPHERE 4 1 0 0 0",
-        "1:1",
-        "SPHERE uses surface 4, which is never defined",
-    );
-    rejected(
-        &format!("{SURF}\n{SURF}"),
-        "3:1",
-        "SURFACE 1 is defined twice (first on line 1)",
-    );
+    rejected("SPHERE 4 1 0 0 0", "1:1", "SPHERE uses surface 4, which is never defined");
+    rejected(&format!("{SURF}\n{SURF}"), "3:1", "SURFACE 1 is defined twice (first on line 1)");
 }
 
 #[test]
 fn degenerate_and_non_planar_shapes() {
-    rejected(
-        &format!("{SURF}TRIANGLE 1 0 0 0 1 1 1 3 3 3"),
-        "2:1",
-        "TRIANGLE is degenerate",
-    );
-    rejected(
-        &format!("{SURF}RECTANGLE 1 0 0 0 1 0 0 1 1 1 0 1 0"),
-        "2:1",
-        "RECTANGLE is not planar",
-    );
-    rejected(
-        &format!("{SURF}RECTANGLE 1 0 0 0 1 1 0 1 0 0 0 1 0"),
-        "2:1",
-        "RECTANGLE is not convex",
-    );
+    rejected(&format!("{SURF}TRIANGLE 1 0 0 0 1 1 1 3 3 3"), "2:1", "TRIANGLE is degenerate");
+    rejected(&format!("{SURF}RECTANGLE 1 0 0 0 1 0 0 1 1 1 0 1 0"), "2:1", "RECTANGLE is not planar");
+    rejected(&format!("{SURF}RECTANGLE 1 0 0 0 1 1 0 1 0 0 0 1 0"), "2:1", "RECTANGLE is not convex");
 }
 
 #[test]
 fn bad_cameras() {
     rejected("ORIGIN 0 0 10", "1:1", "VIEWPOINT equals ORIGIN");
-    rejected(
-        "VIEWPOINT 0 5 0\nUPVECTOR 0 -2 0",
-        "2:1",
-        "UPVECTOR is zero or parallel to the view direction",
-    );
+    rejected("VIEWPOINT 0 5 0\nUPVECTOR 0 -2 0", "2:1", "UPVECTOR is zero or parallel to the view direction");
 }
 
 #[test]
 fn unterminated_comment_names_its_opening() {
-    rejected(
-        "RDEPTH 1\n  /* a comment\n that never ends",
-        "2:3",
-        "unterminated comment",
-    );
+    rejected("RDEPTH 1\n  /* a comment\n that never ends", "2:3", "unterminated comment");
 }
 
 #[test]
 fn invalid_utf8() {
-    rejected_bytes(
-        b"RDEPTH 1\nIMAGEFILE caf\xe9.png",
-        "2:14",
-        "the file is not valid UTF-8",
-    );
+    rejected_bytes(b"RDEPTH 1\nIMAGEFILE caf\xe9.png", "2:14", "the file is not valid UTF-8");
 }
 
 #[test]
@@ -216,12 +121,7 @@ fn capacity_names_the_limit_and_how_to_raise_it() {
 fn several_errors_are_all_reported() {
     let r = run_bytes(b"RDEPTH x\nGAMMA -1\nFOO\n");
     assert_eq!(r.code, 2);
-    for want in [
-        "scene.txt:1:8:",
-        "scene.txt:2:7:",
-        "scene.txt:3:1:",
-        "3 error(s)",
-    ] {
+    for want in ["scene.txt:1:8:", "scene.txt:2:7:", "scene.txt:3:1:", "3 error(s)"] {
         assert!(r.stderr.contains(want), "{want:?} in {}", r.stderr);
     }
 }
@@ -230,10 +130,7 @@ fn several_errors_are_all_reported() {
 fn a_valid_scene_renders() {
     let r = run_bytes(format!("RASTER 8 6 {SURF} SPHERE 1 1 0 0 0 LIGHT 10 0 0 10").as_bytes());
     assert_eq!(r.code, 0, "{}", r.stderr);
-    let img = host_sim::RgbImage::read_png(std::io::BufReader::new(
-        std::fs::File::open(&r.out).unwrap(),
-    ))
-    .unwrap();
+    let img = host_sim::RgbImage::read_png(std::io::BufReader::new(std::fs::File::open(&r.out).unwrap())).unwrap();
     assert_eq!((img.width, img.height), (8, 6));
 }
 
@@ -250,10 +147,7 @@ fn run_args(args: &[&std::ffi::OsStr]) -> (i32, String) {
 #[test]
 fn missing_scene_file_is_an_io_error() {
     let dir = tempfile::tempdir().unwrap();
-    let (code, err) = run_args(&[
-        dir.path().join("nope.txt").as_os_str(),
-        dir.path().join("o.png").as_os_str(),
-    ]);
+    let (code, err) = run_args(&[dir.path().join("nope.txt").as_os_str(), dir.path().join("o.png").as_os_str()]);
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("cannot read"), "{err}");
 }
@@ -286,11 +180,7 @@ fn imagefile_is_the_default_output_and_no_output_is_an_error() {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("s.txt");
     let out = dir.path().join("from-imagefile.png");
-    std::fs::write(
-        &scene,
-        format!("RASTER 4 4 IMAGEFILE \"{}\" {SURF}", out.display()),
-    )
-    .unwrap();
+    std::fs::write(&scene, format!("RASTER 4 4 IMAGEFILE \"{}\" {SURF}", out.display())).unwrap();
     let (code, err) = run_args(&[scene.as_os_str()]);
     assert_eq!(code, 0, "{err}");
     assert!(out.exists());

@@ -21,28 +21,17 @@ fn every_scene_matches_its_golden_image() {
         let golden = gallery.join(format!("{name}.png"));
         if blessing() {
             std::fs::create_dir_all(&gallery).unwrap();
-            image
-                .write_png(std::fs::File::create(&golden).unwrap())
-                .unwrap();
+            image.write_png(std::fs::File::create(&golden).unwrap()).unwrap();
             println!("blessed {}", golden.display());
             continue;
         }
-        let expected = std::fs::read(&golden)
-            .map_err(|e| e.to_string())
-            .and_then(|b| RgbImage::read_png(std::io::Cursor::new(b)));
+        let expected =
+            std::fs::read(&golden).map_err(|e| e.to_string()).and_then(|b| RgbImage::read_png(std::io::Cursor::new(b)));
         match expected {
             Err(e) => failures.push(format!("{name}: cannot read {}: {e}", golden.display())),
             Ok(expected) if expected != image => {
-                let differing = expected
-                    .data
-                    .chunks(3)
-                    .zip(image.data.chunks(3))
-                    .filter(|(a, b)| a != b)
-                    .count();
-                failures.push(format!(
-                    "{name}: {differing} pixels differ from {}",
-                    golden.display()
-                ));
+                let differing = expected.data.chunks(3).zip(image.data.chunks(3)).filter(|(a, b)| a != b).count();
+                failures.push(format!("{name}: {differing} pixels differ from {}", golden.display()));
             }
             Ok(_) => println!("{name}: identical"),
         }

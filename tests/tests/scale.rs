@@ -62,23 +62,13 @@ fn tiny_and_huge_scenes_render_like_unit_scale() {
         let mut off = 0;
         let mut worst = 0;
         for (a, b) in unit.data.chunks(3).zip(other.data.chunks(3)) {
-            let d = a
-                .iter()
-                .zip(b)
-                .map(|(x, y)| x.abs_diff(*y))
-                .max()
-                .unwrap_or(0);
+            let d = a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).max().unwrap_or(0);
             worst = worst.max(d);
             if d > 2 {
                 off += 1;
             }
         }
-        println!(
-            "scale {s:e}: {off} of {pixels} pixels differ by more than 2 levels, worst {worst}"
-        );
-        assert!(
-            off * 200 <= pixels,
-            "scale {s:e}: {off} pixels of {pixels} differ by more than 2 levels"
-        );
+        println!("scale {s:e}: {off} of {pixels} pixels differ by more than 2 levels, worst {worst}");
+        assert!(off * 200 <= pixels, "scale {s:e}: {off} pixels of {pixels} differ by more than 2 levels");
     }
 }

@@ -1,7 +1,8 @@
 //! The naive mode: every object tested for every ray, as the thesis's first
 //! version did. It is the reference the other modes must match bit for bit.
+//! Each object is tested once by construction, so it needs no mailbox.
 
-use super::{Accelerator, Hit, RayStart};
+use super::{Accelerator, Hit, Mailbox, RayStart};
 use crate::math::Scalar;
 use crate::scene::{ObjectId, SceneView};
 use crate::shapes::Ray;
@@ -11,7 +12,7 @@ use crate::shapes::Ray;
 pub struct Naive;
 
 impl Accelerator for Naive {
-    fn nearest(&self, scene: &SceneView<'_>, ray: &Ray, start: Option<RayStart>) -> Option<Hit> {
+    fn nearest(&self, scene: &SceneView<'_>, ray: &Ray, start: Option<RayStart>, _: &mut Mailbox<'_>) -> Option<Hit> {
         let mut best: Option<Hit> = None;
         let mut t_max = Scalar::MAX;
         for (i, &handle) in scene.objects.iter().enumerate() {
@@ -34,13 +35,11 @@ impl Accelerator for Naive {
         ray: &Ray,
         t_max: Scalar,
         start: Option<RayStart>,
+        _: &mut Mailbox<'_>,
     ) -> bool {
         scene.objects.iter().enumerate().any(|(i, &handle)| {
             let leaving = RayStart::leaving(start, ObjectId(i as u32));
-            scene
-                .shape_of(handle)
-                .intersect(ray, t_max, leaving)
-                .is_some()
+            scene.shape_of(handle).intersect(ray, t_max, leaving).is_some()
         })
     }
 }

@@ -176,10 +176,7 @@ mod tests {
         for raw in [1u64, 3, 1000, 65_535, 65_536, 99_999, 1 << 40] {
             let back = exp2_q32(log2_q32(raw, 16)) as i128; // Q32
             let want = (raw as i128) << 16;
-            assert!(
-                (back - want).abs() * 100_000 <= want + 100_000,
-                "{raw}: {back} vs {want}"
-            );
+            assert!((back - want).abs() * 100_000 <= want + 100_000, "{raw}: {back} vs {want}");
         }
     }
 

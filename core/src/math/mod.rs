@@ -63,19 +63,7 @@ mod tests {
 
     #[test]
     fn isqrt_is_floor() {
-        for n in [
-            0u64,
-            1,
-            2,
-            3,
-            4,
-            15,
-            16,
-            17,
-            u64::MAX,
-            (1 << 62) - 1,
-            1 << 62,
-        ] {
+        for n in [0u64, 1, 2, 3, 4, 15, 16, 17, u64::MAX, (1 << 62) - 1, 1 << 62] {
             let r = isqrt(n);
             assert!(r * r <= n);
             assert!((r + 1).checked_mul(r + 1).is_none_or(|s| s > n));

@@ -29,11 +29,7 @@ impl Vec3 {
 
     #[inline]
     pub const fn from_bits(b: [i32; 3]) -> Self {
-        Vec3 {
-            x: Scalar::from_bits(b[0]),
-            y: Scalar::from_bits(b[1]),
-            z: Scalar::from_bits(b[2]),
-        }
+        Vec3 { x: Scalar::from_bits(b[0]), y: Scalar::from_bits(b[1]), z: Scalar::from_bits(b[2]) }
     }
 
     #[inline]
@@ -95,11 +91,7 @@ impl Add for Vec3 {
     type Output = Vec3;
     #[inline]
     fn add(self, o: Vec3) -> Vec3 {
-        Vec3 {
-            x: self.x + o.x,
-            y: self.y + o.y,
-            z: self.z + o.z,
-        }
+        Vec3 { x: self.x + o.x, y: self.y + o.y, z: self.z + o.z }
     }
 }
 
@@ -107,11 +99,7 @@ impl Sub for Vec3 {
     type Output = Vec3;
     #[inline]
     fn sub(self, o: Vec3) -> Vec3 {
-        Vec3 {
-            x: self.x - o.x,
-            y: self.y - o.y,
-            z: self.z - o.z,
-        }
+        Vec3 { x: self.x - o.x, y: self.y - o.y, z: self.z - o.z }
     }
 }
 
@@ -119,11 +107,7 @@ impl Neg for Vec3 {
     type Output = Vec3;
     #[inline]
     fn neg(self) -> Vec3 {
-        Vec3 {
-            x: -self.x,
-            y: -self.y,
-            z: -self.z,
-        }
+        Vec3 { x: -self.x, y: -self.y, z: -self.z }
     }
 }
 
@@ -134,11 +118,7 @@ impl Dir {
 
     #[inline]
     pub const fn from_bits(b: [i32; 3]) -> Self {
-        Dir {
-            x: Unit::from_bits(b[0]),
-            y: Unit::from_bits(b[1]),
-            z: Unit::from_bits(b[2]),
-        }
+        Dir { x: Unit::from_bits(b[0]), y: Unit::from_bits(b[1]), z: Unit::from_bits(b[2]) }
     }
 
     #[inline]
@@ -189,11 +169,7 @@ impl Dir {
     pub fn scale(self, t: Scalar) -> Vec3 {
         let t = t.to_bits() as i64;
         let d = self.wide();
-        Vec3::from_bits([
-            ((d[0] * t) >> 30) as i32,
-            ((d[1] * t) >> 30) as i32,
-            ((d[2] * t) >> 30) as i32,
-        ])
+        Vec3::from_bits([((d[0] * t) >> 30) as i32, ((d[1] * t) >> 30) as i32, ((d[2] * t) >> 30) as i32])
     }
 
     /// The unit vector along the integer vector `v` (any common scale), or
@@ -227,11 +203,7 @@ impl Dir {
     pub fn cross(self, o: Dir) -> Option<Dir> {
         let a = self.wide();
         let b = o.wide();
-        Dir::normalize([
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ])
+        Dir::normalize([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
     }
 
     /// The mirror image of `self` about the unit normal `n`: `2(n·self)n − self`.
@@ -241,9 +213,7 @@ impl Dir {
         let d = self.dot_q60(n) >> 29; // 2(n·self) in Q2.30
         let nb = n.wide();
         let s = self.wide();
-        Dir::from_bits(
-            [0, 1, 2].map(|i| (((d * nb[i]) >> 30) - s[i]).clamp(-UNIT_ONE, UNIT_ONE) as i32),
-        )
+        Dir::from_bits([0, 1, 2].map(|i| (((d * nb[i]) >> 30) - s[i]).clamp(-UNIT_ONE, UNIT_ONE) as i32))
     }
 }
 
@@ -297,10 +267,7 @@ mod tests {
         let r = (-d).reflect_about(Dir::Y);
         let b = r.bits();
         let e = d.bits();
-        assert!(
-            (b[0] - e[0]).abs() <= 1 && (b[1] + e[1]).abs() <= 1,
-            "{r:?}"
-        );
+        assert!((b[0] - e[0]).abs() <= 1 && (b[1] + e[1]).abs() <= 1, "{r:?}");
     }
 
     #[test]

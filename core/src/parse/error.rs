@@ -173,7 +173,9 @@ impl fmt::Display for ErrorKind<'_> {
                 write!(f, "{keyword} uses surface {number}, which is never defined")
             }
             ErrorKind::Degenerate { keyword, why } => write!(f, "{keyword} is degenerate: {why}"),
-            ErrorKind::NotPlanar => f.write_str("RECTANGLE is not planar: its fourth corner is off the plane of the other three"),
+            ErrorKind::NotPlanar => {
+                f.write_str("RECTANGLE is not planar: its fourth corner is off the plane of the other three")
+            }
             ErrorKind::NotConvex => f.write_str(
                 "RECTANGLE is not convex: its corners must turn the same way (counter-clockwise seen from the front)",
             ),
@@ -183,7 +185,9 @@ impl fmt::Display for ErrorKind<'_> {
                  (below 2^-16 of its size after scaling to the fixed-point range)"
             ),
             ErrorKind::EyeAtOrigin => f.write_str("VIEWPOINT equals ORIGIN: there is no view direction"),
-            ErrorKind::UpParallel => f.write_str("UPVECTOR is zero or parallel to the view direction (ORIGIN − VIEWPOINT)"),
+            ErrorKind::UpParallel => {
+                f.write_str("UPVECTOR is zero or parallel to the view direction (ORIGIN − VIEWPOINT)")
+            }
             ErrorKind::Capacity(c) => write!(
                 f,
                 "the scene needs more {} than this build holds ({}, capacity profile {}); \

@@ -23,11 +23,7 @@ pub struct Lexer<'a> {
 
 impl<'a> Lexer<'a> {
     pub fn new(src: &'a str) -> Lexer<'a> {
-        Lexer {
-            src,
-            offset: 0,
-            pos: Pos { line: 1, column: 1 },
-        }
+        Lexer { src, offset: 0, pos: Pos { line: 1, column: 1 } }
     }
 
     /// Where the lexer stands: after the last token, or the end of the text.
@@ -97,11 +93,7 @@ impl<'a> Lexer<'a> {
                 loop {
                     match self.bump() {
                         Some('"') => {
-                            return Ok(Some(Token {
-                                text: &self.src[inner..self.offset - 1],
-                                pos,
-                                quoted: true,
-                            }))
+                            return Ok(Some(Token { text: &self.src[inner..self.offset - 1], pos, quoted: true }))
                         }
                         Some(_) => {}
                         None => return Err(ParseError::new(pos, ErrorKind::UnterminatedString)),
@@ -112,21 +104,13 @@ impl<'a> Lexer<'a> {
                 loop {
                     let rest = self.rest();
                     match rest.chars().next() {
-                        Some(c)
-                            if !c.is_whitespace()
-                                && !rest.starts_with("/*")
-                                && !rest.starts_with("//") =>
-                        {
+                        Some(c) if !c.is_whitespace() && !rest.starts_with("/*") && !rest.starts_with("//") => {
                             self.bump();
                         }
                         _ => break,
                     }
                 }
-                Ok(Some(Token {
-                    text: &self.src[start..self.offset],
-                    pos,
-                    quoted: false,
-                }))
+                Ok(Some(Token { text: &self.src[start..self.offset], pos, quoted: false }))
             }
         }
     }
@@ -148,25 +132,13 @@ mod tests {
     #[test]
     fn tokens_carry_line_and_column() {
         let t = tokens("LIGHT 1.0\n  2 3 4\n");
-        assert_eq!(
-            &t[..],
-            &[
-                ("LIGHT", 1, 1),
-                ("1.0", 1, 7),
-                ("2", 2, 3),
-                ("3", 2, 5),
-                ("4", 2, 7)
-            ]
-        );
+        assert_eq!(&t[..], &[("LIGHT", 1, 1), ("1.0", 1, 7), ("2", 2, 3), ("3", 2, 5), ("4", 2, 7)]);
     }
 
     #[test]
     fn comments_of_both_kinds_end_tokens() {
         let t = tokens("A/*x\ny*/B // c\n C//d\nD");
-        assert_eq!(
-            &t[..],
-            &[("A", 1, 1), ("B", 2, 4), ("C", 3, 2), ("D", 4, 1)]
-        );
+        assert_eq!(&t[..], &[("A", 1, 1), ("B", 2, 4), ("C", 3, 2), ("D", 4, 1)]);
     }
 
     #[test]
@@ -197,9 +169,6 @@ mod tests {
     #[test]
     fn unterminated_string() {
         let mut lx = Lexer::new("\"abc");
-        assert_eq!(
-            lx.next_token().unwrap_err().kind,
-            ErrorKind::UnterminatedString
-        );
+        assert_eq!(lx.next_token().unwrap_err().kind, ErrorKind::UnterminatedString);
     }
 }

@@ -26,9 +26,7 @@ pub use number::{parse_integer, Decimal};
 pub use statement::{keyword, Statement, KEYWORDS};
 
 use crate::capacity::Capacities;
-use crate::scene::{
-    Camera, CameraError, CapacityError, Light, Normalization, Scene, SurfaceEntry, WorldPoint,
-};
+use crate::scene::{Camera, CameraError, CapacityError, Light, Normalization, Scene, SurfaceEntry, WorldPoint};
 use crate::shapes::{AxisAlignedBox, Rectangle, Sphere, Superquadric, Triangle};
 use statement::Cursor;
 
@@ -41,10 +39,7 @@ pub struct Parsed<'a> {
 
 /// Reads every statement of `text`, handing each (or its error) to `each`;
 /// skips to the next keyword after an error.
-fn for_each_statement<'a>(
-    text: &'a str,
-    mut each: impl FnMut(Pos, Result<Statement<'a>, ParseError<'a>>),
-) {
+fn for_each_statement<'a>(text: &'a str, mut each: impl FnMut(Pos, Result<Statement<'a>, ParseError<'a>>)) {
     let mut cur = Cursor::new(text);
     loop {
         let token = match cur.next() {
@@ -57,10 +52,7 @@ fn for_each_statement<'a>(
         };
         let result = match keyword(token.text).filter(|_| !token.quoted) {
             Some(kw) => statement::statement(&mut cur, kw, token.pos),
-            None => Err(ParseError::new(
-                token.pos,
-                ErrorKind::UnknownKeyword(token.text),
-            )),
+            None => Err(ParseError::new(token.pos, ErrorKind::UnknownKeyword(token.text))),
         };
         let failed = result.is_err();
         each(token.pos, result);
@@ -71,10 +63,7 @@ fn for_each_statement<'a>(
             let mut first = true;
             loop {
                 match cur.peek() {
-                    Ok(Some(t))
-                        if (first && keyword(t.text).is_none())
-                            || Decimal::parse(t.text).is_some() =>
-                    {
+                    Ok(Some(t)) if (first && keyword(t.text).is_none()) || Decimal::parse(t.text).is_some() => {
                         let _ = cur.next();
                     }
                     Ok(_) => break,
@@ -99,13 +88,9 @@ pub fn parse_bytes<'a, C: Capacities>(
             let line = 1 + good.iter().filter(|&&b| b == b'\n').count() as u32;
             let line_start = good.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
             // The valid prefix is UTF-8: count its characters on this line.
-            let column = 1 + core::str::from_utf8(&good[line_start..])
-                .map_or(0, |s| s.chars().count()) as u32;
+            let column = 1 + core::str::from_utf8(&good[line_start..]).map_or(0, |s| s.chars().count()) as u32;
             scene.clear();
-            on_error(ParseError::new(
-                Pos { line, column },
-                ErrorKind::InvalidUtf8,
-            ));
+            on_error(ParseError::new(Pos { line, column }, ErrorKind::InvalidUtf8));
             Err(1)
         }
     }
@@ -171,12 +156,7 @@ fn survey<C: Capacities>(text: &str, scene: &mut Scene<C>) {
         Ok(Statement::Light { position, .. }) => add(position, position),
         Ok(Statement::Surface { number, surface }) => {
             // A full arena is reported by the build pass.
-            let _ = scene.push_surface(SurfaceEntry {
-                number,
-                line: pos.line,
-                column: pos.column,
-                surface,
-            });
+            let _ = scene.push_surface(SurfaceEntry { number, line: pos.line, column: pos.column, surface });
         }
         Ok(s) => {
             if let Some((lo, hi)) = s.object_bounds() {
@@ -247,13 +227,7 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
     fn once(&mut self, keyword: &'static str, pos: Pos) -> bool {
         let i = PARAMETERS.iter().position(|&k| k == keyword).unwrap_or(0);
         if let Some(first) = self.first[i] {
-            self.report(ParseError::new(
-                pos,
-                ErrorKind::Repeated {
-                    keyword,
-                    first_line: first.line,
-                },
-            ));
+            self.report(ParseError::new(pos, ErrorKind::Repeated { keyword, first_line: first.line }));
             return false;
         }
         self.first[i] = Some(pos);
@@ -264,10 +238,7 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
     fn surface(&mut self, keyword: &'static str, number: u32, pos: Pos) -> Option<u16> {
         let found = self.scene.view().surface_index(number);
         if found.is_none() && self.reported_capacity & 64 == 0 {
-            self.report(ParseError::new(
-                pos,
-                ErrorKind::UndefinedSurface { keyword, number },
-            ));
+            self.report(ParseError::new(pos, ErrorKind::UndefinedSurface { keyword, number }));
         }
         found
     }
@@ -331,48 +302,26 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
                     self.scene.settings.samples = n;
                 }
             }
-            Statement::Light {
-                brightness,
-                position,
-            } => {
-                let light = Light {
-                    position: norm.point(position),
-                    brightness,
-                };
+            Statement::Light { brightness, position } => {
+                let light = Light { position: norm.point(position), brightness };
                 if let Err(e) = self.scene.push_light(light) {
                     self.capacity(pos, e);
                 }
             }
             Statement::Surface { number, .. } => {
                 let view = self.scene.view();
-                match view
-                    .surface_index(number)
-                    .map(|i| view.surfaces[i as usize])
-                {
-                    Some(first) if (first.line, first.column) != (pos.line, pos.column) => self
-                        .report(ParseError::new(
-                            pos,
-                            ErrorKind::SurfaceRepeated {
-                                number,
-                                first_line: first.line,
-                            },
-                        )),
+                match view.surface_index(number).map(|i| view.surfaces[i as usize]) {
+                    Some(first) if (first.line, first.column) != (pos.line, pos.column) => {
+                        self.report(ParseError::new(pos, ErrorKind::SurfaceRepeated { number, first_line: first.line }))
+                    }
                     Some(_) => {}
                     None => self.capacity(
                         pos,
-                        CapacityError {
-                            what: "surfaces",
-                            capacity: Scene::<C>::surface_capacity(),
-                            profile: C::NAME,
-                        },
+                        CapacityError { what: "surfaces", capacity: Scene::<C>::surface_capacity(), profile: C::NAME },
                     ),
                 }
             }
-            Statement::Sphere {
-                surface,
-                radius,
-                center,
-            } => {
+            Statement::Sphere { surface, radius, center } => {
                 let Some(surface) = self.surface("SPHERE", surface, pos) else {
                     return;
                 };
@@ -380,18 +329,12 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
                 if radius.to_bits() <= 0 {
                     return self.report(too_small("SPHERE"));
                 }
-                let r = self
-                    .scene
-                    .push_sphere(Sphere::new(norm.point(center), radius, surface));
+                let r = self.scene.push_sphere(Sphere::new(norm.point(center), radius, surface));
                 if let Err(e) = r {
                     self.capacity(pos, e);
                 }
             }
-            Statement::Box {
-                surface,
-                center,
-                half,
-            } => {
+            Statement::Box { surface, center, half } => {
                 let Some(surface) = self.surface("BOX", surface, pos) else {
                     return;
                 };
@@ -405,25 +348,16 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
                     self.capacity(pos, e);
                 }
             }
-            Statement::Superquadric {
-                surface,
-                power,
-                center,
-                half,
-            } => {
+            Statement::Superquadric { surface, power, center, half } => {
                 let Some(surface) = self.surface("SUPERQUADRIC", surface, pos) else {
                     return;
                 };
-                let half = crate::math::Vec3 {
-                    x: norm.length(half[0]),
-                    y: norm.length(half[1]),
-                    z: norm.length(half[2]),
-                };
+                let half =
+                    crate::math::Vec3 { x: norm.length(half[0]), y: norm.length(half[1]), z: norm.length(half[2]) };
                 if half.bits().iter().any(|&h| h <= 0) {
                     return self.report(too_small("SUPERQUADRIC"));
                 }
-                let power =
-                    crate::math::Scalar::from_bits(statement::q32_to_q16(power.to_bits()) as i32);
+                let power = crate::math::Scalar::from_bits(statement::q32_to_q16(power.to_bits()) as i32);
                 let q = Superquadric::new(norm.point(center), half, power, surface);
                 if let Err(e) = self.scene.push_superquadric(q) {
                     self.capacity(pos, e);
@@ -461,9 +395,7 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
         let view_pos = at(0).max(at(1)).unwrap_or(start);
         match Camera::check(&self.scene.settings.view) {
             Ok(()) => {}
-            Err(CameraError::EyeAtOrigin) => {
-                self.report(ParseError::new(view_pos, ErrorKind::EyeAtOrigin))
-            }
+            Err(CameraError::EyeAtOrigin) => self.report(ParseError::new(view_pos, ErrorKind::EyeAtOrigin)),
             Err(CameraError::UpParallel) => {
                 let pos = at(2).unwrap_or(view_pos);
                 self.report(ParseError::new(pos, ErrorKind::UpParallel))
@@ -485,13 +417,7 @@ mod tests {
 
     type TestScene = Scene<Board64K>;
 
-    fn load(
-        text: &str,
-    ) -> (
-        std::boxed::Box<TestScene>,
-        Result<Parsed<'_>, usize>,
-        Vec<String>,
-    ) {
+    fn load(text: &str) -> (std::boxed::Box<TestScene>, Result<Parsed<'_>, usize>, Vec<String>) {
         let mut scene = std::boxed::Box::new(TestScene::new());
         let mut errors = Vec::new();
         let r = parse(text, &mut scene, &mut |e| errors.push(e.to_string()));
@@ -570,13 +496,7 @@ mod tests {
         let kinds: Vec<ShapeKind> = v.objects.iter().map(|h| h.kind()).collect();
         assert_eq!(
             kinds,
-            [
-                ShapeKind::Sphere,
-                ShapeKind::Box,
-                ShapeKind::Superquadric,
-                ShapeKind::Triangle,
-                ShapeKind::Rectangle
-            ]
+            [ShapeKind::Sphere, ShapeKind::Box, ShapeKind::Superquadric, ShapeKind::Triangle, ShapeKind::Rectangle]
         );
         let surf = v.surface(v.spheres[0].surface);
         assert_eq!(surf.transparency, Scalar::from_num(0.3));
@@ -586,14 +506,8 @@ mod tests {
 
     #[test]
     fn the_scene_is_normalised_into_range_at_any_scale() {
-        for (scale, ten) in [
-            ("0.001", "0.01"),
-            ("1", "10"),
-            ("1000", "10000"),
-            ("100000", "1000000"),
-        ] {
-            let text =
-                format!("VIEWPOINT 0 0 {ten} SPHERE 1 {scale} 0 0 0 LIGHT 1 {ten} {ten} 0 {SURF}");
+        for (scale, ten) in [("0.001", "0.01"), ("1", "10"), ("1000", "10000"), ("100000", "1000000")] {
+            let text = format!("VIEWPOINT 0 0 {ten} SPHERE 1 {scale} 0 0 0 LIGHT 1 {ten} {ten} 0 {SURF}");
             let s = ok(&text);
             let v = s.view();
             assert!(crate::scene::Normalization::in_range(v.spheres[0].center));
@@ -602,10 +516,7 @@ mod tests {
             // fractions such as 0.001 round in Q32.32 when read).
             let r = v.spheres[0].radius.to_bits() as i64;
             let lx = (v.lights[0].position - v.spheres[0].center).x.to_bits() as i64;
-            assert!(
-                (lx - 10 * r).abs() * 1_000_000 <= lx,
-                "{scale}: {lx} vs {r}"
-            );
+            assert!((lx - 10 * r).abs() * 1_000_000 <= lx, "{scale}: {lx} vs {r}");
             assert!(r > 1 << 24, "{scale}: radius keeps precision ({r})");
         }
     }
@@ -617,37 +528,16 @@ mod tests {
 
     #[test]
     fn lexical_and_number_errors() {
-        check(
-            "SPHERE 1 nan 0 0 0",
-            "1:10: expected a number for SPHERE radius, found `nan`",
-        );
-        check(
-            "SPHERE 1 1 inf 0 0",
-            "expected a number for SPHERE x, found `inf`",
-        );
+        check("SPHERE 1 nan 0 0 0", "1:10: expected a number for SPHERE radius, found `nan`");
+        check("SPHERE 1 1 inf 0 0", "expected a number for SPHERE x, found `inf`");
         check("SPHERE 1 1 0x10 0 0", "found `0x10`");
-        check(
-            "SPHERE 1 1 0 0",
-            "1:15: expected a number for SPHERE z, found the end of the file",
-        );
-        check(
-            "RASTER 3.5 2",
-            "expected an integer for RASTER width, found `3.5`",
-        );
-        check(
-            "SPHERE 1.5 1 0 0 0",
-            "expected an integer for SPHERE surface number",
-        );
+        check("SPHERE 1 1 0 0", "1:15: expected a number for SPHERE z, found the end of the file");
+        check("RASTER 3.5 2", "expected an integer for RASTER width, found `3.5`");
+        check("SPHERE 1.5 1 0 0 0", "expected an integer for SPHERE surface number");
         check("\n\n  /* open", "3:3: unterminated comment");
         check("IMAGEFILE \"abc", "unterminated string");
-        check(
-            "SPHERE 1 1e400 0 0 0",
-            "SPHERE radius must be at most 1e6 in magnitude, found 1e400",
-        );
-        check(
-            "VIEWPOINT 1000000.5 0 0",
-            "VIEWPOINT x must be at most 1e6 in magnitude",
-        );
+        check("SPHERE 1 1e400 0 0 0", "SPHERE radius must be at most 1e6 in magnitude, found 1e400");
+        check("VIEWPOINT 1000000.5 0 0", "VIEWPOINT x must be at most 1e6 in magnitude");
         check("SPHER 1 1 0 0 0", "unknown keyword `SPHER`");
     }
 
@@ -656,91 +546,40 @@ mod tests {
         check("SPHERE 1 -1 0 0 0", "SPHERE radius must be > 0, found -1");
         check("SPHERE 1 0 0 0 0", "SPHERE radius must be > 0, found 0");
         check("BOX 1 0 0 0 1 0 1", "BOX ys must be > 0, found 0");
-        check(
-            "SUPERQUADRIC 1 1.5 0 0 0 1 1 1",
-            "SUPERQUADRIC power must be between 2 and 64, found 1.5",
-        );
+        check("SUPERQUADRIC 1 1.5 0 0 0 1 1 1", "SUPERQUADRIC power must be between 2 and 64, found 1.5");
         check("SUPERQUADRIC 1 65 0 0 0 1 1 1", "between 2 and 64");
-        check(
-            "RASTER 0 10",
-            "RASTER width must be an integer from 1 to 16384, found 0",
-        );
-        check(
-            "RASTER 10 16385",
-            "RASTER height must be an integer from 1 to 16384",
-        );
-        check(
-            "SAMPLES 17",
-            "SAMPLES count must be an integer from 1 to 16",
-        );
-        check(
-            "RDEPTH -1",
-            "RDEPTH depth must be an integer from 0 to 1000000",
-        );
+        check("RASTER 0 10", "RASTER width must be an integer from 1 to 16384, found 0");
+        check("RASTER 10 16385", "RASTER height must be an integer from 1 to 16384");
+        check("SAMPLES 17", "SAMPLES count must be an integer from 1 to 16");
+        check("RDEPTH -1", "RDEPTH depth must be an integer from 0 to 1000000");
         check("GAMMA 0", "GAMMA value must be > 0");
         check("ATTENUATION -2", "ATTENUATION d0 must be > 0");
         check("LIGHT -0.5 0 0 0", "LIGHT brightness must be >= 0");
-        check(
-            "BACKGROUND 0 1.5 0",
-            "BACKGROUND green must be between 0 and 1, found 1.5",
-        );
+        check("BACKGROUND 0 1.5 0", "BACKGROUND green must be between 0 and 1, found 1.5");
         check("VIEWPORT 0 1", "VIEWPORT width must be > 0");
-        check(
-            "SURFACE -1 0 0 0 0 0 0 0 0 0 0 0 0",
-            "SURFACE surface number must be an integer from 0 to 1000000",
-        );
-        check(
-            "SURFACE 1 0 0 0 0 0 0 0 0 0 -1 0 0",
-            "SURFACE specular exponent must be >= 0",
-        );
-        check(
-            "SURFACE 1 0 0 0 0 0 0 0 0 0 0 2 0",
-            "SURFACE reflectivity must be between 0 and 1",
-        );
+        check("SURFACE -1 0 0 0 0 0 0 0 0 0 0 0 0", "SURFACE surface number must be an integer from 0 to 1000000");
+        check("SURFACE 1 0 0 0 0 0 0 0 0 0 -1 0 0", "SURFACE specular exponent must be >= 0");
+        check("SURFACE 1 0 0 0 0 0 0 0 0 0 0 2 0", "SURFACE reflectivity must be between 0 and 1");
     }
 
     #[test]
     fn context_errors() {
-        check(
-            "RDEPTH 2\nRDEPTH 3",
-            "2:1: RDEPTH is given twice (first on line 1)",
-        );
-        check(
-            &format!("{SURF}{SURF}"),
-            "2:1: SURFACE 1 is defined twice (first on line 1)",
-        );
+        check("RDEPTH 2\nRDEPTH 3", "2:1: RDEPTH is given twice (first on line 1)");
+        check(&format!("{SURF}{SURF}"), "2:1: SURFACE 1 is defined twice (first on line 1)");
         check(
             "SURFACE 1 0 0 0 0 0 0 0 0 0 0 0 0 SURFACE 1 0 0 0 0 0 0 0 0 0 0 0 0",
             "1:35: SURFACE 1 is defined twice",
         );
-        check(
-            "\nSPHERE 7 1 0 0 0",
-            "2:1: SPHERE uses surface 7, which is never defined",
-        );
+        check("\nSPHERE 7 1 0 0 0", "2:1: SPHERE uses surface 7, which is never defined");
         check(
             &format!("TRIANGLE 1 0 0 0 1 1 1 2 2 2 {SURF}"),
             "1:1: TRIANGLE is degenerate: its corners are collinear",
         );
-        check(
-            &format!("RECTANGLE 1 0 0 0 1 0 0 1 1 0.5 0 1 0 {SURF}"),
-            "RECTANGLE is not planar",
-        );
-        check(
-            &format!("RECTANGLE 1 0 0 0 1 1 0 1 0 0 0 1 0 {SURF}"),
-            "RECTANGLE is not convex",
-        );
-        check(
-            &format!("RECTANGLE 1 0 0 0 0 0 0 0 0 0 0 0 0 {SURF}"),
-            "RECTANGLE is degenerate",
-        );
-        check(
-            "VIEWPOINT 1 2 3 ORIGIN 1 2 3",
-            "1:17: VIEWPOINT equals ORIGIN",
-        );
-        check(
-            "UPVECTOR 0 0 5",
-            "1:1: UPVECTOR is zero or parallel to the view direction",
-        );
+        check(&format!("RECTANGLE 1 0 0 0 1 0 0 1 1 0.5 0 1 0 {SURF}"), "RECTANGLE is not planar");
+        check(&format!("RECTANGLE 1 0 0 0 1 1 0 1 0 0 0 1 0 {SURF}"), "RECTANGLE is not convex");
+        check(&format!("RECTANGLE 1 0 0 0 0 0 0 0 0 0 0 0 0 {SURF}"), "RECTANGLE is degenerate");
+        check("VIEWPOINT 1 2 3 ORIGIN 1 2 3", "1:17: VIEWPOINT equals ORIGIN");
+        check("UPVECTOR 0 0 5", "1:1: UPVECTOR is zero or parallel to the view direction");
         check("UPVECTOR 0 0 0", "UPVECTOR is zero or parallel");
     }
 
@@ -751,14 +590,10 @@ mod tests {
 
     #[test]
     fn all_errors_are_reported_in_order() {
-        let e =
-            errs("SPHERE 1 -1 0 0 0\nFOO 1 2 3\nRASTER 1 1\nRASTER 2 2 BOX 1 0 0 0 0 1 1\n/* open");
+        let e = errs("SPHERE 1 -1 0 0 0\nFOO 1 2 3\nRASTER 1 1\nRASTER 2 2 BOX 1 0 0 0 0 1 1\n/* open");
         assert_eq!(e.len(), 5, "{e:?}");
         assert!(e[0].starts_with("1:10:") && e[1].starts_with("2:1:") && e[2].starts_with("4:1:"));
-        assert!(
-            e[3].starts_with("4:24:") && e[4].starts_with("5:1:"),
-            "{e:?}"
-        );
+        assert!(e[3].starts_with("4:24:") && e[4].starts_with("5:1:"), "{e:?}");
     }
 
     #[test]
@@ -767,10 +602,7 @@ mod tests {
         // then read normally.
         let e = errs(&format!("SPHERE 1 1 0 0\n{SURF}RDEPTH 2 RDEPTH 3"));
         assert_eq!(e.len(), 2, "{e:?}");
-        assert!(
-            e[0].contains("2:1: expected a number for SPHERE z, found `SURFACE`"),
-            "{e:?}"
-        );
+        assert!(e[0].contains("2:1: expected a number for SPHERE z, found `SURFACE`"), "{e:?}");
         assert!(e[1].contains("RDEPTH is given twice"), "{e:?}");
     }
 
@@ -783,11 +615,7 @@ mod tests {
         let e = errs(&text);
         assert_eq!(e.len(), 1, "{e:?}");
         assert_eq!(
-            e.iter()
-                .filter(
-                    |m| m.contains("boxes than this build holds (32, capacity profile Board64K)")
-                )
-                .count(),
+            e.iter().filter(|m| m.contains("boxes than this build holds (32, capacity profile Board64K)")).count(),
             1,
             "{e:?}"
         );
@@ -800,17 +628,12 @@ mod tests {
         let bytes = b"RDEPTH 2\nLIGHT 1 \xff 0 0";
         let r = parse_bytes(bytes, &mut scene, &mut |e| errors.push(e.to_string()));
         assert_eq!(r, Err(1));
-        assert_eq!(
-            errors,
-            ["2:9: the file is not valid UTF-8 (invalid byte here)"]
-        );
+        assert_eq!(errors, ["2:9: the file is not valid UTF-8 (invalid byte here)"]);
     }
 
     #[test]
     fn objects_keep_file_order_and_positions() {
-        let s = ok(&format!(
-            "SPHERE 1 1 0 0 0 SPHERE 1 2 5 0 0 {SURF} LIGHT 1 -5 0 0"
-        ));
+        let s = ok(&format!("SPHERE 1 1 0 0 0 SPHERE 1 2 5 0 0 {SURF} LIGHT 1 -5 0 0"));
         let v = s.view();
         let a = v.spheres[0];
         let b = v.spheres[1];

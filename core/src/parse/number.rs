@@ -90,10 +90,7 @@ impl Decimal {
             let start = i;
             let mut e: i32 = 0;
             while i < b.len() && b[i].is_ascii_digit() {
-                e = e
-                    .saturating_mul(10)
-                    .saturating_add((b[i] - b'0') as i32)
-                    .min(1_000_000);
+                e = e.saturating_mul(10).saturating_add((b[i] - b'0') as i32).min(1_000_000);
                 i += 1;
             }
             if i == start {
@@ -101,11 +98,7 @@ impl Decimal {
             }
             exponent = exponent.saturating_add(if exp_negative { -e } else { e });
         }
-        (i == b.len()).then_some(Decimal {
-            negative,
-            mantissa,
-            exponent,
-        })
+        (i == b.len()).then_some(Decimal { negative, mantissa, exponent })
     }
 
     pub fn is_zero(&self) -> bool {
@@ -117,12 +110,7 @@ impl Decimal {
         if self.mantissa == 0 {
             return false;
         }
-        let digits = 20
-            - POW10
-                .iter()
-                .rev()
-                .position(|&p| self.mantissa >= p)
-                .unwrap_or(19) as i32;
+        let digits = 20 - POW10.iter().rev().position(|&p| self.mantissa >= p).unwrap_or(19) as i32;
         let magnitude = digits + self.exponent; // value in [10^(m−1), 10^m)
         if magnitude <= 6 {
             false
@@ -167,9 +155,7 @@ pub fn parse_integer(text: &str) -> Option<i64> {
     if digits.is_empty() || !digits.bytes().all(|c| c.is_ascii_digit()) {
         return None;
     }
-    let v = digits.bytes().fold(0i64, |v, c| {
-        v.saturating_mul(10).saturating_add((c - b'0') as i64)
-    });
+    let v = digits.bytes().fold(0i64, |v, c| v.saturating_mul(10).saturating_add((c - b'0') as i64));
     Some(if negative { -v } else { v })
 }
 
@@ -183,15 +169,10 @@ mod tests {
 
     #[test]
     fn the_grammar() {
-        for ok in [
-            "3", "-0.5", ".25", "1e-3", "+2.5E2", "3.", "-0", "0.000", "1E+2",
-        ] {
+        for ok in ["3", "-0.5", ".25", "1e-3", "+2.5E2", "3.", "-0", "0.000", "1E+2"] {
             assert!(Decimal::parse(ok).is_some(), "{ok}");
         }
-        for bad in [
-            "", "+", "-", ".", "e5", "1e", "1e+", "nan", "inf", "-inf", "0x10", "1.2.3", "1,5",
-            "2f", "--1",
-        ] {
+        for bad in ["", "+", "-", ".", "e5", "1e", "1e+", "nan", "inf", "-inf", "0x10", "1.2.3", "1,5", "2f", "--1"] {
             assert!(Decimal::parse(bad).is_none(), "{bad}");
         }
     }
@@ -207,10 +188,7 @@ mod tests {
         assert_eq!(q("0.1"), 429_496_730); // 429496729.6 rounds up
         assert_eq!(q("1e6"), 1_000_000 << 32);
         assert_eq!(q("1e-50"), 0);
-        assert_eq!(
-            q("123456789012345678901234e-18"),
-            q("123456.789012345678901234")
-        );
+        assert_eq!(q("123456789012345678901234e-18"), q("123456.789012345678901234"));
     }
 
     #[test]
@@ -218,14 +196,7 @@ mod tests {
         for inside in ["1000000", "-1e6", "999999.9999", "0.1e7", "1e-400", "0"] {
             assert!(!Decimal::parse(inside).unwrap().out_of_range(), "{inside}");
         }
-        for outside in [
-            "1000000.0001",
-            "1e400",
-            "-1e7",
-            "10000000",
-            "1000001",
-            &"9".repeat(200),
-        ] {
+        for outside in ["1000000.0001", "1e400", "-1e7", "10000000", "1000001", &"9".repeat(200)] {
             assert!(Decimal::parse(outside).unwrap().out_of_range(), "{outside}");
         }
     }

@@ -19,53 +19,23 @@ pub enum Statement<'a> {
     Viewport([WorldValue; 2]),
     Rdepth(u32),
     Imagefile(&'a str),
-    Light {
-        brightness: I32F32,
-        position: WorldPoint,
-    },
+    Light { brightness: I32F32, position: WorldPoint },
     Background(Color),
     Gamma(I32F32),
     Attenuation(I32F32),
     Samples(u32),
-    Sphere {
-        surface: u32,
-        radius: WorldValue,
-        center: WorldPoint,
-    },
-    Box {
-        surface: u32,
-        center: WorldPoint,
-        half: WorldPoint,
-    },
-    Superquadric {
-        surface: u32,
-        power: I32F32,
-        center: WorldPoint,
-        half: WorldPoint,
-    },
-    Triangle {
-        surface: u32,
-        corners: [WorldPoint; 3],
-    },
-    Rectangle {
-        surface: u32,
-        corners: [WorldPoint; 4],
-    },
-    Surface {
-        number: u32,
-        surface: Surface,
-    },
+    Sphere { surface: u32, radius: WorldValue, center: WorldPoint },
+    Box { surface: u32, center: WorldPoint, half: WorldPoint },
+    Superquadric { surface: u32, power: I32F32, center: WorldPoint, half: WorldPoint },
+    Triangle { surface: u32, corners: [WorldPoint; 3] },
+    Rectangle { surface: u32, corners: [WorldPoint; 4] },
+    Surface { number: u32, surface: Surface },
 }
 
 impl Statement<'_> {
     /// The world-space box holding an object statement, if it is one.
     pub fn object_bounds(&self) -> Option<(WorldPoint, WorldPoint)> {
-        let spread = |c: WorldPoint, h: WorldPoint| {
-            (
-                [0, 1, 2].map(|a| c[a] - h[a]),
-                [0, 1, 2].map(|a| c[a] + h[a]),
-            )
-        };
+        let spread = |c: WorldPoint, h: WorldPoint| ([0, 1, 2].map(|a| c[a] - h[a]), [0, 1, 2].map(|a| c[a] + h[a]));
         let corners = |cs: &[WorldPoint]| {
             let mut lo = cs[0];
             let mut hi = cs[0];
@@ -114,10 +84,7 @@ pub const KEYWORDS: [&str; 19] = [
 
 /// The keyword `text` names (case-insensitively), if any.
 pub fn keyword(text: &str) -> Option<&'static str> {
-    KEYWORDS
-        .iter()
-        .copied()
-        .find(|k| k.eq_ignore_ascii_case(text))
+    KEYWORDS.iter().copied().find(|k| k.eq_ignore_ascii_case(text))
 }
 
 /// Tokens with one token of look-ahead.
@@ -128,10 +95,7 @@ pub struct Cursor<'a> {
 
 impl<'a> Cursor<'a> {
     pub fn new(text: &'a str) -> Cursor<'a> {
-        Cursor {
-            lexer: Lexer::new(text),
-            peeked: None,
-        }
+        Cursor { lexer: Lexer::new(text), peeked: None }
     }
 
     pub fn peek(&mut self) -> Result<Option<Token<'a>>, ParseError<'a>> {
@@ -159,21 +123,9 @@ impl<'a> Cursor<'a> {
     /// so error recovery always starts at the offending token.
     fn number(&mut self, field: Field) -> Result<(Decimal, Token<'a>), ParseError<'a>> {
         match self.peek()? {
-            None => Err(ParseError::new(
-                self.end_pos(),
-                ErrorKind::ExpectedNumber {
-                    field,
-                    found: Found::EndOfFile,
-                },
-            )),
+            None => Err(ParseError::new(self.end_pos(), ErrorKind::ExpectedNumber { field, found: Found::EndOfFile })),
             Some(t) => match Decimal::parse(t.text).filter(|_| !t.quoted) {
-                None => Err(ParseError::new(
-                    t.pos,
-                    ErrorKind::ExpectedNumber {
-                        field,
-                        found: Found::Token(t.text),
-                    },
-                )),
+                None => Err(ParseError::new(t.pos, ErrorKind::ExpectedNumber { field, found: Found::Token(t.text) })),
                 Some(d) if d.out_of_range() => Err(out_of_range(t, field, Rule::Magnitude)),
                 Some(d) => Ok((d, t)),
             },
@@ -205,23 +157,14 @@ impl<'a> Cursor<'a> {
             None => {
                 return Err(ParseError::new(
                     self.end_pos(),
-                    ErrorKind::ExpectedInteger {
-                        field,
-                        found: Found::EndOfFile,
-                    },
+                    ErrorKind::ExpectedInteger { field, found: Found::EndOfFile },
                 ))
             }
             Some(t) => t,
         };
         let v = parse_integer(t.text)
             .filter(|_| !t.quoted)
-            .ok_or(ParseError::new(
-                t.pos,
-                ErrorKind::ExpectedInteger {
-                    field,
-                    found: Found::Token(t.text),
-                },
-            ))?;
+            .ok_or(ParseError::new(t.pos, ErrorKind::ExpectedInteger { field, found: Found::Token(t.text) }))?;
         if v < lo || v > hi {
             return Err(out_of_range(t, field, Rule::Between(lo, hi)));
         }
@@ -229,11 +172,7 @@ impl<'a> Cursor<'a> {
         Ok(v)
     }
 
-    fn point(
-        &mut self,
-        statement: &'static str,
-        names: [&'static str; 3],
-    ) -> Result<WorldPoint, ParseError<'a>> {
+    fn point(&mut self, statement: &'static str, names: [&'static str; 3]) -> Result<WorldPoint, ParseError<'a>> {
         let mut p = [0; 3];
         for (v, name) in p.iter_mut().zip(names) {
             *v = self.real(Field { statement, name }, Rule::Magnitude)?;
@@ -253,11 +192,7 @@ impl<'a> Cursor<'a> {
         Ok(p)
     }
 
-    fn color(
-        &mut self,
-        statement: &'static str,
-        names: [&'static str; 3],
-    ) -> Result<Color, ParseError<'a>> {
+    fn color(&mut self, statement: &'static str, names: [&'static str; 3]) -> Result<Color, ParseError<'a>> {
         let mut c = [0; 3];
         for (v, name) in c.iter_mut().zip(names) {
             *v = q32_to_q16(self.real(Field { statement, name }, Rule::UnitInterval)?) as i32;
@@ -266,23 +201,13 @@ impl<'a> Cursor<'a> {
     }
 
     fn surface_number(&mut self, statement: &'static str) -> Result<u32, ParseError<'a>> {
-        let field = Field {
-            statement,
-            name: "surface number",
-        };
+        let field = Field { statement, name: "surface number" };
         Ok(self.integer(field, 0, super::number::LIMIT as i64)? as u32)
     }
 }
 
 fn out_of_range<'a>(t: Token<'a>, field: Field, rule: Rule) -> ParseError<'a> {
-    ParseError::new(
-        t.pos,
-        ErrorKind::OutOfRange {
-            field,
-            rule,
-            found: t.text,
-        },
-    )
+    ParseError::new(t.pos, ErrorKind::OutOfRange { field, rule, found: t.text })
 }
 
 /// Q32.32 to Q16.16, rounded to nearest.
@@ -291,41 +216,23 @@ pub fn q32_to_q16(v: i64) -> i64 {
 }
 
 /// Reads the statement that `keyword` (already consumed) begins.
-pub fn statement<'a>(
-    cur: &mut Cursor<'a>,
-    kw: &'static str,
-    at: Pos,
-) -> Result<Statement<'a>, ParseError<'a>> {
-    let f = |name| Field {
-        statement: kw,
-        name,
-    };
+pub fn statement<'a>(cur: &mut Cursor<'a>, kw: &'static str, at: Pos) -> Result<Statement<'a>, ParseError<'a>> {
+    let f = |name| Field { statement: kw, name };
     let xyz = ["x", "y", "z"];
     Ok(match kw {
         "VIEWPOINT" => Statement::Viewpoint(cur.point(kw, xyz)?),
         "ORIGIN" => Statement::Origin(cur.point(kw, xyz)?),
         "UPVECTOR" => Statement::Upvector(cur.point(kw, xyz)?),
-        "RASTER" => Statement::Raster([
-            cur.integer(f("width"), 1, 16384)? as u32,
-            cur.integer(f("height"), 1, 16384)? as u32,
-        ]),
-        "VIEWPORT" => Statement::Viewport([
-            cur.real(f("width"), Rule::Positive)?,
-            cur.real(f("height"), Rule::Positive)?,
-        ]),
-        "RDEPTH" => {
-            Statement::Rdepth(cur.integer(f("depth"), 0, super::number::LIMIT as i64)? as u32)
+        "RASTER" => {
+            Statement::Raster([cur.integer(f("width"), 1, 16384)? as u32, cur.integer(f("height"), 1, 16384)? as u32])
         }
+        "VIEWPORT" => {
+            Statement::Viewport([cur.real(f("width"), Rule::Positive)?, cur.real(f("height"), Rule::Positive)?])
+        }
+        "RDEPTH" => Statement::Rdepth(cur.integer(f("depth"), 0, super::number::LIMIT as i64)? as u32),
         "IMAGEFILE" => match cur.next()? {
             Some(t) => Statement::Imagefile(t.text),
-            None => {
-                return Err(ParseError::new(
-                    cur.end_pos(),
-                    ErrorKind::ExpectedName {
-                        field: f("file name"),
-                    },
-                ))
-            }
+            None => return Err(ParseError::new(cur.end_pos(), ErrorKind::ExpectedName { field: f("file name") })),
         },
         "LIGHT" => Statement::Light {
             brightness: I32F32::from_bits(cur.real(f("brightness"), Rule::NonNegative)?),
@@ -333,9 +240,7 @@ pub fn statement<'a>(
         },
         "BACKGROUND" => Statement::Background(cur.color(kw, ["red", "green", "blue"])?),
         "GAMMA" => Statement::Gamma(I32F32::from_bits(cur.real(f("value"), Rule::Positive)?)),
-        "ATTENUATION" => {
-            Statement::Attenuation(I32F32::from_bits(cur.real(f("d0"), Rule::Positive)?))
-        }
+        "ATTENUATION" => Statement::Attenuation(I32F32::from_bits(cur.real(f("d0"), Rule::Positive)?)),
         "SAMPLES" => Statement::Samples(cur.integer(f("count"), 1, 16)? as u32),
         "SPHERE" => Statement::Sphere {
             surface: cur.surface_number(kw)?,
@@ -363,10 +268,7 @@ pub fn statement<'a>(
             if cross(sub(corners[1], corners[0]), sub(corners[2], corners[0])) == [0; 3] {
                 return Err(ParseError::new(
                     at,
-                    ErrorKind::Degenerate {
-                        keyword: kw,
-                        why: "its corners are collinear (zero area)",
-                    },
+                    ErrorKind::Degenerate { keyword: kw, why: "its corners are collinear (zero area)" },
                 ));
             }
             Statement::Triangle { surface, corners }
@@ -387,9 +289,7 @@ pub fn statement<'a>(
             let ambient = cur.color(kw, ["ambient red", "ambient green", "ambient blue"])?;
             let diffuse = cur.color(kw, ["diffuse red", "diffuse green", "diffuse blue"])?;
             let specular = cur.color(kw, ["specular red", "specular green", "specular blue"])?;
-            let exponent = I48F16::from_bits(q32_to_q16(
-                cur.real(f("specular exponent"), Rule::NonNegative)?,
-            ));
+            let exponent = I48F16::from_bits(q32_to_q16(cur.real(f("specular exponent"), Rule::NonNegative)?));
             let reflectivity = q32_to_q16(cur.real(f("reflectivity"), Rule::UnitInterval)?) as i32;
             let transparency = q32_to_q16(cur.real(f("transparency"), Rule::UnitInterval)?) as i32;
             Statement::Surface {
@@ -413,11 +313,7 @@ fn sub(a: WorldPoint, b: WorldPoint) -> [i128; 3] {
 }
 
 fn cross(a: [i128; 3], b: [i128; 3]) -> [i128; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 fn dot(a: [i128; 3], b: [i128; 3]) -> i128 {
@@ -433,33 +329,18 @@ fn check_quadrilateral(c: &[WorldPoint; 4]) -> Result<(), ErrorKind<'static>> {
     for (i, e) in v.iter_mut().enumerate() {
         *e = sub(c[(i + 1) % 4], c[i]);
     }
-    let largest = v
-        .iter()
-        .flatten()
-        .map(|x| x.unsigned_abs())
-        .max()
-        .unwrap_or(0);
+    let largest = v.iter().flatten().map(|x| x.unsigned_abs()).max().unwrap_or(0);
     if largest == 0 {
-        return Err(ErrorKind::Degenerate {
-            keyword: "RECTANGLE",
-            why: "its corners coincide",
-        });
+        return Err(ErrorKind::Degenerate { keyword: "RECTANGLE", why: "its corners coincide" });
     }
     let shift = (128 - largest.leading_zeros()).saturating_sub(24);
     let v = v.map(|e| e.map(|x| x >> shift));
     // The turn at each corner; for a strictly convex quadrilateral all four
     // point the same way (counter-clockwise: along the front normal).
     let turns: [[i128; 3]; 4] = core::array::from_fn(|i| cross(v[i], v[(i + 1) % 4]));
-    let reference = turns
-        .iter()
-        .copied()
-        .max_by_key(|c| dot(*c, *c))
-        .unwrap_or([0; 3]);
+    let reference = turns.iter().copied().max_by_key(|c| dot(*c, *c)).unwrap_or([0; 3]);
     if reference == [0; 3] {
-        return Err(ErrorKind::Degenerate {
-            keyword: "RECTANGLE",
-            why: "its corners are collinear (zero area)",
-        });
+        return Err(ErrorKind::Degenerate { keyword: "RECTANGLE", why: "its corners are collinear (zero area)" });
     }
     if turns.iter().any(|c| dot(*c, reference) <= 0) {
         return Err(ErrorKind::NotConvex);

@@ -15,10 +15,9 @@ mod gamma;
 
 pub use gamma::GammaTable;
 
-use crate::accel::Accelerator;
+use crate::accel::{Accelerator, Mailbox};
 use crate::scene::{Camera, CameraError, Color, ObjectId, SceneView};
-use crate::shade::{Stats, Tracer};
-use core::cell::Cell;
+use crate::shade::{Scratch, Stats, Tracer};
 use core::ops::Range;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
@@ -33,11 +32,14 @@ pub struct PixelSample {
     pub object: Option<ObjectId>,
 }
 
-/// Renders one scene through one accelerator.
+/// Renders one scene through one accelerator. A renderer holds the mutable
+/// state of one thread (counters, mailbox); to render on several threads,
+/// give each its own renderer over the same scene and accelerator.
 pub struct Renderer<'a, A> {
     tracer: Tracer<'a, A>,
     camera: Camera,
     gamma: GammaTable,
+    scratch: Scratch<'a>,
 }
 
 impl<'a, A: Accelerator> Renderer<'a, A> {
@@ -48,19 +50,28 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     }
 
     /// A renderer at another size (the default VIEWPORT follows its aspect).
-    pub fn with_size(
-        scene: SceneView<'a>,
-        accel: &'a A,
-        width: u32,
-        height: u32,
-    ) -> Result<Self, CameraError> {
+    pub fn with_size(scene: SceneView<'a>, accel: &'a A, width: u32, height: u32) -> Result<Self, CameraError> {
         let s = scene.settings;
         let camera = Camera::new(&s.view, &scene.normalization, width, height, s.samples)?;
         Ok(Renderer {
             tracer: Tracer::new(scene, accel),
             camera,
             gamma: GammaTable::new(s.gamma),
+            scratch: Scratch::new(Mailbox::none()),
         })
+    }
+
+    /// Gives the renderer a mailbox of `words` (one bit per object,
+    /// [`Mailbox::words_for`]), so that accelerators filing an object in
+    /// several cells test it once per ray.
+    pub fn with_mailbox(mut self, words: &'a mut [u32]) -> Self {
+        self.scratch.mailbox = Mailbox::new(words);
+        self
+    }
+
+    /// Counters since the renderer was made.
+    pub fn stats(&self) -> Stats {
+        self.scratch.stats
     }
 
     pub fn size(&self) -> Size {
@@ -72,13 +83,13 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     }
 
     /// The pixel at (`x`, `y`), `x` to the right and `y` down.
-    pub fn pixel(&self, x: u32, y: u32, stats: &mut Stats) -> PixelSample {
+    pub fn pixel(&mut self, x: u32, y: u32) -> PixelSample {
         let n = self.camera.samples();
         let mut object = None;
         let mut sum = [0i64; 3];
         for sy in 0..n {
             for sx in 0..n {
-                let (c, o) = self.tracer.trace(self.camera.ray(x, y, sx, sy), stats);
+                let (c, o) = self.tracer.trace(self.camera.ray(x, y, sx, sy), &mut self.scratch);
                 if sx == n / 2 && sy == n / 2 {
                     object = o;
                 }
@@ -90,32 +101,18 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         let count = (n * n) as i64;
         let mean = Color::from_bits(sum.map(|s| ((s + count / 2) / count) as i32));
         PixelSample {
-            color: Rgb888::new(
-                self.gamma.encode(mean.r),
-                self.gamma.encode(mean.g),
-                self.gamma.encode(mean.b),
-            ),
+            color: Rgb888::new(self.gamma.encode(mean.r), self.gamma.encode(mean.g), self.gamma.encode(mean.b)),
             object,
         }
     }
 
     /// The pixels of row `y` for the columns `xs`, traced lazily.
-    pub fn row<'s>(
-        &'s self,
-        y: u32,
-        xs: Range<u32>,
-        stats: &'s Cell<Stats>,
-    ) -> impl Iterator<Item = PixelSample> + 's {
-        xs.map(move |x| {
-            let mut s = stats.get();
-            let p = self.pixel(x, y, &mut s);
-            stats.set(s);
-            p
-        })
+    pub fn row(&mut self, y: u32, xs: Range<u32>) -> impl Iterator<Item = PixelSample> + use<'_, 'a, A> {
+        xs.map(move |x| self.pixel(x, y))
     }
 
     /// Renders the whole image.
-    pub fn render<D>(&self, target: &mut D) -> Result<Stats, D::Error>
+    pub fn render<D>(&mut self, target: &mut D) -> Result<Stats, D::Error>
     where
         D: DrawTarget,
         D::Color: From<Rgb888>,
@@ -124,39 +121,34 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     }
 
     /// Renders the rows `rows` (clipped to the image).
-    pub fn render_rows<D>(&self, rows: Range<u32>, target: &mut D) -> Result<Stats, D::Error>
+    pub fn render_rows<D>(&mut self, rows: Range<u32>, target: &mut D) -> Result<Stats, D::Error>
     where
         D: DrawTarget,
         D::Color: From<Rgb888>,
     {
         let h = self.camera.height();
         let (start, end) = (rows.start.min(h), rows.end.min(h));
-        let rect = Rectangle::new(
-            Point::new(0, start as i32),
-            Size::new(self.camera.width(), end.saturating_sub(start)),
-        );
+        let rect =
+            Rectangle::new(Point::new(0, start as i32), Size::new(self.camera.width(), end.saturating_sub(start)));
         self.render_rect(&rect, target)
     }
 
     /// Renders the pixels of `rect` (clipped to the image), one
-    /// `fill_contiguous` per row.
-    pub fn render_rect<D>(&self, rect: &Rectangle, target: &mut D) -> Result<Stats, D::Error>
+    /// `fill_contiguous` per row. Returns the counters of this call.
+    pub fn render_rect<D>(&mut self, rect: &Rectangle, target: &mut D) -> Result<Stats, D::Error>
     where
         D: DrawTarget,
         D::Color: From<Rgb888>,
     {
         let image = Rectangle::new(Point::zero(), self.size());
         let r = rect.intersection(&image);
-        let stats = Cell::new(Stats::default());
-        if r.size.width == 0 || r.size.height == 0 {
-            return Ok(stats.get());
-        }
+        let before = self.scratch.stats;
         let x0 = r.top_left.x as u32;
         for y in r.top_left.y as u32..r.top_left.y as u32 + r.size.height {
             let line = Rectangle::new(Point::new(x0 as i32, y as i32), Size::new(r.size.width, 1));
-            let pixels = self.row(y, x0..x0 + r.size.width, &stats);
+            let pixels = self.row(y, x0..x0 + r.size.width);
             target.fill_contiguous(&line, pixels.map(|p| p.color.into()))?;
         }
-        Ok(stats.get())
+        Ok(self.scratch.stats.since(&before))
     }
 }

@@ -32,12 +32,7 @@ pub struct View {
 
 impl Default for View {
     fn default() -> View {
-        View {
-            eye: [0, 0, 10 << 32],
-            look_at: [0; 3],
-            up: [0, 1 << 32, 0],
-            viewport: None,
-        }
+        View { eye: [0, 0, 10 << 32], look_at: [0; 3], up: [0, 1 << 32, 0], viewport: None }
     }
 }
 
@@ -78,11 +73,7 @@ impl Camera {
         let up = Dir::normalize(view.up).ok_or(CameraError::UpParallel)?;
         let a = f.wide();
         let b = up.wide();
-        let cross = [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ];
+        let cross = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
         // Parallel: the sine of the angle is below 2^-20 (Q4.60 raw 2^40).
         if cross.iter().all(|c| c.unsigned_abs() < 1 << 40) {
             return Err(CameraError::UpParallel);
@@ -102,18 +93,11 @@ impl Camera {
         samples: u32,
     ) -> Result<Camera, CameraError> {
         let (f, r, u, dist) = Self::basis(view)?;
-        let (w, h, n) = (
-            width.max(1) as i128,
-            height.max(1) as i128,
-            samples.max(1) as i128,
-        );
+        let (w, h, n) = (width.max(1) as i128, height.max(1) as i128, samples.max(1) as i128);
         let dist = dist.max(1) as i128;
         // Tangent-like ratios vw/d and vh/d in Q32.32.
         let (ax, ay) = match view.viewport {
-            Some([vw, vh]) => (
-                mul_div(vw as i128, 1 << 32, dist),
-                mul_div(vh as i128, 1 << 32, dist),
-            ),
+            Some([vw, vh]) => (mul_div(vw as i128, 1 << 32, dist), mul_div(vh as i128, 1 << 32, dist)),
             None => {
                 // 2·tan 30° = 2/√3 = sqrt(4/3).
                 let ax = isqrt_u128((4u128 << 64) / 3) as i128;
@@ -126,18 +110,11 @@ impl Camera {
         let frac = (60 - (128 - reach.leading_zeros() as i32)).clamp(8, 44) as u32;
         let scale = |d: Dir, ratio: i128, div: i128| -> [i64; 3] {
             // ratio (Q32) · d (Q30) / div, to `frac` bits.
-            d.wide()
-                .map(|c| mul_div(ratio * c as i128, 1 << frac, div << 62) as i64)
+            d.wide().map(|c| mul_div(ratio * c as i128, 1 << frac, div << 62) as i64)
         };
         Ok(Camera {
             eye: norm.point(view.eye),
-            forward: f.wide().map(|c| {
-                if frac >= 30 {
-                    c << (frac - 30)
-                } else {
-                    c >> (30 - frac)
-                }
-            }),
+            forward: f.wide().map(|c| if frac >= 30 { c << (frac - 30) } else { c >> (30 - frac) }),
             step_x: scale(r, ax, 2 * n * w),
             step_y: scale(u, ay, 2 * n * h),
             width: width.max(1),
@@ -221,12 +198,8 @@ mod tests {
 
     #[test]
     fn explicit_viewport_and_non_perpendicular_up() {
-        let view = View {
-            eye: [0, 0, 4 * ONE],
-            look_at: [0; 3],
-            up: [0, ONE, ONE],
-            viewport: Some([8 * ONE, 4 * ONE]),
-        };
+        let view =
+            View { eye: [0, 0, 4 * ONE], look_at: [0; 3], up: [0, ONE, ONE], viewport: Some([8 * ONE, 4 * ONE]) };
         let c = camera(&view, 2, 1, 1);
         // Pixel 1's centre is at x = +2 on the window, at distance 4.
         let d = c.ray(1, 0, 0, 0).dir.bits();
@@ -246,23 +219,11 @@ mod tests {
     #[test]
     fn degenerate_views_are_errors() {
         let norm = Normalization::IDENTITY;
-        let at_origin = View {
-            eye: [0; 3],
-            ..View::default()
-        };
-        assert_eq!(
-            Camera::new(&at_origin, &norm, 4, 4, 1),
-            Err(CameraError::EyeAtOrigin)
-        );
-        let parallel = View {
-            up: [0, 0, -3 * ONE],
-            ..View::default()
-        };
+        let at_origin = View { eye: [0; 3], ..View::default() };
+        assert_eq!(Camera::new(&at_origin, &norm, 4, 4, 1), Err(CameraError::EyeAtOrigin));
+        let parallel = View { up: [0, 0, -3 * ONE], ..View::default() };
         assert_eq!(Camera::check(&parallel), Err(CameraError::UpParallel));
-        let zero_up = View {
-            up: [0; 3],
-            ..View::default()
-        };
+        let zero_up = View { up: [0; 3], ..View::default() };
         assert_eq!(Camera::check(&zero_up), Err(CameraError::UpParallel));
     }
 }

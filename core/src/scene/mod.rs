@@ -21,9 +21,7 @@ pub use surface::{Color, Surface, SurfaceEntry};
 
 use crate::capacity::{Arena, Capacities};
 use crate::math::{Vec3, Wide};
-use crate::shapes::{
-    AxisAlignedBox, Rectangle, ShapeHandle, ShapeKind, ShapeRef, Sphere, Superquadric, Triangle,
-};
+use crate::shapes::{AxisAlignedBox, Rectangle, ShapeHandle, ShapeKind, ShapeRef, Sphere, Superquadric, Triangle};
 
 /// An object's position in the scene file (0 for the first object).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -98,11 +96,7 @@ fn push<T, A: Arena<T>>(
     profile: &'static str,
 ) -> Result<usize, CapacityError> {
     let index = arena.as_slice().len();
-    arena.push(item).map_err(|_| CapacityError {
-        what,
-        capacity: A::CAPACITY,
-        profile,
-    })?;
+    arena.push(item).map_err(|_| CapacityError { what, capacity: A::CAPACITY, profile })?;
     Ok(index)
 }
 
@@ -177,19 +171,9 @@ impl<C: Capacities> Scene<C> {
 
     fn register(&mut self, kind: ShapeKind, index: usize) -> Result<(), CapacityError> {
         if self.objects.as_slice().len() >= Self::object_capacity() {
-            return Err(CapacityError {
-                what: "objects",
-                capacity: Self::object_capacity(),
-                profile: C::NAME,
-            });
+            return Err(CapacityError { what: "objects", capacity: Self::object_capacity(), profile: C::NAME });
         }
-        push(
-            &mut self.objects,
-            ShapeHandle::new(kind, index),
-            "objects",
-            C::NAME,
-        )
-        .map(|_| ())
+        push(&mut self.objects, ShapeHandle::new(kind, index), "objects", C::NAME).map(|_| ())
     }
 
     /// Checks that one more object of `kind` fits, before it is built.
@@ -203,18 +187,10 @@ impl<C: Capacities> Scene<C> {
         };
         let capacity = Self::capacity_of(kind).min(ShapeHandle::MAX_INDEX);
         if len >= capacity {
-            return Err(CapacityError {
-                what,
-                capacity,
-                profile: C::NAME,
-            });
+            return Err(CapacityError { what, capacity, profile: C::NAME });
         }
         if self.objects.as_slice().len() >= Self::object_capacity() {
-            return Err(CapacityError {
-                what: "objects",
-                capacity: Self::object_capacity(),
-                profile: C::NAME,
-            });
+            return Err(CapacityError { what: "objects", capacity: Self::object_capacity(), profile: C::NAME });
         }
         Ok(())
     }
@@ -255,11 +231,7 @@ impl<C: Capacities> Scene<C> {
 
     pub fn push_surface(&mut self, s: SurfaceEntry) -> Result<(), CapacityError> {
         if self.surfaces.as_slice().len() >= Self::surface_capacity() {
-            return Err(CapacityError {
-                what: "surfaces",
-                capacity: Self::surface_capacity(),
-                profile: C::NAME,
-            });
+            return Err(CapacityError { what: "surfaces", capacity: Self::surface_capacity(), profile: C::NAME });
         }
         push(&mut self.surfaces, s, "surfaces", C::NAME).map(|_| ())
     }
@@ -267,9 +239,7 @@ impl<C: Capacities> Scene<C> {
     /// Sorts the surfaces by number (first definition first), so that
     /// [`SceneView::surface_index`] can binary-search them.
     pub fn sort_surfaces(&mut self) {
-        self.surfaces
-            .as_mut_slice()
-            .sort_unstable_by_key(|s| (s.number, s.line, s.column));
+        self.surfaces.as_mut_slice().sort_unstable_by_key(|s| (s.number, s.line, s.column));
     }
 
     /// Drops the objects and lights but keeps the surfaces (the parser's
@@ -286,12 +256,7 @@ impl<C: Capacities> Scene<C> {
 }
 
 const DEFAULT_SETTINGS: Settings = Settings {
-    view: View {
-        eye: [0, 0, 10 << 32],
-        look_at: [0; 3],
-        up: [0, 1 << 32, 0],
-        viewport: None,
-    },
+    view: View { eye: [0, 0, 10 << 32], look_at: [0; 3], up: [0, 1 << 32, 0], viewport: None },
     raster: [320, 240],
     rdepth: 3,
     background: Color::BLACK,

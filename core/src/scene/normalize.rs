@@ -44,18 +44,12 @@ fn round_shift(v: i64, s: u32) -> i64 {
 }
 
 impl Normalization {
-    pub const IDENTITY: Normalization = Normalization {
-        center: [0; 3],
-        shift: 16,
-    };
+    pub const IDENTITY: Normalization = Normalization { center: [0; 3], shift: 16 };
 
     /// The normalisation that fits the world box `[min, max]`.
     pub fn fit(min: WorldPoint, max: WorldPoint) -> Normalization {
         let center = [0, 1, 2].map(|a| min[a] / 2 + max[a] / 2 + (min[a] % 2 + max[a] % 2) / 2);
-        let half = (0..3)
-            .map(|a| (max[a] - center[a]).max(center[a] - min[a]).unsigned_abs())
-            .max()
-            .unwrap_or(0);
+        let half = (0..3).map(|a| (max[a] - center[a]).max(center[a] - min[a]).unsigned_abs()).max().unwrap_or(0);
         // Largest shift with half · 2^shift ≤ 2^13 in Q32.32, i.e. ≤ 2^45 raw.
         let shift = if half == 0 {
             MAX_SHIFT
@@ -134,15 +128,9 @@ mod tests {
     fn scaled_scenes_normalise_to_the_same_numbers() {
         // The same scene at unit scale and at 1024 times: identical.
         let a = Normalization::fit([-3 * ONE, -ONE, 0], [5 * ONE, ONE, 2 * ONE]);
-        let b = Normalization::fit(
-            [-3 * ONE * 1024, -ONE * 1024, 0],
-            [5 * ONE * 1024, ONE * 1024, 2 * ONE * 1024],
-        );
+        let b = Normalization::fit([-3 * ONE * 1024, -ONE * 1024, 0], [5 * ONE * 1024, ONE * 1024, 2 * ONE * 1024]);
         assert_eq!(a.shift, b.shift + 10);
-        assert_eq!(
-            a.point([ONE, ONE / 2, ONE]),
-            b.point([ONE * 1024, ONE * 512, ONE * 1024])
-        );
+        assert_eq!(a.point([ONE, ONE / 2, ONE]), b.point([ONE * 1024, ONE * 512, ONE * 1024]));
         assert_eq!(a.length(3 * ONE), b.length(3 * ONE * 1024));
     }
 

@@ -20,11 +20,7 @@ impl Color {
     pub const BLACK: Color = Color::from_bits([0; 3]);
 
     pub const fn from_bits(c: [i32; 3]) -> Color {
-        Color {
-            r: Scalar::from_bits(c[0]),
-            g: Scalar::from_bits(c[1]),
-            b: Scalar::from_bits(c[2]),
-        }
+        Color { r: Scalar::from_bits(c[0]), g: Scalar::from_bits(c[1]), b: Scalar::from_bits(c[2]) }
     }
 
     pub const fn bits(self) -> [i32; 3] {
@@ -33,11 +29,7 @@ impl Color {
 
     #[inline]
     pub fn saturating_add(self, o: Color) -> Color {
-        Color {
-            r: self.r.saturating_add(o.r),
-            g: self.g.saturating_add(o.g),
-            b: self.b.saturating_add(o.b),
-        }
+        Color { r: self.r.saturating_add(o.r), g: self.g.saturating_add(o.g), b: self.b.saturating_add(o.b) }
     }
 
     /// Each channel times `k` (Q16.16), saturating.

@@ -15,7 +15,7 @@
 //! time per pixel is `SAMPLES² · MAX_RAYS_PER_SAMPLE · (1 + lights)` ray
 //! queries, each O(objects) in the naive mode.
 
-use crate::accel::{Accelerator, Hit, RayStart};
+use crate::accel::{Accelerator, Hit, Mailbox, RayStart};
 use crate::math::{pow_unit, Dir, Scalar, Unit};
 use crate::scene::{Color, ObjectId, SceneView};
 use crate::shapes::{Leaving, Ray};
@@ -38,10 +38,31 @@ pub struct Stats {
 }
 
 impl Stats {
+    /// What was counted after `earlier` (a copy of these counters).
+    pub fn since(&self, earlier: &Stats) -> Stats {
+        Stats {
+            rays: self.rays - earlier.rays,
+            shadow_rays: self.shadow_rays - earlier.shadow_rays,
+            truncated: self.truncated - earlier.truncated,
+        }
+    }
+
     pub fn add(&mut self, o: &Stats) {
         self.rays += o.rays;
         self.shadow_rays += o.shadow_rays;
         self.truncated += o.truncated;
+    }
+}
+
+/// The mutable state of one thread of rendering: counters and the mailbox.
+pub struct Scratch<'m> {
+    pub stats: Stats,
+    pub mailbox: Mailbox<'m>,
+}
+
+impl<'m> Scratch<'m> {
+    pub fn new(mailbox: Mailbox<'m>) -> Scratch<'m> {
+        Scratch { stats: Stats::default(), mailbox }
     }
 }
 
@@ -100,25 +121,21 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
     }
 
     /// The linear colour seen along a primary ray, and the object it hits.
-    pub fn trace(&self, ray: Ray, stats: &mut Stats) -> (Color, Option<ObjectId>) {
+    pub fn trace(&self, ray: Ray, scratch: &mut Scratch<'_>) -> (Color, Option<ObjectId>) {
         let mut stack: heapless::Vec<Pending, PENDING_RAYS> = heapless::Vec::new();
         let mut color = Color::BLACK;
         let mut first_object = None;
         let mut traced = 0;
-        let mut next = Some(Pending {
-            ray,
-            start: None,
-            depth: 0,
-            weight: Scalar::ONE,
-        });
+        let mut next = Some(Pending { ray, start: None, depth: 0, weight: Scalar::ONE });
         while let Some(p) = next.take().or_else(|| stack.pop()) {
             if traced == MAX_RAYS_PER_SAMPLE {
-                stats.truncated += 1 + stack.len() as u64;
+                scratch.stats.truncated += 1 + stack.len() as u64;
                 break;
             }
             traced += 1;
-            stats.rays += 1;
-            let hit = self.accel.nearest(&self.scene, &p.ray, p.start);
+            scratch.stats.rays += 1;
+            scratch.mailbox.clear();
+            let hit = self.accel.nearest(&self.scene, &p.ray, p.start, &mut scratch.mailbox);
             if p.depth == 0 {
                 first_object = hit.map(|h| h.object);
             }
@@ -126,7 +143,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
                 color = color.saturating_add(self.scene.settings.background.scale(p.weight));
                 continue;
             };
-            let children = self.shade(&p, hit, &mut color, stats);
+            let children = self.shade(&p, hit, &mut color, scratch);
             for child in children.into_iter().flatten() {
                 if child.weight.to_bits() <= 0 {
                     continue;
@@ -134,7 +151,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
                 if next.is_none() {
                     next = Some(child);
                 } else if stack.push(child).is_err() {
-                    stats.truncated += 1;
+                    scratch.stats.truncated += 1;
                 }
             }
         }
@@ -143,22 +160,12 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
 
     /// Adds the weighted local colour at `hit` to `color` and returns the
     /// transmitted and reflected rays to trace.
-    fn shade(
-        &self,
-        p: &Pending,
-        hit: Hit,
-        color: &mut Color,
-        stats: &mut Stats,
-    ) -> [Option<Pending>; 2] {
+    fn shade(&self, p: &Pending, hit: Hit, color: &mut Color, scratch: &mut Scratch<'_>) -> [Option<Pending>; 2] {
         let shape = self.scene.shape(hit.object);
         let point = p.ray.at(hit.t);
         let geometric = shape.normal_at(point);
         // Two-sided: shade with the normal facing the incoming ray.
-        let normal = if geometric.dot_q60(p.ray.dir) > 0 {
-            -geometric
-        } else {
-            geometric
-        };
+        let normal = if geometric.dot_q60(p.ray.dir) > 0 { -geometric } else { geometric };
         let to_eye = -p.ray.dir;
         let surface = self.scene.surface(shape.surface());
         let mut local = surface.ambient;
@@ -172,30 +179,20 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
                 continue;
             }
             let distance = to_light.length();
-            stats.shadow_rays += 1;
-            let shadow = Ray {
-                origin: point,
-                dir: light_dir,
-            };
-            let start = RayStart {
-                object: hit.object,
-                leaving: leaving_along(geometric, light_dir),
-            };
+            scratch.stats.shadow_rays += 1;
+            let shadow = Ray { origin: point, dir: light_dir };
+            let start = RayStart { object: hit.object, leaving: leaving_along(geometric, light_dir) };
             let t_max = Scalar::from_bits((distance.to_bits() - 1).max(0));
-            if self
-                .accel
-                .occluded(&self.scene, &shadow, t_max, Some(start))
-            {
+            scratch.mailbox.clear();
+            if self.accel.occluded(&self.scene, &shadow, t_max, Some(start), &mut scratch.mailbox) {
                 continue;
             }
             let attenuation = self.attenuation(light.brightness.to_bits(), distance);
             let mirrored = light_dir.reflect_about(normal);
             let rv = mirrored.dot(to_eye).to_bits().max(0);
             let spec = pow_unit(rv, surface.exponent.to_bits() << 16);
-            let term = surface
-                .diffuse
-                .scale_unit(cos)
-                .saturating_add(surface.specular.scale_unit(Unit::from_bits(spec)));
+            let term =
+                surface.diffuse.scale_unit(cos).saturating_add(surface.specular.scale_unit(Unit::from_bits(spec)));
             local = local.saturating_add(term.scale(attenuation));
         }
         let t = surface.transparency;
@@ -207,10 +204,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         let child = |dir: Dir, k: Scalar| {
             (k.to_bits() > 0).then(|| Pending {
                 ray: Ray { origin: point, dir },
-                start: Some(RayStart {
-                    object: hit.object,
-                    leaving: leaving_along(geometric, dir),
-                }),
+                start: Some(RayStart { object: hit.object, leaving: leaving_along(geometric, dir) }),
                 depth: p.depth + 1,
                 weight: mul(p.weight, k),
             })
@@ -265,15 +259,9 @@ mod shading_tests {
         let view = scene.view();
         let eye = view.normalization.point(view.settings.view.eye);
         let tracer = Tracer::new(view, &Naive);
-        let mut stats = Stats::default();
-        let (c, o) = tracer.trace(
-            Ray {
-                origin: eye,
-                dir: -Dir::Z,
-            },
-            &mut stats,
-        );
-        (c, o, stats)
+        let mut scratch = Scratch::new(Mailbox::none());
+        let (c, o) = tracer.trace(Ray { origin: eye, dir: -Dir::Z }, &mut scratch);
+        (c, o, scratch.stats)
     }
 
     fn approx(c: Color, rgb: [i32; 3]) {
@@ -296,10 +284,7 @@ mod shading_tests {
     #[test]
     fn ambient_diffuse_and_specular_add_up() {
         // Light at the eye, 9 units from the hit point: B/(d + d0) = 10/10.
-        let text = format!(
-            "{SPHERE}LIGHT 10 0 0 10\n{}",
-            surface("0.1", "0.5", "0.25", "10", "0", "0")
-        );
+        let text = format!("{SPHERE}LIGHT 10 0 0 10\n{}", surface("0.1", "0.5", "0.25", "10", "0", "0"));
         let (c, o, stats) = look(&text);
         approx(c, [m(850); 3]);
         assert_eq!(o, Some(ObjectId(0)));
@@ -309,10 +294,7 @@ mod shading_tests {
     #[test]
     fn attenuation_uses_world_distance_and_d0() {
         // d = 9, d0 = 3: factor 10 / 12; diffuse only.
-        let text = format!(
-            "{SPHERE}ATTENUATION 3 LIGHT 10 0 0 10\n{}",
-            surface("0", "0.6", "0", "0", "0", "0")
-        );
+        let text = format!("{SPHERE}ATTENUATION 3 LIGHT 10 0 0 10\n{}", surface("0", "0.6", "0", "0", "0", "0"));
         approx(look(&text).0, [m(500); 3]);
         // The same scene 1000 times larger, with d0 scaled too: same colour.
         let big = format!(
@@ -325,10 +307,7 @@ mod shading_tests {
     #[test]
     fn specular_exponent_zero_is_constant() {
         // Light off to the side: R·V < 1, but k = 0 makes the term constant.
-        let text = format!(
-            "{SPHERE}LIGHT 9 7 0 8\n{}",
-            surface("0", "0", "0.5", "0", "0", "0")
-        );
+        let text = format!("{SPHERE}LIGHT 9 7 0 8\n{}", surface("0", "0", "0.5", "0", "0", "0"));
         let (c, _, _) = look(&text);
         // d = |(7, 0, 7)| = 9.8995 from P = (0, 0, 1): 9 / 10.8995 · 0.5.
         approx(c, [m(413); 3]);
@@ -336,10 +315,7 @@ mod shading_tests {
 
     #[test]
     fn light_behind_the_surface_gives_ambient_only() {
-        let text = format!(
-            "{SPHERE}LIGHT 10 0 0 -10\n{}",
-            surface("0.2", "0.5", "0.5", "10", "0", "0")
-        );
+        let text = format!("{SPHERE}LIGHT 10 0 0 -10\n{}", surface("0.2", "0.5", "0.5", "10", "0", "0"));
         let (c, _, stats) = look(&text);
         assert_eq!(c.bits(), [m(200); 3]);
         assert_eq!(stats.shadow_rays, 0);
@@ -362,10 +338,7 @@ mod shading_tests {
 
     #[test]
     fn reflection_adds_r_times_what_the_mirror_sees() {
-        let text = format!(
-            "{SPHERE}BACKGROUND 0.5 0.5 0.5\n{}",
-            surface("0.1", "0", "0", "0", "0.4", "0")
-        );
+        let text = format!("{SPHERE}BACKGROUND 0.5 0.5 0.5\n{}", surface("0.1", "0", "0", "0", "0.4", "0"));
         // The mirror direction at the pole is straight back to the eye:
         // background. C = 0.1 + 0.4 · 0.5.
         let (c, _, stats) = look(&text);
@@ -378,26 +351,17 @@ mod shading_tests {
         // t = 0.5: C = 0.5 · 0.2 + 0.5 · background (the ray passes the
         // sphere: its far side, then nothing). The far side's own colour
         // counts too (it is the same transparent surface).
-        let text = format!(
-            "{SPHERE}BACKGROUND 1 1 1 RDEPTH 1\n{}",
-            surface("0.2", "0", "0", "0", "0", "0.5")
-        );
+        let text = format!("{SPHERE}BACKGROUND 1 1 1 RDEPTH 1\n{}", surface("0.2", "0", "0", "0", "0", "0.5"));
         // Depth 1: the far side is reached but not passed: 0.5·0.2 + 0.5·(0.5·0.2).
         approx(look(&text).0, [m(150); 3]);
-        let text = format!(
-            "{SPHERE}BACKGROUND 1 1 1 RDEPTH 2\n{}",
-            surface("0.2", "0", "0", "0", "0", "0.5")
-        );
+        let text = format!("{SPHERE}BACKGROUND 1 1 1 RDEPTH 2\n{}", surface("0.2", "0", "0", "0", "0", "0.5"));
         // Depth 2: … + 0.25 · background.
         approx(look(&text).0, [m(400); 3]);
     }
 
     #[test]
     fn rdepth_zero_traces_primary_rays_only() {
-        let text = format!(
-            "{SPHERE}BACKGROUND 1 1 1 RDEPTH 0\n{}",
-            surface("0.2", "0", "0", "0", "1", "1")
-        );
+        let text = format!("{SPHERE}BACKGROUND 1 1 1 RDEPTH 0\n{}", surface("0.2", "0", "0", "0", "1", "1"));
         let (c, _, stats) = look(&text);
         assert_eq!(c.bits(), [0; 3]); // (1 − t) · local = 0
         assert_eq!(stats.rays, 1);
@@ -421,10 +385,8 @@ mod shading_tests {
     fn the_back_of_a_triangle_is_lit_from_behind() {
         // Clockwise seen from the eye: its front faces −z, the eye sees its
         // back, lit from the eye's side at d = 10: 10/11 · 0.5.
-        let text = format!(
-            "TRIANGLE 1 -2 -2 0  0 2 0  2 -2 0\nLIGHT 10 0 0 10\n{}",
-            surface("0", "0.5", "0", "0", "0", "0")
-        );
+        let text =
+            format!("TRIANGLE 1 -2 -2 0  0 2 0  2 -2 0\nLIGHT 10 0 0 10\n{}", surface("0", "0.5", "0", "0", "0", "0"));
         approx(look(&text).0, [(5 << 16) / 11; 3]);
     }
 }

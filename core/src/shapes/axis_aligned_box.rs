@@ -63,11 +63,7 @@ pub(crate) fn slab_span(ray: &Ray, min: Vec3, max: Vec3) -> Option<SlabSpan> {
 
 impl AxisAlignedBox {
     pub fn new(center: Vec3, half: Vec3, surface: u16) -> AxisAlignedBox {
-        AxisAlignedBox {
-            min: center - half,
-            max: center + half,
-            surface,
-        }
+        AxisAlignedBox { min: center - half, max: center + half, surface }
     }
 
     #[inline]
@@ -91,11 +87,8 @@ impl AxisAlignedBox {
     /// Outward normal of the face nearest to `p` (relative to each half-size);
     /// on an edge or corner the lowest axis wins.
     pub fn normal_at(&self, p: Vec3) -> Dir {
-        let c = [0, 1, 2]
-            .map(|a| (self.min.axis(a).to_bits() as i64 + self.max.axis(a).to_bits() as i64) / 2);
-        let h = [0, 1, 2].map(|a| {
-            (self.max.axis(a).to_bits() as i64 - self.min.axis(a).to_bits() as i64).max(1)
-        });
+        let c = [0, 1, 2].map(|a| (self.min.axis(a).to_bits() as i64 + self.max.axis(a).to_bits() as i64) / 2);
+        let h = [0, 1, 2].map(|a| (self.max.axis(a).to_bits() as i64 - self.min.axis(a).to_bits() as i64).max(1));
         let off = [0, 1, 2].map(|a| p.axis(a).to_bits() as i64 - c[a]);
         // Largest |off_a| / h_a by cross multiplication.
         let mut best = 0;
@@ -108,10 +101,7 @@ impl AxisAlignedBox {
     }
 
     pub fn bounds(&self) -> Aabb {
-        Aabb {
-            min: self.min,
-            max: self.max,
-        }
+        Aabb { min: self.min, max: self.max }
     }
 }
 
@@ -136,20 +126,11 @@ mod tests {
 
     #[test]
     fn misses_and_parallel_rays() {
-        assert_eq!(
-            cube().intersect(&ray(p(2, 0, 0), [0, 0, -1]), far(), Leaving::No),
-            None
-        );
+        assert_eq!(cube().intersect(&ray(p(2, 0, 0), [0, 0, -1]), far(), Leaving::No), None);
         // Parallel to the x faces, inside the x slab: hits.
-        assert_eq!(
-            cube().intersect(&ray(p(1, 0, 0), [0, 0, -1]), far(), Leaving::No),
-            Some(s(7))
-        );
+        assert_eq!(cube().intersect(&ray(p(1, 0, 0), [0, 0, -1]), far(), Leaving::No), Some(s(7)));
         // Pointing away.
-        assert_eq!(
-            cube().intersect(&ray(p(0, 0, 0), [0, 0, 1]), far(), Leaving::No),
-            None
-        );
+        assert_eq!(cube().intersect(&ray(p(0, 0, 0), [0, 0, 1]), far(), Leaving::No), None);
     }
 
     #[test]
@@ -158,10 +139,7 @@ mod tests {
         assert_eq!(cube().intersect(&r, far(), Leaving::No), Some(s(4)));
         assert_eq!(cube().normal_at(r.at(s(4))), -Dir::X);
         let r = ray(p(0, 10, -10), [0, -1, 0]);
-        assert_eq!(
-            cube().normal_at(r.at(cube().intersect(&r, far(), Leaving::No).unwrap())),
-            Dir::Y
-        );
+        assert_eq!(cube().normal_at(r.at(cube().intersect(&r, far(), Leaving::No).unwrap())), Dir::Y);
     }
 
     #[test]
@@ -172,15 +150,9 @@ mod tests {
 
     #[test]
     fn nearly_parallel_ray_has_no_overflow() {
-        let r = Ray {
-            origin: p(0, 0, 0),
-            dir: Dir::from_bits([1, 0, -(1 << 30)]),
-        };
+        let r = Ray { origin: p(0, 0, 0), dir: Dir::from_bits([1, 0, -(1 << 30)]) };
         assert_eq!(cube().intersect(&r, far(), Leaving::No), Some(s(7)));
-        let r = Ray {
-            origin: p(5, 0, -10),
-            dir: Dir::from_bits([-1, 0, 1 << 30]),
-        };
+        let r = Ray { origin: p(5, 0, -10), dir: Dir::from_bits([-1, 0, 1 << 30]) };
         assert_eq!(cube().intersect(&r, far(), Leaving::No), None);
     }
 }

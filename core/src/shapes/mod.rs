@@ -70,16 +70,8 @@ impl Aabb {
     /// The smallest box holding both.
     pub fn union(self, o: Aabb) -> Aabb {
         Aabb {
-            min: Vec3 {
-                x: self.min.x.min(o.min.x),
-                y: self.min.y.min(o.min.y),
-                z: self.min.z.min(o.min.z),
-            },
-            max: Vec3 {
-                x: self.max.x.max(o.max.x),
-                y: self.max.y.max(o.max.y),
-                z: self.max.z.max(o.max.z),
-            },
+            min: Vec3 { x: self.min.x.min(o.min.x), y: self.min.y.min(o.min.y), z: self.min.z.min(o.min.z) },
+            max: Vec3 { x: self.max.x.max(o.max.x), y: self.max.y.max(o.max.y), z: self.max.z.max(o.max.z) },
         }
     }
 
@@ -101,13 +93,8 @@ pub enum ShapeKind {
 }
 
 impl ShapeKind {
-    pub const ALL: [ShapeKind; 5] = [
-        ShapeKind::Sphere,
-        ShapeKind::Box,
-        ShapeKind::Superquadric,
-        ShapeKind::Triangle,
-        ShapeKind::Rectangle,
-    ];
+    pub const ALL: [ShapeKind; 5] =
+        [ShapeKind::Sphere, ShapeKind::Box, ShapeKind::Superquadric, ShapeKind::Triangle, ShapeKind::Rectangle];
 
     /// The scene-file keyword.
     pub const fn keyword(self) -> &'static str {
@@ -261,18 +248,11 @@ pub(crate) mod test_util {
     }
 
     pub fn p(x: i32, y: i32, z: i32) -> Vec3 {
-        Vec3 {
-            x: s(x),
-            y: s(y),
-            z: s(z),
-        }
+        Vec3 { x: s(x), y: s(y), z: s(z) }
     }
 
     pub fn ray(o: Vec3, d: [i64; 3]) -> Ray {
-        Ray {
-            origin: o,
-            dir: Dir::normalize(d).unwrap(),
-        }
+        Ray { origin: o, dir: Dir::normalize(d).unwrap() }
     }
 
     pub fn far() -> Scalar {
@@ -281,9 +261,6 @@ pub(crate) mod test_util {
 
     /// `|a − b|` below `tol` raw units on every axis.
     pub fn close(a: Vec3, b: Vec3, tol: i32) -> bool {
-        a.bits()
-            .iter()
-            .zip(b.bits())
-            .all(|(x, y)| (x - y).abs() <= tol)
+        a.bits().iter().zip(b.bits()).all(|(x, y)| (x - y).abs() <= tol)
     }
 }

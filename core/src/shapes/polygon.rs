@@ -37,12 +37,7 @@ impl<const N: usize> Polygon<N> {
         } else {
             2
         };
-        Some(Polygon {
-            corners,
-            normal,
-            offset: corners[0].dot_dir(normal),
-            drop_axis,
-        })
+        Some(Polygon { corners, normal, offset: corners[0].dot_dir(normal), drop_axis })
     }
 
     #[inline]
@@ -121,13 +116,8 @@ impl<const N: usize> Polygon<N> {
     }
 
     pub fn bounds(&self) -> Aabb {
-        let first = Aabb {
-            min: self.corners[0],
-            max: self.corners[0],
-        };
-        self.corners
-            .iter()
-            .fold(first, |b, &c| b.union(Aabb { min: c, max: c }))
+        let first = Aabb { min: self.corners[0], max: self.corners[0] };
+        self.corners.iter().fold(first, |b, &c| b.union(Aabb { min: c, max: c }))
     }
 }
 
@@ -135,9 +125,5 @@ impl<const N: usize> Polygon<N> {
 pub fn cross_of_edges(a: Vec3, b: Vec3, c: Vec3) -> [i64; 3] {
     let e1 = (b - a).wide();
     let e2 = (c - a).wide();
-    [
-        e1[1] * e2[2] - e1[2] * e2[1],
-        e1[2] * e2[0] - e1[0] * e2[2],
-        e1[0] * e2[1] - e1[1] * e2[0],
-    ]
+    [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]]
 }

@@ -19,15 +19,8 @@ impl Rectangle {
         // counter-clockwise quadrilateral, using all four corners.
         let d1 = (corners[2] - corners[0]).wide();
         let d2 = (corners[3] - corners[1]).wide();
-        let normal = [
-            d1[1] * d2[2] - d1[2] * d2[1],
-            d1[2] * d2[0] - d1[0] * d2[2],
-            d1[0] * d2[1] - d1[1] * d2[0],
-        ];
-        Some(Rectangle {
-            polygon: Polygon::with_normal(corners, normal)?,
-            surface,
-        })
+        let normal = [d1[1] * d2[2] - d1[2] * d2[1], d1[2] * d2[0] - d1[0] * d2[2], d1[0] * d2[1] - d1[1] * d2[0]];
+        Some(Rectangle { polygon: Polygon::with_normal(corners, normal)?, surface })
     }
 
     #[inline]
@@ -58,31 +51,16 @@ mod tests {
     fn front_normal_and_hits() {
         let f = floor();
         assert_eq!(f.normal(), Dir::Y);
-        assert_eq!(
-            f.intersect(&ray(p(0, 3, 0), [0, -1, 0]), far(), Leaving::No),
-            Some(s(4))
-        );
-        assert_eq!(
-            f.intersect(&ray(p(1, -5, 1), [0, 1, 0]), far(), Leaving::No),
-            Some(s(4))
-        );
-        assert_eq!(
-            f.intersect(&ray(p(2, 3, -2), [0, -1, 0]), far(), Leaving::No),
-            Some(s(4))
-        );
+        assert_eq!(f.intersect(&ray(p(0, 3, 0), [0, -1, 0]), far(), Leaving::No), Some(s(4)));
+        assert_eq!(f.intersect(&ray(p(1, -5, 1), [0, 1, 0]), far(), Leaving::No), Some(s(4)));
+        assert_eq!(f.intersect(&ray(p(2, 3, -2), [0, -1, 0]), far(), Leaving::No), Some(s(4)));
     }
 
     #[test]
     fn misses_outside_the_corners() {
         let f = floor();
-        assert_eq!(
-            f.intersect(&ray(p(3, 3, 0), [0, -1, 0]), far(), Leaving::No),
-            None
-        );
-        assert_eq!(
-            f.intersect(&ray(p(0, 3, 3), [0, -1, 0]), far(), Leaving::No),
-            None
-        );
+        assert_eq!(f.intersect(&ray(p(3, 3, 0), [0, -1, 0]), far(), Leaving::No), None);
+        assert_eq!(f.intersect(&ray(p(0, 3, 3), [0, -1, 0]), far(), Leaving::No), None);
     }
 
     #[test]
@@ -99,14 +77,9 @@ mod tests {
         let a = Rectangle::new([p(-2, 0, 2), p(0, 0, 2), p(0, 0, -2), p(-2, 0, -2)], 0).unwrap();
         let b = Rectangle::new([p(0, 0, 2), p(2, 0, 2), p(2, 0, -2), p(0, 0, -2)], 0).unwrap();
         for k in -50..50 {
-            let origin = Vec3 {
-                x: Scalar::from_bits(k),
-                ..p(0, 5, 0)
-            };
+            let origin = Vec3 { x: Scalar::from_bits(k), ..p(0, 5, 0) };
             let r = ray(origin, [1, -1000, 3]);
-            let hit = a
-                .intersect(&r, far(), Leaving::No)
-                .or(b.intersect(&r, far(), Leaving::No));
+            let hit = a.intersect(&r, far(), Leaving::No).or(b.intersect(&r, far(), Leaving::No));
             assert!(hit.is_some(), "crack at k = {k}");
         }
     }

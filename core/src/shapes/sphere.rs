@@ -18,11 +18,7 @@ pub struct Sphere {
 
 impl Sphere {
     pub fn new(center: Vec3, radius: Scalar, surface: u16) -> Sphere {
-        Sphere {
-            center,
-            radius,
-            surface,
-        }
+        Sphere { center, radius, surface }
     }
 
     #[inline]
@@ -47,11 +43,7 @@ impl Sphere {
         let h = isqrt(disc as u64) as i64;
         let near = center_t - h;
         let far = center_t + h;
-        let t = if leaving == Leaving::No && near > 0 {
-            near
-        } else {
-            far
-        };
+        let t = if leaving == Leaving::No && near > 0 { near } else { far };
         (t > 0 && t <= t_max.to_bits() as i64).then(|| Scalar::from_bits(t as i32))
     }
 
@@ -61,15 +53,8 @@ impl Sphere {
     }
 
     pub fn bounds(&self) -> Aabb {
-        let r = Vec3 {
-            x: self.radius,
-            y: self.radius,
-            z: self.radius,
-        };
-        Aabb {
-            min: self.center - r,
-            max: self.center + r,
-        }
+        let r = Vec3 { x: self.radius, y: self.radius, z: self.radius };
+        Aabb { min: self.center - r, max: self.center + r }
     }
 }
 
@@ -97,18 +82,9 @@ mod tests {
     #[test]
     fn misses_beside_and_behind() {
         let sph = unit_sphere_at(-5);
-        assert_eq!(
-            sph.intersect(&ray(p(2, 0, 0), [0, 0, -1]), far(), Leaving::No),
-            None
-        );
-        assert_eq!(
-            sph.intersect(&ray(p(0, 0, 0), [0, 0, 1]), far(), Leaving::No),
-            None
-        );
-        assert_eq!(
-            sph.intersect(&ray(p(0, 0, 0), [0, 1, 0]), far(), Leaving::No),
-            None
-        );
+        assert_eq!(sph.intersect(&ray(p(2, 0, 0), [0, 0, -1]), far(), Leaving::No), None);
+        assert_eq!(sph.intersect(&ray(p(0, 0, 0), [0, 0, 1]), far(), Leaving::No), None);
+        assert_eq!(sph.intersect(&ray(p(0, 0, 0), [0, 1, 0]), far(), Leaving::No), None);
     }
 
     #[test]
@@ -145,14 +121,10 @@ mod tests {
     #[test]
     fn tiny_and_huge_spheres() {
         let tiny = Sphere::new(p(0, 0, -100), Scalar::from_bits(64), 0);
-        let t = tiny
-            .intersect(&ray(p(0, 0, 0), [0, 0, -1]), far(), Leaving::No)
-            .unwrap();
+        let t = tiny.intersect(&ray(p(0, 0, 0), [0, 0, -1]), far(), Leaving::No).unwrap();
         assert_eq!(t.to_bits(), (100 << 16) - 64);
         let huge = Sphere::new(p(0, 0, -8000), s(4000), 0);
-        let t = huge
-            .intersect(&ray(p(0, 0, 8000), [0, 0, -1]), far(), Leaving::No)
-            .unwrap();
+        let t = huge.intersect(&ray(p(0, 0, 8000), [0, 0, -1]), far(), Leaving::No).unwrap();
         assert_eq!(t, s(12000));
     }
 }

@@ -45,12 +45,7 @@ struct Segment {
 
 impl Superquadric {
     pub fn new(center: Vec3, half: Vec3, power: Scalar, surface: u16) -> Superquadric {
-        Superquadric {
-            center,
-            half,
-            power,
-            surface,
-        }
+        Superquadric { center, half, power, surface }
     }
 
     /// `p` in unit-cube coordinates (Q2.30).
@@ -136,12 +131,8 @@ impl Superquadric {
         let t1 = exit.to_scalar();
         let l0 = self.local(ray.at(t0));
         let l1 = self.local(ray.at(t1));
-        let seg = Segment {
-            t0: t0.to_bits() as i64,
-            t1: t1.to_bits() as i64,
-            l0,
-            delta: [0, 1, 2].map(|i| l1[i] - l0[i]),
-        };
+        let seg =
+            Segment { t0: t0.to_bits() as i64, t1: t1.to_bits() as i64, l0, delta: [0, 1, 2].map(|i| l1[i] - l0[i]) };
         let (f0, _) = self.evaluate(seg.l0, seg.delta);
         let starts_inside = f0 <= ONE;
         let u = if leaving == Leaving::No && !starts_inside {
@@ -179,10 +170,7 @@ impl Superquadric {
     }
 
     pub fn bounds(&self) -> Aabb {
-        Aabb {
-            min: self.center - self.half,
-            max: self.center + self.half,
-        }
+        Aabb { min: self.center - self.half, max: self.center + self.half }
     }
 }
 
@@ -225,11 +213,7 @@ mod tests {
         for power in [2, 3, 8, 20, 64] {
             let q = sq(s(power));
             let r = ray(p(0, 0, 0), [0, 0, -1]);
-            assert_eq!(
-                q.intersect(&r, far(), Leaving::No),
-                Some(s(8)),
-                "p = {power}"
-            );
+            assert_eq!(q.intersect(&r, far(), Leaving::No), Some(s(8)), "p = {power}");
             assert_eq!(q.intersect(&r, far(), Leaving::Inward), Some(s(12)));
             assert_eq!(q.normal_at(p(0, 0, -8)), Dir::Z);
         }
@@ -253,16 +237,11 @@ mod tests {
         // one near the box corner.
         let r = ray(p(10, 10, 0), [-1, -1, -1]);
         let d = Scalar::from_num(10.0 * 1.7320508);
-        let t2 = sq(s(2))
-            .intersect(&ray(p(10, 10, 0), [-1, -1, -1]), far(), Leaving::No)
-            .unwrap();
+        let t2 = sq(s(2)).intersect(&ray(p(10, 10, 0), [-1, -1, -1]), far(), Leaving::No).unwrap();
         assert!((t2 - (d - s(2))).abs() < Scalar::from_num(0.01), "{t2}");
         let t64 = sq(s(64)).intersect(&r, far(), Leaving::No).unwrap();
         let corner = d - Scalar::from_num(2.0 * 1.7320508);
-        assert!(
-            t64 > corner && t64 < corner + Scalar::from_num(0.1),
-            "{t64}"
-        );
+        assert!(t64 > corner && t64 < corner + Scalar::from_num(0.1), "{t64}");
     }
 
     #[test]
@@ -278,9 +257,7 @@ mod tests {
     fn non_integer_power_between_neighbours() {
         let r = ray(p(10, 10, 0), [-1, -1, -1]);
         let t3 = sq(s(3)).intersect(&r, far(), Leaving::No).unwrap();
-        let t35 = sq(Scalar::from_num(3.5))
-            .intersect(&r, far(), Leaving::No)
-            .unwrap();
+        let t35 = sq(Scalar::from_num(3.5)).intersect(&r, far(), Leaving::No).unwrap();
         let t4 = sq(s(4)).intersect(&r, far(), Leaving::No).unwrap();
         assert!(t3 > t35 && t35 > t4, "{t3} {t35} {t4}");
     }
@@ -301,9 +278,6 @@ mod tests {
         let t = q.intersect(&r, far(), Leaving::No).unwrap();
         let n = q.normal_at(r.at(t));
         let b = n.bits();
-        assert!(
-            b[0] > 0 && b[1] > 0 && b[2] > 0 && (b[0] - b[1]).abs() < 1 << 12,
-            "{n:?}"
-        );
+        assert!(b[0] > 0 && b[1] > 0 && b[2] > 0 && (b[0] - b[1]).abs() < 1 << 12, "{n:?}");
     }
 }

@@ -15,10 +15,7 @@ impl Triangle {
     /// `None` when the corners are collinear at this precision.
     pub fn new(corners: [Vec3; 3], surface: u16) -> Option<Triangle> {
         let normal = cross_of_edges(corners[0], corners[1], corners[2]);
-        Some(Triangle {
-            polygon: Polygon::with_normal(corners, normal)?,
-            surface,
-        })
+        Some(Triangle { polygon: Polygon::with_normal(corners, normal)?, surface })
     }
 
     #[inline]
@@ -48,52 +45,25 @@ mod tests {
     fn hits_inside_from_both_sides() {
         let t = tri();
         assert_eq!(t.normal(), Dir::Z);
-        assert_eq!(
-            t.intersect(&ray(p(1, 1, 0), [0, 0, -1]), far(), Leaving::No),
-            Some(s(5))
-        );
-        assert_eq!(
-            t.intersect(&ray(p(1, 1, -10), [0, 0, 1]), far(), Leaving::No),
-            Some(s(5))
-        );
+        assert_eq!(t.intersect(&ray(p(1, 1, 0), [0, 0, -1]), far(), Leaving::No), Some(s(5)));
+        assert_eq!(t.intersect(&ray(p(1, 1, -10), [0, 0, 1]), far(), Leaving::No), Some(s(5)));
     }
 
     #[test]
     fn misses_outside_parallel_and_behind() {
         let t = tri();
-        assert_eq!(
-            t.intersect(&ray(p(3, 3, 0), [0, 0, -1]), far(), Leaving::No),
-            None
-        );
-        assert_eq!(
-            t.intersect(&ray(p(1, 1, 0), [1, 0, 0]), far(), Leaving::No),
-            None
-        );
-        assert_eq!(
-            t.intersect(&ray(p(1, 1, 0), [0, 0, 1]), far(), Leaving::No),
-            None
-        );
-        assert_eq!(
-            t.intersect(&ray(p(1, 1, 0), [0, 0, -1]), s(4), Leaving::No),
-            None
-        );
+        assert_eq!(t.intersect(&ray(p(3, 3, 0), [0, 0, -1]), far(), Leaving::No), None);
+        assert_eq!(t.intersect(&ray(p(1, 1, 0), [1, 0, 0]), far(), Leaving::No), None);
+        assert_eq!(t.intersect(&ray(p(1, 1, 0), [0, 0, 1]), far(), Leaving::No), None);
+        assert_eq!(t.intersect(&ray(p(1, 1, 0), [0, 0, -1]), s(4), Leaving::No), None);
     }
 
     #[test]
     fn edges_count_as_inside_and_leaving_never_rehits() {
         let t = tri();
-        assert_eq!(
-            t.intersect(&ray(p(2, 2, 0), [0, 0, -1]), far(), Leaving::No),
-            Some(s(5))
-        );
-        assert_eq!(
-            t.intersect(&ray(p(0, 0, 0), [0, 0, -1]), far(), Leaving::No),
-            Some(s(5))
-        );
-        assert_eq!(
-            t.intersect(&ray(p(1, 1, 0), [0, 0, -1]), far(), Leaving::Inward),
-            None
-        );
+        assert_eq!(t.intersect(&ray(p(2, 2, 0), [0, 0, -1]), far(), Leaving::No), Some(s(5)));
+        assert_eq!(t.intersect(&ray(p(0, 0, 0), [0, 0, -1]), far(), Leaving::No), Some(s(5)));
+        assert_eq!(t.intersect(&ray(p(1, 1, 0), [0, 0, -1]), far(), Leaving::Inward), None);
     }
 
     #[test]
@@ -105,9 +75,6 @@ mod tests {
     fn clockwise_corners_face_the_other_way() {
         let t = Triangle::new([p(0, 0, -5), p(0, 4, -5), p(4, 0, -5)], 0).unwrap();
         assert_eq!(t.normal(), -Dir::Z);
-        assert_eq!(
-            t.intersect(&ray(p(1, 1, 0), [0, 0, -1]), far(), Leaving::No),
-            Some(s(5))
-        );
+        assert_eq!(t.intersect(&ray(p(1, 1, 0), [0, 0, -1]), far(), Leaving::No), Some(s(5)));
     }
 }
