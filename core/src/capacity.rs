@@ -11,6 +11,7 @@
 //! To raise a limit, define your own profile (copy one below and change the
 //! numbers); nothing else changes.
 
+use crate::accel::{HashEntry, OctreeNode};
 use crate::scene::{Light, SurfaceEntry};
 use crate::shapes::{AxisAlignedBox, Rectangle, ShapeHandle, Sphere, Superquadric, Triangle};
 
@@ -25,6 +26,8 @@ pub trait Arena<T>: Sized {
     fn as_slice(&self) -> &[T];
     fn as_mut_slice(&mut self) -> &mut [T];
     fn clear(&mut self);
+    /// Drops the items from `len` on.
+    fn truncate(&mut self, len: usize);
 }
 
 impl<T, const N: usize> Arena<T> for heapless::Vec<T, N> {
@@ -45,6 +48,10 @@ impl<T, const N: usize> Arena<T> for heapless::Vec<T, N> {
 
     fn clear(&mut self) {
         heapless::Vec::clear(self)
+    }
+
+    fn truncate(&mut self, len: usize) {
+        heapless::Vec::truncate(self, len)
     }
 }
 
@@ -77,6 +84,10 @@ impl<T, const N: usize> Arena<T> for HeapArena<T, N> {
     fn clear(&mut self) {
         self.0.clear()
     }
+
+    fn truncate(&mut self, len: usize) {
+        self.0.truncate(len)
+    }
 }
 
 /// The capacities of one build: how many of each thing a scene may hold.
@@ -93,6 +104,16 @@ pub trait Capacities {
     /// Surface definitions; at most 65,535 (objects refer to them by `u16`).
     type Surfaces: Arena<SurfaceEntry>;
     type Lights: Arena<Light>;
+    /// Octree boxes (8 per subdivision, plus the root).
+    type OctreeNodes: Arena<OctreeNode>;
+    /// Object references of the octree's leaves (an object in several
+    /// leaves counts once per leaf), and working room while building.
+    type OctreeRefs: Arena<u32>;
+    /// Hash-table entries: one per subdivided box (the thesis's structure
+    /// holding the addresses of a box's eight children).
+    type OctreeEntries: Arena<HashEntry>;
+    /// Hash-table buckets; the table size is this arena's capacity.
+    type OctreeBuckets: Arena<u32>;
 }
 
 /// The host build: a million objects of any mix (heap-backed arenas).
@@ -110,6 +131,10 @@ impl Capacities for Host {
     type Rectangles = HeapArena<Rectangle, 1_000_000>;
     type Surfaces = HeapArena<SurfaceEntry, 65_535>;
     type Lights = HeapArena<Light, 4_096>;
+    type OctreeNodes = HeapArena<OctreeNode, 16_000_000>;
+    type OctreeRefs = HeapArena<u32, 64_000_000>;
+    type OctreeEntries = HeapArena<HashEntry, 2_000_000>;
+    type OctreeBuckets = HeapArena<u32, 65_521>;
 }
 
 /// A board with 16 KiB of RAM (BBC micro:bit v1): about 6 KiB of scene.
@@ -125,6 +150,10 @@ impl Capacities for Board16K {
     type Rectangles = heapless::Vec<Rectangle, 4>;
     type Surfaces = heapless::Vec<SurfaceEntry, 16>;
     type Lights = heapless::Vec<Light, 4>;
+    type OctreeNodes = heapless::Vec<OctreeNode, 400>;
+    type OctreeRefs = heapless::Vec<u32, 1024>;
+    type OctreeEntries = heapless::Vec<HashEntry, 50>;
+    type OctreeBuckets = heapless::Vec<u32, 31>;
 }
 
 /// A board with 64 KiB of RAM or more (Cortex-M3/M4 class).
@@ -140,4 +169,8 @@ impl Capacities for Board64K {
     type Rectangles = heapless::Vec<Rectangle, 96>;
     type Surfaces = heapless::Vec<SurfaceEntry, 64>;
     type Lights = heapless::Vec<Light, 8>;
+    type OctreeNodes = heapless::Vec<OctreeNode, 2048>;
+    type OctreeRefs = heapless::Vec<u32, 6144>;
+    type OctreeEntries = heapless::Vec<HashEntry, 256>;
+    type OctreeBuckets = heapless::Vec<u32, 127>;
 }

@@ -1,6 +1,6 @@
 //! The `host-sim` command line.
 
-use crate::{load_file, new_scene, render_with_progress, LoadError};
+use crate::{load_file, new_scene, render_with_progress, AccelMode, LoadError, RenderOptions};
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::{IsTerminal, Write};
@@ -30,6 +30,16 @@ pub struct Args {
     /// preview; a default VIEWPORT follows the new aspect ratio).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
+    /// Intersection strategy: auto picks the fastest for the scene (naive
+    /// for a handful of objects, else dda). All give the same image.
+    #[arg(long, value_enum, default_value_t = AccelMode::Auto)]
+    pub accel: AccelMode,
+    /// Octree criterion: a box holding more objects than this is subdivided.
+    #[arg(long, value_name = "N", default_value_t = 2)]
+    pub max_objects: usize,
+    /// Octree criterion: boxes are not subdivided below this depth (at most 18).
+    #[arg(long, value_name = "D", default_value_t = 12, value_parser = clap::value_parser!(u32).range(0..=18))]
+    pub max_depth: u32,
     /// Print nothing but errors.
     #[arg(long, short)]
     pub quiet: bool,
@@ -117,7 +127,16 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
         None
     };
     let started = Instant::now();
-    let rendered = render_with_progress(&scene, Some((w, h)), |_| {
+    let options = RenderOptions {
+        size: Some((w, h)),
+        accel: args.accel,
+        octree: octrace_core::accel::OctreeConfig {
+            max_objects: args.max_objects,
+            max_depth: args.max_depth,
+            ..Default::default()
+        },
+    };
+    let rendered = render_with_progress(&scene, &options, |_| {
         if let Some(b) = &bar {
             b.inc(1);
         }
@@ -125,7 +144,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let (image, stats) = match rendered {
+    let rendered = match rendered {
         Ok(r) => r,
         Err(e) => {
             // The parser rejects these; a scene built by hand may not.
@@ -134,17 +153,29 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
         }
     };
     let elapsed = started.elapsed();
+    let (image, stats) = (&rendered.image, rendered.stats);
     if let Err(e) = write_atomically(&out, |f| image.write_png(f).map_err(std::io::Error::other)) {
         let _ = writeln!(stderr, "host-sim: cannot write {}: {e}", out.display());
         return Err(EXIT_IO);
     }
     if !args.quiet {
+        if let Some((report, _)) = &rendered.build {
+            if let Some(what) = report.exhausted {
+                let _ = writeln!(
+                    stderr,
+                    "host-sim: the octree ran out of {what}: {} boxes left unsplit (slower, same image)",
+                    report.unsplit
+                );
+            }
+        }
         let _ = writeln!(
             stderr,
-            "{w}x{h} in {:.3} s: {} rays, {} shadow rays{} -> {}",
+            "{w}x{h} in {:.3} s ({}): {} rays, {} shadow rays, {} cells{} -> {}",
             elapsed.as_secs_f64(),
+            rendered.accel.name(),
             stats.rays,
             stats.shadow_rays,
+            stats.cells,
             if stats.truncated > 0 {
                 format!(" ({} ray-tree branches cut at the per-sample limits)", stats.truncated)
             } else {

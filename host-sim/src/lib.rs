@@ -7,7 +7,7 @@ pub mod image;
 
 pub use image::RgbImage;
 
-use octrace_core::accel::Naive;
+use octrace_core::accel::{BuildReport, Mailbox, Naive, Octree, OctreeConfig, Traversal};
 use octrace_core::capacity::Host;
 use octrace_core::parse::{parse_bytes, ParseError};
 use octrace_core::render::Renderer;
@@ -65,30 +65,121 @@ pub fn load_file(path: &Path, scene: &mut HostScene) -> Result<Loaded, LoadError
     load_bytes(&path.display().to_string(), &bytes, scene)
 }
 
-/// Renders a loaded scene into a new image (`size` overrides RASTER).
-pub fn render(scene: &HostScene, size: Option<(u32, u32)>) -> Result<(RgbImage, Stats), CameraError> {
-    render_with_progress(scene, size, |_| {})
+/// Which intersection strategy to use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum AccelMode {
+    /// The fastest for the scene: naive for a handful of objects, else dda.
+    Auto,
+    /// Every object tested for every ray (the thesis's first version).
+    Naive,
+    /// The thesis's octree walk: Minlen steps and hash-table lookups.
+    Octree,
+    /// The octree walked with integer 3DDDA.
+    Dda,
+}
+
+/// Scenes with at most this many objects render fastest without an octree
+/// (measured: see BENCHMARKS.md).
+pub const NAIVE_UP_TO: usize = 8;
+
+impl AccelMode {
+    /// The concrete mode `Auto` stands for on a scene with `objects` objects.
+    pub fn resolve(self, objects: usize) -> AccelMode {
+        match self {
+            AccelMode::Auto if objects <= NAIVE_UP_TO => AccelMode::Naive,
+            AccelMode::Auto => AccelMode::Dda,
+            m => m,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            AccelMode::Auto => "auto",
+            AccelMode::Naive => "naive",
+            AccelMode::Octree => "octree",
+            AccelMode::Dda => "dda",
+        }
+    }
+}
+
+/// How to render.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderOptions {
+    /// Overrides RASTER.
+    pub size: Option<(u32, u32)>,
+    pub accel: AccelMode,
+    /// Subdivision criterion (the traversal follows `accel`).
+    pub octree: OctreeConfig,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions { size: None, accel: AccelMode::Auto, octree: OctreeConfig::default() }
+    }
+}
+
+/// A finished render.
+pub struct Rendered {
+    pub image: RgbImage,
+    pub stats: Stats,
+    /// The mode actually used (never `Auto`).
+    pub accel: AccelMode,
+    /// The octree's build report and time, when one was built.
+    pub build: Option<(BuildReport, std::time::Duration)>,
+}
+
+/// The host's octree.
+pub type HostOctree = Octree<Host>;
+
+/// Builds the acceleration structure for `mode` (none for naive).
+pub fn build_octree(scene: &HostScene, mode: AccelMode, config: &OctreeConfig) -> Option<Box<HostOctree>> {
+    let traversal = match mode.resolve(scene.view().object_count()) {
+        AccelMode::Naive | AccelMode::Auto => return None,
+        AccelMode::Octree => Traversal::Named,
+        AccelMode::Dda => Traversal::Dda,
+    };
+    let mut octree: Box<HostOctree> = Box::default();
+    octree.build(&scene.view(), &OctreeConfig { traversal, ..*config });
+    Some(octree)
+}
+
+/// Renders a loaded scene into a new image.
+pub fn render(scene: &HostScene, options: &RenderOptions) -> Result<Rendered, CameraError> {
+    render_with_progress(scene, options, |_| {})
 }
 
 /// As [`render`], calling `row_done(y)` after each row.
 pub fn render_with_progress(
     scene: &HostScene,
-    size: Option<(u32, u32)>,
+    options: &RenderOptions,
     mut row_done: impl FnMut(u32),
-) -> Result<(RgbImage, Stats), CameraError> {
+) -> Result<Rendered, CameraError> {
     let view = scene.view();
-    let [w, h] = size.map_or(view.settings.raster, |(w, h)| [w, h]);
-    let mut renderer = Renderer::with_size(view, &Naive, w, h)?;
+    let [w, h] = options.size.map_or(view.settings.raster, |(w, h)| [w, h]);
+    let accel = options.accel.resolve(view.object_count());
+    let started = std::time::Instant::now();
+    let octree = build_octree(scene, accel, &options.octree);
+    let build = octree.as_ref().map(|o| (*o.report(), started.elapsed()));
     let mut image = RgbImage::new(w, h);
     let mut stats = Stats::default();
-    for y in 0..h {
-        match renderer.render_rows(y..y + 1, &mut image) {
-            Ok(s) => stats.add(&s),
-            Err(never) => match never {},
+    let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
+    let mut rows = |renderer: &mut dyn FnMut(u32, &mut RgbImage) -> Stats| {
+        for y in 0..h {
+            stats.add(&renderer(y, &mut image));
+            row_done(y);
         }
-        row_done(y);
+    };
+    match &octree {
+        None => {
+            let mut r = Renderer::with_size(view, &Naive, w, h)?;
+            rows(&mut |y, img| r.render_rows(y..y + 1, img).unwrap_or_else(|never| match never {}));
+        }
+        Some(tree) => {
+            let mut r = Renderer::with_size(view, &**tree, w, h)?.with_mailbox(&mut words);
+            rows(&mut |y, img| r.render_rows(y..y + 1, img).unwrap_or_else(|never| match never {}));
+        }
     }
-    Ok((image, stats))
+    Ok(Rendered { image, stats, accel, build })
 }
 
 /// Runs the command line `args` (including the program name); help goes to

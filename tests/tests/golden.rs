@@ -7,7 +7,7 @@
 //!
 //!     OCTRACE_BLESS=1 cargo test -p octrace-tests --test golden
 
-use host_sim::{load_file, new_scene, render, RgbImage};
+use host_sim::{load_file, new_scene, render, RenderOptions, RgbImage};
 use octrace_tests::{blessing, repo, scenes};
 
 #[test]
@@ -17,7 +17,7 @@ fn every_scene_matches_its_golden_image() {
     for (name, path) in scenes() {
         let mut scene = new_scene();
         load_file(&path, &mut scene).unwrap_or_else(|e| panic!("{name}: {e}"));
-        let (image, _) = render(&scene, None).unwrap_or_else(|e| panic!("{name}: {e:?}"));
+        let image = render(&scene, &RenderOptions::default()).unwrap_or_else(|e| panic!("{name}: {e:?}")).image;
         let golden = gallery.join(format!("{name}.png"));
         if blessing() {
             std::fs::create_dir_all(&gallery).unwrap();

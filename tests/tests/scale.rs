@@ -4,7 +4,7 @@
 //! Scaling a scene by s scales every length, the VIEWPORT and ATTENUATION d0;
 //! the light brightness scales too, so that B/(d + d0) is unchanged.
 
-use host_sim::{load_bytes, new_scene, render, RgbImage};
+use host_sim::{load_bytes, new_scene, render, RenderOptions, RgbImage};
 
 /// A scene with every primitive, two lights and reflections, at scale `s`.
 fn scene(s: f64) -> String {
@@ -50,7 +50,7 @@ fn scene(s: f64) -> String {
 fn image(s: f64) -> RgbImage {
     let mut sc = new_scene();
     load_bytes("scale", scene(s).as_bytes(), &mut sc).unwrap_or_else(|e| panic!("scale {s}: {e}"));
-    render(&sc, None).unwrap().0
+    render(&sc, &RenderOptions::default()).unwrap().image
 }
 
 #[test]

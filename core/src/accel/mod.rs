@@ -11,8 +11,12 @@
 //!   [`Mailbox`] large enough for the scene (one bit per object).
 
 mod naive;
+mod octree;
 
 pub use naive::Naive;
+pub use octree::{
+    overlaps, BuildReport, Cell, HashEntry, Octree, OctreeConfig, OctreeNode, Traversal, FILING_MARGIN, MAX_DEPTH,
+};
 
 use crate::math::Scalar;
 use crate::scene::{ObjectId, SceneView};
@@ -52,18 +56,20 @@ pub struct Mailbox<'m> {
     words: &'m mut [u32],
     touched: heapless::Vec<u32, 64>,
     overflowed: bool,
+    /// Cells (leaves) visited, for the benchmarks.
+    pub cells: u64,
 }
 
 impl<'m> Mailbox<'m> {
     /// A mailbox over `words`, for up to `32 · words.len()` objects.
     pub fn new(words: &'m mut [u32]) -> Mailbox<'m> {
         words.fill(0);
-        Mailbox { words, touched: heapless::Vec::new(), overflowed: false }
+        Mailbox { words, touched: heapless::Vec::new(), overflowed: false, cells: 0 }
     }
 
     /// No mailbox: every candidate is tested.
     pub fn none() -> Mailbox<'static> {
-        Mailbox { words: &mut [], touched: heapless::Vec::new(), overflowed: false }
+        Mailbox { words: &mut [], touched: heapless::Vec::new(), overflowed: false, cells: 0 }
     }
 
     /// Words needed for `objects` objects.

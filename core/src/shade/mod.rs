@@ -35,6 +35,8 @@ pub struct Stats {
     /// Branches of the ray tree not traced because a bound was reached
     /// (weights below 2^-16 are not counted: they are invisible).
     pub truncated: u64,
+    /// Acceleration cells (octree leaves) visited by all queries.
+    pub cells: u64,
 }
 
 impl Stats {
@@ -44,6 +46,7 @@ impl Stats {
             rays: self.rays - earlier.rays,
             shadow_rays: self.shadow_rays - earlier.shadow_rays,
             truncated: self.truncated - earlier.truncated,
+            cells: self.cells - earlier.cells,
         }
     }
 
@@ -51,6 +54,7 @@ impl Stats {
         self.rays += o.rays;
         self.shadow_rays += o.shadow_rays;
         self.truncated += o.truncated;
+        self.cells += o.cells;
     }
 }
 
@@ -155,6 +159,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
                 }
             }
         }
+        scratch.stats.cells = scratch.mailbox.cells;
         (color, first_object)
     }
 

@@ -26,12 +26,14 @@ pub(crate) struct SlabSpan {
 /// Clips `ray` against the box `[min, max]`; `None` when the ray's line misses
 /// it. The span may lie partly or wholly behind the origin.
 pub(crate) fn slab_span(ray: &Ray, min: Vec3, max: Vec3) -> Option<SlabSpan> {
+    slab_span_wide(ray.origin.wide(), ray.dir.wide(), min.wide(), max.wide())
+}
+
+/// [`slab_span`] for a ray and a box given as raw integers (origin and box in
+/// Q16.16, direction in Q2.30; coordinates within ±2^31).
+pub(crate) fn slab_span_wide(o: [i64; 3], d: [i64; 3], lo: [i64; 3], hi: [i64; 3]) -> Option<SlabSpan> {
     let mut enter: Option<Ratio> = None;
     let mut exit: Option<Ratio> = None;
-    let o = ray.origin.wide();
-    let d = ray.dir.wide();
-    let lo = min.wide();
-    let hi = max.wide();
     for axis in 0..3 {
         let (near, far) = match d[axis] {
             0 => {

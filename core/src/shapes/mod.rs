@@ -11,7 +11,7 @@
 //! ([`Leaving`]); no test divides by zero or overflows for rays whose origin
 //! lies in the normalised scene range.
 
-mod axis_aligned_box;
+pub(crate) mod axis_aligned_box;
 mod polygon;
 mod rectangle;
 mod sphere;
@@ -214,7 +214,7 @@ impl ShapeRef<'_> {
 /// A ratio `num / den` with `den > 0`, compared exactly by cross
 /// multiplication: the slab tests use it to order crossings without dividing.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Ratio {
+pub struct Ratio {
     pub num: i64,
     pub den: i64,
 }

@@ -5,7 +5,7 @@
 //! Times are the best of several runs on one thread; the machine is printed
 //! first so every table says where it came from.
 
-use host_sim::{load_file, new_scene, render};
+use host_sim::{load_file, new_scene, render, AccelMode, RenderOptions};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -57,7 +57,8 @@ fn scenes_table(dir: &Path) {
         }
         let view = scene.view();
         let [w, h] = view.settings.raster;
-        let (time, stats) = best_of(3, || render(&scene, None).map(|(_, s)| s));
+        let naive = RenderOptions { accel: AccelMode::Naive, ..Default::default() };
+        let (time, stats) = best_of(3, || render(&scene, &naive).map(|r| r.stats));
         let Ok(stats) = stats else { continue };
         println!(
             "| {name} | {w}×{h} | {} | {} | {} | {} | {:.1} ms | {:.0} |",

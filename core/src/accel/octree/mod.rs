@@ -1,0 +1,510 @@
+//! The octree of the thesis's chapter 4, and two ways to walk it.
+//!
+//! *Build.* A cubic root box (a power of two in Q16.16 units) encloses every
+//! object. A box is cut into eight equal children while it holds more than
+//! `max_objects` and is shallower than `max_depth`. Boxes are named as in the
+//! thesis: the root is 1, its children 11 … 18, the children of 15 are
+//! 151 … 158 (digit = 1 + x + 2y + 4z, the octant's bits). A hash table keyed
+//! by name (name mod table size, chained, as Glassner's) holds, for every
+//! subdivided box, where its eight children are. Objects are filed by exact
+//! tests against the box widened by [`FILING_MARGIN`].
+//!
+//! *Walks.* Both visit, in ray order, the leaves the ray passes through,
+//! each with the parameter at which the ray leaves it, compared exactly as
+//! ratios of integers:
+//! - [`Traversal::Named`], the thesis's method: from the exit point step by
+//!   half of Minlen (the smallest box side) across the faces the ray leaves
+//!   through, then find the leaf holding that point from the root, one hash
+//!   lookup per level. (A full Minlen step lands exactly on the far face of a
+//!   smallest neighbour, which exact arithmetic would then skip.)
+//! - [`Traversal::Dda`], octrace's integer 3DDDA in parametric form
+//!   (Revelles et al., after Fujimoto's ARTS and Amanatides & Woo): per axis
+//!   the crossing parameters of the current box's planes as integer
+//!   numerators over `|d_a|`; children inherit them and middle planes are
+//!   means, so a step needs no division, and the plane met first is found by
+//!   cross multiplication (see `dda.rs`).
+//!
+//! *Exactness.* A leaf's hits are final once the nearest is before the leaf's
+//! exit (strictly: an equal hit in the next leaf may come earlier in the
+//! file). With the filing margin wider than any rounding of a hit point,
+//! every mode returns exactly the naive mode's hit.
+//!
+//! *Capacity.* When an arena runs out while building, the box being split
+//! stays a leaf (with more objects): slower, never wrong. The
+//! [`BuildReport`] says how often that happened.
+
+mod dda;
+mod named;
+mod overlap;
+
+pub use overlap::{overlaps, Cell};
+
+use super::{Accelerator, Hit, Mailbox, RayStart};
+use crate::capacity::{Arena, Capacities};
+use crate::math::Scalar;
+use crate::scene::{ObjectId, SceneView};
+use crate::shapes::{Aabb, Ratio, Ray};
+use dda::DdaWalk;
+use named::NamedWalk;
+
+/// Where the ray leaves a leaf: an exact ratio (the thesis's walk) or a
+/// Q40.24 parameter (3DDDA).
+#[derive(Clone, Copy, Debug)]
+enum Exit {
+    Ratio(Ratio),
+    Q24(i64),
+}
+
+impl Exit {
+    /// Whether `t` comes strictly before the exit.
+    #[inline]
+    fn after(self, t: Scalar) -> bool {
+        match self {
+            Exit::Ratio(r) => !r.le_scalar(t),
+            Exit::Q24(e) => to_q24(t) < e,
+        }
+    }
+}
+
+#[inline]
+fn to_q24(t: Scalar) -> i64 {
+    (t.to_bits() as i64) << 8
+}
+
+/// Visits the leaves along `ray` with `visit(leaf objects, exit)`, which
+/// returns the parameter beyond which nothing matters any more (the nearest
+/// hit so far, or the shadow ray's end), or `None` to stop.
+#[inline]
+fn walk_leaves<C: Capacities>(
+    tree: &Octree<C>,
+    ray: &Ray,
+    mailbox: &mut Mailbox<'_>,
+    stop: Scalar,
+    mut visit: impl FnMut(u32, Exit, &mut Mailbox<'_>) -> Option<Scalar>,
+) {
+    match tree.traversal {
+        Traversal::Dda => {
+            let mut stop = stop;
+            let mut walk = DdaWalk::new();
+            walk.start(tree, ray);
+            while let Some((leaf, exit)) = walk.next_leaf(tree, to_q24(stop)) {
+                mailbox.cells += 1;
+                match visit(leaf, Exit::Q24(exit), mailbox) {
+                    Some(s) => stop = s,
+                    None => return,
+                }
+            }
+        }
+        Traversal::Named => {
+            // The thesis's walk visits every leaf until a hit is final.
+            let mut walk = NamedWalk::new(tree, ray);
+            while let Some((leaf, exit)) = walk.next_leaf(tree) {
+                mailbox.cells += 1;
+                if visit(leaf, Exit::Ratio(exit), mailbox).is_none() {
+                    return;
+                }
+            }
+        }
+    }
+}
+
+/// How far (Q16.16 raw units) beyond a box an object still counts as in it:
+/// more than any fixed-point error of a hit point (about 8 units).
+pub const FILING_MARGIN: i64 = 32;
+/// Box names are decimal, so they fit a `u64` up to this depth.
+pub const MAX_DEPTH: u32 = 18;
+
+const NONE: u32 = u32::MAX;
+/// `OctreeNode::count` of a box that is subdivided.
+const INTERNAL: u32 = u32::MAX;
+
+/// A box of the octree: a leaf with its objects, or a subdivided box.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OctreeNode {
+    /// Leaf: index of the first object reference. Subdivided: index of the
+    /// first of the eight children, which are consecutive.
+    first: u32,
+    /// Leaf: number of objects. Subdivided: [`INTERNAL`].
+    count: u32,
+}
+
+/// The thesis's hash-table structure: a subdivided box's name and where its
+/// eight children are, chained by `next`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HashEntry {
+    name: u64,
+    children: u32,
+    next: u32,
+}
+
+/// How to walk the octree.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Traversal {
+    /// The thesis's method: Minlen steps and hash-table point location.
+    Named,
+    /// Integer 3DDDA over the leaves.
+    Dda,
+}
+
+/// The subdivision criterion and the walk.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OctreeConfig {
+    /// A box holding more objects than this is subdivided.
+    pub max_objects: usize,
+    /// Boxes deeper than this are not subdivided (at most [`MAX_DEPTH`]).
+    pub max_depth: u32,
+    pub traversal: Traversal,
+}
+
+impl Default for OctreeConfig {
+    fn default() -> Self {
+        OctreeConfig { max_objects: 2, max_depth: 12, traversal: Traversal::Dda }
+    }
+}
+
+/// What a build produced.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BuildReport {
+    pub nodes: usize,
+    pub leaves: usize,
+    pub references: usize,
+    /// Peak object references while building (the arena must hold these).
+    pub peak_references: usize,
+    pub hash_entries: usize,
+    pub depth: u32,
+    /// Boxes left unsplit because an arena was full (0 when all went well).
+    pub unsplit: usize,
+    /// The capacity that ran out first, if any.
+    pub exhausted: Option<&'static str>,
+    /// Bytes of the structure (nodes, references, hash table).
+    pub bytes: usize,
+}
+
+/// The octree over one scene, in arenas sized by the profile `C`.
+pub struct Octree<C: Capacities> {
+    nodes: C::OctreeNodes,
+    refs: C::OctreeRefs,
+    entries: C::OctreeEntries,
+    buckets: C::OctreeBuckets,
+    /// The root box: `[root_min, root_min + 2^root_log2]` per axis.
+    root_min: [i64; 3],
+    /// The objects' own bounds, widened by the filing margin.
+    bounds_min: [i64; 3],
+    bounds_max: [i64; 3],
+    root_log2: u32,
+    /// log2 of Minlen, the smallest box side.
+    min_log2: u32,
+    traversal: Traversal,
+    report: BuildReport,
+}
+
+impl<C: Capacities> Default for Octree<C> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Where to put a box's objects and children while building.
+struct Split {
+    node: usize,
+    depth: u32,
+    name: u64,
+    lo: [i64; 3],
+    log2: u32,
+    refs_start: usize,
+}
+
+impl<C: Capacities> Octree<C> {
+    /// An empty octree (a constant: it can live in a `static`).
+    pub const fn new() -> Self {
+        Octree {
+            nodes: C::OctreeNodes::EMPTY,
+            refs: C::OctreeRefs::EMPTY,
+            entries: C::OctreeEntries::EMPTY,
+            buckets: C::OctreeBuckets::EMPTY,
+            root_min: [0; 3],
+            bounds_min: [0; 3],
+            bounds_max: [0; 3],
+            root_log2: 0,
+            min_log2: 0,
+            traversal: Traversal::Dda,
+            report: BuildReport {
+                nodes: 0,
+                leaves: 0,
+                references: 0,
+                peak_references: 0,
+                hash_entries: 0,
+                depth: 0,
+                unsplit: 0,
+                exhausted: None,
+                bytes: 0,
+            },
+        }
+    }
+
+    pub fn report(&self) -> &BuildReport {
+        &self.report
+    }
+
+    pub fn traversal(&self) -> Traversal {
+        self.traversal
+    }
+
+    /// Switches the walk without rebuilding.
+    pub fn set_traversal(&mut self, t: Traversal) {
+        self.traversal = t;
+    }
+
+    /// Builds the octree over `scene`'s objects.
+    pub fn build(&mut self, scene: &SceneView<'_>, config: &OctreeConfig) -> BuildReport {
+        self.nodes.clear();
+        self.refs.clear();
+        self.entries.clear();
+        self.buckets.clear();
+        self.report = BuildReport::default();
+        self.traversal = config.traversal;
+        while self.buckets.push(NONE).is_ok() {}
+
+        let Some(bounds) = scene.object_ids().map(|id| scene.shape(id).bounds()).reduce(Aabb::union) else {
+            // No objects: a single empty leaf.
+            let _ = self.nodes.push(OctreeNode { first: 0, count: 0 });
+            self.finish(0);
+            return self.report;
+        };
+        let (lo, hi) = (bounds.min.wide(), bounds.max.wide());
+        let extent = (0..3).map(|a| hi[a] - lo[a]).max().unwrap_or(0) + 2 * FILING_MARGIN;
+        self.root_log2 = 64 - (extent.max(2) as u64 - 1).leading_zeros();
+        self.root_min = lo.map(|v| v - FILING_MARGIN);
+        self.bounds_min = self.root_min;
+        self.bounds_max = hi.map(|v| v + FILING_MARGIN);
+        self.min_log2 = self.root_log2;
+
+        let count = scene.object_count();
+        let all_fit = self.nodes.push(OctreeNode { first: 0, count: 0 }).is_ok()
+            && (0..count).all(|i| self.refs.push(i as u32).is_ok());
+        if !all_fit {
+            // Not even the root's list fits: one leaf that stands for every
+            // object (the walk then tests them all, as the naive mode does).
+            self.nodes.clear();
+            self.refs.clear();
+            let _ = self.nodes.push(OctreeNode { first: 0, count: INTERNAL - 1 });
+            self.report.unsplit = 1;
+            self.report.exhausted = Some(if self.nodes.as_slice().is_empty() { "nodes" } else { "references" });
+            self.finish(0);
+            return self.report;
+        }
+        let max_depth = config.max_depth.min(MAX_DEPTH);
+        let root = Split { node: 0, depth: 0, name: 1, lo: self.root_min, log2: self.root_log2, refs_start: 0 };
+        self.split(scene, root, config.max_objects.max(1), max_depth);
+        self.compact();
+        self.finish(max_depth);
+        self.report
+    }
+
+    /// Files the box's objects (in `refs[refs_start..]`) into children, or
+    /// makes it a leaf.
+    fn split(&mut self, scene: &SceneView<'_>, s: Split, max_objects: usize, max_depth: u32) {
+        let count = self.refs.as_slice().len() - s.refs_start;
+        self.report.peak_references = self.report.peak_references.max(self.refs.as_slice().len());
+        let leaf = OctreeNode { first: s.refs_start as u32, count: count as u32 };
+        if count <= max_objects || s.depth >= max_depth || s.log2 <= 1 {
+            self.nodes.as_mut_slice()[s.node] = leaf;
+            self.min_log2 = self.min_log2.min(s.log2);
+            return;
+        }
+        // Room for eight children, a hash entry, and (at worst) every object
+        // in every child.
+        let room = |len: usize, cap: usize, need: usize| len + need <= cap;
+        let exhausted = if !room(self.nodes.as_slice().len(), C::OctreeNodes::CAPACITY, 8) {
+            Some("nodes")
+        } else if !room(self.entries.as_slice().len(), C::OctreeEntries::CAPACITY, 1) {
+            Some("hash entries")
+        } else if !room(self.refs.as_slice().len(), C::OctreeRefs::CAPACITY, 8 * count) {
+            Some("references")
+        } else {
+            None
+        };
+        if let Some(what) = exhausted {
+            self.nodes.as_mut_slice()[s.node] = leaf;
+            self.min_log2 = self.min_log2.min(s.log2);
+            self.report.unsplit += 1;
+            self.report.exhausted.get_or_insert(what);
+            return;
+        }
+        let children = self.nodes.as_slice().len();
+        for _ in 0..8 {
+            let _ = self.nodes.push(leaf);
+        }
+        self.insert_entry(s.name, children as u32);
+        self.nodes.as_mut_slice()[s.node] = OctreeNode { first: children as u32, count: INTERNAL };
+        let half = 1i64 << (s.log2 - 1);
+        let parent_end = s.refs_start + count;
+        for octant in 0..8usize {
+            let lo = [0, 1, 2].map(|a| s.lo[a] + if octant >> a & 1 == 1 { half } else { 0 });
+            let cell = Cell {
+                lo: lo.map(|v| v - FILING_MARGIN),
+                hi: lo.map(|v| v + half + FILING_MARGIN),
+            };
+            let start = self.refs.as_slice().len();
+            for i in s.refs_start..parent_end {
+                let id = self.refs.as_slice()[i];
+                if overlaps(scene.shape(ObjectId(id)), &cell) {
+                    let _ = self.refs.push(id);
+                }
+            }
+            let child = Split {
+                node: children + octant,
+                depth: s.depth + 1,
+                name: s.name * 10 + 1 + octant as u64,
+                lo,
+                log2: s.log2 - 1,
+                refs_start: start,
+            };
+            self.split(scene, child, max_objects, max_depth);
+        }
+    }
+
+    fn insert_entry(&mut self, name: u64, children: u32) {
+        let index = self.entries.as_slice().len() as u32;
+        let _ = self.entries.push(HashEntry { name, children, next: NONE });
+        let bucket = (name % self.buckets.as_slice().len() as u64) as usize;
+        // Append at the end of the bucket's chain, as the thesis does.
+        let mut at = self.buckets.as_slice()[bucket];
+        if at == NONE {
+            self.buckets.as_mut_slice()[bucket] = index;
+            return;
+        }
+        loop {
+            let next = self.entries.as_slice()[at as usize].next;
+            if next == NONE {
+                self.entries.as_mut_slice()[at as usize].next = index;
+                return;
+            }
+            at = next;
+        }
+    }
+
+    /// Moves every leaf's references together (the subdivided boxes' working
+    /// lists are garbage after the build). Leaves were filed depth first, so
+    /// a depth-first walk meets their lists in increasing position.
+    fn compact(&mut self) {
+        let mut write = 0usize;
+        let mut stack: heapless::Vec<(u32, u8), { MAX_DEPTH as usize + 1 }> = heapless::Vec::new();
+        let _ = stack.push((0, 0));
+        while let Some((node, next_child)) = stack.pop() {
+            let n = self.nodes.as_slice()[node as usize];
+            if n.count != INTERNAL {
+                let (from, len) = (n.first as usize, n.count as usize);
+                self.refs.as_mut_slice().copy_within(from..from + len, write);
+                self.nodes.as_mut_slice()[node as usize].first = write as u32;
+                write += len;
+                continue;
+            }
+            if next_child < 8 {
+                let _ = stack.push((node, next_child + 1));
+                let _ = stack.push((n.first + next_child as u32, 0));
+            }
+        }
+        self.refs.truncate(write);
+    }
+
+    fn finish(&mut self, max_depth: u32) {
+        let nodes = self.nodes.as_slice();
+        self.report.nodes = nodes.len();
+        self.report.leaves = nodes.iter().filter(|n| n.count != INTERNAL).count();
+        self.report.references = self.refs.as_slice().len();
+        self.report.hash_entries = self.entries.as_slice().len();
+        self.report.depth = self.root_log2.saturating_sub(self.min_log2).min(max_depth);
+        self.report.bytes = core::mem::size_of_val(nodes)
+            + core::mem::size_of_val(self.refs.as_slice())
+            + core::mem::size_of_val(self.entries.as_slice())
+            + core::mem::size_of_val(self.buckets.as_slice());
+    }
+
+    /// The children of the box called `name`, looked up in the hash table.
+    fn lookup(&self, name: u64) -> Option<u32> {
+        let buckets = self.buckets.as_slice();
+        let mut at = *buckets.get((name % buckets.len().max(1) as u64) as usize)?;
+        while at != NONE {
+            let e = self.entries.as_slice().get(at as usize)?;
+            if e.name == name {
+                return Some(e.children);
+            }
+            at = e.next;
+        }
+        None
+    }
+
+    /// The object ids filed in leaf `node` (`None` for the all-objects leaf).
+    fn leaf_objects(&self, node: u32) -> Option<&[u32]> {
+        let n = self.nodes.as_slice()[node as usize];
+        if n.count == INTERNAL - 1 {
+            return None;
+        }
+        Some(&self.refs.as_slice()[n.first as usize..(n.first + n.count) as usize])
+    }
+}
+
+impl<C: Capacities> Accelerator for Octree<C> {
+    fn nearest(
+        &self,
+        scene: &SceneView<'_>,
+        ray: &Ray,
+        start: Option<RayStart>,
+        mailbox: &mut Mailbox<'_>,
+    ) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        walk_leaves(self, ray, mailbox, Scalar::MAX, |leaf, exit, mailbox| {
+            let mut test = |id: u32| {
+                if !mailbox.first_visit(id) {
+                    return;
+                }
+                let object = ObjectId(id);
+                let t_max = best.map_or(Scalar::MAX, |b| b.t);
+                let leaving = RayStart::leaving(start, object);
+                if let Some(t) = scene.shape(object).intersect(ray, t_max, leaving) {
+                    if best.is_none_or(|b| t < b.t || (t == b.t && object < b.object)) {
+                        best = Some(Hit { t, object });
+                    }
+                }
+            };
+            match self.leaf_objects(leaf) {
+                Some(ids) => ids.iter().for_each(|&id| test(id)),
+                None => (0..scene.object_count() as u32).for_each(test),
+            }
+            // Final once strictly before the exit: an equal hit in the next
+            // leaf might belong to an earlier object.
+            match best {
+                Some(b) if exit.after(b.t) => None,
+                Some(b) => Some(b.t),
+                None => Some(Scalar::MAX),
+            }
+        });
+        best
+    }
+
+    fn occluded(
+        &self,
+        scene: &SceneView<'_>,
+        ray: &Ray,
+        t_max: Scalar,
+        start: Option<RayStart>,
+        mailbox: &mut Mailbox<'_>,
+    ) -> bool {
+        let mut blocked = false;
+        walk_leaves(self, ray, mailbox, t_max, |leaf, exit, mailbox| {
+            let mut test = |id: u32| {
+                mailbox.first_visit(id) && {
+                    let object = ObjectId(id);
+                    scene.shape(object).intersect(ray, t_max, RayStart::leaving(start, object)).is_some()
+                }
+            };
+            blocked = match self.leaf_objects(leaf) {
+                Some(ids) => ids.iter().any(|&id| test(id)),
+                None => (0..scene.object_count() as u32).any(test),
+            };
+            (!blocked && !exit.after(t_max)).then_some(t_max)
+        });
+        blocked
+    }
+}
