@@ -1,5 +1,7 @@
 #![no_std]
 #![forbid(unsafe_code)]
+// Per-axis loops index several arrays at once; iterators would obscure them.
+#![allow(clippy::needless_range_loop)]
 
 #[cfg(feature = "alloc")]
 extern crate alloc;

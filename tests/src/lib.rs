@@ -26,3 +26,43 @@ pub fn scenes() -> Vec<(String, PathBuf)> {
 pub fn blessing() -> bool {
     std::env::var_os("OCTRACE_BLESS").is_some_and(|v| v != "0")
 }
+
+/// A small deterministic generator (xorshift64*) for property tests. The
+/// seed comes from `OCTRACE_SEED` or the clock and is printed, so a failure
+/// can be replayed.
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Rng {
+        Rng(seed.max(1))
+    }
+
+    /// Seeded from `OCTRACE_SEED`, else the clock; prints the seed.
+    pub fn from_env(test: &str) -> Rng {
+        let seed = std::env::var("OCTRACE_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or_else(|| {
+            std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(1, |d| d.as_nanos() as u64)
+        });
+        println!("{test}: seed {seed} (replay with OCTRACE_SEED={seed})");
+        eprintln!("{test}: seed {seed} (replay with OCTRACE_SEED={seed})");
+        Rng::new(seed)
+    }
+
+    pub fn next_u64(&mut self) -> u64 {
+        let mut x = self.0;
+        x ^= x >> 12;
+        x ^= x << 25;
+        x ^= x >> 27;
+        self.0 = x;
+        x.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+
+    /// Uniform in `0..n` (n > 0).
+    pub fn below(&mut self, n: u32) -> u32 {
+        (((self.next_u64() >> 32) * n as u64) >> 32) as u32
+    }
+
+    /// Uniform in `[lo, hi)`.
+    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}

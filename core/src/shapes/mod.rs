@@ -232,10 +232,13 @@ impl Ratio {
         Scalar::from_bits(((self.num << 30) / self.den) as i32)
     }
 
-    /// `self ≤ t` for a Q16.16 `t` (same units as [`Ratio::to_scalar`]).
+    /// `self.to_scalar() ≤ t` for a non-negative ratio, without dividing.
+    /// (Comparing the exact ratio instead would reject a hit whose rounded
+    /// parameter equals `t`: a hit test must filter on the value it returns,
+    /// or the order in which objects are tested would change the result.)
     #[inline]
     pub fn le_scalar(self, t: Scalar) -> bool {
-        (self.num << 30) <= t.to_bits() as i64 * self.den
+        (self.num << 30) < (t.to_bits() as i64 + 1) * self.den
     }
 }
 

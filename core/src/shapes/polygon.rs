@@ -53,7 +53,8 @@ impl<const N: usize> Polygon<N> {
         // (offset − n·o) in Q18.46; t = num / den is then Q16.16.
         let num = ((self.offset.to_bits() as i64) << 30) - ray.origin.dot_dir_q46(self.normal);
         let (num, den) = if den < 0 { (-num, -den) } else { (num, den) };
-        if num <= 0 || num > t_max.to_bits() as i64 * den {
+        // Filter on the rounded parameter (num / den ≤ t_max), as returned.
+        if num <= 0 || num >= (t_max.to_bits() as i64 + 1) * den {
             return None;
         }
         let t = num / den;

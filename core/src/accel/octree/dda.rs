@@ -9,15 +9,15 @@
 //! unit of 2^-24 per level), so a step is additions, shifts and comparisons:
 //! no division, no multiplication, no float. Negative directions are mirrored
 //! about the root's centre so every axis runs forwards; a zero component is
-//! nudged to one unit (2^-30). Empty leaves are passed over, and boxes the
+//! nudged to one unit (2^-30). Crossings saturate at ±2^36 (a ray almost
+//! parallel to an axis); a middle plane next to a saturated one gets its
+//! crossing computed directly, as the mean would be meaningless. Empty leaves are passed over, and boxes the
 //! ray enters after the nearest hit found so far are skipped whole.
 //!
 //! None of this can change an image: the walked line differs from the true
 //! ray by at most two Q16.16 units across the scene and the parameters by far
 //! less, both well inside the filing margin, and objects are still tested
-//! with the true ray. A crossing parameter beyond 2^36 (a ray almost
-//! parallel to an axis) saturates there; halving keeps it beyond every
-//! parameter that matters (below 2^16) for the 18 levels a tree may have.
+//! with the true ray.
 
 use super::{Octree, INTERNAL};
 use crate::capacity::{Arena, Capacities};
@@ -34,6 +34,9 @@ const LIMIT: i64 = 1 << (36 + FRAC);
 struct Frame {
     t0: [i64; 3],
     t1: [i64; 3],
+    /// The box's low corner (mirrored space) and log2 of its side.
+    lo: [i64; 3],
+    log2: u32,
     children: u32,
     /// The next child to visit, in mirrored octant order; 8 when done.
     next: u8,
@@ -42,6 +45,9 @@ struct Frame {
 pub(super) struct DdaWalk {
     /// Octant bits of the mirrored axes.
     mirror: u8,
+    /// The ray's origin in mirrored space and 2^62 / |d_a|.
+    origin: [i64; 3],
+    inverse: [u64; 3],
     /// Where the ray is inside the objects' own bounds (tighter than the
     /// cubic root): boxes left before `near` or entered after `far` hold
     /// nothing this ray can hit.
@@ -84,7 +90,15 @@ fn min_axis(t: &[i64; 3]) -> usize {
 
 impl DdaWalk {
     pub const fn new() -> DdaWalk {
-        DdaWalk { mirror: 0, near: 0, far: 0, stack: heapless::Vec::new(), root_leaf: None }
+        DdaWalk {
+            mirror: 0,
+            origin: [0; 3],
+            inverse: [0; 3],
+            near: 0,
+            far: 0,
+            stack: heapless::Vec::new(),
+            root_leaf: None,
+        }
     }
 
     /// Starts a walk along `ray` (in place: the walk's stack is not small).
@@ -94,7 +108,7 @@ impl DdaWalk {
         self.root_leaf = None;
         let walk = self;
         let nodes = tree.nodes.as_slice();
-        let Some(root) = nodes.first() else { return };
+        let Some(root) = nodes.first().filter(|r| r.count != 0) else { return };
         let o = ray.origin.wide();
         let d = ray.dir.wide();
         let half = 1i64 << (tree.root_log2 - 1);
@@ -109,15 +123,10 @@ impl DdaWalk {
             } else {
                 o[a]
             };
-            // t = (plane − o) / |d| in Q40.24: Q16.16 over Q2.30 is
-            // (num · 2^38) / den, through the reciprocal 2^62 / den.
-            let inverse = (1u64 << 62) / d[a].unsigned_abs().max(1);
-            let t = |plane: i64| {
-                let v = ((plane - oa) as i128 * inverse as i128) >> 24;
-                v.clamp(-(LIMIT as i128), LIMIT as i128) as i64
-            };
-            t0[a] = t(tree.root_min[a]);
-            t1[a] = t(tree.root_min[a] + 2 * half);
+            walk.origin[a] = oa;
+            walk.inverse[a] = (1u64 << 62) / d[a].unsigned_abs().max(1);
+            t0[a] = walk.crossing(a, tree.root_min[a]);
+            t1[a] = walk.crossing(a, tree.root_min[a] + 2 * half);
         }
         let enter = t0[max_axis(&t0)];
         let exit = t1[min_axis(&t1)];
@@ -127,7 +136,8 @@ impl DdaWalk {
         // Clip to the objects' bounds, exactly, then in Q40.24 (rounding
         // outwards a little: a wider span only visits more boxes).
         let Some(span) = slab_span_wide(o, d, tree.bounds_min, tree.bounds_max) else { return };
-        let to_q24 = |r: Ratio| ((r.num as i128) << 38).div_euclid(r.den as i128).clamp(-(LIMIT as i128), LIMIT as i128) as i64;
+        let to_q24 =
+            |r: Ratio| ((r.num as i128) << 38).div_euclid(r.den as i128).clamp(-(LIMIT as i128), LIMIT as i128) as i64;
         walk.near = span.enter.map_or(-LIMIT, to_q24) - 1;
         walk.far = span.exit.map_or(LIMIT, to_q24) + 1;
         if walk.far < 0 {
@@ -136,23 +146,45 @@ impl DdaWalk {
         if root.count != INTERNAL {
             walk.root_leaf = Some((0, exit));
         } else {
-            walk.push(root.first, t0, t1);
+            walk.push(root.first, t0, t1, tree.root_min, tree.root_log2);
         }
+    }
+
+    /// The parameter (Q40.24, saturated) at which the ray crosses the plane
+    /// at `plane` (mirrored space) on axis `a`: (plane − o)·2^38 / |d|
+    /// through the reciprocal 2^62 / |d|.
+    #[inline]
+    fn crossing(&self, a: usize, plane: i64) -> i64 {
+        let v = ((plane - self.origin[a]) as i128 * self.inverse[a] as i128) >> 24;
+        v.clamp(-(LIMIT as i128), LIMIT as i128) as i64
     }
 
     /// Enters a subdivided box: the first child the ray meets lies beyond
     /// every middle plane crossed before the entry plane.
     #[inline]
-    fn push(&mut self, children: u32, t0: [i64; 3], t1: [i64; 3]) {
+    fn push(&mut self, children: u32, t0: [i64; 3], t1: [i64; 3], lo: [i64; 3], log2: u32) {
         let entry_axis = max_axis(&t0);
         let entry = t0[entry_axis];
         let mut first = 0u8;
         for a in 0..3 {
-            if a != entry_axis && (t0[a] + t1[a]) >> 1 < entry {
+            if a != entry_axis && self.middle(a, t0[a], t1[a], lo[a], log2) < entry {
                 first |= 1 << a;
             }
         }
-        let _ = self.stack.push(Frame { t0, t1, children, next: first });
+        let _ = self.stack.push(Frame { t0, t1, lo, log2, children, next: first });
+    }
+
+    /// The crossing of a box's middle plane on axis `a`: the mean of the
+    /// outer planes' crossings (exact: the mean plane's crossing), unless one
+    /// of them saturated (a ray almost parallel to the axis), where the mean
+    /// would be meaningless; then it is computed directly.
+    #[inline]
+    fn middle(&self, a: usize, t0: i64, t1: i64, lo: i64, log2: u32) -> i64 {
+        if t0.abs() == LIMIT || t1.abs() == LIMIT {
+            self.crossing(a, lo + (1i64 << (log2 - 1)))
+        } else {
+            (t0 + t1) >> 1
+        }
     }
 
     /// The next non-empty leaf along the ray that the ray enters no later
@@ -172,16 +204,19 @@ impl DdaWalk {
                 self.stack.pop();
                 continue;
             }
-            let mut t0 = top.t0;
-            let mut t1 = top.t1;
+            let frame = *top;
+            let (mut t0, mut t1, mut lo) = (frame.t0, frame.t1, frame.lo);
+            let half = 1i64 << (frame.log2 - 1);
             for a in 0..3 {
-                let mid = (top.t0[a] + top.t1[a]) >> 1;
+                let mid = self.middle(a, frame.t0[a], frame.t1[a], frame.lo[a], frame.log2);
                 if c >> a & 1 == 1 {
                     t0[a] = mid;
+                    lo[a] += half;
                 } else {
                     t1[a] = mid;
                 }
             }
+            let top = self.stack.last_mut()?;
             if t0[max_axis(&t0)] > stop.min(self.far) {
                 top.next = 8;
                 continue;
@@ -191,14 +226,14 @@ impl DdaWalk {
             let axis = min_axis(&t1);
             let bit = 1u8 << axis;
             top.next = if c & bit != 0 { 8 } else { c | bit };
-            let node = top.children + (c ^ self.mirror) as u32;
+            let node = frame.children + (c ^ self.mirror) as u32;
             let exit = t1[axis];
             if exit < 0 || exit < self.near {
                 continue; // wholly behind the origin, or before the objects
             }
             let n = nodes[node as usize];
             if n.count == INTERNAL {
-                self.push(n.first, t0, t1);
+                self.push(n.first, t0, t1, lo, frame.log2 - 1);
             } else if n.count != 0 {
                 return Some((node, exit));
             }

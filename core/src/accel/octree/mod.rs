@@ -267,6 +267,8 @@ impl<C: Capacities> Octree<C> {
 
         let Some(bounds) = scene.object_ids().map(|id| scene.shape(id).bounds()).reduce(Aabb::union) else {
             // No objects: a single empty leaf.
+            (self.root_min, self.root_log2, self.min_log2) = ([0; 3], 1, 1);
+            (self.bounds_min, self.bounds_max) = ([0; 3], [0; 3]);
             let _ = self.nodes.push(OctreeNode { first: 0, count: 0 });
             self.finish(0);
             return self.report;
@@ -341,10 +343,7 @@ impl<C: Capacities> Octree<C> {
         let parent_end = s.refs_start + count;
         for octant in 0..8usize {
             let lo = [0, 1, 2].map(|a| s.lo[a] + if octant >> a & 1 == 1 { half } else { 0 });
-            let cell = Cell {
-                lo: lo.map(|v| v - FILING_MARGIN),
-                hi: lo.map(|v| v + half + FILING_MARGIN),
-            };
+            let cell = Cell { lo: lo.map(|v| v - FILING_MARGIN), hi: lo.map(|v| v + half + FILING_MARGIN) };
             let start = self.refs.as_slice().len();
             for i in s.refs_start..parent_end {
                 let id = self.refs.as_slice()[i];

@@ -13,7 +13,7 @@
 use super::{Octree, INTERNAL};
 use crate::capacity::{Arena, Capacities};
 use crate::shapes::axis_aligned_box::slab_span_wide;
-use crate::shapes::{Ray, Ratio};
+use crate::shapes::{Ratio, Ray};
 
 /// The leaf the walk stands in.
 #[derive(Clone, Copy, Debug)]

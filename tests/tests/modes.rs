@@ -1,0 +1,204 @@
+//! The three intersection modes (naive, the thesis's octree walk, 3DDDA)
+//! give bit-identical images: on every scene in `scenes/`, and on random
+//! scenes and rays (the seed is printed; set `OCTRACE_SEED` to replay one).
+
+use host_sim::{build_octree, load_bytes, load_file, new_scene, render, AccelMode, HostScene, RenderOptions};
+use octrace_core::accel::{Accelerator, Mailbox, Naive, OctreeConfig, RayStart, Traversal};
+use octrace_core::math::{Dir, Scalar, Vec3};
+use octrace_core::scene::ObjectId;
+use octrace_core::shapes::{Leaving, Ray};
+use octrace_tests::{scenes, Rng};
+
+fn image(scene: &HostScene, accel: AccelMode, octree: OctreeConfig, size: Option<(u32, u32)>) -> host_sim::RgbImage {
+    render(scene, &RenderOptions { size, accel, octree }).expect("renders").image
+}
+
+#[test]
+fn every_scene_is_identical_in_every_mode() {
+    for (name, path) in scenes() {
+        let mut scene = new_scene();
+        load_file(&path, &mut scene).unwrap();
+        let config = OctreeConfig::default();
+        let naive = image(&scene, AccelMode::Naive, config, None);
+        for mode in [AccelMode::Octree, AccelMode::Dda] {
+            let other = image(&scene, mode, config, None);
+            let differ = naive.data.chunks(3).zip(other.data.chunks(3)).filter(|(a, b)| a != b).count();
+            assert_eq!(differ, 0, "{name}: {} differs from naive in {differ} pixels", mode.name());
+        }
+        println!("{name}: naive, octree and dda identical");
+    }
+}
+
+/// A random scene of every primitive, with reflective and transparent
+/// surfaces, objects touching, overlapping and sharing faces.
+fn random_scene(rng: &mut Rng) -> String {
+    let mut s = String::new();
+    let c = |rng: &mut Rng| rng.range(-4.0, 4.0);
+    s += &format!(
+        "RASTER 40 30 RDEPTH 3 VIEWPOINT {} {} {} ORIGIN 0 0 0 BACKGROUND 0.2 0.3 0.4\n",
+        rng.range(-12.0, 12.0),
+        rng.range(2.0, 12.0),
+        rng.range(6.0, 14.0)
+    );
+    for _ in 0..1 + rng.below(3) {
+        s += &format!("LIGHT {} {} {} {}\n", rng.range(3.0, 15.0), c(rng) * 3.0, rng.range(3.0, 12.0), c(rng) * 3.0);
+    }
+    for n in 1..=4 {
+        s += &format!(
+            "SURFACE {n} 0.1 0.1 0.1 {} {} {} 0.5 0.5 0.5 {} {} {}\n",
+            rng.range(0.2, 1.0),
+            rng.range(0.2, 1.0),
+            rng.range(0.2, 1.0),
+            rng.below(60),
+            if rng.below(3) == 0 { 0.5 } else { 0.0 },
+            if rng.below(4) == 0 { 0.6 } else { 0.0 },
+        );
+    }
+    // A floor of tiles sharing edges.
+    let tiles = rng.below(4) as i32;
+    for i in -tiles..tiles {
+        for j in -tiles..tiles {
+            let (x0, z0, x1, z1) = (i * 2, j * 2, i * 2 + 2, j * 2 + 2);
+            s += &format!(
+                "RECTANGLE {} {x0} -2 {z1} {x1} -2 {z1} {x1} -2 {z0} {x0} -2 {z0}\n",
+                1 + (i + j).rem_euclid(2)
+            );
+        }
+    }
+    for _ in 0..rng.below(40) {
+        let surf = 1 + rng.below(4);
+        let (x, y, z) = (c(rng), c(rng), c(rng));
+        match rng.below(5) {
+            0 => s += &format!("SPHERE {surf} {} {x} {y} {z}\n", rng.range(0.1, 1.5)),
+            1 => {
+                s += &format!(
+                    "BOX {surf} {x} {y} {z} {} {} {}\n",
+                    rng.range(0.1, 1.0),
+                    rng.range(0.1, 1.0),
+                    rng.range(0.1, 1.0)
+                )
+            }
+            2 => {
+                s += &format!(
+                    "SUPERQUADRIC {surf} {} {x} {y} {z} {} {} {}\n",
+                    rng.range(2.0, 30.0),
+                    rng.range(0.2, 1.0),
+                    rng.range(0.2, 1.0),
+                    rng.range(0.2, 1.0)
+                )
+            }
+            3 => {
+                s += &format!(
+                    "TRIANGLE {surf} {x} {y} {z} {} {} {} {} {} {}\n",
+                    x + rng.range(0.5, 2.0),
+                    y + rng.range(-1.0, 1.0),
+                    z,
+                    x,
+                    y + rng.range(0.5, 2.0),
+                    z + rng.range(-1.0, 1.0)
+                )
+            }
+            _ => {
+                // Two spheres touching, or a sphere on a box: exact ties.
+                s += &format!("SPHERE {surf} 0.5 {x} {y} {z}\nSPHERE {surf} 0.5 {} {y} {z}\n", x + 1.0);
+                s += &format!("BOX {surf} {x} {} {z} 0.5 0.5 0.5\n", y - 1.0);
+            }
+        }
+    }
+    s
+}
+
+#[test]
+fn random_scenes_are_identical_in_every_mode() {
+    let mut rng = Rng::from_env("random_scenes_are_identical_in_every_mode");
+    for round in 0..24 {
+        let text = random_scene(&mut rng);
+        let mut scene = new_scene();
+        if let Err(e) = load_bytes("random", text.as_bytes(), &mut scene) {
+            // Random corners can make a degenerate triangle: skip those.
+            assert!(e.to_string().contains("degenerate"), "round {round}: {e}\n{text}");
+            continue;
+        }
+        let config =
+            OctreeConfig { max_objects: 1 + rng.below(6) as usize, max_depth: 1 + rng.below(10), ..Default::default() };
+        let naive = image(&scene, AccelMode::Naive, config, None);
+        for mode in [AccelMode::Octree, AccelMode::Dda] {
+            let other = image(&scene, mode, config, None);
+            assert!(naive == other, "round {round}: {} differs from naive ({config:?})\n{text}", mode.name());
+        }
+    }
+}
+
+/// Query-level check: random rays from random points inside and outside the
+/// scene, starting on objects or not, nearest and any-hit.
+#[test]
+fn random_queries_agree_with_the_naive_mode() {
+    let mut rng = Rng::from_env("random_queries_agree_with_the_naive_mode");
+    for round in 0..12 {
+        let text = random_scene(&mut rng);
+        let mut scene = new_scene();
+        if load_bytes("random", text.as_bytes(), &mut scene).is_err() {
+            continue;
+        }
+        let view = scene.view();
+        let n = view.object_count() as u32;
+        for traversal in [Traversal::Named, Traversal::Dda] {
+            let config =
+                OctreeConfig { max_objects: 1 + rng.below(4) as usize, max_depth: 2 + rng.below(9), traversal };
+            let mode = if traversal == Traversal::Dda { AccelMode::Dda } else { AccelMode::Octree };
+            let Some(tree) = build_octree(&scene, mode, &config) else { continue };
+            let mut words = vec![0u32; Mailbox::words_for(n as usize)];
+            let mut mailbox = Mailbox::new(&mut words);
+            for _ in 0..2000 {
+                let scale = view.normalization.length(4 << 32).to_bits() as f64;
+                let p = |rng: &mut Rng| Scalar::from_bits((rng.range(-1.6, 1.6) * scale) as i32);
+                let origin = Vec3 { x: p(&mut rng), y: p(&mut rng), z: p(&mut rng) };
+                let d = [0, 1, 2].map(|_| match rng.below(6) {
+                    0 => 0,
+                    _ => (rng.range(-1.0, 1.0) * (1u64 << 40) as f64) as i64,
+                });
+                let Some(dir) = Dir::normalize(d) else { continue };
+                let ray = Ray { origin, dir };
+                let start = (n > 0 && rng.below(3) == 0).then(|| RayStart {
+                    object: ObjectId(rng.below(n)),
+                    leaving: if rng.below(2) == 0 { Leaving::Inward } else { Leaving::Outward },
+                });
+                mailbox.clear();
+                let a = Naive.nearest(&view, &ray, start, &mut mailbox);
+                mailbox.clear();
+                let b = tree.nearest(&view, &ray, start, &mut mailbox);
+                assert_eq!(a, b, "round {round} {traversal:?} {config:?}: nearest along {ray:?}\n{text}");
+                let t_max = Scalar::from_bits((rng.range(0.0, 2.0) * scale) as i32);
+                mailbox.clear();
+                let a = Naive.occluded(&view, &ray, t_max, start, &mut mailbox);
+                mailbox.clear();
+                let b = tree.occluded(&view, &ray, t_max, start, &mut mailbox);
+                assert_eq!(a, b, "round {round} {traversal:?}: occluded along {ray:?} to {t_max}\n{text}");
+            }
+        }
+    }
+}
+
+#[test]
+fn small_capacities_fall_back_without_changing_the_image() {
+    use octrace_core::capacity::Board16K;
+    use octrace_core::parse::parse;
+    use octrace_core::render::Renderer;
+    use octrace_core::scene::Scene;
+    // fig5_3's 200 spheres in the 16 KiB board profile: the octree's arenas
+    // are small, so boxes stay unsplit; the image must not change.
+    let text = std::fs::read_to_string(octrace_tests::repo().join("scenes/fig5_3.txt")).unwrap();
+    let mut scene: Box<Scene<Board16K>> = Box::default();
+    parse(&text, &mut scene, &mut |e| panic!("{e}")).unwrap();
+    let view = scene.view();
+    let mut tree: Box<octrace_core::accel::Octree<Board16K>> = Box::default();
+    let report = tree.build(&view, &OctreeConfig { max_objects: 1, max_depth: 12, traversal: Traversal::Dda });
+    println!("{report:?}");
+    assert!(report.unsplit > 0, "the small profile should run out: {report:?}");
+    let mut a = host_sim::RgbImage::new(64, 48);
+    let mut b = host_sim::RgbImage::new(64, 48);
+    Renderer::with_size(view, &Naive, 64, 48).unwrap().render(&mut a).unwrap();
+    let mut words = [0u32; 8];
+    Renderer::with_size(view, &*tree, 64, 48).unwrap().with_mailbox(&mut words).render(&mut b).unwrap();
+    assert!(a == b);
+}
