@@ -35,7 +35,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = AccelMode::Auto)]
     pub accel: AccelMode,
     /// Octree criterion: a box holding more objects than this is subdivided.
-    #[arg(long, value_name = "N", default_value_t = 2)]
+    #[arg(long, value_name = "N", default_value_t = 6)]
     pub max_objects: usize,
     /// Octree criterion: boxes are not subdivided below this depth (at most 18).
     #[arg(long, value_name = "D", default_value_t = 12, value_parser = clap::value_parser!(u32).range(0..=18))]

@@ -80,7 +80,7 @@ pub enum AccelMode {
 
 /// Scenes with at most this many objects render fastest without an octree
 /// (measured: see BENCHMARKS.md).
-pub const NAIVE_UP_TO: usize = 8;
+pub const NAIVE_UP_TO: usize = 16;
 
 impl AccelMode {
     /// The concrete mode `Auto` stands for on a scene with `objects` objects.
@@ -152,14 +152,31 @@ pub fn render(scene: &HostScene, options: &RenderOptions) -> Result<Rendered, Ca
 pub fn render_with_progress(
     scene: &HostScene,
     options: &RenderOptions,
-    mut row_done: impl FnMut(u32),
+    row_done: impl FnMut(u32),
 ) -> Result<Rendered, CameraError> {
-    let view = scene.view();
-    let [w, h] = options.size.map_or(view.settings.raster, |(w, h)| [w, h]);
-    let accel = options.accel.resolve(view.object_count());
+    let accel = options.accel.resolve(scene.view().object_count());
     let started = std::time::Instant::now();
     let octree = build_octree(scene, accel, &options.octree);
     let build = octree.as_ref().map(|o| (*o.report(), started.elapsed()));
+    let mut rendered = render_prebuilt(scene, options.size, octree.as_deref(), row_done)?;
+    rendered.build = build;
+    Ok(rendered)
+}
+
+/// Renders with an octree built beforehand (`None`: the naive mode).
+pub fn render_prebuilt(
+    scene: &HostScene,
+    size: Option<(u32, u32)>,
+    octree: Option<&HostOctree>,
+    mut row_done: impl FnMut(u32),
+) -> Result<Rendered, CameraError> {
+    let view = scene.view();
+    let [w, h] = size.map_or(view.settings.raster, |(w, h)| [w, h]);
+    let accel = match octree.map(|o| o.traversal()) {
+        None => AccelMode::Naive,
+        Some(Traversal::Named) => AccelMode::Octree,
+        Some(Traversal::Dda) => AccelMode::Dda,
+    };
     let mut image = RgbImage::new(w, h);
     let mut stats = Stats::default();
     let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
@@ -169,17 +186,17 @@ pub fn render_with_progress(
             row_done(y);
         }
     };
-    match &octree {
+    match octree {
         None => {
             let mut r = Renderer::with_size(view, &Naive, w, h)?;
             rows(&mut |y, img| r.render_rows(y..y + 1, img).unwrap_or_else(|never| match never {}));
         }
         Some(tree) => {
-            let mut r = Renderer::with_size(view, &**tree, w, h)?.with_mailbox(&mut words);
+            let mut r = Renderer::with_size(view, tree, w, h)?.with_mailbox(&mut words);
             rows(&mut |y, img| r.render_rows(y..y + 1, img).unwrap_or_else(|never| match never {}));
         }
     }
-    Ok(Rendered { image, stats, accel, build })
+    Ok(Rendered { image, stats, accel, build: None })
 }
 
 /// Runs the command line `args` (including the program name); help goes to

@@ -195,8 +195,18 @@ impl Dir {
             }
         });
         let len2 = scaled.iter().map(|&c| (c * c) as u64).sum::<u64>();
-        let len = super::isqrt(len2) as i64;
-        Some(Dir::from_bits(scaled.map(|c| ((c << 30) / len) as i32)))
+        let len = super::isqrt(len2);
+        // One division: c / len = c · (2^62 / len) / 2^32, rounded, within
+        // one unit.
+        let inverse = (1u64 << 62) / len;
+        Some(Dir::from_bits(scaled.map(|c| {
+            let m = ((c.unsigned_abs() * inverse + (1 << 31)) >> 32) as i32;
+            if c < 0 {
+                -m
+            } else {
+                m
+            }
+        })))
     }
 
     /// Cross product, renormalised; `None` for parallel inputs.

@@ -1,11 +1,17 @@
-//! octrace's benchmarks: prints Markdown tables for BENCHMARKS.md.
+//! octrace's benchmarks: prints the Markdown tables of BENCHMARKS.md.
 //!
-//!     cargo run --release -p host-sim --bin octrace-bench -- [scenes]
+//!     cargo run --release -p host-sim --bin octrace-bench -- [TABLE…]
 //!
-//! Times are the best of several runs on one thread; the machine is printed
-//! first so every table says where it came from.
+//! Tables: `scenes` (every scene, naive), `table51` (the thesis's Table 5.1),
+//! `table52` (Table 5.2), `scaling` (random spheres, N = 10 … 100,000),
+//! `criterion` (the octree's subdivision criterion). No argument: all.
+//! Times are wall-clock on one thread, the best of several runs; the machine
+//! is printed first so every table says where it came from.
 
-use host_sim::{load_file, new_scene, render, AccelMode, RenderOptions};
+use host_sim::{
+    build_octree, load_bytes, load_file, new_scene, render, render_prebuilt, AccelMode, HostScene, RenderOptions,
+};
+use octrace_core::accel::OctreeConfig;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -36,6 +42,10 @@ fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (Duration, T) {
     (best, last.expect("at least one run"))
 }
 
+fn ms(d: Duration) -> String {
+    format!("{:.1} ms", d.as_secs_f64() * 1e3)
+}
+
 fn scene_files(dir: &Path) -> Vec<PathBuf> {
     let mut v: Vec<PathBuf> =
         std::fs::read_dir(dir).map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect()).unwrap_or_default();
@@ -44,31 +54,200 @@ fn scene_files(dir: &Path) -> Vec<PathBuf> {
     v
 }
 
+fn load(path: &Path) -> Box<HostScene> {
+    let mut scene = new_scene();
+    if let Err(e) = load_file(path, &mut scene) {
+        eprintln!("octrace-bench: {e}");
+        std::process::exit(2);
+    }
+    scene
+}
+
+/// Render time (best of `runs`), including the octree build.
+fn time(scene: &HostScene, accel: AccelMode, octree: OctreeConfig, size: Option<(u32, u32)>, runs: usize) -> Duration {
+    let options = RenderOptions { size, accel, octree };
+    best_of(runs, || render(scene, &options).map(|r| r.stats)).0
+}
+
 fn scenes_table(dir: &Path) {
     println!("### Every scene at its RASTER size, naive mode, one thread\n");
     println!("| scene | size | objects | lights | rays | shadow rays | time (best of 3) | ns / pixel |");
     println!("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |");
     for path in scene_files(dir) {
         let name = path.file_stem().unwrap_or_default().to_string_lossy().into_owned();
-        let mut scene = new_scene();
-        if let Err(e) = load_file(&path, &mut scene) {
-            println!("| {name} | error: {e} |");
-            continue;
-        }
+        let scene = load(&path);
         let view = scene.view();
         let [w, h] = view.settings.raster;
         let naive = RenderOptions { accel: AccelMode::Naive, ..Default::default() };
         let (time, stats) = best_of(3, || render(&scene, &naive).map(|r| r.stats));
         let Ok(stats) = stats else { continue };
         println!(
-            "| {name} | {w}×{h} | {} | {} | {} | {} | {:.1} ms | {:.0} |",
+            "| {name} | {w}×{h} | {} | {} | {} | {} | {} | {:.0} |",
             view.object_count(),
             view.lights.len(),
             stats.rays,
             stats.shadow_rays,
-            time.as_secs_f64() * 1e3,
+            ms(time),
             time.as_nanos() as f64 / (w as f64 * h as f64)
         );
+    }
+    println!();
+}
+
+fn table51(dir: &Path) {
+    println!("### Table 5.1: naive against the octree (thesis) and 3DDDA (octrace)\n");
+    println!("Each scene at its RASTER size; times include building the octree (default criterion).\n");
+    println!("| figure | objects | thesis naive | thesis fast | thesis ratio | naive | octree | ratio | dda | ratio |");
+    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    let thesis =
+        [("fig5_1", "05:06", "08:50", 0.58), ("fig5_2", "54:26", "25:40", 2.12), ("fig5_3", "123:20", "40:52", 3.02)];
+    for (name, tn, tf, tr) in thesis {
+        let scene = load(&dir.join(format!("{name}.txt")));
+        let c = OctreeConfig::default();
+        let naive = time(&scene, AccelMode::Naive, c, None, 5);
+        let octree = time(&scene, AccelMode::Octree, c, None, 5);
+        let dda = time(&scene, AccelMode::Dda, c, None, 5);
+        let r = |t: Duration| naive.as_secs_f64() / t.as_secs_f64();
+        println!(
+            "| {name} | {} | {tn} | {tf} | {tr:.2}× | {} | {} | {:.2}× | {} | {:.2}× |",
+            scene.view().object_count(),
+            ms(naive),
+            ms(octree),
+            r(octree),
+            ms(dda),
+            r(dda)
+        );
+    }
+    println!();
+}
+
+fn table52(dir: &Path) {
+    println!("### Table 5.2: fig5_4 (24 spheres) by the maximum number of objects per box\n");
+    println!("| objects per box | thesis (octree) | octree | dda | boxes | leaves | references | depth |");
+    println!("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    let scene = load(&dir.join("fig5_4.txt"));
+    let default = OctreeConfig::default();
+    for (max, thesis) in [(2usize, "22:21"), (6, "17:52"), (8, "28:36"), (default.max_objects, "(default)")] {
+        let c = OctreeConfig { max_objects: max, ..default };
+        let octree = time(&scene, AccelMode::Octree, c, None, 5);
+        let dda = time(&scene, AccelMode::Dda, c, None, 5);
+        let report = *build_octree(&scene, AccelMode::Dda, &c).map(|o| *o.report()).as_ref().expect("an octree");
+        println!(
+            "| {max} | {thesis} | {} | {} | {} | {} | {} | {} |",
+            ms(octree),
+            ms(dda),
+            report.nodes,
+            report.leaves,
+            report.references,
+            report.depth
+        );
+    }
+    let naive = time(&scene, AccelMode::Naive, default, None, 5);
+    println!("\nnaive on the same scene: {}\n", ms(naive));
+}
+
+/// `n` non-overlapping spheres of equal radius dropped at random (random
+/// sequential adsorption) on the 16 × 12 rectangle the camera sees face on,
+/// the radius chosen so that they cover 40 % of it for every `n`: every
+/// image has the same share of pixels on spheres and of rays that pass
+/// between them.
+fn carpet(n: usize, seed: u64) -> String {
+    let (w, h) = (16.0f64, 12.0f64);
+    let r = (0.4 * w * h / (n as f64 * std::f64::consts::PI)).sqrt();
+    let mut state = seed | 1;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    // A grid of cells of side 2r: a new sphere only needs its 3×3 cells.
+    let (cols, rows) = ((w / (2.0 * r)).ceil() as usize + 1, (h / (2.0 * r)).ceil() as usize + 1);
+    let mut grid: Vec<Vec<(f64, f64)>> = vec![Vec::new(); cols * rows];
+    let mut placed = Vec::with_capacity(n);
+    while placed.len() < n {
+        let (x, z) = (r + next() * (w - 2.0 * r), r + next() * (h - 2.0 * r));
+        let (cx, cz) = ((x / (2.0 * r)) as usize, (z / (2.0 * r)) as usize);
+        let clear = (cx.saturating_sub(1)..=(cx + 1).min(cols - 1)).all(|i| {
+            (cz.saturating_sub(1)..=(cz + 1).min(rows - 1))
+                .all(|j| grid[j * cols + i].iter().all(|&(px, pz)| (px - x).powi(2) + (pz - z).powi(2) >= 4.0 * r * r))
+        });
+        if clear {
+            grid[cz * cols + cx].push((x, z));
+            placed.push((x - w / 2.0, z - h / 2.0));
+        }
+    }
+    let mut s = format!(
+        "RASTER 160 120 RDEPTH 1 VIEWPORT {w} {h}\nVIEWPOINT 0 20 0 ORIGIN 0 0 0 UPVECTOR 0 0 -1\nLIGHT 22 4 20 6\n\
+         SURFACE 1 0.1 0.05 0.05 0.8 0.3 0.2 0.6 0.6 0.6 30 0.2 0\n\
+         SURFACE 2 0.05 0.05 0.1 0.2 0.4 0.8 0.6 0.6 0.6 30 0.2 0\n"
+    );
+    for (i, (x, z)) in placed.into_iter().enumerate() {
+        s += &format!("SPHERE {} {r:.6} {x:.6} {r:.6} {z:.6}\n", 1 + i % 2);
+    }
+    s
+}
+
+fn scaling() {
+    println!("### Scaling: N random spheres covering 40 % of the same screen area, 160×120\n");
+    println!("Times per pixel are rendering only; building the structure is its own column.");
+    println!("Naive is not run beyond 10,000 spheres (it would take hours); memory is the");
+    println!("octree's arenas.\n");
+    println!("| N | naive ns/pixel | octree ns/pixel | dda ns/pixel | build | octree memory | leaves | depth |");
+    println!("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    let pixels = 160.0 * 120.0;
+    let mut dda_times = Vec::new();
+    for n in [10usize, 100, 1_000, 10_000, 100_000] {
+        let text = carpet(n, 0x9e37_79b9_7f4a_7c15 ^ n as u64);
+        let mut scene = new_scene();
+        load_bytes("carpet", text.as_bytes(), &mut scene).expect("the carpet parses");
+        let c = OctreeConfig::default();
+        let per_px = |d: Duration| format!("{:.0}", d.as_nanos() as f64 / pixels);
+        let naive = if n <= 10_000 { per_px(time(&scene, AccelMode::Naive, c, None, 1)) } else { "—".into() };
+        let walk = |mode| {
+            let tree = build_octree(&scene, mode, &c).expect("an octree");
+            best_of(3, || render_prebuilt(&scene, None, Some(&tree), |_| {}).map(|r| r.stats)).0
+        };
+        let octree = walk(AccelMode::Octree);
+        let dda = walk(AccelMode::Dda);
+        dda_times.push((n, dda));
+        let (build, tree) = best_of(3, || build_octree(&scene, AccelMode::Dda, &c));
+        let report = *tree.expect("an octree").report();
+        println!(
+            "| {n} | {naive} | {} | {} | {} | {:.1} MB | {} | {} |",
+            per_px(octree),
+            per_px(dda),
+            ms(build),
+            report.bytes as f64 / 1e6,
+            report.leaves,
+            report.depth
+        );
+    }
+    let t = |n| dda_times.iter().find(|(m, _)| *m == n).map(|(_, d)| d.as_secs_f64()).unwrap_or(f64::NAN);
+    println!("\ndda: time(N = 10,000) / time(N = 10) = {:.2}\n", t(10_000) / t(10));
+}
+
+fn criterion(dir: &Path) {
+    println!("### Choosing the default criterion (dda, ms, best of 3)\n");
+    let combos = [(1usize, 12u32), (2, 12), (3, 12), (4, 12), (6, 12), (8, 12), (4, 8), (4, 16)];
+    print!("| scene |");
+    for (m, d) in combos {
+        print!(" ≤ {m}, depth {d} |");
+    }
+    println!();
+    println!("| --- |{}", " ---: |".repeat(combos.len()));
+    for path in scene_files(dir) {
+        let name = path.file_stem().unwrap_or_default().to_string_lossy().into_owned();
+        let scene = load(&path);
+        if scene.view().object_count() <= host_sim::NAIVE_UP_TO {
+            continue;
+        }
+        print!("| {name} |");
+        for (m, d) in combos {
+            let c = OctreeConfig { max_objects: m, max_depth: d, ..Default::default() };
+            print!(" {:.1} |", time(&scene, AccelMode::Dda, c, None, 3).as_secs_f64() * 1e3);
+        }
+        println!();
     }
     println!();
 }
@@ -76,13 +255,19 @@ fn scenes_table(dir: &Path) {
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
-    let which: Vec<&str> = if args.is_empty() { vec!["scenes"] } else { args.iter().map(String::as_str).collect() };
+    let scenes = root.join("scenes");
+    let all = ["scenes", "table51", "table52", "criterion", "scaling"];
+    let which: Vec<&str> = if args.is_empty() { all.to_vec() } else { args.iter().map(String::as_str).collect() };
     println!("Machine: {}\n", machine());
     for w in which {
         match w {
-            "scenes" => scenes_table(&root.join("scenes")),
+            "scenes" => scenes_table(&scenes),
+            "table51" => table51(&scenes),
+            "table52" => table52(&scenes),
+            "criterion" => criterion(&scenes),
+            "scaling" => scaling(),
             other => {
-                eprintln!("octrace-bench: unknown table `{other}` (known: scenes)");
+                eprintln!("octrace-bench: unknown table `{other}` (known: {})", all.join(", "));
                 std::process::exit(2);
             }
         }

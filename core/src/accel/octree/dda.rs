@@ -21,8 +21,7 @@
 
 use super::{Octree, INTERNAL};
 use crate::capacity::{Arena, Capacities};
-use crate::shapes::axis_aligned_box::slab_span_wide;
-use crate::shapes::{Ratio, Ray};
+use crate::shapes::Ray;
 
 /// Parameters are Q40.24.
 const FRAC: u32 = 24;
@@ -33,6 +32,7 @@ const LIMIT: i64 = 1 << (36 + FRAC);
 #[derive(Clone, Copy, Debug)]
 struct Frame {
     t0: [i64; 3],
+    tm: [i64; 3],
     t1: [i64; 3],
     /// The box's low corner (mirrored space) and log2 of its side.
     lo: [i64; 3],
@@ -133,14 +133,21 @@ impl DdaWalk {
         if enter >= exit || exit < 0 {
             return;
         }
-        // Clip to the objects' bounds, exactly, then in Q40.24 (rounding
-        // outwards a little: a wider span only visits more boxes).
-        let Some(span) = slab_span_wide(o, d, tree.bounds_min, tree.bounds_max) else { return };
-        let to_q24 =
-            |r: Ratio| ((r.num as i128) << 38).div_euclid(r.den as i128).clamp(-(LIMIT as i128), LIMIT as i128) as i64;
-        walk.near = span.enter.map_or(-LIMIT, to_q24) - 1;
-        walk.far = span.exit.map_or(LIMIT, to_q24) + 1;
-        if walk.far < 0 {
+        // Clip to the objects' own bounds (rounding outwards: a wider span
+        // only visits more boxes).
+        let (mut near, mut far) = (-LIMIT, LIMIT);
+        for a in 0..3 {
+            let (lo, hi) = if walk.mirror >> a & 1 == 1 {
+                let c2 = 2 * (tree.root_min[a] + half);
+                (c2 - tree.bounds_max[a], c2 - tree.bounds_min[a])
+            } else {
+                (tree.bounds_min[a], tree.bounds_max[a])
+            };
+            near = near.max(walk.crossing(a, lo));
+            far = far.min(walk.crossing(a, hi));
+        }
+        (walk.near, walk.far) = (near - 1, far + 1);
+        if walk.far < walk.near || walk.far < 0 {
             return;
         }
         if root.count != INTERNAL {
@@ -163,15 +170,16 @@ impl DdaWalk {
     /// every middle plane crossed before the entry plane.
     #[inline]
     fn push(&mut self, children: u32, t0: [i64; 3], t1: [i64; 3], lo: [i64; 3], log2: u32) {
+        let tm = [0, 1, 2].map(|a| self.middle(a, t0[a], t1[a], lo[a], log2));
         let entry_axis = max_axis(&t0);
         let entry = t0[entry_axis];
         let mut first = 0u8;
         for a in 0..3 {
-            if a != entry_axis && self.middle(a, t0[a], t1[a], lo[a], log2) < entry {
+            if a != entry_axis && tm[a] < entry {
                 first |= 1 << a;
             }
         }
-        let _ = self.stack.push(Frame { t0, t1, lo, log2, children, next: first });
+        let _ = self.stack.push(Frame { t0, tm, t1, lo, log2, children, next: first });
     }
 
     /// The crossing of a box's middle plane on axis `a`: the mean of the
@@ -204,19 +212,14 @@ impl DdaWalk {
                 self.stack.pop();
                 continue;
             }
-            let frame = *top;
-            let (mut t0, mut t1, mut lo) = (frame.t0, frame.t1, frame.lo);
-            let half = 1i64 << (frame.log2 - 1);
+            let (mut t0, mut t1) = (top.t0, top.t1);
             for a in 0..3 {
-                let mid = self.middle(a, frame.t0[a], frame.t1[a], frame.lo[a], frame.log2);
                 if c >> a & 1 == 1 {
-                    t0[a] = mid;
-                    lo[a] += half;
+                    t0[a] = top.tm[a];
                 } else {
-                    t1[a] = mid;
+                    t1[a] = top.tm[a];
                 }
             }
-            let top = self.stack.last_mut()?;
             if t0[max_axis(&t0)] > stop.min(self.far) {
                 top.next = 8;
                 continue;
@@ -226,14 +229,17 @@ impl DdaWalk {
             let axis = min_axis(&t1);
             let bit = 1u8 << axis;
             top.next = if c & bit != 0 { 8 } else { c | bit };
-            let node = frame.children + (c ^ self.mirror) as u32;
+            let node = top.children + (c ^ self.mirror) as u32;
             let exit = t1[axis];
             if exit < 0 || exit < self.near {
                 continue; // wholly behind the origin, or before the objects
             }
             let n = nodes[node as usize];
             if n.count == INTERNAL {
-                self.push(n.first, t0, t1, lo, frame.log2 - 1);
+                let half = 1i64 << (top.log2 - 1);
+                let lo = [0, 1, 2].map(|a| top.lo[a] + if c >> a & 1 == 1 { half } else { 0 });
+                let log2 = top.log2 - 1;
+                self.push(n.first, t0, t1, lo, log2);
             } else if n.count != 0 {
                 return Some((node, exit));
             }

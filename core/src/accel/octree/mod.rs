@@ -71,7 +71,7 @@ fn to_q24(t: Scalar) -> i64 {
     (t.to_bits() as i64) << 8
 }
 
-/// Visits the leaves along `ray` with `visit(leaf objects, exit)`, which
+/// Visits the leaves along `ray` with `visit(leaf, exit)`, which
 /// returns the parameter beyond which nothing matters any more (the nearest
 /// hit so far, or the shadow ray's end), or `None` to stop.
 #[inline]
@@ -158,7 +158,7 @@ pub struct OctreeConfig {
 
 impl Default for OctreeConfig {
     fn default() -> Self {
-        OctreeConfig { max_objects: 2, max_depth: 12, traversal: Traversal::Dda }
+        OctreeConfig { max_objects: 4, max_depth: 12, traversal: Traversal::Dda }
     }
 }
 
