@@ -85,6 +85,15 @@ impl Vec3 {
     pub fn direction(self) -> Option<Dir> {
         Dir::normalize(self.wide())
     }
+
+    /// The unit vector along `self` and its length (rounded to nearest), with
+    /// one square root; `None` for the zero vector.
+    #[inline]
+    pub fn direction_and_length(self) -> Option<(Dir, Scalar)> {
+        let (d, len, shift) = Dir::normalize_with_length(self.wide())?;
+        let length = if shift >= 0 { len << shift } else { (len + (1 << (-shift - 1))) >> -shift };
+        Some((d, Scalar::from_bits(length.min(i32::MAX as u64) as i32)))
+    }
 }
 
 impl Add for Vec3 {
@@ -176,6 +185,12 @@ impl Dir {
     /// `None` when `v` is zero. Rounding is symmetric: `normalize(-v) ==
     /// -normalize(v)`.
     pub fn normalize(v: [i64; 3]) -> Option<Dir> {
+        Self::normalize_with_length(v).map(|(d, _, _)| d)
+    }
+
+    /// [`Dir::normalize`], also giving the length of `v` as `len · 2^shift`
+    /// (`len` between 2^29 and 2^31): one square root serves both.
+    pub fn normalize_with_length(v: [i64; 3]) -> Option<(Dir, u64, i32)> {
         let mag = |c: i64| c.unsigned_abs();
         let largest = mag(v[0]).max(mag(v[1])).max(mag(v[2]));
         if largest == 0 {
@@ -199,14 +214,15 @@ impl Dir {
         // One division: c / len = c · (2^62 / len) / 2^32, rounded, within
         // one unit.
         let inverse = (1u64 << 62) / len;
-        Some(Dir::from_bits(scaled.map(|c| {
+        let dir = Dir::from_bits(scaled.map(|c| {
             let m = ((c.unsigned_abs() * inverse + (1 << 31)) >> 32) as i32;
             if c < 0 {
                 -m
             } else {
                 m
             }
-        })))
+        }));
+        Some((dir, len, shift))
     }
 
     /// Cross product, renormalised; `None` for parallel inputs.
@@ -278,6 +294,17 @@ mod tests {
         let b = r.bits();
         let e = d.bits();
         assert!((b[0] - e[0]).abs() <= 1 && (b[1] + e[1]).abs() <= 1, "{r:?}");
+    }
+
+    #[test]
+    fn direction_and_length_agree_with_the_separate_ones() {
+        for v in [[3 << 16, 4 << 16, 0], [-7, 2, 9], [1 << 28, -(1 << 27), 12345], [0, 0, -1], [5, 0, 0]] {
+            let v = Vec3::from_bits(v);
+            let (d, l) = v.direction_and_length().unwrap();
+            assert_eq!(d, v.direction().unwrap());
+            assert!((l.to_bits() - v.length().to_bits()).abs() <= 1, "{v:?}: {l} vs {}", v.length());
+        }
+        assert_eq!(Vec3::ZERO.direction_and_length(), None);
     }
 
     #[test]

@@ -45,6 +45,10 @@ struct Frame {
 pub(super) struct DdaWalk {
     /// Octant bits of the mirrored axes.
     mirror: u8,
+    /// Octant bits of the axes whose root crossings saturated (the ray runs
+    /// almost parallel to them); on every other axis all crossings inside
+    /// the root are exact and middle planes are plain means.
+    saturated: u8,
     /// The ray's origin in mirrored space and 2^62 / |d_a|.
     origin: [i64; 3],
     inverse: [u64; 3],
@@ -92,6 +96,7 @@ impl DdaWalk {
     pub const fn new() -> DdaWalk {
         DdaWalk {
             mirror: 0,
+            saturated: 0,
             origin: [0; 3],
             inverse: [0; 3],
             near: 0,
@@ -104,6 +109,7 @@ impl DdaWalk {
     /// Starts a walk along `ray` (in place: the walk's stack is not small).
     pub fn start<C: Capacities>(&mut self, tree: &Octree<C>, ray: &Ray) {
         self.mirror = 0;
+        self.saturated = 0;
         self.stack.clear();
         self.root_leaf = None;
         let walk = self;
@@ -127,6 +133,9 @@ impl DdaWalk {
             walk.inverse[a] = (1u64 << 62) / d[a].unsigned_abs().max(1);
             t0[a] = walk.crossing(a, tree.root_min[a]);
             t1[a] = walk.crossing(a, tree.root_min[a] + 2 * half);
+            if t0[a].abs() == LIMIT || t1[a].abs() == LIMIT {
+                walk.saturated |= 1 << a;
+            }
         }
         let enter = t0[max_axis(&t0)];
         let exit = t1[min_axis(&t1)];
@@ -188,7 +197,7 @@ impl DdaWalk {
     /// would be meaningless; then it is computed directly.
     #[inline]
     fn middle(&self, a: usize, t0: i64, t1: i64, lo: i64, log2: u32) -> i64 {
-        if t0.abs() == LIMIT || t1.abs() == LIMIT {
+        if self.saturated >> a & 1 == 1 && (t0.abs() == LIMIT || t1.abs() == LIMIT) {
             self.crossing(a, lo + (1i64 << (log2 - 1)))
         } else {
             (t0 + t1) >> 1
