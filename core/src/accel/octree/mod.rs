@@ -507,3 +507,129 @@ impl<C: Capacities> Accelerator for Octree<C> {
         blocked
     }
 }
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::capacity::Board64K;
+    use crate::math::Dir;
+    use crate::parse::parse;
+    use crate::scene::Scene;
+    use std::boxed::Box;
+    use std::format;
+    use std::string::String;
+    use std::vec::Vec;
+
+    const SURF: &str = "SURFACE 1 0.1 0.1 0.1 0.5 0.5 0.5 0 0 0 0 0 0\n";
+
+    fn scene(objects: &str) -> Box<Scene<Board64K>> {
+        let mut s: Box<Scene<Board64K>> = Box::default();
+        parse(&format!("{SURF}{objects}"), &mut s, &mut |e| panic!("{e}")).unwrap();
+        s
+    }
+
+    /// A row of spheres along x.
+    fn row(n: usize) -> String {
+        (0..n).map(|i| format!("SPHERE 1 0.4 {} 0 0\n", i as i32 - n as i32 / 2)).collect()
+    }
+
+    #[test]
+    fn boxes_are_named_as_in_the_thesis_and_found_by_hash() {
+        let s = scene(&row(12));
+        let mut tree: Box<Octree<Board64K>> = Box::default();
+        let report = tree.build(&s.view(), &OctreeConfig { max_objects: 2, max_depth: 6, traversal: Traversal::Named });
+        assert!(report.depth >= 2 && report.unsplit == 0, "{report:?}");
+        // The root is 1 and its children are found under that name.
+        assert_eq!(tree.lookup(1), Some(tree.nodes.as_slice()[0].first));
+        // Every subdivided box is in the table under its decimal name: walk
+        // the tree by names and compare with the child indices.
+        let mut stack = Vec::from([(0u32, 1u64)]);
+        let mut subdivided = 0;
+        while let Some((node, name)) = stack.pop() {
+            let n = tree.nodes.as_slice()[node as usize];
+            if n.count != INTERNAL {
+                continue;
+            }
+            subdivided += 1;
+            assert_eq!(tree.lookup(name), Some(n.first), "box {name}");
+            for k in 0..8u32 {
+                stack.push((n.first + k, name * 10 + 1 + k as u64));
+            }
+        }
+        assert_eq!(subdivided, report.hash_entries);
+        assert_eq!(tree.lookup(19), None, "no digit 9");
+    }
+
+    #[test]
+    fn every_leaf_holds_exactly_the_objects_that_touch_it() {
+        let s = scene(&row(9));
+        let view = s.view();
+        let mut tree: Box<Octree<Board64K>> = Box::default();
+        tree.build(&view, &OctreeConfig { max_objects: 1, max_depth: 5, traversal: Traversal::Dda });
+        let mut stack = Vec::from([(0u32, tree.root_min, tree.root_log2)]);
+        let mut references = 0;
+        while let Some((node, lo, log2)) = stack.pop() {
+            let n = tree.nodes.as_slice()[node as usize];
+            if n.count == INTERNAL {
+                let half = 1i64 << (log2 - 1);
+                for k in 0..8u32 {
+                    let l = [0, 1, 2].map(|a| lo[a] + if k >> a & 1 == 1 { half } else { 0 });
+                    stack.push((n.first + k, l, log2 - 1));
+                }
+                continue;
+            }
+            let objects = tree.leaf_objects(node).unwrap();
+            references += objects.len();
+            let cell = Cell { lo: lo.map(|v| v - FILING_MARGIN), hi: lo.map(|v| v + (1 << log2) + FILING_MARGIN) };
+            for id in view.object_ids() {
+                assert_eq!(objects.contains(&id.0), overlaps(view.shape(id), &cell), "leaf {node}, object {id:?}");
+            }
+        }
+        assert_eq!(references, tree.report().references, "compaction kept every list");
+    }
+
+    #[test]
+    fn running_out_of_room_leaves_boxes_unsplit() {
+        use crate::capacity::Board16K;
+        let mut s: Box<Scene<Board16K>> = Box::default();
+        let text = format!("{SURF}{}", row(60));
+        parse(&text, &mut s, &mut |e| panic!("{e}")).unwrap();
+        let mut tree: Box<Octree<Board16K>> = Box::default();
+        let report = tree.build(&s.view(), &OctreeConfig { max_objects: 1, max_depth: 12, traversal: Traversal::Dda });
+        assert!(report.unsplit > 0 && report.exhausted.is_some(), "{report:?}");
+        assert!(report.nodes <= 400);
+    }
+
+    /// 3DDDA skips what lies outside the objects' own bounds; otherwise both
+    /// walks meet the same non-empty leaves in the same order.
+    #[test]
+    fn both_walks_visit_the_same_leaves_in_ray_order() {
+        let s = scene(&row(16));
+        let view = s.view();
+        let mut tree: Box<Octree<Board64K>> = Box::default();
+        tree.build(&view, &OctreeConfig { max_objects: 1, max_depth: 6, traversal: Traversal::Dda });
+        let eye = view.normalization.point([-20 << 32, 1 << 29, 1 << 28]);
+        for d in [[1i64, 0, 0], [3, -1, 0], [1, 1, 1], [5, 0, -1], [1, 0, 1 << 20]] {
+            let ray = Ray { origin: eye, dir: Dir::normalize(d).unwrap() };
+            let mut visits = [Vec::new(), Vec::new()];
+            for (i, t) in [Traversal::Dda, Traversal::Named].into_iter().enumerate() {
+                tree.set_traversal(t);
+                let mut m = Mailbox::none();
+                walk_leaves(&tree, &ray, &mut m, Scalar::MAX, |leaf, exit, _| {
+                    if tree.leaf_objects(leaf).is_some_and(|o| !o.is_empty()) {
+                        visits[i].push(leaf);
+                    }
+                    let _ = exit;
+                    Some(Scalar::MAX)
+                });
+            }
+            let mut named = visits[1].iter();
+            assert!(visits[0].iter().all(|leaf| named.any(|n| n == leaf)), "{d:?}: {visits:?}");
+            if d[1] == 0 && d[2] == 0 {
+                assert_eq!(visits[0], visits[1], "along the row");
+                assert!(visits[0].len() > 8);
+            }
+        }
+    }
+}
