@@ -90,6 +90,41 @@ impl<T, const N: usize> Arena<T> for HeapArena<T, N> {
     }
 }
 
+/// The integer type of the octree's indices: `u32` on hosts, `u16` on small
+/// boards (half the RAM for the octree). Its largest two values are
+/// reserved as markers.
+pub trait Index: Copy + Eq + core::fmt::Debug + 'static {
+    /// The largest value.
+    const MAX: u32;
+    /// `v` as an index; `v` must not exceed [`Index::MAX`].
+    fn new(v: u32) -> Self;
+    fn get(self) -> u32;
+}
+
+impl Index for u16 {
+    const MAX: u32 = u16::MAX as u32;
+    #[inline]
+    fn new(v: u32) -> u16 {
+        v as u16
+    }
+    #[inline]
+    fn get(self) -> u32 {
+        self as u32
+    }
+}
+
+impl Index for u32 {
+    const MAX: u32 = u32::MAX;
+    #[inline]
+    fn new(v: u32) -> u32 {
+        v
+    }
+    #[inline]
+    fn get(self) -> u32 {
+        self
+    }
+}
+
 /// The capacities of one build: how many of each thing a scene may hold.
 pub trait Capacities {
     /// The profile's name, shown in capacity errors.
@@ -104,16 +139,18 @@ pub trait Capacities {
     /// Surface definitions; at most 65,535 (objects refer to them by `u16`).
     type Surfaces: Arena<SurfaceEntry>;
     type Lights: Arena<Light>;
+    /// The octree's index type (bounds its arenas and the objects it files).
+    type Index: Index;
     /// Octree boxes (8 per subdivision, plus the root).
-    type OctreeNodes: Arena<OctreeNode>;
+    type OctreeNodes: Arena<OctreeNode<Self::Index>>;
     /// Object references of the octree's leaves (an object in several
     /// leaves counts once per leaf), and working room while building.
-    type OctreeRefs: Arena<u32>;
+    type OctreeRefs: Arena<Self::Index>;
     /// Hash-table entries: one per subdivided box (the thesis's structure
     /// holding the addresses of a box's eight children).
-    type OctreeEntries: Arena<HashEntry>;
+    type OctreeEntries: Arena<HashEntry<Self::Index>>;
     /// Hash-table buckets; the table size is this arena's capacity.
-    type OctreeBuckets: Arena<u32>;
+    type OctreeBuckets: Arena<Self::Index>;
 }
 
 /// The host build: a million objects of any mix (heap-backed arenas).
@@ -131,29 +168,33 @@ impl Capacities for Host {
     type Rectangles = HeapArena<Rectangle, 1_000_000>;
     type Surfaces = HeapArena<SurfaceEntry, 65_535>;
     type Lights = HeapArena<Light, 4_096>;
-    type OctreeNodes = HeapArena<OctreeNode, 16_000_000>;
+    type Index = u32;
+    type OctreeNodes = HeapArena<OctreeNode<u32>, 16_000_000>;
     type OctreeRefs = HeapArena<u32, 64_000_000>;
-    type OctreeEntries = HeapArena<HashEntry, 2_000_000>;
+    type OctreeEntries = HeapArena<HashEntry<u32>, 2_000_000>;
     type OctreeBuckets = HeapArena<u32, 65_521>;
 }
 
-/// A board with 16 KiB of RAM (BBC micro:bit v1): about 6 KiB of scene.
+/// A board with 16 KiB of RAM (BBC micro:bit v1): scenes of up to 200
+/// spheres and a few other shapes in about 6 KiB, and an octree of up to 128
+/// boxes in about 2 KiB (16-bit indices), leaving 6 KiB of stack.
 pub struct Board16K;
 
 impl Capacities for Board16K {
     const NAME: &'static str = "Board16K";
-    type Objects = heapless::Vec<ShapeHandle, 224>;
-    type Spheres = heapless::Vec<Sphere, 208>;
-    type Boxes = heapless::Vec<AxisAlignedBox, 4>;
-    type Superquadrics = heapless::Vec<Superquadric, 4>;
-    type Triangles = heapless::Vec<Triangle, 4>;
-    type Rectangles = heapless::Vec<Rectangle, 4>;
-    type Surfaces = heapless::Vec<SurfaceEntry, 16>;
+    type Objects = heapless::Vec<ShapeHandle, 208>;
+    type Spheres = heapless::Vec<Sphere, 200>;
+    type Boxes = heapless::Vec<AxisAlignedBox, 2>;
+    type Superquadrics = heapless::Vec<Superquadric, 2>;
+    type Triangles = heapless::Vec<Triangle, 2>;
+    type Rectangles = heapless::Vec<Rectangle, 2>;
+    type Surfaces = heapless::Vec<SurfaceEntry, 12>;
     type Lights = heapless::Vec<Light, 4>;
-    type OctreeNodes = heapless::Vec<OctreeNode, 400>;
-    type OctreeRefs = heapless::Vec<u32, 1024>;
-    type OctreeEntries = heapless::Vec<HashEntry, 50>;
-    type OctreeBuckets = heapless::Vec<u32, 31>;
+    type Index = u16;
+    type OctreeNodes = heapless::Vec<OctreeNode<u16>, 128>;
+    type OctreeRefs = heapless::Vec<u16, 640>;
+    type OctreeEntries = heapless::Vec<HashEntry<u16>, 16>;
+    type OctreeBuckets = heapless::Vec<u16, 13>;
 }
 
 /// A board with 64 KiB of RAM or more (Cortex-M3/M4 class).
@@ -169,8 +210,9 @@ impl Capacities for Board64K {
     type Rectangles = heapless::Vec<Rectangle, 96>;
     type Surfaces = heapless::Vec<SurfaceEntry, 64>;
     type Lights = heapless::Vec<Light, 8>;
-    type OctreeNodes = heapless::Vec<OctreeNode, 2048>;
-    type OctreeRefs = heapless::Vec<u32, 6144>;
-    type OctreeEntries = heapless::Vec<HashEntry, 256>;
-    type OctreeBuckets = heapless::Vec<u32, 127>;
+    type Index = u16;
+    type OctreeNodes = heapless::Vec<OctreeNode<u16>, 2048>;
+    type OctreeRefs = heapless::Vec<u16, 6144>;
+    type OctreeEntries = heapless::Vec<HashEntry<u16>, 256>;
+    type OctreeBuckets = heapless::Vec<u16, 127>;
 }

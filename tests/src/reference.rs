@@ -40,11 +40,7 @@ impl V3 {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
     fn cross(self, o: V3) -> V3 {
-        V3::new(
-            self.y * o.z - self.z * o.y,
-            self.z * o.x - self.x * o.z,
-            self.x * o.y - self.y * o.x,
-        )
+        V3::new(self.y * o.z - self.z * o.y, self.z * o.x - self.x * o.z, self.x * o.y - self.y * o.x)
     }
     fn length(self) -> f64 {
         self.dot(self).sqrt()
@@ -236,9 +232,7 @@ fn tokenize(text: &str) -> Result<Vec<Token>, String> {
             step(&mut i, &mut line, &mut col);
             loop {
                 if i >= chars.len() {
-                    return Err(format!(
-                        "{open_line}:{open_col}: unterminated comment opened on line {open_line}"
-                    ));
+                    return Err(format!("{open_line}:{open_col}: unterminated comment opened on line {open_line}"));
                 }
                 if chars[i] == '*' && i + 1 < chars.len() && chars[i + 1] == '/' {
                     step(&mut i, &mut line, &mut col);
@@ -262,11 +256,7 @@ fn tokenize(text: &str) -> Result<Vec<Token>, String> {
                 s.push(chars[i]);
                 step(&mut i, &mut line, &mut col);
             }
-            tokens.push(Token {
-                text: s,
-                line: tl,
-                col: tc,
-            });
+            tokens.push(Token { text: s, line: tl, col: tc });
         } else {
             let (tl, tc) = (line, col);
             let mut s = String::new();
@@ -274,11 +264,7 @@ fn tokenize(text: &str) -> Result<Vec<Token>, String> {
                 s.push(chars[i]);
                 step(&mut i, &mut line, &mut col);
             }
-            tokens.push(Token {
-                text: s,
-                line: tl,
-                col: tc,
-            });
+            tokens.push(Token { text: s, line: tl, col: tc });
         }
     }
     Ok(tokens)
@@ -343,59 +329,33 @@ impl Parser {
                 self.pos += 1;
                 Ok(t)
             }
-            None => Err(format!(
-                "{}:{}: expected {what}, found end of file",
-                self.end.0, self.end.1
-            )),
+            None => Err(format!("{}:{}: expected {what}, found end of file", self.end.0, self.end.1)),
         }
     }
 
     fn number(&mut self, what: &str) -> Result<f64, String> {
         let t = self.next(what)?;
-        let v = if is_number(&t.text) {
-            t.text.parse::<f64>().ok()
-        } else {
-            None
-        };
+        let v = if is_number(&t.text) { t.text.parse::<f64>().ok() } else { None };
         match v {
             Some(v) if v.abs() <= 1e6 => Ok(v),
-            Some(v) => Err(format!(
-                "{}:{}: {what} is out of range (magnitude above 1e6), found {v}",
-                t.line, t.col
-            )),
-            None => Err(format!(
-                "{}:{}: expected {what} (a number), found `{}`",
-                t.line, t.col, t.text
-            )),
+            Some(v) => Err(format!("{}:{}: {what} is out of range (magnitude above 1e6), found {v}", t.line, t.col)),
+            None => Err(format!("{}:{}: expected {what} (a number), found `{}`", t.line, t.col, t.text)),
         }
     }
 
     fn integer(&mut self, what: &str, min: i64, max: i64) -> Result<i64, String> {
         let t = self.next(what)?;
-        let v = if is_integer(&t.text) {
-            t.text.parse::<i64>().ok()
-        } else {
-            None
-        };
+        let v = if is_integer(&t.text) { t.text.parse::<i64>().ok() } else { None };
         match v {
             Some(v) if (min..=max).contains(&v) => Ok(v),
-            Some(v) => Err(format!(
-                "{}:{}: {what} must be in {min}..={max}, found {v}",
-                t.line, t.col
-            )),
-            None => Err(format!(
-                "{}:{}: expected {what} (an integer), found `{}`",
-                t.line, t.col, t.text
-            )),
+            Some(v) => Err(format!("{}:{}: {what} must be in {min}..={max}, found {v}", t.line, t.col)),
+            None => Err(format!("{}:{}: expected {what} (an integer), found `{}`", t.line, t.col, t.text)),
         }
     }
 
     /// A number that must satisfy `ok`; `rule` describes the requirement.
     fn checked(&mut self, what: &str, rule: &str, ok: impl Fn(f64) -> bool) -> Result<f64, String> {
-        let (line, col) = self
-            .tokens
-            .get(self.pos)
-            .map_or(self.end, |t| (t.line, t.col));
+        let (line, col) = self.tokens.get(self.pos).map_or(self.end, |t| (t.line, t.col));
         let v = self.number(what)?;
         if ok(v) {
             Ok(v)
@@ -405,11 +365,7 @@ impl Parser {
     }
 
     fn vec3(&mut self, what: &str) -> Result<V3, String> {
-        Ok(V3::new(
-            self.number(what)?,
-            self.number(what)?,
-            self.number(what)?,
-        ))
+        Ok(V3::new(self.number(what)?, self.number(what)?, self.number(what)?))
     }
 
     fn colour(&mut self, what: &str) -> Result<Rgb, String> {
@@ -425,11 +381,7 @@ pub fn parse(text: &str) -> Result<RefScene, String> {
         let last_col = text.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
         (lines, last_col)
     };
-    let mut p = Parser {
-        tokens,
-        pos: 0,
-        end,
-    };
+    let mut p = Parser { tokens, pos: 0, end };
 
     let mut scene = RefScene {
         viewpoint: V3::new(0.0, 0.0, 10.0),
@@ -474,9 +426,7 @@ pub fn parse(text: &str) -> Result<RefScene, String> {
         );
         if is_parameter {
             if let Some(first) = seen.insert(keyword.clone(), line) {
-                return Err(format!(
-                    "{line}:{col}: {keyword} given twice (lines {first} and {line})"
-                ));
+                return Err(format!("{line}:{col}: {keyword} given twice (lines {first} and {line})"));
             }
         }
         match keyword.as_str() {
@@ -498,10 +448,7 @@ pub fn parse(text: &str) -> Result<RefScene, String> {
             "LIGHT" => {
                 let brightness = p.checked("LIGHT brightness", ">= 0", |v| v >= 0.0)?;
                 let position = p.vec3("LIGHT coordinate")?;
-                scene.lights.push(Light {
-                    brightness,
-                    position,
-                });
+                scene.lights.push(Light { brightness, position });
             }
             "BACKGROUND" => scene.background = p.colour("BACKGROUND component")?,
             "GAMMA" => scene.gamma = p.checked("GAMMA", "> 0", |v| v > 0.0)?,
@@ -528,24 +475,13 @@ pub fn parse(text: &str) -> Result<RefScene, String> {
                 references.push((s, line, col));
                 scene.objects.push(Object { shape, surface: 0 });
             }
-            "BSPLINE" => {
-                return Err(format!(
-                    "{line}:{col}: BSPLINE is not supported by the reference tracer"
-                ))
-            }
-            _ => {
-                return Err(format!(
-                    "{line}:{col}: expected a keyword, found `{}`",
-                    p.tokens[p.pos - 1].text
-                ))
-            }
+            "BSPLINE" => return Err(format!("{line}:{col}: BSPLINE is not supported by the reference tracer")),
+            _ => return Err(format!("{line}:{col}: expected a keyword, found `{}`", p.tokens[p.pos - 1].text)),
         }
     }
 
     for (object, &(s, line, col)) in scene.objects.iter_mut().zip(&references) {
-        object.surface = *surface_index
-            .get(&s)
-            .ok_or_else(|| format!("{line}:{col}: surface {s} is not defined"))?;
+        object.surface = *surface_index.get(&s).ok_or_else(|| format!("{line}:{col}: surface {s} is not defined"))?;
     }
 
     let forward = scene.origin - scene.viewpoint;
@@ -564,10 +500,7 @@ fn parse_shape(p: &mut Parser, keyword: &str, line: usize, col: usize) -> Result
     Ok(match keyword {
         "SPHERE" => {
             let radius = p.checked("SPHERE radius", "> 0", positive)?;
-            Shape::Sphere {
-                centre: p.vec3("SPHERE centre")?,
-                radius,
-            }
+            Shape::Sphere { centre: p.vec3("SPHERE centre")?, radius }
         }
         "BOX" => {
             let centre = p.vec3("BOX centre")?;
@@ -579,35 +512,22 @@ fn parse_shape(p: &mut Parser, keyword: &str, line: usize, col: usize) -> Result
             Shape::Box { centre, half }
         }
         "SUPERQUADRIC" => {
-            let power = p.checked("SUPERQUADRIC power", "in 2..=64", |v| {
-                (2.0..=64.0).contains(&v)
-            })?;
+            let power = p.checked("SUPERQUADRIC power", "in 2..=64", |v| (2.0..=64.0).contains(&v))?;
             let centre = p.vec3("SUPERQUADRIC centre")?;
             let half = V3::new(
                 p.checked("SUPERQUADRIC size", "> 0", positive)?,
                 p.checked("SUPERQUADRIC size", "> 0", positive)?,
                 p.checked("SUPERQUADRIC size", "> 0", positive)?,
             );
-            Shape::Superquadric {
-                power,
-                centre,
-                half,
-            }
+            Shape::Superquadric { power, centre, half }
         }
         "TRIANGLE" => {
-            let pts = [
-                p.vec3("TRIANGLE corner")?,
-                p.vec3("TRIANGLE corner")?,
-                p.vec3("TRIANGLE corner")?,
-            ];
+            let pts = [p.vec3("TRIANGLE corner")?, p.vec3("TRIANGLE corner")?, p.vec3("TRIANGLE corner")?];
             let n = (pts[1] - pts[0]).cross(pts[2] - pts[0]);
             if n.length() == 0.0 {
                 return degenerate();
             }
-            Shape::Triangle {
-                p: pts,
-                normal: n.normalised(),
-            }
+            Shape::Triangle { p: pts, normal: n.normalised() }
         }
         _ => {
             let pts = [
@@ -622,10 +542,7 @@ fn parse_shape(p: &mut Parser, keyword: &str, line: usize, col: usize) -> Result
             if n.length() == 0.0 {
                 return degenerate();
             }
-            Shape::Rectangle {
-                p: pts,
-                normal: n.normalised(),
-            }
+            Shape::Rectangle { p: pts, normal: n.normalised() }
         }
     })
 }
@@ -723,9 +640,7 @@ fn superquadric_hit(power: f64, centre: V3, half: V3, o: V3, d: V3, roots: Roots
     };
     let df = |t: f64| {
         let x = at(t);
-        (0..3)
-            .map(|i| x.get(i).signum() * x.get(i).abs().powf(power - 1.0) * ld.get(i))
-            .sum::<f64>()
+        (0..3).map(|i| x.get(i).signum() * x.get(i).abs().powf(power - 1.0) * ld.get(i)).sum::<f64>()
     };
     let start = t0.max(0.0);
     // The minimum of f on [start, t1]: bisect on the sign of f'.
@@ -757,11 +672,7 @@ fn superquadric_hit(power: f64, centre: V3, half: V3, o: V3, d: V3, roots: Roots
         }
         // Otherwise the ray starts inside the surface: report the exit.
     }
-    let exit = if f(t1) <= 0.0 {
-        t1
-    } else {
-        bisect(tmin, t1, |t| f(t) <= 0.0).0
-    };
+    let exit = if f(t1) <= 0.0 { t1 } else { bisect(tmin, t1, |t| f(t) <= 0.0).0 };
     (exit > 0.0).then_some(exit)
 }
 
@@ -813,11 +724,7 @@ impl Object {
         match self.shape {
             Shape::Sphere { centre, radius } => sphere_hit(centre, radius, o, d, roots),
             Shape::Box { centre, half } => box_hit(centre, half, o, d, roots),
-            Shape::Superquadric {
-                power,
-                centre,
-                half,
-            } => superquadric_hit(power, centre, half, o, d, roots),
+            Shape::Superquadric { power, centre, half } => superquadric_hit(power, centre, half, o, d, roots),
             Shape::Triangle { ref p, .. } => triangle_hit(p, o, d),
             Shape::Rectangle { ref p, normal } => rectangle_hit(p, normal, o, d),
         }
@@ -839,11 +746,7 @@ impl Object {
                 let sign = if rel(axis) < 0.0 { -1.0 } else { 1.0 };
                 V3::from_fn(|i| if i == axis { sign } else { 0.0 })
             }
-            Shape::Superquadric {
-                power,
-                centre,
-                half,
-            } => {
+            Shape::Superquadric { power, centre, half } => {
                 let g = V3::from_fn(|i| {
                     let x = (at.get(i) - centre.get(i)) / half.get(i);
                     x.signum() * x.abs().powf(power - 1.0) / half.get(i)
@@ -943,9 +846,7 @@ impl RefScene {
     /// True if any object is hit with 0 < t < max_t.
     fn blocked(&self, o: V3, d: V3, max_t: f64, start: Start) -> bool {
         self.objects.iter().enumerate().any(|(i, object)| {
-            roots_for(object, i, d, Some(start))
-                .and_then(|roots| object.hit(o, d, roots))
-                .is_some_and(|t| t < max_t)
+            roots_for(object, i, d, Some(start)).and_then(|roots| object.hit(o, d, roots)).is_some_and(|t| t < max_t)
         })
     }
 
@@ -960,10 +861,7 @@ impl RefScene {
         let ng = object.normal(p);
         let n = if ng.dot(d) < 0.0 { ng } else { -ng };
         let v = -d;
-        let here = Start {
-            object: index,
-            normal: ng,
-        };
+        let here = Start { object: index, normal: ng };
 
         let mut local = surface.ambient;
         for light in &self.lights {
@@ -979,14 +877,10 @@ impl RefScene {
             }
             let r = n * (2.0 * ndl) - lv;
             let rv = r.dot(v).max(0.0);
-            let spec = if surface.exponent == 0.0 {
-                1.0
-            } else {
-                rv.powf(surface.exponent)
-            };
+            let spec = if surface.exponent == 0.0 { 1.0 } else { rv.powf(surface.exponent) };
             let scale = light.brightness / (dist + self.attenuation);
-            for c in 0..3 {
-                local[c] += scale * (surface.diffuse[c] * ndl + surface.specular[c] * spec);
+            for (c, channel) in local.iter_mut().enumerate() {
+                *channel += scale * (surface.diffuse[c] * ndl + surface.specular[c] * spec);
             }
         }
 
@@ -1082,11 +976,7 @@ mod tests {
         // 127.5 and 63.75 round half up.
         assert!(image.iter().all(|&p| p == [128, 64, 255]));
         // An empty file renders black.
-        assert!(parse("")
-            .unwrap()
-            .render(4, 4)
-            .iter()
-            .all(|&p| p == [0, 0, 0]));
+        assert!(parse("").unwrap().render(4, 4).iter().all(|&p| p == [0, 0, 0]));
     }
 
     #[test]
@@ -1147,10 +1037,7 @@ mod tests {
                     RECTANGLE 1 -9 -9 0  9 -9 0  9 9 0  -9 9 0
                     SURFACE 1 0.1 0.1 0.1  0.5 0.5 0.5  0 0 0  0 0 0";
         let shadowed = |t: &str| {
-            let s = parse(&format!(
-                "{base} SPHERE 2 0.5 2.5 0 2.5 SURFACE 2 1 1 1 1 1 1 0 0 0 0 0 {t}"
-            ))
-            .unwrap();
+            let s = parse(&format!("{base} SPHERE 2 0.5 2.5 0 2.5 SURFACE 2 1 1 1 1 1 1 0 0 0 0 0 {t}")).unwrap();
             s.sample(3, 3, 1, 1, 0, 0)
         };
         assert!(close(shadowed("0"), [0.1; 3]));
@@ -1213,11 +1100,7 @@ mod tests {
         assert_eq!(s.render(4, 2).len(), 8);
 
         let err = |text: &str| parse(text).unwrap_err();
-        assert!(
-            err("SPHERE 1 1 0 0 0\n  FOO").starts_with("2:3:"),
-            "{}",
-            err("\n  FOO")
-        );
+        assert!(err("SPHERE 1 1 0 0 0\n  FOO").starts_with("2:3:"), "{}", err("\n  FOO"));
         assert!(err("RASTER 3 nan").starts_with("1:10:"));
         assert!(err("GAMMA 0x10").starts_with("1:7:"));
         assert!(err("RASTER 3.5 2").starts_with("1:8:"));

@@ -50,11 +50,11 @@ impl RayStart {
 
 /// Remembers which objects a query has tested, so that an object filed in
 /// several cells is tested once. One bit per object in caller-owned words;
-/// clearing costs only the bits that were set (up to 64, else the words are
+/// clearing costs only the bits that were set (up to 32, else the words are
 /// zeroed). Words too few for an object just disable the check for it.
 pub struct Mailbox<'m> {
     words: &'m mut [u32],
-    touched: heapless::Vec<u32, 64>,
+    touched: heapless::Vec<u32, 32>,
     overflowed: bool,
     /// Cells (leaves) visited, for the benchmarks.
     pub cells: u64,

@@ -14,9 +14,11 @@
 
 mod exp_log;
 mod vector;
+mod wide;
 
 pub use exp_log::{exp2_q32, isqrt_u128, log2_q32, pow_q30, pow_unit};
 pub use vector::{Dir, Vec3};
+pub use wide::{isqrt, isqrt_from, mul_u32_wide, mul_wide, rsqrt};
 
 pub use fixed::types::{I16F16, I2F30, I32F32};
 
@@ -34,12 +36,6 @@ pub const SCENE_RANGE_LOG2: u32 = 13;
 pub const UNIT_ONE: i64 = 1 << 30;
 /// One in Q16.16.
 pub const SCALAR_ONE: i32 = 1 << 16;
-
-/// Floor of the square root of a `u64`.
-#[inline]
-pub fn isqrt(n: u64) -> u64 {
-    n.isqrt()
-}
 
 /// `a * b >> shift` for signed operands whose exact product fits an `i64`.
 #[inline]
@@ -60,15 +56,6 @@ pub fn div_scaled_saturating(num: i64, den: i64, shift: u32) -> i32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn isqrt_is_floor() {
-        for n in [0u64, 1, 2, 3, 4, 15, 16, 17, u64::MAX, (1 << 62) - 1, 1 << 62] {
-            let r = isqrt(n);
-            assert!(r * r <= n);
-            assert!((r + 1).checked_mul(r + 1).is_none_or(|s| s > n));
-        }
-    }
 
     #[test]
     fn saturating_division_clamps() {

@@ -5,7 +5,7 @@
 //! Arithmetic on [`Vec3`] uses `fixed`'s operators, which panic on overflow in
 //! debug builds; the scene normalisation keeps every value in range.
 
-use super::{Scalar, Unit, UNIT_ONE};
+use super::{mul_u32_wide, mul_wide, Scalar, Unit, UNIT_ONE};
 use core::ops::{Add, Neg, Sub};
 
 /// A point or an offset in normalised scene space.
@@ -62,16 +62,16 @@ impl Vec3 {
     /// `self · d` exactly, in Q18.46.
     #[inline]
     pub fn dot_dir_q46(self, d: Dir) -> i64 {
-        let v = self.wide();
-        let e = d.wide();
-        v[0] * e[0] + v[1] * e[1] + v[2] * e[2]
+        let v = self.bits();
+        let e = d.bits();
+        mul_wide(v[0], e[0]) + mul_wide(v[1], e[1]) + mul_wide(v[2], e[2])
     }
 
     /// `|self|²` exactly, in Q32.32. Components must be within ±2^15.
     #[inline]
     pub fn length_squared_q32(self) -> i64 {
-        let v = self.wide();
-        v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+        let v = self.bits();
+        mul_wide(v[0], v[0]) + mul_wide(v[1], v[1]) + mul_wide(v[2], v[2])
     }
 
     /// `|self|` in Q16.16, rounded down.
@@ -162,9 +162,9 @@ impl Dir {
     /// `self · o` exactly, in Q4.60.
     #[inline]
     pub fn dot_q60(self, o: Dir) -> i64 {
-        let a = self.wide();
-        let b = o.wide();
-        a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+        let a = self.bits();
+        let b = o.bits();
+        mul_wide(a[0], b[0]) + mul_wide(a[1], b[1]) + mul_wide(a[2], b[2])
     }
 
     /// `self · o` in Q2.30, rounded towards minus infinity.
@@ -176,9 +176,9 @@ impl Dir {
     /// `t · self` in Q16.16; `|t|` below 2^15.
     #[inline]
     pub fn scale(self, t: Scalar) -> Vec3 {
-        let t = t.to_bits() as i64;
-        let d = self.wide();
-        Vec3::from_bits([((d[0] * t) >> 30) as i32, ((d[1] * t) >> 30) as i32, ((d[2] * t) >> 30) as i32])
+        let t = t.to_bits();
+        let d = self.bits();
+        Vec3::from_bits(d.map(|c| (mul_wide(c, t) >> 30) as i32))
     }
 
     /// The unit vector along the integer vector `v` (any common scale), or
@@ -189,47 +189,63 @@ impl Dir {
     }
 
     /// [`Dir::normalize`], also giving the length of `v` as `len · 2^shift`
-    /// (`len` between 2^29 and 2^31): one square root serves both.
+    /// (`len` between 2^29 and 2^31, the exact floor of the scaled length).
     pub fn normalize_with_length(v: [i64; 3]) -> Option<(Dir, u64, i32)> {
+        let (scaled, shift, len2) = Self::scaled(v)?;
+        let (g, e) = super::rsqrt(len2);
+        let len = super::isqrt_from(len2, g, e);
+        Some((Self::divided(v, scaled, g, e, len as u32), len, shift))
+    }
+
+    /// `v` scaled by a power of two (`shift`: right, negative left) so that
+    /// its largest component is in [2^29, 2^30) — the squared length then
+    /// fits a u64 with 29 bits of precision whatever the input scale — and
+    /// that squared length.
+    #[inline]
+    fn scaled(v: [i64; 3]) -> Option<([u32; 3], i32, u64)> {
         let mag = |c: i64| c.unsigned_abs();
         let largest = mag(v[0]).max(mag(v[1])).max(mag(v[2]));
         if largest == 0 {
             return None;
         }
-        // Bring the largest magnitude to [2^29, 2^30): the squared length then
-        // fits a u64 and keeps 29 bits of precision whatever the input scale.
         let bits = 64 - largest.leading_zeros() as i32;
         let shift = bits - 30;
-        let scaled = v.map(|c| {
-            let m = mag(c);
-            let m = if shift > 0 { m >> shift } else { m << -shift } as i64;
-            if c < 0 {
-                -m
-            } else {
-                m
+        let scaled = v.map(|c| (if shift > 0 { mag(c) >> shift } else { mag(c) << -shift }) as u32);
+        let len2 = scaled.iter().map(|&c| mul_u32_wide(c, c)).sum::<u64>();
+        Some((scaled, shift, len2))
+    }
+
+    /// The scaled magnitudes divided by their length `len` (= ⌊√len2⌋,
+    /// `1/√len2 ≈ g · 2^-e`), with `v`'s signs: `round(c · 2^30 / len)`
+    /// exactly, but without a division — estimated through g, then corrected
+    /// by the exact product with `len`.
+    #[inline]
+    fn divided(v: [i64; 3], scaled: [u32; 3], g: u32, e: i32, len: u32) -> Dir {
+        let down = (e - 30) as u32; // 30 or 31: scaled lengths are 2^29 to 2^31
+        Dir::from_bits([0, 1, 2].map(|a| {
+            let target = (scaled[a] as u64) << 30; // c · 2^30, < 2^60
+            let mut m = ((mul_u32_wide(scaled[a], g) + (1 << (down - 1))) >> down) as u32;
+            // |m·len − c·2^30| ≤ len/2 picks the rounded quotient.
+            while m > 0 && mul_u32_wide(m, len) > target + (len / 2) as u64 {
+                m -= 1;
             }
-        });
-        let len2 = scaled.iter().map(|&c| (c * c) as u64).sum::<u64>();
-        let len = super::isqrt(len2);
-        // One division: c / len = c · (2^62 / len) / 2^32, rounded, within
-        // one unit.
-        let inverse = (1u64 << 62) / len;
-        let dir = Dir::from_bits(scaled.map(|c| {
-            let m = ((c.unsigned_abs() * inverse + (1 << 31)) >> 32) as i32;
-            if c < 0 {
-                -m
-            } else {
-                m
+            while mul_u32_wide(m + 1, len) <= target + (len / 2) as u64 {
+                m += 1;
             }
-        }));
-        Some((dir, len, shift))
+            if v[a] < 0 {
+                -(m as i32)
+            } else {
+                m as i32
+            }
+        }))
     }
 
     /// Cross product, renormalised; `None` for parallel inputs.
     pub fn cross(self, o: Dir) -> Option<Dir> {
         let a = self.wide();
         let b = o.wide();
-        Dir::normalize([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+        let m = |x: usize, y: usize| mul_wide(a[x] as i32, b[y] as i32);
+        Dir::normalize([m(1, 2) - m(2, 1), m(2, 0) - m(0, 2), m(0, 1) - m(1, 0)])
     }
 
     /// The mirror image of `self` about the unit normal `n`: `2(n·self)n − self`.
@@ -314,7 +330,6 @@ mod tests {
         assert_eq!(v.dot_dir(Dir::X).to_bits(), 3 << 16);
         let s = Dir::Y.scale(Scalar::from_bits(-(5 << 16)));
         assert_eq!(s.bits(), [0, -(5 << 16), 0]);
-        let c = Dir::X.cross(Dir::Y).unwrap();
-        assert_eq!(c, Dir::Z);
+        assert_eq!(Dir::X.cross(Dir::Y), Some(Dir::Z));
     }
 }

@@ -10,14 +10,21 @@ use crate::math::{pow_unit, Scalar, Wide};
 
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct GammaTable {
-    thresholds: [u16; 255],
+    pub(crate) thresholds: [u16; 255],
 }
 
 impl GammaTable {
     /// The table for display gamma `gamma` (> 0; 1 disables correction).
     pub fn new(gamma: Wide) -> GammaTable {
+        let mut table = GammaTable { thresholds: [0; 255] };
+        table.fill(gamma);
+        table
+    }
+
+    /// Recomputes the table in place for `gamma`.
+    pub fn fill(&mut self, gamma: Wide) {
         let g = gamma.to_bits();
-        let mut thresholds = [0u16; 255];
+        let thresholds = &mut self.thresholds;
         for (k, t) in thresholds.iter_mut().enumerate() {
             // ((2k + 1) / 510) in Q2.30, raised to γ, rounded up to Q0.16.
             let x = ((2 * k as i64 + 1) << 30) / 510;
@@ -33,7 +40,6 @@ impl GammaTable {
         for k in 1..255 {
             thresholds[k] = thresholds[k].max(thresholds[k - 1]);
         }
-        GammaTable { thresholds }
     }
 
     /// The 8-bit display value of the linear intensity `c` (clamped to 0..1).

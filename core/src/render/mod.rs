@@ -50,23 +50,36 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     }
 
     /// A renderer at another size (the default VIEWPORT follows its aspect).
+    // Not inlined: the set-up's temporaries then live in its own frame, gone
+    // before the first pixel, instead of in the caller's for the whole render.
+    #[inline(never)]
     pub fn with_size(scene: SceneView<'a>, accel: &'a A, width: u32, height: u32) -> Result<Self, CameraError> {
         let s = scene.settings;
         let camera = Camera::new(&s.view, &scene.normalization, width, height, s.samples)?;
-        Ok(Renderer {
+        // The table is filled in place: moving a 510-byte table around costs
+        // a board stack space it does not have.
+        let mut renderer = Renderer {
             tracer: Tracer::new(scene, accel),
             camera,
-            gamma: GammaTable::new(s.gamma),
+            gamma: GammaTable { thresholds: [0; 255] },
             scratch: Scratch::new(Mailbox::none()),
-        })
+        };
+        renderer.gamma.fill(s.gamma);
+        Ok(renderer)
     }
 
     /// Gives the renderer a mailbox of `words` (one bit per object,
     /// [`Mailbox::words_for`]), so that accelerators filing an object in
     /// several cells test it once per ray.
     pub fn with_mailbox(mut self, words: &'a mut [u32]) -> Self {
-        self.scratch.mailbox = Mailbox::new(words);
+        self.set_mailbox(words);
         self
+    }
+
+    /// [`Renderer::with_mailbox`] in place (no move of the renderer, which
+    /// matters on a board with a few KiB of stack).
+    pub fn set_mailbox(&mut self, words: &'a mut [u32]) {
+        self.scratch.mailbox = Mailbox::new(words);
     }
 
     /// Counters since the renderer was made.
@@ -83,6 +96,9 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     }
 
     /// The pixel at (`x`, `y`), `x` to the right and `y` down.
+    // Not inlined into the row loop: keeps the caller's frame (a display
+    // driver's) small on a board.
+    #[inline(never)]
     pub fn pixel(&mut self, x: u32, y: u32) -> PixelSample {
         let n = self.camera.samples();
         let mut object = None;

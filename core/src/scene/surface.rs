@@ -4,7 +4,7 @@
 //! 32767.99); it never wraps, so an over-bright light clamps to white as the
 //! shading model's final `min(1, …)` says.
 
-use crate::math::{Scalar, Unit};
+use crate::math::{mul_wide, Scalar, Unit};
 use fixed::types::I48F16;
 
 /// A linear RGB colour, Q16.16 per channel (1.0 is full intensity; values
@@ -35,15 +35,15 @@ impl Color {
     /// Each channel times `k` (Q16.16), saturating.
     #[inline]
     pub fn scale(self, k: Scalar) -> Color {
-        let k = k.to_bits() as i64;
-        Color::from_bits(self.bits().map(|c| sat(((c as i64) * k) >> 16)))
+        let k = k.to_bits();
+        Color::from_bits(self.bits().map(|c| sat(mul_wide(c, k) >> 16)))
     }
 
     /// Each channel times a cosine in Q2.30.
     #[inline]
     pub fn scale_unit(self, k: Unit) -> Color {
-        let k = k.to_bits() as i64;
-        Color::from_bits(self.bits().map(|c| sat(((c as i64) * k) >> 30)))
+        let k = k.to_bits();
+        Color::from_bits(self.bits().map(|c| sat(mul_wide(c, k) >> 30)))
     }
 
     /// Channel-wise product (filtering one colour by another).
@@ -51,7 +51,7 @@ impl Color {
     pub fn modulate(self, o: Color) -> Color {
         let o = o.bits();
         let s = self.bits();
-        Color::from_bits([0, 1, 2].map(|i| sat(((s[i] as i64) * o[i] as i64) >> 16)))
+        Color::from_bits([0, 1, 2].map(|i| sat(mul_wide(s[i], o[i]) >> 16)))
     }
 
     pub fn is_black(self) -> bool {

@@ -23,7 +23,7 @@ use crate::shapes::{Leaving, Ray};
 /// Rays traced (not counting shadow rays) for one primary sample at most.
 pub const MAX_RAYS_PER_SAMPLE: u32 = 4096;
 /// Secondary rays waiting to be traced, at most.
-pub const PENDING_RAYS: usize = 24;
+pub const PENDING_RAYS: usize = 10;
 
 /// Counters of one render call.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -125,6 +125,9 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
     }
 
     /// The linear colour seen along a primary ray, and the object it hits.
+    // Not inlined: a frame of its own keeps the stack of a small board bounded
+    // (inlined into the row loop, its locals and the pending rays multiply).
+    #[inline(never)]
     pub fn trace(&self, ray: Ray, scratch: &mut Scratch<'_>) -> (Color, Option<ObjectId>) {
         let mut stack: heapless::Vec<Pending, PENDING_RAYS> = heapless::Vec::new();
         let mut color = Color::BLACK;
@@ -229,7 +232,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
 /// Product of two Q16.16 weights in [0, 1].
 #[inline]
 fn mul(a: Scalar, b: Scalar) -> Scalar {
-    Scalar::from_bits(((a.to_bits() as i64 * b.to_bits() as i64) >> 16) as i32)
+    Scalar::from_bits((crate::math::mul_wide(a.to_bits(), b.to_bits()) >> 16) as i32)
 }
 
 #[cfg(test)]

@@ -8,11 +8,12 @@
 //! neighbours whose planes round differently still leave no crack.
 
 use super::{Aabb, Leaving, Ray};
-use crate::math::{Dir, Scalar, Vec3};
+use crate::math::{mul_wide, Dir, Scalar, Vec3};
 
 /// How far (in Q16.16 raw units, normalised space) a hit may lie outside an
 /// edge and still count: four units, about 6·10^-5, far below a pixel.
-pub const EDGE_TOLERANCE: i64 = 4;
+pub const EDGE_TOLERANCE: i64 = 1 << EDGE_TOLERANCE_LOG2;
+const EDGE_TOLERANCE_LOG2: u32 = 2;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Polygon<const N: usize> {
@@ -54,7 +55,11 @@ impl<const N: usize> Polygon<N> {
         let num = ((self.offset.to_bits() as i64) << 30) - ray.origin.dot_dir_q46(self.normal);
         let (num, den) = if den < 0 { (-num, -den) } else { (num, den) };
         // Filter on the rounded parameter (num / den ≤ t_max), as returned.
-        if num <= 0 || num >= (t_max.to_bits() as i64 + 1) * den {
+        let limit = match t_max.to_bits().checked_add(1) {
+            Some(t) => mul_wide(t, den as i32), // den ≤ 2^30
+            None => i64::MAX,
+        };
+        if num <= 0 || num >= limit {
             return None;
         }
         let t = num / den;
@@ -64,8 +69,8 @@ impl<const N: usize> Polygon<N> {
         // The plane may be met far outside the scene range; only a point
         // inside the polygon's bounds is representable and worth testing.
         let o = ray.origin.wide();
-        let d = ray.dir.wide();
-        let p = [0, 1, 2].map(|a| o[a] + ((d[a] * t) >> 30));
+        let d = ray.dir.bits();
+        let p = [0, 1, 2].map(|a| o[a] + (mul_wide(d[a], t as i32) >> 30));
         let b = self.bounds();
         let (lo, hi) = (b.min.wide(), b.max.wide());
         let slack = EDGE_TOLERANCE;
@@ -80,13 +85,15 @@ impl<const N: usize> Polygon<N> {
     #[inline]
     pub fn contains(&self, p: Vec3) -> bool {
         let (u, v) = self.project(p);
-        let sign = self.normal.axis(self.drop_axis as usize).to_bits().signum() as i64;
+        let flip = self.normal.axis(self.drop_axis as usize).to_bits() < 0;
         let mut prev = self.project(self.corners[N - 1]);
         for corner in &self.corners {
             let cur = self.project(*corner);
+            // Points within ±2^29 units, so differences fit an i32.
             let (du, dv) = (cur.0 - prev.0, cur.1 - prev.1);
-            let edge = (du * (v - prev.1) - dv * (u - prev.0)) * sign;
-            if edge < -EDGE_TOLERANCE * du.abs().max(dv.abs()) {
+            let edge = mul_wide(du, v - prev.1) - mul_wide(dv, u - prev.0);
+            let edge = if flip { -edge } else { edge };
+            if edge < -((du.unsigned_abs().max(dv.unsigned_abs()) as i64) << EDGE_TOLERANCE_LOG2) {
                 return false;
             }
             prev = cur;
@@ -102,13 +109,13 @@ impl<const N: usize> Polygon<N> {
         core::array::from_fn(|i| {
             let a = self.project(self.corners[i]);
             let b = self.project(self.corners[(i + 1) % N]);
-            ((b.0 - a.0) * (v - a.1) - (b.1 - a.1) * (u - a.0)) * sign
+            (mul_wide(b.0 - a.0, v - a.1) - mul_wide(b.1 - a.1, u - a.0)) * sign
         })
     }
 
     #[inline]
-    fn project(&self, p: Vec3) -> (i64, i64) {
-        let b = p.wide();
+    fn project(&self, p: Vec3) -> (i32, i32) {
+        let b = p.bits();
         match self.drop_axis {
             0 => (b[1], b[2]),
             1 => (b[2], b[0]),

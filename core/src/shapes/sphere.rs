@@ -6,7 +6,7 @@
 //! nearly equal numbers).
 
 use super::{Aabb, Leaving, Ray};
-use crate::math::{isqrt, Dir, Scalar, Vec3};
+use crate::math::{isqrt, mul_wide, Dir, Scalar, Vec3};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Sphere {
@@ -36,7 +36,7 @@ impl Sphere {
             return None;
         }
         let q = oc - ray.dir.scale(b);
-        let disc = r * r - q.length_squared_q32();
+        let disc = mul_wide(r as i32, r as i32) - q.length_squared_q32();
         if disc < 0 {
             return None;
         }

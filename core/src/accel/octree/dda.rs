@@ -19,7 +19,7 @@
 //! less, both well inside the filing margin, and objects are still tested
 //! with the true ray.
 
-use super::{Octree, INTERNAL};
+use super::Octree;
 use crate::capacity::{Arena, Capacities};
 use crate::shapes::Ray;
 
@@ -42,7 +42,7 @@ struct Frame {
     next: u8,
 }
 
-pub(super) struct DdaWalk {
+pub(super) struct DdaWalk<const FRAMES: usize> {
     /// Octant bits of the mirrored axes.
     mirror: u8,
     /// Octant bits of the axes whose root crossings saturated (the ray runs
@@ -57,7 +57,7 @@ pub(super) struct DdaWalk {
     /// nothing this ray can hit.
     near: i64,
     far: i64,
-    stack: heapless::Vec<Frame, { super::MAX_DEPTH as usize + 1 }>,
+    stack: heapless::Vec<Frame, FRAMES>,
     /// A root that is itself a leaf, still to be returned.
     root_leaf: Option<(u32, i64)>,
 }
@@ -92,8 +92,8 @@ fn min_axis(t: &[i64; 3]) -> usize {
     }
 }
 
-impl DdaWalk {
-    pub const fn new() -> DdaWalk {
+impl<const FRAMES: usize> DdaWalk<FRAMES> {
+    pub const fn new() -> Self {
         DdaWalk {
             mirror: 0,
             saturated: 0,
@@ -107,14 +107,14 @@ impl DdaWalk {
     }
 
     /// Starts a walk along `ray` (in place: the walk's stack is not small).
-    pub fn start<C: Capacities>(&mut self, tree: &Octree<C>, ray: &Ray) {
+    pub fn start<C: Capacities>(&mut self, tree: &Octree<C, FRAMES>, ray: &Ray) {
         self.mirror = 0;
         self.saturated = 0;
         self.stack.clear();
         self.root_leaf = None;
         let walk = self;
         let nodes = tree.nodes.as_slice();
-        let Some(root) = nodes.first().filter(|r| r.count != 0) else { return };
+        let Some(root) = nodes.first().filter(|r| r.count() != 0) else { return };
         let o = ray.origin.wide();
         let d = ray.dir.wide();
         let half = 1i64 << (tree.root_log2 - 1);
@@ -159,10 +159,10 @@ impl DdaWalk {
         if walk.far < walk.near || walk.far < 0 {
             return;
         }
-        if root.count != INTERNAL {
+        if !root.is_internal() {
             walk.root_leaf = Some((0, exit));
         } else {
-            walk.push(root.first, t0, t1, tree.root_min, tree.root_log2);
+            walk.push(root.first(), t0, t1, tree.root_min, tree.root_log2);
         }
     }
 
@@ -209,7 +209,7 @@ impl DdaWalk {
     /// Boxes entered after `stop` are skipped whole, with every box behind
     /// them in the same parent (children are visited in ray order).
     #[inline]
-    pub fn next_leaf<C: Capacities>(&mut self, tree: &Octree<C>, stop: i64) -> Option<(u32, i64)> {
+    pub fn next_leaf<C: Capacities>(&mut self, tree: &Octree<C, FRAMES>, stop: i64) -> Option<(u32, i64)> {
         if let Some(leaf) = self.root_leaf.take() {
             return Some(leaf);
         }
@@ -244,12 +244,12 @@ impl DdaWalk {
                 continue; // wholly behind the origin, or before the objects
             }
             let n = nodes[node as usize];
-            if n.count == INTERNAL {
+            if n.is_internal() {
                 let half = 1i64 << (top.log2 - 1);
                 let lo = [0, 1, 2].map(|a| top.lo[a] + if c >> a & 1 == 1 { half } else { 0 });
                 let log2 = top.log2 - 1;
-                self.push(n.first, t0, t1, lo, log2);
-            } else if n.count != 0 {
+                self.push(n.first(), t0, t1, lo, log2);
+            } else if n.count() != 0 {
                 return Some((node, exit));
             }
         }

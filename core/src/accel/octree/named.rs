@@ -10,7 +10,7 @@
 //! crosses the box's centre plane. (A full Minlen step would land exactly on
 //! the far face of a smallest neighbour, which exact arithmetic then skips.)
 
-use super::{Octree, INTERNAL};
+use super::Octree;
 use crate::capacity::{Arena, Capacities};
 use crate::shapes::axis_aligned_box::slab_span_wide;
 use crate::shapes::{Ratio, Ray};
@@ -39,7 +39,7 @@ pub(super) struct NamedWalk {
 }
 
 impl NamedWalk {
-    pub fn new<C: Capacities>(tree: &Octree<C>, ray: &Ray) -> NamedWalk {
+    pub fn new<C: Capacities, const F: usize>(tree: &Octree<C, F>, ray: &Ray) -> NamedWalk {
         let mut walk = NamedWalk { o: ray.origin.wide(), d: ray.dir.wide(), current: None };
         if tree.nodes.as_slice().is_empty() {
             return walk;
@@ -60,7 +60,7 @@ impl NamedWalk {
     }
 
     /// The next leaf and the parameter at which the ray leaves it.
-    pub fn next_leaf<C: Capacities>(&mut self, tree: &Octree<C>) -> Option<(u32, Ratio)> {
+    pub fn next_leaf<C: Capacities, const F: usize>(&mut self, tree: &Octree<C, F>) -> Option<(u32, Ratio)> {
         let leaf = self.current.take()?;
         let size = 1i64 << leaf.log2;
         // The faces the ray leaves through, and when: tmax of the thesis.
@@ -117,11 +117,11 @@ impl NamedWalk {
     }
 
     /// The leaf holding `p`, from the root, by name through the hash table.
-    fn locate<C: Capacities>(&self, tree: &Octree<C>, p: Point, follow_ray: bool) -> Option<Leaf> {
+    fn locate<C: Capacities, const F: usize>(&self, tree: &Octree<C, F>, p: Point, follow_ray: bool) -> Option<Leaf> {
         let nodes = tree.nodes.as_slice();
         let (mut node, mut name, mut lo, mut log2) = (0u32, 1u64, tree.root_min, tree.root_log2);
         loop {
-            if nodes[node as usize].count != INTERNAL {
+            if !nodes[node as usize].is_internal() {
                 return Some(Leaf { node, lo, log2 });
             }
             let half = 1i64 << (log2 - 1);

@@ -1,0 +1,54 @@
+//! The few semihosting calls the firmware needs: open and write a host file,
+//! exit with a status code. On a real board these would be a display driver
+//! and a reset; under qemu they carry the pixels to the host.
+
+use cortex_m_semihosting::{nr, syscall};
+
+/// An open host file.
+pub struct HostFile {
+    handle: usize,
+}
+
+impl HostFile {
+    /// Creates (truncates) `name`, a NUL-terminated path on the host.
+    pub fn create(name: &str) -> Option<HostFile> {
+        let bytes = name.as_bytes();
+        if bytes.last() != Some(&0) {
+            return None;
+        }
+        // SAFETY: SYS_OPEN reads `len` bytes of the NUL-terminated name from
+        // the pointer, which stays valid for the call.
+        let handle = unsafe {
+            syscall!(OPEN, bytes.as_ptr(), nr::open::W_TRUNC_BINARY, bytes.len() - 1)
+        };
+        (handle != usize::MAX).then_some(HostFile { handle })
+    }
+
+    /// Writes all of `data`; false if the host refused.
+    pub fn write(&mut self, data: &[u8]) -> bool {
+        // SAFETY: SYS_WRITE reads `len` bytes from the pointer during the
+        // call; it returns the number of bytes *not* written.
+        unsafe { syscall!(WRITE, self.handle, data.as_ptr(), data.len()) == 0 }
+    }
+}
+
+impl Drop for HostFile {
+    fn drop(&mut self) {
+        // SAFETY: SYS_CLOSE takes the handle SYS_OPEN returned.
+        unsafe {
+            syscall!(CLOSE, self.handle);
+        }
+    }
+}
+
+/// Ends the program with `code` as qemu's exit status (SYS_EXIT_EXTENDED).
+pub fn exit(code: u32) -> ! {
+    const SYS_EXIT_EXTENDED: usize = 0x20;
+    const APPLICATION_EXIT: usize = 0x20026;
+    loop {
+        // SAFETY: the call reads the two-word block during the call.
+        unsafe {
+            cortex_m_semihosting::syscall(SYS_EXIT_EXTENDED, &[APPLICATION_EXIT, code as usize]);
+        }
+    }
+}

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Instructions executed per function: profile.sh MACHINE ELF [TOP]
+# Builds the qemu-profile plugin (the header comes from the shared
+# qemu-insncount tool's cache), runs the firmware under it and prints the
+# functions that executed the most instructions, inlined code counted in the
+# function it was inlined into.
+set -euo pipefail
+HERE=$(cd "$(dirname "$0")" && pwd)
+MACHINE=$1; ELF=$2; TOP=${3:-25}
+CACHE=$HOME/.cache/qemu-insncount
+[ -f "$CACHE/qemu-plugin.h" ] || "$HERE/../../../shared/tools/qemu-insncount/build.sh" >/dev/null
+PLUGIN=$CACHE/libqemu-profile.so
+if [ ! -f "$PLUGIN" ] || [ "$HERE/qemu-profile.c" -nt "$PLUGIN" ]; then
+  gcc -O2 -fPIC -shared -Wall -I"$CACHE" -o "$PLUGIN" "$HERE/qemu-profile.c"
+fi
+OUT=$(mktemp)
+cpu=()
+[ "$MACHINE" = mps2-an385 ] && cpu=(-cpu cortex-m3)
+timeout "${QEMU_TIMEOUT:-600}" qemu-system-arm -machine "$MACHINE" "${cpu[@]}" -nographic -monitor none \
+  -semihosting-config enable=on,target=native -plugin "$PLUGIN,out=$OUT" -kernel "$ELF" >/dev/null || true
+python3 - "$ELF" "$OUT" "$TOP" <<'PY'
+import bisect, subprocess, sys
+elf, prof, top = sys.argv[1], sys.argv[2], int(sys.argv[3])
+syms = []
+for line in subprocess.run(["arm-none-eabi-nm", "-n", "-C", elf], capture_output=True, text=True).stdout.splitlines():
+    parts = line.split(maxsplit=2)
+    if len(parts) == 3 and parts[1] in "tTwW":
+        syms.append((int(parts[0], 16) & ~1, parts[2]))
+addrs = [a for a, _ in syms]
+per = {}
+total = 0
+for line in open(prof):
+    a, n = line.split()
+    a, n = int(a, 16), int(n)
+    total += n
+    i = bisect.bisect_right(addrs, a) - 1
+    name = syms[i][1] if i >= 0 else "?"
+    per[name] = per.get(name, 0) + n
+print(f"{total:>14,} instructions in all")
+for name, n in sorted(per.items(), key=lambda x: -x[1])[:top]:
+    print(f"{n:>14,} {100 * n / total:5.1f} %  {name[:110]}")
+PY
+rm -f "$OUT"
