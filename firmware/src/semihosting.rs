@@ -18,9 +18,7 @@ impl HostFile {
         }
         // SAFETY: SYS_OPEN reads `len` bytes of the NUL-terminated name from
         // the pointer, which stays valid for the call.
-        let handle = unsafe {
-            syscall!(OPEN, bytes.as_ptr(), nr::open::W_TRUNC_BINARY, bytes.len() - 1)
-        };
+        let handle = unsafe { syscall!(OPEN, bytes.as_ptr(), nr::open::W_TRUNC_BINARY, bytes.len() - 1) };
         (handle != usize::MAX).then_some(HostFile { handle })
     }
 
