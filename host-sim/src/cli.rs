@@ -3,6 +3,7 @@
 use crate::{load_file, new_scene, render_with_progress, AccelMode, LoadError, RenderOptions};
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressStyle};
+use octrace_core::scene::MAX_SIDE;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -49,10 +50,10 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WxH (for example 160x128), found `{s}`"))?;
     let dim = |v: &str| -> Result<u32, String> {
         let n: u32 = v.parse().map_err(|_| format!("`{v}` is not a whole number"))?;
-        if (1..=16384).contains(&n) {
+        if (1..=MAX_SIDE).contains(&n) {
             Ok(n)
         } else {
-            Err(format!("{n} is outside 1 to 16384"))
+            Err(format!("{n} is outside 1 to {MAX_SIDE}"))
         }
     };
     Ok((dim(w)?, dim(h)?))

@@ -6,6 +6,8 @@
 //! the same bits on every target and no float ever runs. Absolute error: below
 //! 3·10^-6 for `log2` and a relative 2·10^-6 for `exp2`.
 
+use super::mul_wide;
+
 /// log2(1 + i/256) in Q0.32 for i = 0..=256.
 static LOG2_TABLE: [u64; 257] = log2_table();
 /// 2^(i/256) in Q1.62 for i = 0..=256.
@@ -82,13 +84,14 @@ pub fn log2_q32(raw: u64, frac_bits: u32) -> i64 {
     if raw == 0 {
         return i64::MIN;
     }
-    let top = 63 - raw.leading_zeros() as i64;
+    let top = 63 - super::leading_zeros(raw) as i64;
     let m = raw << (63 - top); // top bit at 63: m / 2^63 in [1, 2)
     let index = ((m >> 55) & 0xff) as usize;
-    let rest = (m >> 23) & 0xffff_ffff; // Q0.32 position inside the interval
+    let rest = ((m >> 23) & 0xffff_ffff) as u32; // Q0.32 position inside the interval
     let lo = LOG2_TABLE[index];
     let hi = LOG2_TABLE[index + 1];
-    let frac = lo + (((hi - lo) * rest) >> 32);
+    // Neighbouring entries differ by less than 2^25.
+    let frac = lo + (super::mul_u32_wide((hi - lo) as u32, rest) >> 32);
     ((top - frac_bits as i64) << 32) + frac as i64
 }
 
@@ -101,8 +104,9 @@ pub fn exp2_q32(y: i64) -> u64 {
     let rest = frac & 0xff_ffff; // Q0.24
     let lo = EXP2_TABLE[index];
     let hi = EXP2_TABLE[index + 1];
-    let mant = lo + ((((hi - lo) >> 20) * rest) >> 4); // Q2.62 in [1, 2]
-                                                       // result = mant * 2^int in Q32: shift right by 30 - int.
+    // Neighbouring entries differ by less than 2^54.
+    let mant = lo + super::mul_u32_wide(((hi - lo) >> 24) as u32, rest as u32); // Q2.62 in [1, 2]
+                                                                                // result = mant · 2^int in Q32: shift right by 30 − int.
     let shift = 30 - int;
     if shift >= 64 {
         0
@@ -124,15 +128,21 @@ pub fn pow_q30(x: u32, p: i64) -> u64 {
     if x == 0 {
         return 0;
     }
-    let l = log2_q32(x as u64, 30);
-    let y = (l as i128 * p as i128) >> 32;
-    if y < -(40i128 << 32) {
+    // log2 x lies in [−30, 2): in Q8.24 it fits an i32, and y = p · log2 x
+    // is formed from 32×32 products only (p's whole part, then its
+    // fraction's two halves): 64-bit products are library calls on a
+    // Cortex-M0.
+    let l = (log2_q32(x as u64, 30) >> 8) as i32;
+    let whole = (p >> 32).min(i32::MAX as i64) as i32;
+    let (f_high, f_low) = (((p >> 16) & 0xffff) as i32, (p & 0xffff) as i32);
+    let y = mul_wide(l, whole) + (mul_wide(l, f_high) >> 16) + (mul_wide(l, f_low) >> 32); // Q40.24
+    if y < -(40 << 24) {
         return 0;
     }
-    if y > 10i128 << 32 {
+    if y > 10 << 24 {
         return 1 << 40;
     }
-    (exp2_q32(y as i64) + 2) >> 2
+    (exp2_q32(y << 8) + 2) >> 2
 }
 
 /// `x^p` for `x` in [0, 1] given in Q2.30 (values outside are clamped) and

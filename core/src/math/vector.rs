@@ -5,7 +5,7 @@
 //! Arithmetic on [`Vec3`] uses `fixed`'s operators, which panic on overflow in
 //! debug builds; the scene normalisation keeps every value in range.
 
-use super::{mul_u32_wide, mul_wide, Scalar, Unit, UNIT_ONE};
+use super::{mul_u32_wide, mul_wide, square_u32_wide, square_wide, Scalar, Unit, UNIT_ONE};
 use core::ops::{Add, Neg, Sub};
 
 /// A point or an offset in normalised scene space.
@@ -71,7 +71,7 @@ impl Vec3 {
     #[inline]
     pub fn length_squared_q32(self) -> i64 {
         let v = self.bits();
-        mul_wide(v[0], v[0]) + mul_wide(v[1], v[1]) + mul_wide(v[2], v[2])
+        (square_wide(v[0]) + square_wide(v[1]) + square_wide(v[2])) as i64
     }
 
     /// `|self|` in Q16.16, rounded down.
@@ -83,14 +83,14 @@ impl Vec3 {
     /// The unit vector along `self`, or `None` for the zero vector.
     #[inline]
     pub fn direction(self) -> Option<Dir> {
-        Dir::normalize(self.wide())
+        Dir::normalize_small_with_length(self.bits()).map(|(d, _, _)| d)
     }
 
     /// The unit vector along `self` and its length (rounded to nearest), with
     /// one square root; `None` for the zero vector.
     #[inline]
     pub fn direction_and_length(self) -> Option<(Dir, Scalar)> {
-        let (d, len, shift) = Dir::normalize_with_length(self.wide())?;
+        let (d, len, shift) = Dir::normalize_small_with_length(self.bits())?;
         let length = if shift >= 0 { len << shift } else { (len + (1 << (-shift - 1))) >> -shift };
         Some((d, Scalar::from_bits(length.min(i32::MAX as u64) as i32)))
     }
@@ -190,49 +190,70 @@ impl Dir {
 
     /// [`Dir::normalize`], also giving the length of `v` as `len · 2^shift`
     /// (`len` between 2^29 and 2^31, the exact floor of the scaled length).
+    ///
+    /// `v` is first scaled by a power of two (`shift`: right, negative left)
+    /// so that its largest component is in [2^29, 2^30): the squared length
+    /// then fits a u64 with 29 bits of precision whatever the input scale.
     pub fn normalize_with_length(v: [i64; 3]) -> Option<(Dir, u64, i32)> {
-        let (scaled, shift, len2) = Self::scaled(v)?;
-        let (g, e) = super::rsqrt(len2);
-        let len = super::isqrt_from(len2, g, e);
-        Some((Self::divided(v, scaled, g, e, len as u32), len, shift))
-    }
-
-    /// `v` scaled by a power of two (`shift`: right, negative left) so that
-    /// its largest component is in [2^29, 2^30) — the squared length then
-    /// fits a u64 with 29 bits of precision whatever the input scale — and
-    /// that squared length.
-    #[inline]
-    fn scaled(v: [i64; 3]) -> Option<([u32; 3], i32, u64)> {
-        let mag = |c: i64| c.unsigned_abs();
-        let largest = mag(v[0]).max(mag(v[1])).max(mag(v[2]));
+        let magnitude = v.map(|c| c.unsigned_abs());
+        let largest = magnitude[0].max(magnitude[1]).max(magnitude[2]);
         if largest == 0 {
             return None;
         }
-        let bits = 64 - largest.leading_zeros() as i32;
-        let shift = bits - 30;
-        let scaled = v.map(|c| (if shift > 0 { mag(c) >> shift } else { mag(c) << -shift }) as u32);
-        let len2 = scaled.iter().map(|&c| mul_u32_wide(c, c)).sum::<u64>();
-        Some((scaled, shift, len2))
+        let shift = 64 - super::leading_zeros(largest) as i32 - 30;
+        // Left shifts only happen to magnitudes below 2^30.
+        let scaled =
+            magnitude.map(|m| if shift > 0 { super::shr_to_u32(m, shift as u32) } else { (m as u32) << -shift });
+        Some(Self::from_scaled(v.map(|c| c < 0), scaled, shift))
+    }
+
+    /// [`Dir::normalize_with_length`] for 32-bit components (points and
+    /// their differences), in 32-bit steps only: the same bits, cheaper on
+    /// a 32-bit core.
+    #[inline]
+    pub fn normalize_small_with_length(v: [i32; 3]) -> Option<(Dir, u64, i32)> {
+        let magnitude = v.map(|c| c.unsigned_abs());
+        let largest = magnitude[0].max(magnitude[1]).max(magnitude[2]);
+        if largest == 0 {
+            return None;
+        }
+        let shift = 32 - super::leading_zeros(largest as u64) as i32 + 32 - 30;
+        let scaled = magnitude.map(|m| if shift > 0 { m >> shift } else { m << -shift });
+        Some(Self::from_scaled(v.map(|c| c < 0), scaled, shift))
+    }
+
+    /// The direction and scaled length from the scaled magnitudes.
+    #[inline]
+    fn from_scaled(negative: [bool; 3], scaled: [u32; 3], shift: i32) -> (Dir, u64, i32) {
+        let len2 = scaled.iter().map(|&c| square_u32_wide(c)).sum::<u64>();
+        let (len, g, e) = super::sqrt_and_rsqrt(len2);
+        (Self::divided(negative, scaled, g, e, len as u32), len, shift)
     }
 
     /// The scaled magnitudes divided by their length `len` (= ⌊√len2⌋,
-    /// `1/√len2 ≈ g · 2^-e`), with `v`'s signs: `round(c · 2^30 / len)`
+    /// `1/√len2 ≈ g · 2^-e`), with the given signs: `round(c · 2^30 / len)`
     /// exactly, but without a division — estimated through g, then corrected
     /// by the exact product with `len`.
     #[inline]
-    fn divided(v: [i64; 3], scaled: [u32; 3], g: u32, e: i32, len: u32) -> Dir {
+    fn divided(negative: [bool; 3], scaled: [u32; 3], g: u32, e: i32, len: u32) -> Dir {
         let down = (e - 30) as u32; // 30 or 31: scaled lengths are 2^29 to 2^31
         Dir::from_bits([0, 1, 2].map(|a| {
-            let target = (scaled[a] as u64) << 30; // c · 2^30, < 2^60
-            let mut m = ((mul_u32_wide(scaled[a], g) + (1 << (down - 1))) >> down) as u32;
-            // |m·len − c·2^30| ≤ len/2 picks the rounded quotient.
-            while m > 0 && mul_u32_wide(m, len) > target + (len / 2) as u64 {
+            // The largest m with m·len ≤ c·2^30 + len/2 is the rounded
+            // quotient; the steps keep m·len as `product` (one multiply).
+            let limit = ((scaled[a] as u64) << 30) + (len / 2) as u64;
+            let estimate = mul_u32_wide(scaled[a], g) + (1 << (down - 1));
+            // Two constant shifts: a variable 64-bit one is a library call.
+            let mut m = (if down == 30 { estimate >> 30 } else { estimate >> 31 }) as u32;
+            let mut product = mul_u32_wide(m, len);
+            while product > limit {
                 m -= 1;
+                product -= len as u64;
             }
-            while mul_u32_wide(m + 1, len) <= target + (len / 2) as u64 {
+            while limit - product >= len as u64 {
                 m += 1;
+                product += len as u64;
             }
-            if v[a] < 0 {
+            if negative[a] {
                 -(m as i32)
             } else {
                 m as i32
@@ -252,10 +273,10 @@ impl Dir {
     /// The result stays unit length to rounding, so it is not renormalised.
     #[inline]
     pub fn reflect_about(self, n: Dir) -> Dir {
-        let d = self.dot_q60(n) >> 29; // 2(n·self) in Q2.30
-        let nb = n.wide();
+        let d = (self.dot_q60(n) >> 30) as i32; // n·self in Q2.30
+        let nb = n.bits();
         let s = self.wide();
-        Dir::from_bits([0, 1, 2].map(|i| (((d * nb[i]) >> 30) - s[i]).clamp(-UNIT_ONE, UNIT_ONE) as i32))
+        Dir::from_bits([0, 1, 2].map(|i| ((mul_wide(d, nb[i]) >> 29) - s[i]).clamp(-UNIT_ONE, UNIT_ONE) as i32))
     }
 }
 
@@ -293,6 +314,24 @@ mod tests {
             assert_eq!(n, -d, "symmetric rounding");
         }
         assert_eq!(Dir::normalize([0, 0, 0]), None);
+    }
+
+    #[test]
+    fn small_and_wide_normalisation_agree() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        for i in 0..20_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let v = [x as i32 >> (i % 31), (x >> 32) as i32 >> (i % 17), (x >> 16) as i32 >> (i % 29)];
+            let wide = v.map(|c| c as i64);
+            assert_eq!(Dir::normalize_small_with_length(v), Dir::normalize_with_length(wide), "{v:?}");
+        }
+        assert_eq!(
+            Dir::normalize_small_with_length([i32::MIN, 0, i32::MAX]).map(|r| r.0),
+            Dir::normalize([i32::MIN as i64, 0, i32::MAX as i64])
+        );
+        assert_eq!(Dir::normalize_small_with_length([0, 0, 0]), None);
     }
 
     #[test]

@@ -7,18 +7,18 @@
 //! iteration for 1/√x needs only products, from a 192-entry table built at
 //! compile time. Every function returns the same bits on every target.
 
+/// ARMv6-M (Cortex-M0) has only a 32×32→32 multiply and no
+/// count-leading-zeros instruction: there the `*_by_parts` forms below are
+/// used, elsewhere the native operations. Both give the same bits, and the
+/// tests check the part-wise forms on the host.
+const ARMV6M: bool = cfg!(all(target_arch = "arm", not(target_feature = "thumb2")));
+
 /// `a · b` exactly, for unsigned 32-bit operands.
 #[inline(always)]
 pub fn mul_u32_wide(a: u32, b: u32) -> u64 {
-    #[cfg(all(target_arch = "arm", not(target_feature = "thumb2")))]
-    {
-        let (al, ah) = (a & 0xffff, a >> 16);
-        let (bl, bh) = (b & 0xffff, b >> 16);
-        let mid = (al * bh) as u64 + (ah * bl) as u64;
-        (((ah * bh) as u64) << 32) + (mid << 16) + (al * bl) as u64
-    }
-    #[cfg(not(all(target_arch = "arm", not(target_feature = "thumb2"))))]
-    {
+    if ARMV6M {
+        mul_u32_wide_by_parts(a, b)
+    } else {
         a as u64 * b as u64
     }
 }
@@ -26,29 +26,193 @@ pub fn mul_u32_wide(a: u32, b: u32) -> u64 {
 /// `a · b` exactly, for signed 32-bit operands.
 #[inline(always)]
 pub fn mul_wide(a: i32, b: i32) -> i64 {
-    #[cfg(all(target_arch = "arm", not(target_feature = "thumb2")))]
-    {
-        let m = mul_u32_wide(a.unsigned_abs(), b.unsigned_abs()) as i64;
-        if (a ^ b) < 0 {
-            -m
-        } else {
-            m
-        }
-    }
-    #[cfg(not(all(target_arch = "arm", not(target_feature = "thumb2"))))]
-    {
+    if ARMV6M {
+        mul_wide_by_parts(a, b)
+    } else {
         a as i64 * b as i64
     }
 }
 
-/// 2^30 / √f at the middle of each of 192 intervals of f = m/256, m from 64
-/// to 255: the starting point of Newton's iteration (8 bits right).
-static RSQRT_TABLE: [u32; 192] = {
-    let mut t = [0u32; 192];
+/// `a²` exactly.
+#[inline(always)]
+pub fn square_wide(a: i32) -> u64 {
+    if ARMV6M {
+        square_by_parts(a)
+    } else {
+        (a as i64 * a as i64) as u64
+    }
+}
+
+/// `a · k`, exact when it fits an i64 (wrapping otherwise): two 32-bit
+/// products on ARMv6-M instead of the library's 64×64 routine.
+#[inline(always)]
+pub fn mul_i64_i32(a: i64, k: i32) -> i64 {
+    if ARMV6M {
+        mul_i64_i32_by_parts(a, k)
+    } else {
+        a.wrapping_mul(k as i64)
+    }
+}
+
+/// `a²` exactly, for an unsigned operand.
+#[inline(always)]
+pub fn square_u32_wide(a: u32) -> u64 {
+    if ARMV6M {
+        square_u32_by_parts(a)
+    } else {
+        a as u64 * a as u64
+    }
+}
+
+/// The number of leading zero bits of `x` (64 for zero).
+#[inline(always)]
+pub fn leading_zeros(x: u64) -> u32 {
+    if ARMV6M {
+        leading_zeros_by_search(x)
+    } else {
+        x.leading_zeros()
+    }
+}
+
+/// Four 16×16 products.
+#[inline(always)]
+fn mul_u32_wide_by_parts(a: u32, b: u32) -> u64 {
+    let (al, ah) = (a & 0xffff, a >> 16);
+    let (bl, bh) = (b & 0xffff, b >> 16);
+    let mid = (al * bh) as u64 + (ah * bl) as u64;
+    (((ah * bh) as u64) << 32) + (mid << 16) + (al * bl) as u64
+}
+
+/// Signed high halves and unsigned low ones: every partial product fits an
+/// i32 (low × low a u32), so no sign fix-up is needed.
+#[inline(always)]
+fn mul_wide_by_parts(a: i32, b: i32) -> i64 {
+    let (ah, al) = (a >> 16, (a & 0xffff) as u32);
+    let (bh, bl) = (b >> 16, (b & 0xffff) as u32);
+    let mid = (ah * bl as i32) as i64 + (al as i32 * bh) as i64;
+    (((ah * bh) as i64) << 32) + (mid << 16) + (al * bl) as i64
+}
+
+/// The high word times `k` (only its low 32 bits matter) plus the low word
+/// times `k`.
+#[inline(always)]
+fn mul_i64_i32_by_parts(a: i64, k: i32) -> i64 {
+    let (high, low) = ((a >> 32) as i32, a as u32);
+    let low_part = mul_u32_wide_by_parts(low, k.unsigned_abs()) as i64;
+    let low_part = if k < 0 { low_part.wrapping_neg() } else { low_part };
+    ((high.wrapping_mul(k) as i64) << 32).wrapping_add(low_part)
+}
+
+/// Three products: the two middle ones are equal.
+#[inline(always)]
+fn square_by_parts(a: i32) -> u64 {
+    square_u32_by_parts(a.unsigned_abs())
+}
+
+#[inline(always)]
+fn square_u32_by_parts(m: u32) -> u64 {
+    let (h, l) = (m >> 16, m & 0xffff);
+    (((h * h) as u64) << 32) + (((h * l) as u64) << 17) + (l * l) as u64
+}
+
+/// Binary search over one 32-bit word (the library routine costs about 35
+/// instructions on a Cortex-M0).
+#[inline(always)]
+fn leading_zeros_by_search(x: u64) -> u32 {
+    let (high, low) = ((x >> 32) as u32, x as u32);
+    let (mut n, mut w) = if high != 0 { (0, high) } else { (32, low) };
+    if w == 0 {
+        return 64;
+    }
+    for bits in [16, 8, 4, 2, 1] {
+        if w >> (32 - bits) == 0 {
+            n += bits;
+            w <<= bits;
+        }
+    }
+    n
+}
+
+/// `x >> shift` for a shift in 0 ..= 63 whose result fits 32 bits: on a
+/// 32-bit core, a 64-bit shift by a variable amount is a library call.
+#[inline(always)]
+pub fn shr_to_u32(x: u64, shift: u32) -> u32 {
+    let (high, low) = ((x >> 32) as u32, x as u32);
+    if shift >= 32 {
+        high >> (shift - 32)
+    } else if shift == 0 {
+        low
+    } else {
+        (low >> shift) | (high << (32 - shift))
+    }
+}
+
+/// `⌊n / d⌋`, saturating at `u32::MAX` (also for `d = 0`). Exact on every
+/// target; on ARMv6-M without a division (the library's 64-bit division
+/// costs some 450 instructions there).
+#[inline]
+pub fn div_saturating(n: u64, d: u32) -> u32 {
+    if d == 0 || n >> 32 >= d as u64 {
+        return u32::MAX;
+    }
+    if ARMV6M {
+        div_by_reciprocal(n, d)
+    } else {
+        (n / d as u64) as u32
+    }
+}
+
+/// 2^63 / (m + ½)·2^-8 for m = 256 … 511 (divisors normalised to [1, 2)),
+/// the start of Newton's iteration for the reciprocal.
+static RECIPROCAL_TABLE: [u32; 256] = {
+    let mut t = [0u32; 256];
     let mut i = 0;
-    while i < 192 {
-        // f = (i + 64.5) / 256 = (2i + 129) / 512; 2^30/√f = √(2^60 · 512 / (2i + 129)).
-        t[i] = super::isqrt_u128((1u128 << 69) / (2 * i as u128 + 129)) as u32;
+    while i < 256 {
+        t[i] = ((1u64 << 41) / (513 + 2 * i as u64)) as u32;
+        i += 1;
+    }
+    t
+};
+
+/// `⌊n / d⌋` for `0 < d` and `n < d · 2^32`, from a reciprocal.
+#[inline]
+fn div_by_reciprocal(n: u64, d: u32) -> u32 {
+    // Normalise: dn in [2^31, 2^32); the quotient is unchanged.
+    let s = leading_zeros(d as u64) - 32;
+    let dn = d << s;
+    let numerator = n << s; // below dn · 2^32
+                            // r ≈ 2^63 / dn: about 9 bits from the table, 18 and then 30 after
+                            // two Newton steps r' = r + r·(2^63 − dn·r)/2^63.
+    let mut r = RECIPROCAL_TABLE[((dn >> 23) & 0xff) as usize];
+    for _ in 0..2 {
+        let error = ((1u64 << 63).wrapping_sub(mul_u32_wide(dn, r)) as i64 >> 31) as i32;
+        let step = (mul_u32_wide(r, error.unsigned_abs()) >> 32) as u32;
+        r = if error >= 0 { r.saturating_add(step) } else { r - step };
+    }
+    let (high, low) = ((numerator >> 32) as u32, numerator as u32);
+    let estimate = (mul_u32_wide(high, r) + (mul_u32_wide(low, r) >> 32)) >> 31;
+    // Off by a few at most: step to the exact floor on the remainder.
+    let mut q = estimate.min(u32::MAX as u64) as u32;
+    let mut remainder = n.wrapping_sub(mul_u32_wide(q, d)) as i64;
+    while remainder < 0 {
+        q -= 1;
+        remainder += d as i64;
+    }
+    while remainder >= d as i64 {
+        q += 1;
+        remainder -= d as i64;
+    }
+    q
+}
+
+/// 2^30 / √f at f = m/256 for m from 64 to 256: the end points of 192
+/// intervals, interpolated linearly for the start of Newton's iteration.
+static RSQRT_TABLE: [u32; 193] = {
+    let mut t = [0u32; 193];
+    let mut i = 0;
+    while i < 193 {
+        // 2^30/√(m/256) = √(2^60 · 256 / m), rounded down.
+        t[i] = super::isqrt_u128((1u128 << 68) / (i as u128 + 64)) as u32;
         i += 1;
     }
     t
@@ -58,20 +222,34 @@ static RSQRT_TABLE: [u32; 192] = {
 /// to about 30 bits.
 #[inline]
 pub fn rsqrt(x: u64) -> (u32, i32) {
-    // x = f · 2^shift with f in [2^30, 2^32) and an even shift, so that
-    // 1/√x = (1/√(f / 2^32)) · 2^-(16 + shift/2).
-    let bits = 64 - x.leading_zeros() as i32;
+    let (f, shift) = rsqrt_argument(x);
+    (rsqrt_normalised(f), 46 + shift / 2)
+}
+
+/// `x = f · 2^shift` with `f` in [2^30, 2^32) and an even `shift`, so that
+/// 1/√x = (1/√(f / 2^32)) · 2^-(16 + shift/2).
+#[inline(always)]
+fn rsqrt_argument(x: u64) -> (u32, i32) {
+    let bits = 64 - leading_zeros(x) as i32;
     let shift = (bits - 31) & !1;
-    let f = if shift >= 0 { (x >> shift) as u32 } else { (x << -shift) as u32 };
-    let mut g = RSQRT_TABLE[((f >> 24) - 64) as usize]; // Q2.30
-    for _ in 0..2 {
-        // g' = g (3 − f g²) / 2; g² in Q3.29 and f·g² in Q2.30 stay in u32.
-        let g2 = (mul_u32_wide(g, g) >> 31) as u32;
-        let fg2 = (mul_u32_wide(f, g2) >> 31) as u32;
-        let t = (3u32 << 30).wrapping_sub(fg2);
-        g = (mul_u32_wide(g, t) >> 31) as u32;
-    }
-    (g, 46 + shift / 2)
+    let f = if shift >= 0 { shr_to_u32(x, shift as u32) } else { (x as u32) << -shift };
+    (f, shift)
+}
+
+/// 2^30/√(f / 2^32) for `f` in [2^30, 2^32), in Q2.30.
+#[inline(always)]
+fn rsqrt_normalised(f: u32) -> u32 {
+    // Linear interpolation is good to about 2^-15; one Newton step then
+    // gives about 29 bits. The table falls by less than 2^24 per interval,
+    // so the products here stay in a u32.
+    let i = ((f >> 24) - 64) as usize;
+    let (lo, hi) = (RSQRT_TABLE[i], RSQRT_TABLE[i + 1]);
+    let g = lo - ((((lo - hi) >> 8) * ((f >> 8) & 0xffff)) >> 8); // Q2.30
+                                                                  // g' = g (3 − f g²) / 2; g² in Q3.29 and f·g² in Q2.30 stay in u32.
+    let g2 = (square_u32_wide(g) >> 31) as u32;
+    let fg2 = (mul_u32_wide(f, g2) >> 31) as u32;
+    let t = (3u32 << 30).wrapping_sub(fg2);
+    (mul_u32_wide(g, t) >> 31) as u32
 }
 
 /// Floor of the square root of a `u64`, without division.
@@ -80,25 +258,36 @@ pub fn isqrt(n: u64) -> u64 {
     if n < 2 {
         return n;
     }
-    let (g, e) = rsqrt(n);
-    isqrt_from(n, g, e)
+    let (f, shift) = rsqrt_argument(n);
+    isqrt_from(n, rsqrt_normalised(f), f, shift)
 }
 
-/// ⌊√n⌋ given `1/√n ≈ g · 2^-e` from [`rsqrt`] (`n ≥ 2`).
+/// `(⌊√n⌋, g, e)` with `1/√n ≈ g · 2^-e` as [`rsqrt`] gives it, from one
+/// table look-up, for `n ≥ 2`.
 #[inline]
-pub fn isqrt_from(n: u64, g: u32, e: i32) -> u64 {
-    // √n = n · (1/√n), from the top 32 bits of n, then corrected to the
-    // exact floor (at most a couple of steps).
-    let bits = 64 - n.leading_zeros() as i32;
-    let drop = (bits - 32).max(0);
-    let top = (n >> drop) as u32;
-    let mut s = mul_u32_wide(top, g) >> (e - drop).clamp(0, 63);
-    // √n < 2^32: anything at or above it squares past every u64.
-    let fits = |s: u64| s < 1 << 32 && mul_u32_wide(s as u32, s as u32) <= n;
-    while s > 0 && !fits(s) {
+pub fn sqrt_and_rsqrt(n: u64) -> (u64, u32, i32) {
+    let (f, shift) = rsqrt_argument(n);
+    let g = rsqrt_normalised(f);
+    (isqrt_from(n, g, f, shift), g, 46 + shift / 2)
+}
+
+/// ⌊√n⌋ for `n ≥ 2` given [`rsqrt_argument`]'s `f · 2^shift = n` and
+/// `g ≈ 2^30/√(f / 2^32)`.
+#[inline]
+fn isqrt_from(n: u64, g: u32, f: u32, shift: i32) -> u64 {
+    // √n = f · (1/√f) · 2^(shift/2) = f·g · 2^(shift/2 − 46), then
+    // corrected to the exact floor (at most a couple of steps). The shift
+    // is 30 to 61 for every n ≥ 2.
+    // √n < 2^32, so the estimate is capped below it; s² then fits a u64,
+    // and the steps keep it as `square` (one product in all).
+    let mut s = (mul_u32_wide(f, g) >> (46 - shift / 2)).min(u32::MAX as u64);
+    let mut square = square_u32_wide(s as u32);
+    while square > n {
+        square -= 2 * s - 1;
         s -= 1;
     }
-    while fits(s + 1) {
+    while n - square > 2 * s {
+        square += 2 * s + 1;
         s += 1;
     }
     s
@@ -117,6 +306,63 @@ mod tests {
             s ^= s << 17;
             s >> (s % 64)
         })
+    }
+
+    #[test]
+    fn part_wise_forms_match_the_native_operations() {
+        let edges = [0, 1, 0xffff, 0x1_0000, 0x7fff_ffff, 0x8000_0000, 0xffff_ffff];
+        let words = spread(20_000).map(|v| v as u32).chain(edges);
+        for (i, a) in words.enumerate() {
+            let b = a.rotate_left(i as u32 % 32) ^ (i as u32).wrapping_mul(2_654_435_761);
+            assert_eq!(mul_u32_wide_by_parts(a, b), a as u64 * b as u64, "{a} {b}");
+            let (x, y) = (a as i32, b as i32);
+            assert_eq!(mul_wide_by_parts(x, y), x as i64 * y as i64, "{x} {y}");
+            assert_eq!(square_by_parts(x), (x as i64 * x as i64) as u64, "{x}");
+            let wide = ((a as i64) << 29) ^ b as i64;
+            assert_eq!(mul_i64_i32_by_parts(wide, y), wide.wrapping_mul(y as i64), "{wide} {y}");
+            assert_eq!(mul_i64_i32_by_parts(-wide, y >> 9), (-wide).wrapping_mul((y >> 9) as i64));
+        }
+        for v in spread(20_000).chain([0, 1, u64::MAX, 1 << 32, (1 << 32) - 1, 1 << 63]) {
+            assert_eq!(leading_zeros_by_search(v), v.leading_zeros(), "{v}");
+        }
+        for v in spread(5_000) {
+            for shift in 0..64 {
+                if v >> shift <= u32::MAX as u64 {
+                    assert_eq!(shr_to_u32(v, shift), (v >> shift) as u32, "{v} >> {shift}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn division_by_reciprocal_is_exact() {
+        let mut cases = 0;
+        for (i, v) in spread(40_000).enumerate() {
+            let d = ((v >> 17) as u32 ^ (i as u32).wrapping_mul(2_654_435_761)) >> (i % 32);
+            if d == 0 {
+                continue;
+            }
+            let n = v % ((d as u64) << 32);
+            assert_eq!(div_by_reciprocal(n, d) as u64, n / d as u64, "{n} / {d}");
+            cases += 1;
+        }
+        assert!(cases > 30_000);
+        for d in [1u32, 2, 3, 7, 255, 256, 65_535, 1 << 31, (1 << 31) + 1, u32::MAX - 1, u32::MAX] {
+            let top = ((d as u64) << 32) - 1;
+            for n in [0, 1, d as u64 - 1, d as u64, top, top - d as u64, top / 2, top / 3] {
+                assert_eq!(div_by_reciprocal(n, d) as u64, n / d as u64, "{n} / {d}");
+            }
+        }
+        assert_eq!(div_saturating(1 << 40, 0), u32::MAX);
+        assert_eq!(div_saturating(1 << 40, 255), u32::MAX);
+        assert_eq!(div_saturating(1 << 40, 257), ((1u64 << 40) / 257) as u32);
+    }
+
+    #[test]
+    fn sqrt_and_rsqrt_agree_with_the_separate_ones() {
+        for n in spread(20_000).filter(|&n| n >= 2) {
+            assert_eq!(sqrt_and_rsqrt(n), (n.isqrt(), rsqrt(n).0, rsqrt(n).1), "{n}");
+        }
     }
 
     #[test]

@@ -6,7 +6,7 @@ use super::error::{ErrorKind, Field, Found, ParseError, Pos, Rule};
 use super::lexer::{Lexer, Token};
 use super::number::{parse_integer, Decimal};
 use crate::math::isqrt_u128;
-use crate::scene::{Color, Surface, WorldPoint, WorldValue};
+use crate::scene::{Color, Surface, WorldPoint, WorldValue, MAX_SAMPLES, MAX_SIDE};
 use fixed::types::{I32F32, I48F16};
 
 /// A statement's content, in world units.
@@ -223,9 +223,10 @@ pub fn statement<'a>(cur: &mut Cursor<'a>, kw: &'static str, at: Pos) -> Result<
         "VIEWPOINT" => Statement::Viewpoint(cur.point(kw, xyz)?),
         "ORIGIN" => Statement::Origin(cur.point(kw, xyz)?),
         "UPVECTOR" => Statement::Upvector(cur.point(kw, xyz)?),
-        "RASTER" => {
-            Statement::Raster([cur.integer(f("width"), 1, 16384)? as u32, cur.integer(f("height"), 1, 16384)? as u32])
-        }
+        "RASTER" => Statement::Raster([
+            cur.integer(f("width"), 1, MAX_SIDE as i64)? as u32,
+            cur.integer(f("height"), 1, MAX_SIDE as i64)? as u32,
+        ]),
         "VIEWPORT" => {
             Statement::Viewport([cur.real(f("width"), Rule::Positive)?, cur.real(f("height"), Rule::Positive)?])
         }
@@ -241,7 +242,7 @@ pub fn statement<'a>(cur: &mut Cursor<'a>, kw: &'static str, at: Pos) -> Result<
         "BACKGROUND" => Statement::Background(cur.color(kw, ["red", "green", "blue"])?),
         "GAMMA" => Statement::Gamma(I32F32::from_bits(cur.real(f("value"), Rule::Positive)?)),
         "ATTENUATION" => Statement::Attenuation(I32F32::from_bits(cur.real(f("d0"), Rule::Positive)?)),
-        "SAMPLES" => Statement::Samples(cur.integer(f("count"), 1, 16)? as u32),
+        "SAMPLES" => Statement::Samples(cur.integer(f("count"), 1, MAX_SAMPLES as i64)? as u32),
         "SPHERE" => Statement::Sphere {
             surface: cur.surface_number(kw)?,
             radius: cur.real(f("radius"), Rule::Positive)?,

@@ -102,7 +102,8 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     pub fn pixel(&mut self, x: u32, y: u32) -> PixelSample {
         let n = self.camera.samples();
         let mut object = None;
-        let mut sum = [0i64; 3];
+        // At most 16² samples of at most 2^16 each: the sums fit a u32.
+        let mut sum = [0u32; 3];
         for sy in 0..n {
             for sx in 0..n {
                 let (c, o) = self.tracer.trace(self.camera.ray(x, y, sx, sy), &mut self.scratch);
@@ -110,12 +111,13 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
                     object = o;
                 }
                 for (s, v) in sum.iter_mut().zip(c.bits()) {
-                    *s += v.clamp(0, 1 << 16) as i64;
+                    *s += v.clamp(0, 1 << 16) as u32;
                 }
             }
         }
-        let count = (n * n) as i64;
-        let mean = Color::from_bits(sum.map(|s| ((s + count / 2) / count) as i32));
+        let count = n * n;
+        // One sample needs no division (a library call on a Cortex-M0).
+        let mean = Color::from_bits(sum.map(|s| if count == 1 { s } else { (s + count / 2) / count } as i32));
         PixelSample {
             color: Rgb888::new(self.gamma.encode(mean.r), self.gamma.encode(mean.g), self.gamma.encode(mean.b)),
             object,

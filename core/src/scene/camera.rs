@@ -8,8 +8,15 @@
 //! or row order gives the same bits.
 
 use super::normalize::{Normalization, WorldPoint, WorldValue};
-use crate::math::{isqrt_u128, Dir, Vec3};
+use crate::math::{isqrt_u128, mul_i64_i32, Dir, Vec3};
 use crate::shapes::Ray;
+
+/// The most samples per pixel side (SAMPLES 1 to 16): the renderer sums
+/// 16² samples of at most 2^16 in a `u32`.
+pub const MAX_SAMPLES: u32 = 16;
+/// The widest and tallest image (RASTER 1 to 16384): the camera's pixel
+/// offsets then fit an i32.
+pub const MAX_SIDE: u32 = 16384;
 
 /// Why a camera cannot be built.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -84,7 +91,9 @@ impl Camera {
         Ok((f, r, u, isqrt_u128(d2)))
     }
 
-    /// The camera for a `width × height` image with `samples`² rays per pixel.
+    /// The camera for a `width × height` image with `samples`² rays per pixel
+    /// (`samples` is clamped to 1 ..= [`MAX_SAMPLES`], the sides to
+    /// 1 ..= [`MAX_SIDE`]).
     pub fn new(
         view: &View,
         norm: &Normalization,
@@ -93,7 +102,9 @@ impl Camera {
         samples: u32,
     ) -> Result<Camera, CameraError> {
         let (f, r, u, dist) = Self::basis(view)?;
-        let (w, h, n) = (width.max(1) as i128, height.max(1) as i128, samples.max(1) as i128);
+        let samples = samples.clamp(1, MAX_SAMPLES);
+        let (width, height) = (width.clamp(1, MAX_SIDE), height.clamp(1, MAX_SIDE));
+        let (w, h, n) = (width as i128, height as i128, samples as i128);
         let dist = dist.max(1) as i128;
         // Tangent-like ratios vw/d and vh/d in Q32.32.
         let (ax, ay) = match view.viewport {
@@ -117,9 +128,9 @@ impl Camera {
             forward: f.wide().map(|c| if frac >= 30 { c << (frac - 30) } else { c >> (30 - frac) }),
             step_x: scale(r, ax, 2 * n * w),
             step_y: scale(u, ay, 2 * n * h),
-            width: width.max(1),
-            height: height.max(1),
-            samples: samples.max(1),
+            width,
+            height,
+            samples,
         })
     }
 
@@ -144,10 +155,11 @@ impl Camera {
     /// The ray through sub-cell (`sx`, `sy`) of pixel (`x`, `y`); `x` grows
     /// to the right and `y` downwards.
     pub fn ray(&self, x: u32, y: u32, sx: u32, sy: u32) -> Ray {
-        let n = self.samples as i64;
-        let kx = 2 * n * x as i64 + 2 * sx as i64 + 1 - n * self.width as i64;
-        let ky = n * self.height as i64 - 2 * n * y as i64 - 2 * sy as i64 - 1;
-        let d = [0, 1, 2].map(|a| self.forward[a] + kx * self.step_x[a] + ky * self.step_y[a]);
+        // |k| ≤ 2 · MAX_SAMPLES · MAX_SIDE: the offsets fit an i32.
+        let n = self.samples as i32;
+        let kx = 2 * n * x as i32 + 2 * sx as i32 + 1 - n * self.width as i32;
+        let ky = n * self.height as i32 - 2 * n * y as i32 - 2 * sy as i32 - 1;
+        let d = [0, 1, 2].map(|a| self.forward[a] + mul_i64_i32(self.step_x[a], kx) + mul_i64_i32(self.step_y[a], ky));
         Ray {
             origin: self.eye,
             // Never zero: the forward part dominates any sideways offset's

@@ -15,7 +15,7 @@ mod camera;
 mod normalize;
 mod surface;
 
-pub use camera::{Camera, CameraError, View};
+pub use camera::{Camera, CameraError, View, MAX_SAMPLES, MAX_SIDE};
 pub use normalize::{Normalization, WorldPoint, WorldValue};
 pub use surface::{Color, Surface, SurfaceEntry};
 

@@ -91,7 +91,14 @@ impl Normalization {
     pub fn world_distance_q32(&self, d: i64) -> i64 {
         let s = 16 - self.shift;
         if s >= 0 {
-            d.saturating_mul(1 << s.min(62))
+            // A shift, not a multiply: 64-bit products are library calls on
+            // a Cortex-M0.
+            let s = s.min(62);
+            if d > i64::MAX >> s {
+                i64::MAX
+            } else {
+                d << s
+            }
         } else {
             d >> (-s).min(63)
         }

@@ -16,7 +16,7 @@
 //! queries, each O(objects) in the naive mode.
 
 use crate::accel::{Accelerator, Hit, Mailbox, RayStart};
-use crate::math::{pow_unit, Dir, Scalar, Unit};
+use crate::math::{div_saturating, leading_zeros, pow_unit, Dir, Scalar, Unit};
 use crate::scene::{Color, ObjectId, SceneView};
 use crate::shapes::{Leaving, Ray};
 
@@ -86,22 +86,22 @@ pub struct Tracer<'a, A> {
     accel: &'a A,
 }
 
-/// `num / den` in Q16.16, both Q32.32, saturating.
+/// `num / den` in Q16.16, both Q32.32, saturating (and `i32::MAX` for a
+/// zero `den`). The divisor is cut to its top 32 bits, the numerator by as
+/// much: exact for divisors below 2^32, within 2^-31 relative above.
 fn ratio_q16(num: u64, den: u64) -> i32 {
-    if den == 0 {
-        return i32::MAX;
-    }
-    let lz = num.leading_zeros();
-    let q = if lz >= 16 {
-        (num << 16) / den
+    let cut = 32u32.saturating_sub(leading_zeros(den));
+    let divisor = (den >> cut) as u32;
+    // num · 2^16 / 2^cut, or saturated when that is past any u64: the
+    // quotient would then be above 2^32 anyway.
+    let numerator = if cut >= 16 {
+        num >> (cut - 16)
+    } else if leading_zeros(num) >= 16 - cut {
+        num << (16 - cut)
     } else {
-        let d = den >> (16 - lz);
-        if d == 0 {
-            return i32::MAX;
-        }
-        (num << lz) / d
+        return i32::MAX;
     };
-    q.min(i32::MAX as u64) as i32
+    div_saturating(numerator, divisor).min(i32::MAX as u32) as i32
 }
 
 /// How a ray leaving a surface along `dir` relates to the shape it leaves:
@@ -179,14 +179,13 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         let mut local = surface.ambient;
         for light in self.scene.lights {
             let to_light = light.position - point;
-            let Some(light_dir) = to_light.direction() else {
+            let Some((light_dir, distance)) = to_light.direction_and_length() else {
                 continue;
             };
             let cos = normal.dot(light_dir);
             if cos.to_bits() <= 0 {
                 continue;
             }
-            let distance = to_light.length();
             scratch.stats.shadow_rays += 1;
             let shadow = Ray { origin: point, dir: light_dir };
             let start = RayStart { object: hit.object, leaving: leaving_along(geometric, light_dir) };

@@ -8,7 +8,7 @@
 //! neighbours whose planes round differently still leave no crack.
 
 use super::{Aabb, Leaving, Ray};
-use crate::math::{mul_wide, Dir, Scalar, Vec3};
+use crate::math::{div_saturating, mul_wide, Dir, Scalar, Vec3};
 
 /// How far (in Q16.16 raw units, normalised space) a hit may lie outside an
 /// edge and still count: four units, about 6·10^-5, far below a pixel.
@@ -62,7 +62,8 @@ impl<const N: usize> Polygon<N> {
         if num <= 0 || num >= limit {
             return None;
         }
-        let t = num / den;
+        // Below t_max + 1 ≤ 2^31: fits the division's u32 quotient.
+        let t = div_saturating(num as u64, den as u32) as i64;
         if t <= 0 {
             return None;
         }

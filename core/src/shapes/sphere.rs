@@ -36,6 +36,11 @@ impl Sphere {
             return None;
         }
         let q = oc - ray.dir.scale(b);
+        // Most rays pass wide of a sphere: one coordinate of q beyond the
+        // radius settles it without the squares.
+        if q.bits().iter().any(|c| c.unsigned_abs() as i64 > r) {
+            return None;
+        }
         let disc = mul_wide(r as i32, r as i32) - q.length_squared_q32();
         if disc < 0 {
             return None;
