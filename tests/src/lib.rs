@@ -1,6 +1,7 @@
 //! Support code for octrace's whole-pipeline tests (the tests themselves are
 //! in `tests/`).
 
+pub mod firmware;
 pub mod reference;
 
 use std::path::PathBuf;

@@ -1,0 +1,224 @@
+//! Building and running the board firmware (`firmware/`) in qemu, for the
+//! bit-exactness test and the firmware benchmark.
+//!
+//! Each build is configured by environment variables (see
+//! `firmware/build.rs`) and goes to a target directory per board under
+//! `target/firmware/`, apart from a developer's own builds. A build
+//! replaces the board's previous ELF: build and run one configuration at a
+//! time.
+
+use crate::repo;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// An emulated board.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Board {
+    /// BBC micro:bit: Cortex-M0, 16 KiB RAM, no FPU.
+    Microbit,
+    /// ARM MPS2-AN385: Cortex-M3.
+    Mps2An385,
+}
+
+impl Board {
+    pub fn machine(self) -> &'static str {
+        match self {
+            Board::Microbit => "microbit",
+            Board::Mps2An385 => "mps2-an385",
+        }
+    }
+
+    pub fn target(self) -> &'static str {
+        match self {
+            Board::Microbit => "thumbv6m-none-eabi",
+            Board::Mps2An385 => "thumbv7m-none-eabi",
+        }
+    }
+
+    pub fn core(self) -> &'static str {
+        match self {
+            Board::Microbit => "Cortex-M0",
+            Board::Mps2An385 => "Cortex-M3",
+        }
+    }
+}
+
+/// The display's pixel format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Wire {
+    Rgb888,
+    /// Big-endian RGB565, as SPI displays take it.
+    Rgb565,
+}
+
+impl Wire {
+    fn name(self) -> &'static str {
+        match self {
+            Wire::Rgb888 => "rgb888",
+            Wire::Rgb565 => "rgb565",
+        }
+    }
+}
+
+/// One firmware configuration.
+#[derive(Clone, Debug)]
+pub struct Firmware {
+    pub board: Board,
+    /// A scene in `scenes/`, without `.txt`.
+    pub scene: String,
+    pub width: u32,
+    pub height: u32,
+    pub wire: Wire,
+}
+
+/// What a run printed and wrote.
+#[derive(Debug)]
+pub struct Run {
+    /// The guest's exit status.
+    pub status: i32,
+    /// Everything the guest printed.
+    pub output: String,
+    /// The pixels it sent to the display, as they arrived.
+    pub pixels: Vec<u8>,
+}
+
+impl Run {
+    /// The peak stack the firmware reports (`peak stack: N bytes`).
+    pub fn peak_stack(&self) -> Option<u64> {
+        self.output.lines().find_map(|l| l.strip_prefix("peak stack: ")?.strip_suffix(" bytes")?.parse().ok())
+    }
+}
+
+impl Firmware {
+    pub fn new(board: Board, scene: &str, width: u32, height: u32, wire: Wire) -> Firmware {
+        Firmware { board, scene: scene.to_owned(), width, height, wire }
+    }
+
+    fn slug(&self) -> String {
+        format!("{}-{}-{}x{}-{}", self.board.machine(), self.scene, self.width, self.height, self.wire.name())
+    }
+
+    fn target_dir(&self) -> PathBuf {
+        repo().join("target/firmware").join(self.board.machine())
+    }
+
+    /// Where the guest writes its pixels.
+    fn output_file(&self) -> PathBuf {
+        self.target_dir().join(format!("{}.raw", self.slug()))
+    }
+
+    /// Builds the firmware (release) and returns the ELF.
+    pub fn build(&self) -> Result<PathBuf, String> {
+        let dir = self.target_dir();
+        let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
+        // The firmware's .cargo/config.toml (runner, linker script) is found
+        // from the working directory.
+        cargo.current_dir(repo().join("firmware"));
+        cargo.args(["build", "--release", "--quiet", "--target", self.board.target()]);
+        cargo.arg("--target-dir").arg(&dir);
+        for var in ["CARGO_TARGET_DIR", "RUSTFLAGS", "CARGO_ENCODED_RUSTFLAGS", "CARGO_BUILD_TARGET"] {
+            cargo.env_remove(var);
+        }
+        cargo.env("OCTRACE_SCENE", &self.scene);
+        cargo.env("OCTRACE_SIZE", format!("{}x{}", self.width, self.height));
+        cargo.env("OCTRACE_COLOR", self.wire.name());
+        cargo.env("OCTRACE_OUT", self.output_file());
+        let out = cargo.output().map_err(|e| format!("cannot run cargo: {e}"))?;
+        if !out.status.success() {
+            return Err(format!("firmware build {} failed:\n{}", self.slug(), String::from_utf8_lossy(&out.stderr)));
+        }
+        Ok(dir.join(self.board.target()).join("release/octrace-firmware"))
+    }
+
+    /// Runs the ELF in qemu (through the firmware's runner script, which
+    /// has the timeout) and collects what the display received.
+    pub fn run(&self, elf: &Path) -> Result<Run, String> {
+        let file = self.output_file();
+        let _ = std::fs::remove_file(&file);
+        let out = Command::new("bash")
+            .arg(repo().join("firmware/run.sh"))
+            .arg(self.board.machine())
+            .arg(elf)
+            .output()
+            .map_err(|e| format!("cannot run qemu: {e}"))?;
+        let output = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+        let pixels = std::fs::read(&file).unwrap_or_default();
+        Ok(Run { status: out.status.code().unwrap_or(-1), output, pixels })
+    }
+
+    /// What host-sim renders for the same scene and size, in the wire
+    /// format.
+    pub fn expected_pixels(&self) -> Result<Vec<u8>, String> {
+        let mut scene = host_sim::new_scene();
+        let path = repo().join("scenes").join(format!("{}.txt", self.scene));
+        host_sim::load_file(&path, &mut scene).map_err(|e| e.to_string())?;
+        let options = host_sim::RenderOptions { size: Some((self.width, self.height)), ..Default::default() };
+        let image = host_sim::render(&scene, &options).map_err(|e| format!("{e:?}"))?.image;
+        Ok(match self.wire {
+            Wire::Rgb888 => image.data,
+            Wire::Rgb565 => image.data.chunks(3).flat_map(|p| rgb565(p[0], p[1], p[2]).to_be_bytes()).collect(),
+        })
+    }
+}
+
+/// RGB565 as embedded-graphics converts Rgb888 to it (each channel
+/// rounded to its width), written out here so that the test does not share
+/// the firmware's conversion code.
+fn rgb565(r: u8, g: u8, b: u8) -> u16 {
+    let scale = |v: u8, max: u32| ((v as u32 * max + 127) / 255) as u16;
+    (scale(r, 31) << 11) | (scale(g, 63) << 5) | scale(b, 31)
+}
+
+/// What the benchmark measures of one configuration.
+#[derive(Debug)]
+pub struct Measurement {
+    pub status: i32,
+    pub output: String,
+    /// Instructions executed from reset to exit.
+    pub total: u64,
+    /// Instructions of the render alone (between the firmware's markers).
+    pub render: Option<u64>,
+    /// Flash: text + data.
+    pub flash: u64,
+    /// Static RAM: data + bss.
+    pub static_ram: u64,
+}
+
+impl Firmware {
+    /// Runs the ELF under `qemu-count` (the instruction-counting plugin) and
+    /// reads its sizes with `arm-none-eabi-size`.
+    pub fn measure(&self, elf: &Path, qemu_count: &Path) -> Result<Measurement, String> {
+        let out = Command::new(qemu_count)
+            .arg(self.board.machine())
+            .arg(elf)
+            .output()
+            .map_err(|e| format!("cannot run {}: {e}", qemu_count.display()))?;
+        let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+        let value = |key: &str| text.lines().find_map(|l| l.strip_prefix(key)?.trim().parse::<u64>().ok());
+        let total = value("insns_total=").ok_or_else(|| format!("no instruction count from qemu-count:\n{text}"))?;
+        let size = Command::new("arm-none-eabi-size")
+            .arg("-B")
+            .arg(elf)
+            .output()
+            .map_err(|e| format!("cannot run arm-none-eabi-size: {e}"))?;
+        let size = String::from_utf8_lossy(&size.stdout).into_owned();
+        let numbers: Vec<u64> =
+            size.lines().nth(1).unwrap_or("").split_whitespace().take(3).filter_map(|n| n.parse().ok()).collect();
+        let [text_bytes, data, bss] = numbers[..] else {
+            return Err(format!("unexpected arm-none-eabi-size output:\n{size}"));
+        };
+        Ok(Measurement {
+            status: out.status.code().unwrap_or(-1),
+            render: value("insns_between_markers="),
+            total,
+            flash: text_bytes + data,
+            static_ram: data + bss,
+            output: text,
+        })
+    }
+}
+
+/// Whether qemu for Arm is installed.
+pub fn qemu_available() -> bool {
+    Command::new("qemu-system-arm").arg("--version").output().is_ok_and(|o| o.status.success())
+}
