@@ -1,8 +1,9 @@
 //! The `host-sim` command line.
 
-use crate::{load_file, new_scene, render_with_progress, AccelMode, LoadError, RenderOptions};
+use crate::{all_cores, load_file, new_scene, render_with_progress, AccelMode, LoadError, Partition, RenderOptions};
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressStyle};
+use octrace_core::accel::OctreeConfig;
 use octrace_core::scene::MAX_SIDE;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -36,11 +37,20 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = AccelMode::Auto)]
     pub accel: AccelMode,
     /// Octree criterion: a box holding more objects than this is subdivided.
-    #[arg(long, value_name = "N", default_value_t = 6)]
+    #[arg(long, value_name = "N", default_value_t = OctreeConfig::default().max_objects)]
     pub max_objects: usize,
     /// Octree criterion: boxes are not subdivided below this depth (at most 18).
-    #[arg(long, value_name = "D", default_value_t = 12, value_parser = clap::value_parser!(u32).range(0..=18))]
+    #[arg(long, value_name = "D", default_value_t = OctreeConfig::default().max_depth,
+          value_parser = clap::value_parser!(u32).range(0..=18))]
     pub max_depth: u32,
+    /// Threads to render on (default: every core). Any number gives the
+    /// same image.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// How the image is cut between threads: small tiles handed out as
+    /// threads become free, or the thesis's four equal rectangles.
+    #[arg(long, value_enum, default_value_t = Partition::Tiles)]
+    pub partition: Partition,
     /// Print nothing but errors.
     #[arg(long, short)]
     pub quiet: bool,
@@ -118,9 +128,9 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
     let view = scene.view();
     let (w, h) = args.size.unwrap_or((view.settings.raster[0], view.settings.raster[1]));
     let bar = if !args.quiet && std::io::stderr().is_terminal() {
-        let bar = ProgressBar::new(h as u64);
+        let bar = ProgressBar::new(w as u64 * h as u64);
         bar.set_style(
-            ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} rows, eta {eta}")
+            ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}%, eta {eta}")
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
         Some(bar)
@@ -131,15 +141,13 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
     let options = RenderOptions {
         size: Some((w, h)),
         accel: args.accel,
-        octree: octrace_core::accel::OctreeConfig {
-            max_objects: args.max_objects,
-            max_depth: args.max_depth,
-            ..Default::default()
-        },
+        octree: OctreeConfig { max_objects: args.max_objects, max_depth: args.max_depth, ..Default::default() },
+        threads: args.threads.map_or_else(all_cores, |n| n as usize),
+        partition: args.partition,
     };
-    let rendered = render_with_progress(&scene, &options, |_| {
+    let rendered = render_with_progress(&scene, &options, &|pixels| {
         if let Some(b) = &bar {
-            b.inc(1);
+            b.inc(pixels);
         }
     });
     if let Some(b) = &bar {
@@ -171,9 +179,11 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
         }
         let _ = writeln!(
             stderr,
-            "{w}x{h} in {:.3} s ({}): {} rays, {} shadow rays, {} cells{} -> {}",
+            "{w}x{h} in {:.3} s ({}, {} thread{}): {} rays, {} shadow rays, {} cells{} -> {}",
             elapsed.as_secs_f64(),
             rendered.accel.name(),
+            options.threads,
+            if options.threads == 1 { "" } else { "s" },
             stats.rays,
             stats.shadow_rays,
             stats.cells,

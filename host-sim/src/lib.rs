@@ -7,13 +7,21 @@ pub mod image;
 
 pub use image::RgbImage;
 
-use octrace_core::accel::{BuildReport, Mailbox, Naive, Octree, OctreeConfig, Traversal};
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{OriginDimensions, Point, Size};
+use embedded_graphics_core::pixelcolor::Rgb888;
+use embedded_graphics_core::primitives::Rectangle;
+use embedded_graphics_core::Pixel;
+use octrace_core::accel::{Accelerator, BuildReport, Mailbox, Naive, Octree, OctreeConfig, Traversal};
 use octrace_core::capacity::Host;
 use octrace_core::parse::{parse_bytes, ParseError};
-use octrace_core::render::Renderer;
-use octrace_core::scene::{CameraError, Scene};
+use octrace_core::render::{Renderer, Tiles};
+use octrace_core::scene::{CameraError, Scene, SceneView};
 use octrace_core::shade::Stats;
 use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
 
 /// The host build's scene: a million objects of any mix, heap-backed.
 pub type HostScene = Scene<Host>;
@@ -102,6 +110,23 @@ impl AccelMode {
     }
 }
 
+/// How the image is cut between threads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Partition {
+    /// Tiles of 32×32 pixels handed out one at a time from a shared
+    /// counter: a thread that finishes early takes the next, so all stay
+    /// busy to the end.
+    Tiles,
+    /// The thesis's parallel mode: four equal rectangles (the image's
+    /// quarters), quarter `i` to thread `i mod threads`.
+    Equal4,
+}
+
+/// The side of a tile in [`Partition::Tiles`]: small enough to balance 2 to
+/// 64 threads on a 160×128 image, large enough that handing one out costs
+/// nothing next to tracing it.
+pub const TILE_SIDE: u32 = 32;
+
 /// How to render.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RenderOptions {
@@ -110,12 +135,27 @@ pub struct RenderOptions {
     pub accel: AccelMode,
     /// Subdivision criterion (the traversal follows `accel`).
     pub octree: OctreeConfig,
+    /// Threads to render on (at least 1). The image is the same for any
+    /// number.
+    pub threads: usize,
+    pub partition: Partition,
 }
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions { size: None, accel: AccelMode::Auto, octree: OctreeConfig::default() }
+        RenderOptions {
+            size: None,
+            accel: AccelMode::Auto,
+            octree: OctreeConfig::default(),
+            threads: 1,
+            partition: Partition::Tiles,
+        }
     }
+}
+
+/// Every core of this machine (1 if that cannot be told).
+pub fn all_cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
 /// A finished render.
@@ -126,6 +166,11 @@ pub struct Rendered {
     pub accel: AccelMode,
     /// The octree's build report and time, when one was built.
     pub build: Option<(BuildReport, std::time::Duration)>,
+    /// Wall-clock time of the render (without building the octree).
+    pub wall: Duration,
+    /// For each thread, the time it spent rendering; `wall − busy` is the
+    /// time it stood idle while others worked.
+    pub busy: Vec<Duration>,
 }
 
 /// The host's octree.
@@ -145,58 +190,153 @@ pub fn build_octree(scene: &HostScene, mode: AccelMode, config: &OctreeConfig) -
 
 /// Renders a loaded scene into a new image.
 pub fn render(scene: &HostScene, options: &RenderOptions) -> Result<Rendered, CameraError> {
-    render_with_progress(scene, options, |_| {})
+    render_with_progress(scene, options, &|_| {})
 }
 
-/// As [`render`], calling `row_done(y)` after each row.
+/// As [`render`], calling `progress(pixels)` (from any thread) each time a
+/// piece of the image is done.
 pub fn render_with_progress(
     scene: &HostScene,
     options: &RenderOptions,
-    row_done: impl FnMut(u32),
+    progress: &(dyn Fn(u64) + Sync),
 ) -> Result<Rendered, CameraError> {
     let accel = options.accel.resolve(scene.view().object_count());
-    let started = std::time::Instant::now();
+    let started = Instant::now();
     let octree = build_octree(scene, accel, &options.octree);
     let build = octree.as_ref().map(|o| (*o.report(), started.elapsed()));
-    let mut rendered = render_prebuilt(scene, options.size, octree.as_deref(), row_done)?;
+    let mut rendered = render_prebuilt(scene, options, octree.as_deref(), progress)?;
     rendered.build = build;
     Ok(rendered)
 }
 
-/// Renders with an octree built beforehand (`None`: the naive mode).
+/// Renders with an octree built beforehand (`None`: the naive mode);
+/// `options.accel` and `options.octree` are not used.
 pub fn render_prebuilt(
     scene: &HostScene,
-    size: Option<(u32, u32)>,
+    options: &RenderOptions,
     octree: Option<&HostOctree>,
-    mut row_done: impl FnMut(u32),
+    progress: &(dyn Fn(u64) + Sync),
 ) -> Result<Rendered, CameraError> {
     let view = scene.view();
-    let [w, h] = size.map_or(view.settings.raster, |(w, h)| [w, h]);
-    let accel = match octree.map(|o| o.traversal()) {
-        None => AccelMode::Naive,
-        Some(Traversal::Named) => AccelMode::Octree,
-        Some(Traversal::Dda) => AccelMode::Dda,
-    };
-    let mut image = RgbImage::new(w, h);
-    let mut stats = Stats::default();
-    let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
-    let mut rows = |renderer: &mut dyn FnMut(u32, &mut RgbImage) -> Stats| {
-        for y in 0..h {
-            stats.add(&renderer(y, &mut image));
-            row_done(y);
-        }
-    };
-    match octree {
-        None => {
-            let mut r = Renderer::with_size(view, &Naive, w, h)?;
-            rows(&mut |y, img| r.render_rows(y..y + 1, img).unwrap_or_else(|never| match never {}));
-        }
+    let (w, h) = options.size.unwrap_or((view.settings.raster[0], view.settings.raster[1]));
+    // Set-up errors are found once, before any thread starts.
+    Renderer::with_size(view, &Naive, w, h)?;
+    let (accel, job) = match octree {
+        None => (AccelMode::Naive, render_threads(view, &Naive, (w, h), options, progress)),
         Some(tree) => {
-            let mut r = Renderer::with_size(view, tree, w, h)?.with_mailbox(&mut words);
-            rows(&mut |y, img| r.render_rows(y..y + 1, img).unwrap_or_else(|never| match never {}));
+            let mode = if tree.traversal() == Traversal::Named { AccelMode::Octree } else { AccelMode::Dda };
+            (mode, render_threads(view, tree, (w, h), options, progress))
+        }
+    };
+    let (image, stats, wall, busy) = job;
+    Ok(Rendered { image, stats, accel, build: None, wall, busy })
+}
+
+/// The pieces of the image in the order they are handed out.
+fn pieces(size: Size, partition: Partition) -> Vec<Rectangle> {
+    match partition {
+        Partition::Tiles => Tiles::new(size, TILE_SIDE).iter().collect(),
+        Partition::Equal4 => {
+            let (w, h) = (size.width, size.height);
+            let (left, top) = (w / 2, h / 2);
+            [(0, 0, left, top), (left, 0, w - left, top), (0, top, left, h - top), (left, top, w - left, h - top)]
+                .into_iter()
+                .map(|(x, y, w, h)| Rectangle::new(Point::new(x as i32, y as i32), Size::new(w, h)))
+                .collect()
         }
     }
-    Ok(Rendered { image, stats, accel, build: None })
+}
+
+/// Renders on `options.threads` threads, each with its own renderer (and
+/// mailbox), into one image.
+fn render_threads<A: Accelerator + Sync>(
+    view: SceneView<'_>,
+    accel: &A,
+    (w, h): (u32, u32),
+    options: &RenderOptions,
+    progress: &(dyn Fn(u64) + Sync),
+) -> (RgbImage, Stats, Duration, Vec<Duration>) {
+    let threads = options.threads.max(1);
+    let pieces = pieces(Size::new(w, h), options.partition);
+    let next = AtomicUsize::new(0);
+    let image = Mutex::new(RgbImage::new(w, h));
+    let started = Instant::now();
+    let worker = |thread: usize| {
+        let began = Instant::now();
+        let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
+        let Ok(renderer) = Renderer::with_size(view, accel, w, h) else { return (Stats::default(), Duration::ZERO) };
+        let mut renderer = renderer.with_mailbox(&mut words);
+        let mut stats = Stats::default();
+        let mut piece_index = thread;
+        loop {
+            let index = match options.partition {
+                Partition::Tiles => next.fetch_add(1, Ordering::Relaxed),
+                Partition::Equal4 => {
+                    piece_index += threads;
+                    piece_index - threads
+                }
+            };
+            let Some(piece) = pieces.get(index) else { break };
+            let mut tile = Tile::new(piece);
+            stats.add(&renderer.render_rect(piece, &mut tile).unwrap_or_else(|never| match never {}));
+            tile.copy_into(&mut image.lock().unwrap_or_else(|poisoned| poisoned.into_inner()));
+            progress(piece.size.width as u64 * piece.size.height as u64);
+        }
+        (stats, began.elapsed())
+    };
+    let results: Vec<(Stats, Duration)> = if threads == 1 {
+        vec![worker(0)]
+    } else {
+        std::thread::scope(|scope| {
+            let handles: Vec<_> = (0..threads).map(|t| scope.spawn(move || worker(t))).collect();
+            handles.into_iter().map(|h| h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))).collect()
+        })
+    };
+    let wall = started.elapsed();
+    let mut stats = Stats::default();
+    for (s, _) in &results {
+        stats.add(s);
+    }
+    let image = image.into_inner().unwrap_or_else(|poisoned| poisoned.into_inner());
+    (image, stats, wall, results.into_iter().map(|(_, busy)| busy).collect())
+}
+
+/// A piece of the image being rendered: a `DrawTarget` at the piece's
+/// place, copied into the image when done.
+struct Tile {
+    area: Rectangle,
+    pixels: RgbImage,
+}
+
+impl Tile {
+    fn new(area: &Rectangle) -> Tile {
+        Tile { area: *area, pixels: RgbImage::new(area.size.width, area.size.height) }
+    }
+
+    fn copy_into(&self, image: &mut RgbImage) {
+        let (x0, y0) = (self.area.top_left.x as usize, self.area.top_left.y as usize);
+        let row = self.area.size.width as usize * 3;
+        for (y, line) in self.pixels.data.chunks(row.max(1)).enumerate() {
+            let start = ((y0 + y) * image.width as usize + x0) * 3;
+            image.data[start..start + row].copy_from_slice(line);
+        }
+    }
+}
+
+impl OriginDimensions for Tile {
+    fn size(&self) -> Size {
+        self.area.size
+    }
+}
+
+impl DrawTarget for Tile {
+    type Color = Rgb888;
+    type Error = std::convert::Infallible;
+
+    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb888>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
+        let offset = self.area.top_left;
+        self.pixels.draw_iter(pixels.into_iter().map(|Pixel(p, c)| Pixel(p - offset, c)))
+    }
 }
 
 /// Runs the command line `args` (including the program name); help goes to

@@ -12,8 +12,10 @@
 //! by sample (n/2, n/2), the centre sample for odd n.
 
 mod gamma;
+mod split;
 
 pub use gamma::GammaTable;
+pub use split::{interleaved_rows, Tiles};
 
 use crate::accel::{Accelerator, Mailbox};
 use crate::scene::{Camera, CameraError, Color, ObjectId, SceneView};

@@ -4,12 +4,14 @@
 //!
 //! Tables: `scenes` (every scene, naive), `table51` (the thesis's Table 5.1),
 //! `table52` (Table 5.2), `scaling` (random spheres, N = 10 … 100,000),
-//! `criterion` (the octree's subdivision criterion). No argument: all.
-//! Times are wall-clock on one thread, the best of several runs; the machine
-//! is printed first so every table says where it came from.
+//! `criterion` (the octree's subdivision criterion), `parallel` (threads
+//! and partitions). No argument: all. Times are wall-clock on one thread
+//! (except in `parallel`), the best of several runs; the machine is printed
+//! first so every table says where it came from.
 
 use host_sim::{
-    build_octree, load_bytes, load_file, new_scene, render, render_prebuilt, AccelMode, HostScene, RenderOptions,
+    all_cores, build_octree, load_bytes, load_file, new_scene, render, render_prebuilt, AccelMode, HostScene,
+    Partition, RenderOptions,
 };
 use octrace_core::accel::OctreeConfig;
 use std::path::{Path, PathBuf};
@@ -65,7 +67,7 @@ fn load(path: &Path) -> Box<HostScene> {
 
 /// Render time (best of `runs`), including the octree build.
 fn time(scene: &HostScene, accel: AccelMode, octree: OctreeConfig, size: Option<(u32, u32)>, runs: usize) -> Duration {
-    let options = RenderOptions { size, accel, octree };
+    let options = RenderOptions { size, accel, octree, ..Default::default() };
     best_of(runs, || render(scene, &options).map(|r| r.stats)).0
 }
 
@@ -206,7 +208,7 @@ fn scaling() {
         let naive = if n <= 10_000 { per_px(time(&scene, AccelMode::Naive, c, None, 1)) } else { "—".into() };
         let walk = |mode| {
             let tree = build_octree(&scene, mode, &c).expect("an octree");
-            best_of(3, || render_prebuilt(&scene, None, Some(&tree), |_| {}).map(|r| r.stats)).0
+            best_of(3, || render_prebuilt(&scene, &RenderOptions::default(), Some(&tree), &|_| {}).map(|r| r.stats)).0
         };
         let octree = walk(AccelMode::Octree);
         let dda = walk(AccelMode::Dda);
@@ -252,11 +254,73 @@ fn criterion(dir: &Path) {
     println!();
 }
 
+/// A scene whose work is all in one corner of the image: 60 reflective
+/// spheres in the top-left quarter, the rest background.
+fn corner() -> String {
+    let mut s = String::from(
+        "RASTER 800 600 RDEPTH 3\nVIEWPOINT 0 0 20 ORIGIN 0 0 0\nLIGHT 30 -10 10 20\n\
+         SURFACE 1 0.1 0.1 0.1 0.6 0.5 0.4 0.8 0.8 0.8 40 0.5 0\n",
+    );
+    for i in 0..60 {
+        let (x, y) = (-9.5 + (i % 10) as f64 * 0.8, 1.2 + (i / 10) as f64 * 0.8);
+        s += &format!("SPHERE 1 0.38 {x:.2} {y:.2} {:.2}\n", (i % 3) as f64 * 0.3);
+    }
+    s
+}
+
+fn parallel(dir: &Path) {
+    let cores = all_cores();
+    println!("### Parallel rendering: speed-up and idle time\n");
+    println!("dda mode, octree built once beforehand; wall-clock time of the render, best of 3. Idle is the");
+    println!("share of thread-time spent waiting for the last thread: Σ(wall − busy) / (threads × wall).\n");
+    println!("| scene | size | partition | threads | time | speed-up | idle |");
+    println!("| --- | --- | --- | ---: | ---: | ---: | ---: |");
+    let mut corner_scene = new_scene();
+    load_bytes("corner", corner().as_bytes(), &mut corner_scene).expect("the corner scene parses");
+    let cases: [(&str, Box<HostScene>, (u32, u32)); 3] = [
+        ("fig5_3", load(&dir.join("fig5_3.txt")), (800, 600)),
+        ("fig5_8", load(&dir.join("fig5_8.txt")), (800, 600)),
+        ("corner", corner_scene, (800, 600)),
+    ];
+    for (name, scene, size) in &cases {
+        let tree = build_octree(scene, AccelMode::Dda, &OctreeConfig::default()).expect("an octree");
+        let mut one = None;
+        let mut runs = vec![(Partition::Tiles, 1)];
+        for threads in [2, 4].into_iter().chain((cores > 4).then_some(cores)) {
+            runs.push((Partition::Tiles, threads));
+            runs.push((Partition::Equal4, threads));
+        }
+        for (partition, threads) in runs {
+            let options = RenderOptions { size: Some(*size), threads, partition, ..Default::default() };
+            let rendered = (0..3)
+                .map(|_| render_prebuilt(scene, &options, Some(&tree), &|_| {}).expect("renders"))
+                .min_by_key(|r| r.wall)
+                .expect("three runs");
+            let wall = rendered.wall.as_secs_f64();
+            let one_thread = *one.get_or_insert(wall);
+            let idle: f64 = rendered.busy.iter().map(|b| wall - b.as_secs_f64()).sum::<f64>() / (threads as f64 * wall);
+            let partition = match partition {
+                Partition::Tiles => "tiles 32×32",
+                Partition::Equal4 => "equal 4 (thesis)",
+            };
+            println!(
+                "| {name} | {}×{} | {partition} | {threads} | {} | {:.2}× | {:.0} % |",
+                size.0,
+                size.1,
+                ms(rendered.wall),
+                one_thread / wall,
+                100.0 * idle.max(0.0)
+            );
+        }
+    }
+    println!();
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
     let scenes = root.join("scenes");
-    let all = ["scenes", "table51", "table52", "criterion", "scaling"];
+    let all = ["scenes", "table51", "table52", "criterion", "scaling", "parallel"];
     let which: Vec<&str> = if args.is_empty() { all.to_vec() } else { args.iter().map(String::as_str).collect() };
     println!("Machine: {}\n", machine());
     for w in which {
@@ -266,6 +330,7 @@ fn main() {
             "table52" => table52(&scenes),
             "criterion" => criterion(&scenes),
             "scaling" => scaling(),
+            "parallel" => parallel(&scenes),
             other => {
                 eprintln!("octrace-bench: unknown table `{other}` (known: {})", all.join(", "));
                 std::process::exit(2);
