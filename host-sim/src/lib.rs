@@ -3,6 +3,7 @@
 //! [`run`], so tests drive exactly what a user runs.
 
 pub mod cli;
+pub mod formats;
 pub mod image;
 
 pub use image::RgbImage;
