@@ -6,7 +6,7 @@
 //! | `OCTRACE_SCENE` | a scene in `scenes/` (name without `.txt`) | `fig5_1` |
 //! | `OCTRACE_SIZE` | `WxH` | `160x128` |
 //! | `OCTRACE_ACCEL` | `auto`, `naive`, `octree`, `dda` | `auto` |
-//! | `OCTRACE_COLOR` | `rgb888`, `rgb565` | `rgb888` |
+//! | `OCTRACE_COLOR` | `rgb888`, `rgb565`, `dither` (1-byte indices into the 6×6×6 cube) | `rgb888` |
 //! | `OCTRACE_OUT` | host file the pixels are written to | `octrace-out.raw` |
 
 use std::env;
@@ -58,10 +58,11 @@ fn main() {
         "dda" => "Dda",
         other => fail(format!("OCTRACE_ACCEL={other}: expected auto, naive, octree or dda")),
     };
-    let rgb565 = match var("OCTRACE_COLOR", "rgb888").as_str() {
-        "rgb888" => false,
-        "rgb565" => true,
-        other => fail(format!("OCTRACE_COLOR={other}: expected rgb888 or rgb565")),
+    let wire = match var("OCTRACE_COLOR", "rgb888").as_str() {
+        "rgb888" => "Rgb888",
+        "rgb565" => "Rgb565",
+        "dither" => "Dither",
+        other => fail(format!("OCTRACE_COLOR={other}: expected rgb888, rgb565 or dither")),
     };
     let output = var("OCTRACE_OUT", "octrace-out.raw");
 
@@ -72,7 +73,7 @@ fn main() {
     writeln!(config, "pub const WIDTH: u32 = {w};").unwrap();
     writeln!(config, "pub const HEIGHT: u32 = {h};").unwrap();
     writeln!(config, "pub const ACCEL: crate::Accel = crate::Accel::{accel};").unwrap();
-    writeln!(config, "pub const RGB565: bool = {rgb565};").unwrap();
+    writeln!(config, "pub const WIRE: crate::Wire = crate::Wire::{wire};").unwrap();
     writeln!(config, "pub const OUTPUT: &str = {:?};", format!("{output}\0")).unwrap();
     std::fs::write(out.join("config.rs"), config).expect("write config.rs");
 }

@@ -9,6 +9,7 @@ extern crate alloc;
 pub mod accel;
 pub mod capacity;
 pub mod math;
+pub mod palette;
 pub mod parse;
 pub mod render;
 pub mod scene;

@@ -3,8 +3,9 @@
 //! streams it to the panel. It holds one small chunk of bytes, never a
 //! framebuffer.
 //!
-//! Two pixel formats: `Rgb888` (3 bytes a pixel) and `Rgb565` (2 bytes, big
-//! endian, as common SPI displays take it).
+//! Three pixel formats: `Rgb888` (3 bytes a pixel), `Rgb565` (2 bytes, big
+//! endian, as common SPI displays take it) and `PaletteIndex` (1 byte, an
+//! entry of the display's 256-colour table).
 
 use crate::semihosting::HostFile;
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -12,9 +13,10 @@ use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::{IntoStorage, PixelColor, Rgb565, Rgb888, RgbColor};
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
+use octrace_core::palette::PaletteIndex;
 
 /// How a colour goes on the wire.
-pub trait WireColor: PixelColor + From<Rgb888> {
+pub trait WireColor: PixelColor {
     const BYTES: usize;
     fn encode(self, out: &mut [u8]);
 }
@@ -23,6 +25,13 @@ impl WireColor for Rgb888 {
     const BYTES: usize = 3;
     fn encode(self, out: &mut [u8]) {
         out.copy_from_slice(&[self.r(), self.g(), self.b()]);
+    }
+}
+
+impl WireColor for PaletteIndex {
+    const BYTES: usize = 1;
+    fn encode(self, out: &mut [u8]) {
+        out[0] = self.0;
     }
 }
 

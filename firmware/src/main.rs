@@ -24,6 +24,7 @@ use display::{StreamDisplay, WireColor};
 use embedded_graphics_core::geometry::Size;
 use embedded_graphics_core::pixelcolor::{Rgb565, Rgb888};
 use octrace_core::accel::{Accelerator, Naive, Octree, OctreeConfig, Traversal};
+use octrace_core::palette::{render_indexed, Dither, PaletteIndex};
 use octrace_core::parse::parse;
 use octrace_core::render::Renderer;
 use octrace_core::scene::{Scene, SceneView};
@@ -38,6 +39,15 @@ pub enum Accel {
     Naive,
     Octree,
     Dda,
+}
+
+/// The display's pixel format, chosen at build time.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Wire {
+    Rgb888,
+    Rgb565,
+    /// Palette indices, ordered-dithered onto the 6×6×6 cube.
+    Dither,
 }
 
 /// What each board holds: the capacity profile, the octree's walk depth and
@@ -163,21 +173,28 @@ fn run(scene: &mut Scene<Profile>, octree: &mut BoardOctree) -> u32 {
 /// the stack.
 #[inline(never)]
 fn draw<A: Accelerator>(view: SceneView<'_>, accel: &A, file: HostFile) -> Option<Stats> {
-    if config::RGB565 {
-        render::<A, Rgb565>(view, accel, file)
-    } else {
-        render::<A, Rgb888>(view, accel, file)
+    match config::WIRE {
+        Wire::Rgb888 => render::<A, Rgb888>(view, accel, file, |r, d| r.render(d)),
+        Wire::Rgb565 => render::<A, Rgb565>(view, accel, file, |r, d| r.render(d)),
+        Wire::Dither => {
+            render::<A, PaletteIndex>(view, accel, file, |r, d| render_indexed(r, 0..config::HEIGHT, &mut Dither, d))
+        }
     }
 }
 
 #[inline(never)]
-fn render<A: Accelerator, C: WireColor>(view: SceneView<'_>, accel: &A, file: HostFile) -> Option<Stats> {
+fn render<A: Accelerator, C: WireColor>(
+    view: SceneView<'_>,
+    accel: &A,
+    file: HostFile,
+    paint: impl FnOnce(&mut Renderer<'_, A>, &mut StreamDisplay<C>) -> Result<Stats, display::WriteError>,
+) -> Option<Stats> {
     let mut words = [0u32; MAILBOX_WORDS];
     let mut display = StreamDisplay::<C>::new(file, Size::new(config::WIDTH, config::HEIGHT));
     let Ok(mut renderer) = Renderer::with_size(view, accel, config::WIDTH, config::HEIGHT) else { return None };
     renderer.set_mailbox(&mut words);
     bench_marker(0);
-    let stats = renderer.render(&mut display).ok()?;
+    let stats = paint(&mut renderer, &mut display).ok()?;
     bench_marker(1);
     Some(stats)
 }

@@ -1,5 +1,7 @@
 //! The `host-sim` command line.
 
+use crate::formats::{self, Format};
+use crate::palette::{self, PaletteMode};
 use crate::{all_cores, load_file, new_scene, render_with_progress, AccelMode, LoadError, Partition, RenderOptions};
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -14,20 +16,40 @@ pub const EXIT_SCENE: i32 = 2;
 /// Exit code for a file that cannot be read or written.
 pub const EXIT_IO: i32 = 1;
 
-/// Render an octrace scene file to a PNG image.
+/// Render an octrace scene file to an image (PNG, Targa or Sun raster), in
+/// truecolour or with a 256-entry colour table.
 ///
 /// Exit codes: 0 success, 1 a file could not be read or written, 2 the scene
 /// or the arguments are invalid (every error is printed as file:line:col).
 /// Nothing is written unless the whole image renders: the image goes to a
 /// temporary file that is renamed into place at the end.
 #[derive(Parser, Debug)]
-#[command(name = "host-sim", version, about, long_about)]
+#[command(
+    name = "host-sim",
+    version,
+    about,
+    long_about,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
 pub struct Args {
+    #[command(subcommand)]
+    pub command: Option<Command>,
     /// The scene file (octrace scene format, see the README).
-    pub scene: PathBuf,
-    /// Where to write the PNG; defaults to the scene's IMAGEFILE (relative to
-    /// the current directory).
+    #[arg(required = true)]
+    pub scene: Option<PathBuf>,
+    /// Where to write the image; defaults to the scene's IMAGEFILE (relative
+    /// to the current directory).
     pub out: Option<PathBuf>,
+    /// Map the image onto a 256-entry colour table (written as an indexed
+    /// image): scan (the thesis's hash-scan table), dither (6×6×6 cube,
+    /// ordered), coarse (dither with outlines around objects), gray.
+    #[arg(long, value_enum, default_value_t = PaletteMode::None)]
+    pub palette: PaletteMode,
+    /// The file format; by default from OUT's extension (png, tga, ras),
+    /// else PNG.
+    #[arg(long, value_enum)]
+    pub format: Option<Format>,
     /// Render at WxH pixels instead of the scene's RASTER (for a quick
     /// preview; a default VIEWPORT follows the new aspect ratio).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
@@ -54,6 +76,22 @@ pub struct Args {
     /// Print nothing but errors.
     #[arg(long, short)]
     pub quiet: bool,
+}
+
+/// Other things host-sim does.
+#[derive(clap::Subcommand, Debug)]
+pub enum Command {
+    /// Convert an image between PNG, Targa and Sun raster (truecolour or
+    /// colour-mapped, kept as it is).
+    Convert {
+        /// The image to read (the format is told from its content).
+        input: PathBuf,
+        /// The image to write.
+        output: PathBuf,
+        /// The output format; by default from OUTPUT's extension.
+        #[arg(long, value_enum)]
+        format: Option<Format>,
+    },
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -92,12 +130,41 @@ where
     }
 }
 
+/// The format to write `path` in: the one asked for, else by extension,
+/// else PNG.
+fn output_format(asked: Option<Format>, path: &Path) -> Format {
+    asked.or_else(|| Format::from_path(path)).unwrap_or(Format::Png)
+}
+
+fn convert(input: &Path, output: &Path, format: Option<Format>, stderr: &mut dyn Write) -> Result<(), i32> {
+    let bytes = std::fs::read(input).map_err(|e| {
+        let _ = writeln!(stderr, "host-sim: cannot read {}: {e}", input.display());
+        EXIT_IO
+    })?;
+    let image = formats::read(&bytes).map_err(|e| {
+        let _ = writeln!(stderr, "host-sim: {}: {e}", input.display());
+        EXIT_SCENE
+    })?;
+    let format = output_format(format, output);
+    write_atomically(output, |f| formats::write(&image, format, f).map_err(std::io::Error::other)).map_err(|e| {
+        let _ = writeln!(stderr, "host-sim: cannot write {}: {e}", output.display());
+        EXIT_IO
+    })
+}
+
 fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
+    if let Some(Command::Convert { input, output, format }) = &args.command {
+        return convert(input, output, *format, stderr);
+    }
+    let Some(scene_path) = &args.scene else {
+        // clap requires SCENE without a subcommand.
+        return Err(EXIT_SCENE);
+    };
     let mut scene = new_scene();
-    let loaded = match load_file(&args.scene, &mut scene) {
+    let loaded = match load_file(scene_path, &mut scene) {
         Ok(l) => l,
         Err(LoadError::Io(e)) => {
-            let _ = writeln!(stderr, "host-sim: cannot read {}: {e}", args.scene.display());
+            let _ = writeln!(stderr, "host-sim: cannot read {}: {e}", scene_path.display());
             return Err(EXIT_IO);
         }
         Err(LoadError::Scene(errors)) => {
@@ -105,7 +172,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
                 let _ = writeln!(stderr, "{e}");
             }
             let _ =
-                writeln!(stderr, "host-sim: {} error(s) in {}; nothing rendered", errors.len(), args.scene.display());
+                writeln!(stderr, "host-sim: {} error(s) in {}; nothing rendered", errors.len(), scene_path.display());
             return Err(EXIT_SCENE);
         }
     };
@@ -116,12 +183,12 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
             let _ = writeln!(
                 stderr,
                 "host-sim: no output file: give OUT on the command line or IMAGEFILE in {}",
-                args.scene.display()
+                scene_path.display()
             );
             return Err(EXIT_SCENE);
         }
     };
-    if same_file(&args.scene, &out) {
+    if same_file(scene_path, &out) {
         let _ = writeln!(stderr, "host-sim: refusing to overwrite the scene file {} with the image", out.display());
         return Err(EXIT_SCENE);
     }
@@ -162,8 +229,10 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
         }
     };
     let elapsed = started.elapsed();
-    let (image, stats) = (&rendered.image, rendered.stats);
-    if let Err(e) = write_atomically(&out, |f| image.write_png(f).map_err(std::io::Error::other)) {
+    let stats = rendered.stats;
+    let image = palette::apply(&rendered.image, &rendered.objects, args.palette);
+    let format = output_format(args.format, &out);
+    if let Err(e) = write_atomically(&out, |f| formats::write(&image, format, f).map_err(std::io::Error::other)) {
         let _ = writeln!(stderr, "host-sim: cannot write {}: {e}", out.display());
         return Err(EXIT_IO);
     }
@@ -194,6 +263,16 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
             },
             out.display()
         );
+        if args.palette != PaletteMode::None {
+            let _ = writeln!(
+                stderr,
+                "{} palette: {} colours of 256, {:.1} dB against truecolour ({})",
+                args.palette.name(),
+                palette::colors_used(&image),
+                palette::psnr(&rendered.image, &image.to_rgb()),
+                format.name()
+            );
+        }
     }
     Ok(())
 }

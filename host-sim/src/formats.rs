@@ -22,7 +22,7 @@ use std::io::Write;
 use std::path::Path;
 
 /// An image file format.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
 pub enum Format {
     Png,
     Tga,

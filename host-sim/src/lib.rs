@@ -5,14 +5,13 @@
 pub mod cli;
 pub mod formats;
 pub mod image;
+pub mod palette;
 
 pub use image::RgbImage;
 
-use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{OriginDimensions, Point, Size};
-use embedded_graphics_core::pixelcolor::Rgb888;
+use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::pixelcolor::RgbColor;
 use embedded_graphics_core::primitives::Rectangle;
-use embedded_graphics_core::Pixel;
 use octrace_core::accel::{Accelerator, BuildReport, Mailbox, Naive, Octree, OctreeConfig, Traversal};
 use octrace_core::capacity::Host;
 use octrace_core::parse::{parse_bytes, ParseError};
@@ -159,9 +158,15 @@ pub fn all_cores() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
+/// What [`Rendered::objects`] holds for a pixel that shows the background.
+pub const NO_OBJECT: u32 = u32::MAX;
+
 /// A finished render.
 pub struct Rendered {
     pub image: RgbImage,
+    /// The object seen through each pixel (its centre sample), row-major;
+    /// [`NO_OBJECT`] for background.
+    pub objects: Vec<u32>,
     pub stats: Stats,
     /// The mode actually used (never `Auto`).
     pub accel: AccelMode,
@@ -229,8 +234,8 @@ pub fn render_prebuilt(
             (mode, render_threads(view, tree, (w, h), options, progress))
         }
     };
-    let (image, stats, wall, busy) = job;
-    Ok(Rendered { image, stats, accel, build: None, wall, busy })
+    let (image, objects, stats, wall, busy) = job;
+    Ok(Rendered { image, objects, stats, accel, build: None, wall, busy })
 }
 
 /// The pieces of the image in the order they are handed out.
@@ -248,6 +253,12 @@ fn pieces(size: Size, partition: Partition) -> Vec<Rectangle> {
     }
 }
 
+/// The image and the object of every pixel, filled in pieces.
+struct Canvas {
+    image: RgbImage,
+    objects: Vec<u32>,
+}
+
 /// Renders on `options.threads` threads, each with its own renderer (and
 /// mailbox), into one image.
 fn render_threads<A: Accelerator + Sync>(
@@ -256,18 +267,17 @@ fn render_threads<A: Accelerator + Sync>(
     (w, h): (u32, u32),
     options: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
-) -> (RgbImage, Stats, Duration, Vec<Duration>) {
+) -> (RgbImage, Vec<u32>, Stats, Duration, Vec<Duration>) {
     let threads = options.threads.max(1);
     let pieces = pieces(Size::new(w, h), options.partition);
     let next = AtomicUsize::new(0);
-    let image = Mutex::new(RgbImage::new(w, h));
+    let canvas = Mutex::new(Canvas { image: RgbImage::new(w, h), objects: vec![NO_OBJECT; w as usize * h as usize] });
     let started = Instant::now();
     let worker = |thread: usize| {
         let began = Instant::now();
         let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
         let Ok(renderer) = Renderer::with_size(view, accel, w, h) else { return (Stats::default(), Duration::ZERO) };
         let mut renderer = renderer.with_mailbox(&mut words);
-        let mut stats = Stats::default();
         let mut piece_index = thread;
         loop {
             let index = match options.partition {
@@ -278,12 +288,11 @@ fn render_threads<A: Accelerator + Sync>(
                 }
             };
             let Some(piece) = pieces.get(index) else { break };
-            let mut tile = Tile::new(piece);
-            stats.add(&renderer.render_rect(piece, &mut tile).unwrap_or_else(|never| match never {}));
-            tile.copy_into(&mut image.lock().unwrap_or_else(|poisoned| poisoned.into_inner()));
+            let tile = Tile::render(&mut renderer, piece);
+            tile.copy_into(&mut canvas.lock().unwrap_or_else(|poisoned| poisoned.into_inner()));
             progress(piece.size.width as u64 * piece.size.height as u64);
         }
-        (stats, began.elapsed())
+        (renderer.stats(), began.elapsed())
     };
     let results: Vec<(Stats, Duration)> = if threads == 1 {
         vec![worker(0)]
@@ -298,45 +307,39 @@ fn render_threads<A: Accelerator + Sync>(
     for (s, _) in &results {
         stats.add(s);
     }
-    let image = image.into_inner().unwrap_or_else(|poisoned| poisoned.into_inner());
-    (image, stats, wall, results.into_iter().map(|(_, busy)| busy).collect())
+    let canvas = canvas.into_inner().unwrap_or_else(|poisoned| poisoned.into_inner());
+    (canvas.image, canvas.objects, stats, wall, results.into_iter().map(|(_, busy)| busy).collect())
 }
 
-/// A piece of the image being rendered: a `DrawTarget` at the piece's
-/// place, copied into the image when done.
+/// A rendered piece of the image: colours and objects, row-major.
 struct Tile {
     area: Rectangle,
-    pixels: RgbImage,
+    colors: Vec<u8>,
+    objects: Vec<u32>,
 }
 
 impl Tile {
-    fn new(area: &Rectangle) -> Tile {
-        Tile { area: *area, pixels: RgbImage::new(area.size.width, area.size.height) }
-    }
-
-    fn copy_into(&self, image: &mut RgbImage) {
-        let (x0, y0) = (self.area.top_left.x as usize, self.area.top_left.y as usize);
-        let row = self.area.size.width as usize * 3;
-        for (y, line) in self.pixels.data.chunks(row.max(1)).enumerate() {
-            let start = ((y0 + y) * image.width as usize + x0) * 3;
-            image.data[start..start + row].copy_from_slice(line);
+    fn render<A: Accelerator>(renderer: &mut Renderer<'_, A>, area: &Rectangle) -> Tile {
+        let (x0, y0) = (area.top_left.x as u32, area.top_left.y as u32);
+        let count = area.size.width as usize * area.size.height as usize;
+        let mut tile = Tile { area: *area, colors: Vec::with_capacity(3 * count), objects: Vec::with_capacity(count) };
+        for y in y0..y0 + area.size.height {
+            for p in renderer.row(y, x0..x0 + area.size.width) {
+                tile.colors.extend([p.color.r(), p.color.g(), p.color.b()]);
+                tile.objects.push(p.object.map_or(NO_OBJECT, |o| o.0));
+            }
         }
+        tile
     }
-}
 
-impl OriginDimensions for Tile {
-    fn size(&self) -> Size {
-        self.area.size
-    }
-}
-
-impl DrawTarget for Tile {
-    type Color = Rgb888;
-    type Error = std::convert::Infallible;
-
-    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb888>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
-        let offset = self.area.top_left;
-        self.pixels.draw_iter(pixels.into_iter().map(|Pixel(p, c)| Pixel(p - offset, c)))
+    fn copy_into(&self, canvas: &mut Canvas) {
+        let (x0, y0) = (self.area.top_left.x as usize, self.area.top_left.y as usize);
+        let (w, image_w) = (self.area.size.width as usize, canvas.image.width as usize);
+        for y in 0..self.area.size.height as usize {
+            let at = (y0 + y) * image_w + x0;
+            canvas.image.data[3 * at..3 * (at + w)].copy_from_slice(&self.colors[3 * y * w..3 * (y + 1) * w]);
+            canvas.objects[at..at + w].copy_from_slice(&self.objects[y * w..(y + 1) * w]);
+        }
     }
 }
 

@@ -8,6 +8,8 @@
 //! time.
 
 use crate::repo;
+use host_sim::formats::Image;
+use host_sim::palette::PaletteMode;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -49,6 +51,8 @@ pub enum Wire {
     Rgb888,
     /// Big-endian RGB565, as SPI displays take it.
     Rgb565,
+    /// One byte a pixel: an entry of the dithered 6×6×6 colour cube.
+    Dither,
 }
 
 impl Wire {
@@ -56,6 +60,7 @@ impl Wire {
         match self {
             Wire::Rgb888 => "rgb888",
             Wire::Rgb565 => "rgb565",
+            Wire::Dither => "dither",
         }
     }
 }
@@ -153,10 +158,15 @@ impl Firmware {
         let path = repo().join("scenes").join(format!("{}.txt", self.scene));
         host_sim::load_file(&path, &mut scene).map_err(|e| e.to_string())?;
         let options = host_sim::RenderOptions { size: Some((self.width, self.height)), ..Default::default() };
-        let image = host_sim::render(&scene, &options).map_err(|e| format!("{e:?}"))?.image;
+        let rendered = host_sim::render(&scene, &options).map_err(|e| format!("{e:?}"))?;
+        let image = rendered.image;
         Ok(match self.wire {
             Wire::Rgb888 => image.data,
             Wire::Rgb565 => image.data.chunks(3).flat_map(|p| rgb565(p[0], p[1], p[2]).to_be_bytes()).collect(),
+            Wire::Dither => match host_sim::palette::apply(&image, &rendered.objects, PaletteMode::Dither) {
+                Image::Indexed { indices, .. } => indices,
+                Image::Rgb(_) => return Err("dither gave a truecolour image".into()),
+            },
         })
     }
 }

@@ -130,8 +130,8 @@ fn several_errors_are_all_reported() {
 fn a_valid_scene_renders() {
     let r = run_bytes(format!("RASTER 8 6 {SURF} SPHERE 1 1 0 0 0 LIGHT 10 0 0 10").as_bytes());
     assert_eq!(r.code, 0, "{}", r.stderr);
-    let img = host_sim::RgbImage::read_png(std::io::BufReader::new(std::fs::File::open(&r.out).unwrap())).unwrap();
-    assert_eq!((img.width, img.height), (8, 6));
+    let img = host_sim::formats::read(&std::fs::read(&r.out).unwrap()).unwrap();
+    assert_eq!((img.width(), img.height()), (8, 6));
 }
 
 /// Runs host-sim with `args`; returns the exit code and stdout + stderr.

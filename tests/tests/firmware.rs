@@ -20,6 +20,8 @@ fn boards_render_the_same_bits_as_host_sim() {
         // ...and with 200 spheres and its octree, into an RGB565 display.
         Firmware::new(Board::Microbit, "fig5_3", 160, 128, Wire::Rgb565),
         Firmware::new(Board::Mps2An385, "fig5_3", 160, 128, Wire::Rgb888),
+        // A 256-colour display: indices of the dithered colour cube.
+        Firmware::new(Board::Mps2An385, "fig5_1", 160, 128, Wire::Dither),
     ];
     for firmware in cases {
         let name = format!("{} on {}", firmware.scene, firmware.board.machine());

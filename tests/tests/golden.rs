@@ -7,7 +7,8 @@
 //!
 //!     OCTRACE_BLESS=1 cargo test -p octrace-tests --test golden
 
-use host_sim::{load_file, new_scene, render, RenderOptions, RgbImage};
+use host_sim::formats::{self, Format, Image};
+use host_sim::{load_file, new_scene, render, RenderOptions};
 use octrace_tests::{blessing, repo, scenes};
 
 #[test]
@@ -21,12 +22,14 @@ fn every_scene_matches_its_golden_image() {
         let golden = gallery.join(format!("{name}.png"));
         if blessing() {
             std::fs::create_dir_all(&gallery).unwrap();
-            image.write_png(std::fs::File::create(&golden).unwrap()).unwrap();
+            let mut file = std::fs::File::create(&golden).unwrap();
+            formats::write(&Image::Rgb(image), Format::Png, &mut file).unwrap();
             println!("blessed {}", golden.display());
             continue;
         }
-        let expected =
-            std::fs::read(&golden).map_err(|e| e.to_string()).and_then(|b| RgbImage::read_png(std::io::Cursor::new(b)));
+        let expected = std::fs::read(&golden)
+            .map_err(|e| e.to_string())
+            .and_then(|b| formats::read(&b).map(|i| i.to_rgb()).map_err(|e| e.to_string()));
         match expected {
             Err(e) => failures.push(format!("{name}: cannot read {}: {e}", golden.display())),
             Ok(expected) if expected != image => {

@@ -10,7 +10,7 @@ use octrace_core::shapes::{Leaving, Ray};
 use octrace_tests::{scenes, Rng};
 
 fn image(scene: &HostScene, accel: AccelMode, octree: OctreeConfig, size: Option<(u32, u32)>) -> host_sim::RgbImage {
-    render(scene, &RenderOptions { size, accel, octree }).expect("renders").image
+    render(scene, &RenderOptions { size, accel, octree, ..Default::default() }).expect("renders").image
 }
 
 #[test]

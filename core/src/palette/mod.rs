@@ -1,0 +1,103 @@
+//! 256-colour output: the four ways of the thesis to show an image on a
+//! display with a 256-entry colour table, streaming, without a framebuffer.
+//!
+//! - [`Scan`]: the thesis's method. Colours are hashed into the table as
+//!   they come; a close enough entry is reused, otherwise a free one is
+//!   taken, and once the table is full the closest entry is used.
+//! - [`Dither`]: ordered (8×8 Bayer) dithering onto a fixed 6×6×6 colour
+//!   cube.
+//! - [`Coarse`]: [`Dither`] with black outlines where the object under the
+//!   pixel changes ("it forms boundaries around objects").
+//! - [`Gray`]: 256 gray levels by luma.
+//!
+//! Every mode works on the gamma-encoded colours the display shows, pixel by
+//! pixel in raster order, and gives the same indices on every target.
+//! [`render_indexed`] streams a renderer's rows through a mode into any
+//! `DrawTarget` of [`PaletteIndex`] colours.
+
+mod dither;
+mod gray;
+mod scan;
+
+pub use dither::{Coarse, Dither, BAYER_8X8, CUBE_LEVELS};
+pub use gray::Gray;
+pub use scan::{Scan, CLOSE_ENOUGH};
+
+use crate::accel::Accelerator;
+use crate::render::Renderer;
+use crate::scene::ObjectId;
+use crate::shade::Stats;
+use core::ops::Range;
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::pixelcolor::raw::RawU8;
+use embedded_graphics_core::pixelcolor::{PixelColor, Rgb888, RgbColor};
+use embedded_graphics_core::primitives::Rectangle;
+
+/// A colour given as an entry of a 256-entry colour table: what a palette
+/// display (or an indexed image file) takes. embedded-graphics has no such
+/// colour type.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct PaletteIndex(pub u8);
+
+impl PixelColor for PaletteIndex {
+    type Raw = RawU8;
+}
+
+impl From<RawU8> for PaletteIndex {
+    fn from(raw: RawU8) -> Self {
+        PaletteIndex(embedded_graphics_core::pixelcolor::raw::RawData::into_inner(raw))
+    }
+}
+
+/// A 256-entry colour table; entries not in use are black.
+pub type ColorTable = [Rgb888; 256];
+
+/// A way to map colours onto a colour table.
+pub trait Quantizer {
+    /// The index for the pixel at (`x`, `y`), which shows `color` and
+    /// `object` (`None`: background). Pixels must come in raster order
+    /// (rows top to bottom, each left to right) for modes that look at
+    /// neighbours or learn as they go.
+    fn quantize(&mut self, x: u32, y: u32, color: Rgb888, object: Option<ObjectId>) -> u8;
+
+    /// The colour table as it stands (a learning mode's grows as it goes).
+    fn table(&self) -> &ColorTable;
+
+    /// How many entries of the table are in use.
+    fn used(&self) -> usize;
+}
+
+/// Renders `rows` (clipped to the image) through `quantizer` into `target`,
+/// one `fill_contiguous` per row; returns the counters of this call. Rows
+/// are traced in order, as the neighbour-aware modes need.
+pub fn render_indexed<A, Q, D>(
+    renderer: &mut Renderer<'_, A>,
+    rows: Range<u32>,
+    quantizer: &mut Q,
+    target: &mut D,
+) -> Result<Stats, D::Error>
+where
+    A: Accelerator,
+    Q: Quantizer,
+    D: DrawTarget<Color = PaletteIndex>,
+{
+    let size = renderer.size();
+    let before = renderer.stats();
+    for y in rows.start.min(size.height)..rows.end.min(size.height) {
+        let line = Rectangle::new(Point::new(0, y as i32), Size::new(size.width, 1));
+        // The renderer and the quantizer are both borrowed by the row
+        // iterator: a pixel is traced, then mapped, as the target pulls it.
+        let pixels = renderer.row(y, 0..size.width);
+        let indices = pixels.enumerate().map(|(x, p)| PaletteIndex(quantizer.quantize(x as u32, y, p.color, p.object)));
+        target.fill_contiguous(&line, indices)?;
+    }
+    Ok(renderer.stats().since(&before))
+}
+
+/// The squared distance of two colours in RGB.
+#[inline]
+fn distance_squared(a: Rgb888, b: Rgb888) -> u32 {
+    let d = |x: u8, y: u8| (x as i32 - y as i32).unsigned_abs().pow(2);
+    d(a.r(), b.r()) + d(a.g(), b.g()) + d(a.b(), b.b())
+}
