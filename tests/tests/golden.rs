@@ -3,11 +3,15 @@
 //! deterministic). These are also the README's gallery, so the gallery is
 //! always what the code produces.
 //!
+//! fig5_1 is also kept in each 256-colour mode (`fig5_1-scan.png`, …, indexed
+//! PNGs), the README's palette gallery.
+//!
 //! Re-bless after an intended change of the images:
 //!
 //!     OCTRACE_BLESS=1 cargo test -p octrace-tests --test golden
 
 use host_sim::formats::{self, Format, Image};
+use host_sim::palette::{self, PaletteMode};
 use host_sim::{load_file, new_scene, render, RenderOptions};
 use octrace_tests::{blessing, repo, scenes};
 
@@ -37,6 +41,36 @@ fn every_scene_matches_its_golden_image() {
                 failures.push(format!("{name}: {differing} pixels differ from {}", golden.display()));
             }
             Ok(_) => println!("{name}: identical"),
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{}\n(re-bless with OCTRACE_BLESS=1 cargo test -p octrace-tests --test golden)",
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn fig5_1_in_every_palette_mode_matches_its_golden_image() {
+    let gallery = repo().join("docs/gallery");
+    let mut scene = new_scene();
+    load_file(&repo().join("scenes/fig5_1.txt"), &mut scene).unwrap();
+    let rendered = render(&scene, &RenderOptions::default()).unwrap();
+    let mut failures = Vec::new();
+    for mode in [PaletteMode::Scan, PaletteMode::Dither, PaletteMode::Coarse, PaletteMode::Gray] {
+        let image = palette::apply(&rendered.image, &rendered.objects, mode);
+        let golden = gallery.join(format!("fig5_1-{}.png", mode.name()));
+        if blessing() {
+            formats::write(&image, Format::Png, &mut std::fs::File::create(&golden).unwrap()).unwrap();
+            continue;
+        }
+        match std::fs::read(&golden)
+            .map_err(|e| e.to_string())
+            .and_then(|b| formats::read(&b).map_err(|e| e.to_string()))
+        {
+            Ok(expected) if expected == image => {}
+            Ok(_) => failures.push(format!("{}: differs", golden.display())),
+            Err(e) => failures.push(format!("{}: {e}", golden.display())),
         }
     }
     assert!(

@@ -5,7 +5,7 @@
 //! Tables: `scenes` (every scene, naive), `table51` (the thesis's Table 5.1),
 //! `table52` (Table 5.2), `scaling` (random spheres, N = 10 … 100,000),
 //! `criterion` (the octree's subdivision criterion), `parallel` (threads
-//! and partitions). No argument: all. Times are wall-clock on one thread
+//! and partitions), `palette` (the 256-colour modes). No argument: all. Times are wall-clock on one thread
 //! (except in `parallel`), the best of several runs; the machine is printed
 //! first so every table says where it came from.
 
@@ -316,11 +316,46 @@ fn parallel(dir: &Path) {
     println!();
 }
 
+/// Every scene in every palette mode: entries used, PSNR against the
+/// truecolour render and the cost of the mapping per pixel.
+fn palette_table(dir: &Path) {
+    use host_sim::formats::Image;
+    use host_sim::palette::{self, PaletteMode};
+    println!("### 256-colour modes: every scene at its RASTER size\n");
+    println!("Colours: distinct colours in the image (entries of the 256-colour table in use). PSNR against the");
+    println!("truecolour render. Cost: the mapping alone per pixel, best of 5 (the render is the same for all).\n");
+    println!("| scene | truecolour colours | scan | dither | coarse | gray |");
+    println!("| --- | ---: | --- | --- | --- | --- |");
+    let mut cost = [Duration::ZERO; 5];
+    let mut pixels = 0.0;
+    for path in scene_files(dir) {
+        let name = path.file_stem().unwrap_or_default().to_string_lossy().into_owned();
+        let scene = load(&path);
+        let Ok(rendered) = render(&scene, &RenderOptions { threads: all_cores(), ..Default::default() }) else {
+            continue;
+        };
+        pixels += (rendered.image.width * rendered.image.height) as f64;
+        print!("| {name} | {} |", palette::colors_used(&Image::Rgb(rendered.image.clone())));
+        for (i, mode) in PaletteMode::ALL.into_iter().enumerate().skip(1) {
+            let (time, image) = best_of(5, || palette::apply(&rendered.image, &rendered.objects, mode));
+            cost[i] += time;
+            let psnr = palette::psnr(&rendered.image, &image.to_rgb());
+            print!(" {} colours, {psnr:.1} dB |", palette::colors_used(&image));
+        }
+        println!();
+    }
+    print!("| cost per pixel | |");
+    for c in &cost[1..] {
+        print!(" {:.1} ns |", c.as_nanos() as f64 / pixels);
+    }
+    println!("\n");
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
     let scenes = root.join("scenes");
-    let all = ["scenes", "table51", "table52", "criterion", "scaling", "parallel"];
+    let all = ["scenes", "table51", "table52", "criterion", "scaling", "parallel", "palette"];
     let which: Vec<&str> = if args.is_empty() { all.to_vec() } else { args.iter().map(String::as_str).collect() };
     println!("Machine: {}\n", machine());
     for w in which {
@@ -331,6 +366,7 @@ fn main() {
             "criterion" => criterion(&scenes),
             "scaling" => scaling(),
             "parallel" => parallel(&scenes),
+            "palette" => palette_table(&scenes),
             other => {
                 eprintln!("octrace-bench: unknown table `{other}` (known: {})", all.join(", "));
                 std::process::exit(2);
