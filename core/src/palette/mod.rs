@@ -13,7 +13,8 @@
 //! Every mode works on the gamma-encoded colours the display shows, pixel by
 //! pixel in raster order, and gives the same indices on every target.
 //! [`render_indexed`] streams a renderer's rows through a mode into any
-//! `DrawTarget` of [`PaletteIndex`] colours.
+//! `DrawTarget` of [`PaletteIndex`] colours; [`Quantized`] puts a mode in
+//! front of such a display as a truecolour `DrawTarget`.
 
 mod dither;
 mod gray;
@@ -29,10 +30,11 @@ use crate::scene::ObjectId;
 use crate::shade::Stats;
 use core::ops::Range;
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::geometry::{Dimensions, Point, Size};
 use embedded_graphics_core::pixelcolor::raw::RawU8;
 use embedded_graphics_core::pixelcolor::{PixelColor, Rgb888, RgbColor};
 use embedded_graphics_core::primitives::Rectangle;
+use embedded_graphics_core::Pixel;
 
 /// A colour given as an entry of a 256-entry colour table: what a palette
 /// display (or an indexed image file) takes. embedded-graphics has no such
@@ -95,9 +97,107 @@ where
     Ok(renderer.stats().since(&before))
 }
 
+/// A truecolour `DrawTarget` in front of a palette display: every pixel
+/// drawn is mapped by the quantizer and passed on as a [`PaletteIndex`].
+/// Anything that draws `Rgb888` (the renderer, or embedded-graphics text
+/// and shapes) can so draw on a 256-colour display. It does not know the
+/// objects under the pixels: [`Coarse`] draws no outlines through it (use
+/// [`render_indexed`]).
+pub struct Quantized<'a, D, Q> {
+    pub display: D,
+    pub quantizer: &'a mut Q,
+}
+
+impl<D: Dimensions, Q> Dimensions for Quantized<'_, D, Q> {
+    fn bounding_box(&self) -> Rectangle {
+        self.display.bounding_box()
+    }
+}
+
+impl<D, Q> DrawTarget for Quantized<'_, D, Q>
+where
+    D: DrawTarget<Color = PaletteIndex>,
+    Q: Quantizer,
+{
+    type Color = Rgb888;
+    type Error = D::Error;
+
+    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb888>>>(&mut self, pixels: I) -> Result<(), D::Error> {
+        let quantizer = &mut *self.quantizer;
+        self.display.draw_iter(pixels.into_iter().map(|Pixel(p, c)| {
+            let index = quantizer.quantize(p.x.max(0) as u32, p.y.max(0) as u32, c, None);
+            Pixel(p, PaletteIndex(index))
+        }))
+    }
+
+    fn fill_contiguous<I: IntoIterator<Item = Rgb888>>(&mut self, area: &Rectangle, colors: I) -> Result<(), D::Error> {
+        let (quantizer, width) = (&mut *self.quantizer, area.size.width.max(1));
+        let origin = area.top_left;
+        let indices = colors.into_iter().enumerate().map(|(i, c)| {
+            let (x, y) = (origin.x + (i as u32 % width) as i32, origin.y + (i as u32 / width) as i32);
+            PaletteIndex(quantizer.quantize(x.max(0) as u32, y.max(0) as u32, c, None))
+        });
+        self.display.fill_contiguous(area, indices)
+    }
+}
+
 /// The squared distance of two colours in RGB.
 #[inline]
 fn distance_squared(a: Rgb888, b: Rgb888) -> u32 {
     let d = |x: u8, y: u8| (x as i32 - y as i32).unsigned_abs().pow(2);
     d(a.r(), b.r()) + d(a.g(), b.g()) + d(a.b(), b.b())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::capacity::Board16K;
+    use crate::parse::parse;
+    use crate::scene::Scene;
+    use embedded_graphics_core::geometry::OriginDimensions;
+
+    /// A strict palette display: every pixel must land inside it, once.
+    struct Mock {
+        pixels: [[Option<u8>; 6]; 4],
+    }
+
+    impl OriginDimensions for Mock {
+        fn size(&self) -> Size {
+            Size::new(6, 4)
+        }
+    }
+
+    impl DrawTarget for Mock {
+        type Color = PaletteIndex;
+        type Error = ();
+
+        fn draw_iter<I: IntoIterator<Item = Pixel<PaletteIndex>>>(&mut self, pixels: I) -> Result<(), ()> {
+            for Pixel(p, c) in pixels {
+                assert!(self.bounding_box().contains(p), "{p:?} outside");
+                let slot = &mut self.pixels[p.y as usize][p.x as usize];
+                assert!(slot.is_none(), "{p:?} drawn twice");
+                *slot = Some(c.0);
+            }
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn render_indexed_and_quantized_draw_the_same_indices() {
+        let mut scene: Scene<Board16K> = Scene::new();
+        let text = "RASTER 6 4 LIGHT 10 0 0 10 SPHERE 1 1 0 0 0 SURFACE 1 0.1 0.1 0.1 0.8 0.4 0.2 0 0 0 0 0 0";
+        parse(text, &mut scene, &mut |e| panic!("{e}")).unwrap();
+        let view = scene.view();
+        let mut direct = Mock { pixels: [[None; 6]; 4] };
+        let mut renderer = Renderer::new(view, &crate::accel::Naive).unwrap();
+        render_indexed(&mut renderer, 0..4, &mut Dither, &mut direct).unwrap();
+        let mut through = Quantized { display: Mock { pixels: [[None; 6]; 4] }, quantizer: &mut Dither };
+        Renderer::new(view, &crate::accel::Naive).unwrap().render(&mut through).unwrap();
+        assert_eq!(direct.pixels, through.display.pixels);
+        assert!(direct.pixels.iter().flatten().all(|p| p.is_some()));
+        // Single pixels go through the quantizer too.
+        let mut single = Quantized { display: Mock { pixels: [[None; 6]; 4] }, quantizer: &mut Gray };
+        single.draw_iter([Pixel(Point::new(5, 3), Rgb888::new(255, 255, 255))]).unwrap();
+        assert_eq!(single.display.pixels[3][5], Some(255));
+    }
 }
