@@ -12,8 +12,9 @@
 //! numbers); nothing else changes.
 
 use crate::accel::{HashEntry, OctreeNode};
+use crate::math::Vec3;
 use crate::scene::{Light, SurfaceEntry};
-use crate::shapes::{AxisAlignedBox, Rectangle, ShapeHandle, Sphere, Superquadric, Triangle};
+use crate::shapes::{AxisAlignedBox, Rectangle, ShapeHandle, SmoothTriangle, Sphere, Superquadric, Triangle};
 
 /// A fixed-capacity, append-only store: `heapless::Vec` on boards.
 pub trait Arena<T>: Sized {
@@ -136,6 +137,10 @@ pub trait Capacities {
     type Superquadrics: Arena<Superquadric>;
     type Triangles: Arena<Triangle>;
     type Rectangles: Arena<Rectangle>;
+    /// The triangles of B-spline patches.
+    type SmoothTriangles: Arena<SmoothTriangle>;
+    /// Room for one patch's control points while it is evaluated.
+    type ControlPoints: Arena<Vec3>;
     /// Surface definitions; at most 65,535 (objects refer to them by `u16`).
     type Surfaces: Arena<SurfaceEntry>;
     type Lights: Arena<Light>;
@@ -166,6 +171,8 @@ impl Capacities for Host {
     type Superquadrics = HeapArena<Superquadric, 1_000_000>;
     type Triangles = HeapArena<Triangle, 1_000_000>;
     type Rectangles = HeapArena<Rectangle, 1_000_000>;
+    type SmoothTriangles = HeapArena<SmoothTriangle, 1_000_000>;
+    type ControlPoints = HeapArena<Vec3, 1_048_576>;
     type Surfaces = HeapArena<SurfaceEntry, 65_535>;
     type Lights = HeapArena<Light, 4_096>;
     type Index = u32;
@@ -188,6 +195,8 @@ impl Capacities for Board16K {
     type Superquadrics = heapless::Vec<Superquadric, 2>;
     type Triangles = heapless::Vec<Triangle, 2>;
     type Rectangles = heapless::Vec<Rectangle, 2>;
+    type SmoothTriangles = heapless::Vec<SmoothTriangle, 0>;
+    type ControlPoints = heapless::Vec<Vec3, 0>;
     type Surfaces = heapless::Vec<SurfaceEntry, 12>;
     type Lights = heapless::Vec<Light, 4>;
     type Index = u16;
@@ -208,6 +217,8 @@ impl Capacities for Board64K {
     type Superquadrics = heapless::Vec<Superquadric, 32>;
     type Triangles = heapless::Vec<Triangle, 96>;
     type Rectangles = heapless::Vec<Rectangle, 96>;
+    type SmoothTriangles = heapless::Vec<SmoothTriangle, 32>;
+    type ControlPoints = heapless::Vec<Vec3, 16>;
     type Surfaces = heapless::Vec<SurfaceEntry, 64>;
     type Lights = heapless::Vec<Light, 8>;
     type Index = u16;

@@ -15,7 +15,12 @@
 //! - each sample is clamped to [0, 1], samples are averaged, then gamma
 //!   corrected and rounded (half up) to 0…255.
 //!
-//! `BSPLINE` objects are not supported: [`parse`] rejects them.
+//! - `BSPLINE` patches are evaluated here independently (Cox–de Boor in f64)
+//!   into triangles carrying the surface normals at their corners; a hit on
+//!   one is shaded with the barycentric blend of those normals, and its
+//!   shadow rays leave from the hit point lifted onto the corners' tangent
+//!   planes (when that lifts it towards the viewer's side), as the core does
+//!   against shadow-terminator speckles.
 
 use std::collections::BTreeMap;
 use std::ops::{Add, Mul, Neg, Sub};
@@ -150,11 +155,18 @@ pub enum Shape {
         p: [V3; 4],
         normal: V3,
     },
+    /// A triangle of a B-spline patch, with the surface normals at its
+    /// corners (turned to the front `normal`'s side).
+    SmoothTriangle {
+        p: [V3; 3],
+        normal: V3,
+        normals: [V3; 3],
+    },
 }
 
 impl Shape {
     fn is_flat(&self) -> bool {
-        matches!(self, Shape::Triangle { .. } | Shape::Rectangle { .. })
+        matches!(self, Shape::Triangle { .. } | Shape::Rectangle { .. } | Shape::SmoothTriangle { .. })
     }
 }
 
@@ -475,7 +487,30 @@ pub fn parse(text: &str) -> Result<RefScene, String> {
                 references.push((s, line, col));
                 scene.objects.push(Object { shape, surface: 0 });
             }
-            "BSPLINE" => return Err(format!("{line}:{col}: BSPLINE is not supported by the reference tracer")),
+            "BSPLINE" => {
+                let s = p.integer("surface number", 0, 1_000_000)?;
+                let order = p.integer("BSPLINE order", 2, 8)? as usize;
+                let rows = p.integer("BSPLINE rows", 2, 1024)? as usize;
+                let cols = p.integer("BSPLINE cols", 2, 1024)? as usize;
+                let su = p.integer("BSPLINE su", 2, 1024)? as usize;
+                let sv = p.integer("BSPLINE sv", 2, 1024)? as usize;
+                if rows < order || cols < order {
+                    return Err(format!("{line}:{col}: BSPLINE needs at least `order` control points each way"));
+                }
+                let mut points = Vec::with_capacity(rows * cols);
+                for _ in 0..rows * cols {
+                    points.push(p.vec3("BSPLINE control point")?);
+                }
+                let patch = Patch { order, rows, cols, points };
+                let before = scene.objects.len();
+                for shape in patch.triangles(su, sv) {
+                    references.push((s, line, col));
+                    scene.objects.push(Object { shape, surface: 0 });
+                }
+                if scene.objects.len() == before {
+                    return Err(format!("{line}:{col}: degenerate BSPLINE"));
+                }
+            }
             _ => return Err(format!("{line}:{col}: expected a keyword, found `{}`", p.tokens[p.pos - 1].text)),
         }
     }
@@ -545,6 +580,148 @@ fn parse_shape(p: &mut Parser, keyword: &str, line: usize, col: usize) -> Result
             Shape::Rectangle { p: pts, normal: n.normalised() }
         }
     })
+}
+
+// ---------------------------------------------------------------------------
+// B-spline patches
+// ---------------------------------------------------------------------------
+
+/// A tensor-product B-spline with clamped uniform knots, control points row
+/// by row (`rows` along u, `cols` along v).
+pub struct Patch {
+    pub order: usize,
+    pub rows: usize,
+    pub cols: usize,
+    pub points: Vec<V3>,
+}
+
+/// The clamped uniform knot vector for `n` control points of order `k`, in
+/// knot units (spans of length 1, from 0 to n − k + 1).
+fn knots(n: usize, k: usize) -> Vec<f64> {
+    let m = (n - k + 1) as f64;
+    (0..n + k).map(|j| (j as f64 - (k as f64 - 1.0)).clamp(0.0, m)).collect()
+}
+
+/// N_{i,k}(u) by the Cox–de Boor recursion, with the last span closed at
+/// its right end so that u = end belongs to it.
+fn basis_function(t: &[f64], i: usize, k: usize, u: f64) -> f64 {
+    if k == 1 {
+        let end = *t.last().unwrap_or(&0.0);
+        let last_span = t[i + 1] == end && t[i] < end;
+        return if (t[i] <= u && u < t[i + 1]) || (last_span && u == end) { 1.0 } else { 0.0 };
+    }
+    let mut value = 0.0;
+    let left = t[i + k - 1] - t[i];
+    if left > 0.0 {
+        value += (u - t[i]) / left * basis_function(t, i, k - 1, u);
+    }
+    let right = t[i + k] - t[i + 1];
+    if right > 0.0 {
+        value += (t[i + k] - u) / right * basis_function(t, i + 1, k - 1, u);
+    }
+    value
+}
+
+/// dN_{i,k}/du.
+fn basis_derivative(t: &[f64], i: usize, k: usize, u: f64) -> f64 {
+    let mut value = 0.0;
+    let left = t[i + k - 1] - t[i];
+    if left > 0.0 {
+        value += (k as f64 - 1.0) / left * basis_function(t, i, k - 1, u);
+    }
+    let right = t[i + k] - t[i + 1];
+    if right > 0.0 {
+        value -= (k as f64 - 1.0) / right * basis_function(t, i + 1, k - 1, u);
+    }
+    value
+}
+
+impl Patch {
+    fn span(&self, n: usize) -> f64 {
+        (n - self.order + 1) as f64
+    }
+
+    /// S(u, v), ∂S/∂u and ∂S/∂v at knot-unit parameters.
+    pub fn evaluate(&self, u: f64, v: f64) -> (V3, V3, V3) {
+        let (tu, tv) = (knots(self.rows, self.order), knots(self.cols, self.order));
+        let zero = V3::new(0.0, 0.0, 0.0);
+        let (mut s, mut su, mut sv) = (zero, zero, zero);
+        for i in 0..self.rows {
+            let (nu, du) = (basis_function(&tu, i, self.order, u), basis_derivative(&tu, i, self.order, u));
+            for j in 0..self.cols {
+                let (nv, dv) = (basis_function(&tv, j, self.order, v), basis_derivative(&tv, j, self.order, v));
+                let p = self.points[i * self.cols + j];
+                s = s + p * (nu * nv);
+                su = su + p * (du * nv);
+                sv = sv + p * (nu * dv);
+            }
+        }
+        (s, su, sv)
+    }
+
+    /// The unit normal ∂S/∂u × ∂S/∂v, `None` where the derivatives vanish or
+    /// are parallel (to 2^-20).
+    fn exact_normal(&self, u: f64, v: f64) -> Option<V3> {
+        let (_, su, sv) = self.evaluate(u, v);
+        let n = su.cross(sv);
+        (n.length() > su.length() * sv.length() * 2f64.powi(-20) && n.length() > 0.0).then(|| n.normalised())
+    }
+
+    /// Sample (l, k) of an su × sv grid: the point and its normal, the
+    /// normal taken a little way into the patch (1/1024, then 1/64 of the
+    /// shorter parameter range) where the surface has none.
+    pub fn sample(&self, l: usize, su: usize, k: usize, sv: usize) -> (V3, Option<V3>) {
+        let (mu, mv) = (self.span(self.rows), self.span(self.cols));
+        let (u, v) = (l as f64 * mu / (su - 1) as f64, k as f64 * mv / (sv - 1) as f64);
+        let inward = |t: f64, m: f64, step: f64| if t < m / 2.0 { t + step } else { t - step };
+        let normal = self.exact_normal(u, v).or_else(|| {
+            [1.0 / 1024.0, 1.0 / 64.0].iter().find_map(|f| {
+                let step = mu.min(mv) * f;
+                self.exact_normal(inward(u, mu, step), inward(v, mv, step))
+            })
+        });
+        (self.evaluate(u, v).0, normal)
+    }
+
+    /// The triangles of the su × sv grid, quad by quad: (l,k), (l+1,k),
+    /// (l,k+1) and (l+1,k), (l+1,k+1), (l,k+1); degenerate ones left out.
+    pub fn triangles(&self, su: usize, sv: usize) -> Vec<Shape> {
+        let mut out = Vec::new();
+        for l in 0..su - 1 {
+            for k in 0..sv - 1 {
+                let c = |dl, dk| self.sample(l + dl, su, k + dk, sv);
+                let (a, b, cc, d) = (c(0, 0), c(1, 0), c(0, 1), c(1, 1));
+                for corners in [[a, b, cc], [b, d, cc]] {
+                    let p = corners.map(|c| c.0);
+                    let face = (p[1] - p[0]).cross(p[2] - p[0]);
+                    if face.length() == 0.0 {
+                        continue;
+                    }
+                    let face = face.normalised();
+                    let normals = corners.map(|c| match c.1 {
+                        Some(n) if n.dot(face) >= 0.0 => n,
+                        Some(n) => -n,
+                        None => face,
+                    });
+                    out.push(Shape::SmoothTriangle { p, normal: face, normals });
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Barycentric weights of `x` (on the plane of `p`), clamped to the triangle.
+fn barycentric(p: &[V3; 3], x: V3) -> [f64; 3] {
+    let n = (p[1] - p[0]).cross(p[2] - p[0]);
+    let area = |a: V3, b: V3| (b - a).cross(x - a).dot(n).max(0.0);
+    let w = [area(p[1], p[2]), area(p[2], p[0]), area(p[0], p[1])];
+    let total = w[0] + w[1] + w[2];
+    if total > 0.0 {
+        w.map(|v| v / total)
+    } else {
+        [1.0, 0.0, 0.0]
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -725,7 +902,7 @@ impl Object {
             Shape::Sphere { centre, radius } => sphere_hit(centre, radius, o, d, roots),
             Shape::Box { centre, half } => box_hit(centre, half, o, d, roots),
             Shape::Superquadric { power, centre, half } => superquadric_hit(power, centre, half, o, d, roots),
-            Shape::Triangle { ref p, .. } => triangle_hit(p, o, d),
+            Shape::Triangle { ref p, .. } | Shape::SmoothTriangle { ref p, .. } => triangle_hit(p, o, d),
             Shape::Rectangle { ref p, normal } => rectangle_hit(p, normal, o, d),
         }
     }
@@ -753,7 +930,9 @@ impl Object {
                 });
                 g.normalised()
             }
-            Shape::Triangle { normal, .. } | Shape::Rectangle { normal, .. } => normal,
+            Shape::Triangle { normal, .. } | Shape::Rectangle { normal, .. } | Shape::SmoothTriangle { normal, .. } => {
+                normal
+            }
         }
     }
 }
@@ -859,20 +1038,35 @@ impl RefScene {
         let surface = &self.surfaces[object.surface];
         let p = o + d * t;
         let ng = object.normal(p);
-        let n = if ng.dot(d) < 0.0 { ng } else { -ng };
+        let facing = if ng.dot(d) < 0.0 { ng } else { -ng };
+        // A B-spline's triangle shades with its blended corner normals and
+        // sends shadow rays from the point lifted onto the smooth surface.
+        let (n, shadow_from) = match object.shape {
+            Shape::SmoothTriangle { p: corners, normals, .. } => {
+                let w = barycentric(&corners, p);
+                let blend = (0..3).fold(V3::new(0.0, 0.0, 0.0), |acc, i| acc + normals[i] * w[i]);
+                let blend = if blend.length() > 0.0 { blend.normalised() } else { ng };
+                let n = if facing.dot(ng) < 0.0 { -blend } else { blend };
+                let lifted = (0..3).fold(V3::new(0.0, 0.0, 0.0), |acc, i| {
+                    acc + (p - normals[i] * (p - corners[i]).dot(normals[i])) * w[i]
+                });
+                (n, if (lifted - p).dot(facing) > 0.0 { lifted } else { p })
+            }
+            _ => (facing, p),
+        };
         let v = -d;
         let here = Start { object: index, normal: ng };
 
         let mut local = surface.ambient;
         for light in &self.lights {
-            let to_light = light.position - p;
+            let to_light = light.position - shadow_from;
             let dist = to_light.length();
             if dist == 0.0 {
                 continue;
             }
             let lv = to_light * (1.0 / dist);
             let ndl = n.dot(lv);
-            if ndl <= 0.0 || self.blocked(p, lv, dist, here) {
+            if ndl <= 0.0 || self.blocked(shadow_from, lv, dist, here) {
                 continue;
             }
             let r = n * (2.0 * ndl) - lv;
@@ -1109,6 +1303,7 @@ mod tests {
         assert!(err("GAMMA 1\nGAMMA 2").contains("lines 1 and 2"));
         assert!(err("SPHERE 1 1 0 0").contains("end of file"));
         assert!(err("BSPLINE 1 2").contains("BSPLINE"));
+        assert!(err("BSPLINE 1 3 2 3 4 4").contains("BSPLINE"));
     }
 
     #[test]

@@ -82,8 +82,6 @@ pub enum ErrorKind<'a> {
     /// A `"` that is never closed.
     UnterminatedString,
     UnknownKeyword(&'a str),
-    /// A keyword the format reserves but this build does not implement.
-    Unsupported(&'static str),
     ExpectedNumber {
         field: Field,
         found: Found<'a>,
@@ -120,6 +118,12 @@ pub enum ErrorKind<'a> {
     },
     NotPlanar,
     NotConvex,
+    /// A B-spline with fewer control points along a side than its order.
+    TooFewControlPoints {
+        order: u32,
+        rows: u32,
+        cols: u32,
+    },
     /// A shape that rounds to nothing at the scale the whole scene needs.
     TooSmall {
         keyword: &'static str,
@@ -154,7 +158,6 @@ impl fmt::Display for ErrorKind<'_> {
                  RDEPTH, IMAGEFILE, LIGHT, BACKGROUND, GAMMA, ATTENUATION, SAMPLES, SPHERE, BOX, \
                  SUPERQUADRIC, TRIANGLE, RECTANGLE, BSPLINE or SURFACE)"
             ),
-            ErrorKind::Unsupported(k) => write!(f, "{k} is not supported by this build"),
             ErrorKind::ExpectedNumber { field, found } => {
                 write!(f, "expected a number for {field}, found {found}")
             }
@@ -178,6 +181,10 @@ impl fmt::Display for ErrorKind<'_> {
             }
             ErrorKind::NotConvex => f.write_str(
                 "RECTANGLE is not convex: its corners must turn the same way (counter-clockwise seen from the front)",
+            ),
+            ErrorKind::TooFewControlPoints { order, rows, cols } => write!(
+                f,
+                "BSPLINE of order {order} needs at least {order} control points along each side, found {rows} × {cols}"
             ),
             ErrorKind::TooSmall { keyword } => write!(
                 f,

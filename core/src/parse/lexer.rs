@@ -15,6 +15,7 @@ pub struct Token<'a> {
     pub quoted: bool,
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Lexer<'a> {
     src: &'a str,
     offset: usize,

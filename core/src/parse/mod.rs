@@ -27,7 +27,7 @@ pub use statement::{keyword, Statement, KEYWORDS};
 
 use crate::capacity::Capacities;
 use crate::scene::{Camera, CameraError, CapacityError, Light, Normalization, Scene, SurfaceEntry, WorldPoint};
-use crate::shapes::{AxisAlignedBox, Rectangle, Sphere, Superquadric, Triangle};
+use crate::shapes::{AxisAlignedBox, Rectangle, ShapeKind, Sphere, Superquadric, Triangle};
 use statement::Cursor;
 
 /// What the parse found besides the scene.
@@ -215,6 +215,8 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
             "triangles" => 16,
             "rectangles" => 32,
             "surfaces" => 64,
+            "B-spline triangles" => 256,
+            "B-spline control points" => 512,
             _ => 128,
         };
         if self.reported_capacity & bit == 0 {
@@ -374,6 +376,7 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
                     self.capacity(pos, e);
                 }
             }
+            patch @ Statement::Bspline { .. } => self.bspline(pos, patch),
             Statement::Rectangle { surface, corners } => {
                 let Some(surface) = self.surface("RECTANGLE", surface, pos) else {
                     return;
@@ -385,6 +388,31 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
                     self.capacity(pos, e);
                 }
             }
+        }
+    }
+
+    /// A B-spline patch: its triangles' room is checked as a whole before
+    /// any is made.
+    fn bspline(&mut self, pos: Pos, patch: Statement<'a>) {
+        let Statement::Bspline { surface, order, rows, cols, samples, points } = patch else { return };
+        let Some(surface) = self.surface("BSPLINE", surface, pos) else {
+            return;
+        };
+        let triangles = 2 * (samples[0] as usize - 1) * (samples[1] as usize - 1);
+        if let Err(e) = self.scene.check_room_for(ShapeKind::SmoothTriangle, triangles) {
+            return self.capacity(pos, e);
+        }
+        let norm = self.scene.normalization;
+        if !self.scene.set_control_points(points.iter().map(|p| norm.point(p))) {
+            let capacity = Scene::<C>::control_point_capacity();
+            let e = CapacityError { what: "B-spline control points", capacity, profile: C::NAME };
+            return self.capacity(pos, e);
+        }
+        if self.scene.push_bspline(order, rows, cols, samples, surface) == 0 {
+            self.report(ParseError::new(
+                pos,
+                ErrorKind::Degenerate { keyword: "BSPLINE", why: "its control points do not span a surface" },
+            ));
         }
     }
 
@@ -641,5 +669,52 @@ mod tests {
         assert_eq!((b.center - a.center).x.to_bits(), 5 * a.radius.to_bits());
         assert_eq!(v.lights[0].position.y, a.center.y);
         assert_eq!(a.center.y, Vec3::ZERO.y + a.center.y);
+    }
+
+    /// A 3 × 3 grid of control points in the plane z = 0, row by row.
+    const GRID: &str = "0 0 0  1 0 0  2 0 0   0 1 0  1 1 0  2 1 0   0 2 0  1 2 0  2 2 0";
+
+    #[test]
+    fn bspline_patches_become_smooth_triangles() {
+        let s = ok(&format!("BSPLINE 1 3 3 3 4 3 {GRID} SPHERE 1 1 5 5 5 {SURF}"));
+        let v = s.view();
+        // 2 · (4 − 1) · (3 − 1) triangles, in file order before the sphere.
+        assert_eq!(v.smooth_triangles.len(), 12);
+        assert_eq!(v.object_count(), 13);
+        assert_eq!(v.objects[12].kind(), ShapeKind::Sphere);
+        assert!(v.objects[..12].iter().all(|h| h.kind() == ShapeKind::SmoothTriangle));
+        // Keywords are case-insensitive and the points may span lines.
+        let t = ok(&format!("bspline 1 2 3 3 2 2\n{}\n{SURF}", GRID.replace("   ", "\n")));
+        assert_eq!(t.view().smooth_triangles.len(), 2);
+    }
+
+    #[test]
+    fn bspline_errors() {
+        let check = |text: &str, want: &str| {
+            let e = one_err(&format!("{text} {SURF}"));
+            assert!(e.contains(want), "{text}: {e}");
+        };
+        check(&format!("BSPLINE 1 1 3 3 4 4 {GRID}"), "1:11: BSPLINE order must be an integer from 2 to 8, found 1");
+        check(&format!("BSPLINE 1 9 3 3 4 4 {GRID}"), "BSPLINE order must be an integer from 2 to 8, found 9");
+        check(
+            &format!("BSPLINE 1 4 3 3 4 4 {GRID}"),
+            "1:1: BSPLINE of order 4 needs at least 4 control points along each side, found 3 × 3",
+        );
+        check(&format!("BSPLINE 1 3 3 3 1 4 {GRID}"), "BSPLINE su must be an integer from 2 to 1024, found 1");
+        check(&format!("BSPLINE 1 3 3 3 4 1 {GRID}"), "BSPLINE sv must be an integer from 2 to 1024, found 1");
+        check(
+            "BSPLINE 1 3 3 3 4 4 0 0 0 1 0 0",
+            "1:33: expected a number for BSPLINE control point x, found `SURFACE`",
+        );
+        check(&format!("BSPLINE 1 2 3 3 4 4 {} 1e7", &GRID[..GRID.len() - 2]), "control point z must be at most 1e6");
+        check(&format!("BSPLINE 7 3 3 3 4 4 {GRID}"), "BSPLINE uses surface 7, which is never defined");
+        check("BSPLINE 1 2 2 2 3 3 1 1 1 1 1 1 1 1 1 1 1 1", "BSPLINE is degenerate");
+        // 2 · 5 · 5 = 50 triangles: more than Board64K's 32, said once, up front.
+        let e = errs(&format!("BSPLINE 1 3 3 3 6 6 {GRID} BSPLINE 1 3 3 3 6 6 {GRID} {SURF}"));
+        assert_eq!(e.len(), 1, "{e:?}");
+        assert!(
+            e[0].contains("more B-spline triangles than this build holds (32, capacity profile Board64K)"),
+            "{e:?}"
+        );
     }
 }

@@ -7,6 +7,7 @@ use super::lexer::{Lexer, Token};
 use super::number::{parse_integer, Decimal};
 use crate::math::isqrt_u128;
 use crate::scene::{Color, Surface, WorldPoint, WorldValue, MAX_SAMPLES, MAX_SIDE};
+use crate::shapes::bspline::{MAX_CONTROL_SIDE, MAX_ORDER, MAX_SAMPLE_SIDE};
 use fixed::types::{I32F32, I48F16};
 
 /// A statement's content, in world units.
@@ -19,17 +20,81 @@ pub enum Statement<'a> {
     Viewport([WorldValue; 2]),
     Rdepth(u32),
     Imagefile(&'a str),
-    Light { brightness: I32F32, position: WorldPoint },
+    Light {
+        brightness: I32F32,
+        position: WorldPoint,
+    },
     Background(Color),
     Gamma(I32F32),
     Attenuation(I32F32),
     Samples(u32),
-    Sphere { surface: u32, radius: WorldValue, center: WorldPoint },
-    Box { surface: u32, center: WorldPoint, half: WorldPoint },
-    Superquadric { surface: u32, power: I32F32, center: WorldPoint, half: WorldPoint },
-    Triangle { surface: u32, corners: [WorldPoint; 3] },
-    Rectangle { surface: u32, corners: [WorldPoint; 4] },
-    Surface { number: u32, surface: Surface },
+    Sphere {
+        surface: u32,
+        radius: WorldValue,
+        center: WorldPoint,
+    },
+    Box {
+        surface: u32,
+        center: WorldPoint,
+        half: WorldPoint,
+    },
+    Superquadric {
+        surface: u32,
+        power: I32F32,
+        center: WorldPoint,
+        half: WorldPoint,
+    },
+    Triangle {
+        surface: u32,
+        corners: [WorldPoint; 3],
+    },
+    Rectangle {
+        surface: u32,
+        corners: [WorldPoint; 4],
+    },
+    /// A B-spline patch: its control points stay in the text (validated),
+    /// read again when needed, so the statement is small whatever their
+    /// number.
+    Bspline {
+        surface: u32,
+        order: u32,
+        rows: u32,
+        cols: u32,
+        samples: [u32; 2],
+        points: ControlPoints<'a>,
+    },
+    Surface {
+        number: u32,
+        surface: Surface,
+    },
+}
+
+/// A patch's control points as they stand in the scene text, already
+/// checked to be `count` valid points.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ControlPoints<'a> {
+    lexer: Lexer<'a>,
+    count: u32,
+}
+
+impl<'a> ControlPoints<'a> {
+    pub fn len(&self) -> usize {
+        self.count as usize
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    /// The points in world units, row by row.
+    pub fn iter(&self) -> impl Iterator<Item = WorldPoint> + 'a {
+        let mut lexer = self.lexer;
+        let mut number = move || match lexer.next_token() {
+            Ok(Some(t)) => Decimal::parse(t.text).map_or(0, |d| d.to_q32()),
+            _ => 0,
+        };
+        (0..self.count).map(move |_| [number(), number(), number()])
+    }
 }
 
 impl Statement<'_> {
@@ -54,6 +119,14 @@ impl Statement<'_> {
             }
             Statement::Triangle { corners: c, .. } => Some(corners(c)),
             Statement::Rectangle { corners: c, .. } => Some(corners(c)),
+            // The surface lies within its control points' convex hull.
+            Statement::Bspline { points, .. } => {
+                let mut all = points.iter();
+                let first = all.next()?;
+                Some(all.fold((first, first), |(lo, hi), p| {
+                    ([0, 1, 2].map(|a| lo[a].min(p[a])), [0, 1, 2].map(|a| hi[a].max(p[a])))
+                }))
+            }
             _ => None,
         }
     }
@@ -285,6 +358,26 @@ pub fn statement<'a>(cur: &mut Cursor<'a>, kw: &'static str, at: Pos) -> Result<
             check_quadrilateral(&corners).map_err(|k| ParseError::new(at, k))?;
             Statement::Rectangle { surface, corners }
         }
+        "BSPLINE" => {
+            let surface = cur.surface_number(kw)?;
+            let order = cur.integer(f("order"), 2, MAX_ORDER as i64)? as u32;
+            let rows = cur.integer(f("rows"), 2, MAX_CONTROL_SIDE as i64)? as u32;
+            let cols = cur.integer(f("cols"), 2, MAX_CONTROL_SIDE as i64)? as u32;
+            let samples = [
+                cur.integer(f("su"), 2, MAX_SAMPLE_SIDE as i64)? as u32,
+                cur.integer(f("sv"), 2, MAX_SAMPLE_SIDE as i64)? as u32,
+            ];
+            if rows < order || cols < order {
+                return Err(ParseError::new(at, ErrorKind::TooFewControlPoints { order, rows, cols }));
+            }
+            // Nothing is peeked after a number is taken: the lexer stands at
+            // the first control point.
+            let points = ControlPoints { lexer: cur.lexer, count: rows * cols };
+            for _ in 0..rows * cols {
+                cur.point(kw, ["control point x", "control point y", "control point z"])?;
+            }
+            Statement::Bspline { surface, order, rows, cols, samples, points }
+        }
         "SURFACE" => {
             let number = cur.surface_number(kw)?;
             let ambient = cur.color(kw, ["ambient red", "ambient green", "ambient blue"])?;
@@ -305,7 +398,7 @@ pub fn statement<'a>(cur: &mut Cursor<'a>, kw: &'static str, at: Pos) -> Result<
                 },
             }
         }
-        _ => return Err(ParseError::new(at, ErrorKind::Unsupported(kw))),
+        _ => return Err(ParseError::new(at, ErrorKind::UnknownKeyword(kw))),
     })
 }
 

@@ -21,7 +21,9 @@ pub use surface::{Color, Surface, SurfaceEntry};
 
 use crate::capacity::{Arena, Capacities};
 use crate::math::{Vec3, Wide};
-use crate::shapes::{AxisAlignedBox, Rectangle, ShapeHandle, ShapeKind, ShapeRef, Sphere, Superquadric, Triangle};
+use crate::shapes::{
+    AxisAlignedBox, Rectangle, ShapeHandle, ShapeKind, ShapeRef, SmoothTriangle, Sphere, Superquadric, Triangle,
+};
 
 /// An object's position in the scene file (0 for the first object).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -77,6 +79,9 @@ pub struct Scene<C: Capacities> {
     superquadrics: C::Superquadrics,
     triangles: C::Triangles,
     rectangles: C::Rectangles,
+    smooth_triangles: C::SmoothTriangles,
+    /// Scratch: the control points of the patch being evaluated.
+    control_points: C::ControlPoints,
     surfaces: C::Surfaces,
     lights: C::Lights,
     pub settings: Settings,
@@ -110,6 +115,8 @@ impl<C: Capacities> Scene<C> {
             superquadrics: C::Superquadrics::EMPTY,
             triangles: C::Triangles::EMPTY,
             rectangles: C::Rectangles::EMPTY,
+            smooth_triangles: C::SmoothTriangles::EMPTY,
+            control_points: C::ControlPoints::EMPTY,
             surfaces: C::Surfaces::EMPTY,
             lights: C::Lights::EMPTY,
             settings: DEFAULT_SETTINGS,
@@ -125,6 +132,8 @@ impl<C: Capacities> Scene<C> {
         self.superquadrics.clear();
         self.triangles.clear();
         self.rectangles.clear();
+        self.smooth_triangles.clear();
+        self.control_points.clear();
         self.surfaces.clear();
         self.lights.clear();
         self.settings = Settings::default();
@@ -139,6 +148,7 @@ impl<C: Capacities> Scene<C> {
             superquadrics: self.superquadrics.as_slice(),
             triangles: self.triangles.as_slice(),
             rectangles: self.rectangles.as_slice(),
+            smooth_triangles: self.smooth_triangles.as_slice(),
             surfaces: self.surfaces.as_slice(),
             lights: self.lights.as_slice(),
             settings: &self.settings,
@@ -154,6 +164,7 @@ impl<C: Capacities> Scene<C> {
             ShapeKind::Superquadric => C::Superquadrics::CAPACITY,
             ShapeKind::Triangle => C::Triangles::CAPACITY,
             ShapeKind::Rectangle => C::Rectangles::CAPACITY,
+            ShapeKind::SmoothTriangle => C::SmoothTriangles::CAPACITY,
         }
     }
 
@@ -184,6 +195,7 @@ impl<C: Capacities> Scene<C> {
             ShapeKind::Superquadric => ("superquadrics", self.superquadrics.as_slice().len()),
             ShapeKind::Triangle => ("triangles", self.triangles.as_slice().len()),
             ShapeKind::Rectangle => ("rectangles", self.rectangles.as_slice().len()),
+            ShapeKind::SmoothTriangle => ("B-spline triangles", self.smooth_triangles.as_slice().len()),
         };
         let capacity = Self::capacity_of(kind).min(ShapeHandle::MAX_INDEX);
         if len >= capacity {
@@ -225,6 +237,68 @@ impl<C: Capacities> Scene<C> {
         self.register(ShapeKind::Rectangle, i)
     }
 
+    pub fn push_smooth_triangle(&mut self, s: SmoothTriangle) -> Result<(), CapacityError> {
+        self.check_room(ShapeKind::SmoothTriangle)?;
+        let i = push(&mut self.smooth_triangles, s, "B-spline triangles", C::NAME)?;
+        self.register(ShapeKind::SmoothTriangle, i)
+    }
+
+    /// Checks that `count` more objects of `kind` fit, before any is built
+    /// (a B-spline patch's triangles are checked as a whole).
+    pub fn check_room_for(&self, kind: ShapeKind, count: usize) -> Result<(), CapacityError> {
+        if count == 0 {
+            return Ok(());
+        }
+        let (what, len) = match kind {
+            ShapeKind::SmoothTriangle => ("B-spline triangles", self.smooth_triangles.as_slice().len()),
+            _ => return self.check_room(kind),
+        };
+        let capacity = Self::capacity_of(kind).min(ShapeHandle::MAX_INDEX);
+        if len.saturating_add(count) > capacity {
+            return Err(CapacityError { what, capacity, profile: C::NAME });
+        }
+        if self.objects.as_slice().len().saturating_add(count) > Self::object_capacity() {
+            return Err(CapacityError { what: "objects", capacity: Self::object_capacity(), profile: C::NAME });
+        }
+        Ok(())
+    }
+
+    /// Replaces the control-point scratch with `points`; `false` (and
+    /// nothing kept) if they do not fit.
+    pub fn set_control_points(&mut self, points: impl Iterator<Item = Vec3>) -> bool {
+        self.control_points.clear();
+        for p in points {
+            if self.control_points.push(p).is_err() {
+                self.control_points.clear();
+                return false;
+            }
+        }
+        true
+    }
+
+    /// How many control points one patch may have.
+    pub fn control_point_capacity() -> usize {
+        C::ControlPoints::CAPACITY
+    }
+
+    /// Evaluates the patch whose control points were set, pushing its
+    /// triangles (room checked beforehand with [`Scene::check_room_for`]);
+    /// returns how many were made.
+    pub fn push_bspline(&mut self, order: u32, rows: u32, cols: u32, samples: [u32; 2], surface: u16) -> usize {
+        let points = core::mem::replace(&mut self.control_points, C::ControlPoints::EMPTY);
+        let mut made = 0;
+        if let Some(patch) = crate::shapes::Bspline::new(order, rows, cols, points.as_slice()) {
+            patch.triangles(samples[0], samples[1], surface, |t| {
+                if self.push_smooth_triangle(t).is_ok() {
+                    made += 1;
+                }
+            });
+        }
+        self.control_points = points;
+        self.control_points.clear();
+        made
+    }
+
     pub fn push_light(&mut self, l: Light) -> Result<(), CapacityError> {
         push(&mut self.lights, l, "lights", C::NAME).map(|_| ())
     }
@@ -251,6 +325,8 @@ impl<C: Capacities> Scene<C> {
         self.superquadrics.clear();
         self.triangles.clear();
         self.rectangles.clear();
+        self.smooth_triangles.clear();
+        self.control_points.clear();
         self.lights.clear();
     }
 }
@@ -274,6 +350,7 @@ pub struct SceneView<'a> {
     pub superquadrics: &'a [Superquadric],
     pub triangles: &'a [Triangle],
     pub rectangles: &'a [Rectangle],
+    pub smooth_triangles: &'a [SmoothTriangle],
     pub surfaces: &'a [SurfaceEntry],
     pub lights: &'a [Light],
     pub settings: &'a Settings,
@@ -296,6 +373,7 @@ impl<'a> SceneView<'a> {
             ShapeKind::Superquadric => ShapeRef::Superquadric(&self.superquadrics[i]),
             ShapeKind::Triangle => ShapeRef::Triangle(&self.triangles[i]),
             ShapeKind::Rectangle => ShapeRef::Rectangle(&self.rectangles[i]),
+            ShapeKind::SmoothTriangle => ShapeRef::SmoothTriangle(&self.smooth_triangles[i]),
         }
     }
 

@@ -172,13 +172,16 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         let shape = self.scene.shape(hit.object);
         let point = p.ray.at(hit.t);
         let geometric = shape.normal_at(point);
-        // Two-sided: shade with the normal facing the incoming ray.
-        let normal = if geometric.dot_q60(p.ray.dir) > 0 { -geometric } else { geometric };
+        // Two-sided: shade with the normal facing the incoming ray (for a
+        // B-spline's triangle, its interpolated normal; shadow rays then
+        // leave from the smooth surface, see shapes::SmoothTriangle).
+        let facing = if geometric.dot_q60(p.ray.dir) > 0 { -geometric } else { geometric };
+        let (normal, shadow_from) = shape.shading(point, facing);
         let to_eye = -p.ray.dir;
         let surface = self.scene.surface(shape.surface());
         let mut local = surface.ambient;
         for light in self.scene.lights {
-            let to_light = light.position - point;
+            let to_light = light.position - shadow_from;
             let Some((light_dir, distance)) = to_light.direction_and_length() else {
                 continue;
             };
@@ -187,7 +190,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
                 continue;
             }
             scratch.stats.shadow_rays += 1;
-            let shadow = Ray { origin: point, dir: light_dir };
+            let shadow = Ray { origin: shadow_from, dir: light_dir };
             let start = RayStart { object: hit.object, leaving: leaving_along(geometric, light_dir) };
             let t_max = Scalar::from_bits((distance.to_bits() - 1).max(0));
             scratch.mailbox.clear();

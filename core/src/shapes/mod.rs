@@ -12,15 +12,19 @@
 //! lies in the normalised scene range.
 
 pub(crate) mod axis_aligned_box;
+pub mod bspline;
 mod polygon;
 mod rectangle;
+mod smooth_triangle;
 mod sphere;
 mod superquadric;
 mod triangle;
 
 pub use axis_aligned_box::AxisAlignedBox;
+pub use bspline::Bspline;
 pub use polygon::Polygon;
 pub use rectangle::Rectangle;
+pub use smooth_triangle::SmoothTriangle;
 pub use sphere::Sphere;
 pub use superquadric::Superquadric;
 pub use triangle::Triangle;
@@ -90,11 +94,19 @@ pub enum ShapeKind {
     Superquadric = 2,
     Triangle = 3,
     Rectangle = 4,
+    /// A triangle of a `BSPLINE` patch.
+    SmoothTriangle = 5,
 }
 
 impl ShapeKind {
-    pub const ALL: [ShapeKind; 5] =
-        [ShapeKind::Sphere, ShapeKind::Box, ShapeKind::Superquadric, ShapeKind::Triangle, ShapeKind::Rectangle];
+    pub const ALL: [ShapeKind; 6] = [
+        ShapeKind::Sphere,
+        ShapeKind::Box,
+        ShapeKind::Superquadric,
+        ShapeKind::Triangle,
+        ShapeKind::Rectangle,
+        ShapeKind::SmoothTriangle,
+    ];
 
     /// The scene-file keyword.
     pub const fn keyword(self) -> &'static str {
@@ -104,12 +116,13 @@ impl ShapeKind {
             ShapeKind::Superquadric => "SUPERQUADRIC",
             ShapeKind::Triangle => "TRIANGLE",
             ShapeKind::Rectangle => "RECTANGLE",
+            ShapeKind::SmoothTriangle => "BSPLINE",
         }
     }
 
     /// Flat shapes are seen from both sides; the others are closed.
     pub const fn is_flat(self) -> bool {
-        matches!(self, ShapeKind::Triangle | ShapeKind::Rectangle)
+        matches!(self, ShapeKind::Triangle | ShapeKind::Rectangle | ShapeKind::SmoothTriangle)
     }
 
     const fn from_u8(v: u8) -> ShapeKind {
@@ -118,7 +131,8 @@ impl ShapeKind {
             1 => ShapeKind::Box,
             2 => ShapeKind::Superquadric,
             3 => ShapeKind::Triangle,
-            _ => ShapeKind::Rectangle,
+            4 => ShapeKind::Rectangle,
+            _ => ShapeKind::SmoothTriangle,
         }
     }
 }
@@ -153,6 +167,7 @@ pub enum ShapeRef<'a> {
     Superquadric(&'a Superquadric),
     Triangle(&'a Triangle),
     Rectangle(&'a Rectangle),
+    SmoothTriangle(&'a SmoothTriangle),
 }
 
 impl ShapeRef<'_> {
@@ -165,6 +180,7 @@ impl ShapeRef<'_> {
             ShapeRef::Superquadric(s) => s.intersect(ray, t_max, leaving),
             ShapeRef::Triangle(s) => s.intersect(ray, t_max, leaving),
             ShapeRef::Rectangle(s) => s.intersect(ray, t_max, leaving),
+            ShapeRef::SmoothTriangle(s) => s.intersect(ray, t_max, leaving),
         }
     }
 
@@ -177,6 +193,19 @@ impl ShapeRef<'_> {
             ShapeRef::Superquadric(s) => s.normal_at(p),
             ShapeRef::Triangle(s) => s.normal(),
             ShapeRef::Rectangle(s) => s.normal(),
+            ShapeRef::SmoothTriangle(s) => s.normal(),
+        }
+    }
+
+    /// The normal to shade with and the point shadow rays leave from, given
+    /// a hit point and its geometric normal turned towards the ray: the same
+    /// for every shape but a B-spline's triangles, which interpolate their
+    /// corner normals and lift shadow rays onto the smooth surface.
+    #[inline]
+    pub fn shading(&self, p: Vec3, facing: Dir) -> (Dir, Vec3) {
+        match self {
+            ShapeRef::SmoothTriangle(s) => (s.shading_normal(p, facing), s.shadow_origin(p, facing)),
+            _ => (facing, p),
         }
     }
 
@@ -187,6 +216,7 @@ impl ShapeRef<'_> {
             ShapeRef::Superquadric(s) => s.bounds(),
             ShapeRef::Triangle(s) => s.bounds(),
             ShapeRef::Rectangle(s) => s.bounds(),
+            ShapeRef::SmoothTriangle(s) => s.bounds(),
         }
     }
 
@@ -197,6 +227,7 @@ impl ShapeRef<'_> {
             ShapeRef::Superquadric(s) => s.surface,
             ShapeRef::Triangle(s) => s.surface,
             ShapeRef::Rectangle(s) => s.surface,
+            ShapeRef::SmoothTriangle(s) => s.triangle.surface,
         }
     }
 
@@ -207,6 +238,7 @@ impl ShapeRef<'_> {
             ShapeRef::Superquadric(_) => ShapeKind::Superquadric,
             ShapeRef::Triangle(_) => ShapeKind::Triangle,
             ShapeRef::Rectangle(_) => ShapeKind::Rectangle,
+            ShapeRef::SmoothTriangle(_) => ShapeKind::SmoothTriangle,
         }
     }
 }

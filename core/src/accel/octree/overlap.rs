@@ -52,6 +52,7 @@ pub fn overlaps(shape: ShapeRef<'_>, cell: &Cell) -> bool {
         // Conservative: the bounding boxes meet.
         ShapeRef::Superquadric(_) => true,
         ShapeRef::Triangle(t) => polygon_overlaps(&t.polygon, cell),
+        ShapeRef::SmoothTriangle(t) => polygon_overlaps(&t.triangle.polygon, cell),
         ShapeRef::Rectangle(r) => polygon_overlaps(&r.polygon, cell),
     }
 }
