@@ -37,9 +37,35 @@ pub enum Found<'a> {
 impl fmt::Display for Found<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Found::Token(t) => write!(f, "`{t}`"),
+            Found::Token(t) => write!(f, "`{}`", Shown(t)),
             Found::EndOfFile => f.write_str("the end of the file"),
         }
+    }
+}
+
+/// Scene text as a message shows it: control characters escaped (a scene
+/// must not be able to send escape sequences to a terminal) and at most
+/// [`Shown::LIMIT`] characters, with the length of the rest.
+pub struct Shown<'a>(pub &'a str);
+
+impl Shown<'_> {
+    pub const LIMIT: usize = 40;
+}
+
+impl fmt::Display for Shown<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for c in self.0.chars().take(Self::LIMIT) {
+            if c.is_control() || c == '\u{feff}' {
+                write!(f, "{}", c.escape_unicode())?;
+            } else {
+                write!(f, "{c}")?;
+            }
+        }
+        let total = self.0.chars().count();
+        if total > Self::LIMIT {
+            write!(f, "… ({total} characters)")?;
+        }
+        Ok(())
     }
 }
 
@@ -56,6 +82,8 @@ pub enum Rule {
     Between(i64, i64),
     /// A real number from `.0` to `.1`.
     BetweenReal(i64, i64),
+    /// > 0, for a positive value so small that it reads as 0.
+    AboveResolution,
     /// Magnitude at most 10^6 (every number).
     Magnitude,
 }
@@ -68,6 +96,7 @@ impl fmt::Display for Rule {
             Rule::UnitInterval => f.write_str("between 0 and 1"),
             Rule::Between(a, b) => write!(f, "an integer from {a} to {b}"),
             Rule::BetweenReal(a, b) => write!(f, "between {a} and {b}"),
+            Rule::AboveResolution => f.write_str("at least 2^-32 (smaller positive values read as 0)"),
             Rule::Magnitude => f.write_str("at most 1e6 in magnitude"),
         }
     }
@@ -154,9 +183,10 @@ impl fmt::Display for ErrorKind<'_> {
             ErrorKind::UnterminatedString => f.write_str("unterminated string: this `\"` is never closed"),
             ErrorKind::UnknownKeyword(k) => write!(
                 f,
-                "unknown keyword `{k}`: expected a statement (VIEWPOINT, ORIGIN, UPVECTOR, RASTER, VIEWPORT, \
+                "unknown keyword `{}`: expected a statement (VIEWPOINT, ORIGIN, UPVECTOR, RASTER, VIEWPORT, \
                  RDEPTH, IMAGEFILE, LIGHT, BACKGROUND, GAMMA, ATTENUATION, SAMPLES, SPHERE, BOX, \
-                 SUPERQUADRIC, TRIANGLE, RECTANGLE, BSPLINE or SURFACE)"
+                 SUPERQUADRIC, TRIANGLE, RECTANGLE, BSPLINE or SURFACE)",
+                Shown(k)
             ),
             ErrorKind::ExpectedNumber { field, found } => {
                 write!(f, "expected a number for {field}, found {found}")
@@ -165,7 +195,7 @@ impl fmt::Display for ErrorKind<'_> {
                 write!(f, "expected an integer for {field}, found {found}")
             }
             ErrorKind::ExpectedName { field } => write!(f, "expected {field}, found the end of the file"),
-            ErrorKind::OutOfRange { field, rule, found } => write!(f, "{field} must be {rule}, found {found}"),
+            ErrorKind::OutOfRange { field, rule, found } => write!(f, "{field} must be {rule}, found {}", Shown(found)),
             ErrorKind::Repeated { keyword, first_line } => {
                 write!(f, "{keyword} is given twice (first on line {first_line})")
             }

@@ -39,7 +39,8 @@ impl<'a> Lexer<'a> {
     fn bump(&mut self) -> Option<char> {
         let c = self.rest().chars().next()?;
         self.offset += c.len_utf8();
-        if c == '\n' {
+        // A line ends at LF, CRLF or a lone CR (old Mac files).
+        if c == '\n' || (c == '\r' && !self.rest().starts_with('\n')) {
             self.pos.line += 1;
             self.pos.column = 1;
         } else {
@@ -55,7 +56,7 @@ impl<'a> Lexer<'a> {
             let rest = self.rest();
             if rest.starts_with("//") {
                 while let Some(c) = self.bump() {
-                    if c == '\n' {
+                    if c == '\n' || c == '\r' {
                         break;
                     }
                 }
@@ -73,7 +74,8 @@ impl<'a> Lexer<'a> {
                         return Err(ParseError::new(open, ErrorKind::UnterminatedComment));
                     }
                 }
-            } else if rest.chars().next().is_some_and(char::is_whitespace) {
+            } else if rest.chars().next().is_some_and(|c| c.is_whitespace() || (c == '\u{feff}' && self.offset == 0)) {
+                // A byte-order mark opening the file is whitespace.
                 self.bump();
             } else {
                 return Ok(());

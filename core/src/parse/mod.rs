@@ -20,7 +20,7 @@ mod lexer;
 mod number;
 mod statement;
 
-pub use error::{ErrorKind, Field, Found, ParseError, Pos, Rule};
+pub use error::{ErrorKind, Field, Found, ParseError, Pos, Rule, Shown};
 pub use lexer::{Lexer, Token};
 pub use number::{parse_integer, Decimal};
 pub use statement::{keyword, Statement, KEYWORDS};
@@ -399,6 +399,12 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
             return;
         };
         let triangles = 2 * (samples[0] as usize - 1) * (samples[1] as usize - 1);
+        // Checked on the constant first, so that a profile without room for
+        // patches (a small board's) compiles no evaluation code at all.
+        if Scene::<C>::capacity_of(ShapeKind::SmoothTriangle) == 0 {
+            let e = CapacityError { what: "B-spline triangles", capacity: 0, profile: C::NAME };
+            return self.capacity(pos, e);
+        }
         if let Err(e) = self.scene.check_room_for(ShapeKind::SmoothTriangle, triangles) {
             return self.capacity(pos, e);
         }
@@ -716,5 +722,40 @@ mod tests {
             e[0].contains("more B-spline triangles than this build holds (32, capacity profile Board64K)"),
             "{e:?}"
         );
+    }
+
+    #[test]
+    fn hostile_text_in_messages_is_cut_and_escaped() {
+        let long = "X".repeat(5000);
+        let e = one_err(&long);
+        assert!(e.contains(&format!("`{}… (5000 characters)`", "X".repeat(40))), "{e}");
+        assert!(e.len() < 400, "{} bytes", e.len());
+        let e = one_err("SPHERE 1 \u{1b}[31mred 0 0 0");
+        assert!(e.contains("`\\u{1b}[31mred`"), "{e}");
+        assert!(!e.contains('\u{1b}'));
+    }
+
+    #[test]
+    fn byte_order_marks_and_old_mac_line_ends() {
+        let s = ok(&format!("\u{feff}SPHERE 1 1 0 0 0 {SURF}"));
+        assert_eq!(s.view().object_count(), 1);
+        // A mark anywhere else is not whitespace, and is shown escaped.
+        assert!(one_err("SPHERE 1 1 0 0 0\u{feff}").contains("\\u{feff}"));
+        // Lone CRs end lines (and // comments) like LF and CRLF do.
+        for nl in ["\n", "\r\n", "\r"] {
+            let e = one_err(&format!("// comment{nl}RASTER 8 8{nl}{nl}  FOO{nl}"));
+            assert!(e.starts_with("4:3: unknown keyword `FOO`"), "{nl:?}: {e}");
+        }
+    }
+
+    #[test]
+    fn positive_values_that_read_as_zero_say_so() {
+        let e = one_err(&format!("SPHERE 1 1e-400 0 0 0 {SURF}"));
+        assert!(
+            e.contains("SPHERE radius must be at least 2^-32 (smaller positive values read as 0), found 1e-400"),
+            "{e}"
+        );
+        let e = one_err(&format!("SPHERE 1 -1 0 0 0 {SURF}"));
+        assert!(e.contains("SPHERE radius must be > 0, found -1"), "{e}");
     }
 }

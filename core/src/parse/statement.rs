@@ -214,11 +214,13 @@ impl<'a> Cursor<'a> {
             Rule::NonNegative => !d.negative || d.is_zero(),
             Rule::UnitInterval => (!d.negative || d.is_zero()) && v <= 1 << 32,
             Rule::BetweenReal(lo, hi) => v >= lo << 32 && v <= hi << 32,
-            Rule::Between(..) | Rule::Magnitude => true,
+            Rule::Between(..) | Rule::Magnitude | Rule::AboveResolution => true,
         };
         if ok {
             self.peeked = None;
             Ok(v)
+        } else if rule == Rule::Positive && !d.negative && !d.is_zero() {
+            Err(out_of_range(t, field, Rule::AboveResolution))
         } else {
             Err(out_of_range(t, field, rule))
         }

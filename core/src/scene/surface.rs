@@ -59,9 +59,18 @@ impl Color {
     }
 }
 
+/// `v` saturated to an i32: it fits when its high word is the sign of its
+/// low word (two 32-bit comparisons instead of two 64-bit ones).
 #[inline]
 fn sat(v: i64) -> i32 {
-    v.clamp(i32::MIN as i64, i32::MAX as i64) as i32
+    let low = v as i32;
+    if (v >> 32) as i32 == low >> 31 {
+        low
+    } else if v < 0 {
+        i32::MIN
+    } else {
+        i32::MAX
+    }
 }
 
 /// A `SURFACE` definition: the material of every object that names it.
@@ -102,5 +111,13 @@ mod tests {
         assert_eq!(half.bits(), [1 << 15; 3]);
         let m = Color::from_bits([1 << 16, 1 << 15, 0]).modulate(Color::from_bits([1 << 15; 3]));
         assert_eq!(m.bits(), [1 << 15, 1 << 14, 0]);
+    }
+
+    #[test]
+    fn saturation_matches_clamping() {
+        let edges = [0i64, 1, -1, i32::MAX as i64, i32::MIN as i64, 1 << 31, -(1 << 31) - 1, i64::MAX, i64::MIN];
+        for v in edges.into_iter().chain((0..64).map(|k| 0x5bd1_e995_u64.wrapping_mul(k * 2654435761) as i64 >> k)) {
+            assert_eq!(sat(v), v.clamp(i32::MIN as i64, i32::MAX as i64) as i32, "{v}");
+        }
     }
 }

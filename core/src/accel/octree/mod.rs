@@ -237,7 +237,16 @@ struct Split {
     lo: [i64; 3],
     log2: u32,
     refs_start: usize,
+    /// How many splits in a row above this box separated no objects.
+    stale: u32,
 }
+
+/// Splits in a row that may separate no objects (every child holding all
+/// or none of its parent's) before a box stays a leaf. A split that only
+/// carves off empty space still helps a ray, so one or two are allowed;
+/// coincident objects, which no split ever separates, then stop here instead
+/// of being filed down to the maximum depth all along their surface.
+const MAX_STALE_SPLITS: u32 = 2;
 
 impl<C: Capacities, const FRAMES: usize> Octree<C, FRAMES> {
     /// An empty octree (a constant: it can live in a `static`).
@@ -322,7 +331,8 @@ impl<C: Capacities, const FRAMES: usize> Octree<C, FRAMES> {
             return self.report;
         }
         let max_depth = config.max_depth.min(MAX_DEPTH).min(FRAMES.saturating_sub(1) as u32);
-        let root = Split { node: 0, depth: 0, name: 1, lo: self.root_min, log2: self.root_log2, refs_start: 0 };
+        let root =
+            Split { node: 0, depth: 0, name: 1, lo: self.root_min, log2: self.root_log2, refs_start: 0, stale: 0 };
         self.split(scene, root, config.max_objects.max(1), max_depth, 0);
         self.finish(max_depth);
         self.report
@@ -356,6 +366,12 @@ impl<C: Capacities, const FRAMES: usize> Octree<C, FRAMES> {
                 .filter(|&&id| overlaps(scene.shape(ObjectId(id.get())), &c))
                 .count()
         });
+        let separates = counts.iter().any(|&n| n > 0 && n < count);
+        if !separates && s.stale >= MAX_STALE_SPLITS {
+            self.nodes.as_mut_slice()[s.node] = leaf;
+            self.min_log2 = self.min_log2.min(s.log2);
+            return;
+        }
         let need: usize = counts.iter().sum();
         // The index type bounds every arena too (its top two values mark).
         let limit = |cap: usize| cap.min(C::Index::MAX as usize - 2);
@@ -400,6 +416,7 @@ impl<C: Capacities, const FRAMES: usize> Octree<C, FRAMES> {
                 lo,
                 log2: s.log2 - 1,
                 refs_start: start,
+                stale: if separates { 0 } else { s.stale + 1 },
             };
             self.split(scene, child, max_objects, max_depth, reserved + pending);
         }
