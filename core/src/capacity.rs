@@ -4,7 +4,7 @@
 //! A profile is a type implementing [`Capacities`]; each associated type is an
 //! arena of fixed capacity. On a board the arenas are `heapless::Vec`s that
 //! live in a `static` (no heap, the linker checks the RAM); on a host they may
-//! be [`HeapArena`]s (feature `alloc`): the same fixed limits, but memory is
+//! be `HeapArena`s (feature `alloc`): the same fixed limits, but memory is
 //! taken only as the scene fills them. Exceeding a capacity is a scene error
 //! that names it ([`crate::parse::ErrorKind::Capacity`]).
 //!
