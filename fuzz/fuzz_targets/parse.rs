@@ -1,22 +1,5 @@
-//! Arbitrary bytes into the scene parser: it must never panic, loop or
-//! break its contract (see `octrace_fuzz::parse_checked`).
+//! libFuzzer target: the scene parser on arbitrary bytes (see
+//! `octrace_fuzz::check_parse`).
 #![no_main]
 
-use libfuzzer_sys::fuzz_target;
-use octrace_core::capacity::{Board16K, Board64K};
-use octrace_core::scene::Scene;
-use std::cell::RefCell;
-
-thread_local! {
-    // Allocated once: `clear`ed by the parser before each input.
-    static SCENE64: RefCell<Box<Scene<Board64K>>> = RefCell::new(Box::new(Scene::new()));
-    static SCENE16: RefCell<Box<Scene<Board16K>>> = RefCell::new(Box::new(Scene::new()));
-}
-
-fuzz_target!(|data: &[u8]| {
-    let ok64 = SCENE64.with(|s| octrace_fuzz::parse_checked(data, &mut s.borrow_mut()));
-    // The small board's profile too: the same text, more capacity errors.
-    let ok16 = SCENE16.with(|s| octrace_fuzz::parse_checked(data, &mut s.borrow_mut()));
-    // Whatever fits the small board fits the large one.
-    assert!(!ok16 || ok64, "parses with Board16K but not with Board64K");
-});
+libfuzzer_sys::fuzz_target!(|data: &[u8]| octrace_fuzz::check_parse(data));

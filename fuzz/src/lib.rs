@@ -1,5 +1,12 @@
-//! Helpers shared by the fuzz targets: parsing with the parser's documented
-//! contract checked, and a tiny embedded-graphics sink for renders.
+//! The fuzz targets' checks, as plain functions: the targets call them on
+//! libFuzzer's inputs, and `tests/regressions.rs` calls them on every kept
+//! reproducer (on stable Rust, in CI). A check panics on a finding.
+
+mod parse;
+mod render;
+
+pub use parse::check_parse;
+pub use render::check_render;
 
 use core::convert::Infallible;
 use core::fmt::Write as _;

@@ -67,6 +67,18 @@ mod tests {
     }
 
     #[test]
+    fn a_plane_beyond_the_representable_range_is_no_hit() {
+        // Four raw units above the plane, almost parallel to it: the plane is
+        // met at t = 2^32 raw units, beyond Q16.16. That is no hit — it once
+        // came back as t = −1 unit (found by the render fuzzer: the naive
+        // mode, passing Scalar::MAX, saw a hit the octree did not).
+        let t = Triangle::new([p(-4000, -4000, 0), p(4000, -4000, 0), p(0, 4000, 0)], 0).unwrap();
+        let origin = Vec3 { x: s(0), y: s(0), z: Scalar::from_bits(4) };
+        let r = Ray { origin, dir: Dir::from_bits([(1 << 30) - 1, 0, -1]) };
+        assert_eq!(t.intersect(&r, Scalar::MAX, Leaving::No), None);
+    }
+
+    #[test]
     fn collinear_corners_are_rejected() {
         assert!(Triangle::new([p(0, 0, 0), p(1, 1, 1), p(2, 2, 2)], 0).is_none());
     }
