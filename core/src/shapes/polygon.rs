@@ -54,17 +54,19 @@ impl<const N: usize> Polygon<N> {
         // (offset − n·o) in Q18.46; t = num / den is then Q16.16.
         let num = ((self.offset.to_bits() as i64) << 30) - ray.origin.dot_dir_q46(self.normal);
         let (num, den) = if den < 0 { (-num, -den) } else { (num, den) };
-        // Filter on the rounded parameter (⌊num / den⌋ ≤ t_max), as returned.
-        // With t_max + 1 ≤ 2^31 and den ≤ 2^30 the limit cannot overflow, and
-        // it also bounds the quotient below 2^31 when t_max is Scalar::MAX: a
-        // plane met beyond the representable range is no hit (it once came
-        // back as a negative parameter).
-        let limit = mul_wide(t_max.to_bits(), den as i32) + den;
+        // Filter on the rounded parameter (⌊num / den⌋ ≤ t_max), as returned:
+        // before dividing when t_max < MAX (den ≤ 2^30, so no overflow)...
+        let limit = match t_max.to_bits().checked_add(1) {
+            Some(t) => mul_wide(t, den as i32),
+            None => i64::MAX,
+        };
         if num <= 0 || num >= limit {
             return None;
         }
+        // ...and after, for t_max = MAX: a plane met beyond the Q16.16 range
+        // is no hit (it once came back as a negative parameter).
         let t = div_saturating(num as u64, den as u32) as i64;
-        if t <= 0 {
+        if t <= 0 || t > t_max.to_bits() as i64 {
             return None;
         }
         // The plane may be met far outside the scene range; only a point
