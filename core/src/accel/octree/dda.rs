@@ -179,7 +179,11 @@ impl<const FRAMES: usize> DdaWalk<FRAMES> {
     /// every middle plane crossed before the entry plane.
     #[inline]
     fn push(&mut self, children: u32, t0: [i64; 3], t1: [i64; 3], lo: [i64; 3], log2: u32) {
-        let tm = [0, 1, 2].map(|a| self.middle(a, t0[a], t1[a], lo[a], log2));
+        let tm = if self.saturated == 0 {
+            [0, 1, 2].map(|a| (t0[a] + t1[a]) >> 1)
+        } else {
+            [0, 1, 2].map(|a| self.middle(a, t0[a], t1[a], lo[a], log2))
+        };
         let entry_axis = max_axis(&t0);
         let entry = t0[entry_axis];
         let mut first = 0u8;
@@ -245,8 +249,13 @@ impl<const FRAMES: usize> DdaWalk<FRAMES> {
             }
             let n = nodes[node as usize];
             if n.is_internal() {
-                let half = 1i64 << (top.log2 - 1);
-                let lo = [0, 1, 2].map(|a| top.lo[a] + if c >> a & 1 == 1 { half } else { 0 });
+                // Corners are needed only for the middles of saturated axes.
+                let lo = if self.saturated == 0 {
+                    top.lo
+                } else {
+                    let half = 1i64 << (top.log2 - 1);
+                    [0, 1, 2].map(|a| top.lo[a] + if c >> a & 1 == 1 { half } else { 0 })
+                };
                 let log2 = top.log2 - 1;
                 self.push(n.first(), t0, t1, lo, log2);
             } else if n.count() != 0 {
