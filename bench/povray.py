@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """octrace against POV-Ray 3.7, one thread each, on the same scenes.
 
-    python3 bench/povray.py [scene ...]      (default: fig5_1 fig5_2 fig5_3 fig5_4 fig5_5 fig5_8)
+    python3 bench/povray.py [--size WxH] [scene ...]
+                            (default: fig5_1 fig5_2 fig5_3 fig5_4 fig5_5 fig5_8)
 
 Each octrace scene file is translated into an equivalent POV-Ray scene: the
 same camera (POV's `angle` is octrace's default 60-degree viewport), the
@@ -9,11 +10,13 @@ same spheres, boxes, triangles and rectangles, point lights whose fall-off is
 octrace's B/(d + d0) exactly (POV's fade_power 1 with fade_distance d0 gives
 2·d0/(d0 + d), so the light's colour is B/(2·d0)), Phong highlights, mirror
 reflection, filtered transparency, RDEPTH + 1 trace levels, no
-anti-aliasing. Both programs then render it at its RASTER size on one
-thread, three times. Two times are reported, each the best of three: the
-tracing alone (POV-Ray's own "Trace Time"; host-sim's render time, which
-includes building the octree), and the whole command (start-up, parsing,
-tracing, writing the PNG). Prints a Markdown table.
+anti-aliasing. Both programs then render it on one thread, three times, at
+its RASTER size or at --size WxH (keep RASTER's 4:3 shape; larger images
+time the tracing with less noise from start-up). Two times are reported,
+each the best of three: the tracing alone (POV-Ray's own "Trace Time";
+host-sim's render time, which includes building the octree), and the whole
+command (start-up, parsing, tracing, writing the PNG). Prints a Markdown
+table.
 
 Superquadrics and B-spline surfaces have no exact POV-Ray counterpart, so
 scenes with them are skipped.
@@ -111,7 +114,12 @@ def octrace_trace(output):
 
 
 def main():
-    names = sys.argv[1:] or ["fig5_1", "fig5_2", "fig5_3", "fig5_4", "fig5_5", "fig5_8"]
+    args = sys.argv[1:]
+    size = None
+    if args[:1] == ["--size"]:
+        size = tuple(int(x) for x in args[1].split("x"))
+        args = args[2:]
+    names = args or ["fig5_1", "fig5_2", "fig5_3", "fig5_4", "fig5_5", "fig5_8"]
     host_sim = os.path.join(ROOT, "target/release/host-sim")
     subprocess.run(["cargo", "build", "--release", "-q", "-p", "host-sim"], cwd=ROOT, check=True)
     print("| scene | size | objects | POV-Ray 3.7 trace | octrace trace | faster by | POV-Ray command | octrace command | faster by |")
@@ -124,11 +132,12 @@ def main():
                 print(f"| {name} | skipped: superquadrics or B-splines | | | | | | | |")
                 continue
             pov, w, h, count, gamma = translated
+            w, h = size or (w, h)
             pov_file = os.path.join(tmp, name + ".pov")
             open(pov_file, "w").write(pov)
             povray = ["povray", f"+I{pov_file}", f"+O{tmp}/{name}-pov.png", f"+W{w}", f"+H{h}", "-D", "-A",
                       "+WT1", f"Display_Gamma={gamma}"]
-            octrace = [host_sim, path, f"{tmp}/{name}.png", "--threads", "1"]
+            octrace = [host_sim, path, f"{tmp}/{name}.png", "--threads", "1", "--size", f"{w}x{h}"]
             (pw, pt), (ow, ot) = best_of(3, povray, povray_trace), best_of(3, octrace, octrace_trace)
             ms = lambda x: f"{x * 1e3:.0f} ms"
             print(f"| {name} | {w}×{h} | {count} | {ms(pt)} | {ms(ot)} | {pt / ot:.1f}× | {ms(pw)} | {ms(ow)} | "
