@@ -34,7 +34,9 @@ struct Frame {
     t0: [i64; 3],
     tm: [i64; 3],
     t1: [i64; 3],
-    /// The box's low corner (mirrored space) and log2 of its side.
+    /// The box's low corner (mirrored space) and log2 of its side. The
+    /// corner is kept up to date only when an axis saturated (the one use of
+    /// it); otherwise it stays the root's.
     lo: [i64; 3],
     log2: u32,
     children: u32,
