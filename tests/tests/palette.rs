@@ -102,6 +102,25 @@ fn every_scene_in_every_mode_and_format() {
 }
 
 #[test]
+fn coarse_outlines_a_bspline_patch_not_its_triangles() {
+    // freeform: one 64×64 patch (7,938 triangles) and four spheres. Each
+    // patch is one object as written, so the pixels see at most five, and
+    // coarse outlines stay few (they once drew the whole triangle mesh).
+    let mut scene = new_scene();
+    load_file(&octrace_tests::repo().join("scenes/freeform.txt"), &mut scene).unwrap();
+    let rendered = render(&scene, &RenderOptions { size: Some((160, 120)), ..Default::default() }).unwrap();
+    let mut seen: Vec<u32> = rendered.objects.iter().copied().filter(|&o| o != host_sim::NO_OBJECT).collect();
+    seen.sort_unstable();
+    seen.dedup();
+    assert_eq!(seen.len(), 5, "objects seen (first 8): {:?}", &seen[..seen.len().min(8)]);
+    let Image::Indexed { indices, .. } = palette::apply(&rendered.image, &rendered.objects, PaletteMode::Coarse) else {
+        panic!("indexed")
+    };
+    let black = indices.iter().filter(|&&i| i == 0).count();
+    assert!(black * 20 < indices.len(), "{black} of {} pixels are outline", indices.len());
+}
+
+#[test]
 fn one_colour_and_one_pixel_images() {
     let mut scene = new_scene();
     load_bytes("flat", b"BACKGROUND 0.2 0.4 0.6 RASTER 7 5", &mut scene).unwrap();

@@ -444,6 +444,7 @@ mod tests {
     use super::*;
     use crate::capacity::Board64K;
     use crate::math::{Scalar, Vec3};
+    use crate::scene::ObjectId;
     use crate::shapes::ShapeKind;
     use std::format;
     use std::string::{String, ToString};
@@ -689,6 +690,11 @@ mod tests {
         assert_eq!(v.object_count(), 13);
         assert_eq!(v.objects[12].kind(), ShapeKind::Sphere);
         assert!(v.objects[..12].iter().all(|h| h.kind() == ShapeKind::SmoothTriangle));
+        // Each patch is one object as written: its first triangle.
+        let two = ok(&format!("SPHERE 1 1 5 5 5 BSPLINE 1 3 3 3 3 3 {GRID} BSPLINE 1 3 3 3 3 3 {GRID} {SURF}"));
+        let v = two.view();
+        let written: Vec<u32> = (0..v.object_count() as u32).map(|i| v.written_object(ObjectId(i)).0).collect();
+        assert_eq!(written, [[0].as_slice(), &[1; 8], &[9; 8]].concat());
         // Keywords are case-insensitive and the points may span lines.
         let t = ok(&format!("bspline 1 2 3 3 2 2\n{}\n{SURF}", GRID.replace("   ", "\n")));
         assert_eq!(t.view().smooth_triangles.len(), 2);

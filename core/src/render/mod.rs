@@ -30,7 +30,8 @@ use embedded_graphics_core::primitives::Rectangle;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PixelSample {
     pub color: Rgb888,
-    /// The object the pixel's (centre) primary ray hits; `None` for background.
+    /// The object the pixel's (centre) primary ray hits, as the scene file
+    /// wrote it (see [`SceneView::written_object`]); `None` for background.
     pub object: Option<ObjectId>,
 }
 

@@ -287,9 +287,10 @@ impl<C: Capacities> Scene<C> {
     pub fn push_bspline(&mut self, order: u32, rows: u32, cols: u32, samples: [u32; 2], surface: u16) -> usize {
         let points = core::mem::replace(&mut self.control_points, C::ControlPoints::EMPTY);
         let mut made = 0;
+        let first = self.objects.as_slice().len() as u32;
         if let Some(patch) = crate::shapes::Bspline::new(order, rows, cols, points.as_slice()) {
             patch.triangles(samples[0], samples[1], surface, |t| {
-                if self.push_smooth_triangle(t).is_ok() {
+                if self.push_smooth_triangle(SmoothTriangle { patch: first, ..t }).is_ok() {
                     made += 1;
                 }
             });
@@ -362,6 +363,17 @@ impl<'a> SceneView<'a> {
     #[inline]
     pub fn shape(&self, id: ObjectId) -> ShapeRef<'a> {
         self.shape_of(self.objects[id.0 as usize])
+    }
+
+    /// The object `id` belongs to as the scene file wrote it: itself, or for
+    /// a triangle of a B-spline patch the patch's first triangle (what the
+    /// renderer reports per pixel, so that outlines go round a patch, not
+    /// round each of its triangles).
+    pub fn written_object(&self, id: ObjectId) -> ObjectId {
+        match self.shape(id) {
+            ShapeRef::SmoothTriangle(t) => ObjectId(t.patch),
+            _ => id,
+        }
     }
 
     #[inline]

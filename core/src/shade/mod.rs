@@ -124,7 +124,8 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         &self.scene
     }
 
-    /// The linear colour seen along a primary ray, and the object it hits.
+    /// The linear colour seen along a primary ray, and the object it hits (as
+    /// written: [`SceneView::written_object`]).
     // Not inlined: a frame of its own keeps the stack of a small board bounded
     // (inlined into the row loop, its locals and the pending rays multiply).
     #[inline(never)]
@@ -144,7 +145,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             scratch.mailbox.clear();
             let hit = self.accel.nearest(&self.scene, &p.ray, p.start, &mut scratch.mailbox);
             if p.depth == 0 {
-                first_object = hit.map(|h| h.object);
+                first_object = hit.map(|h| self.scene.written_object(h.object));
             }
             let Some(hit) = hit else {
                 color = color.saturating_add(self.scene.settings.background.scale(p.weight));

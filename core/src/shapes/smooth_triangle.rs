@@ -21,6 +21,9 @@ pub struct SmoothTriangle {
     /// Unit normals at the corners, on the side of the triangle's front
     /// normal.
     pub normals: [Dir; 3],
+    /// The object id of its patch's first triangle: the patch is one object
+    /// as the scene file wrote it (set when the patch is stored).
+    pub patch: u32,
 }
 
 impl SmoothTriangle {
@@ -35,7 +38,7 @@ impl SmoothTriangle {
             Some(n) => -n,
             None => face,
         });
-        Some(SmoothTriangle { triangle, normals })
+        Some(SmoothTriangle { triangle, normals, patch: 0 })
     }
 
     #[inline]
