@@ -370,8 +370,10 @@ impl<'a> SceneView<'a> {
     /// renderer reports per pixel, so that outlines go round a patch, not
     /// round each of its triangles).
     pub fn written_object(&self, id: ObjectId) -> ObjectId {
-        match self.shape(id) {
-            ShapeRef::SmoothTriangle(t) => ObjectId(t.patch),
+        // The handle's kind first: this runs for every primary ray.
+        let h = self.objects[id.0 as usize];
+        match h.kind() {
+            ShapeKind::SmoothTriangle => ObjectId(self.smooth_triangles[h.index()].patch),
             _ => id,
         }
     }
