@@ -237,15 +237,17 @@ struct Split {
     lo: [i64; 3],
     log2: u32,
     refs_start: usize,
-    /// How many splits in a row above this box separated no objects.
+    /// How many boxes in a row, ending with this one, hold every object of
+    /// their parent.
     stale: u32,
 }
 
-/// Splits in a row that may separate no objects (every child holding all
-/// or none of its parent's) before a box stays a leaf. A split that only
-/// carves off empty space still helps a ray, so one or two are allowed;
-/// coincident objects, which no split ever separates, then stop here instead
-/// of being filed down to the maximum depth all along their surface.
+/// Boxes in a row that may hold every object of their parent before the last
+/// stays a leaf. A split that only carves off empty space still helps a
+/// ray, so one or two are allowed; but objects that no split can part —
+/// coincident ones, or surfaces meeting at a point such as the four tiles
+/// and the base at a chessboard's corner — then stop here instead of being
+/// filed down to the maximum depth around that point.
 const MAX_STALE_SPLITS: u32 = 2;
 
 impl<C: Capacities, const FRAMES: usize> Octree<C, FRAMES> {
@@ -347,7 +349,7 @@ impl<C: Capacities, const FRAMES: usize> Octree<C, FRAMES> {
         let count = self.refs.as_slice().len() - s.refs_start;
         self.report.peak_references = self.report.peak_references.max(self.refs.as_slice().len());
         let leaf = OctreeNode::leaf(s.refs_start as u32, count as u32);
-        if count <= max_objects || s.depth >= max_depth || s.log2 <= 1 {
+        if count <= max_objects || s.depth >= max_depth || s.log2 <= 1 || s.stale >= MAX_STALE_SPLITS {
             self.nodes.as_mut_slice()[s.node] = leaf;
             self.min_log2 = self.min_log2.min(s.log2);
             return;
@@ -366,12 +368,6 @@ impl<C: Capacities, const FRAMES: usize> Octree<C, FRAMES> {
                 .filter(|&&id| overlaps(scene.shape(ObjectId(id.get())), &c))
                 .count()
         });
-        let separates = counts.iter().any(|&n| n > 0 && n < count);
-        if !separates && s.stale >= MAX_STALE_SPLITS {
-            self.nodes.as_mut_slice()[s.node] = leaf;
-            self.min_log2 = self.min_log2.min(s.log2);
-            return;
-        }
         let need: usize = counts.iter().sum();
         // The index type bounds every arena too (its top two values mark).
         let limit = |cap: usize| cap.min(C::Index::MAX as usize - 2);
@@ -416,7 +412,7 @@ impl<C: Capacities, const FRAMES: usize> Octree<C, FRAMES> {
                 lo,
                 log2: s.log2 - 1,
                 refs_start: start,
-                stale: if separates { 0 } else { s.stale + 1 },
+                stale: if n == count { s.stale + 1 } else { 0 },
             };
             self.split(scene, child, max_objects, max_depth, reserved + pending);
         }
@@ -640,6 +636,21 @@ mod tests {
             }
         }
         assert_eq!(references, tree.report().references, "compaction kept every list");
+    }
+
+    #[test]
+    fn objects_meeting_at_a_point_stop_the_split_there() {
+        // Four squares meeting at the origin, on a base: every box around
+        // the corner holds all five, however small. Each such box may be
+        // split twice more, not down to the maximum depth (depth 12 before).
+        let squares: String = [(-1, -1), (0, -1), (0, 0), (-1, 0)]
+            .iter()
+            .map(|&(x, z)| format!("RECTANGLE 1 {x} 0 {z} {} 0 {z} {} 0 {} {x} 0 {}\n", x + 1, x + 1, z + 1, z + 1))
+            .collect();
+        let s = scene(&format!("{squares}BOX 1 0 -0.25 0 1 0.25 1\n"));
+        let mut tree: Box<Octree<Board64K>> = Box::default();
+        let report = tree.build(&s.view(), &OctreeConfig { max_objects: 4, max_depth: 12, traversal: Traversal::Dda });
+        assert!(report.depth <= 4, "{report:?}");
     }
 
     #[test]
