@@ -178,7 +178,10 @@ impl<const FRAMES: usize> DdaWalk<FRAMES> {
     }
 
     /// Enters a subdivided box: the first child the ray meets lies beyond
-    /// every middle plane crossed before the entry plane.
+    /// every middle plane crossed before the entry plane. A ray that starts
+    /// inside the box (or whose objects' bounds begin inside it) starts at
+    /// the child holding that point instead: the children before it end
+    /// before the walk begins, and the walk would pass over them one by one.
     #[inline]
     fn push(&mut self, children: u32, t0: [i64; 3], t1: [i64; 3], lo: [i64; 3], log2: u32) {
         let tm = if self.saturated == 0 {
@@ -188,9 +191,10 @@ impl<const FRAMES: usize> DdaWalk<FRAMES> {
         };
         let entry_axis = max_axis(&t0);
         let entry = t0[entry_axis];
+        let begin = entry.max(self.near).max(0);
         let mut first = 0u8;
         for a in 0..3 {
-            if a != entry_axis && tm[a] < entry {
+            if tm[a] < begin && (a != entry_axis || begin > entry) {
                 first |= 1 << a;
             }
         }
