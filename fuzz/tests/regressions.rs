@@ -1,7 +1,7 @@
-//! Every kept reproducer (`regressions/`) and every seed (`seeds/`) through
-//! the fuzz targets' checks, on stable Rust: a fixed finding stays fixed.
-//! `regressions/parse/` inputs get the parse check, `regressions/render/`
-//! and the seeds both checks.
+//! Every kept reproducer (`regressions/`) and every seed (`seeds/` and the
+//! project's own `../scenes/`) through the fuzz targets' checks, on stable
+//! Rust: a fixed finding stays fixed. `regressions/parse/` inputs get the
+//! parse check, `regressions/render/` and the seeds both checks.
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -9,7 +9,10 @@ use std::path::{Path, PathBuf};
 fn files(dir: &str) -> Vec<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
     let mut files: Vec<PathBuf> = match fs::read_dir(&dir) {
-        Ok(entries) => entries.map(|e| e.expect("readable directory").path()).collect(),
+        Ok(entries) => entries
+            .map(|e| e.expect("readable directory").path())
+            .filter(|p| p.extension().is_some_and(|x| x == "txt"))
+            .collect(),
         Err(_) => Vec::new(),
     };
     files.sort();
@@ -42,4 +45,5 @@ fn render_regressions() {
 #[test]
 fn seeds() {
     assert!(run("seeds", true) > 10, "the seed corpus is missing");
+    assert!(run("../scenes", true) > 5, "the scenes are missing");
 }

@@ -165,6 +165,7 @@ mod tests {
                     sum += Dither.table()[i as usize].r() as u32;
                 }
             }
+            // A float in a test only: the core itself never uses one.
             let mean = sum as f64 / 64.0;
             assert!((mean - v as f64).abs() <= 51.0 / 64.0 + 0.5, "{v}: {mean}");
         }
