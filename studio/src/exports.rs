@@ -1,0 +1,133 @@
+//! The module's `extern "C"` interface. The page writes its input into the
+//! input buffer (`studio_input(len)` gives its address), calls an operation,
+//! and reads the output buffer (`studio_output_ptr`/`studio_output_len`).
+//! Operations return 0 on success; otherwise the output holds the error as
+//! UTF-8 text (scene errors one per line, `line:col: message`).
+//!
+//! Invariant: Rust only ever hands out the buffers' addresses; it never
+//! reads memory through a pointer, so the page cannot make it read outside
+//! its own buffers.
+
+// Exported symbols need `no_mangle`, which the `unsafe_code` lint counts;
+// nothing here dereferences a pointer.
+#![allow(unsafe_code)]
+
+use crate::formats::Format;
+use crate::studio::{self, Accel, Display, Studio, StudioError};
+use std::cell::RefCell;
+
+struct State {
+    studio: Studio,
+    input: Vec<u8>,
+    output: Vec<u8>,
+}
+
+thread_local! {
+    static STATE: RefCell<State> =
+        RefCell::new(State { studio: Studio::default(), input: Vec::new(), output: Vec::new() });
+}
+
+/// Runs `operation` on the state; its error, if any, becomes the output.
+fn run(operation: impl FnOnce(&mut State) -> Result<(), StudioError>) -> u32 {
+    STATE.with_borrow_mut(|state| match operation(state) {
+        Ok(()) => 0,
+        Err(e) => {
+            state.output = e.to_string().into_bytes();
+            1
+        }
+    })
+}
+
+/// Makes the input buffer `len` bytes long and returns its address.
+#[no_mangle]
+pub extern "C" fn studio_input(len: usize) -> *mut u8 {
+    STATE.with_borrow_mut(|state| {
+        state.input.clear();
+        state.input.resize(len, 0);
+        state.input.as_mut_ptr()
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn studio_output_ptr() -> *const u8 {
+    STATE.with_borrow(|state| state.output.as_ptr())
+}
+
+#[no_mangle]
+pub extern "C" fn studio_output_len() -> usize {
+    STATE.with_borrow(|state| state.output.len())
+}
+
+/// Parses the input as scene text; the output is `W H OBJECTS` (RASTER and
+/// the object count).
+#[no_mangle]
+pub extern "C" fn studio_load() -> u32 {
+    run(|state| {
+        let ((w, h), objects) = state.studio.load(&state.input)?;
+        state.output = format!("{w} {h} {objects}").into_bytes();
+        Ok(())
+    })
+}
+
+/// Sets the image size and builds the octree for `accel` (0 auto, 1 naive,
+/// 2 octree, 3 dda); the output names the mode used.
+#[no_mangle]
+pub extern "C" fn studio_prepare(accel: u32, width: u32, height: u32) -> u32 {
+    run(|state| {
+        let accel = Accel::from_code(accel).ok_or(StudioError::BadInput("no such mode"))?;
+        let used = state.studio.prepare(accel, width, height)?;
+        state.output = format!("{used:?}").to_ascii_lowercase().into_bytes();
+        Ok(())
+    })
+}
+
+/// Renders a rectangle of the image: the output is its RGB bytes, then a
+/// little-endian `u32` object number per pixel.
+#[no_mangle]
+pub extern "C" fn studio_render(x: u32, y: u32, width: u32, height: u32) -> u32 {
+    run(|state| state.studio.render_rect(x, y, width, height, &mut state.output))
+}
+
+/// The input (a whole render, as `studio_render` writes it) shown in
+/// `display` (0 truecolour, 1 scan, 2 dither, 3 coarse, 4 gray, 5 rgb565,
+/// 6 gray4): the output is its RGB bytes.
+#[no_mangle]
+pub extern "C" fn studio_display(display: u32, width: u32, height: u32) -> u32 {
+    run(|state| {
+        let display = Display::from_code(display).ok_or(StudioError::BadInput("no such display"))?;
+        let (image, objects) = studio::split_render(width, height, &state.input)?;
+        state.output = studio::display(&image, &objects, display).to_rgb().data;
+        Ok(())
+    })
+}
+
+/// The input (a whole render) in `display`, as a file of `format` (0 PNG,
+/// 1 Targa, 2 Sun raster): indexed for the 256-colour displays.
+#[no_mangle]
+pub extern "C" fn studio_encode(display: u32, format: u32, width: u32, height: u32) -> u32 {
+    run(|state| {
+        let display = Display::from_code(display).ok_or(StudioError::BadInput("no such display"))?;
+        let format = [Format::Png, Format::Tga, Format::Ras]
+            .get(format as usize)
+            .copied()
+            .ok_or(StudioError::BadInput("no such format"))?;
+        let (image, objects) = studio::split_render(width, height, &state.input)?;
+        state.output = studio::encode(&studio::display(&image, &objects, display), format)?;
+        Ok(())
+    })
+}
+
+/// Reads the input as an image file: the output is its width and height
+/// (little-endian `u32`s), then its RGB bytes.
+#[no_mangle]
+pub extern "C" fn studio_decode() -> u32 {
+    run(|state| {
+        let image = studio::decode(&state.input)?;
+        let mut out = Vec::with_capacity(8 + image.data.len());
+        out.extend(image.width.to_le_bytes());
+        out.extend(image.height.to_le_bytes());
+        out.extend(&image.data);
+        state.output = out;
+        Ok(())
+    })
+}

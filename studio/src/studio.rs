@@ -1,0 +1,298 @@
+//! The studio's state and operations, in safe Rust, independent of how the
+//! page calls them (tests call them directly).
+//!
+//! Invariant: `octree` was built from the current `scene` (it is dropped
+//! whenever the scene is replaced).
+
+use crate::formats::{self, Format, Image};
+use crate::palette::{self, PaletteMode};
+use crate::{RgbImage, NO_OBJECT};
+use embedded_graphics_core::pixelcolor::{Gray4, Rgb565, Rgb888, RgbColor};
+use octrace_core::accel::{Accelerator, Mailbox, Naive, Octree, OctreeConfig, Traversal};
+use octrace_core::capacity::Host;
+use octrace_core::parse::{parse_bytes, ParseError};
+use octrace_core::render::Renderer;
+use octrace_core::scene::Scene;
+use std::fmt;
+
+/// Scenes with at most this many objects render fastest without an octree
+/// (host-sim's rule for `--accel auto`).
+const NAIVE_UP_TO: usize = 16;
+
+/// The intersection strategy, as the page's process menu names it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Accel {
+    Auto,
+    Naive,
+    Octree,
+    Dda,
+}
+
+impl Accel {
+    /// The mode numbered `code` by the page (0 auto, 1 naive, 2 octree, 3 dda).
+    pub fn from_code(code: u32) -> Option<Accel> {
+        [Accel::Auto, Accel::Naive, Accel::Octree, Accel::Dda].get(code as usize).copied()
+    }
+}
+
+/// How a finished image is shown: truecolour, one of the four 256-colour
+/// modes, or a panel's colour depth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Display {
+    Palette(PaletteMode),
+    Rgb565,
+    Gray4,
+}
+
+impl Display {
+    /// The display numbered `code` by the page: 0 truecolour, 1 scan,
+    /// 2 dither, 3 coarse, 4 gray, 5 rgb565, 6 gray4.
+    pub fn from_code(code: u32) -> Option<Display> {
+        match code {
+            0..=4 => Some(Display::Palette(PaletteMode::ALL[code as usize])),
+            5 => Some(Display::Rgb565),
+            6 => Some(Display::Gray4),
+            _ => None,
+        }
+    }
+}
+
+/// Why an operation could not be done.
+#[derive(Debug)]
+pub enum StudioError {
+    /// The scene text has errors, each `line:col: message`.
+    Scene(Vec<String>),
+    /// No scene is loaded.
+    NoScene,
+    /// The camera cannot be set up or the size is out of range.
+    Camera(String),
+    /// A buffer does not hold what the call needs.
+    BadInput(&'static str),
+    /// An image file could not be read or written.
+    Image(formats::FormatError),
+}
+
+impl fmt::Display for StudioError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            StudioError::Scene(errors) => f.write_str(&errors.join("\n")),
+            StudioError::NoScene => f.write_str("no scene is loaded"),
+            StudioError::Camera(why) => write!(f, "cannot set up the camera: {why}"),
+            StudioError::BadInput(what) => write!(f, "bad input: {what}"),
+            StudioError::Image(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for StudioError {}
+
+/// One scene, its octree and the render size.
+pub struct Studio {
+    scene: Box<Scene<Host>>,
+    loaded: bool,
+    octree: Option<Box<Octree<Host>>>,
+    size: (u32, u32),
+}
+
+impl Default for Studio {
+    fn default() -> Self {
+        Studio { scene: Box::new(Scene::new()), loaded: false, octree: None, size: (1, 1) }
+    }
+}
+
+impl Studio {
+    /// Parses `text`; on success returns the scene's RASTER and object count.
+    pub fn load(&mut self, text: &[u8]) -> Result<((u32, u32), usize), StudioError> {
+        self.octree = None;
+        self.loaded = false;
+        let mut errors = Vec::new();
+        let mut on_error = |e: ParseError<'_>| errors.push(e.to_string());
+        match parse_bytes(text, &mut self.scene, &mut on_error) {
+            Ok(_) => {
+                self.loaded = true;
+                let view = self.scene.view();
+                let raster = (view.settings.raster[0], view.settings.raster[1]);
+                self.size = raster;
+                Ok((raster, view.object_count()))
+            }
+            Err(_) => Err(StudioError::Scene(errors)),
+        }
+    }
+
+    /// Sets the image size and builds what `accel` needs; returns the mode
+    /// used (never `Auto`).
+    pub fn prepare(&mut self, accel: Accel, width: u32, height: u32) -> Result<Accel, StudioError> {
+        if !self.loaded {
+            return Err(StudioError::NoScene);
+        }
+        let view = self.scene.view();
+        Renderer::with_size(view, &Naive, width, height).map_err(|e| StudioError::Camera(format!("{e:?}")))?;
+        self.size = (width, height);
+        let accel = match accel {
+            Accel::Auto if view.object_count() <= NAIVE_UP_TO => Accel::Naive,
+            Accel::Auto => Accel::Dda,
+            other => other,
+        };
+        self.octree = match accel {
+            Accel::Naive | Accel::Auto => None,
+            Accel::Octree | Accel::Dda => {
+                let traversal = if accel == Accel::Octree { Traversal::Named } else { Traversal::Dda };
+                let mut octree: Box<Octree<Host>> = Box::default();
+                octree.build(&view, &OctreeConfig { traversal, ..Default::default() });
+                Some(octree)
+            }
+        };
+        Ok(accel)
+    }
+
+    /// Renders the rectangle at (`x`, `y`) of `width`×`height` pixels into
+    /// `out`: its colours (RGB, row-major), then the object under each pixel
+    /// (little-endian `u32`, [`NO_OBJECT`] for the background).
+    pub fn render_rect(&self, x: u32, y: u32, width: u32, height: u32, out: &mut Vec<u8>) -> Result<(), StudioError> {
+        if !self.loaded {
+            return Err(StudioError::NoScene);
+        }
+        let (w, h) = self.size;
+        if x.checked_add(width).is_none_or(|r| r > w) || y.checked_add(height).is_none_or(|b| b > h) {
+            return Err(StudioError::BadInput("the rectangle is outside the image"));
+        }
+        match self.octree.as_deref() {
+            None => self.render_with(&Naive, (x, y, width, height), out),
+            Some(octree) => self.render_with(octree, (x, y, width, height), out),
+        }
+    }
+
+    fn render_with<A: Accelerator>(
+        &self,
+        accel: &A,
+        (x, y, width, height): (u32, u32, u32, u32),
+        out: &mut Vec<u8>,
+    ) -> Result<(), StudioError> {
+        let view = self.scene.view();
+        let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
+        let renderer = Renderer::with_size(view, accel, self.size.0, self.size.1)
+            .map_err(|e| StudioError::Camera(format!("{e:?}")))?;
+        let mut renderer = renderer.with_mailbox(&mut words);
+        let count = width as usize * height as usize;
+        out.clear();
+        out.reserve(7 * count);
+        let mut objects = Vec::with_capacity(count);
+        for row in y..y + height {
+            for p in renderer.row(row, x..x + width) {
+                out.extend([p.color.r(), p.color.g(), p.color.b()]);
+                objects.push(p.object.map_or(NO_OBJECT, |o| o.0));
+            }
+        }
+        for o in objects {
+            out.extend(o.to_le_bytes());
+        }
+        Ok(())
+    }
+}
+
+/// Splits `input` (colours then objects, as [`Studio::render_rect`] writes
+/// them) into an image and its objects.
+pub fn split_render(width: u32, height: u32, input: &[u8]) -> Result<(RgbImage, Vec<u32>), StudioError> {
+    let count = width as usize * height as usize;
+    if input.len() != 7 * count || count == 0 {
+        return Err(StudioError::BadInput("the image buffer does not match its size"));
+    }
+    let (colours, objects) = input.split_at(3 * count);
+    let objects = objects.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+    Ok((RgbImage { width, height, data: colours.to_vec() }, objects))
+}
+
+/// The image as `display` shows it: indexed for the 256-colour modes,
+/// truecolour otherwise.
+pub fn display(image: &RgbImage, objects: &[u32], display: Display) -> Image {
+    match display {
+        Display::Palette(mode) => palette::apply(image, objects, mode),
+        Display::Rgb565 => Image::Rgb(map_pixels(image, |c| Rgb888::from(Rgb565::from(c)))),
+        Display::Gray4 => Image::Rgb(map_pixels(image, |c| Rgb888::from(Gray4::from(c)))),
+    }
+}
+
+fn map_pixels(image: &RgbImage, f: impl Fn(Rgb888) -> Rgb888) -> RgbImage {
+    let data = image
+        .data
+        .chunks_exact(3)
+        .flat_map(|p| {
+            let c = f(Rgb888::new(p[0], p[1], p[2]));
+            [c.r(), c.g(), c.b()]
+        })
+        .collect();
+    RgbImage { width: image.width, height: image.height, data }
+}
+
+/// `image` as a file of `format`.
+pub fn encode(image: &Image, format: Format) -> Result<Vec<u8>, StudioError> {
+    let mut bytes = Vec::new();
+    formats::write(image, format, &mut bytes).map_err(StudioError::Image)?;
+    Ok(bytes)
+}
+
+/// An image file's pixels.
+pub fn decode(bytes: &[u8]) -> Result<RgbImage, StudioError> {
+    formats::read(bytes).map(|image| image.to_rgb()).map_err(StudioError::Image)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SCENE: &[u8] = b"VIEWPOINT 0 0 5\nRASTER 8 6\nLIGHT 5 3 3 3\nSPHERE 1 1 0 0 0\nSURFACE 1 0.1 0.1 0.1 0.8 0.2 0.2 0.5 0.5 0.5 20 0 0\n";
+
+    #[test]
+    fn every_mode_renders_the_same_bits_in_any_pieces() {
+        let mut studio = Studio::default();
+        assert_eq!(studio.load(SCENE).unwrap(), ((8, 6), 1));
+        studio.prepare(Accel::Naive, 8, 6).unwrap();
+        let mut whole = Vec::new();
+        studio.render_rect(0, 0, 8, 6, &mut whole).unwrap();
+        let (image, objects) = split_render(8, 6, &whole).unwrap();
+        assert!(objects.contains(&0) && objects.contains(&NO_OBJECT));
+        for accel in [Accel::Octree, Accel::Dda, Accel::Auto] {
+            studio.prepare(accel, 8, 6).unwrap();
+            let mut piece = Vec::new();
+            studio.render_rect(3, 2, 4, 3, &mut piece).unwrap();
+            for (i, p) in piece[..36].chunks(3).enumerate() {
+                let (x, y) = (3 + i as u32 % 4, 2 + i as u32 / 4);
+                assert_eq!(p, image.pixel(x, y), "{accel:?} at {x},{y}");
+            }
+        }
+    }
+
+    #[test]
+    fn errors_come_with_line_and_column() {
+        let mut studio = Studio::default();
+        let Err(StudioError::Scene(errors)) = studio.load(b"VIEWPOINT 0 0 5\nSPHERE 1 x 0 0 0\n") else {
+            panic!("the scene has an error")
+        };
+        assert!(errors[0].starts_with("2:10:"), "{errors:?}");
+        assert!(matches!(studio.prepare(Accel::Naive, 4, 4), Err(StudioError::NoScene)));
+    }
+
+    #[test]
+    fn rectangles_outside_the_image_are_refused() {
+        let mut studio = Studio::default();
+        studio.load(SCENE).unwrap();
+        studio.prepare(Accel::Naive, 8, 6).unwrap();
+        let mut out = Vec::new();
+        assert!(studio.render_rect(5, 0, 4, 1, &mut out).is_err());
+        assert!(studio.render_rect(u32::MAX, 0, 2, 1, &mut out).is_err());
+    }
+
+    #[test]
+    fn files_round_trip_and_panels_reduce_colour() {
+        let image = RgbImage { width: 2, height: 1, data: vec![255, 128, 7, 0, 0, 0] };
+        for format in [Format::Png, Format::Tga, Format::Ras] {
+            let bytes = encode(&Image::Rgb(image.clone()), format).unwrap();
+            assert_eq!(decode(&bytes).unwrap(), image);
+        }
+        let panel = display(&image, &[NO_OBJECT; 2], Display::Rgb565).to_rgb();
+        assert_eq!(panel.pixel(0, 0), [255, 130, 8]);
+        let gray = display(&image, &[NO_OBJECT; 2], Display::Gray4).to_rgb();
+        assert!(gray.data.chunks(3).all(|p| p[0] == p[1] && p[1] == p[2]));
+        assert!(decode(b"not an image").is_err());
+    }
+}
