@@ -92,6 +92,9 @@ pub enum Command {
         #[arg(long, value_enum)]
         format: Option<Format>,
     },
+    /// The scene studio: edit, place and render a scene in the browser,
+    /// on this core compiled to WebAssembly (serves 127.0.0.1 only).
+    Studio(crate::studio::StudioArgs),
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -124,6 +127,9 @@ where
             return 0;
         }
     };
+    if let Some(Command::Studio(studio)) = &args.command {
+        return crate::studio::run(studio, stdout, stderr);
+    }
     match execute(&args, stderr) {
         Ok(()) => 0,
         Err(code) => code,

@@ -6,6 +6,7 @@ pub mod cli;
 pub mod formats;
 pub mod image;
 pub mod palette;
+pub mod studio;
 
 pub use image::RgbImage;
 

@@ -3,6 +3,7 @@
 
 pub mod firmware;
 pub mod reference;
+pub mod webdriver;
 
 use std::path::PathBuf;
 

@@ -1,0 +1,68 @@
+//! Builds the studio's WebAssembly module (`studio/`, octrace-core for
+//! wasm32-unknown-unknown) so `host-sim studio` can serve it from the
+//! binary. Nothing prebuilt is committed: a fresh clone builds it here.
+//!
+//! The module gets its own target directory beside this build's (under
+//! `target/studio-wasm`), so debug and release builds of host-sim share one
+//! WebAssembly build and never wait on each other's lock.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn main() {
+    let manifest_dir = PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
+    let out_dir = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
+    let studio = manifest_dir.join("../studio");
+    for watched in
+        ["../studio/src", "../studio/Cargo.toml", "../studio/Cargo.lock", "../core/src", "../core/Cargo.toml"]
+    {
+        println!("cargo:rerun-if-changed={watched}");
+    }
+    // The studio compiles these host-sim modules too.
+    for shared in ["src/formats.rs", "src/image.rs", "src/palette.rs"] {
+        println!("cargo:rerun-if-changed={shared}");
+    }
+    let target_dir = wasm_target_dir(&out_dir);
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let mut command = Command::new(cargo);
+    command
+        .args(["build", "--release", "--locked", "--target", "wasm32-unknown-unknown", "--manifest-path"])
+        .arg(studio.join("Cargo.toml"))
+        .arg("--target-dir")
+        .arg(&target_dir);
+    // This build's settings (flags, clippy's wrapper, the host target) are
+    // not the module's.
+    for variable in [
+        "RUSTFLAGS",
+        "CARGO_ENCODED_RUSTFLAGS",
+        "RUSTC_WRAPPER",
+        "RUSTC_WORKSPACE_WRAPPER",
+        "CARGO_BUILD_TARGET",
+        "CARGO_TARGET_DIR",
+        "CARGO_PRIMARY_PACKAGE",
+    ] {
+        command.env_remove(variable);
+    }
+    let status = command.status().unwrap_or_else(|e| panic!("cannot run cargo to build the studio module: {e}"));
+    if !status.success() {
+        panic!(
+            "building the studio's WebAssembly module failed (is the target installed? \
+             `rustup target add wasm32-unknown-unknown`)"
+        );
+    }
+    let built = target_dir.join("wasm32-unknown-unknown/release/octrace_studio.wasm");
+    std::fs::copy(&built, out_dir.join("octrace_studio.wasm"))
+        .unwrap_or_else(|e| panic!("cannot copy {}: {e}", built.display()));
+}
+
+/// `target/studio-wasm` for an OUT_DIR of `target/<profile>/build/<pkg>/out`
+/// (or `target/<triple>/<profile>/…`), else a directory under OUT_DIR.
+fn wasm_target_dir(out_dir: &Path) -> PathBuf {
+    out_dir
+        .ancestors()
+        .find(|dir| dir.file_name().is_some_and(|name| name == "build"))
+        .and_then(|build| build.parent())
+        .and_then(|profile| profile.parent())
+        .map(|target| target.join("studio-wasm"))
+        .unwrap_or_else(|| out_dir.join("studio-wasm"))
+}

@@ -1,0 +1,210 @@
+//! Just enough HTTP/1.1 for the studio: one request per connection (every
+//! response says `Connection: close`), bodies by Content-Length only.
+//!
+//! Invariant: reading never allocates more than the header limit plus the
+//! body limit the caller gives, whatever the peer declares.
+
+use std::io::{BufRead, BufReader, Read, Write};
+
+/// The most the request line and headers may take together.
+const MAX_HEAD_BYTES: usize = 16 << 10;
+
+/// A parsed request. Header names are lower-case.
+pub(crate) struct Request {
+    pub(crate) method: String,
+    /// The path without the query, exactly as sent (never decoded: it is
+    /// only ever compared with the assets' names).
+    pub(crate) path: String,
+    query: Vec<(String, String)>,
+    headers: Vec<(String, String)>,
+    pub(crate) body: Vec<u8>,
+}
+
+impl Request {
+    pub(crate) fn header(&self, name: &str) -> Option<&str> {
+        self.headers.iter().find(|(n, _)| n == name).map(|(_, v)| v.as_str())
+    }
+
+    pub(crate) fn query(&self, name: &str) -> Option<&str> {
+        self.query.iter().find(|(n, _)| n == name).map(|(_, v)| v.as_str())
+    }
+
+    pub(crate) fn cookie(&self, name: &str) -> Option<&str> {
+        self.headers
+            .iter()
+            .filter(|(n, _)| n == "cookie")
+            .flat_map(|(_, v)| v.split(';'))
+            .filter_map(|pair| pair.trim().split_once('='))
+            .find(|(n, _)| *n == name)
+            .map(|(_, v)| v)
+    }
+}
+
+/// Reads one request; on a malformed or oversized one, the status to
+/// answer with.
+pub(crate) fn read_request(stream: &mut impl Read, max_body: usize) -> Result<Request, u16> {
+    let mut reader = BufReader::new(stream);
+    let mut head = Vec::new();
+    loop {
+        let before = head.len();
+        let read = (&mut reader)
+            .take((MAX_HEAD_BYTES + 1 - before) as u64)
+            .read_until(b'\n', &mut head)
+            .map_err(|_| 400u16)?;
+        if head.len() > MAX_HEAD_BYTES {
+            return Err(431);
+        }
+        if read == 0 {
+            return Err(400);
+        }
+        let line = &head[before..];
+        if line == b"\r\n" || line == b"\n" {
+            break;
+        }
+    }
+    let head = std::str::from_utf8(&head).map_err(|_| 400u16)?;
+    let mut lines = head.lines();
+    let mut request_line = lines.next().unwrap_or("").split(' ');
+    let (Some(method), Some(target), Some(version)) = (request_line.next(), request_line.next(), request_line.next())
+    else {
+        return Err(400);
+    };
+    if !version.starts_with("HTTP/1.") {
+        return Err(505);
+    }
+    let headers: Vec<(String, String)> = lines
+        .filter_map(|line| line.split_once(':'))
+        .map(|(name, value)| (name.trim().to_ascii_lowercase(), value.trim().to_string()))
+        .collect();
+    let (path, query) = target.split_once('?').unwrap_or((target, ""));
+    let query = query
+        .split('&')
+        .filter_map(|pair| pair.split_once('='))
+        .map(|(n, v)| (percent_decode(n), percent_decode(v)))
+        .collect();
+    let mut request = Request { method: method.to_string(), path: path.to_string(), query, headers, body: Vec::new() };
+    if request.header("transfer-encoding").is_some() {
+        return Err(411);
+    }
+    let length = match request.header("content-length") {
+        None => 0,
+        Some(v) => v.parse::<usize>().map_err(|_| 400u16)?,
+    };
+    if length > max_body {
+        return Err(413);
+    }
+    let mut body = vec![0; length];
+    reader.read_exact(&mut body).map_err(|_| 400u16)?;
+    request.body = body;
+    Ok(request)
+}
+
+fn percent_decode(text: &str) -> String {
+    let bytes = text.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = |b: u8| (b as char).to_digit(16);
+        match (bytes[i], bytes.get(i + 1).copied().and_then(hex), bytes.get(i + 2).copied().and_then(hex)) {
+            (b'%', Some(high), Some(low)) => {
+                out.push((high * 16 + low) as u8);
+                i += 3;
+            }
+            (b'+', _, _) => {
+                out.push(b' ');
+                i += 1;
+            }
+            (b, _, _) => {
+                out.push(b);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// Compares a secret in time that does not depend on where they differ.
+pub(crate) fn same_secret(given: &str, secret: &str) -> bool {
+    given.len() == secret.len() && given.bytes().zip(secret.bytes()).fold(0u8, |acc, (a, b)| acc | (a ^ b)) == 0
+}
+
+pub(crate) struct Response {
+    status: u16,
+    pub(crate) headers: Vec<(String, String)>,
+    body: Vec<u8>,
+}
+
+impl Response {
+    pub(crate) fn new(status: u16, content_type: &str, body: Vec<u8>) -> Response {
+        Response { status, headers: vec![("Content-Type".into(), content_type.into())], body }
+    }
+
+    pub(crate) fn text(status: u16, message: &str) -> Response {
+        Response::new(status, "text/plain; charset=utf-8", format!("{message}\n").into_bytes())
+    }
+
+    pub(crate) fn write_to(&self, out: &mut impl Write) -> std::io::Result<()> {
+        let reason = match self.status {
+            200 => "OK",
+            400 => "Bad Request",
+            403 => "Forbidden",
+            404 => "Not Found",
+            405 => "Method Not Allowed",
+            409 => "Conflict",
+            411 => "Length Required",
+            413 => "Content Too Large",
+            421 => "Misdirected Request",
+            428 => "Precondition Required",
+            431 => "Request Header Fields Too Large",
+            505 => "HTTP Version Not Supported",
+            _ => "Error",
+        };
+        let mut head = format!("HTTP/1.1 {} {reason}\r\n", self.status);
+        for (name, value) in &self.headers {
+            head.push_str(&format!("{name}: {value}\r\n"));
+        }
+        // The page is the only client: no caching of a scene or a module
+        // that may have changed, no framing by other sites.
+        head.push_str(&format!(
+            "Content-Length: {}\r\nCache-Control: no-store\r\nX-Frame-Options: DENY\r\n\
+             X-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
+            self.body.len()
+        ));
+        out.write_all(head.as_bytes())?;
+        out.write_all(&self.body)?;
+        out.flush()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn requests_are_parsed() {
+        let raw = b"PUT /scene?token=a%62c HTTP/1.1\r\nHost: 127.0.0.1:9\r\nCookie: x=1; studio_token=t\r\nContent-Length: 3\r\n\r\nabcdef";
+        let request = read_request(&mut &raw[..], 10).unwrap();
+        assert_eq!((request.method.as_str(), request.path.as_str()), ("PUT", "/scene"));
+        assert_eq!(request.query("token"), Some("abc"));
+        assert_eq!(request.header("host"), Some("127.0.0.1:9"));
+        assert_eq!(request.cookie("studio_token"), Some("t"));
+        assert_eq!(request.body, b"abc");
+    }
+
+    #[test]
+    fn oversized_or_malformed_requests_are_refused() {
+        let big = b"PUT / HTTP/1.1\r\nContent-Length: 11\r\n\r\n";
+        assert_eq!(read_request(&mut &big[..], 10).err(), Some(413));
+        let long_head = format!("GET / HTTP/1.1\r\nX: {}\r\n\r\n", "a".repeat(MAX_HEAD_BYTES));
+        assert_eq!(read_request(&mut long_head.as_bytes(), 10).err(), Some(431));
+        assert_eq!(read_request(&mut &b"GET /\r\n\r\n"[..], 10).err(), Some(400));
+        assert_eq!(read_request(&mut &b""[..], 10).err(), Some(400));
+    }
+
+    #[test]
+    fn secrets_compare_whole() {
+        assert!(same_secret("abc", "abc"));
+        assert!(!same_secret("abd", "abc"));
+        assert!(!same_secret("ab", "abc"));
+    }
+}

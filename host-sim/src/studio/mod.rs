@@ -1,0 +1,290 @@
+//! `host-sim studio`: a small HTTP/1.1 server on 127.0.0.1 for the scene
+//! studio page, which runs octrace-core compiled to WebAssembly.
+//!
+//! Invariants (the security rules): the listener is bound to 127.0.0.1
+//! only; every request must carry the session's token (query `token=`,
+//! header `X-Studio-Token` or the cookie the page gets); a request whose
+//! Host is not this address and port is refused (DNS rebinding); the only
+//! file ever read or written is the scene file named on the command line,
+//! through `GET`/`PUT /scene`, and every other path is an embedded asset or
+//! 404 — no request path reaches the file system.
+
+mod http;
+
+use crate::cli::write_atomically;
+use http::{Request, Response};
+use std::io::Write;
+use std::net::{Ipv4Addr, SocketAddr, TcpListener, TcpStream};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+/// Arguments of `host-sim studio`.
+#[derive(clap::Args, Debug)]
+pub struct StudioArgs {
+    /// The scene file to edit (the only file the studio reads or writes);
+    /// created on the first save if it does not exist. Without one, the
+    /// studio starts from an example scene and cannot save it.
+    pub scene: Option<PathBuf>,
+    /// The port to listen on (127.0.0.1 only); 0 or none: any free port.
+    #[arg(long, default_value_t = 0)]
+    pub port: u16,
+    /// Also open the page in the desktop's browser.
+    #[arg(long)]
+    pub open: bool,
+}
+
+/// The page, its script and style, and the WebAssembly module, built into
+/// the binary (the module by `build.rs`).
+const ASSETS: [(&str, &str, &[u8]); 5] = [
+    ("/", "text/html; charset=utf-8", include_bytes!("assets/index.html")),
+    ("/studio.js", "text/javascript; charset=utf-8", include_bytes!("assets/studio.js")),
+    ("/worker.js", "text/javascript; charset=utf-8", include_bytes!("assets/worker.js")),
+    ("/studio.css", "text/css; charset=utf-8", include_bytes!("assets/studio.css")),
+    ("/octrace_studio.wasm", "application/wasm", include_bytes!(concat!(env!("OUT_DIR"), "/octrace_studio.wasm"))),
+];
+
+/// The scene shown when the studio is started without a file.
+const EXAMPLE_SCENE: &str = include_str!("../../../scenes/fig5_1.txt");
+
+/// The most a saved scene may be (the largest scene in `scenes/` is far
+/// smaller).
+const MAX_SCENE_BYTES: usize = 16 << 20;
+
+/// What every connection handler shares.
+struct Shared {
+    token: String,
+    /// The Host values accepted: `127.0.0.1:PORT` and `localhost:PORT`.
+    hosts: [String; 2],
+    scene: Option<PathBuf>,
+    /// Held while the scene file is compared and replaced, so two saves
+    /// cannot interleave.
+    saving: Mutex<()>,
+}
+
+/// Runs the studio until Ctrl-C; returns the exit code.
+pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i32 {
+    let listener = match TcpListener::bind(SocketAddr::from((Ipv4Addr::LOCALHOST, args.port))) {
+        Ok(l) => l,
+        Err(e) => {
+            let _ = writeln!(stderr, "host-sim studio: cannot listen on 127.0.0.1:{}: {e}", args.port);
+            return crate::cli::EXIT_IO;
+        }
+    };
+    let port = match listener.local_addr() {
+        Ok(a) => a.port(),
+        Err(e) => {
+            let _ = writeln!(stderr, "host-sim studio: {e}");
+            return crate::cli::EXIT_IO;
+        }
+    };
+    let token = match new_token() {
+        Ok(t) => t,
+        Err(e) => {
+            let _ = writeln!(stderr, "host-sim studio: no randomness for the token: {e}");
+            return crate::cli::EXIT_IO;
+        }
+    };
+    let url = format!("http://127.0.0.1:{port}/?token={token}");
+    let shared = Arc::new(Shared {
+        token,
+        hosts: [format!("127.0.0.1:{port}"), format!("localhost:{port}")],
+        scene: args.scene.clone(),
+        saving: Mutex::new(()),
+    });
+    let _ = writeln!(stdout, "{url}");
+    let _ = stdout.flush();
+    match &args.scene {
+        Some(path) => {
+            let _ = writeln!(stderr, "host-sim studio: editing {} (Ctrl-C stops)", path.display());
+        }
+        None => {
+            let _ = writeln!(stderr, "host-sim studio: no scene file given: an example, not saved (Ctrl-C stops)");
+        }
+    }
+    if args.open {
+        open_browser(&url, stderr);
+    }
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = Arc::clone(&stop);
+        // A second handler cannot be installed (tests run the server more
+        // than once in a process); Ctrl-C then simply ends the process.
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    serve(&listener, &shared, &stop);
+    let _ = writeln!(stderr, "host-sim studio: stopped");
+    0
+}
+
+/// Accepts connections until `stop` is set, each on its own thread; waits
+/// for those under way before returning, so a save is never cut short.
+fn serve(listener: &TcpListener, shared: &Arc<Shared>, stop: &AtomicBool) {
+    // Polled, so Ctrl-C is noticed within a tenth of a second.
+    if listener.set_nonblocking(true).is_err() {
+        return;
+    }
+    std::thread::scope(|scope| {
+        while !stop.load(Ordering::SeqCst) {
+            match listener.accept() {
+                Ok((stream, _)) => {
+                    let shared = Arc::clone(shared);
+                    scope.spawn(move || handle(stream, &shared));
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => std::thread::sleep(Duration::from_millis(20)),
+                Err(_) => std::thread::sleep(Duration::from_millis(20)),
+            }
+        }
+    });
+}
+
+fn handle(stream: TcpStream, shared: &Shared) {
+    let _ = stream.set_nonblocking(false);
+    let _ = stream.set_read_timeout(Some(Duration::from_secs(30)));
+    let mut stream = stream;
+    let response = match http::read_request(&mut stream, MAX_SCENE_BYTES) {
+        Ok(request) => respond(&request, shared),
+        Err(status) => Response::text(status, "bad request"),
+    };
+    let _ = response.write_to(&mut stream);
+}
+
+/// The response to `request`: the security checks first, then the route.
+fn respond(request: &Request, shared: &Shared) -> Response {
+    if !request.header("host").is_some_and(|host| shared.hosts.iter().any(|h| h.eq_ignore_ascii_case(host))) {
+        return Response::text(421, "this server answers only to its own loopback address");
+    }
+    let token_given =
+        request.query("token").or_else(|| request.header("x-studio-token")).or_else(|| request.cookie("studio_token"));
+    if !token_given.is_some_and(|t| http::same_secret(t, &shared.token)) {
+        return Response::text(403, "a token is needed: open the address host-sim studio printed");
+    }
+    let path = request.path.as_str();
+    match (request.method.as_str(), path) {
+        ("GET", "/scene") => get_scene(shared),
+        ("PUT", "/scene") => put_scene(request, shared),
+        ("GET", _) | ("HEAD", _) => match ASSETS.iter().find(|(name, _, _)| *name == path) {
+            Some((name, kind, body)) => {
+                let mut response = Response::new(200, kind, body.to_vec());
+                if *name == "/" {
+                    // Later requests (scripts, workers, the module, the
+                    // scene) carry the token as a cookie only this origin
+                    // sends.
+                    response.headers.push((
+                        "Set-Cookie".into(),
+                        format!("studio_token={}; Path=/; HttpOnly; SameSite=Strict", shared.token),
+                    ));
+                }
+                response
+            }
+            None => Response::text(404, "no such page"),
+        },
+        _ => Response::text(405, "method not allowed"),
+    }
+}
+
+/// The version of a scene's text the page loaded, to detect a file changed
+/// on disk since (FNV-1a of its bytes; "absent" for no file).
+fn version(bytes: Option<&[u8]>) -> String {
+    match bytes {
+        None => "absent".into(),
+        Some(bytes) => {
+            let hash =
+                bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3));
+            format!("{hash:016x}")
+        }
+    }
+}
+
+fn read_scene(path: &Path) -> std::io::Result<Option<Vec<u8>>> {
+    match std::fs::read(path) {
+        Ok(bytes) => Ok(Some(bytes)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(e),
+    }
+}
+
+fn get_scene(shared: &Shared) -> Response {
+    let (bytes, name, writable) = match &shared.scene {
+        None => (Some(EXAMPLE_SCENE.as_bytes().to_vec()), "example.txt".to_string(), false),
+        Some(path) => match read_scene(path) {
+            Ok(bytes) => (bytes, path.display().to_string(), true),
+            Err(e) => return Response::text(500, &format!("cannot read {}: {e}", path.display())),
+        },
+    };
+    let mut response = Response::new(200, "text/plain; charset=utf-8", bytes.clone().unwrap_or_default());
+    response.headers.push(("ETag".into(), format!("\"{}\"", version(bytes.as_deref()))));
+    response.headers.push(("X-Scene-Name".into(), name.escape_default().to_string()));
+    response.headers.push(("X-Scene-Writable".into(), writable.to_string()));
+    response
+}
+
+/// Saves the scene atomically, unless the file changed since the version
+/// in `If-Match` (`*` overwrites whatever is there: the user said so).
+fn put_scene(request: &Request, shared: &Shared) -> Response {
+    let Some(path) = &shared.scene else {
+        return Response::text(403, "the studio was started without a scene file: nothing to save to");
+    };
+    let Some(expected) = request.header("if-match").map(|v| v.trim().trim_matches('"').to_string()) else {
+        return Response::text(428, "If-Match is needed");
+    };
+    let _guard = shared.saving.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let current = match read_scene(path) {
+        Ok(bytes) => version(bytes.as_deref()),
+        Err(e) => return Response::text(500, &format!("cannot read {}: {e}", path.display())),
+    };
+    if expected != "*" && expected != current {
+        let mut response = Response::text(409, "the scene file changed on disk since it was loaded");
+        response.headers.push(("ETag".into(), format!("\"{current}\"")));
+        return response;
+    }
+    match write_atomically(path, |f| f.write_all(&request.body)) {
+        Ok(()) => {
+            let mut response = Response::text(200, "saved");
+            response.headers.push(("ETag".into(), format!("\"{}\"", version(Some(&request.body)))));
+            response
+        }
+        Err(e) => Response::text(500, &format!("cannot write {}: {e}", path.display())),
+    }
+}
+
+/// 128 random bits in hex, from the operating system.
+fn new_token() -> std::io::Result<String> {
+    use std::io::Read;
+    let mut bytes = [0u8; 16];
+    std::fs::File::open("/dev/urandom")?.read_exact(&mut bytes)?;
+    Ok(bytes.iter().map(|b| format!("{b:02x}")).collect())
+}
+
+fn open_browser(url: &str, stderr: &mut dyn Write) {
+    let opener = if cfg!(target_os = "macos") {
+        "open"
+    } else if cfg!(windows) {
+        "explorer"
+    } else {
+        "xdg-open"
+    };
+    if let Err(e) = std::process::Command::new(opener).arg(url).spawn() {
+        let _ = writeln!(stderr, "host-sim studio: cannot run {opener}: {e}; open the address above yourself");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn versions_follow_the_content() {
+        assert_eq!(version(None), "absent");
+        assert_eq!(version(Some(b"a")), version(Some(b"a")));
+        assert_ne!(version(Some(b"a")), version(Some(b"b")));
+    }
+
+    #[test]
+    fn tokens_are_long_and_differ() {
+        let (a, b) = (new_token().unwrap(), new_token().unwrap());
+        assert_eq!(a.len(), 32);
+        assert_ne!(a, b);
+    }
+}

@@ -1,0 +1,238 @@
+//! Just enough of a W3C WebDriver client, over std's TCP, to drive Debian's
+//! chromium through chromedriver in the studio tests: sessions, navigation,
+//! scripts, pointer actions, elements, alerts and screenshots.
+
+use serde_json::{json, Value};
+use std::io::{Read, Write};
+use std::net::{TcpListener, TcpStream};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// A chromedriver process and one headless chromium session, both ended on
+/// drop.
+pub struct Browser {
+    driver: Child,
+    port: u16,
+    session: String,
+    _profile: tempfile::TempDir,
+}
+
+/// A free port on 127.0.0.1 (bound and released: racy only in theory).
+pub fn free_port() -> u16 {
+    TcpListener::bind("127.0.0.1:0").and_then(|l| l.local_addr()).map(|a| a.port()).expect("a free port")
+}
+
+/// One HTTP/1.1 request to 127.0.0.1:`port`; returns (status, body).
+pub fn http(port: u16, method: &str, path: &str, headers: &[(&str, &str)], body: &[u8]) -> (u16, Vec<u8>) {
+    let mut stream = TcpStream::connect(("127.0.0.1", port)).expect("connect");
+    stream.set_read_timeout(Some(Duration::from_secs(300))).ok();
+    let mut head = format!("{method} {path} HTTP/1.1\r\nContent-Length: {}\r\nConnection: close\r\n", body.len());
+    if !headers.iter().any(|(n, _)| n.eq_ignore_ascii_case("host")) {
+        head.push_str(&format!("Host: 127.0.0.1:{port}\r\n"));
+    }
+    for (n, v) in headers {
+        head.push_str(&format!("{n}: {v}\r\n"));
+    }
+    head.push_str("\r\n");
+    stream.write_all(head.as_bytes()).expect("send");
+    stream.write_all(body).expect("send");
+    let mut response = Vec::new();
+    stream.read_to_end(&mut response).expect("read");
+    let split = response.windows(4).position(|w| w == b"\r\n\r\n").expect("a complete response");
+    let status_line = String::from_utf8_lossy(&response[..split]).lines().next().unwrap_or("").to_string();
+    let status = status_line.split(' ').nth(1).and_then(|s| s.parse().ok()).expect("a status");
+    (status, response[split + 4..].to_vec())
+}
+
+impl Browser {
+    /// Starts chromedriver and a fresh headless chromium (its own profile).
+    pub fn start(window: (u32, u32)) -> Browser {
+        for tool in ["/usr/bin/chromium", "/usr/bin/chromedriver"] {
+            assert!(
+                Path::new(tool).exists(),
+                "{tool} is missing: install Debian's chromium and chromium-driver (scripts/test-all does)"
+            );
+        }
+        let port = free_port();
+        let driver = Command::new("/usr/bin/chromedriver")
+            .arg(format!("--port={port}"))
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("chromedriver starts");
+        let deadline = Instant::now() + Duration::from_secs(30);
+        while TcpStream::connect(("127.0.0.1", port)).is_err() {
+            assert!(Instant::now() < deadline, "chromedriver did not start listening");
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        let profile = tempfile::tempdir().expect("a profile directory");
+        let args = vec![
+            "--headless".to_string(),
+            "--no-sandbox".into(),
+            "--disable-gpu".into(),
+            "--disable-quic".into(),
+            "--no-first-run".into(),
+            "--disable-background-networking".into(),
+            "--disable-component-update".into(),
+            "--disable-sync".into(),
+            format!("--user-data-dir={}", profile.path().display()),
+            format!("--window-size={},{}", window.0, window.1),
+        ];
+        let mut browser = Browser { driver, port, session: String::new(), _profile: profile };
+        let created = browser.command(
+            "POST",
+            "/session",
+            json!({"capabilities": {"alwaysMatch": {"browserName": "chrome",
+                "goog:chromeOptions": {"binary": "/usr/bin/chromium", "args": args}}}}),
+        );
+        browser.session = created["sessionId"].as_str().expect("a session").to_string();
+        browser
+    }
+
+    fn command(&self, method: &str, path: &str, body: Value) -> Value {
+        let body = if method == "GET" || method == "DELETE" { Vec::new() } else { body.to_string().into_bytes() };
+        let (status, response) =
+            http(self.port, method, path, &[("Content-Type", "application/json; charset=utf-8")], &body);
+        let value: Value = serde_json::from_slice(&response).unwrap_or(Value::Null);
+        assert!(status == 200, "WebDriver {method} {path}: {status} {}", String::from_utf8_lossy(&response));
+        value.get("value").cloned().unwrap_or(value)
+    }
+
+    fn session(&self, method: &str, path: &str, body: Value) -> Value {
+        self.command(method, &format!("/session/{}{path}", self.session), body)
+    }
+
+    /// Tries a command; the error message when it fails.
+    fn try_session(&self, method: &str, path: &str, body: Value) -> Result<Value, String> {
+        let body = body.to_string().into_bytes();
+        let (status, response) = http(
+            self.port,
+            method,
+            &format!("/session/{}{path}", self.session),
+            &[("Content-Type", "application/json")],
+            &body,
+        );
+        let value: Value = serde_json::from_slice(&response).unwrap_or(Value::Null);
+        if status == 200 {
+            Ok(value["value"].clone())
+        } else {
+            Err(value["value"]["message"].as_str().unwrap_or("").to_string())
+        }
+    }
+
+    pub fn goto(&self, url: &str) {
+        self.session("POST", "/url", json!({ "url": url }));
+    }
+
+    /// Runs `script` (a function body; a returned promise is awaited).
+    pub fn run(&self, script: &str) -> Value {
+        self.session("POST", "/execute/sync", json!({ "script": script, "args": [] }))
+    }
+
+    /// Waits until `condition` (a JavaScript expression) is true.
+    pub fn wait_for(&self, condition: &str, seconds: u64) {
+        let deadline = Instant::now() + Duration::from_secs(seconds);
+        while self.run(&format!("return !!({condition});")) != Value::Bool(true) {
+            assert!(Instant::now() < deadline, "timed out waiting for {condition}");
+            std::thread::sleep(Duration::from_millis(25));
+        }
+    }
+
+    /// The WebDriver reference of the element `css` selects.
+    pub fn element(&self, css: &str) -> Value {
+        self.session("POST", "/element", json!({"using": "css selector", "value": css}))
+    }
+
+    pub fn click(&self, css: &str) {
+        let id = element_id(&self.element(css));
+        self.session("POST", &format!("/element/{id}/click"), json!({}));
+    }
+
+    /// Types `keys` into the element `css` selects.
+    pub fn type_into(&self, css: &str, keys: &str) {
+        let id = element_id(&self.element(css));
+        self.session("POST", &format!("/element/{id}/value"), json!({ "text": keys }));
+    }
+
+    /// Presses the mouse at `from` (pixels from the element's centre), drags
+    /// through `to` and releases.
+    pub fn drag(&self, css: &str, from: (i64, i64), to: (i64, i64)) {
+        let element = self.element(css);
+        let mv = |(x, y): (i64, i64), duration: u64| json!({"type": "pointerMove", "origin": element.clone(), "x": x, "y": y, "duration": duration});
+        let actions = json!({"actions": [{"type": "pointer", "id": "mouse", "parameters": {"pointerType": "mouse"},
+            "actions": [mv(from, 0), {"type": "pointerDown", "button": 0},
+                        mv(((from.0 + to.0) / 2, (from.1 + to.1) / 2), 50), mv(to, 50),
+                        {"type": "pointerUp", "button": 0}]}]});
+        self.session("POST", "/actions", actions);
+    }
+
+    /// The text of an open alert or confirm, if one is open.
+    pub fn alert_text(&self) -> Option<String> {
+        self.try_session("GET", "/alert/text", Value::Null).ok().and_then(|v| v.as_str().map(str::to_owned))
+    }
+
+    pub fn answer_alert(&self, accept: bool) {
+        self.session("POST", if accept { "/alert/accept" } else { "/alert/dismiss" }, json!({}));
+    }
+
+    /// A PNG of the viewport.
+    pub fn screenshot(&self) -> Vec<u8> {
+        let encoded = self.session("GET", "/screenshot", Value::Null);
+        base64_decode(encoded.as_str().expect("base64"))
+    }
+
+    /// The RGB pixels of `<canvas id=…>`, with its size.
+    pub fn canvas_rgb(&self, id: &str) -> (u32, u32, Vec<u8>) {
+        let v = self.run(&format!(
+            "const c = document.getElementById('{id}');
+             const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+             let s = '';
+             for (let i = 0; i < d.length; i += 4) s += String.fromCharCode(d[i], d[i + 1], d[i + 2]);
+             return [c.width, c.height, btoa(s)];"
+        ));
+        let (w, h) = (v[0].as_u64().expect("width") as u32, v[1].as_u64().expect("height") as u32);
+        (w, h, base64_decode(v[2].as_str().expect("pixels")))
+    }
+}
+
+impl Drop for Browser {
+    fn drop(&mut self) {
+        if !self.session.is_empty() {
+            let _ = self.try_session("DELETE", "", Value::Null);
+        }
+        let _ = self.driver.kill();
+        let _ = self.driver.wait();
+    }
+}
+
+fn element_id(element: &Value) -> String {
+    element["element-6066-11e4-a52f-4a5c6c2ee1c3"].as_str().expect("an element reference").to_string()
+}
+
+/// Standard base64 (with padding) to bytes.
+pub fn base64_decode(text: &str) -> Vec<u8> {
+    let value = |c: u8| match c {
+        b'A'..=b'Z' => c - b'A',
+        b'a'..=b'z' => c - b'a' + 26,
+        b'0'..=b'9' => c - b'0' + 52,
+        b'+' => 62,
+        _ => 63,
+    };
+    let symbols: Vec<u8> = text.bytes().filter(|&c| c != b'=' && !c.is_ascii_whitespace()).map(value).collect();
+    let mut out = Vec::with_capacity(symbols.len() * 3 / 4);
+    for chunk in symbols.chunks(4) {
+        let bits = chunk.iter().enumerate().fold(0u32, |acc, (i, &v)| acc | (v as u32) << (18 - 6 * i));
+        out.extend(&bits.to_be_bytes()[1..chunk.len()]);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn base64_decodes() {
+        assert_eq!(super::base64_decode("aGVsbG8="), b"hello");
+        assert_eq!(super::base64_decode("AP8A"), [0, 255, 0]);
+    }
+}

@@ -1,0 +1,417 @@
+//! The scene studio (`host-sim studio`) in a real browser: Debian's
+//! chromium, headless, driven over WebDriver by chromedriver. The page runs
+//! octrace-core compiled to WebAssembly; these tests check that what it
+//! shows is host-sim's image bit for bit, that a user can place, render and
+//! save with the mouse, and that the server keeps its security rules.
+//!
+//! `OCTRACE_SCREENSHOTS=1` also writes the README's screenshots to
+//! `docs/studio/`.
+
+use embedded_graphics_core::pixelcolor::{Gray4, Rgb565, Rgb888, RgbColor};
+use host_sim::palette::{self, PaletteMode};
+use host_sim::{load_bytes, new_scene, render, RenderOptions, RgbImage};
+use octrace_tests::webdriver::{http, Browser};
+use octrace_tests::{repo, scenes};
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// The host-sim binary, built for this test run.
+fn host_sim_binary() -> PathBuf {
+    let status = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
+        .args(["build", "-p", "host-sim", "--bin", "host-sim"])
+        .current_dir(repo())
+        .status()
+        .expect("cargo runs");
+    assert!(status.success(), "host-sim builds");
+    let exe = std::env::current_exe().expect("the test's path");
+    // target/<profile>/deps/studio-… → target/<profile>/host-sim
+    let binary = exe.parent().and_then(Path::parent).expect("a target directory").join("host-sim");
+    assert!(binary.exists(), "{} exists", binary.display());
+    binary
+}
+
+/// A running `host-sim studio`, stopped (Ctrl-C) on drop.
+struct Studio {
+    child: Child,
+    url: String,
+    port: u16,
+    token: String,
+}
+
+impl Studio {
+    fn start(binary: &Path, scene: Option<&Path>) -> Studio {
+        let mut command = Command::new(binary);
+        command.arg("studio").args(scene).stdout(Stdio::piped()).stderr(Stdio::piped());
+        let mut child = command.spawn().expect("host-sim studio starts");
+        let mut first = String::new();
+        BufReader::new(child.stdout.take().expect("stdout")).read_line(&mut first).expect("a first line");
+        let url = first.trim().to_string();
+        let rest =
+            url.strip_prefix("http://127.0.0.1:").unwrap_or_else(|| panic!("the first line is the address: {url}"));
+        let (port, token) = rest.split_once("/?token=").expect("port and token");
+        let (port, token) = (port.parse().expect("a port"), token.to_string());
+        assert!(token.len() >= 32, "a long token: {token}");
+        Studio { child, url, port, token }
+    }
+
+    /// Sends SIGINT (what Ctrl-C sends) and waits for the exit.
+    fn interrupt(&mut self) -> (std::process::ExitStatus, String) {
+        let status = Command::new("kill").args(["-INT", &self.child.id().to_string()]).status().expect("kill runs");
+        assert!(status.success());
+        let deadline = Instant::now() + Duration::from_secs(10);
+        loop {
+            if let Some(status) = self.child.try_wait().expect("wait") {
+                let mut stderr = String::new();
+                if let Some(mut e) = self.child.stderr.take() {
+                    std::io::Read::read_to_string(&mut e, &mut stderr).ok();
+                }
+                return (status, stderr);
+            }
+            assert!(Instant::now() < deadline, "the studio did not stop on SIGINT");
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+}
+
+impl Drop for Studio {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// host-sim's render of scene `text` (at its RASTER, or `size`).
+fn host_render(text: &str, size: Option<(u32, u32)>) -> host_sim::Rendered {
+    let mut scene = new_scene();
+    load_bytes("scene", text.as_bytes(), &mut scene).unwrap_or_else(|e| panic!("the scene parses: {e}"));
+    render(&scene, &RenderOptions { size, ..Default::default() }).expect("renders")
+}
+
+fn assert_same(name: &str, canvas: (u32, u32, Vec<u8>), expected: &RgbImage) {
+    let (w, h, pixels) = canvas;
+    assert_eq!((w, h), (expected.width, expected.height), "{name}: size");
+    let differing = pixels.chunks(3).zip(expected.data.chunks(3)).filter(|(a, b)| a != b).count();
+    assert_eq!(differing, 0, "{name}: {differing} pixels differ from host-sim's");
+}
+
+/// `text` with its RASTER line replaced (or one added).
+fn with_raster(text: &str, w: u32, h: u32) -> String {
+    let kept: Vec<&str> = text.lines().filter(|l| !l.trim_start().to_ascii_uppercase().starts_with("RASTER")).collect();
+    format!("RASTER {w} {h}\n{}\n", kept.join("\n"))
+}
+
+fn screenshot(browser: &Browser, name: &str) {
+    if std::env::var_os("OCTRACE_SCREENSHOTS").is_some_and(|v| v != "0") {
+        let dir = repo().join("docs/studio");
+        std::fs::create_dir_all(&dir).expect("docs/studio");
+        std::fs::write(dir.join(format!("{name}.png")), browser.screenshot()).expect("screenshot written");
+    }
+}
+
+/// Sets the editor's text as if typed (undoable, drafts follow).
+fn set_text(browser: &Browser, text: &str) {
+    let quoted = serde_json::to_string(text).expect("json");
+    browser.run(&format!("studio.setText({quoted}); return true;"));
+}
+
+fn render_and_wait(browser: &Browser) {
+    browser.run("document.getElementById('image').dataset.state = 'stale'; return true;");
+    browser.click("#render");
+    browser.wait_for("document.getElementById('image').dataset.state === 'done'", 300);
+}
+
+const START: &str = "/* placed with the studio */\nVIEWPOINT 0 4 12\nORIGIN 0 0 0\nRASTER 96 72\n\
+                     BACKGROUND 0.1 0.1 0.15\nLIGHT 12 -5 8 6\n";
+
+#[test]
+fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
+    let binary = host_sim_binary();
+    let dir = tempfile::tempdir().expect("a directory");
+    let scene_path = dir.path().join("placed.txt");
+    std::fs::write(&scene_path, START).expect("scene written");
+    let studio = Studio::start(&binary, Some(&scene_path));
+    let browser = Browser::start((1500, 900));
+    browser.goto(&studio.url);
+    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+
+    // Place a sphere the thesis's way: press on the x–z plane and drag up
+    // for its height, then drag for its radius.
+    browser.click("#toolbar button[data-tool=sphere]");
+    browser.drag("#wire", (0, 40), (0, 10));
+    browser.drag("#wire", (0, 0), (40, 0));
+    let text: String = browser.run("return document.getElementById('scene').value;").as_str().unwrap().into();
+    assert!(text.contains("SPHERE 1 "), "a sphere was placed:\n{text}");
+    // Its surface: red into diffuse, from the 16 colours, and a reflection.
+    browser.run("document.getElementById('surface-target').value = '4'; return true;");
+    browser.click(".swatches button[data-colour='2']");
+    browser.run(
+        "const s = document.querySelector('#panel input[data-field=reflection]');
+         s.value = '0.25'; s.dispatchEvent(new Event('change')); return true;",
+    );
+    browser
+        .wait_for("/SURFACE 1 0\\.1 0\\.1 0\\.1 1 0 0 .* 0\\.25 0/.test(document.getElementById('scene').value)", 10);
+    render_and_wait(&browser);
+    screenshot(&browser, "studio");
+    browser.click("#save-scene");
+    browser.wait_for("document.body.dataset.saved", 10);
+    let saved = std::fs::read_to_string(&scene_path).expect("the scene was saved");
+    assert!(saved.contains("SPHERE 1 ") && saved.starts_with(START), "saved:\n{saved}");
+    let expected = host_render(&saved, None);
+    assert_same("placed sphere", browser.canvas_rgb("image"), &expected.image);
+
+    // Each display mode: the 256-colour modes are host-sim --palette, the
+    // panels are embedded-graphics' own conversions at the panel size.
+    for (code, mode) in
+        [(1, PaletteMode::Scan), (2, PaletteMode::Dither), (3, PaletteMode::Coarse), (4, PaletteMode::Gray)]
+    {
+        browser.run(&format!(
+            "const d = document.getElementById('display'); d.value = '{code}';
+             d.dispatchEvent(new Event('change')); return true;"
+        ));
+        browser.wait_for(&format!("document.getElementById('image').dataset.display === '{code}'"), 30);
+        let shown = palette::apply(&expected.image, &expected.objects, mode).to_rgb();
+        assert_same(mode.name(), browser.canvas_rgb("image"), &shown);
+    }
+    for (code, name) in [(5, "rgb565"), (6, "gray4")] {
+        browser.run(&format!(
+            "document.getElementById('panel-size').value = '40x30';
+             const d = document.getElementById('display'); d.value = '{code}';
+             d.dispatchEvent(new Event('change')); return true;"
+        ));
+        browser.wait_for(
+            &format!(
+                "document.getElementById('image').dataset.display === '{code}'
+                 && document.getElementById('image').dataset.state === 'done'"
+            ),
+            60,
+        );
+        let mut panel = host_render(&saved, Some((40, 30))).image;
+        for p in panel.data.chunks_mut(3) {
+            let c = Rgb888::new(p[0], p[1], p[2]);
+            let shown = if code == 5 { Rgb888::from(Rgb565::from(c)) } else { Rgb888::from(Gray4::from(c)) };
+            p.copy_from_slice(&[shown.r(), shown.g(), shown.b()]);
+        }
+        assert_same(name, browser.canvas_rgb("image"), &panel);
+    }
+    browser.run("const d = document.getElementById('display'); d.value = '0'; d.dispatchEvent(new Event('change')); return true;");
+    browser.wait_for("document.getElementById('image').dataset.state === 'done' && document.getElementById('image').dataset.display === '0'", 60);
+
+    // Image files: what the page writes is host-sim's file format, and
+    // reading it back shows the same pixels.
+    let png = browser.run("return btoa(String.fromCharCode(...studio.imageBytes(0, 2)));");
+    let ras = octrace_tests::webdriver::base64_decode(png.as_str().expect("bytes"));
+    let read = host_sim::formats::read(&ras).expect("the page's Sun raster reads").to_rgb();
+    assert_eq!(read, expected.image);
+
+    // Undo takes the last edit back; redo restores it.
+    let before: String = browser.run("return document.getElementById('scene').value;").as_str().unwrap().into();
+    browser.run("studio.undo(); return true;");
+    let undone: String = browser.run("return document.getElementById('scene').value;").as_str().unwrap().into();
+    assert_ne!(undone, before);
+    browser.run("studio.redo(); return true;");
+    assert_eq!(browser.run("return document.getElementById('scene').value;").as_str().unwrap(), before);
+
+    // A file changed on disk since it was loaded is not overwritten without
+    // asking: declining keeps the other program's text.
+    std::fs::write(&scene_path, "/* changed elsewhere */\n").expect("written");
+    set_text(&browser, &format!("{saved}/* more */\n"));
+    browser.click("#save-scene");
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let question = loop {
+        if let Some(q) = browser.alert_text() {
+            break q;
+        }
+        assert!(Instant::now() < deadline, "no question about the changed file");
+        std::thread::sleep(Duration::from_millis(25));
+    };
+    assert!(question.contains("changed on disk"), "{question}");
+    browser.answer_alert(false);
+    assert_eq!(std::fs::read_to_string(&scene_path).unwrap(), "/* changed elsewhere */\n");
+
+    // Unsaved work survives a reload.
+    browser.goto(&studio.url);
+    browser.wait_for("document.body.dataset.ready === 'true'", 60);
+    let restored: String = browser.run("return document.getElementById('scene').value;").as_str().unwrap().into();
+    assert_eq!(restored, format!("{saved}/* more */\n"));
+
+    // Errors at line and column as you type.
+    set_text(&browser, "VIEWPOINT 0 0 5\nSPHERE 1 x 0 0 0\n");
+    browser.wait_for("document.querySelector('#errors li')", 10);
+    let error: String =
+        browser.run("return document.querySelector('#errors li').textContent;").as_str().unwrap().into();
+    assert!(error.starts_with("2:10:"), "{error}");
+}
+
+#[test]
+fn the_canvas_is_host_sims_image_for_every_scene() {
+    let binary = host_sim_binary();
+    let studio = Studio::start(&binary, None);
+    let browser = Browser::start((1500, 900));
+    browser.goto(&studio.url);
+    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+    // fig5_1 at its own RASTER, the rest small; every process mode.
+    let modes = ["naive", "octree", "dda"];
+    for (i, (name, path)) in scenes().into_iter().enumerate() {
+        let original = std::fs::read_to_string(&path).expect("scene");
+        let text = if name == "fig5_1" { original } else { with_raster(&original, 64, 48) };
+        let (accel, parallel, partition) = match i % 4 {
+            0 => ("3", true, "tiles"),
+            1 => ("2", true, "equal4"),
+            2 => ("1", false, "tiles"),
+            _ => ("0", true, "tiles"),
+        };
+        browser.run(&format!(
+            "document.getElementById('accel').value = '{accel}';
+             document.getElementById('parallel').checked = {parallel};
+             document.getElementById('partition').value = '{partition}'; return true;"
+        ));
+        set_text(&browser, &text);
+        render_and_wait(&browser);
+        let expected = host_render(&text, None);
+        assert_same(
+            &format!(
+                "{name} ({} {partition})",
+                modes.get(accel.parse::<usize>().unwrap_or(0).saturating_sub(1)).unwrap_or(&"auto")
+            ),
+            browser.canvas_rgb("image"),
+            &expected.image,
+        );
+        if name == "fig5_1" {
+            screenshot(&browser, "fig5_1");
+        }
+    }
+
+    // The draft while typing on fig5_3 at 160×120: from the last keystroke
+    // to the finished draft, measured in the page (reported, not asserted:
+    // speed targets live in benchmarks).
+    let fig5_3 = std::fs::read_to_string(repo().join("scenes/fig5_3.txt")).expect("fig5_3");
+    set_text(&browser, &fig5_3);
+    browser.wait_for("document.getElementById('draft').dataset.state === 'done'", 60);
+    let mut latencies = Vec::new();
+    for _ in 0..7 {
+        browser.run("document.getElementById('scene').focus(); return true;");
+        browser.type_into("#scene", " ");
+        browser.wait_for("document.getElementById('draft').dataset.state === 'done'", 60);
+        latencies.push(browser.run("return studio.draftLatency;").as_f64().expect("a latency"));
+    }
+    latencies.sort_by(f64::total_cmp);
+    println!(
+        "draft latency, fig5_3 at 160x120, after the last keystroke: median {:.0} ms (all: {latencies:.0?})",
+        latencies[3]
+    );
+    assert!(latencies.iter().all(|&l| l > 0.0), "latencies are measured");
+}
+
+#[test]
+fn the_server_keeps_its_security_rules() {
+    let binary = host_sim_binary();
+    let dir = tempfile::tempdir().expect("a directory");
+    let scene_path = dir.path().join("s.txt");
+    std::fs::write(&scene_path, START).expect("written");
+    std::fs::write(dir.path().join("secret.txt"), "secret").expect("written");
+    let mut studio = Studio::start(&binary, Some(&scene_path));
+    let port = studio.port;
+    let token = format!("token={}", studio.token);
+    let with_token = |path: &str| format!("{path}?{token}");
+
+    // With the token and the right Host: the page, its assets and the scene.
+    for path in ["/", "/studio.js", "/worker.js", "/studio.css", "/octrace_studio.wasm", "/scene"] {
+        let (status, body) = http(port, "GET", &with_token(path), &[], b"");
+        assert_eq!(status, 200, "{path}");
+        assert!(!body.is_empty(), "{path}");
+    }
+    let (_, scene) = http(port, "GET", &with_token("/scene"), &[], b"");
+    assert_eq!(scene, START.as_bytes());
+    // The token also works as a header or the page's cookie.
+    assert_eq!(http(port, "GET", "/scene", &[("X-Studio-Token", &studio.token)], b"").0, 200);
+    assert_eq!(http(port, "GET", "/", &[("Cookie", &format!("studio_token={}", studio.token))], b"").0, 200);
+
+    // No token, a wrong one: refused, even for the page.
+    for path in ["/", "/scene", "/octrace_studio.wasm"] {
+        assert_eq!(http(port, "GET", path, &[], b"").0, 403, "{path} without a token");
+        assert_eq!(http(port, "GET", &format!("{path}?token=0123"), &[], b"").0, 403, "{path}, wrong token");
+    }
+    let wrong = "0".repeat(studio.token.len());
+    assert_eq!(http(port, "GET", &format!("/?token={wrong}"), &[], b"").0, 403);
+    assert_eq!(http(port, "PUT", "/scene", &[("If-Match", "*")], b"x").0, 403);
+
+    // A foreign Host (DNS rebinding), even with the token.
+    for host in [
+        "evil.example:80",
+        &format!("evil.example:{port}"),
+        "127.0.0.1",
+        &format!("127.0.0.1:{}", port.wrapping_add(1)),
+    ] {
+        assert_eq!(http(port, "GET", &with_token("/scene"), &[("Host", host)], b"").0, 421, "Host {host}");
+    }
+    assert_eq!(http(port, "GET", &with_token("/"), &[("Host", &format!("localhost:{port}"))], b"").0, 200);
+
+    // Paths that try to leave the assets reach nothing.
+    for path in [
+        "/../secret.txt",
+        "/%2e%2e/secret.txt",
+        "/scene/../secret.txt",
+        "//etc/passwd",
+        "/studio.js/../../Cargo.toml",
+        "/secret.txt",
+        "/s.txt",
+        "/assets/studio.js",
+    ] {
+        let (status, body) = http(port, "GET", &with_token(path), &[], b"");
+        assert_eq!(status, 404, "{path}");
+        assert!(!String::from_utf8_lossy(&body).contains("secret"), "{path}");
+    }
+    assert_eq!(http(port, "PUT", &with_token("/secret.txt"), &[("If-Match", "*")], b"x").0, 405);
+    assert_eq!(std::fs::read_to_string(dir.path().join("secret.txt")).unwrap(), "secret");
+
+    // Saving: the version loaded, else a conflict; atomically.
+    let (status, _) = http(port, "PUT", &with_token("/scene"), &[("If-Match", "\"0000000000000000\"")], b"X");
+    assert_eq!(status, 409);
+    assert_eq!(std::fs::read_to_string(&scene_path).unwrap(), START);
+    assert_eq!(http(port, "PUT", &with_token("/scene"), &[("If-Match", "*")], b"RDEPTH 2\n").0, 200);
+    assert_eq!(std::fs::read_to_string(&scene_path).unwrap(), "RDEPTH 2\n");
+    let leftovers: Vec<_> =
+        std::fs::read_dir(dir.path()).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
+    assert_eq!(leftovers.len(), 2, "no temporary file left: {leftovers:?}");
+
+    // Loopback only: the listening socket is bound to 127.0.0.1, not to
+    // every interface.
+    let tcp = std::fs::read_to_string("/proc/net/tcp").expect("/proc/net/tcp");
+    let listening: Vec<&str> = tcp
+        .lines()
+        .skip(1)
+        .filter_map(|l| {
+            let fields: Vec<&str> = l.split_whitespace().collect();
+            (fields.get(3) == Some(&"0A") && fields[1].ends_with(&format!(":{port:04X}"))).then_some(fields[1])
+        })
+        .collect();
+    assert_eq!(listening, [format!("0100007F:{port:04X}")], "bound to 127.0.0.1 only");
+    let tcp6 = std::fs::read_to_string("/proc/net/tcp6").unwrap_or_default();
+    assert!(!tcp6.lines().any(|l| l.split_whitespace().nth(1).is_some_and(|a| a.ends_with(&format!(":{port:04X}")))));
+    // And another address of this machine does not answer.
+    if let Some(address) = std::net::UdpSocket::bind("0.0.0.0:0")
+        .and_then(|s| s.connect("192.0.2.1:9").map(|_| s))
+        .and_then(|s| s.local_addr())
+        .ok()
+        .filter(|a| !a.ip().is_loopback() && !a.ip().is_unspecified())
+    {
+        assert!(std::net::TcpStream::connect((address.ip(), port)).is_err(), "{} answers", address.ip());
+    }
+
+    // Ctrl-C stops it cleanly.
+    let (status, stderr) = studio.interrupt();
+    assert!(status.success(), "{status}: {stderr}");
+    assert!(stderr.contains("stopped"), "{stderr}");
+}
+
+#[test]
+fn a_busy_port_is_an_error_not_a_panic() {
+    let binary = host_sim_binary();
+    let taken = std::net::TcpListener::bind("127.0.0.1:0").expect("a port");
+    let port = taken.local_addr().unwrap().port();
+    let out = Command::new(&binary).args(["studio", "--port", &port.to_string()]).output().expect("runs");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot listen"), "{}", String::from_utf8_lossy(&out.stderr));
+}
