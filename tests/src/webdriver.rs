@@ -37,12 +37,39 @@ pub fn http(port: u16, method: &str, path: &str, headers: &[(&str, &str)], body:
     head.push_str("\r\n");
     stream.write_all(head.as_bytes()).expect("send");
     stream.write_all(body).expect("send");
+    // chromedriver keeps the connection open whatever the request says: read
+    // the head, then Content-Length bytes (or to the end without one).
     let mut response = Vec::new();
-    stream.read_to_end(&mut response).expect("read");
-    let split = response.windows(4).position(|w| w == b"\r\n\r\n").expect("a complete response");
-    let status_line = String::from_utf8_lossy(&response[..split]).lines().next().unwrap_or("").to_string();
-    let status = status_line.split(' ').nth(1).and_then(|s| s.parse().ok()).expect("a status");
-    (status, response[split + 4..].to_vec())
+    let mut buffer = [0u8; 65536];
+    let split = loop {
+        if let Some(split) = response.windows(4).position(|w| w == b"\r\n\r\n") {
+            break split;
+        }
+        let n = stream.read(&mut buffer).expect("read");
+        assert!(n > 0, "the connection closed before the response's head ended");
+        response.extend_from_slice(&buffer[..n]);
+    };
+    let head = String::from_utf8_lossy(&response[..split]).into_owned();
+    let status = head.split(' ').nth(1).and_then(|s| s.parse().ok()).expect("a status");
+    let length = head.lines().find_map(|l| {
+        let (name, value) = l.split_once(':')?;
+        name.trim().eq_ignore_ascii_case("content-length").then(|| value.trim().parse::<usize>().ok())?
+    });
+    let mut body = response[split + 4..].to_vec();
+    match length {
+        Some(length) => {
+            while body.len() < length {
+                let n = stream.read(&mut buffer).expect("read");
+                assert!(n > 0, "the connection closed inside the body");
+                body.extend_from_slice(&buffer[..n]);
+            }
+            body.truncate(length);
+        }
+        None => {
+            stream.read_to_end(&mut body).expect("read");
+        }
+    }
+    (status, body)
 }
 
 impl Browser {
@@ -83,7 +110,7 @@ impl Browser {
         let created = browser.command(
             "POST",
             "/session",
-            json!({"capabilities": {"alwaysMatch": {"browserName": "chrome",
+            json!({"capabilities": {"alwaysMatch": {"browserName": "chrome", "unhandledPromptBehavior": "ignore",
                 "goog:chromeOptions": {"binary": "/usr/bin/chromium", "args": args}}}}),
         );
         browser.session = created["sessionId"].as_str().expect("a session").to_string();
@@ -105,7 +132,7 @@ impl Browser {
 
     /// Tries a command; the error message when it fails.
     fn try_session(&self, method: &str, path: &str, body: Value) -> Result<Value, String> {
-        let body = body.to_string().into_bytes();
+        let body = if method == "GET" || method == "DELETE" { Vec::new() } else { body.to_string().into_bytes() };
         let (status, response) = http(
             self.port,
             method,
@@ -207,7 +234,10 @@ impl Drop for Browser {
 }
 
 fn element_id(element: &Value) -> String {
-    element["element-6066-11e4-a52f-4a5c6c2ee1c3"].as_str().expect("an element reference").to_string()
+    element["element-6066-11e4-a52e-4f735466cecf"]
+        .as_str()
+        .unwrap_or_else(|| panic!("an element reference: {element}"))
+        .to_string()
 }
 
 /// Standard base64 (with padding) to bytes.

@@ -142,7 +142,11 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
     browser.drag("#wire", (0, 40), (0, 10));
     browser.drag("#wire", (0, 0), (40, 0));
     let text: String = browser.run("return document.getElementById('scene').value;").as_str().unwrap().into();
-    assert!(text.contains("SPHERE 1 "), "a sphere was placed:\n{text}");
+    assert!(
+        text.contains("SPHERE 1 "),
+        "a sphere was placed:\n{text}\n{}",
+        browser.run("return JSON.stringify({tool: studio.tool, placing: studio.placing, log: studio.log});")
+    );
     // Its surface: red into diffuse, from the 16 colours, and a reflection.
     browser.run("document.getElementById('surface-target').value = '4'; return true;");
     browser.click(".swatches button[data-colour='2']");

@@ -60,13 +60,15 @@ function main() {
     sceneName: '',
     writable: false,
     lastRender: null, // {width, height, data: colours then objects}
-    undo: [], redo: [],
+    undoStack: [], redoStack: [],
     tool: 'select', selection: -1, placing: null,
     camera: { yaw: 0.7, pitch: 0.45, distance: 30, target: [0, 0, 0] },
     draftSeq: 0, draftSent: 0, draftTimer: 0,
   };
   // Exposed for scripts and the browser tests.
   window.studio = state;
+  // Script errors are kept for the tests' failure messages.
+  window.addEventListener('error', (e) => (state.log = state.log || []).push(['error', e.message, e.lineno]));
 
   const storageKey = () => 'octrace-studio:' + state.sceneName;
 
@@ -109,7 +111,7 @@ function main() {
 
   /** Replaces the text (a tool or the panel changed the scene). */
   function setText(value, remember = true) {
-    if (remember && value !== text.value) { state.undo.push(text.value); state.redo = []; }
+    if (remember && value !== text.value) { state.undoStack.push(text.value); state.redoStack = []; }
     text.value = value;
     textChanged();
   }
@@ -156,7 +158,7 @@ function main() {
     if (typingBase === null) typingBase = lastKnown;
     clearTimeout(typingUndoTimer);
     typingUndoTimer = setTimeout(() => {
-      if (typingBase !== text.value) { state.undo.push(typingBase); state.redo = []; }
+      if (typingBase !== text.value) { state.undoStack.push(typingBase); state.redoStack = []; }
       typingBase = null;
     }, 600);
     textChanged();
@@ -736,7 +738,7 @@ function main() {
     const d = drag;
     drag = null;
     if (d.kind === 'move' && d.moved) {
-      state.undo.push(d.base); state.redo = [];
+      state.undoStack.push(d.base); state.redoStack = [];
       textChanged();
       return;
     }
@@ -946,15 +948,15 @@ function main() {
   // -------------------------------------------------------- undo, keys --
 
   function undo() {
-    if (!state.undo.length) return;
-    state.redo.push(text.value);
-    text.value = state.undo.pop();
+    if (!state.undoStack.length) return;
+    state.redoStack.push(text.value);
+    text.value = state.undoStack.pop();
     textChanged();
   }
   function redo() {
-    if (!state.redo.length) return;
-    state.undo.push(text.value);
-    text.value = state.redo.pop();
+    if (!state.redoStack.length) return;
+    state.undoStack.push(text.value);
+    text.value = state.redoStack.pop();
     textChanged();
   }
   $('undo').onclick = undo;
