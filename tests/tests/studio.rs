@@ -157,7 +157,7 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
     browser
         .wait_for("/SURFACE 1 0\\.1 0\\.1 0\\.1 1 0 0 .* 0\\.25 0/.test(document.getElementById('scene').value)", 10);
     render_and_wait(&browser);
-    screenshot(&browser, "studio");
+    screenshot(&browser, "placed");
     browser.click("#save-scene");
     browser.wait_for("document.body.dataset.saved", 10);
     let saved = std::fs::read_to_string(&scene_path).expect("the scene was saved");
@@ -283,7 +283,7 @@ fn the_canvas_is_host_sims_image_for_every_scene() {
             &expected.image,
         );
         if name == "fig5_1" {
-            screenshot(&browser, "fig5_1");
+            screenshot(&browser, "studio");
         }
     }
 
@@ -294,7 +294,7 @@ fn the_canvas_is_host_sims_image_for_every_scene() {
     set_text(&browser, &fig5_3);
     browser.wait_for("document.getElementById('draft').dataset.state === 'done'", 60);
     let mut latencies = Vec::new();
-    for _ in 0..7 {
+    for _ in 0..11 {
         browser.run("document.getElementById('scene').focus(); return true;");
         browser.type_into("#scene", " ");
         browser.wait_for("document.getElementById('draft').dataset.state === 'done'", 60);
@@ -303,7 +303,7 @@ fn the_canvas_is_host_sims_image_for_every_scene() {
     latencies.sort_by(f64::total_cmp);
     println!(
         "draft latency, fig5_3 at 160x120, after the last keystroke: median {:.0} ms (all: {latencies:.0?})",
-        latencies[3]
+        latencies[latencies.len() / 2]
     );
     assert!(latencies.iter().all(|&l| l > 0.0), "latencies are measured");
 }
