@@ -13,7 +13,7 @@
 #![allow(unsafe_code)]
 
 use crate::formats::Format;
-use crate::studio::{self, Accel, Display, Studio, StudioError};
+use crate::studio::{self, Display, Studio, StudioError};
 use std::cell::RefCell;
 
 struct State {
@@ -74,9 +74,9 @@ pub extern "C" fn studio_load() -> u32 {
 #[no_mangle]
 pub extern "C" fn studio_prepare(accel: u32, width: u32, height: u32) -> u32 {
     run(|state| {
-        let accel = Accel::from_code(accel).ok_or(StudioError::BadInput("no such mode"))?;
+        let accel = studio::accel_from_code(accel).ok_or(StudioError::BadInput("no such mode"))?;
         let used = state.studio.prepare(accel, width, height)?;
-        state.output = format!("{used:?}").to_ascii_lowercase().into_bytes();
+        state.output = used.name().as_bytes().to_vec();
         Ok(())
     })
 }

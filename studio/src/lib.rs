@@ -22,7 +22,7 @@ mod exports;
 mod studio;
 
 pub use image::RgbImage;
-pub use studio::{Accel, Display, Studio, StudioError};
+pub use studio::{accel_from_code, Display, Studio, StudioError};
 
 /// What an object buffer holds for a pixel that shows the background (as
 /// host-sim's `NO_OBJECT`).

@@ -8,31 +8,18 @@ use crate::formats::{self, Format, Image};
 use crate::palette::{self, PaletteMode};
 use crate::{RgbImage, NO_OBJECT};
 use embedded_graphics_core::pixelcolor::{Gray4, Rgb565, Rgb888, RgbColor};
-use octrace_core::accel::{Accelerator, Mailbox, Naive, Octree, OctreeConfig, Traversal};
-use octrace_core::capacity::Host;
+use octrace_core::accel::{Accelerator, Mailbox, Naive, Octree, OctreeConfig};
 use octrace_core::parse::{parse_bytes, ParseError};
+use octrace_core::profile::Host;
 use octrace_core::render::Renderer;
 use octrace_core::scene::Scene;
+use octrace_core::AccelMode;
 use std::fmt;
 
-/// Scenes with at most this many objects render fastest without an octree
-/// (host-sim's rule for `--accel auto`).
-const NAIVE_UP_TO: usize = 16;
-
-/// The intersection strategy, as the page's process menu names it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Accel {
-    Auto,
-    Naive,
-    Octree,
-    Dda,
-}
-
-impl Accel {
-    /// The mode numbered `code` by the page (0 auto, 1 naive, 2 octree, 3 dda).
-    pub fn from_code(code: u32) -> Option<Accel> {
-        [Accel::Auto, Accel::Naive, Accel::Octree, Accel::Dda].get(code as usize).copied()
-    }
+/// The intersection mode the page numbers `code`: 0 auto, 1 naive,
+/// 2 octree, 3 dda (the core's order).
+pub fn accel_from_code(code: u32) -> Option<AccelMode> {
+    AccelMode::ALL.get(code as usize).copied()
 }
 
 /// How a finished image is shown: truecolour, one of the four 256-colour
@@ -121,27 +108,19 @@ impl Studio {
 
     /// Sets the image size and builds what `accel` needs; returns the mode
     /// used (never `Auto`).
-    pub fn prepare(&mut self, accel: Accel, width: u32, height: u32) -> Result<Accel, StudioError> {
+    pub fn prepare(&mut self, accel: AccelMode, width: u32, height: u32) -> Result<AccelMode, StudioError> {
         if !self.loaded {
             return Err(StudioError::NoScene);
         }
         let view = self.scene.view();
         Renderer::with_size(view, &Naive, width, height).map_err(|e| StudioError::Camera(format!("{e:?}")))?;
         self.size = (width, height);
-        let accel = match accel {
-            Accel::Auto if view.object_count() <= NAIVE_UP_TO => Accel::Naive,
-            Accel::Auto => Accel::Dda,
-            other => other,
-        };
-        self.octree = match accel {
-            Accel::Naive | Accel::Auto => None,
-            Accel::Octree | Accel::Dda => {
-                let traversal = if accel == Accel::Octree { Traversal::Named } else { Traversal::Dda };
-                let mut octree: Box<Octree<Host>> = Box::default();
-                octree.build(&view, &OctreeConfig { traversal, ..Default::default() });
-                Some(octree)
-            }
-        };
+        let accel = accel.resolve(view.object_count());
+        self.octree = accel.traversal().map(|traversal| {
+            let mut octree: Box<Octree<Host>> = Box::default();
+            octree.build(&view, &OctreeConfig { traversal, ..Default::default() });
+            octree
+        });
         Ok(accel)
     }
 
@@ -246,12 +225,12 @@ mod tests {
     fn every_mode_renders_the_same_bits_in_any_pieces() {
         let mut studio = Studio::default();
         assert_eq!(studio.load(SCENE).unwrap(), ((8, 6), 1));
-        studio.prepare(Accel::Naive, 8, 6).unwrap();
+        studio.prepare(AccelMode::Naive, 8, 6).unwrap();
         let mut whole = Vec::new();
         studio.render_rect(0, 0, 8, 6, &mut whole).unwrap();
         let (image, objects) = split_render(8, 6, &whole).unwrap();
         assert!(objects.contains(&0) && objects.contains(&NO_OBJECT));
-        for accel in [Accel::Octree, Accel::Dda, Accel::Auto] {
+        for accel in [AccelMode::Octree, AccelMode::Dda, AccelMode::Auto] {
             studio.prepare(accel, 8, 6).unwrap();
             let mut piece = Vec::new();
             studio.render_rect(3, 2, 4, 3, &mut piece).unwrap();
@@ -269,14 +248,14 @@ mod tests {
             panic!("the scene has an error")
         };
         assert!(errors[0].starts_with("2:10:"), "{errors:?}");
-        assert!(matches!(studio.prepare(Accel::Naive, 4, 4), Err(StudioError::NoScene)));
+        assert!(matches!(studio.prepare(AccelMode::Naive, 4, 4), Err(StudioError::NoScene)));
     }
 
     #[test]
     fn rectangles_outside_the_image_are_refused() {
         let mut studio = Studio::default();
         studio.load(SCENE).unwrap();
-        studio.prepare(Accel::Naive, 8, 6).unwrap();
+        studio.prepare(AccelMode::Naive, 8, 6).unwrap();
         let mut out = Vec::new();
         assert!(studio.render_rect(5, 0, 4, 1, &mut out).is_err());
         assert!(studio.render_rect(u32::MAX, 0, 2, 1, &mut out).is_err());
