@@ -194,6 +194,27 @@ impl Browser {
         self.session("POST", "/actions", actions);
     }
 
+    /// Presses and releases each key of `keys` in turn (WebDriver key
+    /// codes: "\u{E009}" holds Control until pressed again).
+    pub fn keys(&self, keys: &str) {
+        let mut actions = Vec::new();
+        let mut held = Vec::new();
+        for key in keys.chars() {
+            let modifier = matches!(key, '\u{E008}' | '\u{E009}' | '\u{E00A}');
+            if modifier && held.contains(&key) {
+                actions.push(json!({"type": "keyUp", "value": key.to_string()}));
+                held.retain(|&k| k != key);
+            } else if modifier {
+                actions.push(json!({"type": "keyDown", "value": key.to_string()}));
+                held.push(key);
+            } else {
+                actions.push(json!({"type": "keyDown", "value": key.to_string()}));
+                actions.push(json!({"type": "keyUp", "value": key.to_string()}));
+            }
+        }
+        self.session("POST", "/actions", json!({"actions": [{"type": "key", "id": "keyboard", "actions": actions}]}));
+    }
+
     /// The text of an open alert or confirm, if one is open.
     pub fn alert_text(&self) -> Option<String> {
         self.try_session("GET", "/alert/text", Value::Null).ok().and_then(|v| v.as_str().map(str::to_owned))

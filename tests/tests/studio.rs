@@ -419,3 +419,105 @@ fn a_busy_port_is_an_error_not_a_panic() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot listen"), "{}", String::from_utf8_lossy(&out.stderr));
 }
+
+/// Presses `key` (a WebDriver key string) on the page.
+fn press(browser: &Browser, key: &str) {
+    browser.run("document.activeElement && document.activeElement.blur(); return true;");
+    browser.keys(key);
+}
+
+fn scene_text(browser: &Browser) -> String {
+    browser.run("return document.getElementById('scene').value;").as_str().expect("text").to_string()
+}
+
+#[test]
+fn every_tool_places_its_object_and_selections_move_and_delete() {
+    let binary = host_sim_binary();
+    let dir = tempfile::tempdir().expect("a directory");
+    let scene_path = dir.path().join("tools.txt");
+    std::fs::write(&scene_path, START).expect("scene written");
+    let studio = Studio::start(&binary, Some(&scene_path));
+    let browser = Browser::start((1500, 900));
+    browser.goto(&studio.url);
+    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+
+    // Keys 1–8 choose the tools; the sized ones take a point and a size.
+    for (key, keyword) in [("2", "BOX 1 "), ("3", "SUPERQUADRIC 1 4 ")] {
+        press(&browser, key);
+        browser.drag("#wire", (-60, 60), (-60, 40));
+        browser.drag("#wire", (0, 0), (20, 0));
+        assert!(scene_text(&browser).contains(keyword), "{keyword} placed:\n{}", scene_text(&browser));
+    }
+    press(&browser, "4");
+    for (x, y) in [(-40, 80), (40, 80), (0, 40)] {
+        browser.drag("#wire", (x, y), (x, y - 10));
+    }
+    assert!(scene_text(&browser).contains("TRIANGLE 1 "));
+    press(&browser, "5");
+    browser.drag("#wire", (-30, 100), (-30, 90));
+    browser.drag("#wire", (30, 130), (30, 130));
+    assert!(scene_text(&browser).contains("RECTANGLE 1 "));
+    press(&browser, "6");
+    for (field, value) in [("order", 2), ("rows", 2), ("cols", 2), ("samples", 4)] {
+        browser.run(&format!(
+            "const i = document.querySelector('#panel input[data-field={field}]');
+             i.value = '{value}'; i.dispatchEvent(new Event('change')); return true;"
+        ));
+    }
+    for (x, y) in [(60, 60), (100, 60), (60, 100), (100, 100)] {
+        browser.drag("#wire", (x, y), (x, y - 5));
+    }
+    assert!(scene_text(&browser).contains("BSPLINE 1 2 2 2 4 4"), "{}", scene_text(&browser));
+    press(&browser, "8");
+    browser.drag("#wire", (-100, 0), (-100, -40));
+    assert_eq!(scene_text(&browser).matches("LIGHT ").count(), 2);
+    press(&browser, "7");
+    browser.drag("#wire", (0, 150), (0, 120));
+    assert!(!scene_text(&browser).contains("VIEWPOINT 0 4 12"), "the eye moved");
+    assert_eq!(scene_text(&browser).matches("VIEWPOINT").count(), 1);
+    // Everything placed is a valid scene, and the page renders it as
+    // host-sim does.
+    assert!(browser.run("return document.querySelectorAll('#errors li').length;") == 0, "{}", scene_text(&browser));
+    render_and_wait(&browser);
+    let text = scene_text(&browser);
+    assert_same("placed objects", browser.canvas_rgb("image"), &host_render(&text, None).image);
+
+    // Select the box by its centre, drag it along the x–z plane, delete it.
+    press(&browser, "s");
+    let centre = browser.run(
+        "const s = studio.model.find((s) => s.keyword === 'BOX');
+         const q = studio.project(s.args.slice(1, 4)); const c = document.getElementById('wire');
+         return [Math.round(q[0] - c.width / 2), Math.round(q[1] - c.height / 2)];",
+    );
+    let (x, y) = (centre[0].as_i64().unwrap(), centre[1].as_i64().unwrap());
+    let before: String = text.lines().find(|l| l.starts_with("BOX")).unwrap().into();
+    browser.drag("#wire", (x, y), (x + 30, y + 10));
+    let after: String = scene_text(&browser).lines().find(|l| l.starts_with("BOX")).unwrap().into();
+    assert_ne!(before, after, "the box moved");
+    assert_eq!(before.split(' ').nth(5), after.split(' ').nth(5), "sizes kept");
+    // The panel edits the selection's numbers.
+    browser.run(
+        "const i = document.querySelector('#panel input[data-field=\"half x\"]');
+         i.value = '0.75'; i.dispatchEvent(new Event('change')); return true;",
+    );
+    assert!(scene_text(&browser).lines().any(|l| l.starts_with("BOX") && l.split(' ').nth(5) == Some("0.75")));
+    press(&browser, "\u{E017}"); // Delete
+    assert!(!scene_text(&browser).contains("BOX"), "deleted");
+    // Undo (Ctrl+Z) brings it back.
+    press(&browser, "\u{E009}z\u{E009}");
+    assert!(scene_text(&browser).contains("BOX"), "undone");
+
+    // An image file loads into the display; Clear empties it; help opens.
+    let image = host_sim::formats::Image::Rgb(host_render(&text, Some((20, 10))).image);
+    let file = dir.path().join("picture.tga");
+    let mut bytes = Vec::new();
+    host_sim::formats::write(&image, host_sim::formats::Format::Tga, &mut bytes).expect("encoded");
+    std::fs::write(&file, bytes).expect("written");
+    browser.type_into("#load-image", &file.display().to_string());
+    browser.wait_for("document.getElementById('image').dataset.state === 'loaded'", 10);
+    assert_same("loaded Targa", browser.canvas_rgb("image"), &image.to_rgb());
+    browser.click("#clear");
+    assert_eq!(browser.run("return document.getElementById('image').dataset.state;"), "clear");
+    press(&browser, "\u{E031}"); // F1
+    assert_eq!(browser.run("return document.getElementById('help').open;"), true);
+}

@@ -615,6 +615,8 @@ function main() {
   function setTool(tool) {
     state.tool = tool;
     state.placing = null;
+    // A placing tool's panel shows its settings, not an old selection.
+    if (tool !== 'select') state.selection = -1;
     for (const b of document.querySelectorAll('#toolbar button')) b.classList.toggle('active', b.dataset.tool === tool);
     $('tool-hint').textContent = HINTS[tool];
     showPanel();
