@@ -204,10 +204,17 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
 
     // Image files: what the page writes is host-sim's file format, and
     // reading it back shows the same pixels.
-    let png = browser.run("return btoa(String.fromCharCode(...studio.imageBytes(0, 2)));");
-    let ras = octrace_tests::webdriver::base64_decode(png.as_str().expect("bytes"));
-    let read = host_sim::formats::read(&ras).expect("the page's Sun raster reads").to_rgb();
-    assert_eq!(read, expected.image);
+    for (format, name) in [(0, "PNG"), (1, "Targa"), (2, "Sun raster")] {
+        let encoded = browser.run(&format!("return btoa(String.fromCharCode(...studio.imageBytes(0, {format})));"));
+        let bytes = octrace_tests::webdriver::base64_decode(encoded.as_str().expect("bytes"));
+        let read = host_sim::formats::read(&bytes).unwrap_or_else(|e| panic!("the page's {name} reads: {e}"));
+        assert_eq!(read.to_rgb(), expected.image, "{name}");
+    }
+    // In a 256-colour mode the file is indexed, as host-sim --palette writes.
+    let encoded = browser.run("return btoa(String.fromCharCode(...studio.imageBytes(2, 0)));");
+    let bytes = octrace_tests::webdriver::base64_decode(encoded.as_str().expect("bytes"));
+    let dithered = palette::apply(&expected.image, &expected.objects, PaletteMode::Dither);
+    assert_eq!(host_sim::formats::read(&bytes).expect("indexed PNG"), dithered);
 
     // Undo takes the last edit back; redo restores it.
     let before: String = browser.run("return document.getElementById('scene').value;").as_str().unwrap().into();
