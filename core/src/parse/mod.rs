@@ -24,13 +24,13 @@ mod statement;
 pub use error::{ErrorKind, Field, Found, ParseError, Pos, Rule, Shown};
 pub use lexer::{Lexer, Token};
 pub use number::{parse_integer, Decimal};
-pub use statement::{ControlPoints, Patch, Statement};
+pub use statement::Statement;
 
 use crate::capacity::Capacities;
 use crate::scene::{Camera, CameraError, CapacityError, Light, Normalization, Scene, SurfaceEntry, WorldPoint};
 use crate::shapes::{AxisAlignedBox, Rectangle, ShapeKind, Sphere, Superquadric, Triangle};
 use keyword::Keyword;
-use statement::Cursor;
+use statement::{Cursor, Patch};
 
 /// What the parse found besides the scene.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
