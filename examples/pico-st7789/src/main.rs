@@ -3,12 +3,14 @@
 //! Pico-LCD-1.3, 240×240) through `mipidsi`. No heap, no framebuffer: the
 //! panel's own memory holds the picture. Pins and wiring are in README.md.
 //!
-//! Invariants: the scene, the octree and the mailbox live in statics owned
-//! by `main` (nothing large on the stack); the image takes the panel's size.
+//! Invariants: the scene, its octree and mailbox live in one static cell
+//! (all zero bits, so in `.bss`: no flash, no copy on the stack); the image
+//! takes the panel's size.
 
 #![no_std]
 #![no_main]
 
+use embedded_graphics::image::Image;
 use embedded_graphics::pixelcolor::Rgb565;
 use embedded_graphics::prelude::*;
 use embedded_hal::digital::OutputPin;
@@ -21,11 +23,7 @@ use mipidsi::interface::SpiInterface;
 use mipidsi::models::ST7789;
 use mipidsi::options::ColorInversion;
 use mipidsi::Builder;
-use octrace_core::accel::{Naive, Octree, OctreeConfig};
-use octrace_core::capacity::Board64K;
-use octrace_core::parse::parse;
-use octrace_core::render::Renderer;
-use octrace_core::scene::Scene;
+use octrace_core::{profile::Board64K, ConstStaticCell, Raytracer};
 use panic_halt as _;
 use rp2040_hal as hal;
 
@@ -47,18 +45,11 @@ const SCENE_TEXT: &str = include_str!("../../../scenes/fig5_1.txt");
 const PANEL_WIDTH: u16 = 240;
 const PANEL_HEIGHT: u16 = 240;
 
-/// The octree's walk stack: one frame a level, for `OctreeConfig`'s default
-/// depth of 12.
-const OCTREE_FRAMES: usize = 13;
+/// Room for the scene, its octree and mailbox, sized by a capacity profile.
+static RAYTRACER: ConstStaticCell<Raytracer<Board64K>> = ConstStaticCell::new(Raytracer::new());
 
 #[entry]
 fn main() -> ! {
-    // cortex-m-rt turns these into `&'static mut`: the arenas live in RAM
-    // for good, never on the stack.
-    static mut SCENE: Scene<Board64K> = Scene::new();
-    static mut OCTREE: Octree<Board64K, OCTREE_FRAMES> = Octree::new();
-    static mut MAILBOX: [u32; 16] = [0; 16];
-
     let mut peripherals = pac::Peripherals::take().unwrap();
     let mut watchdog = Watchdog::new(peripherals.WATCHDOG);
     let clocks = hal::clocks::init_clocks_and_plls(
@@ -103,25 +94,13 @@ fn main() -> ! {
     display.clear(Rgb565::BLACK).unwrap();
     backlight.set_high().unwrap();
 
-    // octrace: parse, choose the accelerator as host-sim's `auto` does, and
-    // trace into the panel at its own size.
-    let size = display.size();
-    let traced = match parse(SCENE_TEXT, SCENE, &mut |_error| ()) {
-        Err(_) => false,
-        Ok(_) if SCENE.view().object_count() <= 16 => {
-            Renderer::with_size(SCENE.view(), &Naive, size.width, size.height)
-                .is_ok_and(|renderer| renderer.with_mailbox(MAILBOX).render(&mut display).is_ok())
-        }
-        Ok(_) => {
-            OCTREE.build(&SCENE.view(), &OctreeConfig::default());
-            Renderer::with_size(SCENE.view(), &*OCTREE, size.width, size.height)
-                .is_ok_and(|renderer| renderer.with_mailbox(MAILBOX).render(&mut display).is_ok())
-        }
-    };
-    // A scene the board cannot trace (check it with host-sim, whose errors
-    // name the line and column) leaves the panel red.
-    if !traced {
-        display.clear(Rgb565::RED).unwrap();
+    // octrace: parse and index the scene, then trace it into the panel at
+    // the panel's size, scanline by scanline. A scene the board cannot trace
+    // (check it with host-sim, whose errors name the line and column) leaves
+    // the panel red.
+    match RAYTRACER.take().load(SCENE_TEXT) {
+        Ok(scene) => Image::new(&scene.image_for(&display), Point::zero()).draw(&mut display).unwrap(),
+        Err(_) => display.clear(Rgb565::RED).unwrap(),
     }
     loop {
         cortex_m::asm::wfi();
