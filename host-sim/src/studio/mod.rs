@@ -118,30 +118,30 @@ pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) ->
     0
 }
 
-/// Accepts connections until `stop` is set, each on its own thread; waits
-/// for those under way before returning, so a save is never cut short.
+/// Accepts connections until `stop` is set, each on its own thread. On
+/// stop it waits only for a save under way (so the scene file is never
+/// left half-replaced); a connection a browser keeps open idle does not
+/// hold Ctrl-C up.
 fn serve(listener: &TcpListener, shared: &Arc<Shared>, stop: &AtomicBool) {
-    // Polled, so Ctrl-C is noticed within a tenth of a second.
+    // Polled, so Ctrl-C is noticed within a few hundredths of a second.
     if listener.set_nonblocking(true).is_err() {
         return;
     }
-    std::thread::scope(|scope| {
-        while !stop.load(Ordering::SeqCst) {
-            match listener.accept() {
-                Ok((stream, _)) => {
-                    let shared = Arc::clone(shared);
-                    scope.spawn(move || handle(stream, &shared));
-                }
-                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => std::thread::sleep(Duration::from_millis(20)),
-                Err(_) => std::thread::sleep(Duration::from_millis(20)),
+    while !stop.load(Ordering::SeqCst) {
+        match listener.accept() {
+            Ok((stream, _)) => {
+                let shared = Arc::clone(shared);
+                std::thread::spawn(move || handle(stream, &shared));
             }
+            Err(_) => std::thread::sleep(Duration::from_millis(20)),
         }
-    });
+    }
+    drop(shared.saving.lock().unwrap_or_else(|poisoned| poisoned.into_inner()));
 }
 
 fn handle(stream: TcpStream, shared: &Shared) {
     let _ = stream.set_nonblocking(false);
-    let _ = stream.set_read_timeout(Some(Duration::from_secs(30)));
+    let _ = stream.set_read_timeout(Some(Duration::from_secs(10)));
     let mut stream = stream;
     let response = match http::read_request(&mut stream, MAX_SCENE_BYTES) {
         Ok(request) => respond(&request, shared),

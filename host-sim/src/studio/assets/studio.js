@@ -250,16 +250,23 @@ function main() {
       progress(w * h);
     };
     let used;
-    if ($('parallel').checked) {
-      used = await renderParallel(text.value, accel, width, height, place, () => job === renderJob);
-    } else {
-      used = state.octrace.prepare(accel, width, height);
-      // Bands of rows, yielding between them so progress shows.
-      for (let y = 0; y < height && job === renderJob; y += 8) {
-        const h = Math.min(8, height - y);
-        place(0, y, width, h, state.octrace.render(0, y, width, h));
-        await new Promise((r) => setTimeout(r, 0));
+    try {
+      if ($('parallel').checked) {
+        used = await renderParallel(text.value, accel, width, height, place, () => job === renderJob);
+      } else {
+        used = state.octrace.prepare(accel, width, height);
+        // Bands of rows, yielding between them so progress shows.
+        for (let y = 0; y < height && job === renderJob; y += 8) {
+          const h = Math.min(8, height - y);
+          place(0, y, width, h, state.octrace.render(0, y, width, h));
+          await new Promise((r) => setTimeout(r, 0));
+        }
       }
+    } catch (e) {
+      for (const w of workers) w.terminate();
+      imageCanvas.dataset.state = 'error';
+      setStatus('render failed: ' + e.message);
+      return;
     }
     if (job !== renderJob) return;
     const seconds = (performance.now() - started) / 1000;
