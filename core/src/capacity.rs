@@ -97,6 +97,7 @@ macro_rules! capacities {
         /// One capacity of a profile: something a scene can run out of.
         // Numbered from 1, so that `None` of an `Option<CapacityKind>` is
         // zero bits (an empty octree's report sits in `.bss`).
+        #[cfg_attr(feature = "defmt", derive(defmt::Format))]
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
         #[repr(u8)]
         pub enum CapacityKind {
@@ -230,6 +231,7 @@ impl Counts {
 }
 
 /// A scene needs more of something than its profile holds.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct CapacityError {
     /// What ran out.

@@ -10,6 +10,7 @@ use crate::scene::CameraError;
 use core::fmt;
 
 /// A position in the scene text: line and column (in characters), from 1.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct Pos {
     pub line: u32,
@@ -17,6 +18,7 @@ pub struct Pos {
 }
 
 /// A parameter of a statement, as the messages name it ("SPHERE radius").
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Field {
     pub statement: &'static str,
@@ -30,6 +32,7 @@ impl fmt::Display for Field {
 }
 
 /// What a token was found instead of the expected one.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Found<'a> {
     Token(&'a str),
@@ -72,6 +75,7 @@ impl fmt::Display for Shown<'_> {
 }
 
 /// The range a value must lie in.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Rule {
     /// > 0
@@ -104,6 +108,7 @@ impl fmt::Display for Rule {
     }
 }
 
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ErrorKind<'a> {
     /// The scene is not valid UTF-8 (the position is the first bad byte).
@@ -165,6 +170,7 @@ pub enum ErrorKind<'a> {
 }
 
 /// One error in a scene.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ParseError<'a> {
     pub pos: Pos,

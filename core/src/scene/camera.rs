@@ -19,6 +19,7 @@ pub const MAX_SAMPLES: u32 = 16;
 pub const MAX_SIDE: u32 = 16384;
 
 /// Why a camera cannot be built.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CameraError {
     /// VIEWPOINT equals ORIGIN: there is no view direction.
