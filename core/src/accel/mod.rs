@@ -14,8 +14,6 @@ mod naive;
 mod octree;
 
 pub use naive::Naive;
-#[doc(hidden)]
-pub use octree::{overlaps, Cell, FILING_MARGIN};
 pub use octree::{
     BuildReport, HashEntry, Index, Octree, OctreeCapacities, OctreeConfig, OctreeNode, OctreeStore, Traversal,
     MAX_DEPTH,
@@ -126,6 +124,15 @@ pub struct Mailbox<'m> {
     overflowed: bool,
     /// Cells (leaves) visited, for the benchmarks.
     pub cells: u64,
+}
+
+impl core::fmt::Debug for Mailbox<'_> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Mailbox")
+            .field("objects", &(self.words.len() * 32))
+            .field("cells", &self.cells)
+            .finish_non_exhaustive()
+    }
 }
 
 impl<'m> Mailbox<'m> {

@@ -103,8 +103,11 @@ where
 /// and shapes) can so draw on a 256-colour display. It does not know the
 /// objects under the pixels: [`Coarse`] draws no outlines through it (use
 /// [`render_indexed`]).
+#[derive(Debug)]
 pub struct Quantized<'a, D, Q> {
+    /// The palette display the indices go to.
     pub display: D,
+    /// Maps each truecolour pixel to an index (and may keep state: dither).
     pub quantizer: &'a mut Q,
 }
 

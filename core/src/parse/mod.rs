@@ -21,10 +21,9 @@ mod lexer;
 mod number;
 mod statement;
 
-pub use error::{ErrorKind, Field, Found, ParseError, Pos, Rule, Shown};
-pub use lexer::{Lexer, Token};
-pub use number::{parse_integer, Decimal};
-pub use statement::Statement;
+pub use error::{ErrorKind, Field, Found, ParseError, Pos, Rule};
+pub(crate) use number::Decimal;
+pub(crate) use statement::Statement;
 
 use crate::capacity::{CapacityError, CapacityKind, Counts};
 use crate::scene::{Camera, CameraError, Light, Normalization, Scene, SceneCapacities, SurfaceEntry, WorldPoint};

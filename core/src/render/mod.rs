@@ -45,6 +45,12 @@ pub struct Renderer<'a, A> {
     scratch: Scratch<'a>,
 }
 
+impl<A> core::fmt::Debug for Renderer<'_, A> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Renderer").field("camera", &self.camera).finish_non_exhaustive()
+    }
+}
+
 impl<'a, A: Accelerator> Renderer<'a, A> {
     /// A renderer at the scene's RASTER size.
     pub fn new(scene: SceneView<'a>, accel: &'a A) -> Result<Self, CameraError> {
@@ -92,10 +98,6 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
 
     pub fn size(&self) -> Size {
         Size::new(self.camera.width(), self.camera.height())
-    }
-
-    pub fn tracer(&self) -> &Tracer<'a, A> {
-        &self.tracer
     }
 
     /// The pixel at (`x`, `y`), `x` to the right and `y` down.

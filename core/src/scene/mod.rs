@@ -108,6 +108,16 @@ pub struct Scene<C: SceneCapacities> {
     pub normalization: Normalization,
 }
 
+impl<C: SceneCapacities> core::fmt::Debug for Scene<C> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Scene")
+            .field("profile", &C::NAME)
+            .field("objects", &self.view().object_count())
+            .field("settings", &self.settings)
+            .finish_non_exhaustive()
+    }
+}
+
 impl<C: SceneCapacities> Default for Scene<C> {
     fn default() -> Self {
         Self::new()

@@ -262,6 +262,12 @@ pub trait OctreeCapacities {
     type HashBuckets: Arena<Self::Index>;
 }
 
+impl<C: OctreeCapacities, const FRAMES: usize> core::fmt::Debug for Octree<C, FRAMES> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Octree").field("report", self.report()).finish_non_exhaustive()
+    }
+}
+
 impl BuildReport {
     /// The octree counts of a profile that builds this very tree (see
     /// [`crate::parse::count`] for the scene's).
