@@ -92,14 +92,18 @@ impl core::fmt::Display for AccelMode {
 /// surface data is computed only for the hit that wins.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Hit {
+    /// Where along the ray, in normalised units.
     pub t: Scalar,
+    /// The object hit.
     pub object: ObjectId,
 }
 
 /// The object a secondary ray leaves, and how it leaves it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RayStart {
+    /// The object the ray starts on.
     pub object: ObjectId,
+    /// Which way it leaves that object.
     pub leaving: Leaving,
 }
 

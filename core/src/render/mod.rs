@@ -14,7 +14,7 @@
 mod gamma;
 mod split;
 
-pub use gamma::GammaTable;
+pub(crate) use gamma::GammaTable;
 pub use split::{interleaved_rows, Tiles};
 
 use crate::accel::{Accelerator, Mailbox};
@@ -29,6 +29,7 @@ use embedded_graphics_core::primitives::Rectangle;
 /// A finished pixel: its display colour and the object seen through it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PixelSample {
+    /// The colour the display shows, gamma applied.
     pub color: Rgb888,
     /// The object the pixel's (centre) primary ray hits, as the scene file
     /// wrote it (see [`SceneView::written_object`]); `None` for background.
@@ -96,6 +97,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         self.scratch.stats
     }
 
+    /// The image size the renderer traces for.
     pub fn size(&self) -> Size {
         Size::new(self.camera.width(), self.camera.height())
     }

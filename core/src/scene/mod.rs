@@ -44,10 +44,13 @@ pub struct Light {
 /// are lengths).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Settings {
+    /// VIEWPOINT, ORIGIN, UPVECTOR and VIEWPORT.
     pub view: View,
     /// RASTER width and height, 1 to 16384.
     pub raster: [u32; 2],
+    /// RDEPTH: how many reflections and refractions a ray may spawn in a row.
     pub rdepth: u32,
+    /// BACKGROUND: the colour of rays that hit nothing.
     pub background: Color,
     /// GAMMA, > 0.
     pub gamma: Wide,
@@ -104,7 +107,9 @@ pub struct Scene<C: SceneCapacities> {
     control_points: C::ControlPoints,
     surfaces: C::Surfaces,
     lights: C::Lights,
+    /// The scene parameters (zero until a scene is loaded).
     pub settings: Settings,
+    /// How world coordinates map to the normalised space the tracer works in.
     pub normalization: Normalization,
 }
 
@@ -173,6 +178,7 @@ impl<C: SceneCapacities> Scene<C> {
         self.normalization = Normalization::IDENTITY;
     }
 
+    /// The loaded scene, read-only, as the tracer and accelerators see it.
     pub fn view(&self) -> SceneView<'_> {
         SceneView {
             objects: self.objects.as_slice(),
@@ -351,16 +357,27 @@ const DEFAULT_SETTINGS: Settings = Settings {
 /// A read-only view of a scene: what the tracer and the accelerators use.
 #[derive(Clone, Copy, Debug)]
 pub struct SceneView<'a> {
+    /// Every object, in the order the scene wrote them: an [`ObjectId`] indexes it.
     pub objects: &'a [ShapeHandle],
+    /// The spheres' arena.
     pub spheres: &'a [Sphere],
+    /// The boxes' arena.
     pub boxes: &'a [AxisAlignedBox],
+    /// The superquadrics' arena.
     pub superquadrics: &'a [Superquadric],
+    /// The triangles' arena.
     pub triangles: &'a [Triangle],
+    /// The rectangles' arena.
     pub rectangles: &'a [Rectangle],
+    /// The B-spline patches' triangles.
     pub smooth_triangles: &'a [SmoothTriangle],
+    /// The surfaces, sorted by number.
     pub surfaces: &'a [SurfaceEntry],
+    /// The point lights.
     pub lights: &'a [Light],
+    /// The scene parameters.
     pub settings: &'a Settings,
+    /// How world coordinates map to normalised space.
     pub normalization: Normalization,
 }
 
@@ -385,6 +402,7 @@ impl<'a> SceneView<'a> {
     }
 
     #[inline]
+    /// The primitive behind a handle.
     pub fn shape_of(&self, h: ShapeHandle) -> ShapeRef<'a> {
         let i = h.index();
         match h.kind() {
@@ -397,6 +415,7 @@ impl<'a> SceneView<'a> {
         }
     }
 
+    /// How many objects the scene holds (B-spline triangles count one each).
     pub fn object_count(&self) -> usize {
         self.objects.len()
     }
@@ -406,6 +425,7 @@ impl<'a> SceneView<'a> {
         (0..self.objects.len() as u32).map(ObjectId)
     }
 
+    /// The surface at `index` in [`SceneView::surfaces`] (objects store that index).
     pub fn surface(&self, index: u16) -> &'a Surface {
         &self.surfaces[index as usize].surface
     }

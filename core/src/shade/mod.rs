@@ -50,6 +50,7 @@ impl Stats {
         }
     }
 
+    /// Adds another render's counters, to total several threads or draws.
     pub fn add(&mut self, o: &Stats) {
         self.rays += o.rays;
         self.shadow_rays += o.shadow_rays;

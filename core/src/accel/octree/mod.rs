@@ -176,6 +176,7 @@ pub struct OctreeConfig {
     /// Boxes deeper than this are not subdivided (at most [`MAX_DEPTH`], and
     /// below the octree's `FRAMES`).
     pub max_depth: u32,
+    /// How rays walk the tree; every walk gives the same hits.
     pub traversal: Traversal,
 }
 
@@ -193,13 +194,18 @@ impl Default for OctreeConfig {
 /// What a build produced.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct BuildReport {
+    /// Boxes in the tree, leaves included.
     pub nodes: usize,
+    /// Boxes holding objects with no children.
     pub leaves: usize,
+    /// Object references filed in the leaves.
     pub references: usize,
     /// Object references the build needed at its peak: an arena of exactly
     /// this many builds the same tree.
     pub peak_references: usize,
+    /// Entries of the hash table that finds a box's children.
     pub hash_entries: usize,
+    /// The deepest level reached (the root is level 0).
     pub depth: u32,
     /// Boxes left unsplit because an arena was full (0 when all went well).
     pub unsplit: usize,
@@ -354,10 +360,12 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
         }
     }
 
+    /// What the last build produced.
     pub fn report(&self) -> &BuildReport {
         &self.report
     }
 
+    /// How rays walk the tree.
     pub fn traversal(&self) -> Traversal {
         self.traversal
     }
