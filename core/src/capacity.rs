@@ -125,6 +125,18 @@ macro_rules! capacities {
 
         /// A number for each [`CapacityKind`]: what a profile holds, or what
         /// a scene needs ([`crate::parse::count`]).
+        ///
+        /// A profile for several scenes holds the largest need of each:
+        ///
+        /// ```
+        /// use octrace_core::{capacity::{CapacityKind, Counts}, parse::count, profile::{Board16K, Profile}};
+        ///
+        /// let a = count("SPHERE 1 1 0 0 0\nSPHERE 1 1 3 0 0\n");
+        /// let b = count("SPHERE 1 1 0 0 0\nTRIANGLE 1 0 0 0 1 0 0 0 1 0\n");
+        /// let both: Counts = a.max(&b);
+        /// assert_eq!((both.spheres, both.triangles), (2, 1));
+        /// assert!(CapacityKind::ALL.into_iter().all(|k| both.get(k) <= Board16K::COUNTS.get(k)));
+        /// ```
         #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
         pub struct Counts {
             $($(#[$doc])* pub $field: usize,)*

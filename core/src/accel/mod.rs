@@ -26,6 +26,15 @@ use crate::shapes::{Leaving, Ray};
 /// How a scene's rays find their objects: the choice a user makes (host-sim's
 /// `--accel`, the firmware's `OCTRACE_ACCEL`). Every mode gives the same
 /// image; they differ in speed and memory.
+///
+/// ```
+/// use octrace_core::AccelMode;
+///
+/// assert_eq!(AccelMode::from_name("DDA"), Some(AccelMode::Dda));
+/// assert_eq!(AccelMode::Auto.resolve(3), AccelMode::Naive);
+/// assert_eq!(AccelMode::Auto.resolve(500), AccelMode::Dda);
+/// assert_eq!(AccelMode::Octree.resolve(3), AccelMode::Octree);
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum AccelMode {
     /// [`AccelMode::Naive`] for a handful of objects, else [`AccelMode::Dda`].

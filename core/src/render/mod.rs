@@ -39,6 +39,22 @@ pub struct PixelSample {
 /// Renders one scene through one accelerator. A renderer holds the mutable
 /// state of one thread (counters, mailbox); to render on several threads,
 /// give each its own renderer over the same scene and accelerator.
+///
+/// ```
+/// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*};
+/// use octrace_core::{accel::Naive, parse::parse, profile::Board16K, render::Renderer, scene::Scene};
+///
+/// let mut scene = Scene::<Board16K>::new();
+/// parse("RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nUPVECTOR 0 1 0\nBACKGROUND 0 0 1\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n", &mut scene, &mut |e| panic!("{e}")).unwrap();
+/// let mut renderer = Renderer::new(scene.view(), &Naive)?; // RASTER 8 8
+/// let mut display = MockDisplay::<Rgb888>::new();
+/// let stats = renderer.render(&mut display)?;
+/// assert_eq!(stats.rays, 64, "one ray a pixel: nothing reflects");
+/// assert_eq!(display.get_pixel(Point::new(0, 0)), Some(Rgb888::BLUE));
+/// // A single pixel, with the object seen through it.
+/// assert!(renderer.pixel(4, 4).object.is_some());
+/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// ```
 pub struct Renderer<'a, A> {
     tracer: Tracer<'a, A>,
     camera: Camera,

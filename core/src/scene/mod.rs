@@ -95,6 +95,20 @@ pub trait SceneCapacities {
 }
 
 /// Scene storage sized by the profile `C`.
+///
+/// An empty scene is all zero bits; [`crate::parse::parse`] fills it, and
+/// [`Scene::view`] is what the renderer and the accelerators read:
+///
+/// ```
+/// use octrace_core::{parse::parse, profile::Board16K, scene::Scene};
+///
+/// let mut scene = Scene::<Board16K>::new();
+/// let text = "RASTER 32 24\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nLIGHT 10 5 5 5\n";
+/// parse(text, &mut scene, &mut |e| panic!("{e}")).unwrap();
+/// assert_eq!(scene.settings.raster, [32, 24]);
+/// let view = scene.view();
+/// assert_eq!((view.object_count(), view.lights.len(), view.surfaces.len()), (1, 1, 1));
+/// ```
 pub struct Scene<C: SceneCapacities> {
     objects: C::Objects,
     spheres: C::Spheres,

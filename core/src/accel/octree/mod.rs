@@ -286,6 +286,28 @@ impl BuildReport {
 /// bounds the depth of a walk (the tree is at most `FRAMES − 1` deep); the
 /// 3DDDA keeps one frame per level, about 100 bytes of stack each, which a
 /// 16 KiB board wants to keep small.
+///
+/// Built over a parsed scene, it is an [`Accelerator`] for a
+/// [`Renderer`](crate::render::Renderer); the image is the same as without it:
+///
+/// ```
+/// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888};
+/// use octrace_core::{accel::{Naive, Octree}, parse::parse, profile::{Board16K, Profile}};
+/// use octrace_core::{render::Renderer, scene::Scene};
+///
+/// let mut scene = Scene::<Board16K>::new();
+/// parse("RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nUPVECTOR 0 1 0\nBACKGROUND 0 0 1\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n", &mut scene, &mut |e| panic!("{e}")).unwrap();
+/// let mut octree = Octree::<Board16K>::new();
+/// let report = octree.build(&scene.view(), &Board16K::OCTREE);
+/// assert_eq!(report.unsplit, 0, "the arenas were large enough");
+///
+/// let mut with_octree = MockDisplay::<Rgb888>::new();
+/// Renderer::new(scene.view(), &octree)?.render(&mut with_octree)?;
+/// let mut without = MockDisplay::<Rgb888>::new();
+/// Renderer::new(scene.view(), &Naive)?.render(&mut without)?;
+/// assert_eq!(with_octree, without);
+/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// ```
 pub struct Octree<C: OctreeCapacities, const FRAMES: usize = { MAX_DEPTH as usize + 1 }> {
     nodes: C::Nodes,
     refs: C::References,
