@@ -1,9 +1,9 @@
 //! octrace's core: a ray tracer in fixed-point arithmetic for small
 //! microcontrollers, `no_std` and allocation-free. A scene is parsed from
 //! text ([`parse`]) into fixed-capacity arenas ([`scene`], sized by a
-//! [`profile`]), optionally indexed by an octree ([`accel`]), and rendered
-//! pixel by pixel ([`render`]) into any embedded-graphics `DrawTarget`, in
-//! truecolour or through a 256-colour [`palette`].
+//! [`profile`](mod@profile)), optionally indexed by an octree ([`accel`]),
+//! and rendered pixel by pixel ([`render`]) into any embedded-graphics
+//! `DrawTarget`, in truecolour or through a 256-colour [`palette`].
 //!
 //! # From scene text to a display
 //!
@@ -48,7 +48,7 @@
 //!
 //! # Capacities
 //!
-//! A [`profile`] says how many of each thing a build holds, so the linker
+//! A [`profile`](mod@profile) says how many of each thing a build holds, so the linker
 //! checks the board's RAM: [`profile::Board16K`] and [`profile::Board64K`]
 //! are ready-made, and [`profile!`] defines one for your own scenes from
 //! counts ([`parse::count`] tells what a scene needs; a scene that needs

@@ -8,7 +8,7 @@
 //!   distance: the earlier object wins) uses that order.
 //!
 //! [`Scene`] owns the storage, arenas sized by [`SceneCapacities`] (which
-//! every [`crate::profile`] implements); the tracer and the accelerators read
+//! every [`crate::profile`](mod@crate::profile) implements); the tracer and the accelerators read
 //! it through [`SceneView`], plain slices, so they do not carry the
 //! profile's type parameters. An empty [`Scene`] is all zero bits, so one in
 //! a `static` costs no flash.
