@@ -75,6 +75,14 @@
 //! to [`AccelMode::AUTO_NAIVE_UP_TO`] objects and `Dda` above. Every mode
 //! gives the same image, bit for bit.
 //!
+//! # Features
+//!
+//! - `static-cell` (default): re-exports [`ConstStaticCell`], the cell a
+//!   board keeps its [`Raytracer`] in.
+//! - `alloc`: the heap-backed `profile::Host` profile, for desktops.
+//! - `defmt`: every error type implements `defmt::Format`, so a board can
+//!   log why a scene did not load or draw.
+//!
 //! # No-panic contract
 //!
 //! For any input text, however malformed or hostile, and any scene the
