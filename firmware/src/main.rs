@@ -1,7 +1,8 @@
 //! octrace on a Cortex-M board: the scene text lives in flash, is parsed on
 //! the board into static arenas, and is rendered row by row straight into
-//! the display driver (here: a host file over semihosting). No heap, no
-//! framebuffer. Build-time choices are in `build.rs`.
+//! the display driver: a host file over semihosting, or on the
+//! LM3S6965EVB its OLED panel (`ssd0323`). No heap, no framebuffer.
+//! Build-time choices are in `build.rs`.
 //!
 //! Exit codes: 0 rendered, 2 the scene has errors, 3 the host refused the
 //! output, 101 panic, 102 HardFault, 103 unexpected interrupt.
@@ -9,8 +10,11 @@
 #![no_std]
 #![no_main]
 
+#[cfg(not(board = "lm3s6965evb"))]
 mod display;
 mod semihosting;
+#[cfg(board = "lm3s6965evb")]
+mod ssd0323;
 
 mod config {
     include!(concat!(env!("OUT_DIR"), "/config.rs"));
@@ -20,16 +24,22 @@ use core::cell::RefCell;
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::hprintln;
 use critical_section::Mutex;
-use display::{StreamDisplay, WireColor};
-use embedded_graphics_core::geometry::Size;
-use embedded_graphics_core::pixelcolor::{Rgb565, Rgb888};
+use embedded_graphics_core::draw_target::DrawTarget;
 use octrace_core::accel::{Accelerator, Naive, Octree, OctreeConfig, Traversal};
-use octrace_core::palette::{render_indexed, Dither, PaletteIndex};
 use octrace_core::parse::parse;
 use octrace_core::render::Renderer;
 use octrace_core::scene::{Scene, SceneView};
 use octrace_core::shade::Stats;
-use semihosting::{exit, HostFile};
+use semihosting::exit;
+// What the boards that stream to a host file use.
+#[cfg(not(board = "lm3s6965evb"))]
+use {
+    display::StreamDisplay,
+    embedded_graphics_core::geometry::Size,
+    embedded_graphics_core::pixelcolor::{Gray4, Rgb565, Rgb888},
+    octrace_core::palette::{render_indexed, Dither, PaletteIndex},
+    semihosting::HostFile,
+};
 
 /// The intersection mode, chosen at build time.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -48,6 +58,8 @@ pub enum Wire {
     Rgb565,
     /// Palette indices, ordered-dithered onto the 6×6×6 cube.
     Dither,
+    /// 16 gray levels (embedded-graphics' conversion from Rgb888).
+    Gray4,
 }
 
 /// What each board holds: the capacity profile, the octree's walk depth and
@@ -60,13 +72,16 @@ mod board {
     pub const FRAMES: usize = 4;
     pub const OCTREE: OctreeConfig = OctreeConfig { max_objects: 8, max_depth: 3, traversal: Traversal::Dda };
 }
-#[cfg(not(board = "microbit"))]
+#[cfg(board = "mps2-an385")]
 mod board {
     use octrace_core::accel::{OctreeConfig, Traversal};
     pub type Profile = octrace_core::capacity::Board64K;
     pub const FRAMES: usize = 13;
     pub const OCTREE: OctreeConfig = OctreeConfig { max_objects: 4, max_depth: 12, traversal: Traversal::Dda };
 }
+#[cfg(board = "lm3s6965evb")]
+#[path = "lm3s6965evb.rs"]
+mod board;
 use board::Profile;
 type BoardOctree = Octree<Profile, { board::FRAMES }>;
 
@@ -96,6 +111,10 @@ fn main() -> ! {
         run(&mut scene, &mut octree)
     });
     hprintln!("peak stack: {} bytes", peak_stack());
+    #[cfg(board = "lm3s6965evb")]
+    if code == 0 {
+        board::show_until_grabbed();
+    }
     exit(code)
 }
 
@@ -135,8 +154,8 @@ fn run(scene: &mut Scene<Profile>, octree: &mut BoardOctree) -> u32 {
         config::WIDTH,
         config::HEIGHT
     );
-    let Some(file) = HostFile::create(config::OUTPUT) else {
-        hprintln!("cannot create the output file on the host");
+    let Some(file) = open_output() else {
+        hprintln!("cannot open the display (or the output file on the host)");
         return 3;
     };
     let result = match traversal {
@@ -162,35 +181,54 @@ fn run(scene: &mut Scene<Profile>, octree: &mut BoardOctree) -> u32 {
             0
         }
         None => {
-            hprintln!("the host refused the pixels");
+            hprintln!("the display refused the pixels");
             3
         }
     }
 }
 
+// The display: a host file on the boards without one (the pixels streamed
+// in the configured format), the OLED panel on the LM3S6965EVB.
+#[cfg(not(board = "lm3s6965evb"))]
+fn open_output() -> Option<HostFile> {
+    HostFile::create(config::OUTPUT)
+}
+#[cfg(board = "lm3s6965evb")]
+use board::open_output;
+
 /// Renders into the display in the configured pixel format. Not inlined:
 /// each instance keeps its renderer in its own frame, so only one is ever on
 /// the stack.
+#[cfg(not(board = "lm3s6965evb"))]
 #[inline(never)]
 fn draw<A: Accelerator>(view: SceneView<'_>, accel: &A, file: HostFile) -> Option<Stats> {
+    let size = Size::new(config::WIDTH, config::HEIGHT);
     match config::WIRE {
-        Wire::Rgb888 => render::<A, Rgb888>(view, accel, file, |r, d| r.render(d)),
-        Wire::Rgb565 => render::<A, Rgb565>(view, accel, file, |r, d| r.render(d)),
-        Wire::Dither => {
-            render::<A, PaletteIndex>(view, accel, file, |r, d| render_indexed(r, 0..config::HEIGHT, &mut Dither, d))
-        }
+        Wire::Rgb888 => render(view, accel, StreamDisplay::<Rgb888>::new(file, size), |r, d| r.render(d)),
+        Wire::Rgb565 => render(view, accel, StreamDisplay::<Rgb565>::new(file, size), |r, d| r.render(d)),
+        Wire::Gray4 => render(view, accel, StreamDisplay::<Gray4>::new(file, size), |r, d| r.render(d)),
+        Wire::Dither => render(view, accel, StreamDisplay::<PaletteIndex>::new(file, size), |r, d| {
+            render_indexed(r, 0..config::HEIGHT, &mut Dither, d)
+        }),
     }
 }
 
+/// The panel shows 16 grays: build.rs allows no other format here.
+#[cfg(board = "lm3s6965evb")]
 #[inline(never)]
-fn render<A: Accelerator, C: WireColor>(
+fn draw<A: Accelerator>(view: SceneView<'_>, accel: &A, panel: board::Output) -> Option<Stats> {
+    debug_assert!(config::WIRE == Wire::Gray4);
+    render(view, accel, panel, |r, d| r.render(d))
+}
+
+#[inline(never)]
+fn render<A: Accelerator, D: DrawTarget>(
     view: SceneView<'_>,
     accel: &A,
-    file: HostFile,
-    paint: impl FnOnce(&mut Renderer<'_, A>, &mut StreamDisplay<C>) -> Result<Stats, display::WriteError>,
+    mut display: D,
+    paint: impl FnOnce(&mut Renderer<'_, A>, &mut D) -> Result<Stats, D::Error>,
 ) -> Option<Stats> {
     let mut words = [0u32; MAILBOX_WORDS];
-    let mut display = StreamDisplay::<C>::new(file, Size::new(config::WIDTH, config::HEIGHT));
     let Ok(mut renderer) = Renderer::with_size(view, accel, config::WIDTH, config::HEIGHT) else { return None };
     renderer.set_mailbox(&mut words);
     bench_marker(0);

@@ -142,7 +142,6 @@ impl Firmware {
         let _ = std::fs::remove_file(&file);
         let out = Command::new("bash")
             .arg(repo().join("firmware/run.sh"))
-            .arg(self.board.machine())
             .arg(elf)
             .output()
             .map_err(|e| format!("cannot run qemu: {e}"))?;
