@@ -77,6 +77,9 @@ fn main() {
     if oled && (w > 128 || h > 64) {
         fail(format!("OCTRACE_SIZE={size}: the lm3s6965evb's panel is 128x64"));
     }
+    if oled && !w.is_multiple_of(2) {
+        fail(format!("OCTRACE_SIZE={size}: the lm3s6965evb's panel takes pixels in pairs: an even width"));
+    }
     let accel = match var("OCTRACE_ACCEL", "auto").as_str() {
         "auto" => "Auto",
         "naive" => "Naive",

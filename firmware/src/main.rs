@@ -4,8 +4,10 @@
 //! LM3S6965EVB its OLED panel (`ssd0323`). No heap, no framebuffer.
 //! Build-time choices are in `build.rs`.
 //!
-//! Exit codes: 0 rendered, 2 the scene has errors, 3 the host refused the
-//! output, 101 panic, 102 HardFault, 103 unexpected interrupt.
+//! Exit codes: 0 rendered, 2 the scene has errors, 3 the display (the host
+//! file, the panel) refused the output, 101 panic, 102 HardFault, 103
+//! unexpected interrupt. The LM3S6965EVB keeps its picture on the panel
+//! until the runner has grabbed the screen, then exits.
 
 #![no_std]
 #![no_main]
@@ -204,12 +206,15 @@ use board::open_output;
 fn draw<A: Accelerator>(view: SceneView<'_>, accel: &A, file: HostFile) -> Option<Stats> {
     let size = Size::new(config::WIDTH, config::HEIGHT);
     match config::WIRE {
-        Wire::Rgb888 => render(view, accel, StreamDisplay::<Rgb888>::new(file, size), |r, d| r.render(d)),
-        Wire::Rgb565 => render(view, accel, StreamDisplay::<Rgb565>::new(file, size), |r, d| r.render(d)),
-        Wire::Gray4 => render(view, accel, StreamDisplay::<Gray4>::new(file, size), |r, d| r.render(d)),
-        Wire::Dither => render(view, accel, StreamDisplay::<PaletteIndex>::new(file, size), |r, d| {
-            render_indexed(r, 0..config::HEIGHT, &mut Dither, d)
-        }),
+        Wire::Rgb888 => render(view, accel, || StreamDisplay::<Rgb888>::new(file, size), |r, d| r.render(d)),
+        Wire::Rgb565 => render(view, accel, || StreamDisplay::<Rgb565>::new(file, size), |r, d| r.render(d)),
+        Wire::Gray4 => render(view, accel, || StreamDisplay::<Gray4>::new(file, size), |r, d| r.render(d)),
+        Wire::Dither => render(
+            view,
+            accel,
+            || StreamDisplay::<PaletteIndex>::new(file, size),
+            |r, d| render_indexed(r, 0..config::HEIGHT, &mut Dither, d),
+        ),
     }
 }
 
@@ -218,17 +223,19 @@ fn draw<A: Accelerator>(view: SceneView<'_>, accel: &A, file: HostFile) -> Optio
 #[inline(never)]
 fn draw<A: Accelerator>(view: SceneView<'_>, accel: &A, panel: board::Output) -> Option<Stats> {
     debug_assert!(config::WIRE == Wire::Gray4);
-    render(view, accel, panel, |r, d| r.render(d))
+    render(view, accel, || panel, |r, d| r.render(d))
 }
 
 #[inline(never)]
 fn render<A: Accelerator, D: DrawTarget>(
     view: SceneView<'_>,
     accel: &A,
-    mut display: D,
+    display: impl FnOnce() -> D,
     paint: impl FnOnce(&mut Renderer<'_, A>, &mut D) -> Result<Stats, D::Error>,
 ) -> Option<Stats> {
     let mut words = [0u32; MAILBOX_WORDS];
+    // Made here, in this frame, as the renderer is.
+    let mut display = display();
     let Ok(mut renderer) = Renderer::with_size(view, accel, config::WIDTH, config::HEIGHT) else { return None };
     renderer.set_mailbox(&mut words);
     bench_marker(0);

@@ -218,7 +218,7 @@ impl DrawTarget for Ssd0323 {
             return Ok(());
         }
         let (x, y) = (shown.top_left.x as u32, shown.top_left.y as u32);
-        if x % 2 != 0 || shown.size.width % 2 != 0 {
+        if !x.is_multiple_of(2) || !shown.size.width.is_multiple_of(2) {
             return Err(Error::OddColumns);
         }
         // Inside the panel, so every bound fits a byte.
