@@ -141,15 +141,17 @@ impl Ssd0323 {
         write_pins(GPIO_C, PC7_DATA_COMMAND, 0);
 
         // SPI mode 3 (clock idles high, data sampled on the rising edge,
-        // where the SSD0323 latches it), 8-bit frames, the clock divided by
-        // 4 × 2: at most 2 MHz from the chip's 8 MHz crystal or its internal
-        // oscillator, within the controller's limit.
+        // where the SSD0323 latches it), 8-bit frames, the system clock
+        // divided by 8 (prescaler 4, serial clock rate 1): 1 MHz from the
+        // board's 8 MHz crystal, about 2 MHz at most from the chip's
+        // internal oscillator, within the controller's limit.
         write(SSI0 + SSI_CR1, 0);
         write(SSI0 + SSI_CPSR, 4);
         write(SSI0 + SSI_CR0, (1 << 8) | (1 << 7) | (1 << 6) | 7);
         write(SSI0 + SSI_CR1, CR1_SSE);
 
-        let mut panel = Ssd0323 { mode: Mode::Data };
+        // The pin was set low just above.
+        let mut panel = Ssd0323 { mode: Mode::Command };
         panel.command(&[
             0xAE, // display off while it is set up
             0xA0, 0x00, // remap: horizontal address increment
