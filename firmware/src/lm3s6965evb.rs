@@ -1,19 +1,12 @@
-//! The TI Stellaris LM3S6965EVB (Cortex-M3, 64 KiB RAM): what the board
-//! holds, and its display, the 128×64 16-gray OLED (`ssd0323`). Invariant:
-//! a rendered picture stays on the panel until the host has grabbed it.
+//! The TI Stellaris LM3S6965EVB (Cortex-M3, 64 KiB RAM) and its display,
+//! the 128×64 16-gray OLED (`ssd0323`). Invariant: a rendered picture stays
+//! on the panel until the host has grabbed it.
 
 use crate::semihosting::HostFile;
 use crate::ssd0323::Ssd0323;
 use cortex_m_semihosting::hprintln;
-use octrace_core::accel::{OctreeConfig, Traversal};
 
-pub type Profile = octrace_core::capacity::Board64K;
-pub const FRAMES: usize = 13;
-pub const OCTREE: OctreeConfig = OctreeConfig { max_objects: 4, max_depth: 12, traversal: Traversal::Dda };
-
-/// The display the picture is drawn into.
-pub type Output = Ssd0323;
-
+/// The panel, brought up and cleared.
 pub fn open_output() -> Option<Ssd0323> {
     Ssd0323::take()
 }
