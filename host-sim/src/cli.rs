@@ -54,8 +54,8 @@ pub struct Args {
     /// --palette dither).
     #[arg(long, value_enum, default_value_t = PanelColor::Rgb888)]
     pub color: PanelColor,
-    /// The file format; by default from OUT's extension (png, tga, ras),
-    /// else PNG.
+    /// The file format; by default from OUT's extension (png, tga, ras), or
+    /// PNG when OUT has none. Any other extension is refused without it.
     #[arg(long, value_enum)]
     pub format: Option<Format>,
     /// Render at WxH pixels instead of the scene's RASTER (for a quick
@@ -96,7 +96,8 @@ pub enum Command {
         input: PathBuf,
         /// The image to write.
         output: PathBuf,
-        /// The output format; by default from OUTPUT's extension.
+        /// The output format; by default from OUTPUT's extension (png, tga,
+        /// ras), or PNG when OUTPUT has none.
         #[arg(long, value_enum)]
         format: Option<Format>,
     },
@@ -202,13 +203,34 @@ where
     }
 }
 
-/// The format to write `path` in: the one asked for, else by extension,
-/// else PNG.
-fn output_format(asked: Option<Format>, path: &Path) -> Format {
-    asked.or_else(|| Format::from_path(path)).unwrap_or(Format::Png)
+/// The format to write `path` in: the one asked for, else the one its
+/// extension names, else (no extension) PNG. Any other extension is refused
+/// before anything is rendered: a PNG named `.bmp` would mislead whatever
+/// opens it.
+fn output_format(asked: Option<Format>, path: &Path, stderr: &mut dyn Write) -> Result<Format, i32> {
+    if let Some(format) = asked {
+        return Ok(format);
+    }
+    let Some(extension) = path.extension() else {
+        return Ok(Format::Png);
+    };
+    Format::from_path(path).ok_or_else(|| {
+        let names: Vec<&str> = <Format as clap::ValueEnum>::value_variants().iter().map(|f| f.name()).collect();
+        let _ = writeln!(
+            stderr,
+            "host-sim: cannot write {}: `.{}` is not a format host-sim writes; it writes {} \
+             (chosen by the extension, or by --format <{}>)",
+            path.display(),
+            extension.to_string_lossy(),
+            names.join(", "),
+            names.join("|"),
+        );
+        EXIT_SCENE
+    })
 }
 
 fn convert(input: &Path, output: &Path, format: Option<Format>, stderr: &mut dyn Write) -> Result<(), i32> {
+    let format = output_format(format, output, stderr)?;
     let bytes = std::fs::read(input).map_err(|e| {
         let _ = writeln!(stderr, "host-sim: cannot read {}: {e}", input.display());
         EXIT_IO
@@ -217,7 +239,6 @@ fn convert(input: &Path, output: &Path, format: Option<Format>, stderr: &mut dyn
         let _ = writeln!(stderr, "host-sim: {}: {e}", input.display());
         EXIT_SCENE
     })?;
-    let format = output_format(format, output);
     write_atomically(output, |f| formats::write(&image, format, f).map_err(std::io::Error::other)).map_err(|e| {
         let _ = writeln!(stderr, "host-sim: cannot write {}: {e}", output.display());
         EXIT_IO
@@ -268,6 +289,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
         let _ = writeln!(stderr, "host-sim: refusing to overwrite the scene file {} with the image", out.display());
         return Err(EXIT_SCENE);
     }
+    let format = output_format(args.format, &out, stderr)?;
     let view = scene.view();
     let (w, h) = args.size.unwrap_or((view.settings.raster[0], view.settings.raster[1]));
     let bar = if !args.quiet && std::io::stderr().is_terminal() {
@@ -308,7 +330,6 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
     let stats = rendered.stats;
     let palette_mode = if args.color == PanelColor::Dither { PaletteMode::Dither } else { args.palette };
     let image = palette::apply(&rendered.image, &rendered.objects, palette_mode);
-    let format = output_format(args.format, &out);
     let written = match panel_preview(&rendered.image, args.color, format) {
         None => write_atomically(&out, |f| formats::write(&image, format, f).map_err(std::io::Error::other)),
         Some(Preview::Image(panel)) => {
