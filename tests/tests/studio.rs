@@ -7,7 +7,6 @@
 //! `OCTRACE_SCREENSHOTS=1` also writes the README's screenshots to
 //! `docs/studio/`.
 
-use embedded_graphics_core::pixelcolor::{Gray4, Rgb565, Rgb888, RgbColor};
 use host_sim::palette::{self, PaletteMode};
 use host_sim::{load_bytes, new_scene, render, RenderOptions, RgbImage};
 use octrace_tests::webdriver::{http, Browser};
@@ -191,12 +190,14 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
             ),
             60,
         );
-        let mut panel = host_render(&saved, Some((40, 30))).image;
-        for p in panel.data.chunks_mut(3) {
-            let c = Rgb888::new(p[0], p[1], p[2]);
-            let shown = if code == 5 { Rgb888::from(Rgb565::from(c)) } else { Rgb888::from(Gray4::from(c)) };
-            p.copy_from_slice(&[shown.r(), shown.g(), shown.b()]);
-        }
+        // host-sim --size 40x30 --color NAME, as a Targa (RGB, or gray as
+        // a colour table).
+        let out = dir.path().join(format!("{name}.tga"));
+        let args = ["host-sim", scene_path.to_str().unwrap(), out.to_str().unwrap(), "--size", "40x30"];
+        let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
+        let code = host_sim::run(args.into_iter().chain(["--color", name, "--quiet"]), &mut stdout, &mut stderr);
+        assert_eq!(code, 0, "{}", String::from_utf8_lossy(&stderr));
+        let panel = host_sim::formats::read(&std::fs::read(&out).unwrap()).expect("host-sim's preview").to_rgb();
         assert_same(name, browser.canvas_rgb("image"), &panel);
     }
     browser.run("const d = document.getElementById('display'); d.value = '0'; d.dispatchEvent(new Event('change')); return true;");
