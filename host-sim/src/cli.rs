@@ -228,6 +228,7 @@ fn part_of(
     };
     let rows = parts::band_rows(h, index, spec.count);
     let info = PartInfo {
+        version: env!("CARGO_PKG_VERSION").into(),
         scene: parts::scene_hash(scene_bytes),
         width: w,
         height: h,

@@ -110,6 +110,8 @@ pub fn scene_hash(bytes: &[u8]) -> u64 {
 /// What a part file says about itself.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct PartInfo {
+    /// The host-sim version that rendered it: another version may give other bits.
+    pub version: String,
     /// [`scene_hash`] of the scene file's bytes.
     pub scene: u64,
     /// The whole image's size.
@@ -123,14 +125,15 @@ pub struct PartInfo {
     pub count: u32,
 }
 
-/// The text every part's line starts with (and its version).
+/// The text every part's line starts with (and the version of the line's layout).
 const MAGIC: &str = "octrace-part 1";
 
 impl fmt::Display for PartInfo {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{MAGIC} scene={:016x} size={}x{} palette={} rows={}..{} part={}/{}",
+            "{MAGIC} version={} scene={:016x} size={}x{} palette={} rows={}..{} part={}/{}",
+            self.version,
             self.scene,
             self.width,
             self.height,
@@ -149,6 +152,7 @@ impl PartInfo {
         let rest = text.strip_prefix(MAGIC)?.strip_prefix(' ')?;
         let mut fields = rest.split(' ');
         let mut field = |name: &str| fields.next()?.strip_prefix(name)?.strip_prefix('=');
+        let version = field("version")?.to_owned();
         let scene = u64::from_str_radix(field("scene")?, 16).ok()?;
         let (width, height) = field("size")?.split_once('x')?;
         let palette_name = field("palette")?;
@@ -159,6 +163,7 @@ impl PartInfo {
             return None;
         }
         let info = PartInfo {
+            version,
             scene,
             width: width.parse().ok()?,
             height: height.parse().ok()?,
@@ -239,6 +244,14 @@ pub fn check_parts(parts: &[PathBuf]) -> Result<(Vec<(PathBuf, PartInfo)>, Heade
         }
         if let Some((first, first_info, _)) = found.first() {
             let other = || format!("{name} and {} are not parts of one render:", first.display());
+            if info.version != first_info.version {
+                return Err(MergeError::Refused(format!(
+                    "{} rendered by host-sim {} and {}, which may give other bits",
+                    other(),
+                    info.version,
+                    first_info.version
+                )));
+            }
             if info.scene != first_info.scene {
                 return Err(MergeError::Refused(format!(
                     "{} another scene (scene hash {:016x}, not {:016x})",
@@ -406,6 +419,7 @@ mod tests {
     #[test]
     fn metadata_round_trips_and_rejects_inconsistent_text() {
         let info = PartInfo {
+            version: "0.1.0".into(),
             scene: 0x0123_4567_89ab_cdef,
             width: 320,
             height: 240,
