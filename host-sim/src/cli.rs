@@ -329,7 +329,8 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
             FormatError::Io(e) => e,
             e => std::io::Error::other(e),
         };
-        let mut sink = FileSink::new(args.palette, format, header, rows.start, f, spool_dir, &spool_name).map_err(io)?;
+        let mut sink =
+            FileSink::new(args.palette, format, header, rows.start, f, spool_dir, &spool_name).map_err(io)?;
         let progress = |pixels| {
             if let Some(b) = &bar {
                 b.inc(pixels);

@@ -184,7 +184,7 @@ pub struct RowWriter<'a> {
 
 enum RowEncoder<'a> {
     /// The encoder owns its output, so it writes into a buffer that is drained into `out` after each row.
-    Png { writer: png::StreamWriter<'static, Buffer>, buffer: Buffer, out: &'a mut dyn Write },
+    Png { writer: Box<png::StreamWriter<'static, Buffer>>, buffer: Buffer, out: &'a mut dyn Write },
     /// Targa and Sun raster rows: BGR when truecolour, padded to `pad` extra bytes.
     Raw { out: &'a mut dyn Write, bgr: bool, pad: usize },
 }
@@ -213,7 +213,7 @@ impl<'a> RowWriter<'a> {
         let encoder = match format {
             Format::Png => {
                 let buffer = Buffer::default();
-                let writer = png_stream_writer(header, buffer.clone())?;
+                let writer = Box::new(png_stream_writer(header, buffer.clone())?);
                 let mut encoder = RowEncoder::Png { writer, buffer, out };
                 encoder.drain()?;
                 encoder
@@ -491,7 +491,8 @@ impl RowReader {
         let part = if is_ras { "Sun raster header" } else { "Targa header" };
         read_exactly(&mut input, &mut fixed, part)?;
         let (width, height, palette, text, pixel_bytes, pad) = if is_ras {
-            let field = |i: usize| u32::from_be_bytes([fixed[4 * i], fixed[4 * i + 1], fixed[4 * i + 2], fixed[4 * i + 3]]);
+            let field =
+                |i: usize| u32::from_be_bytes([fixed[4 * i], fixed[4 * i + 1], fixed[4 * i + 2], fixed[4 * i + 3]]);
             let [width, height, depth, _length, kind, map_type, map_length] = std::array::from_fn(|i| field(i + 1));
             let palette = match (depth, kind, map_type) {
                 (24, RT_STANDARD, RMT_NONE) => None,
@@ -501,7 +502,11 @@ impl RowReader {
                     let entries = map.len() / 3;
                     Some((0..entries).map(|i| [map[i], map[entries + i], map[2 * entries + i]]).collect())
                 }
-                _ => return unsupported(format!("Sun raster of type {kind}, {depth} bits, map {map_type}: not one host-sim writes")),
+                _ => {
+                    return unsupported(format!(
+                        "Sun raster of type {kind}, {depth} bits, map {map_type}: not one host-sim writes"
+                    ))
+                }
             };
             let pixel_bytes = if palette.is_some() { 1 } else { 3 };
             (width, height, palette, None, pixel_bytes, width as usize * pixel_bytes % 2)
@@ -548,7 +553,10 @@ impl RowReader {
         let palette = match (info.color_type, info.bit_depth, info.interlaced) {
             (png::ColorType::Rgb, png::BitDepth::Eight, false) => None,
             (png::ColorType::Indexed, png::BitDepth::Eight, false) => {
-                let palette = info.palette.as_ref().ok_or_else(|| FormatError::Invalid("indexed PNG file without a PLTE chunk".into()))?;
+                let palette = info
+                    .palette
+                    .as_ref()
+                    .ok_or_else(|| FormatError::Invalid("indexed PNG file without a PLTE chunk".into()))?;
                 Some(palette.chunks_exact(3).map(|e| [e[0], e[1], e[2]]).collect())
             }
             (colour, depth, interlaced) => {

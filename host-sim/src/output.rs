@@ -58,7 +58,10 @@ enum RowQuantizer {
     Gray,
     Dither,
     /// Outlines need the objects of the row above: the last row seen.
-    Coarse { above: Vec<u32>, previous: Option<(u32, Vec<u32>)> },
+    Coarse {
+        above: Vec<u32>,
+        previous: Option<(u32, Vec<u32>)>,
+    },
     /// A frozen table.
     Scan(Box<Scan>),
 }
@@ -69,9 +72,12 @@ impl RowQuantizer {
         out.clear();
         let object = |x: usize| objects.get(x).copied().filter(|&o| o != NO_OBJECT).map(ObjectId);
         let mut run = |quantizer: &mut dyn Quantizer| {
-            out.extend(colors.chunks_exact(3).enumerate().map(|(x, p)| {
-                quantizer.quantize(x as u32, y, Rgb888::new(p[0], p[1], p[2]), object(x))
-            }));
+            out.extend(
+                colors
+                    .chunks_exact(3)
+                    .enumerate()
+                    .map(|(x, p)| quantizer.quantize(x as u32, y, Rgb888::new(p[0], p[1], p[2]), object(x))),
+            );
         };
         match self {
             RowQuantizer::Gray => run(&mut Gray),
@@ -138,7 +144,10 @@ enum Stage<'a> {
     Truecolour(RowWriter<'a>),
     Indexed(Box<Indices>),
     /// `scan`'s first pass: colours spooled while the table is learnt.
-    Learning { scan: Box<Scan>, colors: Spool },
+    Learning {
+        scan: Box<Scan>,
+        colors: Spool,
+    },
 }
 
 /// Writes a render's rows to an image file as they come.
@@ -190,9 +199,7 @@ impl<'a> FileSink<'a> {
                 let above = vec![NO_OBJECT; header.width as usize];
                 (indices(RowQuantizer::Coarse { above, previous: None })?, Some(out))
             }
-            PaletteMode::Scan => {
-                (Stage::Learning { scan: Box::new(Scan::new()), colors: spool("colors")? }, Some(out))
-            }
+            PaletteMode::Scan => (Stage::Learning { scan: Box::new(Scan::new()), colors: spool("colors")? }, Some(out)),
         };
         Ok(FileSink {
             stage,

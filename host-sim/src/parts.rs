@@ -331,7 +331,12 @@ pub fn check_parts(parts: &[PathBuf]) -> Result<(Vec<(PathBuf, PartInfo)>, Heade
 }
 
 /// The message for rows no part holds, between the parts `above` and `below` (if any).
-fn missing(found: &[(PathBuf, PartInfo, Header)], gap: Range<u32>, above: Option<&PathBuf>, below: Option<&PathBuf>) -> String {
+fn missing(
+    found: &[(PathBuf, PartInfo, Header)],
+    gap: Range<u32>,
+    above: Option<&PathBuf>,
+    below: Option<&PathBuf>,
+) -> String {
     let count = found[0].1.count;
     let mut message = format!("{} of the image are in no part", rows(&gap));
     if found.iter().all(|(_, info, _)| info.count == count) {
@@ -359,8 +364,8 @@ pub fn write_merged(
     format: Format,
     out: &mut dyn std::io::Write,
 ) -> Result<(), MergeError> {
-    let mut writer =
-        RowWriter::new(format, header, out).map_err(|error| MergeError::Io { path: PathBuf::from("the output"), error })?;
+    let mut writer = RowWriter::new(format, header, out)
+        .map_err(|error| MergeError::Io { path: PathBuf::from("the output"), error })?;
     for (path, info) in parts {
         let mut reader = open(path)?;
         for _ in info.rows.clone() {
@@ -411,8 +416,14 @@ mod tests {
         assert_eq!(auto_index(4, env(&[("JOB_COMPLETION_INDEX", "0")])), Ok(1));
         assert_eq!(auto_index(4, env(&[("JOB_COMPLETION_INDEX", "3"), ("SLURM_ARRAY_TASK_ID", "2")])), Ok(2));
         assert_eq!(auto_index(4, env(&[])), Err(AutoError::Unset));
-        assert!(matches!(auto_index(4, env(&[("JOB_COMPLETION_INDEX", "4")])), Err(AutoError::OutOfRange { index: 5, .. })));
-        assert!(matches!(auto_index(4, env(&[("SLURM_ARRAY_TASK_ID", "0")])), Err(AutoError::OutOfRange { index: 0, .. })));
+        assert!(matches!(
+            auto_index(4, env(&[("JOB_COMPLETION_INDEX", "4")])),
+            Err(AutoError::OutOfRange { index: 5, .. })
+        ));
+        assert!(matches!(
+            auto_index(4, env(&[("SLURM_ARRAY_TASK_ID", "0")])),
+            Err(AutoError::OutOfRange { index: 0, .. })
+        ));
         assert!(matches!(auto_index(4, env(&[("SLURM_ARRAY_TASK_ID", "x")])), Err(AutoError::NotANumber { .. })));
     }
 

@@ -86,7 +86,10 @@ fn streamed_files_equal_the_whole_image_in_every_mode_and_format() {
     expected_files.sort();
     assert_eq!(files(dir.path()), expected_files);
     // The library's equal4 is the thesis's four rectangles, streamed as one band.
-    let equal4 = render(&loaded, &RenderOptions { size: Some((w, h)), threads: 3, partition: Partition::Equal4, ..Default::default() });
+    let equal4 = render(
+        &loaded,
+        &RenderOptions { size: Some((w, h)), threads: 3, partition: Partition::Equal4, ..Default::default() },
+    );
     assert_eq!(equal4.unwrap().image, rendered.image);
 }
 
@@ -119,10 +122,19 @@ fn merged_parts_are_one_render_byte_for_byte() {
     for mode in ["none", "dither", "coarse", "gray"] {
         for extension in ["png", "tga"] {
             let whole = dir.path().join(format!("whole-{mode}.png"));
-            ok(&[path.as_os_str(), whole.as_os_str(), "--size".as_ref(), "40x30".as_ref(), "--palette".as_ref(), mode.as_ref(), "-q".as_ref()]);
+            ok(&[
+                path.as_os_str(),
+                whole.as_os_str(),
+                "--size".as_ref(),
+                "40x30".as_ref(),
+                "--palette".as_ref(),
+                mode.as_ref(),
+                "-q".as_ref(),
+            ]);
             let sub = dir.path().join(format!("{mode}-{extension}"));
             std::fs::create_dir(&sub).unwrap();
-            let mut parts = render_parts(&sub, &path, &["3/3", "1/3", "2/3"], extension, &["--palette", mode, "--threads", "2"]);
+            let mut parts =
+                render_parts(&sub, &path, &["3/3", "1/3", "2/3"], extension, &["--palette", mode, "--threads", "2"]);
             let part = read(&parts[1]);
             assert_eq!((part.width(), part.height()), (40, 10), "a part is an image of its own");
             parts.reverse();
@@ -146,7 +158,13 @@ fn merged_parts_are_one_render_byte_for_byte() {
     let sub = dir.path().join("rows");
     std::fs::create_dir(&sub).unwrap();
     let each: Vec<String> = (1..=30).map(|i| format!("{i}/30")).collect();
-    let parts = render_parts(&sub, &path, &each.iter().map(String::as_str).collect::<Vec<_>>(), "tga", &["--palette", "coarse"]);
+    let parts = render_parts(
+        &sub,
+        &path,
+        &each.iter().map(String::as_str).collect::<Vec<_>>(),
+        "tga",
+        &["--palette", "coarse"],
+    );
     let merged = dir.path().join("rows.png");
     let mut args = vec!["merge".as_ref(), merged.as_os_str()];
     args.extend(parts.iter().map(|p| p.as_os_str()));
@@ -168,7 +186,15 @@ fn merge_refuses_parts_that_do_not_fit_and_writes_nothing() {
     let other_scene = render_parts(&other_dir("scene"), &fig5_2, &["2/3"], "png", &[]).remove(0);
     let other_palette = render_parts(&other_dir("palette"), &fig5_1, &["2/3"], "png", &["--palette", "gray"]).remove(0);
     let other_size = other_dir("size").join("part.png");
-    ok(&[fig5_1.as_os_str(), other_size.as_os_str(), "--size".as_ref(), "40x33".as_ref(), "--part".as_ref(), "2/3".as_ref(), "-q".as_ref()]);
+    ok(&[
+        fig5_1.as_os_str(),
+        other_size.as_os_str(),
+        "--size".as_ref(),
+        "40x33".as_ref(),
+        "--part".as_ref(),
+        "2/3".as_ref(),
+        "-q".as_ref(),
+    ]);
     let plain = dir.path().join("plain.png");
     ok(&[fig5_1.as_os_str(), plain.as_os_str(), "--size".as_ref(), "40x30".as_ref(), "-q".as_ref()]);
     let copy = dir.path().join("copy-of-2.png");
@@ -178,14 +204,26 @@ fn merge_refuses_parts_that_do_not_fit_and_writes_nothing() {
     let [one, two, three] = [&good[0], &good[1], &good[2]];
     let name = |p: &Path| p.display().to_string();
     let cases: Vec<(Vec<&PathBuf>, i32, Vec<String>)> = vec![
-        (vec![one, three], 2, vec!["rows 10..20 of the image are in no part (missing part 2/3)".into(), name(one), name(three)]),
+        (
+            vec![one, three],
+            2,
+            vec!["rows 10..20 of the image are in no part (missing part 2/3)".into(), name(one), name(three)],
+        ),
         (vec![two, three], 2, vec!["rows 0..10".into(), "missing part 1/3".into(), format!("before {}", name(two))]),
         (vec![one, two], 2, vec!["rows 20..30".into(), "missing part 3/3".into(), format!("after {}", name(two))]),
         (vec![one, two, &copy, three], 2, vec!["are the same band".into(), name(two), name(&copy)]),
-        (vec![one, two, three, &half], 2, vec!["are overlapping bands".into(), "part 2/2, rows 15..30".into(), name(&half)]),
+        (
+            vec![one, two, three, &half],
+            2,
+            vec!["are overlapping bands".into(), "part 2/2, rows 15..30".into(), name(&half)],
+        ),
         (vec![one, &other_scene, three], 2, vec!["another scene".into(), name(&other_scene), name(one)]),
         (vec![one, &other_size, three], 2, vec!["another size (40×33, not 40×30)".into(), name(&other_size)]),
-        (vec![one, &other_palette, three], 2, vec!["another palette (--palette gray, not none)".into(), name(&other_palette)]),
+        (
+            vec![one, &other_palette, three],
+            2,
+            vec!["another palette (--palette gray, not none)".into(), name(&other_palette)],
+        ),
         (vec![one, &plain, three], 2, vec![format!("{}: not a part", name(&plain))]),
         (vec![one, two, three, &absent], 1, vec![name(&absent)]),
     ];
@@ -228,7 +266,15 @@ fn part_auto_takes_the_index_from_slurm_or_kubernetes() {
     let given = render_parts(dir.path(), &path, &["2/3", "3/3"], "png", &[]);
     let out = dir.path().join("auto.png");
     let args = |part: &'static str| -> Vec<&OsStr> {
-        vec![path.as_os_str(), out.as_os_str(), "--size".as_ref(), "40x30".as_ref(), "--part".as_ref(), part.as_ref(), "-q".as_ref()]
+        vec![
+            path.as_os_str(),
+            out.as_os_str(),
+            "--size".as_ref(),
+            "40x30".as_ref(),
+            "--part".as_ref(),
+            part.as_ref(),
+            "-q".as_ref(),
+        ]
     };
     let cases: [(&[(&str, &str)], &PathBuf); 4] = [
         (&[("SLURM_ARRAY_TASK_ID", "2")], &given[0]),
