@@ -1078,6 +1078,42 @@ mod tests {
     }
 
     #[test]
+    fn rows_read_back_with_their_text() {
+        let dir = std::env::temp_dir().join(format!("octrace-rows-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for format in FORMATS {
+            for image in samples() {
+                let text = (format != Format::Ras).then(|| "octrace-part 1 and some words".to_string());
+                let (palette, data) = match &image {
+                    Image::Rgb(rgb) => (None, rgb.data.clone()),
+                    Image::Indexed { palette, indices, .. } => (Some(palette.clone()), indices.clone()),
+                };
+                let header = Header { width: image.width(), height: image.height(), palette, text };
+                let mut bytes = Vec::new();
+                let mut writer = RowWriter::new(format, &header, &mut bytes).unwrap();
+                let row_bytes = data.len() / image.height() as usize;
+                data.chunks(row_bytes).for_each(|row| writer.write_row(row).unwrap());
+                writer.finish().unwrap();
+                assert_eq!(read(&bytes).unwrap(), image, "{} as a whole", format.name());
+                let path = dir.join(format!("image.{}", format.name()));
+                std::fs::write(&path, &bytes).unwrap();
+                let mut reader = RowReader::new(std::fs::File::open(&path).unwrap()).unwrap();
+                assert_eq!(reader.header(), &header, "{}", format.name());
+                for row in data.chunks(row_bytes) {
+                    assert_eq!(reader.next_row().unwrap(), row);
+                }
+                assert!(reader.next_row().is_err());
+            }
+        }
+        let header = Header { width: 1, height: 1, palette: None, text: Some("t".into()) };
+        assert!(RowWriter::new(Format::Ras, &header, &mut Vec::new()).is_err(), "a Sun raster has no room for text");
+        let mut sink = std::io::sink();
+        let mut writer = RowWriter::new(Format::Png, &Header { text: None, ..header }, &mut sink).unwrap();
+        assert!(writer.write_row(&[0; 4]).is_err(), "a row of the wrong length");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
     fn formats_are_named_by_extension() {
         assert_eq!(Format::from_path(Path::new("out/fig5_1.PNG")), Some(Format::Png));
         assert_eq!(Format::from_path(Path::new("a.tga")), Some(Format::Tga));
