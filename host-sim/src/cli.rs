@@ -296,8 +296,13 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
         }
         None => (0..h, None),
     };
+    // `coarse` outlines need the objects of the row above a part.
+    let render_rows = match args.palette {
+        PaletteMode::Coarse => rows.start.saturating_sub(1)..rows.end,
+        _ => rows.clone(),
+    };
     let bar = if !args.quiet && std::io::stderr().is_terminal() {
-        let bar = ProgressBar::new(w as u64 * rows.len() as u64);
+        let bar = ProgressBar::new(w as u64 * render_rows.len() as u64);
         bar.set_style(
             ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}%, eta {eta}")
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
@@ -313,11 +318,6 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
         octree: OctreeConfig { max_objects: args.max_objects, max_depth: args.max_depth, ..Default::default() },
         threads: args.threads.map_or_else(all_cores, |n| n as usize),
         partition: args.partition,
-    };
-    // `coarse` outlines need the objects of the row above a part.
-    let render_rows = match args.palette {
-        PaletteMode::Coarse => rows.start.saturating_sub(1)..rows.end,
-        _ => rows.clone(),
     };
     let header = Header { width: w, height: rows.len() as u32, palette: None, text };
     let spool_dir = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
