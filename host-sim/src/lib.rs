@@ -1,6 +1,10 @@
 //! octrace on the desktop: load a scene file, render it with the same core
-//! code a board runs, write a PNG. The binary is a thin wrapper around
-//! [`run`], so tests drive exactly what a user runs.
+//! code a board runs, write an image file. The binary is a thin wrapper
+//! around [`run`], so tests drive exactly what a user runs.
+//!
+//! Invariants: any number of threads and any partition give the same bits;
+//! a streamed render ([`render_streamed`]) holds a few bands of rows, never
+//! the image, and hands every row to its sink once, in order.
 
 pub mod cli;
 pub mod formats;
