@@ -35,6 +35,10 @@ impl Spool {
     fn new(dir: &Path, name: &str) -> std::io::Result<Spool> {
         let path = dir.join(format!(".{name}.{}.spool.tmp", std::process::id()));
         let file = File::options().read(true).write(true).create_new(true).open(&path)?;
+        // Where an open file outlives its name, drop the name now: not even
+        // a killed process leaves the spool behind.
+        #[cfg(unix)]
+        std::fs::remove_file(&path)?;
         Ok(Spool { writer: BufWriter::with_capacity(1 << 16, file), path })
     }
 
