@@ -59,7 +59,7 @@ pub struct Args {
     pub size: Option<(u32, u32)>,
     /// Intersection strategy: auto picks the fastest for the scene (naive
     /// for a handful of objects, else dda). All give the same image.
-    #[arg(long, value_enum, default_value_t = AccelMode::Auto)]
+    #[arg(long, value_name = "MODE", default_value = "auto", value_parser = parse_accel)]
     pub accel: AccelMode,
     /// Octree criterion: a box holding more objects than this is subdivided.
     #[arg(long, value_name = "N", default_value_t = OctreeConfig::default().max_objects)]
@@ -117,6 +117,14 @@ pub enum Command {
         #[arg(long, value_enum)]
         format: Option<Format>,
     },
+}
+
+/// An `--accel` name: the core's [`AccelMode`] vocabulary.
+fn parse_accel(text: &str) -> Result<AccelMode, String> {
+    AccelMode::from_name(text).ok_or_else(|| {
+        let names: Vec<&str> = AccelMode::ALL.iter().map(|m| m.name()).collect();
+        format!("expected one of {}", names.join(", "))
+    })
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -367,10 +375,11 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
     let stats = rendered.stats;
     if !args.quiet {
         if let Some((report, _)) = &rendered.build {
-            if let Some(what) = report.exhausted {
+            if let Some(kind) = report.exhausted {
                 let _ = writeln!(
                     stderr,
-                    "host-sim: the octree ran out of {what}: {} boxes left unsplit (slower, same image)",
+                    "host-sim: the octree ran out of {}: {} boxes left unsplit (slower, same image)",
+                    kind.what(),
                     report.unsplit
                 );
             }

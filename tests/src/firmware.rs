@@ -206,6 +206,32 @@ impl Firmware {
         let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
         let value = |key: &str| text.lines().find_map(|l| l.strip_prefix(key)?.trim().parse::<u64>().ok());
         let total = value("insns_total=").ok_or_else(|| format!("no instruction count from qemu-count:\n{text}"))?;
+        let sizes = Sizes::of(elf)?;
+        Ok(Measurement {
+            status: out.status.code().unwrap_or(-1),
+            render: value("insns_between_markers="),
+            total,
+            flash: sizes.text + sizes.data,
+            static_ram: sizes.data + sizes.bss,
+            output: text,
+        })
+    }
+}
+
+/// An ELF's sections as `arm-none-eabi-size -B` counts them.
+#[derive(Clone, Copy, Debug)]
+pub struct Sizes {
+    /// Code and constants (flash).
+    pub text: u64,
+    /// Initialised statics: flash for their initial values, and RAM.
+    pub data: u64,
+    /// Zeroed statics (RAM only).
+    pub bss: u64,
+}
+
+impl Sizes {
+    /// Reads `elf`'s sizes.
+    pub fn of(elf: &Path) -> Result<Sizes, String> {
         let size = Command::new("arm-none-eabi-size")
             .arg("-B")
             .arg(elf)
@@ -214,17 +240,10 @@ impl Firmware {
         let size = String::from_utf8_lossy(&size.stdout).into_owned();
         let numbers: Vec<u64> =
             size.lines().nth(1).unwrap_or("").split_whitespace().take(3).filter_map(|n| n.parse().ok()).collect();
-        let [text_bytes, data, bss] = numbers[..] else {
+        let [text, data, bss] = numbers[..] else {
             return Err(format!("unexpected arm-none-eabi-size output:\n{size}"));
         };
-        Ok(Measurement {
-            status: out.status.code().unwrap_or(-1),
-            render: value("insns_between_markers="),
-            total,
-            flash: text_bytes + data,
-            static_ram: data + bss,
-            output: text,
-        })
+        Ok(Sizes { text, data, bss })
     }
 }
 

@@ -4,7 +4,8 @@
 //! `Display` writes `line:col: message`; a caller that knows the file name
 //! puts it in front (`fig5_3.txt:41:12: SPHERE radius must be > 0, found -1`).
 
-use crate::scene::CapacityError;
+use crate::capacity::CapacityError;
+use crate::scene::CameraError;
 use core::fmt;
 
 /// A position in the scene text: line and column (in characters), from 1.
@@ -221,16 +222,9 @@ impl fmt::Display for ErrorKind<'_> {
                 "{keyword} is too small to represent next to the rest of the scene \
                  (below 2^-16 of its size after scaling to the fixed-point range)"
             ),
-            ErrorKind::EyeAtOrigin => f.write_str("VIEWPOINT equals ORIGIN: there is no view direction"),
-            ErrorKind::UpParallel => {
-                f.write_str("UPVECTOR is zero or parallel to the view direction (ORIGIN − VIEWPOINT)")
-            }
-            ErrorKind::Capacity(c) => write!(
-                f,
-                "the scene needs more {} than this build holds ({}, capacity profile {}); \
-                 raise it in a capacity profile (octrace-core's capacity.rs)",
-                c.what, c.capacity, c.profile
-            ),
+            ErrorKind::EyeAtOrigin => CameraError::EyeAtOrigin.fmt(f),
+            ErrorKind::UpParallel => CameraError::UpParallel.fmt(f),
+            ErrorKind::Capacity(c) => c.fmt(f),
         }
     }
 }

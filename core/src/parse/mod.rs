@@ -25,8 +25,8 @@ pub use lexer::{Lexer, Token};
 pub use number::{parse_integer, Decimal};
 pub use statement::{keyword, Statement, KEYWORDS};
 
-use crate::capacity::Capacities;
-use crate::scene::{Camera, CameraError, CapacityError, Light, Normalization, Scene, SurfaceEntry, WorldPoint};
+use crate::capacity::{CapacityError, CapacityKind, Counts};
+use crate::scene::{Camera, CameraError, Light, Normalization, Scene, SceneCapacities, SurfaceEntry, WorldPoint};
 use crate::shapes::{AxisAlignedBox, Rectangle, ShapeKind, Sphere, Superquadric, Triangle};
 use statement::Cursor;
 
@@ -76,7 +76,7 @@ fn for_each_statement<'a>(text: &'a str, mut each: impl FnMut(Pos, Result<Statem
 }
 
 /// Parses `bytes`, reporting invalid UTF-8 as an error at the first bad byte.
-pub fn parse_bytes<'a, C: Capacities>(
+pub fn parse_bytes<'a, C: SceneCapacities>(
     bytes: &'a [u8],
     scene: &mut Scene<C>,
     on_error: &mut dyn FnMut(ParseError<'a>),
@@ -113,15 +113,16 @@ impl Extent {
 
 /// Parses `text` into `scene` (cleared first). Every error goes to
 /// `on_error`; the result is the number of errors if there were any.
-pub fn parse<'a, C: Capacities>(
+pub fn parse<'a, C: SceneCapacities>(
     text: &'a str,
     scene: &mut Scene<C>,
     on_error: &mut dyn FnMut(ParseError<'a>),
 ) -> Result<Parsed<'a>, usize> {
     scene.clear();
-    survey(text, scene);
+    let needed = survey(text, scene);
     let mut build = Build {
         scene,
+        needed,
         parsed: Parsed::default(),
         first: [None; PARAMETERS.len()],
         errors: 0,
@@ -141,29 +142,50 @@ pub fn parse<'a, C: Capacities>(
     Ok(parsed)
 }
 
-/// Pass 1: surfaces (sorted by number) and the normalisation.
-fn survey<C: Capacities>(text: &str, scene: &mut Scene<C>) {
+/// What `text` needs of each capacity, counting its valid statements (a
+/// B-spline patch at its full grid of triangles): the counts a profile for
+/// this scene holds, but for the octree's, which depend on the build (see
+/// [`crate::accel::BuildReport::counts`]). Like [`parse`], it never panics.
+pub fn count(text: &str) -> Counts {
+    let mut counts = Counts::ZERO;
+    for_each_statement(text, |_, result| {
+        if let Ok(s) = result {
+            s.count(&mut counts);
+        }
+    });
+    counts.with_objects()
+}
+
+/// Pass 1: surfaces (sorted by number) and the normalisation; returns what
+/// the scene needs of each capacity.
+fn survey<C: SceneCapacities>(text: &str, scene: &mut Scene<C>) -> Counts {
+    let mut counts = Counts::ZERO;
     let mut eye = None;
     let mut extent: Option<Extent> = None;
     let mut add = |lo: WorldPoint, hi: WorldPoint| match &mut extent {
         Some(e) => e.add(lo, hi),
         None => extent = Some(Extent { min: lo, max: hi }),
     };
-    for_each_statement(text, |pos, result| match result {
-        Ok(Statement::Viewpoint(p)) => {
-            eye.get_or_insert(p);
+    for_each_statement(text, |pos, result| {
+        if let Ok(s) = &result {
+            s.count(&mut counts);
         }
-        Ok(Statement::Light { position, .. }) => add(position, position),
-        Ok(Statement::Surface { number, surface }) => {
-            // A full arena is reported by the build pass.
-            let _ = scene.push_surface(SurfaceEntry { number, line: pos.line, column: pos.column, surface });
-        }
-        Ok(s) => {
-            if let Some((lo, hi)) = s.object_bounds() {
-                add(lo, hi);
+        match result {
+            Ok(Statement::Viewpoint(p)) => {
+                eye.get_or_insert(p);
             }
+            Ok(Statement::Light { position, .. }) => add(position, position),
+            Ok(Statement::Surface { number, surface }) => {
+                // A full arena is reported by the build pass.
+                let _ = scene.push_surface(SurfaceEntry { number, line: pos.line, column: pos.column, surface });
+            }
+            Ok(s) => {
+                if let Some((lo, hi)) = s.object_bounds() {
+                    add(lo, hi);
+                }
+            }
+            Err(_) => {}
         }
-        Err(_) => {}
     });
     let eye = eye.unwrap_or(scene.settings.view.eye);
     add(eye, eye);
@@ -171,6 +193,7 @@ fn survey<C: Capacities>(text: &str, scene: &mut Scene<C>) {
     if let Some(e) = extent {
         scene.normalization = Normalization::fit(e.min, e.max);
     }
+    counts.with_objects()
 }
 
 /// Scene parameters that may appear once, in [`Build::first`] order.
@@ -189,39 +212,32 @@ const PARAMETERS: [&str; 11] = [
 ];
 
 /// Pass 2 state.
-struct Build<'s, 'a, 'e, C: Capacities> {
+struct Build<'s, 'a, 'e, C: SceneCapacities> {
     scene: &'s mut Scene<C>,
+    /// What the whole scene needs, for capacity errors.
+    needed: Counts,
     parsed: Parsed<'a>,
     /// Where each parameter was first given.
     first: [Option<Pos>; PARAMETERS.len()],
     errors: usize,
-    /// Bit set of capacities already reported (one error each is enough).
+    /// Bit set of capacities already reported (one error each is enough),
+    /// bit `kind as u8`.
     reported_capacity: u32,
     on_error: &'e mut dyn FnMut(ParseError<'a>),
 }
 
-impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
+impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
     fn report(&mut self, e: ParseError<'a>) {
         self.errors += 1;
         (self.on_error)(e);
     }
 
     fn capacity(&mut self, pos: Pos, e: CapacityError) {
-        let bit = match e.what {
-            "objects" => 1,
-            "spheres" => 2,
-            "boxes" => 4,
-            "superquadrics" => 8,
-            "triangles" => 16,
-            "rectangles" => 32,
-            "surfaces" => 64,
-            "B-spline triangles" => 256,
-            "B-spline control points" => 512,
-            _ => 128,
-        };
+        let bit = 1 << e.kind as u8;
         if self.reported_capacity & bit == 0 {
             self.reported_capacity |= bit;
-            self.report(ParseError::new(pos, ErrorKind::Capacity(e)));
+            let needed = Some(self.needed.get(e.kind));
+            self.report(ParseError::new(pos, ErrorKind::Capacity(CapacityError { needed, ..e })));
         }
     }
 
@@ -239,7 +255,7 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
     /// The surface index for an object, or an error.
     fn surface(&mut self, keyword: &'static str, number: u32, pos: Pos) -> Option<u16> {
         let found = self.scene.view().surface_index(number);
-        if found.is_none() && self.reported_capacity & 64 == 0 {
+        if found.is_none() && self.reported_capacity & (1 << CapacityKind::Surfaces as u8) == 0 {
             self.report(ParseError::new(pos, ErrorKind::UndefinedSurface { keyword, number }));
         }
         found
@@ -317,10 +333,7 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
                         self.report(ParseError::new(pos, ErrorKind::SurfaceRepeated { number, first_line: first.line }))
                     }
                     Some(_) => {}
-                    None => self.capacity(
-                        pos,
-                        CapacityError { what: "surfaces", capacity: Scene::<C>::surface_capacity(), profile: C::NAME },
-                    ),
+                    None => self.capacity(pos, Scene::<C>::surfaces_full()),
                 }
             }
             Statement::Sphere { surface, radius, center } => {
@@ -402,16 +415,13 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
         // Checked on the constant first, so that a profile without room for
         // patches (a small board's) compiles no evaluation code at all.
         if Scene::<C>::capacity_of(ShapeKind::SmoothTriangle) == 0 {
-            let e = CapacityError { what: "B-spline triangles", capacity: 0, profile: C::NAME };
-            return self.capacity(pos, e);
+            return self.capacity(pos, Scene::<C>::full(CapacityKind::BsplineTriangles, 0));
         }
-        if let Err(e) = self.scene.check_room_for(ShapeKind::SmoothTriangle, triangles) {
+        if let Err(e) = self.scene.check_room(ShapeKind::SmoothTriangle, triangles) {
             return self.capacity(pos, e);
         }
         let norm = self.scene.normalization;
-        if !self.scene.set_control_points(points.iter().map(|p| norm.point(p))) {
-            let capacity = Scene::<C>::control_point_capacity();
-            let e = CapacityError { what: "B-spline control points", capacity, profile: C::NAME };
+        if let Err(e) = self.scene.set_control_points(points.iter().map(|p| norm.point(p))) {
             return self.capacity(pos, e);
         }
         if self.scene.push_bspline(order, rows, cols, samples, surface) == 0 {
@@ -442,8 +452,8 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
 mod tests {
     extern crate std;
     use super::*;
-    use crate::capacity::Board64K;
     use crate::math::{Scalar, Vec3};
+    use crate::profile::Board64K;
     use crate::scene::ObjectId;
     use crate::shapes::ShapeKind;
     use std::format;
@@ -650,7 +660,9 @@ mod tests {
         let e = errs(&text);
         assert_eq!(e.len(), 1, "{e:?}");
         assert_eq!(
-            e.iter().filter(|m| m.contains("boxes than this build holds (32, capacity profile Board64K)")).count(),
+            e.iter()
+                .filter(|m| m.contains("too many boxes: the capacity profile Board64K holds 32 and the scene needs 40;"))
+                .count(),
             1,
             "{e:?}"
         );
@@ -725,7 +737,10 @@ mod tests {
         let e = errs(&format!("BSPLINE 1 3 3 3 6 6 {GRID} BSPLINE 1 3 3 3 6 6 {GRID} {SURF}"));
         assert_eq!(e.len(), 1, "{e:?}");
         assert!(
-            e[0].contains("more B-spline triangles than this build holds (32, capacity profile Board64K)"),
+            e[0].contains(
+                "too many B-spline triangles: the capacity profile Board64K holds 32 and the scene needs 100; \
+                 define a profile that holds them with octrace_core::profile! (bspline_triangles: 100, …)"
+            ),
             "{e:?}"
         );
     }

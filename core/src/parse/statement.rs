@@ -5,6 +5,7 @@
 use super::error::{ErrorKind, Field, Found, ParseError, Pos, Rule};
 use super::lexer::{Lexer, Token};
 use super::number::{parse_integer, Decimal};
+use crate::capacity::{CapacityKind, Counts};
 use crate::math::isqrt_u128;
 use crate::scene::{Color, Surface, WorldPoint, WorldValue, MAX_SAMPLES, MAX_SIDE};
 use crate::shapes::bspline::{MAX_CONTROL_SIDE, MAX_ORDER, MAX_SAMPLE_SIDE};
@@ -129,6 +130,30 @@ impl Statement<'_> {
             }
             _ => None,
         }
+    }
+
+    /// Adds what this statement stores to `counts` (a B-spline patch: its
+    /// full grid of triangles, and its control points as scratch room).
+    pub(crate) fn count(&self, counts: &mut Counts) {
+        let kind = match self {
+            Statement::Sphere { .. } => CapacityKind::Spheres,
+            Statement::Box { .. } => CapacityKind::Boxes,
+            Statement::Superquadric { .. } => CapacityKind::Superquadrics,
+            Statement::Triangle { .. } => CapacityKind::Triangles,
+            Statement::Rectangle { .. } => CapacityKind::Rectangles,
+            Statement::Surface { .. } => CapacityKind::Surfaces,
+            Statement::Light { .. } => CapacityKind::Lights,
+            Statement::Bspline { samples, points, .. } => {
+                let cells =
+                    (samples[0].saturating_sub(1) as usize).saturating_mul(samples[1].saturating_sub(1) as usize);
+                counts.bspline_triangles = counts.bspline_triangles.saturating_add(cells.saturating_mul(2));
+                counts.control_points = counts.control_points.max(points.iter().count());
+                return;
+            }
+            _ => return,
+        };
+        let count = counts.get_mut(kind);
+        *count = count.saturating_add(1);
     }
 }
 

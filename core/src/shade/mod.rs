@@ -257,8 +257,8 @@ mod shading_tests {
     extern crate std;
     use super::*;
     use crate::accel::Naive;
-    use crate::capacity::Board64K;
     use crate::parse::parse;
+    use crate::profile::Board64K;
     use crate::scene::Scene;
     use std::boxed::Box;
     use std::format;
