@@ -1,17 +1,24 @@
 //! octrace on a Cortex-M board: the scene text lives in flash, is parsed on
 //! the board into static arenas sized for it at build time, and is drawn row
-//! by row straight into the display driver (here: a host file over
-//! semihosting) as an embedded-graphics image. No heap, no framebuffer.
-//! Build-time choices are in `build.rs`.
+//! by row straight into the display driver (a host file over semihosting,
+//! or on the LM3S6965EVB its OLED panel, `ssd0323`) as an embedded-graphics
+//! image. No heap, no framebuffer. Build-time choices are in `build.rs`.
 //!
-//! Exit codes: 0 rendered, 2 the scene has errors, 3 the host refused the
-//! output, 101 panic, 102 HardFault, 103 unexpected interrupt.
+//! Exit codes: 0 rendered, 2 the scene has errors, 3 the display (the host
+//! file, the panel) refused the output, 101 panic, 102 HardFault, 103
+//! unexpected interrupt. The LM3S6965EVB keeps its picture on the panel
+//! until the runner has grabbed the screen, then exits.
 
 #![no_std]
 #![no_main]
 
+#[cfg(not(board = "lm3s6965evb"))]
 mod display;
+#[cfg(board = "lm3s6965evb")]
+mod lm3s6965evb;
 mod semihosting;
+#[cfg(board = "lm3s6965evb")]
+mod ssd0323;
 
 mod config {
     include!(concat!(env!("OUT_DIR"), "/config.rs"));
@@ -21,13 +28,18 @@ mod config {
 use cortex_m as _;
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::hprintln;
-use display::{StreamDisplay, WireColor};
 use embedded_graphics_core::geometry::Size;
 use embedded_graphics_core::image::ImageDrawable;
-use embedded_graphics_core::pixelcolor::{Rgb565, Rgb888};
-use octrace_core::palette::{Dither, PaletteIndex, Quantized};
 use octrace_core::{ConstStaticCell, LoadedScene, Raytracer};
-use semihosting::{exit, HostFile};
+use semihosting::exit;
+// What the boards that stream to a host file use.
+#[cfg(not(board = "lm3s6965evb"))]
+use {
+    display::{StreamDisplay, WireColor},
+    embedded_graphics_core::pixelcolor::{Gray4, Rgb565, Rgb888},
+    octrace_core::palette::{Dither, PaletteIndex, Quantized},
+    semihosting::HostFile,
+};
 
 /// The display's pixel format, chosen at build time.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -36,6 +48,8 @@ pub enum Wire {
     Rgb565,
     /// Palette indices, ordered-dithered onto the 6×6×6 cube.
     Dither,
+    /// 16 gray levels (embedded-graphics' conversion from Rgb888).
+    Gray4,
 }
 
 /// The capacity profile, sized by `build.rs` for exactly the embedded scene.
@@ -56,6 +70,10 @@ pub extern "C" fn bench_marker(id: u32) {
 fn main() -> ! {
     let code = run(RAYTRACER.take());
     hprintln!("peak stack: {} bytes", peak_stack());
+    #[cfg(board = "lm3s6965evb")]
+    if code == 0 {
+        lm3s6965evb::show_until_grabbed();
+    }
     exit(code)
 }
 
@@ -85,19 +103,15 @@ fn run(raytracer: &'static mut Raytracer<Profile>) -> u32 {
             if report.unsplit > 0 { " (some boxes left unsplit: arenas full)" } else { "" }
         );
     }
-    let Some(file) = HostFile::create(config::OUTPUT) else {
-        hprintln!("cannot create the output file on the host");
+    let Some(output) = open_output() else {
+        hprintln!("cannot open the display (or the output file on the host)");
         return 3;
     };
     bench_marker(0);
-    let drawn = match config::WIRE {
-        Wire::Rgb888 => draw::<Rgb888>(&scene, file),
-        Wire::Rgb565 => draw::<Rgb565>(&scene, file),
-        Wire::Dither => draw_dithered(&scene, file),
-    };
+    let drawn = draw_on(&scene, output);
     bench_marker(1);
     if !drawn {
-        hprintln!("the host refused the pixels");
+        hprintln!("the display refused the pixels");
         return 3;
     }
     let stats = scene.stats();
@@ -121,8 +135,38 @@ fn load(raytracer: &'static mut Raytracer<Profile>) -> Option<LoadedScene<'stati
     }
 }
 
+// The display: a host file on the boards without one (the pixels streamed
+// in the configured format), the OLED panel on the LM3S6965EVB.
+#[cfg(not(board = "lm3s6965evb"))]
+fn open_output() -> Option<HostFile> {
+    HostFile::create(config::OUTPUT)
+}
+#[cfg(board = "lm3s6965evb")]
+use lm3s6965evb::open_output;
+
+/// Draws the scene into the host file in the configured pixel format.
+#[cfg(not(board = "lm3s6965evb"))]
+fn draw_on(scene: &LoadedScene<'_, Profile>, file: HostFile) -> bool {
+    match config::WIRE {
+        Wire::Rgb888 => draw::<Rgb888>(scene, file),
+        Wire::Rgb565 => draw::<Rgb565>(scene, file),
+        Wire::Gray4 => draw::<Gray4>(scene, file),
+        Wire::Dither => draw_dithered(scene, file),
+    }
+}
+
+/// Draws the scene onto the panel, in its 16 grays (build.rs allows no
+/// other format here), at its top left. Not inlined, as `draw`.
+#[cfg(board = "lm3s6965evb")]
+#[inline(never)]
+fn draw_on(scene: &LoadedScene<'_, Profile>, mut panel: ssd0323::Ssd0323) -> bool {
+    debug_assert!(config::WIRE == Wire::Gray4);
+    scene.image(Size::new(config::WIDTH, config::HEIGHT)).draw(&mut panel).is_ok()
+}
+
 /// Draws the scene into a display of colour `C`. Not inlined: each colour's
 /// instance keeps its frame to itself.
+#[cfg(not(board = "lm3s6965evb"))]
 #[inline(never)]
 fn draw<C: WireColor + From<Rgb888>>(scene: &LoadedScene<'_, Profile>, file: HostFile) -> bool {
     let mut display = StreamDisplay::<C>::new(file, Size::new(config::WIDTH, config::HEIGHT));
@@ -130,6 +174,7 @@ fn draw<C: WireColor + From<Rgb888>>(scene: &LoadedScene<'_, Profile>, file: Hos
 }
 
 /// Draws the scene into a 256-colour display, ordered-dithered.
+#[cfg(not(board = "lm3s6965evb"))]
 #[inline(never)]
 fn draw_dithered(scene: &LoadedScene<'_, Profile>, file: HostFile) -> bool {
     let display = StreamDisplay::<PaletteIndex>::new(file, Size::new(config::WIDTH, config::HEIGHT));

@@ -124,6 +124,7 @@ impl Firmware {
         for var in ["CARGO_TARGET_DIR", "RUSTFLAGS", "CARGO_ENCODED_RUSTFLAGS", "CARGO_BUILD_TARGET"] {
             cargo.env_remove(var);
         }
+        cargo.env("OCTRACE_BOARD", self.board.machine());
         cargo.env("OCTRACE_SCENE", &self.scene);
         cargo.env("OCTRACE_SIZE", format!("{}x{}", self.width, self.height));
         cargo.env("OCTRACE_COLOR", self.wire.name());
@@ -142,7 +143,6 @@ impl Firmware {
         let _ = std::fs::remove_file(&file);
         let out = Command::new("bash")
             .arg(repo().join("firmware/run.sh"))
-            .arg(self.board.machine())
             .arg(elf)
             .output()
             .map_err(|e| format!("cannot run qemu: {e}"))?;
@@ -177,6 +177,33 @@ impl Firmware {
 fn rgb565(r: u8, g: u8, b: u8) -> u16 {
     let scale = |v: u8, max: u32| ((v as u32 * max + 127) / 255) as u16;
     (scale(r, 31) << 11) | (scale(g, 63) << 5) | scale(b, 31)
+}
+
+/// The OLED board's user-facing command, run as a user runs it:
+///
+/// ```text
+/// cd firmware && OCTRACE_BOARD=lm3s6965evb OCTRACE_SCENE=SCENE \
+///   OCTRACE_COLOR=gray4 OCTRACE_OUT=OUT cargo run --release --target thumbv7m-none-eabi
+/// ```
+///
+/// with its own target directory (`target/firmware/lm3s6965evb-run`), so the
+/// build is cached between test runs. Returns what the run printed; the
+/// panel's screen is in `out`.
+pub fn run_oled_command(scene: &str, out: &Path) -> Result<Run, String> {
+    let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
+    cargo.current_dir(repo().join("firmware"));
+    cargo.args(["run", "--release", "--quiet", "--target", "thumbv7m-none-eabi"]);
+    cargo.arg("--target-dir").arg(repo().join("target/firmware/lm3s6965evb-run"));
+    for var in ["CARGO_TARGET_DIR", "RUSTFLAGS", "CARGO_ENCODED_RUSTFLAGS", "CARGO_BUILD_TARGET", "OCTRACE_SIZE"] {
+        cargo.env_remove(var);
+    }
+    cargo.env("OCTRACE_BOARD", "lm3s6965evb");
+    cargo.env("OCTRACE_SCENE", scene);
+    cargo.env("OCTRACE_COLOR", "gray4");
+    cargo.env("OCTRACE_OUT", out);
+    let run = cargo.output().map_err(|e| format!("cannot run cargo: {e}"))?;
+    let output = String::from_utf8_lossy(&run.stdout).into_owned() + &String::from_utf8_lossy(&run.stderr);
+    Ok(Run { status: run.status.code().unwrap_or(-1), output, pixels: Vec::new() })
 }
 
 /// What the benchmark measures of one configuration.
