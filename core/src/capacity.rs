@@ -97,6 +97,7 @@ macro_rules! capacities {
         /// One capacity of a profile: something a scene can run out of.
         // Numbered from 1, so that `None` of an `Option<CapacityKind>` is
         // zero bits (an empty octree's report sits in `.bss`).
+        #[cfg_attr(feature = "defmt", derive(defmt::Format))]
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
         #[repr(u8)]
         pub enum CapacityKind {
@@ -124,6 +125,18 @@ macro_rules! capacities {
 
         /// A number for each [`CapacityKind`]: what a profile holds, or what
         /// a scene needs ([`crate::parse::count`]).
+        ///
+        /// A profile for several scenes holds the largest need of each:
+        ///
+        /// ```
+        /// use octrace_core::{capacity::{CapacityKind, Counts}, parse::count, profile::{Board16K, Profile}};
+        ///
+        /// let a = count("SPHERE 1 1 0 0 0\nSPHERE 1 1 3 0 0\n");
+        /// let b = count("SPHERE 1 1 0 0 0\nTRIANGLE 1 0 0 0 1 0 0 0 1 0\n");
+        /// let both: Counts = a.max(&b);
+        /// assert_eq!((both.spheres, both.triangles), (2, 1));
+        /// assert!(CapacityKind::ALL.into_iter().all(|k| both.get(k) <= Board16K::COUNTS.get(k)));
+        /// ```
         #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
         pub struct Counts {
             $($(#[$doc])* pub $field: usize,)*
@@ -230,6 +243,7 @@ impl Counts {
 }
 
 /// A scene needs more of something than its profile holds.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct CapacityError {
     /// What ran out.

@@ -32,6 +32,14 @@ use crate::scene::SceneCapacities;
 
 /// Everything one build holds: a scene's arenas, an octree's, and a mailbox.
 /// Implement it with [`profile!`](crate::profile!).
+///
+/// ```
+/// use octrace_core::profile::{Board16K, Board64K, Profile};
+///
+/// assert_eq!(Board16K::COUNTS.spheres, 200);
+/// assert_eq!(Board16K::OCTREE.max_depth, 3);
+/// assert!(Board64K::COUNTS.objects > Board16K::COUNTS.objects);
+/// ```
 pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
     /// What the profile holds.
     const COUNTS: Counts;

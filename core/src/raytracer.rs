@@ -59,6 +59,7 @@ impl<P: Profile> Default for Raytracer<P> {
 
 /// A scene that did not load: how many errors it has and the first one.
 /// [`Raytracer::load_with`] hands every error to a callback.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LoadError<'t> {
     /// The first error, with its line and column.
@@ -233,6 +234,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
 
 /// Why a [`TracedImage`] could not be drawn with
 /// [`TracedImage::try_draw`].
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DrawError<E> {
     /// The camera cannot be set up for this size (see [`CameraError`]).

@@ -14,8 +14,6 @@ mod naive;
 mod octree;
 
 pub use naive::Naive;
-#[doc(hidden)]
-pub use octree::{overlaps, Cell, FILING_MARGIN};
 pub use octree::{
     BuildReport, HashEntry, Index, Octree, OctreeCapacities, OctreeConfig, OctreeNode, OctreeStore, Traversal,
     MAX_DEPTH,
@@ -28,6 +26,15 @@ use crate::shapes::{Leaving, Ray};
 /// How a scene's rays find their objects: the choice a user makes (host-sim's
 /// `--accel`, the firmware's `OCTRACE_ACCEL`). Every mode gives the same
 /// image; they differ in speed and memory.
+///
+/// ```
+/// use octrace_core::AccelMode;
+///
+/// assert_eq!(AccelMode::from_name("DDA"), Some(AccelMode::Dda));
+/// assert_eq!(AccelMode::Auto.resolve(3), AccelMode::Naive);
+/// assert_eq!(AccelMode::Auto.resolve(500), AccelMode::Dda);
+/// assert_eq!(AccelMode::Octree.resolve(3), AccelMode::Octree);
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum AccelMode {
     /// [`AccelMode::Naive`] for a handful of objects, else [`AccelMode::Dda`].
@@ -94,14 +101,18 @@ impl core::fmt::Display for AccelMode {
 /// surface data is computed only for the hit that wins.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Hit {
+    /// Where along the ray, in normalised units.
     pub t: Scalar,
+    /// The object hit.
     pub object: ObjectId,
 }
 
 /// The object a secondary ray leaves, and how it leaves it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RayStart {
+    /// The object the ray starts on.
     pub object: ObjectId,
+    /// Which way it leaves that object.
     pub leaving: Leaving,
 }
 
@@ -126,6 +137,15 @@ pub struct Mailbox<'m> {
     overflowed: bool,
     /// Cells (leaves) visited, for the benchmarks.
     pub cells: u64,
+}
+
+impl core::fmt::Debug for Mailbox<'_> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Mailbox")
+            .field("objects", &(self.words.len() * 32))
+            .field("cells", &self.cells)
+            .finish_non_exhaustive()
+    }
 }
 
 impl<'m> Mailbox<'m> {

@@ -16,10 +16,10 @@ mod exp_log;
 mod vector;
 mod wide;
 
-pub use exp_log::{exp2_q32, isqrt_u128, log2_q32, pow_q30, pow_unit};
+pub(crate) use exp_log::{isqrt_u128, pow_q30, pow_unit};
 pub use vector::{Dir, Vec3};
-pub use wide::{
-    div_saturating, isqrt, leading_zeros, mul_i64_i32, mul_u32_wide, mul_wide, rsqrt, shr_to_u32, sqrt_and_rsqrt,
+pub(crate) use wide::{
+    div_saturating, isqrt, leading_zeros, mul_i64_i32, mul_u32_wide, mul_wide, shr_to_u32, sqrt_and_rsqrt,
     square_u32_wide, square_wide,
 };
 

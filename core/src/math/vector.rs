@@ -11,28 +11,37 @@ use core::ops::{Add, Neg, Sub};
 /// A point or an offset in normalised scene space.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Vec3 {
+    /// Q16.16, along X.
     pub x: Scalar,
+    /// Q16.16, along Y.
     pub y: Scalar,
+    /// Q16.16, along Z.
     pub z: Scalar,
 }
 
 /// A unit vector.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Dir {
+    /// Q2.30, along X.
     pub x: Unit,
+    /// Q2.30, along Y.
     pub y: Unit,
+    /// Q2.30, along Z.
     pub z: Unit,
 }
 
 impl Vec3 {
+    /// The origin.
     pub const ZERO: Vec3 = Vec3::from_bits([0; 3]);
 
     #[inline]
+    /// The vector whose components have these raw Q16.16 bits.
     pub const fn from_bits(b: [i32; 3]) -> Self {
         Vec3 { x: Scalar::from_bits(b[0]), y: Scalar::from_bits(b[1]), z: Scalar::from_bits(b[2]) }
     }
 
     #[inline]
+    /// The raw Q16.16 bits of the components, for hashing and exact comparisons.
     pub const fn bits(self) -> [i32; 3] {
         [self.x.to_bits(), self.y.to_bits(), self.z.to_bits()]
     }
@@ -45,6 +54,7 @@ impl Vec3 {
     }
 
     #[inline]
+    /// The component along `axis` (0, 1, 2 for X, Y, Z).
     pub fn axis(self, axis: usize) -> Scalar {
         match axis {
             0 => self.x,
@@ -121,21 +131,27 @@ impl Neg for Vec3 {
 }
 
 impl Dir {
+    /// The unit X axis.
     pub const X: Dir = Dir::from_bits([1 << 30, 0, 0]);
+    /// The unit Y axis.
     pub const Y: Dir = Dir::from_bits([0, 1 << 30, 0]);
+    /// The unit Z axis.
     pub const Z: Dir = Dir::from_bits([0, 0, 1 << 30]);
 
     #[inline]
+    /// The direction whose components have these raw Q2.30 bits (the caller keeps it unit length).
     pub const fn from_bits(b: [i32; 3]) -> Self {
         Dir { x: Unit::from_bits(b[0]), y: Unit::from_bits(b[1]), z: Unit::from_bits(b[2]) }
     }
 
     #[inline]
+    /// The raw Q2.30 bits of the components.
     pub const fn bits(self) -> [i32; 3] {
         [self.x.to_bits(), self.y.to_bits(), self.z.to_bits()]
     }
 
     #[inline]
+    /// The components widened to `i64`, ready for exact products.
     pub const fn wide(self) -> [i64; 3] {
         let b = self.bits();
         [b[0] as i64, b[1] as i64, b[2] as i64]
@@ -151,6 +167,7 @@ impl Dir {
     }
 
     #[inline]
+    /// The component along `axis` (0, 1, 2 for X, Y, Z).
     pub fn axis(self, axis: usize) -> Unit {
         match axis {
             0 => self.x,

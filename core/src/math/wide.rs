@@ -220,6 +220,8 @@ static RSQRT_TABLE: [u32; 193] = {
 
 /// `1/√x` for `x > 0` as `(g, e)` with `1/√x ≈ g · 2^-e`, `g` in [2^30, 2^31]
 /// to about 30 bits.
+// The tests' reference for `sqrt_and_rsqrt`, which the tracer uses instead.
+#[cfg(test)]
 #[inline]
 pub fn rsqrt(x: u64) -> (u32, i32) {
     let (f, shift) = rsqrt_argument(x);

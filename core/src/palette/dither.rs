@@ -86,6 +86,7 @@ impl Quantizer for Dither {
 /// [`Dither`] with outlines where the object changes. It remembers the
 /// objects of the row above in caller-owned storage (one `u32` per column),
 /// so pixels must come in raster order over whole rows.
+#[derive(Debug)]
 pub struct Coarse<'a> {
     above: &'a mut [u32],
     left: u32,

@@ -73,6 +73,22 @@ pub trait Quantizer {
 /// Renders `rows` (clipped to the image) through `quantizer` into `target`,
 /// one `fill_contiguous` per row; returns the counters of this call. Rows
 /// are traced in order, as the neighbour-aware modes need.
+///
+/// ```
+/// use embedded_graphics::{mock_display::MockDisplay, prelude::*, primitives::Rectangle};
+/// use octrace_core::{accel::Naive, parse::parse, profile::Board16K, render::Renderer, scene::Scene};
+/// use octrace_core::palette::{render_indexed, Dither, PaletteIndex, Quantizer};
+///
+/// let mut scene = Scene::<Board16K>::new();
+/// parse("RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nUPVECTOR 0 1 0\nBACKGROUND 0 0 1\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n", &mut scene, &mut |e| panic!("{e}")).unwrap();
+/// let mut renderer = Renderer::new(scene.view(), &Naive)?;
+/// let mut display = MockDisplay::<PaletteIndex>::new();
+/// render_indexed(&mut renderer, 0..8, &mut Dither, &mut display)?;
+/// assert_eq!(display.affected_area(), Rectangle::new(Point::zero(), Size::new(8, 8)));
+/// let corner = display.get_pixel(Point::zero()).unwrap();
+/// assert_eq!(Dither.table()[corner.0 as usize].b(), 255, "the blue background");
+/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// ```
 pub fn render_indexed<A, Q, D>(
     renderer: &mut Renderer<'_, A>,
     rows: Range<u32>,
@@ -103,8 +119,29 @@ where
 /// and shapes) can so draw on a 256-colour display. It does not know the
 /// objects under the pixels: [`Coarse`] draws no outlines through it (use
 /// [`render_indexed`]).
+///
+/// ```
+/// use embedded_graphics::{mock_display::MockDisplay, prelude::*};
+/// use octrace_core::{accel::Naive, parse::parse, profile::Board16K, render::Renderer, scene::Scene};
+/// use octrace_core::palette::{Gray, PaletteIndex, Quantized, Quantizer};
+///
+/// let mut scene = Scene::<Board16K>::new();
+/// parse("RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nUPVECTOR 0 1 0\nBACKGROUND 0 0 1\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n", &mut scene, &mut |e| panic!("{e}")).unwrap();
+/// let mut gray = Gray;
+/// let mut target = Quantized { display: MockDisplay::<PaletteIndex>::new(), quantizer: &mut gray };
+/// Renderer::new(scene.view(), &Naive)?.render(&mut target)?;
+/// let corner = target.display.get_pixel(Point::zero()).unwrap();
+/// let centre = target.display.get_pixel(Point::new(4, 4)).unwrap();
+/// assert_ne!(corner, centre, "the sphere stands out from the background");
+/// let shade = gray.table()[centre.0 as usize];
+/// assert!(shade.r() == shade.g() && shade.g() == shade.b());
+/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// ```
+#[derive(Debug)]
 pub struct Quantized<'a, D, Q> {
+    /// The palette display the indices go to.
     pub display: D,
+    /// Maps each truecolour pixel to an index (and may keep state: dither).
     pub quantizer: &'a mut Q,
 }
 

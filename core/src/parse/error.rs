@@ -10,16 +10,22 @@ use crate::scene::CameraError;
 use core::fmt;
 
 /// A position in the scene text: line and column (in characters), from 1.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct Pos {
+    /// The line, from 1.
     pub line: u32,
+    /// The column in characters (not bytes), from 1.
     pub column: u32,
 }
 
 /// A parameter of a statement, as the messages name it ("SPHERE radius").
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Field {
+    /// The statement's keyword ("SPHERE").
     pub statement: &'static str,
+    /// The parameter as the scene format names it ("radius").
     pub name: &'static str,
 }
 
@@ -30,9 +36,12 @@ impl fmt::Display for Field {
 }
 
 /// What a token was found instead of the expected one.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Found<'a> {
+    /// This word of the scene text.
     Token(&'a str),
+    /// The text ended before the statement did.
     EndOfFile,
 }
 
@@ -72,6 +81,7 @@ impl fmt::Display for Shown<'_> {
 }
 
 /// The range a value must lie in.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Rule {
     /// > 0
@@ -104,6 +114,9 @@ impl fmt::Display for Rule {
     }
 }
 
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+/// What is wrong, with the text it concerns borrowed from the scene; its
+/// `Display` is the message without the position.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ErrorKind<'a> {
     /// The scene is not valid UTF-8 (the position is the first bad byte).
@@ -112,66 +125,103 @@ pub enum ErrorKind<'a> {
     UnterminatedComment,
     /// A `"` that is never closed.
     UnterminatedString,
+    /// A word where a statement should start that is no keyword.
     UnknownKeyword(&'a str),
+    /// A parameter that is not a number.
     ExpectedNumber {
+        /// The parameter.
         field: Field,
+        /// What stood in its place.
         found: Found<'a>,
     },
+    /// A parameter that must be a whole number and is not.
     ExpectedInteger {
+        /// The parameter.
         field: Field,
+        /// What stood in its place.
         found: Found<'a>,
     },
+    /// A name (IMAGEFILE's) missing at the end of the text.
     ExpectedName {
+        /// The parameter.
         field: Field,
     },
+    /// A number outside the range its parameter allows.
     OutOfRange {
+        /// The parameter.
         field: Field,
+        /// The range it must lie in.
         rule: Rule,
+        /// The number as written.
         found: &'a str,
     },
     /// A scene parameter given twice.
     Repeated {
+        /// The parameter's keyword.
         keyword: &'static str,
+        /// Where it was first given.
         first_line: u32,
     },
+    /// Two SURFACE statements with one number.
     SurfaceRepeated {
+        /// The surface's number.
         number: u32,
+        /// Where it was first defined.
         first_line: u32,
     },
+    /// An object whose surface is defined nowhere in the scene.
     UndefinedSurface {
+        /// The object's keyword.
         keyword: &'static str,
+        /// The missing surface's number.
         number: u32,
     },
     /// A shape with no area or volume: `why` says how.
     Degenerate {
+        /// The shape's keyword.
         keyword: &'static str,
+        /// How it is degenerate.
         why: &'static str,
     },
+    /// A RECTANGLE whose fourth corner is off the plane of the others.
     NotPlanar,
+    /// A RECTANGLE whose corners do not all turn the same way.
     NotConvex,
     /// A B-spline with fewer control points along a side than its order.
     TooFewControlPoints {
+        /// The B-spline's order.
         order: u32,
+        /// Control points down.
         rows: u32,
+        /// Control points across.
         cols: u32,
     },
     /// A shape that rounds to nothing at the scale the whole scene needs.
     TooSmall {
+        /// The shape's keyword.
         keyword: &'static str,
     },
+    /// VIEWPOINT equals ORIGIN ([`CameraError::EyeAtOrigin`]).
     EyeAtOrigin,
+    /// UPVECTOR is zero or along the view ([`CameraError::UpParallel`]).
     UpParallel,
+    /// The scene needs more of something than the profile holds.
     Capacity(CapacityError),
 }
 
 /// One error in a scene.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ParseError<'a> {
+    /// Where the error is: the start of the offending word, or of the
+    /// statement when the whole statement is wrong.
     pub pos: Pos,
+    /// What is wrong.
     pub kind: ErrorKind<'a>,
 }
 
 impl<'a> ParseError<'a> {
+    /// The error `kind` at `pos`.
     pub fn new(pos: Pos, kind: ErrorKind<'a>) -> ParseError<'a> {
         ParseError { pos, kind }
     }
@@ -231,3 +281,7 @@ impl fmt::Display for ParseError<'_> {
         write!(f, "{}:{}: {}", self.pos.line, self.pos.column, self.kind)
     }
 }
+
+impl core::error::Error for ParseError<'_> {}
+
+impl core::error::Error for ErrorKind<'_> {}

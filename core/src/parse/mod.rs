@@ -21,10 +21,9 @@ mod lexer;
 mod number;
 mod statement;
 
-pub use error::{ErrorKind, Field, Found, ParseError, Pos, Rule, Shown};
-pub use lexer::{Lexer, Token};
-pub use number::{parse_integer, Decimal};
-pub use statement::Statement;
+pub use error::{ErrorKind, Field, Found, ParseError, Pos, Rule};
+pub(crate) use number::Decimal;
+pub(crate) use statement::Statement;
 
 use crate::capacity::{CapacityError, CapacityKind, Counts};
 use crate::scene::{Camera, CameraError, Light, Normalization, Scene, SceneCapacities, SurfaceEntry, WorldPoint};
@@ -117,6 +116,25 @@ impl Extent {
 
 /// Parses `text` into `scene` (cleared first). Every error goes to
 /// `on_error`; the result is the number of errors if there were any.
+///
+/// ```
+/// use octrace_core::{parse::parse, profile::Board16K, scene::Scene};
+///
+/// let mut scene = Scene::<Board16K>::new();
+/// let good = "SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nIMAGEFILE ball.png\n";
+/// let parsed = parse(good, &mut scene, &mut |e| panic!("{e}")).unwrap();
+/// assert_eq!(parsed.imagefile, Some("ball.png"));
+/// assert_eq!(scene.view().object_count(), 1);
+///
+/// // Every error is reported with its line and column; the scene is left empty.
+/// let mut messages = Vec::new();
+/// let bad = "SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nSPHERE 1 -1 0 0 0\nCONE 1\n";
+/// let errors = parse(bad, &mut scene, &mut |e| messages.push(e.to_string())).unwrap_err();
+/// assert_eq!(errors, 2);
+/// assert!(messages[0].starts_with("2:10: SPHERE radius must be > 0"), "{messages:?}");
+/// assert!(messages[1].starts_with("3:1: unknown keyword `CONE`"), "{messages:?}");
+/// assert_eq!(scene.view().object_count(), 0);
+/// ```
 pub fn parse<'a, C: SceneCapacities>(
     text: &'a str,
     scene: &mut Scene<C>,
@@ -150,6 +168,14 @@ pub fn parse<'a, C: SceneCapacities>(
 /// B-spline patch at its full grid of triangles): the counts a profile for
 /// this scene holds, but for the octree's, which depend on the build (see
 /// [`crate::accel::BuildReport::counts`]). Like [`parse`], it never panics.
+///
+/// ```
+/// use octrace_core::{capacity::CapacityKind, parse::count};
+///
+/// let needed = count("SPHERE 1 1 0 0 0\nSPHERE 1 1 3 0 0\nLIGHT 10 5 5 5\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\n");
+/// assert_eq!((needed.spheres, needed.objects, needed.surfaces), (2, 2, 1));
+/// assert_eq!(needed.get(CapacityKind::Lights), 1);
+/// ```
 pub fn count(text: &str) -> Counts {
     let mut counts = Counts::ZERO;
     for_each_statement(text, |_, result| {

@@ -125,7 +125,7 @@ impl Decimal {
 
     /// The value in Q32.32, rounded to nearest (ties away from zero). The
     /// magnitude must be within 10^6 ([`Decimal::out_of_range`] false).
-    pub fn to_q32(&self) -> i64 {
+    pub fn to_q32(self) -> i64 {
         let magnitude: u128 = if self.exponent >= 0 {
             let e = self.exponent.min(19) as usize;
             ((self.mantissa as u128) * POW10[e] as u128).min(LIMIT as u128) << 32

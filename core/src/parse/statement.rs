@@ -58,14 +58,6 @@ pub struct ControlPoints<'a> {
 }
 
 impl<'a> ControlPoints<'a> {
-    pub fn len(&self) -> usize {
-        self.count as usize
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.count == 0
-    }
-
     /// The points in world units, row by row.
     pub fn iter(&self) -> impl Iterator<Item = WorldPoint> + 'a {
         let mut lexer = self.lexer;

@@ -14,7 +14,7 @@
 mod gamma;
 mod split;
 
-pub use gamma::GammaTable;
+pub(crate) use gamma::GammaTable;
 pub use split::{interleaved_rows, Tiles};
 
 use crate::accel::{Accelerator, Mailbox};
@@ -29,6 +29,7 @@ use embedded_graphics_core::primitives::Rectangle;
 /// A finished pixel: its display colour and the object seen through it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PixelSample {
+    /// The colour the display shows, gamma applied.
     pub color: Rgb888,
     /// The object the pixel's (centre) primary ray hits, as the scene file
     /// wrote it (see [`SceneView::written_object`]); `None` for background.
@@ -38,11 +39,33 @@ pub struct PixelSample {
 /// Renders one scene through one accelerator. A renderer holds the mutable
 /// state of one thread (counters, mailbox); to render on several threads,
 /// give each its own renderer over the same scene and accelerator.
+///
+/// ```
+/// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*};
+/// use octrace_core::{accel::Naive, parse::parse, profile::Board16K, render::Renderer, scene::Scene};
+///
+/// let mut scene = Scene::<Board16K>::new();
+/// parse("RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nUPVECTOR 0 1 0\nBACKGROUND 0 0 1\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n", &mut scene, &mut |e| panic!("{e}")).unwrap();
+/// let mut renderer = Renderer::new(scene.view(), &Naive)?; // RASTER 8 8
+/// let mut display = MockDisplay::<Rgb888>::new();
+/// let stats = renderer.render(&mut display)?;
+/// assert_eq!(stats.rays, 64, "one ray a pixel: nothing reflects");
+/// assert_eq!(display.get_pixel(Point::new(0, 0)), Some(Rgb888::BLUE));
+/// // A single pixel, with the object seen through it.
+/// assert!(renderer.pixel(4, 4).object.is_some());
+/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// ```
 pub struct Renderer<'a, A> {
     tracer: Tracer<'a, A>,
     camera: Camera,
     gamma: GammaTable,
     scratch: Scratch<'a>,
+}
+
+impl<A> core::fmt::Debug for Renderer<'_, A> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Renderer").field("camera", &self.camera).finish_non_exhaustive()
+    }
 }
 
 impl<'a, A: Accelerator> Renderer<'a, A> {
@@ -90,12 +113,9 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         self.scratch.stats
     }
 
+    /// The image size the renderer traces for.
     pub fn size(&self) -> Size {
         Size::new(self.camera.width(), self.camera.height())
-    }
-
-    pub fn tracer(&self) -> &Tracer<'a, A> {
-        &self.tracer
     }
 
     /// The pixel at (`x`, `y`), `x` to the right and `y` down.

@@ -44,6 +44,7 @@ impl Tiles {
         Some(Rectangle::new(Point::new(x as i32, y as i32), size))
     }
 
+    /// The tiles in raster order.
     pub fn iter(&self) -> impl Iterator<Item = Rectangle> + '_ {
         (0..self.count()).filter_map(|i| self.get(i))
     }

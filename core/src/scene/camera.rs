@@ -19,6 +19,7 @@ pub const MAX_SAMPLES: u32 = 16;
 pub const MAX_SIDE: u32 = 16384;
 
 /// Why a camera cannot be built.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CameraError {
     /// VIEWPOINT equals ORIGIN: there is no view direction.
@@ -41,8 +42,11 @@ impl core::error::Error for CameraError {}
 /// Everything the camera needs from the scene, in world units (Q32.32).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct View {
+    /// VIEWPOINT: where the eye is.
     pub eye: WorldPoint,
+    /// ORIGIN: the point the eye looks at.
     pub look_at: WorldPoint,
+    /// UPVECTOR: which way is up in the image.
     pub up: WorldPoint,
     /// VIEWPORT width and height; `None` for the default (60° wide).
     pub viewport: Option<[WorldValue; 2]>,
@@ -145,10 +149,12 @@ impl Camera {
         })
     }
 
+    /// Image width in pixels.
     pub fn width(&self) -> u32 {
         self.width
     }
 
+    /// Image height in pixels.
     pub fn height(&self) -> u32 {
         self.height
     }

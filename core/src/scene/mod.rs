@@ -8,7 +8,7 @@
 //!   distance: the earlier object wins) uses that order.
 //!
 //! [`Scene`] owns the storage, arenas sized by [`SceneCapacities`] (which
-//! every [`crate::profile`] implements); the tracer and the accelerators read
+//! every [`crate::profile`](mod@crate::profile) implements); the tracer and the accelerators read
 //! it through [`SceneView`], plain slices, so they do not carry the
 //! profile's type parameters. An empty [`Scene`] is all zero bits, so one in
 //! a `static` costs no flash.
@@ -44,10 +44,13 @@ pub struct Light {
 /// are lengths).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Settings {
+    /// VIEWPOINT, ORIGIN, UPVECTOR and VIEWPORT.
     pub view: View,
     /// RASTER width and height, 1 to 16384.
     pub raster: [u32; 2],
+    /// RDEPTH: how many reflections and refractions a ray may spawn in a row.
     pub rdepth: u32,
+    /// BACKGROUND: the colour of rays that hit nothing.
     pub background: Color,
     /// GAMMA, > 0.
     pub gamma: Wide,
@@ -92,6 +95,20 @@ pub trait SceneCapacities {
 }
 
 /// Scene storage sized by the profile `C`.
+///
+/// An empty scene is all zero bits; [`crate::parse::parse`] fills it, and
+/// [`Scene::view`] is what the renderer and the accelerators read:
+///
+/// ```
+/// use octrace_core::{parse::parse, profile::Board16K, scene::Scene};
+///
+/// let mut scene = Scene::<Board16K>::new();
+/// let text = "RASTER 32 24\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nLIGHT 10 5 5 5\n";
+/// parse(text, &mut scene, &mut |e| panic!("{e}")).unwrap();
+/// assert_eq!(scene.settings.raster, [32, 24]);
+/// let view = scene.view();
+/// assert_eq!((view.object_count(), view.lights.len(), view.surfaces.len()), (1, 1, 1));
+/// ```
 pub struct Scene<C: SceneCapacities> {
     objects: C::Objects,
     spheres: C::Spheres,
@@ -104,8 +121,20 @@ pub struct Scene<C: SceneCapacities> {
     control_points: C::ControlPoints,
     surfaces: C::Surfaces,
     lights: C::Lights,
+    /// The scene parameters (zero until a scene is loaded).
     pub settings: Settings,
+    /// How world coordinates map to the normalised space the tracer works in.
     pub normalization: Normalization,
+}
+
+impl<C: SceneCapacities> core::fmt::Debug for Scene<C> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Scene")
+            .field("profile", &C::NAME)
+            .field("objects", &self.view().object_count())
+            .field("settings", &self.settings)
+            .finish_non_exhaustive()
+    }
 }
 
 impl<C: SceneCapacities> Default for Scene<C> {
@@ -163,6 +192,7 @@ impl<C: SceneCapacities> Scene<C> {
         self.normalization = Normalization::IDENTITY;
     }
 
+    /// The loaded scene, read-only, as the tracer and accelerators see it.
     pub fn view(&self) -> SceneView<'_> {
         SceneView {
             objects: self.objects.as_slice(),
@@ -341,16 +371,27 @@ const DEFAULT_SETTINGS: Settings = Settings {
 /// A read-only view of a scene: what the tracer and the accelerators use.
 #[derive(Clone, Copy, Debug)]
 pub struct SceneView<'a> {
+    /// Every object, in the order the scene wrote them: an [`ObjectId`] indexes it.
     pub objects: &'a [ShapeHandle],
+    /// The spheres' arena.
     pub spheres: &'a [Sphere],
+    /// The boxes' arena.
     pub boxes: &'a [AxisAlignedBox],
+    /// The superquadrics' arena.
     pub superquadrics: &'a [Superquadric],
+    /// The triangles' arena.
     pub triangles: &'a [Triangle],
+    /// The rectangles' arena.
     pub rectangles: &'a [Rectangle],
+    /// The B-spline patches' triangles.
     pub smooth_triangles: &'a [SmoothTriangle],
+    /// The surfaces, sorted by number.
     pub surfaces: &'a [SurfaceEntry],
+    /// The point lights.
     pub lights: &'a [Light],
+    /// The scene parameters.
     pub settings: &'a Settings,
+    /// How world coordinates map to normalised space.
     pub normalization: Normalization,
 }
 
@@ -375,6 +416,7 @@ impl<'a> SceneView<'a> {
     }
 
     #[inline]
+    /// The primitive behind a handle.
     pub fn shape_of(&self, h: ShapeHandle) -> ShapeRef<'a> {
         let i = h.index();
         match h.kind() {
@@ -387,6 +429,7 @@ impl<'a> SceneView<'a> {
         }
     }
 
+    /// How many objects the scene holds (B-spline triangles count one each).
     pub fn object_count(&self) -> usize {
         self.objects.len()
     }
@@ -396,6 +439,7 @@ impl<'a> SceneView<'a> {
         (0..self.objects.len() as u32).map(ObjectId)
     }
 
+    /// The surface at `index` in [`SceneView::surfaces`] (objects store that index).
     pub fn surface(&self, index: u16) -> &'a Surface {
         &self.surfaces[index as usize].surface
     }

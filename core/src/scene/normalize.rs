@@ -19,7 +19,9 @@ pub type WorldPoint = [i64; 3];
 /// `normalised = (world − center) · 2^shift`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Normalization {
+    /// The world point that maps to the origin.
     pub center: WorldPoint,
+    /// The power of two world units are scaled by.
     pub shift: i32,
 }
 
@@ -44,6 +46,7 @@ fn round_shift(v: i64, s: u32) -> i64 {
 }
 
 impl Normalization {
+    /// World space as is (centre 0, Q32.32 to Q16.16).
     pub const IDENTITY: Normalization = Normalization { center: [0; 3], shift: 16 };
     /// An empty scene's, before loading: zero bits (see [`super::Scene::new`]).
     pub(crate) const UNLOADED: Normalization = Normalization { center: [0; 3], shift: 0 };

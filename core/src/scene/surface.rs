@@ -11,23 +11,30 @@ use fixed::types::I48F16;
 /// above 1 are kept until the final clamp).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Color {
+    /// Red, linear, Q16.16 (1.0 is full).
     pub r: Scalar,
+    /// Green, linear, Q16.16.
     pub g: Scalar,
+    /// Blue, linear, Q16.16.
     pub b: Scalar,
 }
 
 impl Color {
+    /// No light.
     pub const BLACK: Color = Color::from_bits([0; 3]);
 
+    /// The colour whose components have these raw Q16.16 bits.
     pub const fn from_bits(c: [i32; 3]) -> Color {
         Color { r: Scalar::from_bits(c[0]), g: Scalar::from_bits(c[1]), b: Scalar::from_bits(c[2]) }
     }
 
+    /// The raw Q16.16 bits of the components.
     pub const fn bits(self) -> [i32; 3] {
         [self.r.to_bits(), self.g.to_bits(), self.b.to_bits()]
     }
 
     #[inline]
+    /// The sum, saturating where light piles up past what Q16.16 holds.
     pub fn saturating_add(self, o: Color) -> Color {
         Color { r: self.r.saturating_add(o.r), g: self.g.saturating_add(o.g), b: self.b.saturating_add(o.b) }
     }
@@ -54,6 +61,7 @@ impl Color {
         Color::from_bits([0, 1, 2].map(|i| sat(mul_wide(s[i], o[i]) >> 16)))
     }
 
+    /// Whether every component is zero (nothing to trace for).
     pub fn is_black(self) -> bool {
         self == Color::BLACK
     }
@@ -76,8 +84,11 @@ fn sat(v: i64) -> i32 {
 /// A `SURFACE` definition: the material of every object that names it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Surface {
+    /// Ambient reflection coefficients, per channel.
     pub ambient: Color,
+    /// Diffuse reflection coefficients, per channel.
     pub diffuse: Color,
+    /// Specular reflection coefficients, per channel.
     pub specular: Color,
     /// The Phong exponent k ≥ 0 (0: a constant specular term).
     pub exponent: I48F16,
@@ -91,9 +102,13 @@ pub struct Surface {
 /// "defined twice" errors).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SurfaceEntry {
+    /// The number the scene gave it.
     pub number: u32,
+    /// The line of its SURFACE statement.
     pub line: u32,
+    /// The column of its SURFACE statement.
     pub column: u32,
+    /// The material.
     pub surface: Surface,
 }
 

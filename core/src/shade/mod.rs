@@ -50,6 +50,7 @@ impl Stats {
         }
     }
 
+    /// Adds another render's counters, to total several threads or draws.
     pub fn add(&mut self, o: &Stats) {
         self.rays += o.rays;
         self.shadow_rays += o.shadow_rays;
@@ -59,7 +60,7 @@ impl Stats {
 }
 
 /// The mutable state of one thread of rendering: counters and the mailbox.
-pub struct Scratch<'m> {
+pub(crate) struct Scratch<'m> {
     pub stats: Stats,
     pub mailbox: Mailbox<'m>,
 }
@@ -81,7 +82,7 @@ struct Pending {
 
 /// Traces rays through a scene with a given accelerator.
 #[derive(Clone, Copy)]
-pub struct Tracer<'a, A> {
+pub(crate) struct Tracer<'a, A> {
     scene: SceneView<'a>,
     accel: &'a A,
 }
@@ -118,10 +119,6 @@ fn leaving_along(geometric_normal: Dir, dir: Dir) -> Leaving {
 impl<'a, A: Accelerator> Tracer<'a, A> {
     pub fn new(scene: SceneView<'a>, accel: &'a A) -> Self {
         Tracer { scene, accel }
-    }
-
-    pub fn scene(&self) -> &SceneView<'a> {
-        &self.scene
     }
 
     /// The linear colour seen along a primary ray, and the object it hits (as

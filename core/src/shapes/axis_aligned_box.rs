@@ -8,6 +8,10 @@
 use super::{Aabb, Leaving, Ratio, Ray};
 use crate::math::{Dir, Scalar, Vec3};
 
+/// A BOX: its corners in normalised space.
+// Public only for `profile!` (arenas of it) and the firmware's RAM
+// estimate; its geometry is the core's own business.
+#[doc(hidden)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct AxisAlignedBox {
     pub min: Vec3,

@@ -35,7 +35,9 @@ use crate::math::{Dir, Scalar, Vec3};
 /// A ray `origin + t·dir`, `t > 0`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Ray {
+    /// Where the ray starts, in normalised space.
     pub origin: Vec3,
+    /// Which way it goes.
     pub dir: Dir,
 }
 
@@ -67,7 +69,9 @@ pub enum Leaving {
 /// An axis-aligned bounding box in normalised space, inclusive.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Aabb {
+    /// The corner with the smallest coordinates.
     pub min: Vec3,
+    /// The corner with the largest coordinates.
     pub max: Vec3,
 }
 
@@ -90,10 +94,15 @@ impl Aabb {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[repr(u8)]
 pub enum ShapeKind {
+    /// A `SPHERE`.
     Sphere = 0,
+    /// A `BOX`, axis-aligned.
     Box = 1,
+    /// A `SUPERQUADRIC`.
     Superquadric = 2,
+    /// A `TRIANGLE`.
     Triangle = 3,
+    /// A `RECTANGLE`.
     Rectangle = 4,
     /// A triangle of a `BSPLINE` patch.
     SmoothTriangle = 5,
@@ -138,14 +147,18 @@ impl ShapeHandle {
     /// Largest index a handle can carry.
     pub const MAX_INDEX: usize = (1 << 29) - 1;
 
+    /// The handle of the `index`th shape of `kind` (indices above
+    /// [`ShapeHandle::MAX_INDEX`] wrap: arenas are never that large).
     pub const fn new(kind: ShapeKind, index: usize) -> ShapeHandle {
         ShapeHandle(((kind as u32) << 29) | (index as u32 & Self::MAX_INDEX as u32))
     }
 
+    /// Which arena the shape is in.
     pub const fn kind(self) -> ShapeKind {
         ShapeKind::from_u8((self.0 >> 29) as u8)
     }
 
+    /// Its place in that arena.
     pub const fn index(self) -> usize {
         (self.0 & Self::MAX_INDEX as u32) as usize
     }
@@ -154,11 +167,17 @@ impl ShapeHandle {
 /// A borrowed primitive: the closed set every caller matches on.
 #[derive(Clone, Copy, Debug)]
 pub enum ShapeRef<'a> {
+    /// A `SPHERE`.
     Sphere(&'a Sphere),
+    /// A `BOX`.
     Box(&'a AxisAlignedBox),
+    /// A `SUPERQUADRIC`.
     Superquadric(&'a Superquadric),
+    /// A `TRIANGLE`.
     Triangle(&'a Triangle),
+    /// A `RECTANGLE`.
     Rectangle(&'a Rectangle),
+    /// A triangle of a `BSPLINE` patch.
     SmoothTriangle(&'a SmoothTriangle),
 }
 
@@ -201,6 +220,7 @@ impl ShapeRef<'_> {
         }
     }
 
+    /// A box holding the whole shape (what an octree files it by).
     pub fn bounds(&self) -> Aabb {
         match self {
             ShapeRef::Sphere(s) => s.bounds(),
@@ -212,6 +232,7 @@ impl ShapeRef<'_> {
         }
     }
 
+    /// The index of its surface in [`SceneView::surfaces`](crate::scene::SceneView::surfaces).
     pub fn surface(&self) -> u16 {
         match self {
             ShapeRef::Sphere(s) => s.surface,
@@ -223,6 +244,7 @@ impl ShapeRef<'_> {
         }
     }
 
+    /// Which primitive it is.
     pub fn kind(&self) -> ShapeKind {
         match self {
             ShapeRef::Sphere(_) => ShapeKind::Sphere,
@@ -238,7 +260,7 @@ impl ShapeRef<'_> {
 /// A ratio `num / den` with `den > 0`, compared exactly by cross
 /// multiplication: the slab tests use it to order crossings without dividing.
 #[derive(Clone, Copy, Debug)]
-pub struct Ratio {
+pub(crate) struct Ratio {
     pub num: i64,
     pub den: i64,
 }

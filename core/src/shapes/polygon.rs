@@ -15,6 +15,10 @@ use crate::math::{div_saturating, mul_wide, Dir, Scalar, Vec3};
 pub const EDGE_TOLERANCE: i64 = 1 << EDGE_TOLERANCE_LOG2;
 const EDGE_TOLERANCE_LOG2: u32 = 2;
 
+/// A flat convex polygon of `N` corners: the core of triangles and rectangles.
+// Public only for `profile!` (arenas of it) and the firmware's RAM
+// estimate; its geometry is the core's own business.
+#[doc(hidden)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Polygon<const N: usize> {
     pub corners: [Vec3; N],

@@ -6,6 +6,10 @@ use super::polygon::Polygon;
 use super::{Aabb, Leaving, Ray};
 use crate::math::{Dir, Scalar, Vec3};
 
+/// A RECTANGLE: a planar convex quadrilateral.
+// Public only for `profile!` (arenas of it) and the firmware's RAM
+// estimate; its geometry is the core's own business.
+#[doc(hidden)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Rectangle {
     pub polygon: Polygon<4>,

@@ -15,6 +15,10 @@ use super::triangle::Triangle;
 use super::{Aabb, Leaving, Ray};
 use crate::math::{div_saturating, leading_zeros, Dir, Scalar, Vec3};
 
+/// One triangle of a BSPLINE patch, with corner normals to shade smoothly.
+// Public only for `profile!` (arenas of it) and the firmware's RAM
+// estimate; its geometry is the core's own business.
+#[doc(hidden)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SmoothTriangle {
     pub triangle: Triangle,

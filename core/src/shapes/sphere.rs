@@ -8,6 +8,10 @@
 use super::{Aabb, Leaving, Ray};
 use crate::math::{isqrt, mul_wide, Dir, Scalar, Vec3};
 
+/// A SPHERE: centre and radius in normalised space.
+// Public only for `profile!` (arenas of it) and the firmware's RAM
+// estimate; its geometry is the core's own business.
+#[doc(hidden)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Sphere {
     pub center: Vec3,

@@ -26,6 +26,10 @@ const ONE: i64 = 1 << 30;
 const CONVERGED: i64 = 1 << 8;
 const MAX_ITERATIONS: u32 = 48;
 
+/// A SUPERQUADRIC (a superellipsoid).
+// Public only for `profile!` (arenas of it) and the firmware's RAM
+// estimate; its geometry is the core's own business.
+#[doc(hidden)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Superquadric {
     pub center: Vec3,

@@ -5,6 +5,10 @@ use super::polygon::{cross_of_edges, Polygon};
 use super::{Aabb, Leaving, Ray};
 use crate::math::{Dir, Scalar, Vec3};
 
+/// A TRIANGLE.
+// Public only for `profile!` (arenas of it) and the firmware's RAM
+// estimate; its geometry is the core's own business.
+#[doc(hidden)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Triangle {
     pub polygon: Polygon<3>,

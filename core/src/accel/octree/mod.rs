@@ -176,6 +176,7 @@ pub struct OctreeConfig {
     /// Boxes deeper than this are not subdivided (at most [`MAX_DEPTH`], and
     /// below the octree's `FRAMES`).
     pub max_depth: u32,
+    /// How rays walk the tree; every walk gives the same hits.
     pub traversal: Traversal,
 }
 
@@ -193,13 +194,18 @@ impl Default for OctreeConfig {
 /// What a build produced.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct BuildReport {
+    /// Boxes in the tree, leaves included.
     pub nodes: usize,
+    /// Boxes holding objects with no children.
     pub leaves: usize,
+    /// Object references filed in the leaves.
     pub references: usize,
     /// Object references the build needed at its peak: an arena of exactly
     /// this many builds the same tree.
     pub peak_references: usize,
+    /// Entries of the hash table that finds a box's children.
     pub hash_entries: usize,
+    /// The deepest level reached (the root is level 0).
     pub depth: u32,
     /// Boxes left unsplit because an arena was full (0 when all went well).
     pub unsplit: usize,
@@ -262,6 +268,12 @@ pub trait OctreeCapacities {
     type HashBuckets: Arena<Self::Index>;
 }
 
+impl<C: OctreeCapacities, const FRAMES: usize> core::fmt::Debug for Octree<C, FRAMES> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Octree").field("report", self.report()).finish_non_exhaustive()
+    }
+}
+
 impl BuildReport {
     /// The octree counts of a profile that builds this very tree (see
     /// [`crate::parse::count`] for the scene's).
@@ -274,6 +286,28 @@ impl BuildReport {
 /// bounds the depth of a walk (the tree is at most `FRAMES − 1` deep); the
 /// 3DDDA keeps one frame per level, about 100 bytes of stack each, which a
 /// 16 KiB board wants to keep small.
+///
+/// Built over a parsed scene, it is an [`Accelerator`] for a
+/// [`Renderer`](crate::render::Renderer); the image is the same as without it:
+///
+/// ```
+/// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888};
+/// use octrace_core::{accel::{Naive, Octree}, parse::parse, profile::{Board16K, Profile}};
+/// use octrace_core::{render::Renderer, scene::Scene};
+///
+/// let mut scene = Scene::<Board16K>::new();
+/// parse("RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nUPVECTOR 0 1 0\nBACKGROUND 0 0 1\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n", &mut scene, &mut |e| panic!("{e}")).unwrap();
+/// let mut octree = Octree::<Board16K>::new();
+/// let report = octree.build(&scene.view(), &Board16K::OCTREE);
+/// assert_eq!(report.unsplit, 0, "the arenas were large enough");
+///
+/// let mut with_octree = MockDisplay::<Rgb888>::new();
+/// Renderer::new(scene.view(), &octree)?.render(&mut with_octree)?;
+/// let mut without = MockDisplay::<Rgb888>::new();
+/// Renderer::new(scene.view(), &Naive)?.render(&mut without)?;
+/// assert_eq!(with_octree, without);
+/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// ```
 pub struct Octree<C: OctreeCapacities, const FRAMES: usize = { MAX_DEPTH as usize + 1 }> {
     nodes: C::Nodes,
     refs: C::References,
@@ -348,10 +382,12 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
         }
     }
 
+    /// What the last build produced.
     pub fn report(&self) -> &BuildReport {
         &self.report
     }
 
+    /// How rays walk the tree.
     pub fn traversal(&self) -> Traversal {
         self.traversal
     }
