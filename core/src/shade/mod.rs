@@ -58,15 +58,23 @@ impl Stats {
     }
 }
 
-/// The mutable state of one thread of rendering: counters and the mailbox.
+/// Lights whose last blocker is remembered (light index modulo this).
+const BLOCKER_SLOTS: usize = 8;
+
+/// The mutable state of one thread of rendering: counters, the mailbox, and
+/// per light the object that last blocked a shadow ray towards it.
 pub struct Scratch<'m> {
     pub stats: Stats,
     pub mailbox: Mailbox<'m>,
+    /// Neighbouring shadow rays are usually blocked by the same object, so
+    /// it is tried before any walk (`u32::MAX`: none). Any blocker gives the
+    /// same answer, so this cannot change an image.
+    blockers: [u32; BLOCKER_SLOTS],
 }
 
 impl<'m> Scratch<'m> {
     pub fn new(mailbox: Mailbox<'m>) -> Scratch<'m> {
-        Scratch { stats: Stats::default(), mailbox }
+        Scratch { stats: Stats::default(), mailbox, blockers: [u32::MAX; BLOCKER_SLOTS] }
     }
 }
 
@@ -181,7 +189,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         let to_eye = -p.ray.dir;
         let surface = self.scene.surface(shape.surface());
         let mut local = surface.ambient;
-        for light in self.scene.lights {
+        for (index, light) in self.scene.lights.iter().enumerate() {
             let to_light = light.position - shadow_from;
             let Some((light_dir, distance)) = to_light.direction_and_length() else {
                 continue;
@@ -194,8 +202,8 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             let shadow = Ray { origin: shadow_from, dir: light_dir };
             let start = RayStart { object: hit.object, leaving: leaving_along(geometric, light_dir) };
             let t_max = Scalar::from_bits((distance.to_bits() - 1).max(0));
-            scratch.mailbox.clear();
-            if self.accel.occluded(&self.scene, &shadow, t_max, Some(start), &mut scratch.mailbox) {
+            if self.occluded(&shadow, t_max, start, &mut scratch.blockers[index % BLOCKER_SLOTS], &mut scratch.mailbox)
+            {
                 continue;
             }
             let attenuation = self.attenuation(light.brightness.to_bits(), distance);
@@ -221,6 +229,35 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             })
         };
         [child(p.ray.dir, t), child(to_eye.reflect_about(normal), r)]
+    }
+
+    /// Whether anything blocks `shadow` before `t_max`, trying `blocker` (the
+    /// last object that blocked this light) first and remembering the next.
+    #[inline]
+    fn occluded(
+        &self,
+        shadow: &Ray,
+        t_max: Scalar,
+        start: RayStart,
+        blocker: &mut u32,
+        mailbox: &mut Mailbox<'_>,
+    ) -> bool {
+        mailbox.clear();
+        if (*blocker as usize) < self.scene.object_count() {
+            let object = ObjectId(*blocker);
+            let leaving = RayStart::leaving(Some(start), object);
+            if self.scene.shape(object).intersect(shadow, t_max, leaving).is_some() {
+                return true;
+            }
+            // Missed: the walk need not test it again.
+            mailbox.first_visit(*blocker);
+        }
+        mailbox.blocker = u32::MAX;
+        let blocked = self.accel.occluded(&self.scene, shadow, t_max, Some(start), mailbox);
+        if blocked {
+            *blocker = mailbox.blocker;
+        }
+        blocked
     }
 
     /// B / (d + d0) with d in world units, Q16.16, saturating.

@@ -145,17 +145,18 @@ impl<const FRAMES: usize> DdaWalk<FRAMES> {
             return;
         }
         // Clip to the objects' own bounds (rounding outwards: a wider span
-        // only visits more boxes).
+        // only visits more boxes). Their low corner is the root's, so on
+        // each axis one of the two crossings is the root's, known already.
         let (mut near, mut far) = (-LIMIT, LIMIT);
         for a in 0..3 {
             let (lo, hi) = if walk.mirror >> a & 1 == 1 {
                 let c2 = 2 * (tree.root_min[a] + half);
-                (c2 - tree.bounds_max[a], c2 - tree.bounds_min[a])
+                (walk.crossing(a, c2 - tree.bounds_max[a]), t1[a])
             } else {
-                (tree.bounds_min[a], tree.bounds_max[a])
+                (t0[a], walk.crossing(a, tree.bounds_max[a]))
             };
-            near = near.max(walk.crossing(a, lo));
-            far = far.min(walk.crossing(a, hi));
+            near = near.max(lo);
+            far = far.min(hi);
         }
         (walk.near, walk.far) = (near - 1, far + 1);
         if walk.far < walk.near || walk.far < 0 {
