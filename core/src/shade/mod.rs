@@ -232,7 +232,8 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
     }
 
     /// Whether anything blocks `shadow` before `t_max`, trying `blocker` (the
-    /// last object that blocked this light) first and remembering the next.
+    /// object that blocked the last shadow ray to this light, if it was
+    /// blocked) first, and remembering the next.
     #[inline]
     fn occluded(
         &self,
@@ -254,9 +255,9 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         }
         mailbox.blocker = u32::MAX;
         let blocked = self.accel.occluded(&self.scene, shadow, t_max, Some(start), mailbox);
-        if blocked {
-            *blocker = mailbox.blocker;
-        }
+        // Forget a blocker that missed once the light is seen: in the open
+        // it would cost every shadow ray an extra test.
+        *blocker = mailbox.blocker;
         blocked
     }
 
@@ -359,6 +360,30 @@ mod shading_tests {
         let (c, _, _) = look(&text);
         // d = |(7, 0, 7)| = 9.8995 from P = (0, 0, 1): 9 / 10.8995 · 0.5.
         approx(c, [m(413); 3]);
+    }
+
+    #[test]
+    fn a_remembered_blocker_never_shadows_a_lit_point() {
+        // A blocker between the light and the pole of the sphere: the ray to
+        // the pole is in shadow, the ray beside it is lit. Tracing the lit
+        // ray after the shadowed one (the blocker remembered) must give the
+        // same colour as tracing it alone.
+        let text = format!(
+            "{SPHERE}SPHERE 2 0.2 0 0 5\nLIGHT 10 0 0 10\n{}SURFACE 2 0 0 0 0 0 0 0 0 0 0 0 0\n",
+            surface("0.1", "0.5", "0", "0", "0", "0")
+        );
+        let mut scene: Box<Scene<Board64K>> = Box::default();
+        parse(&text, &mut scene, &mut |e| panic!("{e}")).unwrap();
+        let view = scene.view();
+        let ray = |x: i64| Ray { origin: view.normalization.point([x, 0, 3 << 32]), dir: -Dir::Z };
+        let tracer = Tracer::new(view, &Naive);
+        let mut alone = Scratch::new(Mailbox::none());
+        let lit = tracer.trace(ray(1 << 31), &mut alone).0;
+        let mut shared = Scratch::new(Mailbox::none());
+        let shadowed = tracer.trace(ray(0), &mut shared).0;
+        approx(shadowed, [m(100); 3]); // the pole is in shadow: ambient only
+        assert_eq!(tracer.trace(ray(1 << 31), &mut shared).0, lit);
+        assert_ne!(lit, shadowed);
     }
 
     #[test]
