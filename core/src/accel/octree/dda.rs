@@ -21,6 +21,7 @@
 
 use super::Octree;
 use crate::capacity::{Arena, Capacities};
+use crate::math::{mul_u64_shr24_clamped, reciprocal_q62};
 use crate::shapes::Ray;
 
 /// Parameters are Q40.24.
@@ -132,7 +133,7 @@ impl<const FRAMES: usize> DdaWalk<FRAMES> {
                 o[a]
             };
             walk.origin[a] = oa;
-            walk.inverse[a] = (1u64 << 62) / d[a].unsigned_abs().max(1);
+            walk.inverse[a] = reciprocal_q62(d[a].unsigned_abs() as u32);
             t0[a] = walk.crossing(a, tree.root_min[a]);
             t1[a] = walk.crossing(a, tree.root_min[a] + 2 * half);
             if t0[a].abs() == LIMIT || t1[a].abs() == LIMIT {
@@ -174,8 +175,7 @@ impl<const FRAMES: usize> DdaWalk<FRAMES> {
     /// through the reciprocal 2^62 / |d|.
     #[inline]
     fn crossing(&self, a: usize, plane: i64) -> i64 {
-        let v = ((plane - self.origin[a]) as i128 * self.inverse[a] as i128) >> 24;
-        v.clamp(-(LIMIT as i128), LIMIT as i128) as i64
+        mul_u64_shr24_clamped::<LIMIT>(plane - self.origin[a], self.inverse[a])
     }
 
     /// Enters a subdivided box: the first child the ray meets lies beyond
