@@ -1,17 +1,47 @@
-//! Chooses the board from the target and the scene, size, mode and pixel
-//! format from the environment, at build time:
+//! Chooses the board, scene, size, mode and pixel format from the
+//! environment, at build time, and sizes the board's arenas
+//! for exactly that scene: it parses the scene and builds its octree here,
+//! on the host, with the core the board runs, and writes a
+//! `octrace_core::profile!` holding what they needed.
 //!
 //! | variable | values | default |
 //! | --- | --- | --- |
+//! | `OCTRACE_BOARD` | `microbit` (thumbv6m), `mps2-an385` or `lm3s6965evb` (thumbv7m) | from the target: thumbv6m `microbit`, thumbv7m `mps2-an385` |
 //! | `OCTRACE_SCENE` | a scene in `scenes/` (name without `.txt`) | `fig5_1` |
-//! | `OCTRACE_SIZE` | `WxH` | `160x128` |
+//! | `OCTRACE_SIZE` | `WxH` (on `lm3s6965evb` at most the panel's 128x64, an even width) | `160x128`; `128x64` on `lm3s6965evb` |
 //! | `OCTRACE_ACCEL` | `auto`, `naive`, `octree`, `dda` | `auto` |
-//! | `OCTRACE_COLOR` | `rgb888`, `rgb565`, `dither` (1-byte indices into the 6×6×6 cube) | `rgb888` |
-//! | `OCTRACE_OUT` | host file the pixels are written to | `octrace-out.raw` |
+//! | `OCTRACE_COLOR` | `rgb888`, `rgb565`, `dither` (1-byte indices into the 6×6×6 cube), `gray4` (1 byte a pixel, the level 0 to 15); only `gray4` on `lm3s6965evb` | `rgb888`; `gray4` on `lm3s6965evb` |
+//! | `OCTRACE_OUT` | host file the pixels are written to; on `lm3s6965evb` the PNG of the panel's screen that the runner grabs | `octrace-out.raw`; `screen.png` on `lm3s6965evb` |
+//!
+//! | board | qemu `-machine` | core | flash | RAM | display |
+//! | --- | --- | --- | --- | --- | --- |
+//! | `microbit` | `microbit` | Cortex-M0 | 256 KiB | 16 KiB | semihosting file |
+//! | `mps2-an385` | `mps2-an385` | Cortex-M3 | 4 MiB | 4 MiB | semihosting file |
+//! | `lm3s6965evb` | `lm3s6965evb` | Cortex-M3 | 256 KiB | 64 KiB | 128×64 16-gray OLED (SSD0323 on SSI0) |
+//!
+//! The runner (`run.sh`) learns the machine and the output from the ELF
+//! itself: this script puts them in the non-loaded section `.octrace_run`
+//! (see `memory-*.x`), so an ELF always runs on the board it was built for.
 
+use octrace_core::accel::{Octree, OctreeConfig};
+use octrace_core::capacity::{CapacityKind, Counts};
+use octrace_core::parse::{count, parse};
+use octrace_core::profile::Host;
+use octrace_core::scene::Scene;
+use octrace_core::AccelMode;
 use std::env;
 use std::fmt::Write as _;
 use std::path::PathBuf;
+
+/// What each board's RAM holds besides the stack, and how its octree is
+/// built (shallow on the micro:bit, whose 7 KiB stack holds one walk frame
+/// of about 100 bytes per level).
+struct Board {
+    name: &'static str,
+    static_ram: usize,
+    octree: &'static str,
+    config: OctreeConfig,
+}
 
 fn var(name: &str, default: &str) -> String {
     println!("cargo:rerun-if-env-changed={name}");
@@ -27,53 +57,179 @@ fn main() {
     let out = PathBuf::from(env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
     let manifest = PathBuf::from(env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
     let target = env::var("TARGET").unwrap_or_default();
-    let board = match target.as_str() {
+    let default_board = match target.as_str() {
         "thumbv6m-none-eabi" => "microbit",
         "thumbv7m-none-eabi" => "mps2-an385",
         other => fail(format!("no board for target {other}: use thumbv6m-none-eabi or thumbv7m-none-eabi")),
     };
-    let memory = manifest.join(format!("memory-{board}.x"));
+    let board = var("OCTRACE_BOARD", default_board);
+    let board = match (board.as_str(), target.as_str()) {
+        ("microbit", "thumbv6m-none-eabi") => Board {
+            name: "microbit",
+            static_ram: 9 * 1024,
+            octree: "max_objects: 8, max_depth: 3",
+            config: OctreeConfig { max_objects: 8, max_depth: 3, ..OctreeConfig::DEFAULT },
+        },
+        ("mps2-an385", "thumbv7m-none-eabi") => Board {
+            name: "mps2-an385",
+            static_ram: 3 * 1024 * 1024,
+            octree: "max_objects: 4, max_depth: 12",
+            config: OctreeConfig::DEFAULT,
+        },
+        ("lm3s6965evb", "thumbv7m-none-eabi") => Board {
+            name: "lm3s6965evb",
+            // Of the 56 KiB beside the stack, 1 KiB is left for the other statics.
+            static_ram: 55 * 1024,
+            octree: "max_objects: 4, max_depth: 12",
+            config: OctreeConfig::DEFAULT,
+        },
+        ("microbit", _) => fail(format!("OCTRACE_BOARD=microbit needs --target thumbv6m-none-eabi, not {target}")),
+        ("mps2-an385" | "lm3s6965evb", _) => {
+            fail(format!("OCTRACE_BOARD={board} needs --target thumbv7m-none-eabi, not {target}"))
+        }
+        (other, _) => fail(format!("OCTRACE_BOARD={other}: expected microbit, mps2-an385 or lm3s6965evb")),
+    };
+    let oled = board.name == "lm3s6965evb";
+    let memory = manifest.join(format!("memory-{}.x", board.name));
     std::fs::copy(&memory, out.join("memory.x")).expect("copy memory.x");
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed={}", memory.display());
-    println!("cargo:rustc-check-cfg=cfg(board, values(\"microbit\", \"mps2-an385\"))");
-    println!("cargo:rustc-cfg=board=\"{board}\"");
+    println!("cargo:rustc-check-cfg=cfg(board, values(\"microbit\", \"mps2-an385\", \"lm3s6965evb\"))");
+    println!("cargo:rustc-cfg=board=\"{}\"", board.name);
 
     let scene = var("OCTRACE_SCENE", "fig5_1");
     let scene_path = manifest.join("../scenes").join(format!("{scene}.txt"));
-    if !scene_path.is_file() {
-        fail(format!("OCTRACE_SCENE={scene}: no file {}", scene_path.display()));
-    }
+    let Ok(text) = std::fs::read_to_string(&scene_path) else {
+        fail(format!("OCTRACE_SCENE={scene}: no file {}", scene_path.display()))
+    };
     println!("cargo:rerun-if-changed={}", scene_path.display());
-    let size = var("OCTRACE_SIZE", "160x128");
+    let size = var("OCTRACE_SIZE", if oled { "128x64" } else { "160x128" });
     let (w, h) = size
         .split_once('x')
         .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
         .filter(|&(w, h)| (1..=16384).contains(&w) && (1..=16384).contains(&h))
         .unwrap_or_else(|| fail(format!("OCTRACE_SIZE={size}: expected WxH, 1 to 16384 each")));
-    let accel = match var("OCTRACE_ACCEL", "auto").as_str() {
-        "auto" => "Auto",
-        "naive" => "Naive",
-        "octree" => "Octree",
-        "dda" => "Dda",
-        other => fail(format!("OCTRACE_ACCEL={other}: expected auto, naive, octree or dda")),
+    if oled && (w > 128 || h > 64) {
+        fail(format!("OCTRACE_SIZE={size}: the lm3s6965evb's panel is 128x64"));
+    }
+    if oled && !w.is_multiple_of(2) {
+        fail(format!("OCTRACE_SIZE={size}: the lm3s6965evb's panel takes pixels in pairs: an even width"));
+    }
+    let accel = var("OCTRACE_ACCEL", "auto");
+    let Some(accel) = AccelMode::from_name(&accel) else {
+        let names: Vec<&str> = AccelMode::ALL.iter().map(|m| m.name()).collect();
+        fail(format!("OCTRACE_ACCEL={accel}: expected {}", names.join(", ")))
     };
-    let wire = match var("OCTRACE_COLOR", "rgb888").as_str() {
+    let wire = match var("OCTRACE_COLOR", if oled { "gray4" } else { "rgb888" }).as_str() {
+        "gray4" => "Gray4",
+        other if oled => fail(format!("OCTRACE_COLOR={other}: the lm3s6965evb's OLED shows 16 grays: use gray4")),
         "rgb888" => "Rgb888",
         "rgb565" => "Rgb565",
         "dither" => "Dither",
-        other => fail(format!("OCTRACE_COLOR={other}: expected rgb888, rgb565 or dither")),
+        other => fail(format!("OCTRACE_COLOR={other}: expected rgb888, rgb565, dither or gray4")),
     };
-    let output = var("OCTRACE_OUT", "octrace-out.raw");
+    let output = var("OCTRACE_OUT", if oled { "screen.png" } else { "octrace-out.raw" });
+    if output.contains(['\0', '\n']) {
+        fail("OCTRACE_OUT: a path without NUL or newline".to_owned());
+    }
+    let counts = needs(&text, accel, &board.config);
+    let bytes = static_bytes(&counts);
+    if bytes > board.static_ram {
+        fail(format!(
+            "{scene} needs about {bytes} bytes of arenas ({}), more than the {} bytes the {} has beside its stack",
+            describe(&counts),
+            board.static_ram,
+            board.name
+        ));
+    }
 
+    let fields: Vec<String> = CapacityKind::ALL
+        .iter()
+        .filter(|&&kind| counts.get(kind) > 0)
+        .map(|&kind| format!("{}: {}", kind.field(), counts.get(kind)))
+        .collect();
     let mut config = String::new();
-    writeln!(config, "pub const BOARD: &str = {board:?};").unwrap();
+    writeln!(config, "pub const BOARD: &str = {:?};", board.name).unwrap();
     writeln!(config, "pub const SCENE_NAME: &str = {scene:?};").unwrap();
     writeln!(config, "pub const SCENE: &str = include_str!({:?});", scene_path.display().to_string()).unwrap();
     writeln!(config, "pub const WIDTH: u32 = {w};").unwrap();
     writeln!(config, "pub const HEIGHT: u32 = {h};").unwrap();
-    writeln!(config, "pub const ACCEL: crate::Accel = crate::Accel::{accel};").unwrap();
+    writeln!(config, "pub const ACCEL: octrace_core::AccelMode = octrace_core::AccelMode::{accel:?};").unwrap();
     writeln!(config, "pub const WIRE: crate::Wire = crate::Wire::{wire};").unwrap();
-    writeln!(config, "pub const OUTPUT: &str = {:?};", format!("{output}\0")).unwrap();
+    if !oled {
+        // The guest writes this file; on the OLED board the runner does.
+        writeln!(config, "pub const OUTPUT: &str = {:?};", format!("{output}\0")).unwrap();
+    }
+    writeln!(
+        config,
+        "octrace_core::profile! {{\n    /// Exactly what {scene} needs (about {bytes} bytes).\n    pub struct Profile {{ {} }}\n    octree: {{ {} }}\n}}",
+        fields.join(", "),
+        board.octree
+    )
+    .unwrap();
+    // What the runner reads from the ELF: `key=value` lines.
+    let run = format!("machine={}\noutput={output}\n", board.name);
+    writeln!(config, "#[used]").unwrap();
+    writeln!(config, "#[link_section = \".octrace_run\"]").unwrap();
+    writeln!(config, "static RUN: [u8; {}] = {:?};", run.len(), run.as_bytes()).unwrap();
     std::fs::write(out.join("config.rs"), config).expect("write config.rs");
+}
+
+/// What the scene needs of each capacity: its statements, and the octree
+/// the board builds for it (built here with the same core and criterion, so
+/// the board's arenas hold exactly the same tree). A scene with errors
+/// needs what it counts; the board then reports its errors.
+fn needs(text: &str, accel: AccelMode, config: &OctreeConfig) -> Counts {
+    let mut counts = count(text);
+    let mut scene = Box::new(Scene::<Host>::new());
+    if parse(text, &mut scene, &mut |_| {}).is_err() {
+        return counts;
+    }
+    let view = scene.view();
+    if let Some(traversal) = accel.resolve(view.object_count()).traversal() {
+        let mut octree: Box<Octree<Host>> = Box::default();
+        let report = octree.build(&view, &OctreeConfig { traversal, ..*config });
+        counts = counts.max(&report.counts());
+    }
+    counts
+}
+
+/// How many bytes of RAM the arenas for `counts` take (the core's types
+/// hold no pointers or `usize`, so their sizes here are the board's).
+fn static_bytes(counts: &Counts) -> usize {
+    use octrace_core::accel::{HashEntry, OctreeNode};
+    use octrace_core::math::Vec3;
+    use octrace_core::scene::{Light, SurfaceEntry};
+    use octrace_core::shapes::{
+        AxisAlignedBox, Rectangle, ShapeHandle, SmoothTriangle, Sphere, Superquadric, Triangle,
+    };
+    use std::mem::size_of;
+    use CapacityKind::*;
+    let per = |kind: CapacityKind| match kind {
+        Objects => size_of::<ShapeHandle>(),
+        Spheres => size_of::<Sphere>(),
+        Boxes => size_of::<AxisAlignedBox>(),
+        Superquadrics => size_of::<Superquadric>(),
+        Triangles => size_of::<Triangle>(),
+        Rectangles => size_of::<Rectangle>(),
+        BsplineTriangles => size_of::<SmoothTriangle>(),
+        ControlPoints => size_of::<Vec3>(),
+        Surfaces => size_of::<SurfaceEntry>(),
+        Lights => size_of::<Light>(),
+        OctreeBoxes => size_of::<OctreeNode<u16>>(),
+        OctreeReferences => size_of::<u16>(),
+    };
+    CapacityKind::ALL.iter().map(|&k| counts.get(k) * per(k)).sum::<usize>()
+        + (counts.octree_hash_entries() * size_of::<HashEntry<u16>>())
+        + (counts.octree_hash_buckets() + 1) * size_of::<u16>()
+        + counts.mailbox_words() * size_of::<u32>()
+}
+
+fn describe(counts: &Counts) -> String {
+    let parts: Vec<String> = CapacityKind::ALL
+        .iter()
+        .filter(|&&k| counts.get(k) > 0)
+        .map(|&k| format!("{} {}", counts.get(k), k.what()))
+        .collect();
+    parts.join(", ")
 }

@@ -1,11 +1,18 @@
 #!/usr/bin/env bash
-# qemu runner for the firmware: run.sh MACHINE ELF. Exits with the guest's
-# semihosting exit code (0 ok, 2 bad scene, 101 panic, 102 HardFault), or 124
-# if it runs longer than QEMU_TIMEOUT seconds (default 600).
+# qemu runner for the firmware: run.sh ELF. The machine (and, for the
+# LM3S6965EVB, where its screen goes) comes from the ELF itself, written
+# there by build.rs. Exits with the guest's semihosting exit code (0 ok,
+# 2 bad scene, 101 panic, 102 HardFault), 124 if it runs longer than
+# QEMU_TIMEOUT seconds (default 600), 4 if the OLED's screen cannot be
+# grabbed (tools/runner.py).
 set -euo pipefail
-machine=$1
-elf=$2
+here=$(dirname "$0")
+elf=$1
+machine=$(python3 "$here/tools/runner.py" info "$elf" machine)
 cpu=()
-[ "$machine" = mps2-an385 ] && cpu=(-cpu cortex-m3)
+case $machine in
+    lm3s6965evb) exec python3 "$here/tools/runner.py" screen "$elf" ;;
+    mps2-an385) cpu=(-cpu cortex-m3) ;;
+esac
 exec timeout "${QEMU_TIMEOUT:-600}" qemu-system-arm -machine "$machine" "${cpu[@]}" -nographic -monitor none \
     -semihosting-config enable=on,target=native -kernel "$elf"

@@ -1,20 +1,14 @@
-//! Every capacity octrace has, in one place: the arenas a scene is stored in
-//! and the profiles that size them.
+//! Fixed-capacity storage and the vocabulary of capacities: the leaf every
+//! sized type builds on (it imports nothing else from the crate).
 //!
-//! A profile is a type implementing [`Capacities`]; each associated type is an
-//! arena of fixed capacity. On a board the arenas are `heapless::Vec`s that
-//! live in a `static` (no heap, the linker checks the RAM); on a host they may
-//! be `HeapArena`s (feature `alloc`): the same fixed limits, but memory is
-//! taken only as the scene fills them. Exceeding a capacity is a scene error
-//! that names it ([`crate::parse::ErrorKind::Capacity`]).
-//!
-//! To raise a limit, define your own profile (copy one below and change the
-//! numbers); nothing else changes.
+//! Invariants: an [`Arena`] never holds more than its `CAPACITY` items and
+//! hands an item back instead of growing; an empty arena is a constant whose
+//! bits are all zero for `heapless::Vec`, so arenas in a `static` land in
+//! `.bss` and cost no flash. Each capacity is named once, by
+//! [`CapacityKind`]; [`Counts`] holds one number per kind (what a profile
+//! holds, or what a scene needs).
 
-use crate::accel::{HashEntry, OctreeNode};
-use crate::math::Vec3;
-use crate::scene::{Light, SurfaceEntry};
-use crate::shapes::{AxisAlignedBox, Rectangle, ShapeHandle, SmoothTriangle, Sphere, Superquadric, Triangle};
+use core::fmt;
 
 /// A fixed-capacity, append-only store: `heapless::Vec` on boards.
 pub trait Arena<T>: Sized {
@@ -24,8 +18,11 @@ pub trait Arena<T>: Sized {
     const CAPACITY: usize;
     /// Appends `item`, or gives it back when the arena is full.
     fn push(&mut self, item: T) -> Result<(), T>;
+    /// The items, in the order they were pushed.
     fn as_slice(&self) -> &[T];
+    /// The items, mutably.
     fn as_mut_slice(&mut self) -> &mut [T];
+    /// Drops every item.
     fn clear(&mut self);
     /// Drops the items from `len` on.
     fn truncate(&mut self, len: usize);
@@ -59,6 +56,7 @@ impl<T, const N: usize> Arena<T> for heapless::Vec<T, N> {
 /// A heap-backed arena with the fixed capacity `N` (feature `alloc`): for
 /// hosts, where a million-object limit should not cost memory up front.
 #[cfg(feature = "alloc")]
+#[derive(Debug)]
 pub struct HeapArena<T, const N: usize>(alloc::vec::Vec<T>);
 
 #[cfg(feature = "alloc")]
@@ -91,139 +89,214 @@ impl<T, const N: usize> Arena<T> for HeapArena<T, N> {
     }
 }
 
-/// The integer type of the octree's indices: `u32` on hosts, `u16` on small
-/// boards (half the RAM for the octree). Its largest two values are
-/// reserved as markers.
-pub trait Index: Copy + Eq + core::fmt::Debug + 'static {
-    /// The largest value.
-    const MAX: u32;
-    /// `v` as an index; `v` must not exceed [`Index::MAX`].
-    fn new(v: u32) -> Self;
-    fn get(self) -> u32;
+/// Declares [`CapacityKind`] and [`Counts`] from one list, so the enum, the
+/// struct's fields, their names in messages and in [`crate::profile!`] can
+/// never drift apart.
+macro_rules! capacities {
+    ($($(#[$doc:meta])* $variant:ident $(= $value:literal)? => $field:ident, $what:literal;)*) => {
+        /// One capacity of a profile: something a scene can run out of.
+        // Numbered from 1, so that `None` of an `Option<CapacityKind>` is
+        // zero bits (an empty octree's report sits in `.bss`).
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        #[repr(u8)]
+        pub enum CapacityKind {
+            $($(#[$doc])* $variant $(= $value)?,)*
+        }
+
+        impl CapacityKind {
+            /// Every kind, in the order of [`Counts`]' fields.
+            pub const ALL: [CapacityKind; [$(CapacityKind::$variant),*].len()] = [$(CapacityKind::$variant),*];
+
+            /// What runs out, in plain words ("spheres").
+            pub const fn what(self) -> &'static str {
+                match self {
+                    $(CapacityKind::$variant => $what,)*
+                }
+            }
+
+            /// Its field in [`Counts`] and in [`crate::profile!`].
+            pub const fn field(self) -> &'static str {
+                match self {
+                    $(CapacityKind::$variant => stringify!($field),)*
+                }
+            }
+        }
+
+        /// A number for each [`CapacityKind`]: what a profile holds, or what
+        /// a scene needs ([`crate::parse::count`]).
+        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+        pub struct Counts {
+            $($(#[$doc])* pub $field: usize,)*
+        }
+
+        impl Counts {
+            /// Nothing at all.
+            pub const ZERO: Counts = Counts { $($field: 0,)* };
+
+            /// The count of `kind`.
+            pub const fn get(&self, kind: CapacityKind) -> usize {
+                match kind {
+                    $(CapacityKind::$variant => self.$field,)*
+                }
+            }
+
+            /// The count of `kind`, mutably.
+            pub fn get_mut(&mut self, kind: CapacityKind) -> &mut usize {
+                match kind {
+                    $(CapacityKind::$variant => &mut self.$field,)*
+                }
+            }
+        }
+    };
 }
 
-impl Index for u16 {
-    const MAX: u32 = u16::MAX as u32;
-    #[inline]
-    fn new(v: u32) -> u16 {
-        v as u16
-    }
-    #[inline]
-    fn get(self) -> u32 {
-        self as u32
-    }
+capacities! {
+    /// All objects (by default the sum of the shapes).
+    Objects = 1 => objects, "objects";
+    /// Spheres.
+    Spheres => spheres, "spheres";
+    /// Axis-aligned boxes.
+    Boxes => boxes, "boxes";
+    /// Superquadrics.
+    Superquadrics => superquadrics, "superquadrics";
+    /// Flat triangles.
+    Triangles => triangles, "triangles";
+    /// Rectangles.
+    Rectangles => rectangles, "rectangles";
+    /// The triangles B-spline patches are cut into (two per grid cell).
+    BsplineTriangles => bspline_triangles, "B-spline triangles";
+    /// Control points of the largest B-spline patch (room to evaluate one).
+    ControlPoints => control_points, "B-spline control points";
+    /// Surface definitions (at most 65,535).
+    Surfaces => surfaces, "surfaces";
+    /// Point lights.
+    Lights => lights, "lights";
+    /// Octree boxes (8 per subdivision, plus the root).
+    OctreeBoxes => octree_boxes, "octree boxes";
+    /// Object references in the octree's leaves, and working room while
+    /// building (an object in several leaves counts once per leaf).
+    OctreeReferences => octree_references, "octree references";
 }
 
-impl Index for u32 {
-    const MAX: u32 = u32::MAX;
-    #[inline]
-    fn new(v: u32) -> u32 {
-        v
+impl Counts {
+    /// The shapes' sum (saturating): the objects a profile needs room for.
+    pub const fn shapes(&self) -> usize {
+        self.spheres
+            .saturating_add(self.boxes)
+            .saturating_add(self.superquadrics)
+            .saturating_add(self.triangles)
+            .saturating_add(self.rectangles)
+            .saturating_add(self.bspline_triangles)
     }
-    #[inline]
-    fn get(self) -> u32 {
+
+    /// Hash-table entries the octree needs: one per subdivided box.
+    pub const fn octree_hash_entries(&self) -> usize {
+        self.octree_boxes.saturating_sub(1) / 8
+    }
+
+    /// The octree's hash-table size: an odd number near half the entries
+    /// (chains of about two), at least 1.
+    pub const fn octree_hash_buckets(&self) -> usize {
+        (self.octree_hash_entries() / 2) | 1
+    }
+
+    /// These counts with `objects` set to the shapes' sum when it is 0
+    /// (what [`crate::profile!`] does when `objects` is not given).
+    pub const fn with_objects(mut self) -> Counts {
+        if self.objects == 0 {
+            self.objects = self.shapes();
+        }
+        self
+    }
+
+    /// Only the octree's counts (the others 0).
+    pub const fn octree_counts(&self) -> Counts {
+        Counts { octree_boxes: self.octree_boxes, octree_references: self.octree_references, ..Counts::ZERO }
+    }
+
+    /// Mailbox words for every object (one bit each).
+    pub const fn mailbox_words(&self) -> usize {
+        self.objects.div_ceil(32)
+    }
+
+    /// Each count the larger of `self`'s and `other`'s.
+    pub fn max(mut self, other: &Counts) -> Counts {
+        for kind in CapacityKind::ALL {
+            let c = self.get_mut(kind);
+            *c = (*c).max(other.get(kind));
+        }
         self
     }
 }
 
-/// The capacities of one build: how many of each thing a scene may hold.
-pub trait Capacities {
-    /// The profile's name, shown in capacity errors.
-    const NAME: &'static str;
-    /// All objects, in file order.
-    type Objects: Arena<ShapeHandle>;
-    type Spheres: Arena<Sphere>;
-    type Boxes: Arena<AxisAlignedBox>;
-    type Superquadrics: Arena<Superquadric>;
-    type Triangles: Arena<Triangle>;
-    type Rectangles: Arena<Rectangle>;
-    /// The triangles of B-spline patches.
-    type SmoothTriangles: Arena<SmoothTriangle>;
-    /// Room for one patch's control points while it is evaluated.
-    type ControlPoints: Arena<Vec3>;
-    /// Surface definitions; at most 65,535 (objects refer to them by `u16`).
-    type Surfaces: Arena<SurfaceEntry>;
-    type Lights: Arena<Light>;
-    /// The octree's index type (bounds its arenas and the objects it files).
-    type Index: Index;
-    /// Octree boxes (8 per subdivision, plus the root).
-    type OctreeNodes: Arena<OctreeNode<Self::Index>>;
-    /// Object references of the octree's leaves (an object in several
-    /// leaves counts once per leaf), and working room while building.
-    type OctreeRefs: Arena<Self::Index>;
-    /// Hash-table entries: one per subdivided box (the thesis's structure
-    /// holding the addresses of a box's eight children).
-    type OctreeEntries: Arena<HashEntry<Self::Index>>;
-    /// Hash-table buckets; the table size is this arena's capacity.
-    type OctreeBuckets: Arena<Self::Index>;
+/// A scene needs more of something than its profile holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CapacityError {
+    /// What ran out.
+    pub kind: CapacityKind,
+    /// How many the profile holds.
+    pub capacity: usize,
+    /// How many the scene needs, when known (the parser counts them all
+    /// before storing any).
+    pub needed: Option<usize>,
+    /// The profile's name.
+    pub profile: &'static str,
 }
 
-/// The host build: a million objects of any mix (heap-backed arenas).
-#[cfg(feature = "alloc")]
-pub struct Host;
-
-#[cfg(feature = "alloc")]
-impl Capacities for Host {
-    const NAME: &'static str = "Host";
-    type Objects = HeapArena<ShapeHandle, 1_000_000>;
-    type Spheres = HeapArena<Sphere, 1_000_000>;
-    type Boxes = HeapArena<AxisAlignedBox, 1_000_000>;
-    type Superquadrics = HeapArena<Superquadric, 1_000_000>;
-    type Triangles = HeapArena<Triangle, 1_000_000>;
-    type Rectangles = HeapArena<Rectangle, 1_000_000>;
-    type SmoothTriangles = HeapArena<SmoothTriangle, 1_000_000>;
-    type ControlPoints = HeapArena<Vec3, 1_048_576>;
-    type Surfaces = HeapArena<SurfaceEntry, 65_535>;
-    type Lights = HeapArena<Light, 4_096>;
-    type Index = u32;
-    type OctreeNodes = HeapArena<OctreeNode<u32>, 16_000_000>;
-    type OctreeRefs = HeapArena<u32, 64_000_000>;
-    type OctreeEntries = HeapArena<HashEntry<u32>, 2_000_000>;
-    type OctreeBuckets = HeapArena<u32, 65_521>;
+impl fmt::Display for CapacityError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "too many {}: the capacity profile {} holds {}", self.kind.what(), self.profile, self.capacity)?;
+        if let Some(needed) = self.needed {
+            write!(f, " and the scene needs {needed}")?;
+        }
+        write!(
+            f,
+            "; define a profile that holds them with octrace_core::profile! ({}: {}, …)",
+            self.kind.field(),
+            self.needed.unwrap_or(self.capacity.saturating_add(1))
+        )
+    }
 }
 
-/// A board with 16 KiB of RAM (BBC micro:bit v1): scenes of up to 200
-/// spheres and a few other shapes in about 6 KiB, and an octree of up to 128
-/// boxes in about 2 KiB (16-bit indices), leaving 6 KiB of stack.
-pub struct Board16K;
+impl core::error::Error for CapacityError {}
 
-impl Capacities for Board16K {
-    const NAME: &'static str = "Board16K";
-    type Objects = heapless::Vec<ShapeHandle, 208>;
-    type Spheres = heapless::Vec<Sphere, 200>;
-    type Boxes = heapless::Vec<AxisAlignedBox, 2>;
-    type Superquadrics = heapless::Vec<Superquadric, 2>;
-    type Triangles = heapless::Vec<Triangle, 2>;
-    type Rectangles = heapless::Vec<Rectangle, 2>;
-    type SmoothTriangles = heapless::Vec<SmoothTriangle, 0>;
-    type ControlPoints = heapless::Vec<Vec3, 0>;
-    type Surfaces = heapless::Vec<SurfaceEntry, 12>;
-    type Lights = heapless::Vec<Light, 4>;
-    type Index = u16;
-    type OctreeNodes = heapless::Vec<OctreeNode<u16>, 128>;
-    type OctreeRefs = heapless::Vec<u16, 640>;
-    type OctreeEntries = heapless::Vec<HashEntry<u16>, 16>;
-    type OctreeBuckets = heapless::Vec<u16, 13>;
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
+    extern crate std;
+    use std::string::ToString;
 
-/// A board with 64 KiB of RAM or more (Cortex-M3/M4 class).
-pub struct Board64K;
+    #[test]
+    fn kinds_and_fields_agree() {
+        let mut c = Counts::ZERO;
+        for (i, kind) in CapacityKind::ALL.into_iter().enumerate() {
+            *c.get_mut(kind) = i + 1;
+        }
+        for (i, kind) in CapacityKind::ALL.into_iter().enumerate() {
+            assert_eq!(c.get(kind), i + 1, "{kind:?}");
+        }
+        assert_eq!(CapacityKind::BsplineTriangles.field(), "bspline_triangles");
+        assert_eq!(CapacityKind::BsplineTriangles.what(), "B-spline triangles");
+    }
 
-impl Capacities for Board64K {
-    const NAME: &'static str = "Board64K";
-    type Objects = heapless::Vec<ShapeHandle, 512>;
-    type Spheres = heapless::Vec<Sphere, 320>;
-    type Boxes = heapless::Vec<AxisAlignedBox, 32>;
-    type Superquadrics = heapless::Vec<Superquadric, 32>;
-    type Triangles = heapless::Vec<Triangle, 96>;
-    type Rectangles = heapless::Vec<Rectangle, 96>;
-    type SmoothTriangles = heapless::Vec<SmoothTriangle, 32>;
-    type ControlPoints = heapless::Vec<Vec3, 16>;
-    type Surfaces = heapless::Vec<SurfaceEntry, 64>;
-    type Lights = heapless::Vec<Light, 8>;
-    type Index = u16;
-    type OctreeNodes = heapless::Vec<OctreeNode<u16>, 2048>;
-    type OctreeRefs = heapless::Vec<u16, 6144>;
-    type OctreeEntries = heapless::Vec<HashEntry<u16>, 256>;
-    type OctreeBuckets = heapless::Vec<u16, 127>;
+    #[test]
+    fn derived_counts() {
+        let c = Counts { spheres: 200, rectangles: 64, octree_boxes: 129, ..Counts::ZERO }.with_objects();
+        assert_eq!(c.objects, 264);
+        assert_eq!(c.with_objects().objects, 264);
+        assert_eq!(c.mailbox_words(), 9);
+        assert_eq!(c.octree_hash_entries(), 16);
+        assert_eq!(c.octree_hash_buckets(), 9);
+        assert_eq!(Counts::ZERO.octree_hash_buckets(), 1);
+    }
+
+    #[test]
+    fn the_message_says_what_how_many_and_how_to_fix_it() {
+        let e = CapacityError { kind: CapacityKind::Rectangles, capacity: 2, needed: Some(64), profile: "Board16K" };
+        assert_eq!(
+            e.to_string(),
+            "too many rectangles: the capacity profile Board16K holds 2 and the scene needs 64; \
+             define a profile that holds them with octrace_core::profile! (rectangles: 64, …)"
+        );
+    }
 }

@@ -52,7 +52,14 @@ pub mod capacity;
 pub mod math;
 pub mod palette;
 pub mod parse;
+pub mod profile;
+mod raytracer;
 pub mod render;
 pub mod scene;
 pub mod shade;
 pub mod shapes;
+
+pub use accel::AccelMode;
+pub use raytracer::{DrawError, LoadError, LoadedScene, Raytracer, TracedImage};
+#[cfg(feature = "static-cell")]
+pub use static_cell::ConstStaticCell;

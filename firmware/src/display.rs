@@ -3,14 +3,15 @@
 //! streams it to the panel. It holds one small chunk of bytes, never a
 //! framebuffer.
 //!
-//! Three pixel formats: `Rgb888` (3 bytes a pixel), `Rgb565` (2 bytes, big
-//! endian, as common SPI displays take it) and `PaletteIndex` (1 byte, an
-//! entry of the display's 256-colour table).
+//! Four pixel formats: `Rgb888` (3 bytes a pixel), `Rgb565` (2 bytes, big
+//! endian, as common SPI displays take it), `PaletteIndex` (1 byte, an
+//! entry of the display's 256-colour table) and `Gray4` (1 byte, the level
+//! 0 to 15).
 
 use crate::semihosting::HostFile;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{OriginDimensions, Size};
-use embedded_graphics_core::pixelcolor::{IntoStorage, PixelColor, Rgb565, Rgb888, RgbColor};
+use embedded_graphics_core::pixelcolor::{Gray4, GrayColor, IntoStorage, PixelColor, Rgb565, Rgb888, RgbColor};
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
 use octrace_core::palette::PaletteIndex;
@@ -32,6 +33,13 @@ impl WireColor for PaletteIndex {
     const BYTES: usize = 1;
     fn encode(self, out: &mut [u8]) {
         out[0] = self.0;
+    }
+}
+
+impl WireColor for Gray4 {
+    const BYTES: usize = 1;
+    fn encode(self, out: &mut [u8]) {
+        out[0] = self.luma();
     }
 }
 

@@ -1,45 +1,45 @@
 //! octrace on a Cortex-M board: the scene text lives in flash, is parsed on
-//! the board into static arenas, and is rendered row by row straight into
-//! the display driver (here: a host file over semihosting). No heap, no
-//! framebuffer. Build-time choices are in `build.rs`.
+//! the board into static arenas sized for it at build time, and is drawn row
+//! by row straight into the display driver (a host file over semihosting,
+//! or on the LM3S6965EVB its OLED panel, `ssd0323`) as an embedded-graphics
+//! image. No heap, no framebuffer. Build-time choices are in `build.rs`.
 //!
-//! Exit codes: 0 rendered, 2 the scene has errors, 3 the host refused the
-//! output, 101 panic, 102 HardFault, 103 unexpected interrupt.
+//! Exit codes: 0 rendered, 2 the scene has errors, 3 the display (the host
+//! file, the panel) refused the output, 101 panic, 102 HardFault, 103
+//! unexpected interrupt. The LM3S6965EVB keeps its picture on the panel
+//! until the runner has grabbed the screen, then exits.
 
 #![no_std]
 #![no_main]
 
+#[cfg(not(board = "lm3s6965evb"))]
 mod display;
+#[cfg(board = "lm3s6965evb")]
+mod lm3s6965evb;
 mod semihosting;
+#[cfg(board = "lm3s6965evb")]
+mod ssd0323;
 
 mod config {
     include!(concat!(env!("OUT_DIR"), "/config.rs"));
 }
 
-use core::cell::RefCell;
+// The single-core critical section the cell's flag takes on a Cortex-M0.
+use cortex_m as _;
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::hprintln;
-use critical_section::Mutex;
-use display::{StreamDisplay, WireColor};
 use embedded_graphics_core::geometry::Size;
-use embedded_graphics_core::pixelcolor::{Rgb565, Rgb888};
-use octrace_core::accel::{Accelerator, Naive, Octree, OctreeConfig, Traversal};
-use octrace_core::palette::{render_indexed, Dither, PaletteIndex};
-use octrace_core::parse::parse;
-use octrace_core::render::Renderer;
-use octrace_core::scene::{Scene, SceneView};
-use octrace_core::shade::Stats;
-use semihosting::{exit, HostFile};
-
-/// The intersection mode, chosen at build time.
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub enum Accel {
-    /// Naive up to 16 objects, else dda (as host-sim's `auto`).
-    Auto,
-    Naive,
-    Octree,
-    Dda,
-}
+use embedded_graphics_core::image::ImageDrawable;
+use octrace_core::{ConstStaticCell, LoadedScene, Raytracer};
+use semihosting::exit;
+// What the boards that stream to a host file use.
+#[cfg(not(board = "lm3s6965evb"))]
+use {
+    display::{StreamDisplay, WireColor},
+    embedded_graphics_core::pixelcolor::{Gray4, Rgb565, Rgb888},
+    octrace_core::palette::{Dither, PaletteIndex, Quantized},
+    semihosting::HostFile,
+};
 
 /// The display's pixel format, chosen at build time.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -48,33 +48,15 @@ pub enum Wire {
     Rgb565,
     /// Palette indices, ordered-dithered onto the 6×6×6 cube.
     Dither,
+    /// 16 gray levels (embedded-graphics' conversion from Rgb888).
+    Gray4,
 }
 
-/// What each board holds: the capacity profile, the octree's walk depth and
-/// its subdivision criterion (shallow on the micro:bit, whose stack is 6 KiB
-/// and whose octree arenas are small).
-#[cfg(board = "microbit")]
-mod board {
-    use octrace_core::accel::{OctreeConfig, Traversal};
-    pub type Profile = octrace_core::capacity::Board16K;
-    pub const FRAMES: usize = 4;
-    pub const OCTREE: OctreeConfig = OctreeConfig { max_objects: 8, max_depth: 3, traversal: Traversal::Dda };
-}
-#[cfg(not(board = "microbit"))]
-mod board {
-    use octrace_core::accel::{OctreeConfig, Traversal};
-    pub type Profile = octrace_core::capacity::Board64K;
-    pub const FRAMES: usize = 13;
-    pub const OCTREE: OctreeConfig = OctreeConfig { max_objects: 4, max_depth: 12, traversal: Traversal::Dda };
-}
-use board::Profile;
-type BoardOctree = Octree<Profile, { board::FRAMES }>;
+/// The capacity profile, sized by `build.rs` for exactly the embedded scene.
+use config::Profile;
 
-/// Objects the mailbox covers (one bit each).
-const MAILBOX_WORDS: usize = 16;
-
-static SCENE: Mutex<RefCell<Scene<Profile>>> = Mutex::new(RefCell::new(Scene::new()));
-static OCTREE: Mutex<RefCell<BoardOctree>> = Mutex::new(RefCell::new(Octree::new()));
+/// Scene, octree and mailbox: zero bits, in `.bss`, taken once.
+static RAYTRACER: ConstStaticCell<Raytracer<Profile>> = ConstStaticCell::new(Raytracer::new());
 
 /// Marks the stretch qemu-count measures (`insns_between_markers`): the
 /// render alone, without parsing and building.
@@ -86,117 +68,118 @@ pub extern "C" fn bench_marker(id: u32) {
 
 #[entry]
 fn main() -> ! {
-    let code = critical_section::with(|cs| {
-        let mut scene = SCENE.borrow_ref_mut(cs);
-        let mut octree = OCTREE.borrow_ref_mut(cs);
-        if !load(&mut scene) {
-            return 2;
-        }
-        hprintln!("stack after parsing: {} bytes", peak_stack());
-        run(&mut scene, &mut octree)
-    });
+    let code = run(RAYTRACER.take());
     hprintln!("peak stack: {} bytes", peak_stack());
+    #[cfg(board = "lm3s6965evb")]
+    if code == 0 {
+        lm3s6965evb::show_until_grabbed();
+    }
     exit(code)
 }
 
-/// Parses the scene from flash; false (with every error printed) if it has
-/// errors. Not inlined, so its frame is gone while rendering.
-#[inline(never)]
-fn load(scene: &mut Scene<Profile>) -> bool {
-    let mut errors = 0;
-    let parsed = parse(config::SCENE, scene, &mut |e| {
-        errors += 1;
-        hprintln!("{}.txt:{}", config::SCENE_NAME, e);
-    });
-    if parsed.is_err() {
-        hprintln!("{} error(s); nothing rendered", errors);
-    }
-    parsed.is_ok()
-}
-
-#[inline(never)]
-fn run(scene: &mut Scene<Profile>, octree: &mut BoardOctree) -> u32 {
+/// Loads the scene from flash and draws it; the exit code.
+fn run(raytracer: &'static mut Raytracer<Profile>) -> u32 {
+    let Some(scene) = load(raytracer) else { return 2 };
+    hprintln!("stack after parsing: {} bytes", peak_stack());
     let view = scene.view();
-    let accel = match config::ACCEL {
-        Accel::Auto if view.object_count() <= 16 => Accel::Naive,
-        Accel::Auto => Accel::Dda,
-        a => a,
-    };
-    let traversal = match accel {
-        Accel::Octree => Some(Traversal::Named),
-        Accel::Dda => Some(Traversal::Dda),
-        _ => None,
-    };
     hprintln!(
-        "octrace on {}: {} ({} objects) at {}x{}",
+        "octrace on {}: {} ({} objects, {}) at {}x{}",
         config::BOARD,
         config::SCENE_NAME,
         view.object_count(),
+        scene.mode(),
         config::WIDTH,
         config::HEIGHT
     );
-    let Some(file) = HostFile::create(config::OUTPUT) else {
-        hprintln!("cannot create the output file on the host");
+    if let Some(report) = scene.octree_report() {
+        hprintln!(
+            "octree: {} boxes, {} leaves, {} references (peak {}), depth {}, {} bytes{}",
+            report.nodes,
+            report.leaves,
+            report.references,
+            report.peak_references,
+            report.depth,
+            report.bytes,
+            if report.unsplit > 0 { " (some boxes left unsplit: arenas full)" } else { "" }
+        );
+    }
+    let Some(output) = open_output() else {
+        hprintln!("cannot open the display (or the output file on the host)");
         return 3;
     };
-    let result = match traversal {
-        None => draw(view, &Naive, file),
-        Some(traversal) => {
-            let report = octree.build(&view, &OctreeConfig { traversal, ..board::OCTREE });
-            hprintln!(
-                "octree: {} boxes, {} leaves, {} references (peak {}), depth {}, {} bytes{}",
-                report.nodes,
-                report.leaves,
-                report.references,
-                report.peak_references,
-                report.depth,
-                report.bytes,
-                if report.unsplit > 0 { " (some boxes left unsplit: arenas full)" } else { "" }
-            );
-            draw(view, &*octree, file)
-        }
-    };
-    match result {
-        Some(stats) => {
-            hprintln!("{} rays, {} shadow rays, {} cells", stats.rays, stats.shadow_rays, stats.cells);
-            0
-        }
-        None => {
-            hprintln!("the host refused the pixels");
-            3
-        }
-    }
-}
-
-/// Renders into the display in the configured pixel format. Not inlined:
-/// each instance keeps its renderer in its own frame, so only one is ever on
-/// the stack.
-#[inline(never)]
-fn draw<A: Accelerator>(view: SceneView<'_>, accel: &A, file: HostFile) -> Option<Stats> {
-    match config::WIRE {
-        Wire::Rgb888 => render::<A, Rgb888>(view, accel, file, |r, d| r.render(d)),
-        Wire::Rgb565 => render::<A, Rgb565>(view, accel, file, |r, d| r.render(d)),
-        Wire::Dither => {
-            render::<A, PaletteIndex>(view, accel, file, |r, d| render_indexed(r, 0..config::HEIGHT, &mut Dither, d))
-        }
-    }
-}
-
-#[inline(never)]
-fn render<A: Accelerator, C: WireColor>(
-    view: SceneView<'_>,
-    accel: &A,
-    file: HostFile,
-    paint: impl FnOnce(&mut Renderer<'_, A>, &mut StreamDisplay<C>) -> Result<Stats, display::WriteError>,
-) -> Option<Stats> {
-    let mut words = [0u32; MAILBOX_WORDS];
-    let mut display = StreamDisplay::<C>::new(file, Size::new(config::WIDTH, config::HEIGHT));
-    let Ok(mut renderer) = Renderer::with_size(view, accel, config::WIDTH, config::HEIGHT) else { return None };
-    renderer.set_mailbox(&mut words);
     bench_marker(0);
-    let stats = paint(&mut renderer, &mut display).ok()?;
+    let drawn = draw_on(&scene, output);
     bench_marker(1);
-    Some(stats)
+    if !drawn {
+        hprintln!("the display refused the pixels");
+        return 3;
+    }
+    let stats = scene.stats();
+    hprintln!("{} rays, {} shadow rays, {} cells", stats.rays, stats.shadow_rays, stats.cells);
+    0
+}
+
+/// Parses the scene from flash; `None` (with every error printed) if it
+/// has errors. Not inlined, so its frame is gone while rendering.
+#[inline(never)]
+fn load(raytracer: &'static mut Raytracer<Profile>) -> Option<LoadedScene<'static, Profile>> {
+    let loaded = raytracer.load_with(config::SCENE.as_bytes(), config::ACCEL, &mut |e| {
+        hprintln!("{}.txt:{}", config::SCENE_NAME, e);
+    });
+    match loaded {
+        Ok(scene) => Some(scene),
+        Err(e) => {
+            hprintln!("{} error(s); nothing rendered", e.count);
+            None
+        }
+    }
+}
+
+// The display: a host file on the boards without one (the pixels streamed
+// in the configured format), the OLED panel on the LM3S6965EVB.
+#[cfg(not(board = "lm3s6965evb"))]
+fn open_output() -> Option<HostFile> {
+    HostFile::create(config::OUTPUT)
+}
+#[cfg(board = "lm3s6965evb")]
+use lm3s6965evb::open_output;
+
+/// Draws the scene into the host file in the configured pixel format.
+#[cfg(not(board = "lm3s6965evb"))]
+fn draw_on(scene: &LoadedScene<'_, Profile>, file: HostFile) -> bool {
+    match config::WIRE {
+        Wire::Rgb888 => draw::<Rgb888>(scene, file),
+        Wire::Rgb565 => draw::<Rgb565>(scene, file),
+        Wire::Gray4 => draw::<Gray4>(scene, file),
+        Wire::Dither => draw_dithered(scene, file),
+    }
+}
+
+/// Draws the scene onto the panel, in its 16 grays (build.rs allows no
+/// other format here), at its top left. Not inlined, as `draw`.
+#[cfg(board = "lm3s6965evb")]
+#[inline(never)]
+fn draw_on(scene: &LoadedScene<'_, Profile>, mut panel: ssd0323::Ssd0323) -> bool {
+    debug_assert!(config::WIRE == Wire::Gray4);
+    scene.image(Size::new(config::WIDTH, config::HEIGHT)).draw(&mut panel).is_ok()
+}
+
+/// Draws the scene into a display of colour `C`. Not inlined: each colour's
+/// instance keeps its frame to itself.
+#[cfg(not(board = "lm3s6965evb"))]
+#[inline(never)]
+fn draw<C: WireColor + From<Rgb888>>(scene: &LoadedScene<'_, Profile>, file: HostFile) -> bool {
+    let mut display = StreamDisplay::<C>::new(file, Size::new(config::WIDTH, config::HEIGHT));
+    scene.image_for(&display).draw(&mut display).is_ok()
+}
+
+/// Draws the scene into a 256-colour display, ordered-dithered.
+#[cfg(not(board = "lm3s6965evb"))]
+#[inline(never)]
+fn draw_dithered(scene: &LoadedScene<'_, Profile>, file: HostFile) -> bool {
+    let display = StreamDisplay::<PaletteIndex>::new(file, Size::new(config::WIDTH, config::HEIGHT));
+    let mut dithered = Quantized { display, quantizer: &mut Dither };
+    scene.image_for(&dithered).draw(&mut dithered).is_ok()
 }
 
 /// Bytes of stack used at most: `paint-stack` filled it with a pattern at

@@ -11,6 +11,7 @@ pub struct HostFile {
 
 impl HostFile {
     /// Creates (truncates) `name`, a NUL-terminated path on the host.
+    #[cfg_attr(board = "lm3s6965evb", allow(dead_code))]
     pub fn create(name: &str) -> Option<HostFile> {
         let bytes = name.as_bytes();
         if bytes.last() != Some(&0) {
@@ -22,7 +23,21 @@ impl HostFile {
         (handle != usize::MAX).then_some(HostFile { handle })
     }
 
+    /// Opens `name`, a NUL-terminated path on the host, for reading; `None`
+    /// if it does not exist.
+    #[cfg_attr(not(board = "lm3s6965evb"), allow(dead_code))]
+    pub fn open(name: &str) -> Option<HostFile> {
+        let bytes = name.as_bytes();
+        if bytes.last() != Some(&0) {
+            return None;
+        }
+        // SAFETY: as in `create`.
+        let handle = unsafe { syscall!(OPEN, bytes.as_ptr(), nr::open::R_BINARY, bytes.len() - 1) };
+        (handle != usize::MAX).then_some(HostFile { handle })
+    }
+
     /// Writes all of `data`; false if the host refused.
+    #[cfg_attr(board = "lm3s6965evb", allow(dead_code))]
     pub fn write(&mut self, data: &[u8]) -> bool {
         // SAFETY: SYS_WRITE reads `len` bytes from the pointer during the
         // call; it returns the number of bytes *not* written.

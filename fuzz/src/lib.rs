@@ -14,8 +14,8 @@ use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::Rgb888;
 use embedded_graphics_core::Pixel;
-use octrace_core::capacity::Capacities;
 use octrace_core::parse::{parse_bytes, ParseError, Parsed};
+use octrace_core::scene::SceneCapacities;
 use octrace_core::scene::{Camera, Normalization, Scene};
 
 /// Parses `bytes` into `scene` and checks what the parser promises:
@@ -26,7 +26,7 @@ use octrace_core::scene::{Camera, Normalization, Scene};
 /// - every error formats (its `Display` must not panic either).
 ///
 /// Returns whether the scene parsed.
-pub fn parse_checked<C: Capacities>(bytes: &[u8], scene: &mut Scene<C>) -> bool {
+pub fn parse_checked<C: SceneCapacities>(bytes: &[u8], scene: &mut Scene<C>) -> bool {
     let mut reported = 0usize;
     let mut text = String::new();
     let result: Result<Parsed<'_>, usize> = parse_bytes(bytes, scene, &mut |e: ParseError<'_>| {

@@ -2,7 +2,7 @@
 //! panic, loop or break its contract (see [`crate::parse_checked`]).
 
 use crate::parse_checked;
-use octrace_core::capacity::{Board16K, Board64K};
+use octrace_core::profile::{Board16K, Board64K};
 use octrace_core::scene::Scene;
 use std::cell::RefCell;
 

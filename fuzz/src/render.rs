@@ -10,7 +10,7 @@
 
 use crate::{parse_checked, Sink};
 use octrace_core::accel::{Accelerator, Mailbox, Naive, Octree, OctreeConfig, Traversal};
-use octrace_core::capacity::Board64K;
+use octrace_core::profile::Board64K;
 use octrace_core::render::{PixelSample, Renderer};
 use octrace_core::scene::{ObjectId, Scene, SceneView};
 use octrace_core::shade::Stats;

@@ -1,8 +1,10 @@
 //! The `host-sim` command line.
 
-use crate::formats::{self, Format};
+use crate::formats::{self, Format, Image};
 use crate::palette::{self, PaletteMode};
-use crate::{all_cores, load_file, new_scene, render_with_progress, AccelMode, LoadError, Partition, RenderOptions};
+use crate::{
+    all_cores, load_file, new_scene, render_with_progress, AccelMode, LoadError, Partition, RenderOptions, RgbImage,
+};
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressStyle};
 use octrace_core::accel::OctreeConfig;
@@ -46,8 +48,14 @@ pub struct Args {
     /// ordered), coarse (dither with outlines around objects), gray.
     #[arg(long, value_enum, default_value_t = PaletteMode::None)]
     pub palette: PaletteMode,
-    /// The file format; by default from OUT's extension (png, tga, ras),
-    /// else PNG.
+    /// Preview a panel: the pixels as a display of this format shows them
+    /// (the firmware's OCTRACE_COLOR): rgb888; rgb565 (written back as
+    /// RGB); gray4, 16 levels (an 8-bit gray PNG, level × 17); dither (as
+    /// --palette dither).
+    #[arg(long, value_enum, default_value_t = PanelColor::Rgb888)]
+    pub color: PanelColor,
+    /// The file format; by default from OUT's extension (png, tga, ras), or
+    /// PNG when OUT has none. Any other extension is refused without it.
     #[arg(long, value_enum)]
     pub format: Option<Format>,
     /// Render at WxH pixels instead of the scene's RASTER (for a quick
@@ -56,7 +64,7 @@ pub struct Args {
     pub size: Option<(u32, u32)>,
     /// Intersection strategy: auto picks the fastest for the scene (naive
     /// for a handful of objects, else dda). All give the same image.
-    #[arg(long, value_enum, default_value_t = AccelMode::Auto)]
+    #[arg(long, value_name = "MODE", default_value = "auto", value_parser = parse_accel)]
     pub accel: AccelMode,
     /// Octree criterion: a box holding more objects than this is subdivided.
     #[arg(long, value_name = "N", default_value_t = OctreeConfig::default().max_objects)]
@@ -88,10 +96,75 @@ pub enum Command {
         input: PathBuf,
         /// The image to write.
         output: PathBuf,
-        /// The output format; by default from OUTPUT's extension.
+        /// The output format; by default from OUTPUT's extension (png, tga,
+        /// ras), or PNG when OUTPUT has none.
         #[arg(long, value_enum)]
         format: Option<Format>,
     },
+}
+
+/// A display's pixel format, named as the firmware's `OCTRACE_COLOR`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum PanelColor {
+    Rgb888,
+    Rgb565,
+    Gray4,
+    Dither,
+}
+
+/// What a `color` panel shows of `image`, each pixel converted by
+/// embedded-graphics (as the firmware's renderer converts it) and widened
+/// back to 8 bits by embedded-graphics: RGB, or for gray4 an 8-bit gray
+/// image (level × 17), kept as a 16-entry gray colour table where a file
+/// format has no gray. `None` for the formats that need no conversion.
+fn panel_preview(image: &RgbImage, color: PanelColor, format: Format) -> Option<Preview> {
+    use embedded_graphics_core::pixelcolor::{Gray4, Gray8, GrayColor, Rgb565, Rgb888, RgbColor};
+    let rgb = image.data.chunks_exact(3).map(|p| Rgb888::new(p[0], p[1], p[2]));
+    let (width, height) = (image.width, image.height);
+    match color {
+        PanelColor::Rgb888 | PanelColor::Dither => None,
+        PanelColor::Rgb565 => {
+            let data = rgb.map(|c| Rgb888::from(Rgb565::from(c))).flat_map(|c| [c.r(), c.g(), c.b()]).collect();
+            Some(Preview::Image(Image::Rgb(RgbImage { width, height, data })))
+        }
+        PanelColor::Gray4 => {
+            let levels = rgb.map(|c| Gray4::from(c).luma());
+            if format == Format::Png {
+                let gray = levels.map(|l| Gray8::from(Gray4::new(l)).luma()).collect();
+                return Some(Preview::Gray { width, height, gray });
+            }
+            let palette = (0..16).map(|l| [Gray8::from(Gray4::new(l)).luma(); 3]).collect();
+            Some(Preview::Image(Image::Indexed { width, height, palette, indices: levels.collect() }))
+        }
+    }
+}
+
+/// A panel preview as it is written.
+enum Preview {
+    Image(Image),
+    /// 8-bit gray, one byte a pixel (PNG only).
+    Gray {
+        width: u32,
+        height: u32,
+        gray: Vec<u8>,
+    },
+}
+
+fn write_gray_png(width: u32, height: u32, gray: &[u8], out: &mut dyn Write) -> std::io::Result<()> {
+    let mut encoder = png::Encoder::new(out, width, height);
+    encoder.set_color(png::ColorType::Grayscale);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
+    writer.write_image_data(gray).map_err(std::io::Error::other)?;
+    writer.finish().map_err(std::io::Error::other)
+}
+
+/// An `--accel` name: the core's [`AccelMode`] vocabulary.
+fn parse_accel(text: &str) -> Result<AccelMode, String> {
+    AccelMode::from_name(text).ok_or_else(|| {
+        let names: Vec<&str> = AccelMode::ALL.iter().map(|m| m.name()).collect();
+        format!("expected one of {}", names.join(", "))
+    })
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -130,13 +203,34 @@ where
     }
 }
 
-/// The format to write `path` in: the one asked for, else by extension,
-/// else PNG.
-fn output_format(asked: Option<Format>, path: &Path) -> Format {
-    asked.or_else(|| Format::from_path(path)).unwrap_or(Format::Png)
+/// The format to write `path` in: the one asked for, else the one its
+/// extension names, else (no extension) PNG. Any other extension is refused
+/// before anything is rendered: a PNG named `.bmp` would mislead whatever
+/// opens it.
+fn output_format(asked: Option<Format>, path: &Path, stderr: &mut dyn Write) -> Result<Format, i32> {
+    if let Some(format) = asked {
+        return Ok(format);
+    }
+    let Some(extension) = path.extension() else {
+        return Ok(Format::Png);
+    };
+    Format::from_path(path).ok_or_else(|| {
+        let names: Vec<&str> = <Format as clap::ValueEnum>::value_variants().iter().map(|f| f.name()).collect();
+        let _ = writeln!(
+            stderr,
+            "host-sim: cannot write {}: `.{}` is not a format host-sim writes; it writes {} \
+             (chosen by the extension, or by --format <{}>)",
+            path.display(),
+            extension.to_string_lossy(),
+            names.join(", "),
+            names.join("|"),
+        );
+        EXIT_SCENE
+    })
 }
 
 fn convert(input: &Path, output: &Path, format: Option<Format>, stderr: &mut dyn Write) -> Result<(), i32> {
+    let format = output_format(format, output, stderr)?;
     let bytes = std::fs::read(input).map_err(|e| {
         let _ = writeln!(stderr, "host-sim: cannot read {}: {e}", input.display());
         EXIT_IO
@@ -145,7 +239,6 @@ fn convert(input: &Path, output: &Path, format: Option<Format>, stderr: &mut dyn
         let _ = writeln!(stderr, "host-sim: {}: {e}", input.display());
         EXIT_SCENE
     })?;
-    let format = output_format(format, output);
     write_atomically(output, |f| formats::write(&image, format, f).map_err(std::io::Error::other)).map_err(|e| {
         let _ = writeln!(stderr, "host-sim: cannot write {}: {e}", output.display());
         EXIT_IO
@@ -188,10 +281,15 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
             return Err(EXIT_SCENE);
         }
     };
+    if args.color != PanelColor::Rgb888 && args.palette != PaletteMode::None {
+        let _ = writeln!(stderr, "host-sim: --color and --palette both choose the pixels: give one");
+        return Err(EXIT_SCENE);
+    }
     if same_file(scene_path, &out) {
         let _ = writeln!(stderr, "host-sim: refusing to overwrite the scene file {} with the image", out.display());
         return Err(EXIT_SCENE);
     }
+    let format = output_format(args.format, &out, stderr)?;
     let view = scene.view();
     let (w, h) = args.size.unwrap_or((view.settings.raster[0], view.settings.raster[1]));
     let bar = if !args.quiet && std::io::stderr().is_terminal() {
@@ -230,18 +328,28 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
     };
     let elapsed = started.elapsed();
     let stats = rendered.stats;
-    let image = palette::apply(&rendered.image, &rendered.objects, args.palette);
-    let format = output_format(args.format, &out);
-    if let Err(e) = write_atomically(&out, |f| formats::write(&image, format, f).map_err(std::io::Error::other)) {
+    let palette_mode = if args.color == PanelColor::Dither { PaletteMode::Dither } else { args.palette };
+    let image = palette::apply(&rendered.image, &rendered.objects, palette_mode);
+    let written = match panel_preview(&rendered.image, args.color, format) {
+        None => write_atomically(&out, |f| formats::write(&image, format, f).map_err(std::io::Error::other)),
+        Some(Preview::Image(panel)) => {
+            write_atomically(&out, |f| formats::write(&panel, format, f).map_err(std::io::Error::other))
+        }
+        Some(Preview::Gray { width, height, gray }) => {
+            write_atomically(&out, |f| write_gray_png(width, height, &gray, f))
+        }
+    };
+    if let Err(e) = written {
         let _ = writeln!(stderr, "host-sim: cannot write {}: {e}", out.display());
         return Err(EXIT_IO);
     }
     if !args.quiet {
         if let Some((report, _)) = &rendered.build {
-            if let Some(what) = report.exhausted {
+            if let Some(kind) = report.exhausted {
                 let _ = writeln!(
                     stderr,
-                    "host-sim: the octree ran out of {what}: {} boxes left unsplit (slower, same image)",
+                    "host-sim: the octree ran out of {}: {} boxes left unsplit (slower, same image)",
+                    kind.what(),
                     report.unsplit
                 );
             }
@@ -263,11 +371,11 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
             },
             out.display()
         );
-        if args.palette != PaletteMode::None {
+        if palette_mode != PaletteMode::None {
             let _ = writeln!(
                 stderr,
                 "{} palette: {} colours of 256, {:.1} dB against truecolour ({})",
-                args.palette.name(),
+                palette_mode.name(),
                 palette::colors_used(&image),
                 palette::psnr(&rendered.image, &image.to_rgb()),
                 format.name()
@@ -326,5 +434,66 @@ mod tests {
         assert!(parse_size("0x5").is_err());
         assert!(parse_size("12").is_err());
         assert!(parse_size("20000x5").is_err());
+    }
+
+    /// Every 8-bit gray a gray4 panel can show, written out apart from
+    /// embedded-graphics: luma by ITU-R BT.601 in 8 bits, rounded to 16
+    /// levels, widened as level × 17.
+    fn gray4_by_hand(r: u32, g: u32, b: u32) -> u8 {
+        let luma = (r * 77 + g * 150 + b * 29 + 128) / 256;
+        ((luma * 15 + 127) / 255 * 17) as u8
+    }
+
+    fn one_pixel_preview(rgb: [u8; 3], color: PanelColor, format: Format) -> Option<Preview> {
+        panel_preview(&RgbImage { width: 1, height: 1, data: rgb.to_vec() }, color, format)
+    }
+
+    #[test]
+    fn gray4_preview_is_the_panels_level_times_17() {
+        for rgb in [[0, 0, 0], [255, 255, 255], [255, 0, 0], [0, 255, 0], [0, 0, 255], [8, 9, 10], [200, 17, 90]] {
+            let expected = gray4_by_hand(rgb[0].into(), rgb[1].into(), rgb[2].into());
+            match one_pixel_preview(rgb, PanelColor::Gray4, Format::Png) {
+                Some(Preview::Gray { gray, .. }) => assert_eq!(gray, [expected], "{rgb:?}"),
+                _ => panic!("gray4 as PNG is an 8-bit gray image"),
+            }
+            match one_pixel_preview(rgb, PanelColor::Gray4, Format::Tga) {
+                Some(Preview::Image(image)) => assert_eq!(image.to_rgb().data, [expected; 3], "{rgb:?}"),
+                _ => panic!("gray4 as Targa is a colour-mapped image"),
+            }
+        }
+    }
+
+    #[test]
+    fn rgb565_preview_rounds_each_channel_to_its_width() {
+        // 5 bits: 8 -> 1 -> 8; 6 bits: 130 -> 32 -> 130; 5 bits: 255 stays.
+        match one_pixel_preview([8, 130, 255], PanelColor::Rgb565, Format::Png) {
+            Some(Preview::Image(image)) => assert_eq!(image.to_rgb().data, [8, 130, 255]),
+            _ => panic!("rgb565 is an RGB image"),
+        }
+        match one_pixel_preview([5, 3, 4], PanelColor::Rgb565, Format::Png) {
+            Some(Preview::Image(image)) => assert_eq!(image.to_rgb().data, [8, 4, 0]),
+            _ => panic!("rgb565 is an RGB image"),
+        }
+        assert!(one_pixel_preview([1, 2, 3], PanelColor::Rgb888, Format::Png).is_none());
+    }
+
+    #[test]
+    fn color_and_palette_together_are_refused() {
+        let dir = tempfile_dir();
+        let out = dir.join("x.png");
+        let mut stderr = Vec::new();
+        let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/fig5_1.txt");
+        let args =
+            ["host-sim", scene, out.to_str().unwrap(), "--color", "gray4", "--palette", "dither", "--size", "4x4"];
+        assert_eq!(run(args, &mut Vec::new(), &mut stderr), EXIT_SCENE);
+        assert!(String::from_utf8_lossy(&stderr).contains("give one"));
+        assert!(!out.exists());
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    fn tempfile_dir() -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("host-sim-cli-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
     }
 }

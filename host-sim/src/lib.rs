@@ -13,8 +13,8 @@ use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::pixelcolor::RgbColor;
 use embedded_graphics_core::primitives::Rectangle;
 use octrace_core::accel::{Accelerator, BuildReport, Mailbox, Naive, Octree, OctreeConfig, Traversal};
-use octrace_core::capacity::Host;
 use octrace_core::parse::{parse_bytes, ParseError};
+use octrace_core::profile::Host;
 use octrace_core::render::{Renderer, Tiles};
 use octrace_core::scene::{CameraError, Scene, SceneView};
 use octrace_core::shade::Stats;
@@ -73,42 +73,7 @@ pub fn load_file(path: &Path, scene: &mut HostScene) -> Result<Loaded, LoadError
     load_bytes(&path.display().to_string(), &bytes, scene)
 }
 
-/// Which intersection strategy to use.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum AccelMode {
-    /// The fastest for the scene: naive for a handful of objects, else dda.
-    Auto,
-    /// Every object tested for every ray (the thesis's first version).
-    Naive,
-    /// The thesis's octree walk: Minlen steps and hash-table lookups.
-    Octree,
-    /// The octree walked with integer 3DDDA.
-    Dda,
-}
-
-/// Scenes with at most this many objects render fastest without an octree
-/// (measured: see BENCHMARKS.md).
-pub const NAIVE_UP_TO: usize = 16;
-
-impl AccelMode {
-    /// The concrete mode `Auto` stands for on a scene with `objects` objects.
-    pub fn resolve(self, objects: usize) -> AccelMode {
-        match self {
-            AccelMode::Auto if objects <= NAIVE_UP_TO => AccelMode::Naive,
-            AccelMode::Auto => AccelMode::Dda,
-            m => m,
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            AccelMode::Auto => "auto",
-            AccelMode::Naive => "naive",
-            AccelMode::Octree => "octree",
-            AccelMode::Dda => "dda",
-        }
-    }
-}
+pub use octrace_core::AccelMode;
 
 /// How the image is cut between threads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -184,11 +149,7 @@ pub type HostOctree = Octree<Host>;
 
 /// Builds the acceleration structure for `mode` (none for naive).
 pub fn build_octree(scene: &HostScene, mode: AccelMode, config: &OctreeConfig) -> Option<Box<HostOctree>> {
-    let traversal = match mode.resolve(scene.view().object_count()) {
-        AccelMode::Naive | AccelMode::Auto => return None,
-        AccelMode::Octree => Traversal::Named,
-        AccelMode::Dda => Traversal::Dda,
-    };
+    let traversal = mode.resolve(scene.view().object_count()).traversal()?;
     let mut octree: Box<HostOctree> = Box::default();
     octree.build(&scene.view(), &OctreeConfig { traversal, ..*config });
     Some(octree)

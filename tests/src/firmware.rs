@@ -124,6 +124,7 @@ impl Firmware {
         for var in ["CARGO_TARGET_DIR", "RUSTFLAGS", "CARGO_ENCODED_RUSTFLAGS", "CARGO_BUILD_TARGET"] {
             cargo.env_remove(var);
         }
+        cargo.env("OCTRACE_BOARD", self.board.machine());
         cargo.env("OCTRACE_SCENE", &self.scene);
         cargo.env("OCTRACE_SIZE", format!("{}x{}", self.width, self.height));
         cargo.env("OCTRACE_COLOR", self.wire.name());
@@ -142,7 +143,6 @@ impl Firmware {
         let _ = std::fs::remove_file(&file);
         let out = Command::new("bash")
             .arg(repo().join("firmware/run.sh"))
-            .arg(self.board.machine())
             .arg(elf)
             .output()
             .map_err(|e| format!("cannot run qemu: {e}"))?;
@@ -179,6 +179,33 @@ fn rgb565(r: u8, g: u8, b: u8) -> u16 {
     (scale(r, 31) << 11) | (scale(g, 63) << 5) | scale(b, 31)
 }
 
+/// The OLED board's user-facing command, run as a user runs it:
+///
+/// ```text
+/// cd firmware && OCTRACE_BOARD=lm3s6965evb OCTRACE_SCENE=SCENE \
+///   OCTRACE_COLOR=gray4 OCTRACE_OUT=OUT cargo run --release --target thumbv7m-none-eabi
+/// ```
+///
+/// with its own target directory (`target/firmware/lm3s6965evb-run`), so the
+/// build is cached between test runs. Returns what the run printed; the
+/// panel's screen is in `out`.
+pub fn run_oled_command(scene: &str, out: &Path) -> Result<Run, String> {
+    let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
+    cargo.current_dir(repo().join("firmware"));
+    cargo.args(["run", "--release", "--quiet", "--target", "thumbv7m-none-eabi"]);
+    cargo.arg("--target-dir").arg(repo().join("target/firmware/lm3s6965evb-run"));
+    for var in ["CARGO_TARGET_DIR", "RUSTFLAGS", "CARGO_ENCODED_RUSTFLAGS", "CARGO_BUILD_TARGET", "OCTRACE_SIZE"] {
+        cargo.env_remove(var);
+    }
+    cargo.env("OCTRACE_BOARD", "lm3s6965evb");
+    cargo.env("OCTRACE_SCENE", scene);
+    cargo.env("OCTRACE_COLOR", "gray4");
+    cargo.env("OCTRACE_OUT", out);
+    let run = cargo.output().map_err(|e| format!("cannot run cargo: {e}"))?;
+    let output = String::from_utf8_lossy(&run.stdout).into_owned() + &String::from_utf8_lossy(&run.stderr);
+    Ok(Run { status: run.status.code().unwrap_or(-1), output, pixels: Vec::new() })
+}
+
 /// What the benchmark measures of one configuration.
 #[derive(Debug)]
 pub struct Measurement {
@@ -206,6 +233,32 @@ impl Firmware {
         let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
         let value = |key: &str| text.lines().find_map(|l| l.strip_prefix(key)?.trim().parse::<u64>().ok());
         let total = value("insns_total=").ok_or_else(|| format!("no instruction count from qemu-count:\n{text}"))?;
+        let sizes = Sizes::of(elf)?;
+        Ok(Measurement {
+            status: out.status.code().unwrap_or(-1),
+            render: value("insns_between_markers="),
+            total,
+            flash: sizes.text + sizes.data,
+            static_ram: sizes.data + sizes.bss,
+            output: text,
+        })
+    }
+}
+
+/// An ELF's sections as `arm-none-eabi-size -B` counts them.
+#[derive(Clone, Copy, Debug)]
+pub struct Sizes {
+    /// Code and constants (flash).
+    pub text: u64,
+    /// Initialised statics: flash for their initial values, and RAM.
+    pub data: u64,
+    /// Zeroed statics (RAM only).
+    pub bss: u64,
+}
+
+impl Sizes {
+    /// Reads `elf`'s sizes.
+    pub fn of(elf: &Path) -> Result<Sizes, String> {
         let size = Command::new("arm-none-eabi-size")
             .arg("-B")
             .arg(elf)
@@ -214,17 +267,10 @@ impl Firmware {
         let size = String::from_utf8_lossy(&size.stdout).into_owned();
         let numbers: Vec<u64> =
             size.lines().nth(1).unwrap_or("").split_whitespace().take(3).filter_map(|n| n.parse().ok()).collect();
-        let [text_bytes, data, bss] = numbers[..] else {
+        let [text, data, bss] = numbers[..] else {
             return Err(format!("unexpected arm-none-eabi-size output:\n{size}"));
         };
-        Ok(Measurement {
-            status: out.status.code().unwrap_or(-1),
-            render: value("insns_between_markers="),
-            total,
-            flash: text_bytes + data,
-            static_ram: data + bss,
-            output: text,
-        })
+        Ok(Sizes { text, data, bss })
     }
 }
 

@@ -1,6 +1,6 @@
 //! An independent double-precision (f64) reference ray tracer.
 //!
-//! It is written from the scene-format contract (`SCENE-FORMAT.md`) alone and
+//! It is written from the scene-format contract (`docs/scene-format.md`) alone and
 //! shares no code with `octrace-core`: the accuracy test renders every scene
 //! with both tracers and compares the images. The code aims to be obviously
 //! correct rather than fast (O(objects) per ray, no acceleration structure).

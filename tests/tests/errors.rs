@@ -1,7 +1,9 @@
-//! Every error kind of the format's section 6 through `host-sim`, as a user
-//! meets it: the message with file:line:col, a non-zero exit code, and no
-//! output file. Also the I/O failures of the command line.
+//! Every error kind of the scene format (`docs/scene-format.md`) through
+//! `host-sim`, as a user meets it: the message with file:line:col, a non-zero
+//! exit code, and no output file. Also the failures of the command line: I/O,
+//! and output files it would not write.
 
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 
 const SURF: &str = "SURFACE 1 0.1 0.1 0.1 0.5 0.5 0.5 1 1 1 10 0 0\n";
@@ -59,6 +61,15 @@ fn missing_and_malformed_numbers() {
 }
 
 #[test]
+fn a_file_that_ends_inside_a_statement_points_after_its_last_token() {
+    let end = "expected a number for SPHERE z, found the end of the file";
+    rejected(&format!("{SURF}SPHERE 1 1 0 0\n"), "2:15", end);
+    rejected(&format!("{SURF}SPHERE 1 1 0 0 // z is missing\n\n\n"), "2:15", end);
+    rejected("RDEPTH 2\n  IMAGEFILE\n", "2:12", "expected IMAGEFILE file name, found the end of the file");
+    rejected("RDEPTH 2\nIMAGEFILE \"out.png\n", "2:11", "unterminated string: this `\"` is never closed");
+}
+
+#[test]
 fn non_integer_where_an_integer_is_required() {
     rejected("RDEPTH 2.5", "1:8", "expected an integer for RDEPTH depth, found `2.5`");
     rejected("RASTER 64 4e1", "1:11", "expected an integer for RASTER height, found `4e1`");
@@ -91,6 +102,27 @@ fn degenerate_and_non_planar_shapes() {
 }
 
 #[test]
+fn patches_need_enough_control_points() {
+    rejected(
+        &format!("{SURF}BSPLINE 1 3 2 2 4 4  0 0 0  1 0 0  0 1 0  1 1 0"),
+        "2:1",
+        "BSPLINE of order 3 needs at least 3 control points along each side, found 2 × 2",
+    );
+}
+
+#[test]
+fn a_shape_too_small_for_the_scene_is_named() {
+    // A scene a million units across resolves about 2^-29 of that (0.002).
+    let wide = "LIGHT 1 -500000 0 0 LIGHT 1 500000 0 0\n";
+    rejected(
+        &format!("{wide}{SURF}BOX 1 0 0 0 0.0001 0.0001 0.0001"),
+        "3:1",
+        "BOX is too small to represent next to the rest of the scene \
+         (sizes below about 2^-29 of the scene's extent round to 0 in fixed point)",
+    );
+}
+
+#[test]
 fn bad_cameras() {
     rejected("ORIGIN 0 0 10", "1:1", "VIEWPOINT equals ORIGIN");
     rejected("VIEWPOINT 0 5 0\nUPVECTOR 0 -2 0", "2:1", "UPVECTOR is zero or parallel to the view direction");
@@ -112,8 +144,8 @@ fn capacity_names_the_limit_and_how_to_raise_it() {
     rejected(
         &lights,
         "4097:1",
-        "the scene needs more lights than this build holds (4096, capacity profile Host); \
-         raise it in a capacity profile (octrace-core's capacity.rs)",
+        "too many lights: the capacity profile Host holds 4096 and the scene needs 4097; \
+         define a profile that holds them with octrace_core::profile! (lights: 4097, …)",
     );
 }
 
@@ -173,6 +205,73 @@ fn output_equal_to_the_scene_is_refused() {
     let (code, err) = run_args(&[scene.as_os_str(), scene.as_os_str()]);
     assert_eq!(code, 2, "{err}");
     assert_eq!(std::fs::read_to_string(&scene).unwrap(), text);
+}
+
+/// A scene that renders, in `dir`.
+fn small_scene(dir: &Path) -> PathBuf {
+    let scene = dir.join("s.txt");
+    std::fs::write(&scene, format!("RASTER 4 4 {SURF} SPHERE 1 1 0 0 0")).unwrap();
+    scene
+}
+
+#[test]
+fn an_output_extension_it_does_not_write_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path());
+    for name in ["out.bmp", "out.png.jpg", "out.PNGX"] {
+        let out = dir.path().join(name);
+        let (code, err) = run_args(&[scene.as_os_str(), out.as_os_str()]);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains(&format!("cannot write {}", out.display())), "{err}");
+        assert!(err.contains("png, tga, ras") && err.contains("--format"), "{err}");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "{name}: a file was written");
+    }
+    // The same through IMAGEFILE, and for `convert`.
+    let imagefile = dir.path().join("i.txt");
+    std::fs::write(&imagefile, format!("IMAGEFILE \"{}\" {SURF}", dir.path().join("x.gif").display())).unwrap();
+    let (code, err) = run_args(&[imagefile.as_os_str()]);
+    assert_eq!((code, err.contains("`.gif` is not a format host-sim writes")), (2, true), "{err}");
+    let png = dir.path().join("a.png");
+    assert_eq!(run_args(&[scene.as_os_str(), png.as_os_str()]).0, 0);
+    let gif = dir.path().join("a.gif");
+    let (code, err) = run_args(&["convert".as_ref(), png.as_os_str(), gif.as_os_str()]);
+    assert_eq!((code, err.contains("--format")), (2, true), "{err}");
+    assert!(!gif.exists());
+}
+
+#[test]
+fn the_formats_it_writes_are_told_by_extension_or_format() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path());
+    // (file name, --format, the file's first bytes)
+    let png = b"\x89PNG".as_slice();
+    let ras = b"\x59\xa6\x6a\x95".as_slice();
+    let cases: [(&str, Option<&str>, &[u8]); 5] = [
+        ("a.PNG", None, png),
+        ("b.Ras", None, ras),
+        ("no-extension", None, png),
+        ("c.bmp", Some("png"), png),
+        ("d.png", Some("ras"), ras),
+    ];
+    for (name, format, magic) in cases {
+        let out = dir.path().join(name);
+        let mut args = vec![scene.as_os_str(), out.as_os_str()];
+        if let Some(f) = format {
+            args.extend([OsStr::new("--format"), OsStr::new(f)]);
+        }
+        let (code, err) = run_args(&args);
+        assert_eq!(code, 0, "{name}: {err}");
+        let bytes = std::fs::read(&out).unwrap();
+        assert!(bytes.starts_with(magic), "{name}: {:?}", &bytes[..4]);
+        let image = host_sim::formats::read(&bytes).unwrap();
+        assert_eq!((image.width(), image.height()), (4, 4));
+    }
+    // Targa has no magic number: read back, it is the same image as the PNG.
+    let tga = dir.path().join("e.tga");
+    assert_eq!(run_args(&[scene.as_os_str(), tga.as_os_str()]).0, 0);
+    let from_png = host_sim::formats::read(&std::fs::read(dir.path().join("a.PNG")).unwrap()).unwrap();
+    assert_eq!(host_sim::formats::read(&std::fs::read(&tga).unwrap()).unwrap(), from_png);
+    assert!(!std::fs::read(&tga).unwrap().starts_with(png));
 }
 
 #[test]

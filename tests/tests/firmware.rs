@@ -5,20 +5,37 @@
 //! Needs `qemu-system-arm` (the test command installs it); set
 //! `OCTRACE_SKIP_FIRMWARE=1` to skip where it cannot be installed.
 
-use octrace_tests::firmware::{qemu_available, Board, Firmware, Wire};
+use octrace_tests::firmware::{qemu_available, run_oled_command, Board, Firmware, Sizes, Wire};
+use octrace_tests::repo;
+
+/// False (the test is skipped) when `OCTRACE_SKIP_FIRMWARE` is set; fails
+/// when qemu is missing.
+fn firmware_tests_run() -> bool {
+    if std::env::var_os("OCTRACE_SKIP_FIRMWARE").is_some_and(|v| v != "0") {
+        println!("skipped: OCTRACE_SKIP_FIRMWARE is set");
+        return false;
+    }
+    assert!(qemu_available(), "qemu-system-arm is not installed (apt-get install qemu-system-arm)");
+    true
+}
 
 #[test]
 fn boards_render_the_same_bits_as_host_sim() {
-    if std::env::var_os("OCTRACE_SKIP_FIRMWARE").is_some_and(|v| v != "0") {
-        println!("skipped: OCTRACE_SKIP_FIRMWARE is set");
+    if !firmware_tests_run() {
         return;
     }
-    assert!(qemu_available(), "qemu-system-arm is not installed (apt-get install qemu-system-arm)");
     let cases = [
         // The 16 KiB Cortex-M0 with the thesis's first figure...
         Firmware::new(Board::Microbit, "fig5_1", 160, 128, Wire::Rgb888),
         // ...and with 200 spheres and its octree, into an RGB565 display.
         Firmware::new(Board::Microbit, "fig5_3", 160, 128, Wire::Rgb565),
+        // Arenas sized from each scene at build time: the chessboard's 64
+        // rectangles, boxes and superquadrics, mirrors, and glass (2×2
+        // samples) all fit the 16 KiB board.
+        Firmware::new(Board::Microbit, "fig5_5", 64, 48, Wire::Rgb565),
+        Firmware::new(Board::Microbit, "fig5_7", 64, 48, Wire::Rgb888),
+        Firmware::new(Board::Microbit, "fig5_8", 64, 48, Wire::Rgb888),
+        Firmware::new(Board::Microbit, "glass", 48, 36, Wire::Rgb888),
         Firmware::new(Board::Mps2An385, "fig5_3", 160, 128, Wire::Rgb888),
         // A 256-colour display: indices of the dithered colour cube.
         Firmware::new(Board::Mps2An385, "fig5_1", 160, 128, Wire::Dither),
@@ -26,6 +43,11 @@ fn boards_render_the_same_bits_as_host_sim() {
     for firmware in cases {
         let name = format!("{} on {}", firmware.scene, firmware.board.machine());
         let elf = firmware.build().unwrap_or_else(|e| panic!("{e}"));
+        if firmware.board == Board::Microbit {
+            // Empty arenas are zero bits: no flash spent on an empty scene.
+            let sizes = Sizes::of(&elf).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert!(sizes.data < 1024, "{name}: .data is {} bytes", sizes.data);
+        }
         let run = firmware.run(&elf).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(run.status, 0, "{name}: the board exited with {}:\n{}", run.status, run.output);
         let expected = firmware.expected_pixels().unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -34,4 +56,59 @@ fn boards_render_the_same_bits_as_host_sim() {
         assert_eq!(differing, 0, "{name}: {differing} bytes differ from host-sim's");
         println!("{name} ({:?}): {} bytes identical; {}", firmware.wire, expected.len(), run.output.trim());
     }
+}
+
+/// An 8-bit gray PNG's size and pixels.
+fn read_gray_png(path: &std::path::Path) -> (u32, u32, Vec<u8>) {
+    let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut reader = png::Decoder::new(std::io::BufReader::new(file)).read_info().expect("a PNG");
+    let mut pixels = vec![0; reader.output_buffer_size().expect("a small image")];
+    let frame = reader.next_frame(&mut pixels).expect("PNG pixels");
+    assert_eq!(
+        (frame.color_type, frame.bit_depth),
+        (png::ColorType::Grayscale, png::BitDepth::Eight),
+        "{}",
+        path.display()
+    );
+    pixels.truncate(frame.buffer_size());
+    (frame.width, frame.height, pixels)
+}
+
+/// The LM3S6965EVB renders fig5_1 onto its emulated 128×64 OLED; the screen
+/// qemu shows, grabbed by the runner, is host-sim's `--color gray4` preview
+/// bit for bit.
+#[test]
+fn oled_screen_is_host_sims_gray4_preview() {
+    if !firmware_tests_run() {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let screen = dir.path().join("screen.png");
+    let run = run_oled_command("fig5_1", &screen).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(run.status, 0, "the OLED board exited with {}:\n{}", run.status, run.output);
+
+    let preview = dir.path().join("preview.png");
+    let scene = repo().join("scenes/fig5_1.txt");
+    let args = [
+        "host-sim".as_ref(),
+        scene.as_os_str(),
+        preview.as_os_str(),
+        "--size".as_ref(),
+        "128x64".as_ref(),
+        "--color".as_ref(),
+        "gray4".as_ref(),
+        "--quiet".as_ref(),
+    ];
+    let mut stderr = Vec::new();
+    assert_eq!(host_sim::cli::run(args, &mut Vec::new(), &mut stderr), 0, "{}", String::from_utf8_lossy(&stderr));
+
+    let (width, height, shown) = read_gray_png(&screen);
+    let expected = read_gray_png(&preview);
+    assert_eq!((width, height), (128, 64), "the panel's own pixels");
+    assert_eq!((width, height), (expected.0, expected.1));
+    let differing = shown.iter().zip(&expected.2).filter(|(a, b)| a != b).count();
+    assert_eq!(differing, 0, "{differing} of {} pixels differ from host-sim's preview\n{}", shown.len(), run.output);
+    let levels: std::collections::BTreeSet<u8> = shown.iter().copied().collect();
+    assert!(levels.len() > 8, "a picture, not a blank screen: levels {levels:?}");
+    println!("lm3s6965evb OLED: {} pixels identical, {} gray levels; {}", shown.len(), levels.len(), run.output.trim());
 }

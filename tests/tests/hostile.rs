@@ -464,7 +464,7 @@ fn row11_degenerate_triangle() {
         format!("{SURF}TRIANGLE 1 0 0 0 1 0 0 0 1e-9 0 LIGHT 1 1e6 0 0").as_bytes(),
         "2:1",
         "TRIANGLE is too small to represent next to the rest of the scene \
-         (below 2^-16 of its size after scaling to the fixed-point range)",
+         (sizes below about 2^-29 of the scene's extent round to 0 in fixed point)",
     );
     // A representable sliver renders.
     let sliver = format!("RASTER 16 16 {SURF}TRIANGLE 1 -3 0 0 3 1e-3 0 3 0 0 LIGHT 1 0 0 10");

@@ -195,8 +195,8 @@ fn random_queries_agree_with_the_naive_mode() {
 
 #[test]
 fn small_capacities_fall_back_without_changing_the_image() {
-    use octrace_core::capacity::Board16K;
     use octrace_core::parse::parse;
+    use octrace_core::profile::Board16K;
     use octrace_core::render::Renderer;
     use octrace_core::scene::Scene;
     // fig5_3's 200 spheres in the 16 KiB board profile: the octree's arenas

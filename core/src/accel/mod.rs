@@ -14,13 +14,81 @@ mod naive;
 mod octree;
 
 pub use naive::Naive;
+#[doc(hidden)]
+pub use octree::{overlaps, Cell, FILING_MARGIN};
 pub use octree::{
-    overlaps, BuildReport, Cell, HashEntry, Octree, OctreeConfig, OctreeNode, Traversal, FILING_MARGIN, MAX_DEPTH,
+    BuildReport, HashEntry, Index, Octree, OctreeCapacities, OctreeConfig, OctreeNode, OctreeStore, Traversal,
+    MAX_DEPTH,
 };
 
 use crate::math::Scalar;
 use crate::scene::{ObjectId, SceneView};
 use crate::shapes::{Leaving, Ray};
+
+/// How a scene's rays find their objects: the choice a user makes (host-sim's
+/// `--accel`, the firmware's `OCTRACE_ACCEL`). Every mode gives the same
+/// image; they differ in speed and memory.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum AccelMode {
+    /// [`AccelMode::Naive`] for a handful of objects, else [`AccelMode::Dda`].
+    #[default]
+    Auto,
+    /// Every object tested for every ray (the thesis's first version).
+    Naive,
+    /// The octree walked the thesis's way ([`Traversal::Named`]).
+    Octree,
+    /// The octree walked by integer 3DDDA ([`Traversal::Dda`]).
+    Dda,
+}
+
+impl AccelMode {
+    /// Every mode, in the order of their names in messages.
+    pub const ALL: [AccelMode; 4] = [AccelMode::Auto, AccelMode::Naive, AccelMode::Octree, AccelMode::Dda];
+
+    /// Up to this many objects, [`AccelMode::Auto`] tests them all: below it
+    /// an octree's walk costs more than it saves.
+    pub const AUTO_NAIVE_UP_TO: usize = 16;
+
+    /// The mode's name: `auto`, `naive`, `octree`, `dda`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            AccelMode::Auto => "auto",
+            AccelMode::Naive => "naive",
+            AccelMode::Octree => "octree",
+            AccelMode::Dda => "dda",
+        }
+    }
+
+    /// The mode its name stands for (case-insensitive).
+    pub fn from_name(name: &str) -> Option<AccelMode> {
+        AccelMode::ALL.into_iter().find(|m| m.name().eq_ignore_ascii_case(name))
+    }
+
+    /// The mode used for a scene of `objects` objects: never `Auto`.
+    pub const fn resolve(self, objects: usize) -> AccelMode {
+        match self {
+            AccelMode::Auto if objects <= AccelMode::AUTO_NAIVE_UP_TO => AccelMode::Naive,
+            AccelMode::Auto => AccelMode::Dda,
+            mode => mode,
+        }
+    }
+
+    /// The octree walk this mode uses, `None` for the naive mode (and for
+    /// `Auto`, which must be resolved first).
+    pub const fn traversal(self) -> Option<Traversal> {
+        match self {
+            AccelMode::Octree => Some(Traversal::Named),
+            AccelMode::Dda => Some(Traversal::Dda),
+            AccelMode::Auto | AccelMode::Naive => None,
+        }
+    }
+}
+
+impl core::fmt::Display for AccelMode {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 /// The nearest intersection: the cheap part of a hit (pbrt's split); the
 /// surface data is computed only for the hit that wins.
@@ -138,6 +206,18 @@ pub trait Accelerator {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn auto_picks_naive_for_few_objects_and_dda_above() {
+        assert_eq!(AccelMode::Auto.resolve(16), AccelMode::Naive);
+        assert_eq!(AccelMode::Auto.resolve(17), AccelMode::Dda);
+        assert_eq!(AccelMode::Octree.resolve(1), AccelMode::Octree);
+        for mode in AccelMode::ALL {
+            assert_eq!(AccelMode::from_name(mode.name()), Some(mode));
+        }
+        assert_eq!(AccelMode::from_name("DDA"), Some(AccelMode::Dda));
+        assert_eq!(AccelMode::from_name("fast"), None);
+    }
 
     #[test]
     fn mailbox_sees_each_object_once_per_query() {

@@ -39,33 +39,3 @@ pub const SCENE_RANGE_LOG2: u32 = 13;
 
 /// One in Q2.30.
 pub const UNIT_ONE: i64 = 1 << 30;
-/// One in Q16.16.
-pub const SCALAR_ONE: i32 = 1 << 16;
-
-/// `a * b >> shift` for signed operands whose exact product fits an `i64`.
-#[inline]
-pub fn mul_shift(a: i64, b: i64, shift: u32) -> i64 {
-    (a * b) >> shift
-}
-
-/// Divides `num` by `den` (> 0) after scaling `num` by 2^`shift`, saturating
-/// the quotient to `i32`. Used where a ratio may be huge (a ray almost parallel
-/// to a plane) and only its comparison with a bound matters.
-#[inline]
-pub fn div_scaled_saturating(num: i64, den: i64, shift: u32) -> i32 {
-    debug_assert!(den > 0);
-    let wide = ((num as i128) << shift) / den as i128;
-    wide.clamp(i32::MIN as i128, i32::MAX as i128) as i32
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn saturating_division_clamps() {
-        assert_eq!(div_scaled_saturating(1, 1, 40), i32::MAX);
-        assert_eq!(div_scaled_saturating(-1, 1, 40), i32::MIN);
-        assert_eq!(div_scaled_saturating(3 << 16, 2, 0), 3 << 15);
-    }
-}

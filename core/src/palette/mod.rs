@@ -151,8 +151,8 @@ fn distance_squared(a: Rgb888, b: Rgb888) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::capacity::Board16K;
     use crate::parse::parse;
+    use crate::profile::Board16K;
     use crate::scene::Scene;
     use embedded_graphics_core::geometry::OriginDimensions;
 

@@ -4,7 +4,9 @@
 //! `Display` writes `line:col: message`; a caller that knows the file name
 //! puts it in front (`fig5_3.txt:41:12: SPHERE radius must be > 0, found -1`).
 
-use crate::scene::CapacityError;
+use super::keyword::Listed;
+use crate::capacity::CapacityError;
+use crate::scene::CameraError;
 use core::fmt;
 
 /// A position in the scene text: line and column (in characters), from 1.
@@ -181,13 +183,9 @@ impl fmt::Display for ErrorKind<'_> {
             ErrorKind::InvalidUtf8 => f.write_str("the file is not valid UTF-8 (invalid byte here)"),
             ErrorKind::UnterminatedComment => f.write_str("unterminated comment: this `/*` is never closed"),
             ErrorKind::UnterminatedString => f.write_str("unterminated string: this `\"` is never closed"),
-            ErrorKind::UnknownKeyword(k) => write!(
-                f,
-                "unknown keyword `{}`: expected a statement (VIEWPOINT, ORIGIN, UPVECTOR, RASTER, VIEWPORT, \
-                 RDEPTH, IMAGEFILE, LIGHT, BACKGROUND, GAMMA, ATTENUATION, SAMPLES, SPHERE, BOX, \
-                 SUPERQUADRIC, TRIANGLE, RECTANGLE, BSPLINE or SURFACE)",
-                Shown(k)
-            ),
+            ErrorKind::UnknownKeyword(k) => {
+                write!(f, "unknown keyword `{}`: expected a statement ({})", Shown(k), Listed)
+            }
             ErrorKind::ExpectedNumber { field, found } => {
                 write!(f, "expected a number for {field}, found {found}")
             }
@@ -219,18 +217,11 @@ impl fmt::Display for ErrorKind<'_> {
             ErrorKind::TooSmall { keyword } => write!(
                 f,
                 "{keyword} is too small to represent next to the rest of the scene \
-                 (below 2^-16 of its size after scaling to the fixed-point range)"
+                 (sizes below about 2^-29 of the scene's extent round to 0 in fixed point)"
             ),
-            ErrorKind::EyeAtOrigin => f.write_str("VIEWPOINT equals ORIGIN: there is no view direction"),
-            ErrorKind::UpParallel => {
-                f.write_str("UPVECTOR is zero or parallel to the view direction (ORIGIN − VIEWPOINT)")
-            }
-            ErrorKind::Capacity(c) => write!(
-                f,
-                "the scene needs more {} than this build holds ({}, capacity profile {}); \
-                 raise it in a capacity profile (octrace-core's capacity.rs)",
-                c.what, c.capacity, c.profile
-            ),
+            ErrorKind::EyeAtOrigin => CameraError::EyeAtOrigin.fmt(f),
+            ErrorKind::UpParallel => CameraError::UpParallel.fmt(f),
+            ErrorKind::Capacity(c) => c.fmt(f),
         }
     }
 }

@@ -11,7 +11,11 @@ use super::error::{ErrorKind, ParseError, Pos};
 pub struct Token<'a> {
     /// The token's text (without the quotes of a quoted string).
     pub text: &'a str,
+    /// Where the token starts.
     pub pos: Pos,
+    /// Just after its last character (after the closing quote of a quoted
+    /// token): where an error for what should have followed it points.
+    pub end: Pos,
     pub quoted: bool,
 }
 
@@ -25,11 +29,6 @@ pub struct Lexer<'a> {
 impl<'a> Lexer<'a> {
     pub fn new(src: &'a str) -> Lexer<'a> {
         Lexer { src, offset: 0, pos: Pos { line: 1, column: 1 } }
-    }
-
-    /// Where the lexer stands: after the last token, or the end of the text.
-    pub fn pos(&self) -> Pos {
-        self.pos
     }
 
     fn rest(&self) -> &'a str {
@@ -96,7 +95,8 @@ impl<'a> Lexer<'a> {
                 loop {
                     match self.bump() {
                         Some('"') => {
-                            return Ok(Some(Token { text: &self.src[inner..self.offset - 1], pos, quoted: true }))
+                            let text = &self.src[inner..self.offset - 1];
+                            return Ok(Some(Token { text, pos, end: self.pos, quoted: true }));
                         }
                         Some(_) => {}
                         None => return Err(ParseError::new(pos, ErrorKind::UnterminatedString)),
@@ -113,7 +113,7 @@ impl<'a> Lexer<'a> {
                         _ => break,
                     }
                 }
-                Ok(Some(Token { text: &self.src[start..self.offset], pos, quoted: false }))
+                Ok(Some(Token { text: &self.src[start..self.offset], pos, end: self.pos, quoted: false }))
             }
         }
     }
@@ -139,6 +139,13 @@ mod tests {
     }
 
     #[test]
+    fn a_token_ends_after_its_last_character() {
+        let mut lx = Lexer::new("  é1\n");
+        let t = lx.next_token().unwrap().unwrap();
+        assert_eq!((t.pos, t.end), (Pos { line: 1, column: 3 }, Pos { line: 1, column: 5 }));
+    }
+
+    #[test]
     fn comments_of_both_kinds_end_tokens() {
         let t = tokens("A/*x\ny*/B // c\n C//d\nD");
         assert_eq!(&t[..], &[("A", 1, 1), ("B", 2, 4), ("C", 3, 2), ("D", 4, 1)]);
@@ -155,7 +162,7 @@ mod tests {
         let mut lx = Lexer::new("IMAGEFILE \"my file.png\" x");
         lx.next_token().unwrap();
         let t = lx.next_token().unwrap().unwrap();
-        assert_eq!((t.text, t.quoted, t.pos.column), ("my file.png", true, 11));
+        assert_eq!((t.text, t.quoted, t.pos.column, t.end.column), ("my file.png", true, 11, 24));
         assert_eq!(lx.next_token().unwrap().unwrap().text, "x");
     }
 

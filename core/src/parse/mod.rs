@@ -16,6 +16,7 @@
 //! O(objects · log surfaces).
 
 mod error;
+mod keyword;
 mod lexer;
 mod number;
 mod statement;
@@ -23,12 +24,13 @@ mod statement;
 pub use error::{ErrorKind, Field, Found, ParseError, Pos, Rule, Shown};
 pub use lexer::{Lexer, Token};
 pub use number::{parse_integer, Decimal};
-pub use statement::{keyword, Statement, KEYWORDS};
+pub use statement::Statement;
 
-use crate::capacity::Capacities;
-use crate::scene::{Camera, CameraError, CapacityError, Light, Normalization, Scene, SurfaceEntry, WorldPoint};
+use crate::capacity::{CapacityError, CapacityKind, Counts};
+use crate::scene::{Camera, CameraError, Light, Normalization, Scene, SceneCapacities, SurfaceEntry, WorldPoint};
 use crate::shapes::{AxisAlignedBox, Rectangle, ShapeKind, Sphere, Superquadric, Triangle};
-use statement::Cursor;
+use keyword::Keyword;
+use statement::{Cursor, Patch};
 
 /// What the parse found besides the scene.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -50,7 +52,7 @@ fn for_each_statement<'a>(text: &'a str, mut each: impl FnMut(Pos, Result<Statem
                 continue;
             }
         };
-        let result = match keyword(token.text).filter(|_| !token.quoted) {
+        let result = match Keyword::from_text(token.text).filter(|_| !token.quoted) {
             Some(kw) => statement::statement(&mut cur, kw, token.pos),
             None => Err(ParseError::new(token.pos, ErrorKind::UnknownKeyword(token.text))),
         };
@@ -63,7 +65,9 @@ fn for_each_statement<'a>(text: &'a str, mut each: impl FnMut(Pos, Result<Statem
             let mut first = true;
             loop {
                 match cur.peek() {
-                    Ok(Some(t)) if (first && keyword(t.text).is_none()) || Decimal::parse(t.text).is_some() => {
+                    Ok(Some(t))
+                        if (first && Keyword::from_text(t.text).is_none()) || Decimal::parse(t.text).is_some() =>
+                    {
                         let _ = cur.next();
                     }
                     Ok(_) => break,
@@ -76,7 +80,7 @@ fn for_each_statement<'a>(text: &'a str, mut each: impl FnMut(Pos, Result<Statem
 }
 
 /// Parses `bytes`, reporting invalid UTF-8 as an error at the first bad byte.
-pub fn parse_bytes<'a, C: Capacities>(
+pub fn parse_bytes<'a, C: SceneCapacities>(
     bytes: &'a [u8],
     scene: &mut Scene<C>,
     on_error: &mut dyn FnMut(ParseError<'a>),
@@ -113,17 +117,18 @@ impl Extent {
 
 /// Parses `text` into `scene` (cleared first). Every error goes to
 /// `on_error`; the result is the number of errors if there were any.
-pub fn parse<'a, C: Capacities>(
+pub fn parse<'a, C: SceneCapacities>(
     text: &'a str,
     scene: &mut Scene<C>,
     on_error: &mut dyn FnMut(ParseError<'a>),
 ) -> Result<Parsed<'a>, usize> {
     scene.clear();
-    survey(text, scene);
+    let needed = survey(text, scene);
     let mut build = Build {
         scene,
+        needed,
         parsed: Parsed::default(),
-        first: [None; PARAMETERS.len()],
+        first: [None; Keyword::COUNT],
         errors: 0,
         reported_capacity: 0,
         on_error,
@@ -141,29 +146,50 @@ pub fn parse<'a, C: Capacities>(
     Ok(parsed)
 }
 
-/// Pass 1: surfaces (sorted by number) and the normalisation.
-fn survey<C: Capacities>(text: &str, scene: &mut Scene<C>) {
+/// What `text` needs of each capacity, counting its valid statements (a
+/// B-spline patch at its full grid of triangles): the counts a profile for
+/// this scene holds, but for the octree's, which depend on the build (see
+/// [`crate::accel::BuildReport::counts`]). Like [`parse`], it never panics.
+pub fn count(text: &str) -> Counts {
+    let mut counts = Counts::ZERO;
+    for_each_statement(text, |_, result| {
+        if let Ok(s) = result {
+            s.count(&mut counts);
+        }
+    });
+    counts.with_objects()
+}
+
+/// Pass 1: surfaces (sorted by number) and the normalisation; returns what
+/// the scene needs of each capacity.
+fn survey<C: SceneCapacities>(text: &str, scene: &mut Scene<C>) -> Counts {
+    let mut counts = Counts::ZERO;
     let mut eye = None;
     let mut extent: Option<Extent> = None;
     let mut add = |lo: WorldPoint, hi: WorldPoint| match &mut extent {
         Some(e) => e.add(lo, hi),
         None => extent = Some(Extent { min: lo, max: hi }),
     };
-    for_each_statement(text, |pos, result| match result {
-        Ok(Statement::Viewpoint(p)) => {
-            eye.get_or_insert(p);
+    for_each_statement(text, |pos, result| {
+        if let Ok(s) = &result {
+            s.count(&mut counts);
         }
-        Ok(Statement::Light { position, .. }) => add(position, position),
-        Ok(Statement::Surface { number, surface }) => {
-            // A full arena is reported by the build pass.
-            let _ = scene.push_surface(SurfaceEntry { number, line: pos.line, column: pos.column, surface });
-        }
-        Ok(s) => {
-            if let Some((lo, hi)) = s.object_bounds() {
-                add(lo, hi);
+        match result {
+            Ok(Statement::Viewpoint(p)) => {
+                eye.get_or_insert(p);
             }
+            Ok(Statement::Light { position, .. }) => add(position, position),
+            Ok(Statement::Surface { number, surface }) => {
+                // A full arena is reported by the build pass.
+                let _ = scene.push_surface(SurfaceEntry { number, line: pos.line, column: pos.column, surface });
+            }
+            Ok(s) => {
+                if let Some((lo, hi)) = s.object_bounds() {
+                    add(lo, hi);
+                }
+            }
+            Err(_) => {}
         }
-        Err(_) => {}
     });
     let eye = eye.unwrap_or(scene.settings.view.eye);
     add(eye, eye);
@@ -171,139 +197,82 @@ fn survey<C: Capacities>(text: &str, scene: &mut Scene<C>) {
     if let Some(e) = extent {
         scene.normalization = Normalization::fit(e.min, e.max);
     }
+    counts.with_objects()
 }
 
-/// Scene parameters that may appear once, in [`Build::first`] order.
-const PARAMETERS: [&str; 11] = [
-    "VIEWPOINT",
-    "ORIGIN",
-    "UPVECTOR",
-    "RASTER",
-    "VIEWPORT",
-    "RDEPTH",
-    "IMAGEFILE",
-    "BACKGROUND",
-    "GAMMA",
-    "ATTENUATION",
-    "SAMPLES",
-];
-
 /// Pass 2 state.
-struct Build<'s, 'a, 'e, C: Capacities> {
+struct Build<'s, 'a, 'e, C: SceneCapacities> {
     scene: &'s mut Scene<C>,
+    /// What the whole scene needs, for capacity errors.
+    needed: Counts,
     parsed: Parsed<'a>,
-    /// Where each parameter was first given.
-    first: [Option<Pos>; PARAMETERS.len()],
+    /// Where each once-only parameter was first given, by keyword.
+    first: [Option<Pos>; Keyword::COUNT],
     errors: usize,
-    /// Bit set of capacities already reported (one error each is enough).
+    /// Bit set of capacities already reported (one error each is enough),
+    /// bit `kind as u8`.
     reported_capacity: u32,
     on_error: &'e mut dyn FnMut(ParseError<'a>),
 }
 
-impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
+impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
     fn report(&mut self, e: ParseError<'a>) {
         self.errors += 1;
         (self.on_error)(e);
     }
 
     fn capacity(&mut self, pos: Pos, e: CapacityError) {
-        let bit = match e.what {
-            "objects" => 1,
-            "spheres" => 2,
-            "boxes" => 4,
-            "superquadrics" => 8,
-            "triangles" => 16,
-            "rectangles" => 32,
-            "surfaces" => 64,
-            "B-spline triangles" => 256,
-            "B-spline control points" => 512,
-            _ => 128,
-        };
+        let bit = 1 << e.kind as u8;
         if self.reported_capacity & bit == 0 {
             self.reported_capacity |= bit;
-            self.report(ParseError::new(pos, ErrorKind::Capacity(e)));
+            let needed = Some(self.needed.get(e.kind));
+            self.report(ParseError::new(pos, ErrorKind::Capacity(CapacityError { needed, ..e })));
         }
     }
 
-    /// Records a parameter; false (with an error) if it was given before.
-    fn once(&mut self, keyword: &'static str, pos: Pos) -> bool {
-        let i = PARAMETERS.iter().position(|&k| k == keyword).unwrap_or(0);
-        if let Some(first) = self.first[i] {
+    /// Records a once-only parameter; false (with an error) if it was
+    /// given before.
+    fn once(&mut self, keyword: Keyword, pos: Pos) -> bool {
+        let first = &mut self.first[keyword as usize];
+        if let Some(first) = *first {
+            let keyword = keyword.name();
             self.report(ParseError::new(pos, ErrorKind::Repeated { keyword, first_line: first.line }));
             return false;
         }
-        self.first[i] = Some(pos);
+        *first = Some(pos);
         true
     }
 
     /// The surface index for an object, or an error.
-    fn surface(&mut self, keyword: &'static str, number: u32, pos: Pos) -> Option<u16> {
+    fn surface(&mut self, keyword: Keyword, number: u32, pos: Pos) -> Option<u16> {
         let found = self.scene.view().surface_index(number);
-        if found.is_none() && self.reported_capacity & 64 == 0 {
+        if found.is_none() && self.reported_capacity & (1 << CapacityKind::Surfaces as u8) == 0 {
+            let keyword = keyword.name();
             self.report(ParseError::new(pos, ErrorKind::UndefinedSurface { keyword, number }));
         }
         found
     }
 
     fn apply(&mut self, pos: Pos, s: Statement<'a>) {
+        let keyword = s.keyword();
+        if keyword.once_only() && !self.once(keyword, pos) {
+            return;
+        }
         let norm = self.scene.normalization;
-        let too_small = |keyword| ParseError::new(pos, ErrorKind::TooSmall { keyword });
+        let too_small = || ParseError::new(pos, ErrorKind::TooSmall { keyword: keyword.name() });
+        let settings = &mut self.scene.settings;
         match s {
-            Statement::Viewpoint(p) => {
-                if self.once("VIEWPOINT", pos) {
-                    self.scene.settings.view.eye = p;
-                }
-            }
-            Statement::Origin(p) => {
-                if self.once("ORIGIN", pos) {
-                    self.scene.settings.view.look_at = p;
-                }
-            }
-            Statement::Upvector(p) => {
-                if self.once("UPVECTOR", pos) {
-                    self.scene.settings.view.up = p;
-                }
-            }
-            Statement::Raster(r) => {
-                if self.once("RASTER", pos) {
-                    self.scene.settings.raster = r;
-                }
-            }
-            Statement::Viewport(v) => {
-                if self.once("VIEWPORT", pos) {
-                    self.scene.settings.view.viewport = Some(v);
-                }
-            }
-            Statement::Rdepth(d) => {
-                if self.once("RDEPTH", pos) {
-                    self.scene.settings.rdepth = d;
-                }
-            }
-            Statement::Imagefile(name) => {
-                if self.once("IMAGEFILE", pos) {
-                    self.parsed.imagefile = Some(name);
-                }
-            }
-            Statement::Background(c) => {
-                if self.once("BACKGROUND", pos) {
-                    self.scene.settings.background = c;
-                }
-            }
-            Statement::Gamma(g) => {
-                if self.once("GAMMA", pos) {
-                    self.scene.settings.gamma = g;
-                }
-            }
-            Statement::Attenuation(d) => {
-                if self.once("ATTENUATION", pos) {
-                    self.scene.settings.attenuation = d;
-                }
-            }
-            Statement::Samples(n) => {
-                if self.once("SAMPLES", pos) {
-                    self.scene.settings.samples = n;
-                }
-            }
+            Statement::Viewpoint(p) => settings.view.eye = p,
+            Statement::Origin(p) => settings.view.look_at = p,
+            Statement::Upvector(p) => settings.view.up = p,
+            Statement::Raster(r) => settings.raster = r,
+            Statement::Viewport(v) => settings.view.viewport = Some(v),
+            Statement::Rdepth(d) => settings.rdepth = d,
+            Statement::Imagefile(name) => self.parsed.imagefile = Some(name),
+            Statement::Background(c) => settings.background = c,
+            Statement::Gamma(g) => settings.gamma = g,
+            Statement::Attenuation(d) => settings.attenuation = d,
+            Statement::Samples(n) => settings.samples = n,
             Statement::Light { brightness, position } => {
                 let light = Light { position: norm.point(position), brightness };
                 if let Err(e) = self.scene.push_light(light) {
@@ -317,19 +286,16 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
                         self.report(ParseError::new(pos, ErrorKind::SurfaceRepeated { number, first_line: first.line }))
                     }
                     Some(_) => {}
-                    None => self.capacity(
-                        pos,
-                        CapacityError { what: "surfaces", capacity: Scene::<C>::surface_capacity(), profile: C::NAME },
-                    ),
+                    None => self.capacity(pos, Scene::<C>::surfaces_full()),
                 }
             }
             Statement::Sphere { surface, radius, center } => {
-                let Some(surface) = self.surface("SPHERE", surface, pos) else {
+                let Some(surface) = self.surface(keyword, surface, pos) else {
                     return;
                 };
                 let radius = norm.length(radius);
                 if radius.to_bits() <= 0 {
-                    return self.report(too_small("SPHERE"));
+                    return self.report(too_small());
                 }
                 let r = self.scene.push_sphere(Sphere::new(norm.point(center), radius, surface));
                 if let Err(e) = r {
@@ -337,13 +303,13 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
                 }
             }
             Statement::Box { surface, center, half } => {
-                let Some(surface) = self.surface("BOX", surface, pos) else {
+                let Some(surface) = self.surface(keyword, surface, pos) else {
                     return;
                 };
                 let min = norm.point([0, 1, 2].map(|a| center[a] - half[a]));
                 let max = norm.point([0, 1, 2].map(|a| center[a] + half[a]));
                 if (0..3).any(|a| min.axis(a) >= max.axis(a)) {
-                    return self.report(too_small("BOX"));
+                    return self.report(too_small());
                 }
                 let b = AxisAlignedBox { min, max, surface };
                 if let Err(e) = self.scene.push_box(b) {
@@ -351,13 +317,13 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
                 }
             }
             Statement::Superquadric { surface, power, center, half } => {
-                let Some(surface) = self.surface("SUPERQUADRIC", surface, pos) else {
+                let Some(surface) = self.surface(keyword, surface, pos) else {
                     return;
                 };
                 let half =
                     crate::math::Vec3 { x: norm.length(half[0]), y: norm.length(half[1]), z: norm.length(half[2]) };
                 if half.bits().iter().any(|&h| h <= 0) {
-                    return self.report(too_small("SUPERQUADRIC"));
+                    return self.report(too_small());
                 }
                 let power = crate::math::Scalar::from_bits(statement::q32_to_q16(power.to_bits()) as i32);
                 let q = Superquadric::new(norm.point(center), half, power, surface);
@@ -366,23 +332,23 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
                 }
             }
             Statement::Triangle { surface, corners } => {
-                let Some(surface) = self.surface("TRIANGLE", surface, pos) else {
+                let Some(surface) = self.surface(keyword, surface, pos) else {
                     return;
                 };
                 let Some(t) = Triangle::new(corners.map(|c| norm.point(c)), surface) else {
-                    return self.report(too_small("TRIANGLE"));
+                    return self.report(too_small());
                 };
                 if let Err(e) = self.scene.push_triangle(t) {
                     self.capacity(pos, e);
                 }
             }
-            patch @ Statement::Bspline { .. } => self.bspline(pos, patch),
+            Statement::Bspline(patch) => self.bspline(pos, patch),
             Statement::Rectangle { surface, corners } => {
-                let Some(surface) = self.surface("RECTANGLE", surface, pos) else {
+                let Some(surface) = self.surface(keyword, surface, pos) else {
                     return;
                 };
                 let Some(r) = Rectangle::new(corners.map(|c| norm.point(c)), surface) else {
-                    return self.report(too_small("RECTANGLE"));
+                    return self.report(too_small());
                 };
                 if let Err(e) = self.scene.push_rectangle(r) {
                     self.capacity(pos, e);
@@ -393,45 +359,45 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
 
     /// A B-spline patch: its triangles' room is checked as a whole before
     /// any is made.
-    fn bspline(&mut self, pos: Pos, patch: Statement<'a>) {
-        let Statement::Bspline { surface, order, rows, cols, samples, points } = patch else { return };
-        let Some(surface) = self.surface("BSPLINE", surface, pos) else {
+    fn bspline(&mut self, pos: Pos, patch: Patch<'a>) {
+        let Patch { surface, order, rows, cols, samples, points } = patch;
+        let Some(surface) = self.surface(Keyword::Bspline, surface, pos) else {
             return;
         };
         let triangles = 2 * (samples[0] as usize - 1) * (samples[1] as usize - 1);
         // Checked on the constant first, so that a profile without room for
         // patches (a small board's) compiles no evaluation code at all.
         if Scene::<C>::capacity_of(ShapeKind::SmoothTriangle) == 0 {
-            let e = CapacityError { what: "B-spline triangles", capacity: 0, profile: C::NAME };
-            return self.capacity(pos, e);
+            return self.capacity(pos, Scene::<C>::full(CapacityKind::BsplineTriangles, 0));
         }
-        if let Err(e) = self.scene.check_room_for(ShapeKind::SmoothTriangle, triangles) {
+        if let Err(e) = self.scene.check_room(ShapeKind::SmoothTriangle, triangles) {
             return self.capacity(pos, e);
         }
         let norm = self.scene.normalization;
-        if !self.scene.set_control_points(points.iter().map(|p| norm.point(p))) {
-            let capacity = Scene::<C>::control_point_capacity();
-            let e = CapacityError { what: "B-spline control points", capacity, profile: C::NAME };
+        if let Err(e) = self.scene.set_control_points(points.iter().map(|p| norm.point(p))) {
             return self.capacity(pos, e);
         }
         if self.scene.push_bspline(order, rows, cols, samples, surface) == 0 {
             self.report(ParseError::new(
                 pos,
-                ErrorKind::Degenerate { keyword: "BSPLINE", why: "its control points do not span a surface" },
+                ErrorKind::Degenerate {
+                    keyword: Keyword::Bspline.name(),
+                    why: "its control points do not span a surface",
+                },
             ));
         }
     }
 
     /// The camera needs VIEWPOINT ≠ ORIGIN and an UPVECTOR off the view line.
     fn check_camera(&mut self) {
-        let at = |i: usize| self.first[i];
+        let at = |keyword: Keyword| self.first[keyword as usize];
         let start = Pos { line: 1, column: 1 };
-        let view_pos = at(0).max(at(1)).unwrap_or(start);
+        let view_pos = at(Keyword::Viewpoint).max(at(Keyword::Origin)).unwrap_or(start);
         match Camera::check(&self.scene.settings.view) {
             Ok(()) => {}
             Err(CameraError::EyeAtOrigin) => self.report(ParseError::new(view_pos, ErrorKind::EyeAtOrigin)),
             Err(CameraError::UpParallel) => {
-                let pos = at(2).unwrap_or(view_pos);
+                let pos = at(Keyword::Upvector).unwrap_or(view_pos);
                 self.report(ParseError::new(pos, ErrorKind::UpParallel))
             }
         }
@@ -442,8 +408,8 @@ impl<'a, C: Capacities> Build<'_, 'a, '_, C> {
 mod tests {
     extern crate std;
     use super::*;
-    use crate::capacity::Board64K;
-    use crate::math::{Scalar, Vec3};
+    use crate::math::Scalar;
+    use crate::profile::Board64K;
     use crate::scene::ObjectId;
     use crate::shapes::ShapeKind;
     use std::format;
@@ -618,6 +584,48 @@ mod tests {
         check("UPVECTOR 0 0 0", "UPVECTOR is zero or parallel");
     }
 
+    /// A valid statement for each keyword.
+    fn example(keyword: Keyword) -> &'static str {
+        match keyword {
+            Keyword::Viewpoint => "VIEWPOINT 0 0 10",
+            Keyword::Origin => "ORIGIN 0 0 1",
+            Keyword::Upvector => "UPVECTOR 0 1 0",
+            Keyword::Raster => "RASTER 8 8",
+            Keyword::Viewport => "VIEWPORT 1 1",
+            Keyword::Rdepth => "RDEPTH 2",
+            Keyword::Imagefile => "IMAGEFILE a.png",
+            Keyword::Light => "LIGHT 1 5 5 5",
+            Keyword::Background => "BACKGROUND 0 0 0.5",
+            Keyword::Gamma => "GAMMA 2.2",
+            Keyword::Attenuation => "ATTENUATION 1",
+            Keyword::Samples => "SAMPLES 2",
+            Keyword::Sphere => "SPHERE 1 1 0 0 0",
+            Keyword::Box => "BOX 1 0 0 0 1 1 1",
+            Keyword::Superquadric => "SUPERQUADRIC 1 4 0 0 0 1 1 1",
+            Keyword::Triangle => "TRIANGLE 1 0 0 0 1 0 0 0 1 0",
+            Keyword::Rectangle => "RECTANGLE 1 0 0 0 1 0 0 1 1 0 0 1 0",
+            Keyword::Bspline => "BSPLINE 1 2 2 2 2 2 0 0 0 1 0 0 0 1 0 1 1 0",
+            Keyword::Surface => "SURFACE 2 0 0 0 0 0 0 0 0 0 0 0 0",
+        }
+    }
+
+    #[test]
+    fn parameters_may_be_given_once_and_the_rest_repeat() {
+        for keyword in Keyword::ALL {
+            let statement = example(keyword);
+            ok(&format!("{SURF}{statement}"));
+            let twice = format!("{SURF}{statement}\n{statement}");
+            if keyword.once_only() {
+                let name = keyword.name();
+                assert_eq!(one_err(&twice), format!("3:1: {name} is given twice (first on line 2)"));
+            } else if keyword == Keyword::Surface {
+                assert_eq!(one_err(&twice), "3:1: SURFACE 2 is defined twice (first on line 2)");
+            } else {
+                ok(&twice);
+            }
+        }
+    }
+
     #[test]
     fn clockwise_rectangles_are_convex_too() {
         ok(&format!("RECTANGLE 1 0 0 0 0 1 0 1 1 0 1 0 0 {SURF}"));
@@ -650,7 +658,9 @@ mod tests {
         let e = errs(&text);
         assert_eq!(e.len(), 1, "{e:?}");
         assert_eq!(
-            e.iter().filter(|m| m.contains("boxes than this build holds (32, capacity profile Board64K)")).count(),
+            e.iter()
+                .filter(|m| m.contains("too many boxes: the capacity profile Board64K holds 32 and the scene needs 40;"))
+                .count(),
             1,
             "{e:?}"
         );
@@ -675,7 +685,130 @@ mod tests {
         assert_eq!(b.radius.to_bits(), 2 * a.radius.to_bits());
         assert_eq!((b.center - a.center).x.to_bits(), 5 * a.radius.to_bits());
         assert_eq!(v.lights[0].position.y, a.center.y);
-        assert_eq!(a.center.y, Vec3::ZERO.y + a.center.y);
+        assert_eq!([b.center.y, b.center.z], [a.center.y, a.center.z]);
+    }
+
+    /// The single error `text` gives, as a value.
+    fn the_error(text: &[u8]) -> ParseError<'_> {
+        let mut scene = std::boxed::Box::new(TestScene::new());
+        let mut errors = Vec::new();
+        let r = parse_bytes(text, &mut scene, &mut |e| errors.push(e));
+        assert_eq!(r, Err(1), "{:?}: {errors:?}", std::string::String::from_utf8_lossy(text));
+        errors[0]
+    }
+
+    fn at(line: u32, column: u32) -> Pos {
+        Pos { line, column }
+    }
+
+    #[test]
+    fn an_unfinished_statement_is_reported_right_after_its_last_token() {
+        let field = |statement, name| Field { statement, name };
+        let cases: [(&str, Pos, ErrorKind<'_>); 7] = [
+            (
+                "RDEPTH 1\nSPHERE 1 1 0 0",
+                at(2, 15),
+                ErrorKind::ExpectedNumber { field: field("SPHERE", "z"), found: Found::EndOfFile },
+            ),
+            // Not past the end, where blank lines and comments lead.
+            (
+                "RDEPTH 1\nSPHERE 1 1 0 0 // z?\n\n  /* */\n",
+                at(2, 15),
+                ErrorKind::ExpectedNumber { field: field("SPHERE", "z"), found: Found::EndOfFile },
+            ),
+            (
+                "\nSPHERE\n",
+                at(2, 7),
+                ErrorKind::ExpectedInteger { field: field("SPHERE", "surface number"), found: Found::EndOfFile },
+            ),
+            (
+                "RASTER 8\r\n",
+                at(1, 9),
+                ErrorKind::ExpectedInteger { field: field("RASTER", "height"), found: Found::EndOfFile },
+            ),
+            ("RDEPTH 1 IMAGEFILE\n", at(1, 19), ErrorKind::ExpectedName { field: field("IMAGEFILE", "file name") }),
+            (
+                "BSPLINE 1 2 2 2 2 2  0 0 0  1 0 0\n  0 1\n",
+                at(2, 6),
+                ErrorKind::ExpectedNumber { field: field("BSPLINE", "control point z"), found: Found::EndOfFile },
+            ),
+            // Columns count characters: é is one.
+            (
+                "LIGHT 1 1 é",
+                at(1, 11),
+                ErrorKind::ExpectedNumber { field: field("LIGHT", "y"), found: Found::Token("é") },
+            ),
+        ];
+        for (text, pos, kind) in cases {
+            assert_eq!(the_error(text.as_bytes()), ParseError::new(pos, kind), "{text:?}");
+        }
+    }
+
+    /// A number for each error kind; exhaustive, so a new kind does not
+    /// compile until it gets a case in the test below.
+    fn kind_number(kind: &ErrorKind<'_>) -> usize {
+        match kind {
+            ErrorKind::InvalidUtf8 => 0,
+            ErrorKind::UnterminatedComment => 1,
+            ErrorKind::UnterminatedString => 2,
+            ErrorKind::UnknownKeyword(_) => 3,
+            ErrorKind::ExpectedNumber { .. } => 4,
+            ErrorKind::ExpectedInteger { .. } => 5,
+            ErrorKind::ExpectedName { .. } => 6,
+            ErrorKind::OutOfRange { .. } => 7,
+            ErrorKind::Repeated { .. } => 8,
+            ErrorKind::SurfaceRepeated { .. } => 9,
+            ErrorKind::UndefinedSurface { .. } => 10,
+            ErrorKind::Degenerate { .. } => 11,
+            ErrorKind::NotPlanar => 12,
+            ErrorKind::NotConvex => 13,
+            ErrorKind::TooFewControlPoints { .. } => 14,
+            ErrorKind::TooSmall { .. } => 15,
+            ErrorKind::EyeAtOrigin => 16,
+            ErrorKind::UpParallel => 17,
+            ErrorKind::Capacity(_) => 18,
+        }
+    }
+    const ERROR_KINDS: usize = 19;
+
+    #[test]
+    fn every_error_kind_reports_its_line_and_column() {
+        let boxes: String = (0..33).map(|_| "BOX 1 0 0 0 1 1 1\n").collect();
+        // Lights 10^6 apart: one fixed-point step is about 2^-29 of that,
+        // 0.002; a radius of 0.0001 rounds to nothing, 0.002 does not.
+        let wide = "LIGHT 1 -500000 0 0 LIGHT 1 500000 0 0\n";
+        assert!(ok(&format!("{wide}{SURF} SPHERE 1 0.002 0 0 0")).view().spheres[0].radius.to_bits() > 0);
+        let cases: [(String, Pos, usize); 19] = [
+            ("RDEPTH 1\n  /* open\n".into(), at(2, 3), 1),
+            ("RDEPTH 1\nIMAGEFILE \"abc\n".into(), at(2, 11), 2),
+            ("RDEPTH 1\n  FOO 1".into(), at(2, 3), 3),
+            ("LIGHT 1 0\n x".into(), at(2, 2), 4),
+            ("RASTER 8\n4.5".into(), at(2, 1), 5),
+            ("RDEPTH 1 IMAGEFILE\n".into(), at(1, 19), 6),
+            ("SAMPLES 0".into(), at(1, 9), 7),
+            ("GAMMA 2\n GAMMA 2".into(), at(2, 2), 8),
+            (format!("{SURF}  {SURF}"), at(2, 3), 9),
+            ("\n SPHERE 7 1 0 0 0".into(), at(2, 2), 10),
+            (format!("{SURF} TRIANGLE 1 0 0 0 1 1 1 2 2 2"), at(2, 2), 11),
+            (format!("{SURF} BSPLINE 1 2 2 2 2 2 1 1 1 1 1 1 1 1 1 1 1 1"), at(2, 2), 11),
+            (format!("{SURF} RECTANGLE 1 0 0 0 1 0 0 1 1 1 0 1 0"), at(2, 2), 12),
+            (format!("{SURF} RECTANGLE 1 0 0 0 1 1 0 1 0 0 0 1 0"), at(2, 2), 13),
+            (format!("{SURF} BSPLINE 1 4 3 3 4 4 {GRID}"), at(2, 2), 14),
+            (format!("{wide}{SURF} SPHERE 1 0.0001 0 0 0"), at(3, 2), 15),
+            ("VIEWPOINT 0 0 1\n ORIGIN 0 0 1".into(), at(2, 2), 16),
+            ("\n  UPVECTOR 0 0 -3".into(), at(2, 3), 17),
+            (format!("{SURF}{boxes}"), at(34, 1), 18),
+        ];
+        let mut covered = [false; ERROR_KINDS];
+        let bad_byte = (b"RDEPTH 2\n\xc3\xa9 \xff".to_vec(), at(2, 3), 0);
+        for (bytes, pos, kind) in
+            cases.map(|(text, pos, kind)| (text.into_bytes(), pos, kind)).into_iter().chain([bad_byte])
+        {
+            let e = the_error(&bytes);
+            assert_eq!((e.pos, kind_number(&e.kind)), (pos, kind), "{e}");
+            covered[kind] = true;
+        }
+        assert_eq!(covered, [true; ERROR_KINDS], "an error kind has no case");
     }
 
     /// A 3 × 3 grid of control points in the plane z = 0, row by row.
@@ -725,7 +858,10 @@ mod tests {
         let e = errs(&format!("BSPLINE 1 3 3 3 6 6 {GRID} BSPLINE 1 3 3 3 6 6 {GRID} {SURF}"));
         assert_eq!(e.len(), 1, "{e:?}");
         assert!(
-            e[0].contains("more B-spline triangles than this build holds (32, capacity profile Board64K)"),
+            e[0].contains(
+                "too many B-spline triangles: the capacity profile Board64K holds 32 and the scene needs 100; \
+                 define a profile that holds them with octrace_core::profile! (bspline_triangles: 100, …)"
+            ),
             "{e:?}"
         );
     }

@@ -3,8 +3,10 @@
 //! degenerate shapes.
 
 use super::error::{ErrorKind, Field, Found, ParseError, Pos, Rule};
+use super::keyword::Keyword;
 use super::lexer::{Lexer, Token};
 use super::number::{parse_integer, Decimal};
+use crate::capacity::{CapacityKind, Counts};
 use crate::math::isqrt_u128;
 use crate::scene::{Color, Surface, WorldPoint, WorldValue, MAX_SAMPLES, MAX_SIDE};
 use crate::shapes::bspline::{MAX_CONTROL_SIDE, MAX_ORDER, MAX_SAMPLE_SIDE};
@@ -20,53 +22,31 @@ pub enum Statement<'a> {
     Viewport([WorldValue; 2]),
     Rdepth(u32),
     Imagefile(&'a str),
-    Light {
-        brightness: I32F32,
-        position: WorldPoint,
-    },
+    Light { brightness: I32F32, position: WorldPoint },
     Background(Color),
     Gamma(I32F32),
     Attenuation(I32F32),
     Samples(u32),
-    Sphere {
-        surface: u32,
-        radius: WorldValue,
-        center: WorldPoint,
-    },
-    Box {
-        surface: u32,
-        center: WorldPoint,
-        half: WorldPoint,
-    },
-    Superquadric {
-        surface: u32,
-        power: I32F32,
-        center: WorldPoint,
-        half: WorldPoint,
-    },
-    Triangle {
-        surface: u32,
-        corners: [WorldPoint; 3],
-    },
-    Rectangle {
-        surface: u32,
-        corners: [WorldPoint; 4],
-    },
-    /// A B-spline patch: its control points stay in the text (validated),
-    /// read again when needed, so the statement is small whatever their
-    /// number.
-    Bspline {
-        surface: u32,
-        order: u32,
-        rows: u32,
-        cols: u32,
-        samples: [u32; 2],
-        points: ControlPoints<'a>,
-    },
-    Surface {
-        number: u32,
-        surface: Surface,
-    },
+    Sphere { surface: u32, radius: WorldValue, center: WorldPoint },
+    Box { surface: u32, center: WorldPoint, half: WorldPoint },
+    Superquadric { surface: u32, power: I32F32, center: WorldPoint, half: WorldPoint },
+    Triangle { surface: u32, corners: [WorldPoint; 3] },
+    Rectangle { surface: u32, corners: [WorldPoint; 4] },
+    Bspline(Patch<'a>),
+    Surface { number: u32, surface: Surface },
+}
+
+/// A B-spline patch: its control points stay in the text (validated), read
+/// again when needed, so the statement is small whatever their number.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Patch<'a> {
+    pub surface: u32,
+    pub order: u32,
+    pub rows: u32,
+    pub cols: u32,
+    /// Points evaluated along u and v.
+    pub samples: [u32; 2],
+    pub points: ControlPoints<'a>,
 }
 
 /// A patch's control points as they stand in the scene text, already
@@ -120,55 +100,101 @@ impl Statement<'_> {
             Statement::Triangle { corners: c, .. } => Some(corners(c)),
             Statement::Rectangle { corners: c, .. } => Some(corners(c)),
             // The surface lies within its control points' convex hull.
-            Statement::Bspline { points, .. } => {
+            Statement::Bspline(Patch { points, .. }) => {
                 let mut all = points.iter();
                 let first = all.next()?;
                 Some(all.fold((first, first), |(lo, hi), p| {
                     ([0, 1, 2].map(|a| lo[a].min(p[a])), [0, 1, 2].map(|a| hi[a].max(p[a])))
                 }))
             }
-            _ => None,
+            Statement::Viewpoint(_)
+            | Statement::Origin(_)
+            | Statement::Upvector(_)
+            | Statement::Raster(_)
+            | Statement::Viewport(_)
+            | Statement::Rdepth(_)
+            | Statement::Imagefile(_)
+            | Statement::Light { .. }
+            | Statement::Background(_)
+            | Statement::Gamma(_)
+            | Statement::Attenuation(_)
+            | Statement::Samples(_)
+            | Statement::Surface { .. } => None,
         }
     }
-}
 
-/// Every statement keyword, in the case the format writes them.
-pub const KEYWORDS: [&str; 19] = [
-    "VIEWPOINT",
-    "ORIGIN",
-    "UPVECTOR",
-    "RASTER",
-    "VIEWPORT",
-    "RDEPTH",
-    "IMAGEFILE",
-    "LIGHT",
-    "BACKGROUND",
-    "GAMMA",
-    "ATTENUATION",
-    "SAMPLES",
-    "SPHERE",
-    "BOX",
-    "SUPERQUADRIC",
-    "TRIANGLE",
-    "RECTANGLE",
-    "BSPLINE",
-    "SURFACE",
-];
+    /// Adds what this statement stores to `counts` (a B-spline patch: its
+    /// full grid of triangles, and its control points as scratch room).
+    pub(crate) fn count(&self, counts: &mut Counts) {
+        let kind = match self {
+            Statement::Sphere { .. } => CapacityKind::Spheres,
+            Statement::Box { .. } => CapacityKind::Boxes,
+            Statement::Superquadric { .. } => CapacityKind::Superquadrics,
+            Statement::Triangle { .. } => CapacityKind::Triangles,
+            Statement::Rectangle { .. } => CapacityKind::Rectangles,
+            Statement::Surface { .. } => CapacityKind::Surfaces,
+            Statement::Light { .. } => CapacityKind::Lights,
+            Statement::Bspline(Patch { samples, points, .. }) => {
+                let cells =
+                    (samples[0].saturating_sub(1) as usize).saturating_mul(samples[1].saturating_sub(1) as usize);
+                counts.bspline_triangles = counts.bspline_triangles.saturating_add(cells.saturating_mul(2));
+                counts.control_points = counts.control_points.max(points.iter().count());
+                return;
+            }
+            Statement::Viewpoint(_)
+            | Statement::Origin(_)
+            | Statement::Upvector(_)
+            | Statement::Raster(_)
+            | Statement::Viewport(_)
+            | Statement::Rdepth(_)
+            | Statement::Imagefile(_)
+            | Statement::Background(_)
+            | Statement::Gamma(_)
+            | Statement::Attenuation(_)
+            | Statement::Samples(_) => return,
+        };
+        let count = counts.get_mut(kind);
+        *count = count.saturating_add(1);
+    }
 
-/// The keyword `text` names (case-insensitively), if any.
-pub fn keyword(text: &str) -> Option<&'static str> {
-    KEYWORDS.iter().copied().find(|k| k.eq_ignore_ascii_case(text))
+    /// The keyword that begins the statement.
+    pub(crate) fn keyword(&self) -> Keyword {
+        match self {
+            Statement::Viewpoint(_) => Keyword::Viewpoint,
+            Statement::Origin(_) => Keyword::Origin,
+            Statement::Upvector(_) => Keyword::Upvector,
+            Statement::Raster(_) => Keyword::Raster,
+            Statement::Viewport(_) => Keyword::Viewport,
+            Statement::Rdepth(_) => Keyword::Rdepth,
+            Statement::Imagefile(_) => Keyword::Imagefile,
+            Statement::Light { .. } => Keyword::Light,
+            Statement::Background(_) => Keyword::Background,
+            Statement::Gamma(_) => Keyword::Gamma,
+            Statement::Attenuation(_) => Keyword::Attenuation,
+            Statement::Samples(_) => Keyword::Samples,
+            Statement::Sphere { .. } => Keyword::Sphere,
+            Statement::Box { .. } => Keyword::Box,
+            Statement::Superquadric { .. } => Keyword::Superquadric,
+            Statement::Triangle { .. } => Keyword::Triangle,
+            Statement::Rectangle { .. } => Keyword::Rectangle,
+            Statement::Bspline(_) => Keyword::Bspline,
+            Statement::Surface { .. } => Keyword::Surface,
+        }
+    }
 }
 
 /// Tokens with one token of look-ahead.
 pub struct Cursor<'a> {
     lexer: Lexer<'a>,
     peeked: Option<Option<Token<'a>>>,
+    /// Just after the last token taken: where "found the end of the file"
+    /// points, inside the statement the end cuts short.
+    taken_end: Pos,
 }
 
 impl<'a> Cursor<'a> {
     pub fn new(text: &'a str) -> Cursor<'a> {
-        Cursor { lexer: Lexer::new(text), peeked: None }
+        Cursor { lexer: Lexer::new(text), peeked: None, taken_end: Pos { line: 1, column: 1 } }
     }
 
     pub fn peek(&mut self) -> Result<Option<Token<'a>>, ParseError<'a>> {
@@ -182,13 +208,20 @@ impl<'a> Cursor<'a> {
 
     pub fn next(&mut self) -> Result<Option<Token<'a>>, ParseError<'a>> {
         let t = self.peek()?;
-        self.peeked = None;
+        self.take();
         Ok(t)
     }
 
-    /// The position of the end of the text (for "found the end of the file").
-    fn end_pos(&self) -> Pos {
-        self.lexer.pos()
+    /// Consumes the peeked token.
+    fn take(&mut self) {
+        if let Some(Some(t)) = self.peeked.take() {
+            self.taken_end = t.end;
+        }
+    }
+
+    /// The error for a statement that the end of the text cuts short.
+    fn end_of_file(&self, kind: ErrorKind<'a>) -> ParseError<'a> {
+        ParseError::new(self.taken_end, kind)
     }
 
     /// The next token if it is a number, else the error for `field`. The
@@ -196,7 +229,7 @@ impl<'a> Cursor<'a> {
     /// so error recovery always starts at the offending token.
     fn number(&mut self, field: Field) -> Result<(Decimal, Token<'a>), ParseError<'a>> {
         match self.peek()? {
-            None => Err(ParseError::new(self.end_pos(), ErrorKind::ExpectedNumber { field, found: Found::EndOfFile })),
+            None => Err(self.end_of_file(ErrorKind::ExpectedNumber { field, found: Found::EndOfFile })),
             Some(t) => match Decimal::parse(t.text).filter(|_| !t.quoted) {
                 None => Err(ParseError::new(t.pos, ErrorKind::ExpectedNumber { field, found: Found::Token(t.text) })),
                 Some(d) if d.out_of_range() => Err(out_of_range(t, field, Rule::Magnitude)),
@@ -217,7 +250,7 @@ impl<'a> Cursor<'a> {
             Rule::Between(..) | Rule::Magnitude | Rule::AboveResolution => true,
         };
         if ok {
-            self.peeked = None;
+            self.take();
             Ok(v)
         } else if rule == Rule::Positive && !d.negative && !d.is_zero() {
             Err(out_of_range(t, field, Rule::AboveResolution))
@@ -229,12 +262,7 @@ impl<'a> Cursor<'a> {
     /// An integer from `lo` to `hi`.
     fn integer(&mut self, field: Field, lo: i64, hi: i64) -> Result<i64, ParseError<'a>> {
         let t = match self.peek()? {
-            None => {
-                return Err(ParseError::new(
-                    self.end_pos(),
-                    ErrorKind::ExpectedInteger { field, found: Found::EndOfFile },
-                ))
-            }
+            None => return Err(self.end_of_file(ErrorKind::ExpectedInteger { field, found: Found::EndOfFile })),
             Some(t) => t,
         };
         let v = parse_integer(t.text)
@@ -243,40 +271,36 @@ impl<'a> Cursor<'a> {
         if v < lo || v > hi {
             return Err(out_of_range(t, field, Rule::Between(lo, hi)));
         }
-        self.peeked = None;
+        self.take();
         Ok(v)
     }
 
-    fn point(&mut self, statement: &'static str, names: [&'static str; 3]) -> Result<WorldPoint, ParseError<'a>> {
+    fn point(&mut self, keyword: Keyword, names: [&'static str; 3]) -> Result<WorldPoint, ParseError<'a>> {
         let mut p = [0; 3];
         for (v, name) in p.iter_mut().zip(names) {
-            *v = self.real(Field { statement, name }, Rule::Magnitude)?;
+            *v = self.real(Field { statement: keyword.name(), name }, Rule::Magnitude)?;
         }
         Ok(p)
     }
 
-    fn positive_triple(
-        &mut self,
-        statement: &'static str,
-        names: [&'static str; 3],
-    ) -> Result<WorldPoint, ParseError<'a>> {
+    fn positive_triple(&mut self, keyword: Keyword, names: [&'static str; 3]) -> Result<WorldPoint, ParseError<'a>> {
         let mut p = [0; 3];
         for (v, name) in p.iter_mut().zip(names) {
-            *v = self.real(Field { statement, name }, Rule::Positive)?;
+            *v = self.real(Field { statement: keyword.name(), name }, Rule::Positive)?;
         }
         Ok(p)
     }
 
-    fn color(&mut self, statement: &'static str, names: [&'static str; 3]) -> Result<Color, ParseError<'a>> {
+    fn color(&mut self, keyword: Keyword, names: [&'static str; 3]) -> Result<Color, ParseError<'a>> {
         let mut c = [0; 3];
         for (v, name) in c.iter_mut().zip(names) {
-            *v = q32_to_q16(self.real(Field { statement, name }, Rule::UnitInterval)?) as i32;
+            *v = q32_to_q16(self.real(Field { statement: keyword.name(), name }, Rule::UnitInterval)?) as i32;
         }
         Ok(Color::from_bits(c))
     }
 
-    fn surface_number(&mut self, statement: &'static str) -> Result<u32, ParseError<'a>> {
-        let field = Field { statement, name: "surface number" };
+    fn surface_number(&mut self, keyword: Keyword) -> Result<u32, ParseError<'a>> {
+        let field = Field { statement: keyword.name(), name: "surface number" };
         Ok(self.integer(field, 0, super::number::LIMIT as i64)? as u32)
     }
 }
@@ -291,50 +315,50 @@ pub fn q32_to_q16(v: i64) -> i64 {
 }
 
 /// Reads the statement that `keyword` (already consumed) begins.
-pub fn statement<'a>(cur: &mut Cursor<'a>, kw: &'static str, at: Pos) -> Result<Statement<'a>, ParseError<'a>> {
-    let f = |name| Field { statement: kw, name };
+pub fn statement<'a>(cur: &mut Cursor<'a>, kw: Keyword, at: Pos) -> Result<Statement<'a>, ParseError<'a>> {
+    let f = |name| Field { statement: kw.name(), name };
     let xyz = ["x", "y", "z"];
     Ok(match kw {
-        "VIEWPOINT" => Statement::Viewpoint(cur.point(kw, xyz)?),
-        "ORIGIN" => Statement::Origin(cur.point(kw, xyz)?),
-        "UPVECTOR" => Statement::Upvector(cur.point(kw, xyz)?),
-        "RASTER" => Statement::Raster([
+        Keyword::Viewpoint => Statement::Viewpoint(cur.point(kw, xyz)?),
+        Keyword::Origin => Statement::Origin(cur.point(kw, xyz)?),
+        Keyword::Upvector => Statement::Upvector(cur.point(kw, xyz)?),
+        Keyword::Raster => Statement::Raster([
             cur.integer(f("width"), 1, MAX_SIDE as i64)? as u32,
             cur.integer(f("height"), 1, MAX_SIDE as i64)? as u32,
         ]),
-        "VIEWPORT" => {
+        Keyword::Viewport => {
             Statement::Viewport([cur.real(f("width"), Rule::Positive)?, cur.real(f("height"), Rule::Positive)?])
         }
-        "RDEPTH" => Statement::Rdepth(cur.integer(f("depth"), 0, super::number::LIMIT as i64)? as u32),
-        "IMAGEFILE" => match cur.next()? {
+        Keyword::Rdepth => Statement::Rdepth(cur.integer(f("depth"), 0, super::number::LIMIT as i64)? as u32),
+        Keyword::Imagefile => match cur.next()? {
             Some(t) => Statement::Imagefile(t.text),
-            None => return Err(ParseError::new(cur.end_pos(), ErrorKind::ExpectedName { field: f("file name") })),
+            None => return Err(cur.end_of_file(ErrorKind::ExpectedName { field: f("file name") })),
         },
-        "LIGHT" => Statement::Light {
+        Keyword::Light => Statement::Light {
             brightness: I32F32::from_bits(cur.real(f("brightness"), Rule::NonNegative)?),
             position: cur.point(kw, xyz)?,
         },
-        "BACKGROUND" => Statement::Background(cur.color(kw, ["red", "green", "blue"])?),
-        "GAMMA" => Statement::Gamma(I32F32::from_bits(cur.real(f("value"), Rule::Positive)?)),
-        "ATTENUATION" => Statement::Attenuation(I32F32::from_bits(cur.real(f("d0"), Rule::Positive)?)),
-        "SAMPLES" => Statement::Samples(cur.integer(f("count"), 1, MAX_SAMPLES as i64)? as u32),
-        "SPHERE" => Statement::Sphere {
+        Keyword::Background => Statement::Background(cur.color(kw, ["red", "green", "blue"])?),
+        Keyword::Gamma => Statement::Gamma(I32F32::from_bits(cur.real(f("value"), Rule::Positive)?)),
+        Keyword::Attenuation => Statement::Attenuation(I32F32::from_bits(cur.real(f("d0"), Rule::Positive)?)),
+        Keyword::Samples => Statement::Samples(cur.integer(f("count"), 1, MAX_SAMPLES as i64)? as u32),
+        Keyword::Sphere => Statement::Sphere {
             surface: cur.surface_number(kw)?,
             radius: cur.real(f("radius"), Rule::Positive)?,
             center: cur.point(kw, xyz)?,
         },
-        "BOX" => Statement::Box {
+        Keyword::Box => Statement::Box {
             surface: cur.surface_number(kw)?,
             center: cur.point(kw, ["xc", "yc", "zc"])?,
             half: cur.positive_triple(kw, ["xs", "ys", "zs"])?,
         },
-        "SUPERQUADRIC" => Statement::Superquadric {
+        Keyword::Superquadric => Statement::Superquadric {
             surface: cur.surface_number(kw)?,
             power: I32F32::from_bits(cur.real(f("power"), Rule::BetweenReal(2, 64))?),
             center: cur.point(kw, ["xc", "yc", "zc"])?,
             half: cur.positive_triple(kw, ["xs", "ys", "zs"])?,
         },
-        "TRIANGLE" => {
+        Keyword::Triangle => {
             let surface = cur.surface_number(kw)?;
             let corners = [
                 cur.point(kw, ["x1", "y1", "z1"])?,
@@ -344,12 +368,12 @@ pub fn statement<'a>(cur: &mut Cursor<'a>, kw: &'static str, at: Pos) -> Result<
             if cross(sub(corners[1], corners[0]), sub(corners[2], corners[0])) == [0; 3] {
                 return Err(ParseError::new(
                     at,
-                    ErrorKind::Degenerate { keyword: kw, why: "its corners are collinear (zero area)" },
+                    ErrorKind::Degenerate { keyword: kw.name(), why: "its corners are collinear (zero area)" },
                 ));
             }
             Statement::Triangle { surface, corners }
         }
-        "RECTANGLE" => {
+        Keyword::Rectangle => {
             let surface = cur.surface_number(kw)?;
             let corners = [
                 cur.point(kw, ["x1", "y1", "z1"])?,
@@ -360,7 +384,7 @@ pub fn statement<'a>(cur: &mut Cursor<'a>, kw: &'static str, at: Pos) -> Result<
             check_quadrilateral(&corners).map_err(|k| ParseError::new(at, k))?;
             Statement::Rectangle { surface, corners }
         }
-        "BSPLINE" => {
+        Keyword::Bspline => {
             let surface = cur.surface_number(kw)?;
             let order = cur.integer(f("order"), 2, MAX_ORDER as i64)? as u32;
             let rows = cur.integer(f("rows"), 2, MAX_CONTROL_SIDE as i64)? as u32;
@@ -378,9 +402,9 @@ pub fn statement<'a>(cur: &mut Cursor<'a>, kw: &'static str, at: Pos) -> Result<
             for _ in 0..rows * cols {
                 cur.point(kw, ["control point x", "control point y", "control point z"])?;
             }
-            Statement::Bspline { surface, order, rows, cols, samples, points }
+            Statement::Bspline(Patch { surface, order, rows, cols, samples, points })
         }
-        "SURFACE" => {
+        Keyword::Surface => {
             let number = cur.surface_number(kw)?;
             let ambient = cur.color(kw, ["ambient red", "ambient green", "ambient blue"])?;
             let diffuse = cur.color(kw, ["diffuse red", "diffuse green", "diffuse blue"])?;
@@ -400,7 +424,6 @@ pub fn statement<'a>(cur: &mut Cursor<'a>, kw: &'static str, at: Pos) -> Result<
                 },
             }
         }
-        _ => return Err(ParseError::new(at, ErrorKind::UnknownKeyword(kw))),
     })
 }
 
@@ -427,7 +450,7 @@ fn check_quadrilateral(c: &[WorldPoint; 4]) -> Result<(), ErrorKind<'static>> {
     }
     let largest = v.iter().flatten().map(|x| x.unsigned_abs()).max().unwrap_or(0);
     if largest == 0 {
-        return Err(ErrorKind::Degenerate { keyword: "RECTANGLE", why: "its corners coincide" });
+        return Err(ErrorKind::Degenerate { keyword: Keyword::Rectangle.name(), why: "its corners coincide" });
     }
     let shift = (128 - largest.leading_zeros()).saturating_sub(24);
     let v = v.map(|e| e.map(|x| x >> shift));
@@ -436,7 +459,10 @@ fn check_quadrilateral(c: &[WorldPoint; 4]) -> Result<(), ErrorKind<'static>> {
     let turns: [[i128; 3]; 4] = core::array::from_fn(|i| cross(v[i], v[(i + 1) % 4]));
     let reference = turns.iter().copied().max_by_key(|c| dot(*c, *c)).unwrap_or([0; 3]);
     if reference == [0; 3] {
-        return Err(ErrorKind::Degenerate { keyword: "RECTANGLE", why: "its corners are collinear (zero area)" });
+        return Err(ErrorKind::Degenerate {
+            keyword: Keyword::Rectangle.name(),
+            why: "its corners are collinear (zero area)",
+        });
     }
     if turns.iter().any(|c| dot(*c, reference) <= 0) {
         return Err(ErrorKind::NotConvex);

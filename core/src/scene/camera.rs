@@ -27,6 +27,17 @@ pub enum CameraError {
     UpParallel,
 }
 
+impl core::fmt::Display for CameraError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            CameraError::EyeAtOrigin => "VIEWPOINT equals ORIGIN: there is no view direction",
+            CameraError::UpParallel => "UPVECTOR is zero or parallel to the view direction (ORIGIN − VIEWPOINT)",
+        })
+    }
+}
+
+impl core::error::Error for CameraError {}
+
 /// Everything the camera needs from the scene, in world units (Q32.32).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct View {

@@ -7,9 +7,11 @@
 //! - objects are numbered in file order ([`ObjectId`]); the tie rule (equal
 //!   distance: the earlier object wins) uses that order.
 //!
-//! [`Scene`] owns the storage (sized by a [`Capacities`] profile); the tracer
-//! and the accelerators read it through [`SceneView`], plain slices, so they
-//! do not carry the profile's type parameters.
+//! [`Scene`] owns the storage, arenas sized by [`SceneCapacities`] (which
+//! every [`crate::profile`] implements); the tracer and the accelerators read
+//! it through [`SceneView`], plain slices, so they do not carry the
+//! profile's type parameters. An empty [`Scene`] is all zero bits, so one in
+//! a `static` costs no flash.
 
 mod camera;
 mod normalize;
@@ -19,7 +21,7 @@ pub use camera::{Camera, CameraError, View, MAX_SAMPLES, MAX_SIDE};
 pub use normalize::{Normalization, WorldPoint, WorldValue};
 pub use surface::{Color, Surface, SurfaceEntry};
 
-use crate::capacity::{Arena, Capacities};
+use crate::capacity::{Arena, CapacityError, CapacityKind};
 use crate::math::{Vec3, Wide};
 use crate::shapes::{
     AxisAlignedBox, Rectangle, ShapeHandle, ShapeKind, ShapeRef, SmoothTriangle, Sphere, Superquadric, Triangle,
@@ -61,18 +63,36 @@ impl Default for Settings {
     }
 }
 
-/// A scene exceeded one of its profile's capacities.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct CapacityError {
-    /// What ran out ("spheres", "objects", …).
-    pub what: &'static str,
-    pub capacity: usize,
-    /// The [`Capacities`] profile.
-    pub profile: &'static str,
+/// The arenas a [`Scene`] is stored in, each a fixed-capacity [`Arena`].
+/// Every profile implements it; define one with [`crate::profile!`], which
+/// names counts, not these types.
+pub trait SceneCapacities {
+    /// The profile's name, shown in capacity errors.
+    const NAME: &'static str;
+    /// All objects, in file order.
+    type Objects: Arena<ShapeHandle>;
+    /// Spheres.
+    type Spheres: Arena<Sphere>;
+    /// Axis-aligned boxes.
+    type Boxes: Arena<AxisAlignedBox>;
+    /// Superquadrics.
+    type Superquadrics: Arena<Superquadric>;
+    /// Flat triangles.
+    type Triangles: Arena<Triangle>;
+    /// Rectangles.
+    type Rectangles: Arena<Rectangle>;
+    /// The triangles of B-spline patches.
+    type SmoothTriangles: Arena<SmoothTriangle>;
+    /// Room for one patch's control points while it is evaluated.
+    type ControlPoints: Arena<Vec3>;
+    /// Surface definitions; at most 65,535 (objects refer to them by `u16`).
+    type Surfaces: Arena<SurfaceEntry>;
+    /// Point lights.
+    type Lights: Arena<Light>;
 }
 
 /// Scene storage sized by the profile `C`.
-pub struct Scene<C: Capacities> {
+pub struct Scene<C: SceneCapacities> {
     objects: C::Objects,
     spheres: C::Spheres,
     boxes: C::Boxes,
@@ -88,25 +108,28 @@ pub struct Scene<C: Capacities> {
     pub normalization: Normalization,
 }
 
-impl<C: Capacities> Default for Scene<C> {
+impl<C: SceneCapacities> Default for Scene<C> {
     fn default() -> Self {
         Self::new()
     }
 }
 
+/// Appends `item` to `arena`, or names the capacity that ran out.
 fn push<T, A: Arena<T>>(
     arena: &mut A,
     item: T,
-    what: &'static str,
+    kind: CapacityKind,
     profile: &'static str,
 ) -> Result<usize, CapacityError> {
     let index = arena.as_slice().len();
-    arena.push(item).map_err(|_| CapacityError { what, capacity: A::CAPACITY, profile })?;
+    arena.push(item).map_err(|_| CapacityError { kind, capacity: A::CAPACITY, needed: None, profile })?;
     Ok(index)
 }
 
-impl<C: Capacities> Scene<C> {
-    /// An empty scene (a constant expression: it can initialise a `static`).
+impl<C: SceneCapacities> Scene<C> {
+    /// An empty scene, not loaded yet ([`crate::parse::parse`] fills it; its
+    /// settings are all zero until then). A constant of all-zero bits: in a
+    /// `static` it lands in `.bss`, costing no flash and no copy.
     pub const fn new() -> Self {
         Scene {
             objects: C::Objects::EMPTY,
@@ -119,8 +142,8 @@ impl<C: Capacities> Scene<C> {
             control_points: C::ControlPoints::EMPTY,
             surfaces: C::Surfaces::EMPTY,
             lights: C::Lights::EMPTY,
-            settings: DEFAULT_SETTINGS,
-            normalization: Normalization::IDENTITY,
+            settings: UNLOADED_SETTINGS,
+            normalization: Normalization::UNLOADED,
         }
     }
 
@@ -156,135 +179,108 @@ impl<C: Capacities> Scene<C> {
         }
     }
 
-    /// How many objects of `kind` the profile holds.
-    pub fn capacity_of(kind: ShapeKind) -> usize {
-        match kind {
+    /// How many objects of `kind` the profile holds (at most what a
+    /// [`ShapeHandle`] addresses).
+    pub(crate) fn capacity_of(kind: ShapeKind) -> usize {
+        let capacity = match kind {
             ShapeKind::Sphere => C::Spheres::CAPACITY,
             ShapeKind::Box => C::Boxes::CAPACITY,
             ShapeKind::Superquadric => C::Superquadrics::CAPACITY,
             ShapeKind::Triangle => C::Triangles::CAPACITY,
             ShapeKind::Rectangle => C::Rectangles::CAPACITY,
             ShapeKind::SmoothTriangle => C::SmoothTriangles::CAPACITY,
-        }
-    }
-
-    pub fn object_capacity() -> usize {
-        C::Objects::CAPACITY.min(ShapeHandle::MAX_INDEX)
-    }
-
-    pub fn surface_capacity() -> usize {
-        C::Surfaces::CAPACITY.min(u16::MAX as usize)
-    }
-
-    pub fn light_capacity() -> usize {
-        C::Lights::CAPACITY
-    }
-
-    fn register(&mut self, kind: ShapeKind, index: usize) -> Result<(), CapacityError> {
-        if self.objects.as_slice().len() >= Self::object_capacity() {
-            return Err(CapacityError { what: "objects", capacity: Self::object_capacity(), profile: C::NAME });
-        }
-        push(&mut self.objects, ShapeHandle::new(kind, index), "objects", C::NAME).map(|_| ())
-    }
-
-    /// Checks that one more object of `kind` fits, before it is built.
-    pub fn check_room(&self, kind: ShapeKind) -> Result<(), CapacityError> {
-        let (what, len) = match kind {
-            ShapeKind::Sphere => ("spheres", self.spheres.as_slice().len()),
-            ShapeKind::Box => ("boxes", self.boxes.as_slice().len()),
-            ShapeKind::Superquadric => ("superquadrics", self.superquadrics.as_slice().len()),
-            ShapeKind::Triangle => ("triangles", self.triangles.as_slice().len()),
-            ShapeKind::Rectangle => ("rectangles", self.rectangles.as_slice().len()),
-            ShapeKind::SmoothTriangle => ("B-spline triangles", self.smooth_triangles.as_slice().len()),
         };
-        let capacity = Self::capacity_of(kind).min(ShapeHandle::MAX_INDEX);
-        if len >= capacity {
-            return Err(CapacityError { what, capacity, profile: C::NAME });
+        capacity.min(ShapeHandle::MAX_INDEX)
+    }
+
+    fn len_of(&self, kind: ShapeKind) -> usize {
+        match kind {
+            ShapeKind::Sphere => self.spheres.as_slice().len(),
+            ShapeKind::Box => self.boxes.as_slice().len(),
+            ShapeKind::Superquadric => self.superquadrics.as_slice().len(),
+            ShapeKind::Triangle => self.triangles.as_slice().len(),
+            ShapeKind::Rectangle => self.rectangles.as_slice().len(),
+            ShapeKind::SmoothTriangle => self.smooth_triangles.as_slice().len(),
         }
-        if self.objects.as_slice().len() >= Self::object_capacity() {
-            return Err(CapacityError { what: "objects", capacity: Self::object_capacity(), profile: C::NAME });
-        }
-        Ok(())
     }
 
-    pub fn push_sphere(&mut self, s: Sphere) -> Result<(), CapacityError> {
-        self.check_room(ShapeKind::Sphere)?;
-        let i = push(&mut self.spheres, s, "spheres", C::NAME)?;
-        self.register(ShapeKind::Sphere, i)
+    pub(crate) fn full(kind: CapacityKind, capacity: usize) -> CapacityError {
+        CapacityError { kind, capacity, needed: None, profile: C::NAME }
     }
 
-    pub fn push_box(&mut self, s: AxisAlignedBox) -> Result<(), CapacityError> {
-        self.check_room(ShapeKind::Box)?;
-        let i = push(&mut self.boxes, s, "boxes", C::NAME)?;
-        self.register(ShapeKind::Box, i)
-    }
-
-    pub fn push_superquadric(&mut self, s: Superquadric) -> Result<(), CapacityError> {
-        self.check_room(ShapeKind::Superquadric)?;
-        let i = push(&mut self.superquadrics, s, "superquadrics", C::NAME)?;
-        self.register(ShapeKind::Superquadric, i)
-    }
-
-    pub fn push_triangle(&mut self, s: Triangle) -> Result<(), CapacityError> {
-        self.check_room(ShapeKind::Triangle)?;
-        let i = push(&mut self.triangles, s, "triangles", C::NAME)?;
-        self.register(ShapeKind::Triangle, i)
-    }
-
-    pub fn push_rectangle(&mut self, s: Rectangle) -> Result<(), CapacityError> {
-        self.check_room(ShapeKind::Rectangle)?;
-        let i = push(&mut self.rectangles, s, "rectangles", C::NAME)?;
-        self.register(ShapeKind::Rectangle, i)
-    }
-
-    pub fn push_smooth_triangle(&mut self, s: SmoothTriangle) -> Result<(), CapacityError> {
-        self.check_room(ShapeKind::SmoothTriangle)?;
-        let i = push(&mut self.smooth_triangles, s, "B-spline triangles", C::NAME)?;
-        self.register(ShapeKind::SmoothTriangle, i)
+    /// The error for one surface too many.
+    pub(crate) fn surfaces_full() -> CapacityError {
+        Self::full(CapacityKind::Surfaces, C::Surfaces::CAPACITY.min(u16::MAX as usize))
     }
 
     /// Checks that `count` more objects of `kind` fit, before any is built
     /// (a B-spline patch's triangles are checked as a whole).
-    pub fn check_room_for(&self, kind: ShapeKind, count: usize) -> Result<(), CapacityError> {
-        if count == 0 {
-            return Ok(());
+    pub(crate) fn check_room(&self, kind: ShapeKind, count: usize) -> Result<(), CapacityError> {
+        let capacity = Self::capacity_of(kind);
+        if self.len_of(kind).saturating_add(count) > capacity {
+            return Err(Self::full(kind.capacity(), capacity));
         }
-        let (what, len) = match kind {
-            ShapeKind::SmoothTriangle => ("B-spline triangles", self.smooth_triangles.as_slice().len()),
-            _ => return self.check_room(kind),
-        };
-        let capacity = Self::capacity_of(kind).min(ShapeHandle::MAX_INDEX);
-        if len.saturating_add(count) > capacity {
-            return Err(CapacityError { what, capacity, profile: C::NAME });
-        }
-        if self.objects.as_slice().len().saturating_add(count) > Self::object_capacity() {
-            return Err(CapacityError { what: "objects", capacity: Self::object_capacity(), profile: C::NAME });
+        let objects = C::Objects::CAPACITY.min(ShapeHandle::MAX_INDEX);
+        if self.objects.as_slice().len().saturating_add(count) > objects {
+            return Err(Self::full(CapacityKind::Objects, objects));
         }
         Ok(())
     }
 
-    /// Replaces the control-point scratch with `points`; `false` (and
-    /// nothing kept) if they do not fit.
-    pub fn set_control_points(&mut self, points: impl Iterator<Item = Vec3>) -> bool {
+    /// Stores one object of `kind` built by `make` from its index in its
+    /// arena, after checking the room once.
+    fn push_shape<T, A: Arena<T>>(
+        &mut self,
+        kind: ShapeKind,
+        item: T,
+        arena: impl FnOnce(&mut Self) -> &mut A,
+    ) -> Result<(), CapacityError> {
+        self.check_room(kind, 1)?;
+        let index = push(arena(self), item, kind.capacity(), C::NAME)?;
+        push(&mut self.objects, ShapeHandle::new(kind, index), CapacityKind::Objects, C::NAME).map(|_| ())
+    }
+
+    pub(crate) fn push_sphere(&mut self, s: Sphere) -> Result<(), CapacityError> {
+        self.push_shape(ShapeKind::Sphere, s, |scene| &mut scene.spheres)
+    }
+
+    pub(crate) fn push_box(&mut self, s: AxisAlignedBox) -> Result<(), CapacityError> {
+        self.push_shape(ShapeKind::Box, s, |scene| &mut scene.boxes)
+    }
+
+    pub(crate) fn push_superquadric(&mut self, s: Superquadric) -> Result<(), CapacityError> {
+        self.push_shape(ShapeKind::Superquadric, s, |scene| &mut scene.superquadrics)
+    }
+
+    pub(crate) fn push_triangle(&mut self, s: Triangle) -> Result<(), CapacityError> {
+        self.push_shape(ShapeKind::Triangle, s, |scene| &mut scene.triangles)
+    }
+
+    pub(crate) fn push_rectangle(&mut self, s: Rectangle) -> Result<(), CapacityError> {
+        self.push_shape(ShapeKind::Rectangle, s, |scene| &mut scene.rectangles)
+    }
+
+    fn push_smooth_triangle(&mut self, s: SmoothTriangle) -> Result<(), CapacityError> {
+        self.push_shape(ShapeKind::SmoothTriangle, s, |scene| &mut scene.smooth_triangles)
+    }
+
+    /// Replaces the control-point scratch with `points`, or names the
+    /// capacity (nothing kept) if they do not fit.
+    pub(crate) fn set_control_points(&mut self, points: impl Iterator<Item = Vec3>) -> Result<(), CapacityError> {
         self.control_points.clear();
         for p in points {
             if self.control_points.push(p).is_err() {
                 self.control_points.clear();
-                return false;
+                return Err(Self::full(CapacityKind::ControlPoints, C::ControlPoints::CAPACITY));
             }
         }
-        true
-    }
-
-    /// How many control points one patch may have.
-    pub fn control_point_capacity() -> usize {
-        C::ControlPoints::CAPACITY
+        Ok(())
     }
 
     /// Evaluates the patch whose control points were set, pushing its
-    /// triangles (room checked beforehand with [`Scene::check_room_for`]);
+    /// triangles (room checked beforehand with [`Scene::check_room`]);
     /// returns how many were made.
-    pub fn push_bspline(&mut self, order: u32, rows: u32, cols: u32, samples: [u32; 2], surface: u16) -> usize {
+    pub(crate) fn push_bspline(&mut self, order: u32, rows: u32, cols: u32, samples: [u32; 2], surface: u16) -> usize {
         let points = core::mem::replace(&mut self.control_points, C::ControlPoints::EMPTY);
         let mut made = 0;
         let first = self.objects.as_slice().len() as u32;
@@ -300,37 +296,37 @@ impl<C: Capacities> Scene<C> {
         made
     }
 
-    pub fn push_light(&mut self, l: Light) -> Result<(), CapacityError> {
-        push(&mut self.lights, l, "lights", C::NAME).map(|_| ())
+    pub(crate) fn push_light(&mut self, l: Light) -> Result<(), CapacityError> {
+        push(&mut self.lights, l, CapacityKind::Lights, C::NAME).map(|_| ())
     }
 
-    pub fn push_surface(&mut self, s: SurfaceEntry) -> Result<(), CapacityError> {
-        if self.surfaces.as_slice().len() >= Self::surface_capacity() {
-            return Err(CapacityError { what: "surfaces", capacity: Self::surface_capacity(), profile: C::NAME });
+    /// Stores a surface; at most 65,535 whatever the profile (objects refer
+    /// to them by `u16`).
+    pub(crate) fn push_surface(&mut self, s: SurfaceEntry) -> Result<(), CapacityError> {
+        if self.surfaces.as_slice().len() >= C::Surfaces::CAPACITY.min(u16::MAX as usize) {
+            return Err(Self::surfaces_full());
         }
-        push(&mut self.surfaces, s, "surfaces", C::NAME).map(|_| ())
+        push(&mut self.surfaces, s, CapacityKind::Surfaces, C::NAME).map(|_| ())
     }
 
     /// Sorts the surfaces by number (first definition first), so that
     /// [`SceneView::surface_index`] can binary-search them.
-    pub fn sort_surfaces(&mut self) {
+    pub(crate) fn sort_surfaces(&mut self) {
         self.surfaces.as_mut_slice().sort_unstable_by_key(|s| (s.number, s.line, s.column));
     }
-
-    /// Drops the objects and lights but keeps the surfaces (the parser's
-    /// second pass rebuilds them in normalised space).
-    pub fn clear_geometry(&mut self) {
-        self.objects.clear();
-        self.spheres.clear();
-        self.boxes.clear();
-        self.superquadrics.clear();
-        self.triangles.clear();
-        self.rectangles.clear();
-        self.smooth_triangles.clear();
-        self.control_points.clear();
-        self.lights.clear();
-    }
 }
+
+/// What [`Scene::new`] holds until a scene is loaded: zero bits, so that
+/// an empty scene in a `static` needs no initial data in flash.
+const UNLOADED_SETTINGS: Settings = Settings {
+    view: View { eye: [0; 3], look_at: [0; 3], up: [0; 3], viewport: None },
+    raster: [0; 2],
+    rdepth: 0,
+    background: Color::BLACK,
+    gamma: Wide::ZERO,
+    attenuation: Wide::ZERO,
+    samples: 0,
+};
 
 const DEFAULT_SETTINGS: Settings = Settings {
     view: View { eye: [0, 0, 10 << 32], look_at: [0; 3], up: [0, 1 << 32, 0], viewport: None },
@@ -414,8 +410,17 @@ impl<'a> SceneView<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::capacity::Board16K;
     use crate::math::Scalar;
+    use crate::profile::Board16K;
+
+    #[test]
+    fn an_empty_scene_is_zero_until_cleared() {
+        let mut scene: Scene<Board16K> = Scene::new();
+        assert_eq!(scene.settings.raster, [0, 0]);
+        scene.clear();
+        assert_eq!(scene.settings, Settings::default());
+        assert_eq!(scene.normalization, Normalization::IDENTITY);
+    }
 
     #[test]
     fn default_settings_match_the_format() {
@@ -433,7 +438,7 @@ mod tests {
             scene.push_box(b).unwrap();
         }
         let e = scene.push_box(b).unwrap_err();
-        assert_eq!((e.what, e.capacity, e.profile), ("boxes", 2, "Board16K"));
+        assert_eq!((e.kind, e.capacity, e.profile), (CapacityKind::Boxes, 2, "Board16K"));
         assert_eq!(scene.view().object_count(), 2);
         let s = Sphere::new(Vec3::ZERO, Scalar::ONE, 0);
         scene.push_sphere(s).unwrap();

@@ -45,6 +45,8 @@ fn round_shift(v: i64, s: u32) -> i64 {
 
 impl Normalization {
     pub const IDENTITY: Normalization = Normalization { center: [0; 3], shift: 16 };
+    /// An empty scene's, before loading: zero bits (see [`super::Scene::new`]).
+    pub(crate) const UNLOADED: Normalization = Normalization { center: [0; 3], shift: 0 };
 
     /// The normalisation that fits the world box `[min, max]`.
     pub fn fit(min: WorldPoint, max: WorldPoint) -> Normalization {

@@ -29,6 +29,7 @@ pub use sphere::Sphere;
 pub use superquadric::Superquadric;
 pub use triangle::Triangle;
 
+use crate::capacity::CapacityKind;
 use crate::math::{Dir, Scalar, Vec3};
 
 /// A ray `origin + t·dir`, `t > 0`.
@@ -99,24 +100,15 @@ pub enum ShapeKind {
 }
 
 impl ShapeKind {
-    pub const ALL: [ShapeKind; 6] = [
-        ShapeKind::Sphere,
-        ShapeKind::Box,
-        ShapeKind::Superquadric,
-        ShapeKind::Triangle,
-        ShapeKind::Rectangle,
-        ShapeKind::SmoothTriangle,
-    ];
-
-    /// The scene-file keyword.
-    pub const fn keyword(self) -> &'static str {
+    /// The capacity objects of this kind count against.
+    pub const fn capacity(self) -> CapacityKind {
         match self {
-            ShapeKind::Sphere => "SPHERE",
-            ShapeKind::Box => "BOX",
-            ShapeKind::Superquadric => "SUPERQUADRIC",
-            ShapeKind::Triangle => "TRIANGLE",
-            ShapeKind::Rectangle => "RECTANGLE",
-            ShapeKind::SmoothTriangle => "BSPLINE",
+            ShapeKind::Sphere => CapacityKind::Spheres,
+            ShapeKind::Box => CapacityKind::Boxes,
+            ShapeKind::Superquadric => CapacityKind::Superquadrics,
+            ShapeKind::Triangle => CapacityKind::Triangles,
+            ShapeKind::Rectangle => CapacityKind::Rectangles,
+            ShapeKind::SmoothTriangle => CapacityKind::BsplineTriangles,
         }
     }
 

@@ -250,7 +250,7 @@ fn criterion(dir: &Path) {
     for path in scene_files(dir) {
         let name = path.file_stem().unwrap_or_default().to_string_lossy().into_owned();
         let scene = load(&path);
-        if scene.view().object_count() <= host_sim::NAIVE_UP_TO {
+        if scene.view().object_count() <= AccelMode::AUTO_NAIVE_UP_TO {
             continue;
         }
         print!("| {name} |");

@@ -20,7 +20,8 @@
 //! with the true ray.
 
 use super::Octree;
-use crate::capacity::{Arena, Capacities};
+use super::OctreeCapacities;
+use crate::capacity::Arena;
 use crate::math::{mul_u64_shr24_clamped, reciprocal_q62};
 use crate::shapes::Ray;
 
@@ -110,7 +111,7 @@ impl<const FRAMES: usize> DdaWalk<FRAMES> {
     }
 
     /// Starts a walk along `ray` (in place: the walk's stack is not small).
-    pub fn start<C: Capacities>(&mut self, tree: &Octree<C, FRAMES>, ray: &Ray) {
+    pub fn start<C: OctreeCapacities>(&mut self, tree: &Octree<C, FRAMES>, ray: &Ray) {
         self.mirror = 0;
         self.saturated = 0;
         self.stack.clear();
@@ -220,7 +221,7 @@ impl<const FRAMES: usize> DdaWalk<FRAMES> {
     /// Boxes entered after `stop` are skipped whole, with every box behind
     /// them in the same parent (children are visited in ray order).
     #[inline]
-    pub fn next_leaf<C: Capacities>(&mut self, tree: &Octree<C, FRAMES>, stop: i64) -> Option<(u32, i64)> {
+    pub fn next_leaf<C: OctreeCapacities>(&mut self, tree: &Octree<C, FRAMES>, stop: i64) -> Option<(u32, i64)> {
         if let Some(leaf) = self.root_leaf.take() {
             return Some(leaf);
         }

@@ -40,7 +40,7 @@ mod overlap;
 pub use overlap::{overlaps, Cell};
 
 use super::{Accelerator, Hit, Mailbox, RayStart};
-use crate::capacity::{Arena, Capacities, Index};
+use crate::capacity::{Arena, CapacityKind, Counts};
 use crate::math::Scalar;
 use crate::scene::{ObjectId, SceneView};
 use crate::shapes::{Aabb, Ratio, Ray};
@@ -75,7 +75,7 @@ fn to_q24(t: Scalar) -> i64 {
 /// returns the parameter beyond which nothing matters any more (the nearest
 /// hit so far, or the shadow ray's end), or `None` to stop.
 #[inline]
-fn walk_leaves<C: Capacities, const FRAMES: usize>(
+fn walk_leaves<C: OctreeCapacities, const FRAMES: usize>(
     tree: &Octree<C, FRAMES>,
     ray: &Ray,
     mailbox: &mut Mailbox<'_>,
@@ -161,10 +161,11 @@ pub struct HashEntry<I> {
 /// How to walk the octree.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Traversal {
+    /// Integer 3DDDA over the leaves (first: an empty octree's bits are
+    /// zero).
+    Dda,
     /// The thesis's method: Minlen steps and hash-table point location.
     Named,
-    /// Integer 3DDDA over the leaves.
-    Dda,
 }
 
 /// The subdivision criterion and the walk.
@@ -178,9 +179,14 @@ pub struct OctreeConfig {
     pub traversal: Traversal,
 }
 
+impl OctreeConfig {
+    /// At most 4 objects a leaf, 12 levels, the 3DDDA walk.
+    pub const DEFAULT: OctreeConfig = OctreeConfig { max_objects: 4, max_depth: 12, traversal: Traversal::Dda };
+}
+
 impl Default for OctreeConfig {
     fn default() -> Self {
-        OctreeConfig { max_objects: 4, max_depth: 12, traversal: Traversal::Dda }
+        OctreeConfig::DEFAULT
     }
 }
 
@@ -190,27 +196,89 @@ pub struct BuildReport {
     pub nodes: usize,
     pub leaves: usize,
     pub references: usize,
-    /// Peak object references while building (the arena must hold these).
+    /// Object references the build needed at its peak: an arena of exactly
+    /// this many builds the same tree.
     pub peak_references: usize,
     pub hash_entries: usize,
     pub depth: u32,
     /// Boxes left unsplit because an arena was full (0 when all went well).
     pub unsplit: usize,
     /// The capacity that ran out first, if any.
-    pub exhausted: Option<&'static str>,
+    pub exhausted: Option<CapacityKind>,
     /// Bytes of the structure (nodes, references, hash table).
     pub bytes: usize,
+}
+
+/// The integer type of the octree's indices: `u32` on hosts, `u16` on small
+/// boards (half the RAM for the octree). Its largest two values are
+/// reserved as markers.
+pub trait Index: Copy + Eq + core::fmt::Debug + 'static {
+    /// The largest value.
+    const MAX: u32;
+    /// `v` as an index; `v` must not exceed [`Index::MAX`].
+    fn new(v: u32) -> Self;
+    /// The index as a `u32`.
+    fn get(self) -> u32;
+}
+
+impl Index for u16 {
+    const MAX: u32 = u16::MAX as u32;
+    #[inline]
+    fn new(v: u32) -> u16 {
+        v as u16
+    }
+    #[inline]
+    fn get(self) -> u32 {
+        self as u32
+    }
+}
+
+impl Index for u32 {
+    const MAX: u32 = u32::MAX;
+    #[inline]
+    fn new(v: u32) -> u32 {
+        v
+    }
+    #[inline]
+    fn get(self) -> u32 {
+        self
+    }
+}
+
+/// The arenas an [`Octree`] is stored in. Every profile implements it;
+/// define one with [`crate::profile!`], which names counts, not these types.
+pub trait OctreeCapacities {
+    /// The index type (bounds the arenas and the objects it files).
+    type Index: Index;
+    /// Boxes (8 per subdivision, plus the root).
+    type Nodes: Arena<OctreeNode<Self::Index>>;
+    /// Object references of the leaves (an object in several leaves counts
+    /// once per leaf), and working room while building.
+    type References: Arena<Self::Index>;
+    /// Hash-table entries: one per subdivided box (the thesis's structure
+    /// holding the addresses of a box's eight children).
+    type HashEntries: Arena<HashEntry<Self::Index>>;
+    /// Hash-table buckets; the table size is this arena's capacity.
+    type HashBuckets: Arena<Self::Index>;
+}
+
+impl BuildReport {
+    /// The octree counts of a profile that builds this very tree (see
+    /// [`crate::parse::count`] for the scene's).
+    pub fn counts(&self) -> Counts {
+        Counts { octree_boxes: self.nodes, octree_references: self.peak_references, ..Counts::ZERO }
+    }
 }
 
 /// The octree over one scene, in arenas sized by the profile `C`. `FRAMES`
 /// bounds the depth of a walk (the tree is at most `FRAMES − 1` deep); the
 /// 3DDDA keeps one frame per level, about 100 bytes of stack each, which a
 /// 16 KiB board wants to keep small.
-pub struct Octree<C: Capacities, const FRAMES: usize = { MAX_DEPTH as usize + 1 }> {
-    nodes: C::OctreeNodes,
-    refs: C::OctreeRefs,
-    entries: C::OctreeEntries,
-    buckets: C::OctreeBuckets,
+pub struct Octree<C: OctreeCapacities, const FRAMES: usize = { MAX_DEPTH as usize + 1 }> {
+    nodes: C::Nodes,
+    refs: C::References,
+    entries: C::HashEntries,
+    buckets: C::HashBuckets,
     /// The root box: `[root_min, root_min + 2^root_log2]` per axis.
     root_min: [i64; 3],
     /// The objects' own upper bounds, widened by the filing margin (their
@@ -223,7 +291,7 @@ pub struct Octree<C: Capacities, const FRAMES: usize = { MAX_DEPTH as usize + 1 
     report: BuildReport,
 }
 
-impl<C: Capacities, const FRAMES: usize> Default for Octree<C, FRAMES> {
+impl<C: OctreeCapacities, const FRAMES: usize> Default for Octree<C, FRAMES> {
     fn default() -> Self {
         Self::new()
     }
@@ -250,19 +318,21 @@ struct Split {
 /// filed down to the maximum depth around that point.
 const MAX_STALE_SPLITS: u32 = 2;
 
-impl<C: Capacities, const FRAMES: usize> Octree<C, FRAMES> {
+impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
     /// An empty octree (a constant: it can live in a `static`).
     pub const fn new() -> Self {
         Octree {
-            nodes: C::OctreeNodes::EMPTY,
-            refs: C::OctreeRefs::EMPTY,
-            entries: C::OctreeEntries::EMPTY,
-            buckets: C::OctreeBuckets::EMPTY,
+            nodes: C::Nodes::EMPTY,
+            refs: C::References::EMPTY,
+            entries: C::HashEntries::EMPTY,
+            buckets: C::HashBuckets::EMPTY,
             root_min: [0; 3],
             bounds_max: [0; 3],
             root_log2: 0,
             min_log2: 0,
             traversal: Traversal::Dda,
+            // Zero bits, field by field: an empty octree in a `static`
+            // lands in `.bss`.
             report: BuildReport {
                 nodes: 0,
                 leaves: 0,
@@ -326,7 +396,11 @@ impl<C: Capacities, const FRAMES: usize> Octree<C, FRAMES> {
             self.refs.clear();
             let _ = self.nodes.push(OctreeNode::leaf(0, C::Index::MAX - 1));
             self.report.unsplit = 1;
-            self.report.exhausted = Some(if self.nodes.as_slice().is_empty() { "nodes" } else { "references" });
+            self.report.exhausted = Some(if self.nodes.as_slice().is_empty() {
+                CapacityKind::OctreeBoxes
+            } else {
+                CapacityKind::OctreeReferences
+            });
             self.finish(0);
             return self.report;
         }
@@ -370,12 +444,14 @@ impl<C: Capacities, const FRAMES: usize> Octree<C, FRAMES> {
         // The index type bounds every arena too (its top two values mark).
         let limit = |cap: usize| cap.min(C::Index::MAX as usize - 2);
         let room = |len: usize, cap: usize, need: usize| len + need <= limit(cap);
-        let exhausted = if !room(self.nodes.as_slice().len(), C::OctreeNodes::CAPACITY, 8) {
-            Some("nodes")
-        } else if !room(self.entries.as_slice().len(), C::OctreeEntries::CAPACITY, 1) {
-            Some("hash entries")
-        } else if !room(self.refs.as_slice().len() + reserved, C::OctreeRefs::CAPACITY, need) {
-            Some("references")
+        // Hash entries are sized from the boxes (one per eight), so they run
+        // out as the boxes do.
+        let exhausted = if !room(self.nodes.as_slice().len(), C::Nodes::CAPACITY, 8)
+            || !room(self.entries.as_slice().len(), C::HashEntries::CAPACITY, 1)
+        {
+            Some(CapacityKind::OctreeBoxes)
+        } else if !room(self.refs.as_slice().len() + reserved, C::References::CAPACITY, need) {
+            Some(CapacityKind::OctreeReferences)
         } else {
             None
         };
@@ -386,6 +462,10 @@ impl<C: Capacities, const FRAMES: usize> Octree<C, FRAMES> {
             self.report.exhausted.get_or_insert(what);
             return;
         }
+        // The room this split asked for: an arena of the peak passes every
+        // check a larger one passes, so it builds the very same tree.
+        let asked = self.refs.as_slice().len() + reserved + need;
+        self.report.peak_references = self.report.peak_references.max(asked);
         let children = self.nodes.as_slice().len();
         for _ in 0..8 {
             let _ = self.nodes.push(leaf);
@@ -485,10 +565,26 @@ impl<C: Capacities, const FRAMES: usize> Octree<C, FRAMES> {
     }
 }
 
+/// An [`Octree`] whatever its walk depth: what a profile's octree is.
+pub trait OctreeStore: Accelerator {
+    /// An empty octree.
+    const EMPTY: Self;
+    /// Builds the octree over `scene`'s objects (see [`Octree::build`]).
+    fn build(&mut self, scene: &SceneView<'_>, config: &OctreeConfig) -> BuildReport;
+}
+
+impl<C: OctreeCapacities, const FRAMES: usize> OctreeStore for Octree<C, FRAMES> {
+    const EMPTY: Self = Octree::new();
+
+    fn build(&mut self, scene: &SceneView<'_>, config: &OctreeConfig) -> BuildReport {
+        Octree::build(self, scene, config)
+    }
+}
+
 // The queries are not inlined: each walk (up to FRAMES frames of ~100 bytes)
 // then lives in its own stack frame for the query's duration only, instead of
 // two of them sitting in every caller's frame — it matters on a 16 KiB board.
-impl<C: Capacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES> {
+impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES> {
     #[inline(never)]
     fn nearest(
         &self,
@@ -562,9 +658,9 @@ impl<C: Capacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES> {
 mod tests {
     extern crate std;
     use super::*;
-    use crate::capacity::Board64K;
     use crate::math::Dir;
     use crate::parse::parse;
+    use crate::profile::Board64K;
     use crate::scene::Scene;
     use std::boxed::Box;
     use std::format;
@@ -582,6 +678,34 @@ mod tests {
     /// A row of spheres along x.
     fn row(n: usize) -> String {
         (0..n).map(|i| format!("SPHERE 1 0.4 {} 0 0\n", i as i32 - n as i32 / 2)).collect()
+    }
+
+    crate::profile! {
+        /// Exactly what the chessboard below needs, as its report says.
+        struct Exact { spheres: 1, rectangles: 64, surfaces: 1, octree_boxes: 865, octree_references: 1288 }
+    }
+
+    #[test]
+    fn a_profile_sized_from_the_report_builds_the_same_tree() {
+        let squares: String = (0..64)
+            .map(|i| {
+                let (x, z) = (i % 8 - 4, i / 8 - 4);
+                format!("RECTANGLE 1 {x} 0 {z} {} 0 {z} {} 0 {} {x} 0 {}\n", x + 1, x + 1, z + 1, z + 1)
+            })
+            .collect();
+        let text = format!("{SURF}{squares}SPHERE 1 1 0 1 0\n");
+        let config = OctreeConfig::DEFAULT;
+        let roomy = scene(&text[SURF.len()..]);
+        let mut tree: Box<Octree<Board64K>> = Box::default();
+        let report = tree.build(&roomy.view(), &config);
+        assert_eq!(report.unsplit, 0);
+        assert_eq!(report.counts(), <Exact as crate::profile::Profile>::COUNTS.octree_counts(), "update Exact");
+        let mut exact: Box<Scene<Exact>> = Box::default();
+        parse(&text, &mut exact, &mut |e| panic!("{e}")).unwrap();
+        let mut small: Box<Octree<Exact>> = Box::default();
+        // The same tree; only the hash table's size (bytes) differs.
+        assert_eq!(BuildReport { bytes: 0, ..small.build(&exact.view(), &config) }, BuildReport { bytes: 0, ..report });
+        assert_eq!(small.nodes.as_slice(), tree.nodes.as_slice());
     }
 
     #[test]
@@ -657,7 +781,7 @@ mod tests {
 
     #[test]
     fn running_out_of_room_leaves_boxes_unsplit() {
-        use crate::capacity::Board16K;
+        use crate::profile::Board16K;
         let mut s: Box<Scene<Board16K>> = Box::default();
         let text = format!("{SURF}{}", row(60));
         parse(&text, &mut s, &mut |e| panic!("{e}")).unwrap();

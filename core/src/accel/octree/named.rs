@@ -11,7 +11,8 @@
 //! the far face of a smallest neighbour, which exact arithmetic then skips.)
 
 use super::Octree;
-use crate::capacity::{Arena, Capacities};
+use super::OctreeCapacities;
+use crate::capacity::Arena;
 use crate::shapes::axis_aligned_box::slab_span_wide;
 use crate::shapes::{Ratio, Ray};
 
@@ -39,7 +40,7 @@ pub(super) struct NamedWalk {
 }
 
 impl NamedWalk {
-    pub fn new<C: Capacities, const F: usize>(tree: &Octree<C, F>, ray: &Ray) -> NamedWalk {
+    pub fn new<C: OctreeCapacities, const F: usize>(tree: &Octree<C, F>, ray: &Ray) -> NamedWalk {
         let mut walk = NamedWalk { o: ray.origin.wide(), d: ray.dir.wide(), current: None };
         if tree.nodes.as_slice().is_empty() {
             return walk;
@@ -60,7 +61,7 @@ impl NamedWalk {
     }
 
     /// The next leaf and the parameter at which the ray leaves it.
-    pub fn next_leaf<C: Capacities, const F: usize>(&mut self, tree: &Octree<C, F>) -> Option<(u32, Ratio)> {
+    pub fn next_leaf<C: OctreeCapacities, const F: usize>(&mut self, tree: &Octree<C, F>) -> Option<(u32, Ratio)> {
         let leaf = self.current.take()?;
         let size = 1i64 << leaf.log2;
         // The faces the ray leaves through, and when: tmax of the thesis.
@@ -117,7 +118,12 @@ impl NamedWalk {
     }
 
     /// The leaf holding `p`, from the root, by name through the hash table.
-    fn locate<C: Capacities, const F: usize>(&self, tree: &Octree<C, F>, p: Point, follow_ray: bool) -> Option<Leaf> {
+    fn locate<C: OctreeCapacities, const F: usize>(
+        &self,
+        tree: &Octree<C, F>,
+        p: Point,
+        follow_ray: bool,
+    ) -> Option<Leaf> {
         let nodes = tree.nodes.as_slice();
         let (mut node, mut name, mut lo, mut log2) = (0u32, 1u64, tree.root_min, tree.root_log2);
         loop {

@@ -1,0 +1,233 @@
+//! Capacity profiles: how many of each thing one build holds, named as
+//! counts. A profile sizes a [`Scene`](crate::scene::Scene), an
+//! [`Octree`](crate::accel::Octree) and a mailbox, all in fixed arenas, so
+//! the linker checks the RAM of a board.
+//!
+//! Define one for your scene with [`profile!`](crate::profile!); what is
+//! not named is 0, and `objects` defaults to the sum of the shapes:
+//!
+//! ```
+//! octrace_core::profile! {
+//!     /// Two spheres on a checkerboard of 64 rectangles.
+//!     pub struct Chessboard {
+//!         spheres: 2, rectangles: 64, surfaces: 3, lights: 2,
+//!         octree_boxes: 512, octree_references: 1024,
+//!     }
+//!     octree: { max_objects: 4, max_depth: 6 }
+//! }
+//! use octrace_core::profile::Profile;
+//! assert_eq!(Chessboard::COUNTS.objects, 66);
+//! ```
+//!
+//! [`parse::count`](crate::parse::count) tells what a scene needs; a scene
+//! that needs more than its profile holds is a
+//! [`CapacityError`](crate::capacity::CapacityError) naming the count.
+//!
+//! Invariants: a profile's arena types are exactly its [`Profile::COUNTS`];
+//! its octree walks at most `OCTREE.max_depth + 1` frames deep.
+
+use crate::accel::{OctreeCapacities, OctreeConfig, OctreeStore};
+use crate::capacity::{Arena, Counts};
+use crate::scene::SceneCapacities;
+
+/// Everything one build holds: a scene's arenas, an octree's, and a mailbox.
+/// Implement it with [`profile!`](crate::profile!).
+pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
+    /// What the profile holds.
+    const COUNTS: Counts;
+    /// How the octree is built (its depth also bounds the walk's stack).
+    const OCTREE: OctreeConfig;
+    /// The octree, with a walk as deep as [`Profile::OCTREE`] allows.
+    type Octree: OctreeStore;
+    /// One bit per object: an object filed in several octree boxes is then
+    /// tested once per ray.
+    type MailboxWords: Arena<u32>;
+}
+
+/// Defines a [`Profile`] from counts: the fields of
+/// [`Counts`](crate::capacity::Counts) (what is not named is 0; `objects`
+/// defaults to the sum of the shapes), then optionally the octree's
+/// [`OctreeConfig`](crate::accel::OctreeConfig) fields (default: 4 objects a
+/// leaf, 12 levels, 3DDDA). The arenas are `heapless::Vec`s with 16-bit
+/// octree indices (a compile-time check keeps the octree counts within
+/// them); the crate re-exports all it needs.
+///
+/// ```
+/// octrace_core::profile! {
+///     /// Fifty spheres, no octree.
+///     pub struct Spheres50 { spheres: 50, surfaces: 4, lights: 2 }
+/// }
+/// # use octrace_core::profile::Profile;
+/// # assert_eq!(Spheres50::COUNTS.objects, 50);
+/// ```
+#[macro_export]
+macro_rules! profile {
+    (
+        $(#[$meta:meta])*
+        $vis:vis struct $name:ident { $($field:ident : $value:expr),* $(,)? }
+        $(octree: { $($octree_field:ident : $octree_value:expr),* $(,)? })?
+    ) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+        $vis struct $name;
+
+        const _: () = {
+            use $crate::profile::__private as p;
+
+            impl $crate::profile::Profile for $name {
+                #[allow(clippy::needless_update)]
+                const COUNTS: p::Counts = p::Counts { $($field: $value,)* ..p::Counts::ZERO }.with_objects();
+                const OCTREE: p::OctreeConfig =
+                    p::OctreeConfig { $($($octree_field: $octree_value,)*)? ..p::OctreeConfig::DEFAULT };
+                type Octree = p::Octree<$name, { <$name as $crate::profile::Profile>::OCTREE.max_depth as usize + 1 }>;
+                type MailboxWords = p::Vec<u32, { <$name as $crate::profile::Profile>::COUNTS.mailbox_words() }>;
+            }
+
+            // 16-bit indices: their top two values are markers.
+            const _: () = assert!(
+                <$name as $crate::profile::Profile>::COUNTS.octree_boxes < 0xFFFE
+                    && <$name as $crate::profile::Profile>::COUNTS.octree_references < 0xFFFE,
+                "profile!: octree_boxes and octree_references must be below 65534"
+            );
+
+            impl p::SceneCapacities for $name {
+                const NAME: &'static str = stringify!($name);
+                type Objects = p::Vec<p::ShapeHandle, { <$name as $crate::profile::Profile>::COUNTS.objects }>;
+                type Spheres = p::Vec<p::Sphere, { <$name as $crate::profile::Profile>::COUNTS.spheres }>;
+                type Boxes = p::Vec<p::AxisAlignedBox, { <$name as $crate::profile::Profile>::COUNTS.boxes }>;
+                type Superquadrics =
+                    p::Vec<p::Superquadric, { <$name as $crate::profile::Profile>::COUNTS.superquadrics }>;
+                type Triangles = p::Vec<p::Triangle, { <$name as $crate::profile::Profile>::COUNTS.triangles }>;
+                type Rectangles = p::Vec<p::Rectangle, { <$name as $crate::profile::Profile>::COUNTS.rectangles }>;
+                type SmoothTriangles =
+                    p::Vec<p::SmoothTriangle, { <$name as $crate::profile::Profile>::COUNTS.bspline_triangles }>;
+                type ControlPoints = p::Vec<p::Vec3, { <$name as $crate::profile::Profile>::COUNTS.control_points }>;
+                type Surfaces = p::Vec<p::SurfaceEntry, { <$name as $crate::profile::Profile>::COUNTS.surfaces }>;
+                type Lights = p::Vec<p::Light, { <$name as $crate::profile::Profile>::COUNTS.lights }>;
+            }
+
+            impl p::OctreeCapacities for $name {
+                type Index = u16;
+                type Nodes = p::Vec<p::OctreeNode<u16>, { <$name as $crate::profile::Profile>::COUNTS.octree_boxes }>;
+                type References = p::Vec<u16, { <$name as $crate::profile::Profile>::COUNTS.octree_references }>;
+                type HashEntries =
+                    p::Vec<p::HashEntry<u16>, { <$name as $crate::profile::Profile>::COUNTS.octree_hash_entries() }>;
+                type HashBuckets = p::Vec<u16, { <$name as $crate::profile::Profile>::COUNTS.octree_hash_buckets() }>;
+            }
+        };
+    };
+}
+
+/// What [`profile!`](crate::profile!) expands to; not a public API.
+#[doc(hidden)]
+pub mod __private {
+    pub use crate::accel::{HashEntry, Octree, OctreeCapacities, OctreeConfig, OctreeNode};
+    pub use crate::capacity::Counts;
+    pub use crate::math::Vec3;
+    pub use crate::scene::{Light, SceneCapacities, SurfaceEntry};
+    pub use crate::shapes::{AxisAlignedBox, Rectangle, ShapeHandle, SmoothTriangle, Sphere, Superquadric, Triangle};
+    pub use heapless::Vec;
+}
+
+crate::profile! {
+    /// A board with 16 KiB of RAM (BBC micro:bit v1): up to 200 spheres and
+    /// a few other shapes in about 6 KiB, and an octree of up to 128 boxes in
+    /// about 2 KiB, 3 levels deep (the walk's stack stays small).
+    pub struct Board16K {
+        spheres: 200, boxes: 2, superquadrics: 2, triangles: 2, rectangles: 2,
+        surfaces: 12, lights: 4, octree_boxes: 128, octree_references: 640,
+    }
+    octree: { max_objects: 8, max_depth: 3 }
+}
+
+crate::profile! {
+    /// A board with 64 KiB of RAM or more (Cortex-M3/M4 class).
+    pub struct Board64K {
+        spheres: 320, boxes: 32, superquadrics: 32, triangles: 96, rectangles: 96,
+        bspline_triangles: 32, control_points: 16, surfaces: 64, lights: 8,
+        objects: 512, octree_boxes: 2048, octree_references: 6144,
+    }
+}
+
+/// The host build: a million objects of any kind, heap-backed arenas that
+/// take memory only as the scene fills them (feature `alloc`).
+#[cfg(feature = "alloc")]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Host;
+
+#[cfg(feature = "alloc")]
+mod host {
+    use super::{Host, Profile};
+    use crate::accel::{HashEntry, Octree, OctreeCapacities, OctreeConfig, OctreeNode, MAX_DEPTH};
+    use crate::capacity::{Counts, HeapArena};
+    use crate::math::Vec3;
+    use crate::scene::{Light, SceneCapacities, SurfaceEntry};
+    use crate::shapes::{AxisAlignedBox, Rectangle, ShapeHandle, SmoothTriangle, Sphere, Superquadric, Triangle};
+
+    const MILLION: usize = 1_000_000;
+
+    impl Profile for Host {
+        const COUNTS: Counts = Counts {
+            objects: MILLION,
+            spheres: MILLION,
+            boxes: MILLION,
+            superquadrics: MILLION,
+            triangles: MILLION,
+            rectangles: MILLION,
+            bspline_triangles: MILLION,
+            control_points: 1_048_576,
+            surfaces: 65_535,
+            lights: 4_096,
+            octree_boxes: 16_000_000,
+            octree_references: 64_000_000,
+        };
+        const OCTREE: OctreeConfig = OctreeConfig::DEFAULT;
+        type Octree = Octree<Host, { MAX_DEPTH as usize + 1 }>;
+        type MailboxWords = HeapArena<u32, { Host::COUNTS.mailbox_words() }>;
+    }
+
+    impl SceneCapacities for Host {
+        const NAME: &'static str = "Host";
+        type Objects = HeapArena<ShapeHandle, { Host::COUNTS.objects }>;
+        type Spheres = HeapArena<Sphere, { Host::COUNTS.spheres }>;
+        type Boxes = HeapArena<AxisAlignedBox, { Host::COUNTS.boxes }>;
+        type Superquadrics = HeapArena<Superquadric, { Host::COUNTS.superquadrics }>;
+        type Triangles = HeapArena<Triangle, { Host::COUNTS.triangles }>;
+        type Rectangles = HeapArena<Rectangle, { Host::COUNTS.rectangles }>;
+        type SmoothTriangles = HeapArena<SmoothTriangle, { Host::COUNTS.bspline_triangles }>;
+        type ControlPoints = HeapArena<Vec3, { Host::COUNTS.control_points }>;
+        type Surfaces = HeapArena<SurfaceEntry, { Host::COUNTS.surfaces }>;
+        type Lights = HeapArena<Light, { Host::COUNTS.lights }>;
+    }
+
+    impl OctreeCapacities for Host {
+        type Index = u32;
+        type Nodes = HeapArena<OctreeNode<u32>, { Host::COUNTS.octree_boxes }>;
+        type References = HeapArena<u32, { Host::COUNTS.octree_references }>;
+        type HashEntries = HeapArena<HashEntry<u32>, { Host::COUNTS.octree_hash_entries() }>;
+        // A prime: the table's size since the first host profile.
+        type HashBuckets = HeapArena<u32, 65_521>;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::capacity::CapacityKind;
+
+    crate::profile! {
+        struct Tiny { spheres: 3, lights: 1, surfaces: 1 }
+    }
+
+    #[test]
+    fn a_profile_holds_exactly_its_counts() {
+        assert_eq!(<Tiny as SceneCapacities>::Spheres::CAPACITY, 3);
+        assert_eq!(<Tiny as SceneCapacities>::Objects::CAPACITY, 3);
+        assert_eq!(<Tiny as SceneCapacities>::Boxes::CAPACITY, 0);
+        assert_eq!(<Tiny as Profile>::MailboxWords::CAPACITY, 1);
+        assert_eq!(Board16K::COUNTS.objects, 208, "the shapes' sum");
+        assert_eq!(Board16K::COUNTS.get(CapacityKind::Rectangles), 2);
+        assert_eq!(Board16K::OCTREE.max_depth, 3);
+        assert_eq!(Board64K::COUNTS.objects, 512, "given, not summed");
+    }
+}

@@ -1,0 +1,429 @@
+//! The one way in: a [`Raytracer`] holds a scene, its octree and a mailbox
+//! in one place (a `static` on a board), [`Raytracer::load`] parses a scene
+//! text and indexes it, and the [`LoadedScene`] draws as an embedded-graphics
+//! image ([`TracedImage`]) in the colour of any display.
+//!
+//! Invariants: a [`Raytracer::new`] is all zero bits (a `static` of it lands
+//! in `.bss`, initialised in place); a [`LoadedScene`] exists only for a
+//! scene that parsed without errors, with its accelerator built.
+
+use crate::accel::{AccelMode, Accelerator, BuildReport, Mailbox, Naive, OctreeConfig, OctreeStore};
+use crate::capacity::Arena;
+use crate::parse::{parse_bytes, ErrorKind, ParseError, Pos};
+use crate::profile::Profile;
+use crate::render::Renderer;
+use crate::scene::{CameraError, Scene, SceneView};
+use crate::shade::Stats;
+use core::cell::{Cell, RefCell};
+use core::fmt;
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{Dimensions, OriginDimensions, Point, Size};
+use embedded_graphics_core::image::ImageDrawable;
+use embedded_graphics_core::pixelcolor::{PixelColor, Rgb888};
+use embedded_graphics_core::primitives::Rectangle;
+use embedded_graphics_core::Pixel;
+
+/// Room for one scene of the profile `P`: the scene's arenas, its octree and
+/// a mailbox. On a board, keep it in a `static` (it is all zero bits, so it
+/// costs no flash) and take it once with the re-exported
+/// [`ConstStaticCell`](crate::ConstStaticCell); on a host, box it.
+///
+/// ```
+/// use octrace_core::{profile::Board16K, ConstStaticCell, Raytracer};
+///
+/// static RAYTRACER: ConstStaticCell<Raytracer<Board16K>> = ConstStaticCell::new(Raytracer::new());
+/// let raytracer: &'static mut Raytracer<Board16K> = RAYTRACER.take();
+/// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\n").unwrap();
+/// assert_eq!(scene.view().object_count(), 1);
+/// ```
+pub struct Raytracer<P: Profile> {
+    scene: Scene<P>,
+    octree: P::Octree,
+    mailbox: P::MailboxWords,
+}
+
+impl<P: Profile> fmt::Debug for Raytracer<P> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Raytracer")
+            .field("profile", &P::NAME)
+            .field("objects", &self.scene.view().object_count())
+            .finish_non_exhaustive()
+    }
+}
+
+impl<P: Profile> Default for Raytracer<P> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// A scene that did not load: how many errors it has and the first one.
+/// [`Raytracer::load_with`] hands every error to a callback.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LoadError<'t> {
+    /// The first error, with its line and column.
+    pub first: ParseError<'t>,
+    /// How many errors the scene has (at least 1).
+    pub count: usize,
+}
+
+impl fmt::Display for LoadError<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.first)?;
+        match self.count {
+            1 => Ok(()),
+            n => write!(f, " (and {} more error{})", n - 1, if n == 2 { "" } else { "s" }),
+        }
+    }
+}
+
+impl core::error::Error for LoadError<'_> {}
+
+impl<P: Profile> Raytracer<P> {
+    /// Empty room for a scene: a constant of all-zero bits.
+    pub const fn new() -> Self {
+        Raytracer { scene: Scene::new(), octree: P::Octree::EMPTY, mailbox: P::MailboxWords::EMPTY }
+    }
+
+    /// Parses `text` (replacing any scene loaded before) and indexes it for
+    /// tracing, choosing the accelerator with [`AccelMode::Auto`].
+    pub fn load<'t>(&mut self, text: &'t str) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
+        self.load_with(text.as_bytes(), AccelMode::Auto, &mut |_| {})
+    }
+
+    /// [`Raytracer::load`] from bytes (invalid UTF-8 is an error at its
+    /// place), with the accelerator `mode`, handing every error to
+    /// `on_error` as it is found.
+    pub fn load_with<'t>(
+        &mut self,
+        text: &'t [u8],
+        mode: AccelMode,
+        on_error: &mut dyn FnMut(ParseError<'t>),
+    ) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
+        let mut first = None;
+        let parsed = parse_bytes(text, &mut self.scene, &mut |e| {
+            first.get_or_insert(e);
+            on_error(e);
+        });
+        match (parsed, first) {
+            (Ok(_), _) => {}
+            (Err(count), Some(first)) => return Err(LoadError { first, count }),
+            // The parser reports every error it counts.
+            (Err(count), None) => {
+                let first = ParseError::new(Pos { line: 1, column: 1 }, ErrorKind::InvalidUtf8);
+                return Err(LoadError { first, count });
+            }
+        }
+        let view = self.scene.view();
+        let mode = mode.resolve(view.object_count());
+        let octree = mode.traversal().map(|traversal| {
+            let report = self.octree.build(&view, &OctreeConfig { traversal, ..P::OCTREE });
+            (&self.octree, report)
+        });
+        self.mailbox.clear();
+        let words = Mailbox::words_for(view.object_count());
+        while self.mailbox.as_slice().len() < words && self.mailbox.push(0).is_ok() {}
+        Ok(LoadedScene {
+            view,
+            mode,
+            octree,
+            mailbox: RefCell::new(self.mailbox.as_mut_slice()),
+            stats: Cell::new(Stats::default()),
+        })
+    }
+}
+
+/// A scene ready to trace, borrowed from its [`Raytracer`].
+pub struct LoadedScene<'r, P: Profile> {
+    view: SceneView<'r>,
+    mode: AccelMode,
+    octree: Option<(&'r P::Octree, BuildReport)>,
+    mailbox: RefCell<&'r mut [u32]>,
+    stats: Cell<Stats>,
+}
+
+impl<P: Profile> fmt::Debug for LoadedScene<'_, P> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("LoadedScene")
+            .field("objects", &self.view.object_count())
+            .field("mode", &self.mode)
+            .field("octree", &self.octree.map(|(_, report)| report))
+            .finish_non_exhaustive()
+    }
+}
+
+impl<'r, P: Profile> LoadedScene<'r, P> {
+    /// The scene's objects, surfaces, lights and settings.
+    pub fn view(&self) -> SceneView<'r> {
+        self.view
+    }
+
+    /// The accelerator in use (never [`AccelMode::Auto`]).
+    pub fn mode(&self) -> AccelMode {
+        self.mode
+    }
+
+    /// What building the octree produced, if the mode uses one.
+    pub fn octree_report(&self) -> Option<&BuildReport> {
+        self.octree.as_ref().map(|(_, report)| report)
+    }
+
+    /// The counters of every draw so far.
+    pub fn stats(&self) -> Stats {
+        self.stats.get()
+    }
+
+    /// The scene's RASTER size.
+    pub fn raster(&self) -> Size {
+        let [w, h] = self.view.settings.raster;
+        Size::new(w, h)
+    }
+
+    /// The scene as an image of `size` pixels in the colour `C`.
+    pub fn image<C>(&self, size: Size) -> TracedImage<'_, 'r, P, C> {
+        TracedImage { scene: self, size, color: core::marker::PhantomData }
+    }
+
+    /// The scene as an image as large as `target`, in its colour: what
+    /// `Image::new(&scene.image_for(&display), Point::zero())` draws.
+    pub fn image_for<D: DrawTarget>(&self, target: &D) -> TracedImage<'_, 'r, P, D::Color> {
+        self.image(target.bounding_box().size)
+    }
+
+    /// Renders `area` of an image of `size` into `target`, with the pixel at
+    /// `area`'s top-left corner going to `at`.
+    fn draw_area<D>(&self, size: Size, area: &Rectangle, at: Point, target: &mut D) -> Result<(), DrawError<D::Error>>
+    where
+        D: DrawTarget,
+        D::Color: From<Rgb888>,
+    {
+        match self.octree {
+            Some((octree, _)) => self.render(octree, size, area, at, target),
+            None => self.render(&Naive, size, area, at, target),
+        }
+    }
+
+    fn render<A: Accelerator, D>(
+        &self,
+        accel: &A,
+        size: Size,
+        area: &Rectangle,
+        at: Point,
+        target: &mut D,
+    ) -> Result<(), DrawError<D::Error>>
+    where
+        D: DrawTarget,
+        D::Color: From<Rgb888>,
+    {
+        let mut renderer = Renderer::with_size(self.view, accel, size.width, size.height).map_err(DrawError::Camera)?;
+        // Another draw of this scene holds the mailbox (only if a display
+        // draws from inside a draw): render without it, same image.
+        let mut mailbox = self.mailbox.try_borrow_mut();
+        if let Ok(words) = mailbox.as_deref_mut() {
+            renderer.set_mailbox(words);
+        }
+        let mut shifted = Shifted { target, offset: at - area.top_left };
+        let stats = renderer.render_rect(area, &mut shifted).map_err(DrawError::Target)?;
+        let mut total = self.stats.get();
+        total.add(&stats);
+        self.stats.set(total);
+        Ok(())
+    }
+}
+
+/// Why a [`TracedImage`] could not be drawn with
+/// [`TracedImage::try_draw`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DrawError<E> {
+    /// The camera cannot be set up for this size (see [`CameraError`]).
+    Camera(CameraError),
+    /// The display's own error.
+    Target(E),
+}
+
+impl<E: fmt::Display> fmt::Display for DrawError<E> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            DrawError::Camera(e) => write!(f, "{e}"),
+            DrawError::Target(e) => write!(f, "the display failed: {e}"),
+        }
+    }
+}
+
+impl<E: fmt::Debug + fmt::Display> core::error::Error for DrawError<E> {}
+
+/// A traced scene as an embedded-graphics image, `size` pixels in the colour
+/// `C` (any colour that converts from `Rgb888`: `Rgb565`, `Gray4`, …), like
+/// `tinybmp::Bmp<C>`. Each draw traces the pixels as the display takes
+/// them, one scanline at a time: no framebuffer.
+///
+/// ```
+/// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb565, prelude::*};
+/// use octrace_core::{profile::Board16K, Raytracer};
+///
+/// let mut raytracer = Raytracer::<Board16K>::new();
+/// let scene = raytracer.load("BACKGROUND 0 0 1\n").unwrap();
+/// let mut display = MockDisplay::<Rgb565>::new();
+/// Image::new(&scene.image::<Rgb565>(Size::new(4, 2)), Point::zero()).draw(&mut display).unwrap();
+/// display.assert_pattern(&["BBBB", "BBBB"]);
+/// ```
+pub struct TracedImage<'s, 'r, P: Profile, C> {
+    scene: &'s LoadedScene<'r, P>,
+    size: Size,
+    color: core::marker::PhantomData<C>,
+}
+
+impl<P: Profile, C> fmt::Debug for TracedImage<'_, '_, P, C> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("TracedImage").field("size", &self.size).field("scene", self.scene).finish()
+    }
+}
+
+impl<P: Profile, C> Clone for TracedImage<'_, '_, P, C> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<P: Profile, C> Copy for TracedImage<'_, '_, P, C> {}
+
+impl<P: Profile, C: PixelColor + From<Rgb888>> TracedImage<'_, '_, P, C> {
+    /// Draws the image at the origin of `target`, telling a camera that
+    /// cannot be set up (a zero size) apart from the display's errors;
+    /// [`ImageDrawable::draw`] draws nothing then.
+    pub fn try_draw<D: DrawTarget<Color = C>>(&self, target: &mut D) -> Result<(), DrawError<D::Error>> {
+        self.scene.draw_area(self.size, &Rectangle::new(Point::zero(), self.size), Point::zero(), target)
+    }
+}
+
+impl<P: Profile, C> OriginDimensions for TracedImage<'_, '_, P, C> {
+    fn size(&self) -> Size {
+        self.size
+    }
+}
+
+impl<P: Profile, C: PixelColor + From<Rgb888>> ImageDrawable for TracedImage<'_, '_, P, C> {
+    type Color = C;
+
+    fn draw<D: DrawTarget<Color = C>>(&self, target: &mut D) -> Result<(), D::Error> {
+        self.draw_sub_image(target, &self.bounding_box())
+    }
+
+    fn draw_sub_image<D: DrawTarget<Color = C>>(&self, target: &mut D, area: &Rectangle) -> Result<(), D::Error> {
+        match self.scene.draw_area(self.size, area, Point::zero(), target) {
+            Ok(()) | Err(DrawError::Camera(_)) => Ok(()),
+            Err(DrawError::Target(e)) => Err(e),
+        }
+    }
+}
+
+/// A target seen shifted by `offset`: a sub-image's pixels land at the
+/// target's origin.
+struct Shifted<'t, D> {
+    target: &'t mut D,
+    offset: Point,
+}
+
+impl<D: DrawTarget> Dimensions for Shifted<'_, D> {
+    fn bounding_box(&self) -> Rectangle {
+        let b = self.target.bounding_box();
+        Rectangle::new(b.top_left - self.offset, b.size)
+    }
+}
+
+impl<D: DrawTarget> DrawTarget for Shifted<'_, D> {
+    type Color = D::Color;
+    type Error = D::Error;
+
+    fn draw_iter<I: IntoIterator<Item = Pixel<D::Color>>>(&mut self, pixels: I) -> Result<(), D::Error> {
+        let offset = self.offset;
+        self.target.draw_iter(pixels.into_iter().map(|Pixel(p, c)| Pixel(p + offset, c)))
+    }
+
+    fn fill_contiguous<I: IntoIterator<Item = D::Color>>(
+        &mut self,
+        area: &Rectangle,
+        colors: I,
+    ) -> Result<(), D::Error> {
+        self.target.fill_contiguous(&Rectangle::new(area.top_left + self.offset, area.size), colors)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::profile::Board16K;
+    use embedded_graphics_core::pixelcolor::{Gray4, Rgb565};
+
+    const SCENE: &str = "SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n";
+
+    /// Collects what a draw writes.
+    struct Grid<C, const W: usize, const H: usize>([[Option<C>; W]; H]);
+
+    impl<C: PixelColor, const W: usize, const H: usize> OriginDimensions for Grid<C, W, H> {
+        fn size(&self) -> Size {
+            Size::new(W as u32, H as u32)
+        }
+    }
+
+    impl<C: PixelColor, const W: usize, const H: usize> DrawTarget for Grid<C, W, H> {
+        type Color = C;
+        type Error = core::convert::Infallible;
+
+        fn draw_iter<I: IntoIterator<Item = Pixel<C>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
+            for Pixel(p, c) in pixels {
+                assert!(p.x >= 0 && p.y >= 0 && (p.x as usize) < W && (p.y as usize) < H, "{p:?} outside");
+                assert!(self.0[p.y as usize][p.x as usize].replace(c).is_none(), "{p:?} drawn twice");
+            }
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn an_image_sized_from_its_target_draws_every_pixel_once() {
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let scene = raytracer.load(SCENE).unwrap();
+        let mut grid = Grid::<Gray4, 12, 8>([[None; 12]; 8]);
+        let image = scene.image_for(&grid);
+        assert_eq!(image.size(), Size::new(12, 8));
+        image.draw(&mut grid).unwrap();
+        assert!(grid.0.iter().flatten().all(|c| c.is_some()));
+        assert_eq!(scene.stats().rays, 96);
+    }
+
+    #[test]
+    fn a_sub_image_is_the_same_pixels_at_the_origin() {
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let scene = raytracer.load(SCENE).unwrap();
+        let mut whole = Grid::<Rgb565, 12, 8>([[None; 12]; 8]);
+        scene.image_for(&whole).draw(&mut whole).unwrap();
+        let mut part = Grid::<Rgb565, 5, 3>([[None; 5]; 3]);
+        let image = scene.image::<Rgb565>(Size::new(12, 8));
+        image.draw_sub_image(&mut part, &Rectangle::new(Point::new(4, 2), Size::new(5, 3))).unwrap();
+        for y in 0..3 {
+            assert_eq!(part.0[y], whole.0[y + 2][4..9], "row {y}");
+        }
+    }
+
+    #[test]
+    fn every_mode_gives_the_same_pixels() {
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let mut first = None;
+        for mode in AccelMode::ALL {
+            let scene = raytracer.load_with(SCENE.as_bytes(), mode, &mut |e| panic!("{e:?}")).unwrap();
+            assert_ne!(scene.mode(), AccelMode::Auto);
+            assert_eq!(scene.octree_report().is_some(), scene.mode().traversal().is_some());
+            let mut grid = Grid::<Rgb565, 8, 6>([[None; 8]; 6]);
+            scene.image_for(&grid).draw(&mut grid).unwrap();
+            assert_eq!(*first.get_or_insert(grid.0), grid.0, "{mode}");
+        }
+    }
+
+    #[test]
+    fn a_bad_scene_gives_its_first_error_and_the_count() {
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let e = raytracer.load("SPHERE 1 1 0 0 0\nFOO\n").unwrap_err();
+        assert_eq!(e.count, 2);
+        assert_eq!((e.first.pos.line, e.first.pos.column), (1, 1));
+    }
+}
