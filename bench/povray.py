@@ -2,7 +2,8 @@
 """octrace against POV-Ray 3.7, one thread each, on the same scenes.
 
     python3 bench/povray.py [--size WxH] [scene ...]
-                            (default: fig5_1 fig5_2 fig5_3 fig5_4 fig5_5 fig5_8)
+                            (default: fig5_1 fig5_2 fig5_3 fig5_4 fig5_5 fig5_8
+                             chessboard spheres600)
 
 Each octrace scene file is translated into an equivalent POV-Ray scene: the
 same camera (POV's `angle` is octrace's default 60-degree viewport), the
@@ -119,7 +120,7 @@ def main():
     if args[:1] == ["--size"]:
         size = tuple(int(x) for x in args[1].split("x"))
         args = args[2:]
-    names = args or ["fig5_1", "fig5_2", "fig5_3", "fig5_4", "fig5_5", "fig5_8"]
+    names = args or ["fig5_1", "fig5_2", "fig5_3", "fig5_4", "fig5_5", "fig5_8", "chessboard", "spheres600"]
     host_sim = os.path.join(ROOT, "target/release/host-sim")
     subprocess.run(["cargo", "build", "--release", "-q", "-p", "host-sim"], cwd=ROOT, check=True)
     print("| scene | size | objects | POV-Ray 3.7 trace | octrace trace | faster by | POV-Ray command | octrace command | faster by |")

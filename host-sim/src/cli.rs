@@ -1,10 +1,11 @@
 //! The `host-sim` command line.
 
-use crate::formats::{self, Format, Image};
-use crate::palette::{self, PaletteMode};
-use crate::{
-    all_cores, load_file, new_scene, render_with_progress, AccelMode, LoadError, Partition, RenderOptions, RgbImage,
-};
+use crate::formats::{self, Format, FormatError, Header, Image};
+use crate::output::FileSink;
+use crate::palette::PaletteMode;
+use crate::parts::{self, MergeError, PartInfo, PartSpec};
+use crate::{all_cores, load_bytes, new_scene, render_streamed, AccelMode, LoadError, Partition, RenderOptions};
+use crate::{render_with_progress, HostScene, RgbImage, StreamError, Streamed};
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressStyle};
 use octrace_core::accel::OctreeConfig;
@@ -81,6 +82,14 @@ pub struct Args {
     /// threads become free, or the thesis's four equal rectangles.
     #[arg(long, value_enum, default_value_t = Partition::Tiles)]
     pub partition: Partition,
+    /// Render only part I of N horizontal bands of the image (1-based), as an
+    /// image of its own that `host-sim merge` puts together with the others;
+    /// `auto/N` takes I from SLURM_ARRAY_TASK_ID (counted from
+    /// SLURM_ARRAY_TASK_MIN) or JOB_COMPLETION_INDEX (counted from 0). Parts
+    /// are PNG or Targa files: they carry the scene's hash, the image's size,
+    /// the palette and their rows.
+    #[arg(long, value_name = "I/N")]
+    pub part: Option<PartSpec>,
     /// Print nothing but errors.
     #[arg(long, short)]
     pub quiet: bool,
@@ -98,6 +107,20 @@ pub enum Command {
         output: PathBuf,
         /// The output format; by default from OUTPUT's extension (png, tga,
         /// ras), or PNG when OUTPUT has none.
+        #[arg(long, value_enum)]
+        format: Option<Format>,
+    },
+    /// Stack the parts rendered with `--part I/N` into the whole image,
+    /// bit-identical to rendering it at once. Refuses (exit 2, nothing
+    /// written) parts of other scenes, sizes or palettes, and parts that
+    /// leave rows out or hold a row twice.
+    Merge {
+        /// The image to write.
+        output: PathBuf,
+        /// The part files, in any order.
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        /// The output format; by default from OUTPUT's extension, else PNG.
         #[arg(long, value_enum)]
         format: Option<Format>,
     },
@@ -251,16 +274,145 @@ fn convert(input: &Path, output: &Path, format: Option<Format>, stderr: &mut dyn
     })
 }
 
+fn merge(output: &Path, parts: &[PathBuf], format: Option<Format>, stderr: &mut dyn Write) -> Result<(), i32> {
+    let format = output_format(format, output, stderr)?;
+    let (ordered, header) = parts::check_parts(parts).map_err(|e| {
+        let _ = writeln!(stderr, "host-sim: merge: {e}; nothing written");
+        match e {
+            MergeError::Io { .. } => EXIT_IO,
+            MergeError::Refused(_) => EXIT_SCENE,
+        }
+    })?;
+    write_atomically(output, |f| parts::write_merged(&ordered, &header, format, f).map_err(std::io::Error::other))
+        .map_err(|e| {
+            let _ = writeln!(stderr, "host-sim: merge: cannot write {}: {e}", output.display());
+            EXIT_IO
+        })
+}
+
+/// The rows to render and the text to carry for `--part`, checked against the image and the options.
+fn part_of(
+    spec: PartSpec,
+    palette_mode: PaletteMode,
+    color: PanelColor,
+    scene_bytes: &[u8],
+    (w, h): (u32, u32),
+    format: Format,
+    stderr: &mut dyn Write,
+) -> Result<(std::ops::Range<u32>, String), i32> {
+    let mut refuse = |message: String| {
+        let _ = writeln!(stderr, "host-sim: --part: {message}");
+        Err(EXIT_SCENE)
+    };
+    if format == Format::Ras {
+        return refuse("parts are PNG or Targa files (a Sun raster has no room for the part's metadata)".into());
+    }
+    if matches!(color, PanelColor::Rgb565 | PanelColor::Gray4) {
+        return refuse("a --color preview is written whole: render it without --part".into());
+    }
+    if palette_mode == PaletteMode::Scan {
+        return refuse(
+            "--palette scan learns its colour table from the whole image, so a band cannot be mapped on its \
+             own; use dither, coarse or gray, or none"
+                .into(),
+        );
+    }
+    if spec.count > h {
+        return refuse(format!("{} parts of an image {h} rows high: at most {h}", spec.count));
+    }
+    let index = match spec.index {
+        Some(i) => i,
+        None => match parts::auto_index(spec.count, |name| std::env::var(name).ok()) {
+            Ok(i) => i,
+            Err(e) => return refuse(e.to_string()),
+        },
+    };
+    let rows = parts::band_rows(h, index, spec.count);
+    let info = PartInfo {
+        version: env!("CARGO_PKG_VERSION").into(),
+        scene: parts::scene_hash(scene_bytes),
+        width: w,
+        height: h,
+        palette: palette_mode,
+        rows: rows.clone(),
+        index,
+        count: spec.count,
+    };
+    Ok((rows, info.to_string()))
+}
+
+/// `--color rgb565|gray4`: a panel's preview, converted from the whole
+/// image (panels are small; every other image streams).
+fn preview(
+    scene: &HostScene,
+    options: &RenderOptions,
+    color: PanelColor,
+    format: Format,
+    out: &Path,
+    quiet: bool,
+    stderr: &mut dyn Write,
+) -> Result<(), i32> {
+    let started = Instant::now();
+    let rendered = render_with_progress(scene, options, &|_| {}).map_err(|e| {
+        // The parser rejects these; a scene built by hand may not.
+        let _ = writeln!(stderr, "host-sim: cannot set up the camera: {e:?}");
+        EXIT_SCENE
+    })?;
+    let written = match panel_preview(&rendered.image, color, format) {
+        None => {
+            let image = Image::Rgb(rendered.image.clone());
+            write_atomically(out, |f| formats::write(&image, format, f).map_err(std::io::Error::other))
+        }
+        Some(Preview::Image(panel)) => {
+            write_atomically(out, |f| formats::write(&panel, format, f).map_err(std::io::Error::other))
+        }
+        Some(Preview::Gray { width, height, gray }) => {
+            write_atomically(out, |f| write_gray_png(width, height, &gray, f))
+        }
+    };
+    if let Err(e) = written {
+        let _ = writeln!(stderr, "host-sim: cannot write {}: {e}", out.display());
+        return Err(EXIT_IO);
+    }
+    if !quiet {
+        let (image, stats) = (&rendered.image, rendered.stats);
+        let _ = writeln!(
+            stderr,
+            "{}x{} in {:.3} s ({}, {} threads): {} rays, {} shadow rays, {} cells -> {} ({} panel)",
+            image.width,
+            image.height,
+            started.elapsed().as_secs_f64(),
+            rendered.accel.name(),
+            options.threads,
+            stats.rays,
+            stats.shadow_rays,
+            stats.cells,
+            out.display(),
+            <PanelColor as clap::ValueEnum>::to_possible_value(&color)
+                .map_or_else(String::new, |v| v.get_name().to_owned())
+        );
+    }
+    Ok(())
+}
+
 fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
-    if let Some(Command::Convert { input, output, format }) = &args.command {
-        return convert(input, output, *format, stderr);
+    match &args.command {
+        Some(Command::Convert { input, output, format }) => return convert(input, output, *format, stderr),
+        Some(Command::Merge { output, parts, format }) => return merge(output, parts, *format, stderr),
+        // run() serves the studio (it needs stdout) before execute is called.
+        Some(Command::Studio(_)) => return Ok(()),
+        None => {}
     }
     let Some(scene_path) = &args.scene else {
         // clap requires SCENE without a subcommand.
         return Err(EXIT_SCENE);
     };
     let mut scene = new_scene();
-    let loaded = match load_file(scene_path, &mut scene) {
+    let scene_bytes = std::fs::read(scene_path).map_err(|e| {
+        let _ = writeln!(stderr, "host-sim: cannot read {}: {e}", scene_path.display());
+        EXIT_IO
+    })?;
+    let loaded = match load_bytes(&scene_path.display().to_string(), &scene_bytes, &mut scene) {
         Ok(l) => l,
         Err(LoadError::Io(e)) => {
             let _ = writeln!(stderr, "host-sim: cannot read {}: {e}", scene_path.display());
@@ -298,15 +450,13 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
     let format = output_format(args.format, &out, stderr)?;
     let view = scene.view();
     let (w, h) = args.size.unwrap_or((view.settings.raster[0], view.settings.raster[1]));
-    let bar = if !args.quiet && std::io::stderr().is_terminal() {
-        let bar = ProgressBar::new(w as u64 * h as u64);
-        bar.set_style(
-            ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}%, eta {eta}")
-                .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        Some(bar)
-    } else {
-        None
+    let palette_mode = if args.color == PanelColor::Dither { PaletteMode::Dither } else { args.palette };
+    let (rows, text) = match args.part {
+        Some(spec) => {
+            let (rows, text) = part_of(spec, palette_mode, args.color, &scene_bytes, (w, h), format, stderr)?;
+            (rows, Some(text))
+        }
+        None => (0..h, None),
     };
     let started = Instant::now();
     let options = RenderOptions {
@@ -316,39 +466,70 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
         threads: args.threads.map_or_else(all_cores, |n| n as usize),
         partition: args.partition,
     };
-    let rendered = render_with_progress(&scene, &options, &|pixels| {
-        if let Some(b) = &bar {
-            b.inc(pixels);
+    if matches!(args.color, PanelColor::Rgb565 | PanelColor::Gray4) {
+        return preview(&scene, &options, args.color, format, &out, args.quiet, stderr);
+    }
+    // `coarse` outlines need the objects of the row above a part.
+    let render_rows = match palette_mode {
+        PaletteMode::Coarse => rows.start.saturating_sub(1)..rows.end,
+        _ => rows.clone(),
+    };
+    let bar = if !args.quiet && std::io::stderr().is_terminal() {
+        let bar = ProgressBar::new(w as u64 * render_rows.len() as u64);
+        bar.set_style(
+            ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}%, eta {eta}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        Some(bar)
+    } else {
+        None
+    };
+    let header = Header { width: w, height: rows.len() as u32, palette: None, text };
+    let spool_dir = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let spool_name = out.file_name().map_or_else(|| "image".into(), |n| n.to_string_lossy().into_owned());
+    let mut outcome: Option<Result<Streamed, StreamError>> = None;
+    let mut summary = None;
+    let written = write_atomically(&out, |f| {
+        let io = |e: FormatError| match e {
+            FormatError::Io(e) => e,
+            e => std::io::Error::other(e),
+        };
+        let mut sink =
+            FileSink::new(palette_mode, format, header, rows.start, f, spool_dir, &spool_name).map_err(io)?;
+        let progress = |pixels| {
+            if let Some(b) = &bar {
+                b.inc(pixels);
+            }
+        };
+        match render_streamed(&scene, &options, render_rows, &progress, &mut sink) {
+            Ok(streamed) => outcome = Some(Ok(streamed)),
+            Err(StreamError::Sink(e)) => return Err(e),
+            Err(e) => {
+                outcome = Some(Err(e));
+                return Err(std::io::Error::other("no image"));
+            }
         }
+        summary = sink.finish().map_err(io)?;
+        Ok(())
     });
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let rendered = match rendered {
-        Ok(r) => r,
-        Err(e) => {
+    let rendered = match (outcome, written) {
+        (Some(Err(e)), _) => {
             // The parser rejects these; a scene built by hand may not.
-            let _ = writeln!(stderr, "host-sim: cannot set up the camera: {e:?}");
+            let _ = writeln!(stderr, "host-sim: {e}");
             return Err(EXIT_SCENE);
         }
+        (_, Err(e)) => {
+            let _ = writeln!(stderr, "host-sim: cannot write {}: {e}", out.display());
+            return Err(EXIT_IO);
+        }
+        (Some(Ok(rendered)), Ok(())) => rendered,
+        (None, Ok(())) => return Err(EXIT_IO),
     };
     let elapsed = started.elapsed();
     let stats = rendered.stats;
-    let palette_mode = if args.color == PanelColor::Dither { PaletteMode::Dither } else { args.palette };
-    let image = palette::apply(&rendered.image, &rendered.objects, palette_mode);
-    let written = match panel_preview(&rendered.image, args.color, format) {
-        None => write_atomically(&out, |f| formats::write(&image, format, f).map_err(std::io::Error::other)),
-        Some(Preview::Image(panel)) => {
-            write_atomically(&out, |f| formats::write(&panel, format, f).map_err(std::io::Error::other))
-        }
-        Some(Preview::Gray { width, height, gray }) => {
-            write_atomically(&out, |f| write_gray_png(width, height, &gray, f))
-        }
-    };
-    if let Err(e) = written {
-        let _ = writeln!(stderr, "host-sim: cannot write {}: {e}", out.display());
-        return Err(EXIT_IO);
-    }
     if !args.quiet {
         if let Some((report, _)) = &rendered.build {
             if let Some(kind) = report.exhausted {
@@ -362,7 +543,11 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
         }
         let _ = writeln!(
             stderr,
-            "{w}x{h} in {:.3} s ({}, {} thread{}): {} rays, {} shadow rays, {} cells{} -> {}",
+            "{w}x{h}{} in {:.3} s ({}, {} thread{}): {} rays, {} shadow rays, {} cells{} -> {}",
+            match args.part {
+                Some(_) => format!(" rows {}..{}", rows.start, rows.end),
+                None => String::new(),
+            },
             elapsed.as_secs_f64(),
             rendered.accel.name(),
             options.threads,
@@ -377,13 +562,13 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
             },
             out.display()
         );
-        if palette_mode != PaletteMode::None {
+        if let Some(summary) = summary {
             let _ = writeln!(
                 stderr,
                 "{} palette: {} colours of 256, {:.1} dB against truecolour ({})",
                 palette_mode.name(),
-                palette::colors_used(&image),
-                palette::psnr(&rendered.image, &image.to_rgb()),
+                summary.colors_used,
+                summary.psnr,
                 format.name()
             );
         }

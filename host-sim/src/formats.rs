@@ -143,10 +143,199 @@ fn unsupported<T>(message: String) -> Result<T, FormatError> {
 /// Writes `image` to `out` as a `format` file.
 pub fn write(image: &Image, format: Format, out: &mut dyn Write) -> Result<(), FormatError> {
     check(image)?;
-    match format {
-        Format::Png => write_png(image, out),
-        Format::Tga => Ok(out.write_all(&tga_bytes(image)?)?),
-        Format::Ras => Ok(out.write_all(&ras_bytes(image)?)?),
+    let (width, row_bytes) = (image.width() as usize, image.width() as usize * image.bytes_per_pixel());
+    let (palette, data) = match image {
+        Image::Rgb(rgb) => (None, &rgb.data),
+        Image::Indexed { palette, indices, .. } => (Some(palette.clone()), indices),
+    };
+    let header = Header { width: width as u32, height: image.height(), palette, text: None };
+    let mut writer = RowWriter::new(format, &header, out)?;
+    for row in data.chunks_exact(row_bytes) {
+        writer.write_row(row)?;
+    }
+    writer.finish()
+}
+
+/// What a file says before its rows.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Header {
+    pub width: u32,
+    pub height: u32,
+    /// The colour table of an indexed image (rows are then one index a pixel), or `None` for truecolour (rows
+    /// of RGB triples).
+    pub palette: Option<Vec<[u8; 3]>>,
+    /// Text carried in the file: a PNG `tEXt` chunk under [`TEXT_KEYWORD`] or a Targa image ID (at most 255
+    /// bytes). Sun rasters have nowhere to put it.
+    pub text: Option<String>,
+}
+
+/// The keyword of the PNG `tEXt` chunk that carries [`Header::text`].
+pub const TEXT_KEYWORD: &str = "octrace";
+
+/// Writes an image a row at a time, top to bottom, so that no more than a row is held: the file's header
+/// first, then each row as it comes. Every row must come; [`RowWriter::finish`] says if one is missing.
+pub struct RowWriter<'a> {
+    encoder: RowEncoder<'a>,
+    row_bytes: usize,
+    rows_left: u32,
+    /// A row as stored (BGR, padded), reused.
+    stored: Vec<u8>,
+}
+
+enum RowEncoder<'a> {
+    /// The encoder owns its output, so it writes into a buffer that is drained into `out` after each row.
+    Png { writer: Box<png::StreamWriter<'static, Buffer>>, buffer: Buffer, out: &'a mut dyn Write },
+    /// Targa and Sun raster rows: BGR when truecolour, padded to `pad` extra bytes.
+    Raw { out: &'a mut dyn Write, bgr: bool, pad: usize },
+}
+
+fn png_encoding_error(e: png::EncodingError) -> FormatError {
+    match e {
+        png::EncodingError::IoError(e) => FormatError::Io(e),
+        e => FormatError::Invalid(format!("PNG encoder: {e}")),
+    }
+}
+
+impl<'a> RowWriter<'a> {
+    /// Writes the header of a `format` file to `out`; the rows follow through [`RowWriter::write_row`].
+    pub fn new(format: Format, header: &Header, out: &'a mut dyn Write) -> Result<RowWriter<'a>, FormatError> {
+        let (width, height) = (header.width, header.height);
+        if width == 0 || height == 0 {
+            return invalid(format!("the image is {width}×{height} pixels"));
+        }
+        if let Some(palette) = &header.palette {
+            if palette.len() > 256 {
+                return invalid(format!("palette has {} entries, at most 256", palette.len()));
+            }
+        }
+        let pixel_bytes = if header.palette.is_some() { 1 } else { 3 };
+        let row_bytes = width as usize * pixel_bytes;
+        let encoder = match format {
+            Format::Png => {
+                let buffer = Buffer::default();
+                let writer = Box::new(png_stream_writer(header, buffer.clone())?);
+                let mut encoder = RowEncoder::Png { writer, buffer, out };
+                encoder.drain()?;
+                encoder
+            }
+            Format::Tga => {
+                out.write_all(&tga_header(header)?)?;
+                RowEncoder::Raw { out, bgr: header.palette.is_none(), pad: 0 }
+            }
+            Format::Ras => {
+                if header.text.is_some() {
+                    return unsupported("a Sun raster cannot carry text: use PNG or Targa".into());
+                }
+                out.write_all(&ras_header(header)?)?;
+                RowEncoder::Raw { out, bgr: header.palette.is_none(), pad: row_bytes % 2 }
+            }
+        };
+        Ok(RowWriter { encoder, row_bytes, rows_left: height, stored: Vec::new() })
+    }
+
+    /// Writes the next row: `width` RGB triples, or `width` indices into the palette.
+    pub fn write_row(&mut self, row: &[u8]) -> Result<(), FormatError> {
+        if row.len() != self.row_bytes {
+            return invalid(format!("a row of {} bytes where {} were expected", row.len(), self.row_bytes));
+        }
+        if self.rows_left == 0 {
+            return invalid("more rows than the image has".into());
+        }
+        self.rows_left -= 1;
+        match &mut self.encoder {
+            RowEncoder::Png { writer, .. } => {
+                writer.write_all(row).map_err(|e| match e.downcast::<png::EncodingError>() {
+                    Ok(e) => png_encoding_error(e),
+                    Err(e) => FormatError::Io(e),
+                })?;
+                self.encoder.drain()
+            }
+            RowEncoder::Raw { out, bgr, pad } => {
+                let stored = if *bgr {
+                    self.stored.clear();
+                    self.stored.extend(row.chunks_exact(3).flat_map(|p| BGR.map(|i| p[i])));
+                    self.stored.extend_from_slice(&[0][..*pad]);
+                    &self.stored[..]
+                } else if *pad > 0 {
+                    self.stored.clear();
+                    self.stored.extend_from_slice(row);
+                    self.stored.push(0);
+                    &self.stored[..]
+                } else {
+                    row
+                };
+                Ok(out.write_all(stored)?)
+            }
+        }
+    }
+
+    /// Ends the file; fails if rows are missing.
+    pub fn finish(self) -> Result<(), FormatError> {
+        if self.rows_left > 0 {
+            return invalid(format!("{} rows of the image were never written", self.rows_left));
+        }
+        match self.encoder {
+            RowEncoder::Png { writer, buffer, out } => {
+                writer.finish().map_err(png_encoding_error)?;
+                let mut encoder = RowEncoder::Raw { out, bgr: false, pad: 0 };
+                encoder.write_buffered(&buffer)?;
+                encoder.flush()
+            }
+            mut raw @ RowEncoder::Raw { .. } => raw.flush(),
+        }
+    }
+}
+
+/// Bytes the PNG encoder has written and the file has not yet received.
+#[derive(Clone, Default)]
+struct Buffer(std::rc::Rc<std::cell::RefCell<Vec<u8>>>);
+
+impl Write for Buffer {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        self.0.borrow_mut().extend_from_slice(bytes);
+        Ok(bytes.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+impl RowEncoder<'_> {
+    /// Moves what the PNG encoder wrote so far to the file.
+    fn drain(&mut self) -> Result<(), FormatError> {
+        match self {
+            RowEncoder::Png { buffer, out, .. } => {
+                let mut bytes = buffer.0.borrow_mut();
+                out.write_all(&bytes)?;
+                bytes.clear();
+                Ok(())
+            }
+            RowEncoder::Raw { .. } => Ok(()),
+        }
+    }
+
+    fn write_buffered(&mut self, buffer: &Buffer) -> Result<(), FormatError> {
+        if let RowEncoder::Raw { out, .. } = self {
+            out.write_all(&buffer.0.borrow())?;
+        }
+        Ok(())
+    }
+
+    fn flush(&mut self) -> Result<(), FormatError> {
+        match self {
+            RowEncoder::Png { out, .. } | RowEncoder::Raw { out, .. } => Ok(out.flush()?),
+        }
+    }
+}
+
+impl Image {
+    /// Bytes a pixel takes in memory: 3 (RGB) or 1 (an index).
+    pub fn bytes_per_pixel(&self) -> usize {
+        match self {
+            Image::Rgb(_) => 3,
+            Image::Indexed { .. } => 1,
+        }
     }
 }
 
@@ -209,27 +398,20 @@ const PNG_SIGNATURE: &[u8] = b"\x89PNG\r\n\x1a\n";
 /// Deflate turns no byte into more than this many.
 const DEFLATE_MAX_RATIO: u64 = 1032;
 
-fn write_png(image: &Image, out: &mut dyn Write) -> Result<(), FormatError> {
-    let mut encoder = png::Encoder::new(out, image.width(), image.height());
+fn png_stream_writer(header: &Header, out: Buffer) -> Result<png::StreamWriter<'static, Buffer>, FormatError> {
+    let mut encoder = png::Encoder::new(out, header.width, header.height);
     encoder.set_depth(png::BitDepth::Eight);
-    let data = match image {
-        Image::Rgb(rgb) => {
-            encoder.set_color(png::ColorType::Rgb);
-            &rgb.data
-        }
-        Image::Indexed { palette, indices, .. } => {
+    match &header.palette {
+        None => encoder.set_color(png::ColorType::Rgb),
+        Some(palette) => {
             encoder.set_color(png::ColorType::Indexed);
             encoder.set_palette(palette.concat());
-            indices
         }
-    };
-    let encoding_error = |e| match e {
-        png::EncodingError::IoError(e) => FormatError::Io(e),
-        e => FormatError::Invalid(format!("PNG encoder: {e}")),
-    };
-    let mut writer = encoder.write_header().map_err(encoding_error)?;
-    writer.write_image_data(data).map_err(encoding_error)?;
-    writer.finish().map_err(encoding_error)
+    }
+    if let Some(text) = &header.text {
+        encoder.add_text_chunk(TEXT_KEYWORD.into(), text.clone()).map_err(png_encoding_error)?;
+    }
+    encoder.write_header().map_err(png_encoding_error)?.into_stream_writer().map_err(png_encoding_error)
 }
 
 fn read_png(bytes: &[u8]) -> Result<Image, FormatError> {
@@ -280,28 +462,192 @@ fn read_png(bytes: &[u8]) -> Result<Image, FormatError> {
     Ok(Image::Indexed { width, height, palette, indices })
 }
 
+/// Reads an image a row at a time, top to bottom, holding no more than a row: the files this module writes
+/// (PNG of 8-bit RGB or indices, not interlaced; uncompressed top-down Targa; standard Sun rasters), with
+/// the text they carry. Other files (which [`read`] takes whole) are refused.
+pub struct RowReader {
+    header: Header,
+    decoder: RowDecoder,
+    rows_left: u32,
+    row: Vec<u8>,
+}
+
+enum RowDecoder {
+    Png(Box<png::Reader<std::io::BufReader<std::fs::File>>>),
+    Raw { input: std::io::BufReader<std::fs::File>, bgr: bool, stored: Vec<u8> },
+}
+
+impl RowReader {
+    /// Reads the header of the image file `file` (told apart by content).
+    pub fn new(file: std::fs::File) -> Result<RowReader, FormatError> {
+        use std::io::BufRead;
+        let mut input = std::io::BufReader::new(file);
+        let start = input.fill_buf()?;
+        if start.starts_with(PNG_SIGNATURE) {
+            return RowReader::png(input);
+        }
+        let is_ras = start.starts_with(&RAS_MAGIC.to_be_bytes());
+        let mut fixed = vec![0; if is_ras { 32 } else { 18 }];
+        let part = if is_ras { "Sun raster header" } else { "Targa header" };
+        read_exactly(&mut input, &mut fixed, part)?;
+        let (width, height, palette, text, pixel_bytes, pad) = if is_ras {
+            let field =
+                |i: usize| u32::from_be_bytes([fixed[4 * i], fixed[4 * i + 1], fixed[4 * i + 2], fixed[4 * i + 3]]);
+            let [width, height, depth, _length, kind, map_type, map_length] = std::array::from_fn(|i| field(i + 1));
+            let palette = match (depth, kind, map_type) {
+                (24, RT_STANDARD, RMT_NONE) => None,
+                (8, RT_STANDARD, RMT_EQUAL_RGB) if map_length % 3 == 0 && map_length <= 768 => {
+                    let mut map = vec![0; map_length as usize];
+                    read_exactly(&mut input, &mut map, "Sun raster colour map")?;
+                    let entries = map.len() / 3;
+                    Some((0..entries).map(|i| [map[i], map[entries + i], map[2 * entries + i]]).collect())
+                }
+                _ => {
+                    return unsupported(format!(
+                        "Sun raster of type {kind}, {depth} bits, map {map_type}: not one host-sim writes"
+                    ))
+                }
+            };
+            let pixel_bytes = if palette.is_some() { 1 } else { 3 };
+            (width, height, palette, None, pixel_bytes, width as usize * pixel_bytes % 2)
+        } else {
+            let u16_at = |i: usize| u16::from_le_bytes([fixed[i], fixed[i + 1]]);
+            let [id_length, map_type, image_type] = [fixed[0], fixed[1], fixed[2]];
+            let (map_first, map_length, map_bits) = (u16_at(3), u16_at(5) as usize, fixed[7]);
+            let (width, height, pixel_bits, descriptor) = (u16_at(12), u16_at(14), fixed[16], fixed[17]);
+            let mut id = vec![0; id_length as usize];
+            read_exactly(&mut input, &mut id, "Targa image ID")?;
+            let text = String::from_utf8(id).ok().filter(|t| !t.is_empty());
+            let palette = match (map_type, image_type, pixel_bits, map_bits, map_first, descriptor) {
+                (0, 2, 24, _, _, TGA_TOP_DOWN) => None,
+                (1, 1, 8, 24, 0, TGA_TOP_DOWN) if map_length <= 256 => {
+                    let mut map = vec![0; map_length * 3];
+                    read_exactly(&mut input, &mut map, "Targa colour map")?;
+                    Some(map.chunks_exact(3).map(|e| [e[2], e[1], e[0]]).collect())
+                }
+                _ => return unsupported(format!("Targa image type {image_type}, {pixel_bits} bits, descriptor {descriptor:#x}: not one host-sim writes")),
+            };
+            let pixel_bytes = if palette.is_some() { 1 } else { 3 };
+            (u32::from(width), u32::from(height), palette, text, pixel_bytes, 0)
+        };
+        if width == 0 || height == 0 {
+            return invalid(format!("the image is {width}×{height} pixels"));
+        }
+        let bgr = palette.is_none();
+        let stored = vec![0; width as usize * pixel_bytes + pad];
+        let header = Header { width, height, palette, text };
+        Ok(RowReader { header, decoder: RowDecoder::Raw { input, bgr, stored }, rows_left: height, row: Vec::new() })
+    }
+
+    fn png(input: std::io::BufReader<std::fs::File>) -> Result<RowReader, FormatError> {
+        let decoding_error = |e| match e {
+            png::DecodingError::IoError(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => {
+                FormatError::Truncated("PNG file")
+            }
+            e => FormatError::Invalid(format!("malformed PNG file: {e}")),
+        };
+        // Rows are decoded one at a time: the whole image is never allocated.
+        let decoder = png::Decoder::new_with_limits(input, png::Limits { bytes: usize::MAX });
+        let reader = decoder.read_info().map_err(decoding_error)?;
+        let info = reader.info();
+        let palette = match (info.color_type, info.bit_depth, info.interlaced) {
+            (png::ColorType::Rgb, png::BitDepth::Eight, false) => None,
+            (png::ColorType::Indexed, png::BitDepth::Eight, false) => {
+                let palette = info
+                    .palette
+                    .as_ref()
+                    .ok_or_else(|| FormatError::Invalid("indexed PNG file without a PLTE chunk".into()))?;
+                Some(palette.chunks_exact(3).map(|e| [e[0], e[1], e[2]]).collect())
+            }
+            (colour, depth, interlaced) => {
+                return unsupported(format!(
+                    "PNG of {colour:?} colour at {} bits{}: not one host-sim writes",
+                    depth as u8,
+                    if interlaced { ", interlaced" } else { "" }
+                ))
+            }
+        };
+        let text = info.uncompressed_latin1_text.iter().find(|t| t.keyword == TEXT_KEYWORD).map(|t| t.text.clone());
+        let header = Header { width: info.width, height: info.height, palette, text };
+        Ok(RowReader { rows_left: header.height, header, decoder: RowDecoder::Png(Box::new(reader)), row: Vec::new() })
+    }
+
+    /// The file's header, with its text.
+    pub fn header(&self) -> &Header {
+        &self.header
+    }
+
+    /// The next row (RGB triples or indices); an error past the last row.
+    pub fn next_row(&mut self) -> Result<&[u8], FormatError> {
+        if self.rows_left == 0 {
+            return invalid("no rows left".into());
+        }
+        self.rows_left -= 1;
+        match &mut self.decoder {
+            RowDecoder::Png(reader) => {
+                let row = reader.next_row().map_err(|e| match e {
+                    png::DecodingError::IoError(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => {
+                        FormatError::Truncated("PNG file")
+                    }
+                    e => FormatError::Invalid(format!("malformed PNG file: {e}")),
+                })?;
+                let row = row.ok_or(FormatError::Truncated("PNG image data"))?;
+                self.row.clear();
+                self.row.extend_from_slice(row.data());
+            }
+            RowDecoder::Raw { input, bgr, stored } => {
+                read_exactly(input, stored, "pixels")?;
+                self.row.clear();
+                let width = self.header.width as usize;
+                if *bgr {
+                    self.row.extend(stored[..3 * width].chunks_exact(3).flat_map(|p| BGR.map(|i| p[i])));
+                } else {
+                    self.row.extend_from_slice(&stored[..width]);
+                }
+            }
+        }
+        if let Some(palette) = &self.header.palette {
+            if let Some(index) = self.row.iter().find(|&&i| i as usize >= palette.len()) {
+                return invalid(format!("index {index} is outside the {}-entry palette", palette.len()));
+            }
+        }
+        Ok(&self.row)
+    }
+}
+
+fn read_exactly(input: &mut impl std::io::Read, buffer: &mut [u8], part: &'static str) -> Result<(), FormatError> {
+    input.read_exact(buffer).map_err(|e| match e.kind() {
+        std::io::ErrorKind::UnexpectedEof => FormatError::Truncated(part),
+        _ => FormatError::Io(e),
+    })
+}
+
 /// Descriptor bit 5: the first row stored is the top one.
 const TGA_TOP_DOWN: u8 = 0x20;
 /// Descriptor bit 4: each row is stored right to left.
 const TGA_RIGHT_TO_LEFT: u8 = 0x10;
 
-fn tga_bytes(image: &Image) -> Result<Vec<u8>, FormatError> {
-    let (width, height) = (image.width(), image.height());
+fn tga_header(header: &Header) -> Result<Vec<u8>, FormatError> {
+    let (width, height) = (header.width, header.height);
     let (Ok(width), Ok(height)) = (u16::try_from(width), u16::try_from(height)) else {
         return invalid(format!("a Targa image is at most 65535×65535 pixels, not {width}×{height}"));
     };
-    let (map_type, image_type, map, map_bits, pixel_bits, pixels) = match image {
-        Image::Rgb(rgb) => (0, 2, Vec::new(), 0, 24, pick(&rgb.data, 3, BGR)),
-        Image::Indexed { palette, indices, .. } => (1, 1, pick(&palette.concat(), 3, BGR), 24, 8, indices.clone()),
+    let id = header.text.as_deref().unwrap_or("").as_bytes();
+    let Ok(id_length) = u8::try_from(id.len()) else {
+        return invalid(format!("a Targa image ID is at most 255 bytes, not {}", id.len()));
     };
-    let mut out = Vec::with_capacity(18 + map.len() + pixels.len());
-    out.extend([0, map_type, image_type]);
+    let (map_type, image_type, map, map_bits, pixel_bits) = match &header.palette {
+        None => (0, 2, Vec::new(), 0, 24),
+        Some(palette) => (1, 1, pick(&palette.concat(), 3, BGR), 24, 8),
+    };
+    let mut out = Vec::with_capacity(18 + id.len() + map.len());
+    out.extend([id_length, map_type, image_type]);
     out.extend(0u16.to_le_bytes().into_iter().chain((map.len() as u16 / 3).to_le_bytes()));
     out.extend([map_bits, 0, 0, 0, 0]);
     out.extend(width.to_le_bytes().into_iter().chain(height.to_le_bytes()));
     out.extend([pixel_bits, TGA_TOP_DOWN]);
+    out.extend(id);
     out.extend(map);
-    out.extend(pixels);
     Ok(out)
 }
 
@@ -409,27 +755,22 @@ const RMT_EQUAL_RGB: u32 = 1;
 /// The escape byte of RT_BYTE_ENCODED data.
 const RAS_RUN: u8 = 0x80;
 
-fn ras_bytes(image: &Image) -> Result<Vec<u8>, FormatError> {
-    let (width, height) = (image.width(), image.height());
-    let (depth, pixel_bytes, map_type, map, pixels) = match image {
-        Image::Rgb(rgb) => (24, 3, RMT_NONE, Vec::new(), pick(&rgb.data, 3, BGR)),
-        Image::Indexed { palette, indices, .. } => {
-            let map = (0..3).flat_map(|channel| palette.iter().map(move |entry| entry[channel])).collect();
-            (8, 1, RMT_EQUAL_RGB, map, indices.clone())
+fn ras_header(header: &Header) -> Result<Vec<u8>, FormatError> {
+    let (width, height) = (header.width, header.height);
+    let (depth, pixel_bytes, map_type, map) = match &header.palette {
+        None => (24, 3, RMT_NONE, Vec::new()),
+        Some(palette) => {
+            let map: Vec<u8> = (0..3).flat_map(|channel| palette.iter().map(move |entry| entry[channel])).collect();
+            (8, 1, RMT_EQUAL_RGB, map)
         }
     };
-    let row = width as usize * pixel_bytes;
-    let Ok(length) = u32::try_from((row + row % 2) as u64 * u64::from(height)) else {
+    let row = width as u64 * pixel_bytes;
+    let Ok(length) = u32::try_from((row + row % 2) * u64::from(height)) else {
         return invalid(format!("a {width}×{height} image is too large for a Sun raster"));
     };
-    let header = [RAS_MAGIC, width, height, depth, length, RT_STANDARD, map_type, map.len() as u32];
-    let mut out = Vec::with_capacity(32 + map.len() + length as usize);
-    out.extend(header.into_iter().flat_map(u32::to_be_bytes));
+    let fields = [RAS_MAGIC, width, height, depth, length, RT_STANDARD, map_type, map.len() as u32];
+    let mut out: Vec<u8> = fields.into_iter().flat_map(u32::to_be_bytes).collect();
     out.extend(map);
-    for pixels in pixels.chunks_exact(row) {
-        out.extend_from_slice(pixels);
-        out.extend_from_slice(&[0][..row % 2]);
-    }
     Ok(out)
 }
 
@@ -734,6 +1075,42 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn rows_read_back_with_their_text() {
+        let dir = std::env::temp_dir().join(format!("octrace-rows-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for format in FORMATS {
+            for image in samples() {
+                let text = (format != Format::Ras).then(|| "octrace-part 1 and some words".to_string());
+                let (palette, data) = match &image {
+                    Image::Rgb(rgb) => (None, rgb.data.clone()),
+                    Image::Indexed { palette, indices, .. } => (Some(palette.clone()), indices.clone()),
+                };
+                let header = Header { width: image.width(), height: image.height(), palette, text };
+                let mut bytes = Vec::new();
+                let mut writer = RowWriter::new(format, &header, &mut bytes).unwrap();
+                let row_bytes = data.len() / image.height() as usize;
+                data.chunks(row_bytes).for_each(|row| writer.write_row(row).unwrap());
+                writer.finish().unwrap();
+                assert_eq!(read(&bytes).unwrap(), image, "{} as a whole", format.name());
+                let path = dir.join(format!("image.{}", format.name()));
+                std::fs::write(&path, &bytes).unwrap();
+                let mut reader = RowReader::new(std::fs::File::open(&path).unwrap()).unwrap();
+                assert_eq!(reader.header(), &header, "{}", format.name());
+                for row in data.chunks(row_bytes) {
+                    assert_eq!(reader.next_row().unwrap(), row);
+                }
+                assert!(reader.next_row().is_err());
+            }
+        }
+        let header = Header { width: 1, height: 1, palette: None, text: Some("t".into()) };
+        assert!(RowWriter::new(Format::Ras, &header, &mut Vec::new()).is_err(), "a Sun raster has no room for text");
+        let mut sink = std::io::sink();
+        let mut writer = RowWriter::new(Format::Png, &Header { text: None, ..header }, &mut sink).unwrap();
+        assert!(writer.write_row(&[0; 4]).is_err(), "a row of the wrong length");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -1,11 +1,17 @@
 //! octrace on the desktop: load a scene file, render it with the same core
-//! code a board runs, write a PNG. The binary is a thin wrapper around
-//! [`run`], so tests drive exactly what a user runs.
+//! code a board runs, write an image file. The binary is a thin wrapper
+//! around [`run`], so tests drive exactly what a user runs.
+//!
+//! Invariants: any number of threads and any partition give the same bits;
+//! a streamed render ([`render_streamed`]) holds a few bands of rows, never
+//! the image, and hands every row to its sink once, in order.
 
 pub mod cli;
 pub mod formats;
 pub mod image;
+pub mod output;
 pub mod palette;
+pub mod parts;
 pub mod studio;
 
 pub use image::RgbImage;
@@ -16,12 +22,11 @@ use embedded_graphics_core::primitives::Rectangle;
 use octrace_core::accel::{Accelerator, BuildReport, Mailbox, Naive, Octree, OctreeConfig, Traversal};
 use octrace_core::parse::{parse_bytes, ParseError};
 use octrace_core::profile::Host;
-use octrace_core::render::{Renderer, Tiles};
+use octrace_core::render::Renderer;
 use octrace_core::scene::{CameraError, Scene, SceneView};
 use octrace_core::shade::Stats;
 use std::path::Path;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::{Condvar, Mutex};
 use std::time::{Duration, Instant};
 
 /// The host build's scene: a million objects of any mix, heap-backed.
@@ -187,90 +192,316 @@ pub fn render_prebuilt(
 ) -> Result<Rendered, CameraError> {
     let view = scene.view();
     let (w, h) = options.size.unwrap_or((view.settings.raster[0], view.settings.raster[1]));
-    // Set-up errors are found once, before any thread starts.
-    Renderer::with_size(view, &Naive, w, h)?;
-    let (accel, job) = match octree {
-        None => (AccelMode::Naive, render_threads(view, &Naive, (w, h), options, progress)),
-        Some(tree) => {
-            let mode = if tree.traversal() == Traversal::Named { AccelMode::Octree } else { AccelMode::Dda };
-            (mode, render_threads(view, tree, (w, h), options, progress))
-        }
+    let mut canvas = Canvas { image: RgbImage::new(w, h), objects: vec![NO_OBJECT; w as usize * h as usize] };
+    let streamed = match stream_prebuilt(scene, options, octree, 0..h, progress, &mut canvas) {
+        Ok(s) => s,
+        Err(StreamError::Camera(e)) => return Err(e),
+        // The canvas takes every row.
+        Err(StreamError::Sink(e)) => unreachable!("a canvas refused a row: {e}"),
     };
-    let (image, objects, stats, wall, busy) = job;
-    Ok(Rendered { image, objects, stats, accel, build: None, wall, busy })
+    let Streamed { stats, accel, build, wall, busy } = streamed;
+    Ok(Rendered { image: canvas.image, objects: canvas.objects, stats, accel, build, wall, busy })
 }
 
-/// The pieces of the image in the order they are handed out.
-fn pieces(size: Size, partition: Partition) -> Vec<Rectangle> {
-    match partition {
-        Partition::Tiles => Tiles::new(size, TILE_SIDE).iter().collect(),
-        Partition::Equal4 => {
-            let (w, h) = (size.width, size.height);
-            let (left, top) = (w / 2, h / 2);
-            [(0, 0, left, top), (left, 0, w - left, top), (0, top, left, h - top), (left, top, w - left, h - top)]
-                .into_iter()
-                .map(|(x, y, w, h)| Rectangle::new(Point::new(x as i32, y as i32), Size::new(w, h)))
-                .collect()
+/// What a streamed render reports; its rows went to a [`RowSink`].
+#[derive(Clone, Debug)]
+pub struct Streamed {
+    pub stats: Stats,
+    /// The mode actually used (never `Auto`).
+    pub accel: AccelMode,
+    /// The octree's build report and time, when one was built.
+    pub build: Option<(BuildReport, Duration)>,
+    /// Wall-clock time of the render (without building the octree).
+    pub wall: Duration,
+    /// For each thread, the time it spent tracing.
+    pub busy: Vec<Duration>,
+}
+
+/// Receives a streamed render's rows, each once, in order from top to bottom.
+pub trait RowSink {
+    /// Row `y` (counted in the whole image): RGB triples, and the object
+    /// seen through each pixel ([`NO_OBJECT`] for background).
+    fn row(&mut self, y: u32, colors: &[u8], objects: &[u32]) -> std::io::Result<()>;
+}
+
+/// Why a streamed render stopped.
+#[derive(Debug)]
+pub enum StreamError {
+    /// The camera cannot be set up for the size asked (nothing rendered).
+    Camera(CameraError),
+    /// The sink refused a row; the render stopped there.
+    Sink(std::io::Error),
+}
+
+impl std::fmt::Display for StreamError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            StreamError::Camera(e) => write!(f, "cannot set up the camera: {e:?}"),
+            StreamError::Sink(e) => write!(f, "{e}"),
         }
     }
 }
 
-/// The image and the object of every pixel, filled in pieces.
-struct Canvas {
-    image: RgbImage,
-    objects: Vec<u32>,
+impl std::error::Error for StreamError {}
+
+/// Renders the rows `rows` of the whole image (`options.size`, else RASTER)
+/// on `options.threads` threads and hands them to `sink` in order, holding
+/// only a few bands of rows at a time: memory follows the width, not the
+/// height. Builds the octree `options.accel` asks for first.
+pub fn render_streamed(
+    scene: &HostScene,
+    options: &RenderOptions,
+    rows: std::ops::Range<u32>,
+    progress: &(dyn Fn(u64) + Sync),
+    sink: &mut dyn RowSink,
+) -> Result<Streamed, StreamError> {
+    let accel = options.accel.resolve(scene.view().object_count());
+    let started = Instant::now();
+    let octree = build_octree(scene, accel, &options.octree);
+    let build = octree.as_ref().map(|o| (*o.report(), started.elapsed()));
+    let mut streamed = stream_prebuilt(scene, options, octree.as_deref(), rows, progress, sink)?;
+    streamed.build = build;
+    Ok(streamed)
 }
 
-/// Renders on `options.threads` threads, each with its own renderer (and
-/// mailbox), into one image.
-fn render_threads<A: Accelerator + Sync>(
+fn stream_prebuilt(
+    scene: &HostScene,
+    options: &RenderOptions,
+    octree: Option<&HostOctree>,
+    rows: std::ops::Range<u32>,
+    progress: &(dyn Fn(u64) + Sync),
+    sink: &mut dyn RowSink,
+) -> Result<Streamed, StreamError> {
+    let view = scene.view();
+    let (w, h) = options.size.unwrap_or((view.settings.raster[0], view.settings.raster[1]));
+    // Set-up errors are found once, before any thread starts.
+    Renderer::with_size(view, &Naive, w, h).map_err(StreamError::Camera)?;
+    let rows = rows.start.min(h)..rows.end.min(h);
+    let (accel, job) = match octree {
+        None => (AccelMode::Naive, stream_threads(view, &Naive, (w, h), rows, options, progress, sink)),
+        Some(tree) => {
+            let mode = if tree.traversal() == Traversal::Named { AccelMode::Octree } else { AccelMode::Dda };
+            (mode, stream_threads(view, tree, (w, h), rows, options, progress, sink))
+        }
+    };
+    let (stats, wall, busy) = job.map_err(StreamError::Sink)?;
+    Ok(Streamed { stats, accel, build: None, wall, busy })
+}
+
+/// A piece of the image one thread renders at a time, and the band of rows
+/// it belongs to.
+#[derive(Clone, Copy, Debug)]
+struct Piece {
+    band: usize,
+    area: Rectangle,
+}
+
+/// The bands of `rows` (each a range of rows) and their pieces in the order
+/// they are handed out: bands of [`TILE_SIDE`] rows cut into tiles, or for
+/// [`Partition::Equal4`] one band, the thesis's four rectangles.
+fn bands(width: u32, rows: &std::ops::Range<u32>, partition: Partition) -> (Vec<std::ops::Range<u32>>, Vec<Piece>) {
+    let rectangle = |x: u32, y: u32, w: u32, h: u32| Rectangle::new(Point::new(x as i32, y as i32), Size::new(w, h));
+    match partition {
+        Partition::Tiles => {
+            let bands: Vec<_> =
+                rows.clone().step_by(TILE_SIDE as usize).map(|y| y..(y + TILE_SIDE).min(rows.end)).collect();
+            let pieces = bands
+                .iter()
+                .enumerate()
+                .flat_map(|(band, ys)| {
+                    (0..width).step_by(TILE_SIDE as usize).map(move |x| Piece {
+                        band,
+                        area: rectangle(x, ys.start, TILE_SIDE.min(width - x), ys.end - ys.start),
+                    })
+                })
+                .collect();
+            (bands, pieces)
+        }
+        Partition::Equal4 => {
+            let (left, top, height) = (width / 2, rows.start + rows.len() as u32 / 2, rows.len() as u32);
+            let top_height = top - rows.start;
+            let quarters = [
+                (0, rows.start, left, top_height),
+                (left, rows.start, width - left, top_height),
+                (0, top, left, height - top_height),
+                (left, top, width - left, height - top_height),
+            ];
+            let pieces = quarters.into_iter().map(|(x, y, w, h)| Piece { band: 0, area: rectangle(x, y, w, h) });
+            (vec![rows.clone()], pieces.collect())
+        }
+    }
+}
+
+/// A band of rows being filled: colours and objects, row-major.
+struct Slot {
+    band: usize,
+    colors: Vec<u8>,
+    objects: Vec<u32>,
+    /// Pieces of the band not yet copied in.
+    remaining: usize,
+}
+
+/// What the threads of a streamed render share.
+struct Window {
+    /// The next piece to hand out (tiles).
+    next: usize,
+    /// Bands already given to the sink.
+    written: usize,
+    slots: Vec<Slot>,
+    /// Threads still rendering.
+    alive: usize,
+    /// The sink failed: stop.
+    abort: bool,
+}
+
+/// At most this many bytes of bands wait to be written (unless two bands
+/// need more): far below the target of 256 MB for a 16384-pixel-wide image.
+const WINDOW_BYTES: usize = 64 << 20;
+
+/// Renders `rows` on `options.threads` threads, each with its own renderer
+/// (and mailbox): threads take pieces of the bands in order, at most a
+/// window of bands ahead of the oldest one not yet written, while this
+/// thread hands finished bands to `sink` in order.
+fn stream_threads<A: Accelerator + Sync>(
     view: SceneView<'_>,
     accel: &A,
     (w, h): (u32, u32),
+    rows: std::ops::Range<u32>,
     options: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
-) -> (RgbImage, Vec<u32>, Stats, Duration, Vec<Duration>) {
+    sink: &mut dyn RowSink,
+) -> std::io::Result<(Stats, Duration, Vec<Duration>)> {
     let threads = options.threads.max(1);
-    let pieces = pieces(Size::new(w, h), options.partition);
-    let next = AtomicUsize::new(0);
-    let canvas = Mutex::new(Canvas { image: RgbImage::new(w, h), objects: vec![NO_OBJECT; w as usize * h as usize] });
+    let (bands, pieces) = bands(w, &rows, options.partition);
+    let mut pieces_in_band = vec![0usize; bands.len()];
+    pieces.iter().for_each(|p| pieces_in_band[p.band] += 1);
+    let band_bytes = bands.first().map_or(0, |b| b.len()) * w as usize * 7;
+    let window = (2 * threads).max(4).min((WINDOW_BYTES / band_bytes.max(1)).max(2));
+    let slot = |band: usize, mut colors: Vec<u8>, mut objects: Vec<u32>| {
+        let pixels = bands[band].len() * w as usize;
+        colors.resize(3 * pixels, 0);
+        objects.resize(pixels, NO_OBJECT);
+        Slot { band, colors, objects, remaining: pieces_in_band[band] }
+    };
+    let slots = (0..window.min(bands.len())).map(|band| slot(band, Vec::new(), Vec::new())).collect();
+    let shared = Mutex::new(Window { next: 0, written: 0, slots, alive: threads, abort: false });
+    let changed = Condvar::new();
+    let lock = || shared.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     let started = Instant::now();
     let worker = |thread: usize| {
-        let began = Instant::now();
-        let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
-        let Ok(renderer) = Renderer::with_size(view, accel, w, h) else { return (Stats::default(), Duration::ZERO) };
-        let mut renderer = renderer.with_mailbox(&mut words);
-        let mut piece_index = thread;
-        loop {
-            let index = match options.partition {
-                Partition::Tiles => next.fetch_add(1, Ordering::Relaxed),
-                Partition::Equal4 => {
-                    piece_index += threads;
-                    piece_index - threads
-                }
-            };
-            let Some(piece) = pieces.get(index) else { break };
-            let tile = Tile::render(&mut renderer, piece);
-            tile.copy_into(&mut canvas.lock().unwrap_or_else(|poisoned| poisoned.into_inner()));
-            progress(piece.size.width as u64 * piece.size.height as u64);
+        // Counts this thread out even if it panics, so the writer stops waiting.
+        struct Leaving<'a, F: Fn() -> std::sync::MutexGuard<'a, Window>>(&'a F, &'a Condvar);
+        impl<'a, F: Fn() -> std::sync::MutexGuard<'a, Window>> Drop for Leaving<'a, F> {
+            fn drop(&mut self) {
+                (self.0)().alive -= 1;
+                self.1.notify_all();
+            }
         }
-        (renderer.stats(), began.elapsed())
+        let _leaving = Leaving(&lock, &changed);
+        let mut busy = Duration::ZERO;
+        let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
+        let Ok(renderer) = Renderer::with_size(view, accel, w, h) else { return (Stats::default(), busy) };
+        let mut renderer = renderer.with_mailbox(&mut words);
+        // Equal4 hands the thesis's rectangles out statically.
+        let mut own_next = thread;
+        loop {
+            let mut state = lock();
+            let piece = loop {
+                let index = match options.partition {
+                    Partition::Tiles => state.next,
+                    Partition::Equal4 => own_next,
+                };
+                let piece = match pieces.get(index) {
+                    Some(p) if !state.abort => *p,
+                    _ => return (renderer.stats(), busy),
+                };
+                if piece.band < state.written + window {
+                    match options.partition {
+                        Partition::Tiles => state.next += 1,
+                        Partition::Equal4 => own_next += threads,
+                    }
+                    break piece;
+                }
+                state = changed.wait(state).unwrap_or_else(|poisoned| poisoned.into_inner());
+            };
+            drop(state);
+            let began = Instant::now();
+            let tile = Tile::render(&mut renderer, &piece.area);
+            busy += began.elapsed();
+            let mut state = lock();
+            let slot = &mut state.slots[piece.band % window];
+            tile.copy_into(slot, bands[piece.band].start, w);
+            slot.remaining -= 1;
+            if slot.remaining == 0 {
+                changed.notify_all();
+            }
+            drop(state);
+            progress(piece.area.size.width as u64 * piece.area.size.height as u64);
+        }
     };
-    let results: Vec<(Stats, Duration)> = if threads == 1 {
-        vec![worker(0)]
-    } else {
-        std::thread::scope(|scope| {
-            let handles: Vec<_> = (0..threads).map(|t| scope.spawn(move || worker(t))).collect();
-            handles.into_iter().map(|h| h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))).collect()
-        })
+    let mut writer = || -> std::io::Result<()> {
+        for (band, ys) in bands.iter().enumerate() {
+            let mut state = lock();
+            let index = band % window;
+            while state.slots[index].band != band || state.slots[index].remaining > 0 {
+                if state.alive == 0 {
+                    // A thread died (its panic is raised when the scope ends).
+                    return Err(std::io::Error::other("the render stopped before the image was complete"));
+                }
+                state = changed.wait(state).unwrap_or_else(|poisoned| poisoned.into_inner());
+            }
+            let colors = std::mem::take(&mut state.slots[index].colors);
+            let objects = std::mem::take(&mut state.slots[index].objects);
+            drop(state);
+            let width = w as usize;
+            let result = ys.clone().enumerate().try_for_each(|(i, y)| {
+                sink.row(y, &colors[3 * i * width..3 * (i + 1) * width], &objects[i * width..(i + 1) * width])
+            });
+            let mut state = lock();
+            if result.is_err() {
+                state.abort = true;
+                changed.notify_all();
+                return result;
+            }
+            state.slots[index] = if band + window < bands.len() {
+                slot(band + window, colors, objects)
+            } else {
+                Slot { band: usize::MAX, colors: Vec::new(), objects: Vec::new(), remaining: 0 }
+            };
+            state.written = band + 1;
+            changed.notify_all();
+        }
+        Ok(())
     };
+    let (written, results) = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..threads).map(|t| scope.spawn(move || worker(t))).collect();
+        let written = writer();
+        let results: Vec<(Stats, Duration)> =
+            handles.into_iter().map(|h| h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))).collect();
+        (written, results)
+    });
+    written?;
     let wall = started.elapsed();
     let mut stats = Stats::default();
     for (s, _) in &results {
         stats.add(s);
     }
-    let canvas = canvas.into_inner().unwrap_or_else(|poisoned| poisoned.into_inner());
-    (canvas.image, canvas.objects, stats, wall, results.into_iter().map(|(_, busy)| busy).collect())
+    Ok((stats, wall, results.into_iter().map(|(_, busy)| busy).collect()))
+}
+
+/// The image and the object of every pixel, filled row by row.
+struct Canvas {
+    image: RgbImage,
+    objects: Vec<u32>,
+}
+
+impl RowSink for Canvas {
+    fn row(&mut self, y: u32, colors: &[u8], objects: &[u32]) -> std::io::Result<()> {
+        let (w, y) = (self.image.width as usize, y as usize);
+        self.image.data[3 * y * w..3 * (y + 1) * w].copy_from_slice(colors);
+        self.objects[y * w..(y + 1) * w].copy_from_slice(objects);
+        Ok(())
+    }
 }
 
 /// A rendered piece of the image: colours and objects, row-major.
@@ -294,13 +525,15 @@ impl Tile {
         tile
     }
 
-    fn copy_into(&self, canvas: &mut Canvas) {
-        let (x0, y0) = (self.area.top_left.x as usize, self.area.top_left.y as usize);
-        let (w, image_w) = (self.area.size.width as usize, canvas.image.width as usize);
+    /// Copies the tile into the band starting at row `top` of an image
+    /// `width` pixels wide.
+    fn copy_into(&self, slot: &mut Slot, top: u32, width: u32) {
+        let (x0, y0) = (self.area.top_left.x as usize, self.area.top_left.y as usize - top as usize);
+        let (w, image_w) = (self.area.size.width as usize, width as usize);
         for y in 0..self.area.size.height as usize {
             let at = (y0 + y) * image_w + x0;
-            canvas.image.data[3 * at..3 * (at + w)].copy_from_slice(&self.colors[3 * y * w..3 * (y + 1) * w]);
-            canvas.objects[at..at + w].copy_from_slice(&self.objects[y * w..(y + 1) * w]);
+            slot.colors[3 * at..3 * (at + w)].copy_from_slice(&self.colors[3 * y * w..3 * (y + 1) * w]);
+            slot.objects[at..at + w].copy_from_slice(&self.objects[y * w..(y + 1) * w]);
         }
     }
 }

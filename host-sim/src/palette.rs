@@ -2,8 +2,9 @@
 //! a finished render, in raster order, exactly as a board streams them.
 //!
 //! `scan` runs in two passes here (the whole image learnt first, then
-//! mapped), since the host holds the image anyway; `dither`, `coarse` and
-//! `gray` need one.
+//! mapped); `dither`, `coarse` and `gray` need one. [`apply`] maps an image
+//! held whole; host-sim's command line streams rows through the same
+//! quantizers ([`crate::output`]) and writes the same files.
 
 use crate::formats::Image;
 use crate::{RgbImage, NO_OBJECT};

@@ -137,6 +137,9 @@ pub struct Mailbox<'m> {
     overflowed: bool,
     /// Cells (leaves) visited, for the benchmarks.
     pub cells: u64,
+    /// The object that answered the last `occluded` query with true
+    /// (`u32::MAX`: none), so the tracer can try it first next time.
+    pub(crate) blocker: u32,
 }
 
 impl core::fmt::Debug for Mailbox<'_> {
@@ -152,12 +155,12 @@ impl<'m> Mailbox<'m> {
     /// A mailbox over `words`, for up to `32 · words.len()` objects.
     pub fn new(words: &'m mut [u32]) -> Mailbox<'m> {
         words.fill(0);
-        Mailbox { words, touched: heapless::Vec::new(), overflowed: false, cells: 0 }
+        Mailbox { words, touched: heapless::Vec::new(), overflowed: false, cells: 0, blocker: u32::MAX }
     }
 
     /// No mailbox: every candidate is tested.
     pub fn none() -> Mailbox<'static> {
-        Mailbox { words: &mut [], touched: heapless::Vec::new(), overflowed: false, cells: 0 }
+        Mailbox { words: &mut [], touched: heapless::Vec::new(), overflowed: false, cells: 0, blocker: u32::MAX }
     }
 
     /// Words needed for `objects` objects.
@@ -208,7 +211,8 @@ pub trait Accelerator {
         mailbox: &mut Mailbox<'_>,
     ) -> Option<Hit>;
 
-    /// Whether anything is hit with `0 < t ≤ t_max`.
+    /// Whether anything is hit with `0 < t ≤ t_max`; when so, the object
+    /// found is left in the mailbox's `blocker`.
     fn occluded(
         &self,
         scene: &SceneView<'_>,

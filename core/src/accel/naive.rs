@@ -35,11 +35,15 @@ impl Accelerator for Naive {
         ray: &Ray,
         t_max: Scalar,
         start: Option<RayStart>,
-        _: &mut Mailbox<'_>,
+        mailbox: &mut Mailbox<'_>,
     ) -> bool {
-        scene.objects.iter().enumerate().any(|(i, &handle)| {
+        let blocker = scene.objects.iter().enumerate().position(|(i, &handle)| {
             let leaving = RayStart::leaving(start, ObjectId(i as u32));
             scene.shape_of(handle).intersect(ray, t_max, leaving).is_some()
-        })
+        });
+        if let Some(i) = blocker {
+            mailbox.blocker = i as u32;
+        }
+        blocker.is_some()
     }
 }

@@ -162,6 +162,57 @@ pub fn div_saturating(n: u64, d: u32) -> u32 {
     }
 }
 
+/// `⌊2^62 / d⌋` for `d > 0` (the 3DDDA's reciprocals). On ARMv6-M, two
+/// divisions with 32-bit quotients by reciprocal instead of the library's
+/// 64-bit division: the same bits.
+#[inline]
+pub(crate) fn reciprocal_q62(d: u32) -> u64 {
+    let d = d.max(1);
+    if ARMV6M {
+        let high = div_saturating(1 << 30, d);
+        let remainder = (1u64 << 30) - mul_u32_wide(high, d);
+        ((high as u64) << 32) | div_saturating(remainder << 32, d) as u64
+    } else {
+        (1u64 << 62) / d as u64
+    }
+}
+
+/// `⌊x · y / 2^24⌋` clamped to `[−LIMIT, LIMIT]` (`LIMIT` below 2^63): the
+/// 3DDDA's plane crossings. On ARMv6-M, from four 32×32 products instead of
+/// the library's 128-bit multiplication: the same bits.
+#[inline(always)]
+pub(crate) fn mul_u64_shr24_clamped<const LIMIT: i64>(x: i64, y: u64) -> i64 {
+    if ARMV6M {
+        mul_u64_shr24_clamped_by_parts(x, y, LIMIT)
+    } else {
+        ((x as i128 * y as i128) >> 24).clamp(-(LIMIT as i128), LIMIT as i128) as i64
+    }
+}
+
+#[inline]
+fn mul_u64_shr24_clamped_by_parts(x: i64, y: u64, limit: i64) -> i64 {
+    let m = x.unsigned_abs();
+    let (mh, ml, yh, yl) = ((m >> 32) as u32, m as u32, (y >> 32) as u32, y as u32);
+    // The product as high:low (64 bits each).
+    let low_low = mul_u32_wide(ml, yl);
+    let (cross1, cross2) = (mul_u32_wide(ml, yh), mul_u32_wide(mh, yl));
+    let (cross, carry) = cross1.overflowing_add(cross2);
+    let (low, carry_low) = low_low.overflowing_add(cross << 32);
+    let high = mul_u32_wide(mh, yh) + (cross >> 32) + ((carry as u64) << 32) + carry_low as u64;
+    // A negative product rounds towards −∞: the magnitude rounds up.
+    let round = if x < 0 && low & 0xff_ffff != 0 { 1 } else { 0 };
+    if high >> 24 != 0 {
+        return if x < 0 { -limit } else { limit };
+    }
+    let magnitude = ((high << 40) | (low >> 24)).saturating_add(round);
+    let magnitude = magnitude.min(limit as u64) as i64;
+    if x < 0 {
+        -magnitude
+    } else {
+        magnitude
+    }
+}
+
 /// 2^63 / (m + ½)·2^-8 for m = 256 … 511 (divisors normalised to [1, 2)),
 /// the start of Newton's iteration for the reciprocal.
 static RECIPROCAL_TABLE: [u32; 256] = {
@@ -308,6 +359,46 @@ mod tests {
             s ^= s << 17;
             s >> (s % 64)
         })
+    }
+
+    #[test]
+    fn crossing_product_by_parts_is_exact() {
+        let limit = 1i64 << 60;
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let edges = [0i64, 1, -1, (1 << 24) - 1, -(1 << 24), 1 << 33, -(1 << 33), i64::MAX >> 20, -(i64::MAX >> 20)];
+        for i in 0..200_000 {
+            let x = match i % 4 {
+                0 => edges[(next() % edges.len() as u64) as usize],
+                _ => (next() as i64) >> (next() % 40 + 20),
+            };
+            let y = (next() >> (next() % 33)) | 1 << 31;
+            let plain = ((x as i128 * y as i128) >> 24).clamp(-(limit as i128), limit as i128) as i64;
+            assert_eq!(mul_u64_shr24_clamped_by_parts(x, y, limit), plain, "{x} × {y}");
+        }
+    }
+
+    #[test]
+    fn reciprocal_by_two_short_divisions_is_exact() {
+        let by_parts = |d: u32| {
+            let high = div_by_reciprocal(1 << 30, d);
+            let remainder = (1u64 << 30) - mul_u32_wide(high, d);
+            ((high as u64) << 32) | div_by_reciprocal(remainder << 32, d) as u64
+        };
+        let mut d = 1u32;
+        while d < (1 << 30) + 7 {
+            for e in [d, d + 1, d.saturating_mul(3) / 2] {
+                assert_eq!(by_parts(e), (1u64 << 62) / e as u64, "{e}");
+                assert_eq!(reciprocal_q62(e), (1u64 << 62) / e as u64, "{e}");
+            }
+            d = (d as u64 * 5 / 4 + 1) as u32;
+        }
+        assert_eq!(reciprocal_q62(0), 1 << 62);
     }
 
     #[test]

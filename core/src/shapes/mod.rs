@@ -83,11 +83,6 @@ impl Aabb {
             max: Vec3 { x: self.max.x.max(o.max.x), y: self.max.y.max(o.max.y), z: self.max.z.max(o.max.z) },
         }
     }
-
-    /// Whether the two boxes share any point.
-    pub fn overlaps(&self, o: &Aabb) -> bool {
-        (0..3).all(|a| self.min.axis(a) <= o.max.axis(a) && o.min.axis(a) <= self.max.axis(a))
-    }
 }
 
 /// Which primitive an object is.

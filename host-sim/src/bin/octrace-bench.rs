@@ -5,7 +5,8 @@
 //! Tables: `scenes` (every scene, naive), `table51` (the thesis's Table 5.1),
 //! `table52` (Table 5.2), `scaling` (random spheres, N = 10 … 100,000),
 //! `criterion` (the octree's subdivision criterion), `parallel` (threads
-//! and partitions), `palette` (the 256-colour modes). No argument: all. Times are wall-clock on one thread
+//! and partitions), `palette` (the 256-colour modes), `spheres600` (naive against
+//! dda on 600 random spheres at 800×600). No argument: all. Times are wall-clock on one thread
 //! (except in `parallel`), the best of several runs; the machine is printed
 //! first so every table says where it came from.
 
@@ -359,11 +360,37 @@ fn palette_table(dir: &Path) {
     println!("\n");
 }
 
+/// Issue 14's target 2: the 600 random spheres of `scenes/spheres600.txt`
+/// at 800×600, naive against dda, the render alone (octree built
+/// beforehand) and with the build.
+fn spheres600(dir: &Path) {
+    println!("### 600 random spheres at 800×600: naive against dda (one thread, best of 3)\n");
+    println!("| scene | naive | dda render | dda build | render ratio | ratio with build |");
+    println!("| --- | ---: | ---: | ---: | ---: | ---: |");
+    let scene = load(&dir.join("spheres600.txt"));
+    let c = OctreeConfig::default();
+    let size = Some((800, 600));
+    let naive = time(&scene, AccelMode::Naive, c, size, 3);
+    let (build, tree) = best_of(3, || build_octree(&scene, AccelMode::Dda, &c));
+    let tree = tree.expect("an octree");
+    let options = RenderOptions { size, ..Default::default() };
+    let render = best_of(3, || render_prebuilt(&scene, &options, Some(&tree), &|_| {}).map(|r| r.stats)).0;
+    let r = |t: Duration| naive.as_secs_f64() / t.as_secs_f64();
+    println!(
+        "| spheres600 | {} | {} | {} | {:.1}× | {:.1}× |\n",
+        ms(naive),
+        ms(render),
+        ms(build),
+        r(render),
+        r(render + build)
+    );
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
     let scenes = root.join("scenes");
-    let all = ["scenes", "table51", "table52", "criterion", "scaling", "parallel", "palette"];
+    let all = ["scenes", "table51", "table52", "criterion", "scaling", "parallel", "palette", "spheres600"];
     let which: Vec<&str> = if args.is_empty() { all.to_vec() } else { args.iter().map(String::as_str).collect() };
     println!("Machine: {}\n", machine());
     for w in which {
@@ -375,6 +402,7 @@ fn main() {
             "scaling" => scaling(),
             "parallel" => parallel(&scenes),
             "palette" => palette_table(&scenes),
+            "spheres600" => spheres600(&scenes),
             other => {
                 eprintln!("octrace-bench: unknown table `{other}` (known: {})", all.join(", "));
                 std::process::exit(2);

@@ -22,6 +22,7 @@
 use super::Octree;
 use super::OctreeCapacities;
 use crate::capacity::Arena;
+use crate::math::{mul_u64_shr24_clamped, reciprocal_q62};
 use crate::shapes::Ray;
 
 /// Parameters are Q40.24.
@@ -133,7 +134,7 @@ impl<const FRAMES: usize> DdaWalk<FRAMES> {
                 o[a]
             };
             walk.origin[a] = oa;
-            walk.inverse[a] = (1u64 << 62) / d[a].unsigned_abs().max(1);
+            walk.inverse[a] = reciprocal_q62(d[a].unsigned_abs() as u32);
             t0[a] = walk.crossing(a, tree.root_min[a]);
             t1[a] = walk.crossing(a, tree.root_min[a] + 2 * half);
             if t0[a].abs() == LIMIT || t1[a].abs() == LIMIT {
@@ -146,17 +147,18 @@ impl<const FRAMES: usize> DdaWalk<FRAMES> {
             return;
         }
         // Clip to the objects' own bounds (rounding outwards: a wider span
-        // only visits more boxes).
+        // only visits more boxes). Their low corner is the root's, so on
+        // each axis one of the two crossings is the root's, known already.
         let (mut near, mut far) = (-LIMIT, LIMIT);
         for a in 0..3 {
             let (lo, hi) = if walk.mirror >> a & 1 == 1 {
                 let c2 = 2 * (tree.root_min[a] + half);
-                (c2 - tree.bounds_max[a], c2 - tree.bounds_min[a])
+                (walk.crossing(a, c2 - tree.bounds_max[a]), t1[a])
             } else {
-                (tree.bounds_min[a], tree.bounds_max[a])
+                (t0[a], walk.crossing(a, tree.bounds_max[a]))
             };
-            near = near.max(walk.crossing(a, lo));
-            far = far.min(walk.crossing(a, hi));
+            near = near.max(lo);
+            far = far.min(hi);
         }
         (walk.near, walk.far) = (near - 1, far + 1);
         if walk.far < walk.near || walk.far < 0 {
@@ -174,8 +176,7 @@ impl<const FRAMES: usize> DdaWalk<FRAMES> {
     /// through the reciprocal 2^62 / |d|.
     #[inline]
     fn crossing(&self, a: usize, plane: i64) -> i64 {
-        let v = ((plane - self.origin[a]) as i128 * self.inverse[a] as i128) >> 24;
-        v.clamp(-(LIMIT as i128), LIMIT as i128) as i64
+        mul_u64_shr24_clamped::<LIMIT>(plane - self.origin[a], self.inverse[a])
     }
 
     /// Enters a subdivided box: the first child the ray meets lies beyond

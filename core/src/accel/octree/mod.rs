@@ -315,8 +315,8 @@ pub struct Octree<C: OctreeCapacities, const FRAMES: usize = { MAX_DEPTH as usiz
     buckets: C::HashBuckets,
     /// The root box: `[root_min, root_min + 2^root_log2]` per axis.
     root_min: [i64; 3],
-    /// The objects' own bounds, widened by the filing margin.
-    bounds_min: [i64; 3],
+    /// The objects' own upper bounds, widened by the filing margin (their
+    /// lower bounds are `root_min`).
     bounds_max: [i64; 3],
     root_log2: u32,
     /// log2 of Minlen, the smallest box side.
@@ -361,7 +361,6 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
             entries: C::HashEntries::EMPTY,
             buckets: C::HashBuckets::EMPTY,
             root_min: [0; 3],
-            bounds_min: [0; 3],
             bounds_max: [0; 3],
             root_log2: 0,
             min_log2: 0,
@@ -410,7 +409,7 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
         let Some(bounds) = scene.object_ids().map(|id| scene.shape(id).bounds()).reduce(Aabb::union) else {
             // No objects: a single empty leaf.
             (self.root_min, self.root_log2, self.min_log2) = ([0; 3], 1, 1);
-            (self.bounds_min, self.bounds_max) = ([0; 3], [0; 3]);
+            self.bounds_max = [0; 3];
             let _ = self.nodes.push(OctreeNode::leaf(0, 0));
             self.finish(0);
             return self.report;
@@ -419,7 +418,6 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
         let extent = (0..3).map(|a| hi[a] - lo[a]).max().unwrap_or(0) + 2 * FILING_MARGIN;
         self.root_log2 = 64 - (extent.max(2) as u64 - 1).leading_zeros();
         self.root_min = lo.map(|v| v - FILING_MARGIN);
-        self.bounds_min = self.root_min;
         self.bounds_max = hi.map(|v| v + FILING_MARGIN);
         self.min_log2 = self.root_log2;
 
@@ -673,10 +671,14 @@ impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES>
         let mut blocked = false;
         walk_leaves(self, ray, mailbox, t_max, |leaf, exit, mailbox| {
             let mut test = |id: u32| {
-                mailbox.first_visit(id) && {
+                let hit = mailbox.first_visit(id) && {
                     let object = ObjectId(id);
                     scene.shape(object).intersect(ray, t_max, RayStart::leaving(start, object)).is_some()
+                };
+                if hit {
+                    mailbox.blocker = id;
                 }
+                hit
             };
             blocked = match self.leaf_objects(leaf) {
                 Some(ids) => ids.iter().any(|&id| test(id.get())),

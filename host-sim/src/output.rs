@@ -1,0 +1,393 @@
+//! Streams a render's rows into an image file, truecolour or through a palette mode, holding a row at a
+//! time in memory.
+//!
+//! Invariants: rows arrive in order, each once. A truecolour file is written as the rows come. An indexed
+//! file's colour table ends at its last entry in use, which is known only at the end, so its indices wait in
+//! a spool file beside the output (1 byte a pixel, on disk, removed when done); `scan` also spools the
+//! image's colours (3 bytes a pixel) while it learns its table, then maps them (the host's two passes).
+
+use crate::formats::{Format, FormatError, Header, RowWriter};
+use crate::palette::PaletteMode;
+use crate::NO_OBJECT;
+use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
+use octrace_core::palette::{Coarse, Dither, Gray, Quantizer, Scan};
+use octrace_core::scene::ObjectId;
+use std::fs::File;
+use std::io::{BufReader, BufWriter, Read, Seek, Write};
+use std::path::{Path, PathBuf};
+
+/// What a palette mode did to the image, for the report host-sim prints.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PaletteSummary {
+    /// Distinct colours the indexed image shows.
+    pub colors_used: usize,
+    /// Peak signal-to-noise ratio against the truecolour image, in dB.
+    pub psnr: f64,
+}
+
+/// A temporary file that is removed when dropped.
+struct Spool {
+    writer: BufWriter<File>,
+    path: PathBuf,
+}
+
+impl Spool {
+    fn new(dir: &Path, name: &str) -> std::io::Result<Spool> {
+        let path = dir.join(format!(".{name}.{}.spool.tmp", std::process::id()));
+        let file = File::options().read(true).write(true).create_new(true).open(&path)?;
+        // Where an open file outlives its name, drop the name now: not even
+        // a killed process leaves the spool behind.
+        #[cfg(unix)]
+        std::fs::remove_file(&path)?;
+        Ok(Spool { writer: BufWriter::with_capacity(1 << 16, file), path })
+    }
+
+    /// The bytes written so far, from the start.
+    fn reader(&mut self) -> std::io::Result<BufReader<File>> {
+        self.writer.flush()?;
+        let mut file = self.writer.get_ref().try_clone()?;
+        file.rewind()?;
+        Ok(BufReader::with_capacity(1 << 16, file))
+    }
+}
+
+impl Drop for Spool {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
+
+/// A palette mode's quantizer, kept whole between rows.
+enum RowQuantizer {
+    Gray,
+    Dither,
+    /// Outlines need the objects of the row above: the last row seen.
+    Coarse {
+        above: Vec<u32>,
+        previous: Option<(u32, Vec<u32>)>,
+    },
+    /// A frozen table.
+    Scan(Box<Scan>),
+}
+
+impl RowQuantizer {
+    /// Row `y`'s indices into `out`.
+    fn quantize_row(&mut self, y: u32, colors: &[u8], objects: &[u32], out: &mut Vec<u8>) {
+        out.clear();
+        let object = |x: usize| objects.get(x).copied().filter(|&o| o != NO_OBJECT).map(ObjectId);
+        let mut run = |quantizer: &mut dyn Quantizer| {
+            out.extend(
+                colors
+                    .chunks_exact(3)
+                    .enumerate()
+                    .map(|(x, p)| quantizer.quantize(x as u32, y, Rgb888::new(p[0], p[1], p[2]), object(x))),
+            );
+        };
+        match self {
+            RowQuantizer::Gray => run(&mut Gray),
+            RowQuantizer::Dither => run(&mut Dither),
+            RowQuantizer::Scan(scan) => run(scan.as_mut()),
+            RowQuantizer::Coarse { above, previous } => {
+                // A fresh `Coarse` fed the row above (output dropped) is in
+                // the state it would have after streaming that row.
+                let mut coarse = Coarse::new(above);
+                if let Some((previous_y, previous_objects)) = previous.as_ref().filter(|(py, _)| py + 1 == y) {
+                    for (x, &o) in previous_objects.iter().enumerate() {
+                        let o = Some(o).filter(|&o| o != NO_OBJECT).map(ObjectId);
+                        coarse.quantize(x as u32, *previous_y, Rgb888::BLACK, o);
+                    }
+                }
+                run(&mut coarse);
+                match previous {
+                    Some((py, row)) => {
+                        *py = y;
+                        row.clear();
+                        row.extend_from_slice(objects);
+                    }
+                    None => *previous = Some((y, objects.to_vec())),
+                }
+            }
+        }
+    }
+
+    fn table(&self) -> [[u8; 3]; 256] {
+        let table = match self {
+            RowQuantizer::Gray => *Gray.table(),
+            RowQuantizer::Dither | RowQuantizer::Coarse { .. } => *Dither.table(),
+            RowQuantizer::Scan(scan) => *scan.table(),
+        };
+        table.map(|c| [c.r(), c.g(), c.b()])
+    }
+}
+
+/// Indices spooled until the palette's length is known.
+struct Indices {
+    quantizer: RowQuantizer,
+    spool: Spool,
+    row: Vec<u8>,
+    used: [bool; 256],
+    squared_error: u64,
+    pixels: u64,
+}
+
+impl Indices {
+    fn push(&mut self, y: u32, colors: &[u8], objects: &[u32]) -> std::io::Result<()> {
+        self.quantizer.quantize_row(y, colors, objects, &mut self.row);
+        let table = self.quantizer.table();
+        for (&index, p) in self.row.iter().zip(colors.chunks_exact(3)) {
+            self.used[index as usize] = true;
+            let entry = table[index as usize];
+            self.squared_error += (0..3).map(|c| (i64::from(p[c]) - i64::from(entry[c])).pow(2) as u64).sum::<u64>();
+        }
+        self.pixels += self.row.len() as u64;
+        self.spool.writer.write_all(&self.row)
+    }
+}
+
+enum Stage<'a> {
+    Truecolour(RowWriter<'a>),
+    Indexed(Box<Indices>),
+    /// `scan`'s first pass: colours spooled while the table is learnt.
+    Learning {
+        scan: Box<Scan>,
+        colors: Spool,
+    },
+}
+
+/// Writes a render's rows to an image file as they come.
+pub struct FileSink<'a> {
+    stage: Stage<'a>,
+    /// Where the file goes once an indexed image's palette is known.
+    out: Option<&'a mut dyn Write>,
+    format: Format,
+    header: Header,
+    /// Rows before this one only prime the quantizer (a part's row above).
+    first_row: u32,
+    rows_written: u32,
+    spool_dir: PathBuf,
+    spool_name: String,
+}
+
+impl<'a> FileSink<'a> {
+    /// A sink writing `header.width` × `header.height` pixels in `mode` as a `format` file to `out`, the
+    /// header's text carried along; rows before `first_row` are not written (for `coarse`, they are the
+    /// row above). Spool files go in `spool_dir`, named after `spool_name`.
+    pub fn new(
+        mode: PaletteMode,
+        format: Format,
+        header: Header,
+        first_row: u32,
+        out: &'a mut dyn Write,
+        spool_dir: &Path,
+        spool_name: &str,
+    ) -> Result<FileSink<'a>, FormatError> {
+        let spool = |suffix: &str| Spool::new(spool_dir, &format!("{spool_name}.{suffix}"));
+        let indices = |quantizer| -> Result<Stage<'a>, FormatError> {
+            Ok(Stage::Indexed(Box::new(Indices {
+                quantizer,
+                spool: spool("indices")?,
+                row: Vec::new(),
+                used: [false; 256],
+                squared_error: 0,
+                pixels: 0,
+            })))
+        };
+        let (stage, out) = match mode {
+            PaletteMode::None => {
+                let header = Header { palette: None, ..header.clone() };
+                (Stage::Truecolour(RowWriter::new(format, &header, out)?), None)
+            }
+            PaletteMode::Gray => (indices(RowQuantizer::Gray)?, Some(out)),
+            PaletteMode::Dither => (indices(RowQuantizer::Dither)?, Some(out)),
+            PaletteMode::Coarse => {
+                let above = vec![NO_OBJECT; header.width as usize];
+                (indices(RowQuantizer::Coarse { above, previous: None })?, Some(out))
+            }
+            PaletteMode::Scan => (Stage::Learning { scan: Box::new(Scan::new()), colors: spool("colors")? }, Some(out)),
+        };
+        Ok(FileSink {
+            stage,
+            out,
+            format,
+            header,
+            first_row,
+            rows_written: 0,
+            spool_dir: spool_dir.to_owned(),
+            spool_name: spool_name.to_owned(),
+        })
+    }
+
+    /// Ends the file once every row has come: for an indexed image, writes the header, the palette up to its
+    /// last entry in use and the spooled indices.
+    pub fn finish(self) -> Result<Option<PaletteSummary>, FormatError> {
+        let FileSink { stage, out, format, header, rows_written, spool_dir, spool_name, .. } = self;
+        if rows_written != header.height {
+            return Err(FormatError::Invalid(format!("{rows_written} rows of {} were rendered", header.height)));
+        }
+        let mut indices = match stage {
+            Stage::Truecolour(writer) => return writer.finish().map(|()| None),
+            Stage::Indexed(indices) => indices,
+            Stage::Learning { scan, mut colors } => {
+                let scan = relearn(*scan, &mut colors, header.width)?;
+                let mut indices = Box::new(Indices {
+                    quantizer: RowQuantizer::Scan(Box::new(scan)),
+                    spool: Spool::new(&spool_dir, &format!("{spool_name}.indices"))?,
+                    row: Vec::new(),
+                    used: [false; 256],
+                    squared_error: 0,
+                    pixels: 0,
+                });
+                let mut reader = colors.reader()?;
+                let mut row = vec![0; 3 * header.width as usize];
+                for y in 0..header.height {
+                    reader.read_exact(&mut row)?;
+                    indices.push(y, &row, &[])?;
+                }
+                indices
+            }
+        };
+        let table = indices.quantizer.table();
+        let entries = indices.used.iter().rposition(|&u| u).map_or(1, |last| last + 1);
+        let mut shown: Vec<[u8; 3]> = (0..256).filter(|&i| indices.used[i]).map(|i| table[i]).collect();
+        shown.sort_unstable();
+        shown.dedup();
+        let summary = PaletteSummary {
+            colors_used: shown.len(),
+            psnr: if indices.squared_error == 0 {
+                f64::INFINITY
+            } else {
+                let mean = indices.squared_error as f64 / (3 * indices.pixels.max(1)) as f64;
+                10.0 * (255.0f64 * 255.0 / mean).log10()
+            },
+        };
+        let out = out.ok_or_else(|| FormatError::Invalid("the output was already used".into()))?;
+        let header = Header { palette: Some(table[..entries].to_vec()), ..header };
+        let mut writer = RowWriter::new(format, &header, out)?;
+        let mut reader = indices.spool.reader()?;
+        let mut row = vec![0; header.width as usize];
+        for _ in 0..header.height {
+            reader.read_exact(&mut row)?;
+            writer.write_row(&row)?;
+        }
+        writer.finish()?;
+        Ok(Some(summary))
+    }
+}
+
+/// `scan`'s first pass finished from the spooled colours: while the table
+/// overflows, learns again with a closeness limit half as large again; then
+/// freezes it (as [`crate::palette::apply`] does).
+fn relearn(mut scan: Scan, colors: &mut Spool, width: u32) -> std::io::Result<Scan> {
+    // Past 3·255², every colour is close to every entry.
+    while scan.overflowed() && scan.closeness() <= 3 * 255 * 255 {
+        scan = Scan::with_closeness(scan.closeness() * 3 / 2);
+        let mut reader = colors.reader()?;
+        let mut row = vec![0; 3 * width as usize];
+        loop {
+            match reader.read_exact(&mut row) {
+                Ok(()) => row.chunks_exact(3).for_each(|p| scan.learn(Rgb888::new(p[0], p[1], p[2]))),
+                Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => break,
+                Err(e) => return Err(e),
+            }
+        }
+    }
+    scan.freeze();
+    Ok(scan)
+}
+
+impl crate::RowSink for FileSink<'_> {
+    fn row(&mut self, y: u32, colors: &[u8], objects: &[u32]) -> std::io::Result<()> {
+        if y < self.first_row {
+            // The row above a part: only `coarse` looks at it.
+            if let Stage::Indexed(indices) = &mut self.stage {
+                let mut discard = Vec::new();
+                indices.quantizer.quantize_row(y, colors, objects, &mut discard);
+            }
+            return Ok(());
+        }
+        self.rows_written += 1;
+        match &mut self.stage {
+            Stage::Truecolour(writer) => writer.write_row(colors).map_err(into_io),
+            Stage::Indexed(indices) => indices.push(y, colors, objects),
+            Stage::Learning { scan, colors: spool } => {
+                colors.chunks_exact(3).for_each(|p| scan.learn(Rgb888::new(p[0], p[1], p[2])));
+                spool.writer.write_all(colors)
+            }
+        }
+    }
+}
+
+fn into_io(e: FormatError) -> std::io::Error {
+    match e {
+        FormatError::Io(e) => e,
+        e => std::io::Error::other(e),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::formats::read;
+    use crate::{RgbImage, RowSink};
+
+    /// A gradient with objects in vertical stripes, and what `apply` makes of it.
+    fn sample(mode: PaletteMode) -> (RgbImage, Vec<u32>, crate::formats::Image) {
+        let (w, h) = (37u32, 23u32);
+        let data = (0..w * h).flat_map(|i| [(i * 7) as u8, (i / w * 11) as u8, (i % w * 5) as u8]).collect();
+        let image = RgbImage { width: w, height: h, data };
+        let objects: Vec<u32> =
+            (0..w * h).map(|i| if i % w < 9 { NO_OBJECT } else { i % w / 10 + i / w / 8 }).collect();
+        let expected = crate::palette::apply(&image, &objects, mode);
+        (image, objects, expected)
+    }
+
+    #[test]
+    fn streamed_rows_give_what_apply_gives_in_every_mode_and_rows_from_the_middle() {
+        let dir = std::env::temp_dir().join(format!("octrace-output-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for mode in PaletteMode::ALL {
+            let (image, objects, expected) = sample(mode);
+            let w = image.width as usize;
+            // The whole image, then rows 5.. with the row above given first (a part).
+            for first in [0u32, 5] {
+                if first > 0 && mode == PaletteMode::Scan {
+                    // Learnt from the rows it sees: parts refuse it.
+                    continue;
+                }
+                let header = Header { width: image.width, height: image.height - first, palette: None, text: None };
+                let mut bytes = Vec::new();
+                let mut sink = FileSink::new(mode, Format::Png, header, first, &mut bytes, &dir, "t").unwrap();
+                for y in first.saturating_sub(1)..image.height {
+                    let y_ = y as usize;
+                    sink.row(y, &image.data[3 * y_ * w..3 * (y_ + 1) * w], &objects[y_ * w..(y_ + 1) * w]).unwrap();
+                }
+                sink.finish().unwrap();
+                let got = read(&bytes).unwrap();
+                if first == 0 {
+                    assert_eq!(got, expected, "{}", mode.name());
+                } else if let (Some(got), Some(expected)) = (indexed(&got), indexed(&expected)) {
+                    assert_eq!(got, &expected[first as usize * w..], "{} from row {first}", mode.name());
+                }
+            }
+        }
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "spool files left behind");
+        std::fs::remove_dir(&dir).unwrap();
+    }
+
+    fn indexed(image: &crate::formats::Image) -> Option<&[u8]> {
+        match image {
+            crate::formats::Image::Indexed { indices, .. } => Some(indices),
+            crate::formats::Image::Rgb(_) => None,
+        }
+    }
+
+    #[test]
+    fn missing_rows_are_an_error() {
+        let header = Header { width: 2, height: 3, palette: None, text: None };
+        let mut bytes = Vec::new();
+        let mut sink =
+            FileSink::new(PaletteMode::None, Format::Tga, header, 0, &mut bytes, Path::new("."), "t").unwrap();
+        sink.row(0, &[0; 6], &[NO_OBJECT; 2]).unwrap();
+        assert!(sink.finish().unwrap_err().to_string().contains("1 rows of 3"));
+    }
+}
