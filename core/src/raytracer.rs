@@ -109,7 +109,8 @@ impl<P: Profile> Raytracer<P> {
         match (parsed, first) {
             (Ok(_), _) => {}
             (Err(count), Some(first)) => return Err(LoadError { first, count }),
-            // The parser reports every error it counts.
+            // Never taken: `parse_bytes` hands every error it counts to the
+            // callback. Answered at the file's start rather than by a panic.
             (Err(count), None) => {
                 let first = ParseError::new(Pos { line: 1, column: 1 }, ErrorKind::InvalidUtf8);
                 return Err(LoadError { first, count });
