@@ -222,11 +222,6 @@ impl Counts {
         self
     }
 
-    /// Only the octree's counts (the others 0).
-    pub const fn octree_counts(&self) -> Counts {
-        Counts { octree_boxes: self.octree_boxes, octree_references: self.octree_references, ..Counts::ZERO }
-    }
-
     /// Mailbox words for every object (one bit each).
     pub const fn mailbox_words(&self) -> usize {
         self.objects.div_ceil(32)
