@@ -81,6 +81,8 @@ impl fmt::Display for LoadError<'_> {
 impl core::error::Error for LoadError<'_> {}
 
 impl<P: Profile> Raytracer<P> {
+    const HAS_OCTREE: bool = P::COUNTS.octree_boxes > 0;
+
     /// Empty room for a scene: a constant of all-zero bits.
     pub const fn new() -> Self {
         Raytracer { scene: Scene::new(), octree: P::Octree::EMPTY, mailbox: P::MailboxWords::EMPTY }
@@ -94,7 +96,9 @@ impl<P: Profile> Raytracer<P> {
 
     /// [`Raytracer::load`] from bytes (invalid UTF-8 is an error at its
     /// place), with the accelerator `mode`, handing every error to
-    /// `on_error` as it is found.
+    /// `on_error` as it is found. A profile with no room for octree boxes
+    /// always uses [`AccelMode::Naive`] (same image; no octree code is
+    /// linked); [`LoadedScene::mode`] says which mode is in use.
     pub fn load_with<'t>(
         &mut self,
         text: &'t [u8],
@@ -117,7 +121,10 @@ impl<P: Profile> Raytracer<P> {
             }
         }
         let view = self.scene.view();
-        let mode = mode.resolve(view.object_count());
+        // A profile without room for an octree tests every object (what an
+        // octree of no boxes would do too); decided on the constant, so such
+        // a build carries no octree code at all.
+        let mode = if Self::HAS_OCTREE { mode.resolve(view.object_count()) } else { AccelMode::Naive };
         let octree = mode.traversal().map(|traversal| {
             let report = self.octree.build(&view, &OctreeConfig { traversal, ..P::OCTREE });
             (&self.octree, report)
@@ -200,8 +207,8 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         D::Color: From<Rgb888>,
     {
         match self.octree {
-            Some((octree, _)) => self.render(octree, size, area, at, target),
-            None => self.render(&Naive, size, area, at, target),
+            Some((octree, _)) if Raytracer::<P>::HAS_OCTREE => self.render(octree, size, area, at, target),
+            _ => self.render(&Naive, size, area, at, target),
         }
     }
 
@@ -420,6 +427,26 @@ mod tests {
             scene.image_for(&grid).draw(&mut grid).unwrap();
             assert_eq!(*first.get_or_insert(grid.0), grid.0, "{mode}");
         }
+    }
+
+    crate::profile! {
+        /// No octree: one sphere and its light.
+        struct NoOctree { spheres: 1, surfaces: 1, lights: 1 }
+    }
+
+    #[test]
+    fn a_profile_without_octree_room_traces_every_object() {
+        let mut raytracer = Raytracer::<NoOctree>::new();
+        let scene = raytracer.load_with(SCENE.as_bytes(), AccelMode::Dda, &mut |e| panic!("{e:?}")).unwrap();
+        assert_eq!(scene.mode(), AccelMode::Naive);
+        assert!(scene.octree_report().is_none());
+        let mut grid = Grid::<Rgb565, 8, 6>([[None; 8]; 6]);
+        scene.image_for(&grid).draw(&mut grid).unwrap();
+        let mut roomy = Raytracer::<Board16K>::new();
+        let dda = roomy.load_with(SCENE.as_bytes(), AccelMode::Dda, &mut |e| panic!("{e:?}")).unwrap();
+        let mut expected = Grid::<Rgb565, 8, 6>([[None; 8]; 6]);
+        dda.image_for(&expected).draw(&mut expected).unwrap();
+        assert_eq!(grid.0, expected.0);
     }
 
     #[test]
