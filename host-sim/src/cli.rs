@@ -355,7 +355,7 @@ fn preview(
     let started = Instant::now();
     let rendered = render_with_progress(scene, options, &|_| {}).map_err(|e| {
         // The parser rejects these; a scene built by hand may not.
-        let _ = writeln!(stderr, "host-sim: cannot set up the camera: {e:?}");
+        let _ = writeln!(stderr, "host-sim: cannot set up the camera: {e}");
         EXIT_SCENE
     })?;
     let written = match panel_preview(&rendered.image, color, format) {

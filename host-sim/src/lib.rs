@@ -22,7 +22,7 @@ use embedded_graphics_core::primitives::Rectangle;
 use octrace_core::accel::{Accelerator, BuildReport, Mailbox, Naive, Octree, OctreeConfig, Traversal};
 use octrace_core::parse::{parse_bytes, ParseError};
 use octrace_core::profile::Host;
-use octrace_core::render::Renderer;
+use octrace_core::render::{Renderer, Tiles};
 use octrace_core::scene::{CameraError, Scene, SceneView};
 use octrace_core::shade::Stats;
 use std::path::Path;
@@ -236,7 +236,7 @@ pub enum StreamError {
 impl std::fmt::Display for StreamError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            StreamError::Camera(e) => write!(f, "cannot set up the camera: {e:?}"),
+            StreamError::Camera(e) => write!(f, "cannot set up the camera: {e}"),
             StreamError::Sink(e) => write!(f, "{e}"),
         }
     }
@@ -303,16 +303,17 @@ fn bands(width: u32, rows: &std::ops::Range<u32>, partition: Partition) -> (Vec<
     let rectangle = |x: u32, y: u32, w: u32, h: u32| Rectangle::new(Point::new(x as i32, y as i32), Size::new(w, h));
     match partition {
         Partition::Tiles => {
+            // The core's tiles of the rows as an image of their own, in
+            // raster order: a band is a row of tiles.
             let bands: Vec<_> =
                 rows.clone().step_by(TILE_SIDE as usize).map(|y| y..(y + TILE_SIDE).min(rows.end)).collect();
-            let pieces = bands
+            let tiles = Tiles::new(Size::new(width, rows.len() as u32), TILE_SIDE);
+            let offset = Point::new(0, rows.start as i32);
+            let pieces = tiles
                 .iter()
-                .enumerate()
-                .flat_map(|(band, ys)| {
-                    (0..width).step_by(TILE_SIDE as usize).map(move |x| Piece {
-                        band,
-                        area: rectangle(x, ys.start, TILE_SIDE.min(width - x), ys.end - ys.start),
-                    })
+                .map(|t| Piece {
+                    band: t.top_left.y as usize / TILE_SIDE as usize,
+                    area: Rectangle::new(t.top_left + offset, t.size),
                 })
                 .collect();
             (bands, pieces)
