@@ -101,8 +101,14 @@ impl Vec3 {
     #[inline]
     pub fn direction_and_length(self) -> Option<(Dir, Scalar)> {
         let (d, len, shift) = Dir::normalize_small_with_length(self.bits())?;
-        let length = if shift >= 0 { len << shift } else { (len + (1 << (-shift - 1))) >> -shift };
-        Some((d, Scalar::from_bits(length.min(i32::MAX as u64) as i32)))
+        // `len` is below 2^31 and `shift` at most 2; rounding in 32 bits
+        // (a variable 64-bit shift is a library call on a 32-bit core).
+        let length = if shift >= 0 {
+            (len << shift).min(i32::MAX as u64) as u32
+        } else {
+            (len as u32 + (1 << (-shift - 1))) >> -shift
+        };
+        Some((d, Scalar::from_bits(length.min(i32::MAX as u32) as i32)))
     }
 }
 

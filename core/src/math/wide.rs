@@ -147,6 +147,20 @@ pub fn shr_to_u32(x: u64, shift: u32) -> u32 {
     }
 }
 
+/// `min(x >> shift, u32::MAX)` for a shift in 1 ..= 63, in 32-bit steps
+/// (a 64-bit shift by a variable amount is a library call on a 32-bit core).
+#[inline(always)]
+pub(crate) fn shr_saturating_u32(x: u64, shift: u32) -> u32 {
+    let (high, low) = ((x >> 32) as u32, x as u32);
+    if shift >= 32 {
+        high >> (shift - 32)
+    } else if high >> shift != 0 {
+        u32::MAX
+    } else {
+        (low >> shift) | (high << (32 - shift))
+    }
+}
+
 /// `⌊n / d⌋`, saturating at `u32::MAX` (also for `d = 0`). Exact on every
 /// target; on ARMv6-M without a division (the library's 64-bit division
 /// costs some 450 instructions there).
@@ -333,7 +347,7 @@ fn isqrt_from(n: u64, g: u32, f: u32, shift: i32) -> u64 {
     // is 30 to 61 for every n ≥ 2.
     // √n < 2^32, so the estimate is capped below it; s² then fits a u64,
     // and the steps keep it as `square` (one product in all).
-    let mut s = (mul_u32_wide(f, g) >> (46 - shift / 2)).min(u32::MAX as u64);
+    let mut s = shr_saturating_u32(mul_u32_wide(f, g), (46 - shift / 2) as u32) as u64;
     let mut square = square_u32_wide(s as u32);
     while square > n {
         square -= 2 * s - 1;
@@ -417,6 +431,11 @@ mod tests {
         }
         for v in spread(20_000).chain([0, 1, u64::MAX, 1 << 32, (1 << 32) - 1, 1 << 63]) {
             assert_eq!(leading_zeros_by_search(v), v.leading_zeros(), "{v}");
+        }
+        for v in spread(5_000).chain([u64::MAX, 1 << 63, (1 << 32) - 1]) {
+            for shift in 1..64 {
+                assert_eq!(shr_saturating_u32(v, shift), (v >> shift).min(u32::MAX as u64) as u32, "{v} >> {shift}");
+            }
         }
         for v in spread(5_000) {
             for shift in 0..64 {

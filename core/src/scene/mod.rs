@@ -17,6 +17,7 @@ mod camera;
 mod normalize;
 mod surface;
 
+pub(crate) use camera::RayCursor;
 pub use camera::{Camera, CameraError, View, MAX_SAMPLES, MAX_SIDE};
 pub use normalize::{Normalization, WorldPoint, WorldValue};
 pub use surface::{Color, Surface, SurfaceEntry};
