@@ -177,12 +177,12 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
     fn shade(&self, p: &Pending, hit: Hit, color: &mut Color, scratch: &mut Scratch<'_>) -> [Option<Pending>; 2] {
         let shape = self.scene.shape(hit.object);
         let point = p.ray.at(hit.t);
-        let geometric = shape.normal_at(point);
+        let geometric = shape.normal_at_among(A::KINDS, point);
         // Two-sided: shade with the normal facing the incoming ray (for a
         // B-spline's triangle, its interpolated normal; shadow rays then
         // leave from the smooth surface, see shapes::SmoothTriangle).
         let facing = if geometric.dot_q60(p.ray.dir) > 0 { -geometric } else { geometric };
-        let (normal, shadow_from) = shape.shading(point, facing);
+        let (normal, shadow_from) = shape.shading_among(A::KINDS, point, facing);
         let to_eye = -p.ray.dir;
         let surface = self.scene.surface(shape.surface());
         let mut local = surface.ambient;
@@ -244,7 +244,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         if (*blocker as usize) < self.scene.object_count() {
             let object = ObjectId(*blocker);
             let leaving = RayStart::leaving(Some(start), object);
-            if self.scene.shape(object).intersect(shadow, t_max, leaving).is_some() {
+            if self.scene.shape(object).intersect_among(A::KINDS, shadow, t_max, leaving).is_some() {
                 return true;
             }
             // Missed: the walk need not test it again.
