@@ -191,7 +191,7 @@ mod tests {
             state ^= state << 17;
             state
         };
-        let mut coordinate = |next: &mut dyn FnMut() -> u64| ((next() as i32) >> 2) >> (next() % 20);
+        let coordinate = |next: &mut dyn FnMut() -> u64| ((next() as i32) >> 2) >> (next() % 20);
         let (mut hits, mut near) = (0, 0);
         for i in 0..400_000u32 {
             let center = Vec3::from_bits([0; 3].map(|_| coordinate(&mut next)));
