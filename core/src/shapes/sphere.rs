@@ -95,17 +95,21 @@ impl Sphere {
 /// unit directions (|dir_i| ≤ 2^30 + 2^15), whatever `t_max` and the radius.
 #[inline(always)]
 fn surely_missed(oc: [i32; 3], dir: [i32; 3], t_max: i64, radius: i64) -> bool {
-    // oc_i·dir_i = (oc_i >> 17)(dir_i >> 15)·2^32 + what the low bits add.
-    let estimate: i64 = (0..3).map(|a| ((oc[a] >> 17) * (dir[a] >> 15)) as i64).sum::<i64>() * 4;
+    // oc_i·dir_i = (oc_i >> 17)(dir_i >> 15)·2^32 + what the low bits add;
+    // each short product is below 2^28 in magnitude, their sum below 2^30.
+    let short = |a: usize| (oc[a] >> 17).wrapping_mul(dir[a] >> 15);
+    let estimate = 4 * short(0).wrapping_add(short(1)).wrapping_add(short(2)) as i64;
     // The centre lies at parameter −b, within DOT_ERROR of −estimate.
     if -estimate - DOT_ERROR - radius > t_max || -estimate + DOT_ERROR + radius <= 0 {
         return true;
     }
-    // Here |estimate| < 2^32 + 2^20, so `b_high` is within ±(2^16 + 17)
-    // and (dir_i >> 16)·b_high fits an i32.
+    // Here |estimate| < 2^32 + 2^20, so `b_high` is within ±(2^16 + 17),
+    // (dir_i >> 16)·b_high within ±(2^30 + 2^18) and q_i's quarter
+    // estimate below 2^31: 32-bit steps. q_i = 4·quarter + (oc_i & 3) ± OFFSET_ERROR.
     let b_high = (estimate >> 16) as i32;
-    let reach = radius + OFFSET_ERROR;
-    (0..3).any(|a| (oc[a] as i64 - 4 * ((dir[a] >> 16) * b_high) as i64).abs() > reach)
+    let reach = ((radius + OFFSET_ERROR + 3) >> 2) as u32;
+    let off = |a: usize| ((oc[a] >> 2).wrapping_sub((dir[a] >> 16).wrapping_mul(b_high))).unsigned_abs() > reach;
+    off(0) || off(1) || off(2)
 }
 
 #[cfg(test)]
