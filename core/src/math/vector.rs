@@ -249,7 +249,8 @@ impl Dir {
     #[inline]
     fn from_scaled(negative: [bool; 3], scaled: [u32; 3], shift: i32) -> (Dir, u64, i32) {
         let len2 = scaled.iter().map(|&c| square_u32_wide(c)).sum::<u64>();
-        let (len, g, e) = super::sqrt_and_rsqrt(len2);
+        // The largest magnitude is in [2^29, 2^30): len2 in [2^58, 3·2^60).
+        let (len, g, e) = super::sqrt_and_rsqrt_58_62(len2);
         (Self::divided(negative, scaled, g, e, len as u32), len, shift)
     }
 

@@ -349,6 +349,24 @@ pub fn sqrt_and_rsqrt(n: u64) -> (u64, u32, i32) {
     (isqrt_from(n, g, f, shift), g, 46 + shift / 2)
 }
 
+/// [`sqrt_and_rsqrt`] for `n` in [2^58, 2^62) — the squared length of a unit
+/// vector's scaled magnitudes (the largest in [2^29, 2^30)) — where the
+/// argument's scale is one of two, known without counting leading zeros.
+#[inline]
+pub(crate) fn sqrt_and_rsqrt_58_62(n: u64) -> (u64, u32, i32) {
+    let shift = if n >> 62 != 0 || n >> 58 == 0 {
+        return sqrt_and_rsqrt(n);
+    } else if n >> 60 != 0 {
+        30
+    } else {
+        28
+    };
+    // What `rsqrt_argument` gives: f = n / 2^shift in [2^30, 2^32).
+    let f = if shift == 30 { (n >> 30) as u32 } else { (n >> 28) as u32 };
+    let g = rsqrt_normalised(f);
+    (isqrt_from(n, g, f, shift), g, 46 + shift / 2)
+}
+
 /// ⌊√n⌋ for `n ≥ 2` given [`rsqrt_argument`]'s `f · 2^shift = n` and
 /// `g ≈ 2^30/√(f / 2^32)`.
 #[inline]
@@ -498,6 +516,14 @@ mod tests {
         }
         assert_eq!(mul_wide(i32::MIN, i32::MIN), 1 << 62);
         assert_eq!(mul_wide(i32::MIN, i32::MAX), i32::MIN as i64 * i32::MAX as i64);
+    }
+
+    #[test]
+    fn the_two_scale_square_root_is_the_general_one() {
+        let ends = [1 << 58, (1 << 58) - 1, 1 << 60, (1 << 60) - 1, (1 << 62) - 1, 1 << 62, 3 << 60];
+        for n in spread(50_000).map(|v| v | 1 << 58 >> (v % 3)).chain(ends) {
+            assert_eq!(sqrt_and_rsqrt_58_62(n), sqrt_and_rsqrt(n), "{n}");
+        }
     }
 
     #[test]
