@@ -67,7 +67,7 @@ fn nearest(kinds: ShapeKinds, scene: &SceneView<'_>, ray: &Ray, start: Option<Ra
     for (i, &handle) in scene.objects.iter().enumerate() {
         let object = ObjectId(i as u32);
         let leaving = RayStart::leaving(start, object);
-        if let Some(t) = scene.shape_of(handle).intersect_among(kinds, ray, t_max, leaving) {
+        if let Some(t) = scene.intersect_handle(kinds, handle, ray, t_max, leaving) {
             // File order: a later object wins only when strictly nearer.
             if best.is_none_or(|b| t < b.t) {
                 best = Some(Hit { t, object });
@@ -91,7 +91,7 @@ fn occluded(
 ) -> bool {
     let blocker = scene.objects.iter().enumerate().position(|(i, &handle)| {
         let leaving = RayStart::leaving(start, ObjectId(i as u32));
-        scene.shape_of(handle).intersect_among(kinds, ray, t_max, leaving).is_some()
+        scene.intersect_handle(kinds, handle, ray, t_max, leaving).is_some()
     });
     if let Some(i) = blocker {
         mailbox.blocker = i as u32;
