@@ -192,7 +192,8 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         // Two-sided: shade with the normal facing the incoming ray (for a
         // B-spline's triangle, its interpolated normal; shadow rays then
         // leave from the smooth surface, see shapes::SmoothTriangle).
-        let facing = if geometric.dot_q60(p.ray.dir) > 0 { -geometric } else { geometric };
+        let flipped = geometric.dot_q60(p.ray.dir) > 0;
+        let facing = if flipped { -geometric } else { geometric };
         let (normal, shadow_from) = shape.shading_among(A::KINDS, point, facing);
         let to_eye = -p.ray.dir;
         let surface = self.scene.surface(shape.surface());
@@ -214,7 +215,16 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             }
             scratch.stats.shadow_rays += 1;
             let shadow = Ray { origin: shadow_from, dir: light_dir };
-            let start = RayStart { object: hit.object, leaving: leaving_along(geometric, light_dir) };
+            // Shading with the facing normal itself (every shape but a
+            // B-spline's triangles), the positive cosine already says which
+            // side of the geometric normal the light is on: its sign flips
+            // with the normal's, exactly.
+            let leaving = match (normal == facing, flipped) {
+                (true, false) => Leaving::Outward,
+                (true, true) => Leaving::Inward,
+                (false, _) => leaving_along(geometric, light_dir),
+            };
+            let start = RayStart { object: hit.object, leaving };
             let t_max = Scalar::from_bits((distance.to_bits() - 1).max(0));
             if self.occluded(&shadow, t_max, start, &mut scratch.blockers[index % BLOCKER_SLOTS], &mut scratch.mailbox)
             {
