@@ -99,8 +99,11 @@ impl<const N: usize> Polygon<N> {
             // Points within ±2^29 units, so differences fit an i32.
             let (du, dv) = (cur.0 - prev.0, cur.1 - prev.1);
             let edge = mul_wide(du, v - prev.1) - mul_wide(dv, u - prev.0);
-            let edge = if flip { -edge } else { edge };
-            if edge < -((du.unsigned_abs().max(dv.unsigned_abs()) as i64) << EDGE_TOLERANCE_LOG2) {
+            let tolerance = (du.unsigned_abs().max(dv.unsigned_abs()) as i64) << EDGE_TOLERANCE_LOG2;
+            // `−edge < −tolerance` when flipped, without the negation (which
+            // the compiler once made a 64-bit multiply by ±1).
+            let outside = if flip { edge > tolerance } else { edge < -tolerance };
+            if outside {
                 return false;
             }
             prev = cur;
