@@ -84,8 +84,10 @@ impl<const N: usize> Polygon<N> {
         if (0..3).any(|a| p[a] < lo[a] - slack || p[a] > hi[a] + slack) {
             return None;
         }
+        // Within the bounds, so each coordinate fits an i32: this is
+        // `ray.at(t)`, already computed.
         let t = Scalar::from_bits(t as i32);
-        self.contains(ray.at(t)).then_some(t)
+        self.contains(Vec3::from_bits(p.map(|c| c as i32))).then_some(t)
     }
 
     /// Whether `p` (on the plane) lies inside the polygon, edges included.
