@@ -194,9 +194,12 @@ pub fn div_saturating(n: u64, d: u32) -> u32 {
 pub(crate) fn reciprocal_q62(d: u32) -> u64 {
     let d = d.max(1);
     if ARMV6M {
-        let high = div_saturating(1 << 30, d);
+        // Both quotients by the same reciprocal: 2^30 < d·2^32, and the
+        // remainder is below d.
+        let reciprocal = Reciprocal::of(d);
+        let high = reciprocal.quotient(1 << 30);
         let remainder = (1u64 << 30) - mul_u32_wide(high, d);
-        ((high as u64) << 32) | div_saturating(remainder << 32, d) as u64
+        ((high as u64) << 32) | reciprocal.quotient(remainder << 32) as u64
     } else {
         (1u64 << 62) / d as u64
     }
@@ -267,34 +270,60 @@ fn shl_u64(x: u64, shift: u32) -> u64 {
 /// `⌊n / d⌋` for `0 < d` and `n < d · 2^32`, from a reciprocal.
 #[inline]
 fn div_by_reciprocal(n: u64, d: u32) -> u32 {
-    // Normalise: dn in [2^31, 2^32); the quotient is unchanged.
-    let s = leading_zeros(d as u64) - 32;
-    let dn = d << s;
-    let numerator = shl_u64(n, s); // below dn · 2^32
-                                   // r ≈ 2^63 / dn: about 17 bits from the table, interpolated (1/x is
-                                   // within 2^-18 of its chord over an interval), then about 31 after one
-                                   // Newton step r' = r + r·(2^63 − dn·r)/2^63. The interpolation's terms
-                                   // stay in a u32: neighbours differ by less than 2^24.
-    let i = ((dn >> 23) & 0xff) as usize;
-    let (lo, hi) = (RECIPROCAL_TABLE[i], RECIPROCAL_TABLE[i + 1]);
-    let mut r = lo - ((((lo - hi) >> 9) * ((dn >> 7) & 0xffff)) >> 7);
-    let error = ((1u64 << 63).wrapping_sub(mul_u32_wide(dn, r)) as i64 >> 31) as i32;
-    let step = (mul_u32_wide(r, error.unsigned_abs()) >> 32) as u32;
-    r = if error >= 0 { r.saturating_add(step) } else { r - step };
-    let (high, low) = ((numerator >> 32) as u32, numerator as u32);
-    let estimate = (mul_u32_wide(high, r) + (mul_u32_wide(low, r) >> 32)) >> 31;
-    // Off by a few at most: step to the exact floor on the remainder.
-    let mut q = estimate.min(u32::MAX as u64) as u32;
-    let mut remainder = n.wrapping_sub(mul_u32_wide(q, d)) as i64;
-    while remainder < 0 {
-        q -= 1;
-        remainder += d as i64;
+    Reciprocal::of(d).quotient(n)
+}
+
+/// A divisor made ready for exact divisions by products: several quotients
+/// by the same divisor share the normalisation and the Newton step.
+#[derive(Clone, Copy)]
+struct Reciprocal {
+    divisor: u32,
+    /// `divisor · 2^shift` is in [2^31, 2^32).
+    shift: u32,
+    /// About 2^63 / (divisor · 2^shift), to some 31 bits.
+    r: u32,
+}
+
+impl Reciprocal {
+    /// For `d > 0`.
+    #[inline(always)]
+    fn of(d: u32) -> Reciprocal {
+        // Normalise: dn in [2^31, 2^32); the quotients are unchanged.
+        let shift = leading_zeros(d as u64) - 32;
+        let dn = d << shift;
+        // r ≈ 2^63 / dn: about 17 bits from the table, interpolated (1/x is
+        // within 2^-18 of its chord over an interval), then about 31 after
+        // one Newton step r' = r + r·(2^63 − dn·r)/2^63. The interpolation's
+        // terms stay in a u32: neighbours differ by less than 2^24.
+        let i = ((dn >> 23) & 0xff) as usize;
+        let (lo, hi) = (RECIPROCAL_TABLE[i], RECIPROCAL_TABLE[i + 1]);
+        let r = lo - ((((lo - hi) >> 9) * ((dn >> 7) & 0xffff)) >> 7);
+        let error = ((1u64 << 63).wrapping_sub(mul_u32_wide(dn, r)) as i64 >> 31) as i32;
+        let step = (mul_u32_wide(r, error.unsigned_abs()) >> 32) as u32;
+        let r = if error >= 0 { r.saturating_add(step) } else { r - step };
+        Reciprocal { divisor: d, shift, r }
     }
-    while remainder >= d as i64 {
-        q += 1;
-        remainder -= d as i64;
+
+    /// `⌊n / divisor⌋` for `n < divisor · 2^32`.
+    #[inline(always)]
+    fn quotient(&self, n: u64) -> u32 {
+        let (d, r) = (self.divisor, self.r);
+        let numerator = shl_u64(n, self.shift); // below dn · 2^32
+        let (high, low) = ((numerator >> 32) as u32, numerator as u32);
+        let estimate = (mul_u32_wide(high, r) + (mul_u32_wide(low, r) >> 32)) >> 31;
+        // Off by a few at most: step to the exact floor on the remainder.
+        let mut q = estimate.min(u32::MAX as u64) as u32;
+        let mut remainder = n.wrapping_sub(mul_u32_wide(q, d)) as i64;
+        while remainder < 0 {
+            q -= 1;
+            remainder += d as i64;
+        }
+        while remainder >= d as i64 {
+            q += 1;
+            remainder -= d as i64;
+        }
+        q
     }
-    q
 }
 
 /// 2^30 / √f at f = m/256 for m from 64 to 256: the end points of 192
@@ -444,10 +473,12 @@ mod tests {
 
     #[test]
     fn reciprocal_by_two_short_divisions_is_exact() {
+        // The ARMv6-M form: both quotients by one reciprocal.
         let by_parts = |d: u32| {
-            let high = div_by_reciprocal(1 << 30, d);
+            let reciprocal = Reciprocal::of(d);
+            let high = reciprocal.quotient(1 << 30);
             let remainder = (1u64 << 30) - mul_u32_wide(high, d);
-            ((high as u64) << 32) | div_by_reciprocal(remainder << 32, d) as u64
+            ((high as u64) << 32) | reciprocal.quotient(remainder << 32) as u64
         };
         let mut d = 1u32;
         while d < (1 << 30) + 7 {
