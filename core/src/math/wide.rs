@@ -221,12 +221,19 @@ pub(crate) fn mul_u64_shr24_clamped<const LIMIT: i64>(x: i64, y: u64) -> i64 {
 fn mul_u64_shr24_clamped_by_parts(x: i64, y: u64, limit: i64) -> i64 {
     let m = x.unsigned_abs();
     let (mh, ml, yh, yl) = ((m >> 32) as u32, m as u32, (y >> 32) as u32, y as u32);
-    // The product as high:low (64 bits each).
+    // The product as high:low (64 bits each). Differences of scene
+    // coordinates are below 2^32, so mostly two products suffice.
     let low_low = mul_u32_wide(ml, yl);
-    let (cross1, cross2) = (mul_u32_wide(ml, yh), mul_u32_wide(mh, yl));
-    let (cross, carry) = cross1.overflowing_add(cross2);
-    let (low, carry_low) = low_low.overflowing_add(cross << 32);
-    let high = mul_u32_wide(mh, yh) + (cross >> 32) + ((carry as u64) << 32) + carry_low as u64;
+    let (high, low) = if mh == 0 {
+        let cross = mul_u32_wide(ml, yh);
+        let (low, carry_low) = low_low.overflowing_add(cross << 32);
+        ((cross >> 32) + carry_low as u64, low)
+    } else {
+        let (cross1, cross2) = (mul_u32_wide(ml, yh), mul_u32_wide(mh, yl));
+        let (cross, carry) = cross1.overflowing_add(cross2);
+        let (low, carry_low) = low_low.overflowing_add(cross << 32);
+        (mul_u32_wide(mh, yh) + (cross >> 32) + ((carry as u64) << 32) + carry_low as u64, low)
+    };
     // A negative product rounds towards −∞: the magnitude rounds up.
     let round = if x < 0 && low & 0xff_ffff != 0 { 1 } else { 0 };
     if high >> 24 != 0 {
@@ -459,7 +466,20 @@ mod tests {
             state ^= state << 17;
             state
         };
-        let edges = [0i64, 1, -1, (1 << 24) - 1, -(1 << 24), 1 << 33, -(1 << 33), i64::MAX >> 20, -(i64::MAX >> 20)];
+        let edges = [
+            0i64,
+            1,
+            -1,
+            (1 << 24) - 1,
+            -(1 << 24),
+            (1 << 32) - 1,
+            1 << 32,
+            -(1 << 32),
+            1 << 33,
+            -(1 << 33),
+            i64::MAX >> 20,
+            -(i64::MAX >> 20),
+        ];
         for i in 0..200_000 {
             let x = match i % 4 {
                 0 => edges[(next() % edges.len() as u64) as usize],
