@@ -115,6 +115,7 @@ macro_rules! profile {
             }
 
             impl p::OctreeCapacities for $name {
+                const KINDS: p::ShapeKinds = p::ShapeKinds::with_room(&<$name as $crate::profile::Profile>::COUNTS);
                 type Index = u16;
                 type Nodes = p::Vec<p::OctreeNode<u16>, { <$name as $crate::profile::Profile>::COUNTS.octree_boxes }>;
                 type References = p::Vec<u16, { <$name as $crate::profile::Profile>::COUNTS.octree_references }>;
@@ -133,7 +134,9 @@ pub mod __private {
     pub use crate::capacity::Counts;
     pub use crate::math::Vec3;
     pub use crate::scene::{Light, SceneCapacities, SurfaceEntry};
-    pub use crate::shapes::{AxisAlignedBox, Rectangle, ShapeHandle, SmoothTriangle, Sphere, Superquadric, Triangle};
+    pub use crate::shapes::{
+        AxisAlignedBox, Rectangle, ShapeHandle, ShapeKinds, SmoothTriangle, Sphere, Superquadric, Triangle,
+    };
     pub use heapless::Vec;
 }
 

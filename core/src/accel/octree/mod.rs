@@ -43,7 +43,7 @@ use super::{Accelerator, Hit, Mailbox, RayStart};
 use crate::capacity::{Arena, CapacityKind, Counts};
 use crate::math::Scalar;
 use crate::scene::{ObjectId, SceneView};
-use crate::shapes::{Aabb, Ratio, Ray};
+use crate::shapes::{Aabb, Ratio, Ray, ShapeKinds};
 use dda::DdaWalk;
 use named::NamedWalk;
 
@@ -254,6 +254,9 @@ impl Index for u32 {
 /// The arenas an [`Octree`] is stored in. Every profile implements it;
 /// define one with [`crate::profile!`], which names counts, not these types.
 pub trait OctreeCapacities {
+    /// The shape kinds the profile's scenes can hold: the queries dispatch
+    /// on these only (see [`Accelerator::KINDS`]).
+    const KINDS: ShapeKinds = ShapeKinds::ALL;
     /// The index type (bounds the arenas and the objects it files).
     type Index: Index;
     /// Boxes (8 per subdivision, plus the root).
@@ -621,6 +624,8 @@ impl<C: OctreeCapacities, const FRAMES: usize> OctreeStore for Octree<C, FRAMES>
 // then lives in its own stack frame for the query's duration only, instead of
 // two of them sitting in every caller's frame — it matters on a 16 KiB board.
 impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES> {
+    const KINDS: ShapeKinds = C::KINDS;
+
     #[inline(never)]
     fn nearest(
         &self,
@@ -638,7 +643,7 @@ impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES>
                 let object = ObjectId(id);
                 let t_max = best.map_or(Scalar::MAX, |b| b.t);
                 let leaving = RayStart::leaving(start, object);
-                if let Some(t) = scene.shape(object).intersect(ray, t_max, leaving) {
+                if let Some(t) = scene.intersect_handle(C::KINDS, scene.objects[id as usize], ray, t_max, leaving) {
                     if best.is_none_or(|b| t < b.t || (t == b.t && object < b.object)) {
                         best = Some(Hit { t, object });
                     }
@@ -673,7 +678,8 @@ impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES>
             let mut test = |id: u32| {
                 let hit = mailbox.first_visit(id) && {
                     let object = ObjectId(id);
-                    scene.shape(object).intersect(ray, t_max, RayStart::leaving(start, object)).is_some()
+                    let leaving = RayStart::leaving(start, object);
+                    scene.intersect_handle(C::KINDS, scene.objects[id as usize], ray, t_max, leaving).is_some()
                 };
                 if hit {
                     mailbox.blocker = id;
