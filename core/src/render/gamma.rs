@@ -56,6 +56,31 @@ impl GammaTable {
         }
         self.thresholds.partition_point(|&t| t as i32 <= c) as u8
     }
+
+    /// [`GammaTable::encode`], starting from `near` (the neighbouring
+    /// pixel's value: most often this one's or a step away): a few
+    /// comparisons instead of a binary search, which it falls back to.
+    #[inline]
+    pub fn encode_near(&self, c: Scalar, near: u8) -> u8 {
+        let bits = c.to_bits();
+        if bits >= 1 << 16 || bits <= 0 {
+            return self.encode(c);
+        }
+        // The answer is the number of thresholds ≤ c: k with
+        // thresholds[k − 1] ≤ c < thresholds[k].
+        let t = &self.thresholds;
+        let mut k = near as usize;
+        for _ in 0..4 {
+            if k > 0 && t[k - 1] as i32 > bits {
+                k -= 1;
+            } else if k < t.len() && t[k] as i32 <= bits {
+                k += 1;
+            } else {
+                return k as u8;
+            }
+        }
+        self.encode(c)
+    }
 }
 
 #[cfg(test)]
@@ -73,6 +98,23 @@ mod tests {
         assert_eq!(g.encode(Scalar::from_num(-3)), 0);
         assert_eq!(g.encode(Scalar::from_num(7)), 255);
         assert_eq!(g.encode(Scalar::from_num(0.5)), 128); // 127.5 rounds up
+    }
+
+    #[test]
+    fn encoding_from_a_neighbour_is_the_encoding() {
+        for gamma in [1i64 << 32, (22 << 32) / 10, 9 << 32] {
+            let g = GammaTable::new(Wide::from_bits(gamma));
+            for c in (-3..(1 << 16) + 3).step_by(7) {
+                let c = Scalar::from_bits(c);
+                for near in [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 100, 200, 250, 253, 254, 255] {
+                    assert_eq!(g.encode_near(c, near), g.encode(c), "gamma {gamma}, {c:?} near {near}");
+                }
+                let e = g.encode(c);
+                for near in e.saturating_sub(5)..=e.saturating_add(5) {
+                    assert_eq!(g.encode_near(c, near), e, "gamma {gamma}, {c:?} near {near}");
+                }
+            }
+        }
     }
 
     #[test]

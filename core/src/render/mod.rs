@@ -61,6 +61,8 @@ pub struct Renderer<'a, A> {
     /// The last primary ray's direction: the next one along a row is a sum.
     cursor: RayCursor,
     gamma: GammaTable,
+    /// The last pixel's display values, where the next one's search starts.
+    last_encoded: [u8; 3],
     scratch: Scratch<'a>,
 }
 
@@ -91,6 +93,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
             camera,
             cursor: RayCursor::default(),
             gamma: GammaTable { thresholds: [0; 255] },
+            last_encoded: [0; 3],
             scratch: Scratch::new(Mailbox::none()),
         };
         renderer.gamma.fill(s.gamma);
@@ -145,10 +148,13 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         let count = n * n;
         // One sample needs no division (a library call on a Cortex-M0).
         let mean = Color::from_bits(sum.map(|s| if count == 1 { s } else { (s + count / 2) / count } as i32));
-        PixelSample {
-            color: Rgb888::new(self.gamma.encode(mean.r), self.gamma.encode(mean.g), self.gamma.encode(mean.b)),
-            object,
-        }
+        // Neighbouring pixels mostly differ by a level or none: the search
+        // starts at the last pixel's (the same bits from any start).
+        let [r, g, b] = self.last_encoded;
+        let encoded =
+            [self.gamma.encode_near(mean.r, r), self.gamma.encode_near(mean.g, g), self.gamma.encode_near(mean.b, b)];
+        self.last_encoded = encoded;
+        PixelSample { color: Rgb888::new(encoded[0], encoded[1], encoded[2]), object }
     }
 
     /// The pixels of row `y` for the columns `xs`, traced lazily.
