@@ -262,11 +262,25 @@ static RECIPROCAL_TABLE: [u32; 257] = {
     t
 };
 
+/// `x >> shift` for a shift in 0 ..= 63, in 32-bit halves (a variable
+/// 64-bit shift is a library call on a 32-bit core).
+#[inline(always)]
+pub(crate) fn shr_u64(x: u64, shift: u32) -> u64 {
+    let (high, low) = ((x >> 32) as u32, x as u32);
+    if shift >= 32 {
+        (high >> (shift - 32)) as u64
+    } else if shift == 0 {
+        x
+    } else {
+        (((high >> shift) as u64) << 32) | ((low >> shift) | (high << (32 - shift))) as u64
+    }
+}
+
 /// `x << shift` for a shift in 0 ..= 31 whose result fits 64 bits, in
 /// 32-bit halves (a variable 64-bit shift is a library call on a 32-bit
 /// core).
 #[inline(always)]
-fn shl_u64(x: u64, shift: u32) -> u64 {
+pub(crate) fn shl_u64(x: u64, shift: u32) -> u64 {
     if shift == 0 {
         return x;
     }
@@ -529,6 +543,9 @@ mod tests {
             assert_eq!(leading_zeros_by_search(v), v.leading_zeros(), "{v}");
         }
         for v in spread(5_000).chain([u64::MAX, 1 << 63, (1 << 32) - 1, 1]) {
+            for shift in 0..64 {
+                assert_eq!(shr_u64(v, shift), v >> shift, "{v} >> {shift}");
+            }
             for shift in 0..32 {
                 if v.leading_zeros() >= shift {
                     assert_eq!(shl_u64(v, shift), v << shift, "{v} << {shift}");

@@ -16,7 +16,7 @@
 //! queries, each O(objects) in the naive mode.
 
 use crate::accel::{Accelerator, Hit, Mailbox, RayStart};
-use crate::math::{div_saturating, leading_zeros, pow_unit, Dir, Scalar, Unit, Vec3};
+use crate::math::{div_saturating, leading_zeros, pow_unit, shl_u64, shr_to_u32, shr_u64, Dir, Scalar, Unit, Vec3};
 use crate::scene::{Color, ObjectId, SceneView};
 use crate::shapes::{Leaving, Ray};
 
@@ -100,13 +100,14 @@ pub(crate) struct Tracer<'a, A> {
 /// much: exact for divisors below 2^32, within 2^-31 relative above.
 fn ratio_q16(num: u64, den: u64) -> i32 {
     let cut = 32u32.saturating_sub(leading_zeros(den));
-    let divisor = (den >> cut) as u32;
+    let divisor = shr_to_u32(den, cut);
     // num · 2^16 / 2^cut, or saturated when that is past any u64: the
-    // quotient would then be above 2^32 anyway.
+    // quotient would then be above 2^32 anyway. (Shifts in 32-bit halves:
+    // a variable 64-bit shift is a library call on a 32-bit core.)
     let numerator = if cut >= 16 {
-        num >> (cut - 16)
+        shr_u64(num, cut - 16)
     } else if leading_zeros(num) >= 16 - cut {
-        num << (16 - cut)
+        shl_u64(num, 16 - cut)
     } else {
         return i32::MAX;
     };
@@ -244,15 +245,19 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         if p.depth >= self.scene.settings.rdepth {
             return [None, None];
         }
-        let child = |dir: Dir, k: Scalar| {
-            (k.to_bits() > 0).then(|| Pending {
-                ray: Ray { origin: point, dir },
-                start: Some(RayStart { object: hit.object, leaving: leaving_along(geometric, dir) }),
-                depth: p.depth + 1,
-                weight: mul(p.weight, k),
+        // The direction is made only for a ray that will be traced.
+        let child = |dir: &dyn Fn() -> Dir, k: Scalar| {
+            (k.to_bits() > 0).then(|| {
+                let dir = dir();
+                Pending {
+                    ray: Ray { origin: point, dir },
+                    start: Some(RayStart { object: hit.object, leaving: leaving_along(geometric, dir) }),
+                    depth: p.depth + 1,
+                    weight: mul(p.weight, k),
+                }
             })
         };
-        [child(p.ray.dir, t), child(to_eye.reflect_about(normal), r)]
+        [child(&|| p.ray.dir, t), child(&|| to_eye.reflect_about(normal), r)]
     }
 
     /// Whether anything blocks `shadow` before `t_max`, trying `blocker` (the
