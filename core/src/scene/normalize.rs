@@ -9,7 +9,7 @@
 //! the scene. Only the light fall-off needs world distances back:
 //! [`Normalization::world_distance_q32`].
 
-use crate::math::{Scalar, Vec3, SCENE_RANGE_LOG2};
+use crate::math::{leading_zeros, shl_u64, shr_u64, Scalar, Vec3, SCENE_RANGE_LOG2};
 
 /// A world value in Q32.32 (as the parser reads numbers).
 pub type WorldValue = i64;
@@ -95,15 +95,23 @@ impl Normalization {
     #[inline]
     pub fn world_distance_q32(&self, d: i64) -> i64 {
         let s = 16 - self.shift;
+        // Shifts, not multiplies, and in 32-bit halves for a distance (not
+        // negative): 64-bit products and variable 64-bit shifts are library
+        // calls on a Cortex-M0.
         if s >= 0 {
-            // A shift, not a multiply: 64-bit products are library calls on
-            // a Cortex-M0.
-            let s = s.min(62);
-            if d > i64::MAX >> s {
-                i64::MAX
-            } else {
+            let s = s.min(62) as u32;
+            if d < 0 {
                 d << s
+            } else if leading_zeros(d as u64) <= s {
+                // d · 2^s would pass i64::MAX.
+                i64::MAX
+            } else if s >= 32 {
+                ((((d as u32) << (s - 32)) as u64) << 32) as i64
+            } else {
+                shl_u64(d as u64, s) as i64
             }
+        } else if d >= 0 {
+            shr_u64(d as u64, (-s).min(63) as u32) as i64
         } else {
             d >> (-s).min(63)
         }
@@ -119,6 +127,39 @@ impl Normalization {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn world_distances_shift_as_the_plain_forms_do() {
+        let plain = |shift: i32, d: i64| {
+            let s = 16 - shift;
+            if s >= 0 {
+                let s = s.min(62);
+                if d > i64::MAX >> s {
+                    i64::MAX
+                } else {
+                    d << s
+                }
+            } else {
+                d >> (-s).min(63)
+            }
+        };
+        let mut x = 0x1234_5678_9abc_def1u64;
+        for shift in -80..80 {
+            let norm = Normalization { center: [0; 3], shift };
+            for i in 0..400 {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                let d = match i % 4 {
+                    0 => (x >> (x % 64)) as i64,
+                    1 => (x as i64) >> (x % 64),
+                    2 => [0, 1, i64::MAX, i64::MIN, 1 << 31, (1 << 32) - 1][i / 4 % 6],
+                    _ => (x >> 33) as i64,
+                };
+                assert_eq!(norm.world_distance_q32(d), plain(shift, d), "shift {shift}, d {d}");
+            }
+        }
+    }
 
     const ONE: i64 = 1 << 32;
 
