@@ -85,7 +85,10 @@ pub fn log2_q32(raw: u64, frac_bits: u32) -> i64 {
         return i64::MIN;
     }
     let top = 63 - super::leading_zeros(raw) as i64;
-    let m = raw << (63 - top); // top bit at 63: m / 2^63 in [1, 2)
+    // Top bit at 63: m / 2^63 in [1, 2). In 32-bit halves: a variable
+    // 64-bit shift is a library call on a 32-bit core.
+    let up = (63 - top) as u32;
+    let m = if up >= 32 { (((raw as u32) << (up - 32)) as u64) << 32 } else { super::shl_u64(raw, up) };
     let index = ((m >> 55) & 0xff) as usize;
     let rest = ((m >> 23) & 0xffff_ffff) as u32; // Q0.32 position inside the interval
     let lo = LOG2_TABLE[index];
@@ -111,7 +114,9 @@ pub fn exp2_q32(y: i64) -> u64 {
     if shift >= 64 {
         0
     } else if shift > 0 {
-        (mant + (1 << (shift - 1))) >> shift
+        // (mant + 2^(shift−1)) >> shift, which cannot overflow (mant ≤ 2^63),
+        // as the halves' shift by one less, plus one, halved: the same bits.
+        (super::shr_u64(mant, shift as u32 - 1) + 1) >> 1
     } else if -shift <= mant.leading_zeros() as i64 {
         mant << -shift
     } else {
@@ -155,6 +160,26 @@ pub fn pow_unit(x: i32, p: i64) -> i32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn shifts_in_halves_are_the_plain_shifts() {
+        let mut x = 0x0bad_5eed_1234_5678u64;
+        for _ in 0..20_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let raw = (x >> (x % 64)).max(1);
+            let top = 63 - raw.leading_zeros();
+            let up = 63 - top;
+            let m = if up >= 32 { (((raw as u32) << (up - 32)) as u64) << 32 } else { super::super::shl_u64(raw, up) };
+            assert_eq!(m, raw << up, "{raw}");
+            let mant = x >> 1;
+            for shift in 1..64 {
+                let rounded = (super::super::shr_u64(mant, shift - 1) + 1) >> 1;
+                assert_eq!(rounded, (mant + (1 << (shift - 1))) >> shift, "{mant} {shift}");
+            }
+        }
+    }
 
     #[test]
     fn table_end_points_are_exact() {
