@@ -169,7 +169,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
                 continue;
             };
             let children = self.shade(&p, hit, &mut color, scratch);
-            for child in children.into_iter().flatten() {
+            for &child in children.iter().flatten() {
                 if child.weight.to_bits() <= 0 {
                     continue;
                 }
