@@ -151,8 +151,10 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         let mut color = Color::BLACK;
         let mut first_object = None;
         let mut traced = 0;
-        let mut next = Some(Pending { ray, start: None, depth: 0, weight: Scalar::ONE });
-        while let Some(p) = next.take().or_else(|| stack.pop()) {
+        // The ray being traced; its first child follows it directly, the
+        // other waits on the stack (depth first, as a recursion would go).
+        let mut p = Pending { ray, start: None, depth: 0, weight: Scalar::ONE };
+        loop {
             if traced == MAX_RAYS_PER_SAMPLE {
                 scratch.stats.truncated += 1 + stack.len() as u64;
                 break;
@@ -164,20 +166,26 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             if p.depth == 0 {
                 first_object = hit.map(|h| self.scene.written_object(h.object));
             }
-            let Some(hit) = hit else {
-                color = color.saturating_add(self.scene.settings.background.scale(p.weight));
-                continue;
-            };
-            let children = self.shade(&p, hit, &mut color, scratch);
-            for &child in children.iter().flatten() {
-                if child.weight.to_bits() <= 0 {
-                    continue;
+            let mut next = None;
+            match hit {
+                None => color = color.saturating_add(self.scene.settings.background.scale(p.weight)),
+                Some(hit) => {
+                    let children = self.shade(&p, hit, &mut color, scratch);
+                    for &child in children.iter().flatten() {
+                        if child.weight.to_bits() <= 0 {
+                            continue;
+                        }
+                        if next.is_none() {
+                            next = Some(child);
+                        } else if stack.push(child).is_err() {
+                            scratch.stats.truncated += 1;
+                        }
+                    }
                 }
-                if next.is_none() {
-                    next = Some(child);
-                } else if stack.push(child).is_err() {
-                    scratch.stats.truncated += 1;
-                }
+            }
+            match next.or_else(|| stack.pop()) {
+                Some(child) => p = child,
+                None => break,
             }
         }
         scratch.stats.cells = scratch.mailbox.cells;
