@@ -43,6 +43,11 @@ impl Color {
     #[inline]
     pub fn scale(self, k: Scalar) -> Color {
         let k = k.to_bits();
+        // A full weight (every primary ray's) leaves the colour as it is:
+        // c · 2^16 >> 16 = c, without the products.
+        if k == 1 << 16 {
+            return self;
+        }
         Color::from_bits(self.bits().map(|c| sat(mul_wide(c, k) >> 16)))
     }
 
@@ -115,6 +120,15 @@ pub struct SurfaceEntry {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_full_weight_is_the_product_by_one() {
+        for c in [i32::MIN, -1, 0, 1, 65_536, 123_456_789, i32::MAX] {
+            let color = Color::from_bits([c, c / 3, -c / 7]);
+            let product = Color::from_bits(color.bits().map(|v| sat(mul_wide(v, 1 << 16) >> 16)));
+            assert_eq!(color.scale(Scalar::ONE), product);
+        }
+    }
 
     #[test]
     fn saturating_colour_arithmetic() {
