@@ -124,7 +124,7 @@ mod tests {
     #[test]
     fn a_full_weight_is_the_product_by_one() {
         for c in [i32::MIN, -1, 0, 1, 65_536, 123_456_789, i32::MAX] {
-            let color = Color::from_bits([c, c / 3, -c / 7]);
+            let color = Color::from_bits([c, c / 3, c.wrapping_neg() / 7]);
             let product = Color::from_bits(color.bits().map(|v| sat(mul_wide(v, 1 << 16) >> 16)));
             assert_eq!(color.scale(Scalar::ONE), product);
         }
