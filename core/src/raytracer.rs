@@ -7,7 +7,7 @@
 //! in `.bss`, initialised in place); a [`LoadedScene`] exists only for a
 //! scene that parsed without errors, with its accelerator built.
 
-use crate::accel::{AccelMode, Accelerator, BuildReport, Mailbox, Naive, OctreeConfig, OctreeStore};
+use crate::accel::{AccelMode, Accelerator, BuildReport, Mailbox, NaiveFor, OctreeConfig, OctreeStore};
 use crate::capacity::Arena;
 use crate::parse::{parse_bytes, ErrorKind, ParseError, Pos};
 use crate::profile::Profile;
@@ -208,7 +208,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     {
         match self.octree {
             Some((octree, _)) if Raytracer::<P>::HAS_OCTREE => self.render(octree, size, area, at, target),
-            _ => self.render(&Naive, size, area, at, target),
+            _ => self.render(&NaiveFor::<P>::new(), size, area, at, target),
         }
     }
 

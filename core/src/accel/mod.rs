@@ -14,6 +14,7 @@ mod naive;
 mod octree;
 
 pub use naive::Naive;
+pub(crate) use naive::NaiveFor;
 pub use octree::{
     BuildReport, HashEntry, Index, Octree, OctreeCapacities, OctreeConfig, OctreeNode, OctreeStore, Traversal,
     MAX_DEPTH,
@@ -21,7 +22,7 @@ pub use octree::{
 
 use crate::math::Scalar;
 use crate::scene::{ObjectId, SceneView};
-use crate::shapes::{Leaving, Ray};
+use crate::shapes::{Leaving, Ray, ShapeKinds};
 
 /// How a scene's rays find their objects: the choice a user makes (host-sim's
 /// `--accel`, the firmware's `OCTRACE_ACCEL`). Every mode gives the same
@@ -202,6 +203,10 @@ impl<'m> Mailbox<'m> {
 
 /// An intersection strategy over a scene.
 pub trait Accelerator {
+    /// The shape kinds its scenes can hold (a profile's): the tracer
+    /// dispatches on these only, so a build links no other kind's code.
+    const KINDS: ShapeKinds = ShapeKinds::ALL;
+
     /// The nearest hit along `ray` (`t > 0`), ties to the earlier object.
     fn nearest(
         &self,

@@ -4,8 +4,10 @@
 
 use super::{Accelerator, Hit, Mailbox, RayStart};
 use crate::math::Scalar;
+use crate::profile::Profile;
 use crate::scene::{ObjectId, SceneView};
-use crate::shapes::Ray;
+use crate::shapes::{Ray, ShapeKinds};
+use core::marker::PhantomData;
 
 /// Tests every object, in file order.
 #[derive(Clone, Copy, Debug, Default)]
@@ -13,20 +15,7 @@ pub struct Naive;
 
 impl Accelerator for Naive {
     fn nearest(&self, scene: &SceneView<'_>, ray: &Ray, start: Option<RayStart>, _: &mut Mailbox<'_>) -> Option<Hit> {
-        let mut best: Option<Hit> = None;
-        let mut t_max = Scalar::MAX;
-        for (i, &handle) in scene.objects.iter().enumerate() {
-            let object = ObjectId(i as u32);
-            let leaving = RayStart::leaving(start, object);
-            if let Some(t) = scene.shape_of(handle).intersect(ray, t_max, leaving) {
-                // File order: a later object wins only when strictly nearer.
-                if best.is_none_or(|b| t < b.t) {
-                    best = Some(Hit { t, object });
-                    t_max = t;
-                }
-            }
-        }
-        best
+        nearest(ShapeKinds::ALL, scene, ray, start)
     }
 
     fn occluded(
@@ -37,13 +26,75 @@ impl Accelerator for Naive {
         start: Option<RayStart>,
         mailbox: &mut Mailbox<'_>,
     ) -> bool {
-        let blocker = scene.objects.iter().enumerate().position(|(i, &handle)| {
-            let leaving = RayStart::leaving(start, ObjectId(i as u32));
-            scene.shape_of(handle).intersect(ray, t_max, leaving).is_some()
-        });
-        if let Some(i) = blocker {
-            mailbox.blocker = i as u32;
-        }
-        blocker.is_some()
+        occluded(ShapeKinds::ALL, scene, ray, t_max, start, mailbox)
     }
+}
+
+/// [`Naive`] over a scene of the profile `P`: it dispatches only on the
+/// shape kinds `P` has room for, so a board links no other kind's tests.
+pub(crate) struct NaiveFor<P>(PhantomData<P>);
+
+impl<P> NaiveFor<P> {
+    pub const fn new() -> Self {
+        NaiveFor(PhantomData)
+    }
+}
+
+impl<P: Profile> Accelerator for NaiveFor<P> {
+    const KINDS: ShapeKinds = ShapeKinds::with_room(&P::COUNTS);
+
+    fn nearest(&self, scene: &SceneView<'_>, ray: &Ray, start: Option<RayStart>, _: &mut Mailbox<'_>) -> Option<Hit> {
+        nearest(Self::KINDS, scene, ray, start)
+    }
+
+    fn occluded(
+        &self,
+        scene: &SceneView<'_>,
+        ray: &Ray,
+        t_max: Scalar,
+        start: Option<RayStart>,
+        mailbox: &mut Mailbox<'_>,
+    ) -> bool {
+        occluded(Self::KINDS, scene, ray, t_max, start, mailbox)
+    }
+}
+
+/// Every object of `kinds` in file order; the nearest hit wins.
+#[inline(always)]
+fn nearest(kinds: ShapeKinds, scene: &SceneView<'_>, ray: &Ray, start: Option<RayStart>) -> Option<Hit> {
+    let mut best: Option<Hit> = None;
+    let mut t_max = Scalar::MAX;
+    for (i, &handle) in scene.objects.iter().enumerate() {
+        let object = ObjectId(i as u32);
+        let leaving = RayStart::leaving(start, object);
+        if let Some(t) = scene.intersect_handle(kinds, handle, ray, t_max, leaving) {
+            // File order: a later object wins only when strictly nearer.
+            if best.is_none_or(|b| t < b.t) {
+                best = Some(Hit { t, object });
+                t_max = t;
+            }
+        }
+    }
+    best
+}
+
+/// Whether any object of `kinds` blocks the ray; the first that does is
+/// left in the mailbox.
+#[inline(always)]
+fn occluded(
+    kinds: ShapeKinds,
+    scene: &SceneView<'_>,
+    ray: &Ray,
+    t_max: Scalar,
+    start: Option<RayStart>,
+    mailbox: &mut Mailbox<'_>,
+) -> bool {
+    let blocker = scene.objects.iter().enumerate().position(|(i, &handle)| {
+        let leaving = RayStart::leaving(start, ObjectId(i as u32));
+        scene.intersect_handle(kinds, handle, ray, t_max, leaving).is_some()
+    });
+    if let Some(i) = blocker {
+        mailbox.blocker = i as u32;
+    }
+    blocker.is_some()
 }

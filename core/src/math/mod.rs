@@ -19,7 +19,7 @@ mod wide;
 pub(crate) use exp_log::{isqrt_u128, pow_q30, pow_unit};
 pub use vector::{Dir, Vec3};
 pub(crate) use wide::{
-    div_saturating, isqrt, leading_zeros, mul_i64_i32, mul_u32_wide, mul_wide, shr_to_u32, sqrt_and_rsqrt,
+    div_saturating, isqrt, leading_zeros, mul_i64_i32, mul_u32_wide, mul_wide, shr_to_u32, sqrt_and_rsqrt_58_62,
     square_u32_wide, square_wide,
 };
 

@@ -101,8 +101,14 @@ impl Vec3 {
     #[inline]
     pub fn direction_and_length(self) -> Option<(Dir, Scalar)> {
         let (d, len, shift) = Dir::normalize_small_with_length(self.bits())?;
-        let length = if shift >= 0 { len << shift } else { (len + (1 << (-shift - 1))) >> -shift };
-        Some((d, Scalar::from_bits(length.min(i32::MAX as u64) as i32)))
+        // `len` is below 2^31 and `shift` at most 2; rounding in 32 bits
+        // (a variable 64-bit shift is a library call on a 32-bit core).
+        let length = if shift >= 0 {
+            (len << shift).min(i32::MAX as u64) as u32
+        } else {
+            (len as u32 + (1 << (-shift - 1))) >> -shift
+        };
+        Some((d, Scalar::from_bits(length.min(i32::MAX as u32) as i32)))
     }
 }
 
@@ -243,32 +249,32 @@ impl Dir {
     #[inline]
     fn from_scaled(negative: [bool; 3], scaled: [u32; 3], shift: i32) -> (Dir, u64, i32) {
         let len2 = scaled.iter().map(|&c| square_u32_wide(c)).sum::<u64>();
-        let (len, g, e) = super::sqrt_and_rsqrt(len2);
+        // The largest magnitude is in [2^29, 2^30): len2 in [2^58, 3·2^60).
+        let (len, g, e) = super::sqrt_and_rsqrt_58_62(len2);
         (Self::divided(negative, scaled, g, e, len as u32), len, shift)
     }
 
     /// The scaled magnitudes divided by their length `len` (= ⌊√len2⌋,
     /// `1/√len2 ≈ g · 2^-e`), with the given signs: `round(c · 2^30 / len)`
-    /// exactly, but without a division — estimated through g, then corrected
-    /// by the exact product with `len`.
+    /// exactly, without a division: one product with the reciprocal of
+    /// `len` and one 32-bit check per component.
+    ///
+    /// Why it is exact: with `R = ⌊(2^61 − 1)/len⌋` and `c < 2^30`,
+    /// `c·R/2^31` lies in `(c·2^30/len − ½, c·2^30/len]`, so
+    /// `m' = ⌊c·R/2^31 + ½⌋` is the wanted `m = ⌊(c·2^30 + ⌊len/2⌋)/len⌋`
+    /// or `m − 1` (it cannot pass `m + 1`, which is at least `1/len` above
+    /// the quotient while the estimate exceeds it by at most `1/(2·len)`).
+    /// The rest `c·2^30 + ⌊len/2⌋ − m'·len` is then in `[0, 2·len)`, below
+    /// 2^32: its low word, a 32-bit product, tells which.
     #[inline]
     fn divided(negative: [bool; 3], scaled: [u32; 3], g: u32, e: i32, len: u32) -> Dir {
-        let down = (e - 30) as u32; // 30 or 31: scaled lengths are 2^29 to 2^31
+        let reciprocal = reciprocal_of_length(g, e, len);
         Dir::from_bits([0, 1, 2].map(|a| {
-            // The largest m with m·len ≤ c·2^30 + len/2 is the rounded
-            // quotient; the steps keep m·len as `product` (one multiply).
-            let limit = ((scaled[a] as u64) << 30) + (len / 2) as u64;
-            let estimate = mul_u32_wide(scaled[a], g) + (1 << (down - 1));
-            // Two constant shifts: a variable 64-bit one is a library call.
-            let mut m = (if down == 30 { estimate >> 30 } else { estimate >> 31 }) as u32;
-            let mut product = mul_u32_wide(m, len);
-            while product > limit {
-                m -= 1;
-                product -= len as u64;
-            }
-            while limit - product >= len as u64 {
+            let c = scaled[a];
+            let mut m = ((mul_u32_wide(c, reciprocal) + (1 << 30)) >> 31) as u32;
+            let rest = (c << 30).wrapping_add(len / 2).wrapping_sub(m.wrapping_mul(len));
+            if rest >= len {
                 m += 1;
-                product += len as u64;
             }
             if negative[a] {
                 -(m as i32)
@@ -297,6 +303,27 @@ impl Dir {
     }
 }
 
+/// `⌊(2^61 − 1) / len⌋` for `len` in [2^29, 2^31) (below 2^32), from
+/// `1/√len2 ≈ g·2^-e` (`len = ⌊√len2⌋`, e 60 or 61): the estimate
+/// `g·2^(61−e)` is within a few dozen units, then stepped to the exact floor
+/// on the remainder.
+#[inline]
+fn reciprocal_of_length(g: u32, e: i32, len: u32) -> u32 {
+    let estimate = if e == 60 { (g as u64) << 1 } else { g as u64 };
+    let mut r = estimate.min(u32::MAX as u64) as u32;
+    // r·len < 2^63: the remainder fits an i64.
+    let mut rest = ((1i64 << 61) - 1) - mul_u32_wide(r, len) as i64;
+    while rest < 0 {
+        r -= 1;
+        rest += len as i64;
+    }
+    while rest >= len as i64 {
+        r += 1;
+        rest -= len as i64;
+    }
+    r
+}
+
 impl Neg for Dir {
     type Output = Dir;
     #[inline]
@@ -307,6 +334,7 @@ impl Neg for Dir {
 
 #[cfg(test)]
 mod tests {
+    extern crate std;
     use super::*;
 
     fn len2(d: Dir) -> i64 {
@@ -387,5 +415,36 @@ mod tests {
         let s = Dir::Y.scale(Scalar::from_bits(-(5 << 16)));
         assert_eq!(s.bits(), [0, -(5 << 16), 0]);
         assert_eq!(Dir::X.cross(Dir::Y), Some(Dir::Z));
+    }
+    #[test]
+    fn unit_components_are_the_rounded_quotients() {
+        // Against u64 division: every component is round(c·2^30/len), ties
+        // up, for magnitudes at every ratio (the largest in [2^29, 2^30)).
+        let seed = 0x00d1_71de_d0u64;
+        std::println!("seed {seed:#x}");
+        let mut x = seed;
+        for i in 0..300_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let largest = (1 << 29) | (x as u32 & ((1 << 29) - 1));
+            let other = |k: u32| match (x >> (32 + k)) % 4 {
+                0 => largest,
+                1 => (x >> k) as u32 % (largest + 1),
+                2 => ((x >> k) as u32 % (largest + 1)) >> ((x >> (40 + k)) % 30),
+                _ => 0,
+            };
+            let scaled = [largest, other(3), other(11)];
+            let scaled = [scaled[i % 3], scaled[(i + 1) % 3], scaled[(i + 2) % 3]];
+            let (d, len, _) = Dir::from_scaled([false, true, false], scaled, 0);
+            let len2: u64 = scaled.iter().map(|&c| c as u64 * c as u64).sum();
+            assert_eq!(len, len2.isqrt(), "seed {seed:#x}, case {i}");
+            let want = scaled.map(|c| (((c as u64) << 30) + len / 2) / len);
+            assert_eq!(
+                d.bits(),
+                [want[0] as i32, -(want[1] as i32), want[2] as i32],
+                "seed {seed:#x}, case {i}: {scaled:?}"
+            );
+        }
     }
 }

@@ -115,22 +115,33 @@ fn square_u32_by_parts(m: u32) -> u64 {
     (((h * h) as u64) << 32) + (((h * l) as u64) << 17) + (l * l) as u64
 }
 
-/// Binary search over one 32-bit word (the library routine costs about 35
-/// instructions on a Cortex-M0).
+/// Leading zeros of each byte value (8 for zero).
+static BYTE_LEADING_ZEROS: [u8; 256] = {
+    let mut t = [0u8; 256];
+    let mut i = 0;
+    while i < 256 {
+        t[i] = (i as u8).leading_zeros() as u8;
+        i += 1;
+    }
+    t
+};
+
+/// Two halvings of one 32-bit word, then a table of the top byte: about ten
+/// instructions (the library routine costs about 35 on a Cortex-M0, a
+/// five-step binary search about 25).
 #[inline(always)]
 fn leading_zeros_by_search(x: u64) -> u32 {
     let (high, low) = ((x >> 32) as u32, x as u32);
     let (mut n, mut w) = if high != 0 { (0, high) } else { (32, low) };
-    if w == 0 {
-        return 64;
+    if w >> 16 == 0 {
+        n += 16;
+        w <<= 16;
     }
-    for bits in [16, 8, 4, 2, 1] {
-        if w >> (32 - bits) == 0 {
-            n += bits;
-            w <<= bits;
-        }
+    if w >> 24 == 0 {
+        n += 8;
+        w <<= 8;
     }
-    n
+    n + BYTE_LEADING_ZEROS[(w >> 24) as usize] as u32
 }
 
 /// `x >> shift` for a shift in 0 ..= 63 whose result fits 32 bits: on a
@@ -142,6 +153,20 @@ pub fn shr_to_u32(x: u64, shift: u32) -> u32 {
         high >> (shift - 32)
     } else if shift == 0 {
         low
+    } else {
+        (low >> shift) | (high << (32 - shift))
+    }
+}
+
+/// `min(x >> shift, u32::MAX)` for a shift in 1 ..= 63, in 32-bit steps
+/// (a 64-bit shift by a variable amount is a library call on a 32-bit core).
+#[inline(always)]
+pub(crate) fn shr_saturating_u32(x: u64, shift: u32) -> u32 {
+    let (high, low) = ((x >> 32) as u32, x as u32);
+    if shift >= 32 {
+        high >> (shift - 32)
+    } else if high >> shift != 0 {
+        u32::MAX
     } else {
         (low >> shift) | (high << (32 - shift))
     }
@@ -324,6 +349,24 @@ pub fn sqrt_and_rsqrt(n: u64) -> (u64, u32, i32) {
     (isqrt_from(n, g, f, shift), g, 46 + shift / 2)
 }
 
+/// [`sqrt_and_rsqrt`] for `n` in [2^58, 2^62) — the squared length of a unit
+/// vector's scaled magnitudes (the largest in [2^29, 2^30)) — where the
+/// argument's scale is one of two, known without counting leading zeros.
+#[inline]
+pub(crate) fn sqrt_and_rsqrt_58_62(n: u64) -> (u64, u32, i32) {
+    let shift = if n >> 62 != 0 || n >> 58 == 0 {
+        return sqrt_and_rsqrt(n);
+    } else if n >> 60 != 0 {
+        30
+    } else {
+        28
+    };
+    // What `rsqrt_argument` gives: f = n / 2^shift in [2^30, 2^32).
+    let f = if shift == 30 { (n >> 30) as u32 } else { (n >> 28) as u32 };
+    let g = rsqrt_normalised(f);
+    (isqrt_from(n, g, f, shift), g, 46 + shift / 2)
+}
+
 /// ⌊√n⌋ for `n ≥ 2` given [`rsqrt_argument`]'s `f · 2^shift = n` and
 /// `g ≈ 2^30/√(f / 2^32)`.
 #[inline]
@@ -333,7 +376,7 @@ fn isqrt_from(n: u64, g: u32, f: u32, shift: i32) -> u64 {
     // is 30 to 61 for every n ≥ 2.
     // √n < 2^32, so the estimate is capped below it; s² then fits a u64,
     // and the steps keep it as `square` (one product in all).
-    let mut s = (mul_u32_wide(f, g) >> (46 - shift / 2)).min(u32::MAX as u64);
+    let mut s = shr_saturating_u32(mul_u32_wide(f, g), (46 - shift / 2) as u32) as u64;
     let mut square = square_u32_wide(s as u32);
     while square > n {
         square -= 2 * s - 1;
@@ -418,6 +461,11 @@ mod tests {
         for v in spread(20_000).chain([0, 1, u64::MAX, 1 << 32, (1 << 32) - 1, 1 << 63]) {
             assert_eq!(leading_zeros_by_search(v), v.leading_zeros(), "{v}");
         }
+        for v in spread(5_000).chain([u64::MAX, 1 << 63, (1 << 32) - 1]) {
+            for shift in 1..64 {
+                assert_eq!(shr_saturating_u32(v, shift), (v >> shift).min(u32::MAX as u64) as u32, "{v} >> {shift}");
+            }
+        }
         for v in spread(5_000) {
             for shift in 0..64 {
                 if v >> shift <= u32::MAX as u64 {
@@ -468,6 +516,14 @@ mod tests {
         }
         assert_eq!(mul_wide(i32::MIN, i32::MIN), 1 << 62);
         assert_eq!(mul_wide(i32::MIN, i32::MAX), i32::MIN as i64 * i32::MAX as i64);
+    }
+
+    #[test]
+    fn the_two_scale_square_root_is_the_general_one() {
+        let ends = [1 << 58, (1 << 58) - 1, 1 << 60, (1 << 60) - 1, (1 << 62) - 1, 1 << 62, 3 << 60];
+        for n in spread(50_000).map(|v| v | 1 << 58 >> (v % 3)).chain(ends) {
+            assert_eq!(sqrt_and_rsqrt_58_62(n), sqrt_and_rsqrt(n), "{n}");
+        }
     }
 
     #[test]

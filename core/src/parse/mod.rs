@@ -25,9 +25,10 @@ pub use error::{ErrorKind, Field, Found, ParseError, Pos, Rule};
 pub(crate) use number::Decimal;
 pub(crate) use statement::Statement;
 
-use crate::capacity::{CapacityError, CapacityKind, Counts};
+use crate::capacity::{Arena, CapacityError, CapacityKind, Counts};
 use crate::scene::{Camera, CameraError, Light, Normalization, Scene, SceneCapacities, SurfaceEntry, WorldPoint};
 use crate::shapes::{AxisAlignedBox, Rectangle, ShapeKind, Sphere, Superquadric, Triangle};
+use core::marker::PhantomData;
 use keyword::Keyword;
 use statement::{Cursor, Patch};
 
@@ -38,9 +39,36 @@ pub struct Parsed<'a> {
     pub imagefile: Option<&'a str>,
 }
 
+/// Which shapes' geometric checks a parse runs. A profile without room for
+/// a kind makes each of its statements a capacity error anyway, so a board
+/// that holds no rectangles (say) skips their checks and links none of that
+/// code; the capacity error still names the first such statement.
+pub(crate) trait Room {
+    /// Rectangles are checked for area, planarity and convexity.
+    const RECTANGLES: bool;
+    /// Triangles are checked for area.
+    const TRIANGLES: bool;
+}
+
+/// Every check: what [`count`] needs (it holds no scene).
+struct AnyRoom;
+
+impl Room for AnyRoom {
+    const RECTANGLES: bool = true;
+    const TRIANGLES: bool = true;
+}
+
+/// The checks for the shapes the profile `C` has room for.
+struct RoomOf<C>(PhantomData<C>);
+
+impl<C: SceneCapacities> Room for RoomOf<C> {
+    const RECTANGLES: bool = <C::Rectangles as Arena<Rectangle>>::CAPACITY > 0;
+    const TRIANGLES: bool = <C::Triangles as Arena<Triangle>>::CAPACITY > 0;
+}
+
 /// Reads every statement of `text`, handing each (or its error) to `each`;
 /// skips to the next keyword after an error.
-fn for_each_statement<'a>(text: &'a str, mut each: impl FnMut(Pos, Result<Statement<'a>, ParseError<'a>>)) {
+fn for_each_statement<'a, R: Room>(text: &'a str, mut each: impl FnMut(Pos, Result<Statement<'a>, ParseError<'a>>)) {
     let mut cur = Cursor::new(text);
     loop {
         let token = match cur.next() {
@@ -52,7 +80,7 @@ fn for_each_statement<'a>(text: &'a str, mut each: impl FnMut(Pos, Result<Statem
             }
         };
         let result = match Keyword::from_text(token.text).filter(|_| !token.quoted) {
-            Some(kw) => statement::statement(&mut cur, kw, token.pos),
+            Some(kw) => statement::statement::<R>(&mut cur, kw, token.pos),
             None => Err(ParseError::new(token.pos, ErrorKind::UnknownKeyword(token.text))),
         };
         let failed = result.is_err();
@@ -151,7 +179,7 @@ pub fn parse<'a, C: SceneCapacities>(
         reported_capacity: 0,
         on_error,
     };
-    for_each_statement(text, |pos, result| match result {
+    for_each_statement::<RoomOf<C>>(text, |pos, result| match result {
         Ok(s) => build.apply(pos, s),
         Err(e) => build.report(e),
     });
@@ -178,7 +206,7 @@ pub fn parse<'a, C: SceneCapacities>(
 /// ```
 pub fn count(text: &str) -> Counts {
     let mut counts = Counts::ZERO;
-    for_each_statement(text, |_, result| {
+    for_each_statement::<AnyRoom>(text, |_, result| {
         if let Ok(s) = result {
             s.count(&mut counts);
         }
@@ -196,7 +224,7 @@ fn survey<C: SceneCapacities>(text: &str, scene: &mut Scene<C>) -> Counts {
         Some(e) => e.add(lo, hi),
         None => extent = Some(Extent { min: lo, max: hi }),
     };
-    for_each_statement(text, |pos, result| {
+    for_each_statement::<RoomOf<C>>(text, |pos, result| {
         if let Ok(s) = &result {
             s.count(&mut counts);
         }
@@ -361,6 +389,9 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
                 let Some(surface) = self.surface(keyword, surface, pos) else {
                     return;
                 };
+                if Scene::<C>::capacity_of(ShapeKind::Triangle) == 0 {
+                    return self.capacity(pos, Scene::<C>::full(CapacityKind::Triangles, 0));
+                }
                 let Some(t) = Triangle::new(corners.map(|c| norm.point(c)), surface) else {
                     return self.report(too_small());
                 };
@@ -373,6 +404,12 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
                 let Some(surface) = self.surface(keyword, surface, pos) else {
                     return;
                 };
+                // Checked on the constant before the shape is made (like
+                // B-spline patches): a profile without room for rectangles
+                // links none of their set-up (see `Room`).
+                if Scene::<C>::capacity_of(ShapeKind::Rectangle) == 0 {
+                    return self.capacity(pos, Scene::<C>::full(CapacityKind::Rectangles, 0));
+                }
                 let Some(r) = Rectangle::new(corners.map(|c| norm.point(c)), surface) else {
                     return self.report(too_small());
                 };
@@ -690,6 +727,35 @@ mod tests {
             1,
             "{e:?}"
         );
+    }
+
+    #[test]
+    fn a_profile_without_room_for_a_flat_kind_names_its_first_statement() {
+        crate::profile! {
+            struct SpheresOnly { spheres: 2, surfaces: 1, lights: 1 }
+        }
+        let load = |text: &str| {
+            let mut scene = std::boxed::Box::new(Scene::<SpheresOnly>::new());
+            let mut errors = Vec::new();
+            let r = parse(text, &mut scene, &mut |e| errors.push(e.to_string()));
+            assert_eq!(r, Err(errors.len()), "{errors:?}");
+            errors
+        };
+        // A valid rectangle, then one that is not convex: the board skips
+        // their checks, and the first one is the capacity error.
+        let rectangles = format!(
+            "{SURF}SPHERE 1 1 0 0 0\nRECTANGLE 1 0 0 0 1 0 0 1 1 0 0 1 0\nRECTANGLE 1 0 0 0 1 1 0 1 0 0 0 1 0\n"
+        );
+        let e = load(&rectangles);
+        assert_eq!(e.len(), 1, "{e:?}");
+        assert!(e[0].starts_with("3:1: too many rectangles: the capacity profile SpheresOnly holds 0"), "{e:?}");
+        let e = load(&format!("{SURF}TRIANGLE 1 0 0 0 1 0 0 2 0 0\nTRIANGLE 1 0 0 0 1 0 0 0 1 0\n"));
+        assert_eq!(e.len(), 1, "{e:?}");
+        assert!(e[0].starts_with("2:1: too many triangles: the capacity profile SpheresOnly holds 0"), "{e:?}");
+        // With room, the same rectangles are checked as before.
+        let e = errs(&rectangles);
+        assert_eq!(e.len(), 1, "{e:?}");
+        assert!(e[0].starts_with("4:1:") && e[0].contains("convex"), "{e:?}");
     }
 
     #[test]

@@ -307,7 +307,12 @@ pub fn q32_to_q16(v: i64) -> i64 {
 }
 
 /// Reads the statement that `keyword` (already consumed) begins.
-pub fn statement<'a>(cur: &mut Cursor<'a>, kw: Keyword, at: Pos) -> Result<Statement<'a>, ParseError<'a>> {
+/// The shapes' geometric checks run only where `R` has room for them.
+pub fn statement<'a, R: super::Room>(
+    cur: &mut Cursor<'a>,
+    kw: Keyword,
+    at: Pos,
+) -> Result<Statement<'a>, ParseError<'a>> {
     let f = |name| Field { statement: kw.name(), name };
     let xyz = ["x", "y", "z"];
     Ok(match kw {
@@ -357,7 +362,7 @@ pub fn statement<'a>(cur: &mut Cursor<'a>, kw: Keyword, at: Pos) -> Result<State
                 cur.point(kw, ["x2", "y2", "z2"])?,
                 cur.point(kw, ["x3", "y3", "z3"])?,
             ];
-            if cross(sub(corners[1], corners[0]), sub(corners[2], corners[0])) == [0; 3] {
+            if R::TRIANGLES && cross(sub(corners[1], corners[0]), sub(corners[2], corners[0])) == [0; 3] {
                 return Err(ParseError::new(
                     at,
                     ErrorKind::Degenerate { keyword: kw.name(), why: "its corners are collinear (zero area)" },
@@ -373,7 +378,9 @@ pub fn statement<'a>(cur: &mut Cursor<'a>, kw: Keyword, at: Pos) -> Result<State
                 cur.point(kw, ["x3", "y3", "z3"])?,
                 cur.point(kw, ["x4", "y4", "z4"])?,
             ];
-            check_quadrilateral(&corners).map_err(|k| ParseError::new(at, k))?;
+            if R::RECTANGLES {
+                check_quadrilateral(&corners).map_err(|k| ParseError::new(at, k))?;
+            }
             Statement::Rectangle { surface, corners }
         }
         Keyword::Bspline => {

@@ -18,7 +18,7 @@ pub(crate) use gamma::GammaTable;
 pub use split::{interleaved_rows, Tiles};
 
 use crate::accel::{Accelerator, Mailbox};
-use crate::scene::{Camera, CameraError, Color, ObjectId, SceneView};
+use crate::scene::{Camera, CameraError, Color, ObjectId, RayCursor, SceneView};
 use crate::shade::{Scratch, Stats, Tracer};
 use core::ops::Range;
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -58,6 +58,8 @@ pub struct PixelSample {
 pub struct Renderer<'a, A> {
     tracer: Tracer<'a, A>,
     camera: Camera,
+    /// The last primary ray's direction: the next one along a row is a sum.
+    cursor: RayCursor,
     gamma: GammaTable,
     scratch: Scratch<'a>,
 }
@@ -87,6 +89,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         let mut renderer = Renderer {
             tracer: Tracer::new(scene, accel),
             camera,
+            cursor: RayCursor::default(),
             gamma: GammaTable { thresholds: [0; 255] },
             scratch: Scratch::new(Mailbox::none()),
         };
@@ -129,7 +132,8 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         let mut sum = [0u32; 3];
         for sy in 0..n {
             for sx in 0..n {
-                let (c, o) = self.tracer.trace(self.camera.ray(x, y, sx, sy), &mut self.scratch);
+                let ray = self.camera.next_ray(&mut self.cursor, x, y, sx, sy);
+                let (c, o) = self.tracer.trace(ray, &mut self.scratch);
                 if sx == n / 2 && sy == n / 2 {
                     object = o;
                 }

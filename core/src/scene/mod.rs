@@ -17,14 +17,16 @@ mod camera;
 mod normalize;
 mod surface;
 
+pub(crate) use camera::RayCursor;
 pub use camera::{Camera, CameraError, View, MAX_SAMPLES, MAX_SIDE};
 pub use normalize::{Normalization, WorldPoint, WorldValue};
 pub use surface::{Color, Surface, SurfaceEntry};
 
 use crate::capacity::{Arena, CapacityError, CapacityKind};
-use crate::math::{Vec3, Wide};
+use crate::math::{Scalar, Vec3, Wide};
 use crate::shapes::{
-    AxisAlignedBox, Rectangle, ShapeHandle, ShapeKind, ShapeRef, SmoothTriangle, Sphere, Superquadric, Triangle,
+    AxisAlignedBox, Leaving, Ray, Rectangle, ShapeHandle, ShapeKind, ShapeKinds, ShapeRef, SmoothTriangle, Sphere,
+    Superquadric, Triangle,
 };
 
 /// An object's position in the scene file (0 for the first object).
@@ -426,6 +428,34 @@ impl<'a> SceneView<'a> {
             ShapeKind::Triangle => ShapeRef::Triangle(&self.triangles[i]),
             ShapeKind::Rectangle => ShapeRef::Rectangle(&self.rectangles[i]),
             ShapeKind::SmoothTriangle => ShapeRef::SmoothTriangle(&self.smooth_triangles[i]),
+        }
+    }
+
+    /// [`ShapeRef::intersect_among`] of the primitive behind a handle,
+    /// straight from the handle's kind (the object loops' step).
+    #[inline(always)]
+    pub(crate) fn intersect_handle(
+        &self,
+        kinds: ShapeKinds,
+        h: ShapeHandle,
+        ray: &Ray,
+        t_max: Scalar,
+        leaving: Leaving,
+    ) -> Option<Scalar> {
+        use ShapeKind as K;
+        let i = h.index();
+        match h.kind() {
+            K::Sphere if kinds.contains(K::Sphere) => self.spheres.get(i)?.intersect(ray, t_max, leaving),
+            K::Box if kinds.contains(K::Box) => self.boxes.get(i)?.intersect(ray, t_max, leaving),
+            K::Superquadric if kinds.contains(K::Superquadric) => {
+                self.superquadrics.get(i)?.intersect(ray, t_max, leaving)
+            }
+            K::Triangle if kinds.contains(K::Triangle) => self.triangles.get(i)?.intersect(ray, t_max, leaving),
+            K::Rectangle if kinds.contains(K::Rectangle) => self.rectangles.get(i)?.intersect(ray, t_max, leaving),
+            K::SmoothTriangle if kinds.contains(K::SmoothTriangle) => {
+                self.smooth_triangles.get(i)?.intersect(ray, t_max, leaving)
+            }
+            _ => None,
         }
     }
 

@@ -16,7 +16,7 @@
 //! queries, each O(objects) in the naive mode.
 
 use crate::accel::{Accelerator, Hit, Mailbox, RayStart};
-use crate::math::{div_saturating, leading_zeros, pow_unit, Dir, Scalar, Unit};
+use crate::math::{div_saturating, leading_zeros, pow_unit, Dir, Scalar, Unit, Vec3};
 use crate::scene::{Color, ObjectId, SceneView};
 use crate::shapes::{Leaving, Ray};
 
@@ -113,6 +113,17 @@ fn ratio_q16(num: u64, den: u64) -> i32 {
     div_saturating(numerator, divisor).min(i32::MAX as u32) as i32
 }
 
+/// Whether `normal.dot(v.direction())` surely rounds to ≤ 0, from the exact
+/// `normal · v`: the unit vector's components are `v`'s, cut to 30 bits
+/// (each cut moves the sum by less than Σ|n_i| ≤ √3·2^30 of `v`'s scale
+/// 2^shift, shift ≤ 2) and rounded to nearest (less than 0.87·2^30 in
+/// Q4.60). So `n · v ≤ −2^33` in Q18.46 leaves the Q4.60 cosine below 2^30,
+/// its Q2.30 floor at most 0.
+#[inline]
+fn surely_behind(v: Vec3, normal: Dir) -> bool {
+    v.dot_dir_q46(normal) <= -(1 << 33)
+}
+
 /// How a ray leaving a surface along `dir` relates to the shape it leaves:
 /// closed shapes are entered when `dir` points against the outward normal.
 #[inline]
@@ -177,17 +188,23 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
     fn shade(&self, p: &Pending, hit: Hit, color: &mut Color, scratch: &mut Scratch<'_>) -> [Option<Pending>; 2] {
         let shape = self.scene.shape(hit.object);
         let point = p.ray.at(hit.t);
-        let geometric = shape.normal_at(point);
+        let geometric = shape.normal_at_among(A::KINDS, point);
         // Two-sided: shade with the normal facing the incoming ray (for a
         // B-spline's triangle, its interpolated normal; shadow rays then
         // leave from the smooth surface, see shapes::SmoothTriangle).
         let facing = if geometric.dot_q60(p.ray.dir) > 0 { -geometric } else { geometric };
-        let (normal, shadow_from) = shape.shading(point, facing);
+        let (normal, shadow_from) = shape.shading_among(A::KINDS, point, facing);
         let to_eye = -p.ray.dir;
         let surface = self.scene.surface(shape.surface());
         let mut local = surface.ambient;
         for (index, light) in self.scene.lights.iter().enumerate() {
             let to_light = light.position - shadow_from;
+            // A light surely behind the surface is skipped before the unit
+            // vector is made: its cosine would round to ≤ 0 (see
+            // `surely_behind`), so the image cannot change.
+            if surely_behind(to_light, normal) {
+                continue;
+            }
             let Some((light_dir, distance)) = to_light.direction_and_length() else {
                 continue;
             };
@@ -244,7 +261,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         if (*blocker as usize) < self.scene.object_count() {
             let object = ObjectId(*blocker);
             let leaving = RayStart::leaving(Some(start), object);
-            if self.scene.shape(object).intersect(shadow, t_max, leaving).is_some() {
+            if self.scene.shape(object).intersect_among(A::KINDS, shadow, t_max, leaving).is_some() {
                 return true;
             }
             // Missed: the walk need not test it again.
@@ -275,7 +292,41 @@ fn mul(a: Scalar, b: Scalar) -> Scalar {
 
 #[cfg(test)]
 mod tests {
+    extern crate std;
     use super::*;
+
+    #[test]
+    fn a_light_surely_behind_has_a_cosine_of_at_most_zero() {
+        // Vectors of every scale nearly in the plane of random normals: when
+        // the pre-test says "behind", the rounded cosine is ≤ 0.
+        let seed = 0x0c05_1e55_u64;
+        std::println!("seed {seed:#x}");
+        let mut state = seed;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let (mut behind, mut near) = (0, 0);
+        for i in 0..300_000 {
+            let Some(normal) = Dir::normalize([0; 3].map(|_| next() as i32 as i64)) else { continue };
+            let scale = 2 + next() % 29;
+            let v = Vec3::from_bits([0; 3].map(|_| (next() as i32) >> scale));
+            // Push v towards the plane: subtract most of its normal part.
+            let along = v.dot_dir(normal).to_bits();
+            let keep = (next() % 3) as i32;
+            let v = v - normal.scale(Scalar::from_bits(along - (along >> 8) * keep));
+            if surely_behind(v, normal) {
+                behind += 1;
+                near += (v.dot_dir_q46(normal) > -(1 << 40)) as u32;
+                if let Some(d) = v.direction() {
+                    assert!(normal.dot(d).to_bits() <= 0, "seed {seed:#x}, case {i}: {v:?} {normal:?}");
+                }
+            }
+        }
+        assert!(behind > 50_000 && near > 1_000, "{behind} behind, {near} near the plane");
+    }
 
     #[test]
     fn ratio_saturates_and_is_exact() {

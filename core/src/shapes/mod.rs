@@ -29,7 +29,7 @@ pub use sphere::Sphere;
 pub use superquadric::Superquadric;
 pub use triangle::Triangle;
 
-use crate::capacity::CapacityKind;
+use crate::capacity::{CapacityKind, Counts};
 use crate::math::{Dir, Scalar, Vec3};
 
 /// A ray `origin + t·dir`, `t > 0`.
@@ -133,6 +133,45 @@ impl ShapeKind {
     }
 }
 
+/// The primitive kinds a build can meet: a profile's shapes with room
+/// ([`ShapeKinds::with_room`]). Dispatch on a constant set links no code
+/// for a kind outside it (a small board's firmware carries only its scene's
+/// shapes); an object of such a kind cannot be stored, so none is missed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShapeKinds(u8);
+
+impl ShapeKinds {
+    /// Every kind.
+    pub const ALL: ShapeKinds = ShapeKinds(0b11_1111);
+
+    /// The kinds `counts` has room for.
+    pub const fn with_room(counts: &Counts) -> ShapeKinds {
+        let kinds = [
+            ShapeKind::Sphere,
+            ShapeKind::Box,
+            ShapeKind::Superquadric,
+            ShapeKind::Triangle,
+            ShapeKind::Rectangle,
+            ShapeKind::SmoothTriangle,
+        ];
+        let mut bits = 0;
+        let mut i = 0;
+        while i < kinds.len() {
+            if counts.get(kinds[i].capacity()) > 0 {
+                bits |= 1 << kinds[i] as u8;
+            }
+            i += 1;
+        }
+        ShapeKinds(bits)
+    }
+
+    /// Whether `kind` is in the set.
+    #[inline(always)]
+    pub const fn contains(self, kind: ShapeKind) -> bool {
+        self.0 & (1 << kind as u8) != 0
+    }
+}
+
 /// An object's primitive kind and its index in that kind's arena, packed in
 /// 32 bits (3 for the kind, 29 for the index).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -180,26 +219,45 @@ impl ShapeRef<'_> {
     /// The parameter of the nearest hit with `0 < t ≤ t_max`, if any.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
+        self.intersect_among(ShapeKinds::ALL, ray, t_max, leaving)
+    }
+
+    /// [`ShapeRef::intersect`] for a shape of one of `kinds` (a constant:
+    /// the other kinds' tests are not linked; a shape of one of them is
+    /// never hit).
+    #[inline(always)]
+    pub fn intersect_among(&self, kinds: ShapeKinds, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
+        use ShapeKind as K;
         match self {
-            ShapeRef::Sphere(s) => s.intersect(ray, t_max, leaving),
-            ShapeRef::Box(s) => s.intersect(ray, t_max, leaving),
-            ShapeRef::Superquadric(s) => s.intersect(ray, t_max, leaving),
-            ShapeRef::Triangle(s) => s.intersect(ray, t_max, leaving),
-            ShapeRef::Rectangle(s) => s.intersect(ray, t_max, leaving),
-            ShapeRef::SmoothTriangle(s) => s.intersect(ray, t_max, leaving),
+            ShapeRef::Sphere(s) if kinds.contains(K::Sphere) => s.intersect(ray, t_max, leaving),
+            ShapeRef::Box(s) if kinds.contains(K::Box) => s.intersect(ray, t_max, leaving),
+            ShapeRef::Superquadric(s) if kinds.contains(K::Superquadric) => s.intersect(ray, t_max, leaving),
+            ShapeRef::Triangle(s) if kinds.contains(K::Triangle) => s.intersect(ray, t_max, leaving),
+            ShapeRef::Rectangle(s) if kinds.contains(K::Rectangle) => s.intersect(ray, t_max, leaving),
+            ShapeRef::SmoothTriangle(s) if kinds.contains(K::SmoothTriangle) => s.intersect(ray, t_max, leaving),
+            _ => None,
         }
     }
 
     /// The geometric normal at a point on the surface: outward for closed
     /// shapes, the front side (counter-clockwise corners) for flat ones.
     pub fn normal_at(&self, p: Vec3) -> Dir {
+        self.normal_at_among(ShapeKinds::ALL, p)
+    }
+
+    /// [`ShapeRef::normal_at`] for a shape of one of `kinds` (see
+    /// [`ShapeRef::intersect_among`]; another kind's is +Y).
+    #[inline(always)]
+    pub fn normal_at_among(&self, kinds: ShapeKinds, p: Vec3) -> Dir {
+        use ShapeKind as K;
         match self {
-            ShapeRef::Sphere(s) => s.normal_at(p),
-            ShapeRef::Box(s) => s.normal_at(p),
-            ShapeRef::Superquadric(s) => s.normal_at(p),
+            ShapeRef::Sphere(s) if kinds.contains(K::Sphere) => s.normal_at(p),
+            ShapeRef::Box(s) if kinds.contains(K::Box) => s.normal_at(p),
+            ShapeRef::Superquadric(s) if kinds.contains(K::Superquadric) => s.normal_at(p),
             ShapeRef::Triangle(s) => s.normal(),
             ShapeRef::Rectangle(s) => s.normal(),
             ShapeRef::SmoothTriangle(s) => s.normal(),
+            _ => Dir::Y,
         }
     }
 
@@ -209,8 +267,17 @@ impl ShapeRef<'_> {
     /// corner normals and lift shadow rays onto the smooth surface.
     #[inline]
     pub fn shading(&self, p: Vec3, facing: Dir) -> (Dir, Vec3) {
+        self.shading_among(ShapeKinds::ALL, p, facing)
+    }
+
+    /// [`ShapeRef::shading`] for a shape of one of `kinds` (see
+    /// [`ShapeRef::intersect_among`]).
+    #[inline(always)]
+    pub fn shading_among(&self, kinds: ShapeKinds, p: Vec3, facing: Dir) -> (Dir, Vec3) {
         match self {
-            ShapeRef::SmoothTriangle(s) => (s.shading_normal(p, facing), s.shadow_origin(p, facing)),
+            ShapeRef::SmoothTriangle(s) if kinds.contains(ShapeKind::SmoothTriangle) => {
+                (s.shading_normal(p, facing), s.shadow_origin(p, facing))
+            }
             _ => (facing, p),
         }
     }
