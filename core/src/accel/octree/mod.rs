@@ -43,7 +43,7 @@ use super::{Accelerator, Hit, Mailbox, RayStart};
 use crate::capacity::{Arena, CapacityKind, Counts};
 use crate::math::Scalar;
 use crate::scene::{ObjectId, SceneView};
-use crate::shapes::{Aabb, Ratio, Ray};
+use crate::shapes::{Aabb, Ratio, Ray, ShapeKinds};
 use named::NamedWalk;
 
 /// Where the ray leaves a leaf: an exact ratio (the thesis's walk) or a
@@ -629,7 +629,9 @@ impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES>
                 let object = ObjectId(id);
                 let t_max = best.map_or(Scalar::MAX, |b| b.t);
                 let leaving = RayStart::leaving(start, object);
-                if let Some(t) = scene.shape(object).intersect(ray, t_max, leaving) {
+                if let Some(t) =
+                    scene.intersect_handle(ShapeKinds::ALL, scene.objects[id as usize], ray, t_max, leaving)
+                {
                     if best.is_none_or(|b| t < b.t || (t == b.t && object < b.object)) {
                         best = Some(Hit { t, object });
                     }
@@ -664,7 +666,8 @@ impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES>
             let mut test = |id: u32| {
                 let hit = mailbox.first_visit(id) && {
                     let object = ObjectId(id);
-                    scene.shape(object).intersect(ray, t_max, RayStart::leaving(start, object)).is_some()
+                    let leaving = RayStart::leaving(start, object);
+                    scene.intersect_handle(ShapeKinds::ALL, scene.objects[id as usize], ray, t_max, leaving).is_some()
                 };
                 if hit {
                     mailbox.blocker = id;
