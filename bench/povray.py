@@ -15,7 +15,8 @@ anti-aliasing. Both programs then render it on one thread, three times, at
 its RASTER size or at --size WxH (keep RASTER's 4:3 shape; larger images
 time the tracing with less noise from start-up). Two times are reported,
 each the best of three: the tracing alone (POV-Ray's own "Trace Time";
-host-sim's render time, which includes building the octree), and the whole
+host-sim's "tracing" time: building the octree and rendering the pixels,
+without the PNG encoder, which runs between rows), and the whole
 command (start-up, parsing, tracing, writing the PNG). Prints a Markdown
 table.
 
@@ -111,7 +112,7 @@ def povray_trace(output):
 
 
 def octrace_trace(output):
-    return float(re.search(r" in ([0-9.]+) s ", output).group(1))
+    return float(re.search(r"tracing ([0-9.]+) s\)", output).group(1))
 
 
 def main():

@@ -543,7 +543,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
         }
         let _ = writeln!(
             stderr,
-            "{w}x{h}{} in {:.3} s ({}, {} thread{}): {} rays, {} shadow rays, {} cells{} -> {}",
+            "{w}x{h}{} in {:.3} s ({}, {} thread{}, tracing {:.3} s): {} rays, {} shadow rays, {} cells{} -> {}",
             match args.part {
                 Some(_) => format!(" rows {}..{}", rows.start, rows.end),
                 None => String::new(),
@@ -552,6 +552,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
             rendered.accel.name(),
             options.threads,
             if options.threads == 1 { "" } else { "s" },
+            rendered.tracing().as_secs_f64(),
             stats.rays,
             stats.shadow_rays,
             stats.cells,

@@ -217,6 +217,15 @@ pub struct Streamed {
     pub busy: Vec<Duration>,
 }
 
+impl Streamed {
+    /// The time spent tracing: building the octree plus every thread's
+    /// time rendering pixels, without the encoder's time or idle waits.
+    /// With one thread this is what POV-Ray calls its trace time.
+    pub fn tracing(&self) -> Duration {
+        self.build.map_or(Duration::ZERO, |(_, built)| built) + self.busy.iter().sum::<Duration>()
+    }
+}
+
 /// Receives a streamed render's rows, each once, in order from top to bottom.
 pub trait RowSink {
     /// Row `y` (counted in the whole image): RGB triples, and the object

@@ -420,7 +420,7 @@ mod tests {
     fn unit_components_are_the_rounded_quotients() {
         // Against u64 division: every component is round(c·2^30/len), ties
         // up, for magnitudes at every ratio (the largest in [2^29, 2^30)).
-        let seed = 0x00d1_71de_d0u64;
+        let seed = 0x0000_d171_ded0_u64;
         std::println!("seed {seed:#x}");
         let mut x = seed;
         for i in 0..300_000 {

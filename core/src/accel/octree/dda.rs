@@ -14,6 +14,12 @@
 //! crossing computed directly, as the mean would be meaningless. Empty leaves are passed over, and boxes the
 //! ray enters after the nearest hit found so far are skipped whole.
 //!
+//! The walk is one loop that calls the caller's visit for each non-empty
+//! leaf, so the box being walked stays in registers; a box's ancestors wait
+//! on a stack, one frame a level. The boxes' corners, needed only for the
+//! middles of saturated axes, are carried only by the walks that have one
+//! (a second copy of the loop, chosen once per ray).
+//!
 //! None of this can change an image: the walked line differs from the true
 //! ray by at most two Q16.16 units across the scene and the parameters by far
 //! less, both well inside the filing margin, and objects are still tested
@@ -30,23 +36,10 @@ const FRAC: u32 = 24;
 /// Saturation bound: 2^36 in Q40.24.
 const LIMIT: i64 = 1 << (36 + FRAC);
 
-/// A box being walked: its planes' crossing parameters and the next child.
+/// What a ray's walk computes once: its origin and reciprocals in mirrored
+/// space and the span where its objects can be.
 #[derive(Clone, Copy, Debug)]
-struct Frame {
-    t0: [i64; 3],
-    tm: [i64; 3],
-    t1: [i64; 3],
-    /// The box's low corner (mirrored space) and log2 of its side. The
-    /// corner is kept up to date only when an axis saturated (the one use of
-    /// it); otherwise it stays the root's.
-    lo: [i64; 3],
-    log2: u32,
-    children: u32,
-    /// The next child to visit, in mirrored octant order; 8 when done.
-    next: u8,
-}
-
-pub(super) struct DdaWalk<const FRAMES: usize> {
+struct Setup {
     /// Octant bits of the mirrored axes.
     mirror: u8,
     /// Octant bits of the axes whose root crossings saturated (the ray runs
@@ -57,13 +50,95 @@ pub(super) struct DdaWalk<const FRAMES: usize> {
     origin: [i64; 3],
     inverse: [u64; 3],
     /// Where the ray is inside the objects' own bounds (tighter than the
-    /// cubic root): boxes left before `near` or entered after `far` hold
-    /// nothing this ray can hit.
-    near: i64,
+    /// cubic root) and not behind its origin: boxes left before `begin` or
+    /// entered after `far` hold nothing this ray can hit.
+    begin: i64,
     far: i64,
-    stack: heapless::Vec<Frame, FRAMES>,
-    /// A root that is itself a leaf, still to be returned.
-    root_leaf: Option<(u32, i64)>,
+}
+
+impl Setup {
+    /// The parameter (Q40.24, saturated) at which the ray crosses the plane
+    /// at `plane` (mirrored space) on axis `a`: (plane − o)·2^38 / |d|
+    /// through the reciprocal 2^62 / |d|.
+    #[inline]
+    fn crossing(&self, a: usize, plane: i64) -> i64 {
+        mul_u64_shr24_clamped::<LIMIT>(plane - self.origin[a], self.inverse[a])
+    }
+}
+
+/// What a box carries besides its crossings: nothing on rays with no
+/// saturated axis, its corner on the others.
+trait Corner: Copy {
+    /// The corner of child `octant` (mirrored octant bits).
+    fn child(self, octant: u8) -> Self;
+    /// The crossing of the box's middle plane on axis `a`, given its outer
+    /// planes' crossings.
+    fn middle(&self, setup: &Setup, a: usize, t0: i64, t1: i64) -> i64;
+}
+
+/// No saturated axis: every middle plane's crossing is the mean of the outer
+/// ones (exact up to one unit a level).
+impl Corner for () {
+    #[inline]
+    fn child(self, _: u8) -> Self {}
+    #[inline]
+    fn middle(&self, _: &Setup, _: usize, t0: i64, t1: i64) -> i64 {
+        (t0 + t1) >> 1
+    }
+}
+
+/// A box's low corner (mirrored space) and log2 of its side.
+#[derive(Clone, Copy, Debug)]
+struct BoxCorner {
+    lo: [i64; 3],
+    log2: u32,
+}
+
+/// A saturated axis: where an outer crossing saturated the mean would be
+/// meaningless, so the middle plane's crossing is computed directly.
+impl Corner for BoxCorner {
+    #[inline]
+    fn child(self, octant: u8) -> Self {
+        let half = 1i64 << (self.log2 - 1);
+        let lo = [0, 1, 2].map(|a| self.lo[a] + if octant >> a & 1 == 1 { half } else { 0 });
+        BoxCorner { lo, log2: self.log2 - 1 }
+    }
+    #[inline]
+    fn middle(&self, setup: &Setup, a: usize, t0: i64, t1: i64) -> i64 {
+        if setup.saturated >> a & 1 == 1 && (t0.abs() == LIMIT || t1.abs() == LIMIT) {
+            setup.crossing(a, self.lo[a] + (1i64 << (self.log2 - 1)))
+        } else {
+            (t0 + t1) >> 1
+        }
+    }
+}
+
+/// A subdivided box being walked: its planes' crossing parameters and the
+/// next child to visit.
+#[derive(Clone, Copy, Debug)]
+struct Frame<K> {
+    t0: [i64; 3],
+    tm: [i64; 3],
+    t1: [i64; 3],
+    corner: K,
+    children: u32,
+    /// The next child to visit, in mirrored octant order; 8 when done.
+    next: u8,
+}
+
+impl<K: Corner> Frame<K> {
+    /// Enters a subdivided box that the ray enters at `entry`: the first
+    /// child the ray meets lies beyond every middle plane crossed before
+    /// the entry. A ray that starts inside the box (or whose objects'
+    /// bounds begin inside it) starts at the child holding that point
+    /// instead: the children before it end before the walk begins.
+    #[inline]
+    fn enter(setup: &Setup, t0: [i64; 3], t1: [i64; 3], entry: i64, corner: K, children: u32) -> Self {
+        let tm = [0, 1, 2].map(|a| corner.middle(setup, a, t0[a], t1[a]));
+        let begin = entry.max(setup.begin);
+        let next = (tm[0] < begin) as u8 | ((tm[1] < begin) as u8) << 1 | ((tm[2] < begin) as u8) << 2;
+        Frame { t0, tm, t1, corner, children, next }
+    }
 }
 
 #[inline]
@@ -96,178 +171,148 @@ fn min_axis(t: &[i64; 3]) -> usize {
     }
 }
 
-impl<const FRAMES: usize> DdaWalk<FRAMES> {
-    pub const fn new() -> Self {
-        DdaWalk {
-            mirror: 0,
-            saturated: 0,
-            origin: [0; 3],
-            inverse: [0; 3],
-            near: 0,
-            far: 0,
-            stack: heapless::Vec::new(),
-            root_leaf: None,
-        }
+/// Visits, in ray order, the non-empty leaves along `ray` that it enters no
+/// later than the current stop (Q40.24; `stop` at first), calling
+/// `visit(leaf, exit)` with the parameter at which the ray leaves the leaf.
+/// `visit` returns the new stop (the nearest hit so far) or `None` to end
+/// the walk. Boxes entered after the stop are skipped whole, with every box
+/// behind them in the same parent (children are visited in ray order).
+#[inline]
+pub(super) fn walk<C: OctreeCapacities, const FRAMES: usize>(
+    tree: &Octree<C, FRAMES>,
+    ray: &Ray,
+    stop: i64,
+    mut visit: impl FnMut(u32, i64) -> Option<i64>,
+) {
+    let Some(root) = tree.nodes.as_slice().first().filter(|r| r.count() != 0) else { return };
+    let Some((setup, t0, t1)) = set_up(tree, ray) else { return };
+    let entry = t0[max_axis(&t0)];
+    if !root.is_internal() {
+        let _ = visit(0, t1[min_axis(&t1)]);
+    } else if setup.saturated == 0 {
+        let frame = Frame::enter(&setup, t0, t1, entry, (), root.first());
+        descend(tree, &setup, frame, stop, &mut visit);
+    } else {
+        let corner = BoxCorner { lo: tree.root_min, log2: tree.root_log2 };
+        let frame = Frame::enter(&setup, t0, t1, entry, corner, root.first());
+        descend(tree, &setup, frame, stop, &mut visit);
     }
+}
 
-    /// Starts a walk along `ray` (in place: the walk's stack is not small).
-    pub fn start<C: OctreeCapacities>(&mut self, tree: &Octree<C, FRAMES>, ray: &Ray) {
-        self.mirror = 0;
-        self.saturated = 0;
-        self.stack.clear();
-        self.root_leaf = None;
-        let walk = self;
-        let nodes = tree.nodes.as_slice();
-        let Some(root) = nodes.first().filter(|r| r.count() != 0) else { return };
-        let o = ray.origin.wide();
-        let d = ray.dir.wide();
-        let half = 1i64 << (tree.root_log2 - 1);
-        let mut t0 = [0; 3];
-        let mut t1 = [0; 3];
-        for a in 0..3 {
-            let centre = tree.root_min[a] + half;
-            // Mirror a negative axis about the root's centre.
-            let oa = if d[a] < 0 {
-                walk.mirror |= 1 << a;
-                2 * centre - o[a]
-            } else {
-                o[a]
-            };
-            walk.origin[a] = oa;
-            walk.inverse[a] = reciprocal_q62(d[a].unsigned_abs() as u32);
-            t0[a] = walk.crossing(a, tree.root_min[a]);
-            t1[a] = walk.crossing(a, tree.root_min[a] + 2 * half);
-            if t0[a].abs() == LIMIT || t1[a].abs() == LIMIT {
-                walk.saturated |= 1 << a;
-            }
-        }
-        let enter = t0[max_axis(&t0)];
-        let exit = t1[min_axis(&t1)];
-        if enter >= exit || exit < 0 {
-            return;
-        }
-        // Clip to the objects' own bounds (rounding outwards: a wider span
-        // only visits more boxes). Their low corner is the root's, so on
-        // each axis one of the two crossings is the root's, known already.
-        let (mut near, mut far) = (-LIMIT, LIMIT);
-        for a in 0..3 {
-            let (lo, hi) = if walk.mirror >> a & 1 == 1 {
-                let c2 = 2 * (tree.root_min[a] + half);
-                (walk.crossing(a, c2 - tree.bounds_max[a]), t1[a])
-            } else {
-                (t0[a], walk.crossing(a, tree.bounds_max[a]))
-            };
-            near = near.max(lo);
-            far = far.min(hi);
-        }
-        (walk.near, walk.far) = (near - 1, far + 1);
-        if walk.far < walk.near || walk.far < 0 {
-            return;
-        }
-        if !root.is_internal() {
-            walk.root_leaf = Some((0, exit));
+/// The ray's set-up and the root's crossings, or `None` when the ray misses
+/// the root or the objects' bounds.
+#[inline]
+fn set_up<C: OctreeCapacities, const FRAMES: usize>(
+    tree: &Octree<C, FRAMES>,
+    ray: &Ray,
+) -> Option<(Setup, [i64; 3], [i64; 3])> {
+    let o = ray.origin.wide();
+    let d = ray.dir.wide();
+    let half = 1i64 << (tree.root_log2 - 1);
+    let mut setup = Setup { mirror: 0, saturated: 0, origin: [0; 3], inverse: [0; 3], begin: 0, far: 0 };
+    let mut t0 = [0; 3];
+    let mut t1 = [0; 3];
+    for a in 0..3 {
+        let centre = tree.root_min[a] + half;
+        // Mirror a negative axis about the root's centre.
+        setup.origin[a] = if d[a] < 0 {
+            setup.mirror |= 1 << a;
+            2 * centre - o[a]
         } else {
-            walk.push(root.first(), t0, t1, tree.root_min, tree.root_log2);
-        }
-    }
-
-    /// The parameter (Q40.24, saturated) at which the ray crosses the plane
-    /// at `plane` (mirrored space) on axis `a`: (plane − o)·2^38 / |d|
-    /// through the reciprocal 2^62 / |d|.
-    #[inline]
-    fn crossing(&self, a: usize, plane: i64) -> i64 {
-        mul_u64_shr24_clamped::<LIMIT>(plane - self.origin[a], self.inverse[a])
-    }
-
-    /// Enters a subdivided box: the first child the ray meets lies beyond
-    /// every middle plane crossed before the entry plane. A ray that starts
-    /// inside the box (or whose objects' bounds begin inside it) starts at
-    /// the child holding that point instead: the children before it end
-    /// before the walk begins, and the walk would pass over them one by one.
-    #[inline]
-    fn push(&mut self, children: u32, t0: [i64; 3], t1: [i64; 3], lo: [i64; 3], log2: u32) {
-        let tm = if self.saturated == 0 {
-            [0, 1, 2].map(|a| (t0[a] + t1[a]) >> 1)
-        } else {
-            [0, 1, 2].map(|a| self.middle(a, t0[a], t1[a], lo[a], log2))
+            o[a]
         };
-        let entry_axis = max_axis(&t0);
-        let entry = t0[entry_axis];
-        let begin = entry.max(self.near).max(0);
-        let mut first = 0u8;
-        for a in 0..3 {
-            if tm[a] < begin && (a != entry_axis || begin > entry) {
-                first |= 1 << a;
-            }
+        setup.inverse[a] = reciprocal_q62(d[a].unsigned_abs() as u32);
+        t0[a] = setup.crossing(a, tree.root_min[a]);
+        t1[a] = setup.crossing(a, tree.root_min[a] + 2 * half);
+        if t0[a].abs() == LIMIT || t1[a].abs() == LIMIT {
+            setup.saturated |= 1 << a;
         }
-        let _ = self.stack.push(Frame { t0, tm, t1, lo, log2, children, next: first });
     }
-
-    /// The crossing of a box's middle plane on axis `a`: the mean of the
-    /// outer planes' crossings (exact: the mean plane's crossing), unless one
-    /// of them saturated (a ray almost parallel to the axis), where the mean
-    /// would be meaningless; then it is computed directly.
-    #[inline]
-    fn middle(&self, a: usize, t0: i64, t1: i64, lo: i64, log2: u32) -> i64 {
-        if self.saturated >> a & 1 == 1 && (t0.abs() == LIMIT || t1.abs() == LIMIT) {
-            self.crossing(a, lo + (1i64 << (log2 - 1)))
+    let enter = t0[max_axis(&t0)];
+    let exit = t1[min_axis(&t1)];
+    if enter >= exit || exit < 0 {
+        return None;
+    }
+    // Clip to the objects' own bounds (rounding outwards: a wider span only
+    // visits more boxes). Their low corner is the root's, so on each axis
+    // one of the two crossings is the root's, known already.
+    let (mut near, mut far) = (-LIMIT, LIMIT);
+    for a in 0..3 {
+        let (lo, hi) = if setup.mirror >> a & 1 == 1 {
+            let c2 = 2 * (tree.root_min[a] + half);
+            (setup.crossing(a, c2 - tree.bounds_max[a]), t1[a])
         } else {
-            (t0 + t1) >> 1
-        }
+            (t0[a], setup.crossing(a, tree.bounds_max[a]))
+        };
+        near = near.max(lo);
+        far = far.min(hi);
     }
+    let (near, far) = (near - 1, far + 1);
+    if far < near || far < 0 {
+        return None;
+    }
+    (setup.begin, setup.far) = (near.max(0), far);
+    Some((setup, t0, t1))
+}
 
-    /// The next non-empty leaf along the ray that the ray enters no later
-    /// than `stop` (Q40.24), and the parameter at which the ray leaves it.
-    /// Boxes entered after `stop` are skipped whole, with every box behind
-    /// them in the same parent (children are visited in ray order).
-    #[inline]
-    pub fn next_leaf<C: OctreeCapacities>(&mut self, tree: &Octree<C, FRAMES>, stop: i64) -> Option<(u32, i64)> {
-        if let Some(leaf) = self.root_leaf.take() {
-            return Some(leaf);
+/// The walk below a subdivided root; see [`walk`].
+#[inline]
+fn descend<K: Corner, C: OctreeCapacities, const FRAMES: usize>(
+    tree: &Octree<C, FRAMES>,
+    setup: &Setup,
+    root: Frame<K>,
+    stop: i64,
+    visit: &mut impl FnMut(u32, i64) -> Option<i64>,
+) {
+    let nodes = tree.nodes.as_slice();
+    // The box being walked is `current`; its ancestors wait here (the tree
+    // is at most FRAMES − 1 deep, so a push cannot fail).
+    let mut ancestors = heapless::Vec::<Frame<K>, FRAMES>::new();
+    let mut current = root;
+    let mut limit = stop.min(setup.far);
+    loop {
+        let c = current.next;
+        if c == 8 {
+            match ancestors.pop() {
+                Some(parent) => current = parent,
+                None => return,
+            }
+            continue;
         }
-        let nodes = tree.nodes.as_slice();
-        loop {
-            let top = self.stack.last_mut()?;
-            let c = top.next;
-            if c == 8 {
-                self.stack.pop();
-                continue;
+        let (mut t0, mut t1) = (current.t0, current.tm);
+        for a in 0..3 {
+            if c >> a & 1 == 1 {
+                t0[a] = current.tm[a];
+                t1[a] = current.t1[a];
             }
-            let (mut t0, mut t1) = (top.t0, top.t1);
-            for a in 0..3 {
-                if c >> a & 1 == 1 {
-                    t0[a] = top.tm[a];
-                } else {
-                    t1[a] = top.tm[a];
-                }
+        }
+        let entry = t0[max_axis(&t0)];
+        if entry > limit {
+            current.next = 8;
+            continue;
+        }
+        // The sibling the ray enters next: across the child's nearest far
+        // plane, unless that plane is the parent's own.
+        let axis = min_axis(&t1);
+        let bit = 1u8 << axis;
+        current.next = if c & bit != 0 { 8 } else { c | bit };
+        let exit = t1[axis];
+        if exit < setup.begin {
+            continue; // wholly behind the origin, or before the objects
+        }
+        let node = current.children + (c ^ setup.mirror) as u32;
+        let n = nodes[node as usize];
+        if n.is_internal() {
+            let child = Frame::enter(setup, t0, t1, entry, current.corner.child(c), n.first());
+            // A box with no child left to visit need not wait for this one.
+            if current.next != 8 {
+                let _ = ancestors.push(current);
             }
-            if t0[max_axis(&t0)] > stop.min(self.far) {
-                top.next = 8;
-                continue;
-            }
-            // The sibling the ray enters next: across the child's nearest far
-            // plane, unless that plane is the parent's own.
-            let axis = min_axis(&t1);
-            let bit = 1u8 << axis;
-            top.next = if c & bit != 0 { 8 } else { c | bit };
-            let node = top.children + (c ^ self.mirror) as u32;
-            let exit = t1[axis];
-            if exit < 0 || exit < self.near {
-                continue; // wholly behind the origin, or before the objects
-            }
-            let n = nodes[node as usize];
-            if n.is_internal() {
-                // Corners are needed only for the middles of saturated axes.
-                let lo = if self.saturated == 0 {
-                    top.lo
-                } else {
-                    let half = 1i64 << (top.log2 - 1);
-                    [0, 1, 2].map(|a| top.lo[a] + if c >> a & 1 == 1 { half } else { 0 })
-                };
-                let log2 = top.log2 - 1;
-                self.push(n.first(), t0, t1, lo, log2);
-            } else if n.count() != 0 {
-                return Some((node, exit));
+            current = child;
+        } else if n.count() != 0 {
+            match visit(node, exit) {
+                Some(s) => limit = s.min(setup.far),
+                None => return,
             }
         }
     }

@@ -44,7 +44,6 @@ use crate::capacity::{Arena, CapacityKind, Counts};
 use crate::math::Scalar;
 use crate::scene::{ObjectId, SceneView};
 use crate::shapes::{Aabb, Ratio, Ray, ShapeKinds};
-use dda::DdaWalk;
 use named::NamedWalk;
 
 /// Where the ray leaves a leaf: an exact ratio (the thesis's walk) or a
@@ -83,18 +82,10 @@ fn walk_leaves<C: OctreeCapacities, const FRAMES: usize>(
     mut visit: impl FnMut(u32, Exit, &mut Mailbox<'_>) -> Option<Scalar>,
 ) {
     match tree.traversal {
-        Traversal::Dda => {
-            let mut stop = stop;
-            let mut walk = DdaWalk::<FRAMES>::new();
-            walk.start(tree, ray);
-            while let Some((leaf, exit)) = walk.next_leaf(tree, to_q24(stop)) {
-                mailbox.cells += 1;
-                match visit(leaf, Exit::Q24(exit), mailbox) {
-                    Some(s) => stop = s,
-                    None => return,
-                }
-            }
-        }
+        Traversal::Dda => dda::walk(tree, ray, to_q24(stop), |leaf, exit| {
+            mailbox.cells += 1;
+            visit(leaf, Exit::Q24(exit), mailbox).map(to_q24)
+        }),
         Traversal::Named => {
             // The thesis's walk visits every leaf until a hit is final.
             let mut walk = NamedWalk::new(tree, ray);
