@@ -201,7 +201,9 @@ pub(super) fn walk<C: OctreeCapacities, const FRAMES: usize>(
 
 /// The ray's set-up and the root's crossings, or `None` when the ray misses
 /// the root or the objects' bounds.
-#[inline]
+// Always inlined: returned by value, its 100-odd bytes were copied twice
+// with memcpy (and zeroed first) on the Cortex-M0.
+#[inline(always)]
 fn set_up<C: OctreeCapacities, const FRAMES: usize>(
     tree: &Octree<C, FRAMES>,
     ray: &Ray,
