@@ -23,7 +23,7 @@ pub(crate) use wide::{
     square_u32_wide, square_wide,
 };
 
-pub(crate) use wide::{mul_u64_shr24_clamped, reciprocal_q62, shl_u64, shr_u64};
+pub(crate) use wide::{mul_u64_shr24, mul_u64_shr24_clamped, reciprocal_q62, shl_u64, shr_u64};
 
 pub use fixed::types::{I16F16, I2F30, I32F32};
 

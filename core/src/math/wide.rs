@@ -217,6 +217,18 @@ pub(crate) fn mul_u64_shr24_clamped<const LIMIT: i64>(x: i64, y: u64) -> i64 {
     }
 }
 
+/// `⌊x · y / 2^24⌋` for products known to stay below 2^84 in magnitude
+/// (no clamp needed: the 3DDDA's crossings on axes the ray is not almost
+/// parallel to). The same bits as [`mul_u64_shr24_clamped`] there.
+#[inline(always)]
+pub(crate) fn mul_u64_shr24(x: i64, y: u64) -> i64 {
+    if ARMV6M {
+        mul_u64_shr24_clamped_by_parts(x, y, i64::MAX)
+    } else {
+        ((x as i128 * y as i128) >> 24) as i64
+    }
+}
+
 #[inline]
 fn mul_u64_shr24_clamped_by_parts(x: i64, y: u64, limit: i64) -> i64 {
     let m = x.unsigned_abs();

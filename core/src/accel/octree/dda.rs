@@ -28,13 +28,16 @@
 use super::Octree;
 use super::OctreeCapacities;
 use crate::capacity::Arena;
-use crate::math::{mul_u64_shr24_clamped, reciprocal_q62};
+use crate::math::{mul_u64_shr24, mul_u64_shr24_clamped, reciprocal_q62};
 use crate::shapes::Ray;
 
 /// Parameters are Q40.24.
 const FRAC: u32 = 24;
 /// Saturation bound: 2^36 in Q40.24.
 const LIMIT: i64 = 1 << (36 + FRAC);
+/// Direction components (Q2.30) at least this large cannot saturate a
+/// crossing; smaller ones (below 2^-16) take the clamped path.
+const STEEP: u64 = 1 << 14;
 
 /// What a ray's walk computes once: its origin and reciprocals in mirrored
 /// space and the span where its objects can be.
@@ -63,6 +66,16 @@ impl Setup {
     #[inline]
     fn crossing(&self, a: usize, plane: i64) -> i64 {
         mul_u64_shr24_clamped::<LIMIT>(plane - self.origin[a], self.inverse[a])
+    }
+
+    /// [`Setup::crossing`] on an axis with |d_a| ≥ [`STEEP`]: planes and the
+    /// mirrored origin (i32 points, mirrored about a centre inside the root)
+    /// are well within 2^36 of each other and 2^62 / |d_a| is at most 2^48,
+    /// so the crossing stays below 2^60 = `LIMIT` without a clamp.
+    #[inline]
+    fn steep_crossing(&self, a: usize, plane: i64) -> i64 {
+        debug_assert!((plane - self.origin[a]).unsigned_abs() < 1 << 36);
+        mul_u64_shr24(plane - self.origin[a], self.inverse[a])
     }
 }
 
@@ -224,10 +237,15 @@ fn set_up<C: OctreeCapacities, const FRAMES: usize>(
             o[a]
         };
         setup.inverse[a] = reciprocal_q62(d[a].unsigned_abs() as u32);
-        t0[a] = setup.crossing(a, tree.root_min[a]);
-        t1[a] = setup.crossing(a, tree.root_min[a] + 2 * half);
-        if t0[a].abs() == LIMIT || t1[a].abs() == LIMIT {
-            setup.saturated |= 1 << a;
+        if d[a].unsigned_abs() >= STEEP {
+            t0[a] = setup.steep_crossing(a, tree.root_min[a]);
+            t1[a] = setup.steep_crossing(a, tree.root_min[a] + 2 * half);
+        } else {
+            t0[a] = setup.crossing(a, tree.root_min[a]);
+            t1[a] = setup.crossing(a, tree.root_min[a] + 2 * half);
+            if t0[a].abs() == LIMIT || t1[a].abs() == LIMIT {
+                setup.saturated |= 1 << a;
+            }
         }
     }
     let enter = t0[max_axis(&t0)];
@@ -240,11 +258,15 @@ fn set_up<C: OctreeCapacities, const FRAMES: usize>(
     // one of the two crossings is the root's, known already.
     let (mut near, mut far) = (-LIMIT, LIMIT);
     for a in 0..3 {
+        let bound = |plane| match d[a].unsigned_abs() >= STEEP {
+            true => setup.steep_crossing(a, plane),
+            false => setup.crossing(a, plane),
+        };
         let (lo, hi) = if setup.mirror >> a & 1 == 1 {
             let c2 = 2 * (tree.root_min[a] + half);
-            (setup.crossing(a, c2 - tree.bounds_max[a]), t1[a])
+            (bound(c2 - tree.bounds_max[a]), t1[a])
         } else {
-            (t0[a], setup.crossing(a, tree.bounds_max[a]))
+            (t0[a], bound(tree.bounds_max[a]))
         };
         near = near.max(lo);
         far = far.min(hi);
@@ -316,6 +338,34 @@ fn descend<K: Corner, C: OctreeCapacities, const FRAMES: usize>(
                 Some(s) => limit = s.min(setup.far),
                 None => return,
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+
+    /// Unclamped crossings on steep axes are the clamped ones, and never
+    /// reach the clamp: at the bounds and at random points between.
+    #[test]
+    fn steep_crossings_need_no_clamp() {
+        let seed = 0x5eed_0c7a_u64;
+        std::println!("seed {seed:#x}");
+        let mut state = seed;
+        let mut next = move || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state >> 11
+        };
+        let extremes = [(1i64 << 36) - 1, -(1 << 36) + 1, 0, 1, -1];
+        for i in 0..100_000 {
+            let d = if i < 5 { STEEP } else { STEEP + next() % ((1 << 30) - STEEP + 1) };
+            let x = if i < 5 { extremes[i] } else { (next() % (1 << 37)) as i64 - (1 << 36) };
+            let inverse = reciprocal_q62(d as u32);
+            let exact = mul_u64_shr24_clamped::<LIMIT>(x, inverse);
+            assert_eq!(mul_u64_shr24(x, inverse), exact, "x {x}, d {d}");
+            assert!(exact.abs() < LIMIT, "x {x}, d {d}");
         }
     }
 }
