@@ -223,20 +223,20 @@ pub(crate) fn mul_u64_shr24_clamped<const LIMIT: i64>(x: i64, y: u64) -> i64 {
 #[inline(always)]
 pub(crate) fn mul_u64_shr24(x: i64, y: u64) -> i64 {
     if ARMV6M {
-        mul_u64_shr24_clamped_by_parts(x, y, i64::MAX)
+        mul_u64_shr24_by_parts(x, y)
     } else {
         ((x as i128 * y as i128) >> 24) as i64
     }
 }
 
-#[inline]
-fn mul_u64_shr24_clamped_by_parts(x: i64, y: u64, limit: i64) -> i64 {
+/// `|x| · y` as high and low 64-bit words, from 32×32 products: two when
+/// `|x| < 2^32` (every difference of scene coordinates), else four.
+#[inline(always)]
+fn magnitude_product(x: i64, y: u64) -> (u64, u64) {
     let m = x.unsigned_abs();
     let (mh, ml, yh, yl) = ((m >> 32) as u32, m as u32, (y >> 32) as u32, y as u32);
-    // The product as high:low (64 bits each). Differences of scene
-    // coordinates are below 2^32, so mostly two products suffice.
     let low_low = mul_u32_wide(ml, yl);
-    let (high, low) = if mh == 0 {
+    if mh == 0 {
         let cross = mul_u32_wide(ml, yh);
         let (low, carry_low) = low_low.overflowing_add(cross << 32);
         ((cross >> 32) + carry_low as u64, low)
@@ -245,7 +245,26 @@ fn mul_u64_shr24_clamped_by_parts(x: i64, y: u64, limit: i64) -> i64 {
         let (cross, carry) = cross1.overflowing_add(cross2);
         let (low, carry_low) = low_low.overflowing_add(cross << 32);
         (mul_u32_wide(mh, yh) + (cross >> 32) + ((carry as u64) << 32) + carry_low as u64, low)
-    };
+    }
+}
+
+/// [`mul_u64_shr24`] on ARMv6-M: the product's bits 24 to 87 (below 2^84
+/// in magnitude, so no clamp), rounded towards −∞.
+#[inline]
+fn mul_u64_shr24_by_parts(x: i64, y: u64) -> i64 {
+    let (high, low) = magnitude_product(x, y);
+    let round = (x < 0 && low & 0xff_ffff != 0) as u64;
+    let magnitude = (((high << 40) | (low >> 24)) + round) as i64;
+    if x < 0 {
+        -magnitude
+    } else {
+        magnitude
+    }
+}
+
+#[inline]
+fn mul_u64_shr24_clamped_by_parts(x: i64, y: u64, limit: i64) -> i64 {
+    let (high, low) = magnitude_product(x, y);
     // A negative product rounds towards −∞: the magnitude rounds up.
     let round = if x < 0 && low & 0xff_ffff != 0 { 1 } else { 0 };
     if high >> 24 != 0 {
@@ -530,6 +549,9 @@ mod tests {
             let y = (next() >> (next() % 33)) | 1 << 31;
             let plain = ((x as i128 * y as i128) >> 24).clamp(-(limit as i128), limit as i128) as i64;
             assert_eq!(mul_u64_shr24_clamped_by_parts(x, y, limit), plain, "{x} × {y}");
+            if (x.unsigned_abs() as u128 * y as u128) < 1 << 84 {
+                assert_eq!(mul_u64_shr24_by_parts(x, y), ((x as i128 * y as i128) >> 24) as i64, "{x} × {y}");
+            }
         }
     }
 
