@@ -197,9 +197,8 @@ pub(crate) fn reciprocal_q62(d: u32) -> u64 {
         // Both quotients by the same reciprocal: 2^30 < d·2^32, and the
         // remainder is below d.
         let reciprocal = Reciprocal::of(d);
-        let high = reciprocal.quotient_of_2_30();
-        let remainder = (1u64 << 30) - mul_u32_wide(high, d);
-        ((high as u64) << 32) | reciprocal.quotient(remainder << 32) as u64
+        let (high, remainder) = reciprocal.quotient_of_2_30();
+        ((high as u64) << 32) | reciprocal.quotient((remainder as u64) << 32) as u64
     } else {
         (1u64 << 62) / d as u64
     }
@@ -363,22 +362,23 @@ impl Reciprocal {
         let numerator = shl_u64(n, self.shift); // below dn · 2^32
         let (high, low) = ((numerator >> 32) as u32, numerator as u32);
         let estimate = (mul_u32_wide(high, r) + (mul_u32_wide(low, r) >> 32)) >> 31;
-        self.corrected(n, estimate.min(u32::MAX as u64) as u32)
+        self.corrected(n, estimate.min(u32::MAX as u64) as u32).0
     }
 
-    /// `⌊2^30 / divisor⌋`: the numerator, normalised, is a power of two, so
-    /// the estimate above is a shift of the reciprocal (the same value).
+    /// `⌊2^30 / divisor⌋` and the remainder: the numerator, normalised, is a
+    /// power of two, so the estimate above is a shift of the reciprocal (the
+    /// same value).
     #[inline(always)]
-    fn quotient_of_2_30(&self) -> u32 {
+    fn quotient_of_2_30(&self) -> (u32, u32) {
         // (2^(30 + shift) · r) / 2^63, shift ≥ 1 for a divisor below 2^31.
         let estimate = if self.shift == 0 { 0 } else { self.r >> (33 - self.shift).min(31) };
         self.corrected(1 << 30, estimate)
     }
 
     /// The exact floor of `n / divisor` from an estimate a few off at most,
-    /// stepped on the remainder.
+    /// stepped on the remainder, and the remainder.
     #[inline(always)]
-    fn corrected(&self, n: u64, estimate: u32) -> u32 {
+    fn corrected(&self, n: u64, estimate: u32) -> (u32, u32) {
         let d = self.divisor;
         let mut q = estimate;
         let mut remainder = n.wrapping_sub(mul_u32_wide(q, d)) as i64;
@@ -390,7 +390,7 @@ impl Reciprocal {
             q += 1;
             remainder -= d as i64;
         }
-        q
+        (q, remainder as u32)
     }
 }
 
@@ -560,9 +560,10 @@ mod tests {
         // The ARMv6-M form: both quotients by one reciprocal.
         let by_parts = |d: u32| {
             let reciprocal = Reciprocal::of(d);
-            let high = reciprocal.quotient_of_2_30();
+            let (high, rest) = reciprocal.quotient_of_2_30();
             assert_eq!(high, reciprocal.quotient(1 << 30), "{d}");
             let remainder = (1u64 << 30) - mul_u32_wide(high, d);
+            assert_eq!(rest as u64, remainder, "{d}");
             ((high as u64) << 32) | reciprocal.quotient(remainder << 32) as u64
         };
         let mut d = 1u32;
