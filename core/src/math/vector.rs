@@ -240,7 +240,7 @@ impl Dir {
         if largest == 0 {
             return None;
         }
-        let shift = 32 - super::leading_zeros(largest as u64) as i32 + 32 - 30;
+        let shift = 2 - super::leading_zeros_u32(largest) as i32;
         let scaled = magnitude.map(|m| if shift > 0 { m >> shift } else { m << -shift });
         Some(Self::from_scaled(v.map(|c| c < 0), scaled, shift))
     }

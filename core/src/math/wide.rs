@@ -115,6 +115,16 @@ fn square_u32_by_parts(m: u32) -> u64 {
     (((h * h) as u64) << 32) + (((h * l) as u64) << 17) + (l * l) as u64
 }
 
+/// The number of leading zero bits of a 32-bit `x` (32 for zero).
+#[inline(always)]
+pub fn leading_zeros_u32(x: u32) -> u32 {
+    if ARMV6M {
+        leading_zeros_of_word(x, 0)
+    } else {
+        x.leading_zeros()
+    }
+}
+
 /// Leading zeros of each byte value (8 for zero).
 static BYTE_LEADING_ZEROS: [u8; 256] = {
     let mut t = [0u8; 256];
@@ -132,7 +142,17 @@ static BYTE_LEADING_ZEROS: [u8; 256] = {
 #[inline(always)]
 fn leading_zeros_by_search(x: u64) -> u32 {
     let (high, low) = ((x >> 32) as u32, x as u32);
-    let (mut n, mut w) = if high != 0 { (0, high) } else { (32, low) };
+    if high != 0 {
+        leading_zeros_of_word(high, 0)
+    } else {
+        leading_zeros_of_word(low, 32)
+    }
+}
+
+/// `base` plus the leading zeros of `w` (8 more than the table's for zero).
+#[inline(always)]
+fn leading_zeros_of_word(mut w: u32, base: u32) -> u32 {
+    let mut n = base;
     if w >> 16 == 0 {
         n += 16;
         w <<= 16;
@@ -340,7 +360,7 @@ impl Reciprocal {
     #[inline(always)]
     fn of(d: u32) -> Reciprocal {
         // Normalise: dn in [2^31, 2^32); the quotients are unchanged.
-        let shift = leading_zeros(d as u64) - 32;
+        let shift = leading_zeros_u32(d);
         let dn = d << shift;
         // r ≈ 2^63 / dn: about 17 bits from the table, interpolated (1/x is
         // within 2^-18 of its chord over an interval), then about 31 after
@@ -593,6 +613,7 @@ mod tests {
         }
         for v in spread(20_000).chain([0, 1, u64::MAX, 1 << 32, (1 << 32) - 1, 1 << 63]) {
             assert_eq!(leading_zeros_by_search(v), v.leading_zeros(), "{v}");
+            assert_eq!(leading_zeros_of_word(v as u32, 0), (v as u32).leading_zeros(), "{v}");
         }
         for v in spread(5_000).chain([u64::MAX, 1 << 63, (1 << 32) - 1, 1]) {
             for shift in 0..64 {
