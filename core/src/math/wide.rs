@@ -402,6 +402,18 @@ impl Reciprocal {
         let d = self.divisor;
         let mut q = estimate;
         let mut remainder = n.wrapping_sub(mul_u32_wide(q, d)) as i64;
+        // Two steps written out first: the compiler turns a bare stepping
+        // loop into a 64-bit division (a library call of some 450
+        // instructions on a Cortex-M0), which only a far estimate needs.
+        for _ in 0..2 {
+            if remainder < 0 {
+                q = q.wrapping_sub(1);
+                remainder += d as i64;
+            } else if remainder >= d as i64 {
+                q = q.wrapping_add(1);
+                remainder -= d as i64;
+            }
+        }
         while remainder < 0 {
             q -= 1;
             remainder += d as i64;
