@@ -232,10 +232,12 @@ fn mul_u64_shr24_clamped_by_parts(x: i64, y: u64, limit: i64) -> i64 {
     let (mh, ml, yh, yl) = ((m >> 32) as u32, m as u32, (y >> 32) as u32, y as u32);
     // The product as high:low (64 bits each).
     let low_low = mul_u32_wide(ml, yl);
-    let (cross1, cross2) = (mul_u32_wide(ml, yh), mul_u32_wide(mh, yl));
-    let (cross, carry) = cross1.overflowing_add(cross2);
+    // The 3DDDA's distances to planes are below 2^32 but in scenes at the
+    // edge of the range: two of the four products are then zero.
+    let (cross2, high_high) = if mh == 0 { (0, 0) } else { (mul_u32_wide(mh, yl), mul_u32_wide(mh, yh)) };
+    let (cross, carry) = mul_u32_wide(ml, yh).overflowing_add(cross2);
     let (low, carry_low) = low_low.overflowing_add(cross << 32);
-    let high = mul_u32_wide(mh, yh) + (cross >> 32) + ((carry as u64) << 32) + carry_low as u64;
+    let high = high_high + (cross >> 32) + ((carry as u64) << 32) + carry_low as u64;
     // A negative product rounds towards −∞: the magnitude rounds up.
     let round = if x < 0 && low & 0xff_ffff != 0 { 1 } else { 0 };
     if high >> 24 != 0 {
