@@ -194,9 +194,7 @@ pub fn div_saturating(n: u64, d: u32) -> u32 {
 pub(crate) fn reciprocal_q62(d: u32) -> u64 {
     let d = d.max(1);
     if ARMV6M {
-        let high = div_saturating(1 << 30, d);
-        let remainder = (1u64 << 30) - mul_u32_wide(high, d);
-        ((high as u64) << 32) | div_saturating(remainder << 32, d) as u64
+        reciprocal_q62_by_parts(d)
     } else {
         (1u64 << 62) / d as u64
     }
@@ -264,35 +262,70 @@ static RECIPROCAL_TABLE: [u32; 256] = {
     t
 };
 
+/// `⌊2^62 / d⌋` for `d > 0` as two 32-bit quotients from one reciprocal
+/// of `d` (each below 2^32: the first as 2^30 < d·2^32, the second as its
+/// remainder is below d).
+#[inline]
+fn reciprocal_q62_by_parts(d: u32) -> u64 {
+    let by = Reciprocal::new(d);
+    let high = by.quotient(1 << 30);
+    let remainder = (1u64 << 30) - mul_u32_wide(high, d);
+    ((high as u64) << 32) | by.quotient(remainder << 32) as u64
+}
+
 /// `⌊n / d⌋` for `0 < d` and `n < d · 2^32`, from a reciprocal.
 #[inline]
 fn div_by_reciprocal(n: u64, d: u32) -> u32 {
-    // Normalise: dn in [2^31, 2^32); the quotient is unchanged.
-    let s = leading_zeros(d as u64) - 32;
-    let dn = d << s;
-    let numerator = n << s; // below dn · 2^32
-                            // r ≈ 2^63 / dn: about 9 bits from the table, 18 and then 30 after
-                            // two Newton steps r' = r + r·(2^63 − dn·r)/2^63.
-    let mut r = RECIPROCAL_TABLE[((dn >> 23) & 0xff) as usize];
-    for _ in 0..2 {
-        let error = ((1u64 << 63).wrapping_sub(mul_u32_wide(dn, r)) as i64 >> 31) as i32;
-        let step = (mul_u32_wide(r, error.unsigned_abs()) >> 32) as u32;
-        r = if error >= 0 { r.saturating_add(step) } else { r - step };
+    Reciprocal::new(d).quotient(n)
+}
+
+/// A divisor `d > 0` ready for division by reciprocal: made once when
+/// several quotients share it.
+#[derive(Clone, Copy)]
+struct Reciprocal {
+    d: u32,
+    /// The normalising shift: `d << s` is in [2^31, 2^32).
+    s: u32,
+    /// About 2^63 / (d << s), to 30 bits.
+    r: u32,
+}
+
+impl Reciprocal {
+    #[inline]
+    fn new(d: u32) -> Reciprocal {
+        let s = leading_zeros(d as u64) - 32;
+        let dn = d << s;
+        // r ≈ 2^63 / dn: about 9 bits from the table, 18 and then 30 after
+        // two Newton steps r' = r + r·(2^63 − dn·r)/2^63.
+        let mut r = RECIPROCAL_TABLE[((dn >> 23) & 0xff) as usize];
+        for _ in 0..2 {
+            let error = ((1u64 << 63).wrapping_sub(mul_u32_wide(dn, r)) as i64 >> 31) as i32;
+            let step = (mul_u32_wide(r, error.unsigned_abs()) >> 32) as u32;
+            r = if error >= 0 { r.saturating_add(step) } else { r - step };
+        }
+        Reciprocal { d, s, r }
     }
-    let (high, low) = ((numerator >> 32) as u32, numerator as u32);
-    let estimate = (mul_u32_wide(high, r) + (mul_u32_wide(low, r) >> 32)) >> 31;
-    // Off by a few at most: step to the exact floor on the remainder.
-    let mut q = estimate.min(u32::MAX as u64) as u32;
-    let mut remainder = n.wrapping_sub(mul_u32_wide(q, d)) as i64;
-    while remainder < 0 {
-        q -= 1;
-        remainder += d as i64;
+
+    /// `⌊n / d⌋` for `n < d · 2^32`.
+    #[inline]
+    fn quotient(&self, n: u64) -> u32 {
+        let (d, r) = (self.d, self.r);
+        let numerator = n << self.s; // below (d << s) · 2^32
+        let (high, low) = ((numerator >> 32) as u32, numerator as u32);
+        let estimate = (mul_u32_wide(high, r) + (mul_u32_wide(low, r) >> 32)) >> 31;
+        // Off by a few at most: step to the exact floor on the remainder.
+        let mut q = estimate.min(u32::MAX as u64) as u32;
+        let mut remainder = n.wrapping_sub(mul_u32_wide(q, d)) as i64;
+        while remainder < 0 {
+            q -= 1;
+            remainder += d as i64;
+        }
+        while remainder >= d as i64 {
+            q += 1;
+            remainder -= d as i64;
+        }
+        q
     }
-    while remainder >= d as i64 {
-        q += 1;
-        remainder -= d as i64;
-    }
-    q
 }
 
 /// 2^30 / √f at f = m/256 for m from 64 to 256: the end points of 192
@@ -442,15 +475,10 @@ mod tests {
 
     #[test]
     fn reciprocal_by_two_short_divisions_is_exact() {
-        let by_parts = |d: u32| {
-            let high = div_by_reciprocal(1 << 30, d);
-            let remainder = (1u64 << 30) - mul_u32_wide(high, d);
-            ((high as u64) << 32) | div_by_reciprocal(remainder << 32, d) as u64
-        };
         let mut d = 1u32;
         while d < (1 << 30) + 7 {
             for e in [d, d + 1, d.saturating_mul(3) / 2] {
-                assert_eq!(by_parts(e), (1u64 << 62) / e as u64, "{e}");
+                assert_eq!(reciprocal_q62_by_parts(e), (1u64 << 62) / e as u64, "{e}");
                 assert_eq!(reciprocal_q62(e), (1u64 << 62) / e as u64, "{e}");
             }
             d = (d as u64 * 5 / 4 + 1) as u32;
