@@ -11,8 +11,9 @@
 //! about the root's centre so every axis runs forwards; a zero component is
 //! nudged to one unit (2^-30). Crossings saturate at ±2^36 (a ray almost
 //! parallel to an axis); a middle plane next to a saturated one gets its
-//! crossing computed directly, as the mean would be meaningless. Empty leaves are passed over, and boxes the
-//! ray enters after the nearest hit found so far are skipped whole.
+//! crossing computed directly, as the mean would be meaningless. Empty
+//! leaves are passed over, and boxes the ray enters after the nearest hit
+//! found so far are skipped whole.
 //!
 //! The walk is one loop that calls the caller's visit for each non-empty
 //! leaf, so the box being walked stays in registers; a box's ancestors wait

@@ -278,7 +278,8 @@ impl BuildReport {
 
 /// The octree over one scene, in arenas sized by the profile `C`. `FRAMES`
 /// bounds the depth of a walk (the tree is at most `FRAMES − 1` deep); the
-/// 3DDDA keeps one frame per level, about 100 bytes of stack each, which a
+/// 3DDDA keeps one frame per level, 80 bytes of stack each (112 on a ray
+/// almost parallel to an axis), which a
 /// 16 KiB board wants to keep small.
 ///
 /// Built over a parsed scene, it is an [`Accelerator`] for a
