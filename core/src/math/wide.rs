@@ -218,7 +218,7 @@ pub(crate) fn reciprocal_q62(d: u32) -> u64 {
         // remainder is below d.
         let reciprocal = Reciprocal::of(d);
         let (high, remainder) = reciprocal.quotient_of_2_30();
-        ((high as u64) << 32) | reciprocal.quotient((remainder as u64) << 32) as u64
+        ((high as u64) << 32) | reciprocal.quotient::<2>((remainder as u64) << 32) as u64
     } else {
         (1u64 << 62) / d as u64
     }
@@ -341,7 +341,7 @@ pub(crate) fn shl_u64(x: u64, shift: u32) -> u64 {
 /// `⌊n / d⌋` for `0 < d` and `n < d · 2^32`, from a reciprocal.
 #[inline]
 fn div_by_reciprocal(n: u64, d: u32) -> u32 {
-    Reciprocal::of(d).quotient(n)
+    Reciprocal::of(d).quotient::<0>(n)
 }
 
 /// A divisor made ready for exact divisions by products: several quotients
@@ -377,12 +377,12 @@ impl Reciprocal {
 
     /// `⌊n / divisor⌋` for `n < divisor · 2^32`.
     #[inline(always)]
-    fn quotient(&self, n: u64) -> u32 {
+    fn quotient<const STEPS: usize>(&self, n: u64) -> u32 {
         let r = self.r;
         let numerator = shl_u64(n, self.shift); // below dn · 2^32
         let (high, low) = ((numerator >> 32) as u32, numerator as u32);
         let estimate = (mul_u32_wide(high, r) + (mul_u32_wide(low, r) >> 32)) >> 31;
-        self.corrected(n, estimate.min(u32::MAX as u64) as u32).0
+        self.corrected::<STEPS>(n, estimate.min(u32::MAX as u64) as u32).0
     }
 
     /// `⌊2^30 / divisor⌋` and the remainder: the numerator, normalised, is a
@@ -392,20 +392,23 @@ impl Reciprocal {
     fn quotient_of_2_30(&self) -> (u32, u32) {
         // (2^(30 + shift) · r) / 2^63, shift ≥ 1 for a divisor below 2^31.
         let estimate = if self.shift == 0 { 0 } else { self.r >> (33 - self.shift).min(31) };
-        self.corrected(1 << 30, estimate)
+        self.corrected::<0>(1 << 30, estimate)
     }
 
     /// The exact floor of `n / divisor` from an estimate a few off at most,
-    /// stepped on the remainder, and the remainder.
+    /// stepped on the remainder, and the remainder. `STEPS` steps are
+    /// written out first where the compiler would otherwise turn the
+    /// stepping loop into a 64-bit division (see below).
     #[inline(always)]
-    fn corrected(&self, n: u64, estimate: u32) -> (u32, u32) {
+    fn corrected<const STEPS: usize>(&self, n: u64, estimate: u32) -> (u32, u32) {
         let d = self.divisor;
         let mut q = estimate;
         let mut remainder = n.wrapping_sub(mul_u32_wide(q, d)) as i64;
-        // Two steps written out first: the compiler turns a bare stepping
-        // loop into a 64-bit division (a library call of some 450
-        // instructions on a Cortex-M0), which only a far estimate needs.
-        for _ in 0..2 {
+        // Steps written out first: in the 3DDDA's reciprocals the compiler
+        // turned the bare stepping loop into a 64-bit division (a library
+        // call of some 450 instructions on a Cortex-M0), which only a far
+        // estimate needs.
+        for _ in 0..STEPS {
             if remainder < 0 {
                 q = q.wrapping_sub(1);
                 remainder += d as i64;
@@ -593,10 +596,10 @@ mod tests {
         let by_parts = |d: u32| {
             let reciprocal = Reciprocal::of(d);
             let (high, rest) = reciprocal.quotient_of_2_30();
-            assert_eq!(high, reciprocal.quotient(1 << 30), "{d}");
+            assert_eq!(high, reciprocal.quotient::<0>(1 << 30), "{d}");
             let remainder = (1u64 << 30) - mul_u32_wide(high, d);
             assert_eq!(rest as u64, remainder, "{d}");
-            ((high as u64) << 32) | reciprocal.quotient(remainder << 32) as u64
+            ((high as u64) << 32) | reciprocal.quotient::<2>(remainder << 32) as u64
         };
         let mut d = 1u32;
         while d < (1 << 30) + 7 {
