@@ -48,14 +48,14 @@ impl Color {
         if k == 1 << 16 {
             return self;
         }
-        Color::from_bits(self.bits().map(|c| sat(mul_wide(c, k) >> 16)))
+        Color::from_bits(self.bits().map(|c| scale_channel_q16(c, k)))
     }
 
     /// Each channel times a cosine in Q2.30.
     #[inline]
     pub fn scale_unit(self, k: Unit) -> Color {
         let k = k.to_bits();
-        Color::from_bits(self.bits().map(|c| sat(mul_wide(c, k) >> 30)))
+        Color::from_bits(self.bits().map(|c| scale_channel_q30(c, k)))
     }
 
     /// Channel-wise product (filtering one colour by another).
@@ -70,6 +70,63 @@ impl Color {
     pub fn is_black(self) -> bool {
         self == Color::BLACK
     }
+}
+
+/// ARMv6-M (Cortex-M0) has only a 32×32→32 multiply: there the channel
+/// products below take two 32-bit products when one factor is at most 1.0
+/// (nearly always: material coefficients, cosines, weights), instead of the
+/// four of a 32×32→64 product. Elsewhere the plain product is as cheap.
+const ARMV6M: bool = cfg!(all(target_arch = "arm", not(target_feature = "thumb2")));
+
+/// `sat((c · k) >> 16)`, the product of two Q16.16 values.
+///
+/// Why the two-product form is exact: with `0 ≤ s ≤ 2^16` and `0 ≤ l`
+/// (`l = h·2^16 + m`, `h < 2^15`, `m < 2^16`), `⌊s·l / 2^16⌋ = s·h +
+/// ⌊s·m / 2^16⌋`; `s·m < 2^32` and the sum is below `2^31 + 2^16`, so it
+/// fits a u32 and saturates to `i32::MAX` as `sat` would.
+#[inline(always)]
+fn scale_channel_q16(c: i32, k: i32) -> i32 {
+    match ARMV6M.then(|| scale_channel_q16_by_parts(c, k)).flatten() {
+        Some(product) => product,
+        None => sat(mul_wide(c, k) >> 16),
+    }
+}
+
+/// [`scale_channel_q16`] in two 32-bit products, when one factor is in
+/// `[0, 2^16]` and the other non-negative.
+#[inline(always)]
+fn scale_channel_q16_by_parts(c: i32, k: i32) -> Option<i32> {
+    if c < 0 || k < 0 || c.min(k) > 1 << 16 {
+        return None;
+    }
+    let (small, large) = (c.min(k) as u32, c.max(k) as u32);
+    let product = small * (large >> 16) + ((small * (large & 0xffff)) >> 16);
+    Some(product.min(i32::MAX as u32) as i32)
+}
+
+/// `sat((c · k) >> 30)`, a Q16.16 channel times a Q2.30 factor.
+///
+/// Why the two-product form is exact: with `0 ≤ c ≤ 2^16` and `0 ≤ k`
+/// (`k = h·2^15 + m`, `h < 2^16`, `m < 2^15`), `⌊c·k / 2^30⌋ = ⌊(c·h +
+/// ⌊c·m / 2^15⌋) / 2^15⌋`; `c·h ≤ 2^32 − 2^16` and `⌊c·m / 2^15⌋ < 2^16`,
+/// so the sum fits a u32 and the result (below 2^17) needs no saturation.
+#[inline(always)]
+fn scale_channel_q30(c: i32, k: i32) -> i32 {
+    match ARMV6M.then(|| scale_channel_q30_by_parts(c, k)).flatten() {
+        Some(product) => product,
+        None => sat(mul_wide(c, k) >> 30),
+    }
+}
+
+/// [`scale_channel_q30`] in two 32-bit products, for a channel in
+/// `[0, 2^16]` and a non-negative factor.
+#[inline(always)]
+fn scale_channel_q30_by_parts(c: i32, k: i32) -> Option<i32> {
+    if c as u32 > 1 << 16 || k < 0 {
+        return None;
+    }
+    let (c, k) = (c as u32, k as u32);
+    Some(((c * (k >> 15) + ((c * (k & 0x7fff)) >> 15)) >> 15) as i32)
 }
 
 /// `v` saturated to an i32: it fits when its high word is the sign of its
@@ -119,6 +176,7 @@ pub struct SurfaceEntry {
 
 #[cfg(test)]
 mod tests {
+    extern crate std;
     use super::*;
 
     #[test]
@@ -140,6 +198,50 @@ mod tests {
         assert_eq!(half.bits(), [1 << 15; 3]);
         let m = Color::from_bits([1 << 16, 1 << 15, 0]).modulate(Color::from_bits([1 << 15; 3]));
         assert_eq!(m.bits(), [1 << 15, 1 << 14, 0]);
+    }
+
+    #[test]
+    fn channel_products_by_parts_are_the_plain_products() {
+        let seed = 0x5ca1_ab1e_u64;
+        std::println!("seed {seed:#x}");
+        let mut state = seed;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let edges =
+            [0, 1, 2, 0x7fff, 0x8000, 0xffff, 1 << 16, (1 << 16) + 1, 1 << 30, (1 << 30) + 1, i32::MAX, -1, i32::MIN];
+        let mut pairs = std::vec::Vec::new();
+        for &a in &edges {
+            for &b in &edges {
+                pairs.push((a, b));
+            }
+        }
+        for _ in 0..200_000 {
+            let r = next();
+            // Mostly the ranges the fast forms take, with their edges.
+            let a = (r as i32) >> (r >> 59);
+            let b = ((r >> 32) as i32) >> ((r >> 54) & 31);
+            pairs.push((a, b));
+            pairs.push((a & 0x1ffff, b));
+        }
+        let (mut q16, mut q30) = (0, 0);
+        for (a, b) in pairs {
+            if let Some(p) = scale_channel_q16_by_parts(a, b) {
+                assert_eq!(p, sat(mul_wide(a, b) >> 16), "{a} · {b} >> 16");
+                q16 += 1;
+            }
+            if let Some(p) = scale_channel_q30_by_parts(a, b) {
+                assert_eq!(p, sat(mul_wide(a, b) >> 30), "{a} · {b} >> 30");
+                q30 += 1;
+            }
+            assert_eq!(scale_channel_q16(a, b), sat(mul_wide(a, b) >> 16));
+            assert_eq!(scale_channel_q30(a, b), sat(mul_wide(a, b) >> 30));
+        }
+        // The fast forms were exercised, not skipped.
+        assert!(q16 > 50_000 && q30 > 50_000, "{q16} {q30}");
     }
 
     #[test]
