@@ -130,6 +130,26 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     #[inline(never)]
     pub fn pixel(&mut self, x: u32, y: u32) -> PixelSample {
         let n = self.camera.samples();
+        let (mean, object) = if n == 1 {
+            // One sample (the common case on a board): no loops, no sums.
+            let ray = self.camera.next_ray(&mut self.cursor, x, y, 0, 0);
+            let (c, object) = self.tracer.trace(ray, &mut self.scratch);
+            (Color::from_bits(c.bits().map(|v| v.clamp(0, 1 << 16))), object)
+        } else {
+            self.mean_of_samples(n, x, y)
+        };
+        // Neighbouring pixels mostly differ by a level or none: the search
+        // starts at the last pixel's (the same bits from any start).
+        let [r, g, b] = self.last_encoded;
+        let encoded =
+            [self.gamma.encode_near(mean.r, r), self.gamma.encode_near(mean.g, g), self.gamma.encode_near(mean.b, b)];
+        self.last_encoded = encoded;
+        PixelSample { color: Rgb888::new(encoded[0], encoded[1], encoded[2]), object }
+    }
+
+    /// The mean of the `n`² samples of pixel (`x`, `y`) (channels clamped to
+    /// 0..1 first, rounded to nearest) and the object hit by the middle one.
+    fn mean_of_samples(&mut self, n: u32, x: u32, y: u32) -> (Color, Option<ObjectId>) {
         let mut object = None;
         // At most 16² samples of at most 2^16 each: the sums fit a u32.
         let mut sum = [0u32; 3];
@@ -146,15 +166,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
             }
         }
         let count = n * n;
-        // One sample needs no division (a library call on a Cortex-M0).
-        let mean = Color::from_bits(sum.map(|s| if count == 1 { s } else { (s + count / 2) / count } as i32));
-        // Neighbouring pixels mostly differ by a level or none: the search
-        // starts at the last pixel's (the same bits from any start).
-        let [r, g, b] = self.last_encoded;
-        let encoded =
-            [self.gamma.encode_near(mean.r, r), self.gamma.encode_near(mean.g, g), self.gamma.encode_near(mean.b, b)];
-        self.last_encoded = encoded;
-        PixelSample { color: Rgb888::new(encoded[0], encoded[1], encoded[2]), object }
+        (Color::from_bits(sum.map(|s| ((s + count / 2) / count) as i32)), object)
     }
 
     /// The pixels of row `y` for the columns `xs`, traced lazily.
