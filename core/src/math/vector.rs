@@ -8,6 +8,55 @@
 use super::{mul_u32_wide, mul_wide, square_u32_wide, square_wide, Scalar, Unit, UNIT_ONE};
 use core::ops::{Add, Neg, Sub};
 
+/// ARMv6-M (Cortex-M0) has only a 32×32→32 multiply: there sign tests of
+/// dot products try the coarse product first (see [`coarse_dot`]).
+/// Elsewhere the exact product is as cheap.
+const ARMV6M: bool = cfg!(all(target_arch = "arm", not(target_feature = "thumb2")));
+
+/// `H = Σ (a_i >> 17)·(b_i >> 17)`, three 32-bit products: for any i32
+/// components, `|Σ a_i·b_i − H·2^34| < 2^51`.
+///
+/// Why: with `a = h·2^17 + l` (`|h| ≤ 2^14`, `0 ≤ l < 2^17`), each
+/// `a·b − h_a·h_b·2^34 = (h_a·l_b + l_a·h_b)·2^17 + l_a·l_b` is below
+/// `2·2^31·2^17 + 2^34` in magnitude; three of them below 2^51. Each
+/// `h_a·h_b` is at most 2^28, so `H` fits an i32.
+#[inline(always)]
+pub(crate) fn coarse_dot(a: [i32; 3], b: [i32; 3]) -> i32 {
+    (a[0] >> 17) * (b[0] >> 17) + (a[1] >> 17) * (b[1] >> 17) + (a[2] >> 17) * (b[2] >> 17)
+}
+
+/// `H ≥ 2^17` makes `Σ a_i·b_i > H·2^34 − 2^51 ≥ 0`; `H ≤ −2^17` makes it
+/// negative (see [`coarse_dot`]).
+const COARSE_SURE: i32 = 1 << 17;
+
+/// Whether `Σ a_i·b_i ≤ limit` when the coarse product decides it
+/// (`H·2^34 ± 2^51` both on one side of `limit`), else `None`.
+#[inline(always)]
+fn coarse_at_most(a: [i32; 3], b: [i32; 3], limit: i64) -> Option<bool> {
+    let scaled = (coarse_dot(a, b) as i64) << 34;
+    if scaled + (1 << 51) <= limit {
+        Some(true)
+    } else if scaled - (1 << 51) > limit {
+        Some(false)
+    } else {
+        None
+    }
+}
+
+/// The sign of `Σ a_i·b_i` (−1, 1) when the coarse product decides it, else
+/// `None` (0 included: the exact product may be zero).
+#[inline(always)]
+fn coarse_sign(a: [i32; 3], b: [i32; 3]) -> Option<i32> {
+    let h = coarse_dot(a, b);
+    if h >= COARSE_SURE {
+        Some(1)
+    } else if h <= -COARSE_SURE {
+        Some(-1)
+    } else {
+        None
+    }
+}
+
 /// A point or an offset in normalised scene space.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Vec3 {
@@ -75,6 +124,16 @@ impl Vec3 {
         let v = self.bits();
         let e = d.bits();
         mul_wide(v[0], e[0]) + mul_wide(v[1], e[1]) + mul_wide(v[2], e[2])
+    }
+
+    /// `self.dot_dir_q46(d) <= limit`, cheaper on ARMv6-M when the two are
+    /// far apart.
+    #[inline]
+    pub fn dot_dir_q46_at_most(self, d: Dir, limit: i64) -> bool {
+        match ARMV6M.then(|| coarse_at_most(self.bits(), d.bits(), limit)).flatten() {
+            Some(decided) => decided,
+            None => self.dot_dir_q46(d) <= limit,
+        }
     }
 
     /// `|self|²` exactly, in Q32.32. Components must be within ±2^15.
@@ -188,6 +247,26 @@ impl Dir {
         let a = self.bits();
         let b = o.bits();
         mul_wide(a[0], b[0]) + mul_wide(a[1], b[1]) + mul_wide(a[2], b[2])
+    }
+
+    /// `self.dot_q60(o) > 0`, cheaper on ARMv6-M unless the two are nearly
+    /// perpendicular.
+    #[inline]
+    pub fn dot_is_positive(self, o: Dir) -> bool {
+        match ARMV6M.then(|| coarse_sign(self.bits(), o.bits())).flatten() {
+            Some(sign) => sign > 0,
+            None => self.dot_q60(o) > 0,
+        }
+    }
+
+    /// `self.dot_q60(o) < 0`, cheaper on ARMv6-M unless the two are nearly
+    /// perpendicular.
+    #[inline]
+    pub fn dot_is_negative(self, o: Dir) -> bool {
+        match ARMV6M.then(|| coarse_sign(self.bits(), o.bits())).flatten() {
+            Some(sign) => sign < 0,
+            None => self.dot_q60(o) < 0,
+        }
     }
 
     /// `self · o` in Q2.30, rounded towards minus infinity.
@@ -405,6 +484,52 @@ mod tests {
             assert!((l.to_bits() - v.length().to_bits()).abs() <= 1, "{v:?}: {l} vs {}", v.length());
         }
         assert_eq!(Vec3::ZERO.direction_and_length(), None);
+    }
+
+    #[test]
+    fn coarse_dot_decisions_agree_with_the_exact_products() {
+        let seed = 0xd07_c0a5e_u64;
+        std::println!("seed {seed:#x}");
+        let mut state = seed;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let (mut signs, mut limits, mut undecided) = (0, 0, 0);
+        for round in 0..300_000 {
+            // Unit-scale directions, points of every scale, and the extremes.
+            let mut component = |shift: u64| -> i32 {
+                let r = next();
+                match round % 5 {
+                    4 => [i32::MIN, i32::MAX, 0, -1, 1 << 30, -(1 << 30)][(r % 6) as usize],
+                    _ => (r as i32) >> (shift + (r >> 60)),
+                }
+            };
+            let a = [component(1), component(1), component(1)];
+            let b = [component(0), component(0), component(0)];
+            let exact = a.iter().zip(&b).map(|(&x, &y)| x as i128 * y as i128).sum::<i128>();
+            // Only sums the plain i64 form holds are meaningful.
+            if exact.abs() >= 1 << 62 {
+                continue;
+            }
+            let exact = exact as i64;
+            match coarse_sign(a, b) {
+                Some(sign) => {
+                    assert_eq!(sign as i64, exact.signum(), "{a:?} · {b:?}");
+                    signs += 1;
+                }
+                None => undecided += 1,
+            }
+            let limit = [-(1i64 << 33), -(1 << 40), 0, 1 << 50, exact, exact - 1][round % 6];
+            if let Some(at_most) = coarse_at_most(a, b, limit) {
+                assert_eq!(at_most, exact <= limit, "{a:?} · {b:?} against {limit}");
+                limits += 1;
+            }
+        }
+        // Both outcomes of both tests were exercised.
+        assert!(signs > 100_000 && limits > 50_000 && undecided > 1_000, "{signs} {limits} {undecided}");
     }
 
     #[test]

@@ -122,14 +122,14 @@ fn ratio_q16(num: u64, den: u64) -> i32 {
 /// its Q2.30 floor at most 0.
 #[inline]
 fn surely_behind(v: Vec3, normal: Dir) -> bool {
-    v.dot_dir_q46(normal) <= -(1 << 33)
+    v.dot_dir_q46_at_most(normal, -(1 << 33))
 }
 
 /// How a ray leaving a surface along `dir` relates to the shape it leaves:
 /// closed shapes are entered when `dir` points against the outward normal.
 #[inline]
 fn leaving_along(geometric_normal: Dir, dir: Dir) -> Leaving {
-    if geometric_normal.dot_q60(dir) < 0 {
+    if geometric_normal.dot_is_negative(dir) {
         Leaving::Inward
     } else {
         Leaving::Outward
@@ -201,7 +201,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         // Two-sided: shade with the normal facing the incoming ray (for a
         // B-spline's triangle, its interpolated normal; shadow rays then
         // leave from the smooth surface, see shapes::SmoothTriangle).
-        let flipped = geometric.dot_q60(p.ray.dir) > 0;
+        let flipped = geometric.dot_is_positive(p.ray.dir);
         let facing = if flipped { -geometric } else { geometric };
         let (normal, shadow_from) = shape.shading_among(A::KINDS, point, facing);
         let to_eye = -p.ray.dir;

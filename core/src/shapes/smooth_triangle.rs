@@ -38,7 +38,7 @@ impl SmoothTriangle {
         let triangle = Triangle::new(corners, surface)?;
         let face = triangle.normal();
         let normals = normals.map(|n| match n {
-            Some(n) if n.dot_q60(face) >= 0 => n,
+            Some(n) if !n.dot_is_negative(face) => n,
             Some(n) => -n,
             None => face,
         });
@@ -81,7 +81,7 @@ impl SmoothTriangle {
         let w = self.weights(p);
         let n = [0, 1, 2].map(|a| (0..3).map(|i| w[i] as i64 * self.normals[i].wide()[a]).sum::<i64>());
         let n = Dir::normalize(n).unwrap_or(self.normal());
-        if facing.dot_q60(self.normal()) < 0 {
+        if facing.dot_is_negative(self.normal()) {
             -n
         } else {
             n
