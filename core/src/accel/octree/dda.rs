@@ -301,18 +301,16 @@ fn descend<K: Corner, C: OctreeCapacities, const FRAMES: usize>(
             }
             continue;
         }
-        let (mut t0, mut t1) = (current.t0, current.tm);
-        for a in 0..3 {
-            if c >> a & 1 == 1 {
-                t0[a] = current.tm[a];
-                t1[a] = current.t1[a];
-            }
-        }
-        let entry = t0[max_axis(&t0)];
+        // The child's crossings: its parent's low and middle planes' on the
+        // axes where it is the low half, the middle and high ones elsewhere.
+        let high = |a: usize| c >> a & 1 == 1;
+        let t0 = [0, 1, 2].map(|a| if high(a) { current.tm[a] } else { current.t0[a] });
+        let entry = t0[0].max(t0[1]).max(t0[2]);
         if entry > limit {
             current.next = 8;
             continue;
         }
+        let t1 = [0, 1, 2].map(|a| if high(a) { current.t1[a] } else { current.tm[a] });
         // The sibling the ray enters next: across the child's nearest far
         // plane, unless that plane is the parent's own.
         let axis = min_axis(&t1);
