@@ -631,18 +631,20 @@ impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES>
         start: Option<RayStart>,
         mailbox: &mut Mailbox<'_>,
     ) -> Option<Hit> {
-        let mut best: Option<Hit> = None;
+        // No hit yet: the farthest parameter and no object (a hit at
+        // `Scalar::MAX` still wins, by the earlier-object rule).
+        const NONE: ObjectId = ObjectId(u32::MAX);
+        let mut best = Hit { t: Scalar::MAX, object: NONE };
         walk_leaves(self, ray, mailbox, Scalar::MAX, |leaf, exit, mailbox| {
             let mut test = |id: u32| {
                 if !mailbox.first_visit(id) {
                     return;
                 }
                 let object = ObjectId(id);
-                let t_max = best.map_or(Scalar::MAX, |b| b.t);
                 let leaving = RayStart::leaving(start, object);
-                if let Some(t) = scene.intersect_handle(C::KINDS, scene.objects[id as usize], ray, t_max, leaving) {
-                    if best.is_none_or(|b| t < b.t || (t == b.t && object < b.object)) {
-                        best = Some(Hit { t, object });
+                if let Some(t) = scene.intersect_handle(C::KINDS, scene.objects[id as usize], ray, best.t, leaving) {
+                    if t < best.t || (t == best.t && object < best.object) {
+                        best = Hit { t, object };
                     }
                 }
             };
@@ -652,13 +654,13 @@ impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES>
             }
             // Final once strictly before the exit: an equal hit in the next
             // leaf might belong to an earlier object.
-            match best {
-                Some(b) if exit.after(b.t) => None,
-                Some(b) => Some(b.t),
-                None => Some(Scalar::MAX),
+            if best.object != NONE && exit.after(best.t) {
+                None
+            } else {
+                Some(best.t)
             }
         });
-        best
+        (best.object != NONE).then_some(best)
     }
 
     #[inline(never)]
