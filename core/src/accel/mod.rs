@@ -130,8 +130,9 @@ impl RayStart {
 
 /// Remembers which objects a query has tested, so that an object filed in
 /// several cells is tested once. One bit per object in caller-owned words;
-/// clearing costs only the bits that were set (up to 32, else the words are
-/// zeroed). Words too few for an object just disable the check for it.
+/// clearing zeroes the words when they are few (up to 256 objects), else
+/// only the bits that were set (up to 32, else all the words). Words too
+/// few for an object just disable the check for it.
 pub struct Mailbox<'m> {
     words: &'m mut [u32],
     touched: heapless::Vec<u32, 32>,
@@ -153,6 +154,10 @@ impl core::fmt::Debug for Mailbox<'_> {
 }
 
 impl<'m> Mailbox<'m> {
+    /// Up to this many words, clearing zeroes them all: cheaper than
+    /// listing the bits as they are set.
+    const ZERO_ALL_UP_TO: usize = 8;
+
     /// A mailbox over `words`, for up to `32 · words.len()` objects.
     pub fn new(words: &'m mut [u32]) -> Mailbox<'m> {
         words.fill(0);
@@ -178,7 +183,7 @@ impl<'m> Mailbox<'m> {
             return false;
         }
         *word |= bit;
-        if self.touched.push(object).is_err() {
+        if self.words.len() > Self::ZERO_ALL_UP_TO && self.touched.push(object).is_err() {
             self.overflowed = true;
         }
         true
@@ -187,7 +192,7 @@ impl<'m> Mailbox<'m> {
     /// Forgets every visit (call between queries).
     #[inline]
     pub fn clear(&mut self) {
-        if self.overflowed {
+        if self.overflowed || self.words.len() <= Self::ZERO_ALL_UP_TO {
             self.words.fill(0);
             self.overflowed = false;
         } else {
@@ -230,6 +235,7 @@ pub trait Accelerator {
 
 #[cfg(test)]
 mod tests {
+    extern crate std;
     use super::*;
 
     #[test]
@@ -246,19 +252,24 @@ mod tests {
 
     #[test]
     fn mailbox_sees_each_object_once_per_query() {
-        let mut words = [0u32; 4];
-        let mut m = Mailbox::new(&mut words);
-        assert!(m.first_visit(5));
-        assert!(!m.first_visit(5));
-        assert!(m.first_visit(127));
-        assert!(m.first_visit(500), "beyond the words: always tested");
-        assert!(m.first_visit(500));
-        m.clear();
-        assert!(m.first_visit(5));
-        for i in 0..100 {
-            m.first_visit(i);
+        // Few words (zeroed whole) and many (cleared bit by bit, or whole
+        // once more than 32 bits were set).
+        for count in [4, 16] {
+            let mut words = std::vec![0u32; count];
+            let mut m = Mailbox::new(&mut words);
+            assert!(m.first_visit(5));
+            assert!(!m.first_visit(5));
+            assert!(m.first_visit(127));
+            assert!(m.first_visit(1000), "beyond the words: always tested");
+            assert!(m.first_visit(1000));
+            m.clear();
+            assert!(m.first_visit(5) && m.first_visit(127), "{count} words");
+            m.clear();
+            for i in 0..100 {
+                m.first_visit(i);
+            }
+            m.clear();
+            assert!((0..128).all(|i| m.first_visit(i)), "cleared after overflow too, {count} words");
         }
-        m.clear();
-        assert!((0..128).all(|i| m.first_visit(i)), "cleared after overflow too");
     }
 }

@@ -224,26 +224,24 @@ fn set_up<C: OctreeCapacities, const FRAMES: usize>(
 ) -> Option<(Setup, [i64; 3], [i64; 3])> {
     let o = ray.origin.wide();
     let d = ray.dir.wide();
-    let half = 1i64 << (tree.root_log2 - 1);
     let mut setup = Setup { mirror: 0, saturated: 0, origin: [0; 3], inverse: [0; 3], begin: 0, far: 0 };
     let mut t0 = [0; 3];
     let mut t1 = [0; 3];
     for a in 0..3 {
-        let centre = tree.root_min[a] + half;
         // Mirror a negative axis about the root's centre.
         setup.origin[a] = if d[a] < 0 {
             setup.mirror |= 1 << a;
-            2 * centre - o[a]
+            tree.root_min[a] + tree.root_max[a] - o[a]
         } else {
             o[a]
         };
         setup.inverse[a] = reciprocal_q62(d[a].unsigned_abs() as u32);
         if d[a].unsigned_abs() >= STEEP {
             t0[a] = setup.steep_crossing(a, tree.root_min[a]);
-            t1[a] = setup.steep_crossing(a, tree.root_min[a] + 2 * half);
+            t1[a] = setup.steep_crossing(a, tree.root_max[a]);
         } else {
             t0[a] = setup.crossing(a, tree.root_min[a]);
-            t1[a] = setup.crossing(a, tree.root_min[a] + 2 * half);
+            t1[a] = setup.crossing(a, tree.root_max[a]);
             if t0[a].abs() == LIMIT || t1[a].abs() == LIMIT {
                 setup.saturated |= 1 << a;
             }
@@ -264,8 +262,7 @@ fn set_up<C: OctreeCapacities, const FRAMES: usize>(
             false => setup.crossing(a, plane),
         };
         let (lo, hi) = if setup.mirror >> a & 1 == 1 {
-            let c2 = 2 * (tree.root_min[a] + half);
-            (bound(c2 - tree.bounds_max[a]), t1[a])
+            (bound(tree.root_min[a] + tree.root_max[a] - tree.bounds_max[a]), t1[a])
         } else {
             (t0[a], bound(tree.bounds_max[a]))
         };
@@ -304,18 +301,16 @@ fn descend<K: Corner, C: OctreeCapacities, const FRAMES: usize>(
             }
             continue;
         }
-        let (mut t0, mut t1) = (current.t0, current.tm);
-        for a in 0..3 {
-            if c >> a & 1 == 1 {
-                t0[a] = current.tm[a];
-                t1[a] = current.t1[a];
-            }
-        }
-        let entry = t0[max_axis(&t0)];
+        // The child's crossings: its parent's low and middle planes' on the
+        // axes where it is the low half, the middle and high ones elsewhere.
+        let high = |a: usize| c >> a & 1 == 1;
+        let t0 = [0, 1, 2].map(|a| if high(a) { current.tm[a] } else { current.t0[a] });
+        let entry = t0[0].max(t0[1]).max(t0[2]);
         if entry > limit {
             current.next = 8;
             continue;
         }
+        let t1 = [0, 1, 2].map(|a| if high(a) { current.t1[a] } else { current.tm[a] });
         // The sibling the ray enters next: across the child's nearest far
         // plane, unless that plane is the parent's own.
         let axis = min_axis(&t1);

@@ -308,8 +308,11 @@ pub struct Octree<C: OctreeCapacities, const FRAMES: usize = { MAX_DEPTH as usiz
     refs: C::References,
     entries: C::HashEntries,
     buckets: C::HashBuckets,
-    /// The root box: `[root_min, root_min + 2^root_log2]` per axis.
+    /// The root box: `[root_min, root_max]`, `root_max = root_min +
+    /// 2^root_log2` per axis (kept: a 64-bit shift by a variable is a
+    /// library call on a small core, and every ray's set-up needs it).
     root_min: [i64; 3],
+    root_max: [i64; 3],
     /// The objects' own upper bounds, widened by the filing margin (their
     /// lower bounds are `root_min`).
     bounds_max: [i64; 3],
@@ -356,6 +359,7 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
             entries: C::HashEntries::EMPTY,
             buckets: C::HashBuckets::EMPTY,
             root_min: [0; 3],
+            root_max: [0; 3],
             bounds_max: [0; 3],
             root_log2: 0,
             min_log2: 0,
@@ -403,7 +407,7 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
 
         let Some(bounds) = scene.object_ids().map(|id| scene.shape(id).bounds()).reduce(Aabb::union) else {
             // No objects: a single empty leaf.
-            (self.root_min, self.root_log2, self.min_log2) = ([0; 3], 1, 1);
+            (self.root_min, self.root_max, self.root_log2, self.min_log2) = ([0; 3], [2; 3], 1, 1);
             self.bounds_max = [0; 3];
             let _ = self.nodes.push(OctreeNode::leaf(0, 0));
             self.finish(0);
@@ -413,6 +417,7 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
         let extent = (0..3).map(|a| hi[a] - lo[a]).max().unwrap_or(0) + 2 * FILING_MARGIN;
         self.root_log2 = 64 - (extent.max(2) as u64 - 1).leading_zeros();
         self.root_min = lo.map(|v| v - FILING_MARGIN);
+        self.root_max = self.root_min.map(|v| v + (1i64 << self.root_log2));
         self.bounds_max = hi.map(|v| v + FILING_MARGIN);
         self.min_log2 = self.root_log2;
 
@@ -626,18 +631,20 @@ impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES>
         start: Option<RayStart>,
         mailbox: &mut Mailbox<'_>,
     ) -> Option<Hit> {
-        let mut best: Option<Hit> = None;
+        // No hit yet: the farthest parameter and no object (a hit at
+        // `Scalar::MAX` still wins, by the earlier-object rule).
+        const NONE: ObjectId = ObjectId(u32::MAX);
+        let mut best = Hit { t: Scalar::MAX, object: NONE };
         walk_leaves(self, ray, mailbox, Scalar::MAX, |leaf, exit, mailbox| {
             let mut test = |id: u32| {
                 if !mailbox.first_visit(id) {
                     return;
                 }
                 let object = ObjectId(id);
-                let t_max = best.map_or(Scalar::MAX, |b| b.t);
                 let leaving = RayStart::leaving(start, object);
-                if let Some(t) = scene.intersect_handle(C::KINDS, scene.objects[id as usize], ray, t_max, leaving) {
-                    if best.is_none_or(|b| t < b.t || (t == b.t && object < b.object)) {
-                        best = Some(Hit { t, object });
+                if let Some(t) = scene.intersect_handle(C::KINDS, scene.objects[id as usize], ray, best.t, leaving) {
+                    if t < best.t || (t == best.t && object < best.object) {
+                        best = Hit { t, object };
                     }
                 }
             };
@@ -647,13 +654,13 @@ impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES>
             }
             // Final once strictly before the exit: an equal hit in the next
             // leaf might belong to an earlier object.
-            match best {
-                Some(b) if exit.after(b.t) => None,
-                Some(b) => Some(b.t),
-                None => Some(Scalar::MAX),
+            if best.object != NONE && exit.after(best.t) {
+                None
+            } else {
+                Some(best.t)
             }
         });
-        best
+        (best.object != NONE).then_some(best)
     }
 
     #[inline(never)]
