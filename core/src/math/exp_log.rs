@@ -138,9 +138,13 @@ pub fn pow_q30(x: u32, p: i64) -> u64 {
     // fraction's two halves): 64-bit products are library calls on a
     // Cortex-M0.
     let l = (log2_q32(x as u64, 30) >> 8) as i32;
-    let whole = (p >> 32).min(i32::MAX as i64) as i32;
-    let (f_high, f_low) = (((p >> 16) & 0xffff) as i32, (p & 0xffff) as i32);
-    let y = mul_wide(l, whole) + (mul_wide(l, f_high) >> 16) + (mul_wide(l, f_low) >> 32); // Q40.24
+    let y = if p & 0xffff_ffff == 0 {
+        // A whole exponent (the usual Phong power): the fraction's two
+        // products are zero.
+        mul_wide(l, (p >> 32).min(i32::MAX as i64) as i32)
+    } else {
+        exponent_times_log(p, l)
+    }; // Q40.24
     if y < -(40 << 24) {
         return 0;
     }
@@ -148,6 +152,15 @@ pub fn pow_q30(x: u32, p: i64) -> u64 {
         return 1 << 40;
     }
     (exp2_q32(y << 8) + 2) >> 2
+}
+
+/// `p · l` in Q40.24 for `p` ≥ 0 in Q32.32 and `l` in Q8.24, from 32×32
+/// products: p's whole part, then its fraction's two halves.
+#[inline]
+fn exponent_times_log(p: i64, l: i32) -> i64 {
+    let whole = (p >> 32).min(i32::MAX as i64) as i32;
+    let (f_high, f_low) = (((p >> 16) & 0xffff) as i32, (p & 0xffff) as i32);
+    mul_wide(l, whole) + (mul_wide(l, f_high) >> 16) + (mul_wide(l, f_low) >> 32)
 }
 
 /// `x^p` for `x` in [0, 1] given in Q2.30 (values outside are clamped) and
@@ -160,6 +173,16 @@ pub fn pow_unit(x: i32, p: i64) -> i32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn whole_exponents_skip_only_zero_products() {
+        for whole in [0i64, 1, 2, 5, 10, 60, 120, 1000, i32::MAX as i64, 1 << 40] {
+            let p = whole << 32;
+            for l in [0, 1, -1, -(30 << 24), -(1 << 29), (2 << 24) - 1, i32::MIN, i32::MAX] {
+                assert_eq!(mul_wide(l, (p >> 32).min(i32::MAX as i64) as i32), exponent_times_log(p, l), "{whole} {l}");
+            }
+        }
+    }
 
     #[test]
     fn shifts_in_halves_are_the_plain_shifts() {
