@@ -57,6 +57,28 @@ fn coarse_sign(a: [i32; 3], b: [i32; 3]) -> Option<i32> {
     }
 }
 
+/// Whether the ray from `origin` along `dir` surely meets the plane
+/// `n·p = offset` at no positive parameter, from coarse products: true only
+/// when `den = ⌊n·dir⌋` (Q2.30) and `num = offset·2^30 − n·origin` (Q18.46)
+/// are surely of opposite signs or `num` surely zero-or-against (`den > 0`
+/// and `num ≤ 0`, or `den < 0` and `num ≥ 0`).
+///
+/// `den > 0` needs `n·dir ≥ 2^30` (Q4.60): sure when `H ≥ 2^17 + 1`
+/// (`H·2^34 − 2^51 ≥ 2^34`); `den < 0` when `H ≤ −2^17`.
+#[inline(always)]
+fn coarse_plane_behind(dir: [i32; 3], origin: [i32; 3], n: [i32; 3], offset: i32) -> bool {
+    let h_den = coarse_dot(n, dir);
+    let den_positive = h_den > COARSE_SURE;
+    let den_negative = h_den <= -COARSE_SURE;
+    if !den_positive && !den_negative {
+        return false;
+    }
+    let along = (coarse_dot(origin, n) as i64) << 34;
+    let target = (offset as i64) << 30;
+    // num ≤ 0 when n·origin ≥ target; num ≥ 0 when n·origin ≤ target.
+    (den_positive && along - (1 << 51) >= target) || (den_negative && along + (1 << 51) <= target)
+}
+
 /// A point or an offset in normalised scene space.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Vec3 {
@@ -267,6 +289,17 @@ impl Dir {
             Some(sign) => sign < 0,
             None => self.dot_q60(o) < 0,
         }
+    }
+
+    /// Whether the ray from `origin` along `self` surely meets the plane
+    /// `n·p = offset` at no positive parameter: on ARMv6-M from 32-bit
+    /// products when they decide, and `false` (unsure) otherwise and on
+    /// other targets. `true` means `⌊n·self⌋` (Q2.30) and `offset·2^30 −
+    /// n·origin` (Q18.46) are nonzero-and-positive against non-positive or
+    /// negative against non-negative.
+    #[inline]
+    pub fn plane_surely_behind(self, origin: Vec3, n: Dir, offset: Scalar) -> bool {
+        ARMV6M && coarse_plane_behind(self.bits(), origin.bits(), n.bits(), offset.to_bits())
     }
 
     /// `self · o` in Q2.30, rounded towards minus infinity.
@@ -530,6 +563,44 @@ mod tests {
         }
         // Both outcomes of both tests were exercised.
         assert!(signs > 100_000 && limits > 50_000 && undecided > 1_000, "{signs} {limits} {undecided}");
+    }
+
+    #[test]
+    fn coarse_plane_test_rejects_only_what_the_exact_test_rejects() {
+        let seed = 0x9_1a2e_u64;
+        std::println!("seed {seed:#x}");
+        let mut state = seed;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let (mut rejected, mut unsure) = (0, 0);
+        for round in 0..200_000 {
+            let r = next();
+            let unit = |bits: u64| ((bits as i32) >> 1) >> ((bits >> 29) & 7);
+            let point = |bits: u64| (bits as i32) >> ((bits >> 30) & 15);
+            let dir = [unit(r), unit(r >> 8), unit(r >> 16)];
+            let n = [unit(r >> 24), unit(r >> 32), unit(r >> 40)];
+            let s = next();
+            let origin = [point(s), point(s >> 11), point(s >> 22)];
+            let offset = match round % 3 {
+                0 => point(s >> 33),
+                // Planes through or near the origin's projection.
+                _ => ((origin.iter().zip(&n).map(|(&o, &c)| o as i64 * c as i64).sum::<i64>() >> 30) as i32)
+                    .wrapping_add((s >> 60) as i32 - 8),
+            };
+            let den = (dir.iter().zip(&n).map(|(&a, &b)| a as i64 * b as i64).sum::<i64>()) >> 30;
+            let num = ((offset as i64) << 30) - origin.iter().zip(&n).map(|(&a, &b)| a as i64 * b as i64).sum::<i64>();
+            if coarse_plane_behind(dir, origin, n, offset) {
+                assert!((den > 0 && num <= 0) || (den < 0 && num >= 0), "{dir:?} {origin:?} {n:?} {offset}");
+                rejected += 1;
+            } else {
+                unsure += 1;
+            }
+        }
+        assert!(rejected > 10_000 && unsure > 10_000, "{rejected} {unsure}");
     }
 
     #[test]

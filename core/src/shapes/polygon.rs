@@ -51,6 +51,12 @@ impl<const N: usize> Polygon<N> {
         if leaving != Leaving::No {
             return None;
         }
+        // Most rays that miss the plane meet it behind them (or leave it
+        // behind): on a Cortex-M0 short products say so before the exact
+        // ones, which would reject it as well.
+        if ray.dir.plane_surely_behind(ray.origin, self.normal, self.offset) {
+            return None;
+        }
         let den = self.normal.dot(ray.dir).to_bits() as i64; // Q2.30
         if den == 0 {
             return None;
