@@ -218,6 +218,11 @@ pub trait Accelerator {
     /// dispatches on these only, so a build links no other kind's code.
     const KINDS: ShapeKinds = ShapeKinds::ALL;
 
+    /// Whether its queries mark objects in the [`Mailbox`] (which the
+    /// tracer then clears before each query); false for one that tests
+    /// every object once anyway.
+    const USES_MAILBOX: bool = true;
+
     /// The nearest hit along `ray` (`t > 0`), ties to the earlier object.
     fn nearest(
         &self,

@@ -14,6 +14,8 @@ use core::marker::PhantomData;
 pub struct Naive;
 
 impl Accelerator for Naive {
+    const USES_MAILBOX: bool = false;
+
     fn nearest(&self, scene: &SceneView<'_>, ray: &Ray, start: Option<RayStart>, _: &mut Mailbox<'_>) -> Option<Hit> {
         nearest(ShapeKinds::ALL, scene, ray, start)
     }
@@ -42,6 +44,7 @@ impl<P> NaiveFor<P> {
 
 impl<P: Profile> Accelerator for NaiveFor<P> {
     const KINDS: ShapeKinds = ShapeKinds::with_room(&P::COUNTS);
+    const USES_MAILBOX: bool = false;
 
     fn nearest(&self, scene: &SceneView<'_>, ray: &Ray, start: Option<RayStart>, _: &mut Mailbox<'_>) -> Option<Hit> {
         nearest(Self::KINDS, scene, ray, start)

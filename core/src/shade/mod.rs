@@ -161,7 +161,9 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             }
             traced += 1;
             scratch.stats.rays += 1;
-            scratch.mailbox.clear();
+            if A::USES_MAILBOX {
+                scratch.mailbox.clear();
+            }
             let hit = self.accel.nearest(&self.scene, &p.ray, p.start, &mut scratch.mailbox);
             if p.depth == 0 {
                 first_object = hit.map(|h| self.scene.written_object(h.object));
@@ -280,7 +282,9 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         blocker: &mut u32,
         mailbox: &mut Mailbox<'_>,
     ) -> bool {
-        mailbox.clear();
+        if A::USES_MAILBOX {
+            mailbox.clear();
+        }
         if (*blocker as usize) < self.scene.object_count() {
             let object = ObjectId(*blocker);
             let leaving = RayStart::leaving(Some(start), object);
@@ -288,7 +292,9 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
                 return true;
             }
             // Missed: the walk need not test it again.
-            mailbox.first_visit(*blocker);
+            if A::USES_MAILBOX {
+                mailbox.first_visit(*blocker);
+            }
         }
         mailbox.blocker = u32::MAX;
         let blocked = self.accel.occluded(&self.scene, shadow, t_max, Some(start), mailbox);
