@@ -193,13 +193,7 @@ impl<'m> Mailbox<'m> {
     #[inline]
     pub fn clear(&mut self) {
         if self.overflowed || self.words.len() <= Self::ZERO_ALL_UP_TO {
-            // One word (up to 32 objects) in place: `fill` is a call to the
-            // library's memclr, some 20 instructions on a Cortex-M0, made
-            // for every ray.
-            match &mut *self.words {
-                [word] => *word = 0,
-                words => words.fill(0),
-            }
+            self.words.fill(0);
             self.overflowed = false;
         } else {
             for &o in &self.touched {
