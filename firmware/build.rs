@@ -34,12 +34,12 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 /// What each board's RAM holds besides the stack, and how its octree is
-/// built (shallow on the micro:bit, whose 7 KiB stack holds one walk frame
-/// of about 100 bytes per level).
+/// built: at most 4 levels on the micro:bit, whose 7 KiB stack holds one
+/// walk frame of 80 bytes a level (fewer when the scene's arenas would not
+/// fit its RAM otherwise).
 struct Board {
     name: &'static str,
     static_ram: usize,
-    octree: &'static str,
     config: OctreeConfig,
 }
 
@@ -67,20 +67,15 @@ fn main() {
         ("microbit", "thumbv6m-none-eabi") => Board {
             name: "microbit",
             static_ram: 9 * 1024,
-            octree: "max_objects: 8, max_depth: 3",
-            config: OctreeConfig { max_objects: 8, max_depth: 3, ..OctreeConfig::DEFAULT },
+            config: OctreeConfig { max_objects: 8, max_depth: 4, ..OctreeConfig::DEFAULT },
         },
-        ("mps2-an385", "thumbv7m-none-eabi") => Board {
-            name: "mps2-an385",
-            static_ram: 3 * 1024 * 1024,
-            octree: "max_objects: 4, max_depth: 12",
-            config: OctreeConfig::DEFAULT,
-        },
+        ("mps2-an385", "thumbv7m-none-eabi") => {
+            Board { name: "mps2-an385", static_ram: 3 * 1024 * 1024, config: OctreeConfig::DEFAULT }
+        }
         ("lm3s6965evb", "thumbv7m-none-eabi") => Board {
             name: "lm3s6965evb",
             // Of the 56 KiB beside the stack, 1 KiB is left for the other statics.
             static_ram: 55 * 1024,
-            octree: "max_objects: 4, max_depth: 12",
             config: OctreeConfig::DEFAULT,
         },
         ("microbit", _) => fail(format!("OCTRACE_BOARD=microbit needs --target thumbv6m-none-eabi, not {target}")),
@@ -132,8 +127,22 @@ fn main() {
     if output.contains(['\0', '\n']) {
         fail("OCTRACE_OUT: a path without NUL or newline".to_owned());
     }
-    let counts = needs(&text, accel, &board.config);
-    let bytes = static_bytes(&counts);
+    // Only the thesis's walk reads the octree's hash table.
+    let named_walk = accel == AccelMode::Octree;
+    // The board's octree, or a shallower one if the scene's arenas would
+    // not fit its RAM otherwise.
+    let (octree, counts, bytes) = (1..=board.config.max_depth)
+        .rev()
+        .map(|max_depth| {
+            let config = OctreeConfig { max_depth, ..board.config };
+            let counts = needs(&text, accel, &config);
+            (config, counts, static_bytes(&counts, named_walk))
+        })
+        .find(|&(_, _, bytes)| bytes <= board.static_ram)
+        .unwrap_or_else(|| {
+            let counts = needs(&text, accel, &board.config);
+            (board.config, counts, static_bytes(&counts, named_walk))
+        });
     if bytes > board.static_ram {
         fail(format!(
             "{scene} needs about {bytes} bytes of arenas ({}), more than the {} bytes the {} has beside its stack",
@@ -162,9 +171,9 @@ fn main() {
     }
     writeln!(
         config,
-        "octrace_core::profile! {{\n    /// Exactly what {scene} needs (about {bytes} bytes).\n    pub struct Profile {{ {} }}\n    octree: {{ {} }}\n}}",
+        "octrace_core::profile! {{\n    /// Exactly what {scene} needs (about {bytes} bytes).\n    pub struct Profile {{ {} }}\n    octree: {{ {} }}\n    named_walk: {named_walk}\n}}",
         fields.join(", "),
-        board.octree
+        format_args!("max_objects: {}, max_depth: {}", octree.max_objects, octree.max_depth)
     )
     .unwrap();
     // What the runner reads from the ELF: `key=value` lines.
@@ -196,7 +205,7 @@ fn needs(text: &str, accel: AccelMode, config: &OctreeConfig) -> Counts {
 
 /// How many bytes of RAM the arenas for `counts` take (the core's types
 /// hold no pointers or `usize`, so their sizes here are the board's).
-fn static_bytes(counts: &Counts) -> usize {
+fn static_bytes(counts: &Counts, named_walk: bool) -> usize {
     use octrace_core::accel::{HashEntry, OctreeNode};
     use octrace_core::math::Vec3;
     use octrace_core::scene::{Light, SurfaceEntry};
@@ -220,8 +229,8 @@ fn static_bytes(counts: &Counts) -> usize {
         OctreeReferences => size_of::<u16>(),
     };
     CapacityKind::ALL.iter().map(|&k| counts.get(k) * per(k)).sum::<usize>()
-        + (counts.octree_hash_entries() * size_of::<HashEntry<u16>>())
-        + (counts.octree_hash_buckets() + 1) * size_of::<u16>()
+        + (counts.octree_hash_entries_if(named_walk) * size_of::<HashEntry<u16>>())
+        + (counts.octree_hash_buckets_if(named_walk) + 1) * size_of::<u16>()
         + counts.mailbox_words() * size_of::<u32>()
 }
 

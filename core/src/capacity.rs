@@ -213,6 +213,26 @@ impl Counts {
         (self.octree_hash_entries() / 2) | 1
     }
 
+    /// [`Counts::octree_hash_entries`] for a profile with the thesis's walk,
+    /// 0 for one without (see `Profile::NAMED_WALK`).
+    pub const fn octree_hash_entries_if(&self, named_walk: bool) -> usize {
+        if named_walk {
+            self.octree_hash_entries()
+        } else {
+            0
+        }
+    }
+
+    /// [`Counts::octree_hash_buckets`] for a profile with the thesis's walk,
+    /// 0 for one without.
+    pub const fn octree_hash_buckets_if(&self, named_walk: bool) -> usize {
+        if named_walk {
+            self.octree_hash_buckets()
+        } else {
+            0
+        }
+    }
+
     /// These counts with `objects` set to the shapes' sum when it is 0
     /// (what [`crate::profile!`] does when `objects` is not given).
     pub const fn with_objects(mut self) -> Counts {

@@ -50,6 +50,12 @@ pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
     /// One bit per object: an object filed in several octree boxes is then
     /// tested once per ray.
     type MailboxWords: Arena<u32>;
+    /// Whether the octree keeps the thesis's hash table, which only the
+    /// thesis's walk ([`AccelMode::Octree`](crate::AccelMode::Octree))
+    /// reads. A profile without it (`named_walk: false` in
+    /// [`profile!`](crate::profile!)) saves that RAM; its scenes asked for
+    /// that walk are walked by 3DDDA (the same image) and say so.
+    const NAMED_WALK: bool = true;
 }
 
 /// Defines a [`Profile`] from counts: the fields of
@@ -58,7 +64,9 @@ pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
 /// [`OctreeConfig`](crate::accel::OctreeConfig) fields (default: 4 objects a
 /// leaf, 12 levels, 3DDDA). The arenas are `heapless::Vec`s with 16-bit
 /// octree indices (a compile-time check keeps the octree counts within
-/// them); the crate re-exports all it needs.
+/// them); the crate re-exports all it needs. A last `named_walk: false`
+/// leaves out the hash table only the thesis's walk needs (see
+/// [`Profile::NAMED_WALK`]).
 ///
 /// ```
 /// octrace_core::profile! {
@@ -74,6 +82,7 @@ macro_rules! profile {
         $(#[$meta:meta])*
         $vis:vis struct $name:ident { $($field:ident : $value:expr),* $(,)? }
         $(octree: { $($octree_field:ident : $octree_value:expr),* $(,)? })?
+        $(named_walk: $named_walk:expr)?
     ) => {
         $(#[$meta])*
         #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -89,6 +98,7 @@ macro_rules! profile {
                     p::OctreeConfig { $($($octree_field: $octree_value,)*)? ..p::OctreeConfig::DEFAULT };
                 type Octree = p::Octree<$name, { <$name as $crate::profile::Profile>::OCTREE.max_depth as usize + 1 }>;
                 type MailboxWords = p::Vec<u32, { <$name as $crate::profile::Profile>::COUNTS.mailbox_words() }>;
+                const NAMED_WALK: bool = p::given_or_true(&[$($named_walk)?]);
             }
 
             // 16-bit indices: their top two values are markers.
@@ -119,9 +129,14 @@ macro_rules! profile {
                 type Index = u16;
                 type Nodes = p::Vec<p::OctreeNode<u16>, { <$name as $crate::profile::Profile>::COUNTS.octree_boxes }>;
                 type References = p::Vec<u16, { <$name as $crate::profile::Profile>::COUNTS.octree_references }>;
-                type HashEntries =
-                    p::Vec<p::HashEntry<u16>, { <$name as $crate::profile::Profile>::COUNTS.octree_hash_entries() }>;
-                type HashBuckets = p::Vec<u16, { <$name as $crate::profile::Profile>::COUNTS.octree_hash_buckets() }>;
+                type HashEntries = p::Vec<
+                    p::HashEntry<u16>,
+                    { <$name as $crate::profile::Profile>::COUNTS.octree_hash_entries_if(<$name as $crate::profile::Profile>::NAMED_WALK) },
+                >;
+                type HashBuckets = p::Vec<
+                    u16,
+                    { <$name as $crate::profile::Profile>::COUNTS.octree_hash_buckets_if(<$name as $crate::profile::Profile>::NAMED_WALK) },
+                >;
             }
         };
     };
@@ -138,6 +153,14 @@ pub mod __private {
         AxisAlignedBox, Rectangle, ShapeHandle, ShapeKinds, SmoothTriangle, Sphere, Superquadric, Triangle,
     };
     pub use heapless::Vec;
+
+    /// The value given, if one was.
+    pub const fn given_or_true(given: &[bool]) -> bool {
+        match given {
+            [value] => *value,
+            _ => true,
+        }
+    }
 }
 
 crate::profile! {

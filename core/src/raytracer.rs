@@ -124,7 +124,12 @@ impl<P: Profile> Raytracer<P> {
         // A profile without room for an octree tests every object (what an
         // octree of no boxes would do too); decided on the constant, so such
         // a build carries no octree code at all.
-        let mode = if Self::HAS_OCTREE { mode.resolve(view.object_count()) } else { AccelMode::Naive };
+        let mode = match mode.resolve(view.object_count()) {
+            _ if !Self::HAS_OCTREE => AccelMode::Naive,
+            // No hash table for the thesis's walk: 3DDDA, the same image.
+            AccelMode::Octree if !P::NAMED_WALK => AccelMode::Dda,
+            mode => mode,
+        };
         let octree = mode.traversal().map(|traversal| {
             let report = self.octree.build(&view, &OctreeConfig { traversal, ..P::OCTREE });
             (&self.octree, report)
@@ -446,6 +451,41 @@ mod tests {
         let dda = roomy.load_with(SCENE.as_bytes(), AccelMode::Dda, &mut |e| panic!("{e:?}")).unwrap();
         let mut expected = Grid::<Rgb565, 8, 6>([[None; 8]; 6]);
         dda.image_for(&expected).draw(&mut expected).unwrap();
+        assert_eq!(grid.0, expected.0);
+    }
+
+    crate::profile! {
+        /// A row of twelve spheres in an octree without the thesis's hash
+        /// table.
+        struct Hashless { spheres: 12, surfaces: 1, lights: 1, octree_boxes: 200, octree_references: 400 }
+        octree: { max_objects: 1, max_depth: 4 }
+        named_walk: false
+    }
+
+    crate::profile! {
+        /// The same row, no octree.
+        struct Row { spheres: 12, surfaces: 1, lights: 1 }
+    }
+
+    #[test]
+    fn a_profile_without_the_hash_table_walks_the_thesis_mode_by_3ddda() {
+        extern crate std;
+        let spheres: std::string::String = (0..12).map(|i| std::format!("SPHERE 1 0.4 {} 0 0\n", i - 6)).collect();
+        let text = std::format!(
+            "RASTER 8 6\nVIEWPOINT 0 2 9\nLIGHT 10 5 5 5\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n{spheres}"
+        );
+        const _: () = assert!(!<Hashless as Profile>::NAMED_WALK && <Row as Profile>::NAMED_WALK);
+        let mut raytracer = Raytracer::<Hashless>::new();
+        let scene = raytracer.load_with(text.as_bytes(), AccelMode::Octree, &mut |e| panic!("{e:?}")).unwrap();
+        assert_eq!(scene.mode(), AccelMode::Dda, "says which walk it took");
+        let report = scene.octree_report().unwrap();
+        assert!(report.nodes > 9 && report.hash_entries == 0 && report.unsplit == 0, "{report:?}");
+        let mut grid = Grid::<Rgb565, 8, 6>([[None; 8]; 6]);
+        scene.image_for(&grid).draw(&mut grid).unwrap();
+        let mut naive = Raytracer::<Row>::new();
+        let naive = naive.load(&text).unwrap();
+        let mut expected = Grid::<Rgb565, 8, 6>([[None; 8]; 6]);
+        naive.image_for(&expected).draw(&mut expected).unwrap();
         assert_eq!(grid.0, expected.0);
     }
 

@@ -289,7 +289,7 @@ fn stream_prebuilt(
     let (accel, job) = match octree {
         None => (AccelMode::Naive, stream_threads(view, &Naive, (w, h), rows, options, progress, sink)),
         Some(tree) => {
-            let mode = if tree.traversal() == Traversal::Named { AccelMode::Octree } else { AccelMode::Dda };
+            let mode = if tree.walked_by() == Traversal::Named { AccelMode::Octree } else { AccelMode::Dda };
             (mode, stream_threads(view, tree, (w, h), rows, options, progress, sink))
         }
     };

@@ -81,7 +81,7 @@ fn walk_leaves<C: OctreeCapacities, const FRAMES: usize>(
     stop: Scalar,
     mut visit: impl FnMut(u32, Exit, &mut Mailbox<'_>) -> Option<Scalar>,
 ) {
-    match tree.traversal {
+    match tree.walked_by() {
         Traversal::Dda => dda::walk(tree, ray, to_q24(stop), |leaf, exit| {
             mailbox.cells += 1;
             visit(leaf, Exit::Q24(exit), mailbox).map(to_q24)
@@ -351,6 +351,11 @@ struct Split {
 const MAX_STALE_SPLITS: u32 = 2;
 
 impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
+    /// Whether the tree keeps the thesis's hash table: not when its arena
+    /// has no room at all (a profile without the thesis's walk, which alone
+    /// reads it); [`Traversal::Named`] is then walked by 3DDDA.
+    const HASHED: bool = C::HashEntries::CAPACITY > 0;
+
     /// An empty octree (a constant: it can live in a `static`).
     pub const fn new() -> Self {
         Octree {
@@ -393,6 +398,16 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
     /// Switches the walk without rebuilding.
     pub fn set_traversal(&mut self, t: Traversal) {
         self.traversal = t;
+    }
+
+    /// The walk rays take: the one set, but 3DDDA on a tree without the
+    /// hash table the thesis's walk needs.
+    pub fn walked_by(&self) -> Traversal {
+        if Self::HASHED {
+            self.traversal
+        } else {
+            Traversal::Dda
+        }
     }
 
     /// Builds the octree over `scene`'s objects.
@@ -481,9 +496,10 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
         let limit = |cap: usize| cap.min(C::Index::MAX as usize - 2);
         let room = |len: usize, cap: usize, need: usize| len + need <= limit(cap);
         // Hash entries are sized from the boxes (one per eight), so they run
-        // out as the boxes do.
+        // out as the boxes do; a tree without a hash table (a profile
+        // without the thesis's walk) needs none.
         let exhausted = if !room(self.nodes.as_slice().len(), C::Nodes::CAPACITY, 8)
-            || !room(self.entries.as_slice().len(), C::HashEntries::CAPACITY, 1)
+            || (Self::HASHED && !room(self.entries.as_slice().len(), C::HashEntries::CAPACITY, 1))
         {
             Some(CapacityKind::OctreeBoxes)
         } else if !room(self.refs.as_slice().len() + reserved, C::References::CAPACITY, need) {
@@ -506,7 +522,9 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
         for _ in 0..8 {
             let _ = self.nodes.push(leaf);
         }
-        self.insert_entry(s.name, children as u32);
+        if Self::HASHED {
+            self.insert_entry(s.name, children as u32);
+        }
         self.nodes.as_mut_slice()[s.node] = OctreeNode::internal(children as u32);
         let mut pending = need;
         for (octant, &n) in counts.iter().enumerate() {
