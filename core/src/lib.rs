@@ -137,6 +137,8 @@ pub mod render;
 pub mod scene;
 pub mod shade;
 pub mod shapes;
+#[cfg(test)]
+mod test_rng;
 
 pub use accel::AccelMode;
 pub use raytracer::{DrawError, LoadError, LoadedScene, Raytracer, TracedImage};

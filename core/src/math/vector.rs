@@ -521,15 +521,7 @@ mod tests {
 
     #[test]
     fn coarse_dot_decisions_agree_with_the_exact_products() {
-        let seed = 0xd07_c0a5e_u64;
-        std::println!("seed {seed:#x}");
-        let mut state = seed;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = crate::test_rng::seeded(0xd07_c0a5e_u64);
         let (mut signs, mut limits, mut undecided) = (0, 0, 0);
         for round in 0..300_000 {
             // Unit-scale directions, points of every scale, and the extremes.
@@ -567,15 +559,7 @@ mod tests {
 
     #[test]
     fn coarse_plane_test_rejects_only_what_the_exact_test_rejects() {
-        let seed = 0x9_1a2e_u64;
-        std::println!("seed {seed:#x}");
-        let mut state = seed;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = crate::test_rng::seeded(0x9_1a2e_u64);
         let (mut rejected, mut unsure) = (0, 0);
         for round in 0..200_000 {
             let r = next();
@@ -616,13 +600,9 @@ mod tests {
     fn unit_components_are_the_rounded_quotients() {
         // Against u64 division: every component is round(c·2^30/len), ties
         // up, for magnitudes at every ratio (the largest in [2^29, 2^30)).
-        let seed = 0x0000_d171_ded0_u64;
-        std::println!("seed {seed:#x}");
-        let mut x = seed;
+        let mut next = crate::test_rng::seeded(0xd171_ded0);
         for i in 0..300_000 {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            let x = next();
             let largest = (1 << 29) | (x as u32 & ((1 << 29) - 1));
             let other = |k: u32| match (x >> (32 + k)) % 4 {
                 0 => largest,
@@ -634,13 +614,9 @@ mod tests {
             let scaled = [scaled[i % 3], scaled[(i + 1) % 3], scaled[(i + 2) % 3]];
             let (d, len, _) = Dir::from_scaled([false, true, false], scaled, 0);
             let len2: u64 = scaled.iter().map(|&c| c as u64 * c as u64).sum();
-            assert_eq!(len, len2.isqrt(), "seed {seed:#x}, case {i}");
+            assert_eq!(len, len2.isqrt(), "case {i}");
             let want = scaled.map(|c| (((c as u64) << 30) + len / 2) / len);
-            assert_eq!(
-                d.bits(),
-                [want[0] as i32, -(want[1] as i32), want[2] as i32],
-                "seed {seed:#x}, case {i}: {scaled:?}"
-            );
+            assert_eq!(d.bits(), [want[0] as i32, -(want[1] as i32), want[2] as i32], "case {i}: {scaled:?}");
         }
     }
 }

@@ -202,15 +202,7 @@ mod tests {
 
     #[test]
     fn channel_products_by_parts_are_the_plain_products() {
-        let seed = 0x5ca1_ab1e_u64;
-        std::println!("seed {seed:#x}");
-        let mut state = seed;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = crate::test_rng::seeded(0x5ca1_ab1e_u64);
         let edges =
             [0, 1, 2, 0x7fff, 0x8000, 0xffff, 1 << 16, (1 << 16) + 1, 1 << 30, (1 << 30) + 1, i32::MAX, -1, i32::MIN];
         let mut pairs = std::vec::Vec::new();

@@ -347,13 +347,7 @@ mod tests {
     /// reach the clamp: at the bounds and at random points between.
     #[test]
     fn steep_crossings_need_no_clamp() {
-        let seed = 0x5eed_0c7a_u64;
-        std::println!("seed {seed:#x}");
-        let mut state = seed;
-        let mut next = move || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            state >> 11
-        };
+        let mut next = crate::test_rng::seeded(0x5eed_0c7a);
         let extremes = [(1i64 << 36) - 1, -(1 << 36) + 1, 0, 1, -1];
         for i in 0..100_000 {
             let d = if i < 5 { STEEP } else { STEEP + next() % ((1 << 30) - STEEP + 1) };
