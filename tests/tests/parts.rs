@@ -93,21 +93,26 @@ fn streamed_files_equal_the_whole_image_in_every_mode_and_format() {
     assert_eq!(equal4.unwrap().image, rendered.image);
 }
 
+/// The arguments that render `part` (`I/N` or `auto/N`) of `scene` at 40×30 into `out`.
+fn part_args<'a>(scene: &'a Path, out: &'a Path, part: &'a str) -> Vec<&'a OsStr> {
+    vec![
+        scene.as_os_str(),
+        out.as_os_str(),
+        "--size".as_ref(),
+        "40x30".as_ref(),
+        "--part".as_ref(),
+        part.as_ref(),
+        "-q".as_ref(),
+    ]
+}
+
 /// Renders `parts` (I/N strings) of `scene` at 40×30 into `dir`, with `extra` arguments; the part files.
 fn render_parts(dir: &Path, scene: &Path, parts: &[&str], extension: &str, extra: &[&str]) -> Vec<PathBuf> {
     parts
         .iter()
         .map(|part| {
             let out = dir.join(format!("part-{}.{extension}", part.replace('/', "of")));
-            let mut args: Vec<&OsStr> = vec![
-                scene.as_os_str(),
-                out.as_os_str(),
-                "--size".as_ref(),
-                "40x30".as_ref(),
-                "--part".as_ref(),
-                part.as_ref(),
-                "-q".as_ref(),
-            ];
+            let mut args = part_args(scene, &out, part);
             args.extend(extra.iter().map(OsStr::new));
             ok(&args);
             out
@@ -265,17 +270,7 @@ fn part_auto_takes_the_index_from_slurm_or_kubernetes() {
     let path = scene("fig5_1");
     let given = render_parts(dir.path(), &path, &["2/3", "3/3"], "png", &[]);
     let out = dir.path().join("auto.png");
-    let args = |part: &'static str| -> Vec<&OsStr> {
-        vec![
-            path.as_os_str(),
-            out.as_os_str(),
-            "--size".as_ref(),
-            "40x30".as_ref(),
-            "--part".as_ref(),
-            part.as_ref(),
-            "-q".as_ref(),
-        ]
-    };
+    let args = part_args(&path, &out, "auto/3");
     let cases: [(&[(&str, &str)], &PathBuf); 4] = [
         (&[("SLURM_ARRAY_TASK_ID", "2")], &given[0]),
         (&[("SLURM_ARRAY_TASK_ID", "7"), ("SLURM_ARRAY_TASK_MIN", "5")], &given[1]),
@@ -284,7 +279,7 @@ fn part_auto_takes_the_index_from_slurm_or_kubernetes() {
         (&[("JOB_COMPLETION_INDEX", "0"), ("SLURM_ARRAY_TASK_ID", "3")], &given[1]),
     ];
     for (env, expected) in cases {
-        let (code, err) = host_sim(&args("auto/3"), env);
+        let (code, err) = host_sim(&args, env);
         assert_eq!(code, 0, "{env:?}: {err}");
         assert_eq!(std::fs::read(&out).unwrap(), std::fs::read(expected).unwrap(), "{env:?}");
         std::fs::remove_file(&out).unwrap();
@@ -297,7 +292,7 @@ fn part_auto_takes_the_index_from_slurm_or_kubernetes() {
         (&[("SLURM_ARRAY_TASK_ID", "two")], "SLURM_ARRAY_TASK_ID=`two` is not a whole number"),
     ];
     for (env, message) in refusals {
-        let (code, err) = host_sim(&args("auto/3"), env);
+        let (code, err) = host_sim(&args, env);
         assert_eq!(code, 2, "{env:?}: {err}");
         assert!(err.contains(message), "{env:?}: expected `{message}` in: {err}");
         assert!(!out.exists());
