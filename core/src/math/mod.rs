@@ -23,6 +23,12 @@ pub(crate) use wide::{
     sqrt_and_rsqrt_58_62, square_u32_wide, square_wide,
 };
 
+/// Whether this build is for ARMv6-M (Cortex-M0), which has only a
+/// 32×32→32 multiply and no count of leading zeros: there the core takes
+/// part-wise forms of its products where they are cheaper; every form gives
+/// the same bits, and the tests check the part-wise ones on the host.
+pub(crate) const ARMV6M: bool = cfg!(all(target_arch = "arm", not(target_feature = "thumb2")));
+
 pub(crate) use wide::{mul_u64_shr24, mul_u64_shr24_clamped, reciprocal_q62, shl_u64, shr_u64};
 
 pub use fixed::types::{I16F16, I2F30, I32F32};

@@ -5,13 +5,11 @@
 //! Arithmetic on [`Vec3`] uses `fixed`'s operators, which panic on overflow in
 //! debug builds; the scene normalisation keeps every value in range.
 
-use super::{mul_u32_wide, mul_wide, square_u32_wide, square_wide, Scalar, Unit, UNIT_ONE};
+use super::{mul_u32_wide, mul_wide, square_u32_wide, square_wide, Scalar, Unit, ARMV6M, UNIT_ONE};
 use core::ops::{Add, Neg, Sub};
 
-/// ARMv6-M (Cortex-M0) has only a 32×32→32 multiply: there sign tests of
-/// dot products try the coarse product first (see [`coarse_dot`]).
-/// Elsewhere the exact product is as cheap.
-const ARMV6M: bool = cfg!(all(target_arch = "arm", not(target_feature = "thumb2")));
+// On ARMv6-M sign tests of dot products try the coarse product first (see
+// [`coarse_dot`]); elsewhere the exact product is as cheap.
 
 /// `H = Σ (a_i >> 17)·(b_i >> 17)`, three 32-bit products: for any i32
 /// components, `|Σ a_i·b_i − H·2^34| < 2^51`.

@@ -7,11 +7,9 @@
 //! iteration for 1/√x needs only products, from a 192-entry table built at
 //! compile time. Every function returns the same bits on every target.
 
-/// ARMv6-M (Cortex-M0) has only a 32×32→32 multiply and no
-/// count-leading-zeros instruction: there the `*_by_parts` forms below are
-/// used, elsewhere the native operations. Both give the same bits, and the
-/// tests check the part-wise forms on the host.
-const ARMV6M: bool = cfg!(all(target_arch = "arm", not(target_feature = "thumb2")));
+// On ARMv6-M the `*_by_parts` forms below are used, elsewhere the native
+// operations.
+use super::ARMV6M;
 
 /// `a · b` exactly, for unsigned 32-bit operands.
 #[inline(always)]

@@ -4,7 +4,7 @@
 //! 32767.99); it never wraps, so an over-bright light clamps to white as the
 //! shading model's final `min(1, …)` says.
 
-use crate::math::{mul_wide, Scalar, Unit};
+use crate::math::{mul_wide, Scalar, Unit, ARMV6M};
 use fixed::types::I48F16;
 
 /// A linear RGB colour, Q16.16 per channel (1.0 is full intensity; values
@@ -72,11 +72,10 @@ impl Color {
     }
 }
 
-/// ARMv6-M (Cortex-M0) has only a 32×32→32 multiply: there the channel
-/// products below take two 32-bit products when one factor is at most 1.0
-/// (nearly always: material coefficients, cosines, weights), instead of the
-/// four of a 32×32→64 product. Elsewhere the plain product is as cheap.
-const ARMV6M: bool = cfg!(all(target_arch = "arm", not(target_feature = "thumb2")));
+// On ARMv6-M the channel products below take two 32-bit products when one
+// factor is at most 1.0 (nearly always: material coefficients, cosines,
+// weights), instead of the four of a 32×32→64 product. Elsewhere the plain
+// product is as cheap.
 
 /// `sat((c · k) >> 16)`, the product of two Q16.16 values.
 ///
