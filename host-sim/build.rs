@@ -22,6 +22,7 @@ fn main() {
     for shared in ["src/formats.rs", "src/image.rs", "src/palette.rs"] {
         println!("cargo:rerun-if-changed={shared}");
     }
+    install_wasm_target();
     let target_dir = wasm_target_dir(&out_dir);
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let mut command = Command::new(cargo);
@@ -53,6 +54,30 @@ fn main() {
     let built = target_dir.join("wasm32-unknown-unknown/release/octrace_studio.wasm");
     std::fs::copy(&built, out_dir.join("octrace_studio.wasm"))
         .unwrap_or_else(|e| panic!("cannot copy {}: {e}", built.display()));
+}
+
+/// rust-toolchain.toml names the WebAssembly target, but rustup adds a
+/// toolchain file's targets only when it installs the toolchain itself; on a
+/// machine that already had stable, the README's first command would stop
+/// here. So the target is added the way the toolchain file asks for it.
+fn install_wasm_target() {
+    const TARGET: &str = "wasm32-unknown-unknown";
+    let rustc = std::env::var_os("RUSTC").unwrap_or_else(|| "rustc".into());
+    let sysroot = Command::new(rustc)
+        .args(["--print", "sysroot"])
+        .output()
+        .ok()
+        .filter(|output| output.status.success())
+        .map(|output| PathBuf::from(String::from_utf8_lossy(&output.stdout).trim()));
+    if sysroot.is_some_and(|sysroot| sysroot.join("lib/rustlib").join(TARGET).is_dir()) {
+        return;
+    }
+    println!("cargo:warning=adding the {TARGET} target for the studio (rustup target add {TARGET})");
+    // rustup picks the toolchain this build runs on from RUSTUP_TOOLCHAIN.
+    let added = Command::new("rustup").args(["target", "add", TARGET]).status();
+    if !added.is_ok_and(|status| status.success()) {
+        println!("cargo:warning=`rustup target add {TARGET}` failed; the build below will say what is missing");
+    }
 }
 
 /// `target/studio-wasm` for an OUT_DIR of `target/<profile>/build/<pkg>/out`
