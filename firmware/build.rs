@@ -34,9 +34,8 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 /// What each board's RAM holds besides the stack, and how its octree is
-/// built: at most 4 levels on the micro:bit, whose 7 KiB stack holds one
-/// walk frame of 80 bytes a level (fewer when the scene's arenas would not
-/// fit its RAM otherwise).
+/// built: on the micro:bit at most 4 levels of 8 objects a leaf (fewer
+/// levels when the scene's arenas would not fit its RAM otherwise).
 struct Board {
     name: &'static str,
     static_ram: usize,

@@ -10,19 +10,20 @@
 //! tests against the box widened by [`FILING_MARGIN`].
 //!
 //! *Walks.* Both visit, in ray order, the leaves the ray passes through,
-//! each with the parameter at which the ray leaves it, compared exactly as
-//! ratios of integers:
-//! - [`Traversal::Named`], the thesis's method: from the exit point step by
+//! each with the parameter at which the ray leaves it:
+//! - [`Traversal::Named`], the thesis's method, its parameters compared
+//!   exactly as ratios of integers: from the exit point step by
 //!   half of Minlen (the smallest box side) across the faces the ray leaves
 //!   through, then find the leaf holding that point from the root, one hash
 //!   lookup per level. (A full Minlen step lands exactly on the far face of a
 //!   smallest neighbour, which exact arithmetic would then skip.)
-//! - [`Traversal::Dda`], octrace's integer 3DDDA in parametric form
-//!   (Revelles et al., after Fujimoto's ARTS and Amanatides & Woo): per axis
-//!   the crossing parameters of the current box's planes as integer
-//!   numerators over `|d_a|`; children inherit them and middle planes are
-//!   means, so a step needs no division, and the plane met first is found by
-//!   cross multiplication (see `dda.rs`).
+//! - [`Traversal::Dda`], octrace's integer 3DDDA: the same steps, from leaf
+//!   to leaf across the plane the ray meets first (Amanatides & Woo's step,
+//!   one product a plane with the ray's reciprocal, parameters in Q40.24),
+//!   with the next leaf found by the bits of integer coordinates (location
+//!   codes, Frisken & Perry) from the deepest box holding both leaves: no
+//!   hash lookups, no division after the ray's set-up, no stack (see
+//!   `dda.rs`).
 //!
 //! *Exactness.* A leaf's hits are final once the nearest is before the leaf's
 //! exit (strictly: an equal hit in the next leaf may come earlier in the
@@ -278,9 +279,7 @@ impl BuildReport {
 
 /// The octree over one scene, in arenas sized by the profile `C`. `FRAMES`
 /// bounds the depth of a walk (the tree is at most `FRAMES − 1` deep); the
-/// 3DDDA keeps one frame per level, 80 bytes of stack each (112 on a ray
-/// almost parallel to an axis), which a
-/// 16 KiB board wants to keep small.
+/// 3DDDA keeps one node index per level on the stack.
 ///
 /// Built over a parsed scene, it is an [`Accelerator`] for a
 /// [`Renderer`](crate::render::Renderer); the image is the same as without it:
@@ -455,7 +454,13 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
             self.finish(0);
             return self.report;
         }
-        let max_depth = config.max_depth.min(MAX_DEPTH).min(FRAMES.saturating_sub(1) as u32);
+        // The 3DDDA's coordinates inside the root are u32s: a root wider
+        // than 2^31 units (beyond the normalised range of every parsed
+        // scene) stays one leaf.
+        let max_depth = match self.root_log2 <= 31 {
+            true => config.max_depth.min(MAX_DEPTH).min(FRAMES.saturating_sub(1) as u32),
+            false => 0,
+        };
         let root =
             Split { node: 0, depth: 0, name: 1, lo: self.root_min, log2: self.root_log2, refs_start: 0, stale: 0 };
         self.split(scene, root, config.max_objects.max(1), max_depth, 0);
@@ -635,9 +640,9 @@ impl<C: OctreeCapacities, const FRAMES: usize> OctreeStore for Octree<C, FRAMES>
     }
 }
 
-// The queries are not inlined: each walk (up to FRAMES frames of ~100 bytes)
-// then lives in its own stack frame for the query's duration only, instead of
-// two of them sitting in every caller's frame — it matters on a 16 KiB board.
+// The queries are not inlined: each walk then lives in its own stack frame
+// for the query's duration only, instead of two of them sitting in every
+// caller's frame — it matters on a 16 KiB board.
 impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES> {
     const KINDS: ShapeKinds = C::KINDS;
 
