@@ -419,6 +419,9 @@ impl Dir {
 /// on the remainder.
 #[inline]
 fn reciprocal_of_length(g: u32, e: i32, len: u32) -> u32 {
+    if !ARMV6M {
+        return (((1u64 << 61) - 1) / len as u64) as u32;
+    }
     let estimate = if e == 60 { (g as u64) << 1 } else { g as u64 };
     let mut r = estimate.min(u32::MAX as u64) as u32;
     // r·len < 2^63: the remainder fits an i64.
