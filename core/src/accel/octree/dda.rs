@@ -222,7 +222,12 @@ fn set_up<C: OctreeCapacities, const FRAMES: usize>(tree: &Octree<C, FRAMES>, ra
         };
         setup.direction[a] = d[a].unsigned_abs();
         setup.inverse[a] = reciprocal_q62(d[a].unsigned_abs() as u32);
-        near = near.max(setup.crossing(a, lo));
+        // An origin past the low plane crosses it at a parameter ≤ 0, which
+        // cannot move the walk's start (it is clamped to 0) nor reject a
+        // ray that `far` does not.
+        if setup.origin[a] < lo {
+            near = near.max(setup.crossing(a, lo));
+        }
         far = far.min(setup.crossing(a, hi));
     }
     let (near, far) = (near - 1, far + 1);
