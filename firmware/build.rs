@@ -27,6 +27,7 @@ use octrace_core::accel::{Octree, OctreeConfig};
 use octrace_core::capacity::{CapacityKind, Counts};
 use octrace_core::parse::{count, parse};
 use octrace_core::profile::Host;
+use octrace_core::render::PanelColor;
 use octrace_core::scene::Scene;
 use octrace_core::AccelMode;
 use std::env;
@@ -114,13 +115,15 @@ fn main() {
         let names: Vec<&str> = AccelMode::ALL.iter().map(|m| m.name()).collect();
         fail(format!("OCTRACE_ACCEL={accel}: expected {}", names.join(", ")))
     };
-    let wire = match var("OCTRACE_COLOR", if oled { "gray4" } else { "rgb888" }).as_str() {
-        "gray4" => "Gray4",
-        other if oled => fail(format!("OCTRACE_COLOR={other}: the lm3s6965evb's OLED shows 16 grays: use gray4")),
-        "rgb888" => "Rgb888",
-        "rgb565" => "Rgb565",
-        "dither" => "Dither",
-        other => fail(format!("OCTRACE_COLOR={other}: expected rgb888, rgb565, dither or gray4")),
+    let color = var("OCTRACE_COLOR", if oled { "gray4" } else { "rgb888" });
+    let wire = match PanelColor::from_name(&color) {
+        Some(PanelColor::Gray4) => PanelColor::Gray4,
+        _ if oled => fail(format!("OCTRACE_COLOR={color}: the lm3s6965evb's OLED shows 16 grays: use gray4")),
+        Some(wire) => wire,
+        None => {
+            let names: Vec<&str> = PanelColor::ALL.iter().map(|c| c.name()).collect();
+            fail(format!("OCTRACE_COLOR={color}: expected {}", names.join(", ")))
+        }
     };
     let output = var("OCTRACE_OUT", if oled { "screen.png" } else { "octrace-out.raw" });
     if output.contains(['\0', '\n']) {
@@ -163,7 +166,7 @@ fn main() {
     writeln!(config, "pub const WIDTH: u32 = {w};").unwrap();
     writeln!(config, "pub const HEIGHT: u32 = {h};").unwrap();
     writeln!(config, "pub const ACCEL: octrace_core::AccelMode = octrace_core::AccelMode::{accel:?};").unwrap();
-    writeln!(config, "pub const WIRE: crate::Wire = crate::Wire::{wire};").unwrap();
+    writeln!(config, "pub const WIRE: crate::PanelColor = crate::PanelColor::{wire:?};").unwrap();
     if !oled {
         // The guest writes this file; on the OLED board the runner does.
         writeln!(config, "pub const OUTPUT: &str = {:?};", format!("{output}\0")).unwrap();

@@ -30,6 +30,7 @@ use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::hprintln;
 use embedded_graphics_core::geometry::Size;
 use embedded_graphics_core::image::ImageDrawable;
+use octrace_core::render::PanelColor;
 use octrace_core::{ConstStaticCell, LoadedScene, Raytracer};
 use semihosting::exit;
 // What the boards that stream to a host file use.
@@ -41,16 +42,6 @@ use {
     semihosting::HostFile,
 };
 
-/// The display's pixel format, chosen at build time.
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub enum Wire {
-    Rgb888,
-    Rgb565,
-    /// Palette indices, ordered-dithered onto the 6×6×6 cube.
-    Dither,
-    /// 16 gray levels (embedded-graphics' conversion from Rgb888).
-    Gray4,
-}
 
 /// The capacity profile, sized by `build.rs` for exactly the embedded scene.
 use config::Profile;
@@ -148,10 +139,10 @@ use lm3s6965evb::open_output;
 #[cfg(not(board = "lm3s6965evb"))]
 fn draw_on(scene: &LoadedScene<'_, Profile>, file: HostFile) -> bool {
     match config::WIRE {
-        Wire::Rgb888 => draw::<Rgb888>(scene, file),
-        Wire::Rgb565 => draw::<Rgb565>(scene, file),
-        Wire::Gray4 => draw::<Gray4>(scene, file),
-        Wire::Dither => draw_dithered(scene, file),
+        PanelColor::Rgb888 => draw::<Rgb888>(scene, file),
+        PanelColor::Rgb565 => draw::<Rgb565>(scene, file),
+        PanelColor::Gray4 => draw::<Gray4>(scene, file),
+        PanelColor::Dither => draw_dithered(scene, file),
     }
 }
 
@@ -160,7 +151,7 @@ fn draw_on(scene: &LoadedScene<'_, Profile>, file: HostFile) -> bool {
 #[cfg(board = "lm3s6965evb")]
 #[inline(never)]
 fn draw_on(scene: &LoadedScene<'_, Profile>, mut panel: ssd0323::Ssd0323) -> bool {
-    debug_assert!(config::WIRE == Wire::Gray4);
+    debug_assert!(config::WIRE == PanelColor::Gray4);
     scene.image(Size::new(config::WIDTH, config::HEIGHT)).draw(&mut panel).is_ok()
 }
 

@@ -9,6 +9,7 @@ use crate::{render_with_progress, HostScene, RgbImage, StreamError, Streamed};
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressStyle};
 use octrace_core::accel::OctreeConfig;
+use octrace_core::render::PanelColor;
 use octrace_core::scene::MAX_SIDE;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -53,7 +54,7 @@ pub struct Args {
     /// (the firmware's OCTRACE_COLOR): rgb888; rgb565 (written back as
     /// RGB); gray4, 16 levels (an 8-bit gray PNG, level × 17); dither (as
     /// --palette dither).
-    #[arg(long, value_enum, default_value_t = PanelColor::Rgb888)]
+    #[arg(long, value_name = "COLOR", default_value = "rgb888", value_parser = parse_color)]
     pub color: PanelColor,
     /// The file format; by default from OUT's extension (png, tga, ras), or
     /// PNG when OUT has none. Any other extension is refused without it.
@@ -129,15 +130,6 @@ pub enum Command {
     Studio(crate::studio::StudioArgs),
 }
 
-/// A display's pixel format, named as the firmware's `OCTRACE_COLOR`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum PanelColor {
-    Rgb888,
-    Rgb565,
-    Gray4,
-    Dither,
-}
-
 /// What a `color` panel shows of `image`, each pixel converted by
 /// embedded-graphics (as the firmware's renderer converts it) and widened
 /// back to 8 bits by embedded-graphics: RGB, or for gray4 an 8-bit gray
@@ -187,8 +179,18 @@ fn write_gray_png(width: u32, height: u32, gray: &[u8], out: &mut dyn Write) -> 
 
 /// An `--accel` name: the core's [`AccelMode`] vocabulary.
 fn parse_accel(text: &str) -> Result<AccelMode, String> {
-    AccelMode::from_name(text).ok_or_else(|| {
-        let names: Vec<&str> = AccelMode::ALL.iter().map(|m| m.name()).collect();
+    parse_name(text, &AccelMode::ALL, AccelMode::name)
+}
+
+/// A `--color` name: the core's [`PanelColor`] vocabulary.
+fn parse_color(text: &str) -> Result<PanelColor, String> {
+    parse_name(text, &PanelColor::ALL, PanelColor::name)
+}
+
+/// The one of `all` that `text` names (case-insensitive).
+fn parse_name<T: Copy>(text: &str, all: &[T], name: fn(T) -> &'static str) -> Result<T, String> {
+    all.iter().copied().find(|&v| name(v).eq_ignore_ascii_case(text)).ok_or_else(|| {
+        let names: Vec<&str> = all.iter().map(|&v| name(v)).collect();
         format!("expected one of {}", names.join(", "))
     })
 }
@@ -388,8 +390,7 @@ fn preview(
             stats.shadow_rays,
             stats.cells,
             out.display(),
-            <PanelColor as clap::ValueEnum>::to_possible_value(&color)
-                .map_or_else(String::new, |v| v.get_name().to_owned())
+            color.name()
         );
     }
     Ok(())

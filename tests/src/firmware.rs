@@ -8,8 +8,10 @@
 //! time.
 
 use crate::repo;
+use embedded_graphics_core::pixelcolor::{Gray4, GrayColor, Rgb888};
 use host_sim::formats::Image;
 use host_sim::palette::PaletteMode;
+use octrace_core::render::PanelColor;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -45,26 +47,6 @@ impl Board {
     }
 }
 
-/// The display's pixel format.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Wire {
-    Rgb888,
-    /// Big-endian RGB565, as SPI displays take it.
-    Rgb565,
-    /// One byte a pixel: an entry of the dithered 6×6×6 colour cube.
-    Dither,
-}
-
-impl Wire {
-    fn name(self) -> &'static str {
-        match self {
-            Wire::Rgb888 => "rgb888",
-            Wire::Rgb565 => "rgb565",
-            Wire::Dither => "dither",
-        }
-    }
-}
-
 /// One firmware configuration.
 #[derive(Clone, Debug)]
 pub struct Firmware {
@@ -73,7 +55,7 @@ pub struct Firmware {
     pub scene: String,
     pub width: u32,
     pub height: u32,
-    pub wire: Wire,
+    pub wire: PanelColor,
 }
 
 /// What a run printed and wrote.
@@ -95,7 +77,7 @@ impl Run {
 }
 
 impl Firmware {
-    pub fn new(board: Board, scene: &str, width: u32, height: u32, wire: Wire) -> Firmware {
+    pub fn new(board: Board, scene: &str, width: u32, height: u32, wire: PanelColor) -> Firmware {
         Firmware { board, scene: scene.to_owned(), width, height, wire }
     }
 
@@ -161,9 +143,12 @@ impl Firmware {
         let rendered = host_sim::render(&scene, &options).map_err(|e| format!("{e:?}"))?;
         let image = rendered.image;
         Ok(match self.wire {
-            Wire::Rgb888 => image.data,
-            Wire::Rgb565 => image.data.chunks(3).flat_map(|p| rgb565(p[0], p[1], p[2]).to_be_bytes()).collect(),
-            Wire::Dither => match host_sim::palette::apply(&image, &rendered.objects, PaletteMode::Dither) {
+            PanelColor::Rgb888 => image.data,
+            PanelColor::Rgb565 => image.data.chunks(3).flat_map(|p| rgb565(p[0], p[1], p[2]).to_be_bytes()).collect(),
+            PanelColor::Gray4 => {
+                image.data.chunks(3).map(|p| Gray4::from(Rgb888::new(p[0], p[1], p[2])).luma()).collect()
+            }
+            PanelColor::Dither => match host_sim::palette::apply(&image, &rendered.objects, PaletteMode::Dither) {
                 Image::Indexed { indices, .. } => indices,
                 Image::Rgb(_) => return Err("dither gave a truecolour image".into()),
             },

@@ -5,7 +5,8 @@
 //! Needs `qemu-system-arm` (the test command installs it); set
 //! `OCTRACE_SKIP_FIRMWARE=1` to skip where it cannot be installed.
 
-use octrace_tests::firmware::{qemu_available, run_oled_command, Board, Firmware, Sizes, Wire};
+use octrace_core::render::PanelColor;
+use octrace_tests::firmware::{qemu_available, run_oled_command, Board, Firmware, Sizes};
 use octrace_tests::repo;
 
 /// False (the test is skipped) when `OCTRACE_SKIP_FIRMWARE` is set; fails
@@ -26,19 +27,19 @@ fn boards_render_the_same_bits_as_host_sim() {
     }
     let cases = [
         // The 16 KiB Cortex-M0 with the thesis's first figure...
-        Firmware::new(Board::Microbit, "fig5_1", 160, 128, Wire::Rgb888),
+        Firmware::new(Board::Microbit, "fig5_1", 160, 128, PanelColor::Rgb888),
         // ...and with 200 spheres and its octree, into an RGB565 display.
-        Firmware::new(Board::Microbit, "fig5_3", 160, 128, Wire::Rgb565),
+        Firmware::new(Board::Microbit, "fig5_3", 160, 128, PanelColor::Rgb565),
         // Arenas sized from each scene at build time: the chessboard's 64
         // rectangles, boxes and superquadrics, mirrors, and glass (2×2
         // samples) all fit the 16 KiB board.
-        Firmware::new(Board::Microbit, "fig5_5", 64, 48, Wire::Rgb565),
-        Firmware::new(Board::Microbit, "fig5_7", 64, 48, Wire::Rgb888),
-        Firmware::new(Board::Microbit, "fig5_8", 64, 48, Wire::Rgb888),
-        Firmware::new(Board::Microbit, "glass", 48, 36, Wire::Rgb888),
-        Firmware::new(Board::Mps2An385, "fig5_3", 160, 128, Wire::Rgb888),
+        Firmware::new(Board::Microbit, "fig5_5", 64, 48, PanelColor::Rgb565),
+        Firmware::new(Board::Microbit, "fig5_7", 64, 48, PanelColor::Rgb888),
+        Firmware::new(Board::Microbit, "fig5_8", 64, 48, PanelColor::Rgb888),
+        Firmware::new(Board::Microbit, "glass", 48, 36, PanelColor::Rgb888),
+        Firmware::new(Board::Mps2An385, "fig5_3", 160, 128, PanelColor::Rgb888),
         // A 256-colour display: indices of the dithered colour cube.
-        Firmware::new(Board::Mps2An385, "fig5_1", 160, 128, Wire::Dither),
+        Firmware::new(Board::Mps2An385, "fig5_1", 160, 128, PanelColor::Dither),
     ];
     for firmware in cases {
         let name = format!("{} on {}", firmware.scene, firmware.board.machine());

@@ -12,9 +12,11 @@
 //! by sample (n/2, n/2), the centre sample for odd n.
 
 mod gamma;
+mod panel;
 mod split;
 
 pub(crate) use gamma::GammaTable;
+pub use panel::PanelColor;
 pub use split::{interleaved_rows, Tiles};
 
 use crate::accel::{Accelerator, Mailbox};

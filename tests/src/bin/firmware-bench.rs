@@ -9,7 +9,8 @@
 //! beside the repository. Counts are instructions, exact and repeatable, not
 //! cycles of a real chip.
 
-use octrace_tests::firmware::{Board, Firmware, Wire};
+use octrace_core::render::PanelColor;
+use octrace_tests::firmware::{Board, Firmware};
 use octrace_tests::repo;
 use std::path::PathBuf;
 
@@ -34,7 +35,7 @@ fn main() {
     println!("| --- | --- | --- | ---: | ---: | ---: | ---: | ---: |");
     for board in [Board::Microbit, Board::Mps2An385] {
         for scene in &scenes {
-            let firmware = Firmware::new(board, scene, width, height, Wire::Rgb888);
+            let firmware = Firmware::new(board, scene, width, height, PanelColor::Rgb888);
             let label = format!("{} ({}) | {scene} | {width}×{height}", board.machine(), board.core());
             let result = firmware.build().and_then(|elf| firmware.measure(&elf, &qemu_count));
             match result {
