@@ -31,6 +31,14 @@ impl<'a> Lexer<'a> {
         Lexer { src, offset: 0, pos: Pos { line: 1, column: 1 } }
     }
 
+    /// Where a text ends: the position just after its last character, as
+    /// the lexer counts lines and columns.
+    pub fn end_of(text: &'a str) -> Pos {
+        let mut lexer = Lexer::new(text);
+        while lexer.bump().is_some() {}
+        lexer.pos
+    }
+
     fn rest(&self) -> &'a str {
         &self.src[self.offset..]
     }

@@ -115,13 +115,10 @@ pub fn parse_bytes<'a, C: SceneCapacities>(
     match core::str::from_utf8(bytes) {
         Ok(text) => parse(text, scene, on_error),
         Err(e) => {
-            let good = &bytes[..e.valid_up_to()];
-            let line = 1 + good.iter().filter(|&&b| b == b'\n').count() as u32;
-            let line_start = good.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
-            // The valid prefix is UTF-8: count its characters on this line.
-            let column = 1 + core::str::from_utf8(&good[line_start..]).map_or(0, |s| s.chars().count()) as u32;
+            // The valid prefix is UTF-8; its lines end as the lexer's do.
+            let good = core::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or_default();
             scene.clear();
-            on_error(ParseError::new(Pos { line, column }, ErrorKind::InvalidUtf8));
+            on_error(ParseError::new(lexer::Lexer::end_of(good), ErrorKind::InvalidUtf8));
             Err(1)
         }
     }
@@ -766,6 +763,14 @@ mod tests {
         let r = parse_bytes(bytes, &mut scene, &mut |e| errors.push(e.to_string()));
         assert_eq!(r, Err(1));
         assert_eq!(errors, ["2:9: the file is not valid UTF-8 (invalid byte here)"]);
+        // Lines end at CRLF and at a lone CR too, as everywhere else.
+        for bytes in [&b"RDEPTH 2\r\nLIGHT 1 \xff 0 0"[..], b"RDEPTH 2\rLIGHT 1 \xff 0 0", b"RDEPTH 2\r\xff"] {
+            errors.clear();
+            let r = parse_bytes(bytes, &mut scene, &mut |e| errors.push(e.to_string()));
+            assert_eq!(r, Err(1));
+            let at = if bytes.ends_with(b"\xff") { "2:1" } else { "2:9" };
+            assert_eq!(errors, [format!("{at}: the file is not valid UTF-8 (invalid byte here)")], "{bytes:?}");
+        }
     }
 
     #[test]
