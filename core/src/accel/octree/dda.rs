@@ -265,12 +265,13 @@ mod tests {
     /// (positions round by one), in ray order.
     #[test]
     fn the_walk_visits_every_leaf_the_ray_crosses_in_order() {
+        use super::super::tests::for_each_leaf;
         use super::super::{OctreeConfig, Traversal};
         use crate::math::{Dir, Vec3};
         use crate::parse::parse;
         use crate::profile::Board64K;
         use crate::scene::Scene;
-        use std::{boxed::Box, format, string::String, vec, vec::Vec};
+        use std::{boxed::Box, format, string::String, vec::Vec};
         // The test's own reference is plain f64 geometry.
         const SHRINK: f64 = 4.0;
         let mut next = crate::test_rng::seeded(0x1ea5_c0de);
@@ -293,19 +294,11 @@ mod tests {
             tree.build(&view, &config);
             // Every non-empty leaf's box.
             let mut leaves = Vec::new();
-            let mut stack = vec![(0u32, tree.root_min, tree.root_log2)];
-            while let Some((node, lo, log2)) = stack.pop() {
-                let n = tree.nodes.as_slice()[node as usize];
-                if n.is_internal() {
-                    let half = 1i64 << (log2 - 1);
-                    for k in 0..8u32 {
-                        let l = [0, 1, 2].map(|a| lo[a] + if k >> a & 1 == 1 { half } else { 0 });
-                        stack.push((n.first() + k, l, log2 - 1));
-                    }
-                } else if n.count() != 0 {
+            for_each_leaf(&tree, 0, tree.root_min, tree.root_log2, &mut |node, lo, log2| {
+                if tree.nodes.as_slice()[node as usize].count() != 0 {
                     leaves.push((node, lo, lo.map(|v| v + (1 << log2))));
                 }
-            }
+            });
             let side = tree.root_max[0] - tree.root_min[0];
             for _ in 0..200 {
                 let origin = [0, 1, 2].map(|a| {

@@ -807,18 +807,8 @@ mod tests {
         let view = s.view();
         let mut tree: Box<Octree<Board64K>> = Box::default();
         tree.build(&view, &OctreeConfig { max_objects: 1, max_depth: 5, traversal: Traversal::Dda });
-        let mut stack = Vec::from([(0u32, tree.root_min, tree.root_log2)]);
         let mut references = 0;
-        while let Some((node, lo, log2)) = stack.pop() {
-            let n = tree.nodes.as_slice()[node as usize];
-            if n.is_internal() {
-                let half = 1i64 << (log2 - 1);
-                for k in 0..8u32 {
-                    let l = [0, 1, 2].map(|a| lo[a] + if k >> a & 1 == 1 { half } else { 0 });
-                    stack.push((n.first() + k, l, log2 - 1));
-                }
-                continue;
-            }
+        for_each_leaf(&tree, 0, tree.root_min, tree.root_log2, &mut |node, lo, log2| {
             let objects = tree.leaf_objects(node).unwrap();
             references += objects.len();
             let cell = Cell { lo: lo.map(|v| v - FILING_MARGIN), hi: lo.map(|v| v + (1 << log2) + FILING_MARGIN) };
@@ -826,8 +816,28 @@ mod tests {
                 let filed = objects.iter().any(|o| o.get() == id.0);
                 assert_eq!(filed, overlaps(view.shape(id), &cell), "leaf {node}, object {id:?}");
             }
-        }
+        });
         assert_eq!(references, tree.report().references, "compaction kept every list");
+    }
+
+    /// Calls `f(node, low corner, log2 of the side)` for every leaf below
+    /// `node`, a box with that corner and side.
+    pub(super) fn for_each_leaf<C: OctreeCapacities, const FRAMES: usize>(
+        tree: &Octree<C, FRAMES>,
+        node: u32,
+        lo: [i64; 3],
+        log2: u32,
+        f: &mut impl FnMut(u32, [i64; 3], u32),
+    ) {
+        let n = tree.nodes.as_slice()[node as usize];
+        if !n.is_internal() {
+            return f(node, lo, log2);
+        }
+        let half = 1i64 << (log2 - 1);
+        for k in 0..8u32 {
+            let corner = [0, 1, 2].map(|a| lo[a] + if k >> a & 1 == 1 { half } else { 0 });
+            for_each_leaf(tree, n.first() + k, corner, log2 - 1, f);
+        }
     }
 
     #[test]
