@@ -18,9 +18,9 @@
 //! stack: the walk keeps one node index a level.
 //!
 //! Every step moves one coordinate forward to a plane and none back, so the
-//! walk ends (after at most 3·2^depth steps). Empty
-//! leaves are passed over, and the walk ends at the first leaf entered
-//! after the nearest hit found so far.
+//! walk ends (after at most 3·2^depth steps). Empty leaves are passed over,
+//! and the walk ends at the first leaf entered after the nearest hit found
+//! so far.
 //!
 //! None of this can change an image: a position differs from the true
 //! ray's by at most two units (Q16.16) on each axis, far inside the filing
