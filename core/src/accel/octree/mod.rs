@@ -457,10 +457,8 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
         // The 3DDDA's coordinates inside the root are u32s: a root wider
         // than 2^31 units (beyond the normalised range of every parsed
         // scene) stays one leaf.
-        let max_depth = match self.root_log2 <= 31 {
-            true => config.max_depth.min(MAX_DEPTH).min(FRAMES.saturating_sub(1) as u32),
-            false => 0,
-        };
+        let max_depth =
+            if self.root_log2 <= 31 { config.max_depth.min(MAX_DEPTH).min(FRAMES.saturating_sub(1) as u32) } else { 0 };
         let root =
             Split { node: 0, depth: 0, name: 1, lo: self.root_min, log2: self.root_log2, refs_start: 0, stale: 0 };
         self.split(scene, root, config.max_objects.max(1), max_depth, 0);
