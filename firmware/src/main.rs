@@ -42,7 +42,6 @@ use {
     semihosting::HostFile,
 };
 
-
 /// The capacity profile, sized by `build.rs` for exactly the embedded scene.
 use config::Profile;
 
