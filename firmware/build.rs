@@ -39,9 +39,17 @@ use std::path::PathBuf;
 /// levels when the scene's arenas would not fit its RAM otherwise).
 struct Board {
     name: &'static str,
+    /// Bytes for the statics: the arenas and `OTHER_STATICS`.
     static_ram: usize,
     config: OctreeConfig,
 }
+
+/// What the firmware's statics take besides the arenas (the tracer's
+/// settings and camera, the mailbox's bookkeeping, the display's and
+/// semihosting's buffers): 382 to 394 bytes on every board and scene
+/// measured (`.data` + `.bss` less the arenas' estimate), with room to spare.
+/// Without it a scene could pass here and then overflow RAM at link time.
+const OTHER_STATICS: usize = 512;
 
 fn var(name: &str, default: &str) -> String {
     println!("cargo:rerun-if-env-changed={name}");
@@ -72,12 +80,9 @@ fn main() {
         ("mps2-an385", "thumbv7m-none-eabi") => {
             Board { name: "mps2-an385", static_ram: 3 * 1024 * 1024, config: OctreeConfig::DEFAULT }
         }
-        ("lm3s6965evb", "thumbv7m-none-eabi") => Board {
-            name: "lm3s6965evb",
-            // Of the 56 KiB beside the stack, 1 KiB is left for the other statics.
-            static_ram: 55 * 1024,
-            config: OctreeConfig::DEFAULT,
-        },
+        ("lm3s6965evb", "thumbv7m-none-eabi") => {
+            Board { name: "lm3s6965evb", static_ram: 56 * 1024, config: OctreeConfig::DEFAULT }
+        }
         ("microbit", _) => fail(format!("OCTRACE_BOARD=microbit needs --target thumbv6m-none-eabi, not {target}")),
         ("mps2-an385" | "lm3s6965evb", _) => {
             fail(format!("OCTRACE_BOARD={board} needs --target thumbv7m-none-eabi, not {target}"))
@@ -140,16 +145,17 @@ fn main() {
             let counts = needs(&text, accel, &config);
             (config, counts, static_bytes(&counts, named_walk))
         })
-        .find(|&(_, _, bytes)| bytes <= board.static_ram)
+        .find(|&(_, _, bytes)| bytes <= board.static_ram - OTHER_STATICS)
         .unwrap_or_else(|| {
             let counts = needs(&text, accel, &board.config);
             (board.config, counts, static_bytes(&counts, named_walk))
         });
-    if bytes > board.static_ram {
+    if bytes > board.static_ram - OTHER_STATICS {
         fail(format!(
-            "{scene} needs about {bytes} bytes of arenas ({}), more than the {} bytes the {} has beside its stack",
+            "{scene} needs about {bytes} bytes of arenas ({}), more than the {} bytes the {} has for them \
+             beside its stack and other statics",
             describe(&counts),
-            board.static_ram,
+            board.static_ram - OTHER_STATICS,
             board.name
         ));
     }
