@@ -142,7 +142,7 @@ def main():
             octrace = [host_sim, path, f"{tmp}/{name}.png", "--threads", "1", "--size", f"{w}x{h}"]
             (pw, pt), (ow, ot) = best_of(3, povray, povray_trace), best_of(3, octrace, octrace_trace)
             ms = lambda x: f"{x * 1e3:.0f} ms"
-            print(f"| {name} | {w}×{h} | {count} | {ms(pt)} | {ms(ot)} | {pt / ot:.1f}× | {ms(pw)} | {ms(ow)} | "
+            print(f"| {name} | {w}×{h} | {count} | {ms(pt)} | {ms(ot)} | {pt / ot:.2f}× | {ms(pw)} | {ms(ow)} | "
                   f"{pw / ow:.1f}× |")
 
 
