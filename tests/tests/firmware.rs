@@ -40,6 +40,8 @@ fn boards_render_the_same_bits_as_host_sim() {
         Firmware::new(Board::Mps2An385, "fig5_3", 160, 128, PanelColor::Rgb888),
         // A 256-colour display: indices of the dithered colour cube.
         Firmware::new(Board::Mps2An385, "fig5_1", 160, 128, PanelColor::Dither),
+        // A 16-gray panel, as the OLED's: one level a byte.
+        Firmware::new(Board::Mps2An385, "fig5_4", 64, 48, PanelColor::Gray4),
     ];
     for firmware in cases {
         let name = format!("{} on {}", firmware.scene, firmware.board.machine());
