@@ -29,6 +29,17 @@ pub(crate) use wide::{
 /// the same bits, and the tests check the part-wise ones on the host.
 pub(crate) const ARMV6M: bool = cfg!(all(target_arch = "arm", not(target_feature = "thumb2")));
 
+/// On ARMv6-M, `part_wise()` when it decides the result; else, and on other
+/// targets, `exact()`: the one shape of every "cheaper form when it can"
+/// choice above.
+#[inline(always)]
+pub(crate) fn part_wise_or<T>(part_wise: impl FnOnce() -> Option<T>, exact: impl FnOnce() -> T) -> T {
+    match ARMV6M.then(part_wise).flatten() {
+        Some(value) => value,
+        None => exact(),
+    }
+}
+
 pub(crate) use wide::{mul_u64_shr24, mul_u64_shr24_clamped, reciprocal_q62, shl_u64, shr_u64};
 
 pub use fixed::types::{I16F16, I2F30, I32F32};

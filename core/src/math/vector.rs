@@ -5,7 +5,7 @@
 //! Arithmetic on [`Vec3`] uses `fixed`'s operators, which panic on overflow in
 //! debug builds; the scene normalisation keeps every value in range.
 
-use super::{mul_u32_wide, mul_wide, square_u32_wide, square_wide, Scalar, Unit, ARMV6M, UNIT_ONE};
+use super::{mul_u32_wide, mul_wide, part_wise_or, square_u32_wide, square_wide, Scalar, Unit, ARMV6M, UNIT_ONE};
 use core::ops::{Add, Neg, Sub};
 
 // On ARMv6-M sign tests of dot products try the coarse product first (see
@@ -150,10 +150,7 @@ impl Vec3 {
     /// far apart.
     #[inline]
     pub fn dot_dir_q46_at_most(self, d: Dir, limit: i64) -> bool {
-        match ARMV6M.then(|| coarse_at_most(self.bits(), d.bits(), limit)).flatten() {
-            Some(decided) => decided,
-            None => self.dot_dir_q46(d) <= limit,
-        }
+        part_wise_or(|| coarse_at_most(self.bits(), d.bits(), limit), || self.dot_dir_q46(d) <= limit)
     }
 
     /// `|self|²` exactly, in Q32.32. Components must be within ±2^15.
@@ -273,20 +270,14 @@ impl Dir {
     /// perpendicular.
     #[inline]
     pub fn dot_is_positive(self, o: Dir) -> bool {
-        match ARMV6M.then(|| coarse_sign(self.bits(), o.bits())).flatten() {
-            Some(sign) => sign > 0,
-            None => self.dot_q60(o) > 0,
-        }
+        part_wise_or(|| coarse_sign(self.bits(), o.bits()).map(|sign| sign > 0), || self.dot_q60(o) > 0)
     }
 
     /// `self.dot_q60(o) < 0`, cheaper on ARMv6-M unless the two are nearly
     /// perpendicular.
     #[inline]
     pub fn dot_is_negative(self, o: Dir) -> bool {
-        match ARMV6M.then(|| coarse_sign(self.bits(), o.bits())).flatten() {
-            Some(sign) => sign < 0,
-            None => self.dot_q60(o) < 0,
-        }
+        part_wise_or(|| coarse_sign(self.bits(), o.bits()).map(|sign| sign < 0), || self.dot_q60(o) < 0)
     }
 
     /// Whether the ray from `origin` along `self` surely meets the plane
@@ -413,10 +404,10 @@ impl Dir {
     }
 }
 
-/// `⌊(2^61 − 1) / len⌋` for `len` in [2^29, 2^31) (below 2^32), from
-/// `1/√len2 ≈ g·2^-e` (`len = ⌊√len2⌋`, e 60 or 61): the estimate
-/// `g·2^(61−e)` is within a few dozen units, then stepped to the exact floor
-/// on the remainder.
+/// `⌊(2^61 − 1) / len⌋` for `len` in [2^29, 2^31) (below 2^32). On ARMv6-M,
+/// which has no divider, from `1/√len2 ≈ g·2^-e` (`len = ⌊√len2⌋`, e 60 or
+/// 61): the estimate `g·2^(61−e)` is within a few dozen units, then stepped
+/// to the exact floor on the remainder; elsewhere one division.
 #[inline]
 fn reciprocal_of_length(g: u32, e: i32, len: u32) -> u32 {
     if !ARMV6M {

@@ -4,7 +4,7 @@
 //! 32767.99); it never wraps, so an over-bright light clamps to white as the
 //! shading model's final `min(1, …)` says.
 
-use crate::math::{mul_wide, Scalar, Unit, ARMV6M};
+use crate::math::{mul_wide, part_wise_or, Scalar, Unit};
 use fixed::types::I48F16;
 
 /// A linear RGB colour, Q16.16 per channel (1.0 is full intensity; values
@@ -85,10 +85,7 @@ impl Color {
 /// fits a u32 and saturates to `i32::MAX` as `sat` would.
 #[inline(always)]
 fn scale_channel_q16(c: i32, k: i32) -> i32 {
-    match ARMV6M.then(|| scale_channel_q16_by_parts(c, k)).flatten() {
-        Some(product) => product,
-        None => sat(mul_wide(c, k) >> 16),
-    }
+    part_wise_or(|| scale_channel_q16_by_parts(c, k), || sat(mul_wide(c, k) >> 16))
 }
 
 /// [`scale_channel_q16`] in two 32-bit products, when one factor is in
@@ -111,10 +108,7 @@ fn scale_channel_q16_by_parts(c: i32, k: i32) -> Option<i32> {
 /// so the sum fits a u32 and the result (below 2^17) needs no saturation.
 #[inline(always)]
 fn scale_channel_q30(c: i32, k: i32) -> i32 {
-    match ARMV6M.then(|| scale_channel_q30_by_parts(c, k)).flatten() {
-        Some(product) => product,
-        None => sat(mul_wide(c, k) >> 30),
-    }
+    part_wise_or(|| scale_channel_q30_by_parts(c, k), || sat(mul_wide(c, k) >> 30))
 }
 
 /// [`scale_channel_q30`] in two 32-bit products, for a channel in
