@@ -233,6 +233,16 @@ impl Counts {
         }
     }
 
+    /// Shadow-shaft words the octree keeps, one per box, when its config
+    /// asks for them (`OctreeConfig::shadow_shafts`); 0 otherwise.
+    pub const fn octree_shadow_shafts_if(&self, shadow_shafts: bool) -> usize {
+        if shadow_shafts {
+            self.octree_boxes
+        } else {
+            0
+        }
+    }
+
     /// These counts with `objects` set to the shapes' sum when it is 0
     /// (what [`crate::profile!`] does when `objects` is not given).
     pub const fn with_objects(mut self) -> Counts {

@@ -137,6 +137,10 @@ macro_rules! profile {
                     u16,
                     { <$name as $crate::profile::Profile>::COUNTS.octree_hash_buckets_if(<$name as $crate::profile::Profile>::NAMED_WALK) },
                 >;
+                type ShadowShafts = p::Vec<
+                    p::ShadowShaft,
+                    { <$name as $crate::profile::Profile>::COUNTS.octree_shadow_shafts_if(<$name as $crate::profile::Profile>::OCTREE.shadow_shafts) },
+                >;
             }
         };
     };
@@ -145,7 +149,7 @@ macro_rules! profile {
 /// What [`profile!`](crate::profile!) expands to; not a public API.
 #[doc(hidden)]
 pub mod __private {
-    pub use crate::accel::{HashEntry, Octree, OctreeCapacities, OctreeConfig, OctreeNode};
+    pub use crate::accel::{HashEntry, Octree, OctreeCapacities, OctreeConfig, OctreeNode, ShadowShaft};
     pub use crate::capacity::Counts;
     pub use crate::math::Vec3;
     pub use crate::scene::{Light, SceneCapacities, SurfaceEntry};
@@ -192,7 +196,7 @@ pub struct Host;
 #[cfg(feature = "alloc")]
 mod host {
     use super::{Host, Profile};
-    use crate::accel::{HashEntry, Octree, OctreeCapacities, OctreeConfig, OctreeNode, MAX_DEPTH};
+    use crate::accel::{HashEntry, Octree, OctreeCapacities, OctreeConfig, OctreeNode, ShadowShaft, MAX_DEPTH};
     use crate::capacity::{Counts, HeapArena};
     use crate::math::Vec3;
     use crate::scene::{Light, SceneCapacities, SurfaceEntry};
@@ -215,7 +219,8 @@ mod host {
             octree_boxes: 16_000_000,
             octree_references: 64_000_000,
         };
-        const OCTREE: OctreeConfig = OctreeConfig::DEFAULT;
+        // RAM is plenty: shadow shafts on.
+        const OCTREE: OctreeConfig = OctreeConfig { shadow_shafts: true, ..OctreeConfig::DEFAULT };
         type Octree = Octree<Host, { MAX_DEPTH as usize + 1 }>;
         type MailboxWords = HeapArena<u32, { Host::COUNTS.mailbox_words() }>;
     }
@@ -241,6 +246,7 @@ mod host {
         type HashEntries = HeapArena<HashEntry<u32>, { Host::COUNTS.octree_hash_entries() }>;
         // A prime: the table's size since the first host profile.
         type HashBuckets = HeapArena<u32, 65_521>;
+        type ShadowShafts = HeapArena<ShadowShaft, { Host::COUNTS.octree_boxes }>;
     }
 }
 

@@ -69,10 +69,10 @@ pub struct Args {
     #[arg(long, value_name = "MODE", default_value = "auto", value_parser = parse_accel)]
     pub accel: AccelMode,
     /// Octree criterion: a box holding more objects than this is subdivided.
-    #[arg(long, value_name = "N", default_value_t = OctreeConfig::default().max_objects)]
+    #[arg(long, value_name = "N", default_value_t = crate::OCTREE.max_objects)]
     pub max_objects: usize,
     /// Octree criterion: boxes are not subdivided below this depth (at most 18).
-    #[arg(long, value_name = "D", default_value_t = OctreeConfig::default().max_depth,
+    #[arg(long, value_name = "D", default_value_t = crate::OCTREE.max_depth,
           value_parser = clap::value_parser!(u32).range(0..=18))]
     pub max_depth: u32,
     /// Threads to render on (default: every core). Any number gives the
@@ -463,7 +463,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
     let options = RenderOptions {
         size: Some((w, h)),
         accel: args.accel,
-        octree: OctreeConfig { max_objects: args.max_objects, max_depth: args.max_depth, ..Default::default() },
+        octree: OctreeConfig { max_objects: args.max_objects, max_depth: args.max_depth, ..crate::OCTREE },
         threads: args.threads.map_or_else(all_cores, |n| n as usize),
         partition: args.partition,
     };

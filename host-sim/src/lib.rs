@@ -114,13 +114,7 @@ pub struct RenderOptions {
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions {
-            size: None,
-            accel: AccelMode::Auto,
-            octree: OctreeConfig::default(),
-            threads: 1,
-            partition: Partition::Tiles,
-        }
+        RenderOptions { size: None, accel: AccelMode::Auto, octree: OCTREE, threads: 1, partition: Partition::Tiles }
     }
 }
 
@@ -152,6 +146,10 @@ pub struct Rendered {
 
 /// The host's octree.
 pub type HostOctree = Octree<Host>;
+
+/// How host-sim builds octrees unless told otherwise: the host profile's
+/// config (shadow shafts on).
+pub const OCTREE: OctreeConfig = <Host as octrace_core::profile::Profile>::OCTREE;
 
 /// Builds the acceleration structure for `mode` (none for naive).
 pub fn build_octree(scene: &HostScene, mode: AccelMode, config: &OctreeConfig) -> Option<Box<HostOctree>> {

@@ -118,7 +118,7 @@ impl Studio {
         let accel = accel.resolve(view.object_count());
         self.octree = accel.traversal().map(|traversal| {
             let mut octree: Box<Octree<Host>> = Box::default();
-            octree.build(&view, &OctreeConfig { traversal, ..Default::default() });
+            octree.build(&view, &OctreeConfig { traversal, ..<Host as octrace_core::profile::Profile>::OCTREE });
             octree
         });
         Ok(accel)

@@ -18,7 +18,7 @@ fn every_scene_is_identical_in_every_mode() {
     for (name, path) in scenes() {
         let mut scene = new_scene();
         load_file(&path, &mut scene).unwrap();
-        let config = OctreeConfig::default();
+        let config = host_sim::OCTREE;
         // Half size keeps the naive mode quick on the large free-form scene
         // (the golden test renders every scene at full size).
         let size = Some((160, 120));
@@ -134,7 +134,7 @@ fn random_scenes_are_identical_in_every_mode() {
             continue;
         }
         let config =
-            OctreeConfig { max_objects: 1 + rng.below(6) as usize, max_depth: 1 + rng.below(10), ..Default::default() };
+            OctreeConfig { max_objects: 1 + rng.below(6) as usize, max_depth: 1 + rng.below(10), ..host_sim::OCTREE };
         let naive = image(&scene, AccelMode::Naive, config, None);
         for mode in [AccelMode::Octree, AccelMode::Dda] {
             let other = image(&scene, mode, config, None);
@@ -157,8 +157,12 @@ fn random_queries_agree_with_the_naive_mode() {
         let view = scene.view();
         let n = view.object_count() as u32;
         for traversal in [Traversal::Named, Traversal::Dda] {
-            let config =
-                OctreeConfig { max_objects: 1 + rng.below(4) as usize, max_depth: 2 + rng.below(9), traversal };
+            let config = OctreeConfig {
+                max_objects: 1 + rng.below(4) as usize,
+                max_depth: 2 + rng.below(9),
+                traversal,
+                ..host_sim::OCTREE
+            };
             let mode = if traversal == Traversal::Dda { AccelMode::Dda } else { AccelMode::Octree };
             let Some(tree) = build_octree(&scene, mode, &config) else { continue };
             let mut words = vec![0u32; Mailbox::words_for(n as usize)];
@@ -179,6 +183,7 @@ fn random_queries_agree_with_the_naive_mode() {
                 });
                 mailbox.clear();
                 let a = Naive.nearest(&view, &ray, start, &mut mailbox);
+                let a_hit = a;
                 mailbox.clear();
                 let b = tree.nearest(&view, &ray, start, &mut mailbox);
                 assert_eq!(a, b, "round {round} {traversal:?} {config:?}: nearest along {ray:?}\n{text}");
@@ -188,6 +193,22 @@ fn random_queries_agree_with_the_naive_mode() {
                 mailbox.clear();
                 let b = tree.occluded(&view, &ray, t_max, start, &mut mailbox);
                 assert_eq!(a, b, "round {round} {traversal:?}: occluded along {ray:?} to {t_max}\n{text}");
+                // Shadow rays from the hit to every light, as the tracer
+                // makes them: the octree's shadow shafts answer as the walk.
+                let Some(hit) = a_hit else { continue };
+                let point = ray.at(hit.t);
+                for (light, l) in view.lights.iter().enumerate() {
+                    let Some((dir, distance)) = (l.position - point).direction_and_length() else { continue };
+                    let shadow = Ray { origin: point, dir };
+                    let t_max = Scalar::from_bits((distance.to_bits() - 1).max(0));
+                    let leaving = if rng.below(2) == 0 { Leaving::Inward } else { Leaving::Outward };
+                    let start = Some(RayStart { object: hit.object, leaving });
+                    mailbox.clear();
+                    let a = Naive.occluded(&view, &shadow, t_max, start, &mut mailbox);
+                    mailbox.clear();
+                    let b = tree.occluded_toward(&view, &shadow, t_max, light, start, &mut mailbox);
+                    assert_eq!(a, b, "round {round} {traversal:?}: shadow ray {shadow:?} to light {light}\n{text}");
+                }
             }
         }
     }
@@ -206,7 +227,8 @@ fn small_capacities_fall_back_without_changing_the_image() {
     parse(&text, &mut scene, &mut |e| panic!("{e}")).unwrap();
     let view = scene.view();
     let mut tree: Box<octrace_core::accel::Octree<Board16K>> = Box::default();
-    let report = tree.build(&view, &OctreeConfig { max_objects: 1, max_depth: 12, traversal: Traversal::Dda });
+    let report = tree
+        .build(&view, &OctreeConfig { max_objects: 1, max_depth: 12, traversal: Traversal::Dda, ..host_sim::OCTREE });
     println!("{report:?}");
     assert!(report.unsplit > 0, "the small profile should run out: {report:?}");
     let mut a = host_sim::RgbImage::new(64, 48);

@@ -3,7 +3,7 @@
 
 use embedded_graphics_core::pixelcolor::RgbColor;
 use host_sim::{build_octree, load_file, new_scene, render, render_prebuilt, AccelMode, Partition, RenderOptions};
-use octrace_core::accel::{Mailbox, OctreeConfig};
+use octrace_core::accel::Mailbox;
 use octrace_core::render::{interleaved_rows, Renderer};
 use octrace_tests::scenes;
 use std::sync::Mutex;
@@ -32,7 +32,7 @@ fn stats_do_not_depend_on_the_thread_count() {
     let path = octrace_tests::repo().join("scenes/fig5_3.txt");
     let mut scene = new_scene();
     load_file(&path, &mut scene).unwrap();
-    let tree = build_octree(&scene, AccelMode::Dda, &OctreeConfig::default()).unwrap();
+    let tree = build_octree(&scene, AccelMode::Dda, &host_sim::OCTREE).unwrap();
     let options = |threads| RenderOptions { size: Some((96, 64)), threads, ..Default::default() };
     let one = render_prebuilt(&scene, &options(1), Some(&tree), &|_| {}).unwrap().stats;
     let four = render_prebuilt(&scene, &options(4), Some(&tree), &|_| {}).unwrap().stats;
@@ -48,7 +48,7 @@ fn two_cores_with_interleaved_rows_give_the_same_image() {
     let mut scene = new_scene();
     load_file(&path, &mut scene).unwrap();
     let (w, h) = (120, 90);
-    let tree = build_octree(&scene, AccelMode::Dda, &OctreeConfig::default()).unwrap();
+    let tree = build_octree(&scene, AccelMode::Dda, &host_sim::OCTREE).unwrap();
     let expected = render(&scene, &RenderOptions { size: Some((w, h)), ..Default::default() }).unwrap().image;
     let view = scene.view();
     let display = Mutex::new(host_sim::RgbImage::new(w, h));

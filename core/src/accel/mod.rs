@@ -16,8 +16,8 @@ mod octree;
 pub use naive::Naive;
 pub(crate) use naive::NaiveFor;
 pub use octree::{
-    BuildReport, HashEntry, Index, Octree, OctreeCapacities, OctreeConfig, OctreeNode, OctreeStore, Traversal,
-    MAX_DEPTH,
+    BuildReport, HashEntry, Index, Octree, OctreeCapacities, OctreeConfig, OctreeNode, OctreeStore, ShadowShaft,
+    Traversal, MAX_DEPTH,
 };
 
 use crate::math::Scalar;
@@ -236,6 +236,23 @@ pub trait Accelerator {
         start: Option<RayStart>,
         mailbox: &mut Mailbox<'_>,
     ) -> bool;
+
+    /// [`Accelerator::occluded`] for a shadow ray from its origin towards
+    /// the scene's light `light`, with `t_max` at most the light's distance:
+    /// the same answer, and an accelerator may use what it knows of that
+    /// light (the octree's shadow shafts).
+    fn occluded_toward(
+        &self,
+        scene: &SceneView<'_>,
+        ray: &Ray,
+        t_max: Scalar,
+        light: usize,
+        start: Option<RayStart>,
+        mailbox: &mut Mailbox<'_>,
+    ) -> bool {
+        let _ = light;
+        self.occluded(scene, ray, t_max, start, mailbox)
+    }
 }
 
 #[cfg(test)]

@@ -237,8 +237,14 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             };
             let start = RayStart { object: hit.object, leaving };
             let t_max = Scalar::from_bits((distance.to_bits() - 1).max(0));
-            if self.occluded(&shadow, t_max, start, &mut scratch.blockers[index % BLOCKER_SLOTS], &mut scratch.mailbox)
-            {
+            if self.occluded(
+                &shadow,
+                t_max,
+                index,
+                start,
+                &mut scratch.blockers[index % BLOCKER_SLOTS],
+                &mut scratch.mailbox,
+            ) {
                 continue;
             }
             let attenuation = self.attenuation(light.brightness.to_bits(), distance);
@@ -270,14 +276,15 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         [child(&|| p.ray.dir, t), child(&|| to_eye.reflect_about(normal), r)]
     }
 
-    /// Whether anything blocks `shadow` before `t_max`, trying `blocker` (the
-    /// object that blocked the last shadow ray to this light, if it was
-    /// blocked) first, and remembering the next.
+    /// Whether anything blocks `shadow` to light `light` before `t_max`,
+    /// trying `blocker` (the object that blocked the last shadow ray to this
+    /// light, if it was blocked) first, and remembering the next.
     #[inline]
     fn occluded(
         &self,
         shadow: &Ray,
         t_max: Scalar,
+        light: usize,
         start: RayStart,
         blocker: &mut u32,
         mailbox: &mut Mailbox<'_>,
@@ -297,7 +304,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             }
         }
         mailbox.blocker = u32::MAX;
-        let blocked = self.accel.occluded(&self.scene, shadow, t_max, Some(start), mailbox);
+        let blocked = self.accel.occluded_toward(&self.scene, shadow, t_max, light, Some(start), mailbox);
         // Forget a blocker that missed once the light is seen: in the open
         // it would cost every shadow ray an extra test.
         *blocker = mailbox.blocker;

@@ -114,7 +114,7 @@ fn table51(dir: &Path) {
     ];
     for (name, tn, tf, tr, runs) in rows {
         let scene = load(&dir.join(format!("{name}.txt")));
-        let c = OctreeConfig::default();
+        let c = host_sim::OCTREE;
         let naive = time(&scene, AccelMode::Naive, c, None, runs);
         let octree = time(&scene, AccelMode::Octree, c, None, 3);
         let dda = time(&scene, AccelMode::Dda, c, None, 3);
@@ -137,7 +137,7 @@ fn table52(dir: &Path) {
     println!("| objects per box | thesis (octree) | octree | dda | boxes | leaves | references | depth |");
     println!("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
     let scene = load(&dir.join("fig5_4.txt"));
-    let default = OctreeConfig::default();
+    let default = host_sim::OCTREE;
     for (max, thesis) in [(2usize, "22:21"), (6, "17:52"), (8, "28:36"), (default.max_objects, "(default)")] {
         let c = OctreeConfig { max_objects: max, ..default };
         let octree = time(&scene, AccelMode::Octree, c, None, 5);
@@ -212,7 +212,7 @@ fn scaling() {
         let text = carpet(n, 0x9e37_79b9_7f4a_7c15 ^ n as u64);
         let mut scene = new_scene();
         load_bytes("carpet", text.as_bytes(), &mut scene).expect("the carpet parses");
-        let c = OctreeConfig::default();
+        let c = host_sim::OCTREE;
         let per_px = |d: Duration| format!("{:.0}", d.as_nanos() as f64 / pixels);
         let naive = if n <= 10_000 { per_px(time(&scene, AccelMode::Naive, c, None, 1)) } else { "—".into() };
         let walk = |mode| {
@@ -255,7 +255,7 @@ fn criterion(dir: &Path) {
         }
         print!("| {name} |");
         for (m, d) in combos {
-            let c = OctreeConfig { max_objects: m, max_depth: d, ..Default::default() };
+            let c = OctreeConfig { max_objects: m, max_depth: d, ..host_sim::OCTREE };
             print!(" {:.1} |", time(&scene, AccelMode::Dda, c, None, 3).as_secs_f64() * 1e3);
         }
         println!();
@@ -292,7 +292,7 @@ fn parallel(dir: &Path) {
         ("corner", corner_scene, (800, 600)),
     ];
     for (name, scene, size) in &cases {
-        let tree = build_octree(scene, AccelMode::Dda, &OctreeConfig::default()).expect("an octree");
+        let tree = build_octree(scene, AccelMode::Dda, &host_sim::OCTREE).expect("an octree");
         let mut one = None;
         let mut runs = vec![(Partition::Tiles, 1)];
         for threads in [2, 4].into_iter().chain((cores > 4).then_some(cores)) {
@@ -368,7 +368,7 @@ fn spheres600(dir: &Path) {
     println!("| scene | naive | dda render | dda build | render ratio | ratio with build |");
     println!("| --- | ---: | ---: | ---: | ---: | ---: |");
     let scene = load(&dir.join("spheres600.txt"));
-    let c = OctreeConfig::default();
+    let c = host_sim::OCTREE;
     let size = Some((800, 600));
     let naive = time(&scene, AccelMode::Naive, c, size, 3);
     let (build, tree) = best_of(3, || build_octree(&scene, AccelMode::Dda, &c));

@@ -265,7 +265,7 @@ mod tests {
     /// (positions round by one), in ray order.
     #[test]
     fn the_walk_visits_every_leaf_the_ray_crosses_in_order() {
-        use super::super::tests::for_each_leaf;
+        use super::super::for_each_leaf;
         use super::super::{OctreeConfig, Traversal};
         use crate::math::{Dir, Vec3};
         use crate::parse::parse;
@@ -290,11 +290,12 @@ mod tests {
                 max_objects: 1 + (next() % 3) as usize,
                 max_depth: 2 + (next() % 6) as u32,
                 traversal: Traversal::Dda,
+                ..OctreeConfig::DEFAULT
             };
             tree.build(&view, &config);
             // Every non-empty leaf's box.
             let mut leaves = Vec::new();
-            for_each_leaf(&tree, 0, tree.root_min, tree.root_log2, &mut |node, lo, log2| {
+            for_each_leaf(tree.nodes.as_slice(), (0, tree.root_min, tree.root_log2), &mut |node, lo, log2| {
                 if tree.nodes.as_slice()[node as usize].count() != 0 {
                     leaves.push((node, lo, lo.map(|v| v + (1 << log2))));
                 }

@@ -37,8 +37,10 @@
 mod dda;
 mod named;
 mod overlap;
+mod shaft;
 
 pub use overlap::{overlaps, Cell};
+pub use shaft::ShadowShaft;
 
 use super::{Accelerator, Hit, Mailbox, RayStart};
 use crate::capacity::{Arena, CapacityKind, Counts};
@@ -170,11 +172,18 @@ pub struct OctreeConfig {
     pub max_depth: u32,
     /// How rays walk the tree; every walk gives the same hits.
     pub traversal: Traversal,
+    /// Whether to find, for each leaf and light, whether shadow rays from
+    /// the leaf to the light can skip the walk (a word a box, see
+    /// [`OctreeCapacities::ShadowShafts`]); the image is the same.
+    pub shadow_shafts: bool,
 }
 
 impl OctreeConfig {
-    /// At most 4 objects a leaf, 12 levels, the 3DDDA walk.
-    pub const DEFAULT: OctreeConfig = OctreeConfig { max_objects: 4, max_depth: 12, traversal: Traversal::Dda };
+    /// At most 4 objects a leaf, 12 levels, the 3DDDA walk, no shadow
+    /// shafts (a board's RAM is for the scene; the host profile turns them
+    /// on).
+    pub const DEFAULT: OctreeConfig =
+        OctreeConfig { max_objects: 4, max_depth: 12, traversal: Traversal::Dda, shadow_shafts: false };
 }
 
 impl Default for OctreeConfig {
@@ -203,7 +212,11 @@ pub struct BuildReport {
     pub unsplit: usize,
     /// The capacity that ran out first, if any.
     pub exhausted: Option<CapacityKind>,
-    /// Bytes of the structure (nodes, references, hash table).
+    /// Pairs of a leaf and a light whose shadow rays skip the walk: nothing
+    /// but the leaf's own objects is near their shaft (0 in a profile
+    /// without room for them, see [`OctreeCapacities::ShadowShafts`]).
+    pub clear_shafts: usize,
+    /// Bytes of the structure (nodes, references, hash table, shafts).
     pub bytes: usize,
 }
 
@@ -261,6 +274,11 @@ pub trait OctreeCapacities {
     type HashEntries: Arena<HashEntry<Self::Index>>;
     /// Hash-table buckets; the table size is this arena's capacity.
     type HashBuckets: Arena<Self::Index>;
+    /// One [`ShadowShaft`] per box: the lights that shadow rays from the
+    /// leaf reach testing only its own objects. Found when the config asks
+    /// and the arena holds one for every box; a capacity of 0 leaves the
+    /// shafts out (and their code).
+    type ShadowShafts: Arena<ShadowShaft>;
 }
 
 impl<C: OctreeCapacities, const FRAMES: usize> core::fmt::Debug for Octree<C, FRAMES> {
@@ -307,6 +325,8 @@ pub struct Octree<C: OctreeCapacities, const FRAMES: usize = { MAX_DEPTH as usiz
     refs: C::References,
     entries: C::HashEntries,
     buckets: C::HashBuckets,
+    /// Per box, the lights its shadow rays reach without a walk.
+    shafts: C::ShadowShafts,
     /// The root box: `[root_min, root_max]`, `root_max = root_min +
     /// 2^root_log2` per axis (kept: a 64-bit shift by a variable is a
     /// library call on a small core, and every ray's set-up needs it).
@@ -354,6 +374,8 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
     /// has no room at all (a profile without the thesis's walk, which alone
     /// reads it); [`Traversal::Named`] is then walked by 3DDDA.
     const HASHED: bool = C::HashEntries::CAPACITY > 0;
+    /// Whether the tree may keep shadow shafts.
+    const SHAFTS: bool = C::ShadowShafts::CAPACITY > 0;
 
     /// An empty octree (a constant: it can live in a `static`).
     pub const fn new() -> Self {
@@ -362,6 +384,7 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
             refs: C::References::EMPTY,
             entries: C::HashEntries::EMPTY,
             buckets: C::HashBuckets::EMPTY,
+            shafts: C::ShadowShafts::EMPTY,
             root_min: [0; 3],
             root_max: [0; 3],
             bounds_max: [0; 3],
@@ -379,6 +402,7 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
                 depth: 0,
                 unsplit: 0,
                 exhausted: None,
+                clear_shafts: 0,
                 bytes: 0,
             },
         }
@@ -415,6 +439,7 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
         self.refs.clear();
         self.entries.clear();
         self.buckets.clear();
+        self.shafts.clear();
         self.report = BuildReport::default();
         self.traversal = config.traversal;
         while self.buckets.push(C::Index::new(C::Index::MAX)).is_ok() {}
@@ -462,6 +487,9 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
         let root =
             Split { node: 0, depth: 0, name: 1, lo: self.root_min, log2: self.root_log2, refs_start: 0, stale: 0 };
         self.split(scene, root, config.max_objects.max(1), max_depth, 0);
+        if config.shadow_shafts {
+            self.mark_clear_shafts(scene);
+        }
         self.finish(max_depth);
         self.report
     }
@@ -564,6 +592,70 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
         }
     }
 
+    /// Finds every non-empty leaf's shadow shafts, when the arena holds one
+    /// for every box.
+    fn mark_clear_shafts(&mut self, scene: &SceneView<'_>) {
+        let boxes = self.nodes.as_slice().len();
+        if !Self::SHAFTS || scene.lights.is_empty() || (0..boxes).any(|_| self.shafts.push(ShadowShaft::NONE).is_err())
+        {
+            self.shafts.clear();
+            return;
+        }
+        let (nodes, refs, shafts) = (self.nodes.as_slice(), self.refs.as_slice(), self.shafts.as_mut_slice());
+        let root = (0, self.root_min, self.root_log2);
+        let (mut clear, mut blockers) = (0, [u32::MAX; shaft::LIGHTS]);
+        for_each_leaf(nodes, root, &mut |leaf, lo, log2| {
+            let n = nodes[leaf as usize];
+            let own = &refs[n.first() as usize..(n.first() + n.count()) as usize];
+            let found = shaft::of_leaf::<C>(nodes, refs, scene, root, (lo, log2), own, &mut blockers);
+            clear += found.lights.count_ones() as usize;
+            shafts[leaf as usize] = found;
+        });
+        self.report.clear_shafts = clear;
+    }
+
+    /// The leaf holding `point` (by the bits of its coordinates relative to
+    /// the root), when the point is inside the root.
+    #[inline]
+    fn leaf_at(&self, point: [i64; 3]) -> Option<u32> {
+        let side = self.root_max[0] - self.root_min[0];
+        let relative = [0, 1, 2].map(|a| point[a] - self.root_min[a]);
+        if relative.iter().any(|&v| v < 0 || v >= side) {
+            return None;
+        }
+        let relative = relative.map(|v| v as u32);
+        let nodes = self.nodes.as_slice();
+        let (mut node, mut bit) = (0u32, self.root_log2);
+        while nodes[node as usize].is_internal() {
+            bit -= 1;
+            let octant = (relative[0] >> bit & 1) | (relative[1] >> bit & 1) << 1 | (relative[2] >> bit & 1) << 2;
+            node = nodes[node as usize].first() + octant;
+        }
+        Some(node)
+    }
+
+    /// Whether object `id` blocks a shadow ray (first tested in this query),
+    /// leaving it in the mailbox's `blocker` when so.
+    #[inline]
+    fn blocks(
+        scene: &SceneView<'_>,
+        ray: &Ray,
+        t_max: Scalar,
+        start: Option<RayStart>,
+        mailbox: &mut Mailbox<'_>,
+        id: u32,
+    ) -> bool {
+        let hit = mailbox.first_visit(id) && {
+            let object = ObjectId(id);
+            let leaving = RayStart::leaving(start, object);
+            scene.intersect_handle(C::KINDS, scene.objects[id as usize], ray, t_max, leaving).is_some()
+        };
+        if hit {
+            mailbox.blocker = id;
+        }
+        hit
+    }
+
     fn insert_entry(&mut self, name: u64, children: u32) {
         let none = C::Index::new(C::Index::MAX);
         let index = C::Index::new(self.entries.as_slice().len() as u32);
@@ -594,6 +686,7 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
         self.report.depth = self.root_log2.saturating_sub(self.min_log2).min(max_depth);
         self.report.bytes = core::mem::size_of_val(nodes)
             + core::mem::size_of_val(self.refs.as_slice())
+            + core::mem::size_of_val(self.shafts.as_slice())
             + core::mem::size_of_val(self.entries.as_slice())
             + core::mem::size_of_val(self.buckets.as_slice());
     }
@@ -620,6 +713,41 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
         }
         Some(&self.refs.as_slice()[n.first() as usize..(n.first() + n.count()) as usize])
     }
+}
+
+/// Whether `leaf(node, lo, log2)` holds for a leaf of the subtree at
+/// `node` (box `[lo, lo + 2^log2]`), visiting only the boxes that `enter`
+/// admits, in node order, and stopping at the first.
+pub(super) fn any_leaf<I: Index>(
+    nodes: &[OctreeNode<I>],
+    (node, lo, log2): (u32, [i64; 3], u32),
+    enter: &impl Fn([i64; 3], u32) -> bool,
+    leaf: &mut impl FnMut(u32, [i64; 3], u32) -> bool,
+) -> bool {
+    if !enter(lo, log2) {
+        return false;
+    }
+    let n = nodes[node as usize];
+    if !n.is_internal() {
+        return leaf(node, lo, log2);
+    }
+    let half = 1i64 << (log2 - 1);
+    (0..8u32).any(|k| {
+        let corner = [0, 1, 2].map(|a| lo[a] + if k >> a & 1 == 1 { half } else { 0 });
+        any_leaf(nodes, (n.first() + k, corner, log2 - 1), enter, leaf)
+    })
+}
+
+/// Calls `f(leaf, lo, log2)` for every leaf of the subtree at `node`.
+pub(super) fn for_each_leaf<I: Index>(
+    nodes: &[OctreeNode<I>],
+    root: (u32, [i64; 3], u32),
+    f: &mut impl FnMut(u32, [i64; 3], u32),
+) {
+    any_leaf(nodes, root, &|_, _| true, &mut |node, lo, log2| {
+        f(node, lo, log2);
+        false
+    });
 }
 
 /// An [`Octree`] whatever its walk depth: what a profile's octree is.
@@ -695,17 +823,7 @@ impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES>
     ) -> bool {
         let mut blocked = false;
         walk_leaves(self, ray, mailbox, t_max, |leaf, exit, mailbox| {
-            let mut test = |id: u32| {
-                let hit = mailbox.first_visit(id) && {
-                    let object = ObjectId(id);
-                    let leaving = RayStart::leaving(start, object);
-                    scene.intersect_handle(C::KINDS, scene.objects[id as usize], ray, t_max, leaving).is_some()
-                };
-                if hit {
-                    mailbox.blocker = id;
-                }
-                hit
-            };
+            let mut test = |id: u32| Self::blocks(scene, ray, t_max, start, mailbox, id);
             blocked = match self.leaf_objects(leaf) {
                 Some(ids) => ids.iter().any(|&id| test(id.get())),
                 None => (0..scene.object_count() as u32).any(test),
@@ -713,6 +831,32 @@ impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES>
             (!blocked && !exit.after(t_max)).then_some(t_max)
         });
         blocked
+    }
+
+    /// From a leaf whose shaft to the light is clear, only the leaf's own
+    /// objects are tested; otherwise the walk of [`Accelerator::occluded`].
+    #[inline(never)]
+    fn occluded_toward(
+        &self,
+        scene: &SceneView<'_>,
+        ray: &Ray,
+        t_max: Scalar,
+        light: usize,
+        start: Option<RayStart>,
+        mailbox: &mut Mailbox<'_>,
+    ) -> bool {
+        if Self::SHAFTS && light < shaft::LIGHTS {
+            if let Some(leaf) = self.leaf_at(ray.origin.wide()) {
+                if self.shafts.as_slice().get(leaf as usize).is_some_and(|s| s.clear(ray.origin.bits(), light)) {
+                    mailbox.cells += 1;
+                    // A leaf with bits has its own list (not the one that
+                    // stands for every object).
+                    let ids = self.leaf_objects(leaf).unwrap_or_default();
+                    return ids.iter().any(|&id| Self::blocks(scene, ray, t_max, start, mailbox, id.get()));
+                }
+            }
+        }
+        self.occluded(scene, ray, t_max, start, mailbox)
     }
 }
 
@@ -776,7 +920,10 @@ mod tests {
     fn boxes_are_named_as_in_the_thesis_and_found_by_hash() {
         let s = scene(&row(12));
         let mut tree: Box<Octree<Board64K>> = Box::default();
-        let report = tree.build(&s.view(), &OctreeConfig { max_objects: 2, max_depth: 6, traversal: Traversal::Named });
+        let report = tree.build(
+            &s.view(),
+            &OctreeConfig { max_objects: 2, max_depth: 6, traversal: Traversal::Named, ..OctreeConfig::DEFAULT },
+        );
         assert!(report.depth >= 2 && report.unsplit == 0, "{report:?}");
         // The root is 1 and its children are found under that name.
         assert_eq!(tree.lookup(1), Some(tree.nodes.as_slice()[0].first()));
@@ -804,9 +951,12 @@ mod tests {
         let s = scene(&row(9));
         let view = s.view();
         let mut tree: Box<Octree<Board64K>> = Box::default();
-        tree.build(&view, &OctreeConfig { max_objects: 1, max_depth: 5, traversal: Traversal::Dda });
+        tree.build(
+            &view,
+            &OctreeConfig { max_objects: 1, max_depth: 5, traversal: Traversal::Dda, ..OctreeConfig::DEFAULT },
+        );
         let mut references = 0;
-        for_each_leaf(&tree, 0, tree.root_min, tree.root_log2, &mut |node, lo, log2| {
+        for_each_leaf(tree.nodes.as_slice(), (0, tree.root_min, tree.root_log2), &mut |node, lo, log2| {
             let objects = tree.leaf_objects(node).unwrap();
             references += objects.len();
             let cell = Cell { lo: lo.map(|v| v - FILING_MARGIN), hi: lo.map(|v| v + (1 << log2) + FILING_MARGIN) };
@@ -820,24 +970,6 @@ mod tests {
 
     /// Calls `f(node, low corner, log2 of the side)` for every leaf below
     /// `node`, a box with that corner and side.
-    pub(super) fn for_each_leaf<C: OctreeCapacities, const FRAMES: usize>(
-        tree: &Octree<C, FRAMES>,
-        node: u32,
-        lo: [i64; 3],
-        log2: u32,
-        f: &mut impl FnMut(u32, [i64; 3], u32),
-    ) {
-        let n = tree.nodes.as_slice()[node as usize];
-        if !n.is_internal() {
-            return f(node, lo, log2);
-        }
-        let half = 1i64 << (log2 - 1);
-        for k in 0..8u32 {
-            let corner = [0, 1, 2].map(|a| lo[a] + if k >> a & 1 == 1 { half } else { 0 });
-            for_each_leaf(tree, n.first() + k, corner, log2 - 1, f);
-        }
-    }
-
     #[test]
     fn objects_meeting_at_a_point_stop_the_split_there() {
         // Four squares meeting at the origin, on a base: every box around
@@ -849,7 +981,10 @@ mod tests {
             .collect();
         let s = scene(&format!("{squares}BOX 1 0 -0.25 0 1 0.25 1\n"));
         let mut tree: Box<Octree<Board64K>> = Box::default();
-        let report = tree.build(&s.view(), &OctreeConfig { max_objects: 4, max_depth: 12, traversal: Traversal::Dda });
+        let report = tree.build(
+            &s.view(),
+            &OctreeConfig { max_objects: 4, max_depth: 12, traversal: Traversal::Dda, ..OctreeConfig::DEFAULT },
+        );
         assert!(report.depth <= 4, "{report:?}");
     }
 
@@ -860,7 +995,10 @@ mod tests {
         let text = format!("{SURF}{}", row(60));
         parse(&text, &mut s, &mut |e| panic!("{e}")).unwrap();
         let mut tree: Box<Octree<Board16K>> = Box::default();
-        let report = tree.build(&s.view(), &OctreeConfig { max_objects: 1, max_depth: 12, traversal: Traversal::Dda });
+        let report = tree.build(
+            &s.view(),
+            &OctreeConfig { max_objects: 1, max_depth: 12, traversal: Traversal::Dda, ..OctreeConfig::DEFAULT },
+        );
         assert!(report.unsplit > 0 && report.exhausted.is_some(), "{report:?}");
         assert!(report.nodes <= 400);
     }
@@ -872,7 +1010,10 @@ mod tests {
         let s = scene(&row(16));
         let view = s.view();
         let mut tree: Box<Octree<Board64K>> = Box::default();
-        tree.build(&view, &OctreeConfig { max_objects: 1, max_depth: 6, traversal: Traversal::Dda });
+        tree.build(
+            &view,
+            &OctreeConfig { max_objects: 1, max_depth: 6, traversal: Traversal::Dda, ..OctreeConfig::DEFAULT },
+        );
         let eye = view.normalization.point([-20 << 32, 1 << 29, 1 << 28]);
         for d in [[1i64, 0, 0], [3, -1, 0], [1, 1, 1], [5, 0, -1], [1, 0, 1 << 20]] {
             let ray = Ray { origin: eye, dir: Dir::normalize(d).unwrap() };
