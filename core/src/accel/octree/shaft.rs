@@ -136,7 +136,7 @@ pub(super) fn of_leaf<C: OctreeCapacities>(
             let [lo, hi] = widened(lo, lo.map(|v| v + (1 << log2)));
             shaft.meets(lo, hi)
         };
-        let blocked = any_leaf(nodes, root, &near, &mut |leaf, _, _| {
+        let blocked = any_leaf(nodes, root, low, &near, &mut |leaf, _, _| {
             let n = nodes[leaf as usize];
             let found = refs[n.first() as usize..(n.first() + n.count()) as usize].iter().find(|&&id| blocks(id));
             found.map(|id| *blocker = id.get()).is_some()
