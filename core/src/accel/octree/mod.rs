@@ -718,20 +718,20 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
 }
 
 /// Whether `leaf(node, lo, log2)` holds for a leaf of the subtree at
-/// `node` (box `[lo, lo + 2^log2]`), visiting only the boxes that `enter`
-/// admits, nearest `toward` first (its own octant, then those differing in
+/// `node` (box `[lo, lo + 2^log2]`), visiting only the boxes that
+/// `enter(box, lo, log2)` admits, nearest `toward` first (its own octant, then those differing in
 /// one axis, …), and stopping at the first.
 pub(super) fn any_leaf<I: Index>(
     nodes: &[OctreeNode<I>],
     (node, lo, log2): (u32, [i64; 3], u32),
     toward: [i64; 3],
-    enter: &impl Fn([i64; 3], u32) -> bool,
+    enter: &impl Fn(OctreeNode<I>, [i64; 3], u32) -> bool,
     leaf: &mut impl FnMut(u32, [i64; 3], u32) -> bool,
 ) -> bool {
-    if !enter(lo, log2) {
+    let n = nodes[node as usize];
+    if !enter(n, lo, log2) {
         return false;
     }
-    let n = nodes[node as usize];
     if !n.is_internal() {
         return leaf(node, lo, log2);
     }
@@ -750,7 +750,7 @@ pub(super) fn for_each_leaf<I: Index>(
     root: (u32, [i64; 3], u32),
     f: &mut impl FnMut(u32, [i64; 3], u32),
 ) {
-    any_leaf(nodes, root, root.1, &|_, _| true, &mut |node, lo, log2| {
+    any_leaf(nodes, root, root.1, &|_, _, _| true, &mut |node, lo, log2| {
         f(node, lo, log2);
         false
     });

@@ -132,9 +132,10 @@ pub(super) fn of_leaf<C: OctreeCapacities>(
         if *blocker != u32::MAX && blocks(last) {
             continue;
         }
-        let near = |lo: [i64; 3], log2: u32| {
+        // Empty leaves need no test.
+        let near = |node: OctreeNode<C::Index>, lo: [i64; 3], log2: u32| {
             let [lo, hi] = widened(lo, lo.map(|v| v + (1 << log2)));
-            shaft.meets(lo, hi)
+            (node.is_internal() || node.count() != 0) && shaft.meets(lo, hi)
         };
         let blocked = any_leaf(nodes, root, low, &near, &mut |leaf, _, _| {
             let n = nodes[leaf as usize];
