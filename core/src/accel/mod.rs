@@ -6,6 +6,8 @@
 //!   equal `t` the smallest [`ObjectId`] (the format's tie rule);
 //! - [`Accelerator::occluded`] answers whether any object is hit with
 //!   `0 < t ≤ t_max`, and may stop at the first one;
+//!   [`Accelerator::occluded_toward`] gives the same answer for a shadow ray
+//!   towards one of the scene's lights;
 //! - the object a ray starts on is treated as [`RayStart`] says;
 //! - an object is tested at most once per query when the caller provides a
 //!   [`Mailbox`] large enough for the scene (one bit per object).

@@ -25,6 +25,11 @@
 //!   hash lookups, no division after the ray's set-up, no stack (see
 //!   `dda.rs`).
 //!
+//! *Shadow shafts* (`shaft.rs`, when the config asks and the profile has
+//! room): per leaf and light, whether only the leaf's own objects come near
+//! the hull of those objects and the light; a shadow ray from such a leaf
+//! tests them and skips the walk, with the walk's answer.
+//!
 //! *Exactness.* A leaf's hits are final once the nearest is before the leaf's
 //! exit (strictly: an equal hit in the next leaf may come earlier in the
 //! file). With the filing margin wider than any rounding of a hit point,
