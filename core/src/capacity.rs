@@ -233,7 +233,7 @@ impl Counts {
         }
     }
 
-    /// Shadow-shaft words the octree keeps, one per box, when its config
+    /// Shadow shafts the octree keeps, one per box, when its config
     /// asks for them (`OctreeConfig::shadow_shafts`); 0 otherwise.
     pub const fn octree_shadow_shafts_if(&self, shadow_shafts: bool) -> usize {
         if shadow_shafts {

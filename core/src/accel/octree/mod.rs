@@ -146,6 +146,12 @@ impl<I: Index> OctreeNode<I> {
     pub(crate) fn count(&self) -> u32 {
         self.count.get()
     }
+    /// A leaf's object list in `refs` (not for the leaf that stands for
+    /// every object).
+    #[inline]
+    fn list<'r>(&self, refs: &'r [I]) -> &'r [I] {
+        &refs[self.first() as usize..(self.first() + self.count()) as usize]
+    }
 }
 
 /// The thesis's hash-table structure: a subdivided box's name and where its
@@ -178,8 +184,9 @@ pub struct OctreeConfig {
     /// How rays walk the tree; every walk gives the same hits.
     pub traversal: Traversal,
     /// Whether to find, for each leaf and light, whether shadow rays from
-    /// the leaf to the light can skip the walk (a word a box, see
-    /// [`OctreeCapacities::ShadowShafts`]); the image is the same.
+    /// the leaf to the light can skip the walk (a [`ShadowShaft`], 28
+    /// bytes, a box: see [`OctreeCapacities::ShadowShafts`]); the image is
+    /// the same.
     pub shadow_shafts: bool,
 }
 
@@ -610,8 +617,7 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
         let root = (0, self.root_min, self.root_log2);
         let (mut clear, mut blockers) = (0, [u32::MAX; shaft::LIGHTS]);
         for_each_leaf(nodes, root, &mut |leaf, lo, log2| {
-            let n = nodes[leaf as usize];
-            let own = &refs[n.first() as usize..(n.first() + n.count()) as usize];
+            let own = nodes[leaf as usize].list(refs);
             let found = shaft::of_leaf::<C>(nodes, refs, scene, root, (lo, log2), own, &mut blockers);
             clear += found.lights.count_ones() as usize;
             shafts[leaf as usize] = found;
@@ -718,14 +724,14 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
         if n.count() == C::Index::MAX - 1 {
             return None;
         }
-        Some(&self.refs.as_slice()[n.first() as usize..(n.first() + n.count()) as usize])
+        Some(n.list(self.refs.as_slice()))
     }
 }
 
 /// Whether `leaf(node, lo, log2)` holds for a leaf of the subtree at
 /// `node` (box `[lo, lo + 2^log2]`), visiting only the boxes that
-/// `enter(box, lo, log2)` admits, nearest `toward` first (its own octant, then those differing in
-/// one axis, …), and stopping at the first.
+/// `enter(box, lo, log2)` admits, nearest `toward` first (its own octant,
+/// then those differing in one axis, …), and stopping at the first.
 pub(super) fn any_leaf<I: Index>(
     nodes: &[OctreeNode<I>],
     (node, lo, log2): (u32, [i64; 3], u32),

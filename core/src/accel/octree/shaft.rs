@@ -39,6 +39,9 @@ pub struct ShadowShaft {
     high: [i32; 3],
 }
 
+// What the README and `OctreeConfig::shadow_shafts` say a box costs.
+const _: () = assert!(core::mem::size_of::<ShadowShaft>() == 28);
+
 impl ShadowShaft {
     /// No shaft: every shadow ray walks.
     pub(super) const NONE: ShadowShaft = ShadowShaft { lights: 0, low: [0; 3], high: [0; 3] };
@@ -124,12 +127,13 @@ pub(super) fn of_leaf<C: OctreeCapacities>(
     for ((index, light), blocker) in scene.lights.iter().take(LIGHTS).enumerate().zip(blockers) {
         let shaft = Shaft { low, high, light: light.position.wide() };
         let blocks = |id: C::Index| {
-            let b = bounds(id);
-            let [lo, hi] = widened(b.min.wide(), b.max.wide());
-            !own.contains(&id) && shaft.meets(lo, hi)
+            !own.contains(&id) && {
+                let b = bounds(id);
+                let [lo, hi] = widened(b.min.wide(), b.max.wide());
+                shaft.meets(lo, hi)
+            }
         };
-        let last = C::Index::new((*blocker).min(C::Index::MAX));
-        if *blocker != u32::MAX && blocks(last) {
+        if *blocker != u32::MAX && blocks(C::Index::new(*blocker)) {
             continue;
         }
         // Empty leaves need no test.
@@ -138,8 +142,7 @@ pub(super) fn of_leaf<C: OctreeCapacities>(
             (node.is_internal() || node.count() != 0) && shaft.meets(lo, hi)
         };
         let blocked = any_leaf(nodes, root, low, &near, &mut |leaf, _, _| {
-            let n = nodes[leaf as usize];
-            let found = refs[n.first() as usize..(n.first() + n.count()) as usize].iter().find(|&&id| blocks(id));
+            let found = nodes[leaf as usize].list(refs).iter().find(|&&id| blocks(id));
             found.map(|id| *blocker = id.get()).is_some()
         });
         if !blocked {
