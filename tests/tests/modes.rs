@@ -182,11 +182,10 @@ fn random_queries_agree_with_the_naive_mode() {
                     leaving: if rng.below(2) == 0 { Leaving::Inward } else { Leaving::Outward },
                 });
                 mailbox.clear();
-                let a = Naive.nearest(&view, &ray, start, &mut mailbox);
-                let a_hit = a;
+                let nearest = Naive.nearest(&view, &ray, start, &mut mailbox);
                 mailbox.clear();
                 let b = tree.nearest(&view, &ray, start, &mut mailbox);
-                assert_eq!(a, b, "round {round} {traversal:?} {config:?}: nearest along {ray:?}\n{text}");
+                assert_eq!(nearest, b, "round {round} {traversal:?} {config:?}: nearest along {ray:?}\n{text}");
                 let t_max = Scalar::from_bits((rng.range(0.0, 2.0) * scale) as i32);
                 mailbox.clear();
                 let a = Naive.occluded(&view, &ray, t_max, start, &mut mailbox);
@@ -195,7 +194,7 @@ fn random_queries_agree_with_the_naive_mode() {
                 assert_eq!(a, b, "round {round} {traversal:?}: occluded along {ray:?} to {t_max}\n{text}");
                 // Shadow rays from the hit to every light, as the tracer
                 // makes them: the octree's shadow shafts answer as the walk.
-                let Some(hit) = a_hit else { continue };
+                let Some(hit) = nearest else { continue };
                 let point = ray.at(hit.t);
                 for (light, l) in view.lights.iter().enumerate() {
                     let Some((dir, distance)) = (l.position - point).direction_and_length() else { continue };

@@ -164,6 +164,8 @@ mod tests {
     /// section moves less than that between samples).
     #[test]
     fn a_box_meets_the_shaft_when_a_cross_section_overlaps_it() {
+        // The test's own reference is plain f64 sampling; the shafts
+        // themselves are integers only.
         let seed = 0x5_4af7;
         let mut next = crate::test_rng::seeded(seed);
         let mut coordinate = move |span: u64| (next() % span) as i64 - (span / 2) as i64;
