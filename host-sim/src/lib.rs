@@ -409,7 +409,8 @@ fn stream_threads<A: Accelerator + Sync>(
         let mut busy = Duration::ZERO;
         let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
         let Ok(renderer) = Renderer::with_size(view, accel, w, h) else { return (Stats::default(), busy) };
-        let mut renderer = renderer.with_mailbox(&mut words);
+        let mut bounds = vec![octrace_core::render::ScreenBound::EMPTY; 2 * view.object_count()];
+        let mut renderer = renderer.with_mailbox(&mut words).with_first_hits(&mut bounds);
         // Equal4 hands the thesis's rectangles out statically.
         let mut own_next = thread;
         loop {

@@ -17,6 +17,7 @@ mod octree;
 
 pub use naive::Naive;
 pub(crate) use naive::NaiveFor;
+pub(crate) use octree::FILING_MARGIN;
 pub use octree::{
     BuildReport, HashEntry, Index, Octree, OctreeCapacities, OctreeConfig, OctreeNode, OctreeStore, ShadowShaft,
     Traversal, MAX_DEPTH,
@@ -218,6 +219,14 @@ pub trait Accelerator {
     /// tracer then clears before each query); false for one that tests
     /// every object once anyway.
     const USES_MAILBOX: bool = true;
+
+    /// Whether the renderer may find camera rays' hits in its screen-space
+    /// lists (see [`Renderer::with_first_hits`](crate::render::Renderer::with_first_hits))
+    /// instead of asking [`Accelerator::nearest`]: the same hits. False for
+    /// the naive mode, which stays the thesis's test of every object.
+    fn first_hits_by_screen(&self) -> bool {
+        false
+    }
 
     /// The nearest hit along `ray` (`t > 0`), ties to the earlier object.
     fn nearest(

@@ -11,16 +11,19 @@
 //! neighbours), then gamma-corrected and rounded. Its object is the one hit
 //! by sample (n/2, n/2), the centre sample for odd n.
 
+mod first_hit;
 mod gamma;
 mod panel;
 mod split;
 
+use first_hit::FirstHits;
+pub use first_hit::ScreenBound;
 pub(crate) use gamma::GammaTable;
 pub use panel::PanelColor;
 pub use split::{interleaved_rows, Tiles};
 
-use crate::accel::{Accelerator, Mailbox};
-use crate::scene::{Camera, CameraError, Color, ObjectId, RayCursor, SceneView};
+use crate::accel::{Accelerator, Hit, Mailbox};
+use crate::scene::{Camera, CameraError, Color, ObjectId, Projection, RayCursor, SceneView};
 use crate::shade::{Scratch, Stats, Tracer};
 use core::ops::Range;
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -66,6 +69,8 @@ pub struct Renderer<'a, A> {
     /// The last pixel's display values, where the next one's search starts.
     last_encoded: [u8; 3],
     scratch: Scratch<'a>,
+    /// Camera rays' objects by where they are seen, when given storage.
+    first_hits: Option<FirstHits<'a>>,
 }
 
 impl<A> core::fmt::Debug for Renderer<'_, A> {
@@ -97,6 +102,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
             gamma: GammaTable { thresholds: [0; 255] },
             last_encoded: [0; 3],
             scratch: Scratch::new(Mailbox::none()),
+            first_hits: None,
         };
         renderer.gamma.fill(s.gamma);
         Ok(renderer)
@@ -114,6 +120,30 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     /// matters on a board with a few KiB of stack).
     pub fn set_mailbox(&mut self, words: &'a mut [u32]) {
         self.scratch.mailbox = Mailbox::new(words);
+    }
+
+    /// Gives the renderer room for two [`ScreenBound`]s per object, so that
+    /// camera rays find their hits among the objects seen around their
+    /// pixel instead of walking the accelerator (when it allows:
+    /// [`Accelerator::first_hits_by_screen`]). The same image; too little
+    /// room leaves the walk.
+    pub fn with_first_hits(mut self, storage: &'a mut [ScreenBound]) -> Self {
+        if self.tracer.accel().first_hits_by_screen() {
+            let projection = Projection::new(&self.camera);
+            self.first_hits = FirstHits::new(self.tracer.scene(), &projection, storage);
+        }
+        self
+    }
+
+    /// The camera ray's hit from the screen lists, if the renderer has them.
+    #[inline]
+    fn first_hit(&mut self, ray: &crate::shapes::Ray, x: u32, y: u32, sx: u32, sy: u32) -> Option<Option<Hit>> {
+        let hits = self.first_hits.as_mut()?;
+        let camera = &self.camera;
+        let last = camera.samples() - 1;
+        let band = hits.for_row(y, |row| [camera.offsets(0, row, 0, last).1, camera.offsets(0, row, 0, 0).1]);
+        let offsets = camera.offsets(x, y, sx, sy);
+        Some(first_hit::nearest(self.tracer.scene(), A::KINDS, band, ray, offsets))
     }
 
     /// Counters since the renderer was made.
@@ -135,7 +165,8 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         let (mean, object) = if n == 1 {
             // One sample (the common case on a board): no loops, no sums.
             let ray = self.camera.next_ray(&mut self.cursor, x, y, 0, 0);
-            let (c, object) = self.tracer.trace(ray, &mut self.scratch);
+            let first = self.first_hit(&ray, x, y, 0, 0);
+            let (c, object) = self.tracer.trace(ray, first, &mut self.scratch);
             (Color::from_bits(c.bits().map(|v| v.clamp(0, 1 << 16))), object)
         } else {
             self.mean_of_samples(n, x, y)
@@ -158,7 +189,8 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         for sy in 0..n {
             for sx in 0..n {
                 let ray = self.camera.next_ray(&mut self.cursor, x, y, sx, sy);
-                let (c, o) = self.tracer.trace(ray, &mut self.scratch);
+                let first = self.first_hit(&ray, x, y, sx, sy);
+                let (c, o) = self.tracer.trace(ray, first, &mut self.scratch);
                 if sx == n / 2 && sy == n / 2 {
                     object = o;
                 }

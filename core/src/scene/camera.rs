@@ -203,7 +203,7 @@ impl Camera {
 
     /// The sub-cell's offsets from the image centre in half sub-cells.
     #[inline]
-    fn offsets(&self, x: u32, y: u32, sx: u32, sy: u32) -> (i32, i32) {
+    pub(crate) fn offsets(&self, x: u32, y: u32, sx: u32, sy: u32) -> (i32, i32) {
         // |k| ≤ 2 · MAX_SAMPLES · MAX_SIDE: the offsets fit an i32.
         let n = self.samples as i32;
         let kx = 2 * n * x as i32 + 2 * sx as i32 + 1 - n * self.width as i32;
@@ -224,6 +224,90 @@ impl Camera {
             // perpendicular component.
             dir: Dir::normalize(d).unwrap_or(Dir::Z),
         }
+    }
+}
+
+/// Where the camera sees points: the offsets (as [`Camera::offsets`]) of the
+/// ray through a point in front of the eye. A direction is `F + kx·X + ky·Y`
+/// (forward and the two steps), so a point `v` from the eye lies on the ray
+/// of `kx = v·(Y×F) / v·(X×Y)` and `ky = v·(F×X) / v·(X×Y)` (Cramer's
+/// rule, no assumption that the steps are orthogonal). The three normals
+/// are kept in `i64`, all cut by the same shift so their ratios hold.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Projection {
+    eye: [i64; 3],
+    across: [i64; 3],
+    down: [i64; 3],
+    depth: [i64; 3],
+    /// Each normal's components are below 2^s of the true ones' scale: the
+    /// cut moves a product with `v` by less than Σ|v_a| (in that scale).
+    _cut: u32,
+}
+
+/// The offsets' range beyond which a window is not worth bounding.
+const OFFSET_LIMIT: i128 = 1 << 40;
+
+impl Projection {
+    pub(crate) fn new(camera: &Camera) -> Projection {
+        let wide = |v: [i64; 3]| v.map(|c| c as i128);
+        let (f, x, y) = (wide(camera.forward), wide(camera.step_x), wide(camera.step_y));
+        let cross = |a: [i128; 3], b: [i128; 3]| {
+            [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+        };
+        let (across, down, depth) = (cross(y, f), cross(f, x), cross(x, y));
+        let top = [across, down, depth].iter().flatten().map(|c| c.unsigned_abs()).max().unwrap_or(0);
+        let cut = (128 - top.leading_zeros()).saturating_sub(62);
+        let cut_down = |v: [i128; 3]| v.map(|c| (c >> cut) as i64);
+        let (mut across, mut down, mut depth) = (cut_down(across), cut_down(down), cut_down(depth));
+        // Oriented so that points ahead of the eye have a positive depth.
+        let ahead: i128 = (0..3).map(|a| f[a] * depth[a] as i128).sum();
+        if ahead < 0 {
+            for v in [&mut across, &mut down, &mut depth] {
+                *v = v.map(|c| -c);
+            }
+        }
+        let eye = camera.eye.bits().map(|c| c as i64);
+        Projection { eye, across, down, depth, _cut: cut }
+    }
+
+    /// The offsets `[kx_min, kx_max]` and `[ky_min, ky_max]` of every ray
+    /// that can pass through the box `[lo, hi]` (normalised units), widened
+    /// by the projection's rounding and two half sub-cells; `None` when the
+    /// box is not wholly ahead of the eye (any ray may then meet it).
+    pub(crate) fn window(&self, lo: [i64; 3], hi: [i64; 3]) -> Option<[[i32; 2]; 2]> {
+        let dot = |n: &[i64; 3], v: &[i64; 3]| (0..3).map(|a| n[a] as i128 * v[a] as i128).sum::<i128>();
+        let mut window = [[i128::MAX, i128::MIN]; 2];
+        for corner in 0..8 {
+            let v = [0, 1, 2].map(|a| if corner >> a & 1 == 1 { hi[a] } else { lo[a] } - self.eye[a]);
+            let depth = dot(&self.depth, &v);
+            // Σ|v_a| bounds what the cut normals' rounding moves each product.
+            let slack = v.iter().map(|c| c.unsigned_abs() as i128).sum::<i128>();
+            if depth <= 2 * slack {
+                return None;
+            }
+            for (axis, normal) in [&self.across, &self.down].into_iter().enumerate() {
+                let num = dot(normal, &v);
+                let k = num.div_euclid(depth);
+                if k.abs() >= OFFSET_LIMIT {
+                    return None;
+                }
+                // |true k − num/depth| ≤ slack·(1 + |k|) / (depth − slack).
+                let error = slack * (2 + k.abs()) / (depth - slack) + 1;
+                window[axis][0] = window[axis][0].min(k - error);
+                window[axis][1] = window[axis][1].max(k + 1 + error);
+            }
+        }
+        Some(window.map(|[a, b]| {
+            [
+                (a - 2).clamp(i32::MIN as i128, i32::MAX as i128) as i32,
+                (b + 2).clamp(i32::MIN as i128, i32::MAX as i128) as i32,
+            ]
+        }))
+    }
+
+    /// The eye in normalised units.
+    pub(crate) fn eye(&self) -> [i64; 3] {
+        self.eye
     }
 }
 

@@ -17,8 +17,8 @@ mod camera;
 mod normalize;
 mod surface;
 
-pub(crate) use camera::RayCursor;
 pub use camera::{Camera, CameraError, View, MAX_SAMPLES, MAX_SIDE};
+pub(crate) use camera::{Projection, RayCursor};
 pub use normalize::{Normalization, WorldPoint, WorldValue};
 pub use surface::{Color, Surface, SurfaceEntry};
 

@@ -141,12 +141,25 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         Tracer { scene, accel }
     }
 
+    pub fn scene(&self) -> &SceneView<'a> {
+        &self.scene
+    }
+
+    pub fn accel(&self) -> &'a A {
+        self.accel
+    }
+
     /// The linear colour seen along a primary ray, and the object it hits (as
     /// written: [`SceneView::written_object`]).
     // Not inlined: a frame of its own keeps the stack of a small board bounded
     // (inlined into the row loop, its locals and the pending rays multiply).
     #[inline(never)]
-    pub fn trace(&self, ray: Ray, scratch: &mut Scratch<'_>) -> (Color, Option<ObjectId>) {
+    pub fn trace(
+        &self,
+        ray: Ray,
+        mut first_hit: Option<Option<Hit>>,
+        scratch: &mut Scratch<'_>,
+    ) -> (Color, Option<ObjectId>) {
         let mut stack: heapless::Vec<Pending, PENDING_RAYS> = heapless::Vec::new();
         let mut color = Color::BLACK;
         let mut first_object = None;
@@ -164,7 +177,10 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             if A::USES_MAILBOX {
                 scratch.mailbox.clear();
             }
-            let hit = self.accel.nearest(&self.scene, &p.ray, p.start, &mut scratch.mailbox);
+            let hit = match first_hit.take() {
+                Some(hit) => hit,
+                None => self.accel.nearest(&self.scene, &p.ray, p.start, &mut scratch.mailbox),
+            };
             if p.depth == 0 {
                 first_object = hit.map(|h| self.scene.written_object(h.object));
             }
@@ -385,7 +401,7 @@ mod shading_tests {
         let eye = view.normalization.point(view.settings.view.eye);
         let tracer = Tracer::new(view, &Naive);
         let mut scratch = Scratch::new(Mailbox::none());
-        let (c, o) = tracer.trace(Ray { origin: eye, dir: -Dir::Z }, &mut scratch);
+        let (c, o) = tracer.trace(Ray { origin: eye, dir: -Dir::Z }, None, &mut scratch);
         (c, o, scratch.stats)
     }
 
@@ -454,11 +470,11 @@ mod shading_tests {
         let ray = |x: i64| Ray { origin: view.normalization.point([x, 0, 3 << 32]), dir: -Dir::Z };
         let tracer = Tracer::new(view, &Naive);
         let mut alone = Scratch::new(Mailbox::none());
-        let lit = tracer.trace(ray(1 << 31), &mut alone).0;
+        let lit = tracer.trace(ray(1 << 31), None, &mut alone).0;
         let mut shared = Scratch::new(Mailbox::none());
-        let shadowed = tracer.trace(ray(0), &mut shared).0;
+        let shadowed = tracer.trace(ray(0), None, &mut shared).0;
         approx(shadowed, [m(100); 3]); // the pole is in shadow: ambient only
-        assert_eq!(tracer.trace(ray(1 << 31), &mut shared).0, lit);
+        assert_eq!(tracer.trace(ray(1 << 31), None, &mut shared).0, lit);
         assert_ne!(lit, shadowed);
     }
 

@@ -789,6 +789,11 @@ impl<C: OctreeCapacities, const FRAMES: usize> OctreeStore for Octree<C, FRAMES>
 impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES> {
     const KINDS: ShapeKinds = C::KINDS;
 
+    /// Only for 3DDDA: the thesis's walk stays the thesis's for every ray.
+    fn first_hits_by_screen(&self) -> bool {
+        self.walked_by() == Traversal::Dda
+    }
+
     #[inline(never)]
     fn nearest(
         &self,
