@@ -19,7 +19,7 @@
 
 use crate::accel::{Hit, FILING_MARGIN};
 use crate::math::{isqrt_u128, Scalar};
-use crate::scene::{ObjectId, Projection, SceneView};
+use crate::scene::{Camera, ObjectId, Projection, SceneView};
 use crate::shapes::{Leaving, Ray, ShapeKinds};
 
 /// Rows of a band: its objects are chosen once for them all.
@@ -90,15 +90,32 @@ impl<'a> FirstHits<'a> {
         Some(FirstHits { storage, objects, band: 0, band_start: u32::MAX })
     }
 
-    /// The objects that camera rays of row `y` may hit, nearest bound first;
-    /// `ky_of_row(y)` gives the offsets `[min, max]` of a row's rays.
+    /// The nearest hit of `camera`'s ray through sub-cell (`sx`, `sy`) of
+    /// pixel (`x`, `y`), `ray`: the hit every accelerator's `nearest`
+    /// returns for it.
     #[inline]
-    pub fn for_row(&mut self, y: u32, ky_of_row: impl Fn(u32) -> [i32; 2]) -> &[ScreenBound] {
+    pub fn nearest(
+        &mut self,
+        scene: &SceneView<'_>,
+        kinds: ShapeKinds,
+        camera: &Camera,
+        ray: &Ray,
+        [x, y, sx, sy]: [u32; 4],
+    ) -> Option<Hit> {
+        let band = self.band(camera, y);
+        nearest(scene, kinds, band, ray, camera.offsets(x, y, sx, sy))
+    }
+
+    /// The objects that camera rays of row `y` may hit, nearest bound first.
+    #[inline]
+    fn band(&mut self, camera: &Camera, y: u32) -> &[ScreenBound] {
         let start = y - y % BAND_ROWS;
         if start != self.band_start {
             self.band_start = start;
-            let [low, _] = ky_of_row(start.saturating_add(BAND_ROWS - 1));
-            let [_, high] = ky_of_row(start);
+            // The band's offsets: from its last row's last sub-cells up to
+            // its first row's first.
+            let low = camera.offsets(0, start.saturating_add(BAND_ROWS - 1), 0, camera.samples() - 1).1;
+            let high = camera.offsets(0, start, 0, 0).1;
             let (all, band) = self.storage.split_at_mut(self.objects);
             let mut kept = 0;
             for bound in all.iter().filter(|b| b.y[0] <= high && b.y[1] >= low) {
@@ -112,9 +129,9 @@ impl<'a> FirstHits<'a> {
 }
 
 /// The nearest hit of the camera ray with offsets `(kx, ky)` among `band`'s
-/// objects: the hit every accelerator's `nearest` returns.
+/// objects.
 #[inline]
-pub(crate) fn nearest(
+fn nearest(
     scene: &SceneView<'_>,
     kinds: ShapeKinds,
     band: &[ScreenBound],
@@ -138,4 +155,183 @@ pub(crate) fn nearest(
         }
     }
     (best.object != NONE).then_some(best)
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::accel::{Accelerator, Mailbox, Naive};
+    use crate::parse::parse;
+    use crate::profile::Board64K;
+    use crate::scene::Scene;
+    use std::{boxed::Box, format, string::String, vec};
+
+    /// A random scene of spheres, boxes, rectangles and triangles around
+    /// the origin, seen from anywhere near or among them (eye inside some
+    /// objects' bounds, objects behind it and beside it), wide or narrow,
+    /// with one to three samples a side.
+    fn random_scene(next: &mut impl FnMut() -> u64) -> Box<Scene<Board64K>> {
+        fn coordinate(next: &mut impl FnMut() -> u64, range: u64) -> f64 {
+            (next() % (2 * range * 100 + 1)) as f64 / 100.0 - range as f64
+        }
+        let mut text = String::from("SURFACE 1 0.1 0.1 0.1 0.5 0.5 0.5 0 0 0 0 0 0\n");
+        let eye = [0; 3].map(|_| coordinate(next, 9));
+        text += &format!("VIEWPOINT {} {} {}\n", eye[0], eye[1], eye[2]);
+        text += &format!("ORIGIN {} {} {}\n", coordinate(next, 2), coordinate(next, 2), coordinate(next, 2));
+        text += &format!("RASTER {} {}\n", 4 + next() % 29, 4 + next() % 23);
+        text += &format!("SAMPLES {}\n", 1 + next() % 3);
+        if next() % 3 == 0 {
+            text +=
+                &format!("VIEWPORT {} {}\n", 0.5 + (next() % 300) as f64 / 10.0, 0.5 + (next() % 300) as f64 / 10.0);
+        }
+        // Sometimes a board: tiles on a box's top face, sharing edges and
+        // the face's plane (equal parameters: the earlier object wins).
+        if next() % 2 == 0 {
+            let board = "BOX 1 0 -1 0 3 1 3\n";
+            let before = next() % 2 == 0;
+            if before {
+                text += board;
+            }
+            for (i, j) in (0..9).map(|k| (k % 3 * 2 - 3, k / 3 * 2 - 3)) {
+                text += &format!("RECTANGLE 1 {i} 0 {} {} 0 {} {} 0 {j} {i} 0 {j}\n", j + 2, i + 2, j + 2, i + 2);
+            }
+            if !before {
+                text += board;
+            }
+        }
+        for _ in 0..1 + next() % 30 {
+            let c = [0; 3].map(|_| coordinate(next, 6));
+            let size = |next: &mut dyn FnMut() -> u64| 0.05 + (next() % 300) as f64 / 100.0;
+            text += &match next() % 4 {
+                0 => format!("SPHERE 1 {} {} {} {}\n", size(next), c[0], c[1], c[2]),
+                1 => format!("BOX 1 {} {} {} {} {} {}\n", c[0], c[1], c[2], size(next), size(next), size(next)),
+                2 => {
+                    let (w, h) = (size(next), size(next));
+                    let [x, y, z] = c;
+                    format!("RECTANGLE 1 {x} {y} {z} {} {y} {z} {} {y} {} {x} {y} {}\n", x + w, x + w, z - h, z - h)
+                }
+                _ => {
+                    let p = [0; 6].map(|_| size(next) - 1.5);
+                    let [x, y, z] = c;
+                    format!(
+                        "TRIANGLE 1 {x} {y} {z} {} {} {} {} {} {}\n",
+                        x + p[0],
+                        y + p[1],
+                        z,
+                        x + p[2],
+                        y + p[3],
+                        z + p[4] + p[5]
+                    )
+                }
+            };
+        }
+        let mut scene: Box<Scene<Board64K>> = Box::default();
+        // Degenerate views or shapes are errors: those scenes are skipped.
+        if parse(&text, &mut scene, &mut |_| {}).is_err() {
+            scene.clear();
+        }
+        scene
+    }
+
+    /// Every camera ray of random scenes gets the naive mode's hit (the
+    /// same parameter and object), while most of the objects' tests are
+    /// skipped.
+    #[test]
+    fn camera_rays_find_the_naive_hit() {
+        let mut next = crate::test_rng::seeded(0xf1a5_7417);
+        let (mut rays, mut skipped, mut naive_tests) = (0u64, 0u64, 0u64);
+        for _ in 0..300 {
+            let scene = random_scene(&mut next);
+            let view = scene.view();
+            let [w, h] = view.settings.raster;
+            if view.object_count() == 0 || w == 0 {
+                continue;
+            }
+            let camera = Camera::new(&view.settings.view, &view.normalization, w, h, view.settings.samples).unwrap();
+            let mut storage = vec![ScreenBound::EMPTY; 2 * view.object_count()];
+            let mut hits = FirstHits::new(&view, &Projection::new(&camera), &mut storage).unwrap();
+            let n = camera.samples();
+            for y in 0..h {
+                let tested = hits.band(&camera, y).len() as u64;
+                for x in 0..w {
+                    for (sx, sy) in (0..n * n).map(|s| (s % n, s / n)) {
+                        let ray = camera.ray(x, y, sx, sy);
+                        let listed = hits.nearest(&view, ShapeKinds::ALL, &camera, &ray, [x, y, sx, sy]);
+                        let naive = Naive.nearest(&view, &ray, None, &mut Mailbox::none());
+                        assert_eq!(listed, naive, "pixel {x} {y}, sample {sx} {sy}");
+                        rays += 1;
+                        skipped += view.object_count() as u64 - tested;
+                        naive_tests += view.object_count() as u64;
+                    }
+                }
+            }
+        }
+        std::println!("{rays} rays; bands left out {skipped} of {naive_tests} objects");
+        assert!(rays > 100_000 && skipped * 3 > naive_tests, "the lists must leave objects out");
+    }
+
+    /// Windows hold the offsets of every point of their box ahead of the
+    /// eye (exact f64 solutions of `v = αF + βX + γY`), and are not much
+    /// wider than the corners' own offsets.
+    #[test]
+    fn windows_hold_every_point_of_the_box_and_little_more() {
+        let mut next = crate::test_rng::seeded(0x3d_b0c5);
+        let mut bounded = 0;
+        for _ in 0..300 {
+            let scene = random_scene(&mut next);
+            let view = scene.view();
+            let [w, h] = view.settings.raster;
+            if w == 0 {
+                continue;
+            }
+            let camera = Camera::new(&view.settings.view, &view.normalization, w, h, view.settings.samples).unwrap();
+            let projection = Projection::new(&camera);
+            let f64s = |v: [i64; 3]| v.map(|c| c as f64);
+            let (f, x, y) = (f64s(camera.forward), f64s(camera.step_x), f64s(camera.step_y));
+            let det = |a: [f64; 3], b: [f64; 3], c: [f64; 3]| {
+                a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                    + a[2] * (b[0] * c[1] - b[1] * c[0])
+            };
+            let offsets = |v: [f64; 3]| {
+                let alpha = det(v, x, y) / det(f, x, y);
+                (alpha, det(f, v, y) / det(v, x, y), det(f, x, v) / det(v, x, y))
+            };
+            let eye = projection.eye();
+            for _ in 0..20 {
+                let lo = [0; 3].map(|_| (next() % (1 << 24)) as i64 - (1 << 23));
+                let hi = [0, 1, 2].map(|a| lo[a] + (next() % (1 << (next() % 24))) as i64);
+                let corners = (0..8).map(|c| [0, 1, 2].map(|a| if c >> a & 1 == 1 { hi[a] } else { lo[a] } - eye[a]));
+                let Some([wx, wy]) = projection.window(lo, hi) else {
+                    continue;
+                };
+                bounded += 1;
+                let (mut min, mut max) = ([f64::MAX; 2], [f64::MIN; 2]);
+                for v in corners {
+                    let (alpha, kx, ky) = offsets(f64s(v));
+                    assert!(alpha > 0.0, "a window for a box not ahead of the eye");
+                    min = [min[0].min(kx), min[1].min(ky)];
+                    max = [max[0].max(kx), max[1].max(ky)];
+                }
+                for (axis, window) in [wx, wy].into_iter().enumerate() {
+                    assert!(
+                        window[0] as f64 <= min[axis] && max[axis] <= window[1] as f64,
+                        "{window:?} {min:?} {max:?}"
+                    );
+                    let fits = |k: f64| k.abs() < (1u64 << 30) as f64;
+                    if fits(min[axis]) && fits(max[axis]) {
+                        assert!(min[axis] - window[0] as f64 <= 8.0 && window[1] as f64 - max[axis] <= 8.0, "loose");
+                    }
+                }
+                // Points inside the box lie between the corners' offsets
+                // (a convex box projects onto its corners' hull).
+                for _ in 0..4 {
+                    let p = [0, 1, 2].map(|a| lo[a] + (next() % (hi[a] - lo[a] + 1) as u64) as i64 - eye[a]);
+                    let (_, kx, ky) = offsets(f64s(p));
+                    assert!(wx[0] as f64 <= kx && kx <= wx[1] as f64 && wy[0] as f64 <= ky && ky <= wy[1] as f64);
+                }
+            }
+        }
+        assert!(bounded > 1000, "{bounded} boxes had windows");
+    }
 }

@@ -139,11 +139,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     #[inline]
     fn first_hit(&mut self, ray: &crate::shapes::Ray, x: u32, y: u32, sx: u32, sy: u32) -> Option<Option<Hit>> {
         let hits = self.first_hits.as_mut()?;
-        let camera = &self.camera;
-        let last = camera.samples() - 1;
-        let band = hits.for_row(y, |row| [camera.offsets(0, row, 0, last).1, camera.offsets(0, row, 0, 0).1]);
-        let offsets = camera.offsets(x, y, sx, sy);
-        Some(first_hit::nearest(self.tracer.scene(), A::KINDS, band, ray, offsets))
+        Some(hits.nearest(self.tracer.scene(), A::KINDS, &self.camera, ray, [x, y, sx, sy]))
     }
 
     /// Counters since the renderer was made.

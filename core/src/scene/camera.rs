@@ -64,9 +64,9 @@ pub struct Camera {
     eye: Vec3,
     /// Forward, and the per-unit steps along r and u, in a common fixed-point
     /// scale chosen so that no pixel's direction overflows.
-    forward: [i64; 3],
-    step_x: [i64; 3],
-    step_y: [i64; 3],
+    pub(crate) forward: [i64; 3],
+    pub(crate) step_x: [i64; 3],
+    pub(crate) step_y: [i64; 3],
     width: u32,
     height: u32,
     samples: u32,
