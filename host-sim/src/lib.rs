@@ -22,7 +22,7 @@ use embedded_graphics_core::primitives::Rectangle;
 use octrace_core::accel::{Accelerator, BuildReport, Mailbox, Naive, Octree, OctreeConfig, Traversal};
 use octrace_core::parse::{parse_bytes, ParseError};
 use octrace_core::profile::Host;
-use octrace_core::render::{Renderer, Tiles};
+use octrace_core::render::{Renderer, ScreenBound, Tiles};
 use octrace_core::scene::{CameraError, Scene, SceneView};
 use octrace_core::shade::Stats;
 use std::path::Path;
@@ -409,7 +409,7 @@ fn stream_threads<A: Accelerator + Sync>(
         let mut busy = Duration::ZERO;
         let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
         let Ok(renderer) = Renderer::with_size(view, accel, w, h) else { return (Stats::default(), busy) };
-        let mut bounds = vec![octrace_core::render::ScreenBound::EMPTY; 2 * view.object_count()];
+        let mut bounds = vec![ScreenBound::EMPTY; ScreenBound::needed_for(view.object_count())];
         let mut renderer = renderer.with_mailbox(&mut words).with_first_hits(&mut bounds);
         // Equal4 hands the thesis's rectangles out statically.
         let mut own_next = thread;

@@ -24,11 +24,15 @@ use crate::shapes::{Leaving, Ray, ShapeKinds};
 
 /// Rows of a band: its objects are chosen once for them all.
 const BAND_ROWS: u32 = 8;
+/// A band seen through more objects than this leaves its camera rays to
+/// the accelerator: a ray that hits nothing reads the whole list, which
+/// would cost more than the walk (a scene of 10,000 small spheres).
+const MAX_BAND_OBJECTS: usize = 128;
 
 /// What a camera ray needs to know of one object: where in the image its
 /// bounds are seen and how near its hit can be. Storage for
-/// [`Renderer::with_first_hits`](super::Renderer::with_first_hits): two per
-/// object.
+/// [`Renderer::with_first_hits`](super::Renderer::with_first_hits), of
+/// [`ScreenBound::needed_for`] the scene's objects.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ScreenBound {
     /// No camera ray hits the object at a smaller parameter (Q16.16 bits).
@@ -44,6 +48,12 @@ pub struct ScreenBound {
 impl ScreenBound {
     /// A placeholder to fill storage with.
     pub const EMPTY: ScreenBound = ScreenBound { near: 0, object: 0, x: [0; 2], y: [0; 2] };
+
+    /// How many a renderer needs for `objects` objects: one each, and a
+    /// band's worth.
+    pub const fn needed_for(objects: usize) -> usize {
+        objects + if objects < MAX_BAND_OBJECTS + 1 { objects } else { MAX_BAND_OBJECTS + 1 }
+    }
 
     fn of(scene: &SceneView<'_>, projection: &Projection, id: ObjectId) -> ScreenBound {
         let bounds = scene.shape(id).bounds();
@@ -79,20 +89,21 @@ pub(crate) struct FirstHits<'a> {
 
 impl<'a> FirstHits<'a> {
     /// The bounds of `scene`'s objects seen by `projection`, or `None`
-    /// when `storage` holds fewer than two per object.
+    /// when `storage` holds fewer than [`ScreenBound::needed_for`] them.
     pub fn new(scene: &SceneView<'_>, projection: &Projection, storage: &'a mut [ScreenBound]) -> Option<Self> {
         let objects = scene.object_count();
-        let all = storage.get_mut(..objects.checked_mul(2)?)?;
+        let storage = storage.get_mut(..ScreenBound::needed_for(objects))?;
+        let all = &mut storage[..objects];
         for (slot, id) in all.iter_mut().zip(scene.object_ids()) {
             *slot = ScreenBound::of(scene, projection, id);
         }
-        all[..objects].sort_unstable_by_key(|b| (b.near, b.object));
+        all.sort_unstable_by_key(|b| (b.near, b.object));
         Some(FirstHits { storage, objects, band: 0, band_start: u32::MAX })
     }
 
     /// The nearest hit of `camera`'s ray through sub-cell (`sx`, `sy`) of
     /// pixel (`x`, `y`), `ray`: the hit every accelerator's `nearest`
-    /// returns for it.
+    /// returns for it; `None` where the lists are too long to pay.
     #[inline]
     pub fn nearest(
         &mut self,
@@ -101,14 +112,15 @@ impl<'a> FirstHits<'a> {
         camera: &Camera,
         ray: &Ray,
         [x, y, sx, sy]: [u32; 4],
-    ) -> Option<Hit> {
-        let band = self.band(camera, y);
-        nearest(scene, kinds, band, ray, camera.offsets(x, y, sx, sy))
+    ) -> Option<Option<Hit>> {
+        let band = self.band(camera, y)?;
+        Some(nearest(scene, kinds, band, ray, camera.offsets(x, y, sx, sy)))
     }
 
-    /// The objects that camera rays of row `y` may hit, nearest bound first.
+    /// The objects that camera rays of row `y` may hit, nearest bound
+    /// first, or `None` when they are too many.
     #[inline]
-    fn band(&mut self, camera: &Camera, y: u32) -> &[ScreenBound] {
+    fn band(&mut self, camera: &Camera, y: u32) -> Option<&[ScreenBound]> {
         let start = y - y % BAND_ROWS;
         if start != self.band_start {
             self.band_start = start;
@@ -119,12 +131,15 @@ impl<'a> FirstHits<'a> {
             let (all, band) = self.storage.split_at_mut(self.objects);
             let mut kept = 0;
             for bound in all.iter().filter(|b| b.y[0] <= high && b.y[1] >= low) {
+                if kept > MAX_BAND_OBJECTS {
+                    break;
+                }
                 band[kept] = *bound;
                 kept += 1;
             }
             self.band = kept;
         }
-        &self.storage[self.objects..self.objects + self.band]
+        (self.band <= MAX_BAND_OBJECTS).then(|| &self.storage[self.objects..self.objects + self.band])
     }
 }
 
@@ -249,17 +264,17 @@ mod tests {
                 continue;
             }
             let camera = Camera::new(&view.settings.view, &view.normalization, w, h, view.settings.samples).unwrap();
-            let mut storage = vec![ScreenBound::EMPTY; 2 * view.object_count()];
+            let mut storage = vec![ScreenBound::EMPTY; ScreenBound::needed_for(view.object_count())];
             let mut hits = FirstHits::new(&view, &Projection::new(&camera), &mut storage).unwrap();
             let n = camera.samples();
             for y in 0..h {
-                let tested = hits.band(&camera, y).len() as u64;
+                let tested = hits.band(&camera, y).map_or(view.object_count(), <[_]>::len) as u64;
                 for x in 0..w {
                     for (sx, sy) in (0..n * n).map(|s| (s % n, s / n)) {
                         let ray = camera.ray(x, y, sx, sy);
                         let listed = hits.nearest(&view, ShapeKinds::ALL, &camera, &ray, [x, y, sx, sy]);
                         let naive = Naive.nearest(&view, &ray, None, &mut Mailbox::none());
-                        assert_eq!(listed, naive, "pixel {x} {y}, sample {sx} {sy}");
+                        assert_eq!(listed.unwrap_or(naive), naive, "pixel {x} {y}, sample {sx} {sy}");
                         rays += 1;
                         skipped += view.object_count() as u64 - tested;
                         naive_tests += view.object_count() as u64;

@@ -122,11 +122,30 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         self.scratch.mailbox = Mailbox::new(words);
     }
 
-    /// Gives the renderer room for two [`ScreenBound`]s per object, so that
-    /// camera rays find their hits among the objects seen around their
-    /// pixel instead of walking the accelerator (when it allows:
-    /// [`Accelerator::first_hits_by_screen`]). The same image; too little
-    /// room leaves the walk.
+    /// Gives the renderer room for [`ScreenBound::needed_for`] the scene's
+    /// objects, so that camera rays find their hits among the objects seen
+    /// around their pixel instead of walking the accelerator, when it
+    /// allows ([`Accelerator::first_hits_by_screen`]: the octree's 3DDDA).
+    /// The same image, faster; too little room leaves the walk.
+    ///
+    /// ```
+    /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888};
+    /// use octrace_core::{accel::Octree, parse::parse, profile::{Board16K, Profile}};
+    /// use octrace_core::{render::{Renderer, ScreenBound}, scene::Scene};
+    ///
+    /// let mut scene = Scene::<Board16K>::new();
+    /// parse("RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSPHERE 1 0.5 2 1 1\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n", &mut scene, &mut |e| panic!("{e}")).unwrap();
+    /// let mut octree = Octree::<Board16K>::new();
+    /// octree.build(&scene.view(), &Board16K::OCTREE);
+    ///
+    /// let mut bounds = [ScreenBound::EMPTY; ScreenBound::needed_for(2)];
+    /// let mut listed = MockDisplay::<Rgb888>::new();
+    /// Renderer::new(scene.view(), &octree)?.with_first_hits(&mut bounds).render(&mut listed)?;
+    /// let mut walked = MockDisplay::<Rgb888>::new();
+    /// Renderer::new(scene.view(), &octree)?.render(&mut walked)?;
+    /// assert_eq!(listed, walked);
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
     pub fn with_first_hits(mut self, storage: &'a mut [ScreenBound]) -> Self {
         if self.tracer.accel().first_hits_by_screen() {
             let projection = Projection::new(&self.camera);
@@ -138,8 +157,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     /// The camera ray's hit from the screen lists, if the renderer has them.
     #[inline]
     fn first_hit(&mut self, ray: &crate::shapes::Ray, x: u32, y: u32, sx: u32, sy: u32) -> Option<Option<Hit>> {
-        let hits = self.first_hits.as_mut()?;
-        Some(hits.nearest(self.tracer.scene(), A::KINDS, &self.camera, ray, [x, y, sx, sy]))
+        self.first_hits.as_mut()?.nearest(self.tracer.scene(), A::KINDS, &self.camera, ray, [x, y, sx, sy])
     }
 
     /// Counters since the renderer was made.
