@@ -18,12 +18,16 @@
 //! object whose bound is not beyond the nearest hit.
 
 use crate::accel::{Hit, FILING_MARGIN};
-use crate::math::{isqrt_u128, Scalar};
+use crate::math::{isqrt, Scalar};
 use crate::scene::{Camera, ObjectId, Projection, SceneView};
 use crate::shapes::{Leaving, Ray, ShapeKinds};
 
 /// Rows of a band: its objects are chosen once for them all.
 const BAND_ROWS: u32 = 8;
+/// The lists pay for their set-up (a projection and a sort per object)
+/// when there are at least this many camera rays per object; a scene of
+/// more objects than that is left to the walk.
+const MIN_RAYS_PER_OBJECT: u64 = 16;
 /// A band seen through more objects than this leaves its camera rays to
 /// the accelerator: a ray that hits nothing reads the whole list, which
 /// would cost more than the walk (a scene of 10,000 small spheres).
@@ -69,7 +73,12 @@ impl ScreenBound {
         // A hit's parameter times |dir| (1 + 2^-29 at most) is the hit
         // point's distance from the eye, at least the box's, up to the
         // rounding of the point: a few units below the distance.
-        let distance = isqrt_u128(gap2) as i64;
+        // Within the normalised range the squares fit a u64; beyond it the
+        // largest gap is a lower bound of the distance too.
+        let distance = match u64::try_from(gap2) {
+            Ok(gap2) => isqrt(gap2) as i64,
+            Err(_) => (0..3).map(|a| (lo[a] - eye[a]).max(eye[a] - hi[a])).max().unwrap_or(0),
+        };
         let near = (distance - (distance >> 28) - 8).clamp(0, i32::MAX as i64) as i32;
         let [x, y] = projection.window(lo, hi).unwrap_or([[i32::MIN, i32::MAX]; 2]);
         ScreenBound { near, object: id.0, x, y }
@@ -88,14 +97,20 @@ pub(crate) struct FirstHits<'a> {
 }
 
 impl<'a> FirstHits<'a> {
-    /// The bounds of `scene`'s objects seen by `projection`, or `None`
-    /// when `storage` holds fewer than [`ScreenBound::needed_for`] them.
-    pub fn new(scene: &SceneView<'_>, projection: &Projection, storage: &'a mut [ScreenBound]) -> Option<Self> {
+    /// The bounds of `scene`'s objects seen by `camera`, or `None` when
+    /// `storage` holds fewer than [`ScreenBound::needed_for`] them or the
+    /// objects are too many for the image to pay for them.
+    pub fn new(scene: &SceneView<'_>, camera: &Camera, storage: &'a mut [ScreenBound]) -> Option<Self> {
         let objects = scene.object_count();
+        let n = camera.samples() as u64;
+        if objects as u64 * MIN_RAYS_PER_OBJECT > camera.width() as u64 * camera.height() as u64 * n * n {
+            return None;
+        }
         let storage = storage.get_mut(..ScreenBound::needed_for(objects))?;
+        let projection = Projection::new(camera);
         let all = &mut storage[..objects];
         for (slot, id) in all.iter_mut().zip(scene.object_ids()) {
-            *slot = ScreenBound::of(scene, projection, id);
+            *slot = ScreenBound::of(scene, &projection, id);
         }
         all.sort_unstable_by_key(|b| (b.near, b.object));
         Some(FirstHits { storage, objects, band: 0, band_start: u32::MAX })
@@ -265,7 +280,7 @@ mod tests {
             }
             let camera = Camera::new(&view.settings.view, &view.normalization, w, h, view.settings.samples).unwrap();
             let mut storage = vec![ScreenBound::EMPTY; ScreenBound::needed_for(view.object_count())];
-            let mut hits = FirstHits::new(&view, &Projection::new(&camera), &mut storage).unwrap();
+            let Some(mut hits) = FirstHits::new(&view, &camera, &mut storage) else { continue };
             let n = camera.samples();
             for y in 0..h {
                 let tested = hits.band(&camera, y).map_or(view.object_count(), <[_]>::len) as u64;

@@ -23,7 +23,7 @@ pub use panel::PanelColor;
 pub use split::{interleaved_rows, Tiles};
 
 use crate::accel::{Accelerator, Hit, Mailbox};
-use crate::scene::{Camera, CameraError, Color, ObjectId, Projection, RayCursor, SceneView};
+use crate::scene::{Camera, CameraError, Color, ObjectId, RayCursor, SceneView};
 use crate::shade::{Scratch, Stats, Tracer};
 use core::ops::Range;
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -148,8 +148,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     /// ```
     pub fn with_first_hits(mut self, storage: &'a mut [ScreenBound]) -> Self {
         if self.tracer.accel().first_hits_by_screen() {
-            let projection = Projection::new(&self.camera);
-            self.first_hits = FirstHits::new(self.tracer.scene(), &projection, storage);
+            self.first_hits = FirstHits::new(self.tracer.scene(), &self.camera, storage);
         }
         self
     }

@@ -232,20 +232,20 @@ impl Camera {
 /// (forward and the two steps), so a point `v` from the eye lies on the ray
 /// of `kx = v·(Y×F) / v·(X×Y)` and `ky = v·(F×X) / v·(X×Y)` (Cramer's
 /// rule, no assumption that the steps are orthogonal). The three normals
-/// are kept in `i64`, all cut by the same shift so their ratios hold.
+/// are kept in `i64`, all cut by the same shift so their ratios hold: the
+/// cut moves a product with `v` by less than Σ|v_a| (in the cut scale).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Projection {
     eye: [i64; 3],
     across: [i64; 3],
     down: [i64; 3],
     depth: [i64; 3],
-    /// Each normal's components are below 2^s of the true ones' scale: the
-    /// cut moves a product with `v` by less than Σ|v_a| (in that scale).
-    _cut: u32,
 }
 
-/// The offsets' range beyond which a window is not worth bounding.
-const OFFSET_LIMIT: i128 = 1 << 40;
+/// Offsets are clamped to ±2^21 half sub-cells, past every pixel's
+/// (2 · 16 · 16384 = 2^19 at most): a box seen further out than that is
+/// seen no nearer to the image.
+const OFFSET_LIMIT: i64 = 1 << 21;
 
 impl Projection {
     pub(crate) fn new(camera: &Camera) -> Projection {
@@ -267,42 +267,51 @@ impl Projection {
             }
         }
         let eye = camera.eye.bits().map(|c| c as i64);
-        Projection { eye, across, down, depth, _cut: cut }
+        Projection { eye, across, down, depth }
     }
 
     /// The offsets `[kx_min, kx_max]` and `[ky_min, ky_max]` of every ray
     /// that can pass through the box `[lo, hi]` (normalised units), widened
     /// by the projection's rounding and two half sub-cells; `None` when the
     /// box is not wholly ahead of the eye (any ray may then meet it).
+    ///
+    /// A box projects onto the hull of its corners' offsets. Per corner `v`
+    /// the products with the cut normals are exact in `i128`; each is within
+    /// Σ|v_a| of the true one's (in the cut scale), and cutting both to about
+    /// 41 bits adds less than one more. With `e` bounding both errors, the
+    /// true offset is within `e·(1 + |k|) / (depth − e)` of the quotient `k`.
     pub(crate) fn window(&self, lo: [i64; 3], hi: [i64; 3]) -> Option<[[i32; 2]; 2]> {
         let dot = |n: &[i64; 3], v: &[i64; 3]| (0..3).map(|a| n[a] as i128 * v[a] as i128).sum::<i128>();
-        let mut window = [[i128::MAX, i128::MIN]; 2];
+        let mut window = [[i64::MAX, i64::MIN]; 2];
         for corner in 0..8 {
             let v = [0, 1, 2].map(|a| if corner >> a & 1 == 1 { hi[a] } else { lo[a] } - self.eye[a]);
             let depth = dot(&self.depth, &v);
-            // Σ|v_a| bounds what the cut normals' rounding moves each product.
-            let slack = v.iter().map(|c| c.unsigned_abs() as i128).sum::<i128>();
-            if depth <= 2 * slack {
+            if depth <= 0 {
+                return None;
+            }
+            let shift = (128 - depth.leading_zeros()).saturating_sub(41);
+            let slack = v.iter().map(|c| c.unsigned_abs()).sum::<u64>();
+            let error = (slack >> shift) as i64 + 2;
+            let depth = (depth >> shift) as i64;
+            if depth <= 2 * error {
                 return None;
             }
             for (axis, normal) in [&self.across, &self.down].into_iter().enumerate() {
-                let num = dot(normal, &v);
-                let k = num.div_euclid(depth);
-                if k.abs() >= OFFSET_LIMIT {
-                    return None;
-                }
-                // |true k − num/depth| ≤ slack·(1 + |k|) / (depth − slack).
-                let error = slack * (2 + k.abs()) / (depth - slack) + 1;
+                let num = dot(normal, &v) >> shift;
+                // |num| below 2^62 keeps the quotient in i64; beyond, the
+                // offset is past the limit anyway (depth < 2^41).
+                let k = if num.unsigned_abs() < 1 << 62 {
+                    (num as i64).div_euclid(depth)
+                } else {
+                    num.signum() as i64 * OFFSET_LIMIT
+                };
+                let k = k.clamp(-OFFSET_LIMIT, OFFSET_LIMIT);
+                let error = error * (2 + k.abs()) / (depth - error) + 1;
                 window[axis][0] = window[axis][0].min(k - error);
                 window[axis][1] = window[axis][1].max(k + 1 + error);
             }
         }
-        Some(window.map(|[a, b]| {
-            [
-                (a - 2).clamp(i32::MIN as i128, i32::MAX as i128) as i32,
-                (b + 2).clamp(i32::MIN as i128, i32::MAX as i128) as i32,
-            ]
-        }))
+        Some(window.map(|[a, b]| [(a - 2) as i32, (b + 2) as i32]))
     }
 
     /// The eye in normalised units.
