@@ -156,6 +156,11 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     /// The camera ray's hit from the screen lists, if the renderer has them.
     #[inline]
     fn first_hit(&mut self, ray: &crate::shapes::Ray, x: u32, y: u32, sx: u32, sy: u32) -> Option<Option<Hit>> {
+        // Asked first: for an accelerator that never allows the lists (the
+        // naive modes) the whole path folds away, a board's cycles too.
+        if !self.tracer.accel().first_hits_by_screen() {
+            return None;
+        }
         self.first_hits.as_mut()?.nearest(self.tracer.scene(), A::KINDS, &self.camera, ray, [x, y, sx, sy])
     }
 
