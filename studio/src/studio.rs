@@ -11,7 +11,7 @@ use embedded_graphics_core::pixelcolor::{Gray4, Rgb565, Rgb888, RgbColor};
 use octrace_core::accel::{Accelerator, Mailbox, Naive, Octree, OctreeConfig};
 use octrace_core::parse::{parse_bytes, ParseError};
 use octrace_core::profile::Host;
-use octrace_core::render::Renderer;
+use octrace_core::render::{Renderer, ScreenBound};
 use octrace_core::scene::Scene;
 use octrace_core::AccelMode;
 use std::fmt;
@@ -151,7 +151,8 @@ impl Studio {
         let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
         let renderer = Renderer::with_size(view, accel, self.size.0, self.size.1)
             .map_err(|e| StudioError::Camera(format!("{e:?}")))?;
-        let mut renderer = renderer.with_mailbox(&mut words);
+        let mut bounds = vec![ScreenBound::EMPTY; ScreenBound::needed_for(view.object_count())];
+        let mut renderer = renderer.with_mailbox(&mut words).with_first_hits(&mut bounds);
         let count = width as usize * height as usize;
         out.clear();
         out.reserve(7 * count);
