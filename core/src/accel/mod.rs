@@ -9,6 +9,9 @@
 //!   [`Accelerator::occluded_toward`] gives the same answer for a shadow ray
 //!   towards one of the scene's lights;
 //! - the object a ray starts on is treated as [`RayStart`] says;
+//! - camera rays may be answered by the renderer's screen-space lists
+//!   instead, where [`Accelerator::first_hits_by_screen`] allows: the
+//!   same hits;
 //! - an object is tested at most once per query when the caller provides a
 //!   [`Mailbox`] large enough for the scene (one bit per object).
 

@@ -6,6 +6,10 @@
 //! Every pixel depends only on its coordinates, so any split of the image
 //! into rows, tiles or threads gives the same bits.
 //!
+//! Given room ([`Renderer::with_first_hits`]), camera rays find their hits
+//! among the objects seen around their pixel, nearest first, instead of
+//! walking the accelerator (`first_hit.rs`): the same hits.
+//!
 //! A pixel with SAMPLES n is the mean of its n² sample colours, each clamped
 //! to [0, 1] first (an over-bright highlight does not bleed into its
 //! neighbours), then gamma-corrected and rounded. Its object is the one hit
