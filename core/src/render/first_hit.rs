@@ -70,15 +70,15 @@ impl ScreenBound {
                 gap * gap
             })
             .sum();
-        // A hit's parameter times |dir| (1 + 2^-29 at most) is the hit
-        // point's distance from the eye, at least the box's, up to the
-        // rounding of the point: a few units below the distance.
         // Within the normalised range the squares fit a u64; beyond it the
         // largest gap is a lower bound of the distance too.
         let distance = match u64::try_from(gap2) {
             Ok(gap2) => isqrt(gap2) as i64,
             Err(_) => (0..3).map(|a| (lo[a] - eye[a]).max(eye[a] - hi[a])).max().unwrap_or(0),
         };
+        // A hit's parameter times |dir| (1 + 2^-29 at most) is the hit
+        // point's distance from the eye, at least the box's, up to the
+        // rounding of the point: a few units below the distance.
         let near = (distance - (distance >> 28) - 8).clamp(0, i32::MAX as i64) as i32;
         let [x, y] = projection.window(lo, hi).unwrap_or([[i32::MIN, i32::MAX]; 2]);
         ScreenBound { near, object: id.0, x, y }
