@@ -24,14 +24,19 @@ use crate::shapes::{Leaving, Ray, ShapeKinds};
 
 /// Rows of a band: its objects are chosen once for them all.
 const BAND_ROWS: u32 = 8;
+/// Columns of a tile of a band: the band's objects are chosen again for
+/// each, so that a ray passing wide of them all reads a short list.
+const TILE_COLUMNS: u32 = 16;
 /// The lists pay for their set-up (a projection and a sort per object)
 /// when there are at least this many camera rays per object; a scene of
 /// more objects than that is left to the walk.
 const MIN_RAYS_PER_OBJECT: u64 = 16;
-/// A band seen through more objects than this leaves its camera rays to
-/// the accelerator: a ray that hits nothing reads the whole list, which
-/// would cost more than the walk (a scene of 10,000 small spheres).
-const MAX_BAND_OBJECTS: usize = 128;
+/// A band seen through more objects than this, or a tile through more
+/// than the second, leaves its camera rays to the accelerator: a tile's
+/// choice reads the band's list, and a ray that hits nothing the tile's,
+/// which would then cost more than the walk.
+const MAX_BAND_OBJECTS: usize = 512;
+const MAX_TILE_OBJECTS: usize = 128;
 
 /// What a camera ray needs to know of one object: where in the image its
 /// bounds are seen and how near its hit can be. Storage for
@@ -54,9 +59,11 @@ impl ScreenBound {
     pub const EMPTY: ScreenBound = ScreenBound { near: 0, object: 0, x: [0; 2], y: [0; 2] };
 
     /// How many a renderer needs for `objects` objects: one each, and a
-    /// band's worth.
+    /// band's and a tile's worth.
     pub const fn needed_for(objects: usize) -> usize {
-        objects + if objects < MAX_BAND_OBJECTS + 1 { objects } else { MAX_BAND_OBJECTS + 1 }
+        let band = if objects < MAX_BAND_OBJECTS { objects } else { MAX_BAND_OBJECTS };
+        let tile = if objects < MAX_TILE_OBJECTS { objects } else { MAX_TILE_OBJECTS };
+        objects + band + tile
     }
 
     fn of(scene: &SceneView<'_>, projection: &Projection, id: ObjectId) -> ScreenBound {
@@ -85,15 +92,32 @@ impl ScreenBound {
     }
 }
 
-/// The sorted bounds of every object and the chosen ones of the current
-/// band, in caller-owned storage.
+/// Keeps the bounds of `from` that `keep` admits, in order, in `to`;
+/// `None` when more than `to` holds.
+fn filter(from: &[ScreenBound], to: &mut [ScreenBound], keep: impl Fn(&ScreenBound) -> bool) -> Option<usize> {
+    let mut kept = 0;
+    for bound in from.iter().filter(|b| keep(b)) {
+        *to.get_mut(kept)? = *bound;
+        kept += 1;
+    }
+    Some(kept)
+}
+
+/// The sorted bounds of every object, the chosen ones of the current band
+/// and those of its current tile, in caller-owned storage.
 pub(crate) struct FirstHits<'a> {
-    /// Every object's bound, nearest first, then the band's.
+    /// Every object's bound, nearest first; then room for a band's and a
+    /// tile's.
     storage: &'a mut [ScreenBound],
     objects: usize,
-    band: usize,
-    /// The band's first row, `u32::MAX` before the first.
+    /// The band's first row (`u32::MAX` before the first) and how many
+    /// objects it kept (`None`: too many).
     band_start: u32,
+    band: Option<usize>,
+    /// The tile's first column (`u32::MAX`: none yet in this band) and
+    /// its objects (`None`: too many).
+    tile_start: u32,
+    tile: Option<usize>,
 }
 
 impl<'a> FirstHits<'a> {
@@ -113,7 +137,7 @@ impl<'a> FirstHits<'a> {
             *slot = ScreenBound::of(scene, &projection, id);
         }
         all.sort_unstable_by_key(|b| (b.near, b.object));
-        Some(FirstHits { storage, objects, band: 0, band_start: u32::MAX })
+        Some(FirstHits { storage, objects, band_start: u32::MAX, band: None, tile_start: u32::MAX, tile: None })
     }
 
     /// The nearest hit of `camera`'s ray through sub-cell (`sx`, `sy`) of
@@ -128,33 +152,36 @@ impl<'a> FirstHits<'a> {
         ray: &Ray,
         [x, y, sx, sy]: [u32; 4],
     ) -> Option<Option<Hit>> {
-        let band = self.band(camera, y)?;
-        Some(nearest(scene, kinds, band, ray, camera.offsets(x, y, sx, sy)))
+        let tile = self.tile(camera, x, y)?;
+        Some(nearest(scene, kinds, tile, ray, camera.offsets(x, y, sx, sy)))
     }
 
-    /// The objects that camera rays of row `y` may hit, nearest bound
-    /// first, or `None` when they are too many.
+    /// The objects that camera rays of pixel (`x`, `y`)'s tile may hit,
+    /// nearest bound first, or `None` when they are too many.
     #[inline]
-    fn band(&mut self, camera: &Camera, y: u32) -> Option<&[ScreenBound]> {
-        let start = y - y % BAND_ROWS;
-        if start != self.band_start {
-            self.band_start = start;
+    fn tile(&mut self, camera: &Camera, x: u32, y: u32) -> Option<&[ScreenBound]> {
+        let (band_start, tile_start) = (y - y % BAND_ROWS, x - x % TILE_COLUMNS);
+        let last = camera.samples() - 1;
+        let (all, rest) = self.storage.split_at_mut(self.objects);
+        let (band, tile) = rest.split_at_mut(self.objects.min(MAX_BAND_OBJECTS));
+        if band_start != self.band_start {
+            self.band_start = band_start;
+            self.tile_start = u32::MAX;
             // The band's offsets: from its last row's last sub-cells up to
             // its first row's first.
-            let low = camera.offsets(0, start.saturating_add(BAND_ROWS - 1), 0, camera.samples() - 1).1;
-            let high = camera.offsets(0, start, 0, 0).1;
-            let (all, band) = self.storage.split_at_mut(self.objects);
-            let mut kept = 0;
-            for bound in all.iter().filter(|b| b.y[0] <= high && b.y[1] >= low) {
-                if kept > MAX_BAND_OBJECTS {
-                    break;
-                }
-                band[kept] = *bound;
-                kept += 1;
-            }
-            self.band = kept;
+            let low = camera.offsets(0, band_start.saturating_add(BAND_ROWS - 1), 0, last).1;
+            let high = camera.offsets(0, band_start, 0, 0).1;
+            self.band = filter(all, band, |b| b.y[0] <= high && b.y[1] >= low);
         }
-        (self.band <= MAX_BAND_OBJECTS).then(|| &self.storage[self.objects..self.objects + self.band])
+        if tile_start != self.tile_start {
+            self.tile_start = tile_start;
+            // The tile's offsets: from its first column's first sub-cells
+            // to its last column's last.
+            let low = camera.offsets(tile_start, 0, 0, 0).0;
+            let high = camera.offsets(tile_start.saturating_add(TILE_COLUMNS - 1), 0, last, 0).0;
+            self.tile = filter(&band[..self.band?], tile, |b| b.x[0] <= high && b.x[1] >= low);
+        }
+        Some(&tile[..self.tile?])
     }
 }
 
@@ -283,8 +310,8 @@ mod tests {
             let Some(mut hits) = FirstHits::new(&view, &camera, &mut storage) else { continue };
             let n = camera.samples();
             for y in 0..h {
-                let tested = hits.band(&camera, y).map_or(view.object_count(), <[_]>::len) as u64;
                 for x in 0..w {
+                    let tested = hits.tile(&camera, x, y).map_or(view.object_count(), <[_]>::len) as u64;
                     for (sx, sy) in (0..n * n).map(|s| (s % n, s / n)) {
                         let ray = camera.ray(x, y, sx, sy);
                         let listed = hits.nearest(&view, ShapeKinds::ALL, &camera, &ray, [x, y, sx, sy]);
@@ -297,7 +324,7 @@ mod tests {
                 }
             }
         }
-        std::println!("{rays} rays; bands left out {skipped} of {naive_tests} objects");
+        std::println!("{rays} rays; tiles left out {skipped} of {naive_tests} objects");
         assert!(rays > 100_000 && skipped * 3 > naive_tests, "the lists must leave objects out");
     }
 
