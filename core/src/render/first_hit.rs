@@ -6,9 +6,11 @@
 //! are projected into the camera's offsets ([`Projection::window`]), and the
 //! objects are sorted by a lower bound of the parameter of any hit on them
 //! (the distance from the eye to the widened box). For a band of rows the
-//! objects whose window meets the band are kept, still in that order. A
-//! camera ray then tests the kept objects whose window holds its offsets,
-//! in order, until the next one's bound is beyond the nearest hit so far.
+//! objects whose window meets the band are kept, still in that order, and
+//! of those, for each tile of the band, the ones whose window meets the
+//! tile. A camera ray then tests its tile's objects whose window holds its
+//! offsets, in order, until the next one's bound is beyond the nearest hit
+//! so far.
 //!
 //! Exactness: a hit point strays from its object by less than the filing
 //! margin (the octree relies on the same bound), and a camera ray from its
