@@ -114,6 +114,25 @@ pub struct Hit {
     pub object: ObjectId,
 }
 
+impl Hit {
+    /// No hit yet: the farthest parameter and no object (a hit at
+    /// `Scalar::MAX` still wins, by the earlier-object rule).
+    pub(crate) const NONE: Hit = Hit { t: Scalar::MAX, object: ObjectId(u32::MAX) };
+
+    /// Whether this hit wins over `other`: nearer, or as near and on an
+    /// earlier object (the format's tie rule).
+    #[inline]
+    pub(crate) fn beats(&self, other: &Hit) -> bool {
+        self.t < other.t || (self.t == other.t && self.object < other.object)
+    }
+
+    /// The hit, unless it is [`Hit::NONE`].
+    #[inline]
+    pub(crate) fn found(self) -> Option<Hit> {
+        (self.object != Hit::NONE.object).then_some(self)
+    }
+}
+
 /// The object a secondary ray leaves, and how it leaves it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RayStart {

@@ -20,7 +20,7 @@
 //! object whose bound is not beyond the nearest hit.
 
 use crate::accel::{Hit, FILING_MARGIN};
-use crate::math::{isqrt, Scalar};
+use crate::math::isqrt;
 use crate::scene::{Camera, ObjectId, Projection, SceneView};
 use crate::shapes::{Leaving, Ray, ShapeKinds};
 
@@ -197,8 +197,7 @@ fn nearest(
     ray: &Ray,
     (kx, ky): (i32, i32),
 ) -> Option<Hit> {
-    const NONE: ObjectId = ObjectId(u32::MAX);
-    let mut best = Hit { t: Scalar::MAX, object: NONE };
+    let mut best = Hit::NONE;
     for bound in band {
         if bound.near > best.t.to_bits() {
             break;
@@ -206,14 +205,14 @@ fn nearest(
         if kx < bound.x[0] || kx > bound.x[1] || ky < bound.y[0] || ky > bound.y[1] {
             continue;
         }
-        let object = ObjectId(bound.object);
         if let Some(t) = scene.intersect_handle(kinds, scene.objects[bound.object as usize], ray, best.t, Leaving::No) {
-            if t < best.t || (t == best.t && object < best.object) {
-                best = Hit { t, object };
+            let hit = Hit { t, object: ObjectId(bound.object) };
+            if hit.beats(&best) {
+                best = hit;
             }
         }
     }
-    (best.object != NONE).then_some(best)
+    best.found()
 }
 
 #[cfg(test)]

@@ -802,10 +802,7 @@ impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES>
         start: Option<RayStart>,
         mailbox: &mut Mailbox<'_>,
     ) -> Option<Hit> {
-        // No hit yet: the farthest parameter and no object (a hit at
-        // `Scalar::MAX` still wins, by the earlier-object rule).
-        const NONE: ObjectId = ObjectId(u32::MAX);
-        let mut best = Hit { t: Scalar::MAX, object: NONE };
+        let mut best = Hit::NONE;
         walk_leaves(self, ray, mailbox, Scalar::MAX, |leaf, exit, mailbox| {
             let mut test = |id: u32| {
                 if !mailbox.first_visit(id) {
@@ -814,8 +811,9 @@ impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES>
                 let object = ObjectId(id);
                 let leaving = RayStart::leaving(start, object);
                 if let Some(t) = scene.intersect_handle(C::KINDS, scene.objects[id as usize], ray, best.t, leaving) {
-                    if t < best.t || (t == best.t && object < best.object) {
-                        best = Hit { t, object };
+                    let hit = Hit { t, object };
+                    if hit.beats(&best) {
+                        best = hit;
                     }
                 }
             };
@@ -825,13 +823,13 @@ impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES>
             }
             // Final once strictly before the exit: an equal hit in the next
             // leaf might belong to an earlier object.
-            if best.object != NONE && exit.after(best.t) {
+            if best.found().is_some() && exit.after(best.t) {
                 None
             } else {
                 Some(best.t)
             }
         });
-        (best.object != NONE).then_some(best)
+        best.found()
     }
 
     #[inline(never)]
