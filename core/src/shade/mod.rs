@@ -174,12 +174,14 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             }
             traced += 1;
             scratch.stats.rays += 1;
-            if A::USES_MAILBOX {
-                scratch.mailbox.clear();
-            }
             let hit = match first_hit.take() {
                 Some(hit) => hit,
-                None => self.accel.nearest(&self.scene, &p.ray, p.start, &mut scratch.mailbox),
+                None => {
+                    if A::USES_MAILBOX {
+                        scratch.mailbox.clear();
+                    }
+                    self.accel.nearest(&self.scene, &p.ray, p.start, &mut scratch.mailbox)
+                }
             };
             if p.depth == 0 {
                 first_object = hit.map(|h| self.scene.written_object(h.object));
