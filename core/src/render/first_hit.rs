@@ -215,6 +215,8 @@ fn nearest(
     best.found()
 }
 
+// f64 appears only here: to write scene text and as the window test's own
+// reference. The lists themselves are integers only.
 #[cfg(test)]
 mod tests {
     extern crate std;
