@@ -23,12 +23,11 @@
 //! itself: this script puts them in the non-loaded section `.octrace_run`
 //! (see `memory-*.x`), so an ELF always runs on the board it was built for.
 
-use octrace_core::accel::{Octree, OctreeConfig};
+use octrace_core::accel::OctreeConfig;
 use octrace_core::capacity::{CapacityKind, Counts};
-use octrace_core::parse::{count, parse};
-use octrace_core::profile::Host;
+use octrace_core::parse::count;
+use octrace_core::profile::needed_by;
 use octrace_core::render::PanelColor;
-use octrace_core::scene::Scene;
 use octrace_core::AccelMode;
 use std::env;
 use std::fmt::Write as _;
@@ -160,11 +159,6 @@ fn main() {
         ));
     }
 
-    let fields: Vec<String> = CapacityKind::ALL
-        .iter()
-        .filter(|&&kind| counts.get(kind) > 0)
-        .map(|&kind| format!("{}: {}", kind.field(), counts.get(kind)))
-        .collect();
     let mut config = String::new();
     writeln!(config, "pub const BOARD: &str = {:?};", board.name).unwrap();
     writeln!(config, "pub const SCENE_NAME: &str = {scene:?};").unwrap();
@@ -180,7 +174,7 @@ fn main() {
     writeln!(
         config,
         "octrace_core::profile! {{\n    /// Exactly what {scene} needs (about {bytes} bytes).\n    pub struct Profile {{ {} }}\n    octree: {{ {} }}\n    named_walk: {named_walk}\n}}",
-        fields.join(", "),
+        counts.profile_fields(),
         format_args!("max_objects: {}, max_depth: {}", octree.max_objects, octree.max_depth)
     )
     .unwrap();
@@ -192,23 +186,10 @@ fn main() {
     std::fs::write(out.join("config.rs"), config).expect("write config.rs");
 }
 
-/// What the scene needs of each capacity: its statements, and the octree
-/// the board builds for it (built here with the same core and criterion, so
-/// the board's arenas hold exactly the same tree). A scene with errors
-/// needs what it counts; the board then reports its errors.
+/// What the scene needs of each capacity with the board's octree; a scene
+/// with errors needs what it counts, and the board then reports its errors.
 fn needs(text: &str, accel: AccelMode, config: &OctreeConfig) -> Counts {
-    let mut counts = count(text);
-    let mut scene = Box::new(Scene::<Host>::new());
-    if parse(text, &mut scene, &mut |_| {}).is_err() {
-        return counts;
-    }
-    let view = scene.view();
-    if let Some(traversal) = accel.resolve(view.object_count()).traversal() {
-        let mut octree: Box<Octree<Host>> = Box::default();
-        let report = octree.build(&view, &OctreeConfig { traversal, ..*config });
-        counts = counts.max(&report.counts());
-    }
-    counts
+    needed_by(text, accel, config, &mut |_| {}).unwrap_or_else(|_| count(text))
 }
 
 /// How many bytes of RAM the arenas for `counts` take (the core's types

@@ -257,6 +257,31 @@ impl Counts {
         self.objects.div_ceil(32)
     }
 
+    /// The counts as the fields of a [`crate::profile!`], those that are not
+    /// 0 (`spheres: 4, surfaces: 2, lights: 1`): a build script writes a
+    /// profile sized for its scene with it.
+    ///
+    /// ```
+    /// use octrace_core::{capacity::Counts, parse::count};
+    ///
+    /// let needs = count("SPHERE 1 1 0 0 0\nSPHERE 1 1 3 0 0\nLIGHT 1 0 9 0\n");
+    /// assert_eq!(needs.profile_fields().to_string(), "objects: 2, spheres: 2, lights: 1");
+    /// ```
+    pub fn profile_fields(&self) -> impl fmt::Display + '_ {
+        struct Fields<'a>(&'a Counts);
+        impl fmt::Display for Fields<'_> {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                let given = CapacityKind::ALL.into_iter().filter(|&kind| self.0.get(kind) > 0);
+                for (i, kind) in given.enumerate() {
+                    let separator = if i == 0 { "" } else { ", " };
+                    write!(f, "{separator}{}: {}", kind.field(), self.0.get(kind))?;
+                }
+                Ok(())
+            }
+        }
+        Fields(self)
+    }
+
     /// Each count the larger of `self`'s and `other`'s.
     pub fn max(mut self, other: &Counts) -> Counts {
         for kind in CapacityKind::ALL {

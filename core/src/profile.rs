@@ -29,6 +29,11 @@
 use crate::accel::{OctreeCapacities, OctreeConfig, OctreeStore};
 use crate::capacity::{Arena, Counts};
 use crate::scene::SceneCapacities;
+#[cfg(feature = "alloc")]
+use crate::{
+    parse::{count, parse, ParseError},
+    AccelMode,
+};
 
 /// Everything one build holds: a scene's arenas, an octree's, and a mailbox.
 /// Implement it with [`profile!`](crate::profile!).
@@ -144,6 +149,48 @@ macro_rules! profile {
             }
         };
     };
+}
+
+/// What `text` needs of each capacity when its accelerator is built the way
+/// `mode` and `octree` say: its statements' counts (as
+/// [`parse::count`](crate::parse::count)) and, when `mode` resolves to an
+/// octree walk, the octree's ([`BuildReport::counts`](crate::accel::BuildReport::counts)),
+/// built here with the same code a board runs, so a profile of exactly these
+/// counts builds exactly the same tree. A build script sizes a board's
+/// profile with it (write the profile with
+/// [`Counts::profile_fields`](crate::capacity::Counts::profile_fields)).
+/// A scene with errors hands each to `on_error` and gives how many there are.
+///
+/// ```
+/// use octrace_core::{accel::OctreeConfig, profile::needed_by, AccelMode};
+///
+/// let text = "SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nSPHERE 1 1 3 0 0\n";
+/// let needs = needed_by(text, AccelMode::Dda, &OctreeConfig::DEFAULT, &mut |_| {}).unwrap();
+/// assert_eq!((needs.spheres, needs.surfaces), (2, 1));
+/// assert!(needs.octree_boxes >= 1);
+/// assert_eq!(needed_by("SPHERE 1 1 0 0", AccelMode::Auto, &OctreeConfig::DEFAULT, &mut |_| {}), Err(1));
+/// ```
+#[cfg(feature = "alloc")]
+pub fn needed_by<'t>(
+    text: &'t str,
+    mode: AccelMode,
+    octree: &OctreeConfig,
+    on_error: &mut dyn FnMut(ParseError<'t>),
+) -> Result<Counts, usize> {
+    use crate::accel::Octree;
+    use crate::scene::Scene;
+    use alloc::boxed::Box;
+
+    let mut scene = Box::new(Scene::<Host>::new());
+    parse(text, &mut scene, on_error)?;
+    let mut counts = count(text);
+    let view = scene.view();
+    if let Some(traversal) = mode.resolve(view.object_count()).traversal() {
+        let mut tree: Box<Octree<Host>> = Box::default();
+        let report = tree.build(&view, &OctreeConfig { traversal, ..*octree });
+        counts = counts.max(&report.counts());
+    }
+    Ok(counts)
 }
 
 /// What [`profile!`](crate::profile!) expands to; not a public API.
