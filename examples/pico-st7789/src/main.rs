@@ -23,7 +23,7 @@ use mipidsi::interface::SpiInterface;
 use mipidsi::models::ST7789;
 use mipidsi::options::ColorInversion;
 use mipidsi::Builder;
-use octrace_core::{profile::Board64K, ConstStaticCell, Raytracer};
+use octrace_core::{ConstStaticCell, Raytracer};
 use panic_halt as _;
 use rp2040_hal as hal;
 
@@ -36,17 +36,21 @@ static BOOT2: [u8; 256] = rp2040_boot2::BOOT_LOADER_W25Q080;
 /// The Pico's crystal.
 const CRYSTAL_HZ: u32 = 12_000_000;
 
-/// The scene, in flash. Any scene in `scenes/` whose objects fit the
-/// capacity profile below will do.
-const SCENE_TEXT: &str = include_str!("../../../scenes/fig5_1.txt");
+/// The scene (`SCENE_TEXT`, in flash) and a capacity profile that holds
+/// exactly what it needs (`SceneProfile`), from `build.rs`: set
+/// `OCTRACE_SCENE` to your scene's file when you build.
+mod scene {
+    include!(concat!(env!("OUT_DIR"), "/scene.rs"));
+}
+use scene::{SceneProfile, SCENE_TEXT};
 
 /// The panel: a 240×240 IPS ST7789, which shows true colours only with the
 /// controller's inversion on.
 const PANEL_WIDTH: u16 = 240;
 const PANEL_HEIGHT: u16 = 240;
 
-/// Room for the scene, its octree and mailbox, sized by a capacity profile.
-static RAYTRACER: ConstStaticCell<Raytracer<Board64K>> = ConstStaticCell::new(Raytracer::new());
+/// Room for the scene, its octree and mailbox.
+static RAYTRACER: ConstStaticCell<Raytracer<SceneProfile>> = ConstStaticCell::new(Raytracer::new());
 
 #[entry]
 fn main() -> ! {
