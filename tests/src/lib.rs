@@ -2,6 +2,7 @@
 //! in `tests/`).
 
 pub mod firmware;
+pub mod pico;
 pub mod reference;
 pub mod webdriver;
 

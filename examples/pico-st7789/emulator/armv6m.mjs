@@ -1,0 +1,126 @@
+// Corrections to rp2040js 1.4.1's Cortex-M0+ core, where it computes a
+// different result from the Armv6-M Architecture Reference Manual (and from
+// qemu, which `node test/instructions.mjs` checks these against):
+//
+// - ADCS and SBCS compute the overflow flag V from `Rm + carry` (or
+//   `Rm + 1 - carry`) folded into one 32-bit operand, which wraps: V comes
+//   out inverted when ADCS adds to 0x7fffffff with the carry set, or SBCS
+//   subtracts 0x7fffffff with the carry clear. A signed 64-bit comparison
+//   with i64::MAX (whose high word is 0x7fffffff) is such an SBCS, so
+//   `x < i64::MAX` came out false for every x >= 0.
+// - LSLS, LSRS, ASRS and RORS by a register: a shift of 0 must leave the
+//   carry alone (rp2040js sets it from bit 31: JavaScript masks the shift
+//   count -1 to 31), and LSLS by 33 to 255 must clear it.
+//
+// Each corrected instruction is executed here instead of by rp2040js, with
+// the same cycle count (1); every other instruction is rp2040js's own.
+//
+// Invariant: `addWithCarry` and `shiftCarry` are the manual's pseudocode
+// functions of the same names; nothing else is changed.
+
+/** The manual's AddWithCarry: sets N, Z, C, V and returns the 32-bit result. */
+function addWithCarry(core, x, y, carryIn) {
+  const unsignedSum = x + y + carryIn;
+  const signedSum = (x | 0) + (y | 0) + carryIn;
+  const result = unsignedSum >>> 0;
+  core.N = result >= 0x80000000;
+  core.Z = result === 0;
+  core.C = unsignedSum > 0xffffffff;
+  core.V = (result | 0) !== signedSum;
+  return result;
+}
+
+const LSL = 0;
+const LSR = 1;
+const ASR = 2;
+const ROR = 3;
+
+/** The manual's Shift_C for a shift by a register (its bottom byte): result and carry out. */
+function shiftCarry(value, type, amount, carryIn) {
+  if (amount === 0) {
+    return [value, carryIn];
+  }
+  switch (type) {
+    case LSL:
+      if (amount > 32) return [0, false];
+      return [amount === 32 ? 0 : (value << amount) >>> 0, ((value >>> (32 - amount)) & 1) === 1];
+    case LSR:
+      if (amount > 32) return [0, false];
+      return [amount === 32 ? 0 : value >>> amount, ((value >>> (amount - 1)) & 1) === 1];
+    case ASR: {
+      const n = Math.min(amount, 32);
+      const result = n === 32 ? (value & 0x80000000 ? 0xffffffff : 0) : (value | 0) >> n;
+      return [result >>> 0, ((value | 0) >> (n - 1)) & 1 ? true : false];
+    }
+    case ROR: {
+      const n = amount % 32;
+      const result = n === 0 ? value : ((value >>> n) | (value << (32 - n))) >>> 0;
+      return [result, result >= 0x80000000];
+    }
+  }
+  throw new Error(`shift type ${type}`);
+}
+
+// The 16-bit "data processing" encodings 0100 00oo ooMM MDDD, by their
+// opcode field oooo.
+const ADCS = 0b0101;
+const SBCS = 0b0110;
+const SHIFTS = new Map([
+  [0b0010, LSL],
+  [0b0011, LSR],
+  [0b0100, ASR],
+  [0b0111, ROR],
+]);
+
+/** The instructions corrected here, by mnemonic. */
+export const CORRECTED = ['adcs', 'sbcs', 'lsls', 'lsrs', 'asrs', 'rors'];
+
+/** Executes `opcode` if it is one rp2040js gets wrong; false when it is not. */
+function executeCorrected(core, opcode) {
+  if (opcode >> 10 !== 0b010000) {
+    return false;
+  }
+  const operation = (opcode >> 6) & 0xf;
+  const rm = (opcode >> 3) & 7;
+  const rdn = opcode & 7;
+  const registers = core.registers;
+  if (operation === ADCS) {
+    registers[rdn] = addWithCarry(core, registers[rdn], registers[rm], core.C ? 1 : 0);
+  } else if (operation === SBCS) {
+    registers[rdn] = addWithCarry(core, registers[rdn], ~registers[rm] >>> 0, core.C ? 1 : 0);
+  } else if (SHIFTS.has(operation)) {
+    const [result, carry] = shiftCarry(registers[rdn], SHIFTS.get(operation), registers[rm] & 0xff, core.C);
+    registers[rdn] = result;
+    core.N = result >= 0x80000000;
+    core.Z = result === 0;
+    core.C = carry;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+/**
+ * Puts the corrections in front of `core.executeInstruction`. Pending
+ * interrupts are taken first, exactly once, as rp2040js does; the corrected
+ * instruction is then the one at the (possibly new) PC.
+ */
+export function correctInstructions(core) {
+  const execute = core.executeInstruction.bind(core);
+  core.executeInstruction = () => {
+    if (core.interruptsUpdated && core.checkForInterrupts()) {
+      core.waiting = false;
+    }
+    if (executeCorrected(core, core.readUint16(core.PC & ~1))) {
+      core.PC += 2;
+      core.cycles += 1;
+      return 1;
+    }
+    // Interrupts were just checked: rp2040js need not look again first.
+    const pending = core.interruptsUpdated;
+    core.interruptsUpdated = false;
+    const cycles = execute();
+    core.interruptsUpdated ||= pending;
+    return cycles;
+  };
+}

@@ -1,0 +1,121 @@
+#!/usr/bin/env node
+// Runs a Pico firmware ELF on the emulated Pico with its ST7789 panel and
+// writes the picture the panel shows as a PNG. As the template's cargo
+// runner (see README.md):
+//
+//   CARGO_TARGET_THUMBV6M_NONE_EABI_RUNNER="node emulator/run.mjs" cargo run --release [-- OPTIONS]
+//
+// Options: --out FILE (default panel.png), --panel WxH (the panel's size,
+// default 240x240, the Pico-LCD-1.3), --panel-offset X,Y (where it starts in
+// the controller's 240x320 memory, default 0,0), --max-seconds S (emulated
+// time before giving up, default 120), --json (the report as JSON on
+// standard output), --quiet.
+//
+// Exit codes: 0 the run ended with the core asleep and the picture written;
+// 1 the firmware or the ELF did something a real Pico would not survive, or
+// the panel was sent what it does not take (the message says what); 2 bad
+// arguments.
+
+import { readFileSync } from 'node:fs';
+import { parseArgs } from 'node:util';
+import { CLOCK_HZ, RunError, runPico } from './pico.mjs';
+import { ElfError } from './elf.mjs';
+import { PanelError } from './st7789.mjs';
+import { encodePng, writeAtomically } from './png.mjs';
+
+const USAGE =
+  'usage: node run.mjs ELF [--out FILE.png] [--panel WxH] [--panel-offset X,Y] [--max-seconds S] [--json] [--quiet]';
+
+function usage(message) {
+  console.error(`octrace-pico-emulator: ${message}\n${USAGE}`);
+  process.exit(2);
+}
+
+function numbers(text, separator, option) {
+  const parts = text.split(separator).map(Number);
+  if (parts.length !== 2 || !parts.every((n) => Number.isInteger(n) && n >= 0)) {
+    usage(`${option} ${text}: expected two whole numbers separated by '${separator}'`);
+  }
+  return parts;
+}
+
+let args;
+try {
+  args = parseArgs({
+    allowPositionals: true,
+    options: {
+      out: { type: 'string', default: 'panel.png' },
+      panel: { type: 'string', default: '240x240' },
+      'panel-offset': { type: 'string', default: '0,0' },
+      'max-seconds': { type: 'string', default: '120' },
+      json: { type: 'boolean', default: false },
+      quiet: { type: 'boolean', default: false },
+    },
+  });
+} catch (error) {
+  usage(error.message);
+}
+const { values, positionals } = args;
+if (positionals.length !== 1) {
+  usage(positionals.length === 0 ? 'no ELF given' : `one ELF, not ${positionals.length} arguments`);
+}
+const [elfPath] = positionals;
+const [width, height] = numbers(values.panel, 'x', '--panel');
+const [offsetX, offsetY] = numbers(values['panel-offset'], ',', '--panel-offset');
+const maxSeconds = Number(values['max-seconds']);
+if (!(maxSeconds > 0)) {
+  usage(`--max-seconds ${values['max-seconds']}: expected a positive number`);
+}
+if (!values.out.toLowerCase().endsWith('.png')) {
+  usage(`--out ${values.out}: the picture is written as PNG: name a .png file`);
+}
+
+const progress = !values.quiet && !values.json && process.stderr.isTTY;
+const seconds = (cycles) => (cycles / CLOCK_HZ).toFixed(3);
+let report;
+try {
+  const elf = readFileSync(elfPath);
+  const run = runPico(elf, elfPath, {
+    panel: { width, height, offsetX, offsetY },
+    maxCycles: maxSeconds * CLOCK_HZ,
+    onProgress: progress
+      ? (cycles, rows) => process.stderr.write(`\r${seconds(cycles)} s emulated, ${rows} panel writes`)
+      : undefined,
+  });
+  if (progress) process.stderr.write('\r\x1b[K');
+  writeAtomically(values.out, encodePng(width, height, run.panel.picture()));
+  report = {
+    elf: elfPath,
+    out: values.out,
+    panel: `${width}x${height}`,
+    dark: run.panel.darkBecause,
+    clockHz: CLOCK_HZ,
+    instructions: run.instructions,
+    cycles: run.phases,
+  };
+} catch (error) {
+  if (progress) process.stderr.write('\r\x1b[K');
+  if (error instanceof RunError || error instanceof ElfError || error instanceof PanelError || error.code === 'ENOENT') {
+    console.error(`octrace-pico-emulator: ${error.message}`);
+    process.exit(1);
+  }
+  throw error;
+}
+
+if (values.json) {
+  console.log(JSON.stringify(report, null, 2));
+} else if (!values.quiet) {
+  const row = (what, cycles) =>
+    `  ${what.padEnd(44)} ${cycles === null ? 'never reached' : `${cycles.toLocaleString('en').padStart(13)} cycles  ${seconds(cycles)} s`}`;
+  const { startUp, parseAndIndex, render, total } = report.cycles;
+  console.error(
+    [
+      `${elfPath} on an emulated Raspberry Pi Pico (one Cortex-M0+ at 125 MHz):`,
+      row('start-up (clocks, panel set-up and clear)', startUp),
+      row('parse and index the scene', parseAndIndex),
+      row('render into the panel', render),
+      row('in all', total),
+      report.dark ? `the panel is dark: ${report.dark}` : `the panel's ${report.panel} picture: ${values.out}`,
+    ].join('\n'),
+  );
+}

@@ -1,0 +1,128 @@
+// A small Thumb (Armv6-M) assembler: just the instructions the boot ROM
+// stand-in and the instruction checks are written in, so the emulator runs
+// real machine code for them (and counts its cycles) with no toolchain.
+//
+// Invariant: every encoding here is the Armv6-M Architecture Reference
+// Manual's 16-bit one for low registers; an operand out of range throws.
+
+const COND = { eq: 0, ne: 1, cs: 2, cc: 3, mi: 4, pl: 5, vs: 6, vc: 7, hi: 8, ls: 9, ge: 10, lt: 11, gt: 12, le: 13 };
+
+function low(register) {
+  if (!Number.isInteger(register) || register < 0 || register > 7) {
+    throw new RangeError(`r${register} is not a low register`);
+  }
+  return register;
+}
+
+function unsigned(value, bits, what) {
+  if (!Number.isInteger(value) || value < 0 || value >= 1 << bits) {
+    throw new RangeError(`${what} ${value} does not fit ${bits} bits`);
+  }
+  return value;
+}
+
+/** Assembles code placed at `base`; labels are strings, branches resolve at `bytes()`. */
+export class Thumb {
+  constructor(base) {
+    this.base = base;
+    this.halves = [];
+    this.labels = new Map();
+    this.branches = [];
+  }
+
+  /** The address of the next instruction. */
+  get here() {
+    return this.base + 2 * this.halves.length;
+  }
+
+  label(name) {
+    if (this.labels.has(name)) {
+      throw new Error(`label ${name} defined twice`);
+    }
+    this.labels.set(name, this.here);
+    return this;
+  }
+
+  emit(half) {
+    this.halves.push(half & 0xffff);
+    return this;
+  }
+
+  // Data processing (flags set, as the 16-bit encodings do outside IT blocks).
+  movsImm(rd, imm8) { return this.emit(0x2000 | (low(rd) << 8) | unsigned(imm8, 8, 'immediate')); }
+  movs(rd, rm) { return this.emit((low(rm) << 3) | low(rd)); } // LSLS rd, rm, #0
+  mov(rd, rm) { return this.emit(0x4600 | ((rd & 8) << 4) | (rm << 3) | (rd & 7)); } // any registers, flags kept
+  addsImm(rdn, imm8) { return this.emit(0x3000 | (low(rdn) << 8) | unsigned(imm8, 8, 'immediate')); }
+  subsImm(rdn, imm8) { return this.emit(0x3800 | (low(rdn) << 8) | unsigned(imm8, 8, 'immediate')); }
+  cmpImm(rn, imm8) { return this.emit(0x2800 | (low(rn) << 8) | unsigned(imm8, 8, 'immediate')); }
+  adds(rd, rn, rm) { return this.emit(0x1800 | (low(rm) << 6) | (low(rn) << 3) | low(rd)); }
+  subs(rd, rn, rm) { return this.emit(0x1a00 | (low(rm) << 6) | (low(rn) << 3) | low(rd)); }
+  lslsImm(rd, rm, imm5) { return this.emit((unsigned(imm5, 5, 'shift') << 6) | (low(rm) << 3) | low(rd)); }
+  lsrsImm(rd, rm, imm5) { return this.emit(0x0800 | (unsigned(imm5, 5, 'shift') << 6) | (low(rm) << 3) | low(rd)); }
+  asrsImm(rd, rm, imm5) { return this.emit(0x1000 | (unsigned(imm5, 5, 'shift') << 6) | (low(rm) << 3) | low(rd)); }
+  // Two-register data processing: RDN = RDN op RM.
+  alu(op, rdn, rm) {
+    const ops = ['ands', 'eors', 'lsls', 'lsrs', 'asrs', 'adcs', 'sbcs', 'rors', 'tst', 'rsbs', 'cmp', 'cmn', 'orrs', 'muls', 'bics', 'mvns'];
+    const index = ops.indexOf(op);
+    if (index < 0) {
+      throw new Error(`unknown data-processing instruction ${op}`);
+    }
+    return this.emit(0x4000 | (index << 6) | (low(rm) << 3) | low(rdn));
+  }
+
+  // Loads and stores with an immediate offset in bytes.
+  ldr(rt, rn, offset = 0) { return this.emit(0x6800 | (unsigned(offset / 4, 5, 'offset') << 6) | (low(rn) << 3) | low(rt)); }
+  str(rt, rn, offset = 0) { return this.emit(0x6000 | (unsigned(offset / 4, 5, 'offset') << 6) | (low(rn) << 3) | low(rt)); }
+  ldrh(rt, rn, offset = 0) { return this.emit(0x8800 | (unsigned(offset / 2, 5, 'offset') << 6) | (low(rn) << 3) | low(rt)); }
+  ldrb(rt, rn, offset = 0) { return this.emit(0x7800 | (unsigned(offset, 5, 'offset') << 6) | (low(rn) << 3) | low(rt)); }
+  strb(rt, rn, offset = 0) { return this.emit(0x7000 | (unsigned(offset, 5, 'offset') << 6) | (low(rn) << 3) | low(rt)); }
+  ldmia(rn, registers) { return this.emit(0xc800 | (low(rn) << 8) | registerList(registers)); }
+  stmia(rn, registers) { return this.emit(0xc000 | (low(rn) << 8) | registerList(registers)); }
+
+  // Control.
+  bxLr() { return this.emit(0x4770); }
+  bkpt(imm8) { return this.emit(0xbe00 | unsigned(imm8, 8, 'breakpoint')); }
+  /** MRS rd, APSR (32 bits). */
+  mrsApsr(rd) { return this.emit(0xf3ef).emit(0x8000 | (low(rd) << 8)); }
+  /** MSR APSR_nzcvq, rn (32 bits). */
+  msrApsr(rn) { return this.emit(0xf380 | low(rn)).emit(0x8800); }
+  b(label) {
+    this.branches.push({ at: this.halves.length, label, cond: null });
+    return this.emit(0);
+  }
+  bcc(cond, label) {
+    if (!(cond in COND)) {
+      throw new Error(`unknown condition ${cond}`);
+    }
+    this.branches.push({ at: this.halves.length, label, cond: COND[cond] });
+    return this.emit(0);
+  }
+
+  /** The machine code, little-endian, with every branch resolved. */
+  bytes() {
+    for (const { at, label, cond } of this.branches) {
+      const target = this.labels.get(label);
+      if (target === undefined) {
+        throw new Error(`branch to undefined label ${label}`);
+      }
+      const offset = (target - (this.base + 2 * at + 4)) >> 1;
+      if (cond === null) {
+        if (offset < -1024 || offset > 1023) throw new RangeError(`branch to ${label} is too far`);
+        this.halves[at] = 0xe000 | (offset & 0x7ff);
+      } else {
+        if (offset < -128 || offset > 127) throw new RangeError(`branch to ${label} is too far`);
+        this.halves[at] = 0xd000 | (cond << 8) | (offset & 0xff);
+      }
+    }
+    const out = new Uint8Array(2 * this.halves.length);
+    this.halves.forEach((half, i) => {
+      out[2 * i] = half & 0xff;
+      out[2 * i + 1] = half >> 8;
+    });
+    return out;
+  }
+}
+
+function registerList(registers) {
+  return registers.reduce((mask, r) => mask | (1 << low(r)), 0);
+}
