@@ -22,7 +22,12 @@ fn target_dir() -> PathBuf {
     repo().join("target/pico-st7789")
 }
 
+/// The scene the template embeds when `OCTRACE_SCENE` is not set.
+const DEFAULT_SCENE: &str = "fig5_1";
+
 /// Builds the template (release) with `scenes/SCENE.txt` and returns its ELF.
+/// The default scene is built as a user builds the template, without
+/// `OCTRACE_SCENE` (and so as `scripts/test-all` built it already).
 pub fn build(scene: &str) -> Result<PathBuf, String> {
     let dir = target_dir();
     let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
@@ -30,10 +35,12 @@ pub fn build(scene: &str) -> Result<PathBuf, String> {
     // from the working directory.
     cargo.current_dir(template());
     cargo.args(["build", "--release", "--quiet"]).arg("--target-dir").arg(&dir);
-    for var in ["CARGO_TARGET_DIR", "RUSTFLAGS", "CARGO_ENCODED_RUSTFLAGS", "CARGO_BUILD_TARGET"] {
+    for var in ["CARGO_TARGET_DIR", "RUSTFLAGS", "CARGO_ENCODED_RUSTFLAGS", "CARGO_BUILD_TARGET", "OCTRACE_SCENE"] {
         cargo.env_remove(var);
     }
-    cargo.env("OCTRACE_SCENE", repo().join("scenes").join(format!("{scene}.txt")));
+    if scene != DEFAULT_SCENE {
+        cargo.env("OCTRACE_SCENE", repo().join("scenes").join(format!("{scene}.txt")));
+    }
     let out = cargo.output().map_err(|e| format!("cannot run cargo: {e}"))?;
     if !out.status.success() {
         return Err(format!("the Pico template with {scene} did not build:\n{}", String::from_utf8_lossy(&out.stderr)));
@@ -88,9 +95,8 @@ pub fn run(elf: &Path, png: &Path) -> Result<Cycles, String> {
     }
     let report: serde_json::Value =
         serde_json::from_slice(&out.stdout).map_err(|e| format!("the emulator's report is not JSON: {e}"))?;
-    let cycles = |key: &str| {
-        report["cycles"][key].as_u64().ok_or_else(|| format!("the run has no {key} phase: {report}"))
-    };
+    let cycles =
+        |key: &str| report["cycles"][key].as_u64().ok_or_else(|| format!("the run has no {key} phase: {report}"));
     Ok(Cycles {
         start_up: cycles("startUp")?,
         parse_and_index: cycles("parseAndIndex")?,

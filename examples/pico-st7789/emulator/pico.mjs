@@ -60,7 +60,7 @@ export function runPico(elfBytes, elfPath, { panel: panelSize, maxCycles, onProg
           `does not stand in for (called from ${functionAt(elf.functions, core.LR & ~1)})`,
       );
     }
-    fail(`breakpoint #${code} at ${functionAt(elf.functions, pc() - 2)}`);
+    fail(`a breakpoint or undefined instruction (#${code}) at ${functionAt(elf.functions, pc() - 2)}`);
   };
 
   const panel = new ST7789(panelSize);
