@@ -25,6 +25,27 @@ pub fn scenes() -> Vec<(String, PathBuf)> {
     v
 }
 
+/// Writes host-sim's preview of a panel, as its user asks for it:
+/// `host-sim scenes/SCENE.txt OUT --size WxH --color COLOR --quiet`.
+pub fn host_sim_preview(scene: &str, out: &std::path::Path, size: &str, color: &str) -> Result<(), String> {
+    let path = repo().join("scenes").join(format!("{scene}.txt"));
+    let args = [
+        "host-sim".as_ref(),
+        path.as_os_str(),
+        out.as_os_str(),
+        "--size".as_ref(),
+        size.as_ref(),
+        "--color".as_ref(),
+        color.as_ref(),
+        "--quiet".as_ref(),
+    ];
+    let mut stderr = Vec::new();
+    match host_sim::cli::run(args, &mut Vec::new(), &mut stderr) {
+        0 => Ok(()),
+        code => Err(format!("host-sim exited with {code}: {}", String::from_utf8_lossy(&stderr))),
+    }
+}
+
 /// Whether the tests should rewrite their expected files (`OCTRACE_BLESS=1`).
 pub fn blessing() -> bool {
     std::env::var_os("OCTRACE_BLESS").is_some_and(|v| v != "0")

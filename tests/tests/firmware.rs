@@ -7,7 +7,7 @@
 
 use octrace_core::render::PanelColor;
 use octrace_tests::firmware::{qemu_available, run_oled_command, Board, Firmware, Sizes};
-use octrace_tests::repo;
+use octrace_tests::host_sim_preview;
 
 /// False (the test is skipped) when `OCTRACE_SKIP_FIRMWARE` is set; fails
 /// when qemu is missing.
@@ -91,19 +91,7 @@ fn oled_screen_is_host_sims_gray4_preview() {
     assert_eq!(run.status, 0, "the OLED board exited with {}:\n{}", run.status, run.output);
 
     let preview = dir.path().join("preview.png");
-    let scene = repo().join("scenes/fig5_1.txt");
-    let args = [
-        "host-sim".as_ref(),
-        scene.as_os_str(),
-        preview.as_os_str(),
-        "--size".as_ref(),
-        "128x64".as_ref(),
-        "--color".as_ref(),
-        "gray4".as_ref(),
-        "--quiet".as_ref(),
-    ];
-    let mut stderr = Vec::new();
-    assert_eq!(host_sim::cli::run(args, &mut Vec::new(), &mut stderr), 0, "{}", String::from_utf8_lossy(&stderr));
+    host_sim_preview("fig5_1", &preview, "128x64", "gray4").unwrap_or_else(|e| panic!("{e}"));
 
     let (width, height, shown) = read_gray_png(&screen);
     let expected = read_gray_png(&preview);

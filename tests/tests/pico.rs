@@ -7,8 +7,7 @@
 //! `examples/pico-st7789/emulator`; the test command does it); set
 //! `OCTRACE_SKIP_FIRMWARE=1` to skip where they cannot be installed.
 
-use octrace_tests::pico;
-use octrace_tests::repo;
+use octrace_tests::{host_sim_preview, pico};
 use std::path::Path;
 
 /// The thesis's first figure (naive, no octree), 200 spheres in an
@@ -50,19 +49,7 @@ fn the_pico_template_shows_host_sims_picture() {
     for (scene, (cycles, panel)) in SCENES.iter().zip(runs) {
         let cycles = cycles.unwrap_or_else(|e| panic!("{scene}: {e}"));
         let preview = dir.path().join(format!("{scene}-host-sim.png"));
-        let path = repo().join("scenes").join(format!("{scene}.txt"));
-        let args = [
-            "host-sim".as_ref(),
-            path.as_os_str(),
-            preview.as_os_str(),
-            "--size".as_ref(),
-            "240x240".as_ref(),
-            "--color".as_ref(),
-            "rgb565".as_ref(),
-            "--quiet".as_ref(),
-        ];
-        let mut stderr = Vec::new();
-        assert_eq!(host_sim::cli::run(args, &mut Vec::new(), &mut stderr), 0, "{}", String::from_utf8_lossy(&stderr));
+        host_sim_preview(scene, &preview, "240x240", "rgb565").unwrap_or_else(|e| panic!("{e}"));
 
         let (width, height, shown) = read_rgb_png(&panel);
         let expected = read_rgb_png(&preview);

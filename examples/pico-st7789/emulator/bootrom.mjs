@@ -50,17 +50,7 @@ export function codeLetters(key) {
 // Each function takes its arguments in r0..r2 (AAPCS) and returns in r0.
 const FUNCTIONS = {
   // memset(ptr, c, n) -> ptr
-  MS: (t) =>
-    t.movs(3, 0)
-      .cmpImm(2, 0)
-      .bcc('eq', 'ms.done')
-      .label('ms.byte')
-      .strb(1, 3)
-      .addsImm(3, 1)
-      .subsImm(2, 1)
-      .bcc('ne', 'ms.byte')
-      .label('ms.done')
-      .bxLr(),
+  MS: (t) => storeBytes(t.movs(3, 0).cmpImm(2, 0).bcc('eq', 'ms.done'), 'ms').label('ms.done').bxLr(),
   // memset4(ptr, c, n) -> ptr, ptr word-aligned
   S4: (t) =>
     t.movsImm(3, 0xff)
@@ -80,28 +70,11 @@ const FUNCTIONS = {
       .label('s4.tail')
       .addsImm(2, 4)
       .bcc('eq', 's4.done')
-      .label('s4.byte')
-      .strb(1, 3)
-      .addsImm(3, 1)
-      .subsImm(2, 1)
-      .bcc('ne', 's4.byte')
+      .inline(storeBytes, 's4')
       .label('s4.done')
       .bxLr(),
   // memcpy(dest, src, n) -> dest
-  MC: (t) =>
-    t.mov(12, 0)
-      .cmpImm(2, 0)
-      .bcc('eq', 'mc.done')
-      .label('mc.byte')
-      .ldrb(3, 1)
-      .strb(3, 0)
-      .addsImm(1, 1)
-      .addsImm(0, 1)
-      .subsImm(2, 1)
-      .bcc('ne', 'mc.byte')
-      .label('mc.done')
-      .mov(0, 12)
-      .bxLr(),
+  MC: (t) => copyBytes(t.mov(12, 0).cmpImm(2, 0).bcc('eq', 'mc.done'), 'mc').label('mc.done').mov(0, 12).bxLr(),
   // memcpy44(dest, src, n) -> dest, both word-aligned
   C4: (t) =>
     t.mov(12, 0)
@@ -115,13 +88,7 @@ const FUNCTIONS = {
       .label('c4.tail')
       .addsImm(2, 4)
       .bcc('eq', 'c4.done')
-      .label('c4.byte')
-      .ldrb(3, 1)
-      .strb(3, 0)
-      .addsImm(1, 1)
-      .addsImm(0, 1)
-      .subsImm(2, 1)
-      .bcc('ne', 'c4.byte')
+      .inline(copyBytes, 'c4')
       .label('c4.done')
       .mov(0, 12)
       .bxLr(),
@@ -152,6 +119,23 @@ const FUNCTIONS = {
       .movs(0, 1)
       .bxLr(),
 };
+
+// Stores the byte r1 at r3 onwards, r2 times (r2 > 0).
+function storeBytes(t, prefix) {
+  return t.label(`${prefix}.byte`).strb(1, 3).addsImm(3, 1).subsImm(2, 1).bcc('ne', `${prefix}.byte`);
+}
+
+// Copies r2 bytes (r2 > 0) from r1 onwards to r0 onwards.
+function copyBytes(t, prefix) {
+  return t
+    .label(`${prefix}.byte`)
+    .ldrb(3, 1)
+    .strb(3, 0)
+    .addsImm(1, 1)
+    .addsImm(0, 1)
+    .subsImm(2, 1)
+    .bcc('ne', `${prefix}.byte`);
+}
 
 // Counts the zero bits at one end of r0 by halving steps: `test` shifts the
 // end's 16, 8, 4, 2, 1 bits down to see whether they are all zero; if so they

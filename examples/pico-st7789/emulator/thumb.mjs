@@ -43,6 +43,12 @@ export class Thumb {
     return this;
   }
 
+  /** Appends what `write(this, ...args)` assembles (a routine shared by several). */
+  inline(write, ...args) {
+    write(this, ...args);
+    return this;
+  }
+
   emit(half) {
     this.halves.push(half & 0xffff);
     return this;
