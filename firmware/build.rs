@@ -135,26 +135,33 @@ fn main() {
     }
     // Only the thesis's walk reads the octree's hash table.
     let named_walk = accel == AccelMode::Octree;
+    let techniques = var("OCTRACE_TECHNIQUES", "auto");
+    let Some(wanted) = Techniques::from_names(&techniques) else {
+        fail(format!(
+            "OCTRACE_TECHNIQUES={techniques}: expected auto, none, or a comma list of first-hits, shadow-shafts"
+        ))
+    };
     // The board's octree, or a shallower one if the scene's arenas would
-    // not fit its RAM otherwise.
-    let (octree, counts, bytes) = (1..=board.config.max_depth)
+    // not fit its RAM otherwise, with every technique that fits beside it
+    // (a level less costs more than either technique gains).
+    let budget = board.static_ram - OTHER_STATICS;
+    let plan = |techniques: Techniques, max_depth: u32| {
+        let config = OctreeConfig { max_depth, shadow_shafts: techniques.shadow_shafts, ..board.config };
+        let counts = needs(&text, accel, &config);
+        (config, techniques, counts, static_bytes(&counts, named_walk, techniques))
+    };
+    let (octree, techniques, counts, bytes) = (1..=board.config.max_depth)
         .rev()
-        .map(|max_depth| {
-            let config = OctreeConfig { max_depth, ..board.config };
-            let counts = needs(&text, accel, &config);
-            (config, counts, static_bytes(&counts, named_walk))
-        })
-        .find(|&(_, _, bytes)| bytes <= board.static_ram - OTHER_STATICS)
-        .unwrap_or_else(|| {
-            let counts = needs(&text, accel, &board.config);
-            (board.config, counts, static_bytes(&counts, named_walk))
-        });
-    if bytes > board.static_ram - OTHER_STATICS {
+        .flat_map(|depth| wanted.subsets().map(move |techniques| (techniques, depth)))
+        .map(|(techniques, depth)| plan(techniques, depth))
+        .find(|&(.., bytes)| bytes <= budget)
+        .unwrap_or_else(|| plan(Techniques::NONE, board.config.max_depth));
+    if bytes > budget {
         fail(format!(
             "{scene} needs about {bytes} bytes of arenas ({}), more than the {} bytes the {} has for them \
              beside its stack and other statics",
             describe(&counts),
-            board.static_ram - OTHER_STATICS,
+            budget,
             board.name
         ));
     }
@@ -173,9 +180,13 @@ fn main() {
     }
     writeln!(
         config,
-        "octrace_core::profile! {{\n    /// Exactly what {scene} needs (about {bytes} bytes).\n    pub struct Profile {{ {} }}\n    octree: {{ {} }}\n    named_walk: {named_walk}\n}}",
+        "octrace_core::profile! {{\n    /// Exactly what {scene} needs (about {bytes} bytes).\n    pub struct Profile {{ {} }}\n    octree: {{ {} }}\n    named_walk: {named_walk}\n    first_hits: {}\n}}",
         counts.profile_fields(),
-        format_args!("max_objects: {}, max_depth: {}", octree.max_objects, octree.max_depth)
+        format_args!(
+            "max_objects: {}, max_depth: {}, shadow_shafts: {}",
+            octree.max_objects, octree.max_depth, octree.shadow_shafts
+        ),
+        techniques.first_hits
     )
     .unwrap();
     // What the runner reads from the ELF: `key=value` lines.
@@ -192,11 +203,52 @@ fn needs(text: &str, accel: AccelMode, config: &OctreeConfig) -> Counts {
     needed_by(text, accel, config, &mut |_| {}).unwrap_or_else(|_| count(text))
 }
 
+/// What a board may spend RAM on beyond the scene to render faster (the
+/// same image): the camera rays' screen lists and the octree's shadow shafts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Techniques {
+    first_hits: bool,
+    shadow_shafts: bool,
+}
+
+impl Techniques {
+    const NONE: Techniques = Techniques { first_hits: false, shadow_shafts: false };
+    const NAMES: [&str; 2] = ["first-hits", "shadow-shafts"];
+
+    /// `auto` (both, where they fit), `none`, or a comma list of names.
+    fn from_names(names: &str) -> Option<Techniques> {
+        match names {
+            "auto" => return Some(Techniques { first_hits: true, shadow_shafts: true }),
+            "none" => return Some(Techniques::NONE),
+            _ => {}
+        }
+        let mut wanted = Techniques::NONE;
+        for name in names.split(',') {
+            match Techniques::NAMES.iter().position(|n| *n == name.trim())? {
+                0 => wanted.first_hits = true,
+                _ => wanted.shadow_shafts = true,
+            }
+        }
+        Some(wanted)
+    }
+
+    /// These techniques and their subsets, the most helpful first: the
+    /// screen lists spare every camera ray its walk, the shafts only the
+    /// shadow rays that see their light.
+    fn subsets(self) -> impl Iterator<Item = Techniques> {
+        [(true, true), (true, false), (false, true), (false, false)]
+            .into_iter()
+            .map(|(first_hits, shadow_shafts)| Techniques { first_hits, shadow_shafts })
+            .filter(move |t| (self.first_hits || !t.first_hits) && (self.shadow_shafts || !t.shadow_shafts))
+    }
+}
+
 /// How many bytes of RAM the arenas for `counts` take (the core's types
 /// hold no pointers or `usize`, so their sizes here are the board's).
-fn static_bytes(counts: &Counts, named_walk: bool) -> usize {
-    use octrace_core::accel::{HashEntry, OctreeNode};
+fn static_bytes(counts: &Counts, named_walk: bool, techniques: Techniques) -> usize {
+    use octrace_core::accel::{HashEntry, OctreeNode, ShadowShaft};
     use octrace_core::math::Vec3;
+    use octrace_core::render::ScreenBound;
     use octrace_core::scene::{Light, SurfaceEntry};
     use octrace_core::shapes::{
         AxisAlignedBox, Rectangle, ShapeHandle, SmoothTriangle, Sphere, Superquadric, Triangle,
@@ -221,6 +273,8 @@ fn static_bytes(counts: &Counts, named_walk: bool) -> usize {
         + (counts.octree_hash_entries_if(named_walk) * size_of::<HashEntry<u16>>())
         + (counts.octree_hash_buckets_if(named_walk) + 1) * size_of::<u16>()
         + counts.mailbox_words() * size_of::<u32>()
+        + ScreenBound::needed_if(techniques.first_hits, counts.objects) * size_of::<ScreenBound>()
+        + counts.octree_shadow_shafts_if(techniques.shadow_shafts) * size_of::<ShadowShaft>()
 }
 
 fn describe(counts: &Counts) -> String {

@@ -137,6 +137,7 @@ pub mod render;
 pub mod scene;
 pub mod shade;
 pub mod shapes;
+mod sort;
 #[cfg(test)]
 mod test_rng;
 

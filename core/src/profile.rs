@@ -28,6 +28,7 @@
 
 use crate::accel::{OctreeCapacities, OctreeConfig, OctreeStore};
 use crate::capacity::{Arena, Counts};
+use crate::render::ScreenBound;
 use crate::scene::SceneCapacities;
 #[cfg(feature = "alloc")]
 use crate::{
@@ -61,6 +62,17 @@ pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
     /// [`profile!`](crate::profile!)) saves that RAM; its scenes asked for
     /// that walk are walked by 3DDDA (the same image) and say so.
     const NAMED_WALK: bool = true;
+    /// Whether camera rays find their hits among the objects seen around
+    /// their pixel (see [`Renderer::with_first_hits`](crate::render::Renderer::with_first_hits)):
+    /// the same image, with [`ScreenBound::needed_for`] the objects' worth
+    /// of [`ScreenBound`]s of RAM (`first_hits: true` in
+    /// [`profile!`](crate::profile!)). [`Raytracer`](crate::Raytracer) then
+    /// uses them in every mode but [`AccelMode::Naive`](crate::AccelMode::Naive)
+    /// asked for by name, which stays the thesis's test of every object.
+    const FIRST_HITS: bool = false;
+    /// Room for the screen lists: [`ScreenBound::needed_for`] the objects
+    /// when [`Profile::FIRST_HITS`], else none.
+    type ScreenBounds: Arena<ScreenBound>;
 }
 
 /// Defines a [`Profile`] from counts: the fields of
@@ -71,7 +83,8 @@ pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
 /// octree indices (a compile-time check keeps the octree counts within
 /// them); the crate re-exports all it needs. A last `named_walk: false`
 /// leaves out the hash table only the thesis's walk needs (see
-/// [`Profile::NAMED_WALK`]).
+/// [`Profile::NAMED_WALK`]); a last `first_hits: true` gives camera rays
+/// the screen lists (see [`Profile::FIRST_HITS`]).
 ///
 /// ```
 /// octrace_core::profile! {
@@ -87,7 +100,8 @@ macro_rules! profile {
         $(#[$meta:meta])*
         $vis:vis struct $name:ident { $($field:ident : $value:expr),* $(,)? }
         $(octree: { $($octree_field:ident : $octree_value:expr),* $(,)? })?
-        $(named_walk: $named_walk:expr)?
+        $(named_walk: $named_walk:literal)?
+        $(first_hits: $first_hits:literal)?
     ) => {
         $(#[$meta])*
         #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -103,7 +117,12 @@ macro_rules! profile {
                     p::OctreeConfig { $($($octree_field: $octree_value,)*)? ..p::OctreeConfig::DEFAULT };
                 type Octree = p::Octree<$name, { <$name as $crate::profile::Profile>::OCTREE.max_depth as usize + 1 }>;
                 type MailboxWords = p::Vec<u32, { <$name as $crate::profile::Profile>::COUNTS.mailbox_words() }>;
-                const NAMED_WALK: bool = p::given_or_true(&[$($named_walk)?]);
+                const NAMED_WALK: bool = p::given_or(&[$($named_walk)?], true);
+                const FIRST_HITS: bool = p::given_or(&[$($first_hits)?], false);
+                type ScreenBounds = p::Vec<
+                    p::ScreenBound,
+                    { p::ScreenBound::needed_if(<$name as $crate::profile::Profile>::FIRST_HITS, <$name as $crate::profile::Profile>::COUNTS.objects) },
+                >;
             }
 
             // 16-bit indices: their top two values are markers.
@@ -199,17 +218,18 @@ pub mod __private {
     pub use crate::accel::{HashEntry, Octree, OctreeCapacities, OctreeConfig, OctreeNode, ShadowShaft};
     pub use crate::capacity::Counts;
     pub use crate::math::Vec3;
+    pub use crate::render::ScreenBound;
     pub use crate::scene::{Light, SceneCapacities, SurfaceEntry};
     pub use crate::shapes::{
         AxisAlignedBox, Rectangle, ShapeHandle, ShapeKinds, SmoothTriangle, Sphere, Superquadric, Triangle,
     };
     pub use heapless::Vec;
 
-    /// The value given, if one was.
-    pub const fn given_or_true(given: &[bool]) -> bool {
+    /// The value given, if one was, else `default`.
+    pub const fn given_or(given: &[bool], default: bool) -> bool {
         match given {
             [value] => *value,
-            _ => true,
+            _ => default,
         }
     }
 }
@@ -246,6 +266,7 @@ mod host {
     use crate::accel::{HashEntry, Octree, OctreeCapacities, OctreeConfig, OctreeNode, ShadowShaft, MAX_DEPTH};
     use crate::capacity::{Counts, HeapArena};
     use crate::math::Vec3;
+    use crate::render::ScreenBound;
     use crate::scene::{Light, SceneCapacities, SurfaceEntry};
     use crate::shapes::{AxisAlignedBox, Rectangle, ShapeHandle, SmoothTriangle, Sphere, Superquadric, Triangle};
 
@@ -270,6 +291,8 @@ mod host {
         const OCTREE: OctreeConfig = OctreeConfig { shadow_shafts: true, ..OctreeConfig::DEFAULT };
         type Octree = Octree<Host, { MAX_DEPTH as usize + 1 }>;
         type MailboxWords = HeapArena<u32, { Host::COUNTS.mailbox_words() }>;
+        const FIRST_HITS: bool = true;
+        type ScreenBounds = HeapArena<ScreenBound, { ScreenBound::needed_for(Host::COUNTS.objects) }>;
     }
 
     impl SceneCapacities for Host {

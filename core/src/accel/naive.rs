@@ -46,6 +46,13 @@ impl<P: Profile> Accelerator for NaiveFor<P> {
     const KINDS: ShapeKinds = ShapeKinds::with_room(&P::COUNTS);
     const USES_MAILBOX: bool = false;
 
+    /// Only the [`Raytracer`](crate::Raytracer) tests every object this
+    /// way: it gives camera rays the screen lists when its profile has
+    /// room for them and the naive mode was not asked for by name.
+    fn first_hits_by_screen(&self) -> bool {
+        true
+    }
+
     fn nearest(&self, scene: &SceneView<'_>, ray: &Ray, start: Option<RayStart>, _: &mut Mailbox<'_>) -> Option<Hit> {
         nearest(Self::KINDS, scene, ray, start)
     }

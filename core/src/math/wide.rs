@@ -52,6 +52,14 @@ pub fn mul_i64_i32(a: i64, k: i32) -> i64 {
     }
 }
 
+/// `a · b` exactly, in 128 bits. Not inlined: 128-bit products are long
+/// code on a 32-bit core, and their callers (a camera's and an object's
+/// set-up) run once per render, not per ray.
+#[inline(never)]
+pub fn mul_i64_wide(a: i64, b: i64) -> i128 {
+    a as i128 * b as i128
+}
+
 /// `a²` exactly, for an unsigned operand.
 #[inline(always)]
 pub fn square_u32_wide(a: u32) -> u64 {

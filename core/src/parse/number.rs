@@ -125,6 +125,9 @@ impl Decimal {
 
     /// The value in Q32.32, rounded to nearest (ties away from zero). The
     /// magnitude must be within 10^6 ([`Decimal::out_of_range`] false).
+    // Not inlined: its 128-bit division is long code on a 32-bit core,
+    // and the parser reads numbers in many places.
+    #[inline(never)]
     pub fn to_q32(self) -> i64 {
         let magnitude: u128 = if self.exponent >= 0 {
             let e = self.exponent.min(19) as usize;

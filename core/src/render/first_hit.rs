@@ -20,7 +20,7 @@
 //! object whose bound is not beyond the nearest hit.
 
 use crate::accel::{Hit, FILING_MARGIN};
-use crate::math::isqrt;
+use crate::math::{isqrt, mul_i64_wide};
 use crate::scene::{Camera, ObjectId, Projection, SceneView};
 use crate::shapes::{Leaving, Ray, ShapeKinds};
 
@@ -68,6 +68,17 @@ impl ScreenBound {
         objects + band + tile
     }
 
+    /// [`ScreenBound::needed_for`] `objects` when `wanted`, else 0: a
+    /// profile's room for them.
+    pub const fn needed_if(wanted: bool, objects: usize) -> usize {
+        if wanted {
+            Self::needed_for(objects)
+        } else {
+            0
+        }
+    }
+
+    #[inline(never)]
     fn of(scene: &SceneView<'_>, projection: &Projection, id: ObjectId) -> ScreenBound {
         let bounds = scene.shape(id).bounds();
         let lo = bounds.min.wide().map(|v| v - FILING_MARGIN);
@@ -75,8 +86,8 @@ impl ScreenBound {
         let eye = projection.eye();
         let gap2: u128 = (0..3)
             .map(|a| {
-                let gap = (lo[a] - eye[a]).max(eye[a] - hi[a]).max(0) as u128;
-                gap * gap
+                let gap = (lo[a] - eye[a]).max(eye[a] - hi[a]).max(0);
+                mul_i64_wide(gap, gap) as u128
             })
             .sum();
         // Within the normalised range the squares fit a u64; beyond it the
@@ -138,7 +149,7 @@ impl<'a> FirstHits<'a> {
         for (slot, id) in all.iter_mut().zip(scene.object_ids()) {
             *slot = ScreenBound::of(scene, &projection, id);
         }
-        all.sort_unstable_by_key(|b| (b.near, b.object));
+        crate::sort::sort_by_key(all, |b| (b.near, b.object));
         Some(FirstHits { storage, objects, band_start: u32::MAX, band: None, tile_start: u32::MAX, tile: None })
     }
 

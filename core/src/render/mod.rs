@@ -151,10 +151,15 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
     pub fn with_first_hits(mut self, storage: &'a mut [ScreenBound]) -> Self {
+        self.set_first_hits(storage);
+        self
+    }
+
+    /// [`Renderer::with_first_hits`] in place.
+    pub fn set_first_hits(&mut self, storage: &'a mut [ScreenBound]) {
         if self.tracer.accel().first_hits_by_screen() {
             self.first_hits = FirstHits::new(self.tracer.scene(), &self.camera, storage);
         }
-        self
     }
 
     /// The camera ray's hit from the screen lists, if the renderer has them.

@@ -8,7 +8,7 @@
 //! or row order gives the same bits.
 
 use super::normalize::{Normalization, WorldPoint, WorldValue};
-use crate::math::{isqrt_u128, mul_i64_i32, Dir, Vec3};
+use crate::math::{isqrt_u128, mul_i64_i32, mul_i64_wide, Dir, Vec3};
 use crate::shapes::Ray;
 
 /// The most samples per pixel side (SAMPLES 1 to 16): the renderer sums
@@ -79,7 +79,9 @@ pub(crate) struct RayCursor {
     last: Option<(i32, i32, [i64; 3])>,
 }
 
-/// Rounded `a · b / c` in `i128`, `c > 0`.
+/// Rounded `a · b / c` in `i128`, `c > 0`. Not inlined: 128-bit division
+/// is long code on a 32-bit core, and a camera's set-up uses it often.
+#[inline(never)]
 fn mul_div(a: i128, b: i128, c: i128) -> i128 {
     let p = a * b;
     if p >= 0 {
@@ -248,11 +250,14 @@ pub(crate) struct Projection {
 const OFFSET_LIMIT: i64 = 1 << 21;
 
 impl Projection {
+    #[inline(never)]
     pub(crate) fn new(camera: &Camera) -> Projection {
-        let wide = |v: [i64; 3]| v.map(|c| c as i128);
-        let (f, x, y) = (wide(camera.forward), wide(camera.step_x), wide(camera.step_y));
-        let cross = |a: [i128; 3], b: [i128; 3]| {
-            [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+        let (f, x, y) = (camera.forward, camera.step_x, camera.step_y);
+        let cross = |a: [i64; 3], b: [i64; 3]| {
+            [0, 1, 2].map(|i| {
+                let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+                mul_i64_wide(a[j], b[k]) - mul_i64_wide(a[k], b[j])
+            })
         };
         let (across, down, depth) = (cross(y, f), cross(f, x), cross(x, y));
         let top = [across, down, depth].iter().flatten().map(|c| c.unsigned_abs()).max().unwrap_or(0);
@@ -260,7 +265,7 @@ impl Projection {
         let cut_down = |v: [i128; 3]| v.map(|c| (c >> cut) as i64);
         let (mut across, mut down, mut depth) = (cut_down(across), cut_down(down), cut_down(depth));
         // Oriented so that points ahead of the eye have a positive depth.
-        let ahead: i128 = (0..3).map(|a| f[a] * depth[a] as i128).sum();
+        let ahead = dot(&f, &depth);
         if ahead < 0 {
             for v in [&mut across, &mut down, &mut depth] {
                 *v = v.map(|c| -c);
@@ -280,8 +285,10 @@ impl Projection {
     /// Σ|v_a| of the true one's (in the cut scale), and cutting both to about
     /// 41 bits adds less than one more. With `e` bounding both errors, the
     /// true offset is within `e·(1 + |k|) / (depth − e)` of the quotient `k`.
+    // Not inlined, nor its products: once per object, and 128-bit code is
+    // large on a 32-bit core (flash, not time, is what it costs a board).
+    #[inline(never)]
     pub(crate) fn window(&self, lo: [i64; 3], hi: [i64; 3]) -> Option<[[i32; 2]; 2]> {
-        let dot = |n: &[i64; 3], v: &[i64; 3]| (0..3).map(|a| n[a] as i128 * v[a] as i128).sum::<i128>();
         let mut window = [[i64::MAX, i64::MIN]; 2];
         for corner in 0..8 {
             let v = [0, 1, 2].map(|a| if corner >> a & 1 == 1 { hi[a] } else { lo[a] } - self.eye[a]);
@@ -318,6 +325,12 @@ impl Projection {
     pub(crate) fn eye(&self) -> [i64; 3] {
         self.eye
     }
+}
+
+/// `n · v`, exactly.
+#[inline(never)]
+fn dot(n: &[i64; 3], v: &[i64; 3]) -> i128 {
+    (0..3).map(|a| mul_i64_wide(n[a], v[a])).sum()
 }
 
 #[cfg(test)]

@@ -344,7 +344,7 @@ impl<C: SceneCapacities> Scene<C> {
     /// Sorts the surfaces by number (first definition first), so that
     /// [`SceneView::surface_index`] can binary-search them.
     pub(crate) fn sort_surfaces(&mut self) {
-        self.surfaces.as_mut_slice().sort_unstable_by_key(|s| (s.number, s.line, s.column));
+        crate::sort::sort_by_key(self.surfaces.as_mut_slice(), |s| (s.number, s.line, s.column));
     }
 }
 
