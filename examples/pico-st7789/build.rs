@@ -4,7 +4,11 @@
 //! host, with the parser the board runs: its errors fail the build with their
 //! line and column. `SceneProfile` holds exactly what it needs, its octree
 //! included, so the Pico's RAM holds just this scene (the linker says so if
-//! it does not fit).
+//! it does not fit). It also holds the screen lists of first hits, which
+//! render the same picture faster for RAM the Pico has to spare (24 bytes
+//! for each object, times about three). The octree's shadow shafts are left
+//! out: on the thesis's scenes they take longer to build than they save in
+//! one picture (BENCHMARKS.md).
 
 use octrace_core::accel::OctreeConfig;
 use octrace_core::profile::needed_by;
@@ -41,7 +45,8 @@ fn main() {
              /// Exactly what `{scene}` needs, its octree included.\n    \
              pub struct SceneProfile {{ {fields} }}\n    \
              // `load` walks the octree by 3DDDA: no room for the thesis's hash table.\n    \
-             named_walk: false\n\
+             named_walk: false\n    \
+             first_hits: true\n\
          }}\n",
         fields = needs.profile_fields(),
     );

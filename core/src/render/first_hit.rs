@@ -21,8 +21,8 @@
 
 use crate::accel::{Hit, FILING_MARGIN};
 use crate::math::{isqrt, mul_i64_wide};
-use crate::scene::{Camera, ObjectId, Projection, SceneView};
-use crate::shapes::{Leaving, Ray, ShapeKinds};
+use crate::scene::{Camera, CameraRay, ObjectId, Projection, SceneView};
+use crate::shapes::{Leaving, ShapeKinds};
 
 /// Rows of a band: its objects are chosen once for them all.
 const BAND_ROWS: u32 = 8;
@@ -162,11 +162,11 @@ impl<'a> FirstHits<'a> {
         scene: &SceneView<'_>,
         kinds: ShapeKinds,
         camera: &Camera,
-        ray: &Ray,
+        ray: &mut CameraRay,
         [x, y, sx, sy]: [u32; 4],
     ) -> Option<Option<Hit>> {
         let tile = self.tile(camera, x, y)?;
-        Some(nearest(scene, kinds, tile, ray, camera.offsets(x, y, sx, sy)))
+        Some(nearest(scene, kinds, tile, camera, ray, camera.offsets(x, y, sx, sy)))
     }
 
     /// The objects that camera rays of pixel (`x`, `y`)'s tile may hit,
@@ -199,13 +199,14 @@ impl<'a> FirstHits<'a> {
 }
 
 /// The nearest hit of the camera ray with offsets `(kx, ky)` among `band`'s
-/// objects.
+/// objects. The ray is made only when a window holds the offsets.
 #[inline]
 fn nearest(
     scene: &SceneView<'_>,
     kinds: ShapeKinds,
     band: &[ScreenBound],
-    ray: &Ray,
+    camera: &Camera,
+    ray: &mut CameraRay,
     (kx, ky): (i32, i32),
 ) -> Option<Hit> {
     let mut best = Hit::NONE;
@@ -216,7 +217,9 @@ fn nearest(
         if kx < bound.x[0] || kx > bound.x[1] || ky < bound.y[0] || ky > bound.y[1] {
             continue;
         }
-        if let Some(t) = scene.intersect_handle(kinds, scene.objects[bound.object as usize], ray, best.t, Leaving::No) {
+        if let Some(t) =
+            scene.intersect_handle(kinds, scene.objects[bound.object as usize], ray.get(camera), best.t, Leaving::No)
+        {
             let hit = Hit { t, object: ObjectId(bound.object) };
             if hit.beats(&best) {
                 best = hit;
@@ -235,7 +238,7 @@ mod tests {
     use crate::accel::{Accelerator, Mailbox, Naive};
     use crate::parse::parse;
     use crate::profile::Board64K;
-    use crate::scene::Scene;
+    use crate::scene::{RayCursor, Scene};
     use std::{boxed::Box, format, string::String, vec};
 
     /// A random scene of spheres, boxes, rectangles and triangles around
@@ -328,7 +331,8 @@ mod tests {
                     let tested = hits.tile(&camera, x, y).map_or(view.object_count(), <[_]>::len) as u64;
                     for (sx, sy) in (0..n * n).map(|s| (s % n, s / n)) {
                         let ray = camera.ray(x, y, sx, sy);
-                        let listed = hits.nearest(&view, ShapeKinds::ALL, &camera, &ray, [x, y, sx, sy]);
+                        let mut lazy = camera.next_ray(&mut RayCursor::default(), x, y, sx, sy);
+                        let listed = hits.nearest(&view, ShapeKinds::ALL, &camera, &mut lazy, [x, y, sx, sy]);
                         let naive = Naive.nearest(&view, &ray, None, &mut Mailbox::none());
                         assert_eq!(listed.unwrap_or(naive), naive, "pixel {x} {y}, sample {sx} {sy}");
                         rays += 1;

@@ -27,7 +27,7 @@ pub use panel::PanelColor;
 pub use split::{interleaved_rows, Tiles};
 
 use crate::accel::{Accelerator, Hit, Mailbox};
-use crate::scene::{Camera, CameraError, Color, ObjectId, RayCursor, SceneView};
+use crate::scene::{Camera, CameraError, CameraRay, Color, ObjectId, RayCursor, SceneView};
 use crate::shade::{Scratch, Stats, Tracer};
 use core::ops::Range;
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -164,7 +164,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
 
     /// The camera ray's hit from the screen lists, if the renderer has them.
     #[inline]
-    fn first_hit(&mut self, ray: &crate::shapes::Ray, x: u32, y: u32, sx: u32, sy: u32) -> Option<Option<Hit>> {
+    fn first_hit(&mut self, ray: &mut CameraRay, x: u32, y: u32, sx: u32, sy: u32) -> Option<Option<Hit>> {
         // Asked first: for an accelerator that never allows the lists (the
         // naive modes) the whole path folds away, a board's cycles too.
         if !self.tracer.accel().first_hits_by_screen() {
@@ -191,9 +191,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         let n = self.camera.samples();
         let (mean, object) = if n == 1 {
             // One sample (the common case on a board): no loops, no sums.
-            let ray = self.camera.next_ray(&mut self.cursor, x, y, 0, 0);
-            let first = self.first_hit(&ray, x, y, 0, 0);
-            let (c, object) = self.tracer.trace(ray, first, &mut self.scratch);
+            let (c, object) = self.sample(x, y, 0, 0);
             (Color::from_bits(c.bits().map(|v| v.clamp(0, 1 << 16))), object)
         } else {
             self.mean_of_samples(n, x, y)
@@ -207,6 +205,17 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         PixelSample { color: Rgb888::new(encoded[0], encoded[1], encoded[2]), object }
     }
 
+    /// The colour and object of sample (`sx`, `sy`) of pixel (`x`, `y`).
+    #[inline]
+    fn sample(&mut self, x: u32, y: u32, sx: u32, sy: u32) -> (Color, Option<ObjectId>) {
+        let mut ray = self.camera.next_ray(&mut self.cursor, x, y, sx, sy);
+        match self.first_hit(&mut ray, x, y, sx, sy) {
+            // Shown by the lists to miss: the ray itself is never made.
+            Some(None) => self.tracer.missed(&mut self.scratch),
+            first => self.tracer.trace(*ray.get(&self.camera), first, &mut self.scratch),
+        }
+    }
+
     /// The mean of the `n`² samples of pixel (`x`, `y`) (channels clamped to
     /// 0..1 first, rounded to nearest) and the object hit by the middle one.
     fn mean_of_samples(&mut self, n: u32, x: u32, y: u32) -> (Color, Option<ObjectId>) {
@@ -215,9 +224,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         let mut sum = [0u32; 3];
         for sy in 0..n {
             for sx in 0..n {
-                let ray = self.camera.next_ray(&mut self.cursor, x, y, sx, sy);
-                let first = self.first_hit(&ray, x, y, sx, sy);
-                let (c, o) = self.tracer.trace(ray, first, &mut self.scratch);
+                let (c, o) = self.sample(x, y, sx, sy);
                 if sx == n / 2 && sy == n / 2 {
                     object = o;
                 }

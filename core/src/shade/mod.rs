@@ -149,6 +149,19 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         self.accel
     }
 
+    /// What [`Tracer::trace`] gives for a primary ray known to hit nothing
+    /// (the same colour and counts), without the ray.
+    pub fn missed(&self, scratch: &mut Scratch<'_>) -> (Color, Option<ObjectId>) {
+        scratch.stats.rays += 1;
+        (Color::BLACK.saturating_add(self.background(Scalar::ONE)), None)
+    }
+
+    /// The background's share in a ray of `weight` that hits nothing.
+    #[inline]
+    fn background(&self, weight: Scalar) -> Color {
+        self.scene.settings.background.scale(weight)
+    }
+
     /// The linear colour seen along a primary ray, and the object it hits (as
     /// written: [`SceneView::written_object`]).
     // Not inlined: a frame of its own keeps the stack of a small board bounded
@@ -188,7 +201,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             }
             let mut next = None;
             match hit {
-                None => color = color.saturating_add(self.scene.settings.background.scale(p.weight)),
+                None => color = color.saturating_add(self.background(p.weight)),
                 Some(hit) => {
                     let children = self.shade(&p, hit, &mut color, scratch);
                     for &child in children.iter().flatten() {
