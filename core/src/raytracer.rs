@@ -585,6 +585,37 @@ mod tests {
         assert_eq!(grid.0, expected.0);
     }
 
+    crate::profile! {
+        /// [`Hashless`] with room for the camera rays' screen lists.
+        struct Listed { spheres: 12, surfaces: 1, lights: 1, octree_boxes: 200, octree_references: 400 }
+        octree: { max_objects: 1, max_depth: 4 }
+        named_walk: false
+        first_hits: true
+    }
+
+    #[test]
+    fn a_profile_with_first_hits_draws_the_same_pixels_without_walking_camera_rays() {
+        extern crate std;
+        let spheres: std::string::String = (0..12).map(|i| std::format!("SPHERE 1 0.4 {} 0 0\n", i - 6)).collect();
+        let text = std::format!("VIEWPOINT 0 2 9\nLIGHT 10 5 5 5\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n{spheres}");
+        fn draw<P: Profile>(scene: &LoadedScene<'_, P>) -> [[Option<Rgb565>; 32]; 24] {
+            let mut grid = Grid::<Rgb565, 32, 24>([[None; 32]; 24]);
+            scene.image_for(&grid).draw(&mut grid).unwrap();
+            grid.0
+        }
+        let mut walked = Raytracer::<Hashless>::new();
+        let walked = walked.load_with(text.as_bytes(), AccelMode::Dda, &mut |e| panic!("{e:?}")).unwrap();
+        let mut listed = Raytracer::<Listed>::new();
+        let listed = listed.load_with(text.as_bytes(), AccelMode::Dda, &mut |e| panic!("{e:?}")).unwrap();
+        assert!(listed.first_hits() && !walked.first_hits());
+        assert_eq!(draw(&listed), draw(&walked));
+        let (cells, walked_cells) = (listed.stats().cells, walked.stats().cells);
+        assert!(cells < walked_cells, "camera rays skip the walk: {cells} cells against {walked_cells}");
+        let mut by_name = Raytracer::<Listed>::new();
+        let naive = by_name.load_with(text.as_bytes(), AccelMode::Naive, &mut |e| panic!("{e:?}")).unwrap();
+        assert!(!naive.first_hits(), "the naive mode named tests every object");
+    }
+
     #[test]
     fn a_bad_scene_gives_its_first_error_and_the_count() {
         let mut raytracer = Raytracer::<Board16K>::new();
