@@ -274,7 +274,8 @@ fn static_bytes(counts: &Counts, named_walk: bool, techniques: Techniques) -> us
         + (counts.octree_hash_entries_if(named_walk) * size_of::<HashEntry<u16>>())
         + (counts.octree_hash_buckets_if(named_walk) + 1) * size_of::<u16>()
         + counts.mailbox_words() * size_of::<u32>()
-        + ScreenBound::needed_if(techniques.first_hits, counts.objects) * size_of::<ScreenBound>()
+        + ScreenBound::if_wanted(techniques.first_hits, counts.objects) * size_of::<ScreenBound>()
+        + ScreenBound::if_wanted(techniques.first_hits, ScreenBound::positions_for(counts.objects)) * size_of::<u16>()
         + counts.octree_shadow_shafts_if(techniques.shadow_shafts) * size_of::<ShadowShaft>()
 }
 

@@ -64,15 +64,18 @@ pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
     const NAMED_WALK: bool = true;
     /// Whether camera rays find their hits among the objects seen around
     /// their pixel (see [`Renderer::with_first_hits`](crate::render::Renderer::with_first_hits)):
-    /// the same image, with [`ScreenBound::needed_for`] the objects' worth
-    /// of [`ScreenBound`]s of RAM (`first_hits: true` in
+    /// the same image, for a [`ScreenBound`] (24 bytes) an object and
+    /// [`ScreenBound::positions_for`] them (2 bytes each) of RAM (`first_hits: true` in
     /// [`profile!`](crate::profile!)). [`Raytracer`](crate::Raytracer) then
     /// uses them in every mode but [`AccelMode::Naive`](crate::AccelMode::Naive)
     /// asked for by name, which stays the thesis's test of every object.
     const FIRST_HITS: bool = false;
-    /// Room for the screen lists: [`ScreenBound::needed_for`] the objects
-    /// when [`Profile::FIRST_HITS`], else none.
+    /// Room for the screen lists: a bound for each object when
+    /// [`Profile::FIRST_HITS`], else none.
     type ScreenBounds: Arena<ScreenBound>;
+    /// And for the lists' positions: [`ScreenBound::positions_for`] the
+    /// objects when [`Profile::FIRST_HITS`], else none.
+    type ScreenPositions: Arena<u16>;
 }
 
 /// Defines a [`Profile`] from counts: the fields of
@@ -121,7 +124,11 @@ macro_rules! profile {
                 const FIRST_HITS: bool = p::given_or(&[$($first_hits)?], false);
                 type ScreenBounds = p::Vec<
                     p::ScreenBound,
-                    { p::ScreenBound::needed_if(<$name as $crate::profile::Profile>::FIRST_HITS, <$name as $crate::profile::Profile>::COUNTS.objects) },
+                    { p::ScreenBound::if_wanted(<$name as $crate::profile::Profile>::FIRST_HITS, <$name as $crate::profile::Profile>::COUNTS.objects) },
+                >;
+                type ScreenPositions = p::Vec<
+                    u16,
+                    { p::ScreenBound::if_wanted(<$name as $crate::profile::Profile>::FIRST_HITS, p::ScreenBound::positions_for(<$name as $crate::profile::Profile>::COUNTS.objects)) },
                 >;
             }
 
@@ -292,7 +299,8 @@ mod host {
         type Octree = Octree<Host, { MAX_DEPTH as usize + 1 }>;
         type MailboxWords = HeapArena<u32, { Host::COUNTS.mailbox_words() }>;
         const FIRST_HITS: bool = true;
-        type ScreenBounds = HeapArena<ScreenBound, { ScreenBound::needed_for(Host::COUNTS.objects) }>;
+        type ScreenBounds = HeapArena<ScreenBound, { Host::COUNTS.objects }>;
+        type ScreenPositions = HeapArena<u16, { ScreenBound::positions_for(Host::COUNTS.objects) }>;
     }
 
     impl SceneCapacities for Host {

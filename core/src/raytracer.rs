@@ -44,6 +44,7 @@ pub struct Raytracer<P: Profile> {
     octree: P::Octree,
     mailbox: P::MailboxWords,
     screen_bounds: P::ScreenBounds,
+    screen_positions: P::ScreenPositions,
 }
 
 impl<P: Profile> fmt::Debug for Raytracer<P> {
@@ -94,6 +95,7 @@ impl<P: Profile> Raytracer<P> {
             octree: P::Octree::EMPTY,
             mailbox: P::MailboxWords::EMPTY,
             screen_bounds: P::ScreenBounds::EMPTY,
+            screen_positions: P::ScreenPositions::EMPTY,
         }
     }
 
@@ -148,14 +150,15 @@ impl<P: Profile> Raytracer<P> {
         // The naive mode asked for by name stays the thesis's test of
         // every object, camera rays too.
         let first_hits = P::FIRST_HITS && requested != AccelMode::Naive;
-        let bounds = if first_hits { ScreenBound::needed_for(view.object_count()) } else { 0 };
-        fill(&mut self.screen_bounds, bounds, ScreenBound::EMPTY);
+        let objects = if first_hits { view.object_count() } else { 0 };
+        fill(&mut self.screen_bounds, objects, ScreenBound::EMPTY);
+        fill(&mut self.screen_positions, ScreenBound::positions_for(objects), 0);
         Ok(LoadedScene {
             view,
             mode,
             octree,
             mailbox: RefCell::new(self.mailbox.as_mut_slice()),
-            screen_bounds: RefCell::new(self.screen_bounds.as_mut_slice()),
+            screen_lists: RefCell::new((self.screen_bounds.as_mut_slice(), self.screen_positions.as_mut_slice())),
             first_hits,
             stats: Cell::new(Stats::default()),
         })
@@ -174,8 +177,9 @@ pub struct LoadedScene<'r, P: Profile> {
     mode: AccelMode,
     octree: Option<(&'r P::Octree, BuildReport)>,
     mailbox: RefCell<&'r mut [u32]>,
-    /// Room for the camera rays' screen lists, if they are used.
-    screen_bounds: RefCell<&'r mut [ScreenBound]>,
+    /// Room for the camera rays' screen lists (bounds and positions), if
+    /// they are used.
+    screen_lists: RefCell<(&'r mut [ScreenBound], &'r mut [u16])>,
     first_hits: bool,
     stats: Cell<Stats>,
 }
@@ -269,9 +273,9 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
             renderer.set_mailbox(words);
         }
         // Likewise the screen lists.
-        let mut screen_bounds = self.screen_bounds.try_borrow_mut();
-        if let (true, Ok(bounds)) = (self.first_hits, screen_bounds.as_deref_mut()) {
-            renderer.set_first_hits(bounds);
+        let mut screen_lists = self.screen_lists.try_borrow_mut();
+        if let (true, Ok((bounds, positions))) = (self.first_hits, screen_lists.as_deref_mut()) {
+            renderer.set_first_hits(bounds, positions);
         }
         let mut shifted = Shifted { target, offset: at - area.top_left };
         let stats = renderer.render_rect(area, &mut shifted).map_err(DrawError::Target)?;

@@ -5,8 +5,8 @@
 //! line and column. `SceneProfile` holds exactly what it needs, its octree
 //! included, so the Pico's RAM holds just this scene (the linker says so if
 //! it does not fit). It also holds the screen lists of first hits, which
-//! render the same picture faster for RAM the Pico has to spare (24 bytes
-//! for each object, times about three). The octree's shadow shafts are left
+//! render the same picture faster for RAM the Pico has to spare (at most
+//! 28 bytes an object). The octree's shadow shafts are left
 //! out: on the thesis's scenes they take longer to build than they save in
 //! one picture (BENCHMARKS.md).
 

@@ -409,8 +409,9 @@ fn stream_threads<A: Accelerator + Sync>(
         let mut busy = Duration::ZERO;
         let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
         let Ok(renderer) = Renderer::with_size(view, accel, w, h) else { return (Stats::default(), busy) };
-        let mut bounds = vec![ScreenBound::EMPTY; ScreenBound::needed_for(view.object_count())];
-        let mut renderer = renderer.with_mailbox(&mut words).with_first_hits(&mut bounds);
+        let mut bounds = vec![ScreenBound::EMPTY; view.object_count()];
+        let mut positions = vec![0; ScreenBound::positions_for(view.object_count())];
+        let mut renderer = renderer.with_mailbox(&mut words).with_first_hits(&mut bounds, &mut positions);
         // Equal4 hands the thesis's rectangles out statically.
         let mut own_next = thread;
         loop {

@@ -151,8 +151,9 @@ impl Studio {
         let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
         let renderer = Renderer::with_size(view, accel, self.size.0, self.size.1)
             .map_err(|e| StudioError::Camera(format!("{e:?}")))?;
-        let mut bounds = vec![ScreenBound::EMPTY; ScreenBound::needed_for(view.object_count())];
-        let mut renderer = renderer.with_mailbox(&mut words).with_first_hits(&mut bounds);
+        let mut bounds = vec![ScreenBound::EMPTY; view.object_count()];
+        let mut positions = vec![0; ScreenBound::positions_for(view.object_count())];
+        let mut renderer = renderer.with_mailbox(&mut words).with_first_hits(&mut bounds, &mut positions);
         let count = width as usize * height as usize;
         out.clear();
         out.reserve(7 * count);

@@ -8,7 +8,8 @@
 //! (the distance from the eye to the widened box). For a band of rows the
 //! objects whose window meets the band are kept, still in that order, and
 //! of those, for each tile of the band, the ones whose window meets the
-//! tile. A camera ray then tests its tile's objects whose window holds its
+//! tile (both lists as 16-bit positions in the sorted bounds: 2 bytes an
+//! entry, not a bound's 24, which is what lets a 16 KiB board keep them). A camera ray then tests its tile's objects whose window holds its
 //! offsets, in order, until the next one's bound is beyond the nearest hit
 //! so far.
 //!
@@ -39,11 +40,15 @@ const MIN_RAYS_PER_OBJECT: u64 = 16;
 /// which would then cost more than the walk.
 const MAX_BAND_OBJECTS: usize = 512;
 const MAX_TILE_OBJECTS: usize = 128;
+/// The lists hold 16-bit positions: a scene of more objects leaves its
+/// camera rays to the accelerator.
+const MAX_OBJECTS: usize = 1 << 16;
 
 /// What a camera ray needs to know of one object: where in the image its
 /// bounds are seen and how near its hit can be. Storage for
-/// [`Renderer::with_first_hits`](super::Renderer::with_first_hits), of
-/// [`ScreenBound::needed_for`] the scene's objects.
+/// [`Renderer::with_first_hits`](super::Renderer::with_first_hits): one
+/// for each of the scene's objects, beside
+/// [`ScreenBound::positions_for`] them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ScreenBound {
     /// No camera ray hits the object at a smaller parameter (Q16.16 bits).
@@ -60,19 +65,19 @@ impl ScreenBound {
     /// A placeholder to fill storage with.
     pub const EMPTY: ScreenBound = ScreenBound { near: 0, object: 0, x: [0; 2], y: [0; 2] };
 
-    /// How many a renderer needs for `objects` objects: one each, and a
-    /// band's and a tile's worth.
-    pub const fn needed_for(objects: usize) -> usize {
+    /// How many positions (`u16`s) a renderer needs beside the bounds of
+    /// `objects` objects: a band's and a tile's worth.
+    pub const fn positions_for(objects: usize) -> usize {
         let band = if objects < MAX_BAND_OBJECTS { objects } else { MAX_BAND_OBJECTS };
         let tile = if objects < MAX_TILE_OBJECTS { objects } else { MAX_TILE_OBJECTS };
-        objects + band + tile
+        band + tile
     }
 
-    /// [`ScreenBound::needed_for`] `objects` when `wanted`, else 0: a
-    /// profile's room for them.
-    pub const fn needed_if(wanted: bool, objects: usize) -> usize {
+    /// `count` when `wanted`, else 0: a profile's room for the bounds or
+    /// the positions.
+    pub const fn if_wanted(wanted: bool, count: usize) -> usize {
         if wanted {
-            Self::needed_for(objects)
+            count
         } else {
             0
         }
@@ -105,12 +110,17 @@ impl ScreenBound {
     }
 }
 
-/// Keeps the bounds of `from` that `keep` admits, in order, in `to`;
-/// `None` when more than `to` holds.
-fn filter(from: &[ScreenBound], to: &mut [ScreenBound], keep: impl Fn(&ScreenBound) -> bool) -> Option<usize> {
+/// Keeps the positions of `from` whose bounds in `all` `keep` admits, in
+/// order, in `to`; `None` when more than `to` holds.
+fn filter(
+    all: &[ScreenBound],
+    from: impl Iterator<Item = u16>,
+    to: &mut [u16],
+    keep: impl Fn(&ScreenBound) -> bool,
+) -> Option<usize> {
     let mut kept = 0;
-    for bound in from.iter().filter(|b| keep(b)) {
-        *to.get_mut(kept)? = *bound;
+    for position in from.filter(|&p| all.get(p as usize).is_some_and(&keep)) {
+        *to.get_mut(kept)? = position;
         kept += 1;
     }
     Some(kept)
@@ -119,10 +129,10 @@ fn filter(from: &[ScreenBound], to: &mut [ScreenBound], keep: impl Fn(&ScreenBou
 /// The sorted bounds of every object, the chosen ones of the current band
 /// and those of its current tile, in caller-owned storage.
 pub(crate) struct FirstHits<'a> {
-    /// Every object's bound, nearest first; then room for a band's and a
-    /// tile's.
-    storage: &'a mut [ScreenBound],
-    objects: usize,
+    /// Every object's bound, nearest first.
+    all: &'a [ScreenBound],
+    /// Room for the positions in `all` of a band's objects, then a tile's.
+    positions: &'a mut [u16],
     /// The band's first row (`u32::MAX` before the first) and how many
     /// objects it kept (`None`: too many).
     band_start: u32,
@@ -135,22 +145,30 @@ pub(crate) struct FirstHits<'a> {
 
 impl<'a> FirstHits<'a> {
     /// The bounds of `scene`'s objects seen by `camera`, or `None` when
-    /// `storage` holds fewer than [`ScreenBound::needed_for`] them or the
-    /// objects are too many for the image to pay for them.
-    pub fn new(scene: &SceneView<'_>, camera: &Camera, storage: &'a mut [ScreenBound]) -> Option<Self> {
+    /// `bounds` holds fewer than the objects, `positions` fewer than
+    /// [`ScreenBound::positions_for`] them, or the objects are too many for
+    /// the image to pay for them (or for 16-bit positions).
+    pub fn new(
+        scene: &SceneView<'_>,
+        camera: &Camera,
+        bounds: &'a mut [ScreenBound],
+        positions: &'a mut [u16],
+    ) -> Option<Self> {
         let objects = scene.object_count();
         let n = camera.samples() as u64;
-        if objects as u64 * MIN_RAYS_PER_OBJECT > camera.width() as u64 * camera.height() as u64 * n * n {
+        if objects > MAX_OBJECTS
+            || objects as u64 * MIN_RAYS_PER_OBJECT > camera.width() as u64 * camera.height() as u64 * n * n
+        {
             return None;
         }
-        let storage = storage.get_mut(..ScreenBound::needed_for(objects))?;
+        let all = bounds.get_mut(..objects)?;
+        let positions = positions.get_mut(..ScreenBound::positions_for(objects))?;
         let projection = Projection::new(camera);
-        let all = &mut storage[..objects];
         for (slot, id) in all.iter_mut().zip(scene.object_ids()) {
             *slot = ScreenBound::of(scene, &projection, id);
         }
         crate::sort::sort_by_key(all, |b| (b.near, b.object));
-        Some(FirstHits { storage, objects, band_start: u32::MAX, band: None, tile_start: u32::MAX, tile: None })
+        Some(FirstHits { all, positions, band_start: u32::MAX, band: None, tile_start: u32::MAX, tile: None })
     }
 
     /// The nearest hit of `camera`'s ray through sub-cell (`sx`, `sy`) of
@@ -165,18 +183,20 @@ impl<'a> FirstHits<'a> {
         ray: &mut CameraRay,
         [x, y, sx, sy]: [u32; 4],
     ) -> Option<Option<Hit>> {
+        let all = self.all;
         let tile = self.tile(camera, x, y)?;
-        Some(nearest(scene, kinds, tile, camera, ray, camera.offsets(x, y, sx, sy)))
+        Some(nearest(scene, kinds, all, tile, camera, ray, camera.offsets(x, y, sx, sy)))
     }
 
-    /// The objects that camera rays of pixel (`x`, `y`)'s tile may hit,
-    /// nearest bound first, or `None` when they are too many.
+    /// The positions in the bounds of the objects that camera rays of
+    /// pixel (`x`, `y`)'s tile may hit, nearest bound first, or `None` when
+    /// they are too many.
     #[inline]
-    fn tile(&mut self, camera: &Camera, x: u32, y: u32) -> Option<&[ScreenBound]> {
+    fn tile(&mut self, camera: &Camera, x: u32, y: u32) -> Option<&[u16]> {
         let (band_start, tile_start) = (y - y % BAND_ROWS, x - x % TILE_COLUMNS);
         let last = camera.samples() - 1;
-        let (all, rest) = self.storage.split_at_mut(self.objects);
-        let (band, tile) = rest.split_at_mut(self.objects.min(MAX_BAND_OBJECTS));
+        let all = self.all;
+        let (band, tile) = self.positions.split_at_mut(all.len().min(MAX_BAND_OBJECTS));
         if band_start != self.band_start {
             self.band_start = band_start;
             self.tile_start = u32::MAX;
@@ -184,7 +204,8 @@ impl<'a> FirstHits<'a> {
             // its first row's first.
             let low = camera.offsets(0, band_start.saturating_add(BAND_ROWS - 1), 0, last).1;
             let high = camera.offsets(0, band_start, 0, 0).1;
-            self.band = filter(all, band, |b| b.y[0] <= high && b.y[1] >= low);
+            // Positions below MAX_OBJECTS: the casts are exact.
+            self.band = filter(all, (0..all.len()).map(|p| p as u16), band, |b| b.y[0] <= high && b.y[1] >= low);
         }
         if tile_start != self.tile_start {
             self.tile_start = tile_start;
@@ -192,25 +213,27 @@ impl<'a> FirstHits<'a> {
             // to its last column's last.
             let low = camera.offsets(tile_start, 0, 0, 0).0;
             let high = camera.offsets(tile_start.saturating_add(TILE_COLUMNS - 1), 0, last, 0).0;
-            self.tile = filter(&band[..self.band?], tile, |b| b.x[0] <= high && b.x[1] >= low);
+            self.tile = filter(all, band[..self.band?].iter().copied(), tile, |b| b.x[0] <= high && b.x[1] >= low);
         }
         Some(&tile[..self.tile?])
     }
 }
 
-/// The nearest hit of the camera ray with offsets `(kx, ky)` among `band`'s
-/// objects. The ray is made only when a window holds the offsets.
+/// The nearest hit of the camera ray with offsets `(kx, ky)` among the
+/// objects at `tile`'s positions in `all`. The ray is made only when a
+/// window holds the offsets.
 #[inline]
 fn nearest(
     scene: &SceneView<'_>,
     kinds: ShapeKinds,
-    band: &[ScreenBound],
+    all: &[ScreenBound],
+    tile: &[u16],
     camera: &Camera,
     ray: &mut CameraRay,
     (kx, ky): (i32, i32),
 ) -> Option<Hit> {
     let mut best = Hit::NONE;
-    for bound in band {
+    for bound in tile.iter().filter_map(|&p| all.get(p as usize)) {
         if bound.near > best.t.to_bits() {
             break;
         }
@@ -323,8 +346,9 @@ mod tests {
                 continue;
             }
             let camera = Camera::new(&view.settings.view, &view.normalization, w, h, view.settings.samples).unwrap();
-            let mut storage = vec![ScreenBound::EMPTY; ScreenBound::needed_for(view.object_count())];
-            let Some(mut hits) = FirstHits::new(&view, &camera, &mut storage) else { continue };
+            let mut bounds = vec![ScreenBound::EMPTY; view.object_count()];
+            let mut positions = vec![0; ScreenBound::positions_for(view.object_count())];
+            let Some(mut hits) = FirstHits::new(&view, &camera, &mut bounds, &mut positions) else { continue };
             let n = camera.samples();
             for y in 0..h {
                 for x in 0..w {

@@ -126,8 +126,8 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         self.scratch.mailbox = Mailbox::new(words);
     }
 
-    /// Gives the renderer room for [`ScreenBound::needed_for`] the scene's
-    /// objects, so that camera rays find their hits among the objects seen
+    /// Gives the renderer room for a [`ScreenBound`] for each of the
+    /// scene's objects and [`ScreenBound::positions_for`] them, so that camera rays find their hits among the objects seen
     /// around their pixel instead of walking the accelerator, when it
     /// allows ([`Accelerator::first_hits_by_screen`]: the octree's 3DDDA).
     /// The same image, faster; too little room leaves the walk.
@@ -142,23 +142,24 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     /// let mut octree = Octree::<Board16K>::new();
     /// octree.build(&scene.view(), &Board16K::OCTREE);
     ///
-    /// let mut bounds = [ScreenBound::EMPTY; ScreenBound::needed_for(2)];
+    /// let mut bounds = [ScreenBound::EMPTY; 2];
+    /// let mut positions = [0; ScreenBound::positions_for(2)];
     /// let mut listed = MockDisplay::<Rgb888>::new();
-    /// Renderer::new(scene.view(), &octree)?.with_first_hits(&mut bounds).render(&mut listed)?;
+    /// Renderer::new(scene.view(), &octree)?.with_first_hits(&mut bounds, &mut positions).render(&mut listed)?;
     /// let mut walked = MockDisplay::<Rgb888>::new();
     /// Renderer::new(scene.view(), &octree)?.render(&mut walked)?;
     /// assert_eq!(listed, walked);
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
-    pub fn with_first_hits(mut self, storage: &'a mut [ScreenBound]) -> Self {
-        self.set_first_hits(storage);
+    pub fn with_first_hits(mut self, bounds: &'a mut [ScreenBound], positions: &'a mut [u16]) -> Self {
+        self.set_first_hits(bounds, positions);
         self
     }
 
     /// [`Renderer::with_first_hits`] in place.
-    pub fn set_first_hits(&mut self, storage: &'a mut [ScreenBound]) {
+    pub fn set_first_hits(&mut self, bounds: &'a mut [ScreenBound], positions: &'a mut [u16]) {
         if self.tracer.accel().first_hits_by_screen() {
-            self.first_hits = FirstHits::new(self.tracer.scene(), &self.camera, storage);
+            self.first_hits = FirstHits::new(self.tracer.scene(), &self.camera, bounds, positions);
         }
     }
 
