@@ -1,0 +1,196 @@
+//! Exact division without a divide instruction: a reciprocal from a table
+//! and one Newton step, then a remainder fix-up. The same bits as the
+//! native division on every target.
+
+use super::super::ARMV6M;
+use super::bits::{leading_zeros_u32, shl_u64};
+use super::product::mul_u32_wide;
+
+/// `⌊n / d⌋`, saturating at `u32::MAX` (also for `d = 0`). Exact on every
+/// target; on ARMv6-M without a division (the library's 64-bit division
+/// costs some 450 instructions there).
+#[inline]
+pub fn div_saturating(n: u64, d: u32) -> u32 {
+    if d == 0 || n >> 32 >= d as u64 {
+        return u32::MAX;
+    }
+    if ARMV6M {
+        div_by_reciprocal(n, d)
+    } else {
+        (n / d as u64) as u32
+    }
+}
+
+/// `⌊2^62 / d⌋` for `d > 0` (the 3DDDA's reciprocals). On ARMv6-M, two
+/// divisions with 32-bit quotients by reciprocal instead of the library's
+/// 64-bit division: the same bits.
+#[inline]
+pub(crate) fn reciprocal_q62(d: u32) -> u64 {
+    let d = d.max(1);
+    if ARMV6M {
+        // Both quotients by the same reciprocal: 2^30 < d·2^32, and the
+        // remainder is below d.
+        let reciprocal = Reciprocal::of(d);
+        let (high, remainder) = reciprocal.quotient_of_2_30();
+        ((high as u64) << 32) | reciprocal.quotient::<2>((remainder as u64) << 32) as u64
+    } else {
+        (1u64 << 62) / d as u64
+    }
+}
+
+/// 2^63 / (m · 2^-8) for m = 256 … 512 (divisors normalised to [1, 2]; the
+/// first, 2^32, is one below), the ends of the intervals that the start of
+/// Newton's iteration for the reciprocal is interpolated in.
+static RECIPROCAL_TABLE: [u32; 257] = {
+    let mut t = [0u32; 257];
+    let mut i = 0;
+    while i < 257 {
+        let r = (1u64 << 40) / (256 + i as u64);
+        t[i] = if r > u32::MAX as u64 { u32::MAX } else { r as u32 };
+        i += 1;
+    }
+    t
+};
+
+/// `⌊n / d⌋` for `0 < d` and `n < d · 2^32`, from a reciprocal.
+#[inline]
+fn div_by_reciprocal(n: u64, d: u32) -> u32 {
+    Reciprocal::of(d).quotient::<0>(n)
+}
+
+/// A divisor made ready for exact divisions by products: several quotients
+/// by the same divisor share the normalisation and the Newton step.
+#[derive(Clone, Copy)]
+struct Reciprocal {
+    divisor: u32,
+    /// `divisor · 2^shift` is in [2^31, 2^32).
+    shift: u32,
+    /// About 2^63 / (divisor · 2^shift), to some 31 bits.
+    r: u32,
+}
+
+impl Reciprocal {
+    /// For `d > 0`.
+    #[inline(always)]
+    fn of(d: u32) -> Reciprocal {
+        // Normalise: dn in [2^31, 2^32); the quotients are unchanged.
+        let shift = leading_zeros_u32(d);
+        let dn = d << shift;
+        // r ≈ 2^63 / dn: about 17 bits from the table, interpolated (1/x is
+        // within 2^-18 of its chord over an interval), then about 31 after
+        // one Newton step r' = r + r·(2^63 − dn·r)/2^63. The interpolation's
+        // terms stay in a u32: neighbours differ by less than 2^24.
+        let i = ((dn >> 23) & 0xff) as usize;
+        let (lo, hi) = (RECIPROCAL_TABLE[i], RECIPROCAL_TABLE[i + 1]);
+        let r = lo - ((((lo - hi) >> 9) * ((dn >> 7) & 0xffff)) >> 7);
+        let error = ((1u64 << 63).wrapping_sub(mul_u32_wide(dn, r)) as i64 >> 31) as i32;
+        let step = (mul_u32_wide(r, error.unsigned_abs()) >> 32) as u32;
+        let r = if error >= 0 { r.saturating_add(step) } else { r - step };
+        Reciprocal { divisor: d, shift, r }
+    }
+
+    /// `⌊n / divisor⌋` for `n < divisor · 2^32`.
+    #[inline(always)]
+    fn quotient<const STEPS: usize>(&self, n: u64) -> u32 {
+        let r = self.r;
+        let numerator = shl_u64(n, self.shift); // below dn · 2^32
+        let (high, low) = ((numerator >> 32) as u32, numerator as u32);
+        let estimate = (mul_u32_wide(high, r) + (mul_u32_wide(low, r) >> 32)) >> 31;
+        self.corrected::<STEPS>(n, estimate.min(u32::MAX as u64) as u32).0
+    }
+
+    /// `⌊2^30 / divisor⌋` and the remainder: the numerator, normalised, is a
+    /// power of two, so the estimate above is a shift of the reciprocal (the
+    /// same value).
+    #[inline(always)]
+    fn quotient_of_2_30(&self) -> (u32, u32) {
+        // (2^(30 + shift) · r) / 2^63, shift ≥ 1 for a divisor below 2^31.
+        let estimate = if self.shift == 0 { 0 } else { self.r >> (33 - self.shift).min(31) };
+        self.corrected::<0>(1 << 30, estimate)
+    }
+
+    /// The exact floor of `n / divisor` from an estimate a few off at most,
+    /// stepped on the remainder, and the remainder. `STEPS` steps are
+    /// written out first where the compiler would otherwise turn the
+    /// stepping loop into a 64-bit division (see below).
+    #[inline(always)]
+    fn corrected<const STEPS: usize>(&self, n: u64, estimate: u32) -> (u32, u32) {
+        let d = self.divisor;
+        let mut q = estimate;
+        let mut remainder = n.wrapping_sub(mul_u32_wide(q, d)) as i64;
+        // Steps written out first: in the 3DDDA's reciprocals the compiler
+        // turned the bare stepping loop into a 64-bit division (a library
+        // call of some 450 instructions on a Cortex-M0), which only a far
+        // estimate needs.
+        for _ in 0..STEPS {
+            if remainder < 0 {
+                q = q.wrapping_sub(1);
+                remainder += d as i64;
+            } else if remainder >= d as i64 {
+                q = q.wrapping_add(1);
+                remainder -= d as i64;
+            }
+        }
+        while remainder < 0 {
+            q -= 1;
+            remainder += d as i64;
+        }
+        while remainder >= d as i64 {
+            q += 1;
+            remainder -= d as i64;
+        }
+        (q, remainder as u32)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::wide::tests::spread;
+
+    #[test]
+    fn reciprocal_by_two_short_divisions_is_exact() {
+        // The ARMv6-M form: both quotients by one reciprocal.
+        let by_parts = |d: u32| {
+            let reciprocal = Reciprocal::of(d);
+            let (high, rest) = reciprocal.quotient_of_2_30();
+            assert_eq!(high, reciprocal.quotient::<0>(1 << 30), "{d}");
+            let remainder = (1u64 << 30) - mul_u32_wide(high, d);
+            assert_eq!(rest as u64, remainder, "{d}");
+            ((high as u64) << 32) | reciprocal.quotient::<2>(remainder << 32) as u64
+        };
+        let mut d = 1u32;
+        while d < (1 << 30) + 7 {
+            for e in [d, d + 1, d.saturating_mul(3) / 2] {
+                assert_eq!(by_parts(e), (1u64 << 62) / e as u64, "{e}");
+                assert_eq!(reciprocal_q62(e), (1u64 << 62) / e as u64, "{e}");
+            }
+            d = (d as u64 * 5 / 4 + 1) as u32;
+        }
+        assert_eq!(reciprocal_q62(0), 1 << 62);
+    }
+
+    #[test]
+    fn division_by_reciprocal_is_exact() {
+        let mut cases = 0;
+        for (i, v) in spread(40_000).enumerate() {
+            let d = ((v >> 17) as u32 ^ (i as u32).wrapping_mul(2_654_435_761)) >> (i % 32);
+            if d == 0 {
+                continue;
+            }
+            let n = v % ((d as u64) << 32);
+            assert_eq!(div_by_reciprocal(n, d) as u64, n / d as u64, "{n} / {d}");
+            cases += 1;
+        }
+        assert!(cases > 30_000);
+        for d in [1u32, 2, 3, 7, 255, 256, 65_535, 1 << 31, (1 << 31) + 1, u32::MAX - 1, u32::MAX] {
+            let top = ((d as u64) << 32) - 1;
+            for n in [0, 1, d as u64 - 1, d as u64, top, top - d as u64, top / 2, top / 3] {
+                assert_eq!(div_by_reciprocal(n, d) as u64, n / d as u64, "{n} / {d}");
+            }
+        }
+        assert_eq!(div_saturating(1 << 40, 0), u32::MAX);
+        assert_eq!(div_saturating(1 << 40, 255), u32::MAX);
+        assert_eq!(div_saturating(1 << 40, 257), ((1u64 << 40) / 257) as u32);
+    }
+}
