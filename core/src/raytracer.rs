@@ -7,7 +7,7 @@
 //! in `.bss`, initialised in place); a [`LoadedScene`] exists only for a
 //! scene that parsed without errors, with its accelerator built.
 
-use crate::accel::{AccelMode, Accelerator, BuildReport, Hit, Mailbox, NaiveFor, OctreeConfig, OctreeStore, RayStart};
+use crate::accel::{naive, AccelMode, Accelerator, BuildReport, Hit, Mailbox, OctreeConfig, OctreeStore, RayStart};
 use crate::capacity::Arena;
 use crate::math::Scalar;
 use crate::parse::{parse_bytes, ErrorKind, ParseError, Pos};
@@ -18,7 +18,6 @@ use crate::shade::Stats;
 use crate::shapes::{Ray, ShapeKinds};
 use core::cell::{Cell, RefCell};
 use core::fmt;
-use core::marker::PhantomData;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Dimensions, OriginDimensions, Point, Size};
 use embedded_graphics_core::image::ImageDrawable;
@@ -245,12 +244,8 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         D: DrawTarget,
         D::Color: From<Rgb888>,
     {
-        match self.octree {
-            Some((octree, _)) if Raytracer::<P>::HAS_OCTREE => {
-                self.render(&Profiled::<P, _>::new(octree), size, area, at, target)
-            }
-            _ => self.render(&Profiled::<P, _>::new(&NaiveFor::<P>::new()), size, area, at, target),
-        }
+        let walk = Profiled::<P> { octree: self.octree.as_ref().map(|(octree, _)| *octree) };
+        self.render(&walk, size, area, at, target)
     }
 
     fn render<A: Accelerator, D>(
@@ -286,26 +281,30 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     }
 }
 
-/// The accelerator `A` as a profile `P` may use it: with the screen lists
-/// only if `P` has room for them, decided on the constant, so that a build
-/// without links none of their code.
-struct Profiled<'a, P, A> {
-    accel: &'a A,
-    profile: PhantomData<P>,
+/// What a [`Raytracer`] renders with: its octree, or (without one) every
+/// object, over only the shape kinds its profile has room for, and with
+/// the screen lists only if the profile has room for them. Both are
+/// decided on the profile's constants, so that a build without an octree
+/// or without the lists links none of their code.
+struct Profiled<'a, P: Profile> {
+    octree: Option<&'a P::Octree>,
 }
 
-impl<'a, P, A> Profiled<'a, P, A> {
-    fn new(accel: &'a A) -> Self {
-        Profiled { accel, profile: PhantomData }
+impl<P: Profile> Profiled<'_, P> {
+    /// The octree, if the profile has room for one and the scene uses it.
+    #[inline(always)]
+    fn octree(&self) -> Option<&P::Octree> {
+        self.octree.filter(|_| Raytracer::<P>::HAS_OCTREE)
     }
 }
 
-impl<P: Profile, A: Accelerator> Accelerator for Profiled<'_, P, A> {
-    const KINDS: ShapeKinds = A::KINDS;
-    const USES_MAILBOX: bool = A::USES_MAILBOX;
+impl<P: Profile> Accelerator for Profiled<'_, P> {
+    const KINDS: ShapeKinds = ShapeKinds::with_room(&P::COUNTS);
+    // The octree's mailbox, only if the profile can have an octree.
+    const USES_MAILBOX: bool = Raytracer::<P>::HAS_OCTREE && <P::Octree as Accelerator>::USES_MAILBOX;
 
     fn first_hits_by_screen(&self) -> bool {
-        P::FIRST_HITS && self.accel.first_hits_by_screen()
+        P::FIRST_HITS && self.octree().is_none_or(|octree| octree.first_hits_by_screen())
     }
 
     #[inline]
@@ -316,7 +315,10 @@ impl<P: Profile, A: Accelerator> Accelerator for Profiled<'_, P, A> {
         start: Option<RayStart>,
         mailbox: &mut Mailbox<'_>,
     ) -> Option<Hit> {
-        self.accel.nearest(scene, ray, start, mailbox)
+        match self.octree() {
+            Some(octree) => octree.nearest(scene, ray, start, mailbox),
+            None => naive::nearest(Self::KINDS, scene, ray, start),
+        }
     }
 
     #[inline]
@@ -328,7 +330,10 @@ impl<P: Profile, A: Accelerator> Accelerator for Profiled<'_, P, A> {
         start: Option<RayStart>,
         mailbox: &mut Mailbox<'_>,
     ) -> bool {
-        self.accel.occluded(scene, ray, t_max, start, mailbox)
+        match self.octree() {
+            Some(octree) => octree.occluded(scene, ray, t_max, start, mailbox),
+            None => naive::occluded(Self::KINDS, scene, ray, t_max, start, mailbox),
+        }
     }
 
     #[inline]
@@ -341,7 +346,10 @@ impl<P: Profile, A: Accelerator> Accelerator for Profiled<'_, P, A> {
         start: Option<RayStart>,
         mailbox: &mut Mailbox<'_>,
     ) -> bool {
-        self.accel.occluded_toward(scene, ray, t_max, light, start, mailbox)
+        match self.octree() {
+            Some(octree) => octree.occluded_toward(scene, ray, t_max, light, start, mailbox),
+            None => self.occluded(scene, ray, t_max, start, mailbox),
+        }
     }
 }
 

@@ -15,11 +15,10 @@
 //! - an object is tested at most once per query when the caller provides a
 //!   [`Mailbox`] large enough for the scene (one bit per object).
 
-mod naive;
+pub(crate) mod naive;
 mod octree;
 
 pub use naive::Naive;
-pub(crate) use naive::NaiveFor;
 pub(crate) use octree::FILING_MARGIN;
 pub use octree::{
     BuildReport, HashEntry, Index, Octree, OctreeCapacities, OctreeConfig, OctreeNode, OctreeStore, ShadowShaft,

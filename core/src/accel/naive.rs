@@ -4,10 +4,8 @@
 
 use super::{Accelerator, Hit, Mailbox, RayStart};
 use crate::math::Scalar;
-use crate::profile::Profile;
 use crate::scene::{ObjectId, SceneView};
 use crate::shapes::{Ray, ShapeKinds};
-use core::marker::PhantomData;
 
 /// Tests every object, in file order.
 #[derive(Clone, Copy, Debug, Default)]
@@ -32,46 +30,11 @@ impl Accelerator for Naive {
     }
 }
 
-/// [`Naive`] over a scene of the profile `P`: it dispatches only on the
-/// shape kinds `P` has room for, so a board links no other kind's tests.
-pub(crate) struct NaiveFor<P>(PhantomData<P>);
-
-impl<P> NaiveFor<P> {
-    pub const fn new() -> Self {
-        NaiveFor(PhantomData)
-    }
-}
-
-impl<P: Profile> Accelerator for NaiveFor<P> {
-    const KINDS: ShapeKinds = ShapeKinds::with_room(&P::COUNTS);
-    const USES_MAILBOX: bool = false;
-
-    /// Only the [`Raytracer`](crate::Raytracer) tests every object this
-    /// way: it gives camera rays the screen lists when its profile has
-    /// room for them and the naive mode was not asked for by name.
-    fn first_hits_by_screen(&self) -> bool {
-        true
-    }
-
-    fn nearest(&self, scene: &SceneView<'_>, ray: &Ray, start: Option<RayStart>, _: &mut Mailbox<'_>) -> Option<Hit> {
-        nearest(Self::KINDS, scene, ray, start)
-    }
-
-    fn occluded(
-        &self,
-        scene: &SceneView<'_>,
-        ray: &Ray,
-        t_max: Scalar,
-        start: Option<RayStart>,
-        mailbox: &mut Mailbox<'_>,
-    ) -> bool {
-        occluded(Self::KINDS, scene, ray, t_max, start, mailbox)
-    }
-}
-
-/// Every object of `kinds` in file order; the nearest hit wins.
+/// Every object of `kinds` in file order; the nearest hit wins. Also the
+/// [`Raytracer`](crate::Raytracer)'s naive walk, over the kinds its
+/// profile has room for.
 #[inline(always)]
-fn nearest(kinds: ShapeKinds, scene: &SceneView<'_>, ray: &Ray, start: Option<RayStart>) -> Option<Hit> {
+pub(crate) fn nearest(kinds: ShapeKinds, scene: &SceneView<'_>, ray: &Ray, start: Option<RayStart>) -> Option<Hit> {
     let mut best: Option<Hit> = None;
     let mut t_max = Scalar::MAX;
     for (i, &handle) in scene.objects.iter().enumerate() {
@@ -91,7 +54,7 @@ fn nearest(kinds: ShapeKinds, scene: &SceneView<'_>, ray: &Ray, start: Option<Ra
 /// Whether any object of `kinds` blocks the ray; the first that does is
 /// left in the mailbox.
 #[inline(always)]
-fn occluded(
+pub(crate) fn occluded(
     kinds: ShapeKinds,
     scene: &SceneView<'_>,
     ray: &Ray,
