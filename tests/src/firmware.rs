@@ -22,28 +22,33 @@ pub enum Board {
     Microbit,
     /// ARM MPS2-AN385: Cortex-M3.
     Mps2An385,
+    /// ARM MPS2-AN505: Cortex-M33 (Armv8-M Mainline), in its Secure state.
+    Mps2An505,
 }
 
 impl Board {
-    pub fn machine(self) -> &'static str {
+    /// Every board the firmware streams pixels from, in the benchmark's order.
+    pub const ALL: [Board; 3] = [Board::Microbit, Board::Mps2An385, Board::Mps2An505];
+
+    /// qemu's `-machine`, the Rust target and the core.
+    fn facts(self) -> (&'static str, &'static str, &'static str) {
         match self {
-            Board::Microbit => "microbit",
-            Board::Mps2An385 => "mps2-an385",
+            Board::Microbit => ("microbit", "thumbv6m-none-eabi", "Cortex-M0"),
+            Board::Mps2An385 => ("mps2-an385", "thumbv7m-none-eabi", "Cortex-M3"),
+            Board::Mps2An505 => ("mps2-an505", "thumbv8m.main-none-eabihf", "Cortex-M33"),
         }
+    }
+
+    pub fn machine(self) -> &'static str {
+        self.facts().0
     }
 
     pub fn target(self) -> &'static str {
-        match self {
-            Board::Microbit => "thumbv6m-none-eabi",
-            Board::Mps2An385 => "thumbv7m-none-eabi",
-        }
+        self.facts().1
     }
 
     pub fn core(self) -> &'static str {
-        match self {
-            Board::Microbit => "Cortex-M0",
-            Board::Mps2An385 => "Cortex-M3",
-        }
+        self.facts().2
     }
 }
 

@@ -42,6 +42,9 @@ fn boards_render_the_same_bits_as_host_sim() {
         Firmware::new(Board::Mps2An385, "fig5_1", 160, 128, PanelColor::Dither),
         // A 16-gray panel, as the OLED's: one level a byte.
         Firmware::new(Board::Mps2An385, "fig5_4", 64, 48, PanelColor::Gray4),
+        // Armv8-M Mainline (Cortex-M33, the Pico 2's and nRF5340's core),
+        // with the octree and both techniques.
+        Firmware::new(Board::Mps2An505, "fig5_5", 160, 128, PanelColor::Rgb565),
     ];
     for firmware in cases {
         let name = format!("{} on {}", firmware.scene, firmware.board.machine());

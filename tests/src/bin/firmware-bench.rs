@@ -33,7 +33,7 @@ fn main() {
         "| board | scene | size | instructions / pixel | pixels / M instructions | flash | static RAM | peak stack |"
     );
     println!("| --- | --- | --- | ---: | ---: | ---: | ---: | ---: |");
-    for board in [Board::Microbit, Board::Mps2An385] {
+    for board in Board::ALL {
         for scene in &scenes {
             let firmware = Firmware::new(board, scene, width, height, PanelColor::Rgb888);
             let label = format!("{} ({}) | {scene} | {width}×{height}", board.machine(), board.core());
