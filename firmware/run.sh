@@ -9,10 +9,12 @@ set -euo pipefail
 here=$(dirname "$0")
 elf=$1
 machine=$(python3 "$here/tools/runner.py" info "$elf" machine)
-cpu=()
+qemu=(qemu-system-arm -machine "$machine")
 case $machine in
     lm3s6965evb) exec python3 "$here/tools/runner.py" screen "$elf" ;;
-    mps2-an385) cpu=(-cpu cortex-m3) ;;
+    mps2-an385) qemu+=(-cpu cortex-m3) ;;
+    # No firmware of qemu's own: the ELF starts at the RAM's base.
+    virt) qemu=(qemu-system-riscv32 -machine virt -bios none) ;;
 esac
-exec timeout "${QEMU_TIMEOUT:-600}" qemu-system-arm -machine "$machine" "${cpu[@]}" -nographic -monitor none \
+exec timeout "${QEMU_TIMEOUT:-600}" "${qemu[@]}" -nographic -monitor none \
     -semihosting-config enable=on,target=native -kernel "$elf"

@@ -1,12 +1,12 @@
-//! octrace on a Cortex-M board: the scene text lives in flash, is parsed on
+//! octrace on a Cortex-M or RISC-V board: the scene text lives in flash, is parsed on
 //! the board into static arenas sized for it at build time, and is drawn row
 //! by row straight into the display driver (a host file over semihosting,
 //! or on the LM3S6965EVB its OLED panel, `ssd0323`) as an embedded-graphics
 //! image. No heap, no framebuffer. Build-time choices are in `build.rs`.
 //!
 //! Exit codes: 0 rendered, 2 the scene has errors, 3 the display (the host
-//! file, the panel) refused the output, 101 panic, 102 HardFault, 103
-//! unexpected interrupt. The LM3S6965EVB keeps its picture on the panel
+//! file, the panel) refused the output, 101 panic, 102 HardFault (a RISC-V
+//! exception), 103 unexpected interrupt. The LM3S6965EVB keeps its picture on the panel
 //! until the runner has grabbed the screen, then exits.
 
 #![no_std]
@@ -24,15 +24,25 @@ mod config {
     include!(concat!(env!("OUT_DIR"), "/config.rs"));
 }
 
-// The single-core critical section the cell's flag takes on a Cortex-M0.
-use cortex_m as _;
-use cortex_m_rt::{entry, exception, ExceptionFrame};
-use cortex_m_semihosting::hprintln;
+// The single-core critical section the cell's flag takes on a Cortex-M0
+// (and on a RISC-V hart without atomics).
 use embedded_graphics_core::geometry::Size;
 use embedded_graphics_core::image::ImageDrawable;
 use octrace_core::render::PanelColor;
 use octrace_core::{ConstStaticCell, LoadedScene, Raytracer};
 use semihosting::exit;
+#[cfg(target_arch = "arm")]
+use {
+    cortex_m as _,
+    cortex_m_rt::{entry, exception, ExceptionFrame},
+    cortex_m_semihosting::hprintln,
+};
+#[cfg(target_arch = "riscv32")]
+use {
+    riscv as _,
+    riscv_rt::{entry, TrapFrame},
+    riscv_semihosting::hprintln,
+};
 // What the boards that stream to a host file use.
 #[cfg(not(board = "lm3s6965evb"))]
 use {
@@ -58,6 +68,8 @@ pub extern "C" fn bench_marker(id: u32) {
 
 #[entry]
 fn main() -> ! {
+    #[cfg(target_arch = "riscv32")]
+    paint_stack();
     let code = run(RAYTRACER.take());
     hprintln!("peak stack: {} bytes", peak_stack());
     #[cfg(board = "lm3s6965evb")]
@@ -172,19 +184,50 @@ fn draw_dithered(scene: &LoadedScene<'_, Profile>, file: HostFile) -> bool {
     scene.image_for(&dithered).draw(&mut dithered).is_ok()
 }
 
-/// Bytes of stack used at most: `paint-stack` filled it with a pattern at
-/// reset; the lowest word no longer holding it is the high-water mark.
-fn peak_stack() -> usize {
+/// The stack's lowest and highest addresses, from the linker script.
+fn stack_ends() -> (usize, usize) {
+    #[cfg(target_arch = "arm")]
     extern "C" {
         static _stack_end: u32;
         static _stack_start: u32;
     }
-    // SAFETY: the linker places both symbols at the ends of the stack
-    // region; only their addresses are taken, and every word between them
-    // is RAM owned by the stack.
+    // riscv-rt's names for them.
+    #[cfg(target_arch = "riscv32")]
+    extern "C" {
+        #[link_name = "__estack"]
+        static _stack_end: u32;
+        #[link_name = "__sstack"]
+        static _stack_start: u32;
+    }
+    // Only the symbols' addresses are taken, never their values.
+    (core::ptr::addr_of!(_stack_end) as usize, core::ptr::addr_of!(_stack_start) as usize)
+}
+
+/// Fills the stack below this frame with the pattern `peak_stack` looks
+/// for, as cortex-m-rt's `paint-stack` does at reset (riscv-rt has none).
+#[cfg(target_arch = "riscv32")]
+#[inline(never)]
+fn paint_stack() {
+    let here = 0u32;
+    // Well below this frame: what this function and its callee use.
+    let top = (core::ptr::addr_of!(here) as usize - 256) & !3;
+    let (low, _) = stack_ends();
+    let mut p = low;
+    while p < top {
+        // SAFETY: every word from the stack's bottom to below this frame
+        // is stack RAM that nothing uses yet.
+        unsafe { core::ptr::write_volatile(p as *mut u32, 0xCCCC_CCCC) };
+        p += 4;
+    }
+    core::hint::black_box(&here);
+}
+
+/// Bytes of stack used at most: the stack was filled with a pattern at
+/// reset; the lowest word no longer holding it is the high-water mark.
+fn peak_stack() -> usize {
+    let (low, high) = stack_ends();
+    // SAFETY: every word between the stack's ends is RAM owned by the stack.
     unsafe {
-        let low = core::ptr::addr_of!(_stack_end) as usize;
-        let high = core::ptr::addr_of!(_stack_start) as usize;
         let mut p = low;
         while p < high && core::ptr::read_volatile(p as *const u32) == 0xCCCC_CCCC {
             p += 4;
@@ -199,14 +242,30 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
     exit(101)
 }
 
+#[cfg(target_arch = "arm")]
 #[exception]
 unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
     hprintln!("HardFault at {:#010x}", frame.pc());
     exit(102)
 }
 
+#[cfg(target_arch = "arm")]
 #[exception]
 unsafe fn DefaultHandler(irq: i16) {
     hprintln!("unexpected interrupt {}", irq);
+    exit(103)
+}
+
+#[cfg(target_arch = "riscv32")]
+#[export_name = "ExceptionHandler"]
+fn exception_handler(_frame: &TrapFrame) -> ! {
+    hprintln!("exception {:#x} at {:#010x}", riscv::register::mcause::read().bits(), riscv::register::mepc::read());
+    exit(102)
+}
+
+#[cfg(target_arch = "riscv32")]
+#[export_name = "DefaultHandler"]
+fn default_handler() {
+    hprintln!("unexpected interrupt {:#x}", riscv::register::mcause::read().bits());
     exit(103)
 }

@@ -2,7 +2,13 @@
 //! exit with a status code. On a real board these would be a display driver
 //! and a reset; under qemu they carry the pixels to the host.
 
-use cortex_m_semihosting::{nr, syscall};
+// The two crates give the same calls: Arm's (BKPT 0xAB) and RISC-V's
+// (EBREAK between the marker shifts).
+#[cfg(target_arch = "arm")]
+use cortex_m_semihosting as host;
+use host::{nr, syscall};
+#[cfg(target_arch = "riscv32")]
+use riscv_semihosting as host;
 
 /// An open host file.
 pub struct HostFile {
@@ -61,7 +67,7 @@ pub fn exit(code: u32) -> ! {
     loop {
         // SAFETY: the call reads the two-word block during the call.
         unsafe {
-            cortex_m_semihosting::syscall(SYS_EXIT_EXTENDED, &[APPLICATION_EXIT, code as usize]);
+            host::syscall(SYS_EXIT_EXTENDED, &[APPLICATION_EXIT, code as usize]);
         }
     }
 }

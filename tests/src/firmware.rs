@@ -24,11 +24,13 @@ pub enum Board {
     Mps2An385,
     /// ARM MPS2-AN505: Cortex-M33 (Armv8-M Mainline), in its Secure state.
     Mps2An505,
+    /// qemu's RISC-V `virt` machine with one RV32IMC hart.
+    Virt,
 }
 
 impl Board {
     /// Every board the firmware streams pixels from, in the benchmark's order.
-    pub const ALL: [Board; 3] = [Board::Microbit, Board::Mps2An385, Board::Mps2An505];
+    pub const ALL: [Board; 4] = [Board::Microbit, Board::Mps2An385, Board::Mps2An505, Board::Virt];
 
     /// qemu's `-machine`, the Rust target and the core.
     fn facts(self) -> (&'static str, &'static str, &'static str) {
@@ -36,6 +38,7 @@ impl Board {
             Board::Microbit => ("microbit", "thumbv6m-none-eabi", "Cortex-M0"),
             Board::Mps2An385 => ("mps2-an385", "thumbv7m-none-eabi", "Cortex-M3"),
             Board::Mps2An505 => ("mps2-an505", "thumbv8m.main-none-eabihf", "Cortex-M33"),
+            Board::Virt => ("virt", "riscv32imc-unknown-none-elf", "RV32IMC"),
         }
     }
 
@@ -213,13 +216,17 @@ pub struct Measurement {
 
 impl Firmware {
     /// Runs the ELF under `qemu-count` (the instruction-counting plugin) and
-    /// reads its sizes with `arm-none-eabi-size`.
+    /// reads its sizes with `arm-none-eabi-size`. qemu-count runs Arm boards
+    /// only: the RISC-V one runs under the same plugin here.
     pub fn measure(&self, elf: &Path, qemu_count: &Path) -> Result<Measurement, String> {
-        let out = Command::new(qemu_count)
-            .arg(self.board.machine())
-            .arg(elf)
-            .output()
-            .map_err(|e| format!("cannot run {}: {e}", qemu_count.display()))?;
+        let out = match self.board {
+            Board::Virt => count_riscv(elf, qemu_count)?,
+            _ => Command::new(qemu_count)
+                .arg(self.board.machine())
+                .arg(elf)
+                .output()
+                .map_err(|e| format!("cannot run {}: {e}", qemu_count.display()))?,
+        };
         let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
         let value = |key: &str| text.lines().find_map(|l| l.strip_prefix(key)?.trim().parse::<u64>().ok());
         let total = value("insns_total=").ok_or_else(|| format!("no instruction count from qemu-count:\n{text}"))?;
@@ -235,6 +242,47 @@ impl Firmware {
     }
 }
 
+/// `qemu-count`'s run and report for the RISC-V `virt` machine: its plugin
+/// (built by the `qemu-insncount/build.sh` beside it), told the address of
+/// `bench_marker`, on `qemu-system-riscv32`; the same `insns_total=` and
+/// `insns_between_markers=` lines.
+fn count_riscv(elf: &Path, qemu_count: &Path) -> Result<std::process::Output, String> {
+    let run = |command: &mut Command| {
+        let out = command.output().map_err(|e| format!("cannot run {command:?}: {e}"))?;
+        Ok::<_, String>((out.status.success(), String::from_utf8_lossy(&out.stdout).into_owned()))
+    };
+    let build = qemu_count.with_file_name("qemu-insncount").join("build.sh");
+    let (built, plugin) = run(Command::new("bash").arg(&build))?;
+    let plugin = plugin.lines().last().filter(|_| built).ok_or_else(|| format!("{} failed", build.display()))?;
+    let (_, symbols) = run(Command::new("arm-none-eabi-nm").arg(elf))?;
+    let marker = symbols.lines().find_map(|l| l.strip_suffix(" T bench_marker")).unwrap_or_default();
+    let log = elf.with_extension("plugin.log");
+    let mut out = Command::new("timeout")
+        .arg(std::env::var("QEMU_TIMEOUT").unwrap_or_else(|_| "300".into()))
+        .args(["qemu-system-riscv32", "-machine", "virt", "-bios", "none", "-nographic", "-monitor", "none"])
+        .args(["-semihosting-config", "enable=on,target=native", "-d", "plugin", "-D"])
+        .arg(&log)
+        .arg("-plugin")
+        .arg(format!("{plugin},marker=0x{marker}"))
+        .arg("-kernel")
+        .arg(elf)
+        .output()
+        .map_err(|e| format!("cannot run qemu-system-riscv32: {e}"))?;
+    let log = std::fs::read_to_string(&log).map_err(|e| format!("{}: {e}", log.display()))?;
+    let total = log.lines().find_map(|l| l.strip_prefix("insns: ")).unwrap_or_default();
+    // Each marker line ends in `icount=N`: the count when it was reached.
+    let marks: Vec<u64> = log
+        .lines()
+        .filter(|l| l.starts_with("marker"))
+        .filter_map(|l| l.split_whitespace().nth(4)?.strip_prefix("icount=")?.parse().ok())
+        .collect();
+    out.stdout.extend(format!("insns_total={total}\n").bytes());
+    if let [first, second, ..] = marks[..] {
+        out.stdout.extend(format!("insns_between_markers={}\n", second - first).bytes());
+    }
+    Ok(out)
+}
+
 /// An ELF's sections as `arm-none-eabi-size -B` counts them.
 #[derive(Clone, Copy, Debug)]
 pub struct Sizes {
@@ -247,20 +295,29 @@ pub struct Sizes {
 }
 
 impl Sizes {
-    /// Reads `elf`'s sizes.
+    /// Reads `elf`'s sizes. riscv-rt reserves the stack as a section of
+    /// its own, which `size` counts with `.bss`: it is left out, as the
+    /// Cortex-M boards' stack is.
     pub fn of(elf: &Path) -> Result<Sizes, String> {
-        let size = Command::new("arm-none-eabi-size")
-            .arg("-B")
-            .arg(elf)
-            .output()
-            .map_err(|e| format!("cannot run arm-none-eabi-size: {e}"))?;
-        let size = String::from_utf8_lossy(&size.stdout).into_owned();
-        let numbers: Vec<u64> =
-            size.lines().nth(1).unwrap_or("").split_whitespace().take(3).filter_map(|n| n.parse().ok()).collect();
-        let [text, data, bss] = numbers[..] else {
-            return Err(format!("unexpected arm-none-eabi-size output:\n{size}"));
+        let size = |format: &str| {
+            let out = Command::new("arm-none-eabi-size")
+                .arg(format)
+                .arg(elf)
+                .output()
+                .map_err(|e| format!("cannot run arm-none-eabi-size: {e}"))?;
+            Ok::<_, String>(String::from_utf8_lossy(&out.stdout).into_owned())
         };
-        Ok(Sizes { text, data, bss })
+        let (totals, sections) = (size("-B")?, size("-A")?);
+        let numbers: Vec<u64> =
+            totals.lines().nth(1).unwrap_or("").split_whitespace().take(3).filter_map(|n| n.parse().ok()).collect();
+        let [text, data, bss] = numbers[..] else {
+            return Err(format!("unexpected arm-none-eabi-size output:\n{totals}"));
+        };
+        let stack = sections
+            .lines()
+            .find_map(|l| l.strip_prefix(".stack ")?.split_whitespace().next()?.parse::<u64>().ok())
+            .unwrap_or(0);
+        Ok(Sizes { text, data, bss: bss - stack.min(bss) })
     }
 }
 
