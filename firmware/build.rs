@@ -6,7 +6,7 @@
 //!
 //! | variable | values | default |
 //! | --- | --- | --- |
-//! | `OCTRACE_BOARD` | `microbit` (thumbv6m), `mps2-an385` or `lm3s6965evb` (thumbv7m), `mps2-an505` (thumbv8m.main), `virt` (riscv32imc) | from the target: thumbv6m `microbit`, thumbv7m `mps2-an385`, thumbv8m.main `mps2-an505`, riscv32imc `virt` |
+//! | `OCTRACE_BOARD` | `microbit` (thumbv6m), `mps2-an385` or `lm3s6965evb` (thumbv7m), `mps2-an505` or `mps2-an521` (thumbv8m.main), `virt` (riscv32imc) | from the target: thumbv6m `microbit`, thumbv7m `mps2-an385`, thumbv8m.main `mps2-an505`, riscv32imc `virt` |
 //! | `OCTRACE_SCENE` | a scene in `scenes/` (name without `.txt`) | `fig5_1` |
 //! | `OCTRACE_SIZE` | `WxH` (on `lm3s6965evb` at most the panel's 128x64, an even width) | `160x128`; `128x64` on `lm3s6965evb` |
 //! | `OCTRACE_ACCEL` | `auto`, `naive`, `octree`, `dda` | `auto` |
@@ -19,6 +19,7 @@
 //! | `microbit` | `microbit` | Cortex-M0 | 256 KiB | 16 KiB | semihosting file |
 //! | `mps2-an385` | `mps2-an385` | Cortex-M3 | 4 MiB | 4 MiB | semihosting file |
 //! | `mps2-an505` | `mps2-an505` | Cortex-M33 (Secure state) | 4 MiB | 4 MiB | semihosting file |
+//! | `mps2-an521` | `mps2-an521` | two Cortex-M33s, both rendering (`src/both_cores.rs`) | 4 MiB | 4 MiB | semihosting file |
 //! | `virt` | `virt` (`qemu-system-riscv32`) | RV32IMC hart | none (code in RAM) | 8 MiB | semihosting file |
 //! | `lm3s6965evb` | `lm3s6965evb` | Cortex-M3 | 256 KiB | 64 KiB | 128×64 16-gray OLED (SSD0323 on SSI0) |
 //!
@@ -90,6 +91,9 @@ fn main() {
         ("mps2-an505", "thumbv8m.main-none-eabihf") => {
             Board { name: "mps2-an505", static_ram: 3 * 1024 * 1024, config: OctreeConfig::DEFAULT }
         }
+        ("mps2-an521", "thumbv8m.main-none-eabihf") => {
+            Board { name: "mps2-an521", static_ram: 3 * 1024 * 1024, config: OctreeConfig::DEFAULT }
+        }
         ("virt", "riscv32imc-unknown-none-elf") => {
             Board { name: "virt", static_ram: 3 * 1024 * 1024, config: OctreeConfig::DEFAULT }
         }
@@ -101,19 +105,19 @@ fn main() {
             fail(format!("OCTRACE_BOARD={board} needs --target thumbv7m-none-eabi, not {target}"))
         }
         ("virt", _) => fail(format!("OCTRACE_BOARD=virt needs --target riscv32imc-unknown-none-elf, not {target}")),
-        ("mps2-an505", _) => {
-            fail(format!("OCTRACE_BOARD=mps2-an505 needs --target thumbv8m.main-none-eabihf, not {target}"))
+        ("mps2-an505" | "mps2-an521", _) => {
+            fail(format!("OCTRACE_BOARD={board} needs --target thumbv8m.main-none-eabihf, not {target}"))
         }
-        (other, _) => {
-            fail(format!("OCTRACE_BOARD={other}: expected microbit, mps2-an385, mps2-an505, lm3s6965evb or virt"))
-        }
+        (other, _) => fail(format!(
+            "OCTRACE_BOARD={other}: expected microbit, mps2-an385, mps2-an505, mps2-an521, lm3s6965evb or virt"
+        )),
     };
     let oled = board.name == "lm3s6965evb";
     let memory = manifest.join(format!("memory-{}.x", board.name));
     std::fs::copy(&memory, out.join("memory.x")).expect("copy memory.x");
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed={}", memory.display());
-    println!("cargo:rustc-check-cfg=cfg(board, values(\"microbit\", \"mps2-an385\", \"mps2-an505\", \"lm3s6965evb\", \"virt\"))");
+    println!("cargo:rustc-check-cfg=cfg(board, values(\"microbit\", \"mps2-an385\", \"mps2-an505\", \"mps2-an521\", \"lm3s6965evb\", \"virt\"))");
     println!("cargo:rustc-cfg=board=\"{}\"", board.name);
 
     let scene = var("OCTRACE_SCENE", "fig5_1");
@@ -191,6 +195,7 @@ fn main() {
     writeln!(config, "pub const SCENE_NAME: &str = {scene:?};").unwrap();
     writeln!(config, "pub const SCENE: &str = include_str!({:?});", scene_path.display().to_string()).unwrap();
     writeln!(config, "pub const WIDTH: u32 = {w};").unwrap();
+    writeln!(config, "pub const OBJECTS: usize = {};", counts.objects).unwrap();
     writeln!(config, "pub const HEIGHT: u32 = {h};").unwrap();
     writeln!(config, "pub const ACCEL: octrace_core::AccelMode = octrace_core::AccelMode::{accel:?};").unwrap();
     writeln!(config, "pub const WIRE: crate::PanelColor = crate::PanelColor::{wire:?};").unwrap();

@@ -13,6 +13,8 @@ qemu=(qemu-system-arm -machine "$machine")
 case $machine in
     lm3s6965evb) exec python3 "$here/tools/runner.py" screen "$elf" ;;
     mps2-an385) qemu+=(-cpu cortex-m3) ;;
+    # Both cores: the second waits until the firmware releases it.
+    mps2-an521) qemu+=(-smp 2) ;;
     # No firmware of qemu's own: the ELF starts at the RAM's base.
     virt) qemu=(qemu-system-riscv32 -machine virt -bios none) ;;
 esac

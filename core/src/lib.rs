@@ -142,6 +142,6 @@ mod sort;
 mod test_rng;
 
 pub use accel::AccelMode;
-pub use raytracer::{DrawError, LoadError, LoadedScene, Raytracer, TracedImage};
+pub use raytracer::{DrawError, LoadError, LoadedScene, Raytracer, SceneAccelerator, TracedImage};
 #[cfg(feature = "static-cell")]
 pub use static_cell::ConstStaticCell;

@@ -204,6 +204,37 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         self.mode
     }
 
+    /// What this scene's images render with: its octree, or every object
+    /// (over only the shape kinds the profile has room for). For a board
+    /// that renders with [`Renderer`]s of its own, one per core (each with
+    /// its own mailbox and screen lists) over this one scene: see
+    /// [`interleaved_rows`](crate::render::interleaved_rows).
+    ///
+    /// ```
+    /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888};
+    /// use embedded_graphics::{image::Image, prelude::*};
+    /// use octrace_core::{profile::Board16K, render::{interleaved_rows, Renderer}, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
+    /// let accelerator = scene.accelerator();
+    /// let mut whole = MockDisplay::<Rgb888>::new();
+    /// Image::new(&scene.image(Size::new(8, 8)), Point::zero()).draw(&mut whole)?;
+    /// // Two "cores", each with its own renderer, rows dealt out in turn.
+    /// for core in 0..2 {
+    ///     let mut renderer = Renderer::with_size(scene.view(), &accelerator, 8, 8)?;
+    ///     for y in interleaved_rows(8, core, 2) {
+    ///         for (x, pixel) in renderer.row(y, 0..8).enumerate() {
+    ///             assert_eq!(whole.get_pixel(Point::new(x as i32, y as i32)), Some(pixel.color));
+    ///         }
+    ///     }
+    /// }
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn accelerator(&self) -> SceneAccelerator<'r, P> {
+        SceneAccelerator { octree: self.octree.as_ref().map(|(octree, _)| *octree) }
+    }
+
     /// Whether camera rays find their hits in the screen lists
     /// ([`Profile::FIRST_HITS`]): the same image as the walk's.
     pub fn first_hits(&self) -> bool {
@@ -244,8 +275,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         D: DrawTarget,
         D::Color: From<Rgb888>,
     {
-        let walk = Profiled::<P> { octree: self.octree.as_ref().map(|(octree, _)| *octree) };
-        self.render(&walk, size, area, at, target)
+        self.render(&self.accelerator(), size, area, at, target)
     }
 
     fn render<A: Accelerator, D>(
@@ -281,16 +311,30 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     }
 }
 
-/// What a [`Raytracer`] renders with: its octree, or (without one) every
-/// object, over only the shape kinds its profile has room for, and with
-/// the screen lists only if the profile has room for them. Both are
-/// decided on the profile's constants, so that a build without an octree
-/// or without the lists links none of their code.
-struct Profiled<'a, P: Profile> {
-    octree: Option<&'a P::Octree>,
+/// What a [`LoadedScene`] renders with ([`LoadedScene::accelerator`]):
+/// its octree, or (without one) every object, over only the shape kinds
+/// its profile has room for, and with the screen lists only if the profile
+/// has room for them. Both are decided on the profile's constants, so that
+/// a build without an octree or without the lists links none of their code.
+pub struct SceneAccelerator<'r, P: Profile> {
+    octree: Option<&'r P::Octree>,
 }
 
-impl<P: Profile> Profiled<'_, P> {
+impl<P: Profile> Clone for SceneAccelerator<'_, P> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<P: Profile> Copy for SceneAccelerator<'_, P> {}
+
+impl<P: Profile> fmt::Debug for SceneAccelerator<'_, P> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("SceneAccelerator").field("octree", &self.octree.is_some()).finish()
+    }
+}
+
+impl<P: Profile> SceneAccelerator<'_, P> {
     /// The octree, if the profile has room for one and the scene uses it.
     #[inline(always)]
     fn octree(&self) -> Option<&P::Octree> {
@@ -298,7 +342,7 @@ impl<P: Profile> Profiled<'_, P> {
     }
 }
 
-impl<P: Profile> Accelerator for Profiled<'_, P> {
+impl<P: Profile> Accelerator for SceneAccelerator<'_, P> {
     const KINDS: ShapeKinds = ShapeKinds::with_room(&P::COUNTS);
     // The octree's mailbox, only if the profile can have an octree.
     const USES_MAILBOX: bool = Raytracer::<P>::HAS_OCTREE && <P::Octree as Accelerator>::USES_MAILBOX;

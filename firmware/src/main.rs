@@ -12,6 +12,8 @@
 #![no_std]
 #![no_main]
 
+#[cfg(board = "mps2-an521")]
+mod both_cores;
 #[cfg(not(board = "lm3s6965evb"))]
 mod display;
 #[cfg(board = "lm3s6965evb")]
@@ -27,6 +29,7 @@ mod config {
 // The single-core critical section the cell's flag takes on a Cortex-M0
 // (and on a RISC-V hart without atomics).
 use embedded_graphics_core::geometry::Size;
+#[cfg(not(board = "mps2-an521"))]
 use embedded_graphics_core::image::ImageDrawable;
 use octrace_core::render::PanelColor;
 use octrace_core::{ConstStaticCell, LoadedScene, Raytracer};
@@ -47,6 +50,7 @@ use {
 #[cfg(not(board = "lm3s6965evb"))]
 use {
     display::{StreamDisplay, WireColor},
+    embedded_graphics_core::draw_target::DrawTarget,
     embedded_graphics_core::pixelcolor::{Gray4, Rgb565, Rgb888},
     octrace_core::palette::{Dither, PaletteIndex, Quantized},
     semihosting::HostFile,
@@ -116,8 +120,12 @@ fn run(raytracer: &'static mut Raytracer<Profile>) -> u32 {
         hprintln!("the display refused the pixels");
         return 3;
     }
-    let stats = scene.stats();
-    hprintln!("{} rays, {} shadow rays, {} cells", stats.rays, stats.shadow_rays, stats.cells);
+    // Both cores' renderers count their own (printed by `draw_into`).
+    #[cfg(not(board = "mps2-an521"))]
+    {
+        let stats = scene.stats();
+        hprintln!("{} rays, {} shadow rays, {} cells", stats.rays, stats.shadow_rays, stats.cells);
+    }
     0
 }
 
@@ -148,7 +156,7 @@ use lm3s6965evb::open_output;
 
 /// Draws the scene into the host file in the configured pixel format.
 #[cfg(not(board = "lm3s6965evb"))]
-fn draw_on(scene: &LoadedScene<'_, Profile>, file: HostFile) -> bool {
+fn draw_on(scene: &LoadedScene<'static, Profile>, file: HostFile) -> bool {
     match config::WIRE {
         PanelColor::Rgb888 => draw::<Rgb888>(scene, file),
         PanelColor::Rgb565 => draw::<Rgb565>(scene, file),
@@ -170,18 +178,42 @@ fn draw_on(scene: &LoadedScene<'_, Profile>, mut panel: ssd0323::Ssd0323) -> boo
 /// instance keeps its frame to itself.
 #[cfg(not(board = "lm3s6965evb"))]
 #[inline(never)]
-fn draw<C: WireColor + From<Rgb888>>(scene: &LoadedScene<'_, Profile>, file: HostFile) -> bool {
+fn draw<C: WireColor + From<Rgb888>>(scene: &LoadedScene<'static, Profile>, file: HostFile) -> bool {
     let mut display = StreamDisplay::<C>::new(file, Size::new(config::WIDTH, config::HEIGHT));
-    scene.image_for(&display).draw(&mut display).is_ok()
+    draw_into(scene, &mut display)
 }
 
 /// Draws the scene into a 256-colour display, ordered-dithered.
 #[cfg(not(board = "lm3s6965evb"))]
 #[inline(never)]
-fn draw_dithered(scene: &LoadedScene<'_, Profile>, file: HostFile) -> bool {
+fn draw_dithered(scene: &LoadedScene<'static, Profile>, file: HostFile) -> bool {
     let display = StreamDisplay::<PaletteIndex>::new(file, Size::new(config::WIDTH, config::HEIGHT));
     let mut dithered = Quantized { display, quantizer: &mut Dither };
-    scene.image_for(&dithered).draw(&mut dithered).is_ok()
+    draw_into(scene, &mut dithered)
+}
+
+/// Draws the scene into `display` as an embedded-graphics image.
+#[cfg(not(any(board = "lm3s6965evb", board = "mps2-an521")))]
+fn draw_into<D: DrawTarget>(scene: &LoadedScene<'static, Profile>, display: &mut D) -> bool
+where
+    D::Color: From<Rgb888>,
+{
+    scene.image_for(display).draw(display).is_ok()
+}
+
+/// Draws the scene into `display` with both cores.
+#[cfg(board = "mps2-an521")]
+fn draw_into<D: DrawTarget>(scene: &LoadedScene<'static, Profile>, display: &mut D) -> bool
+where
+    D::Color: From<Rgb888>,
+{
+    match both_cores::draw(scene, display) {
+        Ok([core0, core1]) => {
+            hprintln!("rays: core 0 {}, core 1 {}", core0, core1);
+            true
+        }
+        Err(_) => false,
+    }
 }
 
 /// The stack's lowest and highest addresses, from the linker script.

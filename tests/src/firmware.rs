@@ -24,6 +24,8 @@ pub enum Board {
     Mps2An385,
     /// ARM MPS2-AN505: Cortex-M33 (Armv8-M Mainline), in its Secure state.
     Mps2An505,
+    /// ARM MPS2-AN521: two Cortex-M33s, both rendering.
+    Mps2An521,
     /// qemu's RISC-V `virt` machine with one RV32IMC hart.
     Virt,
 }
@@ -38,6 +40,7 @@ impl Board {
             Board::Microbit => ("microbit", "thumbv6m-none-eabi", "Cortex-M0"),
             Board::Mps2An385 => ("mps2-an385", "thumbv7m-none-eabi", "Cortex-M3"),
             Board::Mps2An505 => ("mps2-an505", "thumbv8m.main-none-eabihf", "Cortex-M33"),
+            Board::Mps2An521 => ("mps2-an521", "thumbv8m.main-none-eabihf", "2 × Cortex-M33"),
             Board::Virt => ("virt", "riscv32imc-unknown-none-elf", "RV32IMC"),
         }
     }

@@ -45,6 +45,9 @@ fn boards_render_the_same_bits_as_host_sim() {
         // Armv8-M Mainline (Cortex-M33, the Pico 2's and nRF5340's core),
         // with the octree and both techniques.
         Firmware::new(Board::Mps2An505, "fig5_5", 160, 128, PanelColor::Rgb565),
+        // Both Cortex-M33s of the AN521, rows dealt out in turn.
+        Firmware::new(Board::Mps2An521, "fig5_3", 160, 128, PanelColor::Rgb565),
+        Firmware::new(Board::Mps2An521, "fig5_1", 64, 48, PanelColor::Dither),
         // RISC-V (RV32IMC, as the ESP32-C3), with the octree.
         Firmware::new(Board::Virt, "fig5_3", 160, 128, PanelColor::Rgb888),
         Firmware::new(Board::Virt, "fig5_1", 160, 128, PanelColor::Rgb565),
