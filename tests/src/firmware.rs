@@ -32,7 +32,7 @@ pub enum Board {
 
 impl Board {
     /// Every board the firmware streams pixels from, in the benchmark's order.
-    pub const ALL: [Board; 4] = [Board::Microbit, Board::Mps2An385, Board::Mps2An505, Board::Virt];
+    pub const ALL: [Board; 5] = [Board::Microbit, Board::Mps2An385, Board::Mps2An505, Board::Mps2An521, Board::Virt];
 
     /// qemu's `-machine`, the Rust target and the core.
     fn facts(self) -> (&'static str, &'static str, &'static str) {
@@ -242,6 +242,31 @@ impl Firmware {
             static_ram: sizes.data + sizes.bss,
             output: text,
         })
+    }
+}
+
+impl Firmware {
+    /// Each core's instructions between the markers and, of those, the
+    /// ones spent waiting for the other core (`firmware/tools/cores.sh`):
+    /// for the dual-core board.
+    pub fn cores(&self, elf: &Path) -> Result<Vec<(u64, u64)>, String> {
+        let out = Command::new("bash")
+            .arg(repo().join("firmware/tools/cores.sh"))
+            .arg(elf)
+            .output()
+            .map_err(|e| format!("cannot run cores.sh: {e}"))?;
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        let cores: Vec<(u64, u64)> = text
+            .lines()
+            .filter_map(|l| match l.split_whitespace().collect::<Vec<_>>()[..] {
+                ["core", _, "insns", total, "wait", wait] => Some((total.parse().ok()?, wait.parse().ok()?)),
+                _ => None,
+            })
+            .collect();
+        if cores.is_empty() {
+            return Err(format!("no core counts from cores.sh:\n{text}{}", String::from_utf8_lossy(&out.stderr)));
+        }
+        Ok(cores)
     }
 }
 

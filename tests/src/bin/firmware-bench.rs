@@ -33,15 +33,25 @@ fn main() {
         "| board | scene | size | instructions / pixel | pixels / M instructions | flash | static RAM | peak stack |"
     );
     println!("| --- | --- | --- | ---: | ---: | ---: | ---: | ---: |");
+    let mut dual_rows = Vec::new();
     for board in Board::ALL {
         for scene in &scenes {
             let firmware = Firmware::new(board, scene, width, height, PanelColor::Rgb888);
             let label = format!("{} ({}) | {scene} | {width}×{height}", board.machine(), board.core());
-            let result = firmware.build().and_then(|elf| firmware.measure(&elf, &qemu_count));
+            let result = firmware.build().and_then(|elf| {
+                let measured = firmware.measure(&elf, &qemu_count)?;
+                // Two cores: the time is the busier core's instructions.
+                let cores = if board == Board::Mps2An521 { Some(firmware.cores(&elf)?) } else { None };
+                Ok((measured, cores))
+            });
             match result {
-                Ok(m) if m.status == 0 => {
+                Ok((m, cores)) if m.status == 0 => {
                     let pixels = (width * height) as f64;
-                    let render = m.render.unwrap_or(m.total) as f64;
+                    let mut render = m.render.unwrap_or(m.total) as f64;
+                    if let Some(cores) = cores {
+                        render = cores.iter().map(|&(total, _)| total).max().unwrap_or(0) as f64;
+                        dual_rows.push(dual_row(scene, &cores));
+                    }
                     let stack = m
                         .output
                         .lines()
@@ -55,7 +65,7 @@ fn main() {
                         m.static_ram as f64 / 1024.0,
                     );
                 }
-                Ok(m) => {
+                Ok((m, _)) => {
                     // The first error, without its file position and advice.
                     let reason = m.output.lines().find(|l| l.contains(".txt:")).unwrap_or("");
                     let reason = reason.splitn(4, ':').nth(3).unwrap_or(reason).split(';').next().unwrap_or("").trim();
@@ -65,4 +75,28 @@ fn main() {
             }
         }
     }
+    if !dual_rows.is_empty() {
+        println!();
+        println!(
+            "Both cores of the MPS2-AN521 (instructions between the markers; waiting: spinning for the other core):"
+        );
+        println!();
+        println!("| scene | core 0 | core 0 waiting | core 1 | core 1 waiting | core 0's share of the work |");
+        println!("| --- | ---: | ---: | ---: | ---: | ---: |");
+        for row in dual_rows {
+            println!("{row}");
+        }
+    }
+}
+
+/// A row of the dual-core table: each core's instructions, its waiting,
+/// and core 0's share of the two cores' work (what is not waiting).
+fn dual_row(scene: &str, cores: &[(u64, u64)]) -> String {
+    let [(total0, wait0), (total1, wait1), ..] = cores[..] else {
+        return format!("| {scene} | one core counted | | | | |");
+    };
+    let (work0, work1) = (total0 - wait0, total1 - wait1);
+    let share = 100.0 * work0 as f64 / (work0 + work1).max(1) as f64;
+    let m = |v: u64| format!("{:.1} M", v as f64 / 1e6);
+    format!("| {scene} | {} | {} | {} | {} | {share:.2} % |", m(total0), m(wait0), m(total1), m(wait1))
 }
