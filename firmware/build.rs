@@ -30,7 +30,7 @@
 use octrace_core::accel::OctreeConfig;
 use octrace_core::capacity::{CapacityKind, Counts};
 use octrace_core::parse::count;
-use octrace_core::profile::needed_by;
+use octrace_core::profile::{needed_by, ProfileText};
 use octrace_core::render::PanelColor;
 use octrace_core::AccelMode;
 use std::env;
@@ -206,17 +206,16 @@ fn main() {
         // The guest writes this file; on the OLED board the runner does.
         writeln!(config, "pub const OUTPUT: &str = {:?};", format!("{output}\0")).unwrap();
     }
-    writeln!(
-        config,
-        "octrace_core::profile! {{\n    /// Exactly what {scene} needs (about {bytes} bytes).\n    pub struct Profile {{ {} }}\n    octree: {{ {} }}\n    named_walk: {named_walk}\n    first_hits: {}\n}}",
-        counts.profile_fields(),
-        format_args!(
-            "max_objects: {}, max_depth: {}, shadow_shafts: {}",
-            octree.max_objects, octree.max_depth, octree.shadow_shafts
-        ),
-        techniques.first_hits
-    )
-    .unwrap();
+    let doc = format!("Exactly what {scene} needs (about {bytes} bytes).");
+    let profile = ProfileText {
+        name: "Profile",
+        doc: &doc,
+        counts: &counts,
+        octree: Some(&octree),
+        named_walk,
+        first_hits: techniques.first_hits,
+    };
+    write!(config, "{profile}").unwrap();
     // What the runner reads from the ELF: `key=value` lines.
     let run = format!("machine={}\noutput={output}\n", board.name);
     writeln!(config, "#[used]").unwrap();

@@ -219,6 +219,59 @@ pub fn needed_by<'t>(
     Ok(counts)
 }
 
+/// A [`profile!`](crate::profile!) invocation as text, for a build script
+/// that sizes a board's profile for its scene: it writes this into
+/// `OUT_DIR` and the firmware `include!`s it (octrace's firmware and board
+/// templates do). The counts from [`needed_by`] (or
+/// [`parse::count`](crate::parse::count)), the octree's criterion when it
+/// is not the default one, and the two options.
+///
+/// ```
+/// use octrace_core::{accel::OctreeConfig, parse::count, profile::ProfileText};
+///
+/// let counts = count("SPHERE 1 1 0 0 0\n");
+/// let octree = OctreeConfig { max_depth: 4, ..OctreeConfig::DEFAULT };
+/// let text = ProfileText { name: "Scene", doc: "One sphere.", counts: &counts, octree: Some(&octree), named_walk: false, first_hits: true };
+/// assert_eq!(
+///     text.to_string(),
+///     "octrace_core::profile! {\n    /// One sphere.\n    pub struct Scene { objects: 1, spheres: 1 }\n    \
+///      octree: { max_objects: 4, max_depth: 4, shadow_shafts: false }\n    named_walk: false\n    first_hits: true\n}\n",
+/// );
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct ProfileText<'a> {
+    /// The profile type's name.
+    pub name: &'a str,
+    /// Its doc comment (one line).
+    pub doc: &'a str,
+    /// What the profile holds.
+    pub counts: &'a Counts,
+    /// The octree's criterion, if not [`OctreeConfig::DEFAULT`]'s.
+    pub octree: Option<&'a OctreeConfig>,
+    /// [`Profile::NAMED_WALK`].
+    pub named_walk: bool,
+    /// [`Profile::FIRST_HITS`].
+    pub first_hits: bool,
+}
+
+impl core::fmt::Display for ProfileText<'_> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        writeln!(f, "octrace_core::profile! {{")?;
+        writeln!(f, "    /// {}", self.doc)?;
+        writeln!(f, "    pub struct {} {{ {} }}", self.name, self.counts.profile_fields())?;
+        if let Some(octree) = self.octree {
+            let OctreeConfig { max_objects, max_depth, shadow_shafts, .. } = octree;
+            writeln!(
+                f,
+                "    octree: {{ max_objects: {max_objects}, max_depth: {max_depth}, shadow_shafts: {shadow_shafts} }}"
+            )?;
+        }
+        writeln!(f, "    named_walk: {}", self.named_walk)?;
+        writeln!(f, "    first_hits: {}", self.first_hits)?;
+        writeln!(f, "}}")
+    }
+}
+
 /// What [`profile!`](crate::profile!) expands to; not a public API.
 #[doc(hidden)]
 pub mod __private {

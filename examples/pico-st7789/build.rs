@@ -11,7 +11,7 @@
 //! one picture (BENCHMARKS.md).
 
 use octrace_core::accel::OctreeConfig;
-use octrace_core::profile::needed_by;
+use octrace_core::profile::{needed_by, ProfileText};
 use octrace_core::AccelMode;
 use std::env;
 use std::path::PathBuf;
@@ -38,18 +38,18 @@ fn main() {
     })
     .unwrap_or_else(|errors| fail(&format!("{scene}: {errors} error(s); nothing is built from a scene with errors")));
 
-    let source = format!(
-        "/// The scene, from `{scene}`.\n\
-         pub const SCENE_TEXT: &str = include_str!({path:?});\n\
-         octrace_core::profile! {{\n    \
-             /// Exactly what `{scene}` needs, its octree included.\n    \
-             pub struct SceneProfile {{ {fields} }}\n    \
-             // `load` walks the octree by 3DDDA: no room for the thesis's hash table.\n    \
-             named_walk: false\n    \
-             first_hits: true\n\
-         }}\n",
-        fields = needs.profile_fields(),
-    );
+    // `load` walks the octree by 3DDDA: no room for the thesis's hash table.
+    let doc = format!("Exactly what `{scene}` needs, its octree included.");
+    let profile = ProfileText {
+        name: "SceneProfile",
+        doc: &doc,
+        counts: &needs,
+        octree: None,
+        named_walk: false,
+        first_hits: true,
+    };
+    let source =
+        format!("/// The scene, from `{scene}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n{profile}");
     std::fs::write(out.join("scene.rs"), source).expect("write scene.rs into OUT_DIR");
 }
 
