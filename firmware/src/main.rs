@@ -26,8 +26,6 @@ mod config {
     include!(concat!(env!("OUT_DIR"), "/config.rs"));
 }
 
-// The single-core critical section the cell's flag takes on a Cortex-M0
-// (and on a RISC-V hart without atomics).
 use embedded_graphics_core::geometry::Size;
 #[cfg(not(board = "mps2-an521"))]
 use embedded_graphics_core::image::ImageDrawable;
@@ -36,12 +34,14 @@ use octrace_core::{ConstStaticCell, LoadedScene, Raytracer};
 use semihosting::exit;
 #[cfg(target_arch = "arm")]
 use {
+    // The single-core critical section the cell's flag takes on a Cortex-M0.
     cortex_m as _,
     cortex_m_rt::{entry, exception, ExceptionFrame},
     cortex_m_semihosting::hprintln,
 };
 #[cfg(target_arch = "riscv32")]
 use {
+    // The same for a RISC-V hart without atomics.
     riscv as _,
     riscv_rt::{entry, TrapFrame},
     riscv_semihosting::hprintln,
