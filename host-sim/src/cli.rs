@@ -1,7 +1,7 @@
 //! The `host-sim` command line.
 
 use crate::formats::{self, Format, FormatError, Header, Image};
-use crate::output::FileSink;
+use crate::output::{write_atomically, FileSink};
 use crate::palette::PaletteMode;
 use crate::parts::{self, MergeError, PartInfo, PartSpec};
 use crate::{all_cores, load_bytes, new_scene, render_streamed, AccelMode, LoadError, Partition, RenderOptions};
@@ -15,10 +15,7 @@ use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Exit code for a bad scene or bad arguments.
-pub const EXIT_SCENE: i32 = 2;
-/// Exit code for a file that cannot be read or written.
-pub const EXIT_IO: i32 = 1;
+pub use crate::exit::{EXIT_IO, EXIT_SCENE};
 
 /// Render an octrace scene file to an image (PNG, Targa or Sun raster), in
 /// truecolour or with a 256-entry colour table.
@@ -584,36 +581,6 @@ fn same_file(a: &Path, b: &Path) -> bool {
         (Ok(x), Ok(y)) => x == y,
         _ => false,
     }
-}
-
-/// Writes `path` through a temporary file in the same directory, renamed into
-/// place only when `write` succeeds; on failure no file is left behind.
-pub fn write_atomically(
-    path: &Path,
-    write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
-) -> std::io::Result<()> {
-    // The rename below would replace even a read-only file: refuse it, as
-    // writing to it directly would.
-    if std::fs::metadata(path).is_ok_and(|m| m.permissions().readonly()) {
-        return Err(std::io::Error::new(std::io::ErrorKind::PermissionDenied, "the file is read-only"));
-    }
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::InvalidInput, "the output path names no file"))?;
-    let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
-    let result = (|| {
-        let file = std::fs::File::create(&tmp)?;
-        let mut w = std::io::BufWriter::new(file);
-        write(&mut w)?;
-        w.flush()?;
-        w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@
 //! the image, and hands every row to its sink once, in order.
 
 pub mod cli;
+pub mod exit;
 pub mod formats;
 pub mod image;
 pub mod output;

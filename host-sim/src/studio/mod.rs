@@ -11,7 +11,7 @@
 
 mod http;
 
-use crate::cli::write_atomically;
+use crate::output::write_atomically;
 use http::{Request, Response};
 use std::io::Write;
 use std::net::{Ipv4Addr, SocketAddr, TcpListener, TcpStream};
@@ -69,21 +69,21 @@ pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) ->
         Ok(l) => l,
         Err(e) => {
             let _ = writeln!(stderr, "host-sim studio: cannot listen on 127.0.0.1:{}: {e}", args.port);
-            return crate::cli::EXIT_IO;
+            return crate::exit::EXIT_IO;
         }
     };
     let port = match listener.local_addr() {
         Ok(a) => a.port(),
         Err(e) => {
             let _ = writeln!(stderr, "host-sim studio: {e}");
-            return crate::cli::EXIT_IO;
+            return crate::exit::EXIT_IO;
         }
     };
     let token = match new_token() {
         Ok(t) => t,
         Err(e) => {
             let _ = writeln!(stderr, "host-sim studio: no randomness for the token: {e}");
-            return crate::cli::EXIT_IO;
+            return crate::exit::EXIT_IO;
         }
     };
     let url = format!("http://127.0.0.1:{port}/?token={token}");
