@@ -1,0 +1,258 @@
+//! The threaded streaming render: worker threads take pieces of the image
+//! (tiles of a band of rows, or the thesis's four rectangles) from a shared
+//! counter, each with its own renderer, and a window of bands collects them
+//! so that rows reach the sink in order, holding only a bounded number of
+//! bands in memory.
+//!
+//! Invariants: every piece is rendered once; a band is handed to the sink
+//! only when all its pieces are in, and bands in order; a panicking worker
+//! is counted out so the writer never waits for it.
+
+use crate::{Partition, RenderOptions, RowSink, NO_OBJECT, TILE_SIDE};
+use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::pixelcolor::RgbColor;
+use embedded_graphics_core::primitives::Rectangle;
+use octrace_core::accel::{Accelerator, Mailbox};
+use octrace_core::render::{Renderer, ScreenBound, Tiles};
+use octrace_core::scene::SceneView;
+use octrace_core::shade::Stats;
+use std::sync::{Condvar, Mutex};
+use std::time::{Duration, Instant};
+
+/// A piece of the image one thread renders at a time, and the band of rows
+/// it belongs to.
+#[derive(Clone, Copy, Debug)]
+struct Piece {
+    band: usize,
+    area: Rectangle,
+}
+
+/// The bands of `rows` (each a range of rows) and their pieces in the order
+/// they are handed out: bands of [`TILE_SIDE`] rows cut into tiles, or for
+/// [`Partition::Equal4`] one band, the thesis's four rectangles.
+fn bands(width: u32, rows: &std::ops::Range<u32>, partition: Partition) -> (Vec<std::ops::Range<u32>>, Vec<Piece>) {
+    let rectangle = |x: u32, y: u32, w: u32, h: u32| Rectangle::new(Point::new(x as i32, y as i32), Size::new(w, h));
+    match partition {
+        Partition::Tiles => {
+            // The core's tiles of the rows as an image of their own, in
+            // raster order: a band is a row of tiles.
+            let bands: Vec<_> =
+                rows.clone().step_by(TILE_SIDE as usize).map(|y| y..(y + TILE_SIDE).min(rows.end)).collect();
+            let tiles = Tiles::new(Size::new(width, rows.len() as u32), TILE_SIDE);
+            let offset = Point::new(0, rows.start as i32);
+            let pieces = tiles
+                .iter()
+                .map(|t| Piece {
+                    band: t.top_left.y as usize / TILE_SIDE as usize,
+                    area: Rectangle::new(t.top_left + offset, t.size),
+                })
+                .collect();
+            (bands, pieces)
+        }
+        Partition::Equal4 => {
+            let (left, top, height) = (width / 2, rows.start + rows.len() as u32 / 2, rows.len() as u32);
+            let top_height = top - rows.start;
+            let quarters = [
+                (0, rows.start, left, top_height),
+                (left, rows.start, width - left, top_height),
+                (0, top, left, height - top_height),
+                (left, top, width - left, height - top_height),
+            ];
+            let pieces = quarters.into_iter().map(|(x, y, w, h)| Piece { band: 0, area: rectangle(x, y, w, h) });
+            (vec![rows.clone()], pieces.collect())
+        }
+    }
+}
+
+/// A band of rows being filled: colours and objects, row-major.
+struct Slot {
+    band: usize,
+    colors: Vec<u8>,
+    objects: Vec<u32>,
+    /// Pieces of the band not yet copied in.
+    remaining: usize,
+}
+
+/// What the threads of a streamed render share.
+struct Window {
+    /// The next piece to hand out (tiles).
+    next: usize,
+    /// Bands already given to the sink.
+    written: usize,
+    slots: Vec<Slot>,
+    /// Threads still rendering.
+    alive: usize,
+    /// The sink failed: stop.
+    abort: bool,
+}
+
+/// At most this many bytes of bands wait to be written (unless two bands
+/// need more): far below the target of 256 MB for a 16384-pixel-wide image.
+const WINDOW_BYTES: usize = 64 << 20;
+
+/// Renders `rows` on `options.threads` threads, each with its own renderer
+/// (and mailbox): threads take pieces of the bands in order, at most a
+/// window of bands ahead of the oldest one not yet written, while this
+/// thread hands finished bands to `sink` in order.
+pub(crate) fn stream_threads<A: Accelerator + Sync>(
+    view: SceneView<'_>,
+    accel: &A,
+    (w, h): (u32, u32),
+    rows: std::ops::Range<u32>,
+    options: &RenderOptions,
+    progress: &(dyn Fn(u64) + Sync),
+    sink: &mut dyn RowSink,
+) -> std::io::Result<(Stats, Duration, Vec<Duration>)> {
+    let threads = options.threads.max(1);
+    let (bands, pieces) = bands(w, &rows, options.partition);
+    let mut pieces_in_band = vec![0usize; bands.len()];
+    pieces.iter().for_each(|p| pieces_in_band[p.band] += 1);
+    let band_bytes = bands.first().map_or(0, |b| b.len()) * w as usize * 7;
+    let window = (2 * threads).max(4).min((WINDOW_BYTES / band_bytes.max(1)).max(2));
+    let slot = |band: usize, mut colors: Vec<u8>, mut objects: Vec<u32>| {
+        let pixels = bands[band].len() * w as usize;
+        colors.resize(3 * pixels, 0);
+        objects.resize(pixels, NO_OBJECT);
+        Slot { band, colors, objects, remaining: pieces_in_band[band] }
+    };
+    let slots = (0..window.min(bands.len())).map(|band| slot(band, Vec::new(), Vec::new())).collect();
+    let shared = Mutex::new(Window { next: 0, written: 0, slots, alive: threads, abort: false });
+    let changed = Condvar::new();
+    let lock = || shared.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let started = Instant::now();
+    let worker = |thread: usize| {
+        // Counts this thread out even if it panics, so the writer stops waiting.
+        struct Leaving<'a, F: Fn() -> std::sync::MutexGuard<'a, Window>>(&'a F, &'a Condvar);
+        impl<'a, F: Fn() -> std::sync::MutexGuard<'a, Window>> Drop for Leaving<'a, F> {
+            fn drop(&mut self) {
+                (self.0)().alive -= 1;
+                self.1.notify_all();
+            }
+        }
+        let _leaving = Leaving(&lock, &changed);
+        let mut busy = Duration::ZERO;
+        let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
+        let Ok(renderer) = Renderer::with_size(view, accel, w, h) else { return (Stats::default(), busy) };
+        let mut bounds = vec![ScreenBound::EMPTY; view.object_count()];
+        let mut positions = vec![0; ScreenBound::positions_for(view.object_count())];
+        let mut renderer = renderer.with_mailbox(&mut words).with_first_hits(&mut bounds, &mut positions);
+        // Equal4 hands the thesis's rectangles out statically.
+        let mut own_next = thread;
+        loop {
+            let mut state = lock();
+            let piece = loop {
+                let index = match options.partition {
+                    Partition::Tiles => state.next,
+                    Partition::Equal4 => own_next,
+                };
+                let piece = match pieces.get(index) {
+                    Some(p) if !state.abort => *p,
+                    _ => return (renderer.stats(), busy),
+                };
+                if piece.band < state.written + window {
+                    match options.partition {
+                        Partition::Tiles => state.next += 1,
+                        Partition::Equal4 => own_next += threads,
+                    }
+                    break piece;
+                }
+                state = changed.wait(state).unwrap_or_else(|poisoned| poisoned.into_inner());
+            };
+            drop(state);
+            let began = Instant::now();
+            let tile = Tile::render(&mut renderer, &piece.area);
+            busy += began.elapsed();
+            let mut state = lock();
+            let slot = &mut state.slots[piece.band % window];
+            tile.copy_into(slot, bands[piece.band].start, w);
+            slot.remaining -= 1;
+            if slot.remaining == 0 {
+                changed.notify_all();
+            }
+            drop(state);
+            progress(piece.area.size.width as u64 * piece.area.size.height as u64);
+        }
+    };
+    let mut writer = || -> std::io::Result<()> {
+        for (band, ys) in bands.iter().enumerate() {
+            let mut state = lock();
+            let index = band % window;
+            while state.slots[index].band != band || state.slots[index].remaining > 0 {
+                if state.alive == 0 {
+                    // A thread died (its panic is raised when the scope ends).
+                    return Err(std::io::Error::other("the render stopped before the image was complete"));
+                }
+                state = changed.wait(state).unwrap_or_else(|poisoned| poisoned.into_inner());
+            }
+            let colors = std::mem::take(&mut state.slots[index].colors);
+            let objects = std::mem::take(&mut state.slots[index].objects);
+            drop(state);
+            let width = w as usize;
+            let result = ys.clone().enumerate().try_for_each(|(i, y)| {
+                sink.row(y, &colors[3 * i * width..3 * (i + 1) * width], &objects[i * width..(i + 1) * width])
+            });
+            let mut state = lock();
+            if result.is_err() {
+                state.abort = true;
+                changed.notify_all();
+                return result;
+            }
+            state.slots[index] = if band + window < bands.len() {
+                slot(band + window, colors, objects)
+            } else {
+                Slot { band: usize::MAX, colors: Vec::new(), objects: Vec::new(), remaining: 0 }
+            };
+            state.written = band + 1;
+            changed.notify_all();
+        }
+        Ok(())
+    };
+    let (written, results) = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..threads).map(|t| scope.spawn(move || worker(t))).collect();
+        let written = writer();
+        let results: Vec<(Stats, Duration)> =
+            handles.into_iter().map(|h| h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))).collect();
+        (written, results)
+    });
+    written?;
+    let wall = started.elapsed();
+    let mut stats = Stats::default();
+    for (s, _) in &results {
+        stats.add(s);
+    }
+    Ok((stats, wall, results.into_iter().map(|(_, busy)| busy).collect()))
+}
+
+/// A rendered piece of the image: colours and objects, row-major.
+struct Tile {
+    area: Rectangle,
+    colors: Vec<u8>,
+    objects: Vec<u32>,
+}
+
+impl Tile {
+    fn render<A: Accelerator>(renderer: &mut Renderer<'_, A>, area: &Rectangle) -> Tile {
+        let (x0, y0) = (area.top_left.x as u32, area.top_left.y as u32);
+        let count = area.size.width as usize * area.size.height as usize;
+        let mut tile = Tile { area: *area, colors: Vec::with_capacity(3 * count), objects: Vec::with_capacity(count) };
+        for y in y0..y0 + area.size.height {
+            for p in renderer.row(y, x0..x0 + area.size.width) {
+                tile.colors.extend([p.color.r(), p.color.g(), p.color.b()]);
+                tile.objects.push(p.object.map_or(NO_OBJECT, |o| o.0));
+            }
+        }
+        tile
+    }
+
+    /// Copies the tile into the band starting at row `top` of an image
+    /// `width` pixels wide.
+    fn copy_into(&self, slot: &mut Slot, top: u32, width: u32) {
+        let (x0, y0) = (self.area.top_left.x as usize, self.area.top_left.y as usize - top as usize);
+        let (w, image_w) = (self.area.size.width as usize, width as usize);
+        for y in 0..self.area.size.height as usize {
+            let at = (y0 + y) * image_w + x0;
+            slot.colors[3 * at..3 * (at + w)].copy_from_slice(&self.colors[3 * y * w..3 * (y + 1) * w]);
+            slot.objects[at..at + w].copy_from_slice(&self.objects[y * w..(y + 1) * w]);
+        }
+    }
+}
