@@ -222,8 +222,8 @@ pub fn needed_by<'t>(
 /// A [`profile!`](crate::profile!) invocation as text, for a build script
 /// that sizes a board's profile for its scene: it writes this into
 /// `OUT_DIR` and the firmware `include!`s it (octrace's firmware and board
-/// templates do). The counts from [`needed_by`] (or
-/// [`parse::count`](crate::parse::count)), the octree's criterion when it
+/// templates do). The counts from `needed_by` (feature `alloc`) or
+/// [`parse::count`](crate::parse::count), the octree's criterion when it
 /// is not the default one, and the two options.
 ///
 /// ```
