@@ -13,15 +13,13 @@ fn main() {
     let manifest_dir = PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
     let out_dir = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
     let studio = manifest_dir.join("../studio");
-    for watched in
-        ["../studio/src", "../studio/Cargo.toml", "../studio/Cargo.lock", "../core/src", "../core/Cargo.toml"]
-    {
-        println!("cargo:rerun-if-changed={watched}");
+    // The module is built from the studio, the core and the image files crate.
+    for crate_dir in ["../studio", "../core", "../images"] {
+        for watched in ["src", "Cargo.toml"] {
+            println!("cargo:rerun-if-changed={crate_dir}/{watched}");
+        }
     }
-    // The studio compiles these host-sim modules too.
-    for shared in ["src/formats.rs", "src/image.rs", "src/palette.rs"] {
-        println!("cargo:rerun-if-changed={shared}");
-    }
+    println!("cargo:rerun-if-changed=../studio/Cargo.lock");
     install_wasm_target();
     let target_dir = wasm_target_dir(&out_dir);
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());

@@ -1,8 +1,6 @@
 //! The `host-sim` command line.
 
-use crate::formats::{self, Format, FormatError, Header, Image};
 use crate::output::{write_atomically, FileSink};
-use crate::palette::PaletteMode;
 use crate::parts::{self, MergeError, PartInfo, PartSpec};
 use crate::{all_cores, load_bytes, new_scene, render_streamed, AccelMode, LoadError, Partition, RenderOptions};
 use crate::{render_with_progress, HostScene, RgbImage, StreamError, Streamed};
@@ -11,6 +9,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 use octrace_core::accel::OctreeConfig;
 use octrace_core::render::PanelColor;
 use octrace_core::scene::MAX_SIDE;
+use octrace_images::formats::{self, Format, FormatError, Header, Image};
+use octrace_images::palette::PaletteMode;
+use octrace_images::panel;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -45,7 +46,7 @@ pub struct Args {
     /// Map the image onto a 256-entry colour table (written as an indexed
     /// image): scan (the thesis's hash-scan table), dither (6×6×6 cube,
     /// ordered), coarse (dither with outlines around objects), gray.
-    #[arg(long, value_enum, default_value_t = PaletteMode::None)]
+    #[arg(long, value_name = "MODE", default_value = "none", value_parser = parse_palette)]
     pub palette: PaletteMode,
     /// Preview a panel: the pixels as a display of this format shows them
     /// (the firmware's OCTRACE_COLOR): rgb888; rgb565 (written back as
@@ -55,7 +56,7 @@ pub struct Args {
     pub color: PanelColor,
     /// The file format; by default from OUT's extension (png, tga, ras), or
     /// PNG when OUT has none. Any other extension is refused without it.
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = parse_format)]
     pub format: Option<Format>,
     /// Render at WxH pixels instead of the scene's RASTER (for a quick
     /// preview; a default VIEWPORT follows the new aspect ratio).
@@ -105,7 +106,7 @@ pub enum Command {
         output: PathBuf,
         /// The output format; by default from OUTPUT's extension (png, tga,
         /// ras), or PNG when OUTPUT has none.
-        #[arg(long, value_enum)]
+        #[arg(long, value_parser = parse_format)]
         format: Option<Format>,
     },
     /// Stack the parts rendered with `--part I/N` into the whole image,
@@ -119,7 +120,7 @@ pub enum Command {
         #[arg(required = true)]
         parts: Vec<PathBuf>,
         /// The output format; by default from OUTPUT's extension, else PNG.
-        #[arg(long, value_enum)]
+        #[arg(long, value_parser = parse_format)]
         format: Option<Format>,
     },
     /// The scene studio: edit, place and render a scene in the browser,
@@ -127,51 +128,23 @@ pub enum Command {
     Studio(crate::studio::StudioArgs),
 }
 
-/// What a `color` panel shows of `image`, each pixel converted by
-/// embedded-graphics (as the firmware's renderer converts it) and widened
-/// back to 8 bits by embedded-graphics: RGB, or for gray4 an 8-bit gray
-/// image (level × 17), kept as a 16-entry gray colour table where a file
-/// format has no gray. `None` for the formats that need no conversion.
-fn panel_preview(image: &RgbImage, color: PanelColor, format: Format) -> Option<Preview> {
-    use embedded_graphics_core::pixelcolor::{Gray4, Gray8, GrayColor, Rgb565, Rgb888, RgbColor};
-    let rgb = image.data.chunks_exact(3).map(|p| Rgb888::new(p[0], p[1], p[2]));
-    let (width, height) = (image.width, image.height);
+/// What a `color` panel shows of `image` ([`octrace_images::panel`]), or
+/// `None` for the colours that need no conversion.
+fn panel_preview(image: &RgbImage, color: PanelColor) -> Option<Image> {
     match color {
         PanelColor::Rgb888 | PanelColor::Dither => None,
-        PanelColor::Rgb565 => {
-            let data = rgb.map(|c| Rgb888::from(Rgb565::from(c))).flat_map(|c| [c.r(), c.g(), c.b()]).collect();
-            Some(Preview::Image(Image::Rgb(RgbImage { width, height, data })))
-        }
-        PanelColor::Gray4 => {
-            let levels = rgb.map(|c| Gray4::from(c).luma());
-            if format == Format::Png {
-                let gray = levels.map(|l| Gray8::from(Gray4::new(l)).luma()).collect();
-                return Some(Preview::Gray { width, height, gray });
-            }
-            let palette = (0..16).map(|l| [Gray8::from(Gray4::new(l)).luma(); 3]).collect();
-            Some(Preview::Image(Image::Indexed { width, height, palette, indices: levels.collect() }))
-        }
+        PanelColor::Rgb565 => Some(Image::Rgb(panel::rgb565(image))),
+        PanelColor::Gray4 => Some(panel::gray4(image)),
     }
 }
 
-/// A panel preview as it is written.
-enum Preview {
-    Image(Image),
-    /// 8-bit gray, one byte a pixel (PNG only).
-    Gray {
-        width: u32,
-        height: u32,
-        gray: Vec<u8>,
-    },
-}
-
-fn write_gray_png(width: u32, height: u32, gray: &[u8], out: &mut dyn Write) -> std::io::Result<()> {
-    let mut encoder = png::Encoder::new(out, width, height);
-    encoder.set_color(png::ColorType::Grayscale);
-    encoder.set_depth(png::BitDepth::Eight);
-    let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
-    writer.write_image_data(gray).map_err(std::io::Error::other)?;
-    writer.finish().map_err(std::io::Error::other)
+/// Writes a panel preview: gray4 as an 8-bit gray PNG (level × 17) where
+/// the format is PNG, else as a 16-entry gray colour table.
+fn write_preview(preview: &Image, color: PanelColor, format: Format, out: &mut dyn Write) -> Result<(), FormatError> {
+    match (color, format) {
+        (PanelColor::Gray4, Format::Png) => formats::write_gray_png(preview, out),
+        _ => formats::write(preview, format, out),
+    }
 }
 
 /// An `--accel` name: the core's [`AccelMode`] vocabulary.
@@ -182,6 +155,16 @@ fn parse_accel(text: &str) -> Result<AccelMode, String> {
 /// A `--color` name: the core's [`PanelColor`] vocabulary.
 fn parse_color(text: &str) -> Result<PanelColor, String> {
     parse_name(text, &PanelColor::ALL, PanelColor::name)
+}
+
+/// A `--palette` name: [`PaletteMode`]'s vocabulary.
+fn parse_palette(text: &str) -> Result<PaletteMode, String> {
+    parse_name(text, &PaletteMode::ALL, PaletteMode::name)
+}
+
+/// A `--format` name: [`Format`]'s vocabulary.
+fn parse_format(text: &str) -> Result<Format, String> {
+    parse_name(text, &Format::ALL, Format::name)
 }
 
 /// The one of `all` that `text` names (case-insensitive).
@@ -243,7 +226,7 @@ fn output_format(asked: Option<Format>, path: &Path, stderr: &mut dyn Write) -> 
         return Ok(Format::Png);
     };
     Format::from_path(path).ok_or_else(|| {
-        let names: Vec<&str> = <Format as clap::ValueEnum>::value_variants().iter().map(|f| f.name()).collect();
+        let names: Vec<&str> = Format::ALL.iter().map(|f| f.name()).collect();
         let _ = writeln!(
             stderr,
             "host-sim: cannot write {}: `.{}` is not a format host-sim writes; it writes {} \
@@ -357,18 +340,8 @@ fn preview(
         let _ = writeln!(stderr, "host-sim: cannot set up the camera: {e}");
         EXIT_SCENE
     })?;
-    let written = match panel_preview(&rendered.image, color, format) {
-        None => {
-            let image = Image::Rgb(rendered.image.clone());
-            write_atomically(out, |f| formats::write(&image, format, f).map_err(std::io::Error::other))
-        }
-        Some(Preview::Image(panel)) => {
-            write_atomically(out, |f| formats::write(&panel, format, f).map_err(std::io::Error::other))
-        }
-        Some(Preview::Gray { width, height, gray }) => {
-            write_atomically(out, |f| write_gray_png(width, height, &gray, f))
-        }
-    };
+    let preview = panel_preview(&rendered.image, color).unwrap_or_else(|| Image::Rgb(rendered.image.clone()));
+    let written = write_atomically(out, |f| write_preview(&preview, color, format, f).map_err(std::io::Error::other));
     if let Err(e) = written {
         let _ = writeln!(stderr, "host-sim: cannot write {}: {e}", out.display());
         return Err(EXIT_IO);
@@ -604,37 +577,33 @@ mod tests {
         ((luma * 15 + 127) / 255 * 17) as u8
     }
 
-    fn one_pixel_preview(rgb: [u8; 3], color: PanelColor, format: Format) -> Option<Preview> {
-        panel_preview(&RgbImage { width: 1, height: 1, data: rgb.to_vec() }, color, format)
+    fn one_pixel_preview(rgb: [u8; 3], color: PanelColor) -> Option<Image> {
+        panel_preview(&RgbImage { width: 1, height: 1, data: rgb.to_vec() }, color)
     }
 
     #[test]
     fn gray4_preview_is_the_panels_level_times_17() {
         for rgb in [[0, 0, 0], [255, 255, 255], [255, 0, 0], [0, 255, 0], [0, 0, 255], [8, 9, 10], [200, 17, 90]] {
             let expected = gray4_by_hand(rgb[0].into(), rgb[1].into(), rgb[2].into());
-            match one_pixel_preview(rgb, PanelColor::Gray4, Format::Png) {
-                Some(Preview::Gray { gray, .. }) => assert_eq!(gray, [expected], "{rgb:?}"),
-                _ => panic!("gray4 as PNG is an 8-bit gray image"),
-            }
-            match one_pixel_preview(rgb, PanelColor::Gray4, Format::Tga) {
-                Some(Preview::Image(image)) => assert_eq!(image.to_rgb().data, [expected; 3], "{rgb:?}"),
-                _ => panic!("gray4 as Targa is a colour-mapped image"),
-            }
+            let preview = one_pixel_preview(rgb, PanelColor::Gray4).expect("gray4 is converted");
+            assert_eq!(preview.to_rgb().data, [expected; 3], "{rgb:?}");
+            let mut png = Vec::new();
+            write_preview(&preview, PanelColor::Gray4, Format::Png, &mut png).unwrap();
+            let decoder = png::Decoder::new(std::io::Cursor::new(&png)).read_info().unwrap();
+            assert_eq!(decoder.info().color_type, png::ColorType::Grayscale, "gray4 as PNG is an 8-bit gray image");
+            let mut tga = Vec::new();
+            write_preview(&preview, PanelColor::Gray4, Format::Tga, &mut tga).unwrap();
+            assert!(matches!(formats::read(&tga).unwrap(), Image::Indexed { .. }), "gray4 as Targa is colour-mapped");
         }
     }
 
     #[test]
     fn rgb565_preview_rounds_each_channel_to_its_width() {
         // 5 bits: 8 -> 1 -> 8; 6 bits: 130 -> 32 -> 130; 5 bits: 255 stays.
-        match one_pixel_preview([8, 130, 255], PanelColor::Rgb565, Format::Png) {
-            Some(Preview::Image(image)) => assert_eq!(image.to_rgb().data, [8, 130, 255]),
-            _ => panic!("rgb565 is an RGB image"),
-        }
-        match one_pixel_preview([5, 3, 4], PanelColor::Rgb565, Format::Png) {
-            Some(Preview::Image(image)) => assert_eq!(image.to_rgb().data, [8, 4, 0]),
-            _ => panic!("rgb565 is an RGB image"),
-        }
-        assert!(one_pixel_preview([1, 2, 3], PanelColor::Rgb888, Format::Png).is_none());
+        let shown = |rgb| one_pixel_preview(rgb, PanelColor::Rgb565).expect("rgb565 is converted").to_rgb().data;
+        assert_eq!(shown([8, 130, 255]), [8, 130, 255]);
+        assert_eq!(shown([5, 3, 4]), [8, 4, 0]);
+        assert!(one_pixel_preview([1, 2, 3], PanelColor::Rgb888).is_none());
     }
 
     #[test]

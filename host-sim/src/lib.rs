@@ -8,17 +8,14 @@
 
 pub mod cli;
 pub mod exit;
-pub mod formats;
-pub mod image;
 pub mod output;
-pub mod palette;
 pub mod parts;
 pub mod studio;
 mod threaded;
 
 use threaded::stream_threads;
 
-pub use image::RgbImage;
+pub use octrace_images::{RgbImage, NO_OBJECT};
 
 use octrace_core::accel::{BuildReport, Naive, Octree, OctreeConfig, Traversal};
 use octrace_core::parse::{parse_bytes, ParseError};
@@ -122,9 +119,6 @@ impl Default for RenderOptions {
 pub fn all_cores() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
 }
-
-/// What [`Rendered::objects`] holds for a pixel that shows the background.
-pub const NO_OBJECT: u32 = u32::MAX;
 
 /// A finished render.
 pub struct Rendered {

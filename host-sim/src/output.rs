@@ -6,12 +6,12 @@
 //! a spool file beside the output (1 byte a pixel, on disk, removed when done); `scan` also spools the
 //! image's colours (3 bytes a pixel) while it learns its table, then maps them (the host's two passes).
 
-use crate::formats::{Format, FormatError, Header, RowWriter};
-use crate::palette::PaletteMode;
 use crate::NO_OBJECT;
 use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
 use octrace_core::palette::{Coarse, Dither, Gray, Quantizer, Scan};
 use octrace_core::scene::ObjectId;
+use octrace_images::formats::{Format, FormatError, Header, RowWriter};
+use octrace_images::palette::PaletteMode;
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Seek, Write};
 use std::path::{Path, PathBuf};
@@ -276,7 +276,7 @@ impl<'a> FileSink<'a> {
 
 /// `scan`'s first pass finished from the spooled colours: while the table
 /// overflows, learns again with a closeness limit half as large again; then
-/// freezes it (as [`crate::palette::apply`] does).
+/// freezes it (as [`octrace_images::palette::apply`] does).
 fn relearn(mut scan: Scan, colors: &mut Spool, width: u32) -> std::io::Result<Scan> {
     // Past 3·255², every colour is close to every entry.
     while scan.overflowed() && scan.closeness() <= 3 * 255 * 255 {
@@ -357,17 +357,17 @@ pub fn write_atomically(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::formats::read;
     use crate::{RgbImage, RowSink};
+    use octrace_images::formats::read;
 
     /// A gradient with objects in vertical stripes, and what `apply` makes of it.
-    fn sample(mode: PaletteMode) -> (RgbImage, Vec<u32>, crate::formats::Image) {
+    fn sample(mode: PaletteMode) -> (RgbImage, Vec<u32>, octrace_images::formats::Image) {
         let (w, h) = (37u32, 23u32);
         let data = (0..w * h).flat_map(|i| [(i * 7) as u8, (i / w * 11) as u8, (i % w * 5) as u8]).collect();
         let image = RgbImage { width: w, height: h, data };
         let objects: Vec<u32> =
             (0..w * h).map(|i| if i % w < 9 { NO_OBJECT } else { i % w / 10 + i / w / 8 }).collect();
-        let expected = crate::palette::apply(&image, &objects, mode);
+        let expected = octrace_images::palette::apply(&image, &objects, mode);
         (image, objects, expected)
     }
 
@@ -404,10 +404,10 @@ mod tests {
         std::fs::remove_dir(&dir).unwrap();
     }
 
-    fn indexed(image: &crate::formats::Image) -> Option<&[u8]> {
+    fn indexed(image: &octrace_images::formats::Image) -> Option<&[u8]> {
         match image {
-            crate::formats::Image::Indexed { indices, .. } => Some(indices),
-            crate::formats::Image::Rgb(_) => None,
+            octrace_images::formats::Image::Indexed { indices, .. } => Some(indices),
+            octrace_images::formats::Image::Rgb(_) => None,
         }
     }
 

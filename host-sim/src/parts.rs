@@ -5,8 +5,8 @@
 //! text (PNG `tEXt`, Targa image ID) naming the scene (a hash of its bytes), the whole image's size, the
 //! palette mode and the part's rows; `merge` trusts nothing else and refuses parts that do not fit.
 
-use crate::formats::{Format, FormatError, Header, RowReader, RowWriter};
-use crate::palette::PaletteMode;
+use octrace_images::formats::{Format, FormatError, Header, RowReader, RowWriter};
+use octrace_images::palette::PaletteMode;
 use std::fmt;
 use std::ops::Range;
 use std::path::{Path, PathBuf};

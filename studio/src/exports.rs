@@ -12,8 +12,8 @@
 // nothing here dereferences a pointer.
 #![allow(unsafe_code)]
 
-use crate::formats::Format;
 use crate::studio::{self, Display, Studio, StudioError};
+use octrace_images::formats::Format;
 use std::cell::RefCell;
 
 struct State {
@@ -107,10 +107,7 @@ pub extern "C" fn studio_display(display: u32, width: u32, height: u32) -> u32 {
 pub extern "C" fn studio_encode(display: u32, format: u32, width: u32, height: u32) -> u32 {
     run(|state| {
         let display = Display::from_code(display).ok_or(StudioError::BadInput("no such display"))?;
-        let format = [Format::Png, Format::Tga, Format::Ras]
-            .get(format as usize)
-            .copied()
-            .ok_or(StudioError::BadInput("no such format"))?;
+        let format = Format::ALL.get(format as usize).copied().ok_or(StudioError::BadInput("no such format"))?;
         let (image, objects) = studio::split_render(width, height, &state.input)?;
         state.output = studio::encode(&studio::display(&image, &objects, display), format)?;
         Ok(())

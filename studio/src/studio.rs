@@ -4,16 +4,16 @@
 //! Invariant: `octree` was built from the current `scene` (it is dropped
 //! whenever the scene is replaced).
 
-use crate::formats::{self, Format, Image};
-use crate::palette::{self, PaletteMode};
-use crate::{RgbImage, NO_OBJECT};
-use embedded_graphics_core::pixelcolor::{Gray4, Rgb565, Rgb888, RgbColor};
+use embedded_graphics_core::pixelcolor::RgbColor;
 use octrace_core::accel::{Accelerator, Mailbox, Naive, Octree, OctreeConfig};
 use octrace_core::parse::{parse_bytes, ParseError};
 use octrace_core::profile::Host;
 use octrace_core::render::{Renderer, ScreenBound};
 use octrace_core::scene::Scene;
 use octrace_core::AccelMode;
+use octrace_images::formats::{self, Format, Image};
+use octrace_images::palette::{self, PaletteMode};
+use octrace_images::{panel, RgbImage, NO_OBJECT};
 use std::fmt;
 
 /// The intersection mode the page numbers `code`: 0 auto, 1 naive,
@@ -188,21 +188,10 @@ pub fn split_render(width: u32, height: u32, input: &[u8]) -> Result<(RgbImage, 
 pub fn display(image: &RgbImage, objects: &[u32], display: Display) -> Image {
     match display {
         Display::Palette(mode) => palette::apply(image, objects, mode),
-        Display::Rgb565 => Image::Rgb(map_pixels(image, |c| Rgb888::from(Rgb565::from(c)))),
-        Display::Gray4 => Image::Rgb(map_pixels(image, |c| Rgb888::from(Gray4::from(c)))),
+        Display::Rgb565 => Image::Rgb(panel::rgb565(image)),
+        // As RGB, so that a saved file is the picture shown whatever the format.
+        Display::Gray4 => Image::Rgb(panel::gray4(image).to_rgb()),
     }
-}
-
-fn map_pixels(image: &RgbImage, f: impl Fn(Rgb888) -> Rgb888) -> RgbImage {
-    let data = image
-        .data
-        .chunks_exact(3)
-        .flat_map(|p| {
-            let c = f(Rgb888::new(p[0], p[1], p[2]));
-            [c.r(), c.g(), c.b()]
-        })
-        .collect();
-    RgbImage { width: image.width, height: image.height, data }
 }
 
 /// `image` as a file of `format`.

@@ -9,9 +9,9 @@
 
 use crate::repo;
 use embedded_graphics_core::pixelcolor::{Gray4, GrayColor, Rgb888};
-use host_sim::formats::Image;
-use host_sim::palette::PaletteMode;
 use octrace_core::render::PanelColor;
+use octrace_images::formats::Image;
+use octrace_images::palette::PaletteMode;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -159,10 +159,12 @@ impl Firmware {
             PanelColor::Gray4 => {
                 image.data.chunks(3).map(|p| Gray4::from(Rgb888::new(p[0], p[1], p[2])).luma()).collect()
             }
-            PanelColor::Dither => match host_sim::palette::apply(&image, &rendered.objects, PaletteMode::Dither) {
-                Image::Indexed { indices, .. } => indices,
-                Image::Rgb(_) => return Err("dither gave a truecolour image".into()),
-            },
+            PanelColor::Dither => {
+                match octrace_images::palette::apply(&image, &rendered.objects, PaletteMode::Dither) {
+                    Image::Indexed { indices, .. } => indices,
+                    Image::Rgb(_) => return Err("dither gave a truecolour image".into()),
+                }
+            }
         })
     }
 }

@@ -3,7 +3,6 @@
 
 pub mod firmware;
 pub mod pico;
-pub mod reference;
 pub mod webdriver;
 
 use std::path::PathBuf;

@@ -1,11 +1,12 @@
 //! Accuracy: every scene rendered by the fixed-point core is compared with
-//! the independent f64 reference tracer (`octrace_tests::reference`), which
+//! the independent f64 reference tracer (`octrace-reference`), which
 //! evaluates the same model from the contract alone. At least 99% of the
 //! pixels must be within ±4 levels in every channel; the figures are printed
 //! for each scene (`cargo test -p octrace-tests --test accuracy -- --nocapture`).
 
 use host_sim::{load_file, new_scene, render, RenderOptions};
-use octrace_tests::{reference, scenes};
+use octrace_reference as reference;
+use octrace_tests::scenes;
 
 /// The largest per-channel difference that counts as "close".
 const TOLERANCE: u8 = 4;

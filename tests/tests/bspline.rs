@@ -1,12 +1,12 @@
 //! B-spline patches against an independent double-precision evaluation
-//! (`octrace_tests::reference::Patch`, Cox–de Boor in f64): the fixed-point
+//! (`octrace_reference::Patch`, Cox–de Boor in f64): the fixed-point
 //! core must generate the same triangles, with the same corners and corner
 //! normals, for random patches of every order (the seed is printed; set
 //! `OCTRACE_SEED` to replay one).
 
 use host_sim::{load_bytes, new_scene};
 use octrace_core::math::Vec3;
-use octrace_tests::reference::{Patch, Shape, V3};
+use octrace_reference::{Patch, Shape, V3};
 use octrace_tests::Rng;
 
 /// World coordinates (f64) to the scene's normalised fixed point.

@@ -162,7 +162,7 @@ fn several_errors_are_all_reported() {
 fn a_valid_scene_renders() {
     let r = run_bytes(format!("RASTER 8 6 {SURF} SPHERE 1 1 0 0 0 LIGHT 10 0 0 10").as_bytes());
     assert_eq!(r.code, 0, "{}", r.stderr);
-    let img = host_sim::formats::read(&std::fs::read(&r.out).unwrap()).unwrap();
+    let img = octrace_images::formats::read(&std::fs::read(&r.out).unwrap()).unwrap();
     assert_eq!((img.width(), img.height()), (8, 6));
 }
 
@@ -263,14 +263,14 @@ fn the_formats_it_writes_are_told_by_extension_or_format() {
         assert_eq!(code, 0, "{name}: {err}");
         let bytes = std::fs::read(&out).unwrap();
         assert!(bytes.starts_with(magic), "{name}: {:?}", &bytes[..4]);
-        let image = host_sim::formats::read(&bytes).unwrap();
+        let image = octrace_images::formats::read(&bytes).unwrap();
         assert_eq!((image.width(), image.height()), (4, 4));
     }
     // Targa has no magic number: read back, it is the same image as the PNG.
     let tga = dir.path().join("e.tga");
     assert_eq!(run_args(&[scene.as_os_str(), tga.as_os_str()]).0, 0);
-    let from_png = host_sim::formats::read(&std::fs::read(dir.path().join("a.PNG")).unwrap()).unwrap();
-    assert_eq!(host_sim::formats::read(&std::fs::read(&tga).unwrap()).unwrap(), from_png);
+    let from_png = octrace_images::formats::read(&std::fs::read(dir.path().join("a.PNG")).unwrap()).unwrap();
+    assert_eq!(octrace_images::formats::read(&std::fs::read(&tga).unwrap()).unwrap(), from_png);
     assert!(!std::fs::read(&tga).unwrap().starts_with(png));
 }
 

@@ -10,9 +10,9 @@
 //!
 //!     OCTRACE_BLESS=1 cargo test -p octrace-tests --test golden
 
-use host_sim::formats::{self, Format, Image};
-use host_sim::palette::{self, PaletteMode};
 use host_sim::{load_file, new_scene, render, RenderOptions};
+use octrace_images::formats::{self, Format, Image};
+use octrace_images::palette::{self, PaletteMode};
 use octrace_tests::{blessing, repo, scenes};
 
 #[test]

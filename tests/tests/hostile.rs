@@ -106,7 +106,7 @@ fn short(s: &str) -> String {
 fn assert_image(r: &Run, w: u32, h: u32) -> host_sim::RgbImage {
     assert_eq!(r.code, 0, "stderr:\n{}", short(&r.stderr));
     assert_eq!(r.files(), ["out.png", "scene.txt"], "a temporary file was left behind");
-    let img = host_sim::formats::read(&std::fs::read(&r.out).unwrap()).expect("a valid PNG").to_rgb();
+    let img = octrace_images::formats::read(&std::fs::read(&r.out).unwrap()).expect("a valid PNG").to_rgb();
     assert_eq!((img.width, img.height), (w, h));
     assert_eq!(img.data.len(), 3 * w as usize * h as usize);
     img

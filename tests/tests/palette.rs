@@ -4,9 +4,9 @@
 //! and converted between formats without loss. Prints the palette entries
 //! used and the PSNR against truecolour (`-- --nocapture`).
 
-use host_sim::formats::{self, Format, Image};
-use host_sim::palette::{self, PaletteMode};
 use host_sim::{load_bytes, load_file, new_scene, render, RenderOptions};
+use octrace_images::formats::{self, Format, Image};
+use octrace_images::palette::{self, PaletteMode};
 use octrace_tests::scenes;
 
 const FORMATS: [Format; 3] = [Format::Png, Format::Tga, Format::Ras];

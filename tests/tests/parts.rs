@@ -3,9 +3,9 @@
 //! refuses every kind of misfit, `--part auto/N` reads the schedulers' variables, and the GNU parallel recipe
 //! of docs/distributed.md runs as written.
 
-use host_sim::formats::{self, Image};
-use host_sim::palette::{self, PaletteMode};
 use host_sim::{load_file, new_scene, render, Partition, RenderOptions};
+use octrace_images::formats::{self, Image};
+use octrace_images::palette::{self, PaletteMode};
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::Command;

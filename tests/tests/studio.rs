@@ -7,8 +7,8 @@
 //! `OCTRACE_SCREENSHOTS=1` also writes the README's screenshots to
 //! `docs/studio/`.
 
-use host_sim::palette::{self, PaletteMode};
 use host_sim::{load_bytes, new_scene, render, RenderOptions, RgbImage};
+use octrace_images::palette::{self, PaletteMode};
 use octrace_tests::webdriver::{http, Browser};
 use octrace_tests::{repo, scenes};
 use std::io::{BufRead, BufReader};
@@ -197,7 +197,7 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
         let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
         let code = host_sim::run(args.into_iter().chain(["--color", name, "--quiet"]), &mut stdout, &mut stderr);
         assert_eq!(code, 0, "{}", String::from_utf8_lossy(&stderr));
-        let panel = host_sim::formats::read(&std::fs::read(&out).unwrap()).expect("host-sim's preview").to_rgb();
+        let panel = octrace_images::formats::read(&std::fs::read(&out).unwrap()).expect("host-sim's preview").to_rgb();
         assert_same(name, browser.canvas_rgb("image"), &panel);
     }
     browser.run("const d = document.getElementById('display'); d.value = '0'; d.dispatchEvent(new Event('change')); return true;");
@@ -208,14 +208,14 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
     for (format, name) in [(0, "PNG"), (1, "Targa"), (2, "Sun raster")] {
         let encoded = browser.run(&format!("return btoa(String.fromCharCode(...studio.imageBytes(0, {format})));"));
         let bytes = octrace_tests::webdriver::base64_decode(encoded.as_str().expect("bytes"));
-        let read = host_sim::formats::read(&bytes).unwrap_or_else(|e| panic!("the page's {name} reads: {e}"));
+        let read = octrace_images::formats::read(&bytes).unwrap_or_else(|e| panic!("the page's {name} reads: {e}"));
         assert_eq!(read.to_rgb(), expected.image, "{name}");
     }
     // In a 256-colour mode the file is indexed, as host-sim --palette writes.
     let encoded = browser.run("return btoa(String.fromCharCode(...studio.imageBytes(2, 0)));");
     let bytes = octrace_tests::webdriver::base64_decode(encoded.as_str().expect("bytes"));
     let dithered = palette::apply(&expected.image, &expected.objects, PaletteMode::Dither);
-    assert_eq!(host_sim::formats::read(&bytes).expect("indexed PNG"), dithered);
+    assert_eq!(octrace_images::formats::read(&bytes).expect("indexed PNG"), dithered);
 
     // Undo takes the last edit back; redo restores it.
     let before: String = browser.run("return document.getElementById('scene').value;").as_str().unwrap().into();
@@ -518,10 +518,10 @@ fn every_tool_places_its_object_and_selections_move_and_delete() {
     assert!(scene_text(&browser).contains("BOX"), "undone");
 
     // An image file loads into the display; Clear empties it; help opens.
-    let image = host_sim::formats::Image::Rgb(host_render(&text, Some((20, 10))).image);
+    let image = octrace_images::formats::Image::Rgb(host_render(&text, Some((20, 10))).image);
     let file = dir.path().join("picture.tga");
     let mut bytes = Vec::new();
-    host_sim::formats::write(&image, host_sim::formats::Format::Tga, &mut bytes).expect("encoded");
+    octrace_images::formats::write(&image, octrace_images::formats::Format::Tga, &mut bytes).expect("encoded");
     std::fs::write(&file, bytes).expect("written");
     browser.type_into("#load-image", &file.display().to_string());
     browser.wait_for("document.getElementById('image').dataset.state === 'loaded'", 10);

@@ -328,8 +328,8 @@ fn parallel(dir: &Path) {
 /// Every scene in every palette mode: entries used, PSNR against the
 /// truecolour render and the cost of the mapping per pixel.
 fn palette_table(dir: &Path) {
-    use host_sim::formats::Image;
-    use host_sim::palette::{self, PaletteMode};
+    use octrace_images::formats::Image;
+    use octrace_images::palette::{self, PaletteMode};
     println!("### 256-colour modes: every scene at its RASTER size\n");
     println!("Colours: distinct colours in the image (entries of the 256-colour table in use). PSNR against the");
     println!("truecolour render. Cost: the mapping alone per pixel, best of 5 (the render is the same for all).\n");

@@ -1,5 +1,8 @@
-//! An in-memory RGB image that is an embedded-graphics `DrawTarget` (files:
-//! [`crate::formats`]).
+//! An in-memory RGB image that is an embedded-graphics `DrawTarget` (its
+//! files: [`crate::formats`]).
+//!
+//! Invariant: `data` holds `width × height` RGB triples, row-major; pixels
+//! drawn outside the image are dropped, as a display drops them.
 
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{OriginDimensions, Size};
@@ -9,6 +12,15 @@ use embedded_graphics_core::Pixel;
 use std::convert::Infallible;
 
 /// 8-bit RGB pixels, row-major.
+///
+/// ```
+/// use embedded_graphics_core::{draw_target::DrawTarget, pixelcolor::Rgb888, prelude::*};
+/// use octrace_images::RgbImage;
+///
+/// let mut image = RgbImage::new(2, 2);
+/// image.draw_iter([Pixel(Point::new(1, 0), Rgb888::new(9, 8, 7))]).unwrap();
+/// assert_eq!(image.pixel(1, 0), [9, 8, 7]);
+/// ```
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RgbImage {
     pub width: u32,

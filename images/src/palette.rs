@@ -4,7 +4,7 @@
 //! `scan` runs in two passes here (the whole image learnt first, then
 //! mapped); `dither`, `coarse` and `gray` need one. [`apply`] maps an image
 //! held whole; host-sim's command line streams rows through the same
-//! quantizers ([`crate::output`]) and writes the same files.
+//! quantizers and writes the same files.
 
 use crate::formats::Image;
 use crate::{RgbImage, NO_OBJECT};
@@ -13,7 +13,7 @@ use octrace_core::palette::{Coarse, Dither, Gray, Quantizer, Scan};
 use octrace_core::scene::ObjectId;
 
 /// How to map the image onto a colour table.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PaletteMode {
     /// Truecolour: no colour table.
     None,
@@ -28,9 +28,11 @@ pub enum PaletteMode {
 }
 
 impl PaletteMode {
+    /// Every mode, in the order the studio's page numbers them.
     pub const ALL: [PaletteMode; 5] =
         [PaletteMode::None, PaletteMode::Scan, PaletteMode::Dither, PaletteMode::Coarse, PaletteMode::Gray];
 
+    /// The mode's name on host-sim's command line (`--palette`).
     pub fn name(self) -> &'static str {
         match self {
             PaletteMode::None => "none",
@@ -44,7 +46,18 @@ impl PaletteMode {
 
 /// The image in `mode`: indexed, with the colour table up to its last
 /// entry in use, or the truecolour image itself for `None`. `objects` is
-/// the object under each pixel ([`crate::Rendered::objects`]).
+/// the object under each pixel, or [`NO_OBJECT`].
+///
+/// ```
+/// use octrace_images::palette::{apply, PaletteMode};
+/// use octrace_images::{formats::Image, RgbImage, NO_OBJECT};
+///
+/// let image = RgbImage { width: 2, height: 1, data: vec![0, 0, 0, 255, 255, 255] };
+/// let Image::Indexed { palette, indices, .. } = apply(&image, &[NO_OBJECT; 2], PaletteMode::Gray) else {
+///     unreachable!("a palette mode gives an indexed image")
+/// };
+/// assert_eq!((palette[indices[0] as usize], palette[indices[1] as usize]), ([0; 3], [255; 3]));
+/// ```
 pub fn apply(image: &RgbImage, objects: &[u32], mode: PaletteMode) -> Image {
     match mode {
         PaletteMode::None => Image::Rgb(image.clone()),

@@ -1,0 +1,406 @@
+//! The thesis's image files (PNG, Targa and Sun raster), each truecolour or colour-mapped, read whole or a
+//! row at a time ([`RowReader`], [`RowWriter`]); one module a format.
+//!
+//! Written:
+//! - PNG: 8-bit RGB (colour type 2), or 8-bit indices with a PLTE chunk (colour type 3).
+//! - Targa: uncompressed, origin top-left (descriptor bit 5), no image ID: truecolour as image type 2 with
+//!   24-bit BGR pixels, colour-mapped as image type 1 with a 24-bit BGR map (first entry 0) and 8-bit indices.
+//! - Sun raster: RT_STANDARD (type 1): truecolour with 24-bit BGR pixels and no map, colour-mapped with 8-bit
+//!   indices and an RMT_EQUAL_RGB map (all reds, then all greens, then all blues); each row padded to an
+//!   even number of bytes.
+//!
+//! Read, besides everything written: PNG indices of 1, 2 or 4 bits (transparency ignored); Targa images
+//! stored bottom-up or right-to-left, run-length encoded (types 9 and 10), with an image ID, with 32-bit
+//! pixels or map entries (alpha dropped), or truecolour with a colour map (skipped); Sun rasters of type 0
+//! (RT_OLD), 2 (sun_raster::RT_BYTE_ENCODED) and 3 (RT_FORMAT_RGB, stored RGB), and with 32-bit pixels (pad byte
+//! dropped). Anything else, and any malformed file, is a [`FormatError`]: reading never panics, and rejects
+//! declared sizes the file is too short to hold (even fully compressed) before allocating for them.
+
+mod png;
+mod rows;
+mod sun_raster;
+mod targa;
+
+pub use rows::{RowReader, RowWriter};
+
+use crate::RgbImage;
+use std::fmt;
+use std::io::Write;
+use std::path::Path;
+
+/// An image file format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Format {
+    Png,
+    Tga,
+    Ras,
+}
+
+impl Format {
+    /// Every format.
+    pub const ALL: [Format; 3] = [Format::Png, Format::Tga, Format::Ras];
+
+    /// The format named by `path`'s extension (png, tga or ras, any case).
+    pub fn from_path(path: &Path) -> Option<Format> {
+        let extension = path.extension()?.to_str()?.to_ascii_lowercase();
+        Format::ALL.into_iter().find(|f| f.name() == extension)
+    }
+
+    /// The format's usual file name extension, which also names it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Png => "png",
+            Format::Tga => "tga",
+            Format::Ras => "ras",
+        }
+    }
+}
+
+/// An image as a file holds it: pixels, or indices into a palette.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Image {
+    Rgb(RgbImage),
+    /// `indices` row-major, one per pixel.
+    Indexed {
+        width: u32,
+        height: u32,
+        palette: Vec<[u8; 3]>,
+        indices: Vec<u8>,
+    },
+}
+
+impl Image {
+    pub fn width(&self) -> u32 {
+        match self {
+            Image::Rgb(rgb) => rgb.width,
+            Image::Indexed { width, .. } => *width,
+        }
+    }
+
+    pub fn height(&self) -> u32 {
+        match self {
+            Image::Rgb(rgb) => rgb.height,
+            Image::Indexed { height, .. } => *height,
+        }
+    }
+
+    /// The image's pixels; an index outside the palette gives black.
+    pub fn to_rgb(&self) -> RgbImage {
+        match self {
+            Image::Rgb(rgb) => rgb.clone(),
+            Image::Indexed { width, height, palette, indices } => {
+                let pixels = *width as usize * *height as usize;
+                let colour = |i: usize| indices.get(i).and_then(|&index| palette.get(index as usize));
+                let data = (0..pixels).flat_map(|i| *colour(i).unwrap_or(&[0; 3])).collect();
+                RgbImage { width: *width, height: *height, data }
+            }
+        }
+    }
+}
+
+impl From<RgbImage> for Image {
+    fn from(rgb: RgbImage) -> Image {
+        Image::Rgb(rgb)
+    }
+}
+
+/// Why an image could not be read or written.
+#[derive(Debug)]
+pub enum FormatError {
+    /// Writing the file failed.
+    Io(std::io::Error),
+    /// The file ends inside the named part.
+    Truncated(&'static str),
+    /// A kind of file this module does not handle.
+    Unsupported(String),
+    /// A malformed file, or an image that no file can hold as it is.
+    Invalid(String),
+}
+
+impl fmt::Display for FormatError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            FormatError::Io(e) => write!(f, "{e}"),
+            FormatError::Truncated(part) => write!(f, "truncated {part}"),
+            FormatError::Unsupported(what) | FormatError::Invalid(what) => f.write_str(what),
+        }
+    }
+}
+
+impl std::error::Error for FormatError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            FormatError::Io(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+impl From<std::io::Error> for FormatError {
+    fn from(e: std::io::Error) -> FormatError {
+        FormatError::Io(e)
+    }
+}
+
+fn invalid<T>(message: String) -> Result<T, FormatError> {
+    Err(FormatError::Invalid(message))
+}
+
+fn unsupported<T>(message: String) -> Result<T, FormatError> {
+    Err(FormatError::Unsupported(message))
+}
+
+/// Writes `image` to `out` as a `format` file.
+pub fn write(image: &Image, format: Format, out: &mut dyn Write) -> Result<(), FormatError> {
+    check(image)?;
+    let (width, row_bytes) = (image.width() as usize, image.width() as usize * image.bytes_per_pixel());
+    let (palette, data) = match image {
+        Image::Rgb(rgb) => (None, &rgb.data),
+        Image::Indexed { palette, indices, .. } => (Some(palette.clone()), indices),
+    };
+    let header = Header { width: width as u32, height: image.height(), palette, text: None };
+    let mut writer = RowWriter::new(format, &header, out)?;
+    for row in data.chunks_exact(row_bytes) {
+        writer.write_row(row)?;
+    }
+    writer.finish()
+}
+
+/// Writes an indexed image whose colour table is all grays (red, green and blue equal, as
+/// [`crate::panel::gray4`] makes) as an 8-bit grayscale PNG file, the smallest file that holds it.
+pub fn write_gray_png(image: &Image, out: &mut dyn Write) -> Result<(), FormatError> {
+    check(image)?;
+    let Image::Indexed { width, height, palette, indices } = image else {
+        return invalid("a grayscale PNG is written from a gray colour table, not from RGB pixels".into());
+    };
+    if let Some(entry) = palette.iter().find(|[r, g, b]| r != g || g != b) {
+        return invalid(format!("colour {entry:?} of the table is not a gray"));
+    }
+    let gray: Vec<u8> = indices.iter().map(|&i| palette[i as usize][0]).collect();
+    png::write_gray(*width, *height, &gray, out)
+}
+
+/// What a file says before its rows.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Header {
+    pub width: u32,
+    pub height: u32,
+    /// The colour table of an indexed image (rows are then one index a pixel), or `None` for truecolour (rows
+    /// of RGB triples).
+    pub palette: Option<Vec<[u8; 3]>>,
+    /// Text carried in the file: a PNG `tEXt` chunk under [`TEXT_KEYWORD`] or a Targa image ID (at most 255
+    /// bytes). Sun rasters have nowhere to put it.
+    pub text: Option<String>,
+}
+
+impl Header {
+    /// Bytes a pixel takes in a row: 3 (RGB) or 1 (an index).
+    pub(crate) fn bytes_per_pixel(&self) -> usize {
+        if self.palette.is_some() {
+            1
+        } else {
+            3
+        }
+    }
+}
+
+/// The keyword of the PNG `tEXt` chunk that carries [`Header::text`].
+pub const TEXT_KEYWORD: &str = "octrace";
+
+impl Image {
+    /// Bytes a pixel takes in memory: 3 (RGB) or 1 (an index).
+    pub fn bytes_per_pixel(&self) -> usize {
+        match self {
+            Image::Rgb(_) => 3,
+            Image::Indexed { .. } => 1,
+        }
+    }
+}
+
+/// Reads an image file of any of the formats, told apart by their content.
+pub fn read(bytes: &[u8]) -> Result<Image, FormatError> {
+    let image = if bytes.starts_with(png::SIGNATURE) {
+        png::read(bytes)?
+    } else if bytes.starts_with(&sun_raster::MAGIC.to_be_bytes()) {
+        sun_raster::read(bytes)?
+    } else {
+        // Targa files have no signature.
+        targa::read(bytes)?
+    };
+    check(&image)?;
+    Ok(image)
+}
+
+/// Fails unless `image` is one every format can hold: not empty, the data as long as the size says, at most
+/// 256 palette entries and every index inside the palette.
+fn check(image: &Image) -> Result<(), FormatError> {
+    let (width, height) = (image.width(), image.height());
+    if width == 0 || height == 0 {
+        return invalid(format!("the image is {width}×{height} pixels"));
+    }
+    let (length, per_pixel) = match image {
+        Image::Rgb(rgb) => (rgb.data.len(), 3),
+        Image::Indexed { indices, .. } => (indices.len(), 1),
+    };
+    if length as u64 != u64::from(width) * u64::from(height) * per_pixel {
+        return invalid(format!("{length} bytes of pixel data for a {width}×{height} image"));
+    }
+    if let Image::Indexed { palette, indices, .. } = image {
+        if palette.len() > 256 {
+            return invalid(format!("palette has {} entries, at most 256", palette.len()));
+        }
+        if let Some(index) = indices.iter().find(|&&i| i as usize >= palette.len()) {
+            return invalid(format!("index {index} is outside the {}-entry palette", palette.len()));
+        }
+    }
+    Ok(())
+}
+
+/// The first `n` bytes of `input`, which moves past them.
+fn take<'a>(input: &mut &'a [u8], n: usize, part: &'static str) -> Result<&'a [u8], FormatError> {
+    let (head, rest) = input.split_at_checked(n).ok_or(FormatError::Truncated(part))?;
+    *input = rest;
+    Ok(head)
+}
+
+/// Pixels of `pixel_bytes` bytes each, red, green and blue at `offsets` in each, as RGB (or, as the
+/// offsets are their own inverse, RGB as BGR); other bytes (alpha, padding) are dropped.
+fn pick(pixels: &[u8], pixel_bytes: usize, offsets: [usize; 3]) -> Vec<u8> {
+    pixels.chunks_exact(pixel_bytes).flat_map(|p| offsets.map(|i| p[i])).collect()
+}
+
+/// Where red, green and blue sit in a stored Targa or Sun raster pixel.
+const BGR: [usize; 3] = [2, 1, 0];
+
+fn read_exactly(input: &mut impl std::io::Read, buffer: &mut [u8], part: &'static str) -> Result<(), FormatError> {
+    input.read_exact(buffer).map_err(|e| match e.kind() {
+        std::io::ErrorKind::UnexpectedEof => FormatError::Truncated(part),
+        _ => FormatError::Io(e),
+    })
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    pub(crate) fn rgb(width: u32, height: u32) -> Image {
+        let data = (0..width * height * 3).map(|i| (i * 37 + 11) as u8).collect();
+        Image::Rgb(RgbImage { width, height, data })
+    }
+
+    pub(crate) fn indexed(width: u32, height: u32, entries: usize) -> Image {
+        let palette = (0..entries).map(|i| [i as u8, (i * 7 + 1) as u8, 255 - (i * 3) as u8]).collect();
+        let indices = (0..width as usize * height as usize).map(|i| ((i * 5 + 3) % entries) as u8).collect();
+        Image::Indexed { width, height, palette, indices }
+    }
+
+    pub(crate) fn samples() -> Vec<Image> {
+        let sizes = [(1, 1), (3, 2), (7, 5)];
+        let mut images: Vec<Image> = sizes.iter().flat_map(|&(w, h)| [rgb(w, h), indexed(w, h, 12)]).collect();
+        images.extend([indexed(1, 1, 1), indexed(16, 16, 256), indexed(5, 3, 256)]);
+        images
+    }
+
+    pub(crate) fn encode(image: &Image, format: Format) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        write(image, format, &mut bytes).unwrap();
+        bytes
+    }
+
+    #[test]
+    fn every_format_round_trips_truecolour_and_indexed_images() {
+        for format in Format::ALL {
+            for image in samples() {
+                let back = read(&encode(&image, format));
+                assert_eq!(back.as_ref().ok(), Some(&image), "{} {}×{}", format.name(), image.width(), image.height());
+            }
+        }
+    }
+
+    #[test]
+    fn invalid_images_are_not_written() {
+        let message = |image: &Image, format| write(image, format, &mut Vec::new()).unwrap_err().to_string();
+        for format in Format::ALL {
+            assert_eq!(message(&indexed(3, 2, 300), format), "palette has 300 entries, at most 256");
+            let Image::Indexed { width, height, palette, mut indices } = indexed(3, 2, 12) else { unreachable!() };
+            indices[4] = 17;
+            let image = Image::Indexed { width, height, palette, indices };
+            assert_eq!(message(&image, format), "index 17 is outside the 12-entry palette");
+            assert_eq!(message(&rgb(0, 4), format), "the image is 0×4 pixels");
+            let short = Image::Rgb(RgbImage { width: 2, height: 2, data: vec![0; 11] });
+            assert_eq!(message(&short, format), "11 bytes of pixel data for a 2×2 image");
+        }
+        assert!(message(&rgb(65536, 1), Format::Tga).contains("at most 65535×65535"));
+    }
+
+    #[test]
+    fn malformed_files_give_errors() {
+        let message = |bytes: &[u8]| read(bytes).unwrap_err().to_string();
+        assert_eq!(message(&[]), "truncated Targa header");
+        assert_eq!(message(&sun_raster::MAGIC.to_be_bytes()), "truncated Sun raster header");
+        assert_eq!(message(png::SIGNATURE), "truncated PNG file");
+        let mut tga = encode(&rgb(3, 2), Format::Tga);
+        tga[2] = 3;
+        assert_eq!(message(&tga), "Targa image type 3 is not supported");
+        tga[2] = 2;
+        tga[12..16].copy_from_slice(&[0xff; 4]);
+        assert_eq!(message(&tga), "truncated Targa pixels");
+        tga[2] = 10;
+        assert_eq!(message(&tga), "truncated Targa run-length data");
+
+        let mut ras = encode(&indexed(3, 2, 12), Format::Ras);
+        ras[32 + 36 + 1] = 12;
+        assert_eq!(message(&ras), "index 12 is outside the 12-entry palette");
+        ras[4..12].copy_from_slice(&[0xff; 8]);
+        assert_eq!(message(&ras), "truncated Sun raster pixels");
+        ras[23] = sun_raster::RT_BYTE_ENCODED as u8;
+        assert_eq!(message(&ras), "truncated Sun raster run-length data");
+        ras[23] = 5;
+        assert_eq!(message(&ras), "Sun raster type 5 is not supported");
+        ras[28..32].copy_from_slice(&[0xff; 4]);
+        assert_eq!(message(&ras), "truncated Sun raster colour map");
+
+        let mut huge = Vec::new();
+        let mut encoder = ::png::Encoder::new(&mut huge, 1 << 20, 1 << 20);
+        encoder.set_color(::png::ColorType::Rgb);
+        drop(encoder.write_header().unwrap());
+        assert!(message(&huge).contains("cannot fit in"));
+    }
+
+    #[test]
+    fn mutated_files_never_panic() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut random = move |below: usize| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % below as u64) as usize
+        };
+        for format in Format::ALL {
+            for image in [rgb(7, 5), indexed(7, 5, 12), indexed(2, 1, 1)] {
+                let valid = encode(&image, format);
+                for length in 0..valid.len() {
+                    assert!(read(&valid[..length]).is_err(), "{} cut to {length} bytes", format.name());
+                }
+                for _ in 0..2000 {
+                    let mut bytes = valid.clone();
+                    for _ in 0..1 + random(4) {
+                        let at = random(bytes.len());
+                        bytes[at] = if random(2) == 0 { bytes[at] ^ 1 << random(8) } else { random(256) as u8 };
+                    }
+                    bytes.truncate(bytes.len() - random(4));
+                    let _ = read(&bytes);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn formats_are_named_by_extension() {
+        assert_eq!(Format::from_path(Path::new("out/fig5_1.PNG")), Some(Format::Png));
+        assert_eq!(Format::from_path(Path::new("a.tga")), Some(Format::Tga));
+        assert_eq!(Format::from_path(Path::new("a.b.Ras")), Some(Format::Ras));
+        assert_eq!(Format::from_path(Path::new("ras")), None);
+        assert_eq!(Format::from_path(Path::new("a.jpg")), None);
+    }
+}
