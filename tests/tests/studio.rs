@@ -329,7 +329,8 @@ fn the_server_keeps_its_security_rules() {
     let with_token = |path: &str| format!("{path}?{token}");
 
     // With the token and the right Host: the page, its assets and the scene.
-    for path in ["/", "/studio.js", "/worker.js", "/studio.css", "/octrace_studio.wasm", "/scene"] {
+    let modules = ["/studio.js", "/octrace.js", "/model.js", "/view.js", "/tools.js", "/panel.js", "/worker.js"];
+    for path in ["/", "/studio.css", "/octrace_studio.wasm", "/scene"].into_iter().chain(modules) {
         let (status, body) = http(port, "GET", &with_token(path), &[], b"");
         assert_eq!(status, 200, "{path}");
         assert!(!body.is_empty(), "{path}");
@@ -530,4 +531,26 @@ fn every_tool_places_its_object_and_selections_move_and_delete() {
     assert_eq!(browser.run("return document.getElementById('image').dataset.state;"), "clear");
     press(&browser, "\u{E031}"); // F1
     assert_eq!(browser.run("return document.getElementById('help').open;"), true);
+}
+
+/// The page finds statements in the text by their arities (`ARITY` in
+/// model.js); they must be the core's, keyword for keyword.
+#[test]
+fn the_pages_statement_arities_are_the_cores() {
+    let model = std::fs::read_to_string(repo().join("host-sim/src/studio/assets/model.js")).expect("model.js");
+    let table = model.split("export const ARITY = {").nth(1).and_then(|rest| rest.split('}').next());
+    let table = table.expect("model.js declares `export const ARITY = { … }`");
+    let mut page: Vec<(String, usize)> = table
+        .split(',')
+        .filter(|entry| !entry.trim().is_empty())
+        .map(|entry| {
+            let (keyword, arity) = entry.split_once(':').unwrap_or_else(|| panic!("`{entry}` is KEYWORD: arity"));
+            (keyword.trim().to_string(), arity.trim().parse().unwrap_or_else(|_| panic!("`{entry}`: a number")))
+        })
+        .collect();
+    let mut core: Vec<(String, usize)> =
+        octrace_core::parse::statement_arities().map(|(keyword, arity)| (keyword.to_string(), arity)).collect();
+    page.sort();
+    core.sort();
+    assert_eq!(page, core);
 }

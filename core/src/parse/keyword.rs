@@ -1,17 +1,18 @@
 //! The scene format's vocabulary: one enum of statement keywords, from which
-//! statement matching, the once-only parameters and the unknown-keyword
-//! message all derive.
+//! statement matching, the once-only parameters, the unknown-keyword message
+//! and the arities editors read ([`super::statement_arities`]) all derive.
 //!
-//! Invariant: the enum, the spellings and [`Keyword::ALL`] come from the one
-//! list in `keywords!`, so they cannot drift apart; discriminants are the
+//! Invariant: the enum, the spellings, the arities and [`Keyword::ALL`] come
+//! from the one list in `keywords!`, so they cannot drift apart (a test
+//! checks each arity against what its statement reads); discriminants are the
 //! default ones, so `k as usize` indexes a `[_; Keyword::COUNT]` table.
 
 use core::fmt;
 
-/// Declares [`Keyword`], its spelling and [`Keyword::ALL`] from one list, so
-/// a keyword cannot be added to one and missed in another.
+/// Declares [`Keyword`], its spelling, its arity and [`Keyword::ALL`] from
+/// one list, so a keyword cannot be added to one and missed in another.
 macro_rules! keywords {
-    ($($(#[$doc:meta])* $variant:ident = $text:literal,)*) => {
+    ($($(#[$doc:meta])* $variant:ident = $text:literal / $arity:literal,)*) => {
         /// A statement keyword of the scene format.
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
         pub(crate) enum Keyword {
@@ -28,30 +29,38 @@ macro_rules! keywords {
                     $(Keyword::$variant => $text,)*
                 }
             }
+
+            /// How many arguments follow the keyword; for `BSPLINE`, those
+            /// before its 3 × rows × cols control point coordinates.
+            pub(crate) const fn arity(self) -> usize {
+                match self {
+                    $(Keyword::$variant => $arity,)*
+                }
+            }
         }
     };
 }
 
 keywords! {
-    Viewpoint = "VIEWPOINT",
-    Origin = "ORIGIN",
-    Upvector = "UPVECTOR",
-    Raster = "RASTER",
-    Viewport = "VIEWPORT",
-    Rdepth = "RDEPTH",
-    Imagefile = "IMAGEFILE",
-    Light = "LIGHT",
-    Background = "BACKGROUND",
-    Gamma = "GAMMA",
-    Attenuation = "ATTENUATION",
-    Samples = "SAMPLES",
-    Sphere = "SPHERE",
-    Box = "BOX",
-    Superquadric = "SUPERQUADRIC",
-    Triangle = "TRIANGLE",
-    Rectangle = "RECTANGLE",
-    Bspline = "BSPLINE",
-    Surface = "SURFACE",
+    Viewpoint = "VIEWPOINT" / 3,
+    Origin = "ORIGIN" / 3,
+    Upvector = "UPVECTOR" / 3,
+    Raster = "RASTER" / 2,
+    Viewport = "VIEWPORT" / 2,
+    Rdepth = "RDEPTH" / 1,
+    Imagefile = "IMAGEFILE" / 1,
+    Light = "LIGHT" / 4,
+    Background = "BACKGROUND" / 3,
+    Gamma = "GAMMA" / 1,
+    Attenuation = "ATTENUATION" / 1,
+    Samples = "SAMPLES" / 1,
+    Sphere = "SPHERE" / 5,
+    Box = "BOX" / 7,
+    Superquadric = "SUPERQUADRIC" / 8,
+    Triangle = "TRIANGLE" / 10,
+    Rectangle = "RECTANGLE" / 13,
+    Bspline = "BSPLINE" / 6,
+    Surface = "SURFACE" / 13,
 }
 
 impl Keyword {
@@ -119,6 +128,43 @@ mod tests {
     extern crate std;
     use super::*;
     use std::string::ToString;
+
+    #[test]
+    fn arities_are_what_the_statements_read() {
+        use super::super::statement::{statement, Cursor};
+        // A valid statement of each keyword, its BSPLINE of 2 × 2 points.
+        let samples = [
+            "VIEWPOINT 0 0 5",
+            "ORIGIN 0 0 0",
+            "UPVECTOR 0 1 0",
+            "RASTER 16 12",
+            "VIEWPORT 4 3",
+            "RDEPTH 2",
+            "IMAGEFILE out.png",
+            "LIGHT 1 3 3 3",
+            "BACKGROUND 0 0 1",
+            "GAMMA 2.2",
+            "ATTENUATION 1",
+            "SAMPLES 4",
+            "SPHERE 1 1 0 0 0",
+            "BOX 1 0 0 0 1 1 1",
+            "SUPERQUADRIC 1 4 0 0 0 1 1 1",
+            "TRIANGLE 1 0 0 0 1 0 0 0 1 0",
+            "RECTANGLE 1 0 0 0 1 0 0 1 1 0 0 1 0",
+            "BSPLINE 1 2 2 2 4 4 0 0 0 1 0 0 0 1 0 1 1 0",
+            "SURFACE 1 0.1 0.1 0.1 0.8 0.2 0.2 0.5 0.5 0.5 20 0 0",
+        ];
+        assert_eq!(samples.len(), Keyword::COUNT);
+        for (keyword, sample) in Keyword::ALL.into_iter().zip(samples) {
+            let mut cursor = Cursor::new(sample);
+            let first = cursor.next().unwrap().unwrap();
+            assert_eq!(Keyword::from_text(first.text), Some(keyword), "{sample}");
+            statement::<super::super::AnyRoom>(&mut cursor, keyword, first.pos).unwrap();
+            assert!(cursor.next().unwrap().is_none(), "{sample}: the statement ends at its last token");
+            let points = if keyword == Keyword::Bspline { 3 * 2 * 2 } else { 0 };
+            assert_eq!(sample.split_whitespace().count(), 1 + keyword.arity() + points, "{sample}");
+        }
+    }
 
     #[test]
     fn matching_ignores_case_and_nothing_else() {

@@ -50,6 +50,21 @@ pub(crate) trait Room {
     const TRIANGLES: bool;
 }
 
+/// Every statement keyword of the format, in the format's order, with how
+/// many arguments follow it (for `BSPLINE`, those before its 3 × rows ×
+/// cols control point coordinates). For editors that find statements in
+/// scene text without parsing it, such as the studio's page.
+///
+/// ```
+/// use octrace_core::parse::statement_arities;
+///
+/// let sphere = statement_arities().find(|&(keyword, _)| keyword == "SPHERE");
+/// assert_eq!(sphere, Some(("SPHERE", 5)));
+/// ```
+pub fn statement_arities() -> impl Iterator<Item = (&'static str, usize)> {
+    Keyword::ALL.into_iter().map(|keyword| (keyword.name(), keyword.arity()))
+}
+
 /// Every check: what [`count`] needs (it holds no scene).
 struct AnyRoom;
 

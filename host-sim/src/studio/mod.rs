@@ -37,9 +37,14 @@ pub struct StudioArgs {
 
 /// The page, its script and style, and the WebAssembly module, built into
 /// the binary (the module by `build.rs`).
-const ASSETS: [(&str, &str, &[u8]); 5] = [
+const ASSETS: [(&str, &str, &[u8]); 10] = [
     ("/", "text/html; charset=utf-8", include_bytes!("assets/index.html")),
     ("/studio.js", "text/javascript; charset=utf-8", include_bytes!("assets/studio.js")),
+    ("/octrace.js", "text/javascript; charset=utf-8", include_bytes!("assets/octrace.js")),
+    ("/model.js", "text/javascript; charset=utf-8", include_bytes!("assets/model.js")),
+    ("/view.js", "text/javascript; charset=utf-8", include_bytes!("assets/view.js")),
+    ("/tools.js", "text/javascript; charset=utf-8", include_bytes!("assets/tools.js")),
+    ("/panel.js", "text/javascript; charset=utf-8", include_bytes!("assets/panel.js")),
     ("/worker.js", "text/javascript; charset=utf-8", include_bytes!("assets/worker.js")),
     ("/studio.css", "text/css; charset=utf-8", include_bytes!("assets/studio.css")),
     ("/octrace_studio.wasm", "application/wasm", include_bytes!(concat!(env!("OUT_DIR"), "/octrace_studio.wasm"))),

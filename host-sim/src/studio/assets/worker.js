@@ -1,8 +1,8 @@
 // The studio's render worker: its own instance of the octrace module, the
 // scene loaded once, then rectangles rendered on request. Also the draft
 // renderer (a smaller image first, then the draft size).
-'use strict';
-importScripts('/studio.js');
+
+import { loadOctrace } from './octrace.js';
 
 let octrace = null;
 const ready = loadOctrace().then((o) => { octrace = o; });

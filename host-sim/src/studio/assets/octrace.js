@@ -1,0 +1,43 @@
+// The octrace module (octrace-core compiled to WebAssembly) behind a small
+// JavaScript interface: scene text in, parse errors or pixels, palettes and
+// image files out. The page and every render worker each load their own.
+
+/** Instantiates the octrace module and wraps its byte-buffer interface. */
+export async function loadOctrace() {
+  const response = await fetch('/octrace_studio.wasm');
+  const { instance } = await WebAssembly.instantiateStreaming(response, {});
+  const x = instance.exports;
+  const encoder = new TextEncoder(), decoder = new TextDecoder();
+  const put = (bytes) => {
+    const at = x.studio_input(bytes.length);
+    new Uint8Array(x.memory.buffer, at, bytes.length).set(bytes);
+  };
+  const output = () => new Uint8Array(x.memory.buffer, x.studio_output_ptr(), x.studio_output_len()).slice();
+  const call = (f, ...args) => {
+    const failed = f(...args);
+    const out = output();
+    if (failed) throw new Error(decoder.decode(out));
+    return out;
+  };
+  return {
+    /** {width, height, objects} or {errors: ['line:col: message', …]} */
+    load(text) {
+      put(encoder.encode(text));
+      const failed = x.studio_load();
+      const out = decoder.decode(output());
+      if (failed) return { errors: out.split('\n').filter((l) => l) };
+      const [width, height, objects] = out.split(' ').map(Number);
+      return { width, height, objects };
+    },
+    prepare: (accel, w, h) => decoder.decode(call(x.studio_prepare, accel, w, h)),
+    render: (x0, y0, w, h) => call(x.studio_render, x0, y0, w, h),
+    display(render, mode, w, h) { put(render); return call(x.studio_display, mode, w, h); },
+    encode(render, mode, format, w, h) { put(render); return call(x.studio_encode, mode, format, w, h); },
+    decode(bytes) {
+      put(bytes);
+      const out = call(x.studio_decode);
+      const view = new DataView(out.buffer);
+      return { width: view.getUint32(0, true), height: view.getUint32(4, true), rgb: out.subarray(8) };
+    },
+  };
+}
