@@ -7,7 +7,7 @@
 //! in `.bss`, initialised in place); a [`LoadedScene`] exists only for a
 //! scene that parsed without errors, with its accelerator built.
 
-use crate::accel::{naive, AccelMode, Accelerator, BuildReport, Hit, Mailbox, OctreeConfig, OctreeStore, RayStart};
+use crate::accel::{self, naive, AccelMode, Accelerator, BuildReport, Hit, Mailbox, OctreeStore, Prepared, RayStart};
 use crate::capacity::Arena;
 use crate::math::Scalar;
 use crate::parse::{parse_bytes, ErrorKind, ParseError, Pos};
@@ -85,8 +85,6 @@ impl fmt::Display for LoadError<'_> {
 impl core::error::Error for LoadError<'_> {}
 
 impl<P: Profile> Raytracer<P> {
-    const HAS_OCTREE: bool = P::COUNTS.octree_boxes > 0;
-
     /// Empty room for a scene: a constant of all-zero bits.
     pub const fn new() -> Self {
         Raytracer {
@@ -131,20 +129,9 @@ impl<P: Profile> Raytracer<P> {
             }
         }
         let view = self.scene.view();
-        // A profile without room for an octree tests every object (what an
-        // octree of no boxes would do too); decided on the constant, so such
-        // a build carries no octree code at all.
         let requested = mode;
-        let mode = match mode.resolve(view.object_count()) {
-            _ if !Self::HAS_OCTREE => AccelMode::Naive,
-            // No hash table for the thesis's walk: 3DDDA, the same image.
-            AccelMode::Octree if !P::NAMED_WALK => AccelMode::Dda,
-            mode => mode,
-        };
-        let octree = mode.traversal().map(|traversal| {
-            let report = self.octree.build(&view, &OctreeConfig { traversal, ..P::OCTREE });
-            (&self.octree, report)
-        });
+        let Prepared { mode, report } = accel::prepare(mode, &view, &mut self.octree, &P::OCTREE);
+        let octree = report.map(|report| (&self.octree, report));
         fill(&mut self.mailbox, Mailbox::words_for(view.object_count()), 0);
         // The naive mode asked for by name stays the thesis's test of
         // every object, camera rays too.
@@ -338,14 +325,14 @@ impl<P: Profile> SceneAccelerator<'_, P> {
     /// The octree, if the profile has room for one and the scene uses it.
     #[inline(always)]
     fn octree(&self) -> Option<&P::Octree> {
-        self.octree.filter(|_| Raytracer::<P>::HAS_OCTREE)
+        self.octree.filter(|_| <P::Octree as OctreeStore>::HAS_BOXES)
     }
 }
 
 impl<P: Profile> Accelerator for SceneAccelerator<'_, P> {
     const KINDS: ShapeKinds = ShapeKinds::with_room(&P::COUNTS);
     // The octree's mailbox, only if the profile can have an octree.
-    const USES_MAILBOX: bool = Raytracer::<P>::HAS_OCTREE && <P::Octree as Accelerator>::USES_MAILBOX;
+    const USES_MAILBOX: bool = <P::Octree as OctreeStore>::HAS_BOXES && <P::Octree as Accelerator>::USES_MAILBOX;
 
     fn first_hits_by_screen(&self) -> bool {
         P::FIRST_HITS && self.octree().is_none_or(|octree| octree.first_hits_by_screen())

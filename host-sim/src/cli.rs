@@ -16,7 +16,7 @@ use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-pub use crate::exit::{EXIT_IO, EXIT_SCENE};
+pub use crate::exit::{CliError, EXIT_IO, EXIT_SCENE};
 
 /// Render an octrace scene file to an image (PNG, Targa or Sun raster), in
 /// truecolour or with a 256-entry colour table.
@@ -210,7 +210,10 @@ where
     }
     match execute(&args, stderr) {
         Ok(()) => 0,
-        Err(code) => code,
+        Err(e) => {
+            let _ = writeln!(stderr, "{e}");
+            e.exit_code()
+        }
     }
 }
 
@@ -218,7 +221,7 @@ where
 /// extension names, else (no extension) PNG. Any other extension is refused
 /// before anything is rendered: a PNG named `.bmp` would mislead whatever
 /// opens it.
-fn output_format(asked: Option<Format>, path: &Path, stderr: &mut dyn Write) -> Result<Format, i32> {
+fn output_format(asked: Option<Format>, path: &Path) -> Result<Format, CliError> {
     if let Some(format) = asked {
         return Ok(format);
     }
@@ -227,49 +230,33 @@ fn output_format(asked: Option<Format>, path: &Path, stderr: &mut dyn Write) -> 
     };
     Format::from_path(path).ok_or_else(|| {
         let names: Vec<&str> = Format::ALL.iter().map(|f| f.name()).collect();
-        let _ = writeln!(
-            stderr,
-            "host-sim: cannot write {}: `.{}` is not a format host-sim writes; it writes {} \
+        CliError::Invalid(format!(
+            "cannot write {}: `.{}` is not a format host-sim writes; it writes {} \
              (chosen by the extension, or by --format <{}>)",
             path.display(),
             extension.to_string_lossy(),
             names.join(", "),
             names.join("|"),
-        );
-        EXIT_SCENE
+        ))
     })
 }
 
-fn convert(input: &Path, output: &Path, format: Option<Format>, stderr: &mut dyn Write) -> Result<(), i32> {
-    let format = output_format(format, output, stderr)?;
-    let bytes = std::fs::read(input).map_err(|e| {
-        let _ = writeln!(stderr, "host-sim: cannot read {}: {e}", input.display());
-        EXIT_IO
-    })?;
-    let image = formats::read(&bytes).map_err(|e| {
-        let _ = writeln!(stderr, "host-sim: {}: {e}", input.display());
-        EXIT_SCENE
-    })?;
-    write_atomically(output, |f| formats::write(&image, format, f).map_err(std::io::Error::other)).map_err(|e| {
-        let _ = writeln!(stderr, "host-sim: cannot write {}: {e}", output.display());
-        EXIT_IO
-    })
+fn convert(input: &Path, output: &Path, format: Option<Format>) -> Result<(), CliError> {
+    let format = output_format(format, output)?;
+    let bytes = std::fs::read(input).map_err(|e| CliError::read(input, e))?;
+    let image = formats::read(&bytes).map_err(|e| CliError::Invalid(format!("{}: {e}", input.display())))?;
+    write_atomically(output, |f| formats::write(&image, format, f).map_err(std::io::Error::other))
+        .map_err(|e| CliError::write(output, e))
 }
 
-fn merge(output: &Path, parts: &[PathBuf], format: Option<Format>, stderr: &mut dyn Write) -> Result<(), i32> {
-    let format = output_format(format, output, stderr)?;
-    let (ordered, header) = parts::check_parts(parts).map_err(|e| {
-        let _ = writeln!(stderr, "host-sim: merge: {e}; nothing written");
-        match e {
-            MergeError::Io { .. } => EXIT_IO,
-            MergeError::Refused(_) => EXIT_SCENE,
-        }
+fn merge(output: &Path, parts: &[PathBuf], format: Option<Format>) -> Result<(), CliError> {
+    let format = output_format(format, output)?;
+    let (ordered, header) = parts::check_parts(parts).map_err(|e| match e {
+        MergeError::Io { .. } => CliError::Io(format!("merge: {e}; nothing written")),
+        MergeError::Refused(_) => CliError::Invalid(format!("merge: {e}; nothing written")),
     })?;
     write_atomically(output, |f| parts::write_merged(&ordered, &header, format, f).map_err(std::io::Error::other))
-        .map_err(|e| {
-            let _ = writeln!(stderr, "host-sim: merge: cannot write {}: {e}", output.display());
-            EXIT_IO
-        })
+        .map_err(|e| CliError::Io(format!("merge: cannot write {}: {e}", output.display())))
 }
 
 /// The rows to render and the text to carry for `--part`, checked against the image and the options.
@@ -280,12 +267,8 @@ fn part_of(
     scene_bytes: &[u8],
     (w, h): (u32, u32),
     format: Format,
-    stderr: &mut dyn Write,
-) -> Result<(std::ops::Range<u32>, String), i32> {
-    let mut refuse = |message: String| {
-        let _ = writeln!(stderr, "host-sim: --part: {message}");
-        Err(EXIT_SCENE)
-    };
+) -> Result<(std::ops::Range<u32>, String), CliError> {
+    let refuse = |message: String| Err(CliError::Invalid(format!("--part: {message}")));
     if format == Format::Ras {
         return refuse("parts are PNG or Targa files (a Sun raster has no room for the part's metadata)".into());
     }
@@ -333,19 +316,15 @@ fn preview(
     out: &Path,
     quiet: bool,
     stderr: &mut dyn Write,
-) -> Result<(), i32> {
+) -> Result<(), CliError> {
     let started = Instant::now();
-    let rendered = render_with_progress(scene, options, &|_| {}).map_err(|e| {
-        // The parser rejects these; a scene built by hand may not.
-        let _ = writeln!(stderr, "host-sim: cannot set up the camera: {e}");
-        EXIT_SCENE
-    })?;
+    // The parser rejects a camera that cannot be set up; a scene built by
+    // hand may not.
+    let rendered = render_with_progress(scene, options, &|_| {})
+        .map_err(|e| CliError::Invalid(format!("cannot set up the camera: {e}")))?;
     let preview = panel_preview(&rendered.image, color).unwrap_or_else(|| Image::Rgb(rendered.image.clone()));
-    let written = write_atomically(out, |f| write_preview(&preview, color, format, f).map_err(std::io::Error::other));
-    if let Err(e) = written {
-        let _ = writeln!(stderr, "host-sim: cannot write {}: {e}", out.display());
-        return Err(EXIT_IO);
-    }
+    write_atomically(out, |f| write_preview(&preview, color, format, f).map_err(std::io::Error::other))
+        .map_err(|e| CliError::write(out, e))?;
     if !quiet {
         let (image, stats) = (&rendered.image, rendered.stats);
         let _ = writeln!(
@@ -366,65 +345,49 @@ fn preview(
     Ok(())
 }
 
-fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
+fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     match &args.command {
-        Some(Command::Convert { input, output, format }) => return convert(input, output, *format, stderr),
-        Some(Command::Merge { output, parts, format }) => return merge(output, parts, *format, stderr),
+        Some(Command::Convert { input, output, format }) => return convert(input, output, *format),
+        Some(Command::Merge { output, parts, format }) => return merge(output, parts, *format),
         // run() serves the studio (it needs stdout) before execute is called.
         Some(Command::Studio(_)) => return Ok(()),
         None => {}
     }
     let Some(scene_path) = &args.scene else {
-        // clap requires SCENE without a subcommand.
-        return Err(EXIT_SCENE);
+        return Err(CliError::Invalid("no scene file given".into()));
     };
     let mut scene = new_scene();
-    let scene_bytes = std::fs::read(scene_path).map_err(|e| {
-        let _ = writeln!(stderr, "host-sim: cannot read {}: {e}", scene_path.display());
-        EXIT_IO
+    let scene_bytes = std::fs::read(scene_path).map_err(|e| CliError::read(scene_path, e))?;
+    let loaded = load_bytes(&scene_path.display().to_string(), &scene_bytes, &mut scene).map_err(|e| match e {
+        LoadError::Io(e) => CliError::read(scene_path, e),
+        LoadError::Scene(errors) => CliError::Scene { file: scene_path.display().to_string(), errors },
     })?;
-    let loaded = match load_bytes(&scene_path.display().to_string(), &scene_bytes, &mut scene) {
-        Ok(l) => l,
-        Err(LoadError::Io(e)) => {
-            let _ = writeln!(stderr, "host-sim: cannot read {}: {e}", scene_path.display());
-            return Err(EXIT_IO);
-        }
-        Err(LoadError::Scene(errors)) => {
-            for e in &errors {
-                let _ = writeln!(stderr, "{e}");
-            }
-            let _ =
-                writeln!(stderr, "host-sim: {} error(s) in {}; nothing rendered", errors.len(), scene_path.display());
-            return Err(EXIT_SCENE);
-        }
-    };
     let out = match (&args.out, &loaded.imagefile) {
         (Some(o), _) => o.clone(),
         (None, Some(f)) => PathBuf::from(f),
         (None, None) => {
-            let _ = writeln!(
-                stderr,
-                "host-sim: no output file: give OUT on the command line or IMAGEFILE in {}",
+            return Err(CliError::Invalid(format!(
+                "no output file: give OUT on the command line or IMAGEFILE in {}",
                 scene_path.display()
-            );
-            return Err(EXIT_SCENE);
+            )))
         }
     };
     if args.color != PanelColor::Rgb888 && args.palette != PaletteMode::None {
-        let _ = writeln!(stderr, "host-sim: --color and --palette both choose the pixels: give one");
-        return Err(EXIT_SCENE);
+        return Err(CliError::Invalid("--color and --palette both choose the pixels: give one".into()));
     }
     if same_file(scene_path, &out) {
-        let _ = writeln!(stderr, "host-sim: refusing to overwrite the scene file {} with the image", out.display());
-        return Err(EXIT_SCENE);
+        return Err(CliError::Invalid(format!(
+            "refusing to overwrite the scene file {} with the image",
+            out.display()
+        )));
     }
-    let format = output_format(args.format, &out, stderr)?;
+    let format = output_format(args.format, &out)?;
     let view = scene.view();
     let (w, h) = args.size.unwrap_or((view.settings.raster[0], view.settings.raster[1]));
     let palette_mode = if args.color == PanelColor::Dither { PaletteMode::Dither } else { args.palette };
     let (rows, text) = match args.part {
         Some(spec) => {
-            let (rows, text) = part_of(spec, palette_mode, args.color, &scene_bytes, (w, h), format, stderr)?;
+            let (rows, text) = part_of(spec, palette_mode, args.color, &scene_bytes, (w, h), format)?;
             (rows, Some(text))
         }
         None => (0..h, None),
@@ -487,17 +450,12 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), i32> {
         b.finish_and_clear();
     }
     let rendered = match (outcome, written) {
-        (Some(Err(e)), _) => {
-            // The parser rejects these; a scene built by hand may not.
-            let _ = writeln!(stderr, "host-sim: {e}");
-            return Err(EXIT_SCENE);
-        }
-        (_, Err(e)) => {
-            let _ = writeln!(stderr, "host-sim: cannot write {}: {e}", out.display());
-            return Err(EXIT_IO);
-        }
+        // The parser rejects a camera that cannot be set up; a scene built
+        // by hand may not.
+        (Some(Err(e)), _) => return Err(CliError::Invalid(e.to_string())),
+        (_, Err(e)) => return Err(CliError::write(&out, e)),
         (Some(Ok(rendered)), Ok(())) => rendered,
-        (None, Ok(())) => return Err(EXIT_IO),
+        (None, Ok(())) => return Err(CliError::write(&out, "the render stopped before its first row")),
     };
     let elapsed = started.elapsed();
     let stats = rendered.stats;

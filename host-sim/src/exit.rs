@@ -1,7 +1,58 @@
-//! The exit codes every host-sim command shares: 0 done, 1 a file could not
-//! be read or written, 2 a bad scene or bad arguments.
+//! How a host-sim command fails: [`CliError`], whose exit code is derived in
+//! one place ([`CliError::exit_code`]): 0 done, 1 a file could not be read
+//! or written, 2 a bad scene or bad arguments.
+
+use std::fmt;
+use std::path::Path;
 
 /// Exit code for a bad scene or bad arguments.
 pub const EXIT_SCENE: i32 = 2;
 /// Exit code for a file that cannot be read or written.
 pub const EXIT_IO: i32 = 1;
+
+/// Why a command stopped; printed to stderr as it is displayed.
+#[derive(Debug)]
+pub enum CliError {
+    /// A file could not be read or written; the message says which and why.
+    Io(String),
+    /// The arguments, or an input other than a scene, are not usable.
+    Invalid(String),
+    /// The scene file has errors, each `file:line:col: message`.
+    Scene { file: String, errors: Vec<String> },
+}
+
+impl CliError {
+    /// `path` could not be read.
+    pub fn read(path: &Path, error: impl fmt::Display) -> CliError {
+        CliError::Io(format!("cannot read {}: {error}", path.display()))
+    }
+
+    /// `path` could not be written.
+    pub fn write(path: &Path, error: impl fmt::Display) -> CliError {
+        CliError::Io(format!("cannot write {}: {error}", path.display()))
+    }
+
+    /// The process's exit code for this error.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            CliError::Io(_) => EXIT_IO,
+            CliError::Invalid(_) | CliError::Scene { .. } => EXIT_SCENE,
+        }
+    }
+}
+
+impl fmt::Display for CliError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CliError::Io(message) | CliError::Invalid(message) => write!(f, "host-sim: {message}"),
+            CliError::Scene { file, errors } => {
+                for error in errors {
+                    writeln!(f, "{error}")?;
+                }
+                write!(f, "host-sim: {} error(s) in {file}; nothing rendered", errors.len())
+            }
+        }
+    }
+}
+
+impl std::error::Error for CliError {}

@@ -17,10 +17,9 @@ use threaded::stream_threads;
 
 pub use octrace_images::{RgbImage, NO_OBJECT};
 
-use octrace_core::accel::{BuildReport, Naive, Octree, OctreeConfig, Traversal};
+use octrace_core::accel::{self, BuildReport, Naive, Octree, OctreeConfig, Traversal};
 use octrace_core::parse::{parse_bytes, ParseError};
 use octrace_core::profile::Host;
-use octrace_core::render::Renderer;
 use octrace_core::scene::{CameraError, Scene};
 use octrace_core::shade::Stats;
 use std::path::Path;
@@ -145,12 +144,11 @@ pub type HostOctree = Octree<Host>;
 /// config (shadow shafts on).
 pub const OCTREE: OctreeConfig = <Host as octrace_core::profile::Profile>::OCTREE;
 
-/// Builds the acceleration structure for `mode` (none for naive).
+/// Builds the octree `mode` walks (none for the naive mode), as the core
+/// chooses it ([`octrace_core::accel::prepare`]).
 pub fn build_octree(scene: &HostScene, mode: AccelMode, config: &OctreeConfig) -> Option<Box<HostOctree>> {
-    let traversal = mode.resolve(scene.view().object_count()).traversal()?;
     let mut octree: Box<HostOctree> = Box::default();
-    octree.build(&scene.view(), &OctreeConfig { traversal, ..*config });
-    Some(octree)
+    accel::prepare(mode, &scene.view(), &mut *octree, config).report.map(|_| octree)
 }
 
 /// Renders a loaded scene into a new image.
@@ -165,9 +163,8 @@ pub fn render_with_progress(
     options: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<Rendered, CameraError> {
-    let accel = options.accel.resolve(scene.view().object_count());
     let started = Instant::now();
-    let octree = build_octree(scene, accel, &options.octree);
+    let octree = build_octree(scene, options.accel, &options.octree);
     let build = octree.as_ref().map(|o| (*o.report(), started.elapsed()));
     let mut rendered = render_prebuilt(scene, options, octree.as_deref(), progress)?;
     rendered.build = build;
@@ -256,9 +253,8 @@ pub fn render_streamed(
     progress: &(dyn Fn(u64) + Sync),
     sink: &mut dyn RowSink,
 ) -> Result<Streamed, StreamError> {
-    let accel = options.accel.resolve(scene.view().object_count());
     let started = Instant::now();
-    let octree = build_octree(scene, accel, &options.octree);
+    let octree = build_octree(scene, options.accel, &options.octree);
     let build = octree.as_ref().map(|o| (*o.report(), started.elapsed()));
     let mut streamed = stream_prebuilt(scene, options, octree.as_deref(), rows, progress, sink)?;
     streamed.build = build;
@@ -276,7 +272,7 @@ fn stream_prebuilt(
     let view = scene.view();
     let (w, h) = options.size.unwrap_or((view.settings.raster[0], view.settings.raster[1]));
     // Set-up errors are found once, before any thread starts.
-    Renderer::with_size(view, &Naive, w, h).map_err(StreamError::Camera)?;
+    view.check_camera(w, h).map_err(StreamError::Camera)?;
     let rows = rows.start.min(h)..rows.end.min(h);
     let (accel, job) = match octree {
         None => (AccelMode::Naive, stream_threads(view, &Naive, (w, h), rows, options, progress, sink)),

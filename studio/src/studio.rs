@@ -5,7 +5,7 @@
 //! whenever the scene is replaced).
 
 use embedded_graphics_core::pixelcolor::RgbColor;
-use octrace_core::accel::{Accelerator, Mailbox, Naive, Octree, OctreeConfig};
+use octrace_core::accel::{self, Accelerator, Mailbox, Naive, Octree};
 use octrace_core::parse::{parse_bytes, ParseError};
 use octrace_core::profile::Host;
 use octrace_core::render::{Renderer, ScreenBound};
@@ -113,15 +113,12 @@ impl Studio {
             return Err(StudioError::NoScene);
         }
         let view = self.scene.view();
-        Renderer::with_size(view, &Naive, width, height).map_err(|e| StudioError::Camera(format!("{e:?}")))?;
+        view.check_camera(width, height).map_err(|e| StudioError::Camera(format!("{e:?}")))?;
         self.size = (width, height);
-        let accel = accel.resolve(view.object_count());
-        self.octree = accel.traversal().map(|traversal| {
-            let mut octree: Box<Octree<Host>> = Box::default();
-            octree.build(&view, &OctreeConfig { traversal, ..<Host as octrace_core::profile::Profile>::OCTREE });
-            octree
-        });
-        Ok(accel)
+        let mut octree: Box<Octree<Host>> = Box::default();
+        let prepared = accel::prepare(accel, &view, &mut *octree, &<Host as octrace_core::profile::Profile>::OCTREE);
+        self.octree = prepared.report.map(|_| octree);
+        Ok(prepared.mode)
     }
 
     /// Renders the rectangle at (`x`, `y`) of `width`×`height` pixels into

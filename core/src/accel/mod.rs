@@ -15,9 +15,11 @@
 //! - an object is tested at most once per query when the caller provides a
 //!   [`Mailbox`] large enough for the scene (one bit per object).
 
+mod choice;
 pub(crate) mod naive;
 mod octree;
 
+pub use choice::{prepare, Prepared};
 pub use naive::Naive;
 pub(crate) use octree::FILING_MARGIN;
 pub use octree::{

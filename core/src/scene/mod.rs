@@ -459,6 +459,14 @@ impl<'a> SceneView<'a> {
         }
     }
 
+    /// Whether the scene's camera can be set up for an image of
+    /// `width`×`height` pixels: the check every renderer makes first, for a
+    /// caller that wants the answer before it builds or starts anything.
+    pub fn check_camera(&self, width: u32, height: u32) -> Result<(), CameraError> {
+        let settings = &self.settings;
+        Camera::new(&settings.view, &self.normalization, width, height, settings.samples).map(|_| ())
+    }
+
     /// How many objects the scene holds (B-spline triangles count one each).
     pub fn object_count(&self) -> usize {
         self.objects.len()

@@ -197,12 +197,19 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
 pub trait OctreeStore: Accelerator {
     /// An empty octree.
     const EMPTY: Self;
+    /// Whether it has room for any box (else every mode is the naive one).
+    const HAS_BOXES: bool;
+    /// Whether it has room for the thesis's hash table, which its walk
+    /// ([`Traversal::Named`]) needs.
+    const NAMED_WALK: bool;
     /// Builds the octree over `scene`'s objects (see [`Octree::build`]).
     fn build(&mut self, scene: &SceneView<'_>, config: &OctreeConfig) -> BuildReport;
 }
 
 impl<C: OctreeCapacities, const FRAMES: usize> OctreeStore for Octree<C, FRAMES> {
     const EMPTY: Self = Octree::new();
+    const HAS_BOXES: bool = C::Nodes::CAPACITY > 0;
+    const NAMED_WALK: bool = C::HashBuckets::CAPACITY > 0;
 
     fn build(&mut self, scene: &SceneView<'_>, config: &OctreeConfig) -> BuildReport {
         Octree::build(self, scene, config)
