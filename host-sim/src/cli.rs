@@ -205,10 +205,11 @@ where
             return 0;
         }
     };
-    if let Some(Command::Studio(studio)) = &args.command {
-        return crate::studio::run(studio, stdout, stderr);
-    }
-    match execute(&args, stderr) {
+    let result = match &args.command {
+        Some(Command::Studio(studio)) => crate::studio::run(studio, stdout, stderr),
+        _ => execute(&args, stderr),
+    };
+    match result {
         Ok(()) => 0,
         Err(e) => {
             let _ = writeln!(stderr, "{e}");
@@ -349,7 +350,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     match &args.command {
         Some(Command::Convert { input, output, format }) => return convert(input, output, *format),
         Some(Command::Merge { output, parts, format }) => return merge(output, parts, *format),
-        // run() serves the studio (it needs stdout) before execute is called.
+        // run() serves the studio (it needs stdout) instead of calling this.
         Some(Command::Studio(_)) => return Ok(()),
         None => {}
     }

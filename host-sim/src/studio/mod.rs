@@ -11,6 +11,7 @@
 
 mod http;
 
+use crate::exit::CliError;
 use crate::output::write_atomically;
 use http::{Request, Response};
 use std::io::Write;
@@ -68,29 +69,13 @@ struct Shared {
     saving: Mutex<()>,
 }
 
-/// Runs the studio until Ctrl-C; returns the exit code.
-pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i32 {
-    let listener = match TcpListener::bind(SocketAddr::from((Ipv4Addr::LOCALHOST, args.port))) {
-        Ok(l) => l,
-        Err(e) => {
-            let _ = writeln!(stderr, "host-sim studio: cannot listen on 127.0.0.1:{}: {e}", args.port);
-            return crate::exit::EXIT_IO;
-        }
-    };
-    let port = match listener.local_addr() {
-        Ok(a) => a.port(),
-        Err(e) => {
-            let _ = writeln!(stderr, "host-sim studio: {e}");
-            return crate::exit::EXIT_IO;
-        }
-    };
-    let token = match new_token() {
-        Ok(t) => t,
-        Err(e) => {
-            let _ = writeln!(stderr, "host-sim studio: no randomness for the token: {e}");
-            return crate::exit::EXIT_IO;
-        }
-    };
+/// Runs the studio until Ctrl-C; fails before serving anything if it cannot
+/// listen or make its token.
+pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Result<(), CliError> {
+    let listener = TcpListener::bind(SocketAddr::from((Ipv4Addr::LOCALHOST, args.port)))
+        .map_err(|e| CliError::Io(format!("studio: cannot listen on 127.0.0.1:{}: {e}", args.port)))?;
+    let port = listener.local_addr().map_err(|e| CliError::Io(format!("studio: {e}")))?.port();
+    let token = new_token().map_err(|e| CliError::Io(format!("studio: no randomness for the token: {e}")))?;
     let url = format!("http://127.0.0.1:{port}/?token={token}");
     let shared = Arc::new(Shared {
         token,
@@ -120,7 +105,7 @@ pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) ->
     }
     serve(&listener, &shared, &stop);
     let _ = writeln!(stderr, "host-sim studio: stopped");
-    0
+    Ok(())
 }
 
 /// Accepts connections until `stop` is set, each on its own thread. On
