@@ -235,9 +235,7 @@ pub fn read(bytes: &[u8]) -> Result<Image, FormatError> {
 /// 256 palette entries and every index inside the palette.
 fn check(image: &Image) -> Result<(), FormatError> {
     let (width, height) = (image.width(), image.height());
-    if width == 0 || height == 0 {
-        return invalid(format!("the image is {width}×{height} pixels"));
-    }
+    check_size(width, height)?;
     let (length, per_pixel) = match image {
         Image::Rgb(rgb) => (rgb.data.len(), 3),
         Image::Indexed { indices, .. } => (indices.len(), 1),
@@ -246,12 +244,32 @@ fn check(image: &Image) -> Result<(), FormatError> {
         return invalid(format!("{length} bytes of pixel data for a {width}×{height} image"));
     }
     if let Image::Indexed { palette, indices, .. } = image {
-        if palette.len() > 256 {
-            return invalid(format!("palette has {} entries, at most 256", palette.len()));
-        }
-        if let Some(index) = indices.iter().find(|&&i| i as usize >= palette.len()) {
-            return invalid(format!("index {index} is outside the {}-entry palette", palette.len()));
-        }
+        check_palette_length(palette)?;
+        check_indices(indices, palette)?;
+    }
+    Ok(())
+}
+
+/// Fails for an image without pixels.
+fn check_size(width: u32, height: u32) -> Result<(), FormatError> {
+    if width == 0 || height == 0 {
+        return invalid(format!("the image is {width}×{height} pixels"));
+    }
+    Ok(())
+}
+
+/// Fails for a colour table no format holds (more than 256 entries).
+fn check_palette_length(palette: &[[u8; 3]]) -> Result<(), FormatError> {
+    if palette.len() > 256 {
+        return invalid(format!("palette has {} entries, at most 256", palette.len()));
+    }
+    Ok(())
+}
+
+/// Fails for an index past the end of `palette`.
+fn check_indices(indices: &[u8], palette: &[[u8; 3]]) -> Result<(), FormatError> {
+    if let Some(index) = indices.iter().find(|&&i| i as usize >= palette.len()) {
+        return invalid(format!("index {index} is outside the {}-entry palette", palette.len()));
     }
     Ok(())
 }

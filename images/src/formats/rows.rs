@@ -4,7 +4,10 @@
 //! Invariant: a [`RowWriter`] has written exactly the rows it was given, in order, after the header; a
 //! [`RowReader`] hands back rows of exactly `width` pixels, every index inside the palette.
 
-use super::{invalid, png, read_exactly, sun_raster, targa, unsupported, Format, FormatError, Header, BGR};
+use super::{
+    check_indices, check_palette_length, check_size, invalid, png, read_exactly, sun_raster, targa, unsupported,
+};
+use super::{Format, FormatError, Header, BGR};
 use std::io::{BufRead, BufReader, Write};
 
 /// Writes an image a row at a time, top to bottom, so that no more than a row is held: the file's header
@@ -27,16 +30,11 @@ enum RowEncoder<'a> {
 impl<'a> RowWriter<'a> {
     /// Writes the header of a `format` file to `out`; the rows follow through [`RowWriter::write_row`].
     pub fn new(format: Format, header: &Header, out: &'a mut dyn Write) -> Result<RowWriter<'a>, FormatError> {
-        let (width, height) = (header.width, header.height);
-        if width == 0 || height == 0 {
-            return invalid(format!("the image is {width}×{height} pixels"));
-        }
+        check_size(header.width, header.height)?;
         if let Some(palette) = &header.palette {
-            if palette.len() > 256 {
-                return invalid(format!("palette has {} entries, at most 256", palette.len()));
-            }
+            check_palette_length(palette)?;
         }
-        let row_bytes = width as usize * header.bytes_per_pixel();
+        let row_bytes = header.width as usize * header.bytes_per_pixel();
         let encoder = match format {
             Format::Png => {
                 let buffer = png::Buffer::default();
@@ -57,7 +55,7 @@ impl<'a> RowWriter<'a> {
                 RowEncoder::Raw { out, bgr: header.palette.is_none(), pad: sun_raster::row_padding(row_bytes) }
             }
         };
-        Ok(RowWriter { encoder, row_bytes, rows_left: height, stored: Vec::new() })
+        Ok(RowWriter { encoder, row_bytes, rows_left: header.height, stored: Vec::new() })
     }
 
     /// Writes the next row: `width` RGB triples, or `width` indices into the palette.
@@ -156,11 +154,10 @@ impl RowReader {
                 if is_ras { sun_raster::stream_header(&mut input)? } else { targa::stream_header(&mut input)? };
             let row_bytes = header.width as usize * header.bytes_per_pixel();
             let pad = if is_ras { sun_raster::row_padding(row_bytes) } else { 0 };
-            (header.clone(), RowDecoder::Raw { input, bgr: header.palette.is_none(), stored: vec![0; row_bytes + pad] })
+            let (bgr, stored) = (header.palette.is_none(), vec![0; row_bytes + pad]);
+            (header, RowDecoder::Raw { input, bgr, stored })
         };
-        if header.width == 0 || header.height == 0 {
-            return invalid(format!("the image is {}×{} pixels", header.width, header.height));
-        }
+        check_size(header.width, header.height)?;
         Ok(RowReader { rows_left: header.height, header, decoder, row: Vec::new() })
     }
 
@@ -193,9 +190,7 @@ impl RowReader {
             }
         }
         if let Some(palette) = &self.header.palette {
-            if let Some(index) = self.row.iter().find(|&&i| i as usize >= palette.len()) {
-                return invalid(format!("index {index} is outside the {}-entry palette", palette.len()));
-            }
+            check_indices(&self.row, palette)?;
         }
         Ok(&self.row)
     }
