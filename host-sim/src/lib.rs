@@ -151,6 +151,18 @@ pub fn build_octree(scene: &HostScene, mode: AccelMode, config: &OctreeConfig) -
     accel::prepare(mode, &scene.view(), &mut *octree, config).report.map(|_| octree)
 }
 
+/// The octree `options` ask for, with its build report and the time the
+/// build took.
+fn timed_octree(
+    scene: &HostScene,
+    options: &RenderOptions,
+) -> (Option<Box<HostOctree>>, Option<(BuildReport, Duration)>) {
+    let started = Instant::now();
+    let octree = build_octree(scene, options.accel, &options.octree);
+    let build = octree.as_ref().map(|o| (*o.report(), started.elapsed()));
+    (octree, build)
+}
+
 /// Renders a loaded scene into a new image.
 pub fn render(scene: &HostScene, options: &RenderOptions) -> Result<Rendered, CameraError> {
     render_with_progress(scene, options, &|_| {})
@@ -163,9 +175,7 @@ pub fn render_with_progress(
     options: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<Rendered, CameraError> {
-    let started = Instant::now();
-    let octree = build_octree(scene, options.accel, &options.octree);
-    let build = octree.as_ref().map(|o| (*o.report(), started.elapsed()));
+    let (octree, build) = timed_octree(scene, options);
     let mut rendered = render_prebuilt(scene, options, octree.as_deref(), progress)?;
     rendered.build = build;
     Ok(rendered)
@@ -253,9 +263,7 @@ pub fn render_streamed(
     progress: &(dyn Fn(u64) + Sync),
     sink: &mut dyn RowSink,
 ) -> Result<Streamed, StreamError> {
-    let started = Instant::now();
-    let octree = build_octree(scene, options.accel, &options.octree);
-    let build = octree.as_ref().map(|o| (*o.report(), started.elapsed()));
+    let (octree, build) = timed_octree(scene, options);
     let mut streamed = stream_prebuilt(scene, options, octree.as_deref(), rows, progress, sink)?;
     streamed.build = build;
     Ok(streamed)
