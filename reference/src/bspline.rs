@@ -14,14 +14,14 @@ pub struct Patch {
 
 /// The clamped uniform knot vector for `n` control points of order `k`, in
 /// knot units (spans of length 1, from 0 to n − k + 1).
-pub(crate) fn knots(n: usize, k: usize) -> Vec<f64> {
+fn knots(n: usize, k: usize) -> Vec<f64> {
     let m = (n - k + 1) as f64;
     (0..n + k).map(|j| (j as f64 - (k as f64 - 1.0)).clamp(0.0, m)).collect()
 }
 
 /// N_{i,k}(u) by the Cox–de Boor recursion, with the last span closed at
 /// its right end so that u = end belongs to it.
-pub(crate) fn basis_function(t: &[f64], i: usize, k: usize, u: f64) -> f64 {
+fn basis_function(t: &[f64], i: usize, k: usize, u: f64) -> f64 {
     if k == 1 {
         let end = *t.last().unwrap_or(&0.0);
         let last_span = t[i + 1] == end && t[i] < end;
@@ -40,7 +40,7 @@ pub(crate) fn basis_function(t: &[f64], i: usize, k: usize, u: f64) -> f64 {
 }
 
 /// dN_{i,k}/du.
-pub(crate) fn basis_derivative(t: &[f64], i: usize, k: usize, u: f64) -> f64 {
+fn basis_derivative(t: &[f64], i: usize, k: usize, u: f64) -> f64 {
     let mut value = 0.0;
     let left = t[i + k - 1] - t[i];
     if left > 0.0 {
@@ -54,7 +54,7 @@ pub(crate) fn basis_derivative(t: &[f64], i: usize, k: usize, u: f64) -> f64 {
 }
 
 impl Patch {
-    pub(crate) fn span(&self, n: usize) -> f64 {
+    fn span(&self, n: usize) -> f64 {
         (n - self.order + 1) as f64
     }
 
@@ -78,7 +78,7 @@ impl Patch {
 
     /// The unit normal ∂S/∂u × ∂S/∂v, `None` where the derivatives vanish or
     /// are parallel (to 2^-20).
-    pub(crate) fn exact_normal(&self, u: f64, v: f64) -> Option<V3> {
+    fn exact_normal(&self, u: f64, v: f64) -> Option<V3> {
         let (_, su, sv) = self.evaluate(u, v);
         let n = su.cross(sv);
         (n.length() > su.length() * sv.length() * 2f64.powi(-20) && n.length() > 0.0).then(|| n.normalised())

@@ -14,7 +14,7 @@ pub(crate) enum Roots {
 
 /// The parameter interval [t0, t1] where `o + t·d` is inside the box
 /// |x_i − c_i| ≤ h_i, or `None` if the line misses it.
-pub(crate) fn slab(o: V3, d: V3, c: V3, h: V3) -> Option<(f64, f64)> {
+fn slab(o: V3, d: V3, c: V3, h: V3) -> Option<(f64, f64)> {
     let (mut t0, mut t1) = (f64::NEG_INFINITY, f64::INFINITY);
     for i in 0..3 {
         let (oi, di) = (o.get(i) - c.get(i), d.get(i));
@@ -34,7 +34,7 @@ pub(crate) fn slab(o: V3, d: V3, c: V3, h: V3) -> Option<(f64, f64)> {
 
 /// Bisect [lo, hi] while `is_lo_side(mid)` tells which half to keep, down to
 /// adjacent floating-point numbers. Returns the final (lo, hi).
-pub(crate) fn bisect(mut lo: f64, mut hi: f64, is_lo_side: impl Fn(f64) -> bool) -> (f64, f64) {
+fn bisect(mut lo: f64, mut hi: f64, is_lo_side: impl Fn(f64) -> bool) -> (f64, f64) {
     for _ in 0..300 {
         let mid = 0.5 * (lo + hi);
         if mid <= lo || mid >= hi {
@@ -49,7 +49,7 @@ pub(crate) fn bisect(mut lo: f64, mut hi: f64, is_lo_side: impl Fn(f64) -> bool)
     (lo, hi)
 }
 
-pub(crate) fn sphere_hit(centre: V3, radius: f64, o: V3, d: V3, roots: Roots) -> Option<f64> {
+fn sphere_hit(centre: V3, radius: f64, o: V3, d: V3, roots: Roots) -> Option<f64> {
     let oc = o - centre;
     let b = oc.dot(d);
     // Squared distance from the centre to the line, computed directly for accuracy.
@@ -67,7 +67,7 @@ pub(crate) fn sphere_hit(centre: V3, radius: f64, o: V3, d: V3, roots: Roots) ->
     }
 }
 
-pub(crate) fn box_hit(centre: V3, half: V3, o: V3, d: V3, roots: Roots) -> Option<f64> {
+fn box_hit(centre: V3, half: V3, o: V3, d: V3, roots: Roots) -> Option<f64> {
     let (t0, t1) = slab(o, d, centre, half)?;
     if roots == Roots::Nearest && t0 > 0.0 {
         Some(t0)
@@ -76,7 +76,7 @@ pub(crate) fn box_hit(centre: V3, half: V3, o: V3, d: V3, roots: Roots) -> Optio
     }
 }
 
-pub(crate) fn superquadric_hit(power: f64, centre: V3, half: V3, o: V3, d: V3, roots: Roots) -> Option<f64> {
+fn superquadric_hit(power: f64, centre: V3, half: V3, o: V3, d: V3, roots: Roots) -> Option<f64> {
     // Work in local coordinates where the bounding box is [-1, 1]^3.
     let lo = V3::from_fn(|i| (o.get(i) - centre.get(i)) / half.get(i));
     let ld = V3::from_fn(|i| d.get(i) / half.get(i));
@@ -128,7 +128,7 @@ pub(crate) fn superquadric_hit(power: f64, centre: V3, half: V3, o: V3, d: V3, r
     (exit > 0.0).then_some(exit)
 }
 
-pub(crate) fn triangle_hit(p: &[V3; 3], o: V3, d: V3) -> Option<f64> {
+fn triangle_hit(p: &[V3; 3], o: V3, d: V3) -> Option<f64> {
     // Möller–Trumbore.
     let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
     let pv = d.cross(e2);
@@ -151,7 +151,7 @@ pub(crate) fn triangle_hit(p: &[V3; 3], o: V3, d: V3) -> Option<f64> {
     (t > 0.0).then_some(t)
 }
 
-pub(crate) fn rectangle_hit(p: &[V3; 4], normal: V3, o: V3, d: V3) -> Option<f64> {
+fn rectangle_hit(p: &[V3; 4], normal: V3, o: V3, d: V3) -> Option<f64> {
     let denom = normal.dot(d);
     if denom == 0.0 {
         return None;

@@ -5,13 +5,13 @@ use crate::vector::{Rgb, V3};
 use crate::{Light, Object, RefScene, Shape, Surface};
 use std::collections::BTreeMap;
 
-pub(crate) struct Token {
+struct Token {
     text: String,
     line: usize,
     col: usize,
 }
 
-pub(crate) fn tokenize(text: &str) -> Result<Vec<Token>, String> {
+fn tokenize(text: &str) -> Result<Vec<Token>, String> {
     let chars: Vec<char> = text.chars().collect();
     let mut tokens = Vec::new();
     let (mut i, mut line, mut col) = (0usize, 1usize, 1usize);
@@ -86,7 +86,7 @@ pub(crate) fn tokenize(text: &str) -> Result<Vec<Token>, String> {
 
 /// True when `s` is `[+-]? digits? (. digits?)? ([eE] [+-]? digits)?` with at
 /// least one mantissa digit.
-pub(crate) fn is_number(s: &str) -> bool {
+fn is_number(s: &str) -> bool {
     let b = s.as_bytes();
     let mut i = 0;
     if i < b.len() && (b[i] == b'+' || b[i] == b'-') {
@@ -124,12 +124,12 @@ pub(crate) fn is_number(s: &str) -> bool {
     i == b.len()
 }
 
-pub(crate) fn is_integer(s: &str) -> bool {
+fn is_integer(s: &str) -> bool {
     let digits = s.strip_prefix(['+', '-']).unwrap_or(s);
     !digits.is_empty() && digits.bytes().all(|c| c.is_ascii_digit())
 }
 
-pub(crate) struct Parser {
+struct Parser {
     tokens: Vec<Token>,
     pos: usize,
     /// Position reported for "unexpected end of file".
@@ -137,7 +137,7 @@ pub(crate) struct Parser {
 }
 
 impl Parser {
-    pub(crate) fn next(&mut self, what: &str) -> Result<&Token, String> {
+    fn next(&mut self, what: &str) -> Result<&Token, String> {
         match self.tokens.get(self.pos) {
             Some(t) => {
                 self.pos += 1;
@@ -147,7 +147,7 @@ impl Parser {
         }
     }
 
-    pub(crate) fn number(&mut self, what: &str) -> Result<f64, String> {
+    fn number(&mut self, what: &str) -> Result<f64, String> {
         let t = self.next(what)?;
         let v = if is_number(&t.text) { t.text.parse::<f64>().ok() } else { None };
         match v {
@@ -157,7 +157,7 @@ impl Parser {
         }
     }
 
-    pub(crate) fn integer(&mut self, what: &str, min: i64, max: i64) -> Result<i64, String> {
+    fn integer(&mut self, what: &str, min: i64, max: i64) -> Result<i64, String> {
         let t = self.next(what)?;
         let v = if is_integer(&t.text) { t.text.parse::<i64>().ok() } else { None };
         match v {
@@ -168,7 +168,7 @@ impl Parser {
     }
 
     /// A number that must satisfy `ok`; `rule` describes the requirement.
-    pub(crate) fn checked(&mut self, what: &str, rule: &str, ok: impl Fn(f64) -> bool) -> Result<f64, String> {
+    fn checked(&mut self, what: &str, rule: &str, ok: impl Fn(f64) -> bool) -> Result<f64, String> {
         let (line, col) = self.tokens.get(self.pos).map_or(self.end, |t| (t.line, t.col));
         let v = self.number(what)?;
         if ok(v) {
@@ -178,11 +178,11 @@ impl Parser {
         }
     }
 
-    pub(crate) fn vec3(&mut self, what: &str) -> Result<V3, String> {
+    fn vec3(&mut self, what: &str) -> Result<V3, String> {
         Ok(V3::new(self.number(what)?, self.number(what)?, self.number(what)?))
     }
 
-    pub(crate) fn colour(&mut self, what: &str) -> Result<Rgb, String> {
+    fn colour(&mut self, what: &str) -> Result<Rgb, String> {
         Ok([self.number(what)?, self.number(what)?, self.number(what)?])
     }
 }
@@ -331,7 +331,7 @@ pub fn parse(text: &str) -> Result<RefScene, String> {
     Ok(scene)
 }
 
-pub(crate) fn parse_shape(p: &mut Parser, keyword: &str, line: usize, col: usize) -> Result<Shape, String> {
+fn parse_shape(p: &mut Parser, keyword: &str, line: usize, col: usize) -> Result<Shape, String> {
     let positive = |v: f64| v > 0.0;
     let degenerate = || Err(format!("{line}:{col}: degenerate {keyword}"));
     Ok(match keyword {

@@ -8,7 +8,7 @@ use crate::{Object, RefScene, Shape};
 /// Where a secondary ray starts: on object `object`, whose geometric normal
 /// there is `normal`.
 #[derive(Clone, Copy)]
-pub(crate) struct Start {
+struct Start {
     object: usize,
     normal: V3,
 }
@@ -20,7 +20,7 @@ impl RefScene {
     }
 
     /// The viewport (width, height) for an image of the given size.
-    pub(crate) fn viewport_for(&self, width: u32, height: u32) -> (f64, f64) {
+    fn viewport_for(&self, width: u32, height: u32) -> (f64, f64) {
         self.viewport.unwrap_or_else(|| {
             let d = (self.origin - self.viewpoint).length();
             let vw = 2.0 * d * 30f64.to_radians().tan();
@@ -71,7 +71,7 @@ impl RefScene {
 
     /// The nearest hit (t, object index) along the ray, ignoring what the
     /// start rule excludes; ties go to the earlier object.
-    pub(crate) fn nearest(&self, o: V3, d: V3, start: Option<Start>) -> Option<(f64, usize)> {
+    fn nearest(&self, o: V3, d: V3, start: Option<Start>) -> Option<(f64, usize)> {
         let mut best: Option<(f64, usize)> = None;
         for (i, object) in self.objects.iter().enumerate() {
             let Some(roots) = roots_for(object, i, d, start) else {
@@ -87,14 +87,14 @@ impl RefScene {
     }
 
     /// True if any object is hit with 0 < t < max_t.
-    pub(crate) fn blocked(&self, o: V3, d: V3, max_t: f64, start: Start) -> bool {
+    fn blocked(&self, o: V3, d: V3, max_t: f64, start: Start) -> bool {
         self.objects.iter().enumerate().any(|(i, object)| {
             roots_for(object, i, d, Some(start)).and_then(|roots| object.hit(o, d, roots)).is_some_and(|t| t < max_t)
         })
     }
 
     /// The colour seen along the ray o + t·d (d unit length).
-    pub(crate) fn trace(&self, o: V3, d: V3, depth: u32, start: Option<Start>) -> Rgb {
+    fn trace(&self, o: V3, d: V3, depth: u32, start: Option<Start>) -> Rgb {
         let Some((t, index)) = self.nearest(o, d, start) else {
             return self.background;
         };
@@ -161,7 +161,7 @@ impl RefScene {
 /// How object `i` may be hit by a ray with direction `d` that leaves `start`:
 /// `None` if it cannot be hit at all (flat shape it starts on, or a closed
 /// shape it leaves outward), `FarOnly` for a closed shape it enters.
-pub(crate) fn roots_for(object: &Object, i: usize, d: V3, start: Option<Start>) -> Option<Roots> {
+fn roots_for(object: &Object, i: usize, d: V3, start: Option<Start>) -> Option<Roots> {
     match start {
         Some(s) if s.object == i => {
             if object.shape.is_flat() || d.dot(s.normal) >= 0.0 {
@@ -175,7 +175,7 @@ pub(crate) fn roots_for(object: &Object, i: usize, d: V3, start: Option<Start>) 
 }
 
 /// Gamma-correct a mean (already clamped) channel value and round half up.
-pub(crate) fn to_byte(v: f64, gamma: f64) -> u8 {
+fn to_byte(v: f64, gamma: f64) -> u8 {
     let g = v.clamp(0.0, 1.0).powf(1.0 / gamma);
     (255.0 * g + 0.5).floor().clamp(0.0, 255.0) as u8
 }
