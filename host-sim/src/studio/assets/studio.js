@@ -381,7 +381,7 @@ function main() {
   // ----------------------------------------------- view, tools and panel --
 
   const app = { state, $, text, textChanged, scheduleDraft, single, setSingle, replaceStatement, appendStatement };
-  app.view = createView(state, $('wire'));
+  app.view = createView(state, $('wire'), single);
   app.tools = createTools(app);
   app.panel = createPanel(app);
   const drawWire = app.view.draw, showPanel = app.panel.show, setTool = app.tools.setTool, project = app.view.project;

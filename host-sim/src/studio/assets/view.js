@@ -2,8 +2,6 @@
 // objects, lights, eye and view frustum, and the mapping between canvas
 // points and the scene that the tools place with.
 
-import { single as singleIn } from './model.js';
-
 export const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
 export const add = (a, b) => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
 export const scale = (a, k) => [a[0] * k, a[1] * k, a[2] * k];
@@ -11,10 +9,9 @@ const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
 const normalize = (a) => scale(a, 1 / (Math.hypot(...a) || 1));
 
-/** The view over `wire` (a canvas) of `state.model`, seen by `state.camera`. */
-export function createView(state, wire) {
-  const single = (keyword, fallback) => singleIn(state.model || [], keyword, fallback);
-
+/** The view over `wire` (a canvas) of `state.model`, seen by `state.camera`;
+ *  `single(keyword, fallback)` gives the model's one statement of a kind. */
+export function createView(state, wire, single) {
   function basis() {
     const { yaw, pitch } = state.camera;
     const forward = [-Math.cos(pitch) * Math.sin(yaw), -Math.sin(pitch), -Math.cos(pitch) * Math.cos(yaw)];
