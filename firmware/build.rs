@@ -172,7 +172,16 @@ fn main() {
     let plan = |techniques: Techniques, max_depth: u32| {
         let config = OctreeConfig { max_depth, shadow_shafts: techniques.shadow_shafts, ..board.config };
         let counts = needs(&text, accel, &config);
-        (config, techniques, counts, static_bytes(&counts, named_walk, techniques))
+        let profile = ProfileText {
+            name: "",
+            doc: "",
+            counts: &counts,
+            octree: Some(&config),
+            named_walk,
+            first_hits: techniques.first_hits,
+        };
+        let bytes = profile.arena_bytes();
+        (config, techniques, counts, bytes)
     };
     let (octree, techniques, counts, bytes) = (1..=board.config.max_depth)
         .rev()
@@ -268,41 +277,6 @@ impl Techniques {
             .map(|(first_hits, shadow_shafts)| Techniques { first_hits, shadow_shafts })
             .filter(move |t| (self.first_hits || !t.first_hits) && (self.shadow_shafts || !t.shadow_shafts))
     }
-}
-
-/// How many bytes of RAM the arenas for `counts` take (the core's types
-/// hold no pointers or `usize`, so their sizes here are the board's).
-fn static_bytes(counts: &Counts, named_walk: bool, techniques: Techniques) -> usize {
-    use octrace_core::accel::{HashEntry, OctreeNode, ShadowShaft};
-    use octrace_core::math::Vec3;
-    use octrace_core::render::ScreenBound;
-    use octrace_core::scene::{Light, SurfaceEntry};
-    use octrace_core::shapes::{
-        AxisAlignedBox, Rectangle, ShapeHandle, SmoothTriangle, Sphere, Superquadric, Triangle,
-    };
-    use std::mem::size_of;
-    use CapacityKind::*;
-    let per = |kind: CapacityKind| match kind {
-        Objects => size_of::<ShapeHandle>(),
-        Spheres => size_of::<Sphere>(),
-        Boxes => size_of::<AxisAlignedBox>(),
-        Superquadrics => size_of::<Superquadric>(),
-        Triangles => size_of::<Triangle>(),
-        Rectangles => size_of::<Rectangle>(),
-        BsplineTriangles => size_of::<SmoothTriangle>(),
-        ControlPoints => size_of::<Vec3>(),
-        Surfaces => size_of::<SurfaceEntry>(),
-        Lights => size_of::<Light>(),
-        OctreeBoxes => size_of::<OctreeNode<u16>>(),
-        OctreeReferences => size_of::<u16>(),
-    };
-    CapacityKind::ALL.iter().map(|&k| counts.get(k) * per(k)).sum::<usize>()
-        + (counts.octree_hash_entries_if(named_walk) * size_of::<HashEntry<u16>>())
-        + (counts.octree_hash_buckets_if(named_walk) + 1) * size_of::<u16>()
-        + counts.mailbox_words() * size_of::<u32>()
-        + ScreenBound::if_wanted(techniques.first_hits, counts.objects) * size_of::<ScreenBound>()
-        + ScreenBound::if_wanted(techniques.first_hits, ScreenBound::positions_for(counts.objects)) * size_of::<u16>()
-        + counts.octree_shadow_shafts_if(techniques.shadow_shafts) * size_of::<ShadowShaft>()
 }
 
 fn describe(counts: &Counts) -> String {

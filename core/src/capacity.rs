@@ -1,5 +1,6 @@
 //! Fixed-capacity storage and the vocabulary of capacities: the leaf every
-//! sized type builds on (it imports nothing else from the crate).
+//! sized type builds on (it imports nothing else from the crate; the shape
+//! kinds' capacities come from the list in `shape_kinds`).
 //!
 //! Invariants: an [`Arena`] never holds more than its `CAPACITY` items and
 //! hands an item back instead of growing; an empty arena is a constant whose
@@ -93,6 +94,32 @@ impl<T, const N: usize> Arena<T> for HeapArena<T, N> {
 /// struct's fields, their names in messages and in [`crate::profile!`] can
 /// never drift apart.
 macro_rules! capacities {
+    // The shapes' capacities come from the list of shape kinds, after
+    // `Objects` and before the others.
+    (
+        shapes [$($(#[$shape_doc:meta])* $shape:ident($type:ident) in $shape_field:ident: $shape_kind:ident, $shape_what:literal;)*]
+        $($rest:tt)*
+    ) => {
+        capacities! {
+            /// All objects (by default the sum of the shapes).
+            Objects = 1 => objects, "objects";
+            $(#[doc = concat!("The scene's ", $shape_what, ".")] $shape_kind => $shape_field, $shape_what;)*
+            $($rest)*
+        }
+
+        impl Counts {
+            /// The shapes' sum (saturating): the objects a profile needs room for.
+            pub const fn shapes(&self) -> usize {
+                0usize $(.saturating_add(self.$shape_field))*
+            }
+
+            /// These counts with `count` of every shape kind.
+            pub const fn with_every_shape(mut self, count: usize) -> Counts {
+                $(self.$shape_field = count;)*
+                self
+            }
+        }
+    };
     ($($(#[$doc:meta])* $variant:ident $(= $value:literal)? => $field:ident, $what:literal;)*) => {
         /// One capacity of a profile: something a scene can run out of.
         // Numbered from 1, so that `None` of an `Option<CapacityKind>` is
@@ -163,21 +190,7 @@ macro_rules! capacities {
     };
 }
 
-capacities! {
-    /// All objects (by default the sum of the shapes).
-    Objects = 1 => objects, "objects";
-    /// Spheres.
-    Spheres => spheres, "spheres";
-    /// Axis-aligned boxes.
-    Boxes => boxes, "boxes";
-    /// Superquadrics.
-    Superquadrics => superquadrics, "superquadrics";
-    /// Flat triangles.
-    Triangles => triangles, "triangles";
-    /// Rectangles.
-    Rectangles => rectangles, "rectangles";
-    /// The triangles B-spline patches are cut into (two per grid cell).
-    BsplineTriangles => bspline_triangles, "B-spline triangles";
+crate::__shape_kinds!(capacities! {
     /// Control points of the largest B-spline patch (room to evaluate one).
     ControlPoints => control_points, "B-spline control points";
     /// Surface definitions (at most 65,535).
@@ -189,19 +202,9 @@ capacities! {
     /// Object references in the octree's leaves, and working room while
     /// building (an object in several leaves counts once per leaf).
     OctreeReferences => octree_references, "octree references";
-}
+});
 
 impl Counts {
-    /// The shapes' sum (saturating): the objects a profile needs room for.
-    pub const fn shapes(&self) -> usize {
-        self.spheres
-            .saturating_add(self.boxes)
-            .saturating_add(self.superquadrics)
-            .saturating_add(self.triangles)
-            .saturating_add(self.rectangles)
-            .saturating_add(self.bspline_triangles)
-    }
-
     /// Hash-table entries the octree needs: one per subdivided box.
     pub const fn octree_hash_entries(&self) -> usize {
         self.octree_boxes.saturating_sub(1) / 8

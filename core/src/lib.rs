@@ -136,6 +136,7 @@ mod raytracer;
 pub mod render;
 pub mod scene;
 pub mod shade;
+mod shape_kinds;
 pub mod shapes;
 mod sort;
 #[cfg(test)]

@@ -139,21 +139,7 @@ macro_rules! profile {
                 "profile!: octree_boxes and octree_references must be below 65534"
             );
 
-            impl p::SceneCapacities for $name {
-                const NAME: &'static str = stringify!($name);
-                type Objects = p::Vec<p::ShapeHandle, { <$name as $crate::profile::Profile>::COUNTS.objects }>;
-                type Spheres = p::Vec<p::Sphere, { <$name as $crate::profile::Profile>::COUNTS.spheres }>;
-                type Boxes = p::Vec<p::AxisAlignedBox, { <$name as $crate::profile::Profile>::COUNTS.boxes }>;
-                type Superquadrics =
-                    p::Vec<p::Superquadric, { <$name as $crate::profile::Profile>::COUNTS.superquadrics }>;
-                type Triangles = p::Vec<p::Triangle, { <$name as $crate::profile::Profile>::COUNTS.triangles }>;
-                type Rectangles = p::Vec<p::Rectangle, { <$name as $crate::profile::Profile>::COUNTS.rectangles }>;
-                type SmoothTriangles =
-                    p::Vec<p::SmoothTriangle, { <$name as $crate::profile::Profile>::COUNTS.bspline_triangles }>;
-                type ControlPoints = p::Vec<p::Vec3, { <$name as $crate::profile::Profile>::COUNTS.control_points }>;
-                type Surfaces = p::Vec<p::SurfaceEntry, { <$name as $crate::profile::Profile>::COUNTS.surfaces }>;
-                type Lights = p::Vec<p::Light, { <$name as $crate::profile::Profile>::COUNTS.lights }>;
-            }
+            $crate::__shape_kinds!($crate::__scene_capacities! { $name, p::Vec });
 
             impl p::OctreeCapacities for $name {
                 const KINDS: p::ShapeKinds = p::ShapeKinds::with_room(&<$name as $crate::profile::Profile>::COUNTS);
@@ -172,6 +158,32 @@ macro_rules! profile {
                     p::ShadowShaft,
                     { <$name as $crate::profile::Profile>::COUNTS.octree_shadow_shafts_if(<$name as $crate::profile::Profile>::OCTREE.shadow_shafts) },
                 >;
+            }
+        };
+    };
+}
+
+/// Implements `SceneCapacities` for the profile `$name` with arenas of the
+/// type `$arena` sized by its `COUNTS`, one per shape kind from the list
+/// (`__shape_kinds!`); not a public API ([`profile!`](crate::profile!) and
+/// the `Host` profile expand it).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __scene_capacities {
+    (
+        shapes [$($(#[$doc:meta])* $kind:ident($type:ident) in $field:ident: $capacity:ident, $what:literal;)*]
+        $name:ident, $($arena:ident)::+
+    ) => {
+        const _: () = {
+            type ArenaOf<T, const N: usize> = $($arena)::+<T, N>;
+
+            impl $crate::scene::SceneCapacities for $name {
+                const NAME: &'static str = stringify!($name);
+                type Objects = ArenaOf<$crate::shapes::ShapeHandle, { <$name as $crate::profile::Profile>::COUNTS.objects }>;
+                $(type $capacity = ArenaOf<$crate::shapes::$type, { <$name as $crate::profile::Profile>::COUNTS.$field }>;)*
+                type ControlPoints = ArenaOf<$crate::math::Vec3, { <$name as $crate::profile::Profile>::COUNTS.control_points }>;
+                type Surfaces = ArenaOf<$crate::scene::SurfaceEntry, { <$name as $crate::profile::Profile>::COUNTS.surfaces }>;
+                type Lights = ArenaOf<$crate::scene::Light, { <$name as $crate::profile::Profile>::COUNTS.lights }>;
             }
         };
     };
@@ -254,6 +266,50 @@ pub struct ProfileText<'a> {
     pub first_hits: bool,
 }
 
+impl ProfileText<'_> {
+    /// About how many bytes of RAM the profile's arenas take on a board: its
+    /// counts times their items' sizes (the core's types hold no pointer or
+    /// `usize`, so a build script running on the host gets the board's
+    /// sizes), with the hash table, the mailbox and the techniques' room. A
+    /// build script weighs a scene against a board's RAM with it.
+    ///
+    /// ```
+    /// use octrace_core::{parse::count, profile::ProfileText};
+    ///
+    /// let one = count("SPHERE 1 1 0 0 0\n");
+    /// let two = count("SPHERE 1 1 0 0 0\nSPHERE 1 1 3 0 0\n");
+    /// let text = |counts| ProfileText { name: "Scene", doc: "", counts, octree: None, named_walk: false, first_hits: false };
+    /// assert!(text(&two).arena_bytes() > text(&one).arena_bytes());
+    /// ```
+    pub fn arena_bytes(&self) -> usize {
+        use crate::accel::{HashEntry, OctreeNode, ShadowShaft};
+        use crate::math::Vec3;
+        use crate::scene::{Light, SurfaceEntry};
+        use crate::shapes::{ShapeHandle, ShapeKind};
+        use core::mem::size_of;
+
+        let counts = self.counts;
+        let shadow_shafts = self.octree.is_some_and(|octree| octree.shadow_shafts);
+        let mut shapes = 0;
+        for kind in ShapeKind::ALL {
+            shapes += counts.get(kind.capacity()) * kind.item_bytes();
+        }
+        shapes
+            + counts.objects * size_of::<ShapeHandle>()
+            + counts.control_points * size_of::<Vec3>()
+            + counts.surfaces * size_of::<SurfaceEntry>()
+            + counts.lights * size_of::<Light>()
+            + counts.octree_boxes * size_of::<OctreeNode<u16>>()
+            + counts.octree_references * size_of::<u16>()
+            + counts.octree_hash_entries_if(self.named_walk) * size_of::<HashEntry<u16>>()
+            + (counts.octree_hash_buckets_if(self.named_walk) + 1) * size_of::<u16>()
+            + counts.mailbox_words() * size_of::<u32>()
+            + ScreenBound::if_wanted(self.first_hits, counts.objects) * size_of::<ScreenBound>()
+            + ScreenBound::if_wanted(self.first_hits, ScreenBound::positions_for(counts.objects)) * size_of::<u16>()
+            + counts.octree_shadow_shafts_if(shadow_shafts) * size_of::<ShadowShaft>()
+    }
+}
+
 impl core::fmt::Display for ProfileText<'_> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         writeln!(f, "octrace_core::profile! {{")?;
@@ -277,12 +333,8 @@ impl core::fmt::Display for ProfileText<'_> {
 pub mod __private {
     pub use crate::accel::{HashEntry, Octree, OctreeCapacities, OctreeConfig, OctreeNode, ShadowShaft};
     pub use crate::capacity::Counts;
-    pub use crate::math::Vec3;
     pub use crate::render::ScreenBound;
-    pub use crate::scene::{Light, SceneCapacities, SurfaceEntry};
-    pub use crate::shapes::{
-        AxisAlignedBox, Rectangle, ShapeHandle, ShapeKinds, SmoothTriangle, Sphere, Superquadric, Triangle,
-    };
+    pub use crate::shapes::ShapeKinds;
     pub use heapless::Vec;
 
     /// The value given, if one was, else `default`.
@@ -325,28 +377,21 @@ mod host {
     use super::{Host, Profile};
     use crate::accel::{HashEntry, Octree, OctreeCapacities, OctreeConfig, OctreeNode, ShadowShaft, MAX_DEPTH};
     use crate::capacity::{Counts, HeapArena};
-    use crate::math::Vec3;
     use crate::render::ScreenBound;
-    use crate::scene::{Light, SceneCapacities, SurfaceEntry};
-    use crate::shapes::{AxisAlignedBox, Rectangle, ShapeHandle, SmoothTriangle, Sphere, Superquadric, Triangle};
 
     const MILLION: usize = 1_000_000;
 
     impl Profile for Host {
         const COUNTS: Counts = Counts {
             objects: MILLION,
-            spheres: MILLION,
-            boxes: MILLION,
-            superquadrics: MILLION,
-            triangles: MILLION,
-            rectangles: MILLION,
-            bspline_triangles: MILLION,
             control_points: 1_048_576,
             surfaces: 65_535,
             lights: 4_096,
             octree_boxes: 16_000_000,
             octree_references: 64_000_000,
-        };
+            ..Counts::ZERO
+        }
+        .with_every_shape(MILLION);
         // RAM is plenty: shadow shafts on.
         const OCTREE: OctreeConfig = OctreeConfig { shadow_shafts: true, ..OctreeConfig::DEFAULT };
         type Octree = Octree<Host, { MAX_DEPTH as usize + 1 }>;
@@ -356,19 +401,7 @@ mod host {
         type ScreenPositions = HeapArena<u16, { ScreenBound::positions_for(Host::COUNTS.objects) }>;
     }
 
-    impl SceneCapacities for Host {
-        const NAME: &'static str = "Host";
-        type Objects = HeapArena<ShapeHandle, { Host::COUNTS.objects }>;
-        type Spheres = HeapArena<Sphere, { Host::COUNTS.spheres }>;
-        type Boxes = HeapArena<AxisAlignedBox, { Host::COUNTS.boxes }>;
-        type Superquadrics = HeapArena<Superquadric, { Host::COUNTS.superquadrics }>;
-        type Triangles = HeapArena<Triangle, { Host::COUNTS.triangles }>;
-        type Rectangles = HeapArena<Rectangle, { Host::COUNTS.rectangles }>;
-        type SmoothTriangles = HeapArena<SmoothTriangle, { Host::COUNTS.bspline_triangles }>;
-        type ControlPoints = HeapArena<Vec3, { Host::COUNTS.control_points }>;
-        type Surfaces = HeapArena<SurfaceEntry, { Host::COUNTS.surfaces }>;
-        type Lights = HeapArena<Light, { Host::COUNTS.lights }>;
-    }
+    crate::__shape_kinds!(crate::__scene_capacities! { Host, HeapArena });
 
     impl OctreeCapacities for Host {
         type Index = u32;

@@ -40,7 +40,7 @@ fn random_patches_match_the_f64_evaluation() {
         // `{}` prints the shortest decimal that reads back as the same f64.
         let patch = Patch { order, rows, cols, points };
         let expected = patch.triangles(su, sv);
-        let got = scene.view().smooth_triangles;
+        let got = scene.view().bspline_triangles;
         assert_eq!(got.len(), expected.len(), "round {round}: triangle count");
         for (t, e) in got.iter().zip(&expected) {
             let Shape::SmoothTriangle { p, normals, .. } = e else { panic!("smooth triangles") };

@@ -18,15 +18,18 @@ use std::time::{Duration, Instant};
 
 /// The host-sim binary, built for this test run.
 fn host_sim_binary() -> PathBuf {
-    let status = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
-        .args(["build", "-p", "host-sim", "--bin", "host-sim"])
-        .current_dir(repo())
-        .status()
-        .expect("cargo runs");
-    assert!(status.success(), "host-sim builds");
     let exe = std::env::current_exe().expect("the test's path");
-    // target/<profile>/deps/studio-… → target/<profile>/host-sim
-    let binary = exe.parent().and_then(Path::parent).expect("a target directory").join("host-sim");
+    // target/<profile>/deps/studio-… → target/<profile>/host-sim, built in
+    // the test's own profile (a stale binary of the other would be tested).
+    let profile_dir = exe.parent().and_then(Path::parent).expect("a target directory");
+    let mut build = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
+    build.args(["build", "-p", "host-sim", "--bin", "host-sim"]).current_dir(repo());
+    if profile_dir.ends_with("release") {
+        build.arg("--release");
+    }
+    let status = build.status().expect("cargo runs");
+    assert!(status.success(), "host-sim builds");
+    let binary = profile_dir.join("host-sim");
     assert!(binary.exists(), "{} exists", binary.display());
     binary
 }

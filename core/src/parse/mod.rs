@@ -363,7 +363,7 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
                 if radius.to_bits() <= 0 {
                     return self.report(too_small());
                 }
-                let r = self.scene.push_sphere(Sphere::new(norm.point(center), radius, surface));
+                let r = self.scene.push_shape(Sphere::new(norm.point(center), radius, surface));
                 if let Err(e) = r {
                     self.capacity(pos, e);
                 }
@@ -378,7 +378,7 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
                     return self.report(too_small());
                 }
                 let b = AxisAlignedBox { min, max, surface };
-                if let Err(e) = self.scene.push_box(b) {
+                if let Err(e) = self.scene.push_shape(b) {
                     self.capacity(pos, e);
                 }
             }
@@ -393,7 +393,7 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
                 }
                 let power = crate::math::Scalar::from_bits(statement::q32_to_q16(power.to_bits()) as i32);
                 let q = Superquadric::new(norm.point(center), half, power, surface);
-                if let Err(e) = self.scene.push_superquadric(q) {
+                if let Err(e) = self.scene.push_shape(q) {
                     self.capacity(pos, e);
                 }
             }
@@ -407,7 +407,7 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
                 let Some(t) = Triangle::new(corners.map(|c| norm.point(c)), surface) else {
                     return self.report(too_small());
                 };
-                if let Err(e) = self.scene.push_triangle(t) {
+                if let Err(e) = self.scene.push_shape(t) {
                     self.capacity(pos, e);
                 }
             }
@@ -425,7 +425,7 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
                 let Some(r) = Rectangle::new(corners.map(|c| norm.point(c)), surface) else {
                     return self.report(too_small());
                 };
-                if let Err(e) = self.scene.push_rectangle(r) {
+                if let Err(e) = self.scene.push_shape(r) {
                     self.capacity(pos, e);
                 }
             }
@@ -931,7 +931,7 @@ mod tests {
         let s = ok(&format!("BSPLINE 1 3 3 3 4 3 {GRID} SPHERE 1 1 5 5 5 {SURF}"));
         let v = s.view();
         // 2 · (4 − 1) · (3 − 1) triangles, in file order before the sphere.
-        assert_eq!(v.smooth_triangles.len(), 12);
+        assert_eq!(v.bspline_triangles.len(), 12);
         assert_eq!(v.object_count(), 13);
         assert_eq!(v.objects[12].kind(), ShapeKind::Sphere);
         assert!(v.objects[..12].iter().all(|h| h.kind() == ShapeKind::SmoothTriangle));
@@ -942,7 +942,7 @@ mod tests {
         assert_eq!(written, [[0].as_slice(), &[1; 8], &[9; 8]].concat());
         // Keywords are case-insensitive and the points may span lines.
         let t = ok(&format!("bspline 1 2 3 3 2 2\n{}\n{SURF}", GRID.replace("   ", "\n")));
-        assert_eq!(t.view().smooth_triangles.len(), 2);
+        assert_eq!(t.view().bspline_triangles.len(), 2);
     }
 
     #[test]

@@ -25,8 +25,8 @@ pub use surface::{Color, Surface, SurfaceEntry};
 use crate::capacity::{Arena, CapacityError, CapacityKind};
 use crate::math::{Scalar, Vec3, Wide};
 use crate::shapes::{
-    AxisAlignedBox, Leaving, Ray, Rectangle, ShapeHandle, ShapeKind, ShapeKinds, ShapeRef, SmoothTriangle, Sphere,
-    Superquadric, Triangle,
+    AxisAlignedBox, Leaving, Ray, Rectangle, Shape, ShapeHandle, ShapeKind, ShapeKinds, ShapeRef, SmoothTriangle,
+    Sphere, Superquadric, Triangle,
 };
 
 /// An object's position in the scene file (0 for the first object).
@@ -68,65 +68,176 @@ impl Default for Settings {
     }
 }
 
-/// The arenas a [`Scene`] is stored in, each a fixed-capacity [`Arena`].
-/// Every profile implements it; define one with [`crate::profile!`], which
-/// names counts, not these types.
-pub trait SceneCapacities {
-    /// The profile's name, shown in capacity errors.
-    const NAME: &'static str;
-    /// All objects, in file order.
-    type Objects: Arena<ShapeHandle>;
-    /// Spheres.
-    type Spheres: Arena<Sphere>;
-    /// Axis-aligned boxes.
-    type Boxes: Arena<AxisAlignedBox>;
-    /// Superquadrics.
-    type Superquadrics: Arena<Superquadric>;
-    /// Flat triangles.
-    type Triangles: Arena<Triangle>;
-    /// Rectangles.
-    type Rectangles: Arena<Rectangle>;
-    /// The triangles of B-spline patches.
-    type SmoothTriangles: Arena<SmoothTriangle>;
-    /// Room for one patch's control points while it is evaluated.
-    type ControlPoints: Arena<Vec3>;
-    /// Surface definitions; at most 65,535 (objects refer to them by `u16`).
-    type Surfaces: Arena<SurfaceEntry>;
-    /// Point lights.
-    type Lights: Arena<Light>;
+/// Declares the scene's arenas, one per shape kind from the list of shape
+/// kinds (`crate::shape_kinds`), and what reads and fills them by kind.
+macro_rules! scene_arenas {
+    (shapes [$($(#[$doc:meta])* $kind:ident($type:ident) in $field:ident: $capacity:ident, $what:literal;)*]) => {
+        /// The arenas a [`Scene`] is stored in, each a fixed-capacity [`Arena`].
+        /// Every profile implements it; define one with [`crate::profile!`], which
+        /// names counts, not these types.
+        pub trait SceneCapacities {
+            /// The profile's name, shown in capacity errors.
+            const NAME: &'static str;
+            /// All objects, in file order.
+            type Objects: Arena<ShapeHandle>;
+            $(#[doc = concat!("The ", $what, ".")] type $capacity: Arena<$type>;)*
+            /// Room for one patch's control points while it is evaluated.
+            type ControlPoints: Arena<Vec3>;
+            /// Surface definitions; at most 65,535 (objects refer to them by `u16`).
+            type Surfaces: Arena<SurfaceEntry>;
+            /// Point lights.
+            type Lights: Arena<Light>;
+        }
+
+        /// Scene storage sized by the profile `C`.
+        ///
+        /// An empty scene is all zero bits; [`crate::parse::parse`] fills it, and
+        /// [`Scene::view`] is what the renderer and the accelerators read:
+        ///
+        /// ```
+        /// use octrace_core::{parse::parse, profile::Board16K, scene::Scene};
+        ///
+        /// let mut scene = Scene::<Board16K>::new();
+        /// let text = "RASTER 32 24\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nLIGHT 10 5 5 5\n";
+        /// parse(text, &mut scene, &mut |e| panic!("{e}")).unwrap();
+        /// assert_eq!(scene.settings.raster, [32, 24]);
+        /// let view = scene.view();
+        /// assert_eq!((view.object_count(), view.lights.len(), view.surfaces.len()), (1, 1, 1));
+        /// ```
+        pub struct Scene<C: SceneCapacities> {
+            objects: C::Objects,
+            $($field: C::$capacity,)*
+            /// Scratch: the control points of the patch being evaluated.
+            control_points: C::ControlPoints,
+            surfaces: C::Surfaces,
+            lights: C::Lights,
+            /// The scene parameters (zero until a scene is loaded).
+            pub settings: Settings,
+            /// How world coordinates map to the normalised space the tracer works in.
+            pub normalization: Normalization,
+        }
+
+        impl<C: SceneCapacities> Scene<C> {
+            /// An empty scene, not loaded yet ([`crate::parse::parse`] fills it; its
+            /// settings are all zero until then). A constant of all-zero bits: in a
+            /// `static` it lands in `.bss`, costing no flash and no copy.
+            pub const fn new() -> Self {
+                Scene {
+                    objects: C::Objects::EMPTY,
+                    $($field: C::$capacity::EMPTY,)*
+                    control_points: C::ControlPoints::EMPTY,
+                    surfaces: C::Surfaces::EMPTY,
+                    lights: C::Lights::EMPTY,
+                    settings: UNLOADED_SETTINGS,
+                    normalization: Normalization::UNLOADED,
+                }
+            }
+
+            /// Empties the scene and resets the parameters to their defaults.
+            pub fn clear(&mut self) {
+                self.objects.clear();
+                $(self.$field.clear();)*
+                self.control_points.clear();
+                self.surfaces.clear();
+                self.lights.clear();
+                self.settings = Settings::default();
+                self.normalization = Normalization::IDENTITY;
+            }
+
+            /// The loaded scene, read-only, as the tracer and accelerators see it.
+            pub fn view(&self) -> SceneView<'_> {
+                SceneView {
+                    objects: self.objects.as_slice(),
+                    $($field: self.$field.as_slice(),)*
+                    surfaces: self.surfaces.as_slice(),
+                    lights: self.lights.as_slice(),
+                    settings: &self.settings,
+                    normalization: self.normalization,
+                }
+            }
+
+            /// How many objects of `kind` the profile holds (at most what a
+            /// [`ShapeHandle`] addresses).
+            pub(crate) fn capacity_of(kind: ShapeKind) -> usize {
+                let capacity = match kind {
+                    $(ShapeKind::$kind => C::$capacity::CAPACITY,)*
+                };
+                capacity.min(ShapeHandle::MAX_INDEX)
+            }
+
+            fn len_of(&self, kind: ShapeKind) -> usize {
+                match kind {
+                    $(ShapeKind::$kind => self.$field.as_slice().len(),)*
+                }
+            }
+        }
+
+        $(
+            impl Stored for $type {
+                const KIND: ShapeKind = ShapeKind::$kind;
+
+                fn push_into<C: SceneCapacities>(self, scene: &mut Scene<C>) -> Result<usize, CapacityError> {
+                    push(&mut scene.$field, self, CapacityKind::$capacity, C::NAME)
+                }
+            }
+        )*
+
+        /// A read-only view of a scene: what the tracer and the accelerators use.
+        #[derive(Clone, Copy, Debug)]
+        pub struct SceneView<'a> {
+            /// Every object, in the order the scene wrote them: an [`ObjectId`] indexes it.
+            pub objects: &'a [ShapeHandle],
+            $(#[doc = concat!("The ", $what, ".")] pub $field: &'a [$type],)*
+            /// The surfaces, sorted by number.
+            pub surfaces: &'a [SurfaceEntry],
+            /// The point lights.
+            pub lights: &'a [Light],
+            /// The scene parameters.
+            pub settings: &'a Settings,
+            /// How world coordinates map to normalised space.
+            pub normalization: Normalization,
+        }
+
+        impl<'a> SceneView<'a> {
+            /// The primitive behind a handle.
+            #[inline]
+            pub fn shape_of(&self, h: ShapeHandle) -> ShapeRef<'a> {
+                let i = h.index();
+                match h.kind() {
+                    $(ShapeKind::$kind => ShapeRef::$kind(&self.$field[i]),)*
+                }
+            }
+
+            /// [`ShapeRef::intersect_among`] of the primitive behind a handle,
+            /// straight from the handle's kind (the object loops' step).
+            #[inline(always)]
+            pub(crate) fn intersect_handle(
+                &self,
+                kinds: ShapeKinds,
+                h: ShapeHandle,
+                ray: &Ray,
+                t_max: Scalar,
+                leaving: Leaving,
+            ) -> Option<Scalar> {
+                let i = h.index();
+                match h.kind() {
+                    $(ShapeKind::$kind if kinds.contains(ShapeKind::$kind) => self.$field.get(i)?.intersect(ray, t_max, leaving),)*
+                    _ => None,
+                }
+            }
+        }
+    };
 }
 
-/// Scene storage sized by the profile `C`.
-///
-/// An empty scene is all zero bits; [`crate::parse::parse`] fills it, and
-/// [`Scene::view`] is what the renderer and the accelerators read:
-///
-/// ```
-/// use octrace_core::{parse::parse, profile::Board16K, scene::Scene};
-///
-/// let mut scene = Scene::<Board16K>::new();
-/// let text = "RASTER 32 24\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nLIGHT 10 5 5 5\n";
-/// parse(text, &mut scene, &mut |e| panic!("{e}")).unwrap();
-/// assert_eq!(scene.settings.raster, [32, 24]);
-/// let view = scene.view();
-/// assert_eq!((view.object_count(), view.lights.len(), view.surfaces.len()), (1, 1, 1));
-/// ```
-pub struct Scene<C: SceneCapacities> {
-    objects: C::Objects,
-    spheres: C::Spheres,
-    boxes: C::Boxes,
-    superquadrics: C::Superquadrics,
-    triangles: C::Triangles,
-    rectangles: C::Rectangles,
-    smooth_triangles: C::SmoothTriangles,
-    /// Scratch: the control points of the patch being evaluated.
-    control_points: C::ControlPoints,
-    surfaces: C::Surfaces,
-    lights: C::Lights,
-    /// The scene parameters (zero until a scene is loaded).
-    pub settings: Settings,
-    /// How world coordinates map to the normalised space the tracer works in.
-    pub normalization: Normalization,
+crate::__shape_kinds!(scene_arenas! {});
+
+/// A primitive the scene stores: which arena it goes in.
+pub(crate) trait Stored: Shape + Sized {
+    /// Its kind.
+    const KIND: ShapeKind;
+
+    /// Appends it to its arena, or names the capacity; returns its index there.
+    fn push_into<C: SceneCapacities>(self, scene: &mut Scene<C>) -> Result<usize, CapacityError>;
 }
 
 impl<C: SceneCapacities> core::fmt::Debug for Scene<C> {
@@ -158,84 +269,6 @@ fn push<T, A: Arena<T>>(
 }
 
 impl<C: SceneCapacities> Scene<C> {
-    /// An empty scene, not loaded yet ([`crate::parse::parse`] fills it; its
-    /// settings are all zero until then). A constant of all-zero bits: in a
-    /// `static` it lands in `.bss`, costing no flash and no copy.
-    pub const fn new() -> Self {
-        Scene {
-            objects: C::Objects::EMPTY,
-            spheres: C::Spheres::EMPTY,
-            boxes: C::Boxes::EMPTY,
-            superquadrics: C::Superquadrics::EMPTY,
-            triangles: C::Triangles::EMPTY,
-            rectangles: C::Rectangles::EMPTY,
-            smooth_triangles: C::SmoothTriangles::EMPTY,
-            control_points: C::ControlPoints::EMPTY,
-            surfaces: C::Surfaces::EMPTY,
-            lights: C::Lights::EMPTY,
-            settings: UNLOADED_SETTINGS,
-            normalization: Normalization::UNLOADED,
-        }
-    }
-
-    /// Empties the scene and resets the parameters to their defaults.
-    pub fn clear(&mut self) {
-        self.objects.clear();
-        self.spheres.clear();
-        self.boxes.clear();
-        self.superquadrics.clear();
-        self.triangles.clear();
-        self.rectangles.clear();
-        self.smooth_triangles.clear();
-        self.control_points.clear();
-        self.surfaces.clear();
-        self.lights.clear();
-        self.settings = Settings::default();
-        self.normalization = Normalization::IDENTITY;
-    }
-
-    /// The loaded scene, read-only, as the tracer and accelerators see it.
-    pub fn view(&self) -> SceneView<'_> {
-        SceneView {
-            objects: self.objects.as_slice(),
-            spheres: self.spheres.as_slice(),
-            boxes: self.boxes.as_slice(),
-            superquadrics: self.superquadrics.as_slice(),
-            triangles: self.triangles.as_slice(),
-            rectangles: self.rectangles.as_slice(),
-            smooth_triangles: self.smooth_triangles.as_slice(),
-            surfaces: self.surfaces.as_slice(),
-            lights: self.lights.as_slice(),
-            settings: &self.settings,
-            normalization: self.normalization,
-        }
-    }
-
-    /// How many objects of `kind` the profile holds (at most what a
-    /// [`ShapeHandle`] addresses).
-    pub(crate) fn capacity_of(kind: ShapeKind) -> usize {
-        let capacity = match kind {
-            ShapeKind::Sphere => C::Spheres::CAPACITY,
-            ShapeKind::Box => C::Boxes::CAPACITY,
-            ShapeKind::Superquadric => C::Superquadrics::CAPACITY,
-            ShapeKind::Triangle => C::Triangles::CAPACITY,
-            ShapeKind::Rectangle => C::Rectangles::CAPACITY,
-            ShapeKind::SmoothTriangle => C::SmoothTriangles::CAPACITY,
-        };
-        capacity.min(ShapeHandle::MAX_INDEX)
-    }
-
-    fn len_of(&self, kind: ShapeKind) -> usize {
-        match kind {
-            ShapeKind::Sphere => self.spheres.as_slice().len(),
-            ShapeKind::Box => self.boxes.as_slice().len(),
-            ShapeKind::Superquadric => self.superquadrics.as_slice().len(),
-            ShapeKind::Triangle => self.triangles.as_slice().len(),
-            ShapeKind::Rectangle => self.rectangles.as_slice().len(),
-            ShapeKind::SmoothTriangle => self.smooth_triangles.as_slice().len(),
-        }
-    }
-
     pub(crate) fn full(kind: CapacityKind, capacity: usize) -> CapacityError {
         CapacityError { kind, capacity, needed: None, profile: C::NAME }
     }
@@ -259,41 +292,11 @@ impl<C: SceneCapacities> Scene<C> {
         Ok(())
     }
 
-    /// Stores one object of `kind` built by `make` from its index in its
-    /// arena, after checking the room once.
-    fn push_shape<T, A: Arena<T>>(
-        &mut self,
-        kind: ShapeKind,
-        item: T,
-        arena: impl FnOnce(&mut Self) -> &mut A,
-    ) -> Result<(), CapacityError> {
-        self.check_room(kind, 1)?;
-        let index = push(arena(self), item, kind.capacity(), C::NAME)?;
-        push(&mut self.objects, ShapeHandle::new(kind, index), CapacityKind::Objects, C::NAME).map(|_| ())
-    }
-
-    pub(crate) fn push_sphere(&mut self, s: Sphere) -> Result<(), CapacityError> {
-        self.push_shape(ShapeKind::Sphere, s, |scene| &mut scene.spheres)
-    }
-
-    pub(crate) fn push_box(&mut self, s: AxisAlignedBox) -> Result<(), CapacityError> {
-        self.push_shape(ShapeKind::Box, s, |scene| &mut scene.boxes)
-    }
-
-    pub(crate) fn push_superquadric(&mut self, s: Superquadric) -> Result<(), CapacityError> {
-        self.push_shape(ShapeKind::Superquadric, s, |scene| &mut scene.superquadrics)
-    }
-
-    pub(crate) fn push_triangle(&mut self, s: Triangle) -> Result<(), CapacityError> {
-        self.push_shape(ShapeKind::Triangle, s, |scene| &mut scene.triangles)
-    }
-
-    pub(crate) fn push_rectangle(&mut self, s: Rectangle) -> Result<(), CapacityError> {
-        self.push_shape(ShapeKind::Rectangle, s, |scene| &mut scene.rectangles)
-    }
-
-    fn push_smooth_triangle(&mut self, s: SmoothTriangle) -> Result<(), CapacityError> {
-        self.push_shape(ShapeKind::SmoothTriangle, s, |scene| &mut scene.smooth_triangles)
+    /// Stores one object, after checking the room for it and its handle.
+    pub(crate) fn push_shape<S: Stored>(&mut self, shape: S) -> Result<(), CapacityError> {
+        self.check_room(S::KIND, 1)?;
+        let index = shape.push_into(self)?;
+        push(&mut self.objects, ShapeHandle::new(S::KIND, index), CapacityKind::Objects, C::NAME).map(|_| ())
     }
 
     /// Replaces the control-point scratch with `points`, or names the
@@ -318,7 +321,7 @@ impl<C: SceneCapacities> Scene<C> {
         let first = self.objects.as_slice().len() as u32;
         if let Some(patch) = crate::shapes::Bspline::new(order, rows, cols, points.as_slice()) {
             patch.triangles(samples[0], samples[1], surface, |t| {
-                if self.push_smooth_triangle(SmoothTriangle { patch: first, ..t }).is_ok() {
+                if self.push_shape(SmoothTriangle { patch: first, ..t }).is_ok() {
                     made += 1;
                 }
             });
@@ -370,33 +373,6 @@ const DEFAULT_SETTINGS: Settings = Settings {
     samples: 1,
 };
 
-/// A read-only view of a scene: what the tracer and the accelerators use.
-#[derive(Clone, Copy, Debug)]
-pub struct SceneView<'a> {
-    /// Every object, in the order the scene wrote them: an [`ObjectId`] indexes it.
-    pub objects: &'a [ShapeHandle],
-    /// The spheres' arena.
-    pub spheres: &'a [Sphere],
-    /// The boxes' arena.
-    pub boxes: &'a [AxisAlignedBox],
-    /// The superquadrics' arena.
-    pub superquadrics: &'a [Superquadric],
-    /// The triangles' arena.
-    pub triangles: &'a [Triangle],
-    /// The rectangles' arena.
-    pub rectangles: &'a [Rectangle],
-    /// The B-spline patches' triangles.
-    pub smooth_triangles: &'a [SmoothTriangle],
-    /// The surfaces, sorted by number.
-    pub surfaces: &'a [SurfaceEntry],
-    /// The point lights.
-    pub lights: &'a [Light],
-    /// The scene parameters.
-    pub settings: &'a Settings,
-    /// How world coordinates map to normalised space.
-    pub normalization: Normalization,
-}
-
 impl<'a> SceneView<'a> {
     /// The object `id`. Panics only for an id not taken from this scene.
     #[inline]
@@ -412,50 +388,8 @@ impl<'a> SceneView<'a> {
         // The handle's kind first: this runs for every primary ray.
         let h = self.objects[id.0 as usize];
         match h.kind() {
-            ShapeKind::SmoothTriangle => ObjectId(self.smooth_triangles[h.index()].patch),
+            ShapeKind::SmoothTriangle => ObjectId(self.bspline_triangles[h.index()].patch),
             _ => id,
-        }
-    }
-
-    #[inline]
-    /// The primitive behind a handle.
-    pub fn shape_of(&self, h: ShapeHandle) -> ShapeRef<'a> {
-        let i = h.index();
-        match h.kind() {
-            ShapeKind::Sphere => ShapeRef::Sphere(&self.spheres[i]),
-            ShapeKind::Box => ShapeRef::Box(&self.boxes[i]),
-            ShapeKind::Superquadric => ShapeRef::Superquadric(&self.superquadrics[i]),
-            ShapeKind::Triangle => ShapeRef::Triangle(&self.triangles[i]),
-            ShapeKind::Rectangle => ShapeRef::Rectangle(&self.rectangles[i]),
-            ShapeKind::SmoothTriangle => ShapeRef::SmoothTriangle(&self.smooth_triangles[i]),
-        }
-    }
-
-    /// [`ShapeRef::intersect_among`] of the primitive behind a handle,
-    /// straight from the handle's kind (the object loops' step).
-    #[inline(always)]
-    pub(crate) fn intersect_handle(
-        &self,
-        kinds: ShapeKinds,
-        h: ShapeHandle,
-        ray: &Ray,
-        t_max: Scalar,
-        leaving: Leaving,
-    ) -> Option<Scalar> {
-        use ShapeKind as K;
-        let i = h.index();
-        match h.kind() {
-            K::Sphere if kinds.contains(K::Sphere) => self.spheres.get(i)?.intersect(ray, t_max, leaving),
-            K::Box if kinds.contains(K::Box) => self.boxes.get(i)?.intersect(ray, t_max, leaving),
-            K::Superquadric if kinds.contains(K::Superquadric) => {
-                self.superquadrics.get(i)?.intersect(ray, t_max, leaving)
-            }
-            K::Triangle if kinds.contains(K::Triangle) => self.triangles.get(i)?.intersect(ray, t_max, leaving),
-            K::Rectangle if kinds.contains(K::Rectangle) => self.rectangles.get(i)?.intersect(ray, t_max, leaving),
-            K::SmoothTriangle if kinds.contains(K::SmoothTriangle) => {
-                self.smooth_triangles.get(i)?.intersect(ray, t_max, leaving)
-            }
-            _ => None,
         }
     }
 
@@ -517,13 +451,13 @@ mod tests {
         let mut scene: Scene<Board16K> = Scene::new();
         let b = AxisAlignedBox::new(Vec3::ZERO, Vec3::from_bits([1 << 16; 3]), 0);
         for _ in 0..2 {
-            scene.push_box(b).unwrap();
+            scene.push_shape(b).unwrap();
         }
-        let e = scene.push_box(b).unwrap_err();
+        let e = scene.push_shape(b).unwrap_err();
         assert_eq!((e.kind, e.capacity, e.profile), (CapacityKind::Boxes, 2, "Board16K"));
         assert_eq!(scene.view().object_count(), 2);
         let s = Sphere::new(Vec3::ZERO, Scalar::ONE, 0);
-        scene.push_sphere(s).unwrap();
+        scene.push_shape(s).unwrap();
         assert_eq!(scene.view().objects[2].kind(), ShapeKind::Sphere);
     }
 }

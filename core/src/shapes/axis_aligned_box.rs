@@ -5,7 +5,7 @@
 //! and divides once, for the crossing it returns: a ray parallel to a face, or
 //! nearly so, needs no special case and cannot overflow.
 
-use super::{Aabb, Leaving, Ratio, Ray};
+use super::{Aabb, Leaving, Ratio, Ray, Shape};
 use crate::math::{Dir, Scalar, Vec3};
 
 /// A BOX: its corners in normalised space.
@@ -71,9 +71,13 @@ impl AxisAlignedBox {
     pub fn new(center: Vec3, half: Vec3, surface: u16) -> AxisAlignedBox {
         AxisAlignedBox { min: center - half, max: center + half, surface }
     }
+}
+
+impl Shape for AxisAlignedBox {
+    const FLAT: bool = false;
 
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
+    fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
         if leaving == Leaving::Outward {
             return None;
         }
@@ -92,7 +96,7 @@ impl AxisAlignedBox {
 
     /// Outward normal of the face nearest to `p` (relative to each half-size);
     /// on an edge or corner the lowest axis wins.
-    pub fn normal_at(&self, p: Vec3) -> Dir {
+    fn normal_at(&self, p: Vec3) -> Dir {
         let c = [0, 1, 2].map(|a| (self.min.axis(a).to_bits() as i64 + self.max.axis(a).to_bits() as i64) / 2);
         let h = [0, 1, 2].map(|a| (self.max.axis(a).to_bits() as i64 - self.min.axis(a).to_bits() as i64).max(1));
         let off = [0, 1, 2].map(|a| p.axis(a).to_bits() as i64 - c[a]);
@@ -106,8 +110,12 @@ impl AxisAlignedBox {
         Dir::axis_unit(best, off[best] < 0)
     }
 
-    pub fn bounds(&self) -> Aabb {
+    fn bounds(&self) -> Aabb {
         Aabb { min: self.min, max: self.max }
+    }
+
+    fn surface(&self) -> u16 {
+        self.surface
     }
 }
 

@@ -4,7 +4,10 @@
 //! Every primitive answers three questions, as pbrt splits them: a cheap hit
 //! test that returns only the ray parameter ([`ShapeRef::intersect`]), the
 //! surface normal at a point found by that test ([`ShapeRef::normal_at`]), and
-//! its bounds for the acceleration structures ([`ShapeRef::bounds`]).
+//! its bounds for the acceleration structures ([`ShapeRef::bounds`]). Each
+//! file answers them in its `Shape` implementation; [`ShapeKind`],
+//! [`ShapeRef`] and the dispatch are generated from the list of shape kinds
+//! (`shape_kinds.rs`), so a kind cannot be missed in one of them.
 //!
 //! Invariants: a hit test returns `Some(t)` only for `0 < t ≤ t_max`; the
 //! object a ray leaves is never hit again at the spot it left
@@ -85,53 +88,144 @@ impl Aabb {
     }
 }
 
-/// Which primitive an object is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-#[repr(u8)]
-pub enum ShapeKind {
-    /// A `SPHERE`.
-    Sphere = 0,
-    /// A `BOX`, axis-aligned.
-    Box = 1,
-    /// A `SUPERQUADRIC`.
-    Superquadric = 2,
-    /// A `TRIANGLE`.
-    Triangle = 3,
-    /// A `RECTANGLE`.
-    Rectangle = 4,
-    /// A triangle of a `BSPLINE` patch.
-    SmoothTriangle = 5,
-}
-
-impl ShapeKind {
-    /// The capacity objects of this kind count against.
-    pub const fn capacity(self) -> CapacityKind {
-        match self {
-            ShapeKind::Sphere => CapacityKind::Spheres,
-            ShapeKind::Box => CapacityKind::Boxes,
-            ShapeKind::Superquadric => CapacityKind::Superquadrics,
-            ShapeKind::Triangle => CapacityKind::Triangles,
-            ShapeKind::Rectangle => CapacityKind::Rectangles,
-            ShapeKind::SmoothTriangle => CapacityKind::BsplineTriangles,
-        }
-    }
-
+/// What every primitive answers (the list's dispatch calls these on a
+/// known type: no virtual calls). Its file implements it.
+pub(crate) trait Shape {
     /// Flat shapes are seen from both sides; the others are closed.
-    pub const fn is_flat(self) -> bool {
-        matches!(self, ShapeKind::Triangle | ShapeKind::Rectangle | ShapeKind::SmoothTriangle)
-    }
+    const FLAT: bool;
 
-    const fn from_u8(v: u8) -> ShapeKind {
-        match v {
-            0 => ShapeKind::Sphere,
-            1 => ShapeKind::Box,
-            2 => ShapeKind::Superquadric,
-            3 => ShapeKind::Triangle,
-            4 => ShapeKind::Rectangle,
-            _ => ShapeKind::SmoothTriangle,
-        }
+    /// The parameter of the nearest hit with `0 < t ≤ t_max`, if any.
+    fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar>;
+
+    /// The geometric normal at a point on the surface: outward for closed
+    /// shapes, the front side (counter-clockwise corners) for flat ones.
+    fn normal_at(&self, p: Vec3) -> Dir;
+
+    /// A box holding the whole shape.
+    fn bounds(&self) -> Aabb;
+
+    /// The index of its surface in the scene's surface table.
+    fn surface(&self) -> u16;
+
+    /// The normal to shade with and the point shadow rays leave from, given
+    /// a hit point and its geometric normal turned towards the ray.
+    #[inline(always)]
+    fn shading(&self, p: Vec3, facing: Dir) -> (Dir, Vec3) {
+        (facing, p)
     }
 }
+
+/// Declares [`ShapeKind`] and [`ShapeRef`], and dispatches on them, from
+/// the list of shape kinds (`crate::shape_kinds`).
+macro_rules! shape_kinds {
+    (shapes [$($(#[$doc:meta])* $kind:ident($type:ident) in $field:ident: $capacity:ident, $what:literal;)*]) => {
+        /// Which primitive an object is.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        #[repr(u8)]
+        pub enum ShapeKind {
+            $($(#[$doc])* $kind,)*
+        }
+
+        impl ShapeKind {
+            /// Every kind, in the list's order (`kind as usize` indexes it).
+            pub const ALL: [ShapeKind; [$(ShapeKind::$kind),*].len()] = [$(ShapeKind::$kind),*];
+
+            /// The capacity objects of this kind count against.
+            pub const fn capacity(self) -> CapacityKind {
+                match self {
+                    $(ShapeKind::$kind => CapacityKind::$capacity,)*
+                }
+            }
+
+            /// The kind numbered `v` (the last kind for a number past the
+            /// list: handles are only made from kinds). Comparisons, not a
+            /// table: the compiler folds them into one clamp of `v`.
+            const fn from_u8(v: u8) -> ShapeKind {
+                $(if v == ShapeKind::$kind as u8 {
+                    return ShapeKind::$kind;
+                })*
+                ShapeKind::ALL[ShapeKind::ALL.len() - 1]
+            }
+
+            /// The bytes an object of this kind takes in its arena (the same
+            /// on every target: the primitives hold no pointer or `usize`).
+            pub const fn item_bytes(self) -> usize {
+                match self {
+                    $(ShapeKind::$kind => core::mem::size_of::<$type>(),)*
+                }
+            }
+
+            /// Flat shapes are seen from both sides; the others are closed.
+            pub const fn is_flat(self) -> bool {
+                match self {
+                    $(ShapeKind::$kind => <$type as Shape>::FLAT,)*
+                }
+            }
+        }
+
+        /// A borrowed primitive: the closed set every caller matches on.
+        #[derive(Clone, Copy, Debug)]
+        pub enum ShapeRef<'a> {
+            $($(#[$doc])* $kind(&'a $type),)*
+        }
+
+        impl ShapeRef<'_> {
+            /// [`ShapeRef::intersect`] for a shape of one of `kinds` (a constant:
+            /// the other kinds' tests are not linked; a shape of one of them is
+            /// never hit).
+            #[inline(always)]
+            pub fn intersect_among(&self, kinds: ShapeKinds, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
+                match self {
+                    $(ShapeRef::$kind(s) if kinds.contains(ShapeKind::$kind) => s.intersect(ray, t_max, leaving),)*
+                    _ => None,
+                }
+            }
+
+            /// [`ShapeRef::normal_at`] for a shape of one of `kinds` (see
+            /// [`ShapeRef::intersect_among`]; another kind's is +Y).
+            #[inline(always)]
+            pub fn normal_at_among(&self, kinds: ShapeKinds, p: Vec3) -> Dir {
+                match self {
+                    $(ShapeRef::$kind(s) if kinds.contains(ShapeKind::$kind) => s.normal_at(p),)*
+                    _ => Dir::Y,
+                }
+            }
+
+            /// [`ShapeRef::shading`] for a shape of one of `kinds` (see
+            /// [`ShapeRef::intersect_among`]).
+            #[inline(always)]
+            pub fn shading_among(&self, kinds: ShapeKinds, p: Vec3, facing: Dir) -> (Dir, Vec3) {
+                match self {
+                    $(ShapeRef::$kind(s) if kinds.contains(ShapeKind::$kind) => s.shading(p, facing),)*
+                    _ => (facing, p),
+                }
+            }
+
+            /// A box holding the whole shape (what an octree files it by).
+            pub fn bounds(&self) -> Aabb {
+                match self {
+                    $(ShapeRef::$kind(s) => s.bounds(),)*
+                }
+            }
+
+            /// The index of its surface in [`SceneView::surfaces`](crate::scene::SceneView::surfaces).
+            pub fn surface(&self) -> u16 {
+                match self {
+                    $(ShapeRef::$kind(s) => s.surface(),)*
+                }
+            }
+
+            /// Which primitive it is.
+            pub fn kind(&self) -> ShapeKind {
+                match self {
+                    $(ShapeRef::$kind(_) => ShapeKind::$kind,)*
+                }
+            }
+        }
+    };
+}
+
+crate::__shape_kinds!(shape_kinds! {});
 
 /// The primitive kinds a build can meet: a profile's shapes with room
 /// ([`ShapeKinds::with_room`]). Dispatch on a constant set links no code
@@ -142,18 +236,11 @@ pub struct ShapeKinds(u8);
 
 impl ShapeKinds {
     /// Every kind.
-    pub const ALL: ShapeKinds = ShapeKinds(0b11_1111);
+    pub const ALL: ShapeKinds = ShapeKinds((1 << ShapeKind::ALL.len()) - 1);
 
     /// The kinds `counts` has room for.
     pub const fn with_room(counts: &Counts) -> ShapeKinds {
-        let kinds = [
-            ShapeKind::Sphere,
-            ShapeKind::Box,
-            ShapeKind::Superquadric,
-            ShapeKind::Triangle,
-            ShapeKind::Rectangle,
-            ShapeKind::SmoothTriangle,
-        ];
+        let kinds = ShapeKind::ALL;
         let mut bits = 0;
         let mut i = 0;
         while i < kinds.len() {
@@ -177,6 +264,9 @@ impl ShapeKinds {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ShapeHandle(u32);
 
+// The kind's three bits.
+const _: () = assert!(ShapeKind::ALL.len() <= 8, "a ShapeHandle has three bits for the kind");
+
 impl ShapeHandle {
     /// Largest index a handle can carry.
     pub const MAX_INDEX: usize = (1 << 29) - 1;
@@ -198,23 +288,6 @@ impl ShapeHandle {
     }
 }
 
-/// A borrowed primitive: the closed set every caller matches on.
-#[derive(Clone, Copy, Debug)]
-pub enum ShapeRef<'a> {
-    /// A `SPHERE`.
-    Sphere(&'a Sphere),
-    /// A `BOX`.
-    Box(&'a AxisAlignedBox),
-    /// A `SUPERQUADRIC`.
-    Superquadric(&'a Superquadric),
-    /// A `TRIANGLE`.
-    Triangle(&'a Triangle),
-    /// A `RECTANGLE`.
-    Rectangle(&'a Rectangle),
-    /// A triangle of a `BSPLINE` patch.
-    SmoothTriangle(&'a SmoothTriangle),
-}
-
 impl ShapeRef<'_> {
     /// The parameter of the nearest hit with `0 < t ≤ t_max`, if any.
     #[inline]
@@ -222,43 +295,10 @@ impl ShapeRef<'_> {
         self.intersect_among(ShapeKinds::ALL, ray, t_max, leaving)
     }
 
-    /// [`ShapeRef::intersect`] for a shape of one of `kinds` (a constant:
-    /// the other kinds' tests are not linked; a shape of one of them is
-    /// never hit).
-    #[inline(always)]
-    pub fn intersect_among(&self, kinds: ShapeKinds, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
-        use ShapeKind as K;
-        match self {
-            ShapeRef::Sphere(s) if kinds.contains(K::Sphere) => s.intersect(ray, t_max, leaving),
-            ShapeRef::Box(s) if kinds.contains(K::Box) => s.intersect(ray, t_max, leaving),
-            ShapeRef::Superquadric(s) if kinds.contains(K::Superquadric) => s.intersect(ray, t_max, leaving),
-            ShapeRef::Triangle(s) if kinds.contains(K::Triangle) => s.intersect(ray, t_max, leaving),
-            ShapeRef::Rectangle(s) if kinds.contains(K::Rectangle) => s.intersect(ray, t_max, leaving),
-            ShapeRef::SmoothTriangle(s) if kinds.contains(K::SmoothTriangle) => s.intersect(ray, t_max, leaving),
-            _ => None,
-        }
-    }
-
     /// The geometric normal at a point on the surface: outward for closed
     /// shapes, the front side (counter-clockwise corners) for flat ones.
     pub fn normal_at(&self, p: Vec3) -> Dir {
         self.normal_at_among(ShapeKinds::ALL, p)
-    }
-
-    /// [`ShapeRef::normal_at`] for a shape of one of `kinds` (see
-    /// [`ShapeRef::intersect_among`]; another kind's is +Y).
-    #[inline(always)]
-    pub fn normal_at_among(&self, kinds: ShapeKinds, p: Vec3) -> Dir {
-        use ShapeKind as K;
-        match self {
-            ShapeRef::Sphere(s) if kinds.contains(K::Sphere) => s.normal_at(p),
-            ShapeRef::Box(s) if kinds.contains(K::Box) => s.normal_at(p),
-            ShapeRef::Superquadric(s) if kinds.contains(K::Superquadric) => s.normal_at(p),
-            ShapeRef::Triangle(s) => s.normal(),
-            ShapeRef::Rectangle(s) => s.normal(),
-            ShapeRef::SmoothTriangle(s) => s.normal(),
-            _ => Dir::Y,
-        }
     }
 
     /// The normal to shade with and the point shadow rays leave from, given
@@ -268,54 +308,6 @@ impl ShapeRef<'_> {
     #[inline]
     pub fn shading(&self, p: Vec3, facing: Dir) -> (Dir, Vec3) {
         self.shading_among(ShapeKinds::ALL, p, facing)
-    }
-
-    /// [`ShapeRef::shading`] for a shape of one of `kinds` (see
-    /// [`ShapeRef::intersect_among`]).
-    #[inline(always)]
-    pub fn shading_among(&self, kinds: ShapeKinds, p: Vec3, facing: Dir) -> (Dir, Vec3) {
-        match self {
-            ShapeRef::SmoothTriangle(s) if kinds.contains(ShapeKind::SmoothTriangle) => {
-                (s.shading_normal(p, facing), s.shadow_origin(p, facing))
-            }
-            _ => (facing, p),
-        }
-    }
-
-    /// A box holding the whole shape (what an octree files it by).
-    pub fn bounds(&self) -> Aabb {
-        match self {
-            ShapeRef::Sphere(s) => s.bounds(),
-            ShapeRef::Box(s) => s.bounds(),
-            ShapeRef::Superquadric(s) => s.bounds(),
-            ShapeRef::Triangle(s) => s.bounds(),
-            ShapeRef::Rectangle(s) => s.bounds(),
-            ShapeRef::SmoothTriangle(s) => s.bounds(),
-        }
-    }
-
-    /// The index of its surface in [`SceneView::surfaces`](crate::scene::SceneView::surfaces).
-    pub fn surface(&self) -> u16 {
-        match self {
-            ShapeRef::Sphere(s) => s.surface,
-            ShapeRef::Box(s) => s.surface,
-            ShapeRef::Superquadric(s) => s.surface,
-            ShapeRef::Triangle(s) => s.surface,
-            ShapeRef::Rectangle(s) => s.surface,
-            ShapeRef::SmoothTriangle(s) => s.triangle.surface,
-        }
-    }
-
-    /// Which primitive it is.
-    pub fn kind(&self) -> ShapeKind {
-        match self {
-            ShapeRef::Sphere(_) => ShapeKind::Sphere,
-            ShapeRef::Box(_) => ShapeKind::Box,
-            ShapeRef::Superquadric(_) => ShapeKind::Superquadric,
-            ShapeRef::Triangle(_) => ShapeKind::Triangle,
-            ShapeRef::Rectangle(_) => ShapeKind::Rectangle,
-            ShapeRef::SmoothTriangle(_) => ShapeKind::SmoothTriangle,
-        }
     }
 }
 

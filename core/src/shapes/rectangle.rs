@@ -3,7 +3,7 @@
 //! when the scene is parsed, in world units.
 
 use super::polygon::Polygon;
-use super::{Aabb, Leaving, Ray};
+use super::{Aabb, Leaving, Ray, Shape};
 use crate::math::{Dir, Scalar, Vec3};
 
 /// A RECTANGLE: a planar convex quadrilateral.
@@ -27,17 +27,29 @@ impl Rectangle {
         Some(Rectangle { polygon: Polygon::with_normal(corners, normal)?, surface })
     }
 
-    #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
-        self.polygon.intersect(ray, t_max, leaving)
-    }
-
     pub fn normal(&self) -> Dir {
         self.polygon.normal
     }
+}
 
-    pub fn bounds(&self) -> Aabb {
+impl Shape for Rectangle {
+    const FLAT: bool = true;
+
+    #[inline]
+    fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
+        self.polygon.intersect(ray, t_max, leaving)
+    }
+
+    fn normal_at(&self, _: Vec3) -> Dir {
+        self.normal()
+    }
+
+    fn bounds(&self) -> Aabb {
         self.polygon.bounds()
+    }
+
+    fn surface(&self) -> u16 {
+        self.surface
     }
 }
 

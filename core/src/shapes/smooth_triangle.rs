@@ -12,7 +12,7 @@
 //! Shadow Terminator", 2021).
 
 use super::triangle::Triangle;
-use super::{Aabb, Leaving, Ray};
+use super::{Aabb, Leaving, Ray, Shape};
 use crate::math::{div_saturating, leading_zeros, Dir, Scalar, Vec3};
 
 /// One triangle of a BSPLINE patch, with corner normals to shade smoothly.
@@ -45,18 +45,9 @@ impl SmoothTriangle {
         Some(SmoothTriangle { triangle, normals, patch: 0 })
     }
 
-    #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
-        self.triangle.intersect(ray, t_max, leaving)
-    }
-
     /// The flat (geometric) normal.
     pub fn normal(&self) -> Dir {
         self.triangle.normal()
-    }
-
-    pub fn bounds(&self) -> Aabb {
-        self.triangle.bounds()
     }
 
     /// Barycentric weights of `p` (on the plane) in Q2.30, summing to 2^30
@@ -108,6 +99,31 @@ impl SmoothTriangle {
         } else {
             p
         }
+    }
+}
+
+impl Shape for SmoothTriangle {
+    const FLAT: bool = true;
+
+    #[inline]
+    fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
+        self.triangle.intersect(ray, t_max, leaving)
+    }
+
+    fn normal_at(&self, _: Vec3) -> Dir {
+        self.normal()
+    }
+
+    fn bounds(&self) -> Aabb {
+        self.triangle.bounds()
+    }
+
+    fn surface(&self) -> u16 {
+        self.triangle.surface
+    }
+
+    fn shading(&self, p: Vec3, facing: Dir) -> (Dir, Vec3) {
+        (self.shading_normal(p, facing), self.shadow_origin(p, facing))
     }
 }
 

@@ -5,7 +5,7 @@
 //! far and small spheres keep their precision (no cancellation of two large,
 //! nearly equal numbers).
 
-use super::{Aabb, Leaving, Ray};
+use super::{Aabb, Leaving, Ray, Shape};
 use crate::math::{isqrt, mul_wide, Dir, Scalar, Vec3};
 
 /// How far the estimate of `b = oc·dir` in [`surely_missed`] may be from the
@@ -31,18 +31,6 @@ pub struct Sphere {
 impl Sphere {
     pub fn new(center: Vec3, radius: Scalar, surface: u16) -> Sphere {
         Sphere { center, radius, surface }
-    }
-
-    #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
-        if leaving == Leaving::Outward {
-            return None;
-        }
-        let oc = ray.origin - self.center;
-        if surely_missed(oc.bits(), ray.dir.bits(), t_max.to_bits() as i64, self.radius.to_bits() as i64) {
-            return None;
-        }
-        self.intersect_exactly(oc, ray, t_max, leaving)
     }
 
     /// The exact test, given `oc = origin − center`.
@@ -72,15 +60,35 @@ impl Sphere {
         let t = if leaving == Leaving::No && near > 0 { near } else { far };
         (t > 0 && t <= t_max.to_bits() as i64).then(|| Scalar::from_bits(t as i32))
     }
+}
+
+impl Shape for Sphere {
+    const FLAT: bool = false;
+
+    #[inline]
+    fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
+        if leaving == Leaving::Outward {
+            return None;
+        }
+        let oc = ray.origin - self.center;
+        if surely_missed(oc.bits(), ray.dir.bits(), t_max.to_bits() as i64, self.radius.to_bits() as i64) {
+            return None;
+        }
+        self.intersect_exactly(oc, ray, t_max, leaving)
+    }
 
     /// Outward unit normal at `p`.
-    pub fn normal_at(&self, p: Vec3) -> Dir {
+    fn normal_at(&self, p: Vec3) -> Dir {
         (p - self.center).direction().unwrap_or(Dir::Y)
     }
 
-    pub fn bounds(&self) -> Aabb {
+    fn bounds(&self) -> Aabb {
         let r = Vec3 { x: self.radius, y: self.radius, z: self.radius };
         Aabb { min: self.center - r, max: self.center + r }
+    }
+
+    fn surface(&self) -> u16 {
+        self.surface
     }
 }
 

@@ -18,7 +18,7 @@
 //! hits at the box face.
 
 use super::axis_aligned_box::slab_span;
-use super::{Aabb, Leaving, Ray};
+use super::{Aabb, Leaving, Ray, Shape};
 use crate::math::{pow_q30, Dir, Scalar, Vec3};
 
 const ONE: i64 = 1 << 30;
@@ -112,9 +112,13 @@ impl Superquadric {
         }
         None
     }
+}
+
+impl Shape for Superquadric {
+    const FLAT: bool = false;
 
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
+    fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
         if leaving == Leaving::Outward {
             return None;
         }
@@ -155,7 +159,7 @@ impl Superquadric {
     }
 
     /// Outward normal: the gradient (sgn(x)|x|^(p−1) / half-size) per axis.
-    pub fn normal_at(&self, p: Vec3) -> Dir {
+    fn normal_at(&self, p: Vec3) -> Dir {
         let x = self.local(p);
         let h = self.half.wide();
         let h_min = h[0].min(h[1]).min(h[2]).max(1);
@@ -173,8 +177,12 @@ impl Superquadric {
         Dir::normalize(g).unwrap_or(Dir::Y)
     }
 
-    pub fn bounds(&self) -> Aabb {
+    fn bounds(&self) -> Aabb {
         Aabb { min: self.center - self.half, max: self.center + self.half }
+    }
+
+    fn surface(&self) -> u16 {
+        self.surface
     }
 }
 

@@ -2,7 +2,7 @@
 //! from the front, front normal (p2 − p1) × (p3 − p1).
 
 use super::polygon::{cross_of_edges, Polygon};
-use super::{Aabb, Leaving, Ray};
+use super::{Aabb, Leaving, Ray, Shape};
 use crate::math::{Dir, Scalar, Vec3};
 
 /// A TRIANGLE.
@@ -22,17 +22,29 @@ impl Triangle {
         Some(Triangle { polygon: Polygon::with_normal(corners, normal)?, surface })
     }
 
-    #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
-        self.polygon.intersect(ray, t_max, leaving)
-    }
-
     pub fn normal(&self) -> Dir {
         self.polygon.normal
     }
+}
 
-    pub fn bounds(&self) -> Aabb {
+impl Shape for Triangle {
+    const FLAT: bool = true;
+
+    #[inline]
+    fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
+        self.polygon.intersect(ray, t_max, leaving)
+    }
+
+    fn normal_at(&self, _: Vec3) -> Dir {
+        self.normal()
+    }
+
+    fn bounds(&self) -> Aabb {
         self.polygon.bounds()
+    }
+
+    fn surface(&self) -> u16 {
+        self.surface
     }
 }
 

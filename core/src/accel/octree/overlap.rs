@@ -119,7 +119,7 @@ fn no_separating_axis<const N: usize>(p: &Polygon<N>, cell: &Cell) -> bool {
 mod tests {
     use super::*;
     use crate::math::{Scalar, Vec3};
-    use crate::shapes::{AxisAlignedBox, Sphere, Triangle};
+    use crate::shapes::{AxisAlignedBox, Shape, Sphere, Triangle};
 
     const U: i64 = 1 << 16;
 
