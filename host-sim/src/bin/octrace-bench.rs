@@ -12,9 +12,10 @@
 
 use host_sim::{
     all_cores, build_octree, load_bytes, load_file, new_scene, render, render_prebuilt, AccelMode, HostScene,
-    Partition, RenderOptions,
+    LoadError, Partition, RenderOptions,
 };
 use octrace_core::accel::OctreeConfig;
+use std::fmt;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -57,13 +58,108 @@ fn scene_files(dir: &Path) -> Vec<PathBuf> {
     v
 }
 
-fn load(path: &Path) -> Box<HostScene> {
-    let mut scene = new_scene();
-    if let Err(e) = load_file(path, &mut scene) {
-        eprintln!("octrace-bench: {e}");
-        std::process::exit(2);
+/// The tables, in the order a run without arguments prints them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Table {
+    Scenes,
+    Table51,
+    Table52,
+    Criterion,
+    Scaling,
+    Parallel,
+    Palette,
+    Spheres600,
+}
+
+impl Table {
+    const ALL: [Table; 8] = [
+        Table::Scenes,
+        Table::Table51,
+        Table::Table52,
+        Table::Criterion,
+        Table::Scaling,
+        Table::Parallel,
+        Table::Palette,
+        Table::Spheres600,
+    ];
+
+    /// Its name on the command line.
+    fn name(self) -> &'static str {
+        match self {
+            Table::Scenes => "scenes",
+            Table::Table51 => "table51",
+            Table::Table52 => "table52",
+            Table::Criterion => "criterion",
+            Table::Scaling => "scaling",
+            Table::Parallel => "parallel",
+            Table::Palette => "palette",
+            Table::Spheres600 => "spheres600",
+        }
     }
-    scene
+
+    fn from_name(name: &str) -> Result<Table, BenchError> {
+        Table::ALL.into_iter().find(|t| t.name() == name).ok_or_else(|| BenchError::UnknownTable(name.to_owned()))
+    }
+
+    /// Measures and prints the table, from the scenes in `dir`.
+    fn print(self, dir: &Path) -> Result<(), BenchError> {
+        match self {
+            Table::Scenes => scenes_table(dir),
+            Table::Table51 => table51(dir),
+            Table::Table52 => table52(dir),
+            Table::Criterion => criterion(dir),
+            Table::Scaling => {
+                scaling();
+                Ok(())
+            }
+            Table::Parallel => parallel(dir),
+            Table::Palette => palette_table(dir),
+            Table::Spheres600 => spheres600(dir),
+        }
+    }
+}
+
+/// Why octrace-bench stopped before its tables were done.
+#[derive(Debug)]
+enum BenchError {
+    /// A table it does not know was asked for.
+    UnknownTable(String),
+    /// A scene it measures did not load.
+    Scene { path: PathBuf, error: LoadError },
+}
+
+impl BenchError {
+    /// The process's exit code: 1 for a file that cannot be read, 2 for the
+    /// rest (as host-sim's).
+    fn exit_code(&self) -> i32 {
+        match self {
+            BenchError::Scene { error: LoadError::Io(_), .. } => host_sim::exit::EXIT_IO,
+            _ => host_sim::exit::EXIT_SCENE,
+        }
+    }
+}
+
+impl fmt::Display for BenchError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            BenchError::UnknownTable(name) => {
+                let known: Vec<&str> = Table::ALL.iter().map(|t| t.name()).collect();
+                write!(f, "octrace-bench: unknown table `{name}` (known: {})", known.join(", "))
+            }
+            BenchError::Scene { path, error: LoadError::Io(e) } => {
+                write!(f, "octrace-bench: cannot read {}: {e}", path.display())
+            }
+            BenchError::Scene { path, error } => write!(f, "{error}\noctrace-bench: {} does not load", path.display()),
+        }
+    }
+}
+
+impl std::error::Error for BenchError {}
+
+fn load(path: &Path) -> Result<Box<HostScene>, BenchError> {
+    let mut scene = new_scene();
+    load_file(path, &mut scene).map_err(|error| BenchError::Scene { path: path.to_owned(), error })?;
+    Ok(scene)
 }
 
 /// Render time (best of `runs`), including the octree build.
@@ -72,13 +168,13 @@ fn time(scene: &HostScene, accel: AccelMode, octree: OctreeConfig, size: Option<
     best_of(runs, || render(scene, &options).map(|r| r.stats)).0
 }
 
-fn scenes_table(dir: &Path) {
+fn scenes_table(dir: &Path) -> Result<(), BenchError> {
     println!("### Every scene at its RASTER size, naive mode, one thread\n");
     println!("| scene | size | objects | lights | rays | shadow rays | time (best of 3) | ns / pixel |");
     println!("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |");
     for path in scene_files(dir) {
         let name = path.file_stem().unwrap_or_default().to_string_lossy().into_owned();
-        let scene = load(&path);
+        let scene = load(&path)?;
         let view = scene.view();
         let [w, h] = view.settings.raster;
         let naive = RenderOptions { accel: AccelMode::Naive, ..Default::default() };
@@ -95,9 +191,10 @@ fn scenes_table(dir: &Path) {
         );
     }
     println!();
+    Ok(())
 }
 
-fn table51(dir: &Path) {
+fn table51(dir: &Path) -> Result<(), BenchError> {
     println!("### Table 5.1: naive against the octree (thesis) and 3DDDA (octrace)\n");
     println!("Each scene at its RASTER size; times include building the octree (default criterion).\n");
     println!("| figure | objects | thesis naive | thesis fast | thesis ratio | naive | octree | ratio | dda | ratio |");
@@ -113,7 +210,7 @@ fn table51(dir: &Path) {
         ("freeform", "—", "—", "—", 1),
     ];
     for (name, tn, tf, tr, runs) in rows {
-        let scene = load(&dir.join(format!("{name}.txt")));
+        let scene = load(&dir.join(format!("{name}.txt")))?;
         let c = host_sim::OCTREE;
         let naive = time(&scene, AccelMode::Naive, c, None, runs);
         let octree = time(&scene, AccelMode::Octree, c, None, 3);
@@ -130,13 +227,14 @@ fn table51(dir: &Path) {
         );
     }
     println!();
+    Ok(())
 }
 
-fn table52(dir: &Path) {
+fn table52(dir: &Path) -> Result<(), BenchError> {
     println!("### Table 5.2: fig5_4 (24 spheres) by the maximum number of objects per box\n");
     println!("| objects per box | thesis (octree) | octree | dda | boxes | leaves | references | depth |");
     println!("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
-    let scene = load(&dir.join("fig5_4.txt"));
+    let scene = load(&dir.join("fig5_4.txt"))?;
     let default = host_sim::OCTREE;
     for (max, thesis) in [(2usize, "22:21"), (6, "17:52"), (8, "28:36"), (default.max_objects, "(default)")] {
         let c = OctreeConfig { max_objects: max, ..default };
@@ -155,6 +253,7 @@ fn table52(dir: &Path) {
     }
     let naive = time(&scene, AccelMode::Naive, default, None, 5);
     println!("\nnaive on the same scene: {}\n", ms(naive));
+    Ok(())
 }
 
 /// `n` non-overlapping spheres of equal radius dropped at random (random
@@ -238,7 +337,7 @@ fn scaling() {
     println!("\ndda: time(N = 10,000) / time(N = 10) = {:.2}\n", t(10_000) / t(10));
 }
 
-fn criterion(dir: &Path) {
+fn criterion(dir: &Path) -> Result<(), BenchError> {
     println!("### Choosing the default criterion (dda, ms, best of 3)\n");
     let combos = [(1usize, 12u32), (2, 12), (3, 12), (4, 12), (6, 12), (8, 12), (4, 8), (4, 16)];
     print!("| scene |");
@@ -249,7 +348,7 @@ fn criterion(dir: &Path) {
     println!("| --- |{}", " ---: |".repeat(combos.len()));
     for path in scene_files(dir) {
         let name = path.file_stem().unwrap_or_default().to_string_lossy().into_owned();
-        let scene = load(&path);
+        let scene = load(&path)?;
         if scene.view().object_count() <= AccelMode::AUTO_NAIVE_UP_TO {
             continue;
         }
@@ -261,6 +360,7 @@ fn criterion(dir: &Path) {
         println!();
     }
     println!();
+    Ok(())
 }
 
 /// A scene whose work is all in one corner of the image: 60 reflective
@@ -277,7 +377,7 @@ fn corner() -> String {
     s
 }
 
-fn parallel(dir: &Path) {
+fn parallel(dir: &Path) -> Result<(), BenchError> {
     let cores = all_cores();
     println!("### Parallel rendering: speed-up and idle time\n");
     println!("dda mode, octree built once beforehand; wall-clock time of the render, best of 3. Idle is the");
@@ -287,8 +387,8 @@ fn parallel(dir: &Path) {
     let mut corner_scene = new_scene();
     load_bytes("corner", corner().as_bytes(), &mut corner_scene).expect("the corner scene parses");
     let cases: [(&str, Box<HostScene>, (u32, u32)); 3] = [
-        ("fig5_3", load(&dir.join("fig5_3.txt")), (800, 600)),
-        ("fig5_8", load(&dir.join("fig5_8.txt")), (800, 600)),
+        ("fig5_3", load(&dir.join("fig5_3.txt"))?, (800, 600)),
+        ("fig5_8", load(&dir.join("fig5_8.txt"))?, (800, 600)),
         ("corner", corner_scene, (800, 600)),
     ];
     for (name, scene, size) in &cases {
@@ -323,11 +423,12 @@ fn parallel(dir: &Path) {
         }
     }
     println!();
+    Ok(())
 }
 
 /// Every scene in every palette mode: entries used, PSNR against the
 /// truecolour render and the cost of the mapping per pixel.
-fn palette_table(dir: &Path) {
+fn palette_table(dir: &Path) -> Result<(), BenchError> {
     use octrace_images::formats::Image;
     use octrace_images::palette::{self, PaletteMode};
     println!("### 256-colour modes: every scene at its RASTER size\n");
@@ -339,7 +440,7 @@ fn palette_table(dir: &Path) {
     let mut pixels = 0.0;
     for path in scene_files(dir) {
         let name = path.file_stem().unwrap_or_default().to_string_lossy().into_owned();
-        let scene = load(&path);
+        let scene = load(&path)?;
         let Ok(rendered) = render(&scene, &RenderOptions { threads: all_cores(), ..Default::default() }) else {
             continue;
         };
@@ -358,17 +459,18 @@ fn palette_table(dir: &Path) {
         print!(" {:.1} ns |", c.as_nanos() as f64 / pixels);
     }
     println!("\n");
+    Ok(())
 }
 
 /// Issue 14's target 2: the 600 random spheres of `scenes/spheres600.txt`
 /// at 800×600, naive against dda, the render alone (octree built
 /// beforehand) and with the build. The two modes' runs alternate, so that
 /// a busy spell of a shared machine weighs on both.
-fn spheres600(dir: &Path) {
+fn spheres600(dir: &Path) -> Result<(), BenchError> {
     println!("### 600 random spheres at 800×600: naive against dda (one thread, best of 3, alternating)\n");
     println!("| scene | naive | dda render | dda build | render ratio | ratio with build |");
     println!("| --- | ---: | ---: | ---: | ---: | ---: |");
-    let scene = load(&dir.join("spheres600.txt"));
+    let scene = load(&dir.join("spheres600.txt"))?;
     let c = host_sim::OCTREE;
     let size = Some((800, 600));
     let (build, tree) = best_of(3, || build_octree(&scene, AccelMode::Dda, &c));
@@ -388,29 +490,45 @@ fn spheres600(dir: &Path) {
         r(render),
         r(render + build)
     );
+    Ok(())
 }
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
-    let scenes = root.join("scenes");
-    let all = ["scenes", "table51", "table52", "criterion", "scaling", "parallel", "palette", "spheres600"];
-    let which: Vec<&str> = if args.is_empty() { all.to_vec() } else { args.iter().map(String::as_str).collect() };
-    println!("Machine: {}\n", machine());
-    for w in which {
-        match w {
-            "scenes" => scenes_table(&scenes),
-            "table51" => table51(&scenes),
-            "table52" => table52(&scenes),
-            "criterion" => criterion(&scenes),
-            "scaling" => scaling(),
-            "parallel" => parallel(&scenes),
-            "palette" => palette_table(&scenes),
-            "spheres600" => spheres600(&scenes),
-            other => {
-                eprintln!("octrace-bench: unknown table `{other}` (known: {})", all.join(", "));
-                std::process::exit(2);
-            }
+    let scenes = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+    let tables = if args.is_empty() {
+        Ok(Table::ALL.to_vec())
+    } else {
+        args.iter().map(|name| Table::from_name(name)).collect()
+    };
+    let run = tables.and_then(|tables| {
+        println!("Machine: {}\n", machine());
+        tables.into_iter().try_for_each(|table| table.print(&scenes))
+    });
+    if let Err(e) = run {
+        eprintln!("{e}");
+        std::process::exit(e.exit_code());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_table_is_found_by_its_name_and_an_unknown_one_is_an_error() {
+        for table in Table::ALL {
+            assert_eq!(Table::from_name(table.name()).ok(), Some(table));
         }
+        let e = Table::from_name("table53").unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+        assert!(e.to_string().contains("unknown table `table53` (known: scenes, table51"), "{e}");
+    }
+
+    #[test]
+    fn a_scene_that_cannot_be_read_says_which_and_exits_1() {
+        let e = load(Path::new("/nonexistent/scene.txt")).unwrap_err();
+        assert_eq!(e.exit_code(), 1);
+        assert!(e.to_string().starts_with("octrace-bench: cannot read /nonexistent/scene.txt: "), "{e}");
     }
 }
