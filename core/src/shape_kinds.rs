@@ -7,9 +7,8 @@
 //! [`SceneView`](crate::scene::SceneView)'s slices, and the arenas
 //! [`profile!`](crate::profile!) and the `Host` profile declare all expand
 //! it. Adding a kind is a line here, the shape's file in `shapes/` (its
-//! `Shape` implementation) and its statement in `parse/`; the compiler then
-//! names the few `match`es that treat a kind apart (the octree's overlap
-//! test, the statement's count).
+//! `Shape` implementation) and its statement in `parse/`
+//! (`docs/architecture.md` walks through one).
 //!
 //! Invariants: this file uses nothing from the crate; a kind's place in the
 //! list is its `ShapeKind` discriminant, and there are at most eight (a

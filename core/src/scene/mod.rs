@@ -24,10 +24,7 @@ pub use surface::{Color, Surface, SurfaceEntry};
 
 use crate::capacity::{Arena, CapacityError, CapacityKind};
 use crate::math::{Scalar, Vec3, Wide};
-use crate::shapes::{
-    AxisAlignedBox, Leaving, Ray, Rectangle, Shape, ShapeHandle, ShapeKind, ShapeKinds, ShapeRef, SmoothTriangle,
-    Sphere, Superquadric, Triangle,
-};
+use crate::shapes::{Leaving, Ray, Shape, ShapeHandle, ShapeKind, ShapeKinds, ShapeRef, SmoothTriangle};
 
 /// An object's position in the scene file (0 for the first object).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -80,7 +77,7 @@ macro_rules! scene_arenas {
             const NAME: &'static str;
             /// All objects, in file order.
             type Objects: Arena<ShapeHandle>;
-            $(#[doc = concat!("The ", $what, ".")] type $capacity: Arena<$type>;)*
+            $(#[doc = concat!("The ", $what, ".")] type $capacity: Arena<crate::shapes::$type>;)*
             /// Room for one patch's control points while it is evaluated.
             type ControlPoints: Arena<Vec3>;
             /// Surface definitions; at most 65,535 (objects refer to them by `u16`).
@@ -173,7 +170,7 @@ macro_rules! scene_arenas {
         }
 
         $(
-            impl Stored for $type {
+            impl Stored for crate::shapes::$type {
                 const KIND: ShapeKind = ShapeKind::$kind;
 
                 fn push_into<C: SceneCapacities>(self, scene: &mut Scene<C>) -> Result<usize, CapacityError> {
@@ -187,7 +184,7 @@ macro_rules! scene_arenas {
         pub struct SceneView<'a> {
             /// Every object, in the order the scene wrote them: an [`ObjectId`] indexes it.
             pub objects: &'a [ShapeHandle],
-            $(#[doc = concat!("The ", $what, ".")] pub $field: &'a [$type],)*
+            $(#[doc = concat!("The ", $what, ".")] pub $field: &'a [crate::shapes::$type],)*
             /// The surfaces, sorted by number.
             pub surfaces: &'a [SurfaceEntry],
             /// The point lights.
@@ -428,6 +425,7 @@ mod tests {
     use super::*;
     use crate::math::Scalar;
     use crate::profile::Board16K;
+    use crate::shapes::{AxisAlignedBox, Sphere};
 
     #[test]
     fn an_empty_scene_is_zero_until_cleared() {
