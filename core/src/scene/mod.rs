@@ -229,7 +229,7 @@ macro_rules! scene_arenas {
 crate::__shape_kinds!(scene_arenas! {});
 
 /// A primitive the scene stores: which arena it goes in.
-pub(crate) trait Stored: Shape + Sized {
+pub(crate) trait Stored: Sized {
     /// Its kind.
     const KIND: ShapeKind;
 
