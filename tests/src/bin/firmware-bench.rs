@@ -34,6 +34,7 @@ fn main() {
     );
     println!("| --- | --- | --- | ---: | ---: | ---: | ---: | ---: |");
     let mut dual_rows = Vec::new();
+    let mut failures = 0;
     for board in Board::ALL {
         for scene in &scenes {
             let firmware = Firmware::new(board, scene, width, height, PanelColor::Rgb888);
@@ -71,7 +72,10 @@ fn main() {
                     let reason = reason.splitn(4, ':').nth(3).unwrap_or(reason).split(';').next().unwrap_or("").trim();
                     println!("| {label} | does not run (exit {}): {reason} | | | | |", m.status);
                 }
-                Err(e) => println!("| {label} | failed: {} | | | | |", e.lines().next().unwrap_or("")),
+                Err(e) => {
+                    println!("| {label} | failed: {} | | | | |", e.lines().next().unwrap_or(""));
+                    failures += 1;
+                }
             }
         }
     }
@@ -89,6 +93,11 @@ fn main() {
         for row in dual_rows {
             println!("{row}");
         }
+    }
+    // A row the harness could not measure is not a figure: the run fails.
+    if failures > 0 {
+        eprintln!("firmware-bench: {failures} measurement(s) failed");
+        std::process::exit(1);
     }
 }
 

@@ -20,11 +20,13 @@ fn main() {
     let dir = tempfile::tempdir().expect("a temporary directory");
     println!("| scene | parse and index | render | scene to picture at 125 MHz | flash | static RAM |");
     println!("| --- | ---: | ---: | ---: | ---: | ---: |");
+    let mut failures = 0;
     for scene in &scenes {
         let elf = match pico::build(scene) {
             Ok(elf) => elf,
             Err(e) => {
                 println!("| {scene} | failed to build: {} | | | | |", e.lines().next().unwrap_or(""));
+                failures += 1;
                 continue;
             }
         };
@@ -40,7 +42,15 @@ fn main() {
                 (sizes.text + sizes.data) as f64 / 1024.0,
                 (sizes.data + sizes.bss) as f64 / 1024.0,
             ),
-            Err(e) => println!("| {scene} | failed: {} | | | | |", e.lines().next().unwrap_or("")),
+            Err(e) => {
+                println!("| {scene} | failed: {} | | | | |", e.lines().next().unwrap_or(""));
+                failures += 1;
+            }
         }
+    }
+    // A row that could not be measured is not a figure: the run fails.
+    if failures > 0 {
+        eprintln!("pico-bench: {failures} scene(s) failed");
+        std::process::exit(1);
     }
 }
