@@ -114,6 +114,14 @@ macro_rules! capacities {
             }
 
             /// These counts with `count` of every shape kind.
+            ///
+            /// ```
+            /// use octrace_core::{capacity::Counts, shapes::ShapeKind};
+            ///
+            /// let counts = Counts { lights: 1, ..Counts::ZERO }.with_every_shape(3);
+            /// assert!(ShapeKind::ALL.iter().all(|kind| counts.get(kind.capacity()) == 3));
+            /// assert_eq!((counts.shapes(), counts.lights), (3 * ShapeKind::ALL.len(), 1));
+            /// ```
             pub const fn with_every_shape(mut self, count: usize) -> Counts {
                 $(self.$shape_field = count;)*
                 self

@@ -128,6 +128,14 @@ macro_rules! shape_kinds {
 
         impl ShapeKind {
             /// Every kind, in the list's order (`kind as usize` indexes it).
+            ///
+            /// ```
+            /// use octrace_core::shapes::ShapeKind;
+            ///
+            /// assert_eq!(ShapeKind::ALL[ShapeKind::Triangle as usize], ShapeKind::Triangle);
+            /// assert!(ShapeKind::ALL.iter().all(|kind| kind.item_bytes() > 0));
+            /// assert!(ShapeKind::Rectangle.is_flat() && !ShapeKind::Sphere.is_flat());
+            /// ```
             pub const ALL: [ShapeKind; [$(ShapeKind::$kind),*].len()] = [$(ShapeKind::$kind),*];
 
             /// The capacity objects of this kind count against.
