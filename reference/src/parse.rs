@@ -87,41 +87,17 @@ fn tokenize(text: &str) -> Result<Vec<Token>, String> {
 /// True when `s` is `[+-]? digits? (. digits?)? ([eE] [+-]? digits)?` with at
 /// least one mantissa digit.
 fn is_number(s: &str) -> bool {
-    let b = s.as_bytes();
-    let mut i = 0;
-    if i < b.len() && (b[i] == b'+' || b[i] == b'-') {
-        i += 1;
-    }
-    let mut mantissa_digits = 0;
-    while i < b.len() && b[i].is_ascii_digit() {
-        i += 1;
-        mantissa_digits += 1;
-    }
-    if i < b.len() && b[i] == b'.' {
-        i += 1;
-        while i < b.len() && b[i].is_ascii_digit() {
-            i += 1;
-            mantissa_digits += 1;
-        }
-    }
-    if mantissa_digits == 0 {
-        return false;
-    }
-    if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
-        i += 1;
-        if i < b.len() && (b[i] == b'+' || b[i] == b'-') {
-            i += 1;
-        }
-        let mut exp_digits = 0;
-        while i < b.len() && b[i].is_ascii_digit() {
-            i += 1;
-            exp_digits += 1;
-        }
-        if exp_digits == 0 {
-            return false;
-        }
-    }
-    i == b.len()
+    let (mantissa, exponent) = match s.find(['e', 'E']) {
+        Some(at) => (&s[..at], Some(&s[at + 1..])),
+        None => (s, None),
+    };
+    let unsigned = mantissa.strip_prefix(['+', '-']).unwrap_or(mantissa);
+    let (whole, fraction) = unsigned.split_once('.').unwrap_or((unsigned, ""));
+    let all_digits = |t: &str| t.bytes().all(|c| c.is_ascii_digit());
+    all_digits(whole)
+        && all_digits(fraction)
+        && !(whole.is_empty() && fraction.is_empty())
+        && exponent.is_none_or(is_integer)
 }
 
 fn is_integer(s: &str) -> bool {
@@ -382,4 +358,22 @@ fn parse_shape(p: &mut Parser, keyword: &str, line: usize, col: usize) -> Result
             Shape::Rectangle { p: pts, normal: n.normalised() }
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_are_sign_digits_point_digits_exponent() {
+        for yes in ["1", "+1", "-1", "1.", ".5", "-.5", "1.25", "1e3", "1E-3", "+2.5e+10", "0.0e0"] {
+            assert!(is_number(yes), "{yes}");
+        }
+        for no in [
+            "", "+", "-", ".", "+.", "e3", ".e3", "1e", "1e+", "1.2.3", "+-1", "1e3e4", "1e3.5", "1x", "--1", " 1",
+            "1 ", "é",
+        ] {
+            assert!(!is_number(no), "{no}");
+        }
+    }
 }
