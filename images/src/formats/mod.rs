@@ -153,12 +153,12 @@ fn unsupported<T>(message: String) -> Result<T, FormatError> {
 /// Writes `image` to `out` as a `format` file.
 pub fn write(image: &Image, format: Format, out: &mut dyn Write) -> Result<(), FormatError> {
     check(image)?;
-    let (width, row_bytes) = (image.width() as usize, image.width() as usize * image.bytes_per_pixel());
     let (palette, data) = match image {
         Image::Rgb(rgb) => (None, &rgb.data),
         Image::Indexed { palette, indices, .. } => (Some(palette.clone()), indices),
     };
-    let header = Header { width: width as u32, height: image.height(), palette, text: None };
+    let header = Header { width: image.width(), height: image.height(), palette, text: None };
+    let row_bytes = header.width as usize * header.bytes_per_pixel();
     let mut writer = RowWriter::new(format, &header, out)?;
     for row in data.chunks_exact(row_bytes) {
         writer.write_row(row)?;
@@ -206,16 +206,6 @@ impl Header {
 
 /// The keyword of the PNG `tEXt` chunk that carries [`Header::text`].
 pub const TEXT_KEYWORD: &str = "octrace";
-
-impl Image {
-    /// Bytes a pixel takes in memory: 3 (RGB) or 1 (an index).
-    pub fn bytes_per_pixel(&self) -> usize {
-        match self {
-            Image::Rgb(_) => 3,
-            Image::Indexed { .. } => 1,
-        }
-    }
-}
 
 /// Reads an image file of any of the formats, told apart by their content.
 pub fn read(bytes: &[u8]) -> Result<Image, FormatError> {
