@@ -252,9 +252,12 @@ fn convert(input: &Path, output: &Path, format: Option<Format>) -> Result<(), Cl
 
 fn merge(output: &Path, parts: &[PathBuf], format: Option<Format>) -> Result<(), CliError> {
     let format = output_format(format, output)?;
-    let (ordered, header) = parts::check_parts(parts).map_err(|e| match e {
-        MergeError::Io { .. } => CliError::Io(format!("merge: {e}; nothing written")),
-        MergeError::Refused(_) => CliError::Invalid(format!("merge: {e}; nothing written")),
+    let (ordered, header) = parts::check_parts(parts).map_err(|e| {
+        let message = format!("merge: {e}; nothing written");
+        match e {
+            MergeError::Io { .. } => CliError::Io(message),
+            MergeError::Refused(_) => CliError::Invalid(message),
+        }
     })?;
     write_atomically(output, |f| parts::write_merged(&ordered, &header, format, f).map_err(std::io::Error::other))
         .map_err(|e| CliError::Io(format!("merge: cannot write {}: {e}", output.display())))
