@@ -8,10 +8,10 @@
 //! time.
 
 use crate::repo;
-use embedded_graphics_core::pixelcolor::{Gray4, GrayColor, Rgb888};
 use octrace_core::render::PanelColor;
 use octrace_images::formats::Image;
-use octrace_images::palette::PaletteMode;
+use octrace_images::palette::{self, PaletteMode};
+use octrace_images::panel;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -156,16 +156,18 @@ impl Firmware {
         Ok(match self.wire {
             PanelColor::Rgb888 => image.data,
             PanelColor::Rgb565 => image.data.chunks(3).flat_map(|p| rgb565(p[0], p[1], p[2]).to_be_bytes()).collect(),
-            PanelColor::Gray4 => {
-                image.data.chunks(3).map(|p| Gray4::from(Rgb888::new(p[0], p[1], p[2])).luma()).collect()
-            }
-            PanelColor::Dither => {
-                match octrace_images::palette::apply(&image, &rendered.objects, PaletteMode::Dither) {
-                    Image::Indexed { indices, .. } => indices,
-                    Image::Rgb(_) => return Err("dither gave a truecolour image".into()),
-                }
-            }
+            // host-sim's gray4 preview and dither: their indices are the wire's.
+            PanelColor::Gray4 => indices(panel::gray4(&image))?,
+            PanelColor::Dither => indices(palette::apply(&image, &rendered.objects, PaletteMode::Dither))?,
         })
+    }
+}
+
+/// The colour-table indices of an indexed image.
+fn indices(image: Image) -> Result<Vec<u8>, String> {
+    match image {
+        Image::Indexed { indices, .. } => Ok(indices),
+        Image::Rgb(_) => Err("a truecolour image where colour-table indices were expected".into()),
     }
 }
 
