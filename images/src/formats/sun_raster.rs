@@ -36,12 +36,21 @@ pub(super) fn header_bytes(header: &Header) -> Result<Vec<u8>, FormatError> {
     Ok(out)
 }
 
+/// The seven big-endian words after the magic number (width, height, depth, length, type, map type, map
+/// length), read from `input`, which is left after the 32-byte header.
+fn header_words(input: &mut impl std::io::Read) -> Result<[u32; 7], FormatError> {
+    let mut b = [0; 32];
+    read_exactly(input, &mut b, "Sun raster header")?;
+    Ok(std::array::from_fn(|i| {
+        let at = 4 * (i + 1);
+        u32::from_be_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]])
+    }))
+}
+
 /// A Sun raster read whole.
 pub(super) fn read(bytes: &[u8]) -> Result<Image, FormatError> {
     let mut input = bytes;
-    let header = take(&mut input, 32, "Sun raster header")?;
-    let field = |i: usize| u32::from_be_bytes([header[4 * i], header[4 * i + 1], header[4 * i + 2], header[4 * i + 3]]);
-    let [width, height, depth, _length, kind, map_type, map_length] = std::array::from_fn(|i| field(i + 1));
+    let [width, height, depth, _length, kind, map_type, map_length] = header_words(&mut input)?;
     if width == 0 || height == 0 {
         return invalid(format!("the Sun raster is {width}×{height} pixels"));
     }
@@ -112,10 +121,7 @@ pub(super) fn row_padding(row_bytes: usize) -> usize {
 /// The header of a Sun raster this crate writes (standard, 24 bits or 8 with an RGB map), read from
 /// `input`, which is left at the first row.
 pub(super) fn stream_header(input: &mut impl std::io::Read) -> Result<Header, FormatError> {
-    let mut fixed = [0; 32];
-    read_exactly(input, &mut fixed, "Sun raster header")?;
-    let field = |i: usize| u32::from_be_bytes([fixed[4 * i], fixed[4 * i + 1], fixed[4 * i + 2], fixed[4 * i + 3]]);
-    let [width, height, depth, _length, kind, map_type, map_length] = std::array::from_fn(|i| field(i + 1));
+    let [width, height, depth, _length, kind, map_type, map_length] = header_words(input)?;
     let palette = match (depth, kind, map_type) {
         (24, RT_STANDARD, RMT_NONE) => None,
         (8, RT_STANDARD, RMT_EQUAL_RGB) if map_length % 3 == 0 && map_length <= 768 => {

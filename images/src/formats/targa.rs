@@ -37,14 +37,56 @@ pub(super) fn header_bytes(header: &Header) -> Result<Vec<u8>, FormatError> {
     Ok(out)
 }
 
+/// The 18 bytes every Targa file starts with, as fields.
+struct Fixed {
+    id_length: u8,
+    map_type: u8,
+    image_type: u8,
+    map_first: u16,
+    map_length: usize,
+    map_bits: u8,
+    width: u16,
+    height: u16,
+    pixel_bits: u8,
+    descriptor: u8,
+}
+
+impl Fixed {
+    /// Reads them from `input`, which is left after them.
+    fn read(input: &mut impl std::io::Read) -> Result<Fixed, FormatError> {
+        let mut b = [0; 18];
+        read_exactly(input, &mut b, "Targa header")?;
+        let u16_at = |i: usize| u16::from_le_bytes([b[i], b[i + 1]]);
+        Ok(Fixed {
+            id_length: b[0],
+            map_type: b[1],
+            image_type: b[2],
+            map_first: u16_at(3),
+            map_length: u16_at(5) as usize,
+            map_bits: b[7],
+            width: u16_at(12),
+            height: u16_at(14),
+            pixel_bits: b[16],
+            descriptor: b[17],
+        })
+    }
+}
+
 /// A Targa file read whole.
 pub(super) fn read(bytes: &[u8]) -> Result<Image, FormatError> {
     let mut input = bytes;
-    let header = take(&mut input, 18, "Targa header")?;
-    let u16_at = |i: usize| u16::from_le_bytes([header[i], header[i + 1]]);
-    let [id_length, map_type, image_type] = [header[0], header[1], header[2]];
-    let (map_first, map_length, map_bits) = (u16_at(3), u16_at(5) as usize, header[7]);
-    let (width, height, pixel_bits, descriptor) = (u16_at(12), u16_at(14), header[16], header[17]);
+    let Fixed {
+        id_length,
+        map_type,
+        image_type,
+        map_first,
+        map_length,
+        map_bits,
+        width,
+        height,
+        pixel_bits,
+        descriptor,
+    } = Fixed::read(&mut input)?;
     let (mapped, run_length) = match image_type {
         1 => (true, false),
         2 => (false, false),
@@ -135,15 +177,11 @@ fn orient(stored: &[u8], width: usize, pixel_bytes: usize, descriptor: u8) -> Co
 /// The header of a Targa file this crate writes (uncompressed, top-down), read from `input`, which is left
 /// at the first row.
 pub(super) fn stream_header(input: &mut impl std::io::Read) -> Result<Header, FormatError> {
-    let mut fixed = [0; 18];
-    read_exactly(input, &mut fixed, "Targa header")?;
-    let u16_at = |i: usize| u16::from_le_bytes([fixed[i], fixed[i + 1]]);
-    let [id_length, map_type, image_type] = [fixed[0], fixed[1], fixed[2]];
-    let (map_first, map_length, map_bits) = (u16_at(3), u16_at(5) as usize, fixed[7]);
-    let (width, height, pixel_bits, descriptor) = (u16_at(12), u16_at(14), fixed[16], fixed[17]);
-    let mut id = vec![0; id_length as usize];
+    let fixed = Fixed::read(input)?;
+    let mut id = vec![0; fixed.id_length as usize];
     read_exactly(input, &mut id, "Targa image ID")?;
     let text = String::from_utf8(id).ok().filter(|t| !t.is_empty());
+    let Fixed { map_type, image_type, pixel_bits, map_bits, map_first, descriptor, map_length, .. } = fixed;
     let palette = match (map_type, image_type, pixel_bits, map_bits, map_first, descriptor) {
         (0, 2, 24, _, _, TOP_DOWN) => None,
         (1, 1, 8, 24, 0, TOP_DOWN) if map_length <= 256 => {
@@ -157,7 +195,7 @@ pub(super) fn stream_header(input: &mut impl std::io::Read) -> Result<Header, Fo
             ))
         }
     };
-    Ok(Header { width: u32::from(width), height: u32::from(height), palette, text })
+    Ok(Header { width: u32::from(fixed.width), height: u32::from(fixed.height), palette, text })
 }
 
 #[cfg(test)]
