@@ -52,6 +52,16 @@ static RECIPROCAL_TABLE: [u32; 257] = {
     t
 };
 
+/// About 2^63 / `dn` for `dn` in [2^31, 2^32), to some 17 bits: the table,
+/// interpolated (1/x is within 2^-18 of its chord over an interval). Its
+/// terms stay in a u32: neighbours differ by less than 2^24.
+#[inline(always)]
+pub(crate) fn reciprocal_start(dn: u32) -> u32 {
+    let i = ((dn >> 23) & 0xff) as usize;
+    let (lo, hi) = (RECIPROCAL_TABLE[i], RECIPROCAL_TABLE[i + 1]);
+    lo - ((((lo - hi) >> 9) * ((dn >> 7) & 0xffff)) >> 7)
+}
+
 /// `⌊n / d⌋` for `0 < d` and `n < d · 2^32`, from a reciprocal.
 #[inline]
 fn div_by_reciprocal(n: u64, d: u32) -> u32 {
@@ -76,13 +86,9 @@ impl Reciprocal {
         // Normalise: dn in [2^31, 2^32); the quotients are unchanged.
         let shift = leading_zeros_u32(d);
         let dn = d << shift;
-        // r ≈ 2^63 / dn: about 17 bits from the table, interpolated (1/x is
-        // within 2^-18 of its chord over an interval), then about 31 after
-        // one Newton step r' = r + r·(2^63 − dn·r)/2^63. The interpolation's
-        // terms stay in a u32: neighbours differ by less than 2^24.
-        let i = ((dn >> 23) & 0xff) as usize;
-        let (lo, hi) = (RECIPROCAL_TABLE[i], RECIPROCAL_TABLE[i + 1]);
-        let r = lo - ((((lo - hi) >> 9) * ((dn >> 7) & 0xffff)) >> 7);
+        // r ≈ 2^63 / dn: about 17 bits from the table, then about 31 after
+        // one Newton step r' = r + r·(2^63 − dn·r)/2^63.
+        let r = reciprocal_start(dn);
         let error = ((1u64 << 63).wrapping_sub(mul_u32_wide(dn, r)) as i64 >> 31) as i32;
         let step = (mul_u32_wide(r, error.unsigned_abs()) >> 32) as u32;
         let r = if error >= 0 { r.saturating_add(step) } else { r - step };

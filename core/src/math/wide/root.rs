@@ -78,29 +78,51 @@ pub fn sqrt_and_rsqrt(n: u64) -> (u64, u32, i32) {
 /// argument's scale is one of two, known without counting leading zeros.
 #[inline]
 pub(crate) fn sqrt_and_rsqrt_58_62(n: u64) -> (u64, u32, i32) {
-    let shift = if n >> 62 != 0 || n >> 58 == 0 {
+    let Some((f, shift)) = argument_58_62(n) else {
         return sqrt_and_rsqrt(n);
-    } else if n >> 60 != 0 {
-        30
-    } else {
-        28
     };
-    // What `rsqrt_argument` gives: f = n / 2^shift in [2^30, 2^32).
-    let f = if shift == 30 { (n >> 30) as u32 } else { (n >> 28) as u32 };
     let g = rsqrt_normalised(f);
     (isqrt_from(n, g, f, shift), g, 46 + shift / 2)
+}
+
+/// `(s, g, e)` with `s ≈ √n` and `1/√n ≈ g · 2^-e`, both within 2^-27
+/// (relative), for `n` in [2^58, 2^62): [`sqrt_and_rsqrt_58_62`] without
+/// the steps to the exact floor.
+#[inline]
+pub(crate) fn sqrt_and_rsqrt_estimates_58_62(n: u64) -> (u32, u32, i32) {
+    let (f, shift) = argument_58_62(n).unwrap_or_else(|| rsqrt_argument(n));
+    let g = rsqrt_normalised(f);
+    (sqrt_estimate(g, f, shift), g, 46 + shift / 2)
+}
+
+/// What [`rsqrt_argument`] gives for `n` in [2^58, 2^62), where `n / 2^shift`
+/// is in [2^30, 2^32) for one of two shifts; `None` outside.
+#[inline(always)]
+fn argument_58_62(n: u64) -> Option<(u32, i32)> {
+    if n >> 62 != 0 || n >> 58 == 0 {
+        None
+    } else if n >> 60 != 0 {
+        Some(((n >> 30) as u32, 30))
+    } else {
+        Some(((n >> 28) as u32, 28))
+    }
+}
+
+/// `√n` from `n = f · 2^shift` and `g ≈ 2^30/√(f / 2^32)`: √n = f · (1/√f) ·
+/// 2^(shift/2) = f·g · 2^(shift/2 − 46), capped below 2^32 (√n < 2^32).
+#[inline(always)]
+fn sqrt_estimate(g: u32, f: u32, shift: i32) -> u32 {
+    shr_saturating_u32(mul_u32_wide(f, g), (46 - shift / 2) as u32)
 }
 
 /// ⌊√n⌋ for `n ≥ 2` given [`rsqrt_argument`]'s `f · 2^shift = n` and
 /// `g ≈ 2^30/√(f / 2^32)`.
 #[inline]
 fn isqrt_from(n: u64, g: u32, f: u32, shift: i32) -> u64 {
-    // √n = f · (1/√f) · 2^(shift/2) = f·g · 2^(shift/2 − 46), then
-    // corrected to the exact floor (at most a couple of steps). The shift
-    // is 30 to 61 for every n ≥ 2.
-    // √n < 2^32, so the estimate is capped below it; s² then fits a u64,
-    // and the steps keep it as `square` (one product in all).
-    let mut s = shr_saturating_u32(mul_u32_wide(f, g), (46 - shift / 2) as u32) as u64;
+    // The estimate corrected to the exact floor (at most a couple of
+    // steps). The shift is 30 to 61 for every n ≥ 2; s² fits a u64, and the
+    // steps keep it as `square` (one product in all).
+    let mut s = sqrt_estimate(g, f, shift) as u64;
     let mut square = square_u32_wide(s as u32);
     while square > n {
         square -= 2 * s - 1;
@@ -130,6 +152,18 @@ mod tests {
         let ends = [1 << 58, (1 << 58) - 1, 1 << 60, (1 << 60) - 1, (1 << 62) - 1, 1 << 62, 3 << 60];
         for n in spread(50_000).map(|v| v | 1 << 58 >> (v % 3)).chain(ends) {
             assert_eq!(sqrt_and_rsqrt_58_62(n), sqrt_and_rsqrt(n), "{n}");
+        }
+    }
+
+    #[test]
+    fn the_estimates_are_within_two_to_the_minus_27() {
+        for n in spread(50_000).map(|v| (v | 1 << 58) >> (v % 4)).filter(|&n| n >> 58 != 0) {
+            let (s, g, e) = sqrt_and_rsqrt_estimates_58_62(n);
+            let root = n.isqrt();
+            assert!(root.abs_diff(s as u64) <= root >> 27, "{n}: {s} for {root}");
+            // g²·n ≈ 2^(2e), so g within 2^-27 of 2^e/√n when this is within 2^-26.
+            let err = ((g as u128 * g as u128) * n as u128).abs_diff(1u128 << (2 * e));
+            assert!(err <= (1u128 << (2 * e)) >> 26, "{n}: {g} 2^-{e}");
         }
     }
 
