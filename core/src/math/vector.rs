@@ -560,7 +560,7 @@ mod tests {
         for i in 0..300_000 {
             let v = Vec3::from_bits([0; 3].map(|_| {
                 let x = next();
-                ((x as i32) >> (x >> 32) % 32) * ((x >> 40) % 4 != 0) as i32
+                ((x as i32) >> ((x >> 32) % 32)) * ((x >> 40) % 4 != 0) as i32
             }));
             let Some((exact, length)) = v.direction_and_length() else {
                 assert_eq!(v.direction_and_length_estimate(), None);
