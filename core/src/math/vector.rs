@@ -181,7 +181,7 @@ impl Vec3 {
     }
 
     /// [`Vec3::direction_and_length`] without the steps to exact rounding,
-    /// for about half the instructions on a Cortex-M0: each component
+    /// a fifth fewer instructions on a Cortex-M0: each component
     /// within 5 units in the last place of the rounded quotient (the length
     /// of the direction within 2^-27 of 1), the length within 2^-27 of the
     /// exact one plus its rounding. For the directions to the lights, which
