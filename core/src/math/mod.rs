@@ -20,7 +20,7 @@ pub(crate) use exp_log::{isqrt_u128, pow_q30, pow_unit};
 pub use vector::{Dir, Vec3};
 pub(crate) use wide::{
     div_saturating, isqrt, leading_zeros, leading_zeros_u32, mul_i64_i32, mul_i64_wide, mul_u32_wide, mul_wide,
-    shr_to_u32, sqrt_and_rsqrt_58_62, sqrt_and_rsqrt_estimates_58_62, square_u32_wide, square_wide,
+    sqrt_and_rsqrt_58_62, sqrt_and_rsqrt_estimates_58_62, square_u32_wide, square_wide,
 };
 
 /// Whether this build is for ARMv6-M (Cortex-M0), which has only a
@@ -41,7 +41,8 @@ pub(crate) fn part_wise_or<T>(part_wise: impl FnOnce() -> Option<T>, exact: impl
 }
 
 pub(crate) use wide::{
-    mul_u64_shr24, mul_u64_shr24_clamped, reciprocal_q62, reciprocal_start, shl_u64, shr_saturating_u32, shr_u64,
+    mul_u64_shr24, mul_u64_shr24_clamped, reciprocal_q62, reciprocal_start, shl_u64, shr_saturating_u32,
+    shr_signed_to_u32, shr_u64,
 };
 
 pub use fixed::types::{I16F16, I2F30, I32F32};

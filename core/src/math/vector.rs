@@ -372,8 +372,7 @@ impl Dir {
         }
         let shift = 64 - super::leading_zeros(largest) as i32 - 30;
         // Left shifts only happen to magnitudes below 2^30.
-        let scaled =
-            magnitude.map(|m| if shift > 0 { super::shr_to_u32(m, shift as u32) } else { (m as u32) << -shift });
+        let scaled = magnitude.map(|m| super::shr_signed_to_u32(m, shift));
         Some(Self::from_scaled(v.map(|c| c < 0), scaled, shift))
     }
 

@@ -17,8 +17,8 @@
 
 use crate::accel::{Accelerator, Hit, Mailbox, RayStart};
 use crate::math::{
-    leading_zeros, mul_u32_wide, mul_wide, pow_unit, reciprocal_start, shr_saturating_u32, shr_to_u32, Dir, Scalar,
-    Unit, Vec3, UNIT_ONE,
+    leading_zeros, mul_u32_wide, mul_wide, pow_unit, reciprocal_start, shr_saturating_u32, shr_signed_to_u32, Dir,
+    Scalar, Unit, Vec3, UNIT_ONE,
 };
 use crate::scene::{Color, ObjectId, SceneView};
 use crate::shapes::{Leaving, Ray};
@@ -113,7 +113,7 @@ fn ratio_q16(num: u64, den: u64) -> i32 {
     }
     let (zn, zd) = (leading_zeros(num), leading_zeros(den));
     // Each operand's top 32 bits, in [2^31, 2^32): x = top · 2^(32 − z).
-    let top = |x: u64, z: u32| if z >= 32 { (x as u32) << (z - 32) } else { shr_to_u32(x, 32 - z) };
+    let top = |x: u64, z: u32| shr_signed_to_u32(x, 32 - z as i32);
     // q ≈ (num_top / den_top) · 2^63, and the quotient num·2^16/den is
     // q · 2^(16 + zd − zn − 63), rounded on its last bit.
     let q = mul_u32_wide(top(num, zn), reciprocal_start(top(den, zd)));

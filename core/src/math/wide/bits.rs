@@ -66,7 +66,7 @@ fn leading_zeros_of_word(mut w: u32, base: u32) -> u32 {
 /// `x >> shift` for a shift in 0 ..= 63 whose result fits 32 bits: on a
 /// 32-bit core, a 64-bit shift by a variable amount is a library call.
 #[inline(always)]
-pub fn shr_to_u32(x: u64, shift: u32) -> u32 {
+pub(crate) fn shr_to_u32(x: u64, shift: u32) -> u32 {
     let (high, low) = ((x >> 32) as u32, x as u32);
     if shift >= 32 {
         high >> (shift - 32)
@@ -74,6 +74,19 @@ pub fn shr_to_u32(x: u64, shift: u32) -> u32 {
         low
     } else {
         (low >> shift) | (high << (32 - shift))
+    }
+}
+
+/// `x >> shift` for a shift in −31 ..= 63 whose result fits 32 bits, a
+/// negative shift moving the low word left: a value brought to a chosen
+/// scale, whichever side of it the value is.
+#[inline(always)]
+pub(crate) fn shr_signed_to_u32(x: u64, shift: i32) -> u32 {
+    // A zero shift takes the cheaper arm: the low word, as the result fits.
+    if shift > 0 {
+        shr_to_u32(x, shift as u32)
+    } else {
+        (x as u32) << -shift
     }
 }
 
@@ -147,6 +160,12 @@ mod tests {
             for shift in 0..64 {
                 if v >> shift <= u32::MAX as u64 {
                     assert_eq!(shr_to_u32(v, shift), (v >> shift) as u32, "{v} >> {shift}");
+                    assert_eq!(shr_signed_to_u32(v, shift as i32), (v >> shift) as u32, "{v} >> {shift}");
+                }
+            }
+            for shift in 1..32 {
+                if v.leading_zeros() >= 32 + shift {
+                    assert_eq!(shr_signed_to_u32(v, -(shift as i32)), (v << shift) as u32, "{v} << {shift}");
                 }
             }
         }

@@ -2,7 +2,7 @@
 //! products, from a 192-entry table built at compile time. The exact floor
 //! on every target.
 
-use super::bits::{leading_zeros, shr_saturating_u32, shr_to_u32};
+use super::bits::{leading_zeros, shr_saturating_u32, shr_signed_to_u32};
 use super::product::{mul_u32_wide, square_u32_wide};
 
 /// 2^30 / √f at f = m/256 for m from 64 to 256: the end points of 192
@@ -34,7 +34,7 @@ pub fn rsqrt(x: u64) -> (u32, i32) {
 fn rsqrt_argument(x: u64) -> (u32, i32) {
     let bits = 64 - leading_zeros(x) as i32;
     let shift = (bits - 31) & !1;
-    let f = if shift >= 0 { shr_to_u32(x, shift as u32) } else { (x as u32) << -shift };
+    let f = shr_signed_to_u32(x, shift);
     (f, shift)
 }
 
