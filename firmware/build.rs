@@ -204,10 +204,6 @@ fn main() {
     writeln!(config, "pub const SCENE_NAME: &str = {scene:?};").unwrap();
     writeln!(config, "pub const SCENE: &str = include_str!({:?});", scene_path.display().to_string()).unwrap();
     writeln!(config, "pub const WIDTH: u32 = {w};").unwrap();
-    if board.name == "mps2-an521" {
-        // Each core's own mailbox and screen lists are sized from it.
-        writeln!(config, "pub const OBJECTS: usize = {};", counts.objects).unwrap();
-    }
     writeln!(config, "pub const HEIGHT: u32 = {h};").unwrap();
     writeln!(config, "pub const ACCEL: octrace_core::AccelMode = octrace_core::AccelMode::{accel:?};").unwrap();
     writeln!(config, "pub const WIRE: crate::PanelColor = crate::PanelColor::{wire:?};").unwrap();

@@ -143,6 +143,8 @@ mod sort;
 mod test_rng;
 
 pub use accel::AccelMode;
-pub use raytracer::{DrawError, LoadError, LoadedScene, Raytracer, SceneAccelerator, TracedImage};
+pub use raytracer::{
+    DrawError, LoadError, LoadedScene, Raytracer, RendererRoom, SceneAccelerator, SharedScene, TracedImage,
+};
 #[cfg(feature = "static-cell")]
 pub use static_cell::ConstStaticCell;

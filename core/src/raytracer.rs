@@ -41,10 +41,65 @@ use embedded_graphics_core::Pixel;
 pub struct Raytracer<P: Profile> {
     scene: Scene<P>,
     octree: P::Octree,
+    /// The first core's renderer's own room.
+    room: RendererRoom<P>,
+}
+
+/// Room for one core's [`Renderer`] over a profile's scenes: a mailbox and
+/// screen lists, as the profile sizes them. A [`Raytracer`] holds one for
+/// the core that loads the scene; give each other core one of its own (all
+/// zero bits: a `static`, taken once) and make its renderer with
+/// [`SharedScene::renderer`]: they are the only state a render writes.
+///
+/// ```
+/// use octrace_core::{profile::Board16K, ConstStaticCell, RendererRoom};
+///
+/// static CORE1_ROOM: ConstStaticCell<RendererRoom<Board16K>> = ConstStaticCell::new(RendererRoom::new());
+/// let room: &'static mut RendererRoom<Board16K> = CORE1_ROOM.take();
+/// # let _ = room;
+/// ```
+pub struct RendererRoom<P: Profile> {
     mailbox: P::MailboxWords,
     screen_bounds: P::ScreenBounds,
     screen_positions: P::ScreenPositions,
 }
+
+impl<P: Profile> RendererRoom<P> {
+    /// Empty room: a constant of all-zero bits.
+    pub const fn new() -> Self {
+        RendererRoom {
+            mailbox: P::MailboxWords::EMPTY,
+            screen_bounds: P::ScreenBounds::EMPTY,
+            screen_positions: P::ScreenPositions::EMPTY,
+        }
+    }
+
+    /// The room cleared for a scene of `objects` objects: its mailbox, and
+    /// its screen lists when the scene's camera rays use them.
+    fn prepare(&mut self, objects: usize, first_hits: bool) -> (&mut [u32], Option<ScreenLists<'_>>) {
+        fill(&mut self.mailbox, Mailbox::words_for(objects), 0);
+        let listed = if first_hits { objects } else { 0 };
+        fill(&mut self.screen_bounds, listed, ScreenBound::EMPTY);
+        fill(&mut self.screen_positions, ScreenBound::positions_for(listed), 0);
+        let lists = (self.screen_bounds.as_mut_slice(), self.screen_positions.as_mut_slice());
+        (self.mailbox.as_mut_slice(), first_hits.then_some(lists))
+    }
+}
+
+impl<P: Profile> Default for RendererRoom<P> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<P: Profile> fmt::Debug for RendererRoom<P> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("RendererRoom").field("profile", &P::NAME).finish_non_exhaustive()
+    }
+}
+
+/// A renderer's screen lists: a bound for each object, and their positions.
+type ScreenLists<'a> = (&'a mut [ScreenBound], &'a mut [u16]);
 
 impl<P: Profile> fmt::Debug for Raytracer<P> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -87,13 +142,7 @@ impl core::error::Error for LoadError<'_> {}
 impl<P: Profile> Raytracer<P> {
     /// Empty room for a scene: a constant of all-zero bits.
     pub const fn new() -> Self {
-        Raytracer {
-            scene: Scene::new(),
-            octree: P::Octree::EMPTY,
-            mailbox: P::MailboxWords::EMPTY,
-            screen_bounds: P::ScreenBounds::EMPTY,
-            screen_positions: P::ScreenPositions::EMPTY,
-        }
+        Raytracer { scene: Scene::new(), octree: P::Octree::EMPTY, room: RendererRoom::new() }
     }
 
     /// Parses `text` (replacing any scene loaded before) and indexes it for
@@ -132,19 +181,16 @@ impl<P: Profile> Raytracer<P> {
         let requested = mode;
         let Prepared { mode, report } = accel::prepare(mode, &view, &mut self.octree, &P::OCTREE);
         let octree = report.map(|report| (&self.octree, report));
-        fill(&mut self.mailbox, Mailbox::words_for(view.object_count()), 0);
         // The naive mode asked for by name stays the thesis's test of
         // every object, camera rays too.
         let first_hits = P::FIRST_HITS && requested != AccelMode::Naive;
-        let objects = if first_hits { view.object_count() } else { 0 };
-        fill(&mut self.screen_bounds, objects, ScreenBound::EMPTY);
-        fill(&mut self.screen_positions, ScreenBound::positions_for(objects), 0);
+        let (mailbox, screen_lists) = self.room.prepare(view.object_count(), first_hits);
         Ok(LoadedScene {
             view,
             mode,
             octree,
-            mailbox: RefCell::new(self.mailbox.as_mut_slice()),
-            screen_lists: RefCell::new((self.screen_bounds.as_mut_slice(), self.screen_positions.as_mut_slice())),
+            mailbox: RefCell::new(mailbox),
+            screen_lists: RefCell::new(screen_lists),
             first_hits,
             stats: Cell::new(Stats::default()),
         })
@@ -163,9 +209,9 @@ pub struct LoadedScene<'r, P: Profile> {
     mode: AccelMode,
     octree: Option<(&'r P::Octree, BuildReport)>,
     mailbox: RefCell<&'r mut [u32]>,
-    /// Room for the camera rays' screen lists (bounds and positions), if
-    /// they are used.
-    screen_lists: RefCell<(&'r mut [ScreenBound], &'r mut [u16])>,
+    /// The camera rays' screen lists (bounds and positions), if they are
+    /// used.
+    screen_lists: RefCell<Option<ScreenLists<'r>>>,
     first_hits: bool,
     stats: Cell<Stats>,
 }
@@ -222,6 +268,48 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         SceneAccelerator { octree: self.octree.as_ref().map(|(octree, _)| *octree) }
     }
 
+    /// Runs `f` with a renderer of an image of `size` over this scene, in
+    /// the room its [`Raytracer`] holds: the loading core's renderer on a
+    /// board whose other cores render with [`SharedScene::renderer`]. Its
+    /// counters are added to [`LoadedScene::stats`].
+    ///
+    /// ```
+    /// use embedded_graphics::prelude::*;
+    /// use octrace_core::{profile::Board16K, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load("BACKGROUND 0 0 1\n")?;
+    /// let pixels = scene.with_renderer(Size::new(4, 2), |renderer| renderer.row(1, 0..4).count())?;
+    /// assert_eq!(pixels, 4);
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn with_renderer<R>(
+        &self,
+        size: Size,
+        f: impl FnOnce(&mut Renderer<'_, SceneAccelerator<'r, P>>) -> R,
+    ) -> Result<R, CameraError> {
+        let accelerator = self.accelerator();
+        // Another draw of this scene holds the mailbox or the lists (only if
+        // a display draws from inside a draw): render without, same image.
+        let mut mailbox = self.mailbox.try_borrow_mut();
+        let mut screen_lists = self.screen_lists.try_borrow_mut();
+        let lists = screen_lists.as_deref_mut().ok().and_then(|lists| lists.as_mut());
+        let lists = lists.map(|(bounds, positions)| (&mut **bounds, &mut **positions));
+        let mailbox = mailbox.as_deref_mut().ok().map(|words| &mut **words);
+        let mut renderer = renderer_in(self.view, &accelerator, size, mailbox, lists)?;
+        let result = f(&mut renderer);
+        let mut total = self.stats.get();
+        total.add(&renderer.stats());
+        self.stats.set(total);
+        Ok(result)
+    }
+
+    /// What another core needs to render this scene with a [`Renderer`] of
+    /// its own: see [`SharedScene`].
+    pub fn share(&self) -> SharedScene<'r, P> {
+        SharedScene { view: self.view, accelerator: self.accelerator(), first_hits: self.first_hits }
+    }
+
     /// Whether camera rays find their hits in the screen lists
     /// ([`Profile::FIRST_HITS`]): the same image as the walk's.
     pub fn first_hits(&self) -> bool {
@@ -262,39 +350,107 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         D: DrawTarget,
         D::Color: From<Rgb888>,
     {
-        self.render(&self.accelerator(), size, area, at, target)
+        let mut shifted = Shifted { target, offset: at - area.top_left };
+        let drawn = self.with_renderer(size, |renderer| renderer.render_rect(area, &mut shifted));
+        drawn.map_err(DrawError::Camera)?.map_err(DrawError::Target)?;
+        Ok(())
+    }
+}
+
+/// A renderer over `view` for an image of `size`, with a mailbox and screen
+/// lists where given. Inlined: a board's renderer is made in place.
+#[inline(always)]
+fn renderer_in<'a, A: Accelerator>(
+    view: SceneView<'a>,
+    accel: &'a A,
+    size: Size,
+    mailbox: Option<&'a mut [u32]>,
+    lists: Option<ScreenLists<'a>>,
+) -> Result<Renderer<'a, A>, CameraError> {
+    let mut renderer = Renderer::with_size(view, accel, size.width, size.height)?;
+    if let Some(words) = mailbox {
+        renderer.set_mailbox(words);
+    }
+    if let Some((bounds, positions)) = lists {
+        renderer.set_first_hits(bounds, positions);
+    }
+    Ok(renderer)
+}
+
+/// What another core needs to render a [`LoadedScene`]
+/// ([`LoadedScene::share`]): its objects, its accelerator and whether its
+/// camera rays use the screen lists. `Copy`, read-only and `Send`: hand it
+/// to the other core when you start it.
+///
+/// ```
+/// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*};
+/// use octrace_core::RendererRoom;
+/// use octrace_core::{profile::Board16K, render::interleaved_rows, Raytracer};
+///
+/// let mut raytracer = Raytracer::<Board16K>::new();
+/// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
+/// let mut whole = MockDisplay::<Rgb888>::new();
+/// Image::new(&scene.image(Size::new(8, 8)), Point::zero()).draw(&mut whole)?;
+///
+/// // Core 1 (here, a thread) renders every other row with room of its own.
+/// let shared = scene.share();
+/// let rows = std::thread::scope(|s| {
+///     s.spawn(move || {
+///         let mut room = RendererRoom::<Board16K>::new();
+///         let mut renderer = shared.renderer(&mut room, Size::new(8, 8)).unwrap();
+///         let row = |y| renderer.row(y, 0..8).map(|p| p.color).collect::<Vec<_>>();
+///         interleaved_rows(8, 1, 2).map(row).collect::<Vec<_>>()
+///     })
+///     .join()
+///     .unwrap()
+/// });
+/// for (y, row) in interleaved_rows(8, 1, 2).zip(rows) {
+///     for (x, color) in row.into_iter().enumerate() {
+///         assert_eq!(whole.get_pixel(Point::new(x as i32, y as i32)), Some(color));
+///     }
+/// }
+/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// ```
+pub struct SharedScene<'r, P: Profile> {
+    view: SceneView<'r>,
+    accelerator: SceneAccelerator<'r, P>,
+    first_hits: bool,
+}
+
+impl<P: Profile> Clone for SharedScene<'_, P> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<P: Profile> Copy for SharedScene<'_, P> {}
+
+impl<P: Profile> fmt::Debug for SharedScene<'_, P> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("SharedScene")
+            .field("objects", &self.view.object_count())
+            .field("accelerator", &self.accelerator)
+            .field("first_hits", &self.first_hits)
+            .finish()
+    }
+}
+
+impl<'r, P: Profile> SharedScene<'r, P> {
+    /// The scene's objects, surfaces, lights and settings.
+    pub fn view(&self) -> SceneView<'r> {
+        self.view
     }
 
-    fn render<A: Accelerator, D>(
-        &self,
-        accel: &A,
+    /// A renderer of an image of `size` pixels over this scene that writes
+    /// only `room`: each core renders with one of its own, and any split of
+    /// the image between them gives the same bits as one core.
+    pub fn renderer<'a>(
+        &'a self,
+        room: &'a mut RendererRoom<P>,
         size: Size,
-        area: &Rectangle,
-        at: Point,
-        target: &mut D,
-    ) -> Result<(), DrawError<D::Error>>
-    where
-        D: DrawTarget,
-        D::Color: From<Rgb888>,
-    {
-        let mut renderer = Renderer::with_size(self.view, accel, size.width, size.height).map_err(DrawError::Camera)?;
-        // Another draw of this scene holds the mailbox (only if a display
-        // draws from inside a draw): render without it, same image.
-        let mut mailbox = self.mailbox.try_borrow_mut();
-        if let Ok(words) = mailbox.as_deref_mut() {
-            renderer.set_mailbox(words);
-        }
-        // Likewise the screen lists.
-        let mut screen_lists = self.screen_lists.try_borrow_mut();
-        if let (true, Ok((bounds, positions))) = (self.first_hits, screen_lists.as_deref_mut()) {
-            renderer.set_first_hits(bounds, positions);
-        }
-        let mut shifted = Shifted { target, offset: at - area.top_left };
-        let stats = renderer.render_rect(area, &mut shifted).map_err(DrawError::Target)?;
-        let mut total = self.stats.get();
-        total.add(&stats);
-        self.stats.set(total);
-        Ok(())
+    ) -> Result<Renderer<'a, SceneAccelerator<'r, P>>, CameraError> {
+        let (mailbox, lists) = room.prepare(self.view.object_count(), self.first_hits);
+        renderer_in(self.view, &self.accelerator, size, Some(mailbox), lists)
     }
 }
 

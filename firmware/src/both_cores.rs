@@ -1,13 +1,12 @@
 //! Both Cortex-M33s of the MPS2-AN521 render the picture. Core `c` renders
 //! the rows `interleaved_rows(HEIGHT, c, 2)` with a `Renderer` of its own
-//! (its own mailbox and screen lists) over the one scene and accelerator;
-//! core 0 alone writes to the display, in row order, taking core 1's rows
-//! from a ring of row buffers handed over with atomics: no heap, no lock.
+//! (core 0's in its `Raytracer`, core 1's in a `RendererRoom`) over the one
+//! scene, shared with `LoadedScene::share`; core 0 alone writes to the
+//! display, in row order, taking core 1's rows from a `Handoff` ring: no
+//! heap, no lock.
 //!
-//! Invariants: core 1 starts only after the scene and its accelerator are
-//! published (and never touches the scene's `Raytracer` or semihosting); a
-//! ring slot is written only by core 1 while its row number is 0 and read
-//! only by core 0 while it holds the row's number plus one.
+//! Invariants: core 1 starts only after the shared scene is published (and
+//! never touches the scene's `Raytracer` or semihosting).
 
 use crate::config::{self, Profile};
 use core::cell::UnsafeCell;
@@ -16,36 +15,21 @@ use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::pixelcolor::Rgb888;
 use embedded_graphics_core::primitives::Rectangle;
-use octrace_core::accel::Mailbox;
-use octrace_core::render::{interleaved_rows, Renderer, ScreenBound};
-use octrace_core::scene::SceneView;
-use octrace_core::{LoadedScene, SceneAccelerator};
+use octrace_core::render::{interleaved_rows, Handoff};
+use octrace_core::{ConstStaticCell, LoadedScene, RendererRoom, SharedScene};
 
 const WIDTH: usize = config::WIDTH as usize;
-/// Rows core 1 may render ahead of the display.
-const SLOTS: usize = 4;
 
-/// One of core 1's rows on its way to the display.
-struct Slot {
-    /// The row's number plus one while it holds that row; 0 while free.
-    row: AtomicU32,
-    pixels: UnsafeCell<[Rgb888; WIDTH]>,
-}
+/// Core 1's rows on their way to the display: it may render four ahead.
+static RING: Handoff<WIDTH, 4> = Handoff::new();
 
-struct Ring([Slot; SLOTS]);
-
-// SAFETY: each slot's pixels have one writer (core 1, while `row` is 0) and
-// one reader (core 0, while `row` names the row), handed over by `row`'s
-// release stores and acquire loads.
-unsafe impl Sync for Ring {}
-
-static RING: Ring =
-    Ring([const { Slot { row: AtomicU32::new(0), pixels: UnsafeCell::new([Rgb888::new(0, 0, 0); WIDTH]) } }; SLOTS]);
+/// Core 1's own mailbox and screen lists.
+static CORE1_ROOM: ConstStaticCell<RendererRoom<Profile>> = ConstStaticCell::new(RendererRoom::new());
 
 /// What core 1 renders from, published by core 0 before it starts core 1.
 struct Shared {
     ready: AtomicBool,
-    scene: UnsafeCell<Option<(SceneView<'static>, SceneAccelerator<'static, Profile>)>>,
+    scene: UnsafeCell<Option<SharedScene<'static, Profile>>>,
 }
 
 // SAFETY: `scene` is written once, by core 0, before `ready` is set (and
@@ -89,8 +73,8 @@ where
     D: DrawTarget,
     D::Color: From<Rgb888>,
 {
-    // SAFETY: core 1 is still held in reset: nothing else reads `scene`.
-    unsafe { *SHARED.scene.get() = Some((scene.view(), scene.accelerator())) };
+    // SAFETY: core 1 is still held in reset: nothing else reads `SHARED`.
+    unsafe { *SHARED.scene.get() = Some(scene.share()) };
     SHARED.ready.store(true, Ordering::Release);
     // SAFETY: the documented registers of this board; core 1 starts at the
     // table above, with a stack of its own.
@@ -98,71 +82,38 @@ where
         INITSVTOR1.write_volatile(&CORE1_VECTORS as *const Vectors as usize as u32);
         CPUWAIT.write_volatile(CPUWAIT.read_volatile() & !0b10);
     }
-    let accelerator = scene.accelerator();
-    let mut lists = Lists::new();
-    let mut renderer = lists.renderer(scene.view(), &accelerator);
-    let width = config::WIDTH;
-    for y in 0..config::HEIGHT {
-        let area = Rectangle::new(Point::new(0, y as i32), Size::new(width, 1));
-        if y % 2 == 0 {
-            display.fill_contiguous(&area, renderer.row(y, 0..width).map(|p| p.color.into()))?;
-            continue;
+    let size = Size::new(config::WIDTH, config::HEIGHT);
+    // The size was checked when core 0 loaded the scene.
+    let drawn = scene.with_renderer(size, |renderer| {
+        for y in 0..size.height {
+            let area = Rectangle::new(Point::new(0, y as i32), Size::new(size.width, 1));
+            if y % 2 == 0 {
+                display.fill_contiguous(&area, renderer.row(y, 0..size.width).map(|p| p.color.into()))?;
+                continue;
+            }
+            octrace_wait_until(y, true);
+            // Held, so taken: the row's colours, its slot freed after.
+            if let Some(row) = RING.take(y) {
+                display.fill_contiguous(&area, row.map(Into::into))?;
+            }
         }
-        let slot = &RING.0[(y / 2) as usize % SLOTS];
-        wait_until(&slot.row, y + 1);
-        // SAFETY: the slot holds row y: core 1 will not write it again
-        // until it is freed below.
-        let pixels = unsafe { &*slot.pixels.get() };
-        display.fill_contiguous(&area, pixels.iter().map(|&c| c.into()))?;
-        slot.row.store(0, Ordering::Release);
-    }
-    Ok([renderer.stats().rays, CORE1_RAYS.load(Ordering::Acquire) as u64])
+        Ok(renderer.stats().rays)
+    });
+    let Ok(core0_rays) = drawn else { crate::semihosting::exit(2) };
+    Ok([core0_rays?, CORE1_RAYS.load(Ordering::Acquire) as u64])
 }
 
 /// Rays core 1 traced, once it is done.
 static CORE1_RAYS: AtomicU32 = AtomicU32::new(0);
 
-/// Spins until `cell` holds `value`. Not inlined: the instruction counter
-/// tells a core's waiting from its work by this function's addresses.
+/// Spins until the ring holds row `y` (`sent`) or is free for it (not
+/// `sent`). Not inlined: the instruction counter tells a core's waiting
+/// from its work by this function's addresses (`tools/cores.sh`).
 #[no_mangle]
 #[inline(never)]
-pub extern "C" fn octrace_wait_until(cell: &AtomicU32, value: u32) {
-    while cell.load(Ordering::Acquire) != value {
+pub extern "C" fn octrace_wait_until(y: u32, sent: bool) {
+    while if sent { !RING.holds(y) } else { !RING.is_free_for(y) } {
         core::hint::spin_loop();
-    }
-}
-
-fn wait_until(cell: &AtomicU32, value: u32) {
-    octrace_wait_until(cell, value);
-}
-
-/// A core's own mailbox and screen lists.
-struct Lists {
-    words: [u32; Mailbox::words_for(config::OBJECTS)],
-    bounds: [ScreenBound; config::OBJECTS],
-    positions: [u16; ScreenBound::positions_for(config::OBJECTS)],
-}
-
-impl Lists {
-    fn new() -> Self {
-        Lists {
-            words: [0; Mailbox::words_for(config::OBJECTS)],
-            bounds: [ScreenBound::EMPTY; config::OBJECTS],
-            positions: [0; ScreenBound::positions_for(config::OBJECTS)],
-        }
-    }
-
-    fn renderer<'a>(
-        &'a mut self,
-        view: SceneView<'a>,
-        accelerator: &'a SceneAccelerator<'static, Profile>,
-    ) -> Renderer<'a, SceneAccelerator<'static, Profile>> {
-        // The size was checked when core 0 loaded the scene.
-        let renderer = match Renderer::with_size(view, accelerator, config::WIDTH, config::HEIGHT) {
-            Ok(renderer) => renderer,
-            Err(_) => crate::semihosting::exit(2),
-        };
-        renderer.with_mailbox(&mut self.words).with_first_hits(&mut self.bounds, &mut self.positions)
     }
 }
 
@@ -180,18 +131,14 @@ extern "C" fn core1_main() -> ! {
         core::hint::spin_loop();
     }
     // SAFETY: published before `ready`, never written again.
-    let Some((view, accelerator)) = (unsafe { *SHARED.scene.get() }) else { crate::semihosting::exit(104) };
-    let mut lists = Lists::new();
-    let mut renderer = lists.renderer(view, &accelerator);
+    let Some(shared) = (unsafe { *SHARED.scene.get() }) else { crate::semihosting::exit(104) };
+    let Ok(mut renderer) = shared.renderer(CORE1_ROOM.take(), Size::new(config::WIDTH, config::HEIGHT)) else {
+        crate::semihosting::exit(104)
+    };
     for y in interleaved_rows(config::HEIGHT, 1, 2) {
-        let slot = &RING.0[(y / 2) as usize % SLOTS];
-        wait_until(&slot.row, 0);
-        // SAFETY: the slot is free: core 0 reads it only once it names a row.
-        let pixels = unsafe { &mut *slot.pixels.get() };
-        for (pixel, sample) in pixels.iter_mut().zip(renderer.row(y, 0..config::WIDTH)) {
-            *pixel = sample.color;
-        }
-        slot.row.store(y + 1, Ordering::Release);
+        octrace_wait_until(y, false);
+        // Free, so the row is traced and published.
+        let _ = RING.send(y, renderer.row(y, 0..config::WIDTH).map(|p| p.color));
     }
     CORE1_RAYS.store(renderer.stats().rays as u32, Ordering::Release);
     loop {

@@ -17,12 +17,14 @@
 
 mod first_hit;
 mod gamma;
+mod handoff;
 mod panel;
 mod split;
 
 use first_hit::FirstHits;
 pub use first_hit::ScreenBound;
 pub(crate) use gamma::GammaTable;
+pub use handoff::{Handoff, SlotBusy, Taken};
 pub use panel::PanelColor;
 pub use split::{interleaved_rows, Tiles};
 

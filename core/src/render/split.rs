@@ -13,24 +13,23 @@
 //!
 //! 1. Load the scene once ([`Raytracer::load`](crate::Raytracer::load)),
 //!    on one core.
-//! 2. Hand the other core the scene's [`view`](crate::LoadedScene::view)
-//!    and [`accelerator`](crate::LoadedScene::accelerator) (both `Copy`,
-//!    read-only, `Sync`), then start it.
-//! 3. On each core make a [`Renderer`](super::Renderer) of its own with
-//!    `Renderer::with_size(view, &accelerator, width, height)`, each with
-//!    its own mailbox and screen lists
-//!    ([`with_mailbox`](super::Renderer::with_mailbox),
-//!    [`with_first_hits`](super::Renderer::with_first_hits)): they are the
-//!    only state a render writes.
+//! 2. Hand the other core the scene's [`share`](crate::LoadedScene::share)
+//!    (`Copy`, read-only, `Send`), then start it.
+//! 3. Give each core a [`Renderer`](super::Renderer) of its own: the
+//!    loading core's with [`LoadedScene::with_renderer`](crate::LoadedScene::with_renderer),
+//!    every other core's with [`SharedScene::renderer`](crate::SharedScene::renderer)
+//!    in a [`RendererRoom`](crate::RendererRoom) of its own (a mailbox and
+//!    screen lists, the only state a render writes).
 //! 4. Core `c` renders the rows [`interleaved_rows`]`(height, c, 2)` with
 //!    [`Renderer::row`](super::Renderer::row). One core sends all rows to
-//!    the display in order; the other hands its rows over through a few
-//!    row buffers, each with an atomic row number (0 when free): no heap
-//!    and no lock.
+//!    the display in order; the other hands its rows over through a
+//!    [`Handoff`](super::Handoff), a ring of a few row buffers, each with an
+//!    atomic row number: no heap, no lock, no `unsafe`.
 //!
 //! octrace's firmware does exactly this on qemu's two-core MPS2-AN521
-//! (`firmware/src/both_cores.rs`), and its picture is bit for bit the
-//! one-core picture; each core does 50 ± 0.1 % of the work.
+//! (`firmware/src/both_cores.rs`), and so does the Raspberry Pi Pico
+//! template (`examples/pico-st7789`): their pictures are bit for bit the
+//! one-core picture, and each core does about half of the work.
 
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
