@@ -63,7 +63,7 @@ install_missing_commands() {
             printf '  The conflict: %s %s is installed, newer than the %s that goes with the packages asked for.\n' \
                 "$culprit" "$installed" "$wanted" >&2
             downgrades+=("$culprit=$wanted")
-        done < <(apt_newer_installed_siblings "$output" "${packages[@]}")
+        done < <(apt_newer_installed_siblings "$output")
         local remedy=(install --allow-downgrades "${downgrades[@]}" "${packages[@]}")
         if [ ${#downgrades[@]} -eq 0 ] || ! apt-get --simulate -q "${remedy[@]}" >/dev/null 2>&1; then
             printf '  Once what apt says above is cleared, install them by hand (README.md, section Tests):\n    %s\n' \
@@ -82,7 +82,6 @@ install_missing_commands() {
         fi
     fi
 
-    hash -r
     local command still_missing=()
     for command in "${commands[@]}"; do
         command -v "$command" >/dev/null || still_missing+=("$command")
@@ -110,48 +109,36 @@ report_apt_refusal() {
     } >&2
 }
 
-# apt_newer_installed_siblings APT_OUTPUT PACKAGE...: reads apt's
-# unmet-dependency lines ("X : Breaks: Y (< V) but W is to be installed",
-# "X : Depends: Y (= V) but W is installed", ...) and prints, once per package,
-# "PACKAGE INSTALLED WANTED" for each installed package, not among those asked
-# for, that stands in the way because it is newer than its sibling; WANTED is
-# its version that goes with the sibling: the same version, or else the one
-# the sibling's suite offers.
+# apt_newer_installed_siblings APT_OUTPUT: reads apt's unmet-dependency
+# lines ("X : Breaks: Y (< V) but W is to be installed", "X : Depends: Y (< V)
+# but W is installed", ...) and prints, once per package, "PACKAGE INSTALLED
+# WANTED" for each installed package that stands in the way because it is
+# newer than its sibling in the line; WANTED is its version in the suite that
+# offers the sibling's version.
 apt_newer_installed_siblings() {
-    local output=$1
-    shift
-    local asked=" $* " seen=" " line left="" relation right op version but
-    local culprit sibling sibling_version wanted installed suite
-    local pattern='(Pre-?Depends|Depends|Recommends|Breaks|Conflicts): ([^ ]+) \(([<>=!]+) ([^ )]+)\) but ([^ ]+) is (to be )?installed'
+    local seen=" " line left="" relation right version but culprit sibling sibling_version installed suite wanted
+    local pattern='(Pre-?Depends|Depends|Recommends|Breaks|Conflicts): ([^ ]+) \([<>=!]+ ([^ )]+)\) but ([^ ]+) is (to be )?installed'
     while IFS= read -r line; do
         [[ $line =~ ^\ *([^ ]+)\ :\  ]] && left=${BASH_REMATCH[1]}
         [[ -n $left && $line =~ $pattern ]] || continue
-        relation=${BASH_REMATCH[1]} right=${BASH_REMATCH[2]} op=${BASH_REMATCH[3]}
-        version=${BASH_REMATCH[4]} but=${BASH_REMATCH[5]} wanted=""
+        relation=${BASH_REMATCH[1]} right=${BASH_REMATCH[2]} version=${BASH_REMATCH[3]} but=${BASH_REMATCH[4]}
         if [[ $relation != Breaks && $relation != Conflicts ]] && dpkg --compare-versions "$but" gt "$version"; then
             # The left package needs an older right one: the right one is the newer sibling.
             culprit=$right sibling=$left
             sibling_version=$(apt_policy_version "$left" Candidate)
-            [ "$op" = "=" ] && wanted=$version
         else
             # The left package breaks, or needs a newer, right one as apt would install it.
             culprit=$left sibling=$right sibling_version=$but
         fi
-        [[ $asked != *" $culprit "* && $seen != *" $culprit "* ]] || continue
+        [[ $seen != *" $culprit "* ]] || continue
         installed=$(apt_policy_version "$culprit" Installed)
         [[ -n $installed && $installed != "(none)" ]] || continue
-        if [ -z "$wanted" ]; then
-            if apt_madison "$culprit" | cut -f1 | grep -qxF "$sibling_version"; then
-                wanted=$sibling_version
-            else
-                suite=$(apt_madison "$sibling" | awk -F'\t' -v v="$sibling_version" '$1 == v { print $2; exit }')
-                wanted=$(apt_madison "$culprit" | awk -F'\t' -v s="$suite" 's != "" && $2 == s { print $1; exit }')
-            fi
-        fi
+        suite=$(apt_madison "$sibling" | awk -F'\t' -v v="$sibling_version" '$1 == v { print $2; exit }')
+        wanted=$(apt_madison "$culprit" | awk -F'\t' -v s="$suite" 's != "" && $2 == s { print $1; exit }')
         [[ -n $wanted && $wanted != "$installed" ]] || continue
         seen+="$culprit "
         printf '%s %s %s\n' "$culprit" "$installed" "$wanted"
-    done <<<"$output"
+    done <<<"$1"
 }
 
 # apt_policy_version PACKAGE Installed|Candidate: that line of apt-cache policy.

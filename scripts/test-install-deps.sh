@@ -28,7 +28,11 @@ cat >"$fake/bin/apt-get" <<'EOF'
 #!/usr/bin/env bash
 printf 'apt-get %s\n' "$*" >>"$FAKE_DIR/apt.log"
 args=" $* "
-[[ $args == *" update "* ]] && exit 0
+if [[ $args == *" update "* ]]; then
+    [ "$FAKE_APT" != offline ] && exit 0
+    echo 'E: Failed to fetch http://deb.debian.org/debian/dists/bookworm/InRelease  Temporary failure resolving '"'"'deb.debian.org'"'"'' >&2
+    exit 100
+fi
 case $FAKE_APT in
 backports)
     if [[ $args != *" --allow-downgrades qemu-utils=1:7.2+dfsg-7+deb12u18+b3 "* ]]; then
@@ -59,6 +63,7 @@ newer-library)
         exit 100
     fi ;;
 locked)
+    printf '%s\n' 'Reading package lists...' 'Building dependency tree...' 'Reading state information...'
     echo 'E: Could not get lock /var/lib/dpkg/lock-frontend. It is held by process 4242 (apt-get)' >&2
     exit 100 ;;
 installs-nothing)
@@ -90,7 +95,7 @@ EOF
 chmod +x "$fake"/bin/*
 touch "$fake/bin/octrace-test-present" && chmod +x "$fake/bin/octrace-test-present"
 
-failures=0
+failures=0 cases=0
 fail() {
     printf 'test-install-deps: %s: %s\n--- what it printed:\n%s\n--- what apt was asked:\n%s\n---\n' \
         "$case_name" "$1" "$output" "$(cat "$fake/apt.log" 2>/dev/null)" >&2
@@ -99,7 +104,7 @@ fail() {
 # run CASE APT_CASE [--allow-downgrades]: the install step of the two qemu
 # commands (missing) and one command that is there.
 run() {
-    case_name=$1 && export FAKE_APT=$2 && shift 2
+    case_name=$1 && export FAKE_APT=$2 && shift 2 && cases=$((cases + 1))
     rm -f "$fake/apt.log" "$fake"/bin/octrace-test-qemu-*
     status=0
     output=$(install_missing_commands "$@" octrace-test-qemu-system-arm:qemu-system-arm \
@@ -150,8 +155,16 @@ for flag in "" --allow-downgrades; do
     says_who_and_what
     says '    E: Could not get lock /var/lib/dpkg/lock-frontend. It is held by process 4242 (apt-get)'
     says '    sudo apt-get install qemu-system-arm qemu-system-misc'
+    ! grep -qF 'Reading package lists' <<<"$output" || fail "apt's progress is not its reason"
     not_asked '--allow-downgrades'
 done
+
+run "apt cannot read its package lists" offline
+failed
+says_who_and_what
+says "    E: Failed to fetch http://deb.debian.org/debian/dists/bookworm/InRelease  Temporary failure resolving 'deb.debian.org'"
+says '  apt could not read its package lists; once it can, run scripts/test-all again.'
+not_asked 'install'
 
 run "apt succeeds but the commands do not appear" installs-nothing
 failed
@@ -170,4 +183,4 @@ for name in "${TEST_RUST_COMPONENTS[@]}" "${TEST_RUST_TARGETS[@]}" "${TEST_COMMA
 done
 
 [ "$failures" -eq 0 ] || exit 1
-echo "test-install-deps: the install step says what apt refused and how to resolve it (8 cases)"
+echo "test-install-deps: the install step against a fake apt ($cases cases, and one with nothing missing), README.md's list"
