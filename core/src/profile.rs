@@ -37,7 +37,9 @@ use crate::{
 };
 
 /// Everything one build holds: a scene's arenas, an octree's, and a mailbox.
-/// Implement it with [`profile!`](crate::profile!).
+/// Implement it with [`profile!`](crate::profile!). The octree is `Sync` and
+/// a renderer's room `Send`, so that the cores of a board can share a scene
+/// and each render in room of its own ([`SharedScene`](crate::SharedScene)).
 ///
 /// ```
 /// use octrace_core::profile::{Board16K, Board64K, Profile};
@@ -52,10 +54,10 @@ pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
     /// How the octree is built (its depth also bounds the walk's stack).
     const OCTREE: OctreeConfig;
     /// The octree, with a walk as deep as [`Profile::OCTREE`] allows.
-    type Octree: OctreeStore;
+    type Octree: OctreeStore + Sync;
     /// One bit per object: an object filed in several octree boxes is then
     /// tested once per ray.
-    type MailboxWords: Arena<u32>;
+    type MailboxWords: Arena<u32> + Send;
     /// Whether the octree keeps the thesis's hash table, which only the
     /// thesis's walk ([`AccelMode::Octree`](crate::AccelMode::Octree))
     /// reads. A profile without it (`named_walk: false` in
@@ -72,10 +74,10 @@ pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
     const FIRST_HITS: bool = false;
     /// Room for the screen lists: a bound for each object when
     /// [`Profile::FIRST_HITS`], else none.
-    type ScreenBounds: Arena<ScreenBound>;
+    type ScreenBounds: Arena<ScreenBound> + Send;
     /// And for the lists' positions: [`ScreenBound::positions_for`] the
     /// objects when [`Profile::FIRST_HITS`], else none.
-    type ScreenPositions: Arena<u16>;
+    type ScreenPositions: Arena<u16> + Send;
 }
 
 /// Defines a [`Profile`] from counts: the fields of

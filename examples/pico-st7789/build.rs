@@ -21,9 +21,26 @@ const DEFAULT_SCENE: &str = "../../scenes/fig5_1.txt";
 fn main() {
     let out = PathBuf::from(env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
     let manifest = PathBuf::from(env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
+    // Where the code runs: copied into SRAM at boot (the default), or in
+    // place from the execute-in-place flash through its cache. memory.x
+    // includes `code-placement.x`, written here (the linker finds memory.x
+    // itself in this folder first, so it is not generated).
+    println!("cargo:rerun-if-env-changed=OCTRACE_CODE_IN");
+    let placement = match env::var("OCTRACE_CODE_IN").as_deref() {
+        Ok("sram") | Err(_) => {
+            println!("cargo:rustc-cfg=code_in_sram");
+            std::fs::read_to_string("sram-code.x").expect("read sram-code.x")
+        }
+        Ok("flash") => "/* OCTRACE_CODE_IN=flash: the code runs from flash, through the XIP cache. */\n".to_owned(),
+        Ok(other) => fail(&format!("OCTRACE_CODE_IN={other}: expected `sram` (the default) or `flash`")),
+    };
+    println!("cargo::rustc-check-cfg=cfg(code_in_sram)");
+    std::fs::write(out.join("code-placement.x"), placement).expect("write code-placement.x into OUT_DIR");
+    // Where the linker finds memory.x when it runs elsewhere than here.
     std::fs::copy("memory.x", out.join("memory.x")).expect("copy memory.x into OUT_DIR");
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed=memory.x");
+    println!("cargo:rerun-if-changed=sram-code.x");
     println!("cargo:rerun-if-changed=build.rs");
 
     println!("cargo:rerun-if-env-changed=OCTRACE_SCENE");

@@ -87,6 +87,15 @@ impl<const LEN: usize, const SLOTS: usize> Handoff<LEN, SLOTS> {
         self.slot(piece).tag.load(Ordering::Acquire) == 0
     }
 
+    /// Frees every slot, dropping what they hold: for a consumer that
+    /// stopped taking (a picture cut short), before the producer starts
+    /// again. Call it only while the producer is not sending.
+    pub fn clear(&self) {
+        for slot in &self.slots {
+            slot.tag.store(0, Ordering::Release);
+        }
+    }
+
     /// Whether the producer has sent piece `piece` and the consumer has not
     /// taken it yet: what a consumer waits for before [`take`](Handoff::take).
     pub fn holds(&self, piece: u32) -> bool {
@@ -204,6 +213,17 @@ mod tests {
         assert!(ring.take(5).is_none(), "taken once");
         assert_eq!(ring.send(7, (0..2).map(color)), Ok(2), "a shorter piece");
         assert_eq!(ring.take(7).unwrap().len(), 2);
+    }
+
+    #[test]
+    fn clear_frees_every_slot() {
+        let ring: Handoff<1, 3> = Handoff::new();
+        for n in 0..3 {
+            ring.send(n, [Rgb888::WHITE]).unwrap();
+        }
+        ring.clear();
+        assert!((3..6).all(|n| ring.is_free_for(n)));
+        assert!((0..3).all(|n| !ring.holds(n)));
     }
 
     #[test]

@@ -1,31 +1,31 @@
 //! octrace on a Raspberry Pi Pico: a scene embedded in flash is parsed on the
-//! board and traced row by row straight into an ST7789 panel (Waveshare
+//! board and traced by both cores straight into an ST7789 panel (Waveshare
 //! Pico-LCD-1.3, 240×240) through `mipidsi`. No heap, no framebuffer: the
 //! panel's own memory holds the picture. Pins and wiring are in README.md.
 //!
-//! Invariants: the scene, its octree and mailbox live in one static cell
-//! (all zero bits, so in `.bss`: no flash, no copy on the stack); the image
-//! takes the panel's size.
+//! Invariants: the scene, its octree and core 0's mailbox live in one static
+//! cell, core 1's mailbox and lists in another (all zero bits, so in `.bss`:
+//! no flash, no copy on the stack); the image takes the panel's size; any
+//! split of the rows between the cores gives the same bits as one core.
 
 #![no_std]
 #![no_main]
 
-use embedded_graphics::image::Image;
+use core::ops::ControlFlow;
 use embedded_graphics::pixelcolor::Rgb565;
 use embedded_graphics::prelude::*;
-use embedded_hal::digital::OutputPin;
-use embedded_hal::spi::MODE_0;
-use embedded_hal_bus::spi::ExclusiveDevice;
-use hal::fugit::RateExtU32;
-use hal::gpio::{FunctionSpi, Pins};
-use hal::{entry, pac, Clock, Sio, Spi, Timer, Watchdog};
-use mipidsi::interface::SpiInterface;
-use mipidsi::models::ST7789;
-use mipidsi::options::ColorInversion;
-use mipidsi::Builder;
-use octrace_core::{ConstStaticCell, Raytracer};
+use hal::gpio::Pins;
+use hal::multicore::{Multicore, Stack};
+use hal::{entry, pac, Clock, Sio, Timer, Watchdog};
+use octrace_core::render::Handoff;
+use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
+use octrace_pico_st7789::both_cores::{self, SecondCore};
+use octrace_pico_st7789::panel::{self, PanelPins};
 use panic_halt as _;
 use rp2040_hal as hal;
+
+#[cfg(code_in_sram)]
+mod sram_code;
 
 /// The second-stage loader for the Pico's W25Q16JV flash; the boot ROM
 /// runs it from the first 256 bytes of flash (see memory.x).
@@ -44,13 +44,20 @@ mod scene {
 }
 use scene::{SceneProfile, SCENE_TEXT};
 
-/// The panel: a 240×240 IPS ST7789, which shows true colours only with the
-/// controller's inversion on.
-const PANEL_WIDTH: u16 = 240;
-const PANEL_HEIGHT: u16 = 240;
-
-/// Room for the scene, its octree and mailbox.
+/// Room for the scene, its octree and core 0's mailbox and lists.
 static RAYTRACER: ConstStaticCell<Raytracer<SceneProfile>> = ConstStaticCell::new(Raytracer::new());
+
+/// Core 1's own mailbox and screen lists.
+static CORE1_ROOM: ConstStaticCell<RendererRoom<SceneProfile>> = ConstStaticCell::new(RendererRoom::new());
+
+/// Core 1's stack: 16 KiB (the render needs a few).
+static CORE1_STACK: Stack<4096> = Stack::new();
+
+/// Core 1's rows on their way to the panel: it may render four ahead.
+static ROWS: Handoff<{ panel::WIDTH as usize }, 4> = Handoff::new();
+
+/// The panel's bus buffer.
+static PANEL_BUFFER: ConstStaticCell<[u8; 512]> = ConstStaticCell::new([0; 512]);
 
 #[entry]
 fn main() -> ! {
@@ -66,45 +73,41 @@ fn main() -> ! {
         &mut watchdog,
     )
     .unwrap();
-    let mut timer = Timer::new(peripherals.TIMER, &mut peripherals.RESETS, &clocks);
-    let sio = Sio::new(peripherals.SIO);
+    let timer = Timer::new(peripherals.TIMER, &mut peripherals.RESETS, &clocks);
+    let mut sio = Sio::new(peripherals.SIO);
     let pins = Pins::new(peripherals.IO_BANK0, peripherals.PADS_BANK0, sio.gpio_bank0, &mut peripherals.RESETS);
-
-    // The Pico-LCD-1.3's pins: SPI1 on GP10 (clock) and GP11 (data), chip
-    // select GP9, data/command GP8, reset GP12, backlight GP13. The bus runs
-    // at a quarter of the 125 MHz system clock, which jumper wires to a loose
-    // panel carry too: the tracer, not the bus, sets the pace.
-    let clock = pins.gpio10.into_function::<FunctionSpi>();
-    let data = pins.gpio11.into_function::<FunctionSpi>();
-    let bus = Spi::<_, _, _, 8>::new(peripherals.SPI1, (data, clock)).init(
+    let panel_pins = PanelPins {
+        clock: pins.gpio10,
+        data: pins.gpio11,
+        chip_select: pins.gpio9,
+        data_command: pins.gpio8,
+        reset: pins.gpio12,
+        backlight: pins.gpio13,
+    };
+    let mut display = panel::init(
+        peripherals.SPI1,
+        panel_pins,
         &mut peripherals.RESETS,
         clocks.peripheral_clock.freq(),
-        31_250_000u32.Hz(),
-        MODE_0,
+        timer,
+        PANEL_BUFFER.take(),
     );
-    let chip_select = pins.gpio9.into_push_pull_output();
-    let data_command = pins.gpio8.into_push_pull_output();
-    let reset = pins.gpio12.into_push_pull_output();
-    let mut backlight = pins.gpio13.into_push_pull_output();
-    let device = ExclusiveDevice::new(bus, chip_select, timer).unwrap();
-    let mut buffer = [0u8; 512];
-    let interface = SpiInterface::new(device, data_command, &mut buffer);
-    let mut display = Builder::new(ST7789, interface)
-        .display_size(PANEL_WIDTH, PANEL_HEIGHT)
-        .invert_colors(ColorInversion::Inverted)
-        .reset_pin(reset)
-        .init(&mut timer)
-        .unwrap();
-    display.clear(Rgb565::BLACK).unwrap();
-    backlight.set_high().unwrap();
+    let mut multicore = Multicore::new(&mut peripherals.PSM, &mut peripherals.PPB, &mut sio.fifo);
+    let mut core1 = SecondCore::start(&mut multicore.cores()[1], CORE1_STACK.take().unwrap()).unwrap();
 
     // octrace: parse and index the scene, then trace it into the panel at
-    // the panel's size, scanline by scanline. A scene the board cannot trace
-    // (check it with host-sim, whose errors name the line and column) leaves
-    // the panel red.
-    match RAYTRACER.take().load(SCENE_TEXT) {
-        Ok(scene) => Image::new(&scene.image_for(&display), Point::zero()).draw(&mut display).unwrap(),
-        Err(_) => display.clear(Rgb565::RED).unwrap(),
+    // the panel's size with both cores. A scene the board cannot trace
+    // (check it with host-sim, whose errors name the line and column)
+    // leaves the panel red.
+    let drawn = match RAYTRACER.take().load(SCENE_TEXT) {
+        Ok(scene) => both_cores::draw(&mut core1, &scene, CORE1_ROOM.take(), &ROWS, &mut display, |_, _| {
+            ControlFlow::Continue(())
+        })
+        .is_ok(),
+        Err(_) => false,
+    };
+    if !drawn {
+        display.clear(Rgb565::RED).unwrap();
     }
     loop {
         cortex_m::asm::wfi();

@@ -1,0 +1,78 @@
+//! The panel: a Waveshare Pico-LCD-1.3 (ST7789VW, 240×240 IPS) on SPI1, set
+//! up through `mipidsi` and cleared to black, backlight on.
+//!
+//! Invariants: the pins are the Pico-LCD-1.3's (README.md has the table);
+//! the bus runs at a quarter of the 125 MHz system clock; the panel shows
+//! true colours only with the controller's inversion on.
+
+use embedded_graphics::pixelcolor::Rgb565;
+use embedded_graphics::prelude::*;
+use embedded_hal::digital::OutputPin;
+use embedded_hal::spi::MODE_0;
+use embedded_hal_bus::spi::ExclusiveDevice;
+use hal::fugit::{HertzU32, RateExtU32};
+use hal::gpio::bank0::{Gpio10, Gpio11, Gpio12, Gpio13, Gpio8, Gpio9};
+use hal::gpio::{FunctionNull, FunctionSioOutput, FunctionSpi, Pin, PullDown};
+use hal::spi::Enabled;
+use hal::{pac, Spi, Timer};
+use mipidsi::interface::SpiInterface;
+use mipidsi::models::ST7789;
+use mipidsi::options::ColorInversion;
+use mipidsi::{Builder, Display};
+use rp2040_hal as hal;
+
+/// The panel's size in pixels.
+pub const WIDTH: u16 = 240;
+pub const HEIGHT: u16 = 240;
+
+type Output<Id> = Pin<Id, FunctionSioOutput, PullDown>;
+type SpiPin<Id> = Pin<Id, FunctionSpi, PullDown>;
+type Bus = Spi<Enabled, pac::SPI1, (SpiPin<Gpio11>, SpiPin<Gpio10>), 8>;
+
+/// The panel as an embedded-graphics `DrawTarget` of `Rgb565`.
+pub type Panel =
+    Display<SpiInterface<'static, ExclusiveDevice<Bus, Output<Gpio9>, Timer>, Output<Gpio8>>, ST7789, Output<Gpio12>>;
+
+/// The Pico pins the Pico-LCD-1.3 plugs into, as `Pins::new` hands them out.
+pub struct PanelPins {
+    /// SPI1 clock.
+    pub clock: Pin<Gpio10, FunctionNull, PullDown>,
+    /// SPI1 data (MOSI).
+    pub data: Pin<Gpio11, FunctionNull, PullDown>,
+    pub chip_select: Pin<Gpio9, FunctionNull, PullDown>,
+    pub data_command: Pin<Gpio8, FunctionNull, PullDown>,
+    pub reset: Pin<Gpio12, FunctionNull, PullDown>,
+    pub backlight: Pin<Gpio13, FunctionNull, PullDown>,
+}
+
+/// Sets up the panel, clears it to black and turns its backlight on.
+/// `buffer` batches pixels for the bus (512 bytes is plenty).
+pub fn init(
+    spi1: pac::SPI1,
+    pins: PanelPins,
+    resets: &mut pac::RESETS,
+    peripheral_clock: HertzU32,
+    mut timer: Timer,
+    buffer: &'static mut [u8],
+) -> Panel {
+    // A quarter of the system clock, which jumper wires to a loose panel
+    // carry too: the tracer, not the bus, sets the pace.
+    let bus = Spi::<_, _, _, 8>::new(
+        spi1,
+        (pins.data.into_function::<FunctionSpi>(), pins.clock.into_function::<FunctionSpi>()),
+    )
+    .init(resets, peripheral_clock, 31_250_000u32.Hz(), MODE_0);
+    let chip_select = pins.chip_select.into_push_pull_output();
+    let device = ExclusiveDevice::new(bus, chip_select, timer).unwrap_or_else(|never| match never {});
+    let interface = SpiInterface::new(device, pins.data_command.into_push_pull_output(), buffer);
+    let mut display = Builder::new(ST7789, interface)
+        .display_size(WIDTH, HEIGHT)
+        .invert_colors(ColorInversion::Inverted)
+        .reset_pin(pins.reset.into_push_pull_output())
+        .init(&mut timer)
+        .unwrap_or_else(|_| panic!("the panel did not take its set-up"));
+    display.clear(Rgb565::BLACK).unwrap_or_else(|never| match never {});
+    let mut backlight = pins.backlight.into_push_pull_output();
+    backlight.set_high().unwrap_or_else(|never| match never {});
+    display
+}

@@ -1,0 +1,27 @@
+//! Copies the program's code and constants from flash into SRAM before
+//! anything else runs (`OCTRACE_CODE_IN=sram`, the default; the linker
+//! script fragment is `sram-code.x`).
+//!
+//! Invariants: `__pre_init` is the first code cortex-m-rt's reset handler
+//! calls, before `.bss` and `.data` are set up, so it touches no RAM but
+//! the copy's destination and calls nothing (the code it would call is not
+//! in SRAM yet); it lives in `.flash_code`, which stays in flash. Words are
+//! copied: the linker script aligns both ends to 4 bytes.
+
+core::arch::global_asm!(
+    ".section .flash_code.__pre_init, \"ax\"",
+    ".global __pre_init",
+    ".type __pre_init, %function",
+    ".thumb_func",
+    "__pre_init:",
+    "    ldr r0, =__sram_code_start",
+    "    ldr r1, =__sram_code_end",
+    "    ldr r2, =__sram_code_load",
+    "0:  cmp r0, r1",
+    "    beq 1f",
+    "    ldm r2!, {{r3}}",
+    "    stm r0!, {{r3}}",
+    "    b 0b",
+    "1:  bx lr",
+    "    .ltorg",
+);
