@@ -107,7 +107,7 @@ pub struct Board<'a> {
 impl<'a> Board<'a> {
     /// The board drawing on `panel`, taking scenes as long as `decoder`
     /// holds, running `firmware` (its name and version, for hosts to show).
-    pub fn new(panel: Panel, firmware: &'a str, decoder: &Decoder<'_>) -> Board<'a> {
+    pub fn new<B: AsRef<[u8]> + AsMut<[u8]>>(panel: Panel, firmware: &'a str, decoder: &Decoder<B>) -> Board<'a> {
         let max_scene = u32::try_from(decoder.max_scene()).unwrap_or(u32::MAX);
         Board { panel, max_scene, firmware }
     }

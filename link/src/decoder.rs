@@ -1,5 +1,6 @@
 //! The receiving end: bytes from the line, one at a time, into a buffer the
-//! caller owns; a [`Frame`] or a [`Refusal`] at each delimiter.
+//! caller provides (a borrowed slice or a `static` array on a board, a
+//! `Vec` on a host); a [`Frame`] or a [`Refusal`] at each delimiter.
 //!
 //! Invariants: [`Decoder::push`] never panics, allocates nothing and does a
 //! bounded amount of work a byte (a frame's CRC and payload are checked at
@@ -50,8 +51,8 @@ enum Ended {
 /// assert_eq!(received[1], Ok(Kind::Hello));
 /// ```
 #[derive(Debug)]
-pub struct Decoder<'b> {
-    buffer: &'b mut [u8],
+pub struct Decoder<B> {
+    buffer: B,
     /// Unstuffed bytes of the frame so far, at most the buffer's length.
     held: usize,
     /// Unstuffed bytes of the frame so far, counted past the buffer
@@ -64,22 +65,24 @@ pub struct Decoder<'b> {
     ended: Option<(Ended, u32)>,
 }
 
-impl<'b> Decoder<'b> {
-    /// A decoder keeping frames in `buffer`: a frame longer than it is
-    /// refused ([`Reason::TooLong`]).
-    pub fn new(buffer: &'b mut [u8]) -> Decoder<'b> {
+impl<B> Decoder<B> {
+    /// A decoder keeping frames in `buffer` (`&mut [u8]`, `[u8; N]`,
+    /// `Vec<u8>`): a frame longer than it is refused ([`Reason::TooLong`]).
+    pub const fn new(buffer: B) -> Decoder<B> {
         Decoder { buffer, held: 0, unstuffed: 0, length: 0, blocks: BlockDecoder::new(), ended: None }
     }
+}
 
+impl<B: AsRef<[u8]> + AsMut<[u8]>> Decoder<B> {
     /// The longest frame it holds, in bytes before stuffing.
     pub fn max_frame(&self) -> usize {
-        self.buffer.len()
+        self.buffer.as_ref().len()
     }
 
     /// The longest scene text it holds: a [`Message::Scene`] frame's
     /// header, flag byte and CRC take 9 bytes of the buffer.
     pub fn max_scene(&self) -> usize {
-        self.buffer.len().saturating_sub(OVERHEAD + 1)
+        self.max_frame().saturating_sub(OVERHEAD + 1)
     }
 
     /// Takes the next byte of the line. At a delimiter that ends a frame,
@@ -90,7 +93,7 @@ impl<'b> Decoder<'b> {
         if byte != 0 {
             self.length = self.length.saturating_add(1);
             if let Some(unstuffed) = self.blocks.byte(byte) {
-                if let Some(slot) = self.buffer.get_mut(self.held) {
+                if let Some(slot) = self.buffer.as_mut().get_mut(self.held) {
                     *slot = unstuffed;
                     self.held += 1;
                 }
@@ -104,8 +107,8 @@ impl<'b> Decoder<'b> {
         let length = self.length;
         let ended = if !self.blocks.at_block_end() {
             Ended::Refused(Refusal { tag: 0, reason: Reason::Undecodable { length } })
-        } else if self.unstuffed as usize > self.buffer.len() {
-            let max = u32::try_from(self.buffer.len()).unwrap_or(u32::MAX);
+        } else if self.unstuffed as usize > self.max_frame() {
+            let max = u32::try_from(self.max_frame()).unwrap_or(u32::MAX);
             Ended::Refused(Refusal { tag: 0, reason: Reason::TooLong { length: self.unstuffed, max } })
         } else {
             Ended::Held(self.held)
@@ -121,7 +124,7 @@ impl<'b> Decoder<'b> {
         let (ended, length) = self.ended?;
         Some(match ended {
             Ended::Refused(refusal) => Err(refusal),
-            Ended::Held(held) => RawFrame::check(&self.buffer[..held], length).and_then(|raw| {
+            Ended::Held(held) => RawFrame::check(&self.buffer.as_ref()[..held], length).and_then(|raw| {
                 let message = Message::decode(raw.kind, raw.payload);
                 message
                     .map(|message| Frame { tag: raw.tag, message })
@@ -148,8 +151,7 @@ mod tests {
 
     /// Every frame or refusal `line` gives, as (tag, kind) or the refusal.
     fn read(line: &[u8], buffer_len: usize) -> Vec<Result<(u16, Kind), Refusal>> {
-        let mut buffer = std::vec![0u8; buffer_len];
-        let mut decoder = Decoder::new(&mut buffer);
+        let mut decoder = Decoder::new(std::vec![0u8; buffer_len]);
         line.iter().filter_map(|&b| decoder.push(b).map(|r| r.map(|f| (f.tag, f.message.kind())))).collect()
     }
 
@@ -194,7 +196,7 @@ mod tests {
         let received = read(&line, 60);
         assert_eq!(received[0], refused(0, Reason::TooLong { length: 109, max: 60 }));
         assert_eq!(received[1], Ok((2, Kind::Scene)));
-        assert_eq!(Decoder::new(&mut [0; 60]).max_scene(), 51);
+        assert_eq!(Decoder::new([0; 60]).max_scene(), 51);
     }
 
     #[test]
@@ -217,8 +219,7 @@ mod tests {
     #[test]
     fn received_gives_the_last_frame_again_until_the_next_byte() {
         let line = scene(5, b"RASTER 1 1");
-        let mut buffer = [0u8; 64];
-        let mut decoder = Decoder::new(&mut buffer);
+        let mut decoder = Decoder::new([0u8; 64]);
         for &b in &line {
             let _ = decoder.push(b);
         }

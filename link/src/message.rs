@@ -10,6 +10,8 @@ use crate::cobs::Sink;
 use crate::frame::{FrameWriter, Reason, VERSION};
 use core::fmt;
 use core::time::Duration;
+use embedded_graphics_core::pixelcolor::raw::RawU16;
+use embedded_graphics_core::pixelcolor::{Rgb565, Rgb888};
 
 macro_rules! kinds {
     ($($(#[$doc:meta])* $kind:ident = $byte:literal, $name:literal, $from_host:literal;)*) => {
@@ -115,6 +117,26 @@ impl PixelFormat {
     pub const fn name(self) -> &'static str {
         match self {
             PixelFormat::Rgb565 => "rgb565",
+        }
+    }
+
+    /// The colours of a row's pixels in this format, widened to 8 bits a
+    /// channel as embedded-graphics widens them (what the panel shows);
+    /// a last incomplete pixel is left out.
+    ///
+    /// ```
+    /// use embedded_graphics_core::pixelcolor::Rgb888;
+    /// use octrace_link::PixelFormat;
+    ///
+    /// let row = [0xF8, 0x00, 0x00, 0x1F];
+    /// let colors: Vec<Rgb888> = PixelFormat::Rgb565.colors(&row).collect();
+    /// assert_eq!(colors, [Rgb888::new(255, 0, 0), Rgb888::new(0, 0, 255)]);
+    /// ```
+    pub fn colors(self, pixels: &[u8]) -> impl Iterator<Item = Rgb888> + '_ {
+        match self {
+            PixelFormat::Rgb565 => pixels
+                .chunks_exact(2)
+                .map(|pair| Rgb565::from(RawU16::new(u16::from_be_bytes([pair[0], pair[1]]))).into()),
         }
     }
 }
