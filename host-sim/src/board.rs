@@ -411,7 +411,11 @@ impl<P: Port> BoardLink<P> {
                     self.input.truncate(n);
                     return Ok(());
                 }
-                Err(e) if matches!(e.kind(), io::ErrorKind::TimedOut | io::ErrorKind::WouldBlock | io::ErrorKind::Interrupted) => {}
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        io::ErrorKind::TimedOut | io::ErrorKind::WouldBlock | io::ErrorKind::Interrupted
+                    ) => {}
                 Err(e) => {
                     self.input.clear();
                     return Err(LinkError::Io(e));
@@ -459,7 +463,10 @@ fn ports() -> Vec<serialport::SerialPortInfo> {
 fn write_ports(out: &mut dyn Write) -> io::Result<()> {
     let ports = ports();
     if ports.is_empty() {
-        return writeln!(out, "no serial ports found (a board with octrace's live firmware shows up as a USB serial port)");
+        return writeln!(
+            out,
+            "no serial ports found (a board with octrace's live firmware shows up as a USB serial port)"
+        );
     }
     for port in ports {
         let what = match port.port_type {
@@ -510,7 +517,10 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
     }
     let format = out.map(|out| output_format(args.format, out)).transpose()?;
     if let Some(out) = out.filter(|out| same_file(scene, out)) {
-        return Err(CliError::Invalid(format!("refusing to overwrite the scene file {} with the image", out.display())));
+        return Err(CliError::Invalid(format!(
+            "refusing to overwrite the scene file {} with the image",
+            out.display()
+        )));
     }
     let text = std::fs::read(scene).map_err(|e| CliError::read(scene, e))?;
     let file = scene.display().to_string();
@@ -596,7 +606,9 @@ fn host_render(file: &str, text: &[u8], panel: Panel, format: PixelFormat) -> Re
     let mut scene = new_scene();
     load_bytes(file, text, &mut scene).map_err(|e| match e {
         LoadError::Io(e) => mismatch(format!("host-sim cannot read the scene: {e}")),
-        LoadError::Scene(errors) => mismatch(format!("the board drew a scene host-sim refuses:\n{}", errors.join("\n"))),
+        LoadError::Scene(errors) => {
+            mismatch(format!("the board drew a scene host-sim refuses:\n{}", errors.join("\n")))
+        }
     })?;
     let options = RenderOptions {
         size: Some((panel.width.into(), panel.height.into())),

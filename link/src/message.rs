@@ -679,6 +679,32 @@ mod tests {
         }
     }
 
+    /// The hex of `bytes` as the documentation writes it.
+    fn hex(bytes: &[u8]) -> String {
+        bytes.iter().map(|b| std::format!("{b:02x}")).collect::<Vec<_>>().join(" ")
+    }
+
+    #[test]
+    fn the_frames_of_the_documentation_are_what_is_written() {
+        let doc = include_str!("../../docs/board-protocol.md");
+        let examples = [
+            (Message::Hello, 1),
+            (Message::Scene { pixels: true, text: b"RASTER 4 2\n" }, 0x1234),
+            (Message::Row { y: 1, pixels: &[0xF8, 0, 0x07, 0xE0, 0, 0x1F, 0xFF, 0xFF] }, 0x1234),
+            (Message::Refused(Reason::WrongVersion { expected: 1, found: 2 }), 0x1234),
+        ];
+        for (message, tag) in examples {
+            let mut wire = Vec::new();
+            message.encode(tag, &mut wire).unwrap();
+            let on_line = std::format!("on line:  {}\n", hex(&wire));
+            assert!(doc.contains(&on_line), "{message:?}: {on_line}");
+        }
+        for kind in Kind::ALL {
+            let row = std::format!("| 0x{:02X} | `{}` |", kind.byte(), kind.name());
+            assert!(doc.contains(&row), "{kind} is documented: {row}");
+        }
+    }
+
     #[test]
     fn kinds_and_bytes_agree() {
         for kind in Kind::ALL {

@@ -30,7 +30,8 @@ pub fn open_pty() -> io::Result<(File, PathBuf)> {
     let mut modes = tcgetattr(&controller)?;
     modes.make_raw();
     tcsetattr(&controller, OptionalActions::Now, &modes)?;
-    let path = PathBuf::from(path.into_string().map_err(|_| io::Error::other("a pseudo-terminal's path is not UTF-8"))?);
+    let path =
+        PathBuf::from(path.into_string().map_err(|_| io::Error::other("a pseudo-terminal's path is not UTF-8"))?);
     Ok((File::from(controller), path))
 }
 
