@@ -138,7 +138,7 @@ impl std::fmt::Display for LinkError {
             LinkError::Silent(waited) => write!(
                 f,
                 "no answer within {} s (is octrace's live firmware running there? --timeout waits longer)",
-                waited.as_secs()
+                waited.as_secs_f64()
             ),
             LinkError::Version { board } => write!(
                 f,
@@ -281,9 +281,10 @@ impl<P: Port> BoardLink<P> {
         self.port.discard_input()?;
         let tag = self.next_tag();
         self.send(tag, &Message::Hello)?;
-        let message = self.receive(tag)?;
-        let Message::Board(info) = message else {
-            return Err(unexpected(message.kind(), "the board's description"));
+        let info = match self.receive(tag)? {
+            Message::Board(info) => info,
+            Message::Refused(reason) => return Err(refused(reason)),
+            other => return Err(unexpected(other.kind(), "the board's description")),
         };
         Ok(BoardDescription {
             panel: info.panel,
@@ -633,4 +634,194 @@ fn describe(port: &str, board: &BoardDescription, out: &mut dyn Write) -> io::Re
     writeln!(out, "panel: {width}x{height} {format}; scenes of at most {} bytes", board.max_scene)?;
     let capacities: Vec<String> = board.capacities.iter().map(|(name, count)| format!("{name} {count}")).collect();
     writeln!(out, "profile {}: {}", board.profile, capacities.join(", "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use octrace_link::SceneError;
+    use std::collections::VecDeque;
+
+    /// A board played by a function: each frame host-sim writes is
+    /// answered with the bytes it returns.
+    struct Played<F> {
+        decoder: Decoder<Vec<u8>>,
+        answer: F,
+        out: VecDeque<u8>,
+    }
+
+    impl<F: FnMut(u16, Message<'_>) -> Vec<u8>> Write for Played<F> {
+        fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+            for &byte in buf {
+                if let Some(Ok(frame)) = self.decoder.push(byte) {
+                    let bytes = (self.answer)(frame.tag, frame.message);
+                    self.out.extend(bytes);
+                }
+            }
+            Ok(buf.len())
+        }
+
+        fn flush(&mut self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+
+    impl<F> Read for Played<F> {
+        fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+            if self.out.is_empty() {
+                std::thread::sleep(Duration::from_millis(1));
+                return Err(io::ErrorKind::TimedOut.into());
+            }
+            let n = buf.len().min(self.out.len());
+            for (slot, byte) in buf.iter_mut().zip(self.out.drain(..n)) {
+                *slot = byte;
+            }
+            Ok(n)
+        }
+    }
+
+    impl<F: FnMut(u16, Message<'_>) -> Vec<u8>> Port for Played<F> {
+        fn discard_input(&mut self) -> io::Result<()> {
+            self.out.clear();
+            Ok(())
+        }
+    }
+
+    fn played(answer: impl FnMut(u16, Message<'_>) -> Vec<u8>) -> BoardLink<impl Port> {
+        let port = Played { decoder: Decoder::new(vec![0; 4096]), answer, out: VecDeque::new() };
+        BoardLink::new(port, Duration::from_millis(200))
+    }
+
+    fn frames(messages: &[(Message<'_>, u16)]) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        for (message, tag) in messages {
+            message.encode(*tag, &mut bytes).unwrap();
+        }
+        bytes
+    }
+
+    const PANEL: Panel = Panel { width: 2, height: 2, format: PixelFormat::Rgb565 };
+
+    fn board_info() -> Message<'static> {
+        Message::Board(octrace_link::BoardInfo {
+            panel: PANEL,
+            max_scene: 100,
+            profile: "P",
+            firmware: "f",
+            capacities: octrace_link::Capacities::new(&[]),
+        })
+    }
+
+    /// A board that answers hello and then each scene with `answer(tag)`.
+    fn drawing_board(mut answer: impl FnMut(u16) -> Vec<u8>) -> BoardLink<impl Port> {
+        played(move |tag, message| match message {
+            Message::Hello => frames(&[(board_info(), tag)]),
+            _ => answer(tag),
+        })
+    }
+
+    fn draw(link: &mut BoardLink<impl Port>) -> Result<Answer, LinkError> {
+        link.hello().unwrap();
+        link.draw(b"scene", true, &mut |_| {})
+    }
+
+    #[test]
+    fn what_came_before_the_boards_answer_to_hello_is_skipped() {
+        let mut link = played(|tag, _| {
+            let mut bytes = frames(&[(Message::Row { y: 3, pixels: &[] }, tag.wrapping_sub(1))]);
+            bytes.extend_from_slice(b"\0garbage\0");
+            bytes.extend(frames(&[(Message::Refused(Reason::Undecodable { length: 7 }), 0), (board_info(), tag)]));
+            bytes
+        });
+        assert_eq!(link.hello().unwrap().panel, PANEL);
+    }
+
+    #[test]
+    fn a_drawing_is_followed_to_its_last_row() {
+        let pixels = [0u8; 4];
+        let mut link = drawing_board(|tag| {
+            frames(&[
+                (Message::Drawing { panel: PANEL, pixels: true }, tag),
+                (Message::Row { y: 1, pixels: &pixels }, tag),
+                (Message::Row { y: 0, pixels: &pixels }, tag),
+                (Message::Done { elapsed: None }, tag),
+            ])
+        });
+        assert_eq!(draw(&mut link).unwrap(), Answer::Drawn { panel: PANEL, elapsed: None });
+    }
+
+    #[test]
+    fn rows_twice_short_or_missing_break_the_protocol() {
+        let pixels = [0u8; 4];
+        /// The rows a board sends (their numbers and pixels), and what host-sim says.
+        type Case<'a> = (&'a [(u16, &'a [u8])], &'a str);
+        let cases: [Case<'_>; 4] = [
+            (&[(0, &pixels), (0, &pixels)], "row 0 came twice"),
+            (&[(0, &pixels[..3])], "row 0 has 3 bytes, not 4"),
+            (&[(2, &pixels)], "row 2 of a 2-row panel"),
+            (&[(1, &pixels)], "done without row 0"),
+        ];
+        for (rows, said) in cases {
+            let mut link = drawing_board(|tag| {
+                let mut messages = vec![(Message::Drawing { panel: PANEL, pixels: true }, tag)];
+                messages.extend(rows.iter().map(|&(y, pixels)| (Message::Row { y, pixels }, tag)));
+                messages.push((Message::Done { elapsed: None }, tag));
+                frames(&messages)
+            });
+            let error = draw(&mut link).unwrap_err();
+            assert!(matches!(&error, LinkError::Protocol(what) if what == said), "{said}: {error}");
+        }
+    }
+
+    #[test]
+    fn the_errors_come_all_and_counted() {
+        let error = |line| SceneError { line, column: 2, capacity: None, message: "bad" };
+        let mut link = drawing_board(|tag| {
+            frames(&[
+                (Message::SceneError(error(1)), tag),
+                (Message::SceneError(error(0)), tag),
+                (Message::Rejected { errors: 2 }, tag),
+            ])
+        });
+        let Answer::Rejected(errors) = draw(&mut link).unwrap() else { panic!("rejected") };
+        let located: Vec<String> = errors.iter().map(|e| e.located("s.txt")).collect();
+        assert_eq!(located, ["s.txt:1:2: bad", "s.txt: bad"]);
+        let mut link = drawing_board(|tag| {
+            frames(&[(Message::SceneError(error(1)), tag), (Message::Rejected { errors: 3 }, tag)])
+        });
+        assert!(matches!(draw(&mut link), Err(LinkError::Protocol(_))));
+    }
+
+    #[test]
+    fn once_in_step_a_refusal_without_a_tag_is_of_our_frame_and_garbage_is_an_error() {
+        let checksum = Reason::BadChecksum { sent: 1, computed: 2 };
+        let mut link = drawing_board(|_| frames(&[(Message::Refused(checksum), 0)]));
+        assert!(matches!(draw(&mut link), Err(LinkError::Refused(reason)) if reason == checksum));
+        let mut link = drawing_board(|_| b"\0garbage\0".to_vec());
+        assert!(matches!(draw(&mut link), Err(LinkError::Protocol(_))));
+    }
+
+    #[test]
+    fn a_board_of_another_version_and_a_silent_one_are_said_as_such() {
+        let mut link = played(|tag, _| {
+            let mut bytes = Vec::new();
+            octrace_link::encode_raw(VERSION + 1, octrace_link::Kind::Board.byte(), tag, &[], &mut bytes).unwrap();
+            bytes
+        });
+        assert!(matches!(link.hello(), Err(LinkError::Version { board }) if board == VERSION + 1));
+        let refusal = Message::Refused(Reason::WrongVersion { expected: 7, found: VERSION });
+        let mut link = played(move |tag, _| frames(&[(refusal, tag)]));
+        assert!(matches!(link.hello(), Err(LinkError::Version { board: 7 })));
+        let mut link = played(|_, _| Vec::new());
+        let silent = link.hello().unwrap_err();
+        assert!(silent.to_string().starts_with("no answer within 0.2 s"), "{silent}");
+    }
+
+    #[test]
+    fn a_drawing_cut_short_by_another_host_is_said() {
+        let mut link = drawing_board(|tag| {
+            frames(&[(Message::Drawing { panel: PANEL, pixels: true }, tag), (Message::Cancelled { rows: 0 }, tag)])
+        });
+        assert!(matches!(draw(&mut link), Err(LinkError::Cancelled { rows: 0 })));
+    }
 }
