@@ -15,6 +15,7 @@ use embedded_graphics_core::pixelcolor::RgbColor;
 use octrace_core::render::PanelColor;
 use octrace_images::formats::{self, Format, Image};
 use octrace_link::{Decoder, Message, Panel, PixelFormat, Reason, VERSION};
+use serialport::SerialPort as _;
 use std::io::{self, Read, Write};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -104,7 +105,7 @@ impl Write for SerialLine {
 
 impl Port for SerialLine {
     fn discard_input(&mut self) -> io::Result<()> {
-        serialport::SerialPort::clear(&self.0, serialport::ClearBuffer::Input).map_err(io::Error::from)
+        self.0.clear(serialport::ClearBuffer::Input).map_err(io::Error::from)
     }
 }
 
@@ -536,12 +537,63 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
     }
     let pixels = out.is_some() || args.check;
     let started = Instant::now();
+    let (panel, elapsed, picture) = match draw(&mut link, &text, pixels, args.quiet).map_err(link_error)? {
+        (Answer::Rejected(errors), _) => {
+            let errors = errors.iter().map(|e| e.located(&file)).collect();
+            return Err(CliError::Scene { file, errors });
+        }
+        (Answer::Drawn { panel, elapsed }, picture) => (panel, elapsed, picture),
+    };
+    let (w, h) = (panel.width, panel.height);
+    if !args.quiet {
+        let time = match elapsed {
+            Some(t) => format!("in {:.3} s by its clock", t.as_secs_f64()),
+            None => format!("in {:.3} s here", started.elapsed().as_secs_f64()),
+        };
+        let _ = writeln!(stderr, "{w}x{h} {} drawn by the board at {port} {time}", panel.format);
+    }
+    let Some(image) = picture else { return Ok(()) };
+    if let (Some(out), Some(format)) = (out, format) {
+        crate::output::write_atomically(out, |f| {
+            formats::write(&Image::Rgb(image.clone()), format, f).map_err(io::Error::other)
+        })
+        .map_err(|e| CliError::write(out, e))?;
+        if !args.quiet {
+            let _ = writeln!(stderr, "the board's picture -> {}", out.display());
+        }
+    }
+    if args.check {
+        let ours = host_render(&file, &text, panel)?;
+        let differ = ours.data.chunks_exact(3).zip(image.data.chunks_exact(3)).filter(|(a, b)| a != b).count();
+        if differ > 0 {
+            return Err(CliError::Mismatch(format!(
+                "board --check: {differ} of {} pixels differ from host-sim's {} render at {w}x{h}",
+                w as usize * h as usize,
+                panel.format
+            )));
+        }
+        if !args.quiet {
+            let _ = writeln!(stderr, "--check: bit-identical to host-sim's {} render at {w}x{h}", panel.format);
+        }
+    }
+    Ok(())
+}
+
+/// Sends the scene and follows the board's answer: its picture, if the
+/// rows carry their `pixels`, with a progress bar unless `quiet`.
+fn draw<P: Port>(
+    link: &mut BoardLink<P>,
+    text: &[u8],
+    pixels: bool,
+    quiet: bool,
+) -> Result<(Answer, Option<RgbImage>), LinkError> {
     let mut picture: Option<(PixelFormat, RgbImage)> = None;
     let mut bar = None;
-    let answer = link.draw(&text, pixels, &mut |step| match step {
+    let answer = link.draw(text, pixels, &mut |step| match step {
         Progress::Drawing(panel) => {
-            picture = Some((panel.format, RgbImage::new(panel.width.into(), panel.height.into())));
-            bar = progress_bar(panel.height.into(), args.quiet);
+            let image = RgbImage::new(panel.width.into(), panel.height.into());
+            picture = pixels.then_some((panel.format, image));
+            bar = progress_bar(panel.height.into(), quiet);
         }
         Progress::Row { y, pixels } => {
             if let Some((format, image)) = &mut picture {
@@ -558,51 +610,12 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
-    let (panel, elapsed) = match answer.map_err(link_error)? {
-        Answer::Rejected(errors) => {
-            let errors = errors.iter().map(|e| e.located(&file)).collect();
-            return Err(CliError::Scene { file, errors });
-        }
-        Answer::Drawn { panel, elapsed } => (panel, elapsed),
-    };
-    let (w, h) = (panel.width, panel.height);
-    if !args.quiet {
-        let time = match elapsed {
-            Some(t) => format!("in {:.3} s by its clock", t.as_secs_f64()),
-            None => format!("in {:.3} s here", started.elapsed().as_secs_f64()),
-        };
-        let _ = writeln!(stderr, "{w}x{h} {} drawn by the board at {port} {time}", panel.format);
-    }
-    let Some((format_of_panel, image)) = picture.filter(|_| pixels) else { return Ok(()) };
-    if let (Some(out), Some(format)) = (out, format) {
-        crate::output::write_atomically(out, |f| {
-            formats::write(&Image::Rgb(image.clone()), format, f).map_err(io::Error::other)
-        })
-        .map_err(|e| CliError::write(out, e))?;
-        if !args.quiet {
-            let _ = writeln!(stderr, "the board's picture -> {}", out.display());
-        }
-    }
-    if args.check {
-        let ours = host_render(&file, &text, panel, format_of_panel)?;
-        let differ = ours.data.chunks_exact(3).zip(image.data.chunks_exact(3)).filter(|(a, b)| a != b).count();
-        if differ > 0 {
-            return Err(CliError::Mismatch(format!(
-                "board --check: {differ} of {} pixels differ from host-sim's {} render at {w}x{h}",
-                w as usize * h as usize,
-                format_of_panel
-            )));
-        }
-        if !args.quiet {
-            let _ = writeln!(stderr, "--check: bit-identical to host-sim's {format_of_panel} render at {w}x{h}");
-        }
-    }
-    Ok(())
+    Ok((answer?, picture.map(|(_, image)| image)))
 }
 
 /// host-sim's render of the scene at the panel's size, as the panel shows
 /// it (`host-sim SCENE OUT --size WxH --color rgb565`).
-fn host_render(file: &str, text: &[u8], panel: Panel, format: PixelFormat) -> Result<RgbImage, CliError> {
+fn host_render(file: &str, text: &[u8], panel: Panel) -> Result<RgbImage, CliError> {
     let mismatch = |why: String| CliError::Mismatch(format!("board --check: {why}"));
     let mut scene = new_scene();
     load_bytes(file, text, &mut scene).map_err(|e| match e {
@@ -618,7 +631,7 @@ fn host_render(file: &str, text: &[u8], panel: Panel, format: PixelFormat) -> Re
     };
     let rendered = render_with_progress(&scene, &options, &|_| {})
         .map_err(|e| mismatch(format!("host-sim cannot set up the camera: {e}")))?;
-    let color = match format {
+    let color = match panel.format {
         PixelFormat::Rgb565 => PanelColor::Rgb565,
     };
     Ok(match panel_preview(&rendered.image, color) {
