@@ -127,15 +127,16 @@ impl<'a> RawFrame<'a> {
     /// came on the line.
     pub(crate) fn check(bytes: &'a [u8], length: u32) -> Result<RawFrame<'a>, Refusal> {
         let refuse = |tag, reason| Err(Refusal { tag, reason });
-        let Some((body, crc)) = bytes.split_last_chunk::<CRC>().filter(|(body, _)| body.len() >= HEADER) else {
+        let Some((body, crc)) = bytes.split_last_chunk::<CRC>() else {
+            return refuse(0, Reason::Undecodable { length });
+        };
+        let Some((&[version, kind, tag_hi, tag_lo], payload)) = body.split_first_chunk::<HEADER>() else {
             return refuse(0, Reason::Undecodable { length });
         };
         let (sent, computed) = (u32::from_be_bytes(*crc), Crc32::of(body));
         if sent != computed {
             return refuse(0, Reason::BadChecksum { sent, computed });
         }
-        let ([version, kind, tag_hi, tag_lo], payload) =
-            body.split_first_chunk::<HEADER>().map(|(h, p)| (*h, p)).unwrap_or(([0; HEADER], &[]));
         let tag = u16::from_be_bytes([tag_hi, tag_lo]);
         if version != VERSION {
             return refuse(tag, Reason::WrongVersion { expected: VERSION, found: version });
