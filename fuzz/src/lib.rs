@@ -2,9 +2,11 @@
 //! libFuzzer's inputs, and `tests/regressions.rs` calls them on every kept
 //! reproducer (on stable Rust, in CI). A check panics on a finding.
 
+mod link;
 mod parse;
 mod render;
 
+pub use link::{check_link, seeds as link_seeds};
 pub use parse::check_parse;
 pub use render::check_render;
 

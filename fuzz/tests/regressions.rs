@@ -47,3 +47,44 @@ fn seeds() {
     assert!(run("seeds", true) > 10, "the seed corpus is missing");
     assert!(run("../scenes", true) > 5, "the scenes are missing");
 }
+
+/// Every file of `dir` (any name).
+fn all_files(dir: &str) -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
+    let mut files: Vec<PathBuf> = match fs::read_dir(&dir) {
+        Ok(entries) => entries.map(|e| e.expect("readable directory").path()).collect(),
+        Err(_) => Vec::new(),
+    };
+    files.sort();
+    files
+}
+
+#[test]
+fn link_regressions_and_seeds() {
+    let seeds = all_files("link-seeds");
+    assert!(seeds.len() >= 8, "the link's seed corpus is missing");
+    for path in all_files("regressions/link").iter().chain(&seeds) {
+        println!("{}", path.display());
+        octrace_fuzz::check_link(&fs::read(path).expect("readable input"));
+    }
+}
+
+/// The link's seeds are what today's encoder writes (a change of the
+/// protocol changes them: re-bless with OCTRACE_BLESS=1).
+#[test]
+fn link_seeds_are_current() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("link-seeds");
+    let bless = std::env::var_os("OCTRACE_BLESS").is_some_and(|v| v != "0");
+    for (name, bytes) in octrace_fuzz::link_seeds() {
+        let path = dir.join(name);
+        if bless {
+            fs::create_dir_all(&dir).unwrap();
+            fs::write(&path, &bytes).unwrap();
+        }
+        assert!(
+            fs::read(&path).is_ok_and(|kept| kept == bytes),
+            "{} is not current: OCTRACE_BLESS=1 rewrites it",
+            path.display()
+        );
+    }
+}

@@ -16,13 +16,15 @@ use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-pub use crate::exit::{CliError, EXIT_IO, EXIT_SCENE};
+pub use crate::exit::{CliError, EXIT_IO, EXIT_MISMATCH, EXIT_SCENE};
 
 /// Render an octrace scene file to an image (PNG, Targa or Sun raster), in
 /// truecolour or with a 256-entry colour table.
 ///
-/// Exit codes: 0 success, 1 a file could not be read or written, 2 the scene
-/// or the arguments are invalid (every error is printed as file:line:col).
+/// Exit codes: 0 success, 1 a file could not be read or written (or a
+/// board could not be talked to), 2 the scene or the arguments are invalid
+/// (every error is printed as file:line:col), 3 a board's picture differs
+/// from host-sim's (`board --check`).
 /// Nothing is written unless the whole image renders: the image goes to a
 /// temporary file that is renamed into place at the end.
 #[derive(Parser, Debug)]
@@ -126,11 +128,17 @@ pub enum Command {
     /// The scene studio: edit, place and render a scene in the browser,
     /// on this core compiled to WebAssembly (serves 127.0.0.1 only).
     Studio(crate::studio::StudioArgs),
+    /// Send a scene to a board running octrace's live firmware over its
+    /// serial port: the board's errors are printed as file:line:col (exit
+    /// 2); with OUT, its picture is received and written, and --check
+    /// compares it with host-sim's own. Without PORT, lists the serial
+    /// ports; with PORT alone, the board says what it is.
+    Board(crate::board::BoardArgs),
 }
 
 /// What a `color` panel shows of `image` ([`octrace_images::panel`]), or
 /// `None` for the colours that need no conversion.
-fn panel_preview(image: &RgbImage, color: PanelColor) -> Option<Image> {
+pub(crate) fn panel_preview(image: &RgbImage, color: PanelColor) -> Option<Image> {
     match color {
         PanelColor::Rgb888 | PanelColor::Dither => None,
         PanelColor::Rgb565 => Some(Image::Rgb(panel::rgb565(image))),
@@ -163,7 +171,7 @@ fn parse_palette(text: &str) -> Result<PaletteMode, String> {
 }
 
 /// A `--format` name: [`Format`]'s vocabulary.
-fn parse_format(text: &str) -> Result<Format, String> {
+pub(crate) fn parse_format(text: &str) -> Result<Format, String> {
     parse_name(text, &Format::ALL, Format::name)
 }
 
@@ -207,6 +215,7 @@ where
     };
     let result = match &args.command {
         Some(Command::Studio(studio)) => crate::studio::run(studio, stdout, stderr),
+        Some(Command::Board(board)) => crate::board::run(board, stdout, stderr),
         _ => execute(&args, stderr),
     };
     match result {
@@ -222,7 +231,7 @@ where
 /// extension names, else (no extension) PNG. Any other extension is refused
 /// before anything is rendered: a PNG named `.bmp` would mislead whatever
 /// opens it.
-fn output_format(asked: Option<Format>, path: &Path) -> Result<Format, CliError> {
+pub(crate) fn output_format(asked: Option<Format>, path: &Path) -> Result<Format, CliError> {
     if let Some(format) = asked {
         return Ok(format);
     }
@@ -353,8 +362,9 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     match &args.command {
         Some(Command::Convert { input, output, format }) => return convert(input, output, *format),
         Some(Command::Merge { output, parts, format }) => return merge(output, parts, *format),
-        // run() serves the studio (it needs stdout) instead of calling this.
-        Some(Command::Studio(_)) => return Ok(()),
+        // run() serves the studio and talks to boards (both need stdout)
+        // instead of calling this.
+        Some(Command::Studio(_) | Command::Board(_)) => return Ok(()),
         None => {}
     }
     let Some(scene_path) = &args.scene else {
@@ -412,16 +422,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         PaletteMode::Coarse => rows.start.saturating_sub(1)..rows.end,
         _ => rows.clone(),
     };
-    let bar = if !args.quiet && std::io::stderr().is_terminal() {
-        let bar = ProgressBar::new(w as u64 * render_rows.len() as u64);
-        bar.set_style(
-            ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}%, eta {eta}")
-                .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        Some(bar)
-    } else {
-        None
-    };
+    let bar = progress_bar(w as u64 * render_rows.len() as u64, args.quiet);
     let header = Header { width: w, height: rows.len() as u32, palette: None, text };
     let spool_dir = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let spool_name = out.file_name().map_or_else(|| "image".into(), |n| n.to_string_lossy().into_owned());
@@ -510,8 +511,22 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     Ok(())
 }
 
+/// A progress bar of `total` steps on stderr, if it is a terminal and
+/// the run is not `quiet`.
+pub(crate) fn progress_bar(total: u64, quiet: bool) -> Option<ProgressBar> {
+    if quiet || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = ProgressBar::new(total);
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}%, eta {eta}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    Some(bar)
+}
+
 /// Whether two paths name the same existing file.
-fn same_file(a: &Path, b: &Path) -> bool {
+pub(crate) fn same_file(a: &Path, b: &Path) -> bool {
     match (a.canonicalize(), b.canonicalize()) {
         (Ok(x), Ok(y)) => x == y,
         _ => false,

@@ -1,24 +1,32 @@
 //! How a host-sim command fails: [`CliError`], whose exit code is derived in
 //! one place ([`CliError::exit_code`]): 0 done, 1 a file could not be read
-//! or written, 2 a bad scene or bad arguments.
+//! or written (or a board talked to), 2 a bad scene or bad arguments, 3 a
+//! board's picture that differs from host-sim's.
 
 use std::fmt;
 use std::path::Path;
 
 /// Exit code for a bad scene or bad arguments.
 pub const EXIT_SCENE: i32 = 2;
-/// Exit code for a file that cannot be read or written.
+/// Exit code for a file that cannot be read or written, or a board that
+/// cannot be talked to.
 pub const EXIT_IO: i32 = 1;
+/// Exit code for a board's picture that differs from host-sim's
+/// (`host-sim board --check`).
+pub const EXIT_MISMATCH: i32 = 3;
 
 /// Why a command stopped; printed to stderr as it is displayed.
 #[derive(Debug)]
 pub enum CliError {
-    /// A file could not be read or written; the message says which and why.
+    /// A file could not be read or written, or a board talked to; the
+    /// message says which and why.
     Io(String),
     /// The arguments, or an input other than a scene, are not usable.
     Invalid(String),
     /// The scene file has errors, each `file:line:col: message`.
     Scene { file: String, errors: Vec<String> },
+    /// A board's picture is not host-sim's; the message says how.
+    Mismatch(String),
 }
 
 impl CliError {
@@ -37,6 +45,7 @@ impl CliError {
         match self {
             CliError::Io(_) => EXIT_IO,
             CliError::Invalid(_) | CliError::Scene { .. } => EXIT_SCENE,
+            CliError::Mismatch(_) => EXIT_MISMATCH,
         }
     }
 }
@@ -44,7 +53,9 @@ impl CliError {
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            CliError::Io(message) | CliError::Invalid(message) => write!(f, "host-sim: {message}"),
+            CliError::Io(message) | CliError::Invalid(message) | CliError::Mismatch(message) => {
+                write!(f, "host-sim: {message}")
+            }
             CliError::Scene { file, errors } => {
                 for error in errors {
                     writeln!(f, "{error}")?;

@@ -6,6 +6,7 @@
 //! a streamed render ([`render_streamed`]) holds a few bands of rows, never
 //! the image, and hands every row to its sink once, in order.
 
+pub mod board;
 pub mod cli;
 pub mod exit;
 pub mod output;

@@ -1,6 +1,7 @@
 //! Support code for octrace's whole-pipeline tests (the tests themselves are
 //! in `tests/`).
 
+pub mod board;
 pub mod firmware;
 pub mod pico;
 pub mod webdriver;

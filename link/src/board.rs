@@ -1,0 +1,499 @@
+//! The board's side of the protocol on an octrace-core [`Raytracer`]: each
+//! received frame answered ([`Board::answer`]), and a scene that loaded
+//! handed back as a [`Drawing`] whose rows the firmware renders its own way
+//! (one core, two, a row at a time) and sends as they are drawn.
+//!
+//! Invariants: every frame gets exactly one answer — a [`Message::Board`],
+//! a [`Message::Refused`], the scene's [`Message::SceneError`]s closed by a
+//! [`Message::Rejected`], or a [`Message::Drawing`] whose [`Drawing`] is
+//! closed by [`Drawing::finish`] or [`Drawing::cancel`] — all with the
+//! frame's tag; a scene with errors draws nothing.
+//!
+//! A firmware's loop, on one core (`Rx` and `Usb` stand for its USB serial
+//! class: bytes in, a [`Sink`] out; the rows go to its panel as well):
+//!
+//! ```
+//! use embedded_graphics_core::pixelcolor::Rgb565;
+//! use octrace_core::profile::{Board16K, Profile};
+//! use octrace_core::{accel::Mailbox, render::Renderer, Raytracer};
+//! use octrace_link::board::Board;
+//! use octrace_link::{Decoder, Message, Panel, PixelFormat};
+//! # use std::collections::VecDeque;
+//! # struct Rx(VecDeque<u8>);
+//! # impl Rx { fn next(&mut self) -> Option<u8> { self.0.pop_front() } }
+//! # let mut host = Vec::new();
+//! # Message::Hello.encode(1, &mut host).unwrap();
+//! # Message::Scene { pixels: true, text: b"BACKGROUND 0 0 1\n" }.encode(2, &mut host).unwrap();
+//! # let mut rx = Rx(host.into());
+//! # let mut usb: Vec<u8> = Vec::new();
+//!
+//! let mut buffer = [0u8; 4096]; // a `static` on a board
+//! let mut decoder = Decoder::new(&mut buffer);
+//! let panel = Panel { width: 8, height: 4, format: PixelFormat::Rgb565 };
+//! let board = Board::new(panel, "my-board 0.1.0", &decoder);
+//! let mut raytracer = Raytracer::<Board16K>::new(); // a `static` too
+//! let mut mailbox = [0u32; Mailbox::words_for(Board16K::COUNTS.objects)];
+//! let mut row = [Rgb565::default(); 8];
+//! // Whether a frame came while drawing: it is answered next.
+//! let mut pending = false;
+//! loop {
+//!     if !pending {
+//!         // `rx.next()` waits for a byte on a board; here the bytes run out.
+//!         let Some(byte) = rx.next() else { break };
+//!         if decoder.push(byte).is_none() {
+//!             continue;
+//!         }
+//!     }
+//!     pending = false;
+//!     let Some(received) = decoder.received() else { continue };
+//!     let Some(drawing) = board.answer(received, &mut raytracer, &mut usb).unwrap() else { continue };
+//!     let scene = drawing.scene();
+//!     let accelerator = scene.accelerator();
+//!     let (width, height) = (panel.width as u32, panel.height as u32);
+//!     // `answer` checked the camera at the panel's size.
+//!     let mut renderer = Renderer::with_size(scene.view(), &accelerator, width, height).unwrap();
+//!     renderer.set_mailbox(&mut mailbox);
+//!     let mut drawn = 0;
+//!     while drawn < height && !pending {
+//!         for (pixel, sample) in row.iter_mut().zip(renderer.row(drawn, 0..width)) {
+//!             *pixel = sample.color.into();
+//!         }
+//!         // ... the row to the panel, then to the host:
+//!         drawing.send_row(drawn as u16, &row, &mut usb).unwrap();
+//!         drawn += 1;
+//!         // Between rows, without waiting: a frame from the host stops the drawing.
+//!         while let (false, Some(byte)) = (pending, rx.next()) {
+//!             pending = decoder.push(byte).is_some();
+//!         }
+//!     }
+//!     match pending {
+//!         true => drawing.cancel(drawn as u16, &mut usb).unwrap(),
+//!         false => drawing.finish(None, &mut usb).unwrap(),
+//!     }
+//! }
+//! # let mut buffer = vec![0u8; 1024];
+//! # let mut reader = Decoder::new(&mut buffer);
+//! # let kinds: Vec<_> = usb.iter().filter_map(|&b| reader.push(b).map(|r| r.unwrap().message.kind().name())).collect();
+//! # assert_eq!(kinds, ["board", "drawing", "row", "row", "row", "row", "done"]);
+//! ```
+//!
+//! On two cores, each renders its rows with a `Renderer` of its own over
+//! [`Drawing::scene`]'s view and accelerator (see octrace-core's
+//! `interleaved_rows`), and the core that owns the USB sends them in order.
+
+use crate::cobs::Sink;
+use crate::decoder::{Decoder, Frame};
+use crate::frame::{FrameWriter, Reason, Refusal, VERSION};
+use crate::message::{put_scene_error, BoardInfo, Capacities, Capacity, CapacityNeed, Kind, Message, Panel};
+use core::fmt;
+use core::time::Duration;
+use embedded_graphics_core::pixelcolor::{IntoStorage, Rgb565};
+use octrace_core::capacity::CapacityKind;
+use octrace_core::parse::ErrorKind;
+use octrace_core::profile::Profile;
+use octrace_core::scene::SceneCapacities;
+use octrace_core::{AccelMode, LoadedScene, Raytracer};
+
+/// What a board is: its panel, the longest scene its decoder holds, its
+/// firmware's name. Its profile and capacities come from the
+/// [`Raytracer`] each answer is given.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Board<'a> {
+    panel: Panel,
+    max_scene: u32,
+    firmware: &'a str,
+}
+
+impl<'a> Board<'a> {
+    /// The board drawing on `panel`, taking scenes as long as `decoder`
+    /// holds, running `firmware` (its name and version, for hosts to show).
+    pub fn new<B: AsRef<[u8]> + AsMut<[u8]>>(panel: Panel, firmware: &'a str, decoder: &Decoder<B>) -> Board<'a> {
+        let max_scene = u32::try_from(decoder.max_scene()).unwrap_or(u32::MAX);
+        Board { panel, max_scene, firmware }
+    }
+
+    /// Its panel.
+    pub fn panel(&self) -> Panel {
+        self.panel
+    }
+
+    /// Answers what the decoder `received`: a refusal is sent back, a
+    /// hello gets the board's description, a scene is loaded into
+    /// `raytracer` and gets its errors, or a [`Drawing`] to render.
+    pub fn answer<'r, P: Profile, S: Sink + ?Sized>(
+        &self,
+        received: Result<Frame<'_>, Refusal>,
+        raytracer: &'r mut Raytracer<P>,
+        sink: &mut S,
+    ) -> Result<Option<Drawing<'r, P>>, S::Error> {
+        let Frame { tag, message } = match received {
+            Ok(frame) => frame,
+            Err(refusal) => return Message::Refused(refusal.reason).encode(refusal.tag, sink).map(|()| None),
+        };
+        match message {
+            Message::Hello => self.hello::<P, S>(tag, sink).map(|()| None),
+            Message::Scene { pixels, text } => self.load(tag, pixels, text, raytracer, sink),
+            other => {
+                let refused = Message::Refused(Reason::Unexpected { kind: other.kind().byte() });
+                refused.encode(tag, sink).map(|()| None)
+            }
+        }
+    }
+
+    fn hello<P: Profile, S: Sink + ?Sized>(&self, tag: u16, sink: &mut S) -> Result<(), S::Error> {
+        let list = CapacityKind::ALL.map(|kind| Capacity { name: kind.field(), count: saturate(P::COUNTS.get(kind)) });
+        let info = BoardInfo {
+            panel: self.panel,
+            max_scene: self.max_scene,
+            profile: <P as SceneCapacities>::NAME,
+            firmware: self.firmware,
+            capacities: Capacities::new(&list),
+        };
+        Message::Board(info).encode(tag, sink)
+    }
+
+    fn load<'r, P: Profile, S: Sink + ?Sized>(
+        &self,
+        tag: u16,
+        pixels: bool,
+        text: &[u8],
+        raytracer: &'r mut Raytracer<P>,
+        sink: &mut S,
+    ) -> Result<Option<Drawing<'r, P>>, S::Error> {
+        let mut failed = None;
+        let loaded = raytracer.load_with(text, AccelMode::Auto, &mut |error| {
+            if failed.is_none() {
+                let capacity = match error.kind {
+                    ErrorKind::Capacity(c) => Some(CapacityNeed {
+                        name: c.kind.field(),
+                        needed: c.needed.map(saturate),
+                        holds: saturate(c.capacity),
+                    }),
+                    _ => None,
+                };
+                let (line, column) = (error.pos.line, error.pos.column);
+                failed = send_error(tag, line, column, capacity, &error.kind, sink).err();
+            }
+        });
+        if let Some(e) = failed {
+            return Err(e);
+        }
+        let scene = match loaded {
+            Ok(scene) => scene,
+            Err(e) => return Message::Rejected { errors: saturate(e.count) }.encode(tag, sink).map(|()| None),
+        };
+        // The parser refuses a camera that cannot be set up; this is the
+        // check at the panel's size that a renderer makes.
+        if let Err(e) = scene.view().check_camera(self.panel.width.into(), self.panel.height.into()) {
+            send_error(tag, 0, 0, None, &e, sink)?;
+            return Message::Rejected { errors: 1 }.encode(tag, sink).map(|()| None);
+        }
+        Message::Drawing { panel: self.panel, pixels }.encode(tag, sink)?;
+        Ok(Some(Drawing { scene, tag, pixels, panel: self.panel }))
+    }
+}
+
+/// Sends one [`Message::SceneError`], its message written by `message`'s
+/// `Display` straight into the frame.
+fn send_error<S: Sink + ?Sized>(
+    tag: u16,
+    line: u32,
+    column: u32,
+    capacity: Option<CapacityNeed<'_>>,
+    message: &dyn fmt::Display,
+    sink: &mut S,
+) -> Result<(), S::Error> {
+    let mut w = FrameWriter::begin(sink, VERSION, Kind::SceneError.byte(), tag)?;
+    put_scene_error(&mut w, line, column, capacity, message)?;
+    w.finish()
+}
+
+fn saturate(n: usize) -> u32 {
+    u32::try_from(n).unwrap_or(u32::MAX)
+}
+
+/// A scene that loaded, being drawn at the panel's size: render its rows
+/// from [`Drawing::scene`], send each with [`Drawing::send_row`] as it is
+/// drawn, and close it with [`Drawing::finish`], or with
+/// [`Drawing::cancel`] when a frame comes from the host between rows.
+pub struct Drawing<'r, P: Profile> {
+    scene: LoadedScene<'r, P>,
+    tag: u16,
+    pixels: bool,
+    panel: Panel,
+}
+
+impl<P: Profile> fmt::Debug for Drawing<'_, P> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Drawing")
+            .field("tag", &self.tag)
+            .field("pixels", &self.pixels)
+            .field("panel", &self.panel)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<'r, P: Profile> Drawing<'r, P> {
+    /// The loaded scene: its view and accelerator for the renderers.
+    pub fn scene(&self) -> &LoadedScene<'r, P> {
+        &self.scene
+    }
+
+    /// The panel it is drawn at.
+    pub fn panel(&self) -> Panel {
+        self.panel
+    }
+
+    /// Whether the host asked for the rows' pixels.
+    pub fn sends_pixels(&self) -> bool {
+        self.pixels
+    }
+
+    /// Tells the host row `y` is drawn: `row` is its pixels (the panel's
+    /// width of them), sent only if the host asked for them.
+    pub fn send_row<S: Sink + ?Sized>(&self, y: u16, row: &[Rgb565], sink: &mut S) -> Result<(), S::Error> {
+        let mut w = FrameWriter::begin(sink, VERSION, Kind::Row.byte(), self.tag)?;
+        w.put(&y.to_be_bytes())?;
+        if self.pixels {
+            for pixels in row.chunks(32) {
+                let mut bytes = [0u8; 64];
+                for (pair, color) in bytes.chunks_exact_mut(2).zip(pixels) {
+                    pair.copy_from_slice(&color.into_storage().to_be_bytes());
+                }
+                w.put(&bytes[..2 * pixels.len()])?;
+            }
+        }
+        w.finish()
+    }
+
+    /// Every row is drawn: `elapsed` is the board's time for the scene
+    /// (loading and drawing), if it has a clock.
+    pub fn finish<S: Sink + ?Sized>(self, elapsed: Option<Duration>, sink: &mut S) -> Result<(), S::Error> {
+        Message::Done { elapsed }.encode(self.tag, sink)
+    }
+
+    /// The drawing stops after `rows` rows, because a frame came.
+    pub fn cancel<S: Sink + ?Sized>(self, rows: u16, sink: &mut S) -> Result<(), S::Error> {
+        Message::Cancelled { rows }.encode(self.tag, sink)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::frame::{encode_raw, Reason};
+    use crate::message::PixelFormat;
+    use embedded_graphics_core::pixelcolor::Rgb888;
+    use octrace_core::profile::Board16K;
+    use octrace_core::render::Renderer;
+    use std::string::{String, ToString};
+    use std::vec::Vec;
+
+    const PANEL: Panel = Panel { width: 12, height: 8, format: PixelFormat::Rgb565 };
+    const SCENE: &[u8] = b"SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n";
+
+    /// Hands each frame in `wire` to `each`.
+    fn frames(wire: &[u8], mut each: impl FnMut(Frame<'_>)) {
+        let mut buffer = std::vec![0u8; 4096];
+        let mut decoder = Decoder::new(&mut buffer);
+        for &byte in wire {
+            if let Some(received) = decoder.push(byte) {
+                each(received.expect("the board's frames read"));
+            }
+        }
+    }
+
+    fn kinds(wire: &[u8]) -> Vec<Kind> {
+        let mut kinds = Vec::new();
+        frames(wire, |f| kinds.push(f.message.kind()));
+        kinds
+    }
+
+    /// The board's answer to `message` sent with `tag`, and what it drew
+    /// (every row, in order), as the firmware's loop does on one core.
+    fn ask(raytracer: &mut Raytracer<Board16K>, message: Message<'_>, tag: u16) -> Vec<u8> {
+        let mut host = Vec::new();
+        message.encode(tag, &mut host).unwrap();
+        let mut buffer = [0u8; 1024];
+        let mut decoder = Decoder::new(&mut buffer);
+        let board = Board::new(PANEL, "test 1", &decoder);
+        let mut answer = Vec::new();
+        for byte in host {
+            let Some(received) = decoder.push(byte) else { continue };
+            if let Some(drawing) = board.answer(received, raytracer, &mut answer).unwrap() {
+                let (w, h) = (PANEL.width as u32, PANEL.height as u32);
+                let accelerator = drawing.scene().accelerator();
+                let mut renderer = Renderer::with_size(drawing.scene().view(), &accelerator, w, h).unwrap();
+                for y in 0..h {
+                    let row: Vec<Rgb565> = renderer.row(y, 0..w).map(|p| p.color.into()).collect();
+                    drawing.send_row(y as u16, &row, &mut answer).unwrap();
+                }
+                drawing.finish(Some(Duration::from_millis(12)), &mut answer).unwrap();
+            }
+        }
+        answer
+    }
+
+    #[test]
+    fn hello_is_answered_with_the_panel_the_buffer_and_the_profile() {
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let answer = ask(&mut raytracer, Message::Hello, 21);
+        let mut seen = 0;
+        frames(&answer, |frame| {
+            let Message::Board(info) = frame.message else { panic!("{frame:?}") };
+            assert_eq!((frame.tag, info.panel, info.max_scene), (21, PANEL, 1024 - 9));
+            assert_eq!((info.profile, info.firmware), ("Board16K", "test 1"));
+            assert_eq!(info.capacities.len(), CapacityKind::ALL.len());
+            for (capacity, kind) in info.capacities.iter().zip(CapacityKind::ALL) {
+                assert_eq!((capacity.name, capacity.count as usize), (kind.field(), Board16K::COUNTS.get(kind)));
+            }
+            seen += 1;
+        });
+        assert_eq!(seen, 1);
+    }
+
+    #[test]
+    fn a_scene_is_drawn_row_by_row_as_the_core_draws_it() {
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let answer = ask(&mut raytracer, Message::Scene { pixels: true, text: SCENE }, 4);
+        let expected: Vec<u8> = {
+            let mut roomy = Raytracer::<Board16K>::new();
+            let scene = roomy.load(core::str::from_utf8(SCENE).unwrap()).unwrap();
+            let size = embedded_graphics_core::geometry::Size::new(PANEL.width.into(), PANEL.height.into());
+            let mut pixels = std::vec![Rgb565::default(); size.width as usize * size.height as usize];
+            let mut grid = Grid(&mut pixels, size);
+            scene.image::<Rgb565>(size).try_draw(&mut grid).unwrap();
+            pixels.iter().flat_map(|c| c.into_storage().to_be_bytes()).collect()
+        };
+        let mut received = Vec::new();
+        let mut rows = 0;
+        frames(&answer, |frame| {
+            assert_eq!(frame.tag, 4);
+            match frame.message {
+                Message::Drawing { panel, pixels } => assert_eq!((panel, pixels), (PANEL, true)),
+                Message::Row { y, pixels } => {
+                    assert_eq!((y, pixels.len()), (rows, PANEL.row_bytes()));
+                    received.extend_from_slice(pixels);
+                    rows += 1;
+                }
+                Message::Done { elapsed } => assert_eq!(elapsed, Some(Duration::from_millis(12))),
+                other => panic!("{other:?}"),
+            }
+        });
+        assert_eq!(rows, PANEL.height);
+        assert_eq!(received, expected);
+        assert_ne!(expected.iter().max(), expected.iter().min(), "the sphere is seen");
+    }
+
+    #[test]
+    fn rows_not_asked_for_carry_no_pixels() {
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let answer = ask(&mut raytracer, Message::Scene { pixels: false, text: SCENE }, 4);
+        frames(&answer, |frame| {
+            if let Message::Row { pixels, .. } = frame.message {
+                assert!(pixels.is_empty());
+            }
+        });
+        assert_eq!(kinds(&answer).len(), 1 + PANEL.height as usize + 1);
+    }
+
+    #[test]
+    fn every_error_comes_with_its_position_and_the_cores_message_and_nothing_is_drawn() {
+        let text = b"SPHERE 1 -1 0 0 0\nFOO 3\nRASTER 0 5\n";
+        let mut expected = Vec::new();
+        let _ = Raytracer::<Board16K>::new().load_with(text, AccelMode::Auto, &mut |e| {
+            expected.push((e.pos.line, e.pos.column, e.kind.to_string()));
+        });
+        assert!(expected.len() >= 3, "{expected:?}");
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let answer = ask(&mut raytracer, Message::Scene { pixels: true, text }, 8);
+        let mut errors = Vec::new();
+        let mut rejected = None;
+        frames(&answer, |frame| match frame.message {
+            Message::SceneError(e) => errors.push((e.line, e.column, String::from(e.message))),
+            Message::Rejected { errors } => rejected = Some(errors),
+            other => panic!("nothing else is sent: {other:?}"),
+        });
+        assert_eq!(errors, expected);
+        assert_eq!(rejected, Some(expected.len() as u32));
+        assert_eq!(kinds(&answer).last(), Some(&Kind::Rejected));
+    }
+
+    #[test]
+    fn a_scene_over_the_capacity_names_it_with_both_counts() {
+        let rectangle = "RECTANGLE 1 0 0 0 1 0 0 1 1 0 0 1 0\n";
+        let text = std::format!("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\n{}", rectangle.repeat(3));
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let answer = ask(&mut raytracer, Message::Scene { pixels: false, text: text.as_bytes() }, 8);
+        let mut needs = Vec::new();
+        frames(&answer, |frame| {
+            if let Message::SceneError(e) = frame.message {
+                let need = e.capacity.expect("a capacity error");
+                needs.push((e.line, need.name.to_string(), need.needed, need.holds, e.message.to_string()));
+            }
+        });
+        assert_eq!(needs.len(), 1, "{needs:?}");
+        let (line, name, needed, holds, message) = &needs[0];
+        assert_eq!((*line, name.as_str(), *needed, *holds), (4, "rectangles", Some(3), 2));
+        assert!(message.starts_with("too many rectangles: the capacity profile Board16K holds 2"), "{message}");
+    }
+
+    #[test]
+    fn refusals_are_sent_back_and_a_boards_own_kinds_are_unexpected() {
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let answer = ask(&mut raytracer, Message::Rejected { errors: 1 }, 13);
+        let mut got = Vec::new();
+        frames(&answer, |frame| got.push((frame.tag, frame.message.kind())));
+        assert_eq!(got, [(13, Kind::Refused)]);
+        let mut wire = Vec::new();
+        encode_raw(9, Kind::Hello.byte(), 14, &[], &mut wire).unwrap();
+        let mut buffer = [0u8; 64];
+        let mut decoder = Decoder::new(&mut buffer);
+        let board = Board::new(PANEL, "test 1", &decoder);
+        let mut answer = Vec::new();
+        for byte in wire {
+            if let Some(received) = decoder.push(byte) {
+                assert!(board.answer(received, &mut raytracer, &mut answer).unwrap().is_none());
+            }
+        }
+        let mut reasons = Vec::new();
+        frames(&answer, |frame| match frame.message {
+            Message::Refused(reason) => reasons.push((frame.tag, reason)),
+            other => panic!("{other:?}"),
+        });
+        assert_eq!(reasons, [(14, Reason::WrongVersion { expected: VERSION, found: 9 })]);
+    }
+
+    /// A row-major picture as a `DrawTarget`.
+    struct Grid<'p>(&'p mut [Rgb565], embedded_graphics_core::geometry::Size);
+
+    impl embedded_graphics_core::geometry::OriginDimensions for Grid<'_> {
+        fn size(&self) -> embedded_graphics_core::geometry::Size {
+            self.1
+        }
+    }
+
+    impl embedded_graphics_core::draw_target::DrawTarget for Grid<'_> {
+        type Color = Rgb565;
+        type Error = core::convert::Infallible;
+
+        fn draw_iter<I: IntoIterator<Item = embedded_graphics_core::Pixel<Rgb565>>>(
+            &mut self,
+            pixels: I,
+        ) -> Result<(), Self::Error> {
+            for embedded_graphics_core::Pixel(p, c) in pixels {
+                self.0[p.y as usize * self.1.width as usize + p.x as usize] = c;
+            }
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn the_wire_pixel_is_the_raw_rgb565_big_endian() {
+        let color: Rgb565 = Rgb888::new(255, 130, 8).into();
+        // Red 31 (5 bits), green 32 (6 bits), blue 1 (5 bits): 11111 100000 00001.
+        assert_eq!(color.into_storage(), 0b1111_1100_0000_0001);
+        assert_eq!(color.into_storage().to_be_bytes(), [0xFC, 0x01]);
+    }
+}
