@@ -21,26 +21,41 @@ const DEFAULT_SCENE: &str = "../../scenes/fig5_1.txt";
 fn main() {
     let out = PathBuf::from(env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
     let manifest = PathBuf::from(env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
-    // Where the code runs: copied into SRAM at boot (the default), or in
-    // place from the execute-in-place flash through its cache. memory.x
-    // includes `code-placement.x`, written here (the linker finds memory.x
-    // itself in this folder first, so it is not generated).
+    // Where each firmware's code runs: memory.x includes
+    // `code-placement.x`, found in a folder of its own for each binary.
+    // The embedded-scene firmware's is copied into SRAM at boot (the
+    // default; sram-code.x), or runs in place from the execute-in-place
+    // flash through its cache. The live firmware's runs from flash: its
+    // SRAM goes to the scenes it is sent.
     println!("cargo:rerun-if-env-changed=OCTRACE_CODE_IN");
-    let placement = match env::var("OCTRACE_CODE_IN").as_deref() {
-        Ok("sram") | Err(_) => {
-            println!("cargo:rustc-cfg=code_in_sram");
-            std::fs::read_to_string("sram-code.x").expect("read sram-code.x")
-        }
-        Ok("flash") => "/* OCTRACE_CODE_IN=flash: the code runs from flash, through the XIP cache. */\n".to_owned(),
+    let in_sram = match env::var("OCTRACE_CODE_IN").as_deref() {
+        Ok("sram") | Err(_) => true,
+        Ok("flash") => false,
         Ok(other) => fail(&format!("OCTRACE_CODE_IN={other}: expected `sram` (the default) or `flash`")),
     };
+    let read = |script: &str| {
+        println!("cargo:rerun-if-changed={script}");
+        std::fs::read_to_string(script).unwrap_or_else(|e| fail(&format!("read {script}: {e}")))
+    };
+    let placement = |folder: &str, text: &str| {
+        let dir = out.join(folder);
+        std::fs::create_dir_all(&dir)
+            .and_then(|()| std::fs::write(dir.join("code-placement.x"), text))
+            .unwrap_or_else(|e| fail(&format!("write {folder}/code-placement.x: {e}")));
+        dir
+    };
+    let sram = placement("code-in-sram", &read("sram-code.x"));
+    let flash = placement("code-in-flash", "/* The code runs in place from flash, through the XIP cache. */\n");
+    let scene_firmware = if in_sram { &sram } else { &flash };
+    println!("cargo:rustc-link-arg-bin=octrace-pico-st7789=-L{}", scene_firmware.display());
+    println!("cargo:rustc-link-arg-bin=octrace-pico-live=-L{}", flash.display());
+    if in_sram {
+        println!("cargo:rustc-cfg=code_in_sram");
+    }
     println!("cargo::rustc-check-cfg=cfg(code_in_sram)");
-    std::fs::write(out.join("code-placement.x"), placement).expect("write code-placement.x into OUT_DIR");
     // Where the linker finds memory.x when it runs elsewhere than here.
-    std::fs::copy("memory.x", out.join("memory.x")).expect("copy memory.x into OUT_DIR");
+    std::fs::write(out.join("memory.x"), read("memory.x")).unwrap_or_else(|e| fail(&format!("write memory.x: {e}")));
     println!("cargo:rustc-link-search={}", out.display());
-    println!("cargo:rerun-if-changed=memory.x");
-    println!("cargo:rerun-if-changed=sram-code.x");
     println!("cargo:rerun-if-changed=build.rs");
 
     println!("cargo:rerun-if-env-changed=OCTRACE_SCENE");

@@ -1,0 +1,327 @@
+//! octrace live on a Raspberry Pi Pico: flash it once, then send it scenes.
+//! The Pico enumerates as a USB serial port; `host-sim board PORT
+//! scene.txt` (or the studio's "Send to board") sends a scene, and the Pico
+//! answers with its errors at line and column, or draws it on the panel
+//! with both cores (sending the rows back when asked), then waits for the
+//! next. The protocol is octrace-link's (`docs/board-protocol.md`).
+//!
+//! Invariants: the USB device lives in the USB interrupt, which moves bytes
+//! between it and two rings (`INPUT`, `OUTPUT`); the main loop on core 0
+//! only reads `INPUT` and writes `OUTPUT`, so the port answers the host
+//! while a picture is traced. A frame from the host while drawing stops the
+//! picture after the current row, and is answered next. A host that stops
+//! reading for `STALLED_AFTER_US` loses what the board would send, never
+//! wedges it. Nothing the host sends can make the board panic: every frame
+//! gets an answer from octrace-link's `Board`.
+
+#![no_std]
+#![no_main]
+
+use core::cell::RefCell;
+use core::ops::ControlFlow;
+use core::time::Duration;
+use critical_section::Mutex;
+use hal::gpio::Pins;
+use hal::multicore::{Multicore, Stack};
+use hal::pac::interrupt;
+use hal::usb::UsbBus;
+use hal::{entry, pac, Clock, Sio, Timer, Watchdog};
+use heapless::Deque;
+use octrace_core::render::Handoff;
+use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
+use octrace_link::board::Board;
+use octrace_link::{Decoder, Panel, PixelFormat, Sink};
+use octrace_pico_st7789::both_cores::{self, SecondCore};
+use octrace_pico_st7789::panel::{self, PanelPins};
+use panic_halt as _;
+use rp2040_hal as hal;
+use usb_device::class_prelude::UsbBusAllocator;
+use usb_device::prelude::*;
+use usbd_serial::SerialPort;
+
+/// The second-stage loader for the Pico's W25Q16JV flash (see memory.x).
+#[link_section = ".boot2"]
+#[used]
+static BOOT2: [u8; 256] = rp2040_boot2::BOOT_LOADER_W25Q080;
+
+/// The Pico's crystal.
+const CRYSTAL_HZ: u32 = 12_000_000;
+
+/// What the board says it is (octrace-link's `board` answer).
+const FIRMWARE: &str = concat!("octrace-pico-live ", env!("CARGO_PKG_VERSION"));
+
+octrace_core::profile! {
+    /// The largest scene this firmware holds: what the Pico's 264 KiB of
+    /// SRAM leaves beside the code, both cores' stacks and rooms, the
+    /// scene's text and the USB rings (README.md states it in objects).
+    pub struct LiveProfile {
+        spheres: 400, boxes: 32, superquadrics: 32, triangles: 160, rectangles: 160,
+        surfaces: 64, lights: 8,
+        octree_boxes: 1600, octree_references: 4800,
+    }
+    named_walk: false
+    first_hits: true
+}
+
+/// Room for the scene, its octree and core 0's mailbox and lists.
+static RAYTRACER: ConstStaticCell<Raytracer<LiveProfile>> = ConstStaticCell::new(Raytracer::new());
+
+/// Core 1's own mailbox and screen lists.
+static CORE1_ROOM: ConstStaticCell<RendererRoom<LiveProfile>> = ConstStaticCell::new(RendererRoom::new());
+
+/// Core 1's stack: 16 KiB.
+static CORE1_STACK: Stack<4096> = Stack::new();
+
+/// Core 1's rows on their way to the panel.
+static ROWS: Handoff<{ panel::WIDTH as usize }, 4> = Handoff::new();
+
+/// The panel's bus buffer.
+static PANEL_BUFFER: ConstStaticCell<[u8; 512]> = ConstStaticCell::new([0; 512]);
+
+/// A received frame, the scene's text in it: the longest scene the board takes.
+static FRAME_BUFFER: ConstStaticCell<[u8; 32 * 1024]> = ConstStaticCell::new([0; 32 * 1024]);
+
+/// The USB device and its serial port, owned by the USB interrupt.
+type Usb = (UsbDevice<'static, UsbBus>, SerialPort<'static, UsbBus>);
+static USB: Mutex<RefCell<Option<Usb>>> = Mutex::new(RefCell::new(None));
+
+/// Bytes from the host, not yet read by the main loop; and bytes for the
+/// host, not yet taken by the USB device.
+static INPUT: Mutex<RefCell<Deque<u8, 1024>>> = Mutex::new(RefCell::new(Deque::new()));
+static OUTPUT: Mutex<RefCell<Deque<u8, 1024>>> = Mutex::new(RefCell::new(Deque::new()));
+
+/// How long the board waits for a host that does not read before it drops
+/// what it sends (a second).
+const STALLED_AFTER_US: u64 = 1_000_000;
+
+#[entry]
+fn main() -> ! {
+    let mut peripherals = pac::Peripherals::take().unwrap();
+    let mut watchdog = Watchdog::new(peripherals.WATCHDOG);
+    let clocks = hal::clocks::init_clocks_and_plls(
+        CRYSTAL_HZ,
+        peripherals.XOSC,
+        peripherals.CLOCKS,
+        peripherals.PLL_SYS,
+        peripherals.PLL_USB,
+        &mut peripherals.RESETS,
+        &mut watchdog,
+    )
+    .unwrap();
+    let timer = Timer::new(peripherals.TIMER, &mut peripherals.RESETS, &clocks);
+    let mut sio = Sio::new(peripherals.SIO);
+    let pins = Pins::new(peripherals.IO_BANK0, peripherals.PADS_BANK0, sio.gpio_bank0, &mut peripherals.RESETS);
+    let panel_pins = PanelPins {
+        clock: pins.gpio10,
+        data: pins.gpio11,
+        chip_select: pins.gpio9,
+        data_command: pins.gpio8,
+        reset: pins.gpio12,
+        backlight: pins.gpio13,
+    };
+    let mut display = panel::init(
+        peripherals.SPI1,
+        panel_pins,
+        &mut peripherals.RESETS,
+        clocks.peripheral_clock.freq(),
+        timer,
+        PANEL_BUFFER.take(),
+    );
+    let mut multicore = Multicore::new(&mut peripherals.PSM, &mut peripherals.PPB, &mut sio.fifo);
+    let mut core1 = SecondCore::start(&mut multicore.cores()[1], CORE1_STACK.take().unwrap()).unwrap();
+
+    // The USB serial port, served by its interrupt from here on.
+    let bus: &'static UsbBusAllocator<UsbBus> = cortex_m::singleton!(: UsbBusAllocator<UsbBus> =
+    UsbBusAllocator::new(UsbBus::new(
+        peripherals.USBCTRL_REGS,
+        peripherals.USBCTRL_DPRAM,
+        clocks.usb_clock,
+        true,
+        &mut peripherals.RESETS,
+    )))
+    .unwrap();
+    let serial = SerialPort::new(bus);
+    let strings = StringDescriptors::default().manufacturer("octrace").product("octrace live").serial_number("1");
+    let device = UsbDeviceBuilder::new(bus, UsbVidPid(0x16c0, 0x27dd))
+        .strings(&[strings])
+        .unwrap()
+        .max_packet_size_0(64)
+        .unwrap()
+        .device_class(usbd_serial::USB_CLASS_CDC)
+        .build();
+    critical_section::with(|cs| USB.borrow_ref_mut(cs).replace((device, serial)));
+    // SAFETY: the handler only touches what the critical sections guard.
+    unsafe { pac::NVIC::unmask(pac::Interrupt::USBCTRL_IRQ) };
+
+    let mut decoder = Decoder::new(FRAME_BUFFER.take());
+    let size = display.bounding_box_size();
+    let panel = Panel { width: size.0, height: size.1, format: PixelFormat::Rgb565 };
+    let board = Board::new(panel, FIRMWARE, &decoder);
+    let raytracer = RAYTRACER.take();
+    let room = CORE1_ROOM.take();
+    let mut host = Host { timer, stalled: false };
+    // A frame that came while drawing, to be answered next.
+    let mut pending = false;
+    loop {
+        if !pending {
+            let byte = next_input_byte();
+            if decoder.push(byte).is_none() {
+                continue;
+            }
+        }
+        pending = false;
+        let Some(received) = decoder.received() else { continue };
+        host.stalled = false;
+        let Ok(Some(drawing)) = board.answer(received, raytracer, &mut host) else { continue };
+        let start = timer.get_counter();
+        let mut rows = 0u16;
+        let drawn = both_cores::draw(&mut core1, drawing.scene(), room, &ROWS, &mut display, |y, row| {
+            rows = y as u16 + 1;
+            if drawing.send_row(y as u16, row, &mut host).is_err() {
+                return ControlFlow::Break(());
+            }
+            // Between rows, without waiting: a new frame stops the picture.
+            while let Some(byte) = try_input_byte() {
+                if decoder.push(byte).is_some() {
+                    pending = true;
+                    return ControlFlow::Break(());
+                }
+            }
+            ControlFlow::Continue(())
+        });
+        let answered = match drawn {
+            Ok(()) => {
+                let elapsed = Duration::from_micros((timer.get_counter() - start).to_micros());
+                drawing.finish(Some(elapsed), &mut host)
+            }
+            Err(_) => drawing.cancel(rows, &mut host),
+        };
+        // A host that stopped reading gets nothing more of this picture.
+        if answered.is_err() {
+            critical_section::with(|cs| OUTPUT.borrow_ref_mut(cs).clear());
+        }
+    }
+}
+
+trait BoundingBoxSize {
+    fn bounding_box_size(&self) -> (u16, u16);
+}
+
+impl<D: embedded_graphics::prelude::OriginDimensions> BoundingBoxSize for D {
+    fn bounding_box_size(&self) -> (u16, u16) {
+        let size = self.size();
+        (size.width as u16, size.height as u16)
+    }
+}
+
+/// The host's side of the port, as octrace-link writes to it: bytes into
+/// `OUTPUT`, waiting while it is full, up to `STALLED_AFTER_US`.
+struct Host {
+    timer: Timer,
+    /// The host stopped reading: what is left of this answer is dropped.
+    stalled: bool,
+}
+
+/// The host did not read what the board sends.
+#[derive(Debug)]
+struct Stalled;
+
+impl Sink for Host {
+    type Error = Stalled;
+
+    fn write_all(&mut self, bytes: &[u8]) -> Result<(), Stalled> {
+        if self.stalled {
+            return Err(Stalled);
+        }
+        let mut rest = bytes;
+        let mut since = self.timer.get_counter();
+        while !rest.is_empty() {
+            let taken = critical_section::with(|cs| {
+                let mut output = OUTPUT.borrow_ref_mut(cs);
+                let room = output.capacity() - output.len();
+                let taken = room.min(rest.len());
+                for &byte in &rest[..taken] {
+                    // Room was checked: never refused.
+                    let _ = output.push_back(byte);
+                }
+                taken
+            });
+            rest = &rest[taken..];
+            // The interrupt sends what was queued.
+            pac::NVIC::pend(pac::Interrupt::USBCTRL_IRQ);
+            if taken > 0 {
+                since = self.timer.get_counter();
+            } else if (self.timer.get_counter() - since).to_micros() > STALLED_AFTER_US {
+                self.stalled = true;
+                return Err(Stalled);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The next byte from the host, sleeping until one comes.
+fn next_input_byte() -> u8 {
+    loop {
+        // With interrupts masked, so that one arriving between the look and
+        // the sleep still wakes the core (WFI wakes on a pending interrupt).
+        cortex_m::interrupt::disable();
+        let byte = try_input_byte();
+        if byte.is_none() {
+            cortex_m::asm::wfi();
+        }
+        // SAFETY: enabled again as they were: main runs with interrupts on.
+        unsafe { cortex_m::interrupt::enable() };
+        if let Some(byte) = byte {
+            return byte;
+        }
+    }
+}
+
+/// The next byte from the host, if one has come.
+fn try_input_byte() -> Option<u8> {
+    let (byte, was_full) = critical_section::with(|cs| {
+        let mut input = INPUT.borrow_ref_mut(cs);
+        let was_full = input.capacity() - input.len() < 64;
+        (input.pop_front(), was_full)
+    });
+    // The interrupt stopped reading the port while the ring was full.
+    if was_full {
+        pac::NVIC::pend(pac::Interrupt::USBCTRL_IRQ);
+    }
+    byte
+}
+
+/// Serves the USB device, and moves bytes between it and the rings.
+#[interrupt]
+fn USBCTRL_IRQ() {
+    critical_section::with(|cs| {
+        let mut usb = USB.borrow_ref_mut(cs);
+        let Some((device, serial)) = usb.as_mut() else { return };
+        device.poll(&mut [serial]);
+        let mut input = INPUT.borrow_ref_mut(cs);
+        let mut packet = [0u8; 64];
+        // Only as much as the ring holds: the rest waits in the device (the
+        // host is told to wait), never lost.
+        while input.capacity() - input.len() >= packet.len() {
+            match serial.read(&mut packet) {
+                Ok(read) if read > 0 => packet[..read].iter().for_each(|&byte| {
+                    let _ = input.push_back(byte);
+                }),
+                _ => break,
+            }
+        }
+        let mut output = OUTPUT.borrow_ref_mut(cs);
+        while !output.is_empty() {
+            let (front, _) = output.as_slices();
+            match serial.write(front) {
+                Ok(written) if written > 0 => {
+                    for _ in 0..written {
+                        output.pop_front();
+                    }
+                }
+                _ => break,
+            }
+        }
+    });
+}
