@@ -18,12 +18,14 @@
 mod first_hit;
 mod gamma;
 mod panel;
+mod progressive;
 mod split;
 
 use first_hit::FirstHits;
 pub use first_hit::ScreenBound;
 pub(crate) use gamma::GammaTable;
 pub use panel::PanelColor;
+pub use progressive::{Progressive, ProgressiveError, TracedUnit, Unit};
 pub use split::{interleaved_rows, Tiles};
 
 use crate::accel::{Accelerator, Hit, Mailbox};
@@ -241,6 +243,22 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     /// The pixels of row `y` for the columns `xs`, traced lazily.
     pub fn row(&mut self, y: u32, xs: Range<u32>) -> impl Iterator<Item = PixelSample> + use<'_, 'a, A> {
         xs.map(move |x| self.pixel(x, y))
+    }
+
+    /// The pixels of row `y` at `xs.start`, `xs.start + stride`, … below
+    /// `xs.end`, traced lazily: after the first, each camera ray is a sum
+    /// (the stride is made once), as along a whole row.
+    pub(crate) fn row_strided(
+        &mut self,
+        y: u32,
+        xs: Range<u32>,
+        stride: u32,
+    ) -> impl Iterator<Item = PixelSample> + use<'_, 'a, A> {
+        let jump = self.camera.stride(stride);
+        xs.step_by(stride.max(1) as usize).map(move |x| {
+            self.cursor.skip(&jump);
+            self.pixel(x, y)
+        })
     }
 
     /// Renders the whole image.
