@@ -72,7 +72,7 @@
 //! # Ok::<(), Box<dyn core::error::Error>>(())
 //! ```
 
-use super::Renderer;
+use super::{Renderer, Walk};
 use crate::accel::Accelerator;
 use crate::scene::MAX_SIDE;
 use crate::shade::Stats;
@@ -84,10 +84,18 @@ use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::pixelcolor::{PixelColor, Rgb888};
 use embedded_graphics_core::primitives::Rectangle;
 
-/// Blocks a single core traces before drawing them, when blocks are wider
-/// than a pixel (a run of single pixels streams): its colour buffer, on the
-/// stack.
-const CHUNK_BLOCKS: usize = 64;
+/// Blocks of at least this side are drawn one `fill_solid` each; smaller
+/// ones, a run of them side by side as one `fill_contiguous`. A display
+/// driver sends a solid block as one pixel repeated, as fast as its bus,
+/// but each colour of `fill_contiguous` through a loop a pixel; a block's
+/// own window is repaid from this side on (measured on the emulated Pico's
+/// ST7789 through mipidsi: BENCHMARKS.md, "A picture at once").
+const SOLID_FROM: u32 = 8;
+
+/// Blocks a single core traces before drawing them as one rectangle (runs
+/// of blocks wider than a pixel and narrower than [`SOLID_FROM`]): its
+/// colour buffer, on the stack.
+const CHUNK_BLOCKS: usize = 32;
 
 /// A progressive order over an image of `size`: passes of blocks from
 /// `coarsest` pixels a side down to `finest`, then (if `finest` is more
@@ -126,6 +134,12 @@ const fn at_most_side(value: u32) -> u32 {
 const fn power_of_two_at_most(value: u32) -> u32 {
     // `| 1`: 0 counts as 1; a power of two is unchanged.
     1 << (31 - (at_most_side(value) | 1).leading_zeros())
+}
+
+/// How many blocks of `block` pixels (a power of two) `length` pixels
+/// start: a shift, where a division is a long call on a core without one.
+const fn blocks_across(length: u32, block: u32) -> u32 {
+    (length + block - 1) >> block.trailing_zeros()
 }
 
 impl Progressive {
@@ -254,18 +268,31 @@ impl Progressive {
     {
         let before = renderer.stats();
         let mut chunk = [Rgb888::new(0, 0, 0); CHUNK_BLOCKS];
-        for run in self.units().flat_map(|unit| unit.runs()) {
-            if run.block == 1 && run.blocks > 1 {
-                let pixels = renderer.row_strided(run.y, run.columns(), 1);
-                target.fill_contiguous(&run.area, pixels.map(|p| p.color.into()))?;
-                continue;
-            }
-            for part in run.parts(CHUNK_BLOCKS as u32) {
-                let colors = &mut chunk[..part.blocks as usize];
-                for (color, pixel) in colors.iter_mut().zip(renderer.row_strided(part.y, part.columns(), part.block)) {
-                    *color = pixel.color;
+        for unit in self.units() {
+            let mut walk = Walk::NEW;
+            for run in unit.runs() {
+                let y = run.y;
+                // Blocks drawn alone, and single pixels, stream as traced.
+                if run.solid() {
+                    for (block, x) in (0..).zip(run.columns()) {
+                        let color = renderer.pixel_on(&mut walk, x, y).color;
+                        target.fill_solid(&run.block_area(block), color.into())?;
+                    }
+                } else if run.block == 1 {
+                    // Every pixel traced, even for a display that stops
+                    // short (one smaller than the image).
+                    let mut colors = run.columns().map(|x| renderer.pixel_on(&mut walk, x, y).color);
+                    target.fill_contiguous(&run.area, colors.by_ref().map(Into::into))?;
+                    colors.for_each(drop);
+                } else {
+                    for part in run.parts(CHUNK_BLOCKS as u32) {
+                        let colors = &mut chunk[..part.blocks as usize];
+                        for (slot, x) in colors.iter_mut().zip(part.columns()) {
+                            *slot = renderer.pixel_on(&mut walk, x, y).color;
+                        }
+                        part.draw(colors, target)?;
+                    }
                 }
-                part.draw(colors, target)?;
             }
         }
         Ok(renderer.stats().since(&before))
@@ -325,14 +352,14 @@ impl Unit {
     /// How many pixels the unit traces.
     pub const fn pixel_count(&self) -> usize {
         let (width, block) = (self.size.width, self.level.block);
-        let lines = self.rows().end.saturating_sub(self.y).div_ceil(block);
+        let lines = blocks_across(self.rows().end.saturating_sub(self.y), block);
         if lines == 0 {
             return 0;
         }
-        let across = width.div_ceil(block) as usize;
+        let across = blocks_across(width, block) as usize;
         // The first line skips the parents' pixels, traced before.
         let first = match self.level.parent {
-            Some(parent) => across - width.div_ceil(parent) as usize,
+            Some(parent) => across - blocks_across(width, parent) as usize,
             None => across,
         };
         first + (lines as usize - 1) * across
@@ -341,28 +368,24 @@ impl Unit {
     /// The pixels the unit traces, in order: its colours come in this
     /// order.
     pub fn pixels(&self) -> impl Iterator<Item = Point> {
-        self.runs()
-            .flat_map(|run| run.columns().step_by(run.block as usize).map(move |x| Point::new(x as i32, run.y as i32)))
+        self.runs().flat_map(|run| run.columns().map(move |x| Point::new(x as i32, run.y as i32)))
     }
 
     /// The unit's runs: blocks side by side in one of its lines, drawn as
-    /// one rectangle.
-    fn runs(&self) -> impl Iterator<Item = Run> {
-        let Unit { level, y, size, .. } = *self;
-        let (width, block) = (size.width, level.block);
-        let lines = self.rows().step_by(block as usize);
-        lines.flat_map(move |row| {
-            // The first line of a split has runs between the parents'
-            // pixels; any other line, one run across.
-            let (start, step, most) = match level.parent {
-                Some(parent) if row == y => (block, parent, parent / block - 1),
-                _ => (0, width.max(1), width.div_ceil(block)),
-            };
-            (start..width).step_by(step as usize).map(move |x| {
-                let blocks = most.min((width - x).div_ceil(block));
-                Run::new(Point::new(x as i32, row as i32), block, blocks, size)
-            })
-        })
+    /// one rectangle, line by line and left to right.
+    fn runs(&self) -> Runs {
+        let x = if self.level.parent.is_some() { self.level.block } else { 0 };
+        Runs { unit: *self, row: self.y, x }
+    }
+
+    /// Traces the unit's pixels in order, handing each colour to `to`.
+    fn trace_each<A: Accelerator>(&self, renderer: &mut Renderer<'_, A>, mut to: impl FnMut(Rgb888)) {
+        let mut walk = Walk::NEW;
+        for run in self.runs() {
+            for x in run.columns() {
+                to(renderer.pixel_on(&mut walk, x, run.y).color);
+            }
+        }
     }
 
     /// Traces the unit's pixels with `renderer` into `colors`, in the
@@ -380,12 +403,11 @@ impl Unit {
             .get_mut(..self.pixel_count())
             .ok_or(ProgressiveError::Buffer { pixels: self.pixel_count(), room })?;
         let mut slots = colors.iter_mut();
-        for run in self.runs() {
-            // The pixels first: when they end, no slot is taken.
-            for (pixel, slot) in renderer.row_strided(run.y, run.columns(), run.block).zip(slots.by_ref()) {
-                *slot = pixel.color.into();
+        self.trace_each(renderer, |color| {
+            if let Some(slot) = slots.next() {
+                *slot = color.into();
             }
-        }
+        });
         Ok(TracedUnit { unit: *self, colors })
     }
 
@@ -396,6 +418,43 @@ impl Unit {
         let pixels = self.pixel_count();
         let colors = colors.get(..pixels).ok_or(ProgressiveError::Buffer { pixels, room: colors.len() })?;
         Ok(TracedUnit { unit: *self, colors })
+    }
+}
+
+/// A unit's runs, line by line, left to right: plain arithmetic, no
+/// division, as a board walks them once a pixel or two.
+#[derive(Clone, Copy, Debug)]
+struct Runs {
+    unit: Unit,
+    /// The line, and where its next run starts.
+    row: u32,
+    x: u32,
+}
+
+impl Iterator for Runs {
+    type Item = Run;
+
+    fn next(&mut self) -> Option<Run> {
+        let Unit { level, y, size, .. } = self.unit;
+        let block = level.block;
+        let end = self.unit.rows().end;
+        while self.row < end {
+            // The first line of a split has runs between the parents'
+            // pixels, `parent` apart; any other line, one run across.
+            let (period, most) = match level.parent {
+                Some(parent) if self.row == y => (parent, blocks_across(parent, block) - 1),
+                _ => (size.width, blocks_across(size.width, block)),
+            };
+            if self.x < size.width {
+                let x = self.x;
+                self.x += period;
+                let blocks = most.min(blocks_across(size.width - x, block));
+                return Some(Run::new(Point::new(x as i32, self.row as i32), block, blocks, size));
+            }
+            self.row += block;
+            self.x = 0;
+        }
+        None
     }
 }
 
@@ -454,9 +513,10 @@ impl Run {
         Run { x, y, block, blocks, area: Rectangle::new(at, area) }
     }
 
-    /// The columns its traced pixels are in (every `block`-th).
-    fn columns(&self) -> Range<u32> {
-        self.x..self.x + self.area.size.width
+    /// The columns of its traced pixels, left to right.
+    fn columns(&self) -> impl Iterator<Item = u32> {
+        let (x, block) = (self.x, self.block);
+        (0..self.blocks).map(move |i| x + i * block)
     }
 
     /// The run cut into runs of at most `most` blocks.
@@ -469,25 +529,36 @@ impl Run {
         })
     }
 
-    /// Draws the run with its blocks' `colors`: one `fill_solid` for a
-    /// single block, else one `fill_contiguous`, each colour repeated
+    /// Whether its blocks are drawn one `fill_solid` each: a single block,
+    /// or blocks of [`SOLID_FROM`] and more.
+    fn solid(&self) -> bool {
+        self.blocks == 1 || self.block >= SOLID_FROM
+    }
+
+    /// Block `index`'s area, clipped to the image.
+    fn block_area(&self, index: u32) -> Rectangle {
+        let x = self.x + index * self.block;
+        let width = self.block.min((self.x + self.area.size.width).saturating_sub(x));
+        Rectangle::new(Point::new(x as i32, self.y as i32), Size::new(width, self.area.size.height))
+    }
+
+    /// Draws the run with its blocks' `colors`: a `fill_solid` a block
+    /// ([`Run::solid`]), else one `fill_contiguous`, each colour repeated
     /// across and down its block.
     fn draw<C: PixelColor, D>(&self, colors: &[C], target: &mut D) -> Result<(), D::Error>
     where
         D: DrawTarget,
         D::Color: From<C>,
     {
-        let (width, block) = (self.area.size.width as usize, self.block as usize);
-        match colors {
-            [] => Ok(()),
-            [one] => target.fill_solid(&self.area, (*one).into()),
-            _ => {
-                let row = move || {
-                    colors.iter().flat_map(move |&c| core::iter::repeat_n(D::Color::from(c), block)).take(width)
-                };
-                target.fill_contiguous(&self.area, (0..self.area.size.height).flat_map(move |_| row()))
+        if self.solid() {
+            for (block, &color) in (0..).zip(colors) {
+                target.fill_solid(&self.block_area(block), color.into())?;
             }
+            return Ok(());
         }
+        let (width, block) = (self.area.size.width as usize, self.block as usize);
+        let row = move || colors.iter().flat_map(move |&c| core::iter::repeat_n(D::Color::from(c), block)).take(width);
+        target.fill_contiguous(&self.area, (0..self.area.size.height).flat_map(move |_| row()))
     }
 }
 
@@ -707,14 +778,15 @@ mod tests {
     }
 
     #[test]
-    fn a_240_panel_takes_a_rectangle_a_row_of_blocks_and_one_a_new_block_beside_an_old() {
+    fn a_240_panel_takes_a_rectangle_a_block_of_8_and_more_and_one_a_row_of_smaller() {
         let order = Progressive::new(Size::new(240, 240), 16);
         let p = 240 * 240;
-        // The first pass: one rectangle a row of blocks, every pixel once.
-        // Then, for blocks of b, a rectangle for each new block beside an
-        // old one and one for each row of new blocks: 3/4 of the pixels.
+        // The first pass: a rectangle a block, every pixel once. Then, for
+        // blocks of b, a rectangle for each new block beside an old one,
+        // and for each block of 8 and more below them, or one for each row
+        // of smaller ones: 3/4 of the pixels.
         let expected =
-            [(15, p), (15 * 16, p * 3 / 4), (30 * 31, p * 3 / 4), (60 * 61, p * 3 / 4), (120 * 121, p * 3 / 4)];
+            [(225, p), (15 * 45, p * 3 / 4), (30 * 31, p * 3 / 4), (60 * 61, p * 3 / 4), (120 * 121, p * 3 / 4)];
         assert_eq!(sent_by_pass(&order), expected);
         // Finished from blocks of 4 at full resolution: a rectangle for each
         // three new pixels beside an old one, one for each row below.
