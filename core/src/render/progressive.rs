@@ -25,14 +25,16 @@
 //!
 //! # Drawing, for an SPI panel
 //!
-//! Each drawing call is a rectangle (a window command and its pixels):
-//! the first pass draws each row of blocks as one `fill_contiguous`; a
-//! later pass draws the new blocks beside the old ones one `fill_solid`
-//! each, and the row of wholly new blocks below them as one
-//! `fill_contiguous`. Units go down the display, so each pass sweeps it
-//! from top to bottom. [`Progressive::with_finest`] stops the mosaic at a
-//! block size and then finishes each row of blocks at full resolution:
-//! fewer, larger rectangles (BENCHMARKS.md, "A picture at once").
+//! Each drawing call is a rectangle (a window command and its pixels).
+//! Blocks of 8 pixels a side and more are drawn one `fill_solid` each (a
+//! driver repeats one pixel at the speed of its bus); smaller new blocks
+//! beside old ones one `fill_solid` each too, and a row of wholly new
+//! small blocks as one `fill_contiguous`. Units go down the display, so
+//! each pass sweeps it from top to bottom. [`Progressive::with_finest`]
+//! stops the mosaic at a block size and then finishes each row of blocks
+//! at full resolution: fewer rectangles (BENCHMARKS.md, "A picture at
+//! once", has what each order sends a 240×240 panel and takes on the
+//! emulated Pico).
 //!
 //! # Two cores
 //!
@@ -238,9 +240,10 @@ impl Progressive {
     }
 
     /// Traces the whole image with `renderer` into `target`, unit by unit:
-    /// the order for one core. Runs of blocks are traced a few dozen at a
-    /// time into a buffer on the stack, then drawn; runs of single pixels
-    /// stream. Returns the counters of this call.
+    /// the order for one core. Blocks drawn alone and single pixels stream
+    /// as they are traced; a row of small blocks is traced up to 32 blocks
+    /// at a time into a buffer on the stack, then drawn. Returns the
+    /// counters of this call.
     pub fn render<A, D>(
         &self,
         renderer: &mut Renderer<'_, A>,
@@ -286,7 +289,7 @@ impl Progressive {
                     colors.for_each(drop);
                 } else {
                     for part in run.parts(CHUNK_BLOCKS as u32) {
-                        let colors = &mut chunk[..part.blocks as usize];
+                        let colors = &mut chunk[..(part.blocks as usize).min(CHUNK_BLOCKS)];
                         for (slot, x) in colors.iter_mut().zip(part.columns()) {
                             *slot = renderer.pixel_on(&mut walk, x, y).color;
                         }
@@ -371,21 +374,10 @@ impl Unit {
         self.runs().flat_map(|run| run.columns().map(move |x| Point::new(x as i32, run.y as i32)))
     }
 
-    /// The unit's runs: blocks side by side in one of its lines, drawn as
-    /// one rectangle, line by line and left to right.
+    /// The unit's runs of blocks, line by line and left to right.
     fn runs(&self) -> Runs {
         let x = if self.level.parent.is_some() { self.level.block } else { 0 };
         Runs { unit: *self, row: self.y, x }
-    }
-
-    /// Traces the unit's pixels in order, handing each colour to `to`.
-    fn trace_each<A: Accelerator>(&self, renderer: &mut Renderer<'_, A>, mut to: impl FnMut(Rgb888)) {
-        let mut walk = Walk::NEW;
-        for run in self.runs() {
-            for x in run.columns() {
-                to(renderer.pixel_on(&mut walk, x, run.y).color);
-            }
-        }
     }
 
     /// Traces the unit's pixels with `renderer` into `colors`, in the
@@ -402,12 +394,13 @@ impl Unit {
         let colors = colors
             .get_mut(..self.pixel_count())
             .ok_or(ProgressiveError::Buffer { pixels: self.pixel_count(), room })?;
-        let mut slots = colors.iter_mut();
-        self.trace_each(renderer, |color| {
-            if let Some(slot) = slots.next() {
-                *slot = color.into();
+        let (mut slots, mut walk) = (colors.iter_mut(), Walk::NEW);
+        for run in self.runs() {
+            // The columns first: when they end, no slot is taken.
+            for (x, slot) in run.columns().zip(slots.by_ref()) {
+                *slot = renderer.pixel_on(&mut walk, x, run.y).color.into();
             }
-        });
+        }
         Ok(TracedUnit { unit: *self, colors })
     }
 
@@ -422,7 +415,8 @@ impl Unit {
 }
 
 /// A unit's runs, line by line, left to right: plain arithmetic, no
-/// division, as a board walks them once a pixel or two.
+/// division (a mosaic's lines of new blocks beside old ones have a run a
+/// pixel traced).
 #[derive(Clone, Copy, Debug)]
 struct Runs {
     unit: Unit,
@@ -476,8 +470,8 @@ impl<C: PixelColor> TracedUnit<'_, C> {
         self.colors
     }
 
-    /// Draws the unit: each traced pixel fills its block, one rectangle
-    /// for each run of blocks side by side.
+    /// Draws the unit: each traced pixel fills its block (module docs,
+    /// "Drawing").
     pub fn draw<D>(&self, target: &mut D) -> Result<(), D::Error>
     where
         D: DrawTarget,
@@ -493,8 +487,8 @@ impl<C: PixelColor> TracedUnit<'_, C> {
     }
 }
 
-/// Blocks side by side in one row of blocks, drawn as one rectangle: their
-/// traced pixels are `(x + i · block, y)` for `i` below `blocks`.
+/// Blocks side by side in one row of blocks, drawn together ([`Run::draw`]):
+/// their traced pixels are `(x + i · block, y)` for `i` below `blocks`.
 #[derive(Clone, Copy, Debug)]
 struct Run {
     x: u32,
