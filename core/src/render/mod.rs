@@ -4,7 +4,8 @@
 //! There is no framebuffer: each pixel is traced as the target pulls it from
 //! the row iterator, so the memory cost is the same for 8×8 and 16384×16384.
 //! Every pixel depends only on its coordinates, so any split of the image
-//! into rows, tiles or threads gives the same bits.
+//! into rows, tiles or threads gives the same bits, and so does any order
+//! ([`Progressive`]: the whole picture in coarse blocks first).
 //!
 //! Given room ([`Renderer::with_first_hits`]), camera rays find their hits
 //! among the objects seen around their pixel, nearest first, instead of

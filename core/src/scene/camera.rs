@@ -453,6 +453,7 @@ mod tests {
         let zero_up = View { up: [0; 3], ..View::default() };
         assert_eq!(Camera::check(&zero_up), Err(CameraError::UpParallel));
     }
+
     #[test]
     fn a_skipped_cursor_gives_the_ray() {
         // Every b-th pixel of a row (a sum after the first), after any
