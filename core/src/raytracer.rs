@@ -12,7 +12,7 @@ use crate::capacity::Arena;
 use crate::math::Scalar;
 use crate::parse::{parse_bytes, ErrorKind, ParseError, Pos};
 use crate::profile::Profile;
-use crate::render::{Renderer, ScreenBound};
+use crate::render::{Progressive, Renderer, ScreenBound};
 use crate::scene::{CameraError, Scene, SceneView};
 use crate::shade::Stats;
 use crate::shapes::{Ray, ShapeKinds};
@@ -262,22 +262,50 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         D: DrawTarget,
         D::Color: From<Rgb888>,
     {
-        self.render(&self.accelerator(), size, area, at, target)
+        let mut shifted = Shifted { target, offset: at - area.top_left };
+        self.trace_with(size, |renderer| renderer.render_rect(area, &mut shifted))
     }
 
-    fn render<A: Accelerator, D>(
-        &self,
-        accel: &A,
-        size: Size,
-        area: &Rectangle,
-        at: Point,
-        target: &mut D,
-    ) -> Result<(), DrawError<D::Error>>
+    /// Draws the scene as an image of `order`'s size at the origin of
+    /// `target`, in the [`Progressive`] order: the whole picture in coarse
+    /// blocks first, then finer, until it is exactly the picture
+    /// [`LoadedScene::image`] draws. Every pixel is traced once; the
+    /// drawing streams (no framebuffer), in a few calls a pass.
+    ///
+    /// ```
+    /// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb565, prelude::*};
+    /// use octrace_core::{profile::Board16K, render::Progressive, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
+    /// let mut display = MockDisplay::<Rgb565>::new();
+    /// display.set_allow_overdraw(true); // later passes draw over the coarse blocks
+    /// scene.draw_progressive(&Progressive::new(display.size(), 16), &mut display)?;
+    /// assert_eq!(scene.stats().rays, 64 * 64, "every pixel traced once: nothing reflects");
+    ///
+    /// let mut direct = MockDisplay::<Rgb565>::new();
+    /// Image::new(&scene.image_for(&direct), Point::zero()).draw(&mut direct)?;
+    /// assert_eq!(display, direct);
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn draw_progressive<D>(&self, order: &Progressive, target: &mut D) -> Result<(), DrawError<D::Error>>
     where
         D: DrawTarget,
         D::Color: From<Rgb888>,
     {
-        let mut renderer = Renderer::with_size(self.view, accel, size.width, size.height).map_err(DrawError::Camera)?;
+        self.trace_with(order.size(), |renderer| order.render_unchecked(renderer, target))
+    }
+
+    /// Runs `draw` with a renderer of `size`, lent the scene's mailbox and
+    /// screen lists, and adds the counters it returns to the scene's.
+    fn trace_with<E>(
+        &self,
+        size: Size,
+        draw: impl FnOnce(&mut Renderer<'_, SceneAccelerator<'r, P>>) -> Result<Stats, E>,
+    ) -> Result<(), DrawError<E>> {
+        let accel = self.accelerator();
+        let mut renderer =
+            Renderer::with_size(self.view, &accel, size.width, size.height).map_err(DrawError::Camera)?;
         // Another draw of this scene holds the mailbox (only if a display
         // draws from inside a draw): render without it, same image.
         let mut mailbox = self.mailbox.try_borrow_mut();
@@ -289,8 +317,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         if let (true, Ok((bounds, positions))) = (self.first_hits, screen_lists.as_deref_mut()) {
             renderer.set_first_hits(bounds, positions);
         }
-        let mut shifted = Shifted { target, offset: at - area.top_left };
-        let stats = renderer.render_rect(area, &mut shifted).map_err(DrawError::Target)?;
+        let stats = draw(&mut renderer).map_err(DrawError::Target)?;
         let mut total = self.stats.get();
         total.add(&stats);
         self.stats.set(total);
