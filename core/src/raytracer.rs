@@ -12,7 +12,7 @@ use crate::capacity::Arena;
 use crate::math::Scalar;
 use crate::parse::{parse_bytes, ErrorKind, ParseError, Pos};
 use crate::profile::Profile;
-use crate::render::{Renderer, ScreenBound};
+use crate::render::{Progressive, Renderer, ScreenBound};
 use crate::scene::{CameraError, Scene, SceneView};
 use crate::shade::Stats;
 use crate::shapes::{Ray, ShapeKinds};
@@ -341,6 +341,38 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// `Image::new(&scene.image_for(&display), Point::zero())` draws.
     pub fn image_for<D: DrawTarget>(&self, target: &D) -> TracedImage<'_, 'r, P, D::Color> {
         self.image(target.bounding_box().size)
+    }
+
+    /// Draws the scene as an image of `order`'s size at the origin of
+    /// `target`, in the [`Progressive`] order: the whole picture in coarse
+    /// blocks first, then finer, until it is exactly the picture
+    /// [`LoadedScene::image`] draws. Every pixel is traced once; the
+    /// drawing streams (no framebuffer), in a few calls a pass.
+    ///
+    /// ```
+    /// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb565, prelude::*};
+    /// use octrace_core::{profile::Board16K, render::Progressive, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
+    /// let mut display = MockDisplay::<Rgb565>::new();
+    /// display.set_allow_overdraw(true); // later passes draw over the coarse blocks
+    /// scene.draw_progressive(&Progressive::new(display.size(), 16), &mut display)?;
+    /// assert_eq!(scene.stats().rays, 64 * 64, "every pixel traced once: nothing reflects");
+    ///
+    /// let mut direct = MockDisplay::<Rgb565>::new();
+    /// Image::new(&scene.image_for(&direct), Point::zero()).draw(&mut direct)?;
+    /// assert_eq!(display, direct);
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn draw_progressive<D>(&self, order: &Progressive, target: &mut D) -> Result<(), DrawError<D::Error>>
+    where
+        D: DrawTarget,
+        D::Color: From<Rgb888>,
+    {
+        let drawn = self.with_renderer(order.size(), |renderer| order.render_unchecked(renderer, target));
+        drawn.map_err(DrawError::Camera)?.map_err(DrawError::Target)?;
+        Ok(())
     }
 
     /// Renders `area` of an image of `size` into `target`, with the pixel at

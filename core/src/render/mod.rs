@@ -4,7 +4,8 @@
 //! There is no framebuffer: each pixel is traced as the target pulls it from
 //! the row iterator, so the memory cost is the same for 8×8 and 16384×16384.
 //! Every pixel depends only on its coordinates, so any split of the image
-//! into rows, tiles or threads gives the same bits.
+//! into rows, tiles or threads gives the same bits, and so does any order
+//! ([`Progressive`]: the whole picture in coarse blocks first).
 //!
 //! Given room ([`Renderer::with_first_hits`]), camera rays find their hits
 //! among the objects seen around their pixel, nearest first, instead of
@@ -19,6 +20,7 @@ mod first_hit;
 mod gamma;
 mod handoff;
 mod panel;
+mod progressive;
 mod split;
 
 use first_hit::FirstHits;
@@ -26,16 +28,30 @@ pub use first_hit::ScreenBound;
 pub(crate) use gamma::GammaTable;
 pub use handoff::{Handoff, SlotBusy, Taken};
 pub use panel::PanelColor;
+pub use progressive::{Progressive, ProgressiveError, TracedUnit, Unit};
 pub use split::{interleaved_rows, Tiles};
 
 use crate::accel::{Accelerator, Hit, Mailbox};
-use crate::scene::{Camera, CameraError, CameraRay, Color, ObjectId, RayCursor, SceneView};
+use crate::scene::{Camera, CameraError, CameraRay, Color, ObjectId, RayCursor, SceneView, Stride, MAX_SIDE};
 use crate::shade::{Scratch, Stats, Tracer};
 use core::ops::Range;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::pixelcolor::Rgb888;
 use embedded_graphics_core::primitives::Rectangle;
+
+/// Where a walk over pixels in any order ([`Renderer::pixel_on`]) was,
+/// and its last jump along a row.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Walk {
+    last: [u32; 2],
+    jump: Option<(u32, Stride)>,
+}
+
+impl Walk {
+    /// A walk that has not started.
+    pub(crate) const NEW: Walk = Walk { last: [u32::MAX; 2], jump: None };
+}
 
 /// A finished pixel: its display colour and the object seen through it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -243,6 +259,25 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     /// The pixels of row `y` for the columns `xs`, traced lazily.
     pub fn row(&mut self, y: u32, xs: Range<u32>) -> impl Iterator<Item = PixelSample> + use<'_, 'a, A> {
         xs.map(move |x| self.pixel(x, y))
+    }
+
+    /// The pixel at (`x`, `y`) on `walk`, a walk over pixels in any order:
+    /// along a row, after a jump as long as the walk's last, the camera
+    /// ray is a sum, as after a step (the jump's change of direction is
+    /// kept by the walk, not the renderer), so a row walked every b-th
+    /// pixel costs what a row does.
+    pub(crate) fn pixel_on(&mut self, walk: &mut Walk, x: u32, y: u32) -> PixelSample {
+        let along = x.wrapping_sub(walk.last[0]);
+        if y == walk.last[1] && along > 1 && along <= MAX_SIDE {
+            let stride = match walk.jump {
+                Some((pixels, stride)) if pixels == along => stride,
+                _ => self.camera.stride(along),
+            };
+            walk.jump = Some((along, stride));
+            self.cursor.skip(&stride);
+        }
+        walk.last = [x, y];
+        self.pixel(x, y)
     }
 
     /// Renders the whole image.

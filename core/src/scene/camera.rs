@@ -79,6 +79,30 @@ pub(crate) struct RayCursor {
     last: Option<(i32, i32, [i64; 3])>,
 }
 
+impl RayCursor {
+    /// Moves the remembered ray `stride` along its row, so that the pixel
+    /// that far from the last one is the next sub-cell for
+    /// [`Camera::next_ray`]: a sum, when a row is walked every b-th pixel
+    /// (as a progressive order does). Exact: the cursor stays the ray of
+    /// its offsets (a sum of exact steps), whatever it held.
+    pub(crate) fn skip(&mut self, stride: &Stride) {
+        if let Some((kx, _, d)) = &mut self.last {
+            *kx = kx.wrapping_add(stride.offsets);
+            *d = [0, 1, 2].map(|a| d[a].wrapping_add(stride.step[a]));
+        }
+    }
+}
+
+/// A jump of whole pixels along a row, less the one sub-cell that
+/// [`Camera::next_ray`] steps itself: in offsets, and the change of
+/// direction it makes. Made once for a walk ([`Camera::stride`]), kept by
+/// the walk rather than in the cursor (a renderer's size is stack on a board).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Stride {
+    offsets: i32,
+    step: [i64; 3],
+}
+
 /// A primary ray whose direction is known but not yet a unit vector: the
 /// unit vector (a square root and three divisions, the dearest part of a
 /// camera ray on a board) is made only when something asks for the ray, so
@@ -219,6 +243,15 @@ impl Camera {
         };
         cursor.last = Some((kx, ky, d));
         CameraRay { direction: d, ray: None }
+    }
+
+    /// The jump of `pixels` pixels along a row, for [`RayCursor::skip`].
+    pub(crate) fn stride(&self, pixels: u32) -> Stride {
+        // At most 2 · MAX_SAMPLES · MAX_SIDE: the offsets fit an i32, and
+        // the wrapping products are the exact ones modulo 2^64 (which is
+        // all that the sums need, see `next_ray`).
+        let offsets = (2 * self.samples as i32).wrapping_mul(pixels.min(MAX_SIDE) as i32) - 2;
+        Stride { offsets, step: self.step_x.map(|s| mul_i64_i32(s, offsets)) }
     }
 
     /// The sub-cell's offsets from the image centre in half sub-cells.
@@ -420,6 +453,37 @@ mod tests {
         let zero_up = View { up: [0; 3], ..View::default() };
         assert_eq!(Camera::check(&zero_up), Err(CameraError::UpParallel));
     }
+
+    #[test]
+    fn a_skipped_cursor_gives_the_ray() {
+        // Every b-th pixel of a row (a sum after the first), after any
+        // other ray, with one to three samples: the exact direction.
+        for (w, h, n) in [(40, 5, 1), (33, 3, 3), (16384, 2, 1), (9, 9, 2)] {
+            let view = View { eye: [3 * ONE, ONE / 3, 7 * ONE], viewport: None, ..View::default() };
+            let c = camera(&view, w, h, n);
+            let mut cursor = RayCursor::default();
+            let mut sums = 0;
+            for (y, b) in [(0, 1), (1, 2), (h - 1, 3), (1, 16), (2 % h, 5)] {
+                let stride = c.stride(b);
+                for x in (b / 2..w).step_by(b as usize) {
+                    cursor.skip(&stride);
+                    for sy in 0..n {
+                        for sx in 0..n {
+                            let before = cursor.last;
+                            let mut ray = c.next_ray(&mut cursor, x, y, sx, sy);
+                            let (kx, ky) = c.offsets(x, y, sx, sy);
+                            sums +=
+                                before.is_some_and(|(last_kx, last_ky, _)| (last_kx + 2, last_ky) == (kx, ky)) as u32;
+                            assert_eq!(ray.direction, c.direction(kx, ky), "{w}x{h}/{n}: {x} {y} {sx} {sy}");
+                            assert_eq!(*ray.get(&c), c.ray(x, y, sx, sy));
+                        }
+                    }
+                }
+            }
+            assert!(sums > w, "{w}x{h}/{n}: the skips made sums ({sums})");
+        }
+    }
+
     #[test]
     fn the_next_ray_along_a_row_is_the_ray() {
         // Rows, samples, jumps back and a new row: every ray equals the one

@@ -18,7 +18,7 @@ mod normalize;
 mod surface;
 
 pub use camera::{Camera, CameraError, View, MAX_SAMPLES, MAX_SIDE};
-pub(crate) use camera::{CameraRay, Projection, RayCursor};
+pub(crate) use camera::{CameraRay, Projection, RayCursor, Stride};
 pub use normalize::{Normalization, WorldPoint, WorldValue};
 pub use surface::{Color, Surface, SurfaceEntry};
 
