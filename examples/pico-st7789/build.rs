@@ -53,6 +53,17 @@ fn main() {
         println!("cargo:rustc-cfg=code_in_sram");
     }
     println!("cargo::rustc-check-cfg=cfg(code_in_sram)");
+
+    // The embedded-scene firmware's pixel order: row by row (the default,
+    // the faster), or progressive (the whole panel in coarse blocks at
+    // once, then finer).
+    println!("cargo:rerun-if-env-changed=OCTRACE_ORDER");
+    match env::var("OCTRACE_ORDER").as_deref() {
+        Ok("rows") | Err(_) => {}
+        Ok("progressive") => println!("cargo:rustc-cfg=progressive_order"),
+        Ok(other) => fail(&format!("OCTRACE_ORDER={other}: expected `rows` (the default) or `progressive`")),
+    }
+    println!("cargo::rustc-check-cfg=cfg(progressive_order)");
     // Where the linker finds memory.x when it runs elsewhere than here.
     std::fs::write(out.join("memory.x"), read("memory.x")).unwrap_or_else(|e| fail(&format!("write memory.x: {e}")));
     println!("cargo:rustc-link-search={}", out.display());

@@ -19,12 +19,12 @@ use core::ops::ControlFlow;
 use core::ptr;
 use core::sync::atomic::{AtomicBool, AtomicPtr, Ordering};
 use cortex_m::asm::{sev, wfe};
-use embedded_graphics::pixelcolor::Rgb565;
+use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 use embedded_graphics::prelude::*;
 use embedded_graphics::primitives::Rectangle;
 use octrace_core::profile::Profile;
-use octrace_core::render::{interleaved_rows, Handoff};
-use octrace_core::{LoadedScene, RendererRoom};
+use octrace_core::render::{Handoff, Progressive, Renderer, Unit};
+use octrace_core::{LoadedScene, RendererRoom, SceneAccelerator};
 use rp2040_hal::multicore::{Core, Error as SpawnError, StackAllocation};
 
 /// Core 0's job for core 1, or null.
@@ -73,26 +73,26 @@ impl SecondCore {
     }
 }
 
-/// Why [`draw`] stopped before the last row.
+/// Why a picture stopped before its end.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Unfinished {
     /// The camera cannot be set up at the panel's size.
     Camera,
-    /// The panel refused a row.
+    /// The panel refused a row, or the order is not the panel's.
     Panel,
     /// `each_row` asked to stop.
     Stopped,
 }
 
-/// Traces `scene` into `display` with both cores, core 1 rendering in
-/// `room` (its own mailbox and screen lists) and handing rows over through
-/// `rows`. `each_row` sees every row as it goes to the panel, in order, and
-/// may stop the picture there. `W` is the panel's width.
-pub fn draw<P, D, const W: usize, const SLOTS: usize>(
+/// Traces `scene` into `display` with both cores, row by row, core 1
+/// rendering in `room` (its own mailbox and screen lists) and handing rows
+/// over through `ring`. `each_row` sees every row as it goes to the panel,
+/// in order, and may stop the picture there.
+pub fn draw<P, D, const LEN: usize, const SLOTS: usize>(
     core1: &mut SecondCore,
     scene: &LoadedScene<'_, P>,
     room: &mut RendererRoom<P>,
-    rows: &Handoff<W, SLOTS>,
+    ring: &Handoff<LEN, SLOTS>,
     display: &mut D,
     mut each_row: impl FnMut(u32, &[Rgb565]) -> ControlFlow<()>,
 ) -> Result<(), Unfinished>
@@ -101,65 +101,165 @@ where
     D: DrawTarget<Color = Rgb565>,
 {
     let size = display.bounding_box().size;
-    let width = size.width.min(W as u32);
+    let width = size.width.min(LEN as u32);
+    let trace = |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, y: &u32, colors: &mut [Rgb888]| {
+        let mut traced = 0;
+        for (color, pixel) in colors.iter_mut().zip(renderer.row(*y, 0..width)) {
+            *color = pixel.color;
+            traced += 1;
+        }
+        traced
+    };
+    let present = |y: &u32, colors: &[Rgb888]| {
+        let mut line = [Rgb565::BLACK; LEN];
+        let line = &mut line[..colors.len()];
+        for (pixel, &color) in line.iter_mut().zip(colors) {
+            *pixel = color.into();
+        }
+        let area = Rectangle::new(Point::new(0, *y as i32), Size::new(width, 1));
+        display.fill_contiguous(&area, line.iter().copied()).map_err(|_| Unfinished::Panel)?;
+        match each_row(*y, line) {
+            ControlFlow::Continue(()) => Ok(()),
+            ControlFlow::Break(()) => Err(Unfinished::Stopped),
+        }
+    };
+    share(core1, scene, room, ring, size, || 0..size.height, trace, present)
+}
+
+/// Traces `scene` into `display` with both cores in the progressive
+/// `order` (the whole panel in coarse blocks first, then finer: the same
+/// picture as [`draw`] at the end), core 1 tracing every other unit in
+/// `room` and handing its colours over through `ring`, which holds
+/// `order.max_unit_pixels()`.
+pub fn draw_progressive<P, D, const LEN: usize, const SLOTS: usize>(
+    core1: &mut SecondCore,
+    scene: &LoadedScene<'_, P>,
+    room: &mut RendererRoom<P>,
+    ring: &Handoff<LEN, SLOTS>,
+    display: &mut D,
+    order: &Progressive,
+) -> Result<(), Unfinished>
+where
+    P: Profile,
+    D: DrawTarget<Color = Rgb565>,
+{
+    if order.size() != display.bounding_box().size || order.max_unit_pixels() > LEN {
+        return Err(Unfinished::Panel);
+    }
+    let trace = |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, unit: &Unit, colors: &mut [Rgb888]| {
+        unit.trace(renderer, colors).map_or(0, |traced| traced.colors().len())
+    };
+    let present = |unit: &Unit, colors: &[Rgb888]| {
+        let traced = unit.with_colors(colors).map_err(|_| Unfinished::Panel)?;
+        traced.draw(&mut Converted(display)).map_err(|_| Unfinished::Panel)
+    };
+    share(core1, scene, room, ring, order.size(), || order.units(), trace, present)
+}
+
+/// Both cores trace the pieces (rows, or a progressive order's units) of
+/// an image of `size` that `pieces` lists: core 1 the odd ones into `ring`,
+/// core 0 the even ones; core 0 presents every piece, in order. `trace`
+/// fills a piece's colours and says how many; `present` shows them, or
+/// stops the picture.
+#[allow(clippy::too_many_arguments)]
+fn share<'r, P, T, I, const LEN: usize, const SLOTS: usize>(
+    core1: &mut SecondCore,
+    scene: &LoadedScene<'r, P>,
+    room: &mut RendererRoom<P>,
+    ring: &Handoff<LEN, SLOTS>,
+    size: Size,
+    pieces: impl Fn() -> I + Sync,
+    trace: impl Fn(&mut Renderer<'_, SceneAccelerator<'r, P>>, &T, &mut [Rgb888]) -> usize + Sync,
+    mut present: impl FnMut(&T, &[Rgb888]) -> Result<(), Unfinished>,
+) -> Result<(), Unfinished>
+where
+    P: Profile,
+    I: Iterator<Item = T>,
+{
     let stop = AtomicBool::new(false);
     let shared = scene.share();
     // What a stopped picture left in the ring is not this picture's.
-    rows.clear();
-    let core1_rows = || {
+    ring.clear();
+    let core1_part = || {
         let Ok(mut renderer) = shared.renderer(room, size) else { return };
-        for y in interleaved_rows(size.height, 1, 2) {
+        let mut colors = [Rgb888::BLACK; LEN];
+        for (index, piece) in pieces().enumerate().skip(1).step_by(2) {
+            let index = index as u32;
             loop {
-                // Asked first: a stopped picture traces no further row.
+                // Asked first: a stopped picture traces no further piece.
                 if stop.load(Ordering::Acquire) {
                     return;
                 }
-                if rows.is_free_for(y) {
+                if ring.is_free_for(index) {
                     break;
                 }
                 wfe();
             }
-            // Free, so the row is traced and published.
-            let _ = rows.send(y, renderer.row(y, 0..width).map(|p| p.color));
+            let traced = trace(&mut renderer, &piece, &mut colors);
+            // Free, so published.
+            let _ = ring.send(index, colors[..traced].iter().copied());
             sev();
         }
     };
-    let core0_rows = || {
-        let drawn = scene.with_renderer(size, |renderer| {
-            let mut line = [Rgb565::BLACK; W];
-            let line = &mut line[..width as usize];
-            for y in 0..size.height {
-                if y % 2 == 0 {
-                    for (pixel, sample) in line.iter_mut().zip(renderer.row(y, 0..width)) {
-                        *pixel = sample.color.into();
-                    }
+    let core0_part = || {
+        let presented = scene.with_renderer(size, |renderer| {
+            let mut colors = [Rgb888::BLACK; LEN];
+            for (index, piece) in pieces().enumerate() {
+                let index = index as u32;
+                let traced = if index % 2 == 0 {
+                    trace(renderer, &piece, &mut colors)
                 } else {
-                    let colors = loop {
-                        match rows.take(y) {
-                            Some(colors) => break colors,
+                    let handed = loop {
+                        match ring.take(index) {
+                            Some(handed) => break handed,
                             None => wfe(),
                         }
                     };
-                    for (pixel, color) in line.iter_mut().zip(colors) {
-                        *pixel = color.into();
+                    let mut traced = 0;
+                    for (color, handed) in colors.iter_mut().zip(handed) {
+                        *color = handed;
+                        traced += 1;
                     }
                     // The slot is free again: wake core 1 if it waits for it.
                     sev();
-                }
-                let area = Rectangle::new(Point::new(0, y as i32), Size::new(width, 1));
-                display.fill_contiguous(&area, line.iter().copied()).map_err(|_| Unfinished::Panel)?;
-                if each_row(y, line).is_break() {
-                    return Err(Unfinished::Stopped);
-                }
+                    traced
+                };
+                present(&piece, &colors[..traced])?;
             }
             Ok(())
         });
-        let result = drawn.map_err(|_| Unfinished::Camera).and_then(|rows| rows);
+        let result = presented.map_err(|_| Unfinished::Camera).and_then(|pieces| pieces);
         if result.is_err() {
             stop.store(true, Ordering::Release);
             sev();
         }
         result
     };
-    core1.scope(core1_rows, core0_rows)
+    core1.scope(core1_part, core0_part)
+}
+
+/// A display of `Rgb565` taking the progressive order's `Rgb888` blocks.
+struct Converted<'d, D>(&'d mut D);
+
+impl<D: DrawTarget<Color = Rgb565>> OriginDimensions for Converted<'_, D> {
+    fn size(&self) -> Size {
+        self.0.bounding_box().size
+    }
+}
+
+impl<D: DrawTarget<Color = Rgb565>> DrawTarget for Converted<'_, D> {
+    type Color = Rgb888;
+    type Error = D::Error;
+
+    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb888>>>(&mut self, pixels: I) -> Result<(), D::Error> {
+        self.0.draw_iter(pixels.into_iter().map(|Pixel(at, color)| Pixel(at, color.into())))
+    }
+
+    fn fill_contiguous<I: IntoIterator<Item = Rgb888>>(&mut self, area: &Rectangle, colors: I) -> Result<(), D::Error> {
+        self.0.fill_contiguous(area, colors.into_iter().map(Into::into))
+    }
+
+    fn fill_solid(&mut self, area: &Rectangle, color: Rgb888) -> Result<(), D::Error> {
+        self.0.fill_solid(area, color.into())
+    }
 }

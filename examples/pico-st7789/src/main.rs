@@ -11,13 +11,12 @@
 #![no_std]
 #![no_main]
 
-use core::ops::ControlFlow;
 use embedded_graphics::pixelcolor::Rgb565;
 use embedded_graphics::prelude::*;
 use hal::gpio::Pins;
 use hal::multicore::{Multicore, Stack};
 use hal::{entry, pac, Clock, Sio, Timer, Watchdog};
-use octrace_core::render::Handoff;
+use octrace_core::render::{Handoff, Progressive};
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
 use octrace_pico_st7789::both_cores::{self, SecondCore};
 use octrace_pico_st7789::panel::{self, PanelPins};
@@ -53,8 +52,14 @@ static CORE1_ROOM: ConstStaticCell<RendererRoom<SceneProfile>> = ConstStaticCell
 /// Core 1's stack: 16 KiB (the render needs a few).
 static CORE1_STACK: Stack<4096> = Stack::new();
 
-/// Core 1's rows on their way to the panel: it may render four ahead.
-static ROWS: Handoff<{ panel::WIDTH as usize }, 4> = Handoff::new();
+/// The progressive order (`OCTRACE_ORDER=progressive`): the whole panel in
+/// blocks of 16 first, then 8, then each row of blocks at full resolution.
+const PROGRESSIVE: Progressive =
+    Progressive::new(Size::new(panel::WIDTH as u32, panel::HEIGHT as u32), 16).with_finest(8);
+
+/// What core 1 traced, on its way to the panel (a row, or a unit of the
+/// progressive order): it may trace four ahead.
+static RING: Handoff<{ PROGRESSIVE.max_unit_pixels() }, 4> = Handoff::new();
 
 /// The panel's bus buffer.
 static PANEL_BUFFER: ConstStaticCell<[u8; 512]> = ConstStaticCell::new([0; 512]);
@@ -100,10 +105,16 @@ fn main() -> ! {
     // (check it with host-sim, whose errors name the line and column)
     // leaves the panel red.
     let drawn = match RAYTRACER.take().load(SCENE_TEXT) {
-        Ok(scene) => both_cores::draw(&mut core1, &scene, CORE1_ROOM.take(), &ROWS, &mut display, |_, _| {
-            ControlFlow::Continue(())
-        })
-        .is_ok(),
+        #[cfg(not(progressive_order))]
+        Ok(scene) => {
+            let each_row = |_, _: &_| core::ops::ControlFlow::Continue(());
+            both_cores::draw(&mut core1, &scene, CORE1_ROOM.take(), &RING, &mut display, each_row).is_ok()
+        }
+        #[cfg(progressive_order)]
+        Ok(scene) => {
+            both_cores::draw_progressive(&mut core1, &scene, CORE1_ROOM.take(), &RING, &mut display, &PROGRESSIVE)
+                .is_ok()
+        }
         Err(_) => false,
     };
     if !drawn {
