@@ -616,20 +616,7 @@ pub(crate) fn send_scene(
             board.max_scene
         )));
     }
-    Ok(match draw(&mut link, text, pixels, progress).map_err(|e| link_error(port, e))? {
-        (Answer::Rejected(errors), _) => Sent::Rejected(errors),
-        (Answer::Drawn { panel, elapsed }, picture) => Sent::Drawn { panel, elapsed, picture },
-    })
-}
-
-/// Sends the scene and follows the board's answer, handing each step on to
-/// `progress`: its picture, if the rows carry their `pixels`.
-fn draw<P: Port>(
-    link: &mut BoardLink<P>,
-    text: &[u8],
-    pixels: bool,
-    progress: &mut dyn FnMut(Progress<'_>),
-) -> Result<(Answer, Option<RgbImage>), LinkError> {
+    // The picture, assembled as its rows come.
     let mut picture: Option<(PixelFormat, RgbImage)> = None;
     let answer = link.draw(text, pixels, &mut |step| {
         match &step {
@@ -647,8 +634,11 @@ fn draw<P: Port>(
             }
         }
         progress(step);
-    })?;
-    Ok((answer, picture.map(|(_, image)| image)))
+    });
+    Ok(match answer.map_err(|e| link_error(port, e))? {
+        Answer::Rejected(errors) => Sent::Rejected(errors),
+        Answer::Drawn { panel, elapsed } => Sent::Drawn { panel, elapsed, picture: picture.map(|(_, image)| image) },
+    })
 }
 
 /// How many pixels of the board's `picture` differ from host-sim's render

@@ -628,7 +628,9 @@ fn send_to_board_shows_the_boards_picture_and_verdict_or_its_errors_in_the_edito
     host_sim_preview(name, &preview, &format!("{w}x{h}"), "rgb565").unwrap();
     let preview = octrace_images::formats::read(&std::fs::read(&preview).unwrap()).unwrap().to_rgb();
     assert_same("the board's picture", browser.canvas_rgb("board-image"), &preview);
-    screenshot(&browser, "board");
+    // Its rows were counted as they came (the page shows them while they do).
+    let progress = browser.run("return fetch('/board').then((r) => r.json());");
+    assert_eq!((&progress["rows"], &progress["height"], &progress["busy"]), (&h.into(), &h.into(), &false.into()));
 
     // A scene over the board's capacity (which the page's own core holds):
     // the board's error lands in the editor at its line and column, and no

@@ -188,11 +188,8 @@ fn respond(request: &Request, shared: &Shared) -> Response {
     match (request.method.as_str(), path) {
         ("GET", "/scene") => get_scene(shared),
         ("PUT", "/scene") => put_scene(request, shared),
-        ("GET", "/board") | ("POST", "/board") => match (&shared.board, request.method.as_str()) {
-            (None, _) => Response::text(404, "the studio was started without --board PORT: no board to send to"),
-            (Some(board), "GET") => board.status(),
-            (Some(board), _) => board.send(&scene_name(shared), &request.body),
-        },
+        ("GET", "/board") => with_board(shared, BoardSender::status),
+        ("POST", "/board") => with_board(shared, |board| board.send(&scene_name(shared), &request.body)),
         ("GET", _) | ("HEAD", _) => match ASSETS.iter().find(|(name, _, _)| *name == path) {
             Some((name, kind, body)) => {
                 let mut response = Response::new(200, kind, body.to_vec());
@@ -210,6 +207,14 @@ fn respond(request: &Request, shared: &Shared) -> Response {
             None => Response::text(404, "no such page"),
         },
         _ => Response::text(405, "method not allowed"),
+    }
+}
+
+/// `answer` of the board `--board` names, or 404 without one.
+fn with_board(shared: &Shared, answer: impl FnOnce(&BoardSender) -> Response) -> Response {
+    match &shared.board {
+        Some(board) => answer(board),
+        None => Response::text(404, "the studio was started without --board PORT: no board to send to"),
     }
 }
 

@@ -35,10 +35,10 @@ export function createBoard(app) {
     button.disabled = true;
     show('sending', '', `sending to ${port}…`);
     // The rows as they arrive (the answer comes when the board is done).
-    const poll = setInterval(async () => {
-      const response = await fetch('/board');
-      const progress = response.ok ? await response.json() : {};
-      if (sending && progress.height) verdict.textContent = `drawing: ${progress.rows} of ${progress.height} rows`;
+    const poll = setInterval(() => {
+      fetch('/board').then((response) => (response.ok ? response.json() : {})).then((progress) => {
+        if (sending && progress.height) verdict.textContent = `drawing: ${progress.rows} of ${progress.height} rows`;
+      }).catch(() => {});
     }, 250);
     try {
       const response = await fetch('/board', { method: 'POST', body: text.value });

@@ -105,13 +105,14 @@ function main() {
     return loaded;
   }
 
-  /** An error of the list: `message` (`line:col: …`); a click goes there. */
+  /** An error of the list: `message` (`line:col: …`); a click goes to
+   *  its line and column (line 0: an error of the whole scene). */
   function errorItem(message, line, column) {
     const li = document.createElement('li');
     li.textContent = message;
     li.dataset.line = String(line);
     li.dataset.column = String(column);
-    li.onclick = () => goTo(line, column);
+    if (line > 0) li.onclick = () => goTo(line, column);
     return li;
   }
 
@@ -438,7 +439,7 @@ function main() {
   $('help-close').onclick = () => $('help').close();
 
   // Exposed for scripts and the browser tests.
-  Object.assign(state, { render, saveScene, setText, setTool, saveImage, undo, redo, project, sendToBoard: app.board.send,
+  Object.assign(state, { render, saveScene, setText, setTool, saveImage, undo, redo, project,
     imageBytes: (mode, format) => state.octrace.encode(state.lastRender.data, mode, format, state.lastRender.width, state.lastRender.height) });
 
   (async () => {
