@@ -277,6 +277,10 @@ fn the_canvas_is_host_sims_image_for_every_scene() {
     let browser = Browser::start((1500, 900));
     browser.goto(&studio.url);
     browser.wait_for("document.body.dataset.ready === 'true'", 120);
+    // Started without --board: no board to send to, and the button says so.
+    let send = browser.run("const b = document.getElementById('send-board'); return [b.disabled, b.title];");
+    assert_eq!(send[0], true);
+    assert!(send[1].as_str().is_some_and(|t| t.contains("--board PORT")), "{send}");
     // fig5_1 at its own RASTER, the rest small; every process mode.
     let modes = ["naive", "octree", "dda"];
     for (i, (name, path)) in scenes().into_iter().enumerate() {
