@@ -441,7 +441,7 @@ fn unexpected(kind: octrace_link::Kind, awaited: &str) -> LinkError {
 
 /// Whether `arg` names a serial port: a character device, or a port the
 /// system lists (COM3 on Windows).
-fn is_port(arg: &Path) -> bool {
+pub(crate) fn is_port(arg: &Path) -> bool {
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt;
@@ -462,7 +462,7 @@ fn ports() -> Vec<serialport::SerialPortInfo> {
 }
 
 /// Each port on a line: its name, and what it is when the system knows.
-fn write_ports(out: &mut dyn Write) -> io::Result<()> {
+pub(crate) fn write_ports(out: &mut dyn Write) -> io::Result<()> {
     let ports = ports();
     if ports.is_empty() {
         return writeln!(
@@ -500,18 +500,11 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
         )));
     }
     let port = first.display().to_string();
-    let link_error = |e: LinkError| {
-        let message = format!("board at {port}: {e}");
-        match e {
-            // The board's own answer to the scene: a scene error in all but name.
-            LinkError::Refused(Reason::TooLong { .. }) => CliError::Invalid(message),
-            _ => CliError::Io(message),
-        }
-    };
     let out = args.out.as_ref();
+    let timeout = Duration::from_secs(args.timeout);
     let Some(scene) = &args.scene else {
-        let mut link = BoardLink::open(&port, Duration::from_secs(args.timeout)).map_err(link_error)?;
-        let board = link.hello().map_err(link_error)?;
+        let mut link = BoardLink::open(&port, timeout).map_err(|e| link_error(&port, e))?;
+        let board = link.hello().map_err(|e| link_error(&port, e))?;
         return describe(&port, &board, stdout).map_err(|e| CliError::Io(format!("board: {e}")));
     };
     if out.is_none() && args.format.is_some() {
@@ -526,23 +519,26 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
     }
     let text = std::fs::read(scene).map_err(|e| CliError::read(scene, e))?;
     let file = scene.display().to_string();
-    let mut link = BoardLink::open(&port, Duration::from_secs(args.timeout)).map_err(link_error)?;
-    let board = link.hello().map_err(link_error)?;
-    if text.len() > board.max_scene as usize {
-        return Err(CliError::Invalid(format!(
-            "{file} is {} bytes; the board at {port} takes scenes of at most {} bytes",
-            text.len(),
-            board.max_scene
-        )));
-    }
     let pixels = out.is_some() || args.check;
     let started = Instant::now();
-    let (panel, elapsed, picture) = match draw(&mut link, &text, pixels, args.quiet).map_err(link_error)? {
-        (Answer::Rejected(errors), _) => {
+    let mut bar = None;
+    let sent = send_scene(&port, timeout, &file, &text, pixels, &mut |step| match step {
+        Progress::Drawing(panel) => bar = progress_bar(panel.height.into(), args.quiet),
+        Progress::Row { .. } => {
+            if let Some(bar) = &bar {
+                bar.inc(1);
+            }
+        }
+    });
+    if let Some(bar) = &bar {
+        bar.finish_and_clear();
+    }
+    let (panel, elapsed, picture) = match sent? {
+        Sent::Rejected(errors) => {
             let errors = errors.iter().map(|e| e.located(&file)).collect();
             return Err(CliError::Scene { file, errors });
         }
-        (Answer::Drawn { panel, elapsed }, picture) => (panel, elapsed, picture),
+        Sent::Drawn { panel, elapsed, picture } => (panel, elapsed, picture),
     };
     let (w, h) = (panel.width, panel.height);
     if !args.quiet {
@@ -563,8 +559,7 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
         }
     }
     if args.check {
-        let ours = host_render(&file, &text, panel)?;
-        let differ = ours.data.chunks_exact(3).zip(image.data.chunks_exact(3)).filter(|(a, b)| a != b).count();
+        let differ = differing_pixels(&file, &text, panel, &image)?;
         if differ > 0 {
             return Err(CliError::Mismatch(format!(
                 "board --check: {differ} of {} pixels differ from host-sim's {} render at {w}x{h}",
@@ -579,42 +574,84 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
     Ok(())
 }
 
-/// Sends the scene and follows the board's answer: its picture, if the
-/// rows carry their `pixels`, with a progress bar unless `quiet`.
-fn draw<P: Port>(
-    link: &mut BoardLink<P>,
+/// A failure to talk to the board at `port`, as host-sim reports it.
+fn link_error(port: &str, e: LinkError) -> CliError {
+    let message = format!("board at {port}: {e}");
+    match e {
+        // The board's own answer to the scene: a scene error in all but name.
+        LinkError::Refused(Reason::TooLong { .. }) => CliError::Invalid(message),
+        _ => CliError::Io(message),
+    }
+}
+
+/// What a board made of a scene sent to it.
+#[derive(Debug)]
+pub(crate) enum Sent {
+    /// The scene's errors, as the board found them; nothing drawn.
+    Rejected(Vec<BoardSceneError>),
+    /// Drawn at the panel's size (`elapsed` by the board's clock), with the
+    /// picture if its pixels were asked for.
+    Drawn { panel: Panel, elapsed: Option<Duration>, picture: Option<RgbImage> },
+}
+
+/// Sends scene `text` (named `file` in errors) to the board at `port`,
+/// after its hello and a check of the scene's length against what it
+/// takes, and follows the drawing, handing each step to `progress`. Waits
+/// at most `timeout` for each answer. `host-sim board` and the studio send
+/// through this.
+pub(crate) fn send_scene(
+    port: &str,
+    timeout: Duration,
+    file: &str,
     text: &[u8],
     pixels: bool,
-    quiet: bool,
-) -> Result<(Answer, Option<RgbImage>), LinkError> {
+    progress: &mut dyn FnMut(Progress<'_>),
+) -> Result<Sent, CliError> {
+    let mut link = BoardLink::open(port, timeout).map_err(|e| link_error(port, e))?;
+    let board = link.hello().map_err(|e| link_error(port, e))?;
+    if text.len() > board.max_scene as usize {
+        return Err(CliError::Invalid(format!(
+            "{file} is {} bytes; the board at {port} takes scenes of at most {} bytes",
+            text.len(),
+            board.max_scene
+        )));
+    }
+    // The picture, assembled as its rows come.
     let mut picture: Option<(PixelFormat, RgbImage)> = None;
-    let mut bar = None;
-    let answer = link.draw(text, pixels, &mut |step| match step {
-        Progress::Drawing(panel) => {
-            let image = RgbImage::new(panel.width.into(), panel.height.into());
-            picture = pixels.then_some((panel.format, image));
-            bar = progress_bar(panel.height.into(), quiet);
-        }
-        Progress::Row { y, pixels } => {
-            if let Some((format, image)) = &mut picture {
-                let row = image.data.chunks_exact_mut(3).skip(y as usize * image.width as usize);
-                for (rgb, color) in row.zip(format.colors(pixels)) {
-                    rgb.copy_from_slice(&[color.r(), color.g(), color.b()]);
+    let answer = link.draw(text, pixels, &mut |step| {
+        match &step {
+            Progress::Drawing(panel) => {
+                let image = RgbImage::new(panel.width.into(), panel.height.into());
+                picture = pixels.then_some((panel.format, image));
+            }
+            Progress::Row { y, pixels } => {
+                if let Some((format, image)) = &mut picture {
+                    let row = image.data.chunks_exact_mut(3).skip(*y as usize * image.width as usize);
+                    for (rgb, color) in row.zip(format.colors(pixels)) {
+                        rgb.copy_from_slice(&[color.r(), color.g(), color.b()]);
+                    }
                 }
             }
-            if let Some(bar) = &bar {
-                bar.inc(1);
-            }
         }
+        progress(step);
     });
-    if let Some(bar) = &bar {
-        bar.finish_and_clear();
-    }
-    Ok((answer?, picture.map(|(_, image)| image)))
+    Ok(match answer.map_err(|e| link_error(port, e))? {
+        Answer::Rejected(errors) => Sent::Rejected(errors),
+        Answer::Drawn { panel, elapsed } => Sent::Drawn { panel, elapsed, picture: picture.map(|(_, image)| image) },
+    })
+}
+
+/// How many pixels of the board's `picture` differ from host-sim's render
+/// of the scene at the panel's size, as the panel shows it (`host-sim
+/// SCENE OUT --size WxH --color rgb565`). `host-sim board --check` and the
+/// studio judge the board's picture by this.
+pub(crate) fn differing_pixels(file: &str, text: &[u8], panel: Panel, picture: &RgbImage) -> Result<usize, CliError> {
+    let ours = host_render(file, text, panel)?;
+    Ok(ours.data.chunks_exact(3).zip(picture.data.chunks_exact(3)).filter(|(a, b)| a != b).count())
 }
 
 /// host-sim's render of the scene at the panel's size, as the panel shows
-/// it (`host-sim SCENE OUT --size WxH --color rgb565`).
+/// it.
 fn host_render(file: &str, text: &[u8], panel: Panel) -> Result<RgbImage, CliError> {
     let mismatch = |why: String| CliError::Mismatch(format!("board --check: {why}"));
     let mut scene = new_scene();

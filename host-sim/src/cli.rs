@@ -126,7 +126,8 @@ pub enum Command {
         format: Option<Format>,
     },
     /// The scene studio: edit, place and render a scene in the browser,
-    /// on this core compiled to WebAssembly (serves 127.0.0.1 only).
+    /// on this core compiled to WebAssembly (serves 127.0.0.1 only); with
+    /// --board, send it to a board and see its errors or its picture.
     Studio(crate::studio::StudioArgs),
     /// Send a scene to a board running octrace's live firmware over its
     /// serial port: the board's errors are printed as file:line:col (exit

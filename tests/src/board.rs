@@ -1,14 +1,16 @@
-//! A board at the end of a serial line, for the tests of `host-sim board`:
-//! any command that serves a serial device and names it on its standard
-//! output — the software board (`software-board`: octrace-link's board
-//! logic on a host, behind a pseudo-terminal) or an emulated one — and a
-//! raw host that sends it frames the protocol refuses.
+//! A board at the end of a serial line, for the tests of `host-sim board`
+//! and the studio's "Send to board": any command that serves a serial
+//! device and names it on its standard output — the software board
+//! (`software-board`: octrace-link's board logic on a host, behind a
+//! pseudo-terminal) or an emulated one, chosen by [`RunningBoard::for_tests`]
+//! — and a raw host that sends it frames the protocol refuses.
 //!
 //! Invariants: a [`RunningBoard`] is ended (by its own process id) when it
 //! is dropped, and its command ends by itself when its standard input
 //! closes, so no board outlives its test; every read of a [`RawHost`]
 //! gives up after its timeout.
 
+use host_sim::board::{BoardDescription, BoardLink};
 use octrace_link::{Decoder, Frame, Refusal};
 use std::collections::VecDeque;
 use std::fs::File;
@@ -83,6 +85,34 @@ impl RunningBoard {
         RunningBoard::start(command).unwrap_or_else(|e| panic!("{e}"))
     }
 
+    /// The board the tests talk to: the command `OCTRACE_BOARD` names, run
+    /// in the repository (for instance the emulated Pico's `node
+    /// examples/pico-st7789/emulator/run.mjs ELF --serial`), or else the
+    /// software board `software` (the path of the tests' `software-board`)
+    /// with a 16 KiB board's profile, a 160×128 panel and scenes of up to
+    /// 8 KiB. The tests ask it what it is ([`RunningBoard::describe`]) and
+    /// choose their scenes by that.
+    pub fn for_tests(software: &str) -> RunningBoard {
+        match std::env::var("OCTRACE_BOARD") {
+            Ok(command) => {
+                let mut words = command.split_whitespace();
+                let mut command = Command::new(words.next().expect("OCTRACE_BOARD names a command"));
+                command.args(words).current_dir(crate::repo());
+                RunningBoard::start(command).unwrap_or_else(|e| panic!("{e}"))
+            }
+            Err(_) => RunningBoard::software(
+                software,
+                &["--profile", "board16k", "--panel", "160x128", "--max-scene", "8192"],
+            ),
+        }
+    }
+
+    /// What the board says it is.
+    pub fn describe(&self) -> BoardDescription {
+        let mut link = BoardLink::open(&self.port.to_string_lossy(), Duration::from_secs(30)).expect("the port opens");
+        link.hello().expect("the board answers")
+    }
+
     /// Whether its process still runs.
     pub fn alive(&mut self) -> bool {
         matches!(self.child.try_wait(), Ok(None))
@@ -94,6 +124,17 @@ impl Drop for RunningBoard {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
+}
+
+/// Whether scene `text` fits what the board holds: its length and every
+/// capacity of its profile.
+pub fn fits(board: &BoardDescription, text: &str) -> bool {
+    let needs = octrace_core::parse::count(text);
+    text.len() <= board.max_scene as usize
+        && octrace_core::capacity::CapacityKind::ALL.into_iter().all(|kind| {
+            let holds = board.capacities.iter().find(|(name, _)| name == kind.field()).map_or(0, |(_, n)| *n);
+            needs.get(kind) <= holds as usize
+        })
 }
 
 /// A host that writes any bytes to a board and reads its frames.

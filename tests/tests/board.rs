@@ -12,35 +12,16 @@
 //! serial device it serves. The tests ask the board what it is (panel,
 //! profile, longest scene) and choose their scenes by it.
 
-use host_sim::board::{BoardDescription, BoardLink};
 use octrace_link::{encode_raw, Kind, Message, Reason, Refusal, VERSION};
-use octrace_tests::board::{open_pty, RawHost, RunningBoard};
+use octrace_tests::board::{fits, open_pty, RawHost, RunningBoard};
 use octrace_tests::{host_sim_preview, repo};
 use std::ffi::OsStr;
 use std::path::Path;
 use std::time::Duration;
 
-/// A board to talk to: `OCTRACE_BOARD`'s command, or the software board
-/// with a 16 KiB board's profile and a small panel.
+/// A board to talk to: `OCTRACE_BOARD`'s command, or the software board.
 fn board() -> RunningBoard {
-    match std::env::var("OCTRACE_BOARD") {
-        Ok(command) => {
-            let mut words = command.split_whitespace();
-            let mut command = std::process::Command::new(words.next().expect("OCTRACE_BOARD names a command"));
-            command.args(words).current_dir(repo());
-            RunningBoard::start(command).unwrap_or_else(|e| panic!("{e}"))
-        }
-        Err(_) => RunningBoard::software(
-            env!("CARGO_BIN_EXE_software-board"),
-            &["--profile", "board16k", "--panel", "160x128", "--max-scene", "8192"],
-        ),
-    }
-}
-
-/// What the board says it is.
-fn describe(board: &RunningBoard) -> BoardDescription {
-    let mut link = BoardLink::open(&board.port.to_string_lossy(), Duration::from_secs(30)).expect("the port opens");
-    link.hello().expect("the board answers")
+    RunningBoard::for_tests(env!("CARGO_BIN_EXE_software-board"))
 }
 
 struct Run {
@@ -74,20 +55,10 @@ fn draws_host_sims_picture(board: &RunningBoard, panel: &str, name: &str, dir: &
     assert!(got.data == want.data, "{name}: the board's picture differs from host-sim's");
 }
 
-/// Whether scene `text` fits what the board holds.
-fn fits(board: &BoardDescription, text: &str) -> bool {
-    let needs = octrace_core::parse::count(text);
-    text.len() <= board.max_scene as usize
-        && octrace_core::capacity::CapacityKind::ALL.into_iter().all(|kind| {
-            let holds = board.capacities.iter().find(|(name, _)| name == kind.field()).map_or(0, |(_, n)| *n);
-            needs.get(kind) <= holds as usize
-        })
-}
-
 #[test]
 fn three_scenes_in_a_row_are_each_host_sims_picture() {
     let mut board = board();
-    let description = describe(&board);
+    let description = board.describe();
     let panel = format!("{}x{}", description.panel.width, description.panel.height);
     let dir = tempfile::tempdir().unwrap();
     let names: Vec<&str> = ["fig5_1", "fig5_4", "fig5_2", "fig5_8", "fig5_3", "fig5_7"]
@@ -128,7 +99,7 @@ fn a_scene_with_errors_is_answered_at_each_line_and_column_and_nothing_is_drawn(
 #[test]
 fn a_scene_over_the_boards_capacity_is_refused_naming_it() {
     let board = board();
-    let description = describe(&board);
+    let description = board.describe();
     let lights = description.capacities.iter().find(|(name, _)| name == "lights").expect("lights are a capacity").1;
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("many-lights.txt");
@@ -152,7 +123,7 @@ fn a_scene_over_the_boards_capacity_is_refused_naming_it() {
 #[test]
 fn a_transfer_cut_off_half_way_leaves_the_board_taking_the_next_scene() {
     let mut board = board();
-    let panel = describe(&board).panel;
+    let panel = board.describe().panel;
     let dir = tempfile::tempdir().unwrap();
     let text = std::fs::read(repo().join("scenes/fig5_1.txt")).unwrap();
     let mut frame = Vec::new();
@@ -179,7 +150,7 @@ fn a_transfer_cut_off_half_way_leaves_the_board_taking_the_next_scene() {
 #[test]
 fn a_frame_from_the_host_stops_a_drawing_between_rows() {
     let mut board = board();
-    let description = describe(&board);
+    let description = board.describe();
     let text = std::fs::read(repo().join("scenes/fig5_1.txt")).unwrap();
     // The scene, and a hello right behind it: there when the first row is drawn.
     let mut frames = Vec::new();
@@ -226,7 +197,7 @@ fn answer_to(host: &mut RawHost, bytes: &[u8]) -> Refusal {
 #[test]
 fn garbage_a_wrong_checksum_and_a_wrong_version_are_answered_and_the_board_lives_on() {
     let mut board = board();
-    let description = describe(&board);
+    let description = board.describe();
     let mut host = RawHost::open(&board.port);
     // A modem's greeting, then a delimiter.
     let refused = answer_to(&mut host, b"AT\r\nATZ\r\n\0");
@@ -269,7 +240,7 @@ fn the_board_says_what_it_is() {
     let board = board();
     let run = host_sim_board(&[board.port.as_os_str()]);
     assert_eq!(run.code, 0, "{}", run.stderr);
-    let description = describe(&board);
+    let description = board.describe();
     let Some(first) = run.stdout.lines().next() else { panic!("nothing printed") };
     assert!(first.starts_with(&format!("{}: ", board.port.display())), "{first}");
     let panel = format!("panel: {}x{} rgb565", description.panel.width, description.panel.height);

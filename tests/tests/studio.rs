@@ -2,15 +2,21 @@
 //! chromium, headless, driven over WebDriver by chromedriver. The page runs
 //! octrace-core compiled to WebAssembly; these tests check that what it
 //! shows is host-sim's image bit for bit, that a user can place, render and
-//! save with the mouse, and that the server keeps its security rules.
+//! save with the mouse, that "Send to board" shows a board's errors and
+//! picture, and that the server keeps its security rules.
+//!
+//! The board is the software board, or the command `OCTRACE_BOARD` names
+//! (as in tests/tests/board.rs: [`RunningBoard::for_tests`]).
 //!
 //! `OCTRACE_SCREENSHOTS=1` also writes the README's screenshots to
 //! `docs/studio/`.
 
 use host_sim::{load_bytes, new_scene, render, RenderOptions, RgbImage};
 use octrace_images::palette::{self, PaletteMode};
+use octrace_tests::board::{fits, open_pty, RunningBoard};
 use octrace_tests::webdriver::{http, Browser};
-use octrace_tests::{repo, scenes};
+use octrace_tests::{host_sim_preview, repo, scenes};
+use std::ffi::OsStr;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -44,8 +50,13 @@ struct Studio {
 
 impl Studio {
     fn start(binary: &Path, scene: Option<&Path>) -> Studio {
+        Studio::start_with(binary, scene, &[])
+    }
+
+    /// `host-sim studio [SCENE] ARGS...`.
+    fn start_with(binary: &Path, scene: Option<&Path>, args: &[&OsStr]) -> Studio {
         let mut command = Command::new(binary);
-        command.arg("studio").args(scene).stdout(Stdio::piped()).stderr(Stdio::piped());
+        command.arg("studio").args(scene).args(args).stdout(Stdio::piped()).stderr(Stdio::piped());
         let mut child = command.spawn().expect("host-sim studio starts");
         let mut first = String::new();
         BufReader::new(child.stdout.take().expect("stdout")).read_line(&mut first).expect("a first line");
@@ -266,6 +277,10 @@ fn the_canvas_is_host_sims_image_for_every_scene() {
     let browser = Browser::start((1500, 900));
     browser.goto(&studio.url);
     browser.wait_for("document.body.dataset.ready === 'true'", 120);
+    // Started without --board: no board to send to, and the button says so.
+    let send = browser.run("const b = document.getElementById('send-board'); return [b.disabled, b.title];");
+    assert_eq!(send[0], true);
+    assert!(send[1].as_str().is_some_and(|t| t.contains("--board PORT")), "{send}");
     // fig5_1 at its own RASTER, the rest small; every process mode.
     let modes = ["naive", "octree", "dda"];
     for (i, (name, path)) in scenes().into_iter().enumerate() {
@@ -332,7 +347,8 @@ fn the_server_keeps_its_security_rules() {
     let with_token = |path: &str| format!("{path}?{token}");
 
     // With the token and the right Host: the page, its assets and the scene.
-    let modules = ["/studio.js", "/octrace.js", "/model.js", "/view.js", "/tools.js", "/panel.js", "/worker.js"];
+    let modules =
+        ["/studio.js", "/octrace.js", "/model.js", "/view.js", "/tools.js", "/panel.js", "/board.js", "/worker.js"];
     for path in ["/", "/studio.css", "/octrace_studio.wasm", "/scene"].into_iter().chain(modules) {
         let (status, body) = http(port, "GET", &with_token(path), &[], b"");
         assert_eq!(status, 200, "{path}");
@@ -352,6 +368,13 @@ fn the_server_keeps_its_security_rules() {
     let wrong = "0".repeat(studio.token.len());
     assert_eq!(http(port, "GET", &format!("/?token={wrong}"), &[], b"").0, 403);
     assert_eq!(http(port, "PUT", "/scene", &[("If-Match", "*")], b"x").0, 403);
+    // Without --board there is no board to send to (the rules come first).
+    assert_eq!(http(port, "POST", "/board", &[], START.as_bytes()).0, 403);
+    for method in ["GET", "POST"] {
+        let (status, body) = http(port, method, &with_token("/board"), &[], START.as_bytes());
+        assert_eq!(status, 404, "{method} /board");
+        assert!(String::from_utf8_lossy(&body).contains("without --board"), "{}", String::from_utf8_lossy(&body));
+    }
 
     // A foreign Host (DNS rebinding), even with the token.
     for host in [
@@ -556,4 +579,181 @@ fn the_pages_statement_arities_are_the_cores() {
     page.sort();
     core.sort();
     assert_eq!(page, core);
+}
+
+/// The software board (or `OCTRACE_BOARD`'s) the studio sends to.
+fn test_board() -> RunningBoard {
+    RunningBoard::for_tests(env!("CARGO_BIN_EXE_software-board"))
+}
+
+/// The `#board` figure's state and its verdict's kind and text.
+fn board_verdict(browser: &Browser) -> (String, String, String) {
+    let v = browser.run(
+        "const v = document.getElementById('board-verdict');
+         return [document.getElementById('board').dataset.state, v.dataset.verdict, v.textContent];",
+    );
+    let part = |i: usize| v[i].as_str().unwrap_or_default().to_string();
+    (part(0), part(1), part(2))
+}
+
+/// Sends the editor's text to the board with `how` (a click or the key)
+/// and waits for the answer: the `#board` figure's state.
+fn send_to_board(browser: &Browser, how: &dyn Fn(&Browser)) -> (String, String, String) {
+    browser.run("document.getElementById('board').dataset.state = 'stale'; return true;");
+    how(browser);
+    browser.wait_for("['done', 'rejected', 'error'].includes(document.getElementById('board').dataset.state)", 900);
+    board_verdict(browser)
+}
+
+#[test]
+fn send_to_board_shows_the_boards_picture_and_verdict_or_its_errors_in_the_editor() {
+    let board = test_board();
+    let description = board.describe();
+    let (w, h) = (description.panel.width, description.panel.height);
+    let binary = host_sim_binary();
+    let studio = Studio::start_with(&binary, None, &["--board".as_ref(), board.port.as_os_str()]);
+    let browser = Browser::start((1500, 900));
+    browser.goto(&studio.url);
+    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+    assert_eq!(browser.run("return document.getElementById('send-board').disabled;"), false);
+
+    // A scene of the thesis the board holds: its picture beside the render,
+    // identical to host-sim's panel preview, as the page says and as this
+    // test sees for itself.
+    let name = ["fig5_1", "fig5_4", "fig5_2"]
+        .into_iter()
+        .find(|name| fits(&description, &std::fs::read_to_string(repo().join(format!("scenes/{name}.txt"))).unwrap()))
+        .expect("a scene of the thesis fits the board");
+    set_text(&browser, &std::fs::read_to_string(repo().join(format!("scenes/{name}.txt"))).unwrap());
+    let (state, verdict, said) = send_to_board(&browser, &|b| b.click("#send-board"));
+    assert_eq!((state.as_str(), verdict.as_str(), said.as_str()), ("done", "identical", "identical"), "{name}");
+    let dir = tempfile::tempdir().expect("a directory");
+    let preview = dir.path().join("preview.png");
+    host_sim_preview(name, &preview, &format!("{w}x{h}"), "rgb565").unwrap();
+    let preview = octrace_images::formats::read(&std::fs::read(&preview).unwrap()).unwrap().to_rgb();
+    assert_same("the board's picture", browser.canvas_rgb("board-image"), &preview);
+    // Its rows were counted as they came (the page shows them while they do).
+    let progress = browser.run("return fetch('/board').then((r) => r.json());");
+    assert_eq!((&progress["rows"], &progress["height"], &progress["busy"]), (&h.into(), &h.into(), &false.into()));
+
+    // A scene over the board's capacity (which the page's own core holds):
+    // the board's error lands in the editor at its line and column, and no
+    // picture shows. Sent with the key this time.
+    let lights = description.capacities.iter().find(|(name, _)| name == "lights").expect("lights are a capacity").1;
+    let light = "LIGHT 1 0 5 5\n";
+    let text = light.repeat(lights as usize + 1)
+        + "SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nVIEWPOINT 0 0 5\n";
+    set_text(&browser, &text);
+    let (state, verdict, said) = send_to_board(&browser, &|b| press(b, "\u{E009}\u{E008}\u{E007}\u{E008}\u{E009}"));
+    assert_eq!((state.as_str(), verdict.as_str()), ("rejected", "errors"), "{said}");
+    let errors = browser.run(
+        "return [...document.querySelectorAll('#errors li')].map((li) =>
+           [li.className, li.dataset.line, li.dataset.column, li.textContent]);",
+    );
+    let errors = errors.as_array().expect("a list");
+    let line = (lights + 1).to_string();
+    let want = format!("{line}:1: too many lights: the capacity profile {} holds {lights}", description.profile);
+    assert!(
+        errors.iter().any(|e| e[0] == "board"
+            && e[1] == line.as_str()
+            && e[2] == "1"
+            && e[3].as_str().is_some_and(|t| t.starts_with(&want))),
+        "{want} in {errors:?}"
+    );
+    let cursor = browser
+        .run("const t = document.getElementById('scene'); return [t.selectionStart, document.activeElement === t];");
+    assert_eq!(cursor[0], light.len() * lights as usize, "the cursor is at the error");
+    assert_eq!(cursor[1], true, "in the editor");
+    let picture = browser.run(
+        "const c = document.getElementById('board-image');
+         return [c.width, c.offsetParent === null];",
+    );
+    assert_eq!(picture[0], 0, "no picture");
+    assert_eq!(picture[1], true, "nothing shown");
+
+    // An error the page finds too is listed once, as the board's.
+    set_text(&browser, "VIEWPOINT 0 0 5\nSPHERE 1 x 0 0 0\n");
+    let (state, _, _) = send_to_board(&browser, &|b| b.click("#send-board"));
+    assert_eq!(state, "rejected");
+    let listed = browser.run(
+        "return [...document.querySelectorAll('#errors li')].filter((li) => li.textContent.startsWith('2:10:'))
+           .map((li) => li.className);",
+    );
+    assert_eq!(listed, serde_json::json!(["board"]));
+}
+
+#[test]
+fn the_board_endpoint_keeps_the_security_rules_and_sends_one_at_a_time() {
+    // A board that reads and never answers: what reaches it is seen here.
+    let (controller, port) = open_pty().expect("a pseudo-terminal");
+    let (bytes, received) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let mut controller = controller;
+        let mut chunk = [0u8; 4096];
+        loop {
+            match std::io::Read::read(&mut controller, &mut chunk) {
+                Ok(n) if n > 0 => {
+                    if bytes.send(n).is_err() {
+                        return;
+                    }
+                }
+                // No host has it open (yet, or any more).
+                _ => std::thread::sleep(Duration::from_millis(10)),
+            }
+        }
+    });
+    let binary = host_sim_binary();
+    let args = ["--board".as_ref(), port.as_os_str(), "--board-timeout".as_ref(), "3".as_ref()];
+    let studio = Studio::start_with(&binary, None, &args);
+    let port_number = studio.port;
+    let token = format!("token={}", studio.token);
+    let with_token = |path: &str| format!("{path}?{token}");
+
+    // Without the token, with a wrong one, or from a foreign Host: refused,
+    // and nothing reaches the board.
+    assert_eq!(http(port_number, "POST", "/board", &[], b"RDEPTH 2\n").0, 403);
+    assert_eq!(http(port_number, "GET", "/board", &[], b"").0, 403);
+    assert_eq!(http(port_number, "POST", "/board?token=0123", &[], b"RDEPTH 2\n").0, 403);
+    for host in ["evil.example:80", &format!("evil.example:{port_number}"), "127.0.0.1"] {
+        let (status, _) = http(port_number, "POST", &with_token("/board"), &[("Host", host)], b"RDEPTH 2\n");
+        assert_eq!(status, 421, "Host {host}");
+    }
+    assert_eq!(http(port_number, "PUT", &with_token("/board"), &[], b"RDEPTH 2\n").0, 405);
+    std::thread::sleep(Duration::from_millis(300));
+    assert!(received.try_recv().is_err(), "a refused request reached the board");
+
+    // With the token: the board is named, and a send reaches it.
+    let (status, body) = http(port_number, "GET", &with_token("/board"), &[], b"");
+    assert_eq!(status, 200);
+    let status_json: serde_json::Value = serde_json::from_slice(&body).expect("JSON");
+    assert_eq!(status_json["port"], port.to_string_lossy().as_ref());
+    assert_eq!(status_json["busy"], false);
+    let send = {
+        let path = with_token("/board");
+        std::thread::spawn(move || http(port_number, "POST", &path, &[], b"RDEPTH 2\n"))
+    };
+    received.recv_timeout(Duration::from_secs(10)).expect("the send reached the board");
+    // One send at a time: a second while the first waits is refused as busy.
+    let (status, body) = http(port_number, "POST", &with_token("/board"), &[], b"RDEPTH 2\n");
+    assert_eq!(status, 409, "{}", String::from_utf8_lossy(&body));
+    assert!(String::from_utf8_lossy(&body).starts_with("busy"), "{}", String::from_utf8_lossy(&body));
+    let (_, body) = http(port_number, "GET", &with_token("/board"), &[], b"");
+    assert_eq!(serde_json::from_slice::<serde_json::Value>(&body).unwrap()["busy"], true);
+    // The silent board: an error naming it, and the board free again.
+    let (status, body) = send.join().expect("the first send");
+    let said = String::from_utf8_lossy(&body);
+    assert_eq!(status, 502, "{said}");
+    assert!(said.starts_with(&format!("board at {}: no answer within 3 s", port.display())), "{said}");
+    let (_, body) = http(port_number, "GET", &with_token("/board"), &[], b"");
+    assert_eq!(serde_json::from_slice::<serde_json::Value>(&body).unwrap()["busy"], false);
+}
+
+#[test]
+fn a_board_that_is_no_serial_port_is_an_error_at_start() {
+    let binary = host_sim_binary();
+    let scene = repo().join("scenes/fig5_1.txt");
+    let out = Command::new(&binary).args(["studio", "--board"]).arg(&scene).output().expect("runs");
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains(&format!("--board {} is no serial port", scene.display())), "{stderr}");
 }

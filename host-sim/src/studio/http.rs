@@ -153,9 +153,11 @@ impl Response {
             409 => "Conflict",
             411 => "Length Required",
             413 => "Content Too Large",
+            422 => "Unprocessable Content",
             421 => "Misdirected Request",
             428 => "Precondition Required",
             431 => "Request Header Fields Too Large",
+            502 => "Bad Gateway",
             505 => "HTTP Version Not Supported",
             _ => "Error",
         };

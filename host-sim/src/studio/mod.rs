@@ -7,12 +7,15 @@
 //! Host is not this address and port is refused (DNS rebinding); the only
 //! file ever read or written is the scene file named on the command line,
 //! through `GET`/`PUT /scene`, and every other path is an embedded asset or
-//! 404 — no request path reaches the file system.
+//! 404 — no request path reaches the file system; the only serial port
+//! opened is the one `--board` names, through `GET`/`POST /board`.
 
+mod board;
 mod http;
 
 use crate::exit::CliError;
 use crate::output::write_atomically;
+use board::BoardSender;
 use http::{Request, Response};
 use std::io::Write;
 use std::net::{Ipv4Addr, SocketAddr, TcpListener, TcpStream};
@@ -34,11 +37,21 @@ pub struct StudioArgs {
     /// Also open the page in the desktop's browser.
     #[arg(long)]
     pub open: bool,
+    /// The serial port of a board running octrace's live firmware: the page
+    /// gains "Send to board", which this server sends as `host-sim board
+    /// --check` does (errors at their line and column, or the picture and
+    /// whether it is host-sim's).
+    #[arg(long, value_name = "PORT")]
+    pub board: Option<PathBuf>,
+    /// Seconds to wait for each answer of the board (a row of a slow scene
+    /// included).
+    #[arg(long, value_name = "SECONDS", default_value_t = 30, value_parser = clap::value_parser!(u64).range(1..=86_400))]
+    pub board_timeout: u64,
 }
 
 /// The page, its script and style, and the WebAssembly module, built into
 /// the binary (the module by `build.rs`).
-const ASSETS: [(&str, &str, &[u8]); 10] = [
+const ASSETS: [(&str, &str, &[u8]); 11] = [
     ("/", "text/html; charset=utf-8", include_bytes!("assets/index.html")),
     ("/studio.js", "text/javascript; charset=utf-8", include_bytes!("assets/studio.js")),
     ("/octrace.js", "text/javascript; charset=utf-8", include_bytes!("assets/octrace.js")),
@@ -46,6 +59,7 @@ const ASSETS: [(&str, &str, &[u8]); 10] = [
     ("/view.js", "text/javascript; charset=utf-8", include_bytes!("assets/view.js")),
     ("/tools.js", "text/javascript; charset=utf-8", include_bytes!("assets/tools.js")),
     ("/panel.js", "text/javascript; charset=utf-8", include_bytes!("assets/panel.js")),
+    ("/board.js", "text/javascript; charset=utf-8", include_bytes!("assets/board.js")),
     ("/worker.js", "text/javascript; charset=utf-8", include_bytes!("assets/worker.js")),
     ("/studio.css", "text/css; charset=utf-8", include_bytes!("assets/studio.css")),
     ("/octrace_studio.wasm", "application/wasm", include_bytes!(concat!(env!("OUT_DIR"), "/octrace_studio.wasm"))),
@@ -67,11 +81,27 @@ struct Shared {
     /// Held while the scene file is compared and replaced, so two saves
     /// cannot interleave.
     saving: Mutex<()>,
+    /// The board `--board` names.
+    board: Option<BoardSender>,
 }
 
 /// Runs the studio until Ctrl-C; fails before serving anything if it cannot
 /// listen or make its token.
 pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Result<(), CliError> {
+    let board = match &args.board {
+        None => None,
+        Some(port) if crate::board::is_port(port) => {
+            Some(BoardSender::new(port.display().to_string(), Duration::from_secs(args.board_timeout)))
+        }
+        Some(port) => {
+            let _ = writeln!(stderr, "host-sim studio: the serial ports:");
+            let _ = crate::board::write_ports(stderr);
+            return Err(CliError::Invalid(format!(
+                "studio: --board {} is no serial port: give the port of a board running octrace's live firmware",
+                port.display()
+            )));
+        }
+    };
     let listener = TcpListener::bind(SocketAddr::from((Ipv4Addr::LOCALHOST, args.port)))
         .map_err(|e| CliError::Io(format!("studio: cannot listen on 127.0.0.1:{}: {e}", args.port)))?;
     let port = listener.local_addr().map_err(|e| CliError::Io(format!("studio: {e}")))?.port();
@@ -82,6 +112,7 @@ pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) ->
         hosts: [format!("127.0.0.1:{port}"), format!("localhost:{port}")],
         scene: args.scene.clone(),
         saving: Mutex::new(()),
+        board,
     });
     let _ = writeln!(stdout, "{url}");
     let _ = stdout.flush();
@@ -92,6 +123,9 @@ pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) ->
         None => {
             let _ = writeln!(stderr, "host-sim studio: no scene file given: an example, not saved (Ctrl-C stops)");
         }
+    }
+    if let Some(board) = &shared.board {
+        let _ = writeln!(stderr, "host-sim studio: \"Send to board\" sends to the board at {}", board.port());
     }
     if args.open {
         open_browser(&url, stderr);
@@ -154,6 +188,8 @@ fn respond(request: &Request, shared: &Shared) -> Response {
     match (request.method.as_str(), path) {
         ("GET", "/scene") => get_scene(shared),
         ("PUT", "/scene") => put_scene(request, shared),
+        ("GET", "/board") => with_board(shared, BoardSender::status),
+        ("POST", "/board") => with_board(shared, |board| board.send(&scene_name(shared), &request.body)),
         ("GET", _) | ("HEAD", _) => match ASSETS.iter().find(|(name, _, _)| *name == path) {
             Some((name, kind, body)) => {
                 let mut response = Response::new(200, kind, body.to_vec());
@@ -171,6 +207,14 @@ fn respond(request: &Request, shared: &Shared) -> Response {
             None => Response::text(404, "no such page"),
         },
         _ => Response::text(405, "method not allowed"),
+    }
+}
+
+/// `answer` of the board `--board` names, or 404 without one.
+fn with_board(shared: &Shared, answer: impl FnOnce(&BoardSender) -> Response) -> Response {
+    match &shared.board {
+        Some(board) => answer(board),
+        None => Response::text(404, "the studio was started without --board PORT: no board to send to"),
     }
 }
 
@@ -195,11 +239,17 @@ fn read_scene(path: &Path) -> std::io::Result<Option<Vec<u8>>> {
     }
 }
 
+/// The scene's name in messages: its file, or the example's.
+fn scene_name(shared: &Shared) -> String {
+    shared.scene.as_ref().map_or_else(|| "example.txt".to_string(), |path| path.display().to_string())
+}
+
 fn get_scene(shared: &Shared) -> Response {
-    let (bytes, name, writable) = match &shared.scene {
-        None => (Some(EXAMPLE_SCENE.as_bytes().to_vec()), "example.txt".to_string(), false),
+    let name = scene_name(shared);
+    let (bytes, writable) = match &shared.scene {
+        None => (Some(EXAMPLE_SCENE.as_bytes().to_vec()), false),
         Some(path) => match read_scene(path) {
-            Ok(bytes) => (bytes, path.display().to_string(), true),
+            Ok(bytes) => (bytes, true),
             Err(e) => return Response::text(500, &format!("cannot read {}: {e}", path.display())),
         },
     };

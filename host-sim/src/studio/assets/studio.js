@@ -1,14 +1,16 @@
 // octrace studio: the page. The octrace module (octrace-core compiled to
 // WebAssembly, octrace.js) does all parsing checks, rendering, palettes and
 // image files; this module is the editor and the plumbing, and wires up the
-// scene model (model.js), the wireframe view (view.js), the tools (tools.js)
-// and the panel (panel.js). worker.js renders with its own octrace module.
+// scene model (model.js), the wireframe view (view.js), the tools (tools.js),
+// the panel (panel.js) and the board (board.js). worker.js renders with its
+// own octrace module.
 
 import { loadOctrace } from './octrace.js';
 import { objectCentre, parseModel, single as singleIn, statementText } from './model.js';
 import { createView } from './view.js';
 import { createTools } from './tools.js';
 import { createPanel } from './panel.js';
+import { createBoard } from './board.js';
 
 main();
 
@@ -97,13 +99,21 @@ function main() {
     const list = $('errors');
     list.replaceChildren();
     for (const e of loaded.errors || []) {
-      const li = document.createElement('li');
-      li.textContent = e;
       const [line, column] = e.split(':').map(Number);
-      li.onclick = () => goTo(line, column);
-      list.append(li);
+      list.append(errorItem(e, line, column));
     }
     return loaded;
+  }
+
+  /** An error of the list: `message` (`line:col: …`); a click goes to
+   *  its line and column (line 0: an error of the whole scene). */
+  function errorItem(message, line, column) {
+    const li = document.createElement('li');
+    li.textContent = message;
+    li.dataset.line = String(line);
+    li.dataset.column = String(column);
+    if (line > 0) li.onclick = () => goTo(line, column);
+    return li;
   }
 
   function goTo(line, column) {
@@ -380,10 +390,12 @@ function main() {
 
   // ----------------------------------------------- view, tools and panel --
 
-  const app = { state, $, text, textChanged, scheduleDraft, single, setSingle, replaceStatement, appendStatement };
+  const app = { state, $, text, textChanged, scheduleDraft, single, setSingle, replaceStatement, appendStatement,
+    errorItem, goTo, putRgb, setStatus };
   app.view = createView(state, $('wire'), single);
   app.tools = createTools(app);
   app.panel = createPanel(app);
+  app.board = createBoard(app);
   const drawWire = app.view.draw, showPanel = app.panel.show, setTool = app.tools.setTool, project = app.view.project;
 
   // -------------------------------------------------------- undo, keys --
@@ -406,6 +418,7 @@ function main() {
   document.addEventListener('keydown', (e) => {
     const inText = e.target === text || e.target.tagName === 'INPUT';
     const key = e.key.toLowerCase();
+    if ((e.ctrlKey || e.metaKey) && e.shiftKey && key === 'enter') { e.preventDefault(); app.board.send(); return; }
     if ((e.ctrlKey || e.metaKey) && key === 'enter') { e.preventDefault(); render(); return; }
     if ((e.ctrlKey || e.metaKey) && key === 's') { e.preventDefault(); saveScene(false); return; }
     if (e.key === 'F1') { e.preventDefault(); $('help').showModal(); return; }
@@ -433,6 +446,7 @@ function main() {
     try {
       state.octrace = await loadOctrace();
       await loadScene(true);
+      await app.board.connect();
       setTool('select');
       fitView();
       setStatus('ready: Render (Ctrl+Enter) traces the full image');

@@ -1,0 +1,181 @@
+//! The studio's "Send to board": `POST /board` sends the editor's text to
+//! the board `--board` names, through what `host-sim board --check` sends
+//! and compares with, and answers with the board's errors or its picture
+//! and verdict; `GET /board` names the board and how far its drawing is.
+//!
+//! Invariants: one send at a time (another is refused as busy, never
+//! queued, so two never interleave on the port); the errors are the
+//! board's, at the line and column it gave; the verdict is the count of
+//! pixels that differ from host-sim's render at the board's panel size.
+
+use super::http::Response;
+use crate::board::{differing_pixels, send_scene, Progress, Sent};
+use crate::exit::CliError;
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::time::{Duration, Instant};
+
+/// The board the studio sends to, and its send under way.
+pub(crate) struct BoardSender {
+    port: String,
+    /// The longest wait for each answer of the board.
+    timeout: Duration,
+    /// Whether a send is under way; set and cleared by [`Claim`].
+    busy: AtomicBool,
+    /// The drawing under way (or the last): rows received, of how many.
+    rows: AtomicU32,
+    height: AtomicU32,
+}
+
+/// A send's hold on the board, let go when dropped (a failed send too).
+struct Claim<'a>(&'a AtomicBool);
+
+impl Drop for Claim<'_> {
+    fn drop(&mut self) {
+        self.0.store(false, Ordering::SeqCst);
+    }
+}
+
+impl BoardSender {
+    pub(crate) fn new(port: String, timeout: Duration) -> BoardSender {
+        BoardSender { port, timeout, busy: AtomicBool::new(false), rows: AtomicU32::new(0), height: AtomicU32::new(0) }
+    }
+
+    pub(crate) fn port(&self) -> &str {
+        &self.port
+    }
+
+    /// `GET /board`: the port, whether a send is under way, its rows.
+    pub(crate) fn status(&self) -> Response {
+        let body = format!(
+            "{{\"port\":{},\"busy\":{},\"rows\":{},\"height\":{}}}",
+            json_string(&self.port),
+            self.busy.load(Ordering::SeqCst),
+            self.rows.load(Ordering::SeqCst),
+            self.height.load(Ordering::SeqCst)
+        );
+        Response::new(200, "application/json", body.into_bytes())
+    }
+
+    /// `POST /board`: sends scene `text` (called `name` in messages) and
+    /// answers with the board's errors, or its picture and verdict.
+    pub(crate) fn send(&self, name: &str, text: &[u8]) -> Response {
+        if self.busy.compare_exchange(false, true, Ordering::SeqCst, Ordering::SeqCst).is_err() {
+            return Response::text(
+                409,
+                &format!(
+                    "busy: the board at {} is still answering an earlier send; send again when it is done",
+                    self.port
+                ),
+            );
+        }
+        let _claim = Claim(&self.busy);
+        self.rows.store(0, Ordering::SeqCst);
+        self.height.store(0, Ordering::SeqCst);
+        let started = Instant::now();
+        let sent = send_scene(&self.port, self.timeout, name, text, true, &mut |step| match step {
+            Progress::Drawing(panel) => self.height.store(panel.height.into(), Ordering::SeqCst),
+            Progress::Row { .. } => {
+                self.rows.fetch_add(1, Ordering::SeqCst);
+            }
+        });
+        let body = match sent {
+            // Not the board's fault: the scene is longer than it takes.
+            Err(e @ CliError::Invalid(_)) => return Response::text(422, &message(e)),
+            Err(e) => return Response::text(502, &message(e)),
+            Ok(Sent::Rejected(errors)) => {
+                let errors: Vec<String> = errors
+                    .iter()
+                    .map(|e| {
+                        format!(
+                            "{{\"line\":{},\"column\":{},\"message\":{}}}",
+                            e.line,
+                            e.column,
+                            json_string(&e.message)
+                        )
+                    })
+                    .collect();
+                format!("{{\"answer\":\"rejected\",\"errors\":[{}]}}", errors.join(","))
+            }
+            Ok(Sent::Drawn { panel, elapsed, picture: Some(picture) }) => {
+                let (seconds, clock) = match elapsed {
+                    Some(elapsed) => (elapsed.as_secs_f64(), "board"),
+                    None => (started.elapsed().as_secs_f64(), "host"),
+                };
+                let (differ, problem) = match differing_pixels(name, text, panel, &picture) {
+                    Ok(differ) => (differ.to_string(), "null".to_string()),
+                    Err(e) => ("null".to_string(), json_string(&message(e))),
+                };
+                format!(
+                    "{{\"answer\":\"drawn\",\"width\":{},\"height\":{},\"format\":\"{}\",\"seconds\":{seconds:.3},\
+                     \"clock\":\"{clock}\",\"differ\":{differ},\"problem\":{problem},\"rgb\":\"{}\"}}",
+                    panel.width,
+                    panel.height,
+                    panel.format,
+                    base64(&picture.data)
+                )
+            }
+            Ok(Sent::Drawn { picture: None, .. }) => {
+                return Response::text(502, &format!("the board at {} drew without its pixels", self.port));
+            }
+        };
+        Response::new(200, "application/json", body.into_bytes())
+    }
+}
+
+/// What `e` says, without the `host-sim:` a terminal gets.
+fn message(e: CliError) -> String {
+    match e {
+        CliError::Io(message) | CliError::Invalid(message) | CliError::Mismatch(message) => message,
+        CliError::Scene { errors, .. } => errors.join("\n"),
+    }
+}
+
+/// `text` as a JSON string, quotes included.
+fn json_string(text: &str) -> String {
+    let mut out = String::with_capacity(text.len() + 2);
+    out.push('"');
+    for c in text.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            '\n' => out.push_str("\\n"),
+            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+/// Standard base64 with padding: how the picture's RGB bytes travel in
+/// the JSON answer.
+fn base64(bytes: &[u8]) -> String {
+    const SYMBOLS: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for chunk in bytes.chunks(3) {
+        let bits = chunk.iter().enumerate().fold(0u32, |acc, (i, &b)| acc | u32::from(b) << (16 - 8 * i));
+        for i in 0..4 {
+            out.push(if i <= chunk.len() { SYMBOLS[(bits >> (18 - 6 * i)) as usize & 63] as char } else { '=' });
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn json_strings_escape_what_json_needs() {
+        assert_eq!(json_string("a \"b\" \\ c\nd\u{1}é"), r#""a \"b\" \\ c\nd\u0001é""#);
+    }
+
+    #[test]
+    fn base64_pads_as_the_standard_says() {
+        assert_eq!(base64(b""), "");
+        assert_eq!(base64(b"h"), "aA==");
+        assert_eq!(base64(b"he"), "aGU=");
+        assert_eq!(base64(b"hello"), "aGVsbG8=");
+        assert_eq!(base64(&[0, 255, 0]), "AP8A");
+    }
+}
