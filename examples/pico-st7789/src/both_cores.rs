@@ -206,7 +206,7 @@ where
             let mut colors = [Rgb888::BLACK; LEN];
             for (index, piece) in pieces().enumerate() {
                 let index = index as u32;
-                let traced = if index % 2 == 0 {
+                let traced = if index.is_multiple_of(2) {
                     trace(renderer, &piece, &mut colors)
                 } else {
                     let handed = loop {
