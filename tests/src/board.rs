@@ -85,7 +85,7 @@ impl RunningBoard {
         RunningBoard::start(command).unwrap_or_else(|e| panic!("{e}"))
     }
 
-    /// The board the tests talk to: the command `OCTRACE_BOARD` names, run
+    /// The board the tests talk to: the command `OCTRACE_BOARD_COMMAND` names, run
     /// in the repository (for instance the emulated Pico's `node
     /// examples/pico-st7789/emulator/run.mjs ELF --serial`), or else the
     /// software board `software` (the path of the tests' `software-board`)
@@ -93,10 +93,10 @@ impl RunningBoard {
     /// 8 KiB. The tests ask it what it is ([`RunningBoard::describe`]) and
     /// choose their scenes by that.
     pub fn for_tests(software: &str) -> RunningBoard {
-        match std::env::var("OCTRACE_BOARD") {
+        match std::env::var("OCTRACE_BOARD_COMMAND") {
             Ok(command) => {
                 let mut words = command.split_whitespace();
-                let mut command = Command::new(words.next().expect("OCTRACE_BOARD names a command"));
+                let mut command = Command::new(words.next().expect("OCTRACE_BOARD_COMMAND names a command"));
                 command.args(words).current_dir(crate::repo());
                 RunningBoard::start(command).unwrap_or_else(|e| panic!("{e}"))
             }

@@ -7,7 +7,7 @@
 //!
 //! The board is the software board (`software-board`: the live firmware's
 //! logic, `octrace_link::board`, behind a pseudo-terminal), or the command
-//! `OCTRACE_BOARD` names (for instance the emulated Pico's `node
+//! `OCTRACE_BOARD_COMMAND` names (for instance the emulated Pico's `node
 //! examples/pico-st7789/emulator/run.mjs ELF --serial`), which must print the
 //! serial device it serves. The tests ask the board what it is (panel,
 //! profile, longest scene) and choose their scenes by it.
@@ -19,7 +19,7 @@ use std::ffi::OsStr;
 use std::path::Path;
 use std::time::Duration;
 
-/// A board to talk to: `OCTRACE_BOARD`'s command, or the software board.
+/// A board to talk to: `OCTRACE_BOARD_COMMAND`'s command, or the software board.
 fn board() -> RunningBoard {
     RunningBoard::for_tests(env!("CARGO_BIN_EXE_software-board"))
 }

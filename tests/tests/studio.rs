@@ -5,7 +5,7 @@
 //! save with the mouse, that "Send to board" shows a board's errors and
 //! picture, and that the server keeps its security rules.
 //!
-//! The board is the software board, or the command `OCTRACE_BOARD` names
+//! The board is the software board, or the command `OCTRACE_BOARD_COMMAND` names
 //! (as in tests/tests/board.rs: [`RunningBoard::for_tests`]).
 //!
 //! `OCTRACE_SCREENSHOTS=1` also writes the README's screenshots to
@@ -581,7 +581,7 @@ fn the_pages_statement_arities_are_the_cores() {
     assert_eq!(page, core);
 }
 
-/// The software board (or `OCTRACE_BOARD`'s) the studio sends to.
+/// The software board (or `OCTRACE_BOARD_COMMAND`'s) the studio sends to.
 fn test_board() -> RunningBoard {
     RunningBoard::for_tests(env!("CARGO_BIN_EXE_software-board"))
 }
