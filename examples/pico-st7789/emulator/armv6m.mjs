@@ -15,8 +15,18 @@
 // Each corrected instruction is executed here instead of by rp2040js, with
 // the same cycle count (1); every other instruction is rp2040js's own.
 //
+// Also the events between cores (the manual's B1.5.18), which rp2040js 1.4.1
+// leaves out (its SEV only logs): SEV sets the executing core's own event
+// register and signals `sendEvent`, which the machine wires to the other
+// core; whether a sleeping core went to sleep in WFE (which an event ends)
+// or in WFI (which only an interrupt ends) is kept in `sleepsInWfi`.
+// rp2040js's WFE (clear the event register and go on, or sleep) and its
+// exception entry and return setting the event register are the manual's.
+//
 // Invariant: `addWithCarry` and `shiftCarry` are the manual's pseudocode
-// functions of the same names; nothing else is changed.
+// functions of the same names; nothing else is changed. The look at the next
+// instruction is a `peek` (no count, no stall); the fetch that executes it
+// is the core's own read, once.
 
 /** The manual's AddWithCarry: sets N, Z, C, V and returns the 32-bit result. */
 function addWithCarry(core, x, y, carryIn) {
@@ -100,18 +110,28 @@ function executeCorrected(core, opcode) {
   return true;
 }
 
+const SEV = 0xbf40;
+const WFE = 0xbf20;
+const WFI = 0xbf30;
+
 /**
  * Puts the corrections in front of `core.executeInstruction`. Pending
  * interrupts are taken first, exactly once, as rp2040js does; the corrected
- * instruction is then the one at the (possibly new) PC.
+ * instruction is then the one at the (possibly new) PC. `peek(address)`
+ * reads an instruction without side effects (default: the core's read);
+ * `sendEvent()` is called for each SEV.
  */
-export function correctInstructions(core) {
+export function correctInstructions(core, { peek = (address) => core.readUint16(address), sendEvent = () => {} } = {}) {
   const execute = core.executeInstruction.bind(core);
+  core.sleepsInWfi = false;
   core.executeInstruction = () => {
     if (core.interruptsUpdated && core.checkForInterrupts()) {
       core.waiting = false;
     }
-    if (executeCorrected(core, core.readUint16(core.PC & ~1))) {
+    const pc = core.PC & ~1;
+    const opcode = peek(pc);
+    if (executeCorrected(core, opcode)) {
+      core.readUint16(pc); // the fetch, for what it costs
       core.PC += 2;
       core.cycles += 1;
       return 1;
@@ -121,6 +141,12 @@ export function correctInstructions(core) {
     core.interruptsUpdated = false;
     const cycles = execute();
     core.interruptsUpdated ||= pending;
+    if (opcode === SEV) {
+      core.eventRegistered = true;
+      sendEvent();
+    } else if (opcode === WFE || opcode === WFI) {
+      core.sleepsInWfi = opcode === WFI;
+    }
     return cycles;
   };
 }
