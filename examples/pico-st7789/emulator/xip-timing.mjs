@@ -31,7 +31,7 @@
 // frame format, double data rate) is an error naming the register, never a
 // guess.
 
-export class XipTimingError extends Error {}
+import { RunError } from './errors.mjs';
 
 const INSTRUCTION_BITS = [0, 4, 8, 16];
 const LANES = [1, 2, 4];
@@ -43,14 +43,14 @@ const LINE_BITS = 64;
 export function xipTransferFormat({ ctrlr0, spiCtrlr0 }) {
   const frameFormat = (ctrlr0 >>> 21) & 3;
   if (frameFormat === 3) {
-    throw new XipTimingError(`SSI CTRLR0 0x${ctrlr0.toString(16)}: SPI_FRF 3 is reserved`);
+    throw new RunError(`SSI CTRLR0 0x${ctrlr0.toString(16)}: SPI_FRF 3 is reserved`);
   }
   if (spiCtrlr0 & (1 << 16)) {
-    throw new XipTimingError(`SSI SPI_CTRLR0 0x${spiCtrlr0.toString(16)}: double data rate (SPI_DDR) is not modelled`);
+    throw new RunError(`SSI SPI_CTRLR0 0x${spiCtrlr0.toString(16)}: double data rate (SPI_DDR) is not modelled`);
   }
   const transType = spiCtrlr0 & 3;
   if (transType === 3) {
-    throw new XipTimingError(`SSI SPI_CTRLR0 0x${spiCtrlr0.toString(16)}: TRANS_TYPE 3 is reserved`);
+    throw new RunError(`SSI SPI_CTRLR0 0x${spiCtrlr0.toString(16)}: TRANS_TYPE 3 is reserved`);
   }
   return {
     lanes: LANES[frameFormat],
@@ -66,7 +66,7 @@ export function xipTransferFormat({ ctrlr0, spiCtrlr0 }) {
 export function serialClockCycles(baudr) {
   const divider = baudr & 0xfffe;
   if (divider === 0) {
-    throw new XipTimingError(`SSI BAUDR 0x${baudr.toString(16)}: the serial clock is off (SCKDV 0)`);
+    throw new RunError(`SSI BAUDR 0x${baudr.toString(16)}: the serial clock is off (SCKDV 0)`);
   }
   return divider;
 }

@@ -145,6 +145,11 @@ export function boot2({ divider = 2, waitClocks = 4, sampleDelay = 1, badCrc = f
     .ldr(0, 3, DR0)
     .bx(4)
     .pool();
+  return boot2Image(t, { badCrc });
+}
+
+/** The 256 bytes of a boot2 assembled by `t` (at BOOT2_BASE), with its CRC (wrong if `badCrc`). */
+export function boot2Image(t, { badCrc = false } = {}) {
   const code = t.bytes();
   if (code.length > 252) throw new Error(`the test boot2 is ${code.length} bytes; 252 fit`);
   const image = new Uint8Array(256);
@@ -217,8 +222,12 @@ export function machine(image, { sram = {}, ...options } = {}) {
     source: 'test firmware',
     onBreakpoint: (k, code) => {
       if (code < RECORD || code >= RECORD + 8) return false;
-      const core = pico.cores[k];
-      records[k].push({ value: core.registers[code - RECORD] >>> 0, time: core.cycles });
+      const [core, other] = [pico.cores[k], pico.cores[1 - k]];
+      records[k].push({
+        value: core.registers[code - RECORD] >>> 0,
+        time: core.cycles,
+        other: other.waiting ? null : other.cycles, // the other core's time, if it runs
+      });
       return true;
     },
   });
@@ -325,6 +334,26 @@ export function core1Started(t) {
     .str(0, 7, FIFO_WR)
     .sev()
     .sev();
+}
+
+let unique = 0;
+
+/** write_blocking: register `r` into the TX FIFO once it has room, then SEV (r7 holds the SIO; r1, r2 spent). */
+export function fifoPush(t, r) {
+  const wait = `push.${unique++}`;
+  return t.label(wait).ldr(1, 7, FIFO_ST).movsImm(2, 2).alu('tst', 1, 2).bcc('eq', wait).str(r, 7, FIFO_WR).sev();
+}
+
+/** read_blocking: the next word of the RX FIFO into register `r`, sleeping in WFE while it is empty (r7 the SIO; r1, r2 spent). */
+export function fifoPop(t, r) {
+  const [wait, word] = [`pop.${unique}`, `pop.${unique++}.word`];
+  return t.label(wait).ldr(1, 7, FIFO_ST).movsImm(2, 1).alu('tst', 1, 2).bcc('ne', word).wfe().b(wait).label(word).ldr(r, 7, FIFO_RD);
+}
+
+/** A loop of `n` iterations (subs, bne: 3n - 1 cycles) in r0. */
+export function delay(t, n) {
+  const loop = `delay.${unique++}`;
+  return t.ldrConst(0, n).label(loop).subsImm(0, 1).bcc('ne', loop);
 }
 
 /** Sleeps for good: WFI with nothing to wake it. */
