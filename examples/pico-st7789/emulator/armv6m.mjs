@@ -15,14 +15,6 @@
 // Each corrected instruction is executed here instead of by rp2040js, with
 // the same cycle count (1); every other instruction is rp2040js's own.
 //
-// Also the events between cores (the manual's B1.5.18), which rp2040js 1.4.1
-// leaves out (its SEV only logs): SEV sets the executing core's own event
-// register and signals `sendEvent`, which the machine wires to the other
-// core; whether a sleeping core went to sleep in WFE (which an event ends)
-// or in WFI (which only an interrupt ends) is kept in `sleepsInWfi`.
-// rp2040js's WFE (clear the event register and go on, or sleep) and its
-// exception entry and return setting the event register are the manual's.
-//
 // Invariant: `addWithCarry` and `shiftCarry` are the manual's pseudocode
 // functions of the same names; nothing else is changed. The look at the next
 // instruction is a `peek` (no count, no stall); the fetch that executes it
@@ -110,43 +102,51 @@ function executeCorrected(core, opcode) {
   return true;
 }
 
-const SEV = 0xbf40;
-const WFE = 0xbf20;
-const WFI = 0xbf30;
+// rp2040js's own executeInstruction, which the corrected one calls: one for
+// every core (they are of one class). The corrected one is a single
+// function too, for all cores alike (a closure per core would keep V8 from
+// specialising it, costing a tenth of the emulator's speed).
+let executeOriginal = null;
+
+function executeInstruction() {
+  if (this.interruptsUpdated && this.checkForInterrupts()) {
+    this.waiting = false;
+  }
+  const pc = this.registers[15] & ~1;
+  const opcode = this.peekInstruction(this.peekContext, pc);
+  if (executeCorrected(this, opcode)) {
+    this.readUint16(pc); // the fetch, for what it costs
+    this.PC += 2;
+    this.cycles += 1;
+    return 1;
+  }
+  // Interrupts were just checked: rp2040js need not look again first.
+  const pending = this.interruptsUpdated;
+  this.interruptsUpdated = false;
+  const cycles = executeOriginal.call(this);
+  this.interruptsUpdated ||= pending;
+  return cycles;
+}
 
 /**
  * Puts the corrections in front of `core.executeInstruction`. Pending
  * interrupts are taken first, exactly once, as rp2040js does; the corrected
- * instruction is then the one at the (possibly new) PC. `peek(address)`
- * reads an instruction without side effects (default: the core's read);
- * `sendEvent()` is called for each SEV.
+ * instruction is then the one at the (possibly new) PC. `peek(context,
+ * address)` reads an instruction without side effects (default: the core's
+ * read, with the core as the context); one function for all cores, as the
+ * corrected executeInstruction is.
  */
-export function correctInstructions(core, { peek = (address) => core.readUint16(address), sendEvent = () => {} } = {}) {
-  const execute = core.executeInstruction.bind(core);
-  core.sleepsInWfi = false;
-  core.executeInstruction = () => {
-    if (core.interruptsUpdated && core.checkForInterrupts()) {
-      core.waiting = false;
-    }
-    const pc = core.PC & ~1;
-    const opcode = peek(pc);
-    if (executeCorrected(core, opcode)) {
-      core.readUint16(pc); // the fetch, for what it costs
-      core.PC += 2;
-      core.cycles += 1;
-      return 1;
-    }
-    // Interrupts were just checked: rp2040js need not look again first.
-    const pending = core.interruptsUpdated;
-    core.interruptsUpdated = false;
-    const cycles = execute();
-    core.interruptsUpdated ||= pending;
-    if (opcode === SEV) {
-      core.eventRegistered = true;
-      sendEvent();
-    } else if (opcode === WFE || opcode === WFI) {
-      core.sleepsInWfi = opcode === WFI;
-    }
-    return cycles;
-  };
+export function correctInstructions(core, peek = readInstruction, context = core) {
+  const original = Object.getPrototypeOf(core).executeInstruction;
+  executeOriginal ??= original;
+  if (original !== executeOriginal) {
+    throw new Error("correctInstructions: a core of another class than the first one's");
+  }
+  core.peekInstruction = peek;
+  core.peekContext = context;
+  core.executeInstruction = executeInstruction;
+}
+
+function readInstruction(core, address) {
+  return core.readUint16(address);
 }

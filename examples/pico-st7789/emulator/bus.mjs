@@ -15,13 +15,14 @@
 
 import { RunError } from './errors.mjs';
 import { MPU_GRANULE_BITS, MPU_NO_ACCESS } from './ppb.mjs';
-import { ALIAS_CACHED } from './xip.mjs';
+import { ALIAS_CACHED, CACHE_BYTES } from './xip.mjs';
 
 const ROM_END = 0x4000;
 const FLASH_BASE = 0x10000000;
 const XIP_END = 0x14000000;
 const XIP_SRAM = 0x15;
 const SRAM_BASE = 0x20000000;
+const APB_BASE = 0x40000000;
 const SIO_BASE = 0xd0000000;
 const SIO_END = 0xe0000000;
 const PPB_PAGE = 0xe000e;
@@ -37,6 +38,7 @@ export function installBus(core, index, { rp2040, xip, sio, ppb, fault }) {
   const sramEnd = SRAM_BASE + sram.length;
   const flash = rp2040.flash;
   const flashView = rp2040.flashView;
+  const peripherals = rp2040.peripherals;
   const xipSramView = new DataView(xip.sram.buffer);
   const tags = xip.tags;
   const accesses = xip.accesses;
@@ -87,6 +89,10 @@ export function installBus(core, index, { rp2040, xip, sio, ppb, fault }) {
     if (address >= SIO_BASE && address < SIO_END) return sio.readUint32(address - SIO_BASE);
     if (address >>> 12 === PPB_PAGE) return ppb.readUint32(address & 0xfff);
     if (address >>> 24 === XIP_SRAM) return xipSramView.getUint32(xip.sramAt(address, index), true);
+    if (address >= APB_BASE && address < SIO_BASE) {
+      const peripheral = peripherals[(address >>> 14) << 2];
+      if (peripheral) return peripheral.readUint32(address & 0x3fff);
+    }
     return rp2040.readUint32(address);
   };
 
@@ -175,14 +181,30 @@ export function installBus(core, index, { rp2040, xip, sio, ppb, fault }) {
       rp2040.writeUint8(address, value);
     }
   };
+}
 
-  /** The halfword at `address` without counting, stalling or side effects. */
-  return function peek16(address) {
-    address >>>= 0;
-    if (address >= FLASH_BASE && address < XIP_END) return flashView.getUint16(address & 0xffffff, true);
-    if (address >= SRAM_BASE && address < sramEnd) return sramView.getUint16(address - SRAM_BASE, true);
-    if (address < ROM_END) return rp2040.readUint16(address);
-    if (address >>> 24 === XIP_SRAM) return xipSramView.getUint16(address & (xip.sram.length - 2), true);
-    throw new RunError(`core ${index} executes from 0x${address.toString(16)}, where the emulator runs no code`);
+/**
+ * The halfword at `address` of `memory` (the machine's: rp2040js's flash,
+ * SRAM and ROM, the XIP cache's SRAM), read without counting, stalling or
+ * side effects: the emulator's own look at an instruction, the same for
+ * every core.
+ */
+export function peek16(memory, address) {
+  address >>>= 0;
+  if (address >= FLASH_BASE && address < XIP_END) return memory.flashView.getUint16(address & 0xffffff, true);
+  if (address >= SRAM_BASE && address < memory.sramEnd) return memory.sramView.getUint16(address - SRAM_BASE, true);
+  if (address < ROM_END) return memory.rom.getUint16(address, true);
+  if (address >>> 24 === XIP_SRAM) return memory.xipSramView.getUint16(address & (CACHE_BYTES - 2), true);
+  throw new RunError(`executing from 0x${address.toString(16)}, where the emulator runs no code`);
+}
+
+/** What `peek16` reads from. */
+export function machineMemory(rp2040, xip) {
+  return {
+    flashView: rp2040.flashView,
+    sramView: rp2040.sramView,
+    sramEnd: SRAM_BASE + rp2040.sram.length,
+    rom: new DataView(rp2040.bootrom.buffer),
+    xipSramView: new DataView(xip.sram.buffer),
   };
 }

@@ -29,7 +29,7 @@ import { functionAt, parseElf } from './elf.mjs';
 import { correctInstructions } from './armv6m.mjs';
 import { ST7789 } from './st7789.mjs';
 import { RunError } from './errors.mjs';
-import { installBus } from './bus.mjs';
+import { installBus, machineMemory, peek16 } from './bus.mjs';
 import { CoreSio, InterCoreFifos } from './sio.mjs';
 import { CorePpb } from './ppb.mjs';
 import { W25Q16JV } from './flash-chip.mjs';
@@ -40,12 +40,13 @@ export { RunError };
 
 const FLASH_BASE = 0x10000000;
 const SRAM_BASE = 0x20000000;
-const ROM_END = 0x4000;
 const BOOT2_BYTES = 256;
 export const CLOCK_HZ = 125_000_000;
 const NANOS_PER_CYCLE = 1e9 / CLOCK_HZ;
 const EXC_HARDFAULT = 3;
+const ROM_END = 0x4000;
 const BRANCH_TO_SELF = 0xe7fe;
+const WFE = 0xbf20;
 /** How often (in instructions) the run looks for endless loops, its budget, and reports progress. */
 const CHECK_EVERY = 0xfffff;
 /** rp2040js's peripherals, by `(address >>> 14) << 2`. */
@@ -74,7 +75,8 @@ export class Pico {
     this.clock = rp2040.clock;
     this.functions = functions;
     this.onBreakpoint = onBreakpoint;
-    rp2040.logger = strictLogger();
+    // rp2040js's SEV only logs: each core's logger turns that into the event.
+    rp2040.logger = strictLogger(() => this.sendEvent(0));
     this.rom = buildBootrom();
     rp2040.loadBootrom(this.rom.image); // also erases the flash and resets core 0 into the ROM: load the ELF after it
     loadSegments(rp2040, segments, source);
@@ -89,13 +91,15 @@ export class Pico {
     this.waiting = [0, 0];
     this.instructions = [0, 0];
     this.core1Ran = false;
-    this.coreReset = false;
+    /** Set when a sleeping core wakes or core 1 is reset: a core running alone must look again. */
+    this.woke = false;
     this.irqLines = 0;
 
     // Core 1's rp2040js parts act on `rp2040.core`: give them a view of the chip whose core is core 1.
     const core1View = Object.create(rp2040, {
       core: { get: () => this.cores[1] },
       onBreak: { value: (code) => this.breakpoint(1, code) },
+      logger: { value: strictLogger(() => this.sendEvent(1)) },
     });
     this.core1View = core1View;
     rp2040.onBreak = (code) => this.breakpoint(0, code);
@@ -112,15 +116,33 @@ export class Pico {
     rp2040.setInterrupt = (irq, level) => {
       this.irqLines = level ? this.irqLines | (1 << irq) : this.irqLines & ~(1 << irq);
       for (let k = 0; k < 2; k++) {
-        if (!this.held[k]) this.cores[k].setInterrupt(irq, level);
+        const core = this.cores[k];
+        if (this.held[k]) continue;
+        const asleep = core.waiting;
+        core.setInterrupt(irq, level);
+        if (asleep && !core.waiting) this.woke = true;
       }
     };
+    // rp2040js's SysTick pends its exception but wakes no sleeping core: wake it as an interrupt does.
+    this.ppbs.forEach((ppb, k) => {
+      const alarm = ppb.nvic.systickAlarm;
+      const expire = alarm.callback;
+      alarm.callback = () => {
+        expire();
+        const core = this.cores[k];
+        if (core.waiting && !this.held[k] && core.checkForInterrupts()) {
+          core.waiting = false;
+          this.woke = true;
+        }
+      };
+    });
 
     const now = () => this.clockCycles();
     this.flashChip = new W25Q16JV(rp2040.flash, () => this.clockCycles() / CLOCK_HZ, { statusRegister2: flashStatusRegister2 });
     this.ssi = new Ssi(rp2040, this.flashChip, now);
     rp2040.peripherals[SSI_SLOT] = this.ssi;
     this.xip = new XipCache(this.ssi, this.cores);
+    this.memory = machineMemory(rp2040, this.xip);
     rp2040.peripherals[XIP_CTRL_SLOT] = new XipControl(rp2040, this.xip, now, (cycles) => (this.cores[this.current].cycles += cycles));
     this.watchPsm(rp2040.peripherals[PSM_SLOT]);
 
@@ -143,7 +165,7 @@ export class Pico {
   /** Routes core k's accesses through its own bus and puts the instruction corrections in front of it. */
   attach(k) {
     const core = this.cores[k];
-    const peek = installBus(core, k, {
+    installBus(core, k, {
       rp2040: this.rp2040,
       xip: this.xip,
       sio: this.sios[k],
@@ -152,9 +174,7 @@ export class Pico {
         throw new RunError(message);
       },
     });
-    this.peeks ??= [];
-    this.peeks[k] = peek;
-    correctInstructions(core, { peek, sendEvent: () => this.sendEvent(k) });
+    correctInstructions(core, peek16, this.memory);
   }
 
   /** Core 1 out of reset at time `at`: a new core at the ROM's reset vector, its NVIC seeing the IRQ lines as they are. */
@@ -169,7 +189,7 @@ export class Pico {
     core.interruptsUpdated = true;
     this.cores[1] = core;
     this.held[1] = false;
-    this.coreReset = true;
+    this.woke = true;
     this.ppbs[1].reset();
     this.attach(1);
   }
@@ -189,20 +209,27 @@ export class Pico {
         this.settle(1, at);
         this.held[1] = true;
         this.cores[1].waiting = true;
-        this.coreReset = true;
+        this.woke = true;
       } else if (before & ~psm.frceOff & PSM_PROC1) {
         this.startCore1(at);
       }
     };
   }
 
-  /** SEV on core k: the other core's event register is set, and a WFE of it ends. */
+  /**
+   * SEV on core k (the manual's B1.5.18): its own event register is set,
+   * and the other core's TXEV-RXEV wire sets the other's, or ends its WFE
+   * (not a WFI: only an interrupt ends that), consuming the event.
+   */
   sendEvent(k) {
+    this.cores[k].eventRegistered = true;
     const j = 1 - k;
     if (this.held[j]) return;
     const other = this.cores[j];
-    if (other.waiting && !other.sleepsInWfi) {
+    // A sleeping core's PC is past the WFE or WFI it sleeps in.
+    if (other.waiting && peek16(this.memory, other.PC - 2) === WFE) {
       other.waiting = false;
+      this.woke = true;
     } else {
       other.eventRegistered = true;
     }
@@ -261,9 +288,6 @@ export class Pico {
         continue;
       }
       const core = cores[k];
-      if (core.IPSR === EXC_HARDFAULT) {
-        throw new RunError(`HardFault at ${this.where(k)}`, { located: true });
-      }
       this.current = k;
       core.executeInstruction();
       this.count(k, 1);
@@ -298,7 +322,6 @@ export class Pico {
    */
   runAlone(k, until, maxCycles, onProgress) {
     const core = this.cores[k];
-    const other = this.cores[1 - k];
     const clock = this.clock;
     let time = this.time;
     let steps = 0;
@@ -306,21 +329,19 @@ export class Pico {
     let reason = null;
     let watchLaunch = k === 1 && !this.core1Ran;
     this.current = k;
-    this.coreReset = false;
+    this.woke = false;
     for (;;) {
-      if (core.IPSR === EXC_HARDFAULT) {
-        throw new RunError(`HardFault at ${this.where(k)}`, { located: true });
-      }
       core.executeInstruction();
       steps++;
       if (watchLaunch && core.PC >= ROM_END) {
+        // Core 1 runs outside the ROM: the firmware launched it.
         this.core1Ran = true;
         watchLaunch = false;
       }
       const t = core.cycles;
       clock.tick((t - time) * NANOS_PER_CYCLE);
       time = t;
-      if (core.waiting || !other.waiting || this.coreReset) break;
+      if (core.waiting || this.woke) break;
       if (time >= until) {
         reason = 'until';
         break;
@@ -362,8 +383,12 @@ export class Pico {
   check(maxCycles, onProgress) {
     for (let k = 0; k < 2; k++) {
       const core = this.cores[k];
+      if (core.waiting) continue;
+      if (core.IPSR === EXC_HARDFAULT) {
+        throw new RunError(`HardFault at ${this.where(k)}`, { located: true });
+      }
       // A branch to itself (`b .`, as panic-halt's loop) never ends.
-      if (!core.waiting && this.peeks[k](core.PC & ~1) === BRANCH_TO_SELF) {
+      if (peek16(this.memory, core.PC & ~1) === BRANCH_TO_SELF) {
         throw new RunError(`the firmware stopped in an endless loop in ${this.where(k)} (a panic?)`, { located: true });
       }
     }
@@ -516,12 +541,15 @@ function panelReceive(panel, byte, dataCommand) {
   }
 }
 
-function strictLogger() {
-  const quiet = () => {};
+/** Warnings and errors end the run; of the rest, only a core's SEV (`sendEvent`) matters. */
+function strictLogger(sendEvent) {
   const fail = (component, message) => {
     throw new RunError(`emulator (${component}): ${message}`);
   };
-  return { debug: quiet, info: quiet, warn: fail, error: fail };
+  const info = (component, message) => {
+    if (component === 'CortexM0Core' && message === 'SEV') sendEvent();
+  };
+  return { debug: () => {}, info, warn: fail, error: fail };
 }
 
 function loadSegments(rp2040, segments, source) {
