@@ -3,15 +3,16 @@
 // writeUint32/16/8 for all of them) goes through this core's bus, which
 // sends the SIO (0xd0000000) and the PPB (0xe000e000) to the core's own, the
 // flash aliases (0x10000000-0x13ffffff) through the shared XIP cache, the
-// XIP cache's SRAM (0x15000000) to the cache, and SRAM straight to memory
-// (checked against the core's MPU when it restricts anything); the rest
-// (ROM, peripherals, USB RAM) is rp2040js's.
+// XIP cache's SRAM (0x15000000) to the cache, SRAM straight to memory
+// (checked against the core's MPU when it restricts anything), peripheral
+// loads straight to rp2040js's blocks; the rest (ROM, USB RAM, peripheral
+// stores with their atomic aliases) is rp2040js's.
 //
 // Invariants: no core access to flash bypasses the XIP cache (rp2040js's own
 // shortcuts to the flash array are never taken for a core); a store to the
-// flash changes no flash byte; a store to the ROM is an error (a bus fault on
-// the chip); `peek16` reads without counting or stalling anything (for the
-// emulator's own look at an instruction).
+// flash changes no flash byte; a store to the ROM and an unaligned 32-bit
+// access are errors (faults on the chip); `peek16` reads without counting
+// or stalling anything (for the emulator's own look at an instruction).
 
 import { RunError } from './errors.mjs';
 import { MPU_GRANULE_BITS, MPU_NO_ACCESS } from './ppb.mjs';
@@ -27,12 +28,8 @@ const SIO_BASE = 0xd0000000;
 const SIO_END = 0xe0000000;
 const PPB_PAGE = 0xe000e;
 
-/**
- * Routes core `index`'s accesses: `machine` has rp2040 (rp2040js), xip (the
- * cache), sio and ppb (this core's), `fault(message)` to end the run naming
- * where this core is.
- */
-export function installBus(core, index, { rp2040, xip, sio, ppb, fault }) {
+/** Routes core `index`'s accesses: rp2040 is rp2040js's chip, xip the cache, sio and ppb this core's own. */
+export function installBus(core, index, { rp2040, xip, sio, ppb }) {
   const sram = rp2040.sram;
   const sramView = rp2040.sramView;
   const sramEnd = SRAM_BASE + sram.length;
@@ -63,10 +60,11 @@ export function installBus(core, index, { rp2040, xip, sio, ppb, fault }) {
     const [start, end] = ppb.restrictedSpan(address);
     const noAccess = ppb.mpuMap[(address - SRAM_BASE) >>> MPU_GRANULE_BITS] === MPU_NO_ACCESS;
     const range = `0x${start.toString(16)}-0x${end.toString(16)}`;
+    const at = `0x${address.toString(16)}`;
     if (store && noAccess) {
-      fault(`core ${index} overflowed its stack: a store to 0x${address.toString(16)} hit its MPU guard (${range}, no access)`);
+      throw new RunError(`core ${index} overflowed its stack: a store to ${at} hit its MPU guard (${range}, no access)`);
     }
-    fault(`core ${index}: a ${store ? 'store to' : 'load from'} 0x${address.toString(16)} is a fault in MPU region ${range} (${noAccess ? 'no access' : 'read-only'})`);
+    throw new RunError(`core ${index}: a ${store ? 'store to' : 'load from'} ${at} is a fault in MPU region ${range} (${noAccess ? 'no access' : 'read-only'})`);
   };
   // An SRAM address the MPU forbids: a load from a no-access granule, a store to any restricted one.
   const checkLoad = (address) => {
@@ -198,7 +196,7 @@ export function peek16(memory, address) {
   throw new RunError(`executing from 0x${address.toString(16)}, where the emulator runs no code`);
 }
 
-/** What `peek16` reads from. */
+/** The machine's memories, as `peek16` reads them. */
 export function machineMemory(rp2040, xip) {
   return {
     flashView: rp2040.flashView,

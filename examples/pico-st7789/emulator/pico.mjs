@@ -165,15 +165,7 @@ export class Pico {
   /** Routes core k's accesses through its own bus and puts the instruction corrections in front of it. */
   attach(k) {
     const core = this.cores[k];
-    installBus(core, k, {
-      rp2040: this.rp2040,
-      xip: this.xip,
-      sio: this.sios[k],
-      ppb: this.ppbs[k],
-      fault: (message) => {
-        throw new RunError(message);
-      },
-    });
+    installBus(core, k, { rp2040: this.rp2040, xip: this.xip, sio: this.sios[k], ppb: this.ppbs[k] });
     correctInstructions(core, peek16, this.memory);
   }
 
