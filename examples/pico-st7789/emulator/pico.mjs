@@ -259,51 +259,95 @@ export class Pico {
 
   loop(maxCycles, until, onProgress) {
     const cores = this.cores;
-    const clock = this.clock;
     for (;;) {
       const awake0 = !cores[0].waiting;
       const awake1 = !cores[1].waiting;
-      let k;
-      if (awake0) {
-        k = awake1 && cores[1].cycles < cores[0].cycles ? 1 : 0;
-      } else if (awake1) {
-        k = 1;
+      let reason;
+      if (awake0 && awake1) {
+        reason = this.runBoth(until, maxCycles, onProgress);
+      } else if (awake0 || awake1) {
+        reason = this.runAlone(awake0 ? 0 : 1, until, maxCycles, onProgress);
       } else {
         if (!this.sleepUntilAlarm()) return 'idle';
         if (this.time >= until) return 'until';
         if (this.time > maxCycles) this.check(maxCycles, onProgress);
         continue;
       }
-      if (awake0 !== awake1) {
-        const r = this.runAlone(k, until, maxCycles, onProgress);
-        if (r) return r;
-        continue;
-      }
-      const core = cores[k];
-      this.current = k;
-      core.executeInstruction();
-      this.count(k, 1);
-      if (k === 1 && !this.core1Ran && core.PC >= ROM_END) this.core1Ran = true;
+      if (reason) return reason;
+    }
+  }
 
-      // Woken during this instruction (SEV, an interrupt it raised, a release from reset): from its end on.
-      const j = 1 - k;
-      const other = cores[j];
-      if ((k === 0 ? !awake1 : !awake0) && !other.waiting) this.settle(j, core.cycles);
-
-      // The clock follows the earlier running core (or this one, if both now sleep).
-      let target = core.waiting ? Infinity : core.cycles;
-      if (!other.waiting && other.cycles < target) target = other.cycles;
-      if (target === Infinity) target = core.cycles;
-      if (target > this.time) {
-        const asleep0 = cores[0].waiting;
-        const asleep1 = cores[1].waiting;
-        clock.tick((target - this.time) * NANOS_PER_CYCLE);
-        this.time = target;
-        if (asleep0 && !cores[0].waiting) this.settle(0, target);
-        if (asleep1 && !cores[1].waiting) this.settle(1, target);
+  /**
+   * Both cores run: each step is the next instruction of the core that is
+   * behind (core 0 on a tie), and the clock follows the earlier. Returns a
+   * reason to end the run, or null when a core sleeps or core 1 is reset.
+   */
+  runBoth(until, maxCycles, onProgress) {
+    const c0 = this.cores[0];
+    const c1 = this.cores[1];
+    const clock = this.clock;
+    let time = this.time;
+    let steps0 = 0;
+    let steps1 = 0;
+    let countdown = CHECK_EVERY + 1 - (this.steps & CHECK_EVERY);
+    let reason = null;
+    this.woke = false;
+    for (;;) {
+      if (c1.cycles < c0.cycles) {
+        this.current = 1;
+        c1.executeInstruction();
+        steps1++;
+        if (!this.core1Ran && c1.PC >= ROM_END) this.core1Ran = true;
+      } else {
+        this.current = 0;
+        c0.executeInstruction();
+        steps0++;
       }
-      if (this.time >= until) return 'until';
-      if ((this.steps & CHECK_EVERY) === 0) this.check(maxCycles, onProgress);
+      if (c0.waiting || c1.waiting || this.woke) break;
+      const target = c0.cycles < c1.cycles ? c0.cycles : c1.cycles;
+      if (target > time) {
+        clock.tick((target - time) * NANOS_PER_CYCLE);
+        time = target;
+      }
+      if (time >= until) {
+        reason = 'until';
+        break;
+      }
+      if (--countdown === 0) {
+        this.time = time;
+        this.count(0, steps0);
+        this.count(1, steps1);
+        steps0 = steps1 = 0;
+        this.check(maxCycles, onProgress);
+        countdown = CHECK_EVERY + 1;
+      }
+    }
+    this.time = time;
+    this.count(0, steps0);
+    this.count(1, steps1);
+    if (reason === null) this.follow(this.current);
+    return reason;
+  }
+
+  /**
+   * After core k's instruction that ended a stretch: the clock follows the
+   * earlier running core (or core k, if both now sleep), and a core woken
+   * on the way starts then.
+   */
+  follow(k) {
+    const cores = this.cores;
+    const core = cores[k];
+    let target = core.waiting ? Infinity : core.cycles;
+    const other = cores[1 - k];
+    if (!other.waiting && other.cycles < target) target = other.cycles;
+    if (target === Infinity) target = core.cycles;
+    if (target > this.time) {
+      const asleep0 = cores[0].waiting;
+      const asleep1 = cores[1].waiting;
+      this.clock.tick((target - this.time) * NANOS_PER_CYCLE);
+      this.time = target;
+      if (asleep0 && !cores[0].waiting) this.settle(0, target);
+      if (asleep1 && !cores[1].waiting) this.settle(1, target);
     }
   }
 
