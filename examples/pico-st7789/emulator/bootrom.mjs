@@ -260,29 +260,22 @@ function core1Wait(t) {
   take(() => {});
   t.blx(0).label('core1.done').wfe().b('core1.done');
   // send: r0 into the TX FIFO once it has room, then SEV; r0 kept.
-  t.label('core1.send')
-    .ldr(1, 4, FIFO_ST)
-    .movsImm(2, FIFO_RDY)
-    .alu('tst', 1, 2)
-    .bcc('ne', 'core1.send.room')
-    .wfe()
-    .b('core1.send')
-    .label('core1.send.room')
-    .str(0, 4, FIFO_WR)
-    .sev()
-    .bxLr();
+  sleepUntilFifo(t, 'core1.send', FIFO_RDY).str(0, 4, FIFO_WR).sev().bxLr();
   // receive: r0 from the RX FIFO, sleeping until there is a word.
+  return sleepUntilFifo(t, 'core1.receive', FIFO_VLD).ldr(0, 4, FIFO_RD).bxLr();
+}
+
+// At `label`: WFE until FIFO_ST (r4 the SIO) has `bit` set (r1, r2 spent).
+function sleepUntilFifo(t, label, bit) {
   return t
-    .label('core1.receive')
+    .label(label)
     .ldr(1, 4, FIFO_ST)
-    .movsImm(2, FIFO_VLD)
+    .movsImm(2, bit)
     .alu('tst', 1, 2)
-    .bcc('ne', 'core1.receive.word')
+    .bcc('ne', `${label}.ready`)
     .wfe()
-    .b('core1.receive')
-    .label('core1.receive.word')
-    .ldr(0, 4, FIFO_RD)
-    .bxLr();
+    .b(label)
+    .label(`${label}.ready`);
 }
 
 /** The ROM image (4096 words) and where each function is. */

@@ -34,7 +34,7 @@ const BUSY = 1 << 0;
 const WEL = 1 << 1;
 const QE = 1 << 1;
 /** tW, the write-status-register time: 10 ms typical. */
-export const STATUS_WRITE_SECONDS = 0.01;
+const STATUS_WRITE_SECONDS = 0.01;
 const JEDEC_ID = [0xef, 0x40, 0x15];
 const TRANS_1C1A = 0;
 const TRANS_1C2A = 1;

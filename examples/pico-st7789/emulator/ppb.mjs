@@ -33,8 +33,8 @@ const CTRL_PRIVDEFENA = 1 << 2;
 const RBAR_VALID = 1 << 4;
 
 /** What a 32-byte granule of SRAM allows: every access, loads only, nothing. */
-export const MPU_ALLOWED = 0;
-export const MPU_READ_ONLY = 1;
+const MPU_ALLOWED = 0;
+const MPU_READ_ONLY = 1;
 export const MPU_NO_ACCESS = 2;
 export const MPU_GRANULE_BITS = 5;
 

@@ -34,9 +34,9 @@ const RDY = 1 << 1;
 const WOF = 1 << 2;
 const ROE = 1 << 3;
 
-export const FIFO_DEPTH = 8;
+const FIFO_DEPTH = 8;
 /** SIO_IRQ_PROC0 and SIO_IRQ_PROC1: each core's FIFO interrupt line. */
-export const SIO_IRQ = [15, 16];
+const SIO_IRQ = [15, 16];
 
 /** The two mailboxes: `words[k]` is written by core k and read by the other core. */
 export class InterCoreFifos {

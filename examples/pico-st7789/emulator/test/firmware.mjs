@@ -241,12 +241,12 @@ export const values = (records, k) => records[k].map((r) => r.value);
  * rp2040-hal 0.12's `Core::spawn` for core 1, step by step: FRCE_OFF.PROC1
  * set (read-modify-write), waited for, cleared; then the command sequence 0,
  * 0, 1, vector table (core 0's VTOR), stack pointer, entry, each preceded
- * when 0 by draining the RX FIFO and SEV, pushed with `write_blocking`
- * (wait for RDY, write, SEV, SEV) and its echo read with `read_blocking`
- * (VLD, else WFE); a wrong echo starts the sequence over; after 16 wrong
- * echoes it gives up (BKPT #0x7f). Last, it reads core 1's word saying it
- * has taken its entry. Leaves the number of wrong echoes in r5. The command
- * table goes to SRAM at `table`.
+ * when 0 by draining the RX FIFO and SEV, pushed with `write_blocking` and
+ * its echo read with `read_blocking`; a wrong echo starts the sequence
+ * over; after 16 wrong echoes it gives up (BKPT #0x7f). Last, it reads core
+ * 1's word saying it has taken its entry. Leaves the number of wrong echoes
+ * in r5 and the SIO's address in r7. The command table goes to SRAM at
+ * `table`.
  */
 export function spawnCore1(t, { entry, stack, table = 0x20030000 }) {
   t.ldrConst(0, PSM_FRCE_OFF)
@@ -280,19 +280,10 @@ export function spawnCore1(t, { entry, stack, table = 0x20030000 }) {
     .b('spawn.drain')
     .label('spawn.drained')
     .sev()
-    .label('spawn.write')
-    .ldr(1, 7, FIFO_ST)
-    .movsImm(2, 2)
-    .alu('tst', 1, 2)
-    .bcc('ne', 'spawn.room')
-    .nop()
-    .b('spawn.write')
-    .label('spawn.room')
-    .str(0, 7, FIFO_WR)
-    .sev()
-    .sev()
-    .bl('spawn.read')
-    .alu('cmp', 0, 1)
+    .label('spawn.write');
+  fifoPush(t, 0);
+  fifoPop(t, 1);
+  t.alu('cmp', 0, 1)
     .bcc('ne', 'spawn.wrong')
     .addsImm(4, 1)
     .b('spawn.more')
@@ -304,47 +295,39 @@ export function spawnCore1(t, { entry, stack, table = 0x20030000 }) {
     .bkpt(0x7f)
     .label('spawn.more')
     .cmpImm(4, 6)
-    .bcc('cc', 'spawn.next')
-    .bl('spawn.read')
-    .b('spawn.done');
-  // read_blocking: the next word into r1.
-  t.label('spawn.read')
-    .ldr(1, 7, FIFO_ST)
-    .movsImm(2, 1)
-    .alu('tst', 1, 2)
-    .bcc('ne', 'spawn.word')
-    .wfe()
-    .b('spawn.read')
-    .label('spawn.word')
-    .ldr(1, 7, FIFO_RD)
-    .bxLr()
-    .label('spawn.done');
+    .bcc('cc', 'spawn.next');
+  fifoPop(t, 1);
 }
 
 /** rp2040-hal's core1_startup, as far as the tests need it: tell core 0 the entry is taken (1, write_blocking). */
 export function core1Started(t) {
-  return t
-    .ldrConst(7, SIO)
-    .label('started.wait')
-    .ldr(1, 7, FIFO_ST)
-    .movsImm(2, 2)
-    .alu('tst', 1, 2)
-    .bcc('eq', 'started.wait')
-    .movsImm(0, 1)
-    .str(0, 7, FIFO_WR)
-    .sev()
-    .sev();
+  return fifoPush(t.ldrConst(7, SIO).movsImm(0, 1), 0);
 }
 
 let unique = 0;
 
-/** write_blocking: register `r` into the TX FIFO once it has room, then SEV (r7 holds the SIO; r1, r2 spent). */
+/**
+ * rp2040-hal's `write_blocking`: register `r` into the TX FIFO once it has
+ * room (NOP while full), with `write`'s SEV and its own (r7 holds the SIO;
+ * r1, r2 spent).
+ */
 export function fifoPush(t, r) {
-  const wait = `push.${unique++}`;
-  return t.label(wait).ldr(1, 7, FIFO_ST).movsImm(2, 2).alu('tst', 1, 2).bcc('eq', wait).str(r, 7, FIFO_WR).sev();
+  const [wait, room] = [`push.${unique}`, `push.${unique++}.room`];
+  return t
+    .label(wait)
+    .ldr(1, 7, FIFO_ST)
+    .movsImm(2, 2)
+    .alu('tst', 1, 2)
+    .bcc('ne', room)
+    .nop()
+    .b(wait)
+    .label(room)
+    .str(r, 7, FIFO_WR)
+    .sev()
+    .sev();
 }
 
-/** read_blocking: the next word of the RX FIFO into register `r`, sleeping in WFE while it is empty (r7 the SIO; r1, r2 spent). */
+/** rp2040-hal's `read_blocking`: the next word of the RX FIFO into register `r`, WFE while it is empty (r7 the SIO; r1, r2 spent). */
 export function fifoPop(t, r) {
   const [wait, word] = [`pop.${unique}`, `pop.${unique++}.word`];
   return t.label(wait).ldr(1, 7, FIFO_ST).movsImm(2, 1).alu('tst', 1, 2).bcc('ne', word).wfe().b(wait).label(word).ldr(r, 7, FIFO_RD);

@@ -261,18 +261,24 @@ test("each core has its own hardware divider: core 1's division does not touch c
 
 test("SEV on one core ends the other's WFE, at once; it does not end a WFI", () => {
   const flag = 0x20030100;
+  // Both from SRAM: no flash miss in the way.
+  const [signalling, waiting] = [0x20011000, 0x20012000];
   const wfe = launching({
-    after: (t) => {
-      delay(t, 2000);
-      t.ldrConst(1, flag).movsImm(0, 1).str(0, 1);
-      record(t, 0);
-      t.sev();
-      halt(t);
-    },
-    core1: (t) => {
-      t.ldrConst(1, flag).label('wait').ldr(0, 1).cmpImm(0, 0).bcc('ne', 'woke').wfe().b('wait').label('woke');
-      record(t, 0);
-      halt(t);
+    after: (t) => t.ldrConst(0, signalling | 1).bx(0),
+    core1: (t) => t.ldrConst(0, waiting | 1).bx(0),
+    sram: {
+      [signalling]: (t) => {
+        delay(t, 2000);
+        t.ldrConst(1, flag).movsImm(0, 1).str(0, 1);
+        record(t, 0);
+        t.sev();
+        halt(t);
+      },
+      [waiting]: (t) => {
+        t.ldrConst(1, flag).label('wait').ldr(0, 1).cmpImm(0, 0).bcc('ne', 'woke').wfe().b('wait').label('woke');
+        record(t, 0);
+        halt(t);
+      },
     },
   });
   assert.equal(wfe.pico.run({ maxCycles: 1e6 }), 'idle');
