@@ -14,7 +14,15 @@
 // the end of the instruction or the clock step that woke it. When both
 // sleep, the clock jumps to the next alarm; when none is left, `run`
 // returns 'idle': the firmware waits for the outside world, which a runner
-// may provide (a later serial link) or end the run on.
+// may provide (a later serial link: it raises an IRQ line, then calls `run`
+// again) or end the run on. `run({ until })` runs a slice and resumes
+// exactly where it stopped.
+//
+// Between the cores: SEV (which rp2040js only logs) sets both cores' event
+// registers and ends the other's WFE; every IRQ line reaches both NVICs;
+// PSM FRCE_OFF.PROC1 holds core 1 in reset and, cleared, restarts it in the
+// ROM. rp2040js's SysTick pends its exception without waking a sleeping
+// core; here it wakes it, as any interrupt does.
 //
 // Invariants: the ELF is loaded exactly as built and starts as on the chip
 // (both cores from the ROM's reset vector; core 0 through the ELF's boot2);
@@ -148,7 +156,9 @@ export class Pico {
 
     this.attach(0);
     this.startCore1(0);
-    this.events = panel ? this.wirePanel(new ST7789(panel)) : null;
+    /** The ST7789 on SPI1 (null without one), and the times the run's phases are told by. */
+    this.panel = panel ? new ST7789(panel) : null;
+    this.events = this.panel ? this.wirePanel(this.panel) : null;
   }
 
   /** A Pico running the ELF `bytes` read from `path`. */
@@ -519,7 +529,7 @@ export class Pico {
     const rp2040 = this.rp2040;
     const gpio = rp2040.gpio;
     const spi = rp2040.spi[1];
-    const events = { panel, backlightOn: null, pictureStart: null, lastPixel: null, fullPanel: null, memoryWrites: 0 };
+    const events = { backlightOn: null, pictureStart: null, lastPixel: null, fullPanel: null, memoryWrites: 0 };
     let chipSelected = false;
     const level = (pin) => gpio[pin].value === GPIOPinState.High;
     const now = () => this.clockCycles();

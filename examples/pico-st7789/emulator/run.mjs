@@ -83,7 +83,7 @@ try {
       : undefined,
   });
   if (progress) process.stderr.write('\r\x1b[K');
-  const panel = pico.events.panel;
+  const panel = pico.panel;
   writeAtomically(values.out, encodePng(width, height, panel.picture()));
   const coreCycles = pico.coreCycles();
   report = {

@@ -35,9 +35,10 @@
 //
 // Invariants: the cache holds tags only (the flash is never written during a
 // run, so a line's data is the flash's); every core access to the four
-// aliases goes through `read`, so no flash read escapes the count; the
-// streaming FIFO (STREAM_ADDR, STREAM_CTR, STREAM_FIFO) is not modelled and
-// touching it is an error.
+// aliases is counted here (the bus looks up a 0x10 hit itself, with these
+// tags and counts, and hands the rest to `read` and `miss`), so no flash
+// read escapes the count; the streaming FIFO (STREAM_ADDR, STREAM_CTR,
+// STREAM_FIFO) is not modelled and touching it is an error.
 
 import { BasePeripheral } from 'rp2040js';
 import { RunError } from './errors.mjs';
