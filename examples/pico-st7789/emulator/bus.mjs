@@ -53,7 +53,8 @@ export function installBus(core, index, { rp2040, xip, sio, ppb }) {
     return offset;
   };
   const unaligned = (address, store) => {
-    throw new RunError(`core ${index}: a 32-bit ${store ? 'store to' : 'load from'} 0x${address.toString(16)}, not word-aligned (a HardFault on the M0+)`);
+    const access = store ? 'store to' : 'load from';
+    throw new RunError(`core ${index}: a 32-bit ${access} 0x${address.toString(16)}, not word-aligned (a HardFault on the M0+)`);
   };
 
   const mpuFault = (address, store) => {
@@ -64,7 +65,8 @@ export function installBus(core, index, { rp2040, xip, sio, ppb }) {
     if (store && noAccess) {
       throw new RunError(`core ${index} overflowed its stack: a store to ${at} hit its MPU guard (${range}, no access)`);
     }
-    throw new RunError(`core ${index}: a ${store ? 'store to' : 'load from'} ${at} is a fault in MPU region ${range} (${noAccess ? 'no access' : 'read-only'})`);
+    const access = store ? 'store to' : 'load from';
+    throw new RunError(`core ${index}: a ${access} ${at} is a fault in MPU region ${range} (${noAccess ? 'no access' : 'read-only'})`);
   };
   // An SRAM address the MPU forbids: a load from a no-access granule, a store to any restricted one.
   const checkLoad = (address) => {

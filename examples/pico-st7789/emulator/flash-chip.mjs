@@ -181,7 +181,8 @@ export class W25Q16JV {
         case 0x03:
         case 0x0b:
           if (transType !== TRANS_1C1A || lanes !== 1 || addressBits !== 24 || waitClocks !== (instruction === 0x0b ? 8 : 0)) {
-            this.fail(`${hex(instruction)} takes 1-lane data, a 24-bit address and ${instruction === 0x0b ? 8 : 0} wait clocks; the SSI sent ${framing}`);
+            const wait = instruction === 0x0b ? 8 : 0;
+            this.fail(`${hex(instruction)} takes 1-lane data, a 24-bit address and ${wait} wait clocks; the SSI sent ${framing}`);
           }
           return;
         case 0xeb:

@@ -151,7 +151,8 @@ export class Pico {
     rp2040.peripherals[SSI_SLOT] = this.ssi;
     this.xip = new XipCache(this.ssi, this.cores);
     this.memory = machineMemory(rp2040, this.xip);
-    rp2040.peripherals[XIP_CTRL_SLOT] = new XipControl(rp2040, this.xip, now, (cycles) => (this.cores[this.current].cycles += cycles));
+    const stall = (cycles) => (this.cores[this.current].cycles += cycles);
+    rp2040.peripherals[XIP_CTRL_SLOT] = new XipControl(rp2040, this.xip, now, stall);
     this.watchPsm(rp2040.peripherals[PSM_SLOT]);
 
     this.attach(0);

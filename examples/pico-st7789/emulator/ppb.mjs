@@ -120,7 +120,9 @@ export class CorePpb {
       const sizeField = (rasr >>> 1) & 0x1f;
       const ap = (rasr >>> 24) & 7;
       if (sizeField < 7 || ap === 4) {
-        throw new RunError(`core ${this.index}: MPU region ${region}: RASR 0x${rasr.toString(16)} is unpredictable on the Cortex-M0+ (SIZE < 7 or AP 100)`);
+        throw new RunError(
+          `core ${this.index}: MPU region ${region}: RASR 0x${rasr.toString(16)} is unpredictable on the Cortex-M0+ (SIZE < 7 or AP 100)`,
+        );
       }
       const size = 2 ** (sizeField + 1);
       const base = this.rbar[region] - (this.rbar[region] % size);

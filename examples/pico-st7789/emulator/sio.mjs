@@ -142,6 +142,7 @@ export class CoreSio {
 
   /** The SIO takes 32-bit stores only: a narrower one is not modelled. */
   narrowWrite(offset, bits) {
-    throw new RunError(`core ${this.index}: a ${bits}-bit store to SIO 0x${(0xd0000000 + offset).toString(16)} (the emulator models 32-bit SIO stores only)`);
+    const address = (0xd0000000 + offset).toString(16);
+    throw new RunError(`core ${this.index}: a ${bits}-bit store to SIO 0x${address} (the emulator models 32-bit SIO stores only)`);
   }
 }

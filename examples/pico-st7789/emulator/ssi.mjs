@@ -307,11 +307,12 @@ export class Ssi extends BasePeripheral {
     }
     const registers = this.configuration();
     const format = xipTransferFormat(registers);
-    const continuous = this.chip.continuous;
+    const modeBefore = this.chip.continuous;
     // With no instruction, XIP_CMD goes out as the mode bits after the address.
-    this.flashRead(format, format.instructionBits === 0 ? null : format.command, format.instructionBits === 0 ? format.command : 0);
+    const noInstruction = format.instructionBits === 0;
+    this.flashRead(format, noInstruction ? null : format.command, noInstruction ? format.command : 0);
     this.xipCycles = lineTransferCycles(registers);
-    this.xipReady = this.chip.continuous === continuous;
+    this.xipReady = this.chip.continuous === modeBefore;
     return this.xipCycles;
   }
 }

@@ -163,7 +163,8 @@ export class XipCache {
   sramAt(address, k) {
     if (this.cachingEnabled || this.ctrl & CTRL_POWER_DOWN) {
       throw new RunError(
-        `core ${k}: 0x${address.toString(16)} (the XIP cache as SRAM) is a bus error while the cache is ${this.cachingEnabled ? 'enabled' : 'powered down'}`,
+        `core ${k}: 0x${address.toString(16)} (the XIP cache as SRAM) is a bus error ` +
+          `while the cache is ${this.cachingEnabled ? 'enabled' : 'powered down'}`,
       );
     }
     return address & (CACHE_BYTES - 1);
