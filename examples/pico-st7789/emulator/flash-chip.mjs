@@ -69,7 +69,7 @@ export class W25Q16JV {
   /** A status write that has taken its tW is in effect. */
   settle() {
     if (this.pendingStatus && this.nowSeconds() >= this.busyUntil) {
-      this.status[0] = this.pendingStatus[0] & ~WEL;
+      this.status[0] = this.pendingStatus[0] & ~(BUSY | WEL); // both read-only
       this.status[1] = this.pendingStatus[1];
       this.pendingStatus = null;
     }
