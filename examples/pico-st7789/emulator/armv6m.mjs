@@ -16,7 +16,9 @@
 // the same cycle count (1); every other instruction is rp2040js's own.
 //
 // Invariant: `addWithCarry` and `shiftCarry` are the manual's pseudocode
-// functions of the same names; nothing else is changed.
+// functions of the same names; nothing else is changed. The look at the next
+// instruction is a `peek` (no count, no stall); the fetch that executes it
+// is the core's own read, once.
 
 /** The manual's AddWithCarry: sets N, Z, C, V and returns the 32-bit result. */
 function addWithCarry(core, x, y, carryIn) {
@@ -100,27 +102,51 @@ function executeCorrected(core, opcode) {
   return true;
 }
 
+// rp2040js's own executeInstruction, which the corrected one calls: one for
+// every core (they are of one class). The corrected one is a single
+// function too, for all cores alike (a closure per core would keep V8 from
+// specialising it, costing a tenth of the emulator's speed).
+let executeOriginal = null;
+
+function executeInstruction() {
+  if (this.interruptsUpdated && this.checkForInterrupts()) {
+    this.waiting = false;
+  }
+  const pc = this.registers[15] & ~1;
+  const opcode = this.peekInstruction(this.peekContext, pc);
+  if (executeCorrected(this, opcode)) {
+    this.readUint16(pc); // the fetch, for what it costs
+    this.PC += 2;
+    this.cycles += 1;
+    return 1;
+  }
+  // Interrupts were just checked: rp2040js need not look again first.
+  const pending = this.interruptsUpdated;
+  this.interruptsUpdated = false;
+  const cycles = executeOriginal.call(this);
+  this.interruptsUpdated ||= pending;
+  return cycles;
+}
+
 /**
  * Puts the corrections in front of `core.executeInstruction`. Pending
  * interrupts are taken first, exactly once, as rp2040js does; the corrected
- * instruction is then the one at the (possibly new) PC.
+ * instruction is then the one at the (possibly new) PC. `peek(context,
+ * address)` reads an instruction without side effects (default: the core's
+ * read, with the core as the context); one function for all cores, as the
+ * corrected executeInstruction is.
  */
-export function correctInstructions(core) {
-  const execute = core.executeInstruction.bind(core);
-  core.executeInstruction = () => {
-    if (core.interruptsUpdated && core.checkForInterrupts()) {
-      core.waiting = false;
-    }
-    if (executeCorrected(core, core.readUint16(core.PC & ~1))) {
-      core.PC += 2;
-      core.cycles += 1;
-      return 1;
-    }
-    // Interrupts were just checked: rp2040js need not look again first.
-    const pending = core.interruptsUpdated;
-    core.interruptsUpdated = false;
-    const cycles = execute();
-    core.interruptsUpdated ||= pending;
-    return cycles;
-  };
+export function correctInstructions(core, peek = readInstruction, context = core) {
+  const original = Object.getPrototypeOf(core).executeInstruction;
+  executeOriginal ??= original;
+  if (original !== executeOriginal) {
+    throw new Error("correctInstructions: a core of another class than the first one's");
+  }
+  core.peekInstruction = peek;
+  core.peekContext = context;
+  core.executeInstruction = executeInstruction;
+}
+
+function readInstruction(core, address) {
+  return core.readUint16(address);
 }

@@ -1,7 +1,24 @@
-// A stand-in for the RP2040's boot ROM: the part of it an rp2040-hal
-// firmware calls once it runs. The Raspberry Pi ROM image is not on any
-// package registry, so this one is written here, in Thumb code the emulator
-// runs (its cycles count like the firmware's own).
+// A stand-in for the RP2040's boot ROM: how it starts both cores, and the
+// part of it an rp2040-hal firmware calls once it runs. The Raspberry Pi ROM
+// image is not on any package registry, so this one is written here, in
+// Thumb code the emulator runs (its cycles count like the firmware's own).
+//
+// Both cores enter at the reset vector and read SIO CPUID (datasheet 2.8.1):
+//
+// - Core 0 boots from flash as the real ROM does: it sets the SSI up for
+//   standard 03h reads through XIP at clk_sys / 6, copies the 256 bytes of
+//   boot2 to the top of SRAM (0x20041f00), flushes the XIP cache and enters
+//   boot2 with lr = 0, so boot2 sets up its flash and vectors into the
+//   firmware's table at 0x10000100. (The real ROM first checks boot2's CRC,
+//   which the runner checks before it starts; and it streams boot2 with one
+//   03h command where this one reads it line by line through the cache.)
+// - Core 1 waits for core 0 to launch it (2.8.2): it empties its RX FIFO,
+//   sends 0, and sleeps in WFE until a word comes. A 0, or anything but 1
+//   where the 1 is due, starts it over (empty, send 0); then each word is
+//   echoed back: 1, the vector table (written to its VTOR), the stack
+//   pointer (its MSP) and the entry point, to which it branches. A 0 in
+//   their place starts it over too. It uses no stack; should the entry
+//   return, it sleeps in WFE for good.
 //
 // rp2040-hal (by default, without its `disable-intrinsics` feature) routes
 // these compiler intrinsics through the ROM: it reads the table-lookup
@@ -23,10 +40,12 @@
 // reset to USB boot) is not here: looking it up stops the run with an error
 // naming the code, never a silent zero.
 //
-// Invariants: the layout of the real ROM's header (magic at 0x10, version at
-// 0x13, 16-bit pointers at 0x14, 0x16, 0x18); the copies are word-wise where
-// the real ones are (memset4, memcpy44), byte-wise otherwise, so their costs
-// are of the same order as the real ROM's, not equal to them.
+// Invariants: the layout of the real ROM's header (initial stack pointer
+// and reset vector at 0x00, magic at 0x10, version at 0x13, 16-bit pointers
+// at 0x14, 0x16, 0x18); the launch protocol is the datasheet's; the copies
+// are word-wise where the real ones are (memset4, memcpy44), byte-wise
+// otherwise, so their costs are of the same order as the real ROM's, not
+// equal to them.
 
 import { Thumb } from './thumb.mjs';
 
@@ -35,6 +54,28 @@ export const MISSING_FUNCTION_BREAKPOINT = 0x52;
 
 const ROM_BYTES = 16 * 1024;
 const CODE_START = 0x100;
+const SRAM_END = 0x20042000;
+/** Where the ROM copies boot2 and enters it: the last 256 bytes of SRAM. */
+export const BOOT2_BASE = SRAM_END - 256;
+const XIP_BASE = 0x10000000;
+const XIP_CTRL_FLUSH = 0x14000004;
+const SSI_BASE = 0x18000000;
+const SSI_CTRLR0 = 0x00;
+const SSI_SSIENR = 0x08;
+const SSI_SER = 0x10;
+const SSI_BAUDR = 0x14;
+const SSI_SPI_CTRLR0 = 0xf4;
+/** 03h reads through XIP: standard SPI, 32-bit frames, EEPROM read; 8-bit instruction 03h, 24-bit address. */
+const CTRLR0_03H = (31 << 16) | (3 << 8);
+const SPI_CTRLR0_03H = (0x03 << 24) | (2 << 8) | (6 << 2);
+const ROM_FLASH_DIVIDER = 6;
+const SIO_BASE = 0xd0000000;
+const FIFO_ST = 0x50;
+const FIFO_WR = 0x54;
+const FIFO_RD = 0x58;
+const FIFO_VLD = 1;
+const FIFO_RDY = 2;
+const VTOR = 0xe000ed08;
 
 /** The two letters of a table code, as the ROM's 16-bit key. */
 function code(letters) {
@@ -153,6 +194,90 @@ function leadingOrTrailing(t, prefix, test, move) {
   return t[test](2, 0, 31).bcc('ne', `${prefix}.done`).addsImm(1, 1).label(`${prefix}.done`).movs(0, 1).bxLr();
 }
 
+// Both cores' reset: core 0 boots from flash, core 1 waits to be launched.
+function start(t) {
+  t.label('start').ldrConst(0, SIO_BASE).ldr(1, 0, 0).cmpImm(1, 0).bcc('ne', 'core1.wait');
+  // Core 0: 03h reads through XIP, at the ROM's pace.
+  t.ldrConst(3, SSI_BASE)
+    .movsImm(1, 0)
+    .str(1, 3, SSI_SSIENR)
+    .movsImm(1, ROM_FLASH_DIVIDER)
+    .str(1, 3, SSI_BAUDR)
+    .ldrConst(1, CTRLR0_03H)
+    .str(1, 3, SSI_CTRLR0)
+    .ldrConst(1, SPI_CTRLR0_03H)
+    .ldrConst(2, SSI_BASE + SSI_SPI_CTRLR0)
+    .str(1, 2)
+    .movsImm(1, 1)
+    .str(1, 3, SSI_SER)
+    .str(1, 3, SSI_SSIENR);
+  // boot2 to the top of SRAM, a word at a time.
+  t.ldrConst(0, XIP_BASE)
+    .ldrConst(1, BOOT2_BASE)
+    .movsImm(2, 64)
+    .label('boot2.copy')
+    .ldmia(0, [3])
+    .stmia(1, [3])
+    .subsImm(2, 1)
+    .bcc('ne', 'boot2.copy');
+  // Flush the cache (reading FLUSH waits for it), then boot2 with lr = 0.
+  return t
+    .ldrConst(0, XIP_CTRL_FLUSH)
+    .movsImm(1, 1)
+    .str(1, 0)
+    .ldr(1, 0)
+    .movsImm(1, 0)
+    .mov(14, 1)
+    .ldrConst(0, BOOT2_BASE | 1)
+    .bx(0);
+}
+
+// Core 1's wait for launch (r4 the SIO, r7 VTOR's address; no stack).
+function core1Wait(t) {
+  t.label('core1.wait').ldrConst(4, SIO_BASE).ldrConst(7, VTOR);
+  t.label('core1.handshake')
+    .ldr(1, 4, FIFO_ST)
+    .movsImm(2, FIFO_VLD)
+    .alu('tst', 1, 2)
+    .bcc('eq', 'core1.empty')
+    .ldr(1, 4, FIFO_RD)
+    .b('core1.handshake')
+    .label('core1.empty')
+    .movsImm(0, 0)
+    .bl('core1.send')
+    .bl('core1.receive')
+    .cmpImm(0, 1)
+    .bcc('ne', 'core1.handshake')
+    .bl('core1.send');
+  // The vector table, the stack pointer, the entry: each taken, then echoed.
+  const take = (use) => {
+    t.bl('core1.receive').cmpImm(0, 0).bcc('eq', 'core1.handshake');
+    use();
+    t.bl('core1.send');
+  };
+  take(() => t.str(0, 7));
+  take(() => t.msrMsp(0));
+  take(() => {});
+  t.blx(0).label('core1.done').wfe().b('core1.done');
+  // send: r0 into the TX FIFO once it has room, then SEV; r0 kept.
+  sleepUntilFifo(t, 'core1.send', FIFO_RDY).str(0, 4, FIFO_WR).sev().bxLr();
+  // receive: r0 from the RX FIFO, sleeping until there is a word.
+  return sleepUntilFifo(t, 'core1.receive', FIFO_VLD).ldr(0, 4, FIFO_RD).bxLr();
+}
+
+// At `label`: WFE until FIFO_ST (r4 the SIO) has `bit` set (r1, r2 spent).
+function sleepUntilFifo(t, label, bit) {
+  return t
+    .label(label)
+    .ldr(1, 4, FIFO_ST)
+    .movsImm(2, bit)
+    .alu('tst', 1, 2)
+    .bcc('ne', `${label}.ready`)
+    .wfe()
+    .b(label)
+    .label(`${label}.ready`);
+}
+
 /** The ROM image (4096 words) and where each function is. */
 export function buildBootrom() {
   const t = new Thumb(CODE_START);
@@ -177,15 +302,17 @@ export function buildBootrom() {
     addresses[letters] = t.here;
     write(t);
   }
+  const reset = t.here;
+  start(t);
+  core1Wait(t);
   const code_ = t.bytes();
   const functionTable = align4(CODE_START + code_.length);
   const dataTable = functionTable + 4 * (Object.keys(FUNCTIONS).length + 1);
 
   const rom = new Uint8Array(ROM_BYTES);
   const view = new DataView(rom.buffer);
-  // Never run: the runner starts the firmware at its own vector table.
-  view.setUint32(0x00, 0x20042000, true);
-  view.setUint32(0x04, lookup | 1, true);
+  view.setUint32(0x00, BOOT2_BASE, true); // the stack below boot2's copy, as the real ROM's
+  view.setUint32(0x04, reset | 1, true);
   rom.set([0x4d, 0x75, 0x01, 0x02], 0x10); // 'M', 'u', 1, version 2 (RP2040 B1 and later)
   view.setUint16(0x14, functionTable, true);
   view.setUint16(0x16, dataTable, true);

@@ -1,141 +1,613 @@
 // A Raspberry Pi Pico running a firmware ELF, with an ST7789 panel on SPI1
-// wired as the Waveshare Pico-LCD-1.3 is: rp2040js (one Cortex-M0+ core at
-// 125 MHz, counting its cycles) with this folder's boot ROM stand-in and its
-// corrections to rp2040js's instructions.
+// wired as the Waveshare Pico-LCD-1.3 is: rp2040js's RP2040 with both of its
+// Cortex-M0+ cores at 125 MHz (rp2040js runs one: core 1 is a second
+// rp2040js core on the same bus), this folder's boot ROM stand-in, its
+// corrections to rp2040js's instructions, and the flash as a real Pico has
+// it (the W25Q16JV behind the SSI, the firmware's own boot2, the XIP cache).
 //
-// Invariants: the ELF is loaded exactly as built, and started the way the
-// real boot2 starts it (vector table at 0x10000100); every cycle counted is
-// one the emulated core spent (the ROM stand-in's too); a firmware that
-// faults, stops in an endless loop, touches what the emulator does not
-// model, or outlives its cycle budget ends the run with an error.
+// The cores run in lockstep by cycles: the next instruction is always the
+// one of the core whose time (its cycle count) is lower, core 0 on a tie,
+// and the shared clock (alarms: SPI, timer) follows the earlier of the
+// running cores. A core asleep (WFE, WFI, or core 1 held in reset by the
+// PSM) is carried along at the other's time, counted as waiting; woken by
+// the other core (SEV, an interrupt it caused) or by an alarm, it starts at
+// the end of the instruction or the clock step that woke it. When both
+// sleep, the clock jumps to the next alarm; when none is left, `run`
+// returns 'idle': the firmware waits for the outside world, which a runner
+// may provide (a later serial link: it raises an IRQ line, then calls `run`
+// again) or end the run on. `run({ until })` runs a slice and resumes
+// exactly where it stopped.
+//
+// Between the cores: SEV (which rp2040js only logs) sets both cores' event
+// registers and ends the other's WFE; every IRQ line reaches both NVICs;
+// PSM FRCE_OFF.PROC1 holds core 1 in reset and, cleared, restarts it in the
+// ROM. rp2040js's SysTick pends its exception without waking a sleeping
+// core; here it wakes it, as any interrupt does.
+//
+// Invariants: the ELF is loaded exactly as built and starts as on the chip
+// (both cores from the ROM's reset vector; core 0 through the ELF's boot2);
+// every cycle counted is one an emulated core spent (the ROM stand-in's,
+// boot2's and flash stalls too); a firmware that faults, stops in an endless
+// loop, touches what the emulator does not model, or outlives its cycle
+// budget ends the run with a RunError naming the core and where it was.
 
 import { RP2040, GPIOPinState } from 'rp2040js';
 import { buildBootrom, codeLetters, MISSING_FUNCTION_BREAKPOINT } from './bootrom.mjs';
 import { functionAt, parseElf } from './elf.mjs';
 import { correctInstructions } from './armv6m.mjs';
 import { ST7789 } from './st7789.mjs';
+import { RunError } from './errors.mjs';
+import { installBus, machineMemory, peek16 } from './bus.mjs';
+import { CoreSio, InterCoreFifos } from './sio.mjs';
+import { CorePpb } from './ppb.mjs';
+import { W25Q16JV } from './flash-chip.mjs';
+import { Ssi } from './ssi.mjs';
+import { XipCache, XipControl } from './xip.mjs';
 
-export class RunError extends Error {}
+export { RunError };
 
 const FLASH_BASE = 0x10000000;
 const SRAM_BASE = 0x20000000;
-/** boot2, the first 256 bytes of flash, hands over to the vector table right after it. */
-const VECTOR_TABLE = FLASH_BASE + 0x100;
 const BOOT2_BYTES = 256;
 export const CLOCK_HZ = 125_000_000;
 const NANOS_PER_CYCLE = 1e9 / CLOCK_HZ;
 const EXC_HARDFAULT = 3;
+const ROM_END = 0x4000;
+const BRANCH_TO_SELF = 0xe7fe;
+const WFE = 0xbf20;
+/** How often (in instructions) the run looks for endless loops, its budget, and reports progress. */
+const CHECK_EVERY = 0xfffff;
+/** rp2040js's peripherals, by `(address >>> 14) << 2`. */
+const XIP_CTRL_SLOT = 0x14000;
+const SSI_SLOT = 0x18000;
+const PSM_SLOT = 0x40010;
+const PSM_FRCE_OFF = 0x04;
+const PSM_PROC1 = 1 << 16;
 
 /** The Pico-LCD-1.3's wiring: SPI1 on GP10 (clock) and GP11 (data); the panel's control lines. */
 export const WIRING = { clock: 10, data: 11, chipSelect: 9, dataCommand: 8, reset: 12, backlight: 13 };
 const GPIO_FUNCTION_SPI = 1;
 
-/**
- * Runs `elfBytes` (read from `elfPath`) until the core sleeps with nothing
- * left to wake it. Returns the panel and the cycle counts of the run's
- * phases; throws RunError for anything a real Pico would not have done the
- * same way.
- */
-export function runPico(elfBytes, elfPath, { panel: panelSize, maxCycles, onProgress = () => {} }) {
-  const elf = parseElf(elfBytes, elfPath);
-  const rp2040 = new RP2040();
-  const fail = (message) => {
-    throw new RunError(message);
-  };
-  rp2040.logger = strictLogger(fail);
-  const core = rp2040.core;
-  correctInstructions(core);
+export class Pico {
+  /**
+   * `segments` ({ loadAddress, data }, as an ELF's) are loaded as built;
+   * `source` names them in messages, `functions` (an ELF's symbols) name
+   * where a core is. `panel`: the ST7789's options (null: no panel).
+   * `onBreakpoint(core, code)`: returns true for a BKPT or UDF it handles
+   * (tests); any other ends the run. `flashStatusRegister2`: the flash
+   * chip's at power-on (QE set, as the Pico's).
+   */
+  constructor({ segments, source, functions = [], panel = null, onBreakpoint = () => false, flashStatusRegister2 } = {}) {
+    const rp2040 = new RP2040();
+    this.rp2040 = rp2040;
+    this.clock = rp2040.clock;
+    this.functions = functions;
+    this.onBreakpoint = onBreakpoint;
+    // rp2040js's SEV only logs: each core's logger turns that into the event.
+    rp2040.logger = strictLogger(() => this.sendEvent(0));
+    this.rom = buildBootrom();
+    rp2040.loadBootrom(this.rom.image); // also erases the flash and resets core 0 into the ROM: load the ELF after it
+    loadSegments(rp2040, segments, source);
+    checkBoot2(rp2040.flash, source);
 
-  const rom = buildBootrom();
-  rp2040.loadBootrom(rom.image); // also erases the flash: load the ELF after it
-  loadSegments(rp2040, elf, elfPath, fail);
-  checkBoot2(rp2040.flash, elfPath, fail);
+    /** Machine time in cycles: the clock's, which follows the earlier running core. */
+    this.time = 0;
+    this.steps = 0;
+    this.current = 0;
+    this.cores = [rp2040.core, null];
+    this.held = [false, false];
+    this.waiting = [0, 0];
+    this.instructions = [0, 0];
+    this.core1Ran = false;
+    /** Set when a sleeping core wakes or core 1 is reset: a core running alone must look again. */
+    this.woke = false;
+    this.irqLines = 0;
 
-  const pc = () => core.PC >>> 0;
-  rp2040.onBreak = (code) => {
-    if (code === MISSING_FUNCTION_BREAKPOINT) {
-      const table = core.registers[0] >>> 0 < rom.dataTable ? 'function' : 'data';
-      fail(
-        `the firmware looked up the boot ROM ${table} '${codeLetters(core.registers[1])}', which the runner's ROM ` +
-          `does not stand in for (called from ${functionAt(elf.functions, core.LR & ~1)})`,
-      );
-    }
-    fail(`a breakpoint or undefined instruction (#${code}) at ${functionAt(elf.functions, pc() - 2)}`);
-  };
-
-  const panel = new ST7789(panelSize);
-  const events = wirePanel(rp2040, panel, fail);
-
-  core.VTOR = VECTOR_TABLE;
-  core.SP = rp2040.readUint32(VECTOR_TABLE);
-  core.PC = rp2040.readUint32(VECTOR_TABLE + 4) & ~1;
-
-  const clock = rp2040.clock;
-  let instructions = 0;
-  for (;;) {
-    if (core.waiting) {
-      const nanos = clock.nanosToNextAlarm;
-      if (nanos <= 0 && !clock.nextAlarm) {
-        break; // asleep, and nothing is left to wake the core
+    // Core 1's rp2040js parts act on `rp2040.core`: give them a view of the chip whose core is core 1.
+    const core1View = Object.create(rp2040, {
+      core: { get: () => this.cores[1] },
+      onBreak: { value: (code) => this.breakpoint(1, code) },
+      logger: { value: strictLogger(() => this.sendEvent(1)) },
+    });
+    this.core1View = core1View;
+    rp2040.onBreak = (code) => this.breakpoint(0, code);
+    const ppb1 = new rp2040.ppb.constructor(core1View, 'PPB (core 1)');
+    rp2040.addClockListener((hz) => (ppb1.systickTimer.frequency = hz));
+    const sram = { base: SRAM_BASE, bytes: rp2040.sram.length };
+    this.ppbs = [new CorePpb(0, rp2040.ppb, sram), new CorePpb(1, ppb1, sram)];
+    this.fifos = new InterCoreFifos((irq, level) => rp2040.setInterrupt(irq, level));
+    this.sios = [
+      new CoreSio(0, this.fifos, rp2040.sio, rp2040.sio),
+      new CoreSio(1, this.fifos, rp2040.sio, new rp2040.sio.constructor(core1View)),
+    ];
+    // Every IRQ line reaches both cores' NVICs.
+    rp2040.setInterrupt = (irq, level) => {
+      this.irqLines = level ? this.irqLines | (1 << irq) : this.irqLines & ~(1 << irq);
+      for (let k = 0; k < 2; k++) {
+        const core = this.cores[k];
+        if (this.held[k]) continue;
+        const asleep = core.waiting;
+        core.setInterrupt(irq, level);
+        if (asleep && !core.waiting) this.woke = true;
       }
-      clock.tick(nanos);
-      continue;
-    }
-    if (core.IPSR === EXC_HARDFAULT) {
-      fail(`HardFault at ${functionAt(elf.functions, pc())}`);
-    }
-    const cycles = core.executeInstruction();
-    clock.tick(cycles * NANOS_PER_CYCLE);
-    instructions++;
-    if ((instructions & 0xfffff) === 0) {
-      // A branch to itself (`b .`, as panic-halt's loop) never ends.
-      if (rp2040.readUint16(pc()) === 0xe7fe) {
-        fail(`the firmware stopped in an endless loop in ${functionAt(elf.functions, pc())} (a panic?)`);
+    };
+    // rp2040js's SysTick pends its exception but wakes no sleeping core: wake it as an interrupt does.
+    this.ppbs.forEach((ppb, k) => {
+      const alarm = ppb.nvic.systickAlarm;
+      const expire = alarm.callback;
+      alarm.callback = () => {
+        expire();
+        const core = this.cores[k];
+        if (core.waiting && !this.held[k] && core.checkForInterrupts()) {
+          core.waiting = false;
+          this.woke = true;
+        }
+      };
+    });
+
+    const now = () => this.clockCycles();
+    this.flashChip = new W25Q16JV(rp2040.flash, () => this.clockCycles() / CLOCK_HZ, { statusRegister2: flashStatusRegister2 });
+    this.ssi = new Ssi(rp2040, this.flashChip, now);
+    rp2040.peripherals[SSI_SLOT] = this.ssi;
+    this.xip = new XipCache(this.ssi, this.cores);
+    this.memory = machineMemory(rp2040, this.xip);
+    const stall = (cycles) => (this.cores[this.current].cycles += cycles);
+    rp2040.peripherals[XIP_CTRL_SLOT] = new XipControl(rp2040, this.xip, now, stall);
+    this.watchPsm(rp2040.peripherals[PSM_SLOT]);
+
+    this.attach(0);
+    this.startCore1(0);
+    /** The ST7789 on SPI1 (null without one), and the times the run's phases are told by. */
+    this.panel = panel ? new ST7789(panel) : null;
+    this.events = this.panel ? this.wirePanel(this.panel) : null;
+  }
+
+  /** A Pico running the ELF `bytes` read from `path`. */
+  static fromElf(bytes, path, options) {
+    const elf = parseElf(bytes, path);
+    return new Pico({ ...options, segments: elf.segments, functions: elf.functions, source: path });
+  }
+
+  /** The clock's time in cycles. */
+  clockCycles() {
+    return this.clock.nanos / NANOS_PER_CYCLE;
+  }
+
+  /** Routes core k's accesses through its own bus and puts the instruction corrections in front of it. */
+  attach(k) {
+    const core = this.cores[k];
+    installBus(core, k, { rp2040: this.rp2040, xip: this.xip, sio: this.sios[k], ppb: this.ppbs[k] });
+    correctInstructions(core, peek16, this.memory);
+  }
+
+  /** Core 1 out of reset at time `at`: a new core at the ROM's reset vector, its NVIC seeing the IRQ lines as they are. */
+  startCore1(at) {
+    const previous = this.cores[1];
+    if (previous) this.waiting[1] += at - previous.cycles;
+    const core = new this.rp2040.core.constructor(this.core1View);
+    core.cycles = at;
+    core.SP = this.rp2040.bootrom[0];
+    core.PC = this.rp2040.bootrom[1] & ~1;
+    core.pendingInterrupts = this.irqLines;
+    core.interruptsUpdated = true;
+    this.cores[1] = core;
+    this.held[1] = false;
+    this.woke = true;
+    this.ppbs[1].reset();
+    this.attach(1);
+  }
+
+  /** PSM FRCE_OFF.PROC1 set holds core 1 in reset; cleared, core 1 starts again from the ROM. */
+  watchPsm(psm) {
+    const write = psm.writeUint32.bind(psm);
+    psm.writeUint32 = (offset, value) => {
+      const before = psm.frceOff;
+      write(offset, value);
+      if (offset !== PSM_FRCE_OFF) return;
+      if (psm.frceOff & ~PSM_PROC1) {
+        throw new RunError(`PSM FRCE_OFF 0x${psm.frceOff.toString(16)}: forcing off anything but core 1 is not modelled`);
       }
-      if (core.cycles > maxCycles) {
-        fail(`still running after ${maxCycles} cycles (${maxCycles / CLOCK_HZ} s at 125 MHz), in ${functionAt(elf.functions, pc())}`);
+      const at = this.cores[this.current].cycles;
+      if (psm.frceOff & ~before & PSM_PROC1) {
+        this.settle(1, at);
+        this.held[1] = true;
+        this.cores[1].waiting = true;
+        this.woke = true;
+      } else if (before & ~psm.frceOff & PSM_PROC1) {
+        this.startCore1(at);
       }
-      onProgress(core.cycles, events.memoryWrites);
+    };
+  }
+
+  /**
+   * SEV on core k (the manual's B1.5.18): its own event register is set,
+   * and the other core's TXEV-RXEV wire sets the other's, or ends its WFE
+   * (not a WFI: only an interrupt ends that), consuming the event.
+   */
+  sendEvent(k) {
+    this.cores[k].eventRegistered = true;
+    const j = 1 - k;
+    if (this.held[j]) return;
+    const other = this.cores[j];
+    // A sleeping core's PC is past the WFE or WFI it sleeps in.
+    if (other.waiting && peek16(this.memory, other.PC - 2) === WFE) {
+      other.waiting = false;
+      this.woke = true;
+    } else {
+      other.eventRegistered = true;
     }
   }
-  return { panel, phases: phases(events, core.cycles), cycles: core.cycles, instructions };
+
+  /** Brings an asleep core's time up to `at` (at least), counting the gap as waiting. */
+  settle(j, at) {
+    const core = this.cores[j];
+    if (at > core.cycles) {
+      this.waiting[j] += at - core.cycles;
+      core.cycles = at;
+    }
+  }
+
+  /**
+   * Runs until both cores sleep with nothing scheduled ('idle') or the
+   * machine's time reaches `until` ('until'). Throws RunError for what a
+   * real Pico would not have done the same way, or after `maxCycles`.
+   * `onProgress(cycles, panelWrites)` is called now and then.
+   */
+  run({ maxCycles = Infinity, until = Infinity, onProgress = () => {} } = {}) {
+    try {
+      return this.loop(maxCycles, until, onProgress);
+    } catch (error) {
+      if (error instanceof RunError && !error.located) {
+        throw new RunError(`${error.message} (${this.whereAll()})`, { located: true });
+      }
+      throw error;
+    } finally {
+      for (let j = 0; j < 2; j++) {
+        if (this.cores[j].waiting) this.settle(j, this.time);
+      }
+    }
+  }
+
+  loop(maxCycles, until, onProgress) {
+    const cores = this.cores;
+    for (;;) {
+      const awake0 = !cores[0].waiting;
+      const awake1 = !cores[1].waiting;
+      let reason;
+      if (awake0 && awake1) {
+        reason = this.runBoth(until, maxCycles, onProgress);
+      } else if (awake0 || awake1) {
+        reason = this.runAlone(awake0 ? 0 : 1, until, maxCycles, onProgress);
+      } else {
+        if (!this.sleepUntilAlarm()) return 'idle';
+        if (this.time >= until) return 'until';
+        if (this.time > maxCycles) this.check(maxCycles, onProgress);
+        continue;
+      }
+      if (reason) return reason;
+    }
+  }
+
+  /**
+   * Both cores run: each step is the next instruction of the core that is
+   * behind (core 0 on a tie), and the clock follows the earlier. Returns a
+   * reason to end the run, or null when a core sleeps or core 1 is reset.
+   */
+  runBoth(until, maxCycles, onProgress) {
+    const c0 = this.cores[0];
+    const c1 = this.cores[1];
+    const clock = this.clock;
+    let time = this.time;
+    let steps0 = 0;
+    let steps1 = 0;
+    let countdown = CHECK_EVERY + 1 - (this.steps & CHECK_EVERY);
+    let reason = null;
+    this.woke = false;
+    for (;;) {
+      if (c1.cycles < c0.cycles) {
+        this.current = 1;
+        c1.executeInstruction();
+        steps1++;
+        if (!this.core1Ran && c1.PC >= ROM_END) this.core1Ran = true;
+      } else {
+        this.current = 0;
+        c0.executeInstruction();
+        steps0++;
+      }
+      if (c0.waiting || c1.waiting || this.woke) break;
+      const target = c0.cycles < c1.cycles ? c0.cycles : c1.cycles;
+      if (target > time) {
+        clock.tick((target - time) * NANOS_PER_CYCLE);
+        time = target;
+      }
+      if (time >= until) {
+        reason = 'until';
+        break;
+      }
+      if (--countdown === 0) {
+        this.time = time;
+        this.count(0, steps0);
+        this.count(1, steps1);
+        steps0 = steps1 = 0;
+        this.check(maxCycles, onProgress);
+        countdown = CHECK_EVERY + 1;
+      }
+    }
+    this.time = time;
+    this.count(0, steps0);
+    this.count(1, steps1);
+    if (reason === null) this.follow(this.current);
+    return reason;
+  }
+
+  /**
+   * After core k's instruction that ended a stretch: the clock follows the
+   * earlier running core (or core k, if both now sleep), and a core woken
+   * on the way starts then.
+   */
+  follow(k) {
+    const cores = this.cores;
+    const core = cores[k];
+    let target = core.waiting ? Infinity : core.cycles;
+    const other = cores[1 - k];
+    if (!other.waiting && other.cycles < target) target = other.cycles;
+    if (target === Infinity) target = core.cycles;
+    if (target > this.time) {
+      const asleep0 = cores[0].waiting;
+      const asleep1 = cores[1].waiting;
+      this.clock.tick((target - this.time) * NANOS_PER_CYCLE);
+      this.time = target;
+      if (asleep0 && !cores[0].waiting) this.settle(0, target);
+      if (asleep1 && !cores[1].waiting) this.settle(1, target);
+    }
+  }
+
+  /**
+   * Core k runs while the other sleeps: the same steps as `loop`'s, with
+   * nothing to choose. Returns a reason to end the run, or null when the
+   * other core woke, core 1 was reset, or this one sleeps.
+   */
+  runAlone(k, until, maxCycles, onProgress) {
+    const core = this.cores[k];
+    const clock = this.clock;
+    let time = this.time;
+    let steps = 0;
+    let countdown = CHECK_EVERY + 1 - (this.steps & CHECK_EVERY);
+    let reason = null;
+    let watchLaunch = k === 1 && !this.core1Ran;
+    this.current = k;
+    this.woke = false;
+    for (;;) {
+      core.executeInstruction();
+      steps++;
+      if (watchLaunch && core.PC >= ROM_END) {
+        // Core 1 runs outside the ROM: the firmware launched it.
+        this.core1Ran = true;
+        watchLaunch = false;
+      }
+      const t = core.cycles;
+      clock.tick((t - time) * NANOS_PER_CYCLE);
+      time = t;
+      if (core.waiting || this.woke) break;
+      if (time >= until) {
+        reason = 'until';
+        break;
+      }
+      if (--countdown === 0) {
+        this.time = time;
+        this.count(k, steps);
+        steps = 0;
+        this.check(maxCycles, onProgress);
+        countdown = CHECK_EVERY + 1;
+      }
+    }
+    this.time = time;
+    this.count(k, steps);
+    const j = 1 - k;
+    if (!this.cores[j].waiting) this.settle(j, time);
+    return reason;
+  }
+
+  count(k, steps) {
+    this.steps += steps;
+    this.instructions[k] += steps;
+  }
+
+  /** Both cores asleep: the clock jumps to the next alarm (false when there is none). */
+  sleepUntilAlarm() {
+    const clock = this.clock;
+    if (!clock.nextAlarm) return false;
+    clock.tick(Math.max(0, clock.nextAlarm.nanos - clock.nanos));
+    const time = Math.ceil(clock.nanos / NANOS_PER_CYCLE);
+    if (time * NANOS_PER_CYCLE > clock.nanos) clock.tick(time * NANOS_PER_CYCLE - clock.nanos);
+    this.time = time;
+    for (let j = 0; j < 2; j++) {
+      if (!this.cores[j].waiting) this.settle(j, time);
+    }
+    return true;
+  }
+
+  check(maxCycles, onProgress) {
+    for (let k = 0; k < 2; k++) {
+      const core = this.cores[k];
+      if (core.waiting) continue;
+      if (core.IPSR === EXC_HARDFAULT) {
+        throw new RunError(`HardFault at ${this.where(k)}`, { located: true });
+      }
+      // A branch to itself (`b .`, as panic-halt's loop) never ends.
+      if (peek16(this.memory, core.PC & ~1) === BRANCH_TO_SELF) {
+        throw new RunError(`the firmware stopped in an endless loop in ${this.where(k)} (a panic?)`, { located: true });
+      }
+    }
+    if (this.time > maxCycles) {
+      throw new RunError(`still running after ${maxCycles} cycles (${maxCycles / CLOCK_HZ} s at 125 MHz), in ${this.whereAll()}`, {
+        located: true,
+      });
+    }
+    onProgress(this.time, this.events?.memoryWrites ?? 0);
+  }
+
+  breakpoint(k, code) {
+    if (this.onBreakpoint(k, code)) {
+      return;
+    }
+    const core = this.cores[k];
+    if (code === MISSING_FUNCTION_BREAKPOINT) {
+      const table = core.registers[0] >>> 0 < this.rom.dataTable ? 'function' : 'data';
+      throw new RunError(
+        `the firmware looked up the boot ROM ${table} '${codeLetters(core.registers[1])}', which the runner's ROM ` +
+          `does not stand in for (called from ${functionAt(this.functions, core.LR & ~1)} on core ${k})`,
+        { located: true },
+      );
+    }
+    throw new RunError(
+      `a breakpoint or undefined instruction (#${code}) at ${functionAt(this.functions, (core.PC - 2) >>> 0)} on core ${k}`,
+      { located: true },
+    );
+  }
+
+  /** Where core k is: its function and core. */
+  where(k) {
+    return `${functionAt(this.functions, this.cores[k].PC >>> 0)} on core ${k}`;
+  }
+
+  /** Where the running cores are. */
+  whereAll() {
+    const running = [0, 1].filter((k) => !this.held[k] && (k === 0 || this.core1Ran));
+    return running.map((k) => this.where(k)).join(' and ');
+  }
+
+  /** How many cores ran firmware: 2 once core 1 left the boot ROM. */
+  get coresUsed() {
+    return this.core1Ran ? 2 : 1;
+  }
+
+  /** Each core's busy and waiting cycles, and its flash stalls (part of busy). */
+  coreCycles() {
+    return [0, 1].map((k) => ({
+      core: k,
+      busy: this.cores[k].cycles - this.waiting[k],
+      waiting: this.waiting[k],
+      flashStall: this.xip.stalls[k],
+      instructions: this.instructions[k],
+    }));
+  }
+
+  /** The XIP cache's counts, with the cycles a line read costs as the SSI is set up now. */
+  cacheStatistics() {
+    return this.xip.statistics(this.ssi.xipReady ? this.ssi.xipCycles : null);
+  }
+
+  /**
+   * The run's phases in cycles: start-up (clocks, the panel's set-up and
+   * clear, up to the backlight), parse and index (up to the picture's first
+   * command), render (to its last pixel), first full panel (from the
+   * picture's first command until every pixel of the panel has been written
+   * once: the render's length for a top-to-bottom render). Null where the
+   * run never got there.
+   */
+  phases() {
+    const { backlightOn, pictureStart, lastPixel, fullPanel } = this.events ?? {};
+    const picture = backlightOn != null && pictureStart != null && lastPixel > pictureStart;
+    return {
+      startUp: backlightOn ?? null,
+      parseAndIndex: picture ? pictureStart - backlightOn : null,
+      render: picture ? lastPixel - pictureStart : null,
+      firstFullPanel: picture && fullPanel != null ? fullPanel - pictureStart : null,
+      total: this.time,
+    };
+  }
+
+  /**
+   * Connects the panel to SPI1 and its control pins. Returns the times the
+   * run's phases are told by: when the backlight came on (the template turns
+   * it on once the panel is cleared, before it loads the scene), the first
+   * command after that (the picture's first row), the last pixel, when the
+   * whole panel had been written, and how many rows (RAMWRs) the panel has
+   * taken.
+   */
+  wirePanel(panel) {
+    const rp2040 = this.rp2040;
+    const gpio = rp2040.gpio;
+    const spi = rp2040.spi[1];
+    const events = { backlightOn: null, pictureStart: null, lastPixel: null, fullPanel: null, memoryWrites: 0 };
+    let chipSelected = false;
+    const level = (pin) => gpio[pin].value === GPIOPinState.High;
+    const now = () => this.clockCycles();
+
+    // Chip select frames bytes; the controller keeps its command across frames.
+    gpio[WIRING.chipSelect].addListener((state) => {
+      chipSelected = state === GPIOPinState.Low;
+    });
+    gpio[WIRING.reset].addListener((state) => {
+      if (state === GPIOPinState.Low) {
+        panel.reset();
+      }
+    });
+    gpio[WIRING.backlight].addListener((state) => {
+      if (state === GPIOPinState.High && events.backlightOn === null) {
+        events.backlightOn = now();
+      }
+    });
+
+    // A byte takes 8 clocks of the bus; the next starts when it is out.
+    const done = rp2040.clock.createAlarm(() => spi.completeTransmit(0));
+    spi.onTransmit = (byte) => {
+      const routed = [WIRING.clock, WIRING.data].every((pin) => gpio[pin].functionSelect === GPIO_FUNCTION_SPI);
+      if (routed && chipSelected) {
+        const dataCommand = level(WIRING.dataCommand);
+        panelReceive(panel, byte, dataCommand);
+        if (!dataCommand && events.backlightOn !== null && events.pictureStart === null) {
+          events.pictureStart = now();
+          panel.startCoverage();
+        }
+        if (panel.command?.name === 'RAMWR') {
+          if (dataCommand) {
+            events.lastPixel = now();
+            if (events.fullPanel === null && events.pictureStart !== null && panel.fullyCovered) events.fullPanel = now();
+          } else {
+            events.memoryWrites++;
+          }
+        }
+      }
+      const hz = spi.clockFrequency;
+      if (!hz) {
+        throw new RunError('SPI1 transmits with no clock (SSPCPSR is 0)');
+      }
+      done.schedule((spi.dataBits * 1e9) / hz);
+    };
+    return events;
+  }
 }
 
-/**
- * The run's phases in cycles: start-up (clocks, the panel's set-up and
- * clear, up to the backlight), parse and index (up to the picture's first
- * command), render (to its last pixel). Null where the run never got there.
- */
-function phases(events, total) {
-  const { backlightOn, pictureStart, lastPixel } = events;
-  const picture = backlightOn !== null && pictureStart !== null && lastPixel > pictureStart;
-  return {
-    startUp: backlightOn,
-    parseAndIndex: picture ? pictureStart - backlightOn : null,
-    render: picture ? lastPixel - pictureStart : null,
-    total,
+function panelReceive(panel, byte, dataCommand) {
+  try {
+    panel.receive(byte, dataCommand);
+  } catch (error) {
+    throw new RunError(error.message);
+  }
+}
+
+/** Warnings and errors end the run; of the rest, only a core's SEV (`sendEvent`) matters. */
+function strictLogger(sendEvent) {
+  const fail = (component, message) => {
+    throw new RunError(`emulator (${component}): ${message}`);
   };
-}
-
-function strictLogger(fail) {
-  const quiet = () => {};
-  return {
-    debug: quiet,
-    info: quiet,
-    warn: (component, message) => fail(`emulator (${component}): ${message}`),
-    error: (component, message) => fail(`emulator (${component}): ${message}`),
+  const info = (component, message) => {
+    if (component === 'CortexM0Core' && message === 'SEV') sendEvent();
   };
+  return { debug: () => {}, info, warn: fail, error: fail };
 }
 
-function loadSegments(rp2040, elf, elfPath, fail) {
-  for (const { loadAddress, data } of elf.segments) {
+function loadSegments(rp2040, segments, source) {
+  for (const { loadAddress, data } of segments) {
     const end = loadAddress + data.length;
     if (loadAddress >= FLASH_BASE && end <= FLASH_BASE + rp2040.flash.length) {
       rp2040.flash.set(data, loadAddress - FLASH_BASE);
     } else if (loadAddress >= SRAM_BASE && end <= SRAM_BASE + rp2040.sram.length) {
       rp2040.sram.set(data, loadAddress - SRAM_BASE);
     } else {
-      fail(`${elfPath}: a segment at 0x${loadAddress.toString(16)} (${data.length} bytes) is in neither flash nor RAM`);
+      throw new RunError(`${source}: a segment at 0x${loadAddress.toString(16)} (${data.length} bytes) is in neither flash nor RAM`);
     }
   }
 }
@@ -145,7 +617,7 @@ function loadSegments(rp2040, elf, elfPath, fail) {
  * MSB first, no reflection, no final xor) of its first 252: an ELF without
  * a valid boot2 would not start on a real Pico, so it does not start here.
  */
-function checkBoot2(flash, elfPath, fail) {
+function checkBoot2(flash, source) {
   let crc = 0xffffffff;
   for (let i = 0; i < BOOT2_BYTES - 4; i++) {
     crc ^= flash[i] << 24;
@@ -155,68 +627,6 @@ function checkBoot2(flash, elfPath, fail) {
   }
   const stored = new DataView(flash.buffer).getUint32(BOOT2_BYTES - 4, true);
   if (crc >>> 0 !== stored) {
-    fail(`${elfPath}: no valid boot2 in the first 256 bytes of flash (a real Pico would not start it); see memory.x`);
-  }
-}
-
-/**
- * Connects the panel to SPI1 and its control pins. Returns the cycle counts
- * the run's phases are told by: when the backlight came on (the template
- * turns it on once the panel is cleared, before it loads the scene), the
- * first command after that (the picture's first row), the last pixel, and
- * how many rows (RAMWRs) the panel has taken.
- */
-function wirePanel(rp2040, panel, fail) {
-  const gpio = rp2040.gpio;
-  const spi = rp2040.spi[1];
-  const core = rp2040.core;
-  const events = { backlightOn: null, pictureStart: null, lastPixel: null, memoryWrites: 0 };
-  let chipSelected = false;
-  const level = (pin) => gpio[pin].value === GPIOPinState.High;
-
-  // Chip select frames bytes; the controller keeps its command across frames.
-  gpio[WIRING.chipSelect].addListener((state) => {
-    chipSelected = state === GPIOPinState.Low;
-  });
-  gpio[WIRING.reset].addListener((state) => {
-    if (state === GPIOPinState.Low) {
-      panel.reset();
-    }
-  });
-  gpio[WIRING.backlight].addListener((state) => {
-    if (state === GPIOPinState.High && events.backlightOn === null) {
-      events.backlightOn = core.cycles;
-    }
-  });
-
-  // A byte takes 8 clocks of the bus; the next starts when it is out.
-  const done = rp2040.clock.createAlarm(() => spi.completeTransmit(0));
-  spi.onTransmit = (byte) => {
-    const routed = [WIRING.clock, WIRING.data].every((pin) => gpio[pin].functionSelect === GPIO_FUNCTION_SPI);
-    if (routed && chipSelected) {
-      const dataCommand = level(WIRING.dataCommand);
-      guard(fail, () => panel.receive(byte, dataCommand));
-      if (!dataCommand && events.backlightOn !== null && events.pictureStart === null) {
-        events.pictureStart = core.cycles;
-      }
-      if (panel.command?.name === 'RAMWR') {
-        if (dataCommand) events.lastPixel = core.cycles;
-        else events.memoryWrites++;
-      }
-    }
-    const hz = spi.clockFrequency;
-    if (!hz) {
-      fail('SPI1 transmits with no clock (SSPCPSR is 0)');
-    }
-    done.schedule((spi.dataBits * 1e9) / hz);
-  };
-  return events;
-}
-
-function guard(fail, action) {
-  try {
-    action();
-  } catch (error) {
-    fail(error.message);
+    throw new RunError(`${source}: no valid boot2 in the first 256 bytes of flash (a real Pico would not start it); see memory.x`);
   }
 }

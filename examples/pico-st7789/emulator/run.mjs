@@ -11,14 +11,14 @@
 // time before giving up, default 120), --json (the report as JSON on
 // standard output), --quiet.
 //
-// Exit codes: 0 the run ended with the core asleep and the picture written;
+// Exit codes: 0 the run ended with both cores asleep and the picture written;
 // 1 the firmware or the ELF did something a real Pico would not survive, or
 // the panel was sent what it does not take (the message says what); 2 bad
 // arguments.
 
 import { readFileSync } from 'node:fs';
 import { parseArgs } from 'node:util';
-import { CLOCK_HZ, RunError, runPico } from './pico.mjs';
+import { CLOCK_HZ, Pico, RunError } from './pico.mjs';
 import { ElfError } from './elf.mjs';
 import { PanelError } from './st7789.mjs';
 import { encodePng, writeAtomically } from './png.mjs';
@@ -75,23 +75,28 @@ const seconds = (cycles) => (cycles / CLOCK_HZ).toFixed(3);
 let report;
 try {
   const elf = readFileSync(elfPath);
-  const run = runPico(elf, elfPath, {
-    panel: { width, height, offsetX, offsetY },
+  const pico = Pico.fromElf(elf, elfPath, { panel: { width, height, offsetX, offsetY } });
+  pico.run({
     maxCycles: maxSeconds * CLOCK_HZ,
     onProgress: progress
       ? (cycles, rows) => process.stderr.write(`\r${seconds(cycles)} s emulated, ${rows} panel writes`)
       : undefined,
   });
   if (progress) process.stderr.write('\r\x1b[K');
-  writeAtomically(values.out, encodePng(width, height, run.panel.picture()));
+  const panel = pico.panel;
+  writeAtomically(values.out, encodePng(width, height, panel.picture()));
+  const coreCycles = pico.coreCycles();
   report = {
     elf: elfPath,
     out: values.out,
     panel: `${width}x${height}`,
-    dark: run.panel.darkBecause,
+    dark: panel.darkBecause,
     clockHz: CLOCK_HZ,
-    instructions: run.instructions,
-    cycles: run.phases,
+    cores: pico.coresUsed,
+    instructions: coreCycles[0].instructions + coreCycles[1].instructions,
+    cycles: pico.phases(),
+    coreCycles,
+    xipCache: pico.cacheStatistics(),
   };
 } catch (error) {
   if (progress) process.stderr.write('\r\x1b[K');
@@ -105,16 +110,27 @@ try {
 if (values.json) {
   console.log(JSON.stringify(report, null, 2));
 } else if (!values.quiet) {
+  const count = (n) => n.toLocaleString('en');
   const row = (what, cycles) =>
-    `  ${what.padEnd(44)} ${cycles === null ? 'never reached' : `${cycles.toLocaleString('en').padStart(13)} cycles  ${seconds(cycles)} s`}`;
-  const { startUp, parseAndIndex, render, total } = report.cycles;
+    `  ${what.padEnd(44)} ${cycles === null ? 'never reached' : `${count(cycles).padStart(13)} cycles  ${seconds(cycles)} s`}`;
+  const { startUp, parseAndIndex, render, firstFullPanel, total } = report.cycles;
+  const cores = report.coreCycles.slice(0, report.cores);
+  const cache = report.xipCache;
   console.error(
     [
-      `${elfPath} on an emulated Raspberry Pi Pico (one Cortex-M0+ at 125 MHz):`,
+      `${elfPath} on an emulated Raspberry Pi Pico (${report.cores === 2 ? 'both Cortex-M0+ cores' : 'one Cortex-M0+ core'} at 125 MHz):`,
       row('start-up (clocks, panel set-up and clear)', startUp),
       row('parse and index the scene', parseAndIndex),
       row('render into the panel', render),
+      row('first full panel (from the picture\'s start)', firstFullPanel),
       row('in all', total),
+      ...cores.map(
+        ({ core, busy, waiting, flashStall }) =>
+          `  core ${core}: ${count(busy)} cycles busy (${count(flashStall)} of them stalled on flash), ${count(waiting)} waiting`,
+      ),
+      `  XIP cache: ${count(cache.accesses)} flash reads, ${count(cache.misses)} misses` +
+        (cache.lineReadCycles === null ? '' : ` (${cache.lineReadCycles} cycles a line read)`) +
+        `, ${count(cache.stallCycles)} cycles stalled`,
       report.dark ? `the panel is dark: ${report.dark}` : `the panel's ${report.panel} picture: ${values.out}`,
     ].join('\n'),
   );

@@ -6,7 +6,8 @@
 // Invariants: a command the model does not know, a parameter too many or
 // too few, or pixels in a format it does not model is an error (thrown as
 // PanelError), never ignored; the picture is what the panel shows: black
-// until the controller is out of sleep with its display on.
+// until the controller is out of sleep with its display on. Coverage, once
+// started, counts each of the panel's pixels the first time it is written.
 
 export class PanelError extends Error {}
 
@@ -52,6 +53,9 @@ export class ST7789 {
     }
     Object.assign(this, { width, height, offsetX, offsetY, invertedPanel });
     this.memory = new Uint16Array(MEMORY_COLUMNS * MEMORY_ROWS);
+    /** Memory cells written since `startCoverage` (null: not counting), and how many of them the panel shows. */
+    this.written = null;
+    this.covered = 0;
     /** How many times each command was received, by name. */
     this.counts = new Map();
     this.reset();
@@ -189,7 +193,12 @@ export class ST7789 {
     }
     const pixel = (this.pixelBytes[0] << 8) | this.pixelBytes[1];
     this.pixelBytes = [];
-    this.memory[this.memoryIndex(this.column, this.row)] = pixel;
+    const index = this.memoryIndex(this.column, this.row);
+    this.memory[index] = pixel;
+    if (this.written !== null && this.written[index] === 0) {
+      this.written[index] = 1;
+      if (this.shows(index)) this.covered++;
+    }
     // Along the window's row, then down to the next; past its end, back to its start.
     if (this.column < this.columns[1]) {
       this.column++;
@@ -205,6 +214,24 @@ export class ST7789 {
     if (this.madctl & MADCTL_MX) x = MEMORY_COLUMNS - 1 - x;
     if (this.madctl & MADCTL_MY) y = MEMORY_ROWS - 1 - y;
     return y * MEMORY_COLUMNS + x;
+  }
+
+  /** Counts from now on how many of the panel's pixels have been written at least once. */
+  startCoverage() {
+    this.written = new Uint8Array(MEMORY_COLUMNS * MEMORY_ROWS);
+    this.covered = 0;
+  }
+
+  /** Every pixel the panel shows has been written since `startCoverage`. */
+  get fullyCovered() {
+    return this.covered === this.width * this.height;
+  }
+
+  /** Whether memory cell `index` is one the panel shows. */
+  shows(index) {
+    const x = index % MEMORY_COLUMNS - this.offsetX;
+    const y = Math.floor(index / MEMORY_COLUMNS) - this.offsetY;
+    return x >= 0 && x < this.width && y >= 0 && y < this.height;
   }
 
   /** Why the panel is dark, or null when it shows its memory. */

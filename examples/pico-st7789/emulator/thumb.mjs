@@ -1,9 +1,11 @@
 // A small Thumb (Armv6-M) assembler: just the instructions the boot ROM
-// stand-in and the instruction checks are written in, so the emulator runs
-// real machine code for them (and counts its cycles) with no toolchain.
+// stand-in, the instruction checks and the test programs are written in, so
+// the emulator runs real machine code for them (and counts its cycles) with
+// no toolchain.
 //
 // Invariant: every encoding here is the Armv6-M Architecture Reference
-// Manual's 16-bit one for low registers; an operand out of range throws.
+// Manual's (16-bit ones for low registers, and the 32-bit BL, MRS, MSR);
+// an operand out of range, a branch or literal out of reach throws.
 
 const COND = { eq: 0, ne: 1, cs: 2, cc: 3, mi: 4, pl: 5, vs: 6, vc: 7, hi: 8, ls: 9, ge: 10, lt: 11, gt: 12, le: 13 };
 
@@ -28,6 +30,8 @@ export class Thumb {
     this.halves = [];
     this.labels = new Map();
     this.branches = [];
+    /** LDR (literal)s still to point at their constant: { at, value }. */
+    this.literals = [];
   }
 
   /** The address of the next instruction. */
@@ -85,8 +89,41 @@ export class Thumb {
   ldmia(rn, registers) { return this.emit(0xc800 | (low(rn) << 8) | registerList(registers)); }
   stmia(rn, registers) { return this.emit(0xc000 | (low(rn) << 8) | registerList(registers)); }
 
+  /** LDR rt, =value: the constant goes to the pool `bytes()` puts after the code. */
+  ldrConst(rt, value) {
+    this.literals.push({ at: this.halves.length, value: value >>> 0 });
+    return this.emit(0x4800 | (low(rt) << 8));
+  }
+  strReg(rt, rn, rm) { return this.emit(0x5000 | (low(rm) << 6) | (low(rn) << 3) | low(rt)); }
+  ldrReg(rt, rn, rm) { return this.emit(0x5800 | (low(rm) << 6) | (low(rn) << 3) | low(rt)); }
+
   // Control.
   bxLr() { return this.emit(0x4770); }
+  bx(rm) { return this.emit(0x4700 | (rm << 3)); } // any register
+  blx(rm) { return this.emit(0x4780 | (rm << 3)); } // any register but pc
+  nop() { return this.emit(0xbf00); }
+  wfe() { return this.emit(0xbf20); }
+  wfi() { return this.emit(0xbf30); }
+  sev() { return this.emit(0xbf40); }
+  cpsie() { return this.emit(0xb662); }
+  cpsid() { return this.emit(0xb672); }
+  udf(imm8) { return this.emit(0xde00 | unsigned(imm8, 8, 'immediate')); }
+  /** MSR MSP, rn (32 bits). */
+  msrMsp(rn) { return this.emit(0xf380 | low(rn)).emit(0x8808); }
+  /** BL label (32 bits): a call within ±4 MiB. */
+  bl(label) {
+    this.branches.push({ at: this.halves.length, label, cond: 'bl' });
+    return this.emit(0).emit(0);
+  }
+  /** A 32-bit little-endian data word (at a word-aligned address). */
+  word(value) {
+    if (this.here % 4 !== 0) {
+      throw new RangeError(`a data word at 0x${this.here.toString(16)} is not word-aligned`);
+    }
+    return this.emit(value & 0xffff).emit(value >>> 16);
+  }
+  /** Pads with NOPs to a multiple of 4 bytes. */
+  align4() { return this.here % 4 === 0 ? this : this.nop(); }
   bkpt(imm8) { return this.emit(0xbe00 | unsigned(imm8, 8, 'breakpoint')); }
   /** MRS rd, APSR (32 bits). */
   mrsApsr(rd) { return this.emit(0xf3ef).emit(0x8000 | (low(rd) << 8)); }
@@ -104,15 +141,48 @@ export class Thumb {
     return this.emit(0);
   }
 
-  /** The machine code, little-endian, with every branch resolved. */
+  /** Puts the pending LDR (literal)s' constants here, each once (after an unconditional branch or a return). */
+  pool() {
+    this.align4();
+    const addresses = new Map();
+    for (const { value } of this.literals) {
+      if (!addresses.has(value)) {
+        addresses.set(value, this.here);
+        this.word(value);
+      }
+    }
+    for (const { at, value } of this.literals) {
+      const offset = addresses.get(value) - ((this.base + 2 * at + 4) & ~3);
+      if (offset < 0 || offset > 1020) {
+        throw new RangeError(`the constant 0x${value.toString(16)} is out of an LDR's reach`);
+      }
+      this.halves[at] |= offset / 4;
+    }
+    this.literals = [];
+  }
+
+  /**
+   * The machine code, little-endian, with every branch resolved and the
+   * literal pool (each distinct constant once) after the code.
+   */
   bytes() {
+    if (this.literals.length > 0) {
+      this.pool();
+    }
     for (const { at, label, cond } of this.branches) {
       const target = this.labels.get(label);
       if (target === undefined) {
         throw new Error(`branch to undefined label ${label}`);
       }
       const offset = (target - (this.base + 2 * at + 4)) >> 1;
-      if (cond === null) {
+      if (cond === 'bl') {
+        if (offset < -(1 << 23) || offset >= 1 << 23) throw new RangeError(`call to ${label} is too far`);
+        const s = offset < 0 ? 1 : 0;
+        const j1 = (~(offset >> 22) ^ s) & 1;
+        const j2 = (~(offset >> 21) ^ s) & 1;
+        this.halves[at] = 0xf000 | (s << 10) | ((offset >> 11) & 0x3ff);
+        this.halves[at + 1] = 0xd000 | (j1 << 13) | (j2 << 11) | (offset & 0x7ff);
+      } else if (cond === null) {
         if (offset < -1024 || offset > 1023) throw new RangeError(`branch to ${label} is too far`);
         this.halves[at] = 0xe000 | (offset & 0x7ff);
       } else {

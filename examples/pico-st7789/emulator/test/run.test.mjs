@@ -1,6 +1,7 @@
 // The runner's command line on small firmwares written here: how a run
-// ends (the core asleep; a fault, an endless loop, a ROM function it lacks,
-// no valid boot2), its exit codes, and that a failed run leaves no picture.
+// ends (both cores asleep; a fault, an endless loop, a ROM function it
+// lacks, no valid boot2), its exit codes, its report, and that a failed run
+// leaves no picture.
 
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
@@ -9,56 +10,13 @@ import { existsSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { dirname, join } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { Thumb } from '../thumb.mjs';
+import { boot2, CORE0_CODE, elf, flashImage } from './firmware.mjs';
 
 const RUN = join(dirname(fileURLToPath(import.meta.url)), '..', 'run.mjs');
-const FLASH = 0x10000000;
 
-/** The boot ROM's check of boot2: CRC-32/MPEG-2 of its first 252 bytes. */
-function crc32Mpeg2(bytes) {
-  let crc = 0xffffffff;
-  for (const byte of bytes) {
-    crc ^= byte << 24;
-    for (let bit = 0; bit < 8; bit++) crc = crc & 0x80000000 ? (crc << 1) ^ 0x04c11db7 : crc << 1;
-  }
-  return crc >>> 0;
-}
-
-/**
- * A firmware ELF: boot2 (valid unless `badBoot2`), a vector table at
- * 0x10000100 and `program` (a function of a Thumb assembler) at 0x10000200.
- */
+/** A firmware ELF: boot2 (valid unless `badBoot2`) and `program` at CORE0_CODE, the reset vector. */
 function firmware(program, { badBoot2 = false } = {}) {
-  const image = new Uint8Array(0x400);
-  const view = new DataView(image.buffer);
-  view.setUint32(252, crc32Mpeg2(image.subarray(0, 252)) ^ (badBoot2 ? 1 : 0), true);
-  view.setUint32(0x100, 0x20042000, true);
-  view.setUint32(0x104, (FLASH + 0x200) | 1, true);
-  const code = new Thumb(FLASH + 0x200);
-  program(code);
-  image.set(code.bytes(), 0x200);
-
-  // ELF32, little-endian, ARM, one PT_LOAD segment of the whole image.
-  const elf = Buffer.alloc(52 + 32 + image.length);
-  elf.set([0x7f, 0x45, 0x4c, 0x46, 1, 1, 1], 0);
-  elf.writeUInt16LE(2, 16); // executable
-  elf.writeUInt16LE(40, 18); // ARM
-  elf.writeUInt32LE(1, 20);
-  elf.writeUInt32LE(FLASH + 0x201, 24);
-  elf.writeUInt32LE(52, 28); // program headers
-  elf.writeUInt16LE(52, 40);
-  elf.writeUInt16LE(32, 42);
-  elf.writeUInt16LE(1, 44);
-  elf.writeUInt16LE(40, 46);
-  const header = 52;
-  elf.writeUInt32LE(1, header); // PT_LOAD
-  elf.writeUInt32LE(84, header + 4);
-  elf.writeUInt32LE(FLASH, header + 8);
-  elf.writeUInt32LE(FLASH, header + 12);
-  elf.writeUInt32LE(image.length, header + 16);
-  elf.writeUInt32LE(image.length, header + 20);
-  elf.set(image, 84);
-  return elf;
+  return elf(flashImage({ boot2: boot2({ badCrc: badBoot2 }), programs: { [CORE0_CODE]: program } }));
 }
 
 function run(elf, ...args) {
@@ -83,13 +41,24 @@ test('a firmware that sleeps ends the run: exit 0, the picture written, dark whe
   const report = JSON.parse(result.stdout);
   assert.match(report.dark, /asleep/);
   assert.equal(report.cycles.startUp, null, 'the backlight never came on');
+  assert.equal(report.cycles.firstFullPanel, null);
+  assert.equal(report.cores, 1, 'core 1 stayed in the boot ROM');
+  for (const core of report.coreCycles) {
+    assert.equal(core.busy + core.waiting, report.cycles.total, `core ${core.core}'s busy and waiting cycles make the run`);
+  }
+  // The ROM reads boot2 as 32 lines of 03h reads at clk_sys / 6: (8 + 24 + 64) × 6 = 576 cycles each;
+  // the rest are boot2's quad continuous reads at clk_sys / 2: (8 + 4 + 16) × 2 + 1 = 57.
+  const cache = report.xipCache;
+  assert.equal(cache.lineReadCycles, 57);
+  assert.equal(cache.stallCycles, 32 * 576 + 57 * (cache.misses - 32));
+  assert.equal(cache.accesses, cache.hits + cache.misses);
 });
 
 test('what a real Pico would not survive ends the run with exit 1, a message and no picture', () => {
   const cases = [
-    [firmware((t) => t.label('here').b('here')), /endless loop in 0x10000200/],
+    [firmware((t) => t.label('here').b('here')), /endless loop in 0x10000400 on core 0/],
     [firmware(sleep, { badBoot2: true }), /no valid boot2/],
-    [firmware((t) => t.emit(0xde00)), /undefined instruction \(#0\) at 0x10000200/], // udf
+    [firmware((t) => t.emit(0xde00)), /undefined instruction \(#0\) at 0x10000400 on core 0/], // udf
     // rom_func_lookup(*0x14, 'RE'): flash_range_erase, which the stand-in lacks.
     [
       firmware((t) =>
@@ -111,7 +80,7 @@ test('a run out of time says where it was', () => {
   // A loop that is not a branch to itself: it ends only by the budget.
   const result = run(firmware((t) => t.label('loop').addsImm(0, 1).b('loop')), '--max-seconds', '0.01');
   assert.equal(result.status, 1);
-  assert.match(result.stderr, /still running after 1250000 cycles \(0\.01 s at 125 MHz\), in 0x1000020/);
+  assert.match(result.stderr, /still running after 1250000 cycles \(0\.01 s at 125 MHz\), in 0x1000040. on core 0/);
 });
 
 test('bad arguments exit 2 with the usage', () => {

@@ -100,3 +100,18 @@ test('what the model does not take is an error, never ignored', () => {
   }
   assert.throws(() => new ST7789({ width: 240, height: 321 }), PanelError);
 });
+
+test("coverage counts each of the panel's pixels once, from when it starts, inside the panel's window only", () => {
+  const panel = new ST7789({ width: 2, height: 2, offsetX: 1, offsetY: 1 });
+  setUp(panel);
+  fill(panel, [0, 2], [0, 2], Array(9).fill(0xffff)); // before coverage starts: not counted
+  panel.startCoverage();
+  assert.equal(panel.covered, 0);
+  fill(panel, [0, 2], [0, 1], Array(6).fill(0x1234)); // rows 0 and 1: the panel's top row (memory row 1) only
+  assert.equal(panel.covered, 2);
+  fill(panel, [1, 1], [1, 1], [0x1234]); // written again: no new pixel
+  assert.equal(panel.covered, 2);
+  assert.ok(!panel.fullyCovered);
+  fill(panel, [1, 2], [2, 2], [1, 2]);
+  assert.ok(panel.fullyCovered);
+});

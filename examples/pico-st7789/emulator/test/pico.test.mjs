@@ -1,0 +1,73 @@
+// The machine's run loop: a run in slices ends exactly as a run in one go
+// (what a later serial link will drive it by), 'idle' when both cores sleep
+// with nothing scheduled, a sleeping core woken by its SysTick (which
+// rp2040js pends without waking anyone), and each core's own interpolators.
+
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { CORE0_CODE, FLASH, RECORD, SIO, core1Started, delay, fifoPop, fifoPush, flashImage, halt, machine, spawnCore1, values } from './firmware.mjs';
+
+const record = (t, r) => t.bkpt(RECORD + r);
+
+test('a run in slices ends as a run in one go, and returns idle when both cores sleep with nothing scheduled', () => {
+  const image = flashImage({ programs: { [CORE0_CODE]: (t) => halt(record(delay(t, 20000), 0)) } });
+  const whole = machine(image);
+  assert.equal(whole.pico.run(), 'idle');
+  const sliced = machine(image);
+  let slices = 0;
+  while (sliced.pico.run({ until: sliced.pico.time + 1000 }) === 'until') slices++;
+  assert.ok(slices > 50, `${slices} slices`);
+  assert.equal(sliced.pico.time, whole.pico.time);
+  assert.deepEqual(sliced.records, whole.records);
+  assert.deepEqual(sliced.pico.coreCycles(), whole.pico.coreCycles());
+  assert.deepEqual(sliced.pico.cacheStatistics(), whole.pico.cacheStatistics());
+});
+
+test('SysTick wakes a core sleeping in WFI and takes its exception', () => {
+  const handler = FLASH + 0x2000;
+  const image = flashImage({
+    vectors: { 15: handler },
+    programs: {
+      [CORE0_CODE]: (t) => {
+        t.ldrConst(1, 0xe000e010)
+          .ldrConst(0, 1000)
+          .str(0, 1, 4) // RVR; the counter starts from its reset value, 0xffffff
+          .movsImm(0, 7)
+          .str(0, 1) // CSR: enabled, interrupting, on the processor clock
+          .wfi();
+        halt(record(t, 0));
+      },
+      [handler]: (t) => t.movsImm(0, 0x5c).inline(record, 0).ldrConst(1, 0xe000e010).movsImm(0, 0).str(0, 1).bxLr(),
+    },
+  });
+  const { pico, records } = machine(image);
+  assert.equal(pico.run({ maxCycles: 1e8 }), 'idle');
+  assert.equal(values(records, 0)[0], 0x5c, 'the handler ran');
+  assert.ok(records[0][0].time > 0xffffff, 'when the counter ran out, the core asleep');
+  assert.equal(records[0].length, 2, 'then the core went on after its WFI');
+});
+
+test('each core has its own interpolators', () => {
+  const accum0 = 0x80;
+  const image = flashImage({
+    programs: {
+      [CORE0_CODE]: (t) => {
+        spawnCore1(t, { entry: FLASH + 0x1000, stack: 0x20020000 });
+        t.ldrConst(6, SIO + accum0).movsImm(0, 5).str(0, 6);
+        fifoPush(t, 0);
+        fifoPop(t, 0);
+        halt(t.ldr(0, 6).inline(record, 0));
+      },
+      [FLASH + 0x1000]: (t) => {
+        core1Started(t);
+        fifoPop(t, 0);
+        t.ldrConst(6, SIO + accum0).movsImm(0, 7).str(0, 6);
+        fifoPush(t, 0);
+        halt(t.ldr(0, 6).inline(record, 0));
+      },
+    },
+  });
+  const { pico, records } = machine(image);
+  assert.equal(pico.run({ maxCycles: 1e6 }), 'idle');
+  assert.deepEqual([values(records, 0).at(-1), values(records, 1)[0]], [5, 7]);
+});
