@@ -23,32 +23,30 @@ fn main() {
     let manifest = PathBuf::from(env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
     // Where each firmware's code runs: memory.x includes
     // `code-placement.x`, found in a folder of its own for each binary.
-    // The embedded-scene firmware's is copied into SRAM at boot (the
-    // default; sram-code.x), or runs in place from the execute-in-place
-    // flash through its cache. The live firmware's runs from flash: its
-    // SRAM goes to the scenes it is sent.
     println!("cargo:rerun-if-env-changed=OCTRACE_CODE_IN");
-    let in_sram = match env::var("OCTRACE_CODE_IN").as_deref() {
-        Ok("sram") | Err(_) => true,
-        Ok("flash") => false,
-        Ok(other) => fail(&format!("OCTRACE_CODE_IN={other}: expected `sram` (the default) or `flash`")),
+    let scene_firmware = match env::var("OCTRACE_CODE_IN").as_deref() {
+        Ok("sram") | Err(_) => Placement::AllInSram,
+        Ok("render") => Placement::RenderInSram,
+        Ok("flash") => Placement::Flash,
+        Ok(other) => fail(&format!("OCTRACE_CODE_IN={other}: expected `sram` (the default), `render` or `flash`")),
     };
     let read = |script: &str| {
         println!("cargo:rerun-if-changed={script}");
         std::fs::read_to_string(script).unwrap_or_else(|e| fail(&format!("read {script}: {e}")))
     };
-    let placement = |folder: &str, text: &str| {
-        let dir = out.join(folder);
+    let sram_code = read("sram-code.x");
+    for (binary, placement) in [("octrace-pico-st7789", scene_firmware), ("octrace-pico-live", Placement::RenderInSram)] {
+        let dir = out.join(binary);
+        let script = match placement.copied() {
+            Some(copied) => sram_code.replace("COPIED", copied),
+            None => "/* The code runs in place from flash, through the XIP cache. */\n".to_owned(),
+        };
         std::fs::create_dir_all(&dir)
-            .and_then(|()| std::fs::write(dir.join("code-placement.x"), text))
-            .unwrap_or_else(|e| fail(&format!("write {folder}/code-placement.x: {e}")));
-        dir
-    };
-    let sram = placement("code-in-sram", &read("sram-code.x"));
-    let flash = placement("code-in-flash", "/* The code runs in place from flash, through the XIP cache. */\n");
-    let scene_firmware = if in_sram { &sram } else { &flash };
-    println!("cargo:rustc-link-arg-bin=octrace-pico-st7789=-L{}", scene_firmware.display());
-    println!("cargo:rustc-link-arg-bin=octrace-pico-live=-L{}", flash.display());
+            .and_then(|()| std::fs::write(dir.join("code-placement.x"), script))
+            .unwrap_or_else(|e| fail(&format!("write {binary}/code-placement.x: {e}")));
+        println!("cargo:rustc-link-arg-bin={binary}=-L{}", dir.display());
+    }
+    let in_sram = scene_firmware != Placement::Flash;
     if in_sram {
         println!("cargo:rustc-cfg=code_in_sram");
     }
@@ -99,4 +97,33 @@ fn main() {
 fn fail(message: &str) -> ! {
     eprintln!("octrace-pico-st7789: {message}");
     std::process::exit(1);
+}
+
+/// Where a firmware's code runs.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Placement {
+    /// All of it (and its constants) copied into SRAM at boot.
+    AllInSram,
+    /// The render path copied into SRAM (octrace-core's tracing, the two
+    /// cores' loop, the compiler's 64-bit helpers); the rest (the parser,
+    /// USB, the panel's set-up) runs from flash, so that SRAM is left to
+    /// the scene.
+    RenderInSram,
+    /// All of it in place in flash, through the XIP cache.
+    Flash,
+}
+
+impl Placement {
+    /// The input sections `sram-code.x` copies, or none.
+    fn copied(self) -> Option<&'static str> {
+        match self {
+            Placement::AllInSram => Some("*(.text .text.*); *(.rodata .rodata.*);"),
+            Placement::RenderInSram => Some(concat!(
+                "*(.text.*octrace_core*accel* .text.*octrace_core*shapes* .text.*octrace_core*shade* ",
+                ".text.*octrace_core*render* .text.*octrace_core*math* .text.*octrace_core*raytracer* ",
+                ".text.*both_cores* .text.__aeabi_* .text.__*di3 .text.__*di4);"
+            )),
+            Placement::Flash => None,
+        }
+    }
 }

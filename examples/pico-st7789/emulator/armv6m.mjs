@@ -12,6 +12,21 @@
 //   carry alone (rp2040js sets it from bit 31: JavaScript masks the shift
 //   count -1 to 31), and LSLS by 33 to 255 must clear it.
 //
+// - WFI with PRIMASK set: a pending interrupt that would be taken were
+//   PRIMASK clear ends the sleep (or keeps WFI from sleeping at all, if it
+//   was pending already), and is taken only once PRIMASK is cleared
+//   (Armv6-M ARM, B1.5.18, "WFI" and "Wakeup events"); rp2040js takes it at
+//   once, inside the firmware's critical section, or sleeps through one
+//   pending before the WFI. A firmware that masks interrupts, checks for
+//   work and sleeps (the usual race-free wait) ran its interrupt handler
+//   inside what the mask guards, or slept for ever.
+//
+// - Exception entry: the handler's address comes from the vector table
+//   with its Thumb bit set, and rp2040js keeps that bit in the PC (its
+//   reset and BX clear it). Fetches mask it, but everything that reads the
+//   PC as a value is then one too high: `add rN, pc` in a handler (a
+//   compiled `match`'s jump table) read the wrong entry and jumped wild.
+//
 // Each corrected instruction is executed here instead of by rp2040js, with
 // the same cycle count (1); every other instruction is rp2040js's own.
 //
@@ -125,6 +140,10 @@ function executeInstruction() {
   this.interruptsUpdated = false;
   const cycles = executeOriginal.call(this);
   this.interruptsUpdated ||= pending;
+  // A WFI with PRIMASK set does not sleep while an interrupt is pending.
+  if (opcode === WFI && this.waiting && this.PM && interruptPending(this)) {
+    this.waiting = false;
+  }
   return cycles;
 }
 
@@ -137,15 +156,60 @@ function executeInstruction() {
  * corrected executeInstruction is.
  */
 export function correctInstructions(core, peek = readInstruction, context = core) {
-  const original = Object.getPrototypeOf(core).executeInstruction;
-  executeOriginal ??= original;
-  if (original !== executeOriginal) {
+  const prototype = Object.getPrototypeOf(core);
+  executeOriginal ??= prototype.executeInstruction;
+  checkOriginal ??= prototype.checkForInterrupts;
+  entryOriginal ??= prototype.exceptionEntry;
+  if (
+    prototype.executeInstruction !== executeOriginal ||
+    prototype.checkForInterrupts !== checkOriginal ||
+    prototype.exceptionEntry !== entryOriginal
+  ) {
     throw new Error("correctInstructions: a core of another class than the first one's");
   }
   core.peekInstruction = peek;
   core.peekContext = context;
   core.executeInstruction = executeInstruction;
+  core.checkForInterrupts = checkForInterrupts;
+  core.exceptionEntry = exceptionEntry;
 }
+
+// rp2040js's own exceptionEntry, which the corrected one calls.
+let entryOriginal = null;
+
+/** rp2040js's exception entry, the handler's address taken as the architecture does: without its Thumb bit. */
+function exceptionEntry(exception) {
+  entryOriginal.call(this, exception);
+  this.PC = this.PC & ~1;
+}
+
+// rp2040js's own checkForInterrupts (takes a pending exception, if any may
+// be taken now), which the corrected one calls.
+let checkOriginal = null;
+
+/**
+ * rp2040js's check, but a core asleep with PRIMASK set only wakes: its
+ * callers end the sleep when this returns true, and the interrupt is taken
+ * at the first check after PRIMASK clears (CPSIE and MSR PRIMASK mark the
+ * interrupts for checking). An NMI ignores PRIMASK, as on the chip.
+ */
+function checkForInterrupts() {
+  if (!(this.waiting && this.PM) || this.pendingNMI) {
+    return checkOriginal.call(this);
+  }
+  const wakes = interruptPending(this);
+  if (wakes) {
+    this.interruptsUpdated = true;
+  }
+  return wakes;
+}
+
+/** Whether `core` has an interrupt pending that PRIMASK alone holds back. */
+function interruptPending(core) {
+  return (core.pendingInterrupts & core.enabledInterrupts) !== 0 || core.pendingSystick || core.pendingPendSV;
+}
+
+const WFI = 0xbf30;
 
 function readInstruction(core, address) {
   return core.readUint16(address);

@@ -22,7 +22,9 @@
 // registers and ends the other's WFE; every IRQ line reaches both NVICs;
 // PSM FRCE_OFF.PROC1 holds core 1 in reset and, cleared, restarts it in the
 // ROM. rp2040js's SysTick pends its exception without waking a sleeping
-// core; here it wakes it, as any interrupt does.
+// core; here it wakes it, as any interrupt does. An interrupt's pending
+// state follows the NVIC's rule: cleared on entry, kept only while its line
+// is high (rp2040js keeps it until the line falls).
 //
 // Invariants: the ELF is loaded exactly as built and starts as on the chip
 // (both cores from the ROM's reset vector; core 0 through the ELF's boot2);
@@ -52,6 +54,8 @@ const BOOT2_BYTES = 256;
 export const CLOCK_HZ = 125_000_000;
 const NANOS_PER_CYCLE = 1e9 / CLOCK_HZ;
 const EXC_HARDFAULT = 3;
+/** The exception number of IRQ 0. */
+const FIRST_IRQ = 16;
 const ROM_END = 0x4000;
 const BRANCH_TO_SELF = 0xe7fe;
 const WFE = 0xbf20;
@@ -178,6 +182,16 @@ export class Pico {
     const core = this.cores[k];
     installBus(core, k, { rp2040: this.rp2040, xip: this.xip, sio: this.sios[k], ppb: this.ppbs[k] });
     correctInstructions(core, peek16, this.memory);
+    // An interrupt's pending state clears as its handler is entered, and
+    // stays only while its line is still high (the NVIC's rule; rp2040js
+    // keeps a pending bit until the line falls, so an interrupt pended by
+    // software, NVIC ISPR, with its line low was taken for ever).
+    const enter = core.exceptionEntry;
+    core.exceptionEntry = (exception) => {
+      enter.call(core, exception);
+      const irq = exception - FIRST_IRQ;
+      if (irq >= 0 && !(this.irqLines & (1 << irq))) core.pendingInterrupts &= ~(1 << irq);
+    };
   }
 
   /** Core 1 out of reset at time `at`: a new core at the ROM's reset vector, its NVIC seeing the IRQ lines as they are. */

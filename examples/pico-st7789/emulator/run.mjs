@@ -11,10 +11,17 @@
 // time before giving up, default 120), --json (the report as JSON on
 // standard output), --quiet.
 //
-// Exit codes: 0 the run ended with both cores asleep and the picture written;
-// 1 the firmware or the ELF did something a real Pico would not survive, or
-// the panel was sent what it does not take (the message says what); 2 bad
-// arguments.
+// --serial: the board as a serial device (serial.mjs), for the live
+// firmware: prints the path of a pseudo-terminal on its first line of
+// standard output and serves the firmware's USB serial port there until
+// standard input closes or the process is signalled (`host-sim board PATH
+// scene.txt` then talks to it). With --out, the panel's picture is written
+// each time the firmware waits for the host again.
+//
+// Exit codes: 0 the run ended with both cores asleep and the picture written
+// (or, with --serial, the serve ended); 1 the firmware or the ELF did
+// something a real Pico would not survive, or the panel was sent what it
+// does not take (the message says what); 2 bad arguments.
 
 import { readFileSync } from 'node:fs';
 import { parseArgs } from 'node:util';
@@ -22,9 +29,11 @@ import { CLOCK_HZ, Pico, RunError } from './pico.mjs';
 import { ElfError } from './elf.mjs';
 import { PanelError } from './st7789.mjs';
 import { encodePng, writeAtomically } from './png.mjs';
+import { serveSerial } from './serial.mjs';
 
 const USAGE =
-  'usage: node run.mjs ELF [--out FILE.png] [--panel WxH] [--panel-offset X,Y] [--max-seconds S] [--json] [--quiet]';
+  'usage: node run.mjs ELF [--out FILE.png] [--panel WxH] [--panel-offset X,Y] [--max-seconds S] [--json] [--quiet]\n' +
+  '       node run.mjs ELF --serial [--out FILE.png] [--panel WxH] [--panel-offset X,Y]';
 
 function usage(message) {
   console.error(`octrace-pico-emulator: ${message}\n${USAGE}`);
@@ -44,7 +53,8 @@ try {
   args = parseArgs({
     allowPositionals: true,
     options: {
-      out: { type: 'string', default: 'panel.png' },
+      out: { type: 'string' },
+      serial: { type: 'boolean', default: false },
       panel: { type: 'string', default: '240x240' },
       'panel-offset': { type: 'string', default: '0,0' },
       'max-seconds': { type: 'string', default: '120' },
@@ -66,9 +76,13 @@ const maxSeconds = Number(values['max-seconds']);
 if (!(maxSeconds > 0)) {
   usage(`--max-seconds ${values['max-seconds']}: expected a positive number`);
 }
-if (!values.out.toLowerCase().endsWith('.png')) {
+if (values.out !== undefined && !values.out.toLowerCase().endsWith('.png')) {
   usage(`--out ${values.out}: the picture is written as PNG: name a .png file`);
 }
+if (values.serial) {
+  await serve();
+}
+const out = values.out ?? 'panel.png';
 
 const progress = !values.quiet && !values.json && process.stderr.isTTY;
 const seconds = (cycles) => (cycles / CLOCK_HZ).toFixed(3);
@@ -84,11 +98,11 @@ try {
   });
   if (progress) process.stderr.write('\r\x1b[K');
   const panel = pico.panel;
-  writeAtomically(values.out, encodePng(width, height, panel.picture()));
+  writeAtomically(out, encodePng(width, height, panel.picture()));
   const coreCycles = pico.coreCycles();
   report = {
     elf: elfPath,
-    out: values.out,
+    out,
     panel: `${width}x${height}`,
     dark: panel.darkBecause,
     clockHz: CLOCK_HZ,
@@ -131,7 +145,34 @@ if (values.json) {
       `  XIP cache: ${count(cache.accesses)} flash reads, ${count(cache.misses)} misses` +
         (cache.lineReadCycles === null ? '' : ` (${cache.lineReadCycles} cycles a line read)`) +
         `, ${count(cache.stallCycles)} cycles stalled`,
-      report.dark ? `the panel is dark: ${report.dark}` : `the panel's ${report.panel} picture: ${values.out}`,
+      report.dark ? `the panel is dark: ${report.dark}` : `the panel's ${report.panel} picture: ${out}`,
     ].join('\n'),
   );
+}
+
+/** --serial: serves the board on a pseudo-terminal, then exits. */
+async function serve() {
+  let pico;
+  let drawn = -1;
+  try {
+    pico = Pico.fromElf(readFileSync(elfPath), elfPath, { panel: { width, height, offsetX, offsetY } });
+    await serveSerial(pico, {
+      input: process.stdin,
+      onPath: (path) => console.log(path),
+      onIdle: () => {
+        const writes = pico.events.memoryWrites;
+        if (values.out !== undefined && writes !== drawn) {
+          drawn = writes;
+          writeAtomically(values.out, encodePng(width, height, pico.panel.picture()));
+        }
+      },
+    });
+  } catch (error) {
+    if (error instanceof RunError || error instanceof ElfError || error instanceof PanelError || error.code === 'ENOENT') {
+      console.error(`octrace-pico-emulator: ${error.message}`);
+      process.exit(1);
+    }
+    throw error;
+  }
+  process.exit(0);
 }

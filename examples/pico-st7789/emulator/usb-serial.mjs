@@ -10,11 +10,50 @@
 // real host does: a scene of any length arrives whole, and a firmware that
 // waits for input sleeps instead of spinning on empty packets.
 //
+// rp2040js leaves some of the controller's registers out, and rp2040-hal
+// touches them: `UsbBus::new` writes 0 to every register after the
+// controller's reset, and sets USB_MUXING by read-modify-write. Here the
+// read-only ones (SOF_RD, BUFF_CPU_SHOULD_HANDLE, INTR, INTS) ignore writes
+// as on the chip, and USB_MUXING and the PHY's direct-drive and trim
+// controls keep what is written (from their reset values) and read it
+// back; what they control is not modelled (the bytes the host exchanges
+// do not depend on it).
+//
 // Invariants: bytes reach the firmware in the order `write` was given
-// them, at most one OUT transfer is held at a time, and a held transfer is
+// them, at most one OUT transfer is held at a time on an endpoint, and a held transfer is
 // answered as soon as bytes arrive.
 
 import { USBCDC } from 'rp2040js';
+
+/** USBCTRL_REGS offsets rp2040js leaves out (see above). */
+const READ_ONLY = new Set([0x48, 0x5c, 0x8c, 0x98]); // SOF_RD, BUFF_CPU_SHOULD_HANDLE, INTR, INTS
+const USB_MUXING = 0x74;
+/** Registers kept here, with their values after reset: USB_MUXING, USBPHY_DIRECT, _OVERRIDE, _TRIM, LINESTATE_TUNING. */
+const KEPT_AT_RESET = [
+  [USB_MUXING, 0],
+  [0x7c, 0],
+  [0x80, 0],
+  [0x84, 0x1f1f],
+  [0x88, 0xf8],
+];
+
+/** Completes rp2040js's USB controller with the registers it leaves out. */
+function completeRegisters(usb) {
+  const kept = new Map(KEPT_AT_RESET);
+  const read = usb.readUint32.bind(usb);
+  const write = usb.writeUint32.bind(usb);
+  usb.readUint32 = (offset) => (kept.has(offset) ? kept.get(offset) : read(offset));
+  usb.writeUint32 = (offset, value) => {
+    if (READ_ONLY.has(offset)) return;
+    if (kept.has(offset)) {
+      kept.set(offset, value >>> 0);
+      // rp2040js acts on USB_MUXING writes (its pads' state) without keeping them.
+      if (offset === USB_MUXING) write(offset, value);
+      return;
+    }
+    write(offset, value);
+  };
+}
 
 export class UsbSerialHost {
   /**
@@ -25,10 +64,14 @@ export class UsbSerialHost {
   constructor(rp2040, { onDeviceBytes = () => {}, onConnected = () => {} } = {}) {
     const usb = rp2040.usbCtrl;
     this.usb = usb;
+    completeRegisters(usb);
     this.cdc = new USBCDC(usb);
     this.queue = []; // Uint8Arrays from the host, oldest first
     this.queued = 0; // bytes in `queue`
-    this.heldRead = 0; // size of the OUT transfer the firmware armed and waits on, or 0
+    // The OUT transfers the firmware armed and waits on: size by endpoint.
+    // Kept for every endpoint, since the firmware may arm its data
+    // endpoint before enumeration tells which one it is.
+    this.heldReads = new Map();
     this.connected = false;
     this.cdc.onSerialData = (bytes) => onDeviceBytes(bytes);
     this.cdc.onDeviceConnected = () => {
@@ -37,10 +80,10 @@ export class UsbSerialHost {
     };
     // Replaces USBCDC's answer to an armed OUT transfer (see above).
     usb.onEndpointRead = (endpoint, size) => {
-      if (endpoint !== this.cdc.outEndpoint) {
+      if (endpoint === 0) {
         return;
       }
-      this.heldRead = size;
+      this.heldReads.set(endpoint, size);
       this.answerHeldRead();
     };
   }
@@ -61,10 +104,12 @@ export class UsbSerialHost {
   }
 
   answerHeldRead() {
-    if (this.heldRead === 0 || this.queued === 0) {
+    const endpoint = this.cdc.outEndpoint;
+    const size = this.heldReads.get(endpoint);
+    if (size === undefined || this.queued === 0) {
       return;
     }
-    const packet = new Uint8Array(Math.min(this.heldRead, this.queued));
+    const packet = new Uint8Array(Math.min(size, this.queued));
     let filled = 0;
     while (filled < packet.length) {
       const head = this.queue[0];
@@ -78,7 +123,7 @@ export class UsbSerialHost {
       }
     }
     this.queued -= packet.length;
-    this.heldRead = 0;
-    this.usb.endpointReadDone(this.cdc.outEndpoint, packet);
+    this.heldReads.delete(endpoint);
+    this.usb.endpointReadDone(endpoint, packet);
   }
 }

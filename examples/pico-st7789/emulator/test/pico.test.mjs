@@ -71,3 +71,55 @@ test('each core has its own interpolators', () => {
   assert.equal(pico.run({ maxCycles: 1e6 }), 'idle');
   assert.deepEqual([values(records, 0).at(-1), values(records, 1)[0]], [5, 7]);
 });
+
+test('a core asleep with PRIMASK set wakes on a pending interrupt, which is taken only once PRIMASK clears', () => {
+  const handler = FLASH + 0x2000;
+  const image = flashImage({
+    vectors: { 15: handler },
+    programs: {
+      [CORE0_CODE]: (t) => {
+        t.cpsid()
+          .ldrConst(1, 0xe000e010)
+          .ldrConst(0, 1000)
+          .str(0, 1, 4) // RVR
+          .movsImm(0, 7)
+          .str(0, 1) // CSR: enabled, interrupting, on the processor clock
+          .wfi()
+          .movsImm(0, 1)
+          .inline(record, 0) // awake, the handler not yet run
+          .cpsie()
+          .movsImm(0, 3)
+          .inline(record, 0); // after the handler
+        halt(t);
+      },
+      [handler]: (t) => t.movsImm(0, 2).inline(record, 0).ldrConst(1, 0xe000e010).movsImm(0, 0).str(0, 1).bxLr(),
+    },
+  });
+  const { pico, records } = machine(image);
+  assert.equal(pico.run({ maxCycles: 1e8 }), 'idle');
+  assert.deepEqual(values(records, 0), [1, 2, 3], 'woken inside the mask, the handler ran at CPSIE');
+});
+
+test('an interrupt pended by software (NVIC ISPR) with its line low is taken once', () => {
+  const handler = FLASH + 0x2000;
+  const irq = 25; // nothing drives it
+  const image = flashImage({
+    vectors: { [16 + irq]: handler },
+    programs: {
+      [CORE0_CODE]: (t) => {
+        t.ldrConst(1, 0xe000e100)
+          .ldrConst(0, 1 << irq)
+          .str(0, 1) // ISER: enabled
+          .ldrConst(1, 0xe000e200)
+          .str(0, 1) // ISPR: pending
+          .movsImm(0, 2)
+          .inline(record, 0);
+        halt(t);
+      },
+      [handler]: (t) => t.movsImm(0, 1).inline(record, 0).bxLr(),
+    },
+  });
+  const { pico, records } = machine(image);
+  assert.equal(pico.run({ maxCycles: 1e7 }), 'idle');
+  assert.deepEqual(values(records, 0), [1, 2], 'the handler once, then the program');
+});

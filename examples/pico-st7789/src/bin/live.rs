@@ -8,7 +8,9 @@
 //! Invariants: the USB device lives in the USB interrupt, which moves bytes
 //! between it and two rings (`INPUT`, `OUTPUT`); the main loop on core 0
 //! only reads `INPUT` and writes `OUTPUT`, so the port answers the host
-//! while a picture is traced. A frame from the host while drawing stops the
+//! while a picture is traced. While `INPUT` is full the interrupt is masked
+//! and the host waits (its bytes stay in the port); reading makes room and
+//! unmasks it. A frame from the host while drawing stops the
 //! picture after the current row, and is answered next. A host that stops
 //! reading for `STALLED_AFTER_US` loses what the board would send, never
 //! wedges it. Nothing the host sends can make the board panic: every frame
@@ -38,6 +40,10 @@ use rp2040_hal as hal;
 use usb_device::class_prelude::UsbBusAllocator;
 use usb_device::prelude::*;
 use usbd_serial::SerialPort;
+
+/// The render path runs from SRAM (build.rs): copied there at boot.
+#[path = "../sram_code.rs"]
+mod sram_code;
 
 /// The second-stage loader for the Pico's W25Q16JV flash (see memory.x).
 #[link_section = ".boot2"]
@@ -237,18 +243,21 @@ impl Sink for Host {
         let mut since = self.timer.get_counter();
         while !rest.is_empty() {
             let taken = critical_section::with(|cs| {
-                let mut output = OUTPUT.borrow_ref_mut(cs);
-                let room = output.capacity() - output.len();
-                let taken = room.min(rest.len());
-                for &byte in &rest[..taken] {
-                    // Room was checked: never refused.
-                    let _ = output.push_back(byte);
-                }
+                let taken = {
+                    let mut output = OUTPUT.borrow_ref_mut(cs);
+                    let room = output.capacity() - output.len();
+                    let taken = room.min(rest.len());
+                    for &byte in &rest[..taken] {
+                        // Room was checked: never refused.
+                        let _ = output.push_back(byte);
+                    }
+                    taken
+                };
+                // Sent now, whether or not the interrupt is masked.
+                serve_usb(cs);
                 taken
             });
             rest = &rest[taken..];
-            // The interrupt sends what was queued.
-            pac::NVIC::pend(pac::Interrupt::USBCTRL_IRQ);
             if taken > 0 {
                 since = self.timer.get_counter();
             } else if (self.timer.get_counter() - since).to_micros() > STALLED_AFTER_US {
@@ -285,8 +294,11 @@ fn try_input_byte() -> Option<u8> {
         let was_full = input.capacity() - input.len() < 64;
         (input.pop_front(), was_full)
     });
-    // The interrupt stopped reading the port while the ring was full.
+    // The interrupt stopped reading the port, masked, while the ring was
+    // full: there is room again.
     if was_full {
+        // SAFETY: the handler only touches what the critical sections guard.
+        unsafe { pac::NVIC::unmask(pac::Interrupt::USBCTRL_IRQ) };
         pac::NVIC::pend(pac::Interrupt::USBCTRL_IRQ);
     }
     byte
@@ -295,33 +307,44 @@ fn try_input_byte() -> Option<u8> {
 /// Serves the USB device, and moves bytes between it and the rings.
 #[interrupt]
 fn USBCTRL_IRQ() {
-    critical_section::with(|cs| {
-        let mut usb = USB.borrow_ref_mut(cs);
-        let Some((device, serial)) = usb.as_mut() else { return };
-        device.poll(&mut [serial]);
-        let mut input = INPUT.borrow_ref_mut(cs);
-        let mut packet = [0u8; 64];
-        // Only as much as the ring holds: the rest waits in the device (the
-        // host is told to wait), never lost.
-        while input.capacity() - input.len() >= packet.len() {
-            match serial.read(&mut packet) {
-                Ok(read) if read > 0 => packet[..read].iter().for_each(|&byte| {
-                    let _ = input.push_back(byte);
-                }),
-                _ => break,
-            }
+    critical_section::with(serve_usb);
+}
+
+/// Polls the USB device and moves bytes between it and the rings: from the
+/// USB interrupt, and from the main loop while it waits to send.
+fn serve_usb(cs: critical_section::CriticalSection<'_>) {
+    let mut usb = USB.borrow_ref_mut(cs);
+    let Some((device, serial)) = usb.as_mut() else { return };
+    device.poll(&mut [serial]);
+    let mut input = INPUT.borrow_ref_mut(cs);
+    let mut packet = [0u8; 64];
+    // Only as much as the ring holds: the rest waits in the device (the
+    // host is told to wait), never lost.
+    while input.capacity() - input.len() >= packet.len() {
+        match serial.read(&mut packet) {
+            Ok(read) if read > 0 => packet[..read].iter().for_each(|&byte| {
+                let _ = input.push_back(byte);
+            }),
+            _ => break,
         }
-        let mut output = OUTPUT.borrow_ref_mut(cs);
-        while !output.is_empty() {
-            let (front, _) = output.as_slices();
-            match serial.write(front) {
-                Ok(written) if written > 0 => {
-                    for _ in 0..written {
-                        output.pop_front();
-                    }
+    }
+    // A full ring leaves the port's data unread, and so the interrupt
+    // pending: masked until the main loop has made room, or it would run
+    // again at once, for ever (meanwhile the main loop serves the port
+    // itself when it sends).
+    if input.capacity() - input.len() < packet.len() {
+        pac::NVIC::mask(pac::Interrupt::USBCTRL_IRQ);
+    }
+    let mut output = OUTPUT.borrow_ref_mut(cs);
+    while !output.is_empty() {
+        let (front, _) = output.as_slices();
+        match serial.write(front) {
+            Ok(written) if written > 0 => {
+                for _ in 0..written {
+                    output.pop_front();
                 }
-                _ => break,
             }
+            _ => break,
         }
-    });
+    }
 }
