@@ -77,6 +77,9 @@ export class UsbSerialHost {
     this.cdc.onDeviceConnected = () => {
       this.connected = true;
       onConnected();
+      // Bytes the host wrote before enumeration told which endpoint is the
+      // data endpoint go now.
+      this.answerHeldRead();
     };
     // Replaces USBCDC's answer to an armed OUT transfer (see above).
     usb.onEndpointRead = (endpoint, size) => {
