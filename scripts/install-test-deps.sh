@@ -22,6 +22,7 @@ TEST_COMMAND_PACKAGES=(
     /usr/bin/chromedriver:chromium-driver
     node:nodejs
     npm:npm
+    python3:python3
 )
 
 # install_missing_commands [--allow-downgrades] COMMAND:PACKAGE...

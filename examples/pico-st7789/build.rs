@@ -35,7 +35,8 @@ fn main() {
         std::fs::read_to_string(script).unwrap_or_else(|e| fail(&format!("read {script}: {e}")))
     };
     let sram_code = read("sram-code.x");
-    for (binary, placement) in [("octrace-pico-st7789", scene_firmware), ("octrace-pico-live", Placement::RenderInSram)] {
+    for (binary, placement) in [("octrace-pico-st7789", scene_firmware), ("octrace-pico-live", Placement::RenderInSram)]
+    {
         let dir = out.join(binary);
         let script = match placement.copied() {
             Some(copied) => sram_code.replace("COPIED", copied),

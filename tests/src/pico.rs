@@ -1,7 +1,8 @@
 //! Building the Raspberry Pi Pico template (`examples/pico-st7789`) for a
-//! scene, as its user does (`OCTRACE_SCENE` at build time), and running its
-//! ELF on the emulated Pico (`examples/pico-st7789/emulator`), for the
-//! bit-exactness test and the Pico benchmark.
+//! scene, as its user does (`OCTRACE_SCENE`, and `OCTRACE_CODE_IN` and
+//! `OCTRACE_ORDER` to measure the other ways, at build time), and running
+//! its ELF on the emulated Pico (`examples/pico-st7789/emulator`), for the
+//! bit-exactness tests and the Pico benchmark.
 //!
 //! The builds share one target directory (`target/pico-st7789/`, apart from
 //! a developer's own): build one scene at a time; each ELF is copied out
@@ -25,27 +26,76 @@ fn target_dir() -> PathBuf {
 /// The scene the template embeds when `OCTRACE_SCENE` is not set.
 const DEFAULT_SCENE: &str = "fig5_1";
 
-/// Builds the template (release) with `scenes/SCENE.txt` and returns its ELF.
-/// The default scene is built as a user builds the template, without
-/// `OCTRACE_SCENE` (and so as `scripts/test-all` built it already).
-pub fn build(scene: &str) -> Result<PathBuf, String> {
+/// How the embedded-scene firmware is built: its scene, where its code runs
+/// (`OCTRACE_CODE_IN`) and its pixel order (`OCTRACE_ORDER`). The default is
+/// the template as a user builds it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Build<'a> {
+    pub scene: &'a str,
+    /// `sram` (the default), `render` or `flash`.
+    pub code_in: &'a str,
+    /// `rows` (the default) or `progressive`.
+    pub order: &'a str,
+}
+
+impl<'a> Build<'a> {
+    /// The template as a user builds it, with `scenes/SCENE.txt`.
+    pub fn of(scene: &'a str) -> Build<'a> {
+        Build { scene, code_in: "sram", order: "rows" }
+    }
+
+    /// What the build is named by: the scene, and what differs from the
+    /// default.
+    pub fn name(&self) -> String {
+        let mut name = self.scene.to_owned();
+        for (value, default) in [(self.code_in, "sram"), (self.order, "rows")] {
+            if value != default {
+                name = format!("{name}-{value}");
+            }
+        }
+        name
+    }
+}
+
+/// Builds the template (release) as `build` says and returns its
+/// embedded-scene ELF. The default build is made as a user makes it,
+/// without any variable (and so as `scripts/test-all` built it already).
+pub fn build(build: &Build<'_>) -> Result<PathBuf, String> {
     let dir = target_dir();
     let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
     // The template's .cargo/config.toml (target, linker script) is found
     // from the working directory.
     cargo.current_dir(template());
     cargo.args(["build", "--release", "--quiet"]).arg("--target-dir").arg(&dir);
-    for var in ["CARGO_TARGET_DIR", "RUSTFLAGS", "CARGO_ENCODED_RUSTFLAGS", "CARGO_BUILD_TARGET", "OCTRACE_SCENE"] {
+    for var in [
+        "CARGO_TARGET_DIR",
+        "RUSTFLAGS",
+        "CARGO_ENCODED_RUSTFLAGS",
+        "CARGO_BUILD_TARGET",
+        "OCTRACE_SCENE",
+        "OCTRACE_CODE_IN",
+        "OCTRACE_ORDER",
+    ] {
         cargo.env_remove(var);
     }
-    if scene != DEFAULT_SCENE {
-        cargo.env("OCTRACE_SCENE", repo().join("scenes").join(format!("{scene}.txt")));
+    if build.scene != DEFAULT_SCENE {
+        cargo.env("OCTRACE_SCENE", repo().join("scenes").join(format!("{}.txt", build.scene)));
+    }
+    if build.code_in != "sram" {
+        cargo.env("OCTRACE_CODE_IN", build.code_in);
+    }
+    if build.order != "rows" {
+        cargo.env("OCTRACE_ORDER", build.order);
     }
     let out = cargo.output().map_err(|e| format!("cannot run cargo: {e}"))?;
     if !out.status.success() {
-        return Err(format!("the Pico template with {scene} did not build:\n{}", String::from_utf8_lossy(&out.stderr)));
+        return Err(format!(
+            "the Pico template ({}) did not build:\n{}",
+            build.name(),
+            String::from_utf8_lossy(&out.stderr)
+        ));
     }
-    let elf = dir.join(format!("{scene}.elf"));
+    let elf = dir.join(format!("{}.elf", build.name()));
     std::fs::copy(dir.join("thumbv6m-none-eabi/release/octrace-pico-st7789"), &elf)
         .map_err(|e| format!("cannot copy the ELF to {}: {e}", elf.display()))?;
     Ok(elf)
@@ -60,8 +110,21 @@ pub struct Cycles {
     pub parse_and_index: u64,
     /// Tracing the picture into the panel.
     pub render: u64,
-    /// The whole run, until the core sleeps.
+    /// From the picture's first command until every pixel of the panel has
+    /// been written once: the whole panel coarse, in a progressive order.
+    pub first_full_panel: u64,
+    /// The whole run, until both cores sleep.
     pub total: u64,
+    /// How many cores ran the firmware.
+    pub cores: u64,
+    /// Each core's cycles: busy (of them stalled on a flash cache miss) and
+    /// waiting (asleep).
+    pub busy: [u64; 2],
+    pub stalled: [u64; 2],
+    pub waiting: [u64; 2],
+    /// The XIP cache: flash reads, misses.
+    pub flash_reads: u64,
+    pub cache_misses: u64,
 }
 
 impl Cycles {
@@ -95,12 +158,22 @@ pub fn run(elf: &Path, png: &Path) -> Result<Cycles, String> {
     }
     let report: serde_json::Value =
         serde_json::from_slice(&out.stdout).map_err(|e| format!("the emulator's report is not JSON: {e}"))?;
-    let cycles =
-        |key: &str| report["cycles"][key].as_u64().ok_or_else(|| format!("the run has no {key} phase: {report}"));
+    let number = |value: &serde_json::Value, what: &str| {
+        value.as_u64().ok_or_else(|| format!("the emulator's report has no {what}: {report}"))
+    };
+    let phase = |key: &str| number(&report["cycles"][key], key);
+    let core = |k: usize, key: &str| number(&report["coreCycles"][k][key], key);
     Ok(Cycles {
-        start_up: cycles("startUp")?,
-        parse_and_index: cycles("parseAndIndex")?,
-        render: cycles("render")?,
-        total: cycles("total")?,
+        start_up: phase("startUp")?,
+        parse_and_index: phase("parseAndIndex")?,
+        render: phase("render")?,
+        first_full_panel: phase("firstFullPanel")?,
+        total: phase("total")?,
+        cores: number(&report["cores"], "cores")?,
+        busy: [core(0, "busy")?, core(1, "busy")?],
+        stalled: [core(0, "flashStall")?, core(1, "flashStall")?],
+        waiting: [core(0, "waiting")?, core(1, "waiting")?],
+        flash_reads: number(&report["xipCache"]["accesses"], "accesses")?,
+        cache_misses: number(&report["xipCache"]["misses"], "misses")?,
     })
 }

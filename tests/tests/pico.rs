@@ -1,18 +1,31 @@
 //! The Pico proof: the board template a user copies (`examples/pico-st7789`),
 //! built for a scene as its user builds it and run unmodified on an emulated
-//! Raspberry Pi Pico with its ST7789 panel, shows exactly host-sim's
-//! `--size 240x240 --color rgb565` picture.
+//! Raspberry Pi Pico with its ST7789 panel, both cores tracing, shows
+//! exactly host-sim's `--size 240x240 --color rgb565` picture; and so does
+//! its progressive order (`OCTRACE_ORDER=progressive`), whose first coarse
+//! panel comes within 0.1 s of the picture's start.
 //!
 //! Needs Node and the emulator's packages (`npm ci` in
 //! `examples/pico-st7789/emulator`; the test command does it); set
 //! `OCTRACE_SKIP_FIRMWARE=1` to skip where they cannot be installed.
 
-use octrace_tests::{host_sim_preview, pico};
+use octrace_tests::host_sim_preview;
+use octrace_tests::pico::{self, Build};
 use std::path::Path;
 
 /// The thesis's first figure (naive, no octree), 200 spheres in an
-/// octree, and the chessboard of 64 rectangles.
-const SCENES: [&str; 3] = ["fig5_1", "fig5_3", "fig5_5"];
+/// octree, and the chessboard of 64 rectangles, as a user builds them; and
+/// the first in the progressive order.
+const BUILDS: [Build<'static>; 4] = [
+    Build { scene: "fig5_1", code_in: "sram", order: "rows" },
+    Build { scene: "fig5_3", code_in: "sram", order: "rows" },
+    Build { scene: "fig5_5", code_in: "sram", order: "rows" },
+    Build { scene: "fig5_1", code_in: "sram", order: "progressive" },
+];
+
+/// The first coarse panel of a progressive order, from the picture's start:
+/// at most 0.1 s at 125 MHz.
+const FIRST_PANEL_CYCLES: u64 = 12_500_000;
 
 fn read_rgb_png(path: &Path) -> (u32, u32, Vec<u8>) {
     let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
@@ -33,34 +46,47 @@ fn the_pico_template_shows_host_sims_picture() {
     let dir = tempfile::tempdir().expect("a temporary directory");
     // One build at a time (they share a target directory), then the runs
     // side by side.
-    let elves: Vec<_> = SCENES.iter().map(|scene| pico::build(scene).unwrap_or_else(|e| panic!("{e}"))).collect();
+    let elves: Vec<_> = BUILDS.iter().map(|build| pico::build(build).unwrap_or_else(|e| panic!("{e}"))).collect();
     let runs: Vec<_> = std::thread::scope(|s| {
-        let handles: Vec<_> = SCENES
+        let handles: Vec<_> = BUILDS
             .iter()
             .zip(&elves)
-            .map(|(scene, elf)| {
-                let panel = dir.path().join(format!("{scene}-panel.png"));
+            .map(|(build, elf)| {
+                let panel = dir.path().join(format!("{}-panel.png", build.name()));
                 s.spawn(move || (pico::run(elf, &panel), panel))
             })
             .collect();
         handles.into_iter().map(|h| h.join().expect("the run's thread")).collect()
     });
 
-    for (scene, (cycles, panel)) in SCENES.iter().zip(runs) {
-        let cycles = cycles.unwrap_or_else(|e| panic!("{scene}: {e}"));
-        let preview = dir.path().join(format!("{scene}-host-sim.png"));
-        host_sim_preview(scene, &preview, "240x240", "rgb565").unwrap_or_else(|e| panic!("{e}"));
+    for (build, (cycles, panel)) in BUILDS.iter().zip(runs) {
+        let name = build.name();
+        let cycles = cycles.unwrap_or_else(|e| panic!("{name}: {e}"));
+        let preview = dir.path().join(format!("{name}-host-sim.png"));
+        host_sim_preview(build.scene, &preview, "240x240", "rgb565").unwrap_or_else(|e| panic!("{e}"));
 
         let (width, height, shown) = read_rgb_png(&panel);
         let expected = read_rgb_png(&preview);
-        assert_eq!((width, height), (240, 240), "{scene}: the panel's own size");
+        assert_eq!((width, height), (240, 240), "{name}: the panel's own size");
         let differing = shown.chunks(3).zip(expected.2.chunks(3)).filter(|(a, b)| a != b).count();
-        assert_eq!(differing, 0, "{scene}: {differing} of {} pixels differ from host-sim's preview", width * height);
+        assert_eq!(differing, 0, "{name}: {differing} of {} pixels differ from host-sim's preview", width * height);
+        assert_eq!(cycles.cores, 2, "{name}: both cores trace");
+        if build.order == "progressive" {
+            assert!(
+                cycles.first_full_panel <= FIRST_PANEL_CYCLES,
+                "{name}: the whole panel coarse after {} cycles, more than 0.1 s",
+                cycles.first_full_panel
+            );
+        }
         println!(
-            "{scene}: 240x240 pixels identical; parse and index {} cycles, render {} cycles: {:.2} s at 125 MHz",
+            "{name}: 240x240 pixels identical; parse and index {} cycles, render {} cycles: {:.2} s at 125 MHz; \
+             whole panel after {} cycles; core 0 busy {}, core 1 busy {} cycles",
             cycles.parse_and_index,
             cycles.render,
-            cycles.to_picture_seconds()
+            cycles.to_picture_seconds(),
+            cycles.first_full_panel,
+            cycles.busy[0],
+            cycles.busy[1]
         );
     }
 }

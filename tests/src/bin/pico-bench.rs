@@ -1,56 +1,102 @@
 //! The Pico benchmark: builds the Pico template (`examples/pico-st7789`) for
-//! each scene, runs it on the emulated Pico and prints a Markdown table of
-//! the cycles it took to parse and index the scene and to render it into the
-//! 240×240 panel, the seconds from scene text to picture at 125 MHz, and the
-//! firmware's flash and static RAM (the table in BENCHMARKS.md).
+//! each scene, runs it on the emulated Pico and prints Markdown tables (the
+//! ones in BENCHMARKS.md): the cycles to parse and index the scene and to
+//! render it into the 240×240 panel on both cores, the seconds from scene
+//! text to picture at 125 MHz, the firmware's flash and static RAM; then
+//! each core's busy and waiting cycles, and the flash cache's reads, misses
+//! and stalls.
 //!
-//!     cargo run --release -p octrace-tests --bin pico-bench [scene...]
+//!     cargo run --release -p octrace-tests --bin pico-bench [--code-in sram|render|flash] [--order rows|progressive] [scene...]
 //!
-//! Cycles are the emulator's (rp2040js: Cortex-M0+ timings, no flash-cache
-//! misses), so a real Pico takes somewhat longer.
+//! Cycles are the emulator's: rp2040js's Cortex-M0+ timings, both cores in
+//! lockstep, the flash behind its XIP cache with the QSPI reads of the
+//! firmware's own boot2 (`examples/pico-st7789/emulator`).
 
 use octrace_tests::firmware::Sizes;
-use octrace_tests::pico::{self, CLOCK_HZ};
+use octrace_tests::pico::{self, Build, Cycles, CLOCK_HZ};
+
+const USAGE: &str = "usage: pico-bench [--code-in sram|render|flash] [--order rows|progressive] [scene...]";
 
 fn main() {
-    let mut scenes: Vec<String> = std::env::args().skip(1).collect();
+    let mut code_in = "sram".to_owned();
+    let mut order = "rows".to_owned();
+    let mut scenes = Vec::new();
+    let mut args = std::env::args().skip(1);
+    while let Some(arg) = args.next() {
+        let value = |name: &str, allowed: &[&str], value: Option<String>| match value {
+            Some(v) if allowed.contains(&v.as_str()) => v,
+            _ => usage(&format!("{name} takes one of {}", allowed.join(", "))),
+        };
+        match arg.as_str() {
+            "--code-in" => code_in = value("--code-in", &["sram", "render", "flash"], args.next()),
+            "--order" => order = value("--order", &["rows", "progressive"], args.next()),
+            flag if flag.starts_with('-') => usage(&format!("unknown option {flag}")),
+            _ => scenes.push(arg),
+        }
+    }
     if scenes.is_empty() {
         scenes = ["fig5_1", "fig5_3", "fig5_5"].map(String::from).to_vec();
     }
     let dir = tempfile::tempdir().expect("a temporary directory");
-    println!("| scene | parse and index | render | scene to picture at 125 MHz | flash | static RAM |");
-    println!("| --- | ---: | ---: | ---: | ---: | ---: |");
+    let mut rows = Vec::new();
     let mut failures = 0;
     for scene in &scenes {
-        let elf = match pico::build(scene) {
-            Ok(elf) => elf,
+        let build = Build { scene, code_in: &code_in, order: &order };
+        let measured = pico::build(&build).and_then(|elf| {
+            let cycles = pico::run(&elf, &dir.path().join("panel.png"))?;
+            Ok((cycles, Sizes::of(&elf)?))
+        });
+        match measured {
+            Ok(row) => rows.push((build.name(), row)),
             Err(e) => {
-                println!("| {scene} | failed to build: {} | | | | |", e.lines().next().unwrap_or(""));
-                failures += 1;
-                continue;
-            }
-        };
-        let result = pico::run(&elf, &dir.path().join("panel.png")).and_then(|c| Ok((c, Sizes::of(&elf)?)));
-        match result {
-            Ok((cycles, sizes)) => println!(
-                "| {scene} | {:.1} M cycles ({:.3} s) | {:.1} M cycles ({:.2} s) | **{:.2} s** | {:.1} KiB | {:.1} KiB |",
-                cycles.parse_and_index as f64 / 1e6,
-                cycles.parse_and_index as f64 / CLOCK_HZ,
-                cycles.render as f64 / 1e6,
-                cycles.render as f64 / CLOCK_HZ,
-                cycles.to_picture_seconds(),
-                (sizes.text + sizes.data) as f64 / 1024.0,
-                (sizes.data + sizes.bss) as f64 / 1024.0,
-            ),
-            Err(e) => {
-                println!("| {scene} | failed: {} | | | | |", e.lines().next().unwrap_or(""));
+                eprintln!("pico-bench: {}: {}", build.name(), e.lines().next().unwrap_or(""));
                 failures += 1;
             }
         }
     }
-    // A row that could not be measured is not a figure: the run fails.
+
+    let seconds = |cycles: u64| cycles as f64 / CLOCK_HZ;
+    let millions = |cycles: u64| cycles as f64 / 1e6;
+    println!("| build | parse and index | render | scene to picture at 125 MHz | whole panel drawn once | flash | static RAM |");
+    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: |");
+    for (name, (c, sizes)) in &rows {
+        println!(
+            "| {name} | {:.1} M cycles ({:.3} s) | {:.1} M cycles ({:.2} s) | **{:.2} s** | {:.3} s | {:.1} KiB | {:.1} KiB |",
+            millions(c.parse_and_index),
+            seconds(c.parse_and_index),
+            millions(c.render),
+            seconds(c.render),
+            c.to_picture_seconds(),
+            seconds(c.first_full_panel),
+            (sizes.text + sizes.data) as f64 / 1024.0,
+            (sizes.data + sizes.bss) as f64 / 1024.0,
+        );
+    }
+    println!();
+    println!("| build | core 0 busy (of it on flash misses) | core 0 waiting | core 1 busy (on flash misses) | core 1 waiting | flash reads | cache misses |");
+    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: |");
+    for (name, (c, _)) in &rows {
+        let Cycles { busy, stalled, waiting, .. } = c;
+        println!(
+            "| {name} | {:.1} M ({:.1} M) | {:.1} M | {:.1} M ({:.1} M) | {:.1} M | {:.1} M | {:.2} M |",
+            millions(busy[0]),
+            millions(stalled[0]),
+            millions(waiting[0]),
+            millions(busy[1]),
+            millions(stalled[1]),
+            millions(waiting[1]),
+            millions(c.flash_reads),
+            millions(c.cache_misses),
+        );
+    }
+    // A build that could not be measured is not a figure: the run fails.
     if failures > 0 {
-        eprintln!("pico-bench: {failures} scene(s) failed");
+        eprintln!("pico-bench: {failures} build(s) failed");
         std::process::exit(1);
     }
+}
+
+fn usage(message: &str) -> ! {
+    eprintln!("pico-bench: {message}\n{USAGE}");
+    std::process::exit(2);
 }
