@@ -210,6 +210,10 @@ crate::__shape_kinds!(capacities! {
     /// Object references in the octree's leaves, and working room while
     /// building (an object in several leaves counts once per leaf).
     OctreeReferences => octree_references, "octree references";
+    /// Words of the shadow rays' light buffer (`accel::LightBuffer`; 0:
+    /// none): a few for each light and each cell of its cube that lists
+    /// objects, one for each object listed in a cell.
+    LightBufferWords => light_buffer_words, "light buffer words";
 });
 
 impl Counts {

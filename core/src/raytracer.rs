@@ -7,7 +7,10 @@
 //! in `.bss`, initialised in place); a [`LoadedScene`] exists only for a
 //! scene that parsed without errors, with its accelerator built.
 
-use crate::accel::{self, naive, AccelMode, Accelerator, BuildReport, Hit, Mailbox, OctreeStore, Prepared, RayStart};
+use crate::accel::{
+    self, naive, AccelMode, Accelerator, BuildReport, Hit, LightBuffer, LightBufferError, Mailbox, OctreeStore,
+    Prepared, RayStart, MAX_CELLS_A_SIDE,
+};
 use crate::capacity::Arena;
 use crate::math::Scalar;
 use crate::parse::{parse_bytes, ErrorKind, ParseError, Pos};
@@ -44,6 +47,7 @@ pub struct Raytracer<P: Profile> {
     mailbox: P::MailboxWords,
     screen_bounds: P::ScreenBounds,
     screen_positions: P::ScreenPositions,
+    light_buffer: P::LightBufferWords,
 }
 
 impl<P: Profile> fmt::Debug for Raytracer<P> {
@@ -93,6 +97,7 @@ impl<P: Profile> Raytracer<P> {
             mailbox: P::MailboxWords::EMPTY,
             screen_bounds: P::ScreenBounds::EMPTY,
             screen_positions: P::ScreenPositions::EMPTY,
+            light_buffer: P::LightBufferWords::EMPTY,
         }
     }
 
@@ -139,10 +144,17 @@ impl<P: Profile> Raytracer<P> {
         let objects = if first_hits { view.object_count() } else { 0 };
         fill(&mut self.screen_bounds, objects, ScreenBound::EMPTY);
         fill(&mut self.screen_positions, ScreenBound::positions_for(objects), 0);
+        // Likewise the shadow rays' light buffer.
+        let lights = if <P::LightBufferWords as Arena<u32>>::CAPACITY > 0 && requested != AccelMode::Naive {
+            LightBuffer::build(&view, &mut self.light_buffer, MAX_CELLS_A_SIDE)
+        } else {
+            LightBuffer::NONE
+        };
         Ok(LoadedScene {
             view,
             mode,
             octree,
+            lights,
             mailbox: RefCell::new(self.mailbox.as_mut_slice()),
             screen_lists: RefCell::new((self.screen_bounds.as_mut_slice(), self.screen_positions.as_mut_slice())),
             first_hits,
@@ -162,6 +174,8 @@ pub struct LoadedScene<'r, P: Profile> {
     view: SceneView<'r>,
     mode: AccelMode,
     octree: Option<(&'r P::Octree, BuildReport)>,
+    /// The shadow rays' light buffer (none buffered without room for one).
+    lights: LightBuffer<'r>,
     mailbox: RefCell<&'r mut [u32]>,
     /// Room for the camera rays' screen lists (bounds and positions), if
     /// they are used.
@@ -219,7 +233,44 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
     pub fn accelerator(&self) -> SceneAccelerator<'r, P> {
-        SceneAccelerator { octree: self.octree.as_ref().map(|(octree, _)| *octree) }
+        SceneAccelerator { octree: self.octree.as_ref().map(|(octree, _)| *octree), lights: self.lights }
+    }
+
+    /// The shadow rays' light buffer: built when the scene loaded if the
+    /// profile has room for one (`light_buffer_words`, see
+    /// [`Profile::LightBufferWords`]) and the mode is not
+    /// [`AccelMode::Naive`] asked for by name, else none
+    /// ([`LightBuffer::report`] says how many lights it buffers).
+    pub fn light_buffer(&self) -> LightBuffer<'r> {
+        self.lights
+    }
+
+    /// Uses `words`, a light buffer built beforehand for this scene (its
+    /// [`LightBuffer::words`], kept in flash by a build script), once
+    /// checked to hold every object wherever a buffer built here would
+    /// ([`LightBuffer::verified`]); a buffer that is not refused, and the
+    /// scene keeps the one it had.
+    ///
+    /// ```
+    /// use octrace_core::{accel::LightBuffer, parse::parse, profile::{Board16K, Board64K}, scene::Scene, Raytracer};
+    ///
+    /// let text = "LIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\nSPHERE 1 0.5 1 1 1\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n";
+    /// // Where the scene is known beforehand (a build script): the words.
+    /// let mut built = Scene::<Board64K>::new();
+    /// parse(text, &mut built, &mut |e| panic!("{e}")).unwrap();
+    /// let mut words = heapless::Vec::<u32, 400>::new();
+    /// let prebuilt = LightBuffer::build(&built.view(), &mut words, 8).words();
+    /// // On the board: the scene, and the words from flash.
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let mut scene = raytracer.load(text)?;
+    /// assert_eq!(scene.light_buffer().report().lights, 0, "Board16K has no room for one");
+    /// scene.use_light_buffer(prebuilt)?;
+    /// assert_eq!(scene.light_buffer().report().lights, 1);
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn use_light_buffer(&mut self, words: &'r [u32]) -> Result<(), LightBufferError> {
+        self.lights = LightBuffer::verified(&self.view, words)?;
+        Ok(())
     }
 
     /// Whether camera rays find their hits in the screen lists
@@ -305,6 +356,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
 /// a build without an octree or without the lists links none of their code.
 pub struct SceneAccelerator<'r, P: Profile> {
     octree: Option<&'r P::Octree>,
+    lights: LightBuffer<'r>,
 }
 
 impl<P: Profile> Clone for SceneAccelerator<'_, P> {
@@ -317,7 +369,10 @@ impl<P: Profile> Copy for SceneAccelerator<'_, P> {}
 
 impl<P: Profile> fmt::Debug for SceneAccelerator<'_, P> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("SceneAccelerator").field("octree", &self.octree.is_some()).finish()
+        f.debug_struct("SceneAccelerator")
+            .field("octree", &self.octree.is_some())
+            .field("light_buffer", &self.lights)
+            .finish()
     }
 }
 
@@ -377,6 +432,9 @@ impl<P: Profile> Accelerator for SceneAccelerator<'_, P> {
         start: Option<RayStart>,
         mailbox: &mut Mailbox<'_>,
     ) -> bool {
+        if let Some(blocked) = self.lights.occluded(scene, Self::KINDS, ray, t_max, light, start, mailbox) {
+            return blocked;
+        }
         match self.octree() {
             Some(octree) => octree.occluded_toward(scene, ray, t_max, light, start, mailbox),
             None => self.occluded(scene, ray, t_max, start, mailbox),

@@ -16,10 +16,12 @@
 //!   [`Mailbox`] large enough for the scene (one bit per object).
 
 mod choice;
+mod light_buffer;
 pub(crate) mod naive;
 mod octree;
 
 pub use choice::{prepare, Prepared};
+pub use light_buffer::{LightBuffer, LightBufferError, LightBufferReport, LightBuffered, MAX_CELLS_A_SIDE};
 pub use naive::Naive;
 pub(crate) use octree::FILING_MARGIN;
 pub use octree::{
