@@ -8,8 +8,8 @@
 //! scene that parsed without errors, with its accelerator built.
 
 use crate::accel::{
-    self, naive, AccelMode, Accelerator, BuildReport, Hit, LightBuffer, LightBufferError, Mailbox, OctreeStore,
-    Prepared, RayStart, MAX_CELLS_A_SIDE,
+    self, naive, AccelMode, Accelerator, BuildReport, Hit, LightBuffer, LightBufferError, LightBufferStore, Mailbox,
+    OctreeStore, Prepared, RayStart, MAX_CELLS_A_SIDE,
 };
 use crate::capacity::Arena;
 use crate::math::Scalar;
@@ -47,7 +47,7 @@ pub struct Raytracer<P: Profile> {
     mailbox: P::MailboxWords,
     screen_bounds: P::ScreenBounds,
     screen_positions: P::ScreenPositions,
-    light_buffer: P::LightBufferWords,
+    light_buffer: LightBufferStore<P::LightBufferWords>,
 }
 
 impl<P: Profile> fmt::Debug for Raytracer<P> {
@@ -97,7 +97,7 @@ impl<P: Profile> Raytracer<P> {
             mailbox: P::MailboxWords::EMPTY,
             screen_bounds: P::ScreenBounds::EMPTY,
             screen_positions: P::ScreenPositions::EMPTY,
-            light_buffer: P::LightBufferWords::EMPTY,
+            light_buffer: LightBufferStore::new(),
         }
     }
 
@@ -146,7 +146,7 @@ impl<P: Profile> Raytracer<P> {
         fill(&mut self.screen_positions, ScreenBound::positions_for(objects), 0);
         // Likewise the shadow rays' light buffer.
         let lights = if <P::LightBufferWords as Arena<u32>>::CAPACITY > 0 && requested != AccelMode::Naive {
-            LightBuffer::build(&view, &mut self.light_buffer, MAX_CELLS_A_SIDE)
+            self.light_buffer.build(&view, MAX_CELLS_A_SIDE)
         } else {
             LightBuffer::NONE
         };

@@ -309,30 +309,39 @@ struct Cube {
     light: [i64; 3],
     /// The cell of the light's own list.
     own: usize,
-    /// Per face: its first cell, its rectangle's first cells and sides.
-    faces: [(usize, [u32; 2], [u32; 2]); 6],
+    /// Per face: its first cell and its rectangle's word.
+    faces: [(usize, u32); 6],
 }
 
 impl Cube {
     fn read(words: &[u32]) -> Cube {
-        let rect = |w: u32| ([w & 0xFF, w >> 8 & 0xFF], [w >> 16 & 0xFF, w >> 24]);
         Cube {
             light: [0, 1, 2].map(|a| words[a] as i32 as i64),
             own: words[3] as usize,
-            faces: core::array::from_fn(|f| {
-                let (low, size) = rect(words[5 + 2 * f]);
-                (words[4 + 2 * f] as usize, low, size)
-            }),
+            faces: core::array::from_fn(|f| (words[4 + 2 * f] as usize, words[5 + 2 * f])),
         }
     }
 
-    /// The cell of `rect`'s cell `(i, j)` on face `face`, if its stored
-    /// rectangle holds it.
+    /// The cell of cell `(i, j)` of face `face`, if its rectangle holds it.
     fn cell(&self, face: usize, i: u32, j: u32) -> Option<usize> {
-        let (first, low, size) = self.faces[face];
-        let (di, dj) = (i.wrapping_sub(low[0]), j.wrapping_sub(low[1]));
-        (di < size[0] && dj < size[1]).then(|| first + (di * size[1] + dj) as usize)
+        let (first, rect) = self.faces[face];
+        cell_in(first, rect, i, j)
     }
+}
+
+/// A face's rectangle of cells as a word: its first cells and its sides
+/// along the face's two axes (sides 0: no cell).
+const fn rect_word(low: [u8; 2], size: [u8; 2]) -> u32 {
+    low[0] as u32 | (low[1] as u32) << 8 | (size[0] as u32) << 16 | (size[1] as u32) << 24
+}
+
+/// The cell of cell `(i, j)` in the rectangle `rect` whose first cell is
+/// `first`, if the rectangle holds it (rows along the first axis).
+#[inline(always)]
+fn cell_in(first: usize, rect: u32, i: u32, j: u32) -> Option<usize> {
+    let (i, j) = (i.wrapping_sub(rect & 0xFF), j.wrapping_sub(rect >> 8 & 0xFF));
+    let (rows, columns) = (rect >> 16 & 0xFF, rect >> 24);
+    (i < rows && j < columns).then(|| first + (i * columns + j) as usize)
 }
 
 /// Calls `each(cell, entry)` for every entry of the lists `cube`'s light
@@ -484,8 +493,7 @@ impl<'a> LightBuffer<'a> {
                     None => ([0; 2], [0; 2]),
                 };
                 let _ = words.push(cell as u32);
-                let _ =
-                    words.push(low[0] as u32 | (low[1] as u32) << 8 | (size[0] as u32) << 16 | (size[1] as u32) << 24);
+                let _ = words.push(rect_word(low, size));
                 cell += size[0] as usize * size[1] as usize;
             }
         }
@@ -587,8 +595,9 @@ impl<'a> LightBuffer<'a> {
             if cube.light != scene.lights[light].position.wide() {
                 return Err(OtherScene);
             }
-            let rects_fit = cube.faces.iter().all(|&(first, low, size)| {
-                (0..2).all(|k| low[k] + size[k] <= n) && first + (size[0] * size[1]) as usize <= starts.len() - 1
+            let rects_fit = cube.faces.iter().all(|&(first, rect)| {
+                let [low, size] = [rect, rect >> 16].map(|w| [w & 0xFF, w >> 8 & 0xFF]);
+                (0..2).all(|k| low[k] + size[k] <= n) && first + ((size[0] * size[1]) as usize) < starts.len()
             });
             if !rects_fit || cube.own >= starts.len() - 1 {
                 return Err(Malformed);
@@ -635,6 +644,52 @@ impl<'a> LightBuffer<'a> {
     }
 }
 
+/// A light buffer's words in an arena of their own, for whoever keeps the
+/// buffer beside its scene (a [`Raytracer`](crate::Raytracer), the
+/// studio): built in place ([`LightBufferStore::build`]), read through
+/// [`LightBufferStore::buffer`].
+///
+/// ```
+/// use octrace_core::accel::{LightBufferStore, MAX_CELLS_A_SIDE};
+/// use octrace_core::parse::parse;
+/// use octrace_core::profile::Board64K;
+/// use octrace_core::scene::Scene;
+///
+/// let mut scene = Scene::<Board64K>::new();
+/// parse("LIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n", &mut scene, &mut |e| panic!("{e}")).unwrap();
+/// let mut store = LightBufferStore::<heapless::Vec<u32, 200>>::new();
+/// assert_eq!(store.buffer().report().lights, 0);
+/// store.build(&scene.view(), MAX_CELLS_A_SIDE);
+/// assert_eq!(store.buffer().report().lights, 1);
+/// ```
+#[derive(Debug)]
+pub struct LightBufferStore<W> {
+    words: W,
+}
+
+impl<W: Arena<u32>> Default for LightBufferStore<W> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<W: Arena<u32>> LightBufferStore<W> {
+    /// An empty store (a constant: zero bits for a board's arena).
+    pub const fn new() -> Self {
+        LightBufferStore { words: W::EMPTY }
+    }
+
+    /// Builds `scene`'s buffer in the store (see [`LightBuffer::build`]).
+    pub fn build(&mut self, scene: &SceneView<'_>, cells_a_side: u32) -> LightBuffer<'_> {
+        LightBuffer::build(scene, &mut self.words, cells_a_side)
+    }
+
+    /// The buffer last built (none before the first build).
+    pub fn buffer(&self) -> LightBuffer<'_> {
+        LightBuffer::parse(self.words.as_slice()).unwrap_or(LightBuffer::NONE)
+    }
+}
+
 impl LightBuffer<'_> {
     /// Whether anything blocks `ray`, a shadow ray from its origin towards
     /// the scene's light `light` as the tracer aims it (see [`RAY_SLACK`]),
@@ -666,27 +721,13 @@ impl LightBuffer<'_> {
             return None;
         }
         let cube = self.words.get(Words::HEADER + Words::CUBE * light..)?.get(..Words::CUBE)?;
-        let l = [cube[0] as i32, cube[1] as i32, cube[2] as i32];
-        let [x, y, z] = [origin[0].checked_sub(l[0])?, origin[1].checked_sub(l[1])?, origin[2].checked_sub(l[2])?];
-        let (ax, ay, az) = (x.unsigned_abs(), y.unsigned_abs(), z.unsigned_abs());
-        // The face (its axis's largest component, then its sign) and the
-        // two other components in the face's order.
-        let (face, m, vb, vc) = if ax >= ay && ax >= az {
-            ((x < 0) as usize, ax, y, z)
-        } else if ay >= az {
-            (2 + (y < 0) as usize, ay, z, x)
-        } else {
-            (4 + (z < 0) as usize, az, x, y)
-        };
-        if m == 0 || m >= MAX_COMPONENT {
-            return None;
-        }
+        let v = [0, 1, 2].map(|a| origin[a].checked_sub(cube[a] as i32));
+        let (face, m, [i, j]) = direction([v[0]?, v[1]?, v[2]?], self.level)?;
         let own = self.list(cube[3] as usize)?;
-        let (first, rect) = (cube[4 + 2 * face] as usize, cube[5 + 2 * face]);
-        let i = cell_along(vb, m, self.level).wrapping_sub(rect & 0xFF);
-        let j = cell_along(vc, m, self.level).wrapping_sub(rect >> 8 & 0xFF);
-        let (rows, columns) = (rect >> 16 & 0xFF, rect >> 24);
-        let cell = if i < rows && j < columns { self.list(first + (i * columns + j) as usize)? } else { &[] };
+        let cell = match cell_in(cube[4 + 2 * face] as usize, cube[5 + 2 * face], i, j) {
+            Some(cell) => self.list(cell)?,
+            None => &[],
+        };
         Some(([own, cell], m >> DEPTH_SHIFT))
     }
 
@@ -696,6 +737,27 @@ impl LightBuffer<'_> {
         let starts = self.words.get(self.cells + cell..self.cells + cell + 2)?;
         self.words.get(self.entries + starts[0] as usize..self.entries + starts[1] as usize)
     }
+}
+
+/// Where the direction `v` (from a light) is in a cube of `2^level` cells a
+/// side: its face (its largest component's axis, `x` before `y` before `z`,
+/// then that component's sign), that component's magnitude `m`, and its
+/// cell along the face's two other axes. `None` for the zero vector and
+/// for components of 2^30 or more (none in the scene's range).
+#[inline(always)]
+fn direction([x, y, z]: [i32; 3], level: u8) -> Option<(usize, u32, [u32; 2])> {
+    let (ax, ay, az) = (x.unsigned_abs(), y.unsigned_abs(), z.unsigned_abs());
+    let (face, m, vb, vc) = if ax >= ay && ax >= az {
+        ((x < 0) as usize, ax, y, z)
+    } else if ay >= az {
+        (2 + (y < 0) as usize, ay, z, x)
+    } else {
+        (4 + (z < 0) as usize, az, x, y)
+    };
+    if m == 0 || m >= MAX_COMPONENT {
+        return None;
+    }
+    Some((face, m, [cell_along(vb, m, level), cell_along(vc, m, level)]))
 }
 
 /// The cell `⌊2^level·(v + m) / 2m⌋` of `v` along a face whose axis's
@@ -820,5 +882,320 @@ impl<A: Accelerator> Accelerator for LightBuffered<'_, A> {
             Some(blocked) => blocked,
             None => self.accel.occluded_toward(scene, ray, t_max, light, start, mailbox),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::accel::Naive;
+    use crate::accel::{Accelerator, RayStart};
+    use crate::math::{Dir, Vec3};
+    use crate::parse::parse;
+    use crate::profile::Board64K;
+    use crate::scene::ObjectId;
+    use crate::scene::Scene;
+    use crate::shapes::Leaving;
+    use std::{boxed::Box, format, string::String, vec::Vec};
+
+    type Arena = heapless::Vec<u32, 60_000>;
+
+    /// The cell of the point `p` seen from `light`, as a shadow ray from `p`
+    /// finds it, and whether the footprint lists it there at no greater
+    /// depth.
+    fn listed(footprint: &Footprint, light: [i64; 3], p: [i64; 3], level: u32) -> bool {
+        let v = [0, 1, 2].map(|a| (p[a] - light[a]) as i32);
+        match (direction(v, level as u8), footprint) {
+            (_, Footprint::Around) => true,
+            (None, Footprint::Faces(_)) => false,
+            (Some((face, m, [i, j])), Footprint::Faces(rects)) => rects[face].is_some_and(|r| {
+                (r.low[0] as u32..=r.high[0] as u32).contains(&i)
+                    && (r.low[1] as u32..=r.high[1] as u32).contains(&j)
+                    && r.depth <= m >> DEPTH_SHIFT
+            }),
+        }
+    }
+
+    /// Every point of an object's bounds widened by the margin, corners and
+    /// faces included, is in a cell its footprint lists, at a depth no
+    /// greater than its own: the light's own list when the bounds hold the
+    /// light. Boxes of every size, near the light and far, at every level.
+    #[test]
+    fn every_point_of_the_widened_bounds_is_in_a_listed_cell() {
+        let mut next = crate::test_rng::seeded(0x11647_b0ff);
+        let mut coordinate = move |bits: u32| (next() % (2 << bits)) as i64 - (1 << bits);
+        let (mut around, mut points) = (0, 0);
+        for _ in 0..20_000 {
+            let level = (coordinate(3).unsigned_abs() as u32) % (MAX_LEVEL + 1);
+            let light = [0; 3].map(|_| coordinate(27));
+            let near = coordinate(1) > 0;
+            let lo = [0, 1, 2].map(|a| if near { light[a] + coordinate(12) } else { coordinate(27) });
+            let size = 1 + (coordinate(4).unsigned_abs() as u32 * 2).min(27);
+            let hi = [0, 1, 2].map(|a| lo[a] + coordinate(size).abs());
+            let bounds =
+                Aabb { min: Vec3::from_bits(lo.map(|c| c as i32)), max: Vec3::from_bits(hi.map(|c| c as i32)) };
+            let footprint = footprint(bounds, light, MARGIN, level);
+            around += (footprint == Footprint::Around) as usize;
+            let (wlo, whi) = (lo.map(|c| c - MARGIN), hi.map(|c| c + MARGIN));
+            for k in 0..16 {
+                let p = [0, 1, 2].map(|a| match k {
+                    0..8 => {
+                        if k >> a & 1 == 1 {
+                            whi[a]
+                        } else {
+                            wlo[a]
+                        }
+                    }
+                    _ => wlo[a] + coordinate(28).abs() % (whi[a] - wlo[a] + 1),
+                });
+                points += 1;
+                assert!(listed(&footprint, light, p, level), "{p:?} from {light:?}: {footprint:?}, level {level}");
+            }
+        }
+        assert!(around > 100 && points > 300_000, "{around} around the light");
+    }
+
+    /// `lo` and `hi` as bounds.
+    fn aabb(lo: [i64; 3], hi: [i64; 3]) -> Aabb {
+        Aabb { min: Vec3::from_bits(lo.map(|c| c as i32)), max: Vec3::from_bits(hi.map(|c| c as i32)) }
+    }
+
+    /// A box whose face lies a unit or two past a cell's edge from the light,
+    /// and a point inside it two units from that face, seen in the cell
+    /// beyond the edge (a direction `(m, v)` with `v / m` just below
+    /// `2k / N − 1`): `(light, box, point)` on a random face of the cube.
+    fn across_a_cell_edge(next: &mut impl FnMut() -> u64, level: u32) -> ([i64; 3], [[i64; 3]; 2], [i64; 3]) {
+        let n = 1i64 << level;
+        let light = [0; 3].map(|_| (next() % (1 << 24)) as i64 - (1 << 23));
+        let (face, m) = ((next() % 6) as usize, (1 << 22) + (next() % (1 << 23)) as i64);
+        let (a, sign) = (face / 2, if face % 2 == 0 { 1 } else { -1 });
+        let [b, c] = other_axes(a);
+        // An edge at a ratio in [0, 1): the smallest v beyond it is below.
+        let k = n / 2 + (next() % (n as u64 / 2).max(1)) as i64;
+        let v = ((2 * k - n) * m).div_euclid(n) - ((2 * k - n) * m % n == 0) as i64;
+        let mut point = light;
+        point[a] += sign * m;
+        point[b] += v;
+        point[c] += (next() % 1000) as i64 - 500;
+        let mut lo = point;
+        let mut hi = point;
+        // Two units inside along the face's axis and above the low side.
+        lo[a] = point[a] - if sign > 0 { 1 << 20 } else { 2 };
+        hi[a] = point[a] + if sign > 0 { 2 } else { 1 << 20 };
+        (lo[b], hi[b]) = (point[b] - 2, point[b] + (1 << 20));
+        (lo[c], hi[c]) = (point[c] - 1000, point[c] + 1000);
+        (light, [lo, hi], point)
+    }
+
+    /// The test above is sharp: bounds cut by a few units lose points near a
+    /// cell's edge, so a margin smaller than the straying it covers fails.
+    #[test]
+    fn bounds_cut_by_a_few_units_lose_cells() {
+        let mut next = crate::test_rng::seeded(0xc07_ed9e);
+        let mut lost = 0;
+        for case in 0..2000 {
+            let level = 1 + (next() % MAX_LEVEL as u64) as u32;
+            let (light, [lo, hi], point) = across_a_cell_edge(&mut next, level);
+            let exact = footprint(aabb(lo, hi), light, 0, level);
+            assert!(listed(&exact, light, point, level), "case {case}: the exact bounds list the point");
+            lost += !listed(&footprint(aabb(lo, hi), light, -4, level), light, point, level) as usize;
+        }
+        assert!(lost > 1500, "only {lost} of 2000 points lost by bounds cut by 4 units");
+    }
+
+    /// A Q32.32 world value as exact decimal text.
+    fn decimal(q: i64) -> String {
+        let (int, frac) = (q.unsigned_abs() >> 32, q.unsigned_abs() & 0xFFFF_FFFF);
+        let digits = frac as u128 * 5u128.pow(32);
+        format!("{}{int}.{digits:032}", if q < 0 { "-" } else { "" })
+    }
+
+    /// The scene's text with a light at the normalised point `light` and
+    /// boxes given by normalised corners (even spans, so that their centres
+    /// and half-sizes are exact): the eye and a second light at ±8 fix the
+    /// normalisation (centre 0, a world unit 2^26 raw units).
+    fn exact_scene(light: [i64; 3], boxes: &[[[i64; 3]; 2]]) -> String {
+        let world = |raw: i64| decimal(raw * 64);
+        let mut text = String::from("VIEWPOINT -8 -8 -8\nLIGHT 10 8 8 8\nSURFACE 1 .1 .1 .1 .5 .5 .5 0 0 0 0 0 0\n");
+        text += &format!("LIGHT 10 {} {} {}\n", world(light[0]), world(light[1]), world(light[2]));
+        for [lo, hi] in boxes {
+            let c = [0, 1, 2].map(|a| world((lo[a] + hi[a]) / 2));
+            let h = [0, 1, 2].map(|a| world((hi[a] - lo[a]) / 2));
+            text += &format!("BOX 1 {} {} {} {} {} {}\n", c[0], c[1], c[2], h[0], h[1], h[2]);
+        }
+        text
+    }
+
+    /// Shadow rays aimed through points just past a cell's edge inside a box
+    /// (the box listed in that cell only thanks to rounding outward): the
+    /// light buffer gives the naive mode's answer, and bounds cut by a few
+    /// units would not.
+    #[test]
+    fn grazing_shadow_rays_get_the_naive_answer() {
+        let mut next = crate::test_rng::seeded(0x6a2e_5ad0);
+        let (mut blocked, mut wrong_if_cut) = (0, 0);
+        for case in 0..300 {
+            let (light, corners, point) = across_a_cell_edge(&mut next, MAX_LEVEL);
+            let [lo, hi] = corners.map(|c| c.map(|v| v & !1));
+            let text = exact_scene(light, &[[lo, [0, 1, 2].map(|a| hi[a].max(lo[a] + 2))]]);
+            let mut scene: Box<Scene<Board64K>> = Box::default();
+            parse(&text, &mut scene, &mut |e| panic!("case {case}: {e}\n{text}")).unwrap();
+            let view = scene.view();
+            assert_eq!(view.lights[1].position.wide(), light, "case {case}: the normalisation moved");
+            let origin = Vec3::from_bits([0, 1, 2].map(|a| (light[a] + 3 * (point[a] - light[a])) as i32));
+            let (dir, distance) = (view.lights[1].position - origin).direction_and_length_estimate().unwrap();
+            let ray = Ray { origin, dir };
+            let t_max = Scalar::from_bits(distance.to_bits() - 1);
+            let naive = Naive.occluded(&view, &ray, t_max, None, &mut Mailbox::none());
+            blocked += naive as usize;
+            let mut words = Arena::new();
+            let buffer = LightBuffer::build(&view, &mut words, MAX_CELLS_A_SIDE);
+            assert_eq!(buffer.report().cells_a_side, MAX_CELLS_A_SIDE);
+            let lit = LightBuffered::new(&Naive, buffer);
+            let answer = lit.occluded_toward(&view, &ray, t_max, 1, None, &mut Mailbox::none());
+            assert_eq!(answer, naive, "case {case}: {ray:?} to {t_max:?}\n{text}");
+            let cut = LightBuffer::build_with_margin(&view, &mut words, MAX_CELLS_A_SIDE, -4);
+            let answer =
+                LightBuffered::new(&Naive, cut).occluded_toward(&view, &ray, t_max, 1, None, &mut Mailbox::none());
+            wrong_if_cut += (answer != naive) as usize;
+        }
+        assert!(blocked > 250 && wrong_if_cut > 200, "{blocked} blocked, {wrong_if_cut} wrong with bounds cut by 4");
+    }
+
+    /// A random scene of spheres, boxes, rectangles and triangles near the
+    /// origin, with one to three lights, some inside objects' bounds.
+    fn random_scene(next: &mut impl FnMut() -> u64) -> Box<Scene<Board64K>> {
+        let mut c = |range: u64| (next() % (2 * range * 100 + 1)) as f64 / 100.0 - range as f64;
+        let mut text = String::from("VIEWPOINT 0 2 14\nSURFACE 1 0.1 0.1 0.1 0.5 0.5 0.5 0 0 0 0 0 0\n");
+        let objects = 1 + c(15).abs() as usize;
+        for _ in 0..objects {
+            let (x, y, z, size) = (c(6), c(6), c(6), 0.05 + c(2).abs());
+            text += &match c(2).abs() as u32 {
+                0 => format!("SPHERE 1 {size} {x} {y} {z}\n"),
+                1 => format!("BOX 1 {x} {y} {z} {size} {} {}\n", 0.1 + c(1).abs(), 0.1 + c(1).abs()),
+                _ if c(1) > 0.0 => format!(
+                    "RECTANGLE 1 {x} {y} {z} {} {y} {z} {} {y} {} {x} {y} {}\n",
+                    x + size,
+                    x + size,
+                    z + size,
+                    z + size
+                ),
+                _ => format!("TRIANGLE 1 {x} {y} {z} {} {} {z} {x} {} {}\n", x + size, y + c(1), y + size, z + c(1)),
+            };
+        }
+        for _ in 0..1 + c(1).abs() as usize * 2 {
+            text += &format!("LIGHT 10 {} {} {}\n", c(7), c(7), c(7));
+        }
+        let mut scene: Box<Scene<Board64K>> = Box::default();
+        if parse(&text, &mut scene, &mut |_| {}).is_err() {
+            scene.clear();
+        }
+        scene
+    }
+
+    /// Shadow rays from the hits of random rays on random scenes to every
+    /// light, aimed as the tracer aims them, leaving their object either
+    /// way: the light buffer (at every fineness, and squeezed into arenas
+    /// too small for every light) gives the naive mode's answer.
+    #[test]
+    fn shadow_rays_get_the_naive_answer() {
+        let mut next = crate::test_rng::seeded(0x5_4ad0_b0ff);
+        let (mut rays, mut blocked, mut buffered) = (0u64, 0u64, 0u64);
+        for _ in 0..150 {
+            let scene = random_scene(&mut next);
+            let view = scene.view();
+            if view.object_count() == 0 {
+                continue;
+            }
+            let cells = 1 << (next() % (MAX_LEVEL as u64 + 1));
+            let mut words = Arena::new();
+            let mut small = heapless::Vec::<u32, 160>::new();
+            let buffers = [LightBuffer::build(&view, &mut words, cells), LightBuffer::build(&view, &mut small, 64)];
+            buffered += buffers.iter().map(|b| b.report().lights as u64).sum::<u64>();
+            for _ in 0..300 {
+                // From anywhere near the objects towards a point of one's
+                // bounds.
+                let origin = Vec3::from_bits([0; 3].map(|_| ((next() % (1 << 30)) as i64 - (1 << 29)) as i32));
+                let bounds = view.shape(ObjectId((next() % view.object_count() as u64) as u32)).bounds();
+                let (lo, hi) = (bounds.min.wide(), bounds.max.wide());
+                let target = [0, 1, 2].map(|a| lo[a] + (next() % (hi[a] - lo[a] + 1) as u64) as i64);
+                let Some(dir) = Dir::normalize([0, 1, 2].map(|a| target[a] - origin.wide()[a])) else { continue };
+                let ray = Ray { origin, dir };
+                let Some(hit) = Naive.nearest(&view, &ray, None, &mut Mailbox::none()) else { continue };
+                let point = ray.at(hit.t);
+                for (light, l) in view.lights.iter().enumerate() {
+                    let Some((dir, distance)) = (l.position - point).direction_and_length_estimate() else { continue };
+                    let shadow = Ray { origin: point, dir };
+                    let t_max = Scalar::from_bits((distance.to_bits() - 1).max(0));
+                    let leaving = if next() % 2 == 0 { Leaving::Inward } else { Leaving::Outward };
+                    let start = Some(RayStart { object: hit.object, leaving });
+                    let naive = Naive.occluded(&view, &shadow, t_max, start, &mut Mailbox::none());
+                    rays += 1;
+                    blocked += naive as u64;
+                    for buffer in buffers {
+                        let answer = LightBuffered::new(&Naive, buffer).occluded_toward(
+                            &view,
+                            &shadow,
+                            t_max,
+                            light,
+                            start,
+                            &mut Mailbox::none(),
+                        );
+                        assert_eq!(answer, naive, "{shadow:?} to light {light} ({:?})", buffer.report());
+                    }
+                }
+            }
+        }
+        assert!(
+            rays > 20_000 && blocked > rays / 10 && buffered > 150,
+            "{rays} rays, {blocked} blocked, {buffered} buffered"
+        );
+    }
+
+    /// A buffer built for one scene is refused for another, and one with an
+    /// entry missing, deeper than its object, out of order or cut short.
+    #[test]
+    fn a_buffer_that_misses_anything_is_refused() {
+        let text = "VIEWPOINT -9 -9 -9\nLIGHT 10 9 9 9\nLIGHT 5 -2 9 1\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n\
+                    SPHERE 1 1 0 0 0\nSPHERE 1 0.5 2 2 2\nBOX 1 -3 -3 -3 1 1 1\nBOX 1 0 9 0 20 0.1 20\n";
+        let mut scene: Box<Scene<Board64K>> = Box::default();
+        parse(text, &mut scene, &mut |e| panic!("{e}")).unwrap();
+        let view = scene.view();
+        let mut arena = Arena::new();
+        let words: Vec<u32> = LightBuffer::build(&view, &mut arena, 16).words().to_vec();
+        let buffer = LightBuffer::verified(&view, &words).unwrap();
+        assert_eq!(buffer.report().lights, 2);
+        let entries = buffer.entries;
+        // The second light is inside the big flat box's widened bounds: on
+        // its own list.
+        let own = Cube::read(&words[Words::HEADER + Words::CUBE..]).own;
+        assert!(buffer.list(own).is_some_and(|l| l.iter().any(|&e| e & OBJECT_MASK == 3)), "around the light");
+        let changed = |change: &dyn Fn(&mut Vec<u32>)| {
+            let mut words = words.clone();
+            change(&mut words);
+            LightBuffer::verified(&view, &words).map(|_| ())
+        };
+        assert_eq!(changed(&|w| w.truncate(w.len() - 1)), Err(LightBufferError::Malformed));
+        assert_eq!(changed(&|w| w[0] ^= 1), Err(LightBufferError::Malformed));
+        assert_eq!(changed(&|w| w[4] += 1), Err(LightBufferError::OtherScene));
+        assert_eq!(changed(&|w| w[Words::HEADER] += 1), Err(LightBufferError::OtherScene));
+        // Every entry in turn made another object, or deeper: each is
+        // needed somewhere (unless its object is listed there twice).
+        let (mut missed, mut deeper) = (0, 0);
+        for e in entries..words.len() {
+            let other = |w: &mut Vec<u32>| w[e] = w[e] & !OBJECT_MASK | ((w[e] & OBJECT_MASK) + 1) % 4;
+            missed += matches!(changed(&other), Err(LightBufferError::Incomplete { .. } | LightBufferError::Malformed))
+                as usize;
+            let deepen = |w: &mut Vec<u32>| w[e] += 1 << OBJECT_BITS;
+            deeper += changed(&deepen).is_err() as usize;
+        }
+        assert_eq!(missed, words.len() - entries);
+        assert!(deeper > (words.len() - entries) / 2, "{deeper} of {} deepened entries refused", words.len() - entries);
+        // The same lights and objects but one moved.
+        let mut moved: Box<Scene<Board64K>> = Box::default();
+        parse(&text.replace("0.5 2 2 2", "0.5 2 -2 2"), &mut moved, &mut |e| panic!("{e}")).unwrap();
+        let refused = LightBuffer::verified(&moved.view(), &words);
+        assert!(matches!(refused, Err(LightBufferError::Incomplete { object: ObjectId(1), .. })), "{refused:?}");
     }
 }

@@ -21,7 +21,9 @@ pub(crate) mod naive;
 mod octree;
 
 pub use choice::{prepare, Prepared};
-pub use light_buffer::{LightBuffer, LightBufferError, LightBufferReport, LightBuffered, MAX_CELLS_A_SIDE};
+pub use light_buffer::{
+    LightBuffer, LightBufferError, LightBufferReport, LightBufferStore, LightBuffered, MAX_CELLS_A_SIDE,
+};
 pub use naive::Naive;
 pub(crate) use octree::FILING_MARGIN;
 pub use octree::{
