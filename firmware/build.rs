@@ -231,6 +231,12 @@ fn main() {
         // The guest writes this file; on the OLED board the runner does.
         writeln!(config, "pub const OUTPUT: &str = {:?};", format!("{output}\0")).unwrap();
     }
+    // A light buffer in flash serves every light (and takes no RAM).
+    let light_buffer = if techniques.light_buffer_in_flash { light_buffer_in_flash(&text) } else { Vec::new() };
+    let mut counts = counts;
+    if !light_buffer.is_empty() {
+        counts.light_buffer_lights = counts.lights;
+    }
     let doc = format!("Exactly what {scene} needs (about {bytes} bytes).");
     let profile = ProfileText {
         name: "Profile",
@@ -241,7 +247,6 @@ fn main() {
         first_hits: techniques.first_hits,
     };
     write!(config, "{profile}").unwrap();
-    let light_buffer = if techniques.light_buffer_in_flash { light_buffer_in_flash(&text) } else { Vec::new() };
     writeln!(config, "/// The scene's light buffer, built on the host (empty: none in flash).").unwrap();
     writeln!(config, "pub static LIGHT_BUFFER: [u32; {}] = {light_buffer:?};", light_buffer.len()).unwrap();
     // What the runner reads from the ELF: `key=value` lines.

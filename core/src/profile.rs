@@ -76,10 +76,13 @@ pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
     /// And for the lists' positions: [`ScreenBound::positions_for`] the
     /// objects when [`Profile::FIRST_HITS`], else none.
     type ScreenPositions: Arena<u16>;
-    /// Room for the shadow rays' light buffer
-    /// ([`LightBuffer`](crate::accel::LightBuffer)): `light_buffer_words`
-    /// words (none when 0: [`Raytracer`](crate::Raytracer) then builds none
-    /// and links no code to).
+    /// RAM for the shadow rays' light buffer
+    /// ([`LightBuffer`](crate::accel::LightBuffer)), which
+    /// [`Raytracer`](crate::Raytracer) builds when a scene loads for the
+    /// first `light_buffer_lights` lights: `light_buffer_words` words (none
+    /// when 0; with `light_buffer_lights` above 0 a prebuilt buffer may
+    /// still serve them, see
+    /// [`LoadedScene::use_light_buffer`](crate::LoadedScene::use_light_buffer)).
     type LightBufferWords: Arena<u32>;
 }
 
@@ -256,7 +259,9 @@ pub fn needed_with_light_buffer<'t>(
         counts = counts.max(&report.counts());
     }
     if cells_a_side > 0 {
-        counts.light_buffer_words = light_buffer_of(&view, cells_a_side).len();
+        let mut words = crate::accel::LightBufferStore::<<Host as Profile>::LightBufferWords>::new();
+        let report = words.build(&view, cells_a_side).report();
+        (counts.light_buffer_lights, counts.light_buffer_words) = (report.lights, report.words);
     }
     Ok(counts)
 }
@@ -267,14 +272,19 @@ pub fn needed_with_light_buffer<'t>(
 /// the same text, takes them with
 /// [`LoadedScene::use_light_buffer`](crate::LoadedScene::use_light_buffer)
 /// (which checks them against its scene): the buffer is then in flash, no
-/// RAM spent on it.
+/// RAM spent on it. The profile serves the lights (`light_buffer_lights`)
+/// without RAM for the words (`light_buffer_words: 0`).
 ///
 /// ```
-/// use octrace_core::{profile::{light_buffer_words, Board16K}, Raytracer};
+/// use octrace_core::{profile::light_buffer_words, Raytracer};
 ///
+/// octrace_core::profile! {
+///     /// Two spheres; a light buffer from elsewhere for their light.
+///     struct Spheres { spheres: 2, surfaces: 1, lights: 1, light_buffer_lights: 1 }
+/// }
 /// let text = "LIGHT 1 0 9 0\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nSPHERE 1 1 3 0 0\n";
 /// let words = light_buffer_words(text, 16, &mut |_| {}).unwrap();
-/// let mut raytracer = Raytracer::<Board16K>::new();
+/// let mut raytracer = Raytracer::<Spheres>::new();
 /// let mut scene = raytracer.load(text)?;
 /// scene.use_light_buffer(&words)?;
 /// assert_eq!(scene.light_buffer().report().cells_a_side, 16);
@@ -286,7 +296,8 @@ pub fn light_buffer_words<'t>(
     cells_a_side: u32,
     on_error: &mut dyn FnMut(ParseError<'t>),
 ) -> Result<alloc::vec::Vec<u32>, usize> {
-    Ok(light_buffer_of(&host_scene(text, on_error)?.view(), cells_a_side))
+    let mut words = crate::accel::LightBufferStore::<<Host as Profile>::LightBufferWords>::new();
+    Ok(words.build(&host_scene(text, on_error)?.view(), cells_a_side).words().to_vec())
 }
 
 /// `text`'s scene in the host profile.
@@ -298,14 +309,6 @@ fn host_scene<'t>(
     let mut scene = alloc::boxed::Box::new(crate::scene::Scene::<Host>::new());
     parse(text, &mut scene, on_error)?;
     Ok(scene)
-}
-
-/// The words of `view`'s light buffer with at most `cells_a_side` cells a
-/// face side.
-#[cfg(feature = "alloc")]
-fn light_buffer_of(view: &crate::scene::SceneView<'_>, cells_a_side: u32) -> alloc::vec::Vec<u32> {
-    let mut words = crate::capacity::HeapArena::<u32, { Host::COUNTS.light_buffer_words }>::EMPTY;
-    crate::accel::LightBuffer::build(view, &mut words, cells_a_side).words().to_vec()
 }
 
 /// A [`profile!`](crate::profile!) invocation as text, for a build script
@@ -467,6 +470,7 @@ mod host {
             lights: 4_096,
             octree_boxes: 16_000_000,
             octree_references: 64_000_000,
+            light_buffer_lights: 4_096,
             light_buffer_words: 64_000_000,
             ..Counts::ZERO
         }

@@ -145,8 +145,11 @@ impl<P: Profile> Raytracer<P> {
         fill(&mut self.screen_bounds, objects, ScreenBound::EMPTY);
         fill(&mut self.screen_positions, ScreenBound::positions_for(objects), 0);
         // Likewise the shadow rays' light buffer.
-        let lights = if <P::LightBufferWords as Arena<u32>>::CAPACITY > 0 && requested != AccelMode::Naive {
-            self.light_buffer.build(&view, MAX_CELLS_A_SIDE)
+        let lights = if <P::LightBufferWords as Arena<u32>>::CAPACITY > 0
+            && light_buffer::<P>()
+            && requested != AccelMode::Naive
+        {
+            self.light_buffer.build_for(&view, MAX_CELLS_A_SIDE, P::COUNTS.light_buffer_lights)
         } else {
             LightBuffer::NONE
         };
@@ -161,6 +164,12 @@ impl<P: Profile> Raytracer<P> {
             stats: Cell::new(Stats::default()),
         })
     }
+}
+
+/// Whether profile `P` serves lights with a light buffer (else none of its
+/// code is linked).
+const fn light_buffer<P: Profile>() -> bool {
+    P::COUNTS.light_buffer_lights > 0
 }
 
 /// `arena` emptied, then `len` copies of `item`, as many as it holds.
@@ -248,12 +257,19 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// Uses `words`, a light buffer built beforehand for this scene (its
     /// [`LightBuffer::words`], kept in flash by a build script), once
     /// checked to hold every object wherever a buffer built here would
-    /// ([`LightBuffer::verified`]); a buffer that is not refused, and the
-    /// scene keeps the one it had.
+    /// ([`LightBuffer::verified`]); a buffer that is not is refused, and
+    /// the scene keeps the one it had. The profile must serve lights with a
+    /// light buffer (`light_buffer_lights`), not necessarily hold one in
+    /// RAM (`light_buffer_words`).
     ///
     /// ```
-    /// use octrace_core::{accel::LightBuffer, parse::parse, profile::{Board16K, Board64K}, scene::Scene, Raytracer};
+    /// use octrace_core::{accel::{LightBuffer, LightBufferError}, parse::parse, profile::{Board16K, Board64K}};
+    /// use octrace_core::{scene::Scene, Raytracer};
     ///
+    /// octrace_core::profile! {
+    ///     /// Two spheres; a light buffer from flash for their light.
+    ///     struct Spheres { spheres: 2, surfaces: 1, lights: 1, light_buffer_lights: 1 }
+    /// }
     /// let text = "LIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\nSPHERE 1 0.5 1 1 1\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n";
     /// // Where the scene is known beforehand (a build script): the words.
     /// let mut built = Scene::<Board64K>::new();
@@ -261,14 +277,21 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// let mut words = heapless::Vec::<u32, 400>::new();
     /// let prebuilt = LightBuffer::build(&built.view(), &mut words, 8).words();
     /// // On the board: the scene, and the words from flash.
-    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let mut raytracer = Raytracer::<Spheres>::new();
     /// let mut scene = raytracer.load(text)?;
-    /// assert_eq!(scene.light_buffer().report().lights, 0, "Board16K has no room for one");
+    /// assert_eq!(scene.light_buffer().report().lights, 0, "no RAM for one");
     /// scene.use_light_buffer(prebuilt)?;
     /// assert_eq!(scene.light_buffer().report().lights, 1);
+    ///
+    /// // A profile without light buffers refuses it.
+    /// let mut small = Raytracer::<Board16K>::new();
+    /// assert_eq!(small.load(text)?.use_light_buffer(prebuilt), Err(LightBufferError::NoRoom));
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
     pub fn use_light_buffer(&mut self, words: &'r [u32]) -> Result<(), LightBufferError> {
+        if !light_buffer::<P>() {
+            return Err(LightBufferError::NoRoom);
+        }
         self.lights = LightBuffer::verified(&self.view, words)?;
         Ok(())
     }
@@ -432,8 +455,10 @@ impl<P: Profile> Accelerator for SceneAccelerator<'_, P> {
         start: Option<RayStart>,
         mailbox: &mut Mailbox<'_>,
     ) -> bool {
-        if let Some(blocked) = self.lights.occluded(scene, Self::KINDS, ray, t_max, light, start, mailbox) {
-            return blocked;
+        if light_buffer::<P>() {
+            if let Some(blocked) = self.lights.occluded(scene, Self::KINDS, ray, t_max, light, start, mailbox) {
+                return blocked;
+            }
         }
         match self.octree() {
             Some(octree) => octree.occluded_toward(scene, ray, t_max, light, start, mailbox),

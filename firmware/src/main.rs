@@ -110,7 +110,7 @@ fn run(raytracer: &'static mut Raytracer<Profile>) -> u32 {
         );
     }
     let lights = scene.light_buffer().report();
-    if lights.lights > 0 {
+    if !config::LIGHT_BUFFER.is_empty() {
         hprintln!(
             "light buffer: {} of {} lights, {} cells a side, {} cells, {} entries, {} bytes",
             lights.lights,

@@ -132,14 +132,18 @@ pub struct LightBufferReport {
 impl LightBufferReport {
     /// The counts of a profile that builds this very buffer.
     pub fn counts(&self) -> Counts {
-        Counts { light_buffer_words: self.words, ..Counts::ZERO }
+        Counts { light_buffer_lights: self.lights, light_buffer_words: self.words, ..Counts::ZERO }
     }
 }
 
-/// Why a prebuilt light buffer was refused ([`LightBuffer::verified`]).
+/// Why a prebuilt light buffer was refused ([`LightBuffer::verified`],
+/// [`LoadedScene::use_light_buffer`](crate::LoadedScene::use_light_buffer)).
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LightBufferError {
+    /// The capacity profile serves no lights with a light buffer
+    /// (`light_buffer_lights: 0`), so it links none of its code.
+    NoRoom,
     /// The words are not a light buffer of this version.
     Malformed,
     /// It was built for other lights or another number of objects.
@@ -157,6 +161,9 @@ pub enum LightBufferError {
 impl core::fmt::Display for LightBufferError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
+            LightBufferError::NoRoom => {
+                f.write_str("the capacity profile has no light buffer; give it one with octrace_core::profile! (light_buffer_lights: …)")
+            }
             LightBufferError::Malformed => f.write_str("not a light buffer of this version"),
             LightBufferError::OtherScene => f.write_str("a light buffer built for other lights or objects"),
             LightBufferError::Incomplete { light, object } => write!(
@@ -427,13 +434,16 @@ impl<'a> LightBuffer<'a> {
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
     pub fn build<W: Arena<u32>>(scene: &SceneView<'_>, words: &'a mut W, cells_a_side: u32) -> LightBuffer<'a> {
-        Self::build_with_margin(scene, words, cells_a_side, MARGIN)
+        Self::build_with_margin(scene, words, cells_a_side, usize::MAX, MARGIN)
     }
 
+    /// [`LightBuffer::build`] for at most the first `lights` lights, with
+    /// objects widened by `margin` (tests make it too small).
     pub(crate) fn build_with_margin<W: Arena<u32>>(
         scene: &SceneView<'_>,
         words: &'a mut W,
         cells_a_side: u32,
+        lights: usize,
         margin: i64,
     ) -> LightBuffer<'a> {
         words.clear();
@@ -445,7 +455,7 @@ impl<'a> LightBuffer<'a> {
         }
         // The lights' needs at every level: the finest where all fit, else
         // one cell a face for as many lights as fit.
-        let lights = scene.lights.len();
+        let lights = scene.lights.len().min(lights);
         let mut total = Needs::default();
         for light in 0..lights {
             let (needs, _) = needs(scene, light, finest, margin);
@@ -681,7 +691,12 @@ impl<W: Arena<u32>> LightBufferStore<W> {
 
     /// Builds `scene`'s buffer in the store (see [`LightBuffer::build`]).
     pub fn build(&mut self, scene: &SceneView<'_>, cells_a_side: u32) -> LightBuffer<'_> {
-        LightBuffer::build(scene, &mut self.words, cells_a_side)
+        self.build_for(scene, cells_a_side, usize::MAX)
+    }
+
+    /// [`LightBufferStore::build`] for at most the first `lights` lights.
+    pub(crate) fn build_for(&mut self, scene: &SceneView<'_>, cells_a_side: u32, lights: usize) -> LightBuffer<'_> {
+        LightBuffer::build_with_margin(scene, &mut self.words, cells_a_side, lights, MARGIN)
     }
 
     /// The buffer last built (none before the first build).
@@ -1055,7 +1070,7 @@ mod tests {
             let lit = LightBuffered::new(&Naive, buffer);
             let answer = lit.occluded_toward(&view, &ray, t_max, 1, None, &mut Mailbox::none());
             assert_eq!(answer, naive, "case {case}: {ray:?} to {t_max:?}\n{text}");
-            let cut = LightBuffer::build_with_margin(&view, &mut words, MAX_CELLS_A_SIDE, -4);
+            let cut = LightBuffer::build_with_margin(&view, &mut words, MAX_CELLS_A_SIDE, usize::MAX, -4);
             let answer =
                 LightBuffered::new(&Naive, cut).occluded_toward(&view, &ray, t_max, 1, None, &mut Mailbox::none());
             wrong_if_cut += (answer != naive) as usize;
