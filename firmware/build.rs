@@ -258,11 +258,10 @@ fn main() {
 }
 
 /// The words of the scene's light buffer for flash: the finest cube up to
-/// 32 cells a face side (beyond, fig5_5 gains 2 % for 3.7 times the
-/// words) that takes at most `LIGHT_BUFFER_FLASH` bytes.
+/// 64 cells a face side that takes at most `LIGHT_BUFFER_FLASH` bytes.
 fn light_buffer_in_flash(text: &str) -> Vec<u32> {
-    const LIGHT_BUFFER_FLASH: usize = 32 * 1024;
-    let mut cells = 32;
+    const LIGHT_BUFFER_FLASH: usize = 48 * 1024;
+    let mut cells = 64;
     loop {
         let words = light_buffer_words(text, cells, &mut |_| {}).unwrap_or_default();
         if words.len() * 4 <= LIGHT_BUFFER_FLASH || cells == 1 {

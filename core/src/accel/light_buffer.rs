@@ -722,9 +722,10 @@ impl LightBuffer<'_> {
         start: Option<RayStart>,
         mailbox: &mut Mailbox<'_>,
     ) -> Option<bool> {
-        let (lists, depth) = self.lists(ray.origin.bits(), light)?;
+        let ([own, cell], depth) = self.lists(ray.origin.bits(), light)?;
         let shadow = Shadow { scene, kinds, ray, t_max, start, depth };
-        Some(lists.iter().any(|list| shadow.blocked_by(list, mailbox)))
+        // The light's own list is mostly empty.
+        Some((!own.is_empty() && shadow.blocked_by(own, mailbox)) || shadow.blocked_by(cell, mailbox))
     }
 
     /// The lists a shadow ray from `origin` to light `light` tests (the

@@ -6,7 +6,7 @@
 //! nearly so, needs no special case and cannot overflow.
 
 use super::{Aabb, Leaving, Ratio, Ray, Shape};
-use crate::math::{Dir, Scalar, Vec3};
+use crate::math::{div_saturating, Dir, Scalar, Vec3};
 
 /// A BOX: its corners in normalised space.
 // Public only for `profile!` (arenas of it) and the firmware's RAM
@@ -85,8 +85,9 @@ impl AxisAlignedBox {
         if !positive(chosen) || !chosen.le_scalar(t_max) {
             return None;
         }
-        let t = chosen.to_scalar();
-        (t.to_bits() > 0).then_some(t)
+        // Below t_max + 1, so the quotient of these positive numbers fits.
+        let t = div_saturating((chosen.num << 30) as u64, chosen.den as u32) as i32;
+        (t > 0).then_some(Scalar::from_bits(t))
     }
 }
 
@@ -206,7 +207,13 @@ mod tests {
             let r = Ray { origin: o, dir };
             let t_max = Scalar::from_bits(coordinate(1 << 24).abs());
             for leaving in [Leaving::No, Leaving::Inward] {
-                assert_eq!(b.intersect(&r, t_max, leaving), b.intersect_span(&r, t_max, leaving), "{r:?} {b:?}");
+                let hit = b.intersect(&r, t_max, leaving);
+                assert_eq!(hit, b.intersect_span(&r, t_max, leaving), "{r:?} {b:?}");
+                // The parameter is the span's crossing divided exactly.
+                if let (Some(t), Some(span)) = (hit, slab_span(&r, b.min, b.max)) {
+                    let crossings = [span.enter, span.exit].into_iter().flatten();
+                    assert!(crossings.map(|c| (c.num << 30) / c.den).any(|q| q == t.to_bits() as i64), "{r:?} {b:?}");
+                }
             }
             let (ob, db) = (o.bits(), dir.bits());
             early += (0..3).any(|a| (ob[a] > hi[a] && db[a] >= 0) || (ob[a] < lo[a] && db[a] <= 0)) as u32;
