@@ -1,5 +1,6 @@
-//! The one way in: a [`Raytracer`] holds a scene, its octree, a mailbox and
-//! room for the camera rays' screen lists in one place (a `static` on a board), [`Raytracer::load`] parses a scene
+//! The one way in: a [`Raytracer`] holds a scene, its octree, a mailbox,
+//! room for the camera rays' screen lists and for the shadow rays' light
+//! buffer in one place (a `static` on a board), [`Raytracer::load`] parses a scene
 //! text and indexes it, and the [`LoadedScene`] draws as an embedded-graphics
 //! image ([`TracedImage`]) in the colour of any display.
 //!
