@@ -11,7 +11,7 @@
 //! | `OCTRACE_SIZE` | `WxH` (on `lm3s6965evb` at most the panel's 128x64, an even width) | `160x128`; `128x64` on `lm3s6965evb` |
 //! | `OCTRACE_ACCEL` | `auto`, `naive`, `octree`, `dda` | `auto` |
 //! | `OCTRACE_COLOR` | `rgb888`, `rgb565`, `dither` (1-byte indices into the 6×6×6 cube), `gray4` (1 byte a pixel, the level 0 to 15); only `gray4` on `lm3s6965evb` | `rgb888`; `gray4` on `lm3s6965evb` |
-//! | `OCTRACE_TECHNIQUES` | `auto` (every technique whose RAM fits beside the deepest octree that fits), `none`, or a comma list of `first-hits`, `shadow-shafts` (each still only where it fits) | `auto` |
+//! | `OCTRACE_TECHNIQUES` | `auto` (every technique whose RAM fits beside the deepest octree that fits, and for a scene walked in an octree the light buffer in flash instead of the shadow shafts), `none`, or a comma list of `first-hits`, `shadow-shafts`, `light-buffer` (built here, kept in flash), `light-buffer-ram` (built by the board, in RAM; each still only where it fits) | `auto` |
 //! | `OCTRACE_OUT` | host file the pixels are written to; on `lm3s6965evb` the PNG of the panel's screen that the runner grabs | `octrace-out.raw`; `screen.png` on `lm3s6965evb` |
 //!
 //! | board | qemu `-machine` | core | flash | RAM | display |

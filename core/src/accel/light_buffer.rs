@@ -939,7 +939,7 @@ mod tests {
     /// light. Boxes of every size, near the light and far, at every level.
     #[test]
     fn every_point_of_the_widened_bounds_is_in_a_listed_cell() {
-        let mut next = crate::test_rng::seeded(0x11647_b0ff);
+        let mut next = crate::test_rng::seeded(0x1_1647_b0ff);
         let mut coordinate = move |bits: u32| (next() % (2 << bits)) as i64 - (1 << bits);
         let (mut around, mut points) = (0, 0);
         for _ in 0..20_000 {
@@ -1200,7 +1200,7 @@ mod tests {
         // needed somewhere (unless its object is listed there twice).
         let (mut missed, mut deeper) = (0, 0);
         for e in entries..words.len() {
-            let other = |w: &mut Vec<u32>| w[e] = w[e] & !OBJECT_MASK | ((w[e] & OBJECT_MASK) + 1) % 4;
+            let other = |w: &mut Vec<u32>| w[e] = w[e] & !OBJECT_MASK | (((w[e] & OBJECT_MASK) + 1) % 4);
             missed += matches!(changed(&other), Err(LightBufferError::Incomplete { .. } | LightBufferError::Malformed))
                 as usize;
             let deepen = |w: &mut Vec<u32>| w[e] += 1 << OBJECT_BITS;

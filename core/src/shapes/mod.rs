@@ -375,4 +375,3 @@ pub(crate) mod test_util {
         a.bits().iter().zip(b.bits()).all(|(x, y)| (x - y).abs() <= tol)
     }
 }
-
