@@ -247,9 +247,11 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     }
 
     /// The shadow rays' light buffer: built when the scene loaded if the
-    /// profile has room for one (`light_buffer_words`, see
+    /// profile serves lights with one and has RAM for it
+    /// (`light_buffer_lights` and `light_buffer_words`, see
     /// [`Profile::LightBufferWords`]) and the mode is not
-    /// [`AccelMode::Naive`] asked for by name, else none
+    /// [`AccelMode::Naive`] asked for by name, or the one
+    /// [`LoadedScene::use_light_buffer`] took; else none
     /// ([`LightBuffer::report`] says how many lights it buffers).
     pub fn light_buffer(&self) -> LightBuffer<'r> {
         self.lights
