@@ -210,6 +210,14 @@ crate::__shape_kinds!(capacities! {
     /// Object references in the octree's leaves, and working room while
     /// building (an object in several leaves counts once per leaf).
     OctreeReferences => octree_references, "octree references";
+    /// Lights whose shadow rays the light buffer (`accel::LightBuffer`)
+    /// serves, the first ones: 0 links none of its code.
+    LightBufferLights => light_buffer_lights, "light buffer lights";
+    /// Words of RAM for the light buffer, built when a scene loads (0: none
+    /// built; a prebuilt one, e.g. in flash, may still serve the lights): a
+    /// few for each light and each cell of its cube that lists objects, one
+    /// for each object listed in a cell.
+    LightBufferWords => light_buffer_words, "light buffer words";
 });
 
 impl Counts {

@@ -78,6 +78,14 @@ pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
     /// And for the lists' positions: [`ScreenBound::positions_for`] the
     /// objects when [`Profile::FIRST_HITS`], else none.
     type ScreenPositions: Arena<u16> + Send;
+    /// RAM for the shadow rays' light buffer
+    /// ([`LightBuffer`](crate::accel::LightBuffer)), which
+    /// [`Raytracer`](crate::Raytracer) builds when a scene loads for the
+    /// first `light_buffer_lights` lights: `light_buffer_words` words (none
+    /// when 0; with `light_buffer_lights` above 0 a prebuilt buffer may
+    /// still serve them, see
+    /// [`LoadedScene::use_light_buffer`](crate::LoadedScene::use_light_buffer)).
+    type LightBufferWords: Arena<u32>;
 }
 
 /// Defines a [`Profile`] from counts: the fields of
@@ -132,6 +140,7 @@ macro_rules! profile {
                     u16,
                     { p::ScreenBound::if_wanted(<$name as $crate::profile::Profile>::FIRST_HITS, p::ScreenBound::positions_for(<$name as $crate::profile::Profile>::COUNTS.objects)) },
                 >;
+                type LightBufferWords = p::Vec<u32, { <$name as $crate::profile::Profile>::COUNTS.light_buffer_words }>;
             }
 
             // 16-bit indices: their top two values are markers.
@@ -140,7 +149,6 @@ macro_rules! profile {
                     && <$name as $crate::profile::Profile>::COUNTS.octree_references < 0xFFFE,
                 "profile!: octree_boxes and octree_references must be below 65534"
             );
-
             $crate::__shape_kinds!($crate::__scene_capacities! { $name, p::Vec });
 
             impl p::OctreeCapacities for $name {
@@ -217,12 +225,34 @@ pub fn needed_by<'t>(
     octree: &OctreeConfig,
     on_error: &mut dyn FnMut(ParseError<'t>),
 ) -> Result<Counts, usize> {
+    needed_with_light_buffer(text, mode, octree, 0, on_error)
+}
+
+/// [`needed_by`], and the words of a light buffer with at most
+/// `cells_a_side` cells a face side (see
+/// [`LightBuffer::build`](crate::accel::LightBuffer::build); 0: no light
+/// buffer): a profile of these counts builds this very buffer when the
+/// scene loads, so its shadow rays test only the objects their cells list.
+///
+/// ```
+/// use octrace_core::{accel::OctreeConfig, profile::needed_with_light_buffer, AccelMode};
+///
+/// let text = "LIGHT 1 0 9 0\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nSPHERE 1 1 3 0 0\n";
+/// let needs = needed_with_light_buffer(text, AccelMode::Auto, &OctreeConfig::DEFAULT, 8, &mut |_| {}).unwrap();
+/// assert!(needs.light_buffer_words > 0);
+/// ```
+#[cfg(feature = "alloc")]
+pub fn needed_with_light_buffer<'t>(
+    text: &'t str,
+    mode: AccelMode,
+    octree: &OctreeConfig,
+    cells_a_side: u32,
+    on_error: &mut dyn FnMut(ParseError<'t>),
+) -> Result<Counts, usize> {
     use crate::accel::Octree;
-    use crate::scene::Scene;
     use alloc::boxed::Box;
 
-    let mut scene = Box::new(Scene::<Host>::new());
-    parse(text, &mut scene, on_error)?;
+    let scene = host_scene(text, on_error)?;
     let mut counts = count(text);
     let view = scene.view();
     if let Some(traversal) = mode.resolve(view.object_count()).traversal() {
@@ -230,7 +260,57 @@ pub fn needed_by<'t>(
         let report = tree.build(&view, &OctreeConfig { traversal, ..*octree });
         counts = counts.max(&report.counts());
     }
+    if cells_a_side > 0 {
+        let mut words = crate::accel::LightBufferStore::<<Host as Profile>::LightBufferWords>::new();
+        let report = words.build(&view, cells_a_side).report();
+        (counts.light_buffer_lights, counts.light_buffer_words) = (report.lights, report.words);
+    }
     Ok(counts)
+}
+
+/// The words of the light buffer of `text`'s scene with at most
+/// `cells_a_side` cells a face side, built here as a board builds it: a
+/// build script writes them into a `static`, and the board, having loaded
+/// the same text, takes them with
+/// [`LoadedScene::use_light_buffer`](crate::LoadedScene::use_light_buffer)
+/// (which checks them against its scene): the buffer is then in flash, no
+/// RAM spent on it. The profile serves the lights (`light_buffer_lights`)
+/// without RAM for the words (`light_buffer_words: 0`).
+///
+/// ```
+/// use octrace_core::{profile::light_buffer_words, Raytracer};
+///
+/// octrace_core::profile! {
+///     /// Two spheres; a light buffer from elsewhere for their light.
+///     struct Spheres { spheres: 2, surfaces: 1, lights: 1, light_buffer_lights: 1 }
+/// }
+/// let text = "LIGHT 1 0 9 0\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nSPHERE 1 1 3 0 0\n";
+/// let words = light_buffer_words(text, 16, &mut |_| {}).unwrap();
+/// let mut raytracer = Raytracer::<Spheres>::new();
+/// let mut scene = raytracer.load(text)?;
+/// scene.use_light_buffer(&words)?;
+/// assert_eq!(scene.light_buffer().report().cells_a_side, 16);
+/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// ```
+#[cfg(feature = "alloc")]
+pub fn light_buffer_words<'t>(
+    text: &'t str,
+    cells_a_side: u32,
+    on_error: &mut dyn FnMut(ParseError<'t>),
+) -> Result<alloc::vec::Vec<u32>, usize> {
+    let mut words = crate::accel::LightBufferStore::<<Host as Profile>::LightBufferWords>::new();
+    Ok(words.build(&host_scene(text, on_error)?.view(), cells_a_side).words().to_vec())
+}
+
+/// `text`'s scene in the host profile.
+#[cfg(feature = "alloc")]
+fn host_scene<'t>(
+    text: &'t str,
+    on_error: &mut dyn FnMut(ParseError<'t>),
+) -> Result<alloc::boxed::Box<crate::scene::Scene<Host>>, usize> {
+    let mut scene = alloc::boxed::Box::new(crate::scene::Scene::<Host>::new());
+    parse(text, &mut scene, on_error)?;
+    Ok(scene)
 }
 
 /// A [`profile!`](crate::profile!) invocation as text, for a build script
@@ -309,6 +389,7 @@ impl ProfileText<'_> {
             + ScreenBound::if_wanted(self.first_hits, counts.objects) * size_of::<ScreenBound>()
             + ScreenBound::if_wanted(self.first_hits, ScreenBound::positions_for(counts.objects)) * size_of::<u16>()
             + counts.octree_shadow_shafts_if(shadow_shafts) * size_of::<ShadowShaft>()
+            + counts.light_buffer_words * size_of::<u32>()
     }
 }
 
@@ -391,6 +472,8 @@ mod host {
             lights: 4_096,
             octree_boxes: 16_000_000,
             octree_references: 64_000_000,
+            light_buffer_lights: 4_096,
+            light_buffer_words: 64_000_000,
             ..Counts::ZERO
         }
         .with_every_shape(MILLION);
@@ -401,6 +484,7 @@ mod host {
         const FIRST_HITS: bool = true;
         type ScreenBounds = HeapArena<ScreenBound, { Host::COUNTS.objects }>;
         type ScreenPositions = HeapArena<u16, { ScreenBound::positions_for(Host::COUNTS.objects) }>;
+        type LightBufferWords = HeapArena<u32, { Host::COUNTS.light_buffer_words }>;
     }
 
     crate::__shape_kinds!(crate::__scene_capacities! { Host, HeapArena });

@@ -1,5 +1,6 @@
-//! The one way in: a [`Raytracer`] holds a scene, its octree, a mailbox and
-//! room for the camera rays' screen lists in one place (a `static` on a board), [`Raytracer::load`] parses a scene
+//! The one way in: a [`Raytracer`] holds a scene, its octree, a mailbox,
+//! room for the camera rays' screen lists and for the shadow rays' light
+//! buffer in one place (a `static` on a board), [`Raytracer::load`] parses a scene
 //! text and indexes it, and the [`LoadedScene`] draws as an embedded-graphics
 //! image ([`TracedImage`]) in the colour of any display.
 //!
@@ -7,7 +8,10 @@
 //! in `.bss`, initialised in place); a [`LoadedScene`] exists only for a
 //! scene that parsed without errors, with its accelerator built.
 
-use crate::accel::{self, naive, AccelMode, Accelerator, BuildReport, Hit, Mailbox, OctreeStore, Prepared, RayStart};
+use crate::accel::{
+    self, naive, AccelMode, Accelerator, BuildReport, Hit, LightBuffer, LightBufferError, LightBufferStore, Mailbox,
+    OctreeStore, Prepared, RayStart, MAX_CELLS_A_SIDE,
+};
 use crate::capacity::Arena;
 use crate::math::Scalar;
 use crate::parse::{parse_bytes, ErrorKind, ParseError, Pos};
@@ -43,6 +47,7 @@ pub struct Raytracer<P: Profile> {
     octree: P::Octree,
     /// The first core's renderer's own room.
     room: RendererRoom<P>,
+    light_buffer: LightBufferStore<P::LightBufferWords>,
 }
 
 /// Room for one core's [`Renderer`] over a profile's scenes: a mailbox and
@@ -142,7 +147,12 @@ impl core::error::Error for LoadError<'_> {}
 impl<P: Profile> Raytracer<P> {
     /// Empty room for a scene: a constant of all-zero bits.
     pub const fn new() -> Self {
-        Raytracer { scene: Scene::new(), octree: P::Octree::EMPTY, room: RendererRoom::new() }
+        Raytracer {
+            scene: Scene::new(),
+            octree: P::Octree::EMPTY,
+            room: RendererRoom::new(),
+            light_buffer: LightBufferStore::new(),
+        }
     }
 
     /// Parses `text` (replacing any scene loaded before) and indexes it for
@@ -185,16 +195,32 @@ impl<P: Profile> Raytracer<P> {
         // every object, camera rays too.
         let first_hits = P::FIRST_HITS && requested != AccelMode::Naive;
         let (mailbox, screen_lists) = self.room.prepare(view.object_count(), first_hits);
+        // Likewise the shadow rays' light buffer.
+        let lights = if <P::LightBufferWords as Arena<u32>>::CAPACITY > 0
+            && light_buffer::<P>()
+            && requested != AccelMode::Naive
+        {
+            self.light_buffer.build_for(&view, MAX_CELLS_A_SIDE, P::COUNTS.light_buffer_lights)
+        } else {
+            LightBuffer::NONE
+        };
         Ok(LoadedScene {
             view,
             mode,
             octree,
+            lights,
             mailbox: RefCell::new(mailbox),
             screen_lists: RefCell::new(screen_lists),
             first_hits,
             stats: Cell::new(Stats::default()),
         })
     }
+}
+
+/// Whether profile `P` serves lights with a light buffer (else none of its
+/// code is linked).
+const fn light_buffer<P: Profile>() -> bool {
+    P::COUNTS.light_buffer_lights > 0
 }
 
 /// `arena` emptied, then `len` copies of `item`, as many as it holds.
@@ -208,6 +234,8 @@ pub struct LoadedScene<'r, P: Profile> {
     view: SceneView<'r>,
     mode: AccelMode,
     octree: Option<(&'r P::Octree, BuildReport)>,
+    /// The shadow rays' light buffer (none buffered without room for one).
+    lights: LightBuffer<'r>,
     mailbox: RefCell<&'r mut [u32]>,
     /// The camera rays' screen lists (bounds and positions), if they are
     /// used.
@@ -265,7 +293,60 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
     pub fn accelerator(&self) -> SceneAccelerator<'r, P> {
-        SceneAccelerator { octree: self.octree.as_ref().map(|(octree, _)| *octree) }
+        SceneAccelerator { octree: self.octree.as_ref().map(|(octree, _)| *octree), lights: self.lights }
+    }
+
+    /// The shadow rays' light buffer: built when the scene loaded if the
+    /// profile serves lights with one and has RAM for it
+    /// (`light_buffer_lights` and `light_buffer_words`, see
+    /// [`Profile::LightBufferWords`]) and the mode is not
+    /// [`AccelMode::Naive`] asked for by name, or the one
+    /// [`LoadedScene::use_light_buffer`] took; else none
+    /// ([`LightBuffer::report`] says how many lights it buffers).
+    pub fn light_buffer(&self) -> LightBuffer<'r> {
+        self.lights
+    }
+
+    /// Uses `words`, a light buffer built beforehand for this scene (its
+    /// [`LightBuffer::words`], kept in flash by a build script), once
+    /// checked to hold every object wherever a buffer built here would
+    /// ([`LightBuffer::verified`]); a buffer that is not is refused, and
+    /// the scene keeps the one it had. The profile must serve lights with a
+    /// light buffer (`light_buffer_lights`), not necessarily hold one in
+    /// RAM (`light_buffer_words`).
+    ///
+    /// ```
+    /// use octrace_core::{accel::{LightBuffer, LightBufferError}, parse::parse, profile::{Board16K, Board64K}};
+    /// use octrace_core::{scene::Scene, Raytracer};
+    ///
+    /// octrace_core::profile! {
+    ///     /// Two spheres; a light buffer from flash for their light.
+    ///     struct Spheres { spheres: 2, surfaces: 1, lights: 1, light_buffer_lights: 1 }
+    /// }
+    /// let text = "LIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\nSPHERE 1 0.5 1 1 1\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n";
+    /// // Where the scene is known beforehand (a build script): the words.
+    /// let mut built = Scene::<Board64K>::new();
+    /// parse(text, &mut built, &mut |e| panic!("{e}")).unwrap();
+    /// let mut words = heapless::Vec::<u32, 400>::new();
+    /// let prebuilt = LightBuffer::build(&built.view(), &mut words, 8).words();
+    /// // On the board: the scene, and the words from flash.
+    /// let mut raytracer = Raytracer::<Spheres>::new();
+    /// let mut scene = raytracer.load(text)?;
+    /// assert_eq!(scene.light_buffer().report().lights, 0, "no RAM for one");
+    /// scene.use_light_buffer(prebuilt)?;
+    /// assert_eq!(scene.light_buffer().report().lights, 1);
+    ///
+    /// // A profile without light buffers refuses it.
+    /// let mut small = Raytracer::<Board16K>::new();
+    /// assert_eq!(small.load(text)?.use_light_buffer(prebuilt), Err(LightBufferError::NoRoom));
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn use_light_buffer(&mut self, words: &'r [u32]) -> Result<(), LightBufferError> {
+        if !light_buffer::<P>() {
+            return Err(LightBufferError::NoRoom);
+        }
+        self.lights = LightBuffer::verified(&self.view, words)?;
+        Ok(())
     }
 
     /// Runs `f` with a renderer of an image of `size` over this scene, in
@@ -493,6 +574,7 @@ impl<'r, P: Profile> SharedScene<'r, P> {
 /// a build without an octree or without the lists links none of their code.
 pub struct SceneAccelerator<'r, P: Profile> {
     octree: Option<&'r P::Octree>,
+    lights: LightBuffer<'r>,
 }
 
 impl<P: Profile> Clone for SceneAccelerator<'_, P> {
@@ -505,7 +587,10 @@ impl<P: Profile> Copy for SceneAccelerator<'_, P> {}
 
 impl<P: Profile> fmt::Debug for SceneAccelerator<'_, P> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("SceneAccelerator").field("octree", &self.octree.is_some()).finish()
+        f.debug_struct("SceneAccelerator")
+            .field("octree", &self.octree.is_some())
+            .field("light_buffer", &self.lights)
+            .finish()
     }
 }
 
@@ -565,6 +650,11 @@ impl<P: Profile> Accelerator for SceneAccelerator<'_, P> {
         start: Option<RayStart>,
         mailbox: &mut Mailbox<'_>,
     ) -> bool {
+        if light_buffer::<P>() {
+            if let Some(blocked) = self.lights.occluded(scene, Self::KINDS, ray, t_max, light, start, mailbox) {
+                return blocked;
+            }
+        }
         match self.octree() {
             Some(octree) => octree.occluded_toward(scene, ray, t_max, light, start, mailbox),
             None => self.occluded(scene, ray, t_max, start, mailbox),

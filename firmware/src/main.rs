@@ -109,6 +109,18 @@ fn run(raytracer: &'static mut Raytracer<Profile>) -> u32 {
             if report.unsplit > 0 { " (some boxes left unsplit: arenas full)" } else { "" }
         );
     }
+    let lights = scene.light_buffer().report();
+    if !config::LIGHT_BUFFER.is_empty() {
+        hprintln!(
+            "light buffer: {} of {} lights, {} cells a side, {} cells, {} entries, {} bytes",
+            lights.lights,
+            view.lights.len(),
+            lights.cells_a_side,
+            lights.cells,
+            lights.entries,
+            4 * lights.words
+        );
+    }
     let Some(output) = open_output() else {
         hprintln!("cannot open the display (or the output file on the host)");
         return 3;
@@ -137,7 +149,16 @@ fn load(raytracer: &'static mut Raytracer<Profile>) -> Option<LoadedScene<'stati
         hprintln!("{}.txt:{}", config::SCENE_NAME, e);
     });
     match loaded {
-        Ok(scene) => Some(scene),
+        Ok(mut scene) => {
+            // The light buffer the build script made for this scene, checked
+            // against it (a buffer for another scene is refused).
+            if !config::LIGHT_BUFFER.is_empty() {
+                if let Err(e) = scene.use_light_buffer(&config::LIGHT_BUFFER) {
+                    hprintln!("light buffer not used: {}", e);
+                }
+            }
+            Some(scene)
+        }
         Err(e) => {
             hprintln!("{} error(s); nothing rendered", e.count);
             None

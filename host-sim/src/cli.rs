@@ -414,6 +414,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         octree: OctreeConfig { max_objects: args.max_objects, max_depth: args.max_depth, ..crate::OCTREE },
         threads: args.threads.map_or_else(all_cores, |n| n as usize),
         partition: args.partition,
+        light_buffer: crate::LIGHT_BUFFER,
     };
     if matches!(args.color, PanelColor::Rgb565 | PanelColor::Gray4) {
         return preview(&scene, &options, args.color, format, &out, args.quiet, stderr);

@@ -18,9 +18,13 @@ use threaded::stream_threads;
 
 pub use octrace_images::{RgbImage, NO_OBJECT};
 
-use octrace_core::accel::{self, BuildReport, Naive, Octree, OctreeConfig, Traversal};
+use octrace_core::accel::{
+    self, Accelerator, BuildReport, LightBuffer, LightBufferReport, LightBufferStore, LightBuffered, Naive, Octree,
+    OctreeConfig, Traversal,
+};
 use octrace_core::parse::{parse_bytes, ParseError};
 use octrace_core::profile::Host;
+use octrace_core::profile::Profile;
 use octrace_core::scene::{CameraError, Scene};
 use octrace_core::shade::Stats;
 use std::path::Path;
@@ -107,13 +111,32 @@ pub struct RenderOptions {
     /// number.
     pub threads: usize,
     pub partition: Partition,
+    /// Cells a face side of the shadow rays' light buffer (0: none); the
+    /// naive mode asked for by name never has one (the thesis's test of
+    /// every object).
+    pub light_buffer: u32,
 }
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions { size: None, accel: AccelMode::Auto, octree: OCTREE, threads: 1, partition: Partition::Tiles }
+        RenderOptions {
+            size: None,
+            accel: AccelMode::Auto,
+            octree: OCTREE,
+            threads: 1,
+            partition: Partition::Tiles,
+            light_buffer: LIGHT_BUFFER,
+        }
     }
 }
+
+/// A light buffer's words on the host (heap-backed, as large as the
+/// buffer).
+pub type HostLightBuffer = LightBufferStore<<Host as Profile>::LightBufferWords>;
+
+/// Cells a face side of host-sim's light buffers (the finest the core
+/// builds): chosen by measurement, see BENCHMARKS.md.
+pub const LIGHT_BUFFER: u32 = octrace_core::accel::MAX_CELLS_A_SIDE;
 
 /// Every core of this machine (1 if that cannot be told).
 pub fn all_cores() -> usize {
@@ -131,6 +154,8 @@ pub struct Rendered {
     pub accel: AccelMode,
     /// The octree's build report and time, when one was built.
     pub build: Option<(BuildReport, std::time::Duration)>,
+    /// The light buffer's report and build time, when one was built.
+    pub light_buffer: Option<(LightBufferReport, Duration)>,
     /// Wall-clock time of the render (without building the octree).
     pub wall: Duration,
     /// For each thread, the time it spent rendering; `wall − busy` is the
@@ -199,8 +224,8 @@ pub fn render_prebuilt(
         // The canvas takes every row.
         Err(StreamError::Sink(e)) => unreachable!("a canvas refused a row: {e}"),
     };
-    let Streamed { stats, accel, build, wall, busy } = streamed;
-    Ok(Rendered { image: canvas.image, objects: canvas.objects, stats, accel, build, wall, busy })
+    let Streamed { stats, accel, build, light_buffer, wall, busy } = streamed;
+    Ok(Rendered { image: canvas.image, objects: canvas.objects, stats, accel, build, light_buffer, wall, busy })
 }
 
 /// What a streamed render reports; its rows went to a [`RowSink`].
@@ -211,6 +236,8 @@ pub struct Streamed {
     pub accel: AccelMode,
     /// The octree's build report and time, when one was built.
     pub build: Option<(BuildReport, Duration)>,
+    /// The light buffer's report and build time, when one was built.
+    pub light_buffer: Option<(LightBufferReport, Duration)>,
     /// Wall-clock time of the render (without building the octree).
     pub wall: Duration,
     /// For each thread, the time it spent tracing.
@@ -218,11 +245,14 @@ pub struct Streamed {
 }
 
 impl Streamed {
-    /// The time spent tracing: building the octree plus every thread's
-    /// time rendering pixels, without the encoder's time or idle waits.
-    /// With one thread this is what POV-Ray calls its trace time.
+    /// The time spent tracing: building the octree and the light buffer
+    /// plus every thread's time rendering pixels, without the encoder's
+    /// time or idle waits. With one thread this is what POV-Ray calls its
+    /// trace time.
     pub fn tracing(&self) -> Duration {
-        self.build.map_or(Duration::ZERO, |(_, built)| built) + self.busy.iter().sum::<Duration>()
+        self.build.map_or(Duration::ZERO, |(_, built)| built)
+            + self.light_buffer.map_or(Duration::ZERO, |(_, built)| built)
+            + self.busy.iter().sum::<Duration>()
     }
 }
 
@@ -283,15 +313,40 @@ fn stream_prebuilt(
     // Set-up errors are found once, before any thread starts.
     view.check_camera(w, h).map_err(StreamError::Camera)?;
     let rows = rows.start.min(h)..rows.end.min(h);
+    // The light buffer, unless the naive mode is asked for by name.
+    let started = Instant::now();
+    let mut store = HostLightBuffer::new();
+    let cells = if options.accel == AccelMode::Naive { 0 } else { options.light_buffer };
+    let lights = (cells > 0).then(|| store.build(&view, cells));
+    let light_buffer = lights.map(|lights| (lights.report(), started.elapsed()));
     let (accel, job) = match octree {
-        None => (AccelMode::Naive, stream_threads(view, &Naive, (w, h), rows, options, progress, sink)),
+        None => (AccelMode::Naive, stream_lit(view, &Naive, lights, (w, h), rows, options, progress, sink)),
         Some(tree) => {
             let mode = if tree.walked_by() == Traversal::Named { AccelMode::Octree } else { AccelMode::Dda };
-            (mode, stream_threads(view, tree, (w, h), rows, options, progress, sink))
+            (mode, stream_lit(view, tree, lights, (w, h), rows, options, progress, sink))
         }
     };
     let (stats, wall, busy) = job.map_err(StreamError::Sink)?;
-    Ok(Streamed { stats, accel, build: None, wall, busy })
+    Ok(Streamed { stats, accel, build: None, light_buffer, wall, busy })
+}
+
+/// [`stream_threads`] with `accel`, and `lights` in front of its shadow
+/// rays if there is one (an empty buffer otherwise, so that the tracer is
+/// compiled once per accelerator: twice, it no longer inlines the naive
+/// mode's loop, 3 % more instructions on fig5_1).
+#[allow(clippy::too_many_arguments)]
+fn stream_lit<A: Accelerator + Sync>(
+    view: octrace_core::scene::SceneView<'_>,
+    accel: &A,
+    lights: Option<LightBuffer<'_>>,
+    size: (u32, u32),
+    rows: std::ops::Range<u32>,
+    options: &RenderOptions,
+    progress: &(dyn Fn(u64) + Sync),
+    sink: &mut dyn RowSink,
+) -> std::io::Result<(Stats, Duration, Vec<Duration>)> {
+    let lit = LightBuffered::new(accel, lights.unwrap_or(LightBuffer::NONE));
+    stream_threads(view, &lit, size, rows, options, progress, sink)
 }
 
 /// The image and the object of every pixel, filled row by row.

@@ -5,9 +5,11 @@
 //! whenever the scene is replaced).
 
 use embedded_graphics_core::pixelcolor::RgbColor;
-use octrace_core::accel::{self, Accelerator, Mailbox, Naive, Octree};
+use octrace_core::accel::{
+    self, Accelerator, LightBufferStore, LightBuffered, Mailbox, Naive, Octree, MAX_CELLS_A_SIDE,
+};
 use octrace_core::parse::{parse_bytes, ParseError};
-use octrace_core::profile::Host;
+use octrace_core::profile::{Host, Profile};
 use octrace_core::render::{Renderer, ScreenBound};
 use octrace_core::scene::Scene;
 use octrace_core::AccelMode;
@@ -78,12 +80,21 @@ pub struct Studio {
     scene: Box<Scene<Host>>,
     loaded: bool,
     octree: Option<Box<Octree<Host>>>,
+    /// The shadow rays' light buffer (none for the naive mode, the
+    /// thesis's test of every object), as host-sim builds it.
+    lights: LightBufferStore<<Host as Profile>::LightBufferWords>,
     size: (u32, u32),
 }
 
 impl Default for Studio {
     fn default() -> Self {
-        Studio { scene: Box::new(Scene::new()), loaded: false, octree: None, size: (1, 1) }
+        Studio {
+            scene: Box::new(Scene::new()),
+            loaded: false,
+            octree: None,
+            lights: LightBufferStore::new(),
+            size: (1, 1),
+        }
     }
 }
 
@@ -91,6 +102,7 @@ impl Studio {
     /// Parses `text`; on success returns the scene's RASTER and object count.
     pub fn load(&mut self, text: &[u8]) -> Result<((u32, u32), usize), StudioError> {
         self.octree = None;
+        self.lights = LightBufferStore::new();
         self.loaded = false;
         let mut errors = Vec::new();
         let mut on_error = |e: ParseError<'_>| errors.push(e.to_string());
@@ -116,8 +128,12 @@ impl Studio {
         view.check_camera(width, height).map_err(|e| StudioError::Camera(format!("{e:?}")))?;
         self.size = (width, height);
         let mut octree: Box<Octree<Host>> = Box::default();
-        let prepared = accel::prepare(accel, &view, &mut *octree, &<Host as octrace_core::profile::Profile>::OCTREE);
+        let prepared = accel::prepare(accel, &view, &mut *octree, &<Host as Profile>::OCTREE);
         self.octree = prepared.report.map(|_| octree);
+        self.lights = LightBufferStore::new();
+        if accel != AccelMode::Naive {
+            self.lights.build(&view, MAX_CELLS_A_SIDE);
+        }
         Ok(prepared.mode)
     }
 
@@ -132,9 +148,11 @@ impl Studio {
         if x.checked_add(width).is_none_or(|r| r > w) || y.checked_add(height).is_none_or(|b| b > h) {
             return Err(StudioError::BadInput("the rectangle is outside the image"));
         }
+        let rect = (x, y, width, height);
+        let lights = self.lights.buffer();
         match self.octree.as_deref() {
-            None => self.render_with(&Naive, (x, y, width, height), out),
-            Some(octree) => self.render_with(octree, (x, y, width, height), out),
+            None => self.render_with(&LightBuffered::new(&Naive, lights), rect, out),
+            Some(octree) => self.render_with(&LightBuffered::new(octree, lights), rect, out),
         }
     }
 

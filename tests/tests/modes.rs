@@ -1,10 +1,15 @@
 //! The three intersection modes (naive, the thesis's octree walk, 3DDDA)
-//! give bit-identical images: on every scene in `scenes/`, and on random
-//! scenes and rays (the seed is printed; set `OCTRACE_SEED` to replay one).
+//! give bit-identical images, with or without the shadow rays' light
+//! buffer: on every scene in `scenes/`, and on random scenes and rays (the
+//! seed is printed; set `OCTRACE_SEED` to replay one).
 
 use host_sim::{build_octree, load_bytes, load_file, new_scene, render, AccelMode, HostScene, RenderOptions};
-use octrace_core::accel::{Accelerator, Mailbox, Naive, OctreeConfig, RayStart, Traversal};
+use octrace_core::accel::{
+    Accelerator, LightBuffer, LightBuffered, Mailbox, Naive, OctreeConfig, RayStart, Traversal, MAX_CELLS_A_SIDE,
+};
+use octrace_core::capacity::Arena;
 use octrace_core::math::{Dir, Scalar, Vec3};
+use octrace_core::profile::{Host, Profile};
 use octrace_core::scene::ObjectId;
 use octrace_core::shapes::{Leaving, Ray};
 use octrace_tests::{scenes, Rng};
@@ -22,13 +27,15 @@ fn every_scene_is_identical_in_every_mode() {
         // Half size keeps the naive mode quick on the large free-form scene
         // (the golden test renders every scene at full size).
         let size = Some((160, 120));
+        // The naive mode named has no light buffer; `auto` (naive for a
+        // handful of objects) and the octree's walks have one.
         let naive = image(&scene, AccelMode::Naive, config, size);
-        for mode in [AccelMode::Octree, AccelMode::Dda] {
+        for mode in [AccelMode::Auto, AccelMode::Octree, AccelMode::Dda] {
             let other = image(&scene, mode, config, size);
             let differ = naive.data.chunks(3).zip(other.data.chunks(3)).filter(|(a, b)| a != b).count();
             assert_eq!(differ, 0, "{name}: {} differs from naive in {differ} pixels", mode.name());
         }
-        println!("{name}: naive, octree and dda identical");
+        println!("{name}: naive, and auto, octree and dda with a light buffer, identical");
     }
 }
 
@@ -165,6 +172,10 @@ fn random_queries_agree_with_the_naive_mode() {
             };
             let mode = if traversal == Traversal::Dda { AccelMode::Dda } else { AccelMode::Octree };
             let Some(tree) = build_octree(&scene, mode, &config) else { continue };
+            let cells = 1 << rng.below(MAX_CELLS_A_SIDE.trailing_zeros() + 1);
+            let mut arena = <Host as Profile>::LightBufferWords::EMPTY;
+            let buffer = LightBuffer::build(&view, &mut arena, cells);
+            let (lit, lit_tree) = (LightBuffered::new(&Naive, buffer), LightBuffered::new(&*tree, buffer));
             let mut words = vec![0u32; Mailbox::words_for(n as usize)];
             let mut mailbox = Mailbox::new(&mut words);
             for _ in 0..2000 {
@@ -193,20 +204,36 @@ fn random_queries_agree_with_the_naive_mode() {
                 let b = tree.occluded(&view, &ray, t_max, start, &mut mailbox);
                 assert_eq!(a, b, "round {round} {traversal:?}: occluded along {ray:?} to {t_max}\n{text}");
                 // Shadow rays from the hit to every light, as the tracer
-                // makes them: the octree's shadow shafts answer as the walk.
+                // makes them (and exactly aimed): the octree's shadow
+                // shafts, and the light buffer in front of either mode,
+                // answer as the walk.
                 let Some(hit) = nearest else { continue };
                 let point = ray.at(hit.t);
                 for (light, l) in view.lights.iter().enumerate() {
-                    let Some((dir, distance)) = (l.position - point).direction_and_length() else { continue };
-                    let shadow = Ray { origin: point, dir };
-                    let t_max = Scalar::from_bits((distance.to_bits() - 1).max(0));
-                    let leaving = if rng.below(2) == 0 { Leaving::Inward } else { Leaving::Outward };
-                    let start = Some(RayStart { object: hit.object, leaving });
-                    mailbox.clear();
-                    let a = Naive.occluded(&view, &shadow, t_max, start, &mut mailbox);
-                    mailbox.clear();
-                    let b = tree.occluded_toward(&view, &shadow, t_max, light, start, &mut mailbox);
-                    assert_eq!(a, b, "round {round} {traversal:?}: shadow ray {shadow:?} to light {light}\n{text}");
+                    let to_light = l.position - point;
+                    for aimed in [to_light.direction_and_length_estimate(), to_light.direction_and_length()] {
+                        let Some((dir, distance)) = aimed else { continue };
+                        let shadow = Ray { origin: point, dir };
+                        let t_max = Scalar::from_bits((distance.to_bits() - 1).max(0));
+                        let leaving = if rng.below(2) == 0 { Leaving::Inward } else { Leaving::Outward };
+                        let start = Some(RayStart { object: hit.object, leaving });
+                        mailbox.clear();
+                        let a = Naive.occluded(&view, &shadow, t_max, start, &mut mailbox);
+                        let by = |accel: &dyn Fn(&mut Mailbox<'_>) -> bool, mailbox: &mut Mailbox<'_>| {
+                            mailbox.clear();
+                            accel(mailbox)
+                        };
+                        let answers = [
+                            by(&|m| tree.occluded_toward(&view, &shadow, t_max, light, start, m), &mut mailbox),
+                            by(&|m| lit.occluded_toward(&view, &shadow, t_max, light, start, m), &mut mailbox),
+                            by(&|m| lit_tree.occluded_toward(&view, &shadow, t_max, light, start, m), &mut mailbox),
+                        ];
+                        assert_eq!(
+                            answers, [a; 3],
+                            "round {round} {traversal:?}: shadow ray {shadow:?} to light {light} (octree, light \
+                             buffer of {cells} cells a side alone and with the octree)\n{text}"
+                        );
+                    }
                 }
             }
         }

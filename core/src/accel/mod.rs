@@ -7,7 +7,8 @@
 //! - [`Accelerator::occluded`] answers whether any object is hit with
 //!   `0 < t ≤ t_max`, and may stop at the first one;
 //!   [`Accelerator::occluded_toward`] gives the same answer for a shadow ray
-//!   towards one of the scene's lights;
+//!   towards one of the scene's lights (which a [`LightBuffered`]
+//!   accelerator answers from its light buffer's cells);
 //! - the object a ray starts on is treated as [`RayStart`] says;
 //! - camera rays may be answered by the renderer's screen-space lists
 //!   instead, where [`Accelerator::first_hits_by_screen`] allows: the
@@ -16,10 +17,14 @@
 //!   [`Mailbox`] large enough for the scene (one bit per object).
 
 mod choice;
+mod light_buffer;
 pub(crate) mod naive;
 mod octree;
 
 pub use choice::{prepare, Prepared};
+pub use light_buffer::{
+    LightBuffer, LightBufferError, LightBufferReport, LightBufferStore, LightBuffered, MAX_CELLS_A_SIDE,
+};
 pub use naive::Naive;
 pub(crate) use octree::FILING_MARGIN;
 pub use octree::{
@@ -272,9 +277,12 @@ pub trait Accelerator {
     ) -> bool;
 
     /// [`Accelerator::occluded`] for a shadow ray from its origin towards
-    /// the scene's light `light`, with `t_max` at most the light's distance:
-    /// the same answer, and an accelerator may use what it knows of that
-    /// light (the octree's shadow shafts).
+    /// the scene's light `light`, aimed as the tracer aims it (its direction
+    /// [`Vec3::direction_and_length_estimate`](crate::math::Vec3::direction_and_length_estimate)'s
+    /// of the vector to the light, or exactly rounded, and `t_max` at most
+    /// that length): the same answer, and an accelerator may use what it
+    /// knows of that light (the octree's shadow shafts, a
+    /// [`LightBuffered`]'s cells).
     fn occluded_toward(
         &self,
         scene: &SceneView<'_>,

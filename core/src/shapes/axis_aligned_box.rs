@@ -6,7 +6,7 @@
 //! nearly so, needs no special case and cannot overflow.
 
 use super::{Aabb, Leaving, Ratio, Ray, Shape};
-use crate::math::{Dir, Scalar, Vec3};
+use crate::math::{div_saturating, Dir, Scalar, Vec3};
 
 /// A BOX: its corners in normalised space.
 // Public only for `profile!` (arenas of it) and the firmware's RAM
@@ -71,6 +71,24 @@ impl AxisAlignedBox {
     pub fn new(center: Vec3, half: Vec3, surface: u16) -> AxisAlignedBox {
         AxisAlignedBox { min: center - half, max: center + half, surface }
     }
+
+    /// The hit from the ray's span in the box, for a ray not leaving it
+    /// outward.
+    #[inline]
+    fn intersect_span(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
+        let span = slab_span(ray, self.min, self.max)?;
+        let positive = |r: Ratio| r.num > 0;
+        let chosen = match (leaving, span.enter) {
+            (Leaving::No, Some(e)) if positive(e) => e,
+            _ => span.exit?,
+        };
+        if !positive(chosen) || !chosen.le_scalar(t_max) {
+            return None;
+        }
+        // Below t_max + 1, so the quotient of these positive numbers fits.
+        let t = div_saturating((chosen.num << 30) as u64, chosen.den as u32) as i32;
+        (t > 0).then_some(Scalar::from_bits(t))
+    }
 }
 
 impl Shape for AxisAlignedBox {
@@ -81,17 +99,13 @@ impl Shape for AxisAlignedBox {
         if leaving == Leaving::Outward {
             return None;
         }
-        let span = slab_span(ray, self.min, self.max)?;
-        let positive = |r: Ratio| r.num > 0;
-        let chosen = match (leaving, span.enter) {
-            (Leaving::No, Some(e)) if positive(e) => e,
-            _ => span.exit?,
-        };
-        if !positive(chosen) || !chosen.le_scalar(t_max) {
+        // A ray outside a slab and not moving towards it leaves the box
+        // behind: its span would end at a parameter ≤ 0.
+        let (o, d, lo, hi) = (ray.origin.bits(), ray.dir.bits(), self.min.bits(), self.max.bits());
+        if (0..3).any(|a| (o[a] > hi[a] && d[a] >= 0) || (o[a] < lo[a] && d[a] <= 0)) {
             return None;
         }
-        let t = chosen.to_scalar();
-        (t.to_bits() > 0).then_some(t)
+        self.intersect_span(ray, t_max, leaving)
     }
 
     /// Outward normal of the face nearest to `p` (relative to each half-size);
@@ -168,5 +182,42 @@ mod tests {
         assert_eq!(cube().intersect(&r, far(), Leaving::No), Some(s(7)));
         let r = Ray { origin: p(5, 0, -10), dir: Dir::from_bits([-1, 0, 1 << 30]) };
         assert_eq!(cube().intersect(&r, far(), Leaving::No), None);
+    }
+
+    /// Rays from outside a slab moving away from it are rejected before the
+    /// span, with the span's answer: random boxes and rays, many along the
+    /// axes, from outside, inside and on the faces.
+    #[test]
+    fn rays_leaving_a_slab_behind_miss_as_the_span_says() {
+        let mut next = crate::test_rng::seeded(0xb0c5_1ab5);
+        let mut coordinate = move |range: u64| (next() % (2 * range + 1)) as i32 - range as i32;
+        let mut early = 0;
+        for _ in 0..100_000 {
+            let c = Vec3::from_bits([0; 3].map(|_| coordinate(1 << 20)));
+            let h = Vec3::from_bits([0; 3].map(|_| 1 + coordinate(1 << 18).abs()));
+            let b = AxisAlignedBox::new(c, h, 0);
+            let (lo, hi) = (b.min.bits(), b.max.bits());
+            let o = Vec3::from_bits([0, 1, 2].map(|a| match coordinate(2) {
+                -2 => lo[a],
+                2 => hi[a],
+                _ => lo[a] + coordinate(1 << 21),
+            }));
+            let d = [0; 3].map(|_| if coordinate(2) == 0 { 0 } else { coordinate(1 << 20) as i64 });
+            let Some(dir) = Dir::normalize(d) else { continue };
+            let r = Ray { origin: o, dir };
+            let t_max = Scalar::from_bits(coordinate(1 << 24).abs());
+            for leaving in [Leaving::No, Leaving::Inward] {
+                let hit = b.intersect(&r, t_max, leaving);
+                assert_eq!(hit, b.intersect_span(&r, t_max, leaving), "{r:?} {b:?}");
+                // The parameter is the span's crossing divided exactly.
+                if let (Some(t), Some(span)) = (hit, slab_span(&r, b.min, b.max)) {
+                    let crossings = [span.enter, span.exit].into_iter().flatten();
+                    assert!(crossings.map(|c| (c.num << 30) / c.den).any(|q| q == t.to_bits() as i64), "{r:?} {b:?}");
+                }
+            }
+            let (ob, db) = (o.bits(), dir.bits());
+            early += (0..3).any(|a| (ob[a] > hi[a] && db[a] >= 0) || (ob[a] < lo[a] && db[a] <= 0)) as u32;
+        }
+        assert!(early > 30_000, "{early} rejected early");
     }
 }

@@ -28,6 +28,12 @@ pub struct Polygon<const N: usize> {
     pub offset: Scalar,
     /// The axis dropped for the 2-D edge test (the normal's largest).
     drop_axis: u8,
+    /// Whether every edge runs along an axis (a chessboard's tiles, a
+    /// floor's; never a triangle's): the polygon then lies across
+    /// `drop_axis`, its normal is that axis exactly, and it fills its
+    /// bounds in its plane, so the plane's products are one term each and
+    /// the bounds' test is the edges' test (see `intersect`).
+    along_axes: bool,
 }
 
 impl<const N: usize> Polygon<N> {
@@ -42,7 +48,13 @@ impl<const N: usize> Polygon<N> {
         } else {
             2
         };
-        Some(Polygon { corners, normal, offset: corners[0].dot_dir(normal), drop_axis })
+        let along_axes = N == 4
+            && (0..N).all(|i| {
+                let (a, b) = (corners[i].bits(), corners[(i + 1) % N].bits());
+                (0..3).filter(|&k| a[k] != b[k]).count() <= 1
+            })
+            && normal.axis(drop_axis as usize).to_bits().unsigned_abs() == 1 << 30;
+        Some(Polygon { corners, normal, offset: corners[0].dot_dir(normal), drop_axis, along_axes })
     }
 
     #[inline]
@@ -51,18 +63,30 @@ impl<const N: usize> Polygon<N> {
         if leaving != Leaving::No {
             return None;
         }
-        // Most rays that miss the plane meet it behind them (or leave it
-        // behind): on a Cortex-M0 short products say so before the exact
-        // ones, which would reject it as well.
-        if ray.dir.plane_surely_behind(ray.origin, self.normal, self.offset) {
-            return None;
-        }
-        let den = self.normal.dot(ray.dir).to_bits() as i64; // Q2.30
+        let along_axes = N == 4 && self.along_axes;
+        let (den, num) = if along_axes {
+            // The normal is ±2^30 on one axis: n·d and n·o have one term,
+            // exactly the sums below would give.
+            let a = self.drop_axis as usize;
+            let positive = self.normal.axis(a).to_bits() > 0;
+            let (d, o) = (ray.dir.axis(a).to_bits() as i64, ray.origin.axis(a).to_bits() as i64);
+            let (den, o) = if positive { (d, o) } else { (-d, -o) };
+            (den, (self.offset.to_bits() as i64 - o) << 30)
+        } else {
+            // Most rays that miss the plane meet it behind them (or leave
+            // it behind): on a Cortex-M0 short products say so before the
+            // exact ones, which would reject it as well.
+            if ray.dir.plane_surely_behind(ray.origin, self.normal, self.offset) {
+                return None;
+            }
+            // n·d in Q2.30 and (offset − n·o) in Q18.46; t = num / den is
+            // then Q16.16.
+            let den = self.normal.dot(ray.dir).to_bits() as i64;
+            (den, ((self.offset.to_bits() as i64) << 30) - ray.origin.dot_dir_q46(self.normal))
+        };
         if den == 0 {
             return None;
         }
-        // (offset − n·o) in Q18.46; t = num / den is then Q16.16.
-        let num = ((self.offset.to_bits() as i64) << 30) - ray.origin.dot_dir_q46(self.normal);
         let (num, den) = if den < 0 { (-num, -den) } else { (num, den) };
         // Filter on the rounded parameter (⌊num / den⌋ ≤ t_max), as returned:
         // before dividing when t_max < MAX (den ≤ 2^30, so no overflow)...
@@ -91,9 +115,11 @@ impl<const N: usize> Polygon<N> {
             return None;
         }
         // Within the bounds, so each coordinate fits an i32: this is
-        // `ray.at(t)`, already computed.
+        // `ray.at(t)`, already computed. A polygon along the axes fills its
+        // bounds: each edge's test (within its tolerance of the edge) is
+        // the bounds' test just made on that side.
         let t = Scalar::from_bits(t as i32);
-        self.contains(Vec3::from_bits(p.map(|c| c as i32))).then_some(t)
+        (along_axes || self.contains(Vec3::from_bits(p.map(|c| c as i32)))).then_some(t)
     }
 
     /// Whether `p` (on the plane) lies inside the polygon, edges included.
@@ -152,4 +178,66 @@ pub fn cross_of_edges(a: Vec3, b: Vec3, c: Vec3) -> [i64; 3] {
     let e1 = (b - a).wide();
     let e2 = (c - a).wide();
     [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]]
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+
+    /// Rectangles along the axes, in every axis plane and facing either
+    /// way, hit exactly as the general plane-and-edges test hits them: rays
+    /// from anywhere, from their plane and a unit off it, towards their
+    /// edges and corners within a few units.
+    #[test]
+    fn along_the_axes_the_short_test_is_the_general_one() {
+        let mut next = crate::test_rng::seeded(0xa1_0a9e5);
+        let mut coordinate = move |range: u64| (next() % (2 * range + 1)) as i64 - range as i64;
+        let (mut along, mut hits) = (0, 0);
+        for _ in 0..20_000 {
+            let a = (coordinate(1) + 1) as usize;
+            let [u, v] = [(a + 1) % 3, (a + 2) % 3];
+            let plane = coordinate(1 << 22);
+            let (u0, v0) = (coordinate(1 << 22), coordinate(1 << 22));
+            let (u1, v1) = (u0 + 1 + coordinate(1 << 20).abs(), v0 + 1 + coordinate(1 << 20).abs());
+            let corner = |cu: i64, cv: i64| {
+                let mut p = [0i64; 3];
+                (p[a], p[u], p[v]) = (plane, cu, cv);
+                Vec3::from_bits(p.map(|c| c as i32))
+            };
+            let mut corners = [corner(u0, v0), corner(u1, v0), corner(u1, v1), corner(u0, v1)];
+            if coordinate(1) > 0 {
+                corners.reverse();
+            }
+            let d1 = (corners[2] - corners[0]).wide();
+            let d2 = (corners[3] - corners[1]).wide();
+            let normal = [d1[1] * d2[2] - d1[2] * d2[1], d1[2] * d2[0] - d1[0] * d2[2], d1[0] * d2[1] - d1[1] * d2[0]];
+            let fast = Polygon::with_normal(corners, normal).unwrap();
+            assert!(fast.along_axes);
+            along += 1;
+            let general = Polygon { along_axes: false, ..fast };
+            let target = [0, 1, 2].map(|k| match k {
+                k if k == a => plane,
+                k if k == u => [u0, u1][coordinate(1).unsigned_abs() as usize % 2] + coordinate(6),
+                _ => v0 + coordinate((v1 - v0 + 12) as u64).abs() - 6,
+            });
+            let origin = [0, 1, 2].map(|k| match (k == a, coordinate(3)) {
+                (true, 0) => plane,
+                (true, 1) => plane + coordinate(1),
+                _ => target[k] + coordinate(1 << 23),
+            });
+            let Some(dir) = Dir::normalize([0, 1, 2].map(|k| target[k] - origin[k])) else { continue };
+            let ray = Ray { origin: Vec3::from_bits(origin.map(|c| c as i32)), dir };
+            for t_max in [Scalar::MAX, Scalar::from_bits(coordinate(1 << 25).abs() as i32)] {
+                let hit = fast.intersect(&ray, t_max, Leaving::No);
+                assert_eq!(hit, general.intersect(&ray, t_max, Leaving::No), "{ray:?} {fast:?}");
+                hits += hit.is_some() as u32;
+            }
+        }
+        assert!(along > 15_000 && hits > 5_000, "{along} along the axes, {hits} hits");
+        // A tilted one is not along the axes.
+        let tilted =
+            [[0, 0, 0], [1 << 16, 0, 0], [1 << 16, 1 << 16, 1 << 16], [0, 1 << 16, 1 << 16]].map(Vec3::from_bits);
+        assert!(!Polygon::with_normal(tilted, [0, -1, 1]).unwrap().along_axes);
+    }
 }
