@@ -6,12 +6,15 @@
 //! included, so the Pico's RAM holds just this scene (the linker says so if
 //! it does not fit). It also holds the screen lists of first hits, which
 //! render the same picture faster for RAM the Pico has to spare (at most
-//! 28 bytes an object). The octree's shadow shafts are left
+//! 28 bytes an object), and for a scene walked in an octree a light buffer
+//! (its shadow rays test only the objects their direction's cell lists),
+//! built in RAM when the scene loads. The octree's shadow shafts are left
 //! out: on the thesis's scenes they take longer to build than they save in
 //! one picture (BENCHMARKS.md).
 
 use octrace_core::accel::OctreeConfig;
-use octrace_core::profile::{needed_by, ProfileText};
+use octrace_core::accel::MAX_CELLS_A_SIDE;
+use octrace_core::profile::{needed_by, needed_with_light_buffer, ProfileText};
 use octrace_core::AccelMode;
 use std::env;
 use std::path::PathBuf;
@@ -25,10 +28,10 @@ fn main() {
     // `code-placement.x`, found in a folder of its own for each binary.
     println!("cargo:rerun-if-env-changed=OCTRACE_CODE_IN");
     let scene_firmware = match env::var("OCTRACE_CODE_IN").as_deref() {
-        Ok("sram") | Err(_) => Placement::AllInSram,
-        Ok("render") => Placement::RenderInSram,
+        Ok("render") | Err(_) => Placement::RenderInSram,
+        Ok("sram") => Placement::AllInSram,
         Ok("flash") => Placement::Flash,
-        Ok(other) => fail(&format!("OCTRACE_CODE_IN={other}: expected `sram` (the default), `render` or `flash`")),
+        Ok(other) => fail(&format!("OCTRACE_CODE_IN={other}: expected `render` (the default), `sram` or `flash`")),
     };
     let read = |script: &str| {
         println!("cargo:rerun-if-changed={script}");
@@ -75,10 +78,20 @@ fn main() {
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| fail(&format!("OCTRACE_SCENE={scene}: {e}")));
     // `Raytracer::load` picks the accelerator as `Auto` does, with the
     // octree `profile!` builds by default.
-    let needs = needed_by(&text, AccelMode::Auto, &OctreeConfig::DEFAULT, &mut |error| {
-        eprintln!("{scene}:{error}");
-    })
-    .unwrap_or_else(|errors| fail(&format!("{scene}: {errors} error(s); nothing is built from a scene with errors")));
+    let mut report = |error| eprintln!("{scene}:{error}");
+    let needs = needed_by(&text, AccelMode::Auto, &OctreeConfig::DEFAULT, &mut report).unwrap_or_else(|errors| {
+        fail(&format!("{scene}: {errors} error(s); nothing is built from a scene with errors"))
+    });
+    // A scene walked in an octree gets a light buffer for its shadow rays,
+    // built in RAM when the scene loads (the code runs from SRAM, the RAM is
+    // there; in flash its reads would miss the XIP cache). A scene of a few
+    // objects tests them all: the buffer does not pay there.
+    let needs = if needs.octree_boxes > 0 {
+        needed_with_light_buffer(&text, AccelMode::Auto, &OctreeConfig::DEFAULT, MAX_CELLS_A_SIDE, &mut report)
+            .unwrap_or_else(|errors| fail(&format!("{scene}: {errors} error(s)")))
+    } else {
+        needs
+    };
 
     // `load` walks the octree by 3DDDA: no room for the thesis's hash table.
     let doc = format!("Exactly what `{scene}` needs, its octree included.");
@@ -103,12 +116,14 @@ fn fail(message: &str) -> ! {
 /// Where a firmware's code runs.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Placement {
-    /// All of it (and its constants) copied into SRAM at boot.
+    /// All of it (and its constants) copied into SRAM at boot: a little
+    /// faster than `RenderInSram` for a small scene, too large beside a
+    /// large one.
     AllInSram,
-    /// The render path copied into SRAM (octrace-core's tracing, the two
-    /// cores' loop, the compiler's 64-bit helpers); the rest (the parser,
-    /// USB, the panel's set-up) runs from flash, so that SRAM is left to
-    /// the scene.
+    /// The render path copied into SRAM at boot (octrace-core's tracing
+    /// and indexing, the two cores' loop, the compiler's 64-bit helpers);
+    /// the rest (the parser, USB, the panel's set-up) runs from flash, so
+    /// that SRAM is left to the scene.
     RenderInSram,
     /// All of it in place in flash, through the XIP cache.
     Flash,

@@ -32,7 +32,7 @@ const DEFAULT_SCENE: &str = "fig5_1";
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Build<'a> {
     pub scene: &'a str,
-    /// `sram` (the default), `render` or `flash`.
+    /// `render` (the default), `sram` or `flash`.
     pub code_in: &'a str,
     /// `rows` (the default) or `progressive`.
     pub order: &'a str,
@@ -41,14 +41,14 @@ pub struct Build<'a> {
 impl<'a> Build<'a> {
     /// The template as a user builds it, with `scenes/SCENE.txt`.
     pub fn of(scene: &'a str) -> Build<'a> {
-        Build { scene, code_in: "sram", order: "rows" }
+        Build { scene, code_in: "render", order: "rows" }
     }
 
     /// What the build is named by: the scene, and what differs from the
     /// default.
     pub fn name(&self) -> String {
         let mut name = self.scene.to_owned();
-        for (value, default) in [(self.code_in, "sram"), (self.order, "rows")] {
+        for (value, default) in [(self.code_in, "render"), (self.order, "rows")] {
             if value != default {
                 name = format!("{name}-{value}");
             }
@@ -81,7 +81,7 @@ pub fn build(build: &Build<'_>) -> Result<PathBuf, String> {
     if build.scene != DEFAULT_SCENE {
         cargo.env("OCTRACE_SCENE", repo().join("scenes").join(format!("{}.txt", build.scene)));
     }
-    if build.code_in != "sram" {
+    if build.code_in != "render" {
         cargo.env("OCTRACE_CODE_IN", build.code_in);
     }
     if build.order != "rows" {

@@ -17,10 +17,10 @@ use std::path::Path;
 /// octree, and the chessboard of 64 rectangles, as a user builds them; and
 /// the first in the progressive order.
 const BUILDS: [Build<'static>; 4] = [
-    Build { scene: "fig5_1", code_in: "sram", order: "rows" },
-    Build { scene: "fig5_3", code_in: "sram", order: "rows" },
-    Build { scene: "fig5_5", code_in: "sram", order: "rows" },
-    Build { scene: "fig5_1", code_in: "sram", order: "progressive" },
+    Build { scene: "fig5_1", code_in: "render", order: "rows" },
+    Build { scene: "fig5_3", code_in: "render", order: "rows" },
+    Build { scene: "fig5_5", code_in: "render", order: "rows" },
+    Build { scene: "fig5_1", code_in: "render", order: "progressive" },
 ];
 
 /// The first coarse panel of a progressive order, from the picture's start:
