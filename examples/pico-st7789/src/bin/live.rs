@@ -64,6 +64,7 @@ octrace_core::profile! {
         spheres: 400, boxes: 32, superquadrics: 32, triangles: 160, rectangles: 160,
         surfaces: 64, lights: 8,
         octree_boxes: 1600, octree_references: 4800,
+        light_buffer_lights: 8, light_buffer_words: 4096,
     }
     named_walk: false
     first_hits: true
