@@ -179,8 +179,10 @@ fn main() -> ! {
         pending = false;
         let Some(received) = decoder.received() else { continue };
         host.stalled = false;
-        let Ok(Some(drawing)) = board.answer(received, raytracer, &mut host) else { continue };
+        // The board's time from the whole scene received to the last row
+        // drawn: parse, index and render.
         let start = timer.get_counter();
+        let Ok(Some(drawing)) = board.answer(received, raytracer, &mut host) else { continue };
         let mut rows = 0u16;
         let drawn = both_cores::draw(&mut core1, drawing.scene(), room, &ROWS, &mut display, |y, row| {
             rows = y as u16 + 1;
