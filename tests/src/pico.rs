@@ -101,6 +101,21 @@ pub fn build(build: &Build<'_>) -> Result<PathBuf, String> {
     Ok(elf)
 }
 
+/// The bytes of code `elf` copies into SRAM at boot (its `.sram_code`
+/// section; 0 when its code runs from flash).
+pub fn sram_code_bytes(elf: &Path) -> Result<u64, String> {
+    let out = Command::new("arm-none-eabi-size")
+        .arg("-A")
+        .arg(elf)
+        .output()
+        .map_err(|e| format!("cannot run arm-none-eabi-size: {e}"))?;
+    let sections = String::from_utf8_lossy(&out.stdout);
+    Ok(sections
+        .lines()
+        .find_map(|l| l.strip_prefix(".sram_code ")?.split_whitespace().next()?.parse().ok())
+        .unwrap_or(0))
+}
+
 /// What one run on the emulated Pico took, in its cycles (125 MHz).
 #[derive(Clone, Copy, Debug)]
 pub struct Cycles {
