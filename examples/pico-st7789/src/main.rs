@@ -13,13 +13,11 @@
 
 use embedded_graphics::pixelcolor::Rgb565;
 use embedded_graphics::prelude::*;
-use hal::gpio::Pins;
-use hal::multicore::{Multicore, Stack};
-use hal::{entry, pac, Clock, Sio, Timer, Watchdog};
+use hal::entry;
+use hal::multicore::Stack;
 use octrace_core::render::{Handoff, Progressive};
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
-use octrace_pico_st7789::both_cores::{self, SecondCore};
-use octrace_pico_st7789::panel::{self, PanelPins};
+use octrace_pico_st7789::{board, both_cores, panel};
 use panic_halt as _;
 use rp2040_hal as hal;
 
@@ -31,9 +29,6 @@ mod sram_code;
 #[link_section = ".boot2"]
 #[used]
 static BOOT2: [u8; 256] = rp2040_boot2::BOOT_LOADER_W25Q080;
-
-/// The Pico's crystal.
-const CRYSTAL_HZ: u32 = 12_000_000;
 
 /// The scene (`SCENE_TEXT`, in flash) and a capacity profile that holds
 /// exactly what it needs (`SceneProfile`), from `build.rs`: set
@@ -66,39 +61,8 @@ static PANEL_BUFFER: ConstStaticCell<[u8; 512]> = ConstStaticCell::new([0; 512])
 
 #[entry]
 fn main() -> ! {
-    let mut peripherals = pac::Peripherals::take().unwrap();
-    let mut watchdog = Watchdog::new(peripherals.WATCHDOG);
-    let clocks = hal::clocks::init_clocks_and_plls(
-        CRYSTAL_HZ,
-        peripherals.XOSC,
-        peripherals.CLOCKS,
-        peripherals.PLL_SYS,
-        peripherals.PLL_USB,
-        &mut peripherals.RESETS,
-        &mut watchdog,
-    )
-    .unwrap();
-    let timer = Timer::new(peripherals.TIMER, &mut peripherals.RESETS, &clocks);
-    let mut sio = Sio::new(peripherals.SIO);
-    let pins = Pins::new(peripherals.IO_BANK0, peripherals.PADS_BANK0, sio.gpio_bank0, &mut peripherals.RESETS);
-    let panel_pins = PanelPins {
-        clock: pins.gpio10,
-        data: pins.gpio11,
-        chip_select: pins.gpio9,
-        data_command: pins.gpio8,
-        reset: pins.gpio12,
-        backlight: pins.gpio13,
-    };
-    let mut display = panel::init(
-        peripherals.SPI1,
-        panel_pins,
-        &mut peripherals.RESETS,
-        clocks.peripheral_clock.freq(),
-        timer,
-        PANEL_BUFFER.take(),
-    );
-    let mut multicore = Multicore::new(&mut peripherals.PSM, &mut peripherals.PPB, &mut sio.fifo);
-    let mut core1 = SecondCore::start(&mut multicore.cores()[1], CORE1_STACK.take().unwrap()).unwrap();
+    let board = board::start(PANEL_BUFFER.take(), CORE1_STACK.take().unwrap());
+    let (mut display, mut core1) = (board.display, board.core1);
 
     // octrace: parse and index the scene, then trace it into the panel at
     // the panel's size with both cores. A scene the board cannot trace

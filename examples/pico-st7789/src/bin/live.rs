@@ -23,18 +23,16 @@ use core::cell::RefCell;
 use core::ops::ControlFlow;
 use core::time::Duration;
 use critical_section::Mutex;
-use hal::gpio::Pins;
-use hal::multicore::{Multicore, Stack};
+use hal::multicore::Stack;
 use hal::pac::interrupt;
 use hal::usb::UsbBus;
-use hal::{entry, pac, Clock, Sio, Timer, Watchdog};
+use hal::{entry, pac, Timer};
 use heapless::Deque;
 use octrace_core::render::Handoff;
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
 use octrace_link::board::Board;
 use octrace_link::{Decoder, Panel, PixelFormat, Sink};
-use octrace_pico_st7789::both_cores::{self, SecondCore};
-use octrace_pico_st7789::panel::{self, PanelPins};
+use octrace_pico_st7789::{board, both_cores, panel};
 use panic_halt as _;
 use rp2040_hal as hal;
 use usb_device::class_prelude::UsbBusAllocator;
@@ -49,9 +47,6 @@ mod sram_code;
 #[link_section = ".boot2"]
 #[used]
 static BOOT2: [u8; 256] = rp2040_boot2::BOOT_LOADER_W25Q080;
-
-/// The Pico's crystal.
-const CRYSTAL_HZ: u32 = 12_000_000;
 
 /// What the board says it is (octrace-link's `board` answer).
 const FIRMWARE: &str = concat!("octrace-pico-live ", env!("CARGO_PKG_VERSION"));
@@ -103,49 +98,12 @@ const STALLED_AFTER_US: u64 = 1_000_000;
 
 #[entry]
 fn main() -> ! {
-    let mut peripherals = pac::Peripherals::take().unwrap();
-    let mut watchdog = Watchdog::new(peripherals.WATCHDOG);
-    let clocks = hal::clocks::init_clocks_and_plls(
-        CRYSTAL_HZ,
-        peripherals.XOSC,
-        peripherals.CLOCKS,
-        peripherals.PLL_SYS,
-        peripherals.PLL_USB,
-        &mut peripherals.RESETS,
-        &mut watchdog,
-    )
-    .unwrap();
-    let timer = Timer::new(peripherals.TIMER, &mut peripherals.RESETS, &clocks);
-    let mut sio = Sio::new(peripherals.SIO);
-    let pins = Pins::new(peripherals.IO_BANK0, peripherals.PADS_BANK0, sio.gpio_bank0, &mut peripherals.RESETS);
-    let panel_pins = PanelPins {
-        clock: pins.gpio10,
-        data: pins.gpio11,
-        chip_select: pins.gpio9,
-        data_command: pins.gpio8,
-        reset: pins.gpio12,
-        backlight: pins.gpio13,
-    };
-    let mut display = panel::init(
-        peripherals.SPI1,
-        panel_pins,
-        &mut peripherals.RESETS,
-        clocks.peripheral_clock.freq(),
-        timer,
-        PANEL_BUFFER.take(),
-    );
-    let mut multicore = Multicore::new(&mut peripherals.PSM, &mut peripherals.PPB, &mut sio.fifo);
-    let mut core1 = SecondCore::start(&mut multicore.cores()[1], CORE1_STACK.take().unwrap()).unwrap();
+    let board::Board { mut display, mut core1, timer, usb, mut resets } =
+        board::start(PANEL_BUFFER.take(), CORE1_STACK.take().unwrap());
 
     // The USB serial port, served by its interrupt from here on.
     let bus: &'static UsbBusAllocator<UsbBus> = cortex_m::singleton!(: UsbBusAllocator<UsbBus> =
-    UsbBusAllocator::new(UsbBus::new(
-        peripherals.USBCTRL_REGS,
-        peripherals.USBCTRL_DPRAM,
-        clocks.usb_clock,
-        true,
-        &mut peripherals.RESETS,
-    )))
+        UsbBusAllocator::new(UsbBus::new(usb.regs, usb.dpram, usb.clock, true, &mut resets)))
     .unwrap();
     let serial = SerialPort::new(bus);
     let strings = StringDescriptors::default().manufacturer("octrace").product("octrace live").serial_number("1");
