@@ -125,8 +125,8 @@ impl Decimal {
 
     /// The value in Q32.32, rounded to nearest (ties away from zero). The
     /// magnitude must be within 10^6 ([`Decimal::out_of_range`] false).
-    // Not inlined: its 128-bit division is long code on a 32-bit core,
-    // and the parser reads numbers in many places.
+    // Not inlined: its 128-bit division (for long numbers) is long code on
+    // a 32-bit core, and the parser reads numbers in many places.
     #[inline(never)]
     pub fn to_q32(self) -> i64 {
         let magnitude: u128 = if self.exponent >= 0 {
@@ -136,7 +136,15 @@ impl Decimal {
             0
         } else {
             let div = 10u128.pow((-self.exponent) as u32);
-            (((self.mantissa as u128) << 32) + div / 2) / div
+            let numerator = ((self.mantissa as u128) << 32) + div / 2;
+            // A number of a few digits fits 64 bits: one 64-bit division
+            // instead of the 128-bit one, long code on a 32-bit core
+            // (fig5_3's 1,922 numbers took 10 M cycles on a Pico). The
+            // same quotient.
+            match (u64::try_from(numerator), u64::try_from(div)) {
+                (Ok(numerator), Ok(div)) => (numerator / div) as u128,
+                _ => numerator / div,
+            }
         };
         let m = magnitude.min(i64::MAX as u128) as i64;
         if self.negative {
@@ -192,6 +200,31 @@ mod tests {
         assert_eq!(q("1e6"), 1_000_000 << 32);
         assert_eq!(q("1e-50"), 0);
         assert_eq!(q("123456789012345678901234e-18"), q("123456.789012345678901234"));
+    }
+
+    #[test]
+    fn the_64_bit_quotient_is_the_128_bit_one() {
+        // Every fraction a number can have, at the edges of the 64-bit path
+        // and at random: the quotient by the 128-bit formula alone.
+        extern crate std;
+        let mut next = crate::test_rng::seeded(0xd1_91_75);
+        let mut cases: std::vec::Vec<(u64, i32)> = std::vec::Vec::new();
+        for exponent in -38..0 {
+            for mantissa in [0, 1, 5, 9, (1 << 31) - 1, 1 << 31, (1 << 32) - 1, 1 << 32, u64::MAX >> 1, u64::MAX] {
+                cases.push((mantissa, exponent));
+            }
+        }
+        for _ in 0..20_000 {
+            let bits = next() % 65;
+            let mantissa = if bits == 64 { next() } else { next() & ((1u64 << bits) - 1) };
+            cases.push((mantissa, -((next() % 38) as i32) - 1));
+        }
+        for (mantissa, exponent) in cases {
+            let d = Decimal { negative: false, mantissa, exponent };
+            let div = 10u128.pow((-exponent) as u32);
+            let wide = ((((mantissa as u128) << 32) + div / 2) / div).min(i64::MAX as u128) as i64;
+            assert_eq!(d.to_q32(), wide, "{mantissa}e{exponent}");
+        }
     }
 
     #[test]

@@ -27,6 +27,7 @@ use crate::math::{Scalar, Vec3, Wide};
 use crate::shapes::{Leaving, Ray, Shape, ShapeHandle, ShapeKind, ShapeKinds, ShapeRef, SmoothTriangle};
 
 /// An object's position in the scene file (0 for the first object).
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct ObjectId(pub u32);
 

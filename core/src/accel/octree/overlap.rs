@@ -6,6 +6,7 @@
 //! in `i128`; the caller widens each box by a margin so that hits reported
 //! a few units off the ideal surface (fixed-point rounding) are still filed.
 
+use crate::math::square_u32_wide;
 use crate::shapes::{Polygon, ShapeRef};
 
 /// A closed box `[lo, hi]` in Q16.16 raw units.
@@ -23,27 +24,7 @@ pub fn overlaps(shape: ShapeRef<'_>, cell: &Cell) -> bool {
         return false;
     }
     match shape {
-        ShapeRef::Sphere(s) => {
-            let c = s.center.wide();
-            let r = s.radius.to_bits() as i128;
-            let mut near = 0i128;
-            let mut far = 0i128;
-            for a in 0..3 {
-                let to_lo = (c[a] - cell.lo[a]) as i128;
-                let to_hi = (cell.hi[a] - c[a]) as i128;
-                let gap = if to_lo < 0 {
-                    -to_lo
-                } else if to_hi < 0 {
-                    -to_hi
-                } else {
-                    0
-                };
-                near += gap * gap;
-                far += to_lo.abs().max(to_hi.abs()).pow(2);
-            }
-            // The ball reaches the box, and the box is not wholly inside it.
-            near <= r * r && far >= r * r
-        }
+        ShapeRef::Sphere(s) => sphere_overlaps(s.center.wide(), s.radius.to_bits(), cell),
         ShapeRef::Box(b) => {
             let (lo, hi) = (b.min.wide(), b.max.wide());
             let inside = (0..3).all(|a| lo[a] < cell.lo[a] && cell.hi[a] < hi[a]);
@@ -116,6 +97,39 @@ fn no_separating_axis<const N: usize>(p: &Polygon<N>, cell: &Cell) -> bool {
     true
 }
 
+/// Whether a sphere's surface meets the cell: the ball reaches the box,
+/// and the box is not wholly inside it. Sums of squared distances, in
+/// 64 bits from 32-bit squares when every distance is below 2^31 (the
+/// usual case: a cell near the sphere), else in 128 bits; the same answer.
+fn sphere_overlaps(c: [i64; 3], r: i32, cell: &Cell) -> bool {
+    // The gap to the box and the distance to its far corner, per axis.
+    let spans = [0, 1, 2].map(|a| {
+        let (to_lo, to_hi) = (c[a] - cell.lo[a], cell.hi[a] - c[a]);
+        let gap = if to_lo < 0 {
+            -to_lo
+        } else if to_hi < 0 {
+            -to_hi
+        } else {
+            0
+        };
+        (gap, to_lo.abs().max(to_hi.abs()))
+    });
+    let r = r.unsigned_abs();
+    if spans.iter().all(|&(_, far)| far < 1 << 31) {
+        // Three squares below 2^62 each: their sum fits 64 bits.
+        let square = |d: i64| square_u32_wide(d as u32);
+        let near: u64 = spans.iter().map(|&(gap, _)| square(gap)).sum();
+        let far: u64 = spans.iter().map(|&(_, far)| square(far)).sum();
+        let r2 = square_u32_wide(r);
+        return near <= r2 && far >= r2;
+    }
+    let square = |d: i64| (d as i128) * (d as i128);
+    let near: i128 = spans.iter().map(|&(gap, _)| square(gap)).sum();
+    let far: i128 = spans.iter().map(|&(_, far)| square(far)).sum();
+    let r2 = (r as i128) * (r as i128);
+    near <= r2 && far >= r2
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -130,6 +144,35 @@ mod tests {
 
     fn cell(lo: [i64; 3], hi: [i64; 3]) -> Cell {
         Cell { lo: lo.map(|v| v * U), hi: hi.map(|v| v * U) }
+    }
+
+    #[test]
+    fn a_spheres_test_in_64_bits_is_its_test_in_128() {
+        // Cells near and far, small and across the whole range, against the
+        // test in 128 bits alone.
+        let mut next = crate::test_rng::seeded(0x5fe7e_64);
+        let mut below = |bits: u64| (next() % (1 << bits)) as i64 - (1 << (bits - 1));
+        let mut meets = 0;
+        for round in 0..100_000 {
+            // Sphere, radius and cell of one scale, so that all answers come.
+            let bits = [20, 30, 32, 34][round % 4];
+            let c = [below(36), below(36), below(36)];
+            let r = below(bits.min(32)).unsigned_abs().min(i32::MAX as u64) as i32;
+            let lo = [0, 1, 2].map(|i| c[i] + below(bits));
+            let cell = Cell { lo, hi: [0, 1, 2].map(|i| lo[i] + below(bits).abs()) };
+            let (mut near, mut far) = (0i128, 0i128);
+            for i in 0..3 {
+                let (to_lo, to_hi) = ((c[i] - cell.lo[i]) as i128, (cell.hi[i] - c[i]) as i128);
+                let gap = if to_lo < 0 { -to_lo } else { (-to_hi).max(0) };
+                near += gap * gap;
+                far += to_lo.abs().max(to_hi.abs()).pow(2);
+            }
+            let r2 = (r as i128) * (r as i128);
+            let expected = near <= r2 && far >= r2;
+            assert_eq!(sphere_overlaps(c, r, &cell), expected, "{c:?} {r} {cell:?}");
+            meets += expected as u32;
+        }
+        assert!((10_000..90_000).contains(&meets), "{meets} cells of 100,000 meet their sphere");
     }
 
     #[test]
