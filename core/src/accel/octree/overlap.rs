@@ -150,7 +150,7 @@ mod tests {
     fn a_spheres_test_in_64_bits_is_its_test_in_128() {
         // Cells near and far, small and across the whole range, against the
         // test in 128 bits alone.
-        let mut next = crate::test_rng::seeded(0x5fe7e_64);
+        let mut next = crate::test_rng::seeded(0x5fe7_e064);
         let mut below = |bits: u64| (next() % (1 << bits)) as i64 - (1 << (bits - 1));
         let mut meets = 0;
         for round in 0..100_000 {
