@@ -85,7 +85,7 @@ pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
     /// when 0; with `light_buffer_lights` above 0 a prebuilt buffer may
     /// still serve them, see
     /// [`LoadedScene::use_light_buffer`](crate::LoadedScene::use_light_buffer)).
-    type LightBufferWords: Arena<u32>;
+    type LightBufferWords: Arena<u32> + Send;
 }
 
 /// Defines a [`Profile`] from counts: the fields of

@@ -136,7 +136,7 @@ impl Placement {
             Placement::AllInSram => Some("*(.text .text.*); *(.rodata .rodata.*);"),
             Placement::RenderInSram => Some(concat!(
                 "*(.text.*octrace_core*accel* .text.*octrace_core*shapes* .text.*octrace_core*shade* ",
-                ".text.*octrace_core*render* .text.*octrace_core*math* .text.*octrace_core*raytracer* ",
+                ".text.*octrace_core*render* .text.*octrace_core*math* ",
                 ".text.*both_cores* .text.__aeabi_* .text.__*di3 .text.__*di4);"
             )),
             Placement::Flash => None,

@@ -122,6 +122,9 @@ fn for_each_statement<'a, R: Room>(text: &'a str, mut each: impl FnMut(Pos, Resu
 }
 
 /// Parses `bytes`, reporting invalid UTF-8 as an error at the first bad byte.
+// Not inlined: a board may run the loader's indexing from RAM, and the
+// parser (long, run once a scene) stays where the linker puts its module.
+#[inline(never)]
 pub fn parse_bytes<'a, C: SceneCapacities>(
     bytes: &'a [u8],
     scene: &mut Scene<C>,

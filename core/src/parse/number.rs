@@ -135,7 +135,12 @@ impl Decimal {
         } else if self.exponent < -38 {
             0
         } else {
-            let div = 10u128.pow((-self.exponent) as u32);
+            // From the table while it holds the power: `pow` multiplies
+            // in 128 bits, long code on a 32-bit core.
+            let div = match POW10.get((-self.exponent) as usize) {
+                Some(&power) => power as u128,
+                None => 10u128.pow((-self.exponent) as u32),
+            };
             let numerator = ((self.mantissa as u128) << 32) + div / 2;
             // A number of a few digits fits 64 bits: one 64-bit division
             // instead of the 128-bit one, long code on a 32-bit core

@@ -4,10 +4,10 @@
 //! [`SecondCore::start`] starts core 1 once, in a loop that waits for jobs.
 //! [`SecondCore::scope`] runs a job on core 1 while core 0 does its own
 //! part, and returns only when both are done, so a job may borrow anything
-//! core 0 has (like `std::thread::scope`). [`draw`] is the picture: core
-//! `c` traces the rows `interleaved_rows(height, c, 2)` with a renderer of
-//! its own; core 1 hands its rows over in a [`Handoff`] ring; core 0 sends
-//! every row to the panel in order. Each waits for the other with `wfe`,
+//! core 0 has (like `std::thread::scope`). [`draw`] is the picture: each
+//! core takes the next row no core has taken (under the chip's lock) and
+//! traces it with a renderer of its own; core 1 hands its rows over in a
+//! [`Handoff`] ring; core 0 sends every row to the panel in order. Each waits for the other with `wfe`,
 //! woken by the other's `sev`.
 //!
 //! Invariants: `JOB` is null or points at core 0's `&mut dyn FnMut()` for
@@ -15,10 +15,12 @@
 //! null; panics abort (`panic = "abort"`, `panic-halt`), so core 0 never
 //! leaves a scope early by unwinding.
 
+use core::cell::Cell;
 use core::ops::ControlFlow;
 use core::ptr;
 use core::sync::atomic::{AtomicBool, AtomicPtr, Ordering};
 use cortex_m::asm::{sev, wfe};
+use critical_section::Mutex;
 use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 use embedded_graphics::prelude::*;
 use embedded_graphics::primitives::Rectangle;
@@ -157,10 +159,16 @@ where
 }
 
 /// Both cores trace the pieces (rows, or a progressive order's units) of
-/// an image of `size` that `pieces` lists: core 1 the odd ones into `ring`,
-/// core 0 the even ones; core 0 presents every piece, in order. `trace`
-/// fills a piece's colours and says how many; `present` shows them, or
-/// stops the picture.
+/// an image of `size` that `pieces` lists, each taking the next piece not
+/// yet taken (a core that finds its pieces cheap, or has less else to do,
+/// takes more of them); core 1 hands its pieces over through `ring`, and
+/// core 0 presents every piece, in order. `trace` fills a piece's colours
+/// and says how many; `present` shows them, or stops the picture.
+///
+/// Why not halves: core 0 also presents every piece (the colours' format,
+/// the panel's commands, the bus), about 5 % of its time on the Pico, and
+/// pieces differ in cost (a row of sky against a row of spheres), so fixed
+/// halves left core 1 waiting for 10 M cycles of fig5_3's picture.
 #[allow(clippy::too_many_arguments)]
 fn share<'r, P, T, I, const LEN: usize, const SLOTS: usize>(
     core1: &mut SecondCore,
@@ -177,54 +185,76 @@ where
     I: Iterator<Item = T>,
 {
     let stop = AtomicBool::new(false);
+    // The number of the next piece to take: read and advanced under the
+    // chip's lock (ARMv6-M has no atomic read-modify-write).
+    let next = Mutex::new(Cell::new(0u32));
+    let take_next = || {
+        critical_section::with(|cs| {
+            let taken = next.borrow(cs).get();
+            next.borrow(cs).set(taken.saturating_add(1));
+            taken
+        })
+    };
+    let count = pieces().count() as u32;
     let shared = scene.share();
     // What a stopped picture left in the ring is not this picture's.
     ring.clear();
     let core1_part = || {
         let Ok(mut renderer) = shared.renderer(room, size) else { return };
         let mut colors = [Rgb888::BLACK; LEN];
-        for (index, piece) in pieces().enumerate().skip(1).step_by(2) {
-            let index = index as u32;
-            loop {
-                // Asked first: a stopped picture traces no further piece.
+        let mut pieces = pieces().zip(0u32..);
+        // Asked first: a stopped picture traces no further piece.
+        while !stop.load(Ordering::Acquire) {
+            let number = take_next();
+            let Some((piece, _)) = pieces.find(|&(_, n)| n == number) else { return };
+            // Its slot is free once core 0 has presented the piece SLOTS
+            // before it, which it does without waiting for this core.
+            while !ring.is_free_for(number) {
                 if stop.load(Ordering::Acquire) {
                     return;
-                }
-                if ring.is_free_for(index) {
-                    break;
                 }
                 wfe();
             }
             let traced = trace(&mut renderer, &piece, &mut colors);
             // Free, so published.
-            let _ = ring.send(index, colors[..traced].iter().copied());
+            let _ = ring.send(number, colors[..traced].iter().copied());
             sev();
         }
     };
     let core0_part = || {
         let presented = scene.with_renderer(size, |renderer| {
-            let mut colors = [Rgb888::BLACK; LEN];
-            for (index, piece) in pieces().enumerate() {
-                let index = index as u32;
-                let traced = if index.is_multiple_of(2) {
-                    trace(renderer, &piece, &mut colors)
-                } else {
-                    let handed = loop {
-                        match ring.take(index) {
-                            Some(handed) => break handed,
-                            None => wfe(),
+            let mut own = [Rgb888::BLACK; LEN];
+            let mut handed = [Rgb888::BLACK; LEN];
+            // The pieces in order for the panel, and ahead of them core 0's.
+            let (mut to_show, mut to_trace) = (pieces().zip(0u32..), pieces().zip(0u32..));
+            // Every piece before `shown` is on the panel.
+            let mut shown = 0;
+            while shown < count {
+                // Core 1's next piece, if ready, goes to the panel first: its
+                // slot frees up for the piece core 1 takes next.
+                if ring.holds(shown) {
+                    let Some((piece, number)) = to_show.next() else { break };
+                    let handed_len = receive(ring, number, &mut handed);
+                    present(&piece, &handed[..handed_len])?;
+                    shown += 1;
+                    continue;
+                }
+                let number = take_next();
+                let traced = to_trace.find(|&(_, n)| n == number).map(|(piece, _)| trace(renderer, &piece, &mut own));
+                // The pieces from `shown` up to this one are core 1's.
+                for (piece, n) in to_show.by_ref() {
+                    match traced {
+                        Some(traced) if n == number => {
+                            present(&piece, &own[..traced])?;
+                            break;
                         }
-                    };
-                    let mut traced = 0;
-                    for (color, handed) in colors.iter_mut().zip(handed) {
-                        *color = handed;
-                        traced += 1;
+                        _ => {
+                            let handed_len = receive(ring, n, &mut handed);
+                            present(&piece, &handed[..handed_len])?;
+                        }
                     }
-                    // The slot is free again: wake core 1 if it waits for it.
-                    sev();
-                    traced
-                };
-                present(&piece, &colors[..traced])?;
+                }
+                shown = number.saturating_add(1).min(count);
             }
             Ok(())
         });
@@ -236,6 +266,29 @@ where
         result
     };
     core1.scope(core1_part, core0_part)
+}
+
+/// Core 1's piece `number` from `ring` into `colors`, once it is there;
+/// returns how many colours it has.
+fn receive<const LEN: usize, const SLOTS: usize>(
+    ring: &Handoff<LEN, SLOTS>,
+    number: u32,
+    colors: &mut [Rgb888],
+) -> usize {
+    let handed = loop {
+        match ring.take(number) {
+            Some(handed) => break handed,
+            None => wfe(),
+        }
+    };
+    let mut len = 0;
+    for (color, handed) in colors.iter_mut().zip(handed) {
+        *color = handed;
+        len += 1;
+    }
+    // The slot is free again: wake core 1 if it waits for it.
+    sev();
+    len
 }
 
 /// A display of `Rgb565` taking the progressive order's `Rgb888` blocks.

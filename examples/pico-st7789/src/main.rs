@@ -68,7 +68,9 @@ fn main() -> ! {
     // the panel's size with both cores. A scene the board cannot trace
     // (check it with host-sim, whose errors name the line and column)
     // leaves the panel red.
-    let drawn = match RAYTRACER.take().load(SCENE_TEXT) {
+    // The light buffer is built on core 1 while core 0 builds the octree.
+    let loaded = RAYTRACER.take().load_on_two_cores(SCENE_TEXT, |beside, here| core1.scope(beside, here));
+    let drawn = match loaded {
         #[cfg(not(progressive_order))]
         Ok(scene) => {
             let each_row = |_, _: &_| core::ops::ControlFlow::Continue(());
