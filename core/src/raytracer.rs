@@ -253,22 +253,23 @@ impl<P: Profile> Raytracer<P> {
         let buffered =
             <P::LightBufferWords as Arena<u32>>::CAPACITY > 0 && light_buffer::<P>() && requested != AccelMode::Naive;
         let (octree_store, light_buffer) = (&mut self.octree, &mut self.light_buffer);
-        let mut prepared = None;
+        let (mut prepared, mut built) = (None, false);
         both(
             &mut || {
                 if buffered {
                     light_buffer.build_for(&view, MAX_CELLS_A_SIDE, P::COUNTS.light_buffer_lights);
+                    built = true;
                 }
             },
             &mut || prepared = Some(accel::prepare(mode, &view, octree_store, &P::OCTREE)),
         );
-        // `both` ran `here`, unless a caller's broke its promise: then the
-        // octree is built now.
+        // `both` ran both jobs, unless a caller's broke its promise: then
+        // the octree is built now, and the shadow rays go without a buffer
+        // (the store may hold an earlier scene's).
         let Prepared { mode, report } =
             prepared.unwrap_or_else(|| accel::prepare(mode, &view, &mut self.octree, &P::OCTREE));
         let octree = report.map(|report| (&self.octree, report));
-        // What the build made (the store may hold an earlier scene's).
-        let lights = if buffered { self.light_buffer.buffer() } else { LightBuffer::NONE };
+        let lights = if built { self.light_buffer.buffer() } else { LightBuffer::NONE };
         let first_hits = P::FIRST_HITS && requested != AccelMode::Naive;
         let (mailbox, screen_lists) = self.room.prepare(view.object_count(), first_hits);
         Ok(LoadedScene {
@@ -1019,6 +1020,9 @@ mod tests {
         let (walked_pixels, walked) = draw(&unbuffered.load(&text).unwrap());
         assert_eq!(walked_pixels, pixels);
         assert!(walked.cells > stats.cells, "{} cells walked against {}", walked.cells, stats.cells);
+        // A `both` that skips the other core's job: no buffer, not the
+        // last scene's.
+        assert_eq!(draw(&two.load_on_two_cores(&text, |_, here| here()).unwrap()), (walked_pixels, walked));
         // A scene loaded with no buffer after one with: none, not the old one.
         let naive = |raytracer: &mut Raytracer<Buffered>| {
             draw(&raytracer.load_with(text.as_bytes(), AccelMode::Naive, &mut |e| panic!("{e:?}")).unwrap())

@@ -130,9 +130,9 @@ where
 
 /// Traces `scene` into `display` with both cores in the progressive
 /// `order` (the whole panel in coarse blocks first, then finer: the same
-/// picture as [`draw`] at the end), core 1 tracing every other unit in
-/// `room` and handing its colours over through `ring`, which holds
-/// `order.max_unit_pixels()`.
+/// picture as [`draw`] at the end), each core taking the next unit, core 1
+/// tracing in `room` and handing its colours over through `ring`, which
+/// holds `order.max_unit_pixels()`.
 pub fn draw_progressive<P, D, const LEN: usize, const SLOTS: usize>(
     core1: &mut SecondCore,
     scene: &LoadedScene<'_, P>,
