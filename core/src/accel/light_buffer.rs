@@ -225,23 +225,34 @@ const fn other_axes(a: usize) -> [usize; 2] {
 /// is long code on a 32-bit core, and a build makes up to 24 an object and
 /// light (fig5_3's cost a Pico 3 M cycles).
 fn cell_of_ratio(y: i64, x: i64, level: u32) -> u8 {
-    let (mut rest, divisor) = (y + x, 2 * x);
+    let (rest, divisor) = (y + x, 2 * x);
     if rest <= 0 {
         return 0;
     }
     if rest >= divisor {
         return ((1 << level) - 1) as u8;
     }
-    let mut cell = 0;
-    for _ in 0..level {
-        rest <<= 1;
-        cell <<= 1;
+    quotient_bits(rest, divisor, level) as u8
+}
+
+/// The first `steps` bits after the point of `rest / divisor` (`0 ≤ rest ≤
+/// divisor`, all ones when equal; `2·divisor` fits `T`) by long division, a
+/// bit a step: no divider, and on a 32-bit core no 64-bit division either.
+#[inline(always)]
+fn quotient_bits<T>(mut rest: T, divisor: T, steps: u32) -> u32
+where
+    T: Copy + Ord + core::ops::Shl<u32, Output = T> + core::ops::SubAssign,
+{
+    let mut quotient = 0;
+    for _ in 0..steps {
+        rest = rest << 1;
+        quotient <<= 1;
         if rest >= divisor {
             rest -= divisor;
-            cell += 1;
+            quotient += 1;
         }
     }
-    cell
+    quotient
 }
 
 /// Where the box `[min, max]` widened by `margin` is seen from `light`, with
@@ -802,18 +813,7 @@ fn direction([x, y, z]: [i32; 3], level: u8) -> Option<(usize, u32, [u32; 2])> {
 /// of steps, which the compiler writes out without a loop.
 #[inline(never)]
 fn cell_along(v: i32, m: u32, level: u8) -> u32 {
-    let d = m << 1;
-    let mut r = (v as u32).wrapping_add(m);
-    let mut q = 0;
-    for _ in 0..MAX_LEVEL {
-        r <<= 1;
-        q <<= 1;
-        if r >= d {
-            r -= d;
-            q += 1;
-        }
-    }
-    q >> (MAX_LEVEL - level as u32)
+    quotient_bits((v as u32).wrapping_add(m), m << 1, MAX_LEVEL) >> (MAX_LEVEL - level as u32)
 }
 
 /// A shadow ray testing lists.
