@@ -26,13 +26,16 @@ fn target_dir() -> PathBuf {
 /// The scene the template embeds when `OCTRACE_SCENE` is not set.
 const DEFAULT_SCENE: &str = "fig5_1";
 
+/// Where the template's code runs when `OCTRACE_CODE_IN` is not set.
+pub const DEFAULT_CODE_IN: &str = "parse-and-render";
+
 /// How the embedded-scene firmware is built: its scene, where its code runs
 /// (`OCTRACE_CODE_IN`) and its pixel order (`OCTRACE_ORDER`). The default is
 /// the template as a user builds it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Build<'a> {
     pub scene: &'a str,
-    /// `render` (the default), `sram` or `flash`.
+    /// `parse-and-render` (the default), `render`, `sram` or `flash`.
     pub code_in: &'a str,
     /// `rows` (the default) or `progressive`.
     pub order: &'a str,
@@ -41,14 +44,14 @@ pub struct Build<'a> {
 impl<'a> Build<'a> {
     /// The template as a user builds it, with `scenes/SCENE.txt`.
     pub fn of(scene: &'a str) -> Build<'a> {
-        Build { scene, code_in: "render", order: "rows" }
+        Build { scene, code_in: DEFAULT_CODE_IN, order: "rows" }
     }
 
     /// What the build is named by: the scene, and what differs from the
     /// default.
     pub fn name(&self) -> String {
         let mut name = self.scene.to_owned();
-        for (value, default) in [(self.code_in, "render"), (self.order, "rows")] {
+        for (value, default) in [(self.code_in, DEFAULT_CODE_IN), (self.order, "rows")] {
             if value != default {
                 name = format!("{name}-{value}");
             }
@@ -81,7 +84,7 @@ pub fn build(build: &Build<'_>) -> Result<PathBuf, String> {
     if build.scene != DEFAULT_SCENE {
         cargo.env("OCTRACE_SCENE", repo().join("scenes").join(format!("{}.txt", build.scene)));
     }
-    if build.code_in != "render" {
+    if build.code_in != DEFAULT_CODE_IN {
         cargo.env("OCTRACE_CODE_IN", build.code_in);
     }
     if build.order != "rows" {

@@ -10,17 +10,17 @@
 //! `OCTRACE_SKIP_FIRMWARE=1` to skip where they cannot be installed.
 
 use octrace_tests::host_sim_preview;
-use octrace_tests::pico::{self, Build};
+use octrace_tests::pico::{self, Build, DEFAULT_CODE_IN};
 use std::path::Path;
 
 /// The thesis's first figure (naive, no octree), 200 spheres in an
 /// octree, and the chessboard of 64 rectangles, as a user builds them; and
 /// the first in the progressive order.
 const BUILDS: [Build<'static>; 4] = [
-    Build { scene: "fig5_1", code_in: "render", order: "rows" },
-    Build { scene: "fig5_3", code_in: "render", order: "rows" },
-    Build { scene: "fig5_5", code_in: "render", order: "rows" },
-    Build { scene: "fig5_1", code_in: "render", order: "progressive" },
+    Build { scene: "fig5_1", code_in: DEFAULT_CODE_IN, order: "rows" },
+    Build { scene: "fig5_3", code_in: DEFAULT_CODE_IN, order: "rows" },
+    Build { scene: "fig5_5", code_in: DEFAULT_CODE_IN, order: "rows" },
+    Build { scene: "fig5_1", code_in: DEFAULT_CODE_IN, order: "progressive" },
 ];
 
 /// The first coarse panel of a progressive order, from the picture's start:

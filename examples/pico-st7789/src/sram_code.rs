@@ -1,6 +1,6 @@
-//! Copies the program's code and constants from flash into SRAM before
-//! anything else runs (`OCTRACE_CODE_IN=sram`, the default; the linker
-//! script fragment is `sram-code.x`).
+//! Copies the code `sram-code.x` places in SRAM (all of it and its
+//! constants, or the render path with or without the parser, as
+//! `OCTRACE_CODE_IN` says) from flash before anything else runs.
 //!
 //! Invariants: `__pre_init` is the first code cortex-m-rt's reset handler
 //! calls, before `.bss` and `.data` are set up, so it touches no RAM but

@@ -7,7 +7,7 @@
 //! each core's busy and waiting cycles, and the flash cache's reads, misses
 //! and stalls.
 //!
-//!     cargo run --release -p octrace-tests --bin pico-bench [--code-in render|sram|flash] [--order rows|progressive] [scene...]
+//!     cargo run --release -p octrace-tests --bin pico-bench [--code-in parse-and-render|render|sram|flash] [--order rows|progressive] [scene...]
 //!
 //! Cycles are the emulator's: rp2040js's Cortex-M0+ timings, both cores in
 //! lockstep, the flash behind its XIP cache with the QSPI reads of the
@@ -16,10 +16,11 @@
 use octrace_tests::firmware::Sizes;
 use octrace_tests::pico::{self, Build, Cycles, CLOCK_HZ};
 
-const USAGE: &str = "usage: pico-bench [--code-in sram|render|flash] [--order rows|progressive] [scene...]";
+const USAGE: &str =
+    "usage: pico-bench [--code-in parse-and-render|render|sram|flash] [--order rows|progressive] [scene...]";
 
 fn main() {
-    let mut code_in = "render".to_owned();
+    let mut code_in = pico::DEFAULT_CODE_IN.to_owned();
     let mut order = "rows".to_owned();
     let mut scenes = Vec::new();
     let mut args = std::env::args().skip(1);
@@ -29,7 +30,9 @@ fn main() {
             _ => usage(&format!("{name} takes one of {}", allowed.join(", "))),
         };
         match arg.as_str() {
-            "--code-in" => code_in = value("--code-in", &["render", "sram", "flash"], args.next()),
+            "--code-in" => {
+                code_in = value("--code-in", &[pico::DEFAULT_CODE_IN, "render", "sram", "flash"], args.next())
+            }
             "--order" => order = value("--order", &["rows", "progressive"], args.next()),
             flag if flag.starts_with('-') => usage(&format!("unknown option {flag}")),
             _ => scenes.push(arg),
