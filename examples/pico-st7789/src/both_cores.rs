@@ -7,8 +7,8 @@
 //! core 0 has (like `std::thread::scope`). [`draw`] is the picture: each
 //! core takes the next row no core has taken (under the chip's lock) and
 //! traces it with a renderer of its own; core 1 hands its rows over in a
-//! [`Handoff`] ring; core 0 sends every row to the panel in order. Each waits for the other with `wfe`,
-//! woken by the other's `sev`.
+//! [`Handoff`] ring; core 0 sends every row to the panel in order. Each
+//! waits for the other with `wfe`, woken by the other's `sev`.
 //!
 //! Invariants: `JOB` is null or points at core 0's `&mut dyn FnMut()` for
 //! the job, which core 0 keeps alive until core 1 has set `JOB` back to
@@ -166,7 +166,7 @@ where
 /// and says how many; `present` shows them, or stops the picture.
 ///
 /// Why not halves: core 0 also presents every piece (the colours' format,
-/// the panel's commands, the bus), about 5 % of its time on the Pico, and
+/// the panel's commands, the bus), 4 to 5 % of its time on the Pico, and
 /// pieces differ in cost (a row of sky against a row of spheres), so fixed
 /// halves left core 1 waiting for 10 M cycles of fig5_3's picture.
 #[allow(clippy::too_many_arguments)]
