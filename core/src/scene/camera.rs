@@ -518,4 +518,73 @@ mod tests {
             }
         }
     }
+
+    /// `Projection::window` as it was first written: each corner's
+    /// products with the normals one by one, every error divided.
+    fn window_corner_by_corner(p: &Projection, lo: [i64; 3], hi: [i64; 3]) -> Option<[[i32; 2]; 2]> {
+        let mut window = [[i64::MAX, i64::MIN]; 2];
+        for corner in 0..8 {
+            let v = [0, 1, 2].map(|a| if corner >> a & 1 == 1 { hi[a] } else { lo[a] } - p.eye[a]);
+            let depth = dot(&p.depth, &v);
+            if depth <= 0 {
+                return None;
+            }
+            let shift = (128 - depth.leading_zeros()).saturating_sub(41);
+            let slack = v.iter().map(|c| c.unsigned_abs()).sum::<u64>();
+            let error = (slack >> shift) as i64 + 2;
+            let depth = (depth >> shift) as i64;
+            if depth <= 2 * error {
+                return None;
+            }
+            for (axis, normal) in [&p.across, &p.down].into_iter().enumerate() {
+                let num = dot(normal, &v) >> shift;
+                let k = if num.unsigned_abs() < 1 << 62 {
+                    (num as i64).div_euclid(depth)
+                } else {
+                    num.signum() as i64 * OFFSET_LIMIT
+                };
+                let k = k.clamp(-OFFSET_LIMIT, OFFSET_LIMIT);
+                let error = error * (2 + k.abs()) / (depth - error) + 1;
+                window[axis][0] = window[axis][0].min(k - error);
+                window[axis][1] = window[axis][1].max(k + 1 + error);
+            }
+        }
+        Some(window.map(|[a, b]| [(a - 2) as i32, (b + 2) as i32]))
+    }
+
+    /// Boxes of every size, ahead of the eye, beside it, behind it and
+    /// around it, seen by cameras looking every way: the window of six
+    /// products a normal is the window of each corner's.
+    #[test]
+    fn a_window_from_the_sides_products_is_the_corners_window() {
+        let mut next = crate::test_rng::seeded(0x3a1d_0f5e_77c2);
+        let mut coordinate = |scale: u64| (next() % (2 * scale + 1)) as i64 - scale as i64;
+        let mut ahead = 0;
+        for _ in 0..300 {
+            let point = |c: &mut dyn FnMut(u64) -> i64| [0; 3].map(|_| c(9) << 32 | (c(1 << 31) & 0xffff_ffff));
+            let view = View { eye: point(&mut coordinate), look_at: point(&mut coordinate), ..View::default() };
+            let Ok(camera) = Camera::new(&view, &Normalization::fit([-10 * ONE; 3], [10 * ONE; 3]), 320, 240, 2) else {
+                continue;
+            };
+            let projection = Projection::new(&camera);
+            for _ in 0..100 {
+                let size = 1u64 << (coordinate(15).unsigned_abs() + 4);
+                // Half of them near the eye, of any size, where the
+                // rounding's error is large against the depth.
+                let near = coordinate(1) == 0;
+                let lo = [0, 1, 2].map(|a| match near {
+                    true => {
+                        let scale = 1 << coordinate(30).unsigned_abs();
+                        projection.eye[a] + coordinate(scale)
+                    }
+                    false => coordinate(1 << 31),
+                });
+                let hi = [0, 1, 2].map(|a| lo[a] + (coordinate(size / 2) + size as i64 / 2));
+                let window = projection.window(lo, hi);
+                ahead += window.is_some() as u32;
+                assert_eq!(window, window_corner_by_corner(&projection, lo, hi), "{view:?} {lo:?} {hi:?}");
+            }
+        }
+        assert!(ahead > 1_000, "{ahead} boxes ahead of the eye");
+    }
 }
