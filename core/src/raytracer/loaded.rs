@@ -1,0 +1,284 @@
+//! A loaded scene: its view, accelerator, light buffer and the room of the
+//! core that loaded it; it draws as an image, directly or progressively.
+
+use crate::accel::{AccelMode, Accelerator, BuildReport, LightBuffer, LightBufferError};
+use crate::profile::Profile;
+use crate::render::{Progressive, Renderer};
+use crate::scene::{CameraError, SceneView};
+use crate::shade::Stats;
+use core::cell::{Cell, RefCell};
+use core::fmt;
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::pixelcolor::Rgb888;
+use embedded_graphics_core::primitives::Rectangle;
+
+use super::image::Shifted;
+use super::{light_buffer, DrawError, SceneAccelerator, ScreenLists, SharedScene, TracedImage};
+
+/// A scene ready to trace, borrowed from its [`Raytracer`](super::Raytracer).
+pub struct LoadedScene<'r, P: Profile> {
+    pub(super) view: SceneView<'r>,
+    pub(super) mode: AccelMode,
+    pub(super) octree: Option<(&'r P::Octree, BuildReport)>,
+    /// The shadow rays' light buffer (none buffered without room for one).
+    pub(super) lights: LightBuffer<'r>,
+    pub(super) mailbox: RefCell<&'r mut [u32]>,
+    /// The camera rays' screen lists (bounds and positions), if they are
+    /// used.
+    pub(super) screen_lists: RefCell<Option<ScreenLists<'r>>>,
+    pub(super) first_hits: bool,
+    pub(super) stats: Cell<Stats>,
+}
+
+impl<P: Profile> fmt::Debug for LoadedScene<'_, P> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("LoadedScene")
+            .field("objects", &self.view.object_count())
+            .field("mode", &self.mode)
+            .field("octree", &self.octree.map(|(_, report)| report))
+            .finish_non_exhaustive()
+    }
+}
+
+impl<'r, P: Profile> LoadedScene<'r, P> {
+    /// The scene's objects, surfaces, lights and settings.
+    pub fn view(&self) -> SceneView<'r> {
+        self.view
+    }
+
+    /// The accelerator in use (never [`AccelMode::Auto`]).
+    pub fn mode(&self) -> AccelMode {
+        self.mode
+    }
+
+    /// What this scene's images render with: its octree, or every object
+    /// (over only the shape kinds the profile has room for). For a board
+    /// that renders with [`Renderer`]s of its own, one per core (each with
+    /// its own mailbox and screen lists) over this one scene: see
+    /// [`interleaved_rows`](crate::render::interleaved_rows).
+    ///
+    /// ```
+    /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888};
+    /// use embedded_graphics::{image::Image, prelude::*};
+    /// use octrace_core::{profile::Board16K, render::{interleaved_rows, Renderer}, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
+    /// let accelerator = scene.accelerator();
+    /// let mut whole = MockDisplay::<Rgb888>::new();
+    /// Image::new(&scene.image(Size::new(8, 8)), Point::zero()).draw(&mut whole)?;
+    /// // Two "cores", each with its own renderer, rows dealt out in turn.
+    /// for core in 0..2 {
+    ///     let mut renderer = Renderer::with_size(scene.view(), &accelerator, 8, 8)?;
+    ///     for y in interleaved_rows(8, core, 2) {
+    ///         for (x, pixel) in renderer.row(y, 0..8).enumerate() {
+    ///             assert_eq!(whole.get_pixel(Point::new(x as i32, y as i32)), Some(pixel.color));
+    ///         }
+    ///     }
+    /// }
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn accelerator(&self) -> SceneAccelerator<'r, P> {
+        SceneAccelerator { octree: self.octree.as_ref().map(|(octree, _)| *octree), lights: self.lights }
+    }
+
+    /// The shadow rays' light buffer: built when the scene loaded if the
+    /// profile serves lights with one and has RAM for it
+    /// (`light_buffer_lights` and `light_buffer_words`, see
+    /// [`Profile::LightBufferWords`]) and the mode is not
+    /// [`AccelMode::Naive`] asked for by name, or the one
+    /// [`LoadedScene::use_light_buffer`] took; else none
+    /// ([`LightBuffer::report`] says how many lights it buffers).
+    pub fn light_buffer(&self) -> LightBuffer<'r> {
+        self.lights
+    }
+
+    /// Uses `words`, a light buffer built beforehand for this scene (its
+    /// [`LightBuffer::words`], kept in flash by a build script), once
+    /// checked to hold every object wherever a buffer built here would
+    /// ([`LightBuffer::verified`]); a buffer that is not is refused, and
+    /// the scene keeps the one it had. The profile must serve lights with a
+    /// light buffer (`light_buffer_lights`), not necessarily hold one in
+    /// RAM (`light_buffer_words`).
+    ///
+    /// ```
+    /// use octrace_core::{accel::{LightBuffer, LightBufferError}, parse::parse, profile::{Board16K, Board64K}};
+    /// use octrace_core::{scene::Scene, Raytracer};
+    ///
+    /// octrace_core::profile! {
+    ///     /// Two spheres; a light buffer from flash for their light.
+    ///     struct Spheres { spheres: 2, surfaces: 1, lights: 1, light_buffer_lights: 1 }
+    /// }
+    /// let text = "LIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\nSPHERE 1 0.5 1 1 1\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n";
+    /// // Where the scene is known beforehand (a build script): the words.
+    /// let mut built = Scene::<Board64K>::new();
+    /// parse(text, &mut built, &mut |e| panic!("{e}")).unwrap();
+    /// let mut words = heapless::Vec::<u32, 400>::new();
+    /// let prebuilt = LightBuffer::build(&built.view(), &mut words, 8).words();
+    /// // On the board: the scene, and the words from flash.
+    /// let mut raytracer = Raytracer::<Spheres>::new();
+    /// let mut scene = raytracer.load(text)?;
+    /// assert_eq!(scene.light_buffer().report().lights, 0, "no RAM for one");
+    /// scene.use_light_buffer(prebuilt)?;
+    /// assert_eq!(scene.light_buffer().report().lights, 1);
+    ///
+    /// // A profile without light buffers refuses it.
+    /// let mut small = Raytracer::<Board16K>::new();
+    /// assert_eq!(small.load(text)?.use_light_buffer(prebuilt), Err(LightBufferError::NoRoom));
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn use_light_buffer(&mut self, words: &'r [u32]) -> Result<(), LightBufferError> {
+        if !light_buffer::<P>() {
+            return Err(LightBufferError::NoRoom);
+        }
+        self.lights = LightBuffer::verified(&self.view, words)?;
+        Ok(())
+    }
+
+    /// Runs `f` with a renderer of an image of `size` over this scene, in
+    /// the room its [`Raytracer`](super::Raytracer) holds: the loading core's renderer on a
+    /// board whose other cores render with [`SharedScene::renderer`]. Its
+    /// counters are added to [`LoadedScene::stats`].
+    ///
+    /// ```
+    /// use embedded_graphics::prelude::*;
+    /// use octrace_core::{profile::Board16K, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load("BACKGROUND 0 0 1\n")?;
+    /// let pixels = scene.with_renderer(Size::new(4, 2), |renderer| renderer.row(1, 0..4).count())?;
+    /// assert_eq!(pixels, 4);
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn with_renderer<R>(
+        &self,
+        size: Size,
+        f: impl FnOnce(&mut Renderer<'_, SceneAccelerator<'r, P>>) -> R,
+    ) -> Result<R, CameraError> {
+        let accelerator = self.accelerator();
+        // Another draw of this scene holds the mailbox or the lists (only if
+        // a display draws from inside a draw): render without, same image.
+        let mut mailbox = self.mailbox.try_borrow_mut();
+        let mut screen_lists = self.screen_lists.try_borrow_mut();
+        let lists = screen_lists.as_deref_mut().ok().and_then(|lists| lists.as_mut());
+        let lists = lists.map(|(bounds, positions)| (&mut **bounds, &mut **positions));
+        let mailbox = mailbox.as_deref_mut().ok().map(|words| &mut **words);
+        let mut renderer = renderer_in(self.view, &accelerator, size, mailbox, lists)?;
+        let result = f(&mut renderer);
+        let mut total = self.stats.get();
+        total.add(&renderer.stats());
+        self.stats.set(total);
+        Ok(result)
+    }
+
+    /// What another core needs to render this scene with a [`Renderer`] of
+    /// its own: see [`SharedScene`].
+    pub fn share(&self) -> SharedScene<'r, P> {
+        SharedScene { view: self.view, accelerator: self.accelerator(), first_hits: self.first_hits }
+    }
+
+    /// Whether camera rays find their hits in the screen lists
+    /// ([`Profile::FIRST_HITS`]): the same image as the walk's.
+    pub fn first_hits(&self) -> bool {
+        self.first_hits
+    }
+
+    /// What building the octree produced, if the mode uses one.
+    pub fn octree_report(&self) -> Option<&BuildReport> {
+        self.octree.as_ref().map(|(_, report)| report)
+    }
+
+    /// The counters of every draw so far.
+    pub fn stats(&self) -> Stats {
+        self.stats.get()
+    }
+
+    /// The scene's RASTER size.
+    pub fn raster(&self) -> Size {
+        let [w, h] = self.view.settings.raster;
+        Size::new(w, h)
+    }
+
+    /// The scene as an image of `size` pixels in the colour `C`.
+    pub fn image<C>(&self, size: Size) -> TracedImage<'_, 'r, P, C> {
+        TracedImage { scene: self, size, color: core::marker::PhantomData }
+    }
+
+    /// The scene as an image as large as `target`, in its colour: what
+    /// `Image::new(&scene.image_for(&display), Point::zero())` draws.
+    pub fn image_for<D: DrawTarget>(&self, target: &D) -> TracedImage<'_, 'r, P, D::Color> {
+        self.image(target.bounding_box().size)
+    }
+
+    /// Draws the scene as an image of `order`'s size at the origin of
+    /// `target`, in the [`Progressive`] order: the whole picture in coarse
+    /// blocks first, then finer, until it is exactly the picture
+    /// [`LoadedScene::image`] draws. Every pixel is traced once; the
+    /// drawing streams (no framebuffer), in a few calls a pass.
+    ///
+    /// ```
+    /// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb565, prelude::*};
+    /// use octrace_core::{profile::Board16K, render::Progressive, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
+    /// let mut display = MockDisplay::<Rgb565>::new();
+    /// display.set_allow_overdraw(true); // later passes draw over the coarse blocks
+    /// scene.draw_progressive(&Progressive::new(display.size(), 16), &mut display)?;
+    /// assert_eq!(scene.stats().rays, 64 * 64, "every pixel traced once: nothing reflects");
+    ///
+    /// let mut direct = MockDisplay::<Rgb565>::new();
+    /// Image::new(&scene.image_for(&direct), Point::zero()).draw(&mut direct)?;
+    /// assert_eq!(display, direct);
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn draw_progressive<D>(&self, order: &Progressive, target: &mut D) -> Result<(), DrawError<D::Error>>
+    where
+        D: DrawTarget,
+        D::Color: From<Rgb888>,
+    {
+        let drawn = self.with_renderer(order.size(), |renderer| order.render_unchecked(renderer, target));
+        drawn.map_err(DrawError::Camera)?.map_err(DrawError::Target)?;
+        Ok(())
+    }
+
+    /// Renders `area` of an image of `size` into `target`, with the pixel at
+    /// `area`'s top-left corner going to `at`.
+    pub(super) fn draw_area<D>(
+        &self,
+        size: Size,
+        area: &Rectangle,
+        at: Point,
+        target: &mut D,
+    ) -> Result<(), DrawError<D::Error>>
+    where
+        D: DrawTarget,
+        D::Color: From<Rgb888>,
+    {
+        let mut shifted = Shifted { target, offset: at - area.top_left };
+        let drawn = self.with_renderer(size, |renderer| renderer.render_rect(area, &mut shifted));
+        drawn.map_err(DrawError::Camera)?.map_err(DrawError::Target)?;
+        Ok(())
+    }
+}
+
+/// A renderer over `view` for an image of `size`, with a mailbox and screen
+/// lists where given. Inlined: a board's renderer is made in place.
+#[inline(always)]
+pub(super) fn renderer_in<'a, A: Accelerator>(
+    view: SceneView<'a>,
+    accel: &'a A,
+    size: Size,
+    mailbox: Option<&'a mut [u32]>,
+    lists: Option<ScreenLists<'a>>,
+) -> Result<Renderer<'a, A>, CameraError> {
+    let mut renderer = Renderer::with_size(view, accel, size.width, size.height)?;
+    if let Some(words) = mailbox {
+        renderer.set_mailbox(words);
+    }
+    if let Some((bounds, positions)) = lists {
+        renderer.set_first_hits(bounds, positions);
+    }
+    Ok(renderer)
+}
