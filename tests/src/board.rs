@@ -87,7 +87,7 @@ impl RunningBoard {
 
     /// The board the tests talk to: the command `OCTRACE_BOARD_COMMAND` names, run
     /// in the repository (for instance the emulated Pico's `node
-    /// examples/pico-st7789/emulator/run.mjs ELF --serial`), or else the
+    /// emulator/run.mjs ELF --serial`), or else the
     /// software board `software` (the path of the tests' `software-board`)
     /// with a 16 KiB board's profile, a 160×128 panel and scenes of up to
     /// 8 KiB. The tests ask it what it is ([`RunningBoard::describe`]) and

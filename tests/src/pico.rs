@@ -1,7 +1,7 @@
 //! Building the Raspberry Pi Pico template (`examples/pico-st7789`) for a
 //! scene, as its user does (`OCTRACE_SCENE`, and `OCTRACE_CODE_IN` and
 //! `OCTRACE_ORDER` to measure the other ways, at build time), and running
-//! its ELF on the emulated Pico (`examples/pico-st7789/emulator`), for the
+//! its ELF on the emulated Pico (`emulator/`), for the
 //! bit-exactness tests and the Pico benchmark.
 //!
 //! The builds share one target directory (`target/pico-st7789/`, apart from
@@ -154,7 +154,7 @@ impl Cycles {
 
 /// Runs `elf` on the emulated Pico; the panel's picture goes to `png`.
 pub fn run(elf: &Path, png: &Path) -> Result<Cycles, String> {
-    let emulator = template().join("emulator");
+    let emulator = repo().join("emulator");
     if !emulator.join("node_modules/rp2040js").is_dir() {
         return Err(format!("the emulator is not installed: run `npm ci` in {}", emulator.display()));
     }

@@ -8,7 +8,7 @@
 //! The board is the software board (`software-board`: the live firmware's
 //! logic, `octrace_link::board`, behind a pseudo-terminal), or the command
 //! `OCTRACE_BOARD_COMMAND` names (for instance the emulated Pico's `node
-//! examples/pico-st7789/emulator/run.mjs ELF --serial`), which must print the
+//! emulator/run.mjs ELF --serial`), which must print the
 //! serial device it serves. The tests ask the board what it is (panel,
 //! profile, longest scene) and choose their scenes by it.
 

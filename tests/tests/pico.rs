@@ -6,7 +6,7 @@
 //! panel comes within 0.1 s of the picture's start.
 //!
 //! Needs Node and the emulator's packages (`npm ci` in
-//! `examples/pico-st7789/emulator`; the test command does it); set
+//! `emulator/`; the test command does it); set
 //! `OCTRACE_SKIP_FIRMWARE=1` to skip where they cannot be installed.
 
 use octrace_tests::host_sim_preview;

@@ -11,7 +11,7 @@
 //!
 //! Cycles are the emulator's: rp2040js's Cortex-M0+ timings, both cores in
 //! lockstep, the flash behind its XIP cache with the QSPI reads of the
-//! firmware's own boot2 (`examples/pico-st7789/emulator`).
+//! firmware's own boot2 (`emulator/`).
 
 use octrace_tests::firmware::Sizes;
 use octrace_tests::pico::{self, Build, Cycles, CLOCK_HZ};
