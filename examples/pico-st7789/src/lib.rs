@@ -12,3 +12,4 @@
 pub mod board;
 pub mod both_cores;
 pub mod panel;
+pub mod sram_code;

@@ -22,7 +22,7 @@ use panic_halt as _;
 use rp2040_hal as hal;
 
 #[cfg(code_in_sram)]
-mod sram_code;
+octrace_pico_st7789::copy_code_into_sram!();
 
 /// The second-stage loader for the Pico's W25Q16JV flash; the boot ROM
 /// runs it from the first 256 bytes of flash (see memory.x).

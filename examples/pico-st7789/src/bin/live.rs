@@ -39,9 +39,8 @@ use usb_device::class_prelude::UsbBusAllocator;
 use usb_device::prelude::*;
 use usbd_serial::SerialPort;
 
-/// The render path runs from SRAM (build.rs): copied there at boot.
-#[path = "../sram_code.rs"]
-mod sram_code;
+// The render path runs from SRAM (build.rs): copied there at boot.
+octrace_pico_st7789::copy_code_into_sram!();
 
 /// The second-stage loader for the Pico's W25Q16JV flash (see memory.x).
 #[link_section = ".boot2"]
