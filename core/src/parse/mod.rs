@@ -468,14 +468,16 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
         if let Err(e) = self.scene.set_control_points(points.iter().map(|p| norm.point(p))) {
             return self.capacity(pos, e);
         }
-        if self.scene.push_bspline(order, rows, cols, samples, surface) == 0 {
-            self.report(ParseError::new(
+        match self.scene.push_bspline(order, rows, cols, samples, surface) {
+            Ok(0) => self.report(ParseError::new(
                 pos,
                 ErrorKind::Degenerate {
                     keyword: Keyword::Bspline.name(),
                     why: "its control points do not span a surface",
                 },
-            ));
+            )),
+            Ok(_) => {}
+            Err(e) => self.capacity(pos, e),
         }
     }
 
@@ -1035,6 +1037,32 @@ mod tests {
                  define a profile that holds them with octrace_core::profile! (bspline_triangles: 100, …)"
             ),
             "{e:?}"
+        );
+    }
+
+    #[test]
+    fn a_patch_at_exactly_its_capacity_loads_and_one_triangle_over_is_named() {
+        crate::profile! {
+            struct Exactly32 { bspline_triangles: 32, control_points: 9, surfaces: 1 }
+        }
+        crate::profile! {
+            struct Only31 { bspline_triangles: 31, control_points: 9, surfaces: 1 }
+        }
+        // 2 · 4 · 4 = 32 triangles.
+        let text = format!("{SURF}BSPLINE 1 3 3 3 5 5 {GRID}\n");
+        let mut scene = std::boxed::Box::new(Scene::<Exactly32>::new());
+        let mut errors = Vec::new();
+        let r = parse(&text, &mut scene, &mut |e| errors.push(e.to_string()));
+        assert_eq!((r, errors.len()), (Ok(Parsed::default()), 0), "{errors:?}");
+        assert_eq!(scene.view().bspline_triangles.len(), 32);
+        let mut scene = std::boxed::Box::new(Scene::<Only31>::new());
+        let r = parse(&text, &mut scene, &mut |e| errors.push(e.to_string()));
+        assert_eq!(r, Err(1), "{errors:?}");
+        assert!(
+            errors[0].starts_with(
+                "2:1: too many B-spline triangles: the capacity profile Only31 holds 31 and the scene needs 32"
+            ),
+            "{errors:?}"
         );
     }
 
