@@ -8,8 +8,10 @@
 //! by its tag; every row of a picture arrives exactly once, in the panel's
 //! format and width, before the board says it is done, or the run fails.
 
-use crate::cli::{output_format, panel_preview, parse_format, progress_bar, same_file};
+use crate::arguments::{output_format, parse_format, same_file};
 use crate::exit::CliError;
+use crate::output::panel_preview;
+use crate::terminal::progress_bar;
 use crate::{all_cores, load_bytes, new_scene, render_with_progress, LoadError, RenderOptions, RgbImage};
 use embedded_graphics_core::pixelcolor::RgbColor;
 use octrace_core::render::PanelColor;
