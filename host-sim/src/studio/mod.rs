@@ -43,9 +43,9 @@ pub struct StudioArgs {
     /// whether it is host-sim's).
     #[arg(long, value_name = "PORT")]
     pub board: Option<PathBuf>,
-    /// Seconds to wait for each answer of the board (a row of a slow scene
-    /// included).
-    #[arg(long, value_name = "SECONDS", default_value_t = 30, value_parser = clap::value_parser!(u64).range(1..=86_400))]
+    /// Seconds a send may take: the board's hello, the scene, and its
+    /// answer (every error, or every row of the drawing).
+    #[arg(long, value_name = "SECONDS", default_value_t = crate::board::DEFAULT_TIMEOUT, value_parser = clap::value_parser!(u64).range(1..=86_400))]
     pub board_timeout: u64,
 }
 
