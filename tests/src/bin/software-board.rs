@@ -51,7 +51,8 @@ enum Misbehaviour {
     /// Answers every scene with scene errors, one every this many
     /// milliseconds, never closed by `rejected`.
     ErrorsEvery(u64),
-    /// Reads its port slowly: 256 bytes every 4 ms (64 KB/s).
+    /// Reads its port slowly: 1 KiB every 100 ms (10 KiB/s), so that a
+    /// host's write waits longer than a serial port's own timeout.
     ReadsSlowly,
     /// Its firmware's name and its answer to every scene (one error) carry
     /// terminal escapes.
@@ -246,9 +247,9 @@ fn main() {
         let mut chunk = [0u8; 4096];
         loop {
             if slowly {
-                std::thread::sleep(Duration::from_millis(4));
+                std::thread::sleep(Duration::from_millis(100));
             }
-            let chunk = if slowly { &mut chunk[..256] } else { &mut chunk[..] };
+            let chunk = if slowly { &mut chunk[..1024] } else { &mut chunk[..] };
             match reader.read(chunk) {
                 Ok(n) if n > 0 => {
                     if chunks.send(chunk[..n].to_vec()).is_err() {
