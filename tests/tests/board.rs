@@ -399,3 +399,17 @@ fn a_boards_text_is_shown_with_its_control_characters_escaped() {
     );
     assert!(!run.stdout.contains('\u{1b}') && !run.stderr.contains('\u{1b}'));
 }
+
+#[test]
+fn the_board_reports_every_lines_error_as_host_sim_does() {
+    let board = board();
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("five.txt");
+    std::fs::write(&scene, "x\nx\nx\nx\nx\n").unwrap();
+    let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str()]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    for line in 1..=5 {
+        assert!(run.stderr.contains(&format!("five.txt:{line}:1: unknown keyword `x`")), "line {line}: {}", run.stderr);
+    }
+    assert!(run.stderr.contains("host-sim: 5 error(s) in "), "{}", run.stderr);
+}
