@@ -268,6 +268,10 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
     let error: String =
         browser.run("return document.querySelector('#errors li').textContent;").as_str().unwrap().into();
     assert!(error.starts_with("2:10:"), "{error}");
+    // Every line's error, as host-sim and the board report them.
+    set_text(&browser, "x\nx\nx\nx\nx\n");
+    let lines = browser.run("return [...document.querySelectorAll('#errors li')].map((li) => li.dataset.line);");
+    assert_eq!(lines, serde_json::json!(["1", "2", "3", "4", "5"]));
 }
 
 #[test]
@@ -903,4 +907,28 @@ fn another_local_page_cannot_drive_the_studio_nor_learn_its_token() {
     for name in ["GET /scene", "PUT /scene", "POST /board, a guessed token"] {
         assert!(results[name].as_str().is_some_and(|r| r.starts_with("refused")), "{name}: {results}");
     }
+}
+
+#[test]
+fn send_to_board_refuses_what_a_hostile_board_answers() {
+    let software = env!("CARGO_BIN_EXE_software-board");
+    let binary = host_sim_binary();
+    let text = std::fs::read(repo().join("scenes/fig5_1.txt")).expect("fig5_1");
+    // A drawing at a panel it did not describe: an error, not "identical"
+    // over no pixel at all.
+    let board = RunningBoard::software(software, &["--panel", "160x128", "--misbehave", "draws-at:0x0"]);
+    let studio = Studio::start_with(&binary, None, &["--board".as_ref(), board.port.as_os_str()]);
+    let (status, body) = http(studio.port, "POST", &format!("/board?token={}", studio.token), &[], &text);
+    let said = String::from_utf8_lossy(&body);
+    assert_eq!(status, 502, "{said}");
+    assert!(said.contains("it draws at 0x0 rgb565, but described a 160x128 rgb565 panel"), "{said}");
+    // Its errors' terminal escapes reach the page escaped.
+    let board = RunningBoard::software(software, &["--panel", "160x128", "--misbehave", "escapes"]);
+    let studio = Studio::start_with(&binary, None, &["--board".as_ref(), board.port.as_os_str()]);
+    let (status, body) = http(studio.port, "POST", &format!("/board?token={}", studio.token), &[], &text);
+    let answer: serde_json::Value = serde_json::from_slice(&body).expect("JSON");
+    assert_eq!(status, 200, "{answer}");
+    let message = answer["errors"][0]["message"].as_str().expect("an error");
+    assert!(message.starts_with("\\u{1b}[2J\\u{1b}[31mred"), "{answer}");
+    assert!(!message.contains('\u{1b}'), "{answer}");
 }
