@@ -331,3 +331,23 @@ fn describe(port: &str, board: &BoardDescription, out: &mut dyn Write) -> io::Re
     let capacities: Vec<String> = board.capacities.iter().map(|(name, count)| format!("{name} {count}")).collect();
     writeln!(out, "profile {}: {}", board.profile, capacities.join(", "))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_check_that_compares_no_pixel_fails() {
+        let scene = b"SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\n";
+        let panel = |width, height| Panel { width, height, format: PixelFormat::Rgb565 };
+        let picture = |width, height| RgbImage { width, height, data: vec![0; 3 * (width * height) as usize] };
+        for (board, got) in [(panel(0, 0), picture(0, 0)), (panel(4, 2), picture(2, 4)), (panel(4, 2), picture(4, 1))] {
+            let said = differing_pixels("s.txt", scene, board, &got).unwrap_err();
+            assert!(
+                matches!(&said, CliError::Mismatch(m) if m.starts_with("board --check: no pixel to compare")),
+                "{said}"
+            );
+        }
+        assert!(differing_pixels("s.txt", scene, panel(4, 2), &picture(4, 2)).is_ok());
+    }
+}
