@@ -14,11 +14,13 @@
 //! a `static` costs no flash.
 
 mod camera;
+mod motion;
 mod normalize;
 mod surface;
 
 pub use camera::{Camera, CameraError, View, MAX_SAMPLES, MAX_SIDE};
 pub(crate) use camera::{CameraRay, Projection, RayCursor, Stride};
+pub use motion::{displacement_at, Frames};
 pub use normalize::{Normalization, WorldPoint, WorldValue};
 pub use surface::{Color, Surface, SurfaceEntry};
 
@@ -311,15 +313,30 @@ impl<C: SceneCapacities> Scene<C> {
     }
 
     /// Evaluates the patch whose control points were set, pushing its
-    /// triangles (room checked beforehand with [`Scene::check_room`]);
-    /// returns how many were made.
-    pub(crate) fn push_bspline(&mut self, order: u32, rows: u32, cols: u32, samples: [u32; 2], surface: u16) -> usize {
+    /// triangles moved by `shift` (room checked beforehand with
+    /// [`Scene::check_room`]); returns how many were made.
+    pub(crate) fn push_bspline(
+        &mut self,
+        order: u32,
+        rows: u32,
+        cols: u32,
+        samples: [u32; 2],
+        surface: u16,
+        shift: Vec3,
+    ) -> usize {
         let points = core::mem::replace(&mut self.control_points, C::ControlPoints::EMPTY);
         let mut made = 0;
         let first = self.objects.as_slice().len() as u32;
         if let Some(patch) = crate::shapes::Bspline::new(order, rows, cols, points.as_slice()) {
             patch.triangles(samples[0], samples[1], surface, |t| {
-                if self.push_shape(SmoothTriangle { patch: first, ..t }).is_ok() {
+                // Moved corners keep their edges, so the same normal.
+                let corners = t.triangle.polygon.corners.map(|c| c + shift);
+                let moved = match shift == Vec3::ZERO {
+                    true => Some(t.triangle),
+                    false => crate::shapes::Triangle::new(corners, surface),
+                };
+                let Some(triangle) = moved else { return };
+                if self.push_shape(SmoothTriangle { triangle, patch: first, ..t }).is_ok() {
                     made += 1;
                 }
             });
