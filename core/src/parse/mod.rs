@@ -23,7 +23,7 @@ mod number;
 mod statement;
 
 pub use error::{ErrorKind, Field, Found, ParseError, Pos, Rule};
-pub(crate) use motion::{for_each_move, Move, Mover};
+pub(crate) use motion::{for_each_move, frames_of, Mover};
 pub(crate) use number::Decimal;
 pub(crate) use statement::{Keys, Statement};
 

@@ -113,6 +113,17 @@ pub(crate) fn for_each_paired<'a, R: Room>(text: &'a str, mut each: impl FnMut(P
     }
 }
 
+/// The first FRAMES of `text`, if any.
+pub(crate) fn frames_of(text: &str) -> Option<crate::scene::Frames> {
+    let mut frames = None;
+    for_each_statement::<AnyRoom>(text, |_, result| {
+        if let Ok(Statement::Frames(f)) = result {
+            frames.get_or_insert(f);
+        }
+    });
+    frames
+}
+
 /// One MOVE of a scene that parsed: what it moves and its keys.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Move<'a> {

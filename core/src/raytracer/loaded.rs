@@ -4,7 +4,8 @@
 use crate::accel::{AccelMode, Accelerator, BuildReport, LightBuffer, LightBufferError};
 use crate::profile::Profile;
 use crate::render::{Progressive, Renderer};
-use crate::scene::{CameraError, SceneView};
+use crate::animation::{Coherence, Motion};
+use crate::scene::{CameraError, Frames, SceneView};
 use crate::shade::Stats;
 use core::cell::{Cell, RefCell};
 use core::fmt;
@@ -29,6 +30,8 @@ pub struct LoadedScene<'r, P: Profile> {
     pub(super) screen_lists: RefCell<Option<ScreenLists<'r>>>,
     pub(super) first_hits: bool,
     pub(super) stats: Cell<Stats>,
+    /// FRAMES, for an animation.
+    pub(super) frames: Option<Frames>,
 }
 
 impl<P: Profile> fmt::Debug for LoadedScene<'_, P> {
@@ -187,6 +190,70 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// What building the octree produced, if the mode uses one.
     pub fn octree_report(&self) -> Option<&BuildReport> {
         self.octree.as_ref().map(|(_, report)| report)
+    }
+
+    /// The scene's FRAMES, if it is an animation (loaded at one of its
+    /// frames: [`Raytracer::load_frame`](super::Raytracer::load_frame)).
+    pub fn frames(&self) -> Option<Frames> {
+        self.frames
+    }
+
+    /// Draws frame `frame` of an animation, this scene loaded at that
+    /// frame, into `target` (of `coherence`'s size), re-tracing only the
+    /// tiles [`Coherence::plan`] left to trace (call it first) and drawing
+    /// only their runs of pixels: after the frame before it in the loop
+    /// (or at the first frame, everything), `target` shows the frame as a
+    /// whole draw would. An example is [`Coherence`]'s.
+    pub fn draw_changes<D>(
+        &self,
+        motion: &Motion<'_>,
+        frame: u32,
+        coherence: &Coherence<'_>,
+        target: &mut D,
+    ) -> Result<Stats, DrawError<D::Error>>
+    where
+        D: DrawTarget,
+        D::Color: From<Rgb888>,
+    {
+        self.draw_bands(motion, frame, coherence, 0..coherence.bands(), target)
+    }
+
+    /// [`LoadedScene::draw_changes`] of the bands `bands` only, with one
+    /// renderer in the room of the loading core: on a board whose cores
+    /// share the frame, `bands` takes the next band no core has taken yet
+    /// (the other cores trace theirs with [`Coherence::trace_band`] and a
+    /// renderer of their own, [`SharedScene::renderer`]).
+    pub fn draw_bands<D>(
+        &self,
+        motion: &Motion<'_>,
+        frame: u32,
+        coherence: &Coherence<'_>,
+        bands: impl IntoIterator<Item = u32>,
+        target: &mut D,
+    ) -> Result<Stats, DrawError<D::Error>>
+    where
+        D: DrawTarget,
+        D::Color: From<Rgb888>,
+    {
+        let accelerator = self.accelerator();
+        // As `with_renderer`, here: the renderer's room is borrowed no
+        // longer than `motion` lives.
+        let mut mailbox = self.mailbox.try_borrow_mut();
+        let mut screen_lists = self.screen_lists.try_borrow_mut();
+        let lists = screen_lists.as_deref_mut().ok().and_then(|lists| lists.as_mut());
+        let lists = lists.map(|(bounds, positions)| (&mut **bounds, &mut **positions));
+        let mailbox = mailbox.as_deref_mut().ok().map(|words| &mut **words);
+        let mut renderer =
+            renderer_in(self.view, &accelerator, coherence.size(), mailbox, lists).map_err(DrawError::Camera)?;
+        let mut stats = Stats::default();
+        let result = bands.into_iter().try_for_each(|band| {
+            stats.add(&coherence.draw_band(&mut renderer, motion, frame, band, target)?);
+            Ok(())
+        });
+        let mut total = self.stats.get();
+        total.add(&stats);
+        self.stats.set(total);
+        result.map(|()| stats).map_err(DrawError::Target)
     }
 
     /// The counters of every draw so far.
