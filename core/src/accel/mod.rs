@@ -22,11 +22,11 @@ pub(crate) mod naive;
 mod octree;
 
 pub use choice::{prepare, Prepared};
+pub(crate) use light_buffer::RAY_SLACK;
 pub use light_buffer::{
     LightBuffer, LightBufferError, LightBufferReport, LightBufferStore, LightBuffered, MAX_CELLS_A_SIDE,
 };
 pub use naive::Naive;
-pub(crate) use light_buffer::RAY_SLACK;
 pub(crate) use octree::FILING_MARGIN;
 pub use octree::{
     BuildReport, HashEntry, Index, Octree, OctreeCapacities, OctreeConfig, OctreeNode, OctreeStore, ShadowShaft,

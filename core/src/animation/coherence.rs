@@ -10,8 +10,8 @@
 //! tile (loads and stores only, which a Cortex-M0 has), so cores share one
 //! store without a lock.
 
-use crate::motion::{Dependence, Lookout, Motion, NEVER};
 use crate::accel::Accelerator;
+use crate::motion::{Dependence, Lookout, Motion, NEVER};
 use crate::render::{PixelSample, Renderer};
 use crate::shade::Stats;
 use core::fmt;
@@ -171,7 +171,12 @@ impl<'s> Coherence<'s> {
 
     /// How many pixels the planned frame traces.
     pub fn traced_pixels(&self) -> u64 {
-        (0..self.bands()).flat_map(|band| self.runs(band).map(move |tiles| self.pixels_of(band, tiles))).sum()
+        (0..self.bands()).map(|band| self.band_pixels(band)).sum()
+    }
+
+    /// How many pixels the planned frame traces in band `band`.
+    pub fn band_pixels(&self, band: u32) -> u64 {
+        self.runs(band).map(|tiles| self.pixels_of(band, tiles)).sum()
     }
 
     /// The pixels of the tiles `tiles` of band `band`.

@@ -46,7 +46,7 @@
 
 mod coherence;
 
-pub use crate::motion::{Key, Motion, MotionError, MotionNeeds, Track};
-pub use coherence::{Coherence, CoherenceError};
 #[doc(hidden)]
 pub use crate::motion::Dependence;
+pub use crate::motion::{Key, Motion, MotionError, MotionNeeds, Track};
+pub use coherence::{Coherence, CoherenceError};

@@ -11,8 +11,8 @@
 //! anything, the lights stay, and no moving object's box comes near a
 //! segment (or, if it is near one now, moves).
 
-use super::track::{Motion, Target, NEVER};
 use super::sweep::Segment;
+use super::track::{Motion, Target, NEVER};
 use crate::math::{mul_wide, Scalar, Vec3};
 use crate::shapes::Ray;
 

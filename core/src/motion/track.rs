@@ -189,8 +189,9 @@ impl<'s> Motion<'s> {
             let normalised = target != Target::Camera;
             let key_first = key_count;
             let keys_of = m.keys;
-            let values =
-                || keys_of.offsets().map(move |(f, d)| (f, if normalised { d.map(|v| norm.length_wide(v)) } else { d }));
+            let values = || {
+                keys_of.offsets().map(move |(f, d)| (f, if normalised { d.map(|v| norm.length_wide(v)) } else { d }))
+            };
             let last = values().last().map_or([0; 3], |(_, d)| d);
             let mut before = last;
             for (at, value) in values() {

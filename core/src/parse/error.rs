@@ -309,9 +309,9 @@ impl fmt::Display for ErrorKind<'_> {
             ErrorKind::EyeAtOrigin => CameraError::EyeAtOrigin.fmt(f),
             ErrorKind::UpParallel => CameraError::UpParallel.fmt(f),
             ErrorKind::Capacity(c) => c.fmt(f),
-            ErrorKind::MoveWithoutFrames => {
-                f.write_str("MOVE in a scene without FRAMES: an animation first says how many frames it has (FRAMES count)")
-            }
+            ErrorKind::MoveWithoutFrames => f.write_str(
+                "MOVE in a scene without FRAMES: an animation first says how many frames it has (FRAMES count)",
+            ),
             ErrorKind::NothingToMove { after } => {
                 f.write_str("MOVE must follow an object, LIGHT, VIEWPOINT or ORIGIN statement")?;
                 match after {

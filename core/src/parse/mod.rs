@@ -430,9 +430,9 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
         for key in keys.iter() {
             let kind = if key.frame >= frames.count {
                 ErrorKind::FrameBeyond { frame: key.frame, count: frames.count }
-            } else if written.is_some_and(|(lo, hi)| {
-                (0..3).any(|a| lo[a] + key.offset[a] < -limit || hi[a] + key.offset[a] > limit)
-            }) {
+            } else if written
+                .is_some_and(|(lo, hi)| (0..3).any(|a| lo[a] + key.offset[a] < -limit || hi[a] + key.offset[a] > limit))
+            {
                 ErrorKind::MovedOutOfRange { keyword: s.keyword().name(), frame: key.frame }
             } else {
                 continue;

@@ -2,9 +2,9 @@
 //! core that loaded it; it draws as an image, directly or progressively.
 
 use crate::accel::{AccelMode, Accelerator, BuildReport, LightBuffer, LightBufferError};
+use crate::animation::{Coherence, Motion};
 use crate::profile::Profile;
 use crate::render::{Progressive, Renderer};
-use crate::animation::{Coherence, Motion};
 use crate::scene::{CameraError, Frames, SceneView};
 use crate::shade::Stats;
 use core::cell::{Cell, RefCell};

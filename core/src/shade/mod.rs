@@ -16,11 +16,11 @@
 //! queries, each O(objects) in the naive mode.
 
 use crate::accel::{Accelerator, Hit, Mailbox, RayStart};
-use crate::motion::{Lookout, RayKind};
 use crate::math::{
     leading_zeros, mul_u32_wide, mul_wide, pow_unit, reciprocal_start, shr_saturating_u32, shr_signed_to_u32, Dir,
     Scalar, Unit, Vec3, UNIT_ONE,
 };
+use crate::motion::{Lookout, RayKind};
 use crate::scene::{Color, ObjectId, SceneView};
 use crate::shapes::{Leaving, Ray};
 
@@ -336,10 +336,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
                 }
             })
         };
-        [
-            child(&|| p.ray.dir, t, RayKind::Transmitted),
-            child(&|| to_eye.reflect_about(normal), r, RayKind::Reflected),
-        ]
+        [child(&|| p.ray.dir, t, RayKind::Transmitted), child(&|| to_eye.reflect_about(normal), r, RayKind::Reflected)]
     }
 
     /// Whether anything blocks `shadow` to light `light` before `t_max`,
