@@ -49,6 +49,33 @@ impl Segment {
         Segment { p, q, lo, hi }
     }
 
+    /// Whether the segment comes near the raw sphere of centre `center` and
+    /// radius `radius`: on the grid, the radius widened and rounded up,
+    /// then by two cells (more than the rounding of the centre and of the
+    /// segment's ends moves them apart).
+    pub(crate) fn near_sphere(&self, center: [i32; 3], radius: i32) -> bool {
+        let c = center.map(|v| cell(i64::from(v)));
+        let r = i64::from((radius.saturating_add(WIDENING) >> GRID_BITS) + 3);
+        if (0..3).any(|a| i64::from(self.hi[a]) < i64::from(c[a]) - r || i64::from(self.lo[a]) > i64::from(c[a]) + r)
+        {
+            return false;
+        }
+        // Cells are below 2^14: squares and their products fit an i64.
+        let d = [0, 1, 2].map(|a| i64::from(self.q[a] - self.p[a]));
+        let w = [0, 1, 2].map(|a| i64::from(c[a] - self.p[a]));
+        let dot = |u: [i64; 3], v: [i64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+        let (dd, wd, ww) = (dot(d, d), dot(w, d), dot(w, w));
+        if wd <= 0 || dd == 0 {
+            return ww <= r * r;
+        }
+        if wd >= dd {
+            let e = [0, 1, 2].map(|a| w[a] - d[a]);
+            return dot(e, e) <= r * r;
+        }
+        // The distance to the line, squared, times |d|²: |w|²·|d|² − (w·d)².
+        ww * dd - wd * wd <= r * r * dd
+    }
+
     /// Whether the segment comes near the raw box `[lo, hi]`: on the grid,
     /// the box widened and rounded outward, then by a whole cell.
     pub(crate) fn meets(&self, lo: [i32; 3], hi: [i32; 3]) -> bool {
@@ -91,11 +118,13 @@ fn spans(keys: &[Key], n: u32) -> impl Iterator<Item = (u32, u32)> + '_ {
     bounds().zip(bounds().skip(1)).filter(|(a, b)| a <= b)
 }
 
-/// A track's objects through the loop: their box at frame 0, the box
-/// holding them in every frame, their displacement at each frame (from
-/// frame 0) and the keys that cut the loop into monotone spans.
+/// A track's objects through the loop: their box at frame 0 (a sphere's
+/// is its centre ± its radius, and then its own test is used at each
+/// frame), the box holding them in every frame, their displacement at each
+/// frame (from frame 0) and the keys that cut the loop into monotone spans.
 pub(crate) struct Sweep<'m> {
     pub first: [[i32; 3]; 2],
+    pub sphere: bool,
     pub swept: [[i32; 3]; 2],
     pub table: &'m [[i32; 3]],
     pub keys: &'m [Key],
@@ -109,7 +138,15 @@ impl Sweep<'_> {
 
     /// Whether `segment` comes near the objects at frame `frame`.
     pub(crate) fn meets_at(&self, segment: &Segment, frame: u32) -> bool {
-        self.meets_between(segment, frame, frame)
+        match (self.sphere, self.table.get(frame as usize)) {
+            (true, Some(d)) => {
+                let [lo, hi] = self.first;
+                // The box is the centre ± the radius, exactly.
+                let center = [0, 1, 2].map(|a| (lo[a] / 2 + hi[a] / 2 + (lo[a] % 2 + hi[a] % 2) / 2).saturating_add(d[a]));
+                segment.near_sphere(center, hi[0] / 2 - lo[0] / 2 + 1)
+            }
+            _ => self.meets_between(segment, frame, frame),
+        }
     }
 
     /// Whether `segment` comes near the objects in some frame of `a..=b`,
@@ -171,7 +208,10 @@ impl Sweep<'_> {
                 continue;
             }
             if a == b {
-                return Some(a);
+                if self.meets_at(segment, a) {
+                    return Some(a);
+                }
+                continue;
             }
             let mid = a + (b - a) / 2;
             // Room for both: the stack holds at most one range a level.

@@ -40,6 +40,8 @@ pub struct Track {
     table: u32,
     /// Objects: their box at frame 0 (normalised raw units).
     first: [[i32; 3]; 2],
+    /// Objects: a single sphere (tested as one, not as its box).
+    sphere: bool,
     /// Objects: the box holding them in every frame.
     swept: [[i32; 3]; 2],
 }
@@ -47,7 +49,7 @@ pub struct Track {
 impl Track {
     /// A placeholder to fill storage with.
     pub const EMPTY: Track =
-        Track { target: Target::Camera, keys: (0, 0), table: 0, first: [[0; 3]; 2], swept: [[0; 3]; 2] };
+        Track { target: Target::Camera, keys: (0, 0), table: 0, first: [[0; 3]; 2], sphere: false, swept: [[0; 3]; 2] };
 }
 
 /// A key of a track: storage for [`Motion::read`].
@@ -215,7 +217,7 @@ impl<'s> Motion<'s> {
                 }
                 let now = slice.get(frame as usize).copied().unwrap_or([0; 3]);
                 let [mut lo, mut hi] = [[i32::MAX; 3], [i32::MIN; 3]];
-                for id in objects {
+                for id in objects.clone() {
                     let bounds = view.shape(ObjectId(id)).bounds();
                     let (min, max) = (bounds.min.bits(), bounds.max.bits());
                     for a in 0..3 {
@@ -230,6 +232,8 @@ impl<'s> Motion<'s> {
                         swept[1][a] = swept[1][a].max(hi[a].saturating_add(entry[a]));
                     }
                 }
+                track.sphere = objects.len() == 1
+                    && view.shape(ObjectId(objects.start)).kind() == crate::shapes::ShapeKind::Sphere;
                 track.table = table_len as u32;
                 track.first = [lo, hi];
                 track.swept = swept;
@@ -294,7 +298,7 @@ impl<'s> Motion<'s> {
     pub(crate) fn sweep<'m>(&'m self, track: &'m Track) -> Sweep<'m> {
         let keys = &self.keys[track.keys.0 as usize..(track.keys.0 + track.keys.1) as usize];
         let table = &self.table[track.table as usize..track.table as usize + self.frames.count as usize];
-        Sweep { first: track.first, swept: track.swept, table, keys }
+        Sweep { first: track.first, sphere: track.sphere, swept: track.swept, table, keys }
     }
 }
 
