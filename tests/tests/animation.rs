@@ -222,3 +222,173 @@ fn anim_fig5_1_is_exact_and_saves_most_of_the_tracing() {
     let share = exact_and_needs("anim_fig5_1", &text, Some(Dependence::Primary));
     assert!(share < 0.5, "{share}");
 }
+
+/// host-sim's command line as a program (`tests/src/bin/host-sim-cli.rs`).
+const HOST_SIM: &str = env!("CARGO_BIN_EXE_host-sim-cli");
+
+/// Runs host-sim with `args` in `dir`: exit code and standard error.
+fn host_sim(dir: &std::path::Path, args: &[&str]) -> (i32, String) {
+    let output = std::process::Command::new(HOST_SIM)
+        .args(args)
+        .current_dir(dir)
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .env_remove("JOB_COMPLETION_INDEX")
+        .output()
+        .expect("host-sim-cli runs");
+    (output.status.code().unwrap_or(-1), String::from_utf8_lossy(&output.stderr).into_owned())
+}
+
+fn files(dir: &std::path::Path) -> Vec<String> {
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    names
+}
+
+/// A small animation of fig5_1 in `dir` (40×30, the first 8 frames' motion
+/// in 8 frames).
+fn small_animation(dir: &std::path::Path) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(repo().join("scenes/anim_fig5_1.txt")).unwrap();
+    let text = text.replace("FRAMES 48 24", "FRAMES 8 12").replace("RASTER    240 180", "RASTER 40 30");
+    let text = text.replace("MOVE   0    0     0  0", "MOVE   0    0     0  0  7 -3 0 -3 MOVE").replace(
+        "MOVE\n      10",
+        "/* cut */ FRAMES 1 /*",
+    );
+    // The scene keeps its first key and gains one at frame 7; the rest of
+    // the path is cut out.
+    let start = text.find("/* cut */").unwrap();
+    let end = text.find("SPHERE 3").unwrap();
+    let text = format!("{}\n{}", &text[..start], &text[end..]);
+    let path = dir.join("anim.txt");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn host_sim_writes_gif_apng_and_frame_files_identical_to_single_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    small_animation(d);
+    for (out, extra) in [("a.gif", &[][..]), ("b.gif", &["--no-coherence"][..]), ("c.gif", &["--threads", "3"][..])] {
+        let args: Vec<&str> = ["anim.txt", out, "-q"].iter().copied().chain(extra.iter().copied()).collect();
+        let (code, err) = host_sim(d, &args);
+        assert_eq!(code, 0, "{err}");
+    }
+    let gif = std::fs::read(d.join("a.gif")).unwrap();
+    assert_eq!(gif, std::fs::read(d.join("b.gif")).unwrap(), "coherence against every frame whole");
+    assert_eq!(gif, std::fs::read(d.join("c.gif")).unwrap(), "one thread against three");
+    // Frame files, truecolour: each the still `--frame K` writes.
+    assert_eq!(host_sim(d, &["anim.txt", "f%02d.png", "-q"]).0, 0);
+    for k in 0..8 {
+        let still = format!("still{k}.png");
+        assert_eq!(host_sim(d, &["anim.txt", &still, "--frame", &k.to_string(), "-q"]).0, 0);
+        let frame = octrace_images::formats::read(&std::fs::read(d.join(format!("f{k:02}.png"))).unwrap()).unwrap();
+        let still = octrace_images::formats::read(&std::fs::read(d.join(still)).unwrap()).unwrap();
+        assert_eq!(frame.to_rgb(), still.to_rgb(), "frame {k}");
+    }
+    // The APNG's frames are the frame files' pixels.
+    assert_eq!(host_sim(d, &["anim.txt", "a.png", "-q"]).0, 0);
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(d.join("a.png")).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    assert_eq!(reader.info().animation_control().map(|a| (a.num_frames, a.num_plays)), Some((8, 0)));
+    let mut buffer = vec![0; reader.output_buffer_size().unwrap()];
+    for k in 0..8 {
+        reader.next_frame(&mut buffer).unwrap();
+        let frame = octrace_images::formats::read(&std::fs::read(d.join(format!("f{k:02}.png"))).unwrap()).unwrap();
+        assert_eq!(buffer, frame.to_rgb().data, "APNG frame {k}");
+    }
+}
+
+#[test]
+fn frames_rendered_apart_merge_into_the_same_gif() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    small_animation(d);
+    assert_eq!(host_sim(d, &["anim.txt", "whole.gif", "--palette", "dither", "-q"]).0, 0);
+    for part in ["1/3", "2/3", "3/3"] {
+        let (code, err) = host_sim(d, &["anim.txt", "p%d.png", "--part", part, "--palette", "dither", "-q"]);
+        assert_eq!(code, 0, "{err}");
+    }
+    let frames: Vec<String> = (0..8).map(|k| format!("p{k}.png")).collect();
+    let mut args = vec!["merge", "merged.gif"];
+    args.extend(frames.iter().rev().map(String::as_str));
+    let (code, err) = host_sim(d, &args);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(std::fs::read(d.join("merged.gif")).unwrap(), std::fs::read(d.join("whole.gif")).unwrap());
+    // A frame missing, or twice: refused, nothing written.
+    let (code, err) = host_sim(d, &["merge", "bad.gif", "p0.png", "p1.png", "p3.png"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("frame 2 is missing"), "{err}");
+    let (code, err) = host_sim(d, &["merge", "bad.gif", "p0.png", "p0.png", "p1.png"]);
+    assert!(code == 2 && err.contains("frame 0 is twice"), "{err}");
+    assert!(!d.join("bad.gif").exists());
+}
+
+#[test]
+fn animation_errors_name_the_place_and_leave_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    small_animation(d);
+    let before = files(d);
+    // A GIF without a colour table, a still format, --frame out of range.
+    for (args, message) in [
+        (&["anim.txt", "x.gif", "--palette", "none"][..], "a GIF holds 256 colours"),
+        (&["anim.txt", "x.tga"][..], "--frame K renders one frame"),
+        (&["anim.txt", "x.png", "--frame", "8"][..], "has 8 frames, 0 to 7"),
+        (&["anim.txt", "x.gif", "--part", "1/2"][..], "--part splits an animation's frames"),
+    ] {
+        let (code, err) = host_sim(d, args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains(message), "{args:?}: {err}");
+    }
+    // A camera lost at frame 3 only: every file of the run goes.
+    let text = std::fs::read_to_string(d.join("anim.txt")).unwrap();
+    let lost = text.replace("ORIGIN    0 0.6 0", "ORIGIN    0 0.6 0 MOVE 0 0 0 0  6 0 2.6 11");
+    std::fs::write(d.join("lost.txt"), lost).unwrap();
+    for out in ["y.gif", "y%d.png"] {
+        let (code, err) = host_sim(d, &["lost.txt", out]);
+        assert_eq!(code, 2, "{err}");
+        // ORIGIN reaches VIEWPOINT within a unit of rounding: no view, or
+        // one along UPVECTOR.
+        assert!(err.contains("lost.txt:9:19: at frame 6, ") && err.contains("(frame 6); nothing rendered"), "{err}");
+    }
+    let mut after = files(d);
+    after.retain(|f| f != "lost.txt");
+    assert_eq!(after, before, "no file left behind");
+}
+
+#[test]
+fn the_gnu_parallel_frames_recipe_gives_the_single_render() {
+    let found = std::process::Command::new("parallel").arg("--version").output().is_ok_and(|o| o.status.success());
+    if !found {
+        assert!(std::env::var("CI").as_deref() != Ok("true"), "GNU parallel is missing (apt-get install parallel)");
+        println!("SKIPPED: GNU parallel is not installed (apt-get install parallel): the recipe was not run");
+        return;
+    }
+    let doc = std::fs::read_to_string(repo().join("docs/distributed.md")).unwrap();
+    let after = &doc[doc.find("<!-- recipe: parallel-frames -->").expect("the recipe")..];
+    let start = after.find("```bash\n").unwrap() + "```bash\n".len();
+    let script = &after[start..start + after[start..].find("```").unwrap()];
+    let (dir, home) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let bin = dir.path().join("bin");
+    std::fs::create_dir_all(dir.path().join("scenes")).unwrap();
+    std::fs::create_dir(&bin).unwrap();
+    std::os::unix::fs::symlink(HOST_SIM, bin.join("host-sim")).unwrap();
+    // The recipe's scene, small: quick in CI.
+    let small = small_animation(dir.path());
+    std::fs::rename(&small, dir.path().join("scenes/anim_fig5_1.txt")).unwrap();
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
+    let output = std::process::Command::new("bash")
+        .args(["-euo", "pipefail", "-c", script])
+        .current_dir(dir.path())
+        .env("PATH", path)
+        .env("HOME", home.path())
+        .output()
+        .expect("bash runs");
+    assert!(output.status.success(), "the recipe failed:\n{script}\n{}", String::from_utf8_lossy(&output.stderr));
+    let (code, err) = host_sim(dir.path(), &["scenes/anim_fig5_1.txt", "single.gif", "--palette", "scan", "-q"]);
+    assert_eq!(code, 0, "{err}");
+    let merged = std::fs::read(dir.path().join("anim_fig5_1.gif")).unwrap();
+    assert_eq!(merged, std::fs::read(dir.path().join("single.gif")).unwrap());
+    assert_eq!(files(dir.path()), ["anim_fig5_1.gif", "bin", "scenes", "single.gif"]);
+}
