@@ -13,8 +13,22 @@ pub fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// Every scene file in `scenes/`, sorted by name: (name, path).
+/// Every still scene in `scenes/`, sorted by name: (name, path). The
+/// animations (`anim_*.txt`, see [`animations`]) are not among them.
 pub fn scenes() -> Vec<(String, PathBuf)> {
+    scene_files().into_iter().filter(|(name, _)| !name.starts_with(ANIMATION_PREFIX)).collect()
+}
+
+/// Every animation in `scenes/` (a scene with FRAMES, named `anim_*.txt`),
+/// sorted by name: (name, path).
+pub fn animations() -> Vec<(String, PathBuf)> {
+    scene_files().into_iter().filter(|(name, _)| name.starts_with(ANIMATION_PREFIX)).collect()
+}
+
+/// How the names of the animations in `scenes/` begin.
+const ANIMATION_PREFIX: &str = "anim_";
+
+fn scene_files() -> Vec<(String, PathBuf)> {
     let mut v: Vec<(String, PathBuf)> = std::fs::read_dir(repo().join("scenes"))
         .expect("scenes/ exists")
         .filter_map(|e| e.ok().map(|e| e.path()))
