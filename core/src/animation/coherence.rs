@@ -224,7 +224,11 @@ impl<'s> Coherence<'s> {
         each: &mut dyn FnMut(&Rectangle, &mut dyn Iterator<Item = PixelSample>) -> Result<(), E>,
     ) -> Result<Stats, E> {
         let before = renderer.stats();
-        renderer.set_lookout(Some(Lookout::new(motion, frame, self.ignored)));
+        let lookout = Lookout::new(motion, frame, self.ignored);
+        // A camera that moves before the next frame makes every count 0:
+        // the pixels are traced as a still's, at a still's cost.
+        let watching = !lookout.is_idle();
+        renderer.set_lookout(watching.then_some(lookout));
         let result = self.runs(band).try_for_each(|tiles| {
             let area = self.area(band, &tiles);
             let (x0, side) = (area.top_left.x as u32, self.side);
@@ -233,6 +237,10 @@ impl<'s> Coherence<'s> {
                 let line = Rectangle::new(Point::new(x0 as i32, y), Size::new(area.size.width, 1));
                 let mut pixels = (x0..x0 + area.size.width).map(|x| {
                     let tile = ((x - x0) / side) as usize;
+                    if !watching {
+                        clean[tile] = 0;
+                        return renderer.pixel(x, y as u32);
+                    }
                     let (pixel, count) = renderer.watched_pixel(x, y as u32, clean[tile]);
                     clean[tile] = count;
                     pixel

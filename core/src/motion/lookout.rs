@@ -72,6 +72,12 @@ impl<'m> Lookout<'m> {
         Lookout { motion, frame, camera, lights, ignored, clean: NEVER }
     }
 
+    /// Whether the camera moves before the next frame: then every pixel is
+    /// traced again, and watching this frame's rays would only cost.
+    pub(crate) fn is_idle(&self) -> bool {
+        self.camera == 0 && self.follows(Dependence::Camera)
+    }
+
     fn follows(&self, dependence: Dependence) -> bool {
         self.ignored & dependence.bit() == 0
     }

@@ -54,6 +54,8 @@ pub struct AnimationReport {
     /// Time spent loading frames (parsing and indexing) and tracing them.
     pub loading: Duration,
     pub tracing: Duration,
+    /// The first frame's tracing (traced whole).
+    pub first_tracing: Duration,
 }
 
 /// Why frames could not be rendered.
@@ -137,6 +139,9 @@ pub fn render_frames(
             None => job.run(&LightBuffered::new(&Naive, lights), image, progress),
         };
         report.stats.add(&stats);
+        if report.frames == 0 {
+            report.first_tracing = traced.elapsed();
+        }
         report.tracing += traced.elapsed();
         report.frames += 1;
         report.pixels += u64::from(w) * u64::from(h);
