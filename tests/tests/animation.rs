@@ -49,7 +49,11 @@ impl DrawTarget for Panel {
         Ok(())
     }
 
-    fn fill_contiguous<I: IntoIterator<Item = Rgb888>>(&mut self, area: &Rectangle, colors: I) -> Result<(), Self::Error> {
+    fn fill_contiguous<I: IntoIterator<Item = Rgb888>>(
+        &mut self,
+        area: &Rectangle,
+        colors: I,
+    ) -> Result<(), Self::Error> {
         let mut colors = colors.into_iter();
         for y in area.rows() {
             for x in area.columns() {
@@ -82,7 +86,8 @@ fn whole(text: &str, frame: u32) -> Panel {
 /// dropped): the first frame whose panel is not the frame traced whole,
 /// and the share of pixels re-traced after the first frame.
 fn play(text: &str, side: u32, ignored: Option<Dependence>) -> (Option<u32>, f64) {
-    let counts: Vec<AtomicU8> = (0..Coherence::tiles_for(SIZE.width, SIZE.height, side)).map(|_| AtomicU8::new(0)).collect();
+    let counts: Vec<AtomicU8> =
+        (0..Coherence::tiles_for(SIZE.width, SIZE.height, side)).map(|_| AtomicU8::new(0)).collect();
     let mut coherence = Coherence::new(&counts, SIZE, side).unwrap();
     if let Some(dependence) = ignored {
         coherence = coherence.ignoring(dependence);
@@ -154,10 +159,7 @@ fn an_object_seen_only_in_a_mirror() {
 #[test]
 fn an_object_seen_only_by_its_shadow() {
     // The ball moves above the picture; its shadow crosses the floor.
-    let text = scene(
-        8,
-        &format!("{CAMERA}LIGHT 12 0 14 2\n{FLOOR}SPHERE 2 0.6  -3 6 0  MOVE 0 0 0 0  7 6 0 -1\n"),
-    );
+    let text = scene(8, &format!("{CAMERA}LIGHT 12 0 14 2\n{FLOOR}SPHERE 2 0.6  -3 6 0  MOVE 0 0 0 0  7 6 0 -1\n"));
     exact_and_needs("shadow", &text, Some(Dependence::Shadows));
 }
 
@@ -196,10 +198,8 @@ fn a_moving_viewpoint() {
 #[test]
 fn a_moving_bspline_patch() {
     let grid = "-2 0 -2  0 1 -2  2 0 -2   -2 1 0  0 2.5 0  2 1 0   -2 0 2  0 1 2  2 0 2";
-    let text = scene(
-        6,
-        &format!("{CAMERA}LIGHT 12 3 6 8\n{FLOOR}BSPLINE 2 3 3 3 6 6 {grid}  MOVE 0 -2 0 0  5 2 0.5 -1\n"),
-    );
+    let text =
+        scene(6, &format!("{CAMERA}LIGHT 12 3 6 8\n{FLOOR}BSPLINE 2 3 3 3 6 6 {grid}  MOVE 0 -2 0 0  5 2 0.5 -1\n"));
     exact_and_needs("B-spline", &text, Some(Dependence::Primary));
 }
 
@@ -250,10 +250,9 @@ fn files(dir: &std::path::Path) -> Vec<String> {
 fn small_animation(dir: &std::path::Path) -> std::path::PathBuf {
     let text = std::fs::read_to_string(repo().join("scenes/anim_fig5_1.txt")).unwrap();
     let text = text.replace("FRAMES 48 24", "FRAMES 8 12").replace("RASTER    240 180", "RASTER 40 30");
-    let text = text.replace("MOVE   0    0     0  0", "MOVE   0    0     0  0  7 -3 0 -3 MOVE").replace(
-        "MOVE\n      10",
-        "/* cut */ FRAMES 1 /*",
-    );
+    let text = text
+        .replace("MOVE   0    0     0  0", "MOVE   0    0     0  0  7 -3 0 -3 MOVE")
+        .replace("MOVE\n      10", "/* cut */ FRAMES 1 /*");
     // The scene keeps its first key and gains one at frame 7; the rest of
     // the path is cut out.
     let start = text.find("/* cut */").unwrap();

@@ -32,6 +32,11 @@ const MOST: u8 = 253;
 /// stack).
 const RUN_TILES: usize = 32;
 
+/// What receives a traced run's row of pixels: the row (a rectangle one
+/// pixel high) and its pixels as they are traced
+/// ([`Coherence::trace_band`]).
+pub type RunSink<'f, E> = dyn FnMut(&Rectangle, &mut dyn Iterator<Item = PixelSample>) -> Result<(), E> + 'f;
+
 /// Why [`Coherence::new`] refused its storage.
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -221,7 +226,7 @@ impl<'s> Coherence<'s> {
         motion: &'a Motion<'a>,
         frame: u32,
         band: u32,
-        each: &mut dyn FnMut(&Rectangle, &mut dyn Iterator<Item = PixelSample>) -> Result<(), E>,
+        each: &mut RunSink<'_, E>,
     ) -> Result<Stats, E> {
         let before = renderer.stats();
         let lookout = Lookout::new(motion, frame, self.ignored);

@@ -49,4 +49,4 @@ mod coherence;
 #[doc(hidden)]
 pub use crate::motion::Dependence;
 pub use crate::motion::{Key, Motion, MotionError, MotionNeeds, Track};
-pub use coherence::{Coherence, CoherenceError};
+pub use coherence::{Coherence, CoherenceError, RunSink};

@@ -56,8 +56,7 @@ impl Segment {
     pub(crate) fn near_sphere(&self, center: [i32; 3], radius: i32) -> bool {
         let c = center.map(|v| cell(i64::from(v)));
         let r = i64::from((radius.saturating_add(WIDENING) >> GRID_BITS) + 3);
-        if (0..3).any(|a| i64::from(self.hi[a]) < i64::from(c[a]) - r || i64::from(self.lo[a]) > i64::from(c[a]) + r)
-        {
+        if (0..3).any(|a| i64::from(self.hi[a]) < i64::from(c[a]) - r || i64::from(self.lo[a]) > i64::from(c[a]) + r) {
             return false;
         }
         // Cells are below 2^14: squares and their products fit an i64.
@@ -142,7 +141,8 @@ impl Sweep<'_> {
             (true, Some(d)) => {
                 let [lo, hi] = self.first;
                 // The box is the centre ± the radius, exactly.
-                let center = [0, 1, 2].map(|a| (lo[a] / 2 + hi[a] / 2 + (lo[a] % 2 + hi[a] % 2) / 2).saturating_add(d[a]));
+                let center =
+                    [0, 1, 2].map(|a| (lo[a] / 2 + hi[a] / 2 + (lo[a] % 2 + hi[a] % 2) / 2).saturating_add(d[a]));
                 segment.near_sphere(center, hi[0] / 2 - lo[0] / 2 + 1)
             }
             _ => self.meets_between(segment, frame, frame),

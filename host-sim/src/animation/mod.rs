@@ -19,7 +19,7 @@ use crate::{build_octree, HostLightBuffer, HostScene, RenderOptions, RgbImage, N
 use embedded_graphics_core::geometry::Size;
 use embedded_graphics_core::pixelcolor::RgbColor;
 use octrace_core::accel::{Accelerator, LightBuffer, LightBuffered, Mailbox, Naive};
-use octrace_core::animation::{Coherence, Key, Motion, Track};
+use octrace_core::animation::{Coherence, Key, Motion, RunSink, Track};
 use octrace_core::parse::{parse_frame_bytes, ParseError};
 use octrace_core::render::{PixelSample, Renderer, ScreenBound};
 use octrace_core::scene::{Frames, SceneView};
@@ -123,7 +123,7 @@ pub fn render_frames(
         let octree = build_octree(&scene, options.render.accel, &options.render.octree);
         let mut lights = HostLightBuffer::new();
         let cells = if options.render.accel == AccelMode::Naive { 0 } else { options.render.light_buffer };
-        let lights = (cells > 0).then(|| lights.build(&view, cells)).unwrap_or(LightBuffer::NONE);
+        let lights = if cells > 0 { lights.build(&view, cells) } else { LightBuffer::NONE };
         report.loading += started.elapsed();
         let traced = Instant::now();
         let watched = motion.as_ref();
@@ -234,10 +234,7 @@ fn whole_band<A: Accelerator>(
     renderer: &mut Renderer<'_, A>,
     coherence: &Coherence<'_>,
     band: u32,
-    each: &mut dyn FnMut(
-        &embedded_graphics_core::primitives::Rectangle,
-        &mut dyn Iterator<Item = PixelSample>,
-    ) -> Result<(), std::convert::Infallible>,
+    each: &mut RunSink<'_, std::convert::Infallible>,
 ) -> Result<(), std::convert::Infallible> {
     use embedded_graphics_core::geometry::{Point, Size};
     let (side, size) = (coherence.side(), coherence.size());

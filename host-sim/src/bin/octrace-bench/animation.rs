@@ -53,8 +53,7 @@ fn changed(bytes: &[u8], images: &[FrameImage], size: (u32, u32)) -> (f64, f64) 
     for k in 0..images.len() {
         let before = &images[(k + images.len() - 1) % images.len()];
         let now = &images[k];
-        let mask: Vec<bool> =
-            before.image.data.chunks(3).zip(now.image.data.chunks(3)).map(|(a, b)| a != b).collect();
+        let mask: Vec<bool> = before.image.data.chunks(3).zip(now.image.data.chunks(3)).map(|(a, b)| a != b).collect();
         changed += mask.iter().filter(|&&m| m).count() as u64;
         let mut scene = host_sim::new_scene();
         host_sim::load_frame_bytes("", bytes, k as u32, &mut scene).expect("loads");
@@ -143,7 +142,8 @@ pub(crate) fn table(dir: &Path) -> Result<(), BenchError> {
     let (coherent, _) = fastest(coherents);
     let full = whole.tracing / whole.frames;
     let incremental = per_frame(&coherent);
-    let traced = (coherent.traced - u64::from(size.0 * size.1)) as f64 / (coherent.pixels - u64::from(size.0 * size.1)) as f64;
+    let traced =
+        (coherent.traced - u64::from(size.0 * size.1)) as f64 / (coherent.pixels - u64::from(size.0 * size.1)) as f64;
     let (changed_share, changed_time) = changed(&bytes, &images, size);
     let loading = coherent.loading / coherent.frames;
     println!("| measure | value |");
@@ -152,18 +152,25 @@ pub(crate) fn table(dir: &Path) -> Result<(), BenchError> {
     println!("| incremental frame (after the first), mean | {} |", ms(incremental));
     println!("| incremental / full | {:.1} % |", 100.0 * incremental.as_secs_f64() / full.as_secs_f64());
     println!("| pixels re-traced per frame (tiles of {COHERENCE_TILE}×{COHERENCE_TILE}) | {:.1} % |", 100.0 * traced);
-    println!("| first frame with the lookout / without | {:.2}× |", coherent.first_tracing.as_secs_f64() / whole.tracing.as_secs_f64() * whole.frames as f64);
-    println!("| pixels whose colour changes per frame (any exact method re-traces them) | {:.1} % |", 100.0 * changed_share);
+    println!(
+        "| first frame with the lookout / without | {:.2}× |",
+        coherent.first_tracing.as_secs_f64() / whole.tracing.as_secs_f64() * whole.frames as f64
+    );
+    println!(
+        "| pixels whose colour changes per frame (any exact method re-traces them) | {:.1} % |",
+        100.0 * changed_share
+    );
     println!("| tracing only those / a full frame | {:.1} % |", 100.0 * changed_time);
-    println!("| loading a frame (parse, index, light buffer) / full frame | {:.1} % |", 100.0 * loading.as_secs_f64() / full.as_secs_f64());
+    println!(
+        "| loading a frame (parse, index, light buffer) / full frame | {:.1} % |",
+        100.0 * loading.as_secs_f64() / full.as_secs_f64()
+    );
     println!();
 
     // A viewpoint that moves: everything is re-traced, and must cost no
     // more than frames traced whole.
-    let text = String::from_utf8_lossy(&bytes).replace(
-        "VIEWPOINT 0 3.2 11",
-        "VIEWPOINT 0 3.2 11 MOVE 0 0 0 0  24 6 0 -3  47 0.25 0 -0.125",
-    );
+    let text = String::from_utf8_lossy(&bytes)
+        .replace("VIEWPOINT 0 3.2 11", "VIEWPOINT 0 3.2 11 MOVE 0 0 0 0  24 6 0 -3  47 0.25 0 -0.125");
     let (mut whole, mut coherent) = (Duration::MAX, Duration::MAX);
     for _ in 0..3 {
         whole = whole.min(play(text.as_bytes(), frames, size, false).0.tracing);

@@ -58,7 +58,8 @@ fn scene_files(dir: &Path) -> Vec<PathBuf> {
         std::fs::read_dir(dir).map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect()).unwrap_or_default();
     // The stills: the animations (`anim_*`) have a table of their own.
     v.retain(|p| {
-        p.extension().is_some_and(|x| x == "txt") && !p.file_stem().is_some_and(|s| s.to_string_lossy().starts_with("anim_"))
+        p.extension().is_some_and(|x| x == "txt")
+            && !p.file_stem().is_some_and(|s| s.to_string_lossy().starts_with("anim_"))
     });
     v.sort();
     v
