@@ -104,3 +104,32 @@ impl Rng {
         lo + (hi - lo) * (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
     }
 }
+
+/// The first bash block after `<!-- recipe: NAME -->` in docs/distributed.md.
+pub fn recipe(name: &str) -> String {
+    let doc = std::fs::read_to_string(repo().join("docs/distributed.md")).unwrap();
+    let marker = format!("<!-- recipe: {name} -->");
+    let after = &doc[doc.find(&marker).unwrap_or_else(|| panic!("no {marker} in docs/distributed.md"))..];
+    let start = after.find("```bash\n").expect("a bash block") + "```bash\n".len();
+    let end = after[start..].find("```").expect("the block ends");
+    after[start..start + end].to_owned()
+}
+
+/// Runs the recipe `script` with bash in `dir`, with `host_sim` on the PATH
+/// as `host-sim` (in `dir/bin`) and a HOME of its own (GNU parallel keeps
+/// its state there); panics with the script's errors if it fails.
+pub fn run_recipe(script: &str, dir: &std::path::Path, host_sim: &str) {
+    let home = tempfile::tempdir().unwrap();
+    let bin = dir.join("bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    std::os::unix::fs::symlink(host_sim, bin.join("host-sim")).unwrap();
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
+    let output = std::process::Command::new("bash")
+        .args(["-euo", "pipefail", "-c", script])
+        .current_dir(dir)
+        .env("PATH", path)
+        .env("HOME", home.path())
+        .output()
+        .expect("bash runs");
+    assert!(output.status.success(), "the recipe failed:\n{script}\n{}", String::from_utf8_lossy(&output.stderr));
+}

@@ -364,27 +364,12 @@ fn the_gnu_parallel_frames_recipe_gives_the_single_render() {
         println!("SKIPPED: GNU parallel is not installed (apt-get install parallel): the recipe was not run");
         return;
     }
-    let doc = std::fs::read_to_string(repo().join("docs/distributed.md")).unwrap();
-    let after = &doc[doc.find("<!-- recipe: parallel-frames -->").expect("the recipe")..];
-    let start = after.find("```bash\n").unwrap() + "```bash\n".len();
-    let script = &after[start..start + after[start..].find("```").unwrap()];
-    let (dir, home) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
-    let bin = dir.path().join("bin");
+    let dir = tempfile::tempdir().unwrap();
     std::fs::create_dir_all(dir.path().join("scenes")).unwrap();
-    std::fs::create_dir(&bin).unwrap();
-    std::os::unix::fs::symlink(HOST_SIM, bin.join("host-sim")).unwrap();
     // The recipe's scene, small: quick in CI.
     let small = small_animation(dir.path());
     std::fs::rename(&small, dir.path().join("scenes/anim_fig5_1.txt")).unwrap();
-    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
-    let output = std::process::Command::new("bash")
-        .args(["-euo", "pipefail", "-c", script])
-        .current_dir(dir.path())
-        .env("PATH", path)
-        .env("HOME", home.path())
-        .output()
-        .expect("bash runs");
-    assert!(output.status.success(), "the recipe failed:\n{script}\n{}", String::from_utf8_lossy(&output.stderr));
+    octrace_tests::run_recipe(&octrace_tests::recipe("parallel-frames"), dir.path(), HOST_SIM);
     let (code, err) = host_sim(dir.path(), &["scenes/anim_fig5_1.txt", "single.gif", "--palette", "scan", "-q"]);
     assert_eq!(code, 0, "{err}");
     let merged = std::fs::read(dir.path().join("anim_fig5_1.gif")).unwrap();

@@ -160,13 +160,8 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         f: impl FnOnce(&mut Renderer<'_, SceneAccelerator<'r, P>>) -> R,
     ) -> Result<R, CameraError> {
         let accelerator = self.accelerator();
-        // Another draw of this scene holds the mailbox or the lists (only if
-        // a display draws from inside a draw): render without, same image.
-        let mut mailbox = self.mailbox.try_borrow_mut();
-        let mut screen_lists = self.screen_lists.try_borrow_mut();
-        let lists = screen_lists.as_deref_mut().ok().and_then(|lists| lists.as_mut());
-        let lists = lists.map(|(bounds, positions)| (&mut **bounds, &mut **positions));
-        let mailbox = mailbox.as_deref_mut().ok().map(|words| &mut **words);
+        let (mut mailbox, mut screen_lists) = (self.mailbox.try_borrow_mut(), self.screen_lists.try_borrow_mut());
+        let (mailbox, lists) = room_of(&mut mailbox, &mut screen_lists);
         let mut renderer = renderer_in(self.view, &accelerator, size, mailbox, lists)?;
         let result = f(&mut renderer);
         let mut total = self.stats.get();
@@ -238,11 +233,8 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         let accelerator = self.accelerator();
         // As `with_renderer`, here: the renderer's room is borrowed no
         // longer than `motion` lives.
-        let mut mailbox = self.mailbox.try_borrow_mut();
-        let mut screen_lists = self.screen_lists.try_borrow_mut();
-        let lists = screen_lists.as_deref_mut().ok().and_then(|lists| lists.as_mut());
-        let lists = lists.map(|(bounds, positions)| (&mut **bounds, &mut **positions));
-        let mailbox = mailbox.as_deref_mut().ok().map(|words| &mut **words);
+        let (mut mailbox, mut screen_lists) = (self.mailbox.try_borrow_mut(), self.screen_lists.try_borrow_mut());
+        let (mailbox, lists) = room_of(&mut mailbox, &mut screen_lists);
         let mut renderer =
             renderer_in(self.view, &accelerator, coherence.size(), mailbox, lists).map_err(DrawError::Camera)?;
         let mut stats = Stats::default();
@@ -333,6 +325,18 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
 /// A renderer over `view` for an image of `size`, with a mailbox and screen
 /// lists where given. Inlined: a board's renderer is made in place.
 #[inline(always)]
+/// The loading core's room out of its cells: none of what another draw of
+/// the scene holds (only if a display draws from inside a draw: the render
+/// goes without, the same image).
+fn room_of<'g, 'r>(
+    mailbox: &'g mut Result<core::cell::RefMut<'_, &'r mut [u32]>, core::cell::BorrowMutError>,
+    screen_lists: &'g mut Result<core::cell::RefMut<'_, Option<ScreenLists<'r>>>, core::cell::BorrowMutError>,
+) -> (Option<&'g mut [u32]>, Option<ScreenLists<'g>>) {
+    let lists = screen_lists.as_deref_mut().ok().and_then(|lists| lists.as_mut());
+    let lists = lists.map(|(bounds, positions)| (&mut **bounds, &mut **positions));
+    (mailbox.as_deref_mut().ok().map(|words| &mut **words), lists)
+}
+
 pub(super) fn renderer_in<'a, A: Accelerator>(
     view: SceneView<'a>,
     accel: &'a A,
