@@ -8,6 +8,7 @@
 //! by `merge` hold the very pixels (and indices) a direct render to the
 //! animation writes; the GIF and APNG loop forever.
 
+use crate::parts::{Fields, Render};
 use octrace_core::scene::Frames;
 use octrace_images::formats::{Format, FormatError, Header, Image, RowWriter};
 use octrace_images::palette::PaletteMode;
@@ -123,26 +124,21 @@ impl fmt::Display for FrameInfo {
 impl FrameInfo {
     /// The text `Display` writes, read back; `None` for anything else.
     pub fn parse(text: &str) -> Option<FrameInfo> {
-        let rest = text.strip_prefix(MAGIC)?.strip_prefix(' ')?;
-        let mut fields = rest.split(' ');
-        let mut field = |name: &str| fields.next()?.strip_prefix(name)?.strip_prefix('=');
-        let version = field("version")?.to_owned();
-        let scene = u64::from_str_radix(field("scene")?, 16).ok()?;
-        let (width, height) = field("size")?.split_once('x')?;
-        let palette_name = field("palette")?;
-        let palette = PaletteMode::ALL.into_iter().find(|m| m.name() == palette_name)?;
-        let (frame, count) = field("frame")?.split_once('/')?;
-        let rate = field("rate")?.parse().ok()?;
+        let mut fields = Fields::after(text, MAGIC)?;
+        let Render { version, scene, width, height, palette } = fields.render()?;
+        let (frame, count) = fields.next("frame")?.split_once('/')?;
+        let rate = fields.next("rate")?.parse().ok()?;
         let info = FrameInfo {
             version,
             scene,
-            width: width.parse().ok()?,
-            height: height.parse().ok()?,
+            width,
+            height,
             palette,
             frame: frame.parse().ok()?,
             frames: Frames { count: count.parse().ok()?, rate },
         };
-        (fields.next().is_none() && info.frame < info.frames.count && info.width > 0 && info.height > 0).then_some(info)
+        let valid = info.frame < info.frames.count && info.width > 0 && info.height > 0;
+        (fields.end() && valid).then_some(info)
     }
 }
 
