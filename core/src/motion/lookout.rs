@@ -116,7 +116,7 @@ impl<'m> Lookout<'m> {
             Some(t) => [0, 1, 2].map(|a| o[a] + (mul_wide(d[a] as i32, t.to_bits()) >> 30)),
             None => [0, 1, 2].map(|a| o[a] + 2 * d[a]),
         };
-        self.segment(&Segment::new(o, end));
+        self.segment(&Segment::new(o, end), false);
     }
 
     /// A shadow ray from `from` to a light at `light`.
@@ -125,18 +125,26 @@ impl<'m> Lookout<'m> {
         if self.clean == 0 || !self.follows(Dependence::Shadows) {
             return;
         }
-        self.segment(&Segment::new(from.wide(), light.wide()));
+        self.segment(&Segment::new(from.wide(), light.wide()), true);
     }
 
     /// Lowers the clean count for the moving objects `segment` comes near
-    /// now or in the frames to come.
-    fn segment(&mut self, segment: &Segment) {
+    /// now or in the frames to come (`shadow`: a shadow ray's, whose answer
+    /// stays while a moving sphere surely blocks it).
+    fn segment(&mut self, segment: &Segment, shadow: bool) {
         for track in self.motion.tracks_of(Target::Objects) {
             let sweep = self.motion.sweep(track);
             if !sweep.ever_meets(segment) {
                 continue;
             }
-            let clean = if sweep.meets_at(segment, self.frame) {
+            let clean = if shadow && sweep.blocks_at(segment, self.frame) {
+                // Blocked now, surely: blocked, whatever else moves, until
+                // the first frame the sphere may let it through.
+                match sweep.first_unblocked(segment, self.frame, self.clean) {
+                    Some(e) => e - 1,
+                    None => self.clean,
+                }
+            } else if sweep.meets_at(segment, self.frame) {
                 // Near it now: the value stands until the objects move.
                 self.motion.next_change(track, self.frame)
             } else {

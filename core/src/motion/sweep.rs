@@ -75,6 +75,27 @@ impl Segment {
         ww * dd - wd * wd <= r * r * dd
     }
 
+    /// Whether the segment surely passes through the raw sphere of centre
+    /// `center` and radius `radius`, well inside it, with both its ends well
+    /// outside: a shadow ray along it is surely blocked by the sphere. On
+    /// the grid, the radius narrowed by four widenings and four cells for
+    /// the line, and widened likewise for the ends: any ray the tracer
+    /// sends along the segment meets the sphere between its ends.
+    pub(crate) fn through_sphere(&self, center: [i32; 3], radius: i32) -> bool {
+        let c = center.map(|v| cell(i64::from(v)));
+        let inner = i64::from((radius.saturating_sub(4 * WIDENING) >> GRID_BITS) - 4);
+        let outer = i64::from((radius.saturating_add(4 * WIDENING) >> GRID_BITS) + 5);
+        if inner <= 0 {
+            return false;
+        }
+        let d = [0, 1, 2].map(|a| i64::from(self.q[a] - self.p[a]));
+        let w = [0, 1, 2].map(|a| i64::from(c[a] - self.p[a]));
+        let e = [0, 1, 2].map(|a| w[a] - d[a]);
+        let dot = |u: [i64; 3], v: [i64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+        let (dd, wd, ww) = (dot(d, d), dot(w, d), dot(w, w));
+        ww > outer * outer && dot(e, e) > outer * outer && wd > 0 && wd < dd && ww * dd - wd * wd <= inner * inner * dd
+    }
+
     /// Whether the segment comes near the raw box `[lo, hi]`: on the grid,
     /// the box widened and rounded outward, then by a whole cell.
     pub(crate) fn meets(&self, lo: [i32; 3], hi: [i32; 3]) -> bool {
@@ -135,18 +156,35 @@ impl Sweep<'_> {
         segment.meets(self.swept[0], self.swept[1])
     }
 
+    /// A sphere's centre at frame `frame` and its radius, if the track is
+    /// one.
+    fn sphere_at(&self, frame: u32) -> Option<([i32; 3], i32)> {
+        let d = self.table.get(frame as usize).filter(|_| self.sphere)?;
+        let [lo, hi] = self.first;
+        // The box is the centre ± the radius, exactly.
+        let center = [0, 1, 2].map(|a| (lo[a] / 2 + hi[a] / 2 + (lo[a] % 2 + hi[a] % 2) / 2).saturating_add(d[a]));
+        Some((center, hi[0] / 2 - lo[0] / 2 + 1))
+    }
+
     /// Whether `segment` comes near the objects at frame `frame`.
     pub(crate) fn meets_at(&self, segment: &Segment, frame: u32) -> bool {
-        match (self.sphere, self.table.get(frame as usize)) {
-            (true, Some(d)) => {
-                let [lo, hi] = self.first;
-                // The box is the centre ± the radius, exactly.
-                let center =
-                    [0, 1, 2].map(|a| (lo[a] / 2 + hi[a] / 2 + (lo[a] % 2 + hi[a] % 2) / 2).saturating_add(d[a]));
-                segment.near_sphere(center, hi[0] / 2 - lo[0] / 2 + 1)
-            }
-            _ => self.meets_between(segment, frame, frame),
+        match self.sphere_at(frame) {
+            Some((center, radius)) => segment.near_sphere(center, radius),
+            None => self.meets_between(segment, frame, frame),
         }
+    }
+
+    /// Whether the objects (a sphere) surely block a shadow ray along
+    /// `segment` at frame `frame`.
+    pub(crate) fn blocks_at(&self, segment: &Segment, frame: u32) -> bool {
+        self.sphere_at(frame).is_some_and(|(center, radius)| segment.through_sphere(center, radius))
+    }
+
+    /// The smallest `e` in `1..=limit` such that the objects do not surely
+    /// block `segment` at frame `frame + e` of the loop, if any.
+    pub(crate) fn first_unblocked(&self, segment: &Segment, frame: u32, limit: u32) -> Option<u32> {
+        let n = self.table.len() as u32;
+        (1..=limit.min(n.saturating_sub(1))).find(|&e| !self.blocks_at(segment, (frame + e) % n))
     }
 
     /// Whether `segment` comes near the objects in some frame of `a..=b`,
