@@ -1,6 +1,6 @@
 //! An animation's frames into files: an animated GIF (256 colours a frame
-//! from a palette mode, its table in the frame when it differs from the
-//! first frame's), an APNG (truecolour) or one image file a frame named by
+//! from a palette mode, each frame with its own table), an APNG
+//! (truecolour) or one image file a frame named by
 //! a pattern (`f%04d.png`), each frame file carrying what `host-sim merge`
 //! needs to assemble frames rendered apart.
 //!
