@@ -4,7 +4,9 @@
 //! always what the code produces.
 //!
 //! fig5_1 is also kept in each 256-colour mode (`fig5_1-scan.png`, …, indexed
-//! PNGs), the README's palette gallery.
+//! PNGs), the README's palette gallery; each animation (`scenes/anim_*.txt`)
+//! as the animated GIF `host-sim scenes/anim_….txt OUT.gif` writes
+//! (`docs/gallery/anim_….gif`, byte for byte).
 //!
 //! Re-bless after an intended change of the images:
 //!
@@ -13,7 +15,7 @@
 use host_sim::{load_file, new_scene, render, RenderOptions};
 use octrace_images::formats::{self, Format, Image};
 use octrace_images::palette::{self, PaletteMode};
-use octrace_tests::{blessing, repo, scenes};
+use octrace_tests::{animations, blessing, repo, scenes};
 
 #[test]
 fn every_scene_matches_its_golden_image() {
@@ -73,6 +75,43 @@ fn fig5_1_in_every_palette_mode_matches_its_golden_image() {
             Err(e) => failures.push(format!("{}: {e}", golden.display())),
         }
     }
+    assert!(
+        failures.is_empty(),
+        "{}\n(re-bless with OCTRACE_BLESS=1 cargo test -p octrace-tests --test golden)",
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn every_animation_matches_its_golden_gif() {
+    let gallery = repo().join("docs/gallery");
+    let dir = std::env::temp_dir().join(format!("octrace-golden-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut failures = Vec::new();
+    for (name, path) in animations() {
+        let out = dir.join(format!("{name}.gif"));
+        let mut stderr = Vec::new();
+        let code = host_sim::run(
+            ["host-sim".as_ref(), path.as_os_str(), out.as_os_str(), "-q".as_ref()],
+            &mut Vec::new(),
+            &mut stderr,
+        );
+        assert_eq!(code, 0, "{name}: {}", String::from_utf8_lossy(&stderr));
+        let made = std::fs::read(&out).unwrap();
+        let golden = gallery.join(format!("{name}.gif"));
+        if blessing() {
+            std::fs::write(&golden, &made).unwrap();
+            println!("blessed {}", golden.display());
+            continue;
+        }
+        match std::fs::read(&golden) {
+            Err(e) => failures.push(format!("{name}: cannot read {}: {e}", golden.display())),
+            Ok(expected) if expected != made => failures.push(format!("{name}: differs from {}", golden.display())),
+            Ok(_) => println!("{name}: identical"),
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(!animations().is_empty(), "scenes/ holds animations");
     assert!(
         failures.is_empty(),
         "{}\n(re-bless with OCTRACE_BLESS=1 cargo test -p octrace-tests --test golden)",
