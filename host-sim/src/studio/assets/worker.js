@@ -1,6 +1,8 @@
 // The studio's render worker: its own instance of the octrace module, the
-// scene loaded once, then rectangles rendered on request. Also the draft
-// renderer (a smaller image first, then the draft size).
+// scene (a frame of it, for an animation) loaded once, then rectangles
+// rendered on request. Also the draft renderer (a smaller image first, then
+// the draft size), and an animation's player: a frame whole, re-tracing
+// only what moved since the frame it traced before (time.js).
 
 import { loadOctrace } from './octrace.js';
 
@@ -14,13 +16,19 @@ self.onmessage = async (event) => {
   const m = event.data;
   try {
     if (m.type === 'init') {
-      const loaded = octrace.load(m.text);
+      const loaded = octrace.load(m.text, m.frame);
       if (loaded.errors) throw new Error(loaded.errors.join('\n'));
       const accel = octrace.prepare(m.accel, m.width, m.height);
       self.postMessage({ type: 'ready', accel });
     } else if (m.type === 'tile') {
       const data = octrace.render(m.x, m.y, m.width, m.height);
       self.postMessage({ type: 'tile', x: m.x, y: m.y, width: m.width, height: m.height, data }, [data.buffer]);
+    } else if (m.type === 'frame') {
+      const loaded = octrace.load(m.text, m.frame);
+      if (loaded.errors) throw new Error(loaded.errors.join('\n'));
+      octrace.prepare(0, m.width, m.height);
+      const { traced, data } = octrace.traceFrame();
+      self.postMessage({ type: 'frame', seq: m.seq, frame: m.frame, width: m.width, height: m.height, traced, data }, [data.buffer]);
     } else if (m.type === 'draft') {
       // Only the newest text matters: older requests are dropped.
       pendingDraft = m;
@@ -35,7 +43,7 @@ function drainDrafts() {
   while (pendingDraft) {
     const m = pendingDraft;
     pendingDraft = null;
-    const loaded = octrace.load(m.text);
+    const loaded = octrace.load(m.text, m.frame);
     if (loaded.errors) {
       self.postMessage({ type: 'draft-errors', seq: m.seq, errors: loaded.errors });
       continue;
@@ -46,7 +54,7 @@ function drainDrafts() {
       try {
         octrace.prepare(0, w, h);
         const data = octrace.render(0, 0, w, h);
-        self.postMessage({ type: 'draft', seq: m.seq, width: w, height: h, final: scale === 1, data }, [data.buffer]);
+        self.postMessage({ type: 'draft', seq: m.seq, frame: m.frame, width: w, height: h, final: scale === 1, data }, [data.buffer]);
       } catch (e) {
         self.postMessage({ type: 'draft-errors', seq: m.seq, errors: [String(e.message || e)] });
         break;

@@ -1,0 +1,136 @@
+// The time controls of an animation (a scene with FRAMES): the frame shown,
+// which the wireframe, the errors, the draft and the render follow (a
+// slider), and play, every frame in turn at the animation's rate at most. A
+// still scene hides them.
+//
+// Two workers are the players, one for the draft and one for the render
+// when one is shown: each keeps its last frame and the core's coherence, so
+// the next frame forward re-traces only what moved, and a frame is the frame
+// traced whole, bit for bit (host-sim --frame K).
+
+const DRAFT = [160, 120];
+
+/** The time controls of the page `app` (studio.js). They set `state.frame`
+ *  and `state.playing`; `state.played` holds, for each frame played since
+ *  play began, its number, the milliseconds from asking for it to its draft
+ *  and render traced, and the share of the draft's pixels traced (%). */
+export function createTime(app) {
+  const { state, $ } = app;
+  const box = $('time'), slider = $('frame'), button = $('play'), label = $('frame-label');
+  let frames = null; // {count, rate}, or null for a still
+  let timer = 0;
+  /** The frame being traced, and the one to trace after it (the slider
+   *  moved on meanwhile), if any. */
+  let busy = false, wanted = null;
+  const player = () => {
+    const worker = new Worker('worker.js', { type: 'module' });
+    worker.onmessage = (event) => worker.answer(event.data);
+    return worker;
+  };
+  const players = { draft: player(), render: player() };
+
+  /** Frame `frame` of the text at `width`×`height`, traced by `worker`. */
+  function trace(worker, frame, [width, height]) {
+    return new Promise((resolve, reject) => {
+      worker.answer = (m) => (m.type === 'frame' ? resolve(m) : reject(new Error(m.message)));
+      worker.postMessage({ type: 'frame', text: app.editor.text(), frame, width, height });
+    });
+  }
+
+  function showLabel() {
+    label.textContent = frames ? `frame ${state.frame} / ${frames.count - 1} · ${frames.rate} fps` : '';
+  }
+
+  /** The text, loaded at the frame shown (octrace.load's answer): shows the
+   *  controls for an animation, hides them for a still; a scene with errors
+   *  leaves them as they were. */
+  function scene(loaded) {
+    if (loaded.errors) return;
+    frames = loaded.frames ? { count: loaded.frames, rate: loaded.rate } : null;
+    box.hidden = !frames;
+    if (!frames) {
+      stop();
+      state.frame = 0;
+      return;
+    }
+    slider.max = String(frames.count - 1);
+    // FRAMES made fewer: the last frame (as the loader read it already).
+    state.frame = Math.min(state.frame, frames.count - 1);
+    slider.value = String(state.frame);
+    showLabel();
+  }
+
+  /** Shows frame `frame`: its wireframe and errors at once, then its draft
+   *  and, if one is shown, its render, once traced; then the frame the
+   *  slider moved to meanwhile, or, playing, the next when its time comes.
+   *  A frame with errors stops there. */
+  async function go(frame) {
+    if (busy) { wanted = frame; return; }
+    state.frame = frame;
+    slider.value = String(frame);
+    showLabel();
+    if (app.frameChanged().errors) {
+      stop();
+      $('draft-status').textContent = `frame ${frame} has errors`;
+      return;
+    }
+    busy = true;
+    const asked = performance.now(), playing = state.playing;
+    const render = state.lastRender;
+    try {
+      const [draft, image] = await Promise.all([
+        trace(players.draft, frame, DRAFT),
+        render ? trace(players.render, frame, [render.width, render.height]) : null,
+      ]);
+      const ms = performance.now() - asked;
+      app.draftDrawn();
+      const canvas = $('draft');
+      canvas.width = draft.width; canvas.height = draft.height;
+      app.putRgb(canvas, draft.data, draft.width, draft.height);
+      Object.assign(canvas.dataset, { state: 'done', frame: String(frame) });
+      const share = (100 * draft.traced) / (draft.width * draft.height);
+      $('draft-status').textContent = `frame ${frame}: ${share.toFixed(0)} % of the pixels traced, ${ms.toFixed(0)} ms`;
+      if (image) {
+        app.showFrame(frame, image.width, image.height, image.data);
+        const imageShare = (100 * image.traced) / (image.width * image.height);
+        app.setStatus(`frame ${frame}: ${image.width}×${image.height}, ${imageShare.toFixed(0)} % of the pixels traced`);
+      }
+      if (playing) state.played.push({ frame, ms, share });
+      if (state.playing) {
+        timer = setTimeout(() => go((frame + 1) % frames.count), Math.max(0, asked + 1000 / frames.rate - performance.now()));
+      }
+    } catch (e) {
+      stop();
+      $('draft-status').textContent = `frame ${frame}: ${e.message}`;
+    }
+    busy = false;
+    if (wanted !== null) {
+      const next = wanted;
+      wanted = null;
+      go(next);
+    }
+  }
+
+  function play() {
+    if (!frames || state.playing) return;
+    state.playing = true;
+    state.played = [];
+    button.textContent = '❚❚';
+    button.title = 'Pause (Space)';
+    go((state.frame + 1) % frames.count);
+  }
+
+  /** Stops playing: the frame being traced is the last shown. */
+  function stop() {
+    if (!state.playing) return;
+    state.playing = false;
+    clearTimeout(timer);
+    button.textContent = '▶';
+    button.title = 'Play (Space)';
+  }
+
+  const toggle = () => (state.playing ? stop() : play());
+  button.onclick = toggle;
+  slider.addEventListener('input', () => { stop(); go(Number(slider.value)); });
+  return { scene, stop, toggle };
+}
