@@ -53,9 +53,14 @@ impl Studio {
         Studio::start_with(binary, scene, &[])
     }
 
-    /// `host-sim studio [SCENE] ARGS...`.
+    /// `host-sim studio [SCENE] ARGS...`, run in SCENE's directory (so the
+    /// page names it as a user would, not by a scratch directory's path).
     fn start_with(binary: &Path, scene: Option<&Path>, args: &[&OsStr]) -> Studio {
         let mut command = Command::new(binary);
+        if let Some(directory) = scene.and_then(Path::parent).filter(|d| !d.as_os_str().is_empty()) {
+            command.current_dir(directory);
+        }
+        let scene = scene.map(|path| path.file_name().expect("a file"));
         command.arg("studio").args(scene).args(args).stdout(Stdio::piped()).stderr(Stdio::piped());
         let mut child = command.spawn().expect("host-sim studio starts");
         let mut first = String::new();
@@ -790,9 +795,11 @@ fn play_and_pause(browser: &Browser, what: &str) -> u32 {
     let mut shares: Vec<f64> = played.iter().skip(1).map(|p| p["share"].as_f64().expect("a share")).collect();
     ms.sort_by(f64::total_cmp);
     shares.sort_by(f64::total_cmp);
+    let shown = |i: usize| played[i]["at"].as_f64().expect("a time");
+    let rate = 1000.0 * (played.len() - 2) as f64 / (shown(played.len() - 1) - shown(1));
     println!(
-        "anim_fig5_1 played, {what}: {} frames; the first in {:.1} ms, the others each in {:.1} ms (median; \
-         slowest {:.1} ms), {:.1} % of the draft's pixels traced (median)",
+        "anim_fig5_1 played, {what}: {} frames at {rate:.1} a second; the first in {:.1} ms, the others each in \
+         {:.1} ms (median; slowest {:.1} ms), {:.1} % of the draft's pixels traced (median)",
         played.len(),
         played[0]["ms"].as_f64().expect("ms"),
         ms[ms.len() / 2],
@@ -831,6 +838,25 @@ fn the_time_slider_and_play_show_host_sims_frames() {
     let draft = host_frame(&scene, frame, Some("160x120"));
     assert_same(&format!("draft of frame {frame}, played to"), browser.canvas_rgb("draft"), &draft);
     slide_to(&browser, 0);
+    // What the page's module takes for a draft of each frame: traced whole,
+    // and by its player, twice round the loop (loading and indexing the
+    // frame included; printed for BENCHMARKS.md).
+    let timed = browser.run(
+        "const octrace = studio.octrace, text = studio.editor.text(), whole = [], played = [];
+         const time = (k, trace) => { const t = performance.now(); octrace.load(text, k); octrace.prepare(0, 160, 120);
+                                      trace(); return performance.now() - t; };
+         for (let k = 0; k < 48; k++) whole.push(time(k, () => octrace.render(0, 0, 160, 120)));
+         for (let k = 0; k < 96; k++) played.push(time(k % 48, () => octrace.traceFrame()));
+         const median = (all) => all.slice().sort((a, b) => a - b)[all.length >> 1];
+         return [median(whole), played[0], median(played.slice(1))];",
+    );
+    println!(
+        "anim_fig5_1's draft (160x120) in the page's module: a frame traced whole in {:.1} ms (median), \
+         by the player the first in {:.1} ms, the others in {:.1} ms (median)",
+        timed[0].as_f64().expect("ms"),
+        timed[1].as_f64().expect("ms"),
+        timed[2].as_f64().expect("ms")
+    );
 
     // Frame 0, rendered as any scene is (parallel tiles), and its draft.
     render_and_wait(&browser);
@@ -847,6 +873,13 @@ fn the_time_slider_and_play_show_host_sims_frames() {
         let draft = host_frame(&scene, frame, Some("160x120"));
         assert_same(&format!("draft of frame {frame}"), browser.canvas_rgb("draft"), &draft);
     }
+
+    // Play with the render shown, then pause: the frame shown is host-sim's.
+    let frame = play_and_pause(&browser, "the render (240x180) and the draft (160x120)");
+    assert_same(&format!("frame {frame}, played to"), browser.canvas_rgb("image"), &host_frame(&scene, frame, None));
+    let draft = host_frame(&scene, frame, Some("160x120"));
+    assert_same(&format!("draft of frame {frame}, played to"), browser.canvas_rgb("draft"), &draft);
+    screenshot(&browser, "studio");
 
     // The wireframe shows the red sphere where frame 10 has it (its MOVE's
     // second key: 0.3 left of and 3 behind where it is written), and the
@@ -868,13 +901,6 @@ fn the_time_slider_and_play_show_host_sims_frames() {
     browser.drag("#wire", (x, y), (x, y));
     let picked = browser.run("const s = studio.model[studio.selection]; return s && [s.keyword, s.args[1]];");
     assert_eq!(picked, serde_json::json!(["SPHERE", 1.3]), "the red sphere, picked where it is at frame 10");
-
-    // Play with the render shown, then pause: the frame shown is host-sim's.
-    let frame = play_and_pause(&browser, "the render (240x180) and the draft (160x120)");
-    assert_same(&format!("frame {frame}, played to"), browser.canvas_rgb("image"), &host_frame(&scene, frame, None));
-    let draft = host_frame(&scene, frame, Some("160x120"));
-    assert_same(&format!("draft of frame {frame}, played to"), browser.canvas_rgb("draft"), &draft);
-    screenshot(&browser, "studio");
 
     // An error at one frame only: the eye moves onto the point looked at
     // at frame 2, which the page marks at the MOVE when frame 2 is shown.

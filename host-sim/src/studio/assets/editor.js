@@ -87,6 +87,9 @@ export function createEditor(host, onChange) {
     ...(separator ? [EditorState.lineSeparator.of(separator)] : []),
   ];
   const view = new EditorView({ parent: root, state: EditorState.create({ extensions: extensions() }) });
+  // Whether errors are marked (none to mark and none marked: nothing to do,
+  // as for every frame played of a scene without errors).
+  let marked = false;
 
   const text = () => view.state.doc.toString();
 
@@ -121,6 +124,7 @@ export function createEditor(host, onChange) {
     /** A scene loaded: the text, a new history. */
     load(value) {
       view.setState(EditorState.create({ doc: value, extensions: extensions(lineBreaksOf(value)) }));
+      marked = false;
       onChange();
     },
     /** The text becomes `value` as one step of the history (a tool's
@@ -143,6 +147,8 @@ export function createEditor(host, onChange) {
      *  from its column to the end of the word there (a point at a space or
      *  the end); line 0 is the whole scene's, not marked. */
     setErrors(errors) {
+      if (!errors.length && !marked) return;
+      marked = errors.length > 0;
       const doc = view.state.doc;
       const diagnostics = errors.filter((e) => e.line > 0).map((e) => {
         const from = offsetOf(e.line, e.column);

@@ -12,13 +12,16 @@ const DRAFT = [160, 120];
 
 /** The time controls of the page `app` (studio.js). They set `state.frame`
  *  and `state.playing`; `state.played` holds, for each frame played since
- *  play began, its number, the milliseconds from asking for it to its draft
- *  and render traced, and the share of the draft's pixels traced (%). */
+ *  play began, its number, when it was shown (ms), the milliseconds from
+ *  asking for it to its draft and render shown, and the share of the
+ *  draft's pixels traced (%). */
 export function createTime(app) {
   const { state, $ } = app;
   const box = $('time'), slider = $('frame'), button = $('play'), label = $('frame-label');
   let frames = null; // {count, rate}, or null for a still
-  let timer = 0;
+  /** Playing: the timer of the next frame, and when it is due (on a clock
+   *  of its own, so that the rate holds; a late frame moves it on). */
+  let timer = 0, due = 0;
   /** The frame being traced, and the one to trace after it (the slider
    *  moved on meanwhile), if any. */
   let busy = false, wanted = null;
@@ -95,9 +98,11 @@ export function createTime(app) {
         const imageShare = (100 * image.traced) / (image.width * image.height);
         app.setStatus(`frame ${frame}: ${image.width}×${image.height}, ${imageShare.toFixed(0)} % of the pixels traced`);
       }
-      if (playing) state.played.push({ frame, ms, share });
+      if (playing) state.played.push({ frame, at: performance.now(), ms, share });
       if (state.playing) {
-        timer = setTimeout(() => go((frame + 1) % frames.count), Math.max(0, asked + 1000 / frames.rate - performance.now()));
+        const now = performance.now();
+        due = Math.max(due + 1000 / frames.rate, now);
+        timer = setTimeout(() => go((frame + 1) % frames.count), due - now);
       }
     } catch (e) {
       stop();
@@ -115,6 +120,7 @@ export function createTime(app) {
     if (!frames || state.playing) return;
     state.playing = true;
     state.played = [];
+    due = performance.now();
     button.textContent = '❚❚';
     button.title = 'Pause (Space)';
     go((state.frame + 1) % frames.count);

@@ -128,7 +128,7 @@ export function createView(state, wire) {
       const from = s.keyword === 'VIEWPOINT' || s.keyword === 'ORIGIN' ? s.args.slice(0, 3) : objectCentre(s);
       if (!from) continue;
       const points = s.moved.keys.map(([, ...d]) => add(from, d));
-      for (let i = 0; i + 1 < points.length; i++) line(points[i], points[i + 1], '#b39ddb');
+      for (let i = 0; i + 1 < points.length; i++) line(points[i], points[i + 1], '#ce93d8');
     }
   }
 
