@@ -116,7 +116,7 @@ pub(super) fn project(color: Rgb888) -> [i32; 2] {
     }
     // Outside (more green and blue than red): the edges black–red (m = 0),
     // red–white (r = 255) and black–white (r = m).
-    let t = ((r + m2 + 1) / 3).clamp(0, 255);
+    let t = (super::quotient((r + m2 + 1) as u32, 3) as i32).clamp(0, 255);
     let edges = [[r, 0], [255, ((m2 + 1) >> 1).min(255)], [t, t]];
     let distance = |[er, em]: [i32; 2]| 2 * (er - r).pow(2) + (2 * em - m2).pow(2);
     let mut best = edges[0];
