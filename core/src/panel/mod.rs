@@ -215,7 +215,7 @@ impl Panel {
     fn nearest(self, color: Rgb888) -> u8 {
         match self {
             Panel::BlackWhiteRed => BlackWhiteRed::from(color) as u8,
-            gray => quotient(luma(color) as u32 * (gray.levels() as u32 - 1) + 127, 255) as u8,
+            gray => Divisor::BY_255.quotient(luma(color) as u32 * (gray.levels() as u32 - 1) + 127) as u8,
         }
     }
 
@@ -241,7 +241,7 @@ impl Panel {
             }
             gray => {
                 let scaled = luma(color) as u32 * (gray.levels() as u32 - 1);
-                let level = quotient(scaled, 255);
+                let level = Divisor::BY_255.quotient(scaled);
                 let fraction = scaled - 255 * level;
                 (level + (fraction * 32 > bar) as u32) as u8
             }
@@ -270,10 +270,16 @@ impl Panel {
             Panel::Mono => (v >= 128 << 4) as u8,
             gray => {
                 let (step, top) = (gray.step() << 4, gray.levels() as i32 - 1);
+                // Each panel's divisor made when it compiles: a panel known
+                // only when the program runs must not bring the division back.
+                let by_step = match gray {
+                    Panel::Gray2 => const { Divisor::new(16 * 85) },
+                    _ => const { Divisor::new(16 * 17) },
+                };
                 match v + step / 2 {
                     x if x <= 0 => 0,
                     x if x >= top * step => top as u8,
-                    x => quotient(x as u32, step as u32) as u8,
+                    x => by_step.quotient(x as u32) as u8,
                 }
             }
         }
@@ -451,16 +457,30 @@ impl fmt::Display for ErrorRowTooShort {
 
 impl core::error::Error for ErrorRowTooShort {}
 
-/// `x / d`, rounded down, by a multiply and a shift: a Cortex-M0, which
+/// Division by a constant `d` as a multiply and a shift: a Cortex-M0, which
 /// has no divide instruction, would call a routine of some 50 instructions
 /// for each pixel. Exact (and without overflow) for `x` up to 4096 with `d`
 /// from 255 to 4080 (gray values, level steps in 1/16 gray), and for `x`
 /// below 768 with `d` = 3 (the black/white/red projection's third).
-#[inline]
-const fn quotient(x: u32, d: u32) -> u32 {
-    // ceil(2^24 / d): its excess over 2^24 / d is under 1 / x.
-    let reciprocal = (1 << 24) / d + 1;
-    (x * reciprocal) >> 24
+#[derive(Clone, Copy, Debug)]
+struct Divisor {
+    /// ceil(2^24 / d): its excess over 2^24 / d is under 1 / x.
+    reciprocal: u32,
+}
+
+impl Divisor {
+    const BY_255: Divisor = Divisor::new(255);
+    const BY_3: Divisor = Divisor::new(3);
+
+    const fn new(d: u32) -> Divisor {
+        Divisor { reciprocal: (1 << 24) / d + 1 }
+    }
+
+    /// `x / d`, rounded down.
+    #[inline]
+    const fn quotient(self, x: u32) -> u32 {
+        (x * self.reciprocal) >> 24
+    }
 }
 
 /// The gray of `color`, 0 to 255: BT.601 luma as embedded-graphics computes
@@ -542,7 +562,7 @@ mod tests {
         // values below 768.
         for (d, below) in [(255, 4097), (16 * 85, 4097), (16 * 17, 4097), (3, 768)] {
             for x in 0..below {
-                assert_eq!(quotient(x, d), x / d, "{x} / {d}");
+                assert_eq!(Divisor::new(d).quotient(x), x / d, "{x} / {d}");
             }
         }
     }
