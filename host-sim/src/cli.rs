@@ -1,19 +1,19 @@
 //! The `host-sim` command line.
 
-use crate::output::{write_atomically, FileSink};
+use crate::arguments::{output_format, parse_accel, parse_color, parse_dithering, parse_format, parse_palette};
+use crate::arguments::{parse_size, same_file};
+use crate::output::{panel_preview, write_atomically, FileSink};
 use crate::parts::{self, MergeError, PartInfo, PartSpec};
+use crate::terminal::progress_bar;
 use crate::{all_cores, load_bytes, new_scene, render_streamed, AccelMode, LoadError, Partition, RenderOptions};
-use crate::{render_with_progress, HostScene, RgbImage, StreamError, Streamed};
+use crate::{render_with_progress, HostScene, StreamError, Streamed};
 use clap::Parser;
-use indicatif::{ProgressBar, ProgressStyle};
 use octrace_core::accel::OctreeConfig;
 use octrace_core::panel::{Dithering, Panel};
 use octrace_core::render::PanelColor;
-use octrace_core::scene::MAX_SIDE;
 use octrace_images::formats::{self, Format, FormatError, Header, Image};
 use octrace_images::palette::PaletteMode;
-use octrace_images::panel;
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -144,17 +144,6 @@ pub enum Command {
     Board(crate::board::BoardArgs),
 }
 
-/// What a `color` panel shows of `image` ([`octrace_images::panel`]),
-/// dithered by `dithering` if it has few levels, or `None` for the colours
-/// that need no conversion.
-pub(crate) fn panel_preview(image: &RgbImage, color: PanelColor, dithering: Dithering) -> Option<Image> {
-    match (color, color.panel()) {
-        (_, Some(panel)) => Some(panel::dithered(image, panel, dithering)),
-        (PanelColor::Rgb565, None) => Some(Image::Rgb(panel::rgb565(image))),
-        _ => None,
-    }
-}
-
 /// Whether `color` is previewed from the finished image (not streamed).
 fn previewed(color: PanelColor) -> bool {
     !matches!(color, PanelColor::Rgb888 | PanelColor::Dither)
@@ -168,52 +157,6 @@ fn write_preview(preview: &Image, color: PanelColor, format: Format, out: &mut d
         Format::Png if gray => formats::write_gray_png(preview, out),
         _ => formats::write(preview, format, out),
     }
-}
-
-/// An `--accel` name: the core's [`AccelMode`] vocabulary.
-fn parse_accel(text: &str) -> Result<AccelMode, String> {
-    parse_name(text, &AccelMode::ALL, AccelMode::name)
-}
-
-/// A `--color` name: the core's [`PanelColor`] vocabulary.
-fn parse_color(text: &str) -> Result<PanelColor, String> {
-    parse_name(text, &PanelColor::ALL, PanelColor::name)
-}
-
-/// A `--dither` name: the core's [`Dithering`] vocabulary.
-fn parse_dithering(text: &str) -> Result<Dithering, String> {
-    parse_name(text, &Dithering::ALL, Dithering::name)
-}
-
-/// A `--palette` name: [`PaletteMode`]'s vocabulary.
-fn parse_palette(text: &str) -> Result<PaletteMode, String> {
-    parse_name(text, &PaletteMode::ALL, PaletteMode::name)
-}
-
-/// A `--format` name: [`Format`]'s vocabulary.
-pub(crate) fn parse_format(text: &str) -> Result<Format, String> {
-    parse_name(text, &Format::ALL, Format::name)
-}
-
-/// The one of `all` that `text` names (case-insensitive).
-fn parse_name<T: Copy>(text: &str, all: &[T], name: fn(T) -> &'static str) -> Result<T, String> {
-    all.iter().copied().find(|&v| name(v).eq_ignore_ascii_case(text)).ok_or_else(|| {
-        let names: Vec<&str> = all.iter().map(|&v| name(v)).collect();
-        format!("expected one of {}", names.join(", "))
-    })
-}
-
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WxH (for example 160x128), found `{s}`"))?;
-    let dim = |v: &str| -> Result<u32, String> {
-        let n: u32 = v.parse().map_err(|_| format!("`{v}` is not a whole number"))?;
-        if (1..=MAX_SIDE).contains(&n) {
-            Ok(n)
-        } else {
-            Err(format!("{n} is outside 1 to {MAX_SIDE}"))
-        }
-    };
-    Ok((dim(w)?, dim(h)?))
 }
 
 pub fn run<I, T>(args: I, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i32
@@ -245,30 +188,6 @@ where
             e.exit_code()
         }
     }
-}
-
-/// The format to write `path` in: the one asked for, else the one its
-/// extension names, else (no extension) PNG. Any other extension is refused
-/// before anything is rendered: a PNG named `.bmp` would mislead whatever
-/// opens it.
-pub(crate) fn output_format(asked: Option<Format>, path: &Path) -> Result<Format, CliError> {
-    if let Some(format) = asked {
-        return Ok(format);
-    }
-    let Some(extension) = path.extension() else {
-        return Ok(Format::Png);
-    };
-    Format::from_path(path).ok_or_else(|| {
-        let names: Vec<&str> = Format::ALL.iter().map(|f| f.name()).collect();
-        CliError::Invalid(format!(
-            "cannot write {}: `.{}` is not a format host-sim writes; it writes {} \
-             (chosen by the extension, or by --format <{}>)",
-            path.display(),
-            extension.to_string_lossy(),
-            names.join(", "),
-            names.join("|"),
-        ))
-    })
 }
 
 fn convert(input: &Path, output: &Path, format: Option<Format>) -> Result<(), CliError> {
@@ -548,40 +467,10 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     Ok(())
 }
 
-/// A progress bar of `total` steps on stderr, if it is a terminal and
-/// the run is not `quiet`.
-pub(crate) fn progress_bar(total: u64, quiet: bool) -> Option<ProgressBar> {
-    if quiet || !std::io::stderr().is_terminal() {
-        return None;
-    }
-    let bar = ProgressBar::new(total);
-    bar.set_style(
-        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}%, eta {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    Some(bar)
-}
-
-/// Whether two paths name the same existing file.
-pub(crate) fn same_file(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => false,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn sizes() {
-        assert_eq!(parse_size("160x128"), Ok((160, 128)));
-        assert_eq!(parse_size("8X8"), Ok((8, 8)));
-        assert!(parse_size("0x5").is_err());
-        assert!(parse_size("12").is_err());
-        assert!(parse_size("20000x5").is_err());
-    }
+    use crate::RgbImage;
 
     /// Every 8-bit gray a gray4 panel can show, written out apart from
     /// embedded-graphics: luma by ITU-R BT.601 in 8 bits, rounded to 16

@@ -6,12 +6,14 @@
 //! a streamed render ([`render_streamed`]) holds a few bands of rows, never
 //! the image, and hands every row to its sink once, in order.
 
+mod arguments;
 pub mod board;
 pub mod cli;
 pub mod exit;
 pub mod output;
 pub mod parts;
 pub mod studio;
+mod terminal;
 mod threaded;
 
 use threaded::stream_threads;

@@ -297,3 +297,119 @@ fn a_board_of_another_version_is_refused_clearly() {
     );
     assert!(run.stderr.starts_with(&want), "{}", run.stderr);
 }
+
+/// A board that departs from the protocol on command (the software board
+/// with `--misbehave HOW`), with a 16 KiB board's profile and a 160×128
+/// panel.
+fn hostile_board(how: &str, more: &[&str]) -> RunningBoard {
+    let mut args = vec!["--profile", "board16k", "--panel", "160x128", "--misbehave", how];
+    args.extend(more);
+    RunningBoard::software(env!("CARGO_BIN_EXE_software-board"), &args)
+}
+
+/// `host-sim board ARGS...` on a thread of its own: its run, or None if it
+/// has not ended within `limit` (a run with no end fails the test instead
+/// of hanging it).
+fn host_sim_board_within(args: &[&OsStr], limit: Duration) -> Option<Run> {
+    let args: Vec<std::ffi::OsString> = args.iter().map(|a| a.to_os_string()).collect();
+    let (done, ended) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let args: Vec<&OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+        let _ = done.send(host_sim_board(&args));
+    });
+    ended.recv_timeout(limit).ok()
+}
+
+#[test]
+fn a_drawing_at_another_panel_than_described_or_beyond_the_protocol_is_refused_and_nothing_is_written() {
+    let scene = repo().join("scenes/fig5_1.txt");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.png");
+    for size in ["0x0", "65535x65535", "128x160"] {
+        let board = hostile_board(&format!("draws-at:{size}"), &[]);
+        let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str(), out.as_os_str(), "--check".as_ref()]);
+        assert_eq!(run.code, 1, "{size}: {}", run.stderr);
+        let want = format!("it draws at {size} rgb565, but described a 160x128 rgb565 panel");
+        assert!(run.stderr.contains(&want), "{size}: {}", run.stderr);
+        assert!(!run.stderr.contains("bit-identical") && !out.exists(), "{size}: {}", run.stderr);
+    }
+    // A board that describes a panel beyond the protocol's sides.
+    let board = RunningBoard::software(env!("CARGO_BIN_EXE_software-board"), &["--panel", "65535x65535"]);
+    let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str(), out.as_os_str(), "--check".as_ref()]);
+    assert_eq!(run.code, 1, "{}", run.stderr);
+    assert!(
+        run.stderr.contains("it describes a 65535x65535 panel; a panel's sides are 1 to 16384 pixels"),
+        "{}",
+        run.stderr
+    );
+}
+
+#[test]
+fn check_exits_3_when_the_boards_picture_differs_by_a_pixel() {
+    let board = hostile_board("wrong-pixel", &[]);
+    let scene = repo().join("scenes/fig5_1.txt");
+    let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str(), "--check".as_ref()]);
+    assert_eq!(run.code, 3, "{}", run.stderr);
+    let want = "host-sim: board --check: 1 of 20480 pixels differ from host-sim's rgb565 render at 160x128";
+    assert!(run.stderr.contains(want), "{}", run.stderr);
+}
+
+#[test]
+fn a_board_that_keeps_sending_errors_is_given_up_at_the_timeout() {
+    let board = hostile_board("errors-every:20", &[]);
+    let scene = repo().join("scenes/fig5_1.txt");
+    let started = std::time::Instant::now();
+    let args = [board.port.as_os_str(), scene.as_os_str(), "--timeout".as_ref(), "2".as_ref()];
+    let run = host_sim_board_within(&args, Duration::from_secs(30)).expect("host-sim board ends");
+    let took = started.elapsed();
+    assert_eq!(run.code, 1, "{}", run.stderr);
+    let want = format!("host-sim: board at {}: the board's answer did not end within 2 s", board.port.display());
+    assert!(run.stderr.starts_with(&want), "{}", run.stderr);
+    assert!(took < Duration::from_secs(10), "{took:?}");
+}
+
+#[test]
+fn a_board_that_reads_slowly_gets_the_whole_scene_within_the_timeout() {
+    // 28 KB of scene (fig5_1 and a comment) at 10 KiB/s, after what the
+    // line holds (about 20 KB): longer than any one write's wait, well
+    // within the timeout.
+    let board = hostile_board("reads-slowly", &["--max-scene", "65536"]);
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("long.txt");
+    let text = std::fs::read_to_string(repo().join("scenes/fig5_1.txt")).unwrap();
+    std::fs::write(&scene, format!("{text}/* {} */\n", "padding ".repeat(3000))).unwrap();
+    let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str(), "--check".as_ref()]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stderr.contains("--check: bit-identical"), "{}", run.stderr);
+}
+
+#[test]
+fn a_boards_text_is_shown_with_its_control_characters_escaped() {
+    let board = hostile_board("escapes", &[]);
+    let run = host_sim_board(&[board.port.as_os_str()]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stdout.contains(": \\u{1b}]0;pwned\\u{7}\\u{1b}[2Joctrace software board"), "{}", run.stdout);
+    let scene = repo().join("scenes/fig5_1.txt");
+    let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str()]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(
+        run.stderr.contains(":1:1: \\u{1b}[2J\\u{1b}[31mred\\u{1b}[0m\\u{a}host-sim: 0 error(s)\n"),
+        "{}",
+        run.stderr
+    );
+    assert!(!run.stdout.contains('\u{1b}') && !run.stderr.contains('\u{1b}'));
+}
+
+#[test]
+fn the_board_reports_every_lines_error_as_host_sim_does() {
+    let board = board();
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("five.txt");
+    std::fs::write(&scene, "x\nx\nx\nx\nx\n").unwrap();
+    let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str()]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    for line in 1..=5 {
+        assert!(run.stderr.contains(&format!("five.txt:{line}:1: unknown keyword `x`")), "line {line}: {}", run.stderr);
+    }
+    assert!(run.stderr.contains("host-sim: 5 error(s) in "), "{}", run.stderr);
+}

@@ -7,9 +7,10 @@
 //! 2. the *build* reads every statement again, reports every error, and
 //!    stores the objects in normalised space.
 //!
-//! After an error the parser skips to the next keyword and goes on, so one
-//! run reports all errors. A scene with errors is cleared: nothing can be
-//! rendered from it.
+//! After an error the parser skips to where the next statement begins (a
+//! keyword, or a word opening a line) and goes on, so one run reports every
+//! line's error. A scene with errors is cleared: nothing can be rendered
+//! from it.
 //!
 //! No-panic contract: for any input text, [`parse`] returns (it neither
 //! panics nor loops), in time linear in the text's length plus
@@ -82,7 +83,7 @@ impl<C: SceneCapacities> Room for RoomOf<C> {
 }
 
 /// Reads every statement of `text`, handing each (or its error) to `each`;
-/// skips to the next keyword after an error.
+/// after an error, resynchronises at the next statement (see [`recover`]).
 fn for_each_statement<'a, R: Room>(text: &'a str, mut each: impl FnMut(Pos, Result<Statement<'a>, ParseError<'a>>)) {
     let mut cur = Cursor::new(text);
     loop {
@@ -98,26 +99,38 @@ fn for_each_statement<'a, R: Room>(text: &'a str, mut each: impl FnMut(Pos, Resu
             Some(kw) => statement::statement::<R>(&mut cur, kw, token.pos),
             None => Err(ParseError::new(token.pos, ErrorKind::UnknownKeyword(token.text))),
         };
-        let failed = result.is_err();
+        let error_at = result.as_ref().err().map(|e| e.pos);
         each(token.pos, result);
-        if failed {
-            // Recover: drop the offending token unless it starts a statement,
-            // then the numbers that follow; resume at the next word, so an
-            // unknown word right after a bad statement is still reported.
-            let mut first = true;
-            loop {
-                match cur.peek() {
-                    Ok(Some(t))
-                        if (first && Keyword::from_text(t.text).is_none()) || Decimal::parse(t.text).is_some() =>
-                    {
-                        let _ = cur.next();
-                    }
-                    Ok(_) => break,
-                    Err(e) => each(e.pos, Err(e)),
-                }
-                first = false;
+        if let Some(pos) = error_at {
+            recover(&mut cur, pos, &mut |e| each(e.pos, Err(e)));
+        }
+    }
+}
+
+/// After an error at `at`, skips to where the next statement begins: a
+/// keyword, or a word (not a number) that is the first token of its line.
+/// The offending token goes first unless it is a keyword; numbers after it
+/// are the bad statement's (a B-spline's points span lines), whatever line
+/// they are on. So every line that begins with a word is read again as a
+/// statement, and its error, if any, is reported too: five lines of `x`
+/// give five errors. A lexer error met while skipping goes to `lexical`.
+fn recover<'a>(cur: &mut Cursor<'a>, at: Pos, lexical: &mut dyn FnMut(ParseError<'a>)) {
+    let begins_statement = |t: &lexer::Token<'_>| !t.quoted && Keyword::from_text(t.text).is_some();
+    let number = |t: &lexer::Token<'_>| !t.quoted && Decimal::parse(t.text).is_some();
+    loop {
+        match cur.peek() {
+            Ok(None) => return,
+            Ok(Some(t)) if begins_statement(&t) => return,
+            // The offending token, left for recovery by the statement.
+            Ok(Some(t)) if t.pos == at => {}
+            Ok(Some(t)) if !number(&t) && cur.on_a_later_line(t) => return,
+            Ok(Some(_)) => {}
+            Err(e) => {
+                lexical(e);
+                continue;
             }
         }
+        let _ = cur.next();
     }
 }
 
@@ -455,14 +468,16 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
         if let Err(e) = self.scene.set_control_points(points.iter().map(|p| norm.point(p))) {
             return self.capacity(pos, e);
         }
-        if self.scene.push_bspline(order, rows, cols, samples, surface) == 0 {
-            self.report(ParseError::new(
+        match self.scene.push_bspline(order, rows, cols, samples, surface) {
+            Ok(0) => self.report(ParseError::new(
                 pos,
                 ErrorKind::Degenerate {
                     keyword: Keyword::Bspline.name(),
                     why: "its control points do not span a surface",
                 },
-            ));
+            )),
+            Ok(_) => {}
+            Err(e) => self.capacity(pos, e),
         }
     }
 
@@ -720,11 +735,55 @@ mod tests {
     #[test]
     fn recovery_resumes_at_the_next_keyword() {
         // The missing z is reported at the keyword that follows, which is
-        // then read normally.
+        // then read normally, even on the same line.
         let e = errs(&format!("SPHERE 1 1 0 0\n{SURF}RDEPTH 2 RDEPTH 3"));
         assert_eq!(e.len(), 2, "{e:?}");
         assert!(e[0].contains("2:1: expected a number for SPHERE z, found `SURFACE`"), "{e:?}");
         assert!(e[1].contains("RDEPTH is given twice"), "{e:?}");
+    }
+
+    /// Where each error of `text` is, as `line:column`.
+    fn error_positions(text: &str) -> Vec<String> {
+        errs(text).iter().map(|e| e.split(": ").next().unwrap_or_default().to_string()).collect()
+    }
+
+    #[test]
+    fn recovery_reports_every_lines_error() {
+        // An unknown word is its own offending token: the next line's word
+        // is read again as a statement.
+        assert_eq!(error_positions("x\nx\nx\nx\nx\n"), ["1:1", "2:1", "3:1", "4:1", "5:1"]);
+        // A statement cut short by a keyword on the next line: that
+        // statement is read, its own error reported, and the line after.
+        let e = errs("SPHERE 1 1 0 0\nSPHERE 1 -1 0 0 0\nx\n");
+        assert_eq!(e.len(), 3, "{e:?}");
+        assert!(e[0].starts_with("2:1: expected a number for SPHERE z, found `SPHERE`"), "{e:?}");
+        assert!(e[1].starts_with("2:10: SPHERE radius must be > 0"), "{e:?}");
+        assert!(e[2].starts_with("3:1: unknown keyword `x`"), "{e:?}");
+        // A bad number: the rest of its statement is dropped, not the next
+        // line; numbers on the lines after an unknown word are its own.
+        assert_eq!(
+            error_positions("SPHERE 1 y 0 0 0\nx\nLIGHT 1 0 5 q\nx 1 2\n 3 4\nx\n"),
+            ["1:10", "2:1", "3:13", "4:1", "6:1"]
+        );
+        // The offending word opening a line is reported once, as what the
+        // statement did not expect.
+        let e = errs("SPHERE 1 1\nfoo 0 0\nx\n");
+        assert_eq!(e.len(), 2, "{e:?}");
+        assert!(e[0].starts_with("2:1: expected a number for SPHERE x, found `foo`"), "{e:?}");
+        assert!(e[1].starts_with("3:1: unknown keyword `x`"), "{e:?}");
+        // A statement wrong as a whole (reported at its keyword): the next
+        // line's word is still read.
+        assert_eq!(error_positions(&format!("{SURF}TRIANGLE 1 0 0 0 1 1 1 2 2 2\nx\n")), ["2:1", "3:1"]);
+        // A bad control point: the patch's other points, on the lines
+        // after it, are skipped as its own.
+        let patch = "BSPLINE 1 2 3 3 2 2\n0 0 0 1 0 0 2 0 0\n0 1 0 q 1 0 2 1 0\n0 2 0 1 2 0 2 2 0\nx\n";
+        assert_eq!(error_positions(&format!("{SURF}{patch}")), ["4:7", "6:1"]);
+        // An unterminated comment takes the rest of the text: what is in
+        // it is not read, what came before is all reported.
+        assert_eq!(error_positions("x\nSPHERE 1 1 0 /* open\nx\n"), ["1:1", "2:14"]);
+        assert_eq!(error_positions("x\nRDEPTH 2 x\n/* open\nx\n"), ["1:1", "2:10", "3:1"]);
+        // A quoted keyword begins no statement.
+        assert_eq!(error_positions("x \"RDEPTH\" 2\nRDEPTH 2\n"), ["1:1"]);
     }
 
     #[test]
@@ -978,6 +1037,32 @@ mod tests {
                  define a profile that holds them with octrace_core::profile! (bspline_triangles: 100, …)"
             ),
             "{e:?}"
+        );
+    }
+
+    #[test]
+    fn a_patch_at_exactly_its_capacity_loads_and_one_triangle_over_is_named() {
+        crate::profile! {
+            struct Exactly32 { bspline_triangles: 32, control_points: 9, surfaces: 1 }
+        }
+        crate::profile! {
+            struct Only31 { bspline_triangles: 31, control_points: 9, surfaces: 1 }
+        }
+        // 2 · 4 · 4 = 32 triangles.
+        let text = format!("{SURF}BSPLINE 1 3 3 3 5 5 {GRID}\n");
+        let mut scene = std::boxed::Box::new(Scene::<Exactly32>::new());
+        let mut errors = Vec::new();
+        let r = parse(&text, &mut scene, &mut |e| errors.push(e.to_string()));
+        assert_eq!((r, errors.len()), (Ok(Parsed::default()), 0), "{errors:?}");
+        assert_eq!(scene.view().bspline_triangles.len(), 32);
+        let mut scene = std::boxed::Box::new(Scene::<Only31>::new());
+        let r = parse(&text, &mut scene, &mut |e| errors.push(e.to_string()));
+        assert_eq!(r, Err(1), "{errors:?}");
+        assert!(
+            errors[0].starts_with(
+                "2:1: too many B-spline triangles: the capacity profile Only31 holds 31 and the scene needs 32"
+            ),
+            "{errors:?}"
         );
     }
 

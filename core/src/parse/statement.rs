@@ -204,6 +204,12 @@ impl<'a> Cursor<'a> {
         Ok(t)
     }
 
+    /// Whether `token` (the one peeked) begins a line after the last token
+    /// taken: where a statement may begin again after an error.
+    pub fn on_a_later_line(&self, token: Token<'a>) -> bool {
+        token.pos.line > self.taken_end.line
+    }
+
     /// Consumes the peeked token.
     fn take(&mut self) {
         if let Some(Some(t)) = self.peeked.take() {

@@ -7,18 +7,23 @@
 //! to the emulated Pico.
 //!
 //!     software-board [--profile board16k|board64k|host] [--panel WxH] [--max-scene BYTES]
+//!                    [--misbehave HOW]
 //!
 //! It prints `serial: PATH`, the device a host opens, then serves until its
 //! standard input closes. Defaults: Board64K, the Pico template's 240×240
 //! RGB565 panel, scenes of up to 16,384 bytes.
+//!
+//! `--misbehave` makes it a hostile board, for the tests of what a host
+//! does with one ([`Misbehaviour`]): `draws-at:WxH`, `wrong-pixel`,
+//! `errors-every:MS`, `reads-slowly`, `escapes`.
 
-use embedded_graphics_core::pixelcolor::Rgb565;
+use embedded_graphics_core::pixelcolor::{Rgb565, RgbColor};
 use octrace_core::accel::Mailbox;
 use octrace_core::profile::{Board16K, Board64K, Host, Profile};
 use octrace_core::render::Renderer;
 use octrace_core::Raytracer;
 use octrace_link::board::Board;
-use octrace_link::{Decoder, Panel, PixelFormat, OVERHEAD};
+use octrace_link::{Decoder, Message, Panel, PixelFormat, SceneError, OVERHEAD};
 use std::collections::VecDeque;
 use std::fs::File;
 use std::io::{Read, Write};
@@ -32,6 +37,82 @@ struct Options {
     profile: String,
     panel: Panel,
     max_scene: usize,
+    misbehave: Option<Misbehaviour>,
+}
+
+/// How a hostile board departs from the protocol or from octrace's board.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Misbehaviour {
+    /// Answers every scene with `drawing` at this panel (not the one its
+    /// hello describes), then `done`, without a row.
+    DrawsAt { width: u16, height: u16 },
+    /// Draws every scene with its first pixel of another colour.
+    WrongPixel,
+    /// Answers every scene with scene errors, one every this many
+    /// milliseconds, never closed by `rejected`.
+    ErrorsEvery(u64),
+    /// Reads its port slowly: 1 KiB every 100 ms (10 KiB/s), so that a
+    /// host's write waits longer than a serial port's own timeout.
+    ReadsSlowly,
+    /// Its firmware's name and its answer to every scene (one error) carry
+    /// terminal escapes.
+    Escapes,
+}
+
+impl Misbehaviour {
+    fn parse(text: &str) -> Result<Misbehaviour, String> {
+        let size = |size: &str| -> Option<(u16, u16)> {
+            let (w, h) = size.split_once('x')?;
+            Some((w.parse().ok()?, h.parse().ok()?))
+        };
+        Ok(match text.split_once(':') {
+            Some(("draws-at", wxh)) => {
+                let (width, height) = size(wxh).ok_or(format!("--misbehave {text}: expected draws-at:WxH"))?;
+                Misbehaviour::DrawsAt { width, height }
+            }
+            Some(("errors-every", ms)) => {
+                Misbehaviour::ErrorsEvery(ms.parse().map_err(|e| format!("--misbehave {text}: {e}"))?)
+            }
+            _ => match text {
+                "wrong-pixel" => Misbehaviour::WrongPixel,
+                "reads-slowly" => Misbehaviour::ReadsSlowly,
+                "escapes" => Misbehaviour::Escapes,
+                _ => {
+                    return Err(format!(
+                        "--misbehave {text}: draws-at:WxH, wrong-pixel, errors-every:MS, reads-slowly or escapes"
+                    ))
+                }
+            },
+        })
+    }
+
+    /// Answers the scene request `tag` as this misbehaviour does, if it
+    /// answers scenes its own way.
+    fn answer_scene(self, tag: u16, pixels: bool, line: &mut Line, out: &mut File) -> bool {
+        let send = |message: Message<'_>, out: &mut File| message.encode(tag, out).is_ok();
+        match self {
+            Misbehaviour::DrawsAt { width, height } => {
+                let panel = Panel { width, height, format: PixelFormat::Rgb565 };
+                let _ = send(Message::Drawing { panel, pixels }, out) && send(Message::Done { elapsed: None }, out);
+            }
+            Misbehaviour::ErrorsEvery(ms) => {
+                let error = SceneError { line: 1, column: 1, capacity: None, message: "one more error" };
+                // Until the host says something else (the byte that says so
+                // is dropped: a frame's opening delimiter, which a decoder
+                // that ended its last frame does without), or goes.
+                while line.poll().is_none() && send(Message::SceneError(error), out) {
+                    std::thread::sleep(Duration::from_millis(ms));
+                }
+            }
+            Misbehaviour::Escapes => {
+                let message = "\u{1b}[2J\u{1b}[31mred\u{1b}[0m\nhost-sim: 0 error(s)";
+                let error = SceneError { line: 1, column: 1, capacity: None, message };
+                let _ = send(Message::SceneError(error), out) && send(Message::Rejected { errors: 1 }, out);
+            }
+            Misbehaviour::WrongPixel | Misbehaviour::ReadsSlowly => return false,
+        }
+        true
+    }
 }
 
 fn options() -> Result<Options, String> {
@@ -39,6 +120,7 @@ fn options() -> Result<Options, String> {
         profile: "board64k".into(),
         panel: Panel { width: 240, height: 240, format: PixelFormat::Rgb565 },
         max_scene: 16 * 1024,
+        misbehave: None,
     };
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
@@ -53,7 +135,8 @@ fn options() -> Result<Options, String> {
                 options.panel.height = side(h)?;
             }
             "--max-scene" => options.max_scene = value()?.parse().map_err(|e| format!("--max-scene: {e}"))?,
-            _ => return Err(format!("unknown argument {arg} (--profile, --panel, --max-scene)")),
+            "--misbehave" => options.misbehave = Some(Misbehaviour::parse(&value()?)?),
+            _ => return Err(format!("unknown argument {arg} (--profile, --panel, --max-scene, --misbehave)")),
         }
     }
     Ok(options)
@@ -89,7 +172,11 @@ impl Line {
 /// Answers frames until the line ends, as a firmware's main loop does.
 fn serve<P: Profile>(options: &Options, line: &mut Line, out: &mut File) {
     let mut decoder = Decoder::new(vec![0u8; options.max_scene + OVERHEAD + 1]);
-    let board = Board::new(options.panel, FIRMWARE, &decoder);
+    let firmware = match options.misbehave {
+        Some(Misbehaviour::Escapes) => "\u{1b}]0;pwned\u{7}\u{1b}[2Joctrace software board",
+        _ => FIRMWARE,
+    };
+    let board = Board::new(options.panel, firmware, &decoder);
     let mut raytracer = Box::new(Raytracer::<P>::new());
     let (width, height) = (u32::from(options.panel.width), u32::from(options.panel.height));
     let mut row = vec![Rgb565::default(); width as usize];
@@ -104,6 +191,13 @@ fn serve<P: Profile>(options: &Options, line: &mut Line, out: &mut File) {
         }
         pending = false;
         let Some(received) = decoder.received() else { continue };
+        if let (Some(misbehave), Ok(frame)) = (options.misbehave, &received) {
+            if let Message::Scene { pixels, .. } = frame.message {
+                if misbehave.answer_scene(frame.tag, pixels, line, out) {
+                    continue;
+                }
+            }
+        }
         let started = Instant::now();
         // A host that went away while the board wrote is not waited for.
         let Ok(Some(drawing)) = board.answer(received, &mut *raytracer, out) else { continue };
@@ -120,6 +214,9 @@ fn serve<P: Profile>(options: &Options, line: &mut Line, out: &mut File) {
         while drawn < height && sent && !pending {
             for (pixel, sample) in row.iter_mut().zip(renderer.row(drawn, 0..width)) {
                 *pixel = sample.color.into();
+            }
+            if drawn == 0 && options.misbehave == Some(Misbehaviour::WrongPixel) {
+                row[0] = if row[0] == Rgb565::WHITE { Rgb565::BLACK } else { Rgb565::WHITE };
             }
             sent = drawing.send_row(drawn as u16, &row, out).is_ok();
             drawn += 1;
@@ -145,10 +242,15 @@ fn main() {
     });
     let mut reader = controller.try_clone().expect("a second handle on the pseudo-terminal");
     let (chunks, received) = mpsc::channel();
+    let slowly = options.misbehave == Some(Misbehaviour::ReadsSlowly);
     std::thread::spawn(move || {
         let mut chunk = [0u8; 4096];
         loop {
-            match reader.read(&mut chunk) {
+            if slowly {
+                std::thread::sleep(Duration::from_millis(100));
+            }
+            let chunk = if slowly { &mut chunk[..1024] } else { &mut chunk[..] };
+            match reader.read(chunk) {
                 Ok(n) if n > 0 => {
                     if chunks.send(chunk[..n].to_vec()).is_err() {
                         return;

@@ -4,7 +4,8 @@
 
 /** Instantiates the octrace module and wraps its byte-buffer interface. */
 export async function loadOctrace() {
-  const response = await fetch('/octrace_studio.wasm');
+  // Beside this script, under the page's token (see studio.js).
+  const response = await fetch(new URL('octrace_studio.wasm', import.meta.url));
   const { instance } = await WebAssembly.instantiateStreaming(response, {});
   const x = instance.exports;
   const encoder = new TextEncoder(), decoder = new TextDecoder();

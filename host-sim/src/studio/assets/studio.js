@@ -36,10 +36,18 @@ function main() {
 
   const storageKey = () => 'octrace-studio:' + state.sceneName;
 
+  // The server's rules: the page and its assets are loaded under /TOKEN/
+  // (so relative addresses carry it), and every other request names the
+  // token in a header, never in a cookie, which a browser would also send
+  // to every other server on this machine.
+  const token = decodeURIComponent(location.pathname.split('/')[1] || '');
+  /** fetch() of the server's `path` (/scene, /board), with the token. */
+  const api = (path, init = {}) => fetch(path, { ...init, headers: { ...init.headers, 'X-Studio-Token': token } });
+
   // ----------------------------------------------------------- scene file --
 
   async function loadScene(preferStored) {
-    const response = await fetch('/scene');
+    const response = await api('/scene');
     if (!response.ok) throw new Error(await response.text());
     const body = await response.text();
     state.version = (response.headers.get('ETag') || '').replaceAll('"', '');
@@ -53,7 +61,7 @@ function main() {
 
   async function saveScene(force) {
     if (!state.writable) { alert('The studio was started without a scene file: nothing to save to.'); return false; }
-    const response = await fetch('/scene', {
+    const response = await api('/scene', {
       method: 'PUT', body: text.value, headers: { 'If-Match': force ? '*' : '"' + state.version + '"' },
     });
     if (response.status === 409) {
@@ -138,7 +146,7 @@ function main() {
 
   // ---------------------------------------------------------------- draft --
 
-  const draftWorker = new Worker('/worker.js', { type: 'module' });
+  const draftWorker = new Worker('worker.js', { type: 'module' });
   draftWorker.onmessage = (event) => {
     const m = event.data;
     if (m.seq !== state.draftSeq) return; // superseded
@@ -274,7 +282,7 @@ function main() {
         if (piece) worker.postMessage({ type: 'tile', ...piece });
       };
       for (let i = 0; i < count; i++) {
-        const worker = new Worker('/worker.js', { type: 'module' });
+        const worker = new Worker('worker.js', { type: 'module' });
         workers.push(worker);
         worker.onmessage = (event) => {
           const m = event.data;
@@ -393,7 +401,7 @@ function main() {
 
   // ----------------------------------------------- view, tools and panel --
 
-  const app = { state, $, text, textChanged, scheduleDraft, single, setSingle, replaceStatement, appendStatement,
+  const app = { state, $, text, api, textChanged, scheduleDraft, single, setSingle, replaceStatement, appendStatement,
     errorItem, goTo, putRgb, setStatus };
   app.view = createView(state, $('wire'), single);
   app.tools = createTools(app);
