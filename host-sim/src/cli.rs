@@ -537,40 +537,30 @@ mod tests {
         }
     }
 
-    #[test]
-    fn dither_without_a_panel_is_refused() {
-        let dir = tempfile_dir();
-        let out = dir.join("d.png");
-        let mut stderr = Vec::new();
-        let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/fig5_1.txt");
-        let args =
-            ["host-sim", scene, out.to_str().unwrap(), "--color", "rgb565", "--dither", "bayer", "--size", "4x4"];
-        assert_eq!(run(args, &mut Vec::new(), &mut stderr), EXIT_SCENE);
-        assert!(
-            String::from_utf8_lossy(&stderr).contains("--color mono|gray2|gray4|bwr"),
-            "{}",
-            String::from_utf8_lossy(&stderr)
-        );
-        assert!(!out.exists());
-    }
-
-    #[test]
-    fn color_and_palette_together_are_refused() {
-        let dir = tempfile_dir();
+    /// What host-sim prints when it refuses fig5_1 at 4×4 with `options`
+    /// (exit 2, nothing written).
+    fn refusal(options: &[&str]) -> String {
+        let dir = std::env::temp_dir().join(format!("host-sim-cli-{}-{}", std::process::id(), options.join("")));
+        std::fs::create_dir_all(&dir).unwrap();
         let out = dir.join("x.png");
         let mut stderr = Vec::new();
         let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/fig5_1.txt");
         let args =
-            ["host-sim", scene, out.to_str().unwrap(), "--color", "gray4", "--palette", "dither", "--size", "4x4"];
+            ["host-sim", scene, out.to_str().unwrap(), "--size", "4x4"].into_iter().chain(options.iter().copied());
         assert_eq!(run(args, &mut Vec::new(), &mut stderr), EXIT_SCENE);
-        assert!(String::from_utf8_lossy(&stderr).contains("give one"));
         assert!(!out.exists());
         let _ = std::fs::remove_dir_all(dir);
+        String::from_utf8_lossy(&stderr).into_owned()
     }
 
-    fn tempfile_dir() -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("host-sim-cli-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    #[test]
+    fn dither_without_a_panel_is_refused() {
+        let said = refusal(&["--color", "rgb565", "--dither", "bayer"]);
+        assert!(said.contains("--color mono|gray2|gray4|bwr"), "{said}");
+    }
+
+    #[test]
+    fn color_and_palette_together_are_refused() {
+        assert!(refusal(&["--color", "gray4", "--palette", "dither"]).contains("give one"));
     }
 }
