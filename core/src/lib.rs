@@ -129,8 +129,10 @@
 extern crate alloc;
 
 pub mod accel;
+pub mod animation;
 pub mod capacity;
 pub mod math;
+mod motion;
 pub mod palette;
 pub mod panel;
 pub mod parse;

@@ -1,11 +1,12 @@
 //! The `host-sim` command line.
 
+use crate::animation::{animate, is_frame_file, merge_frames, AnimationOptions, Request};
 use crate::arguments::{output_format, parse_accel, parse_color, parse_dithering, parse_format, parse_palette};
 use crate::arguments::{parse_size, same_file};
 use crate::output::{panel_preview, write_atomically, FileSink};
 use crate::parts::{self, MergeError, PartInfo, PartSpec};
 use crate::terminal::progress_bar;
-use crate::{all_cores, load_bytes, new_scene, render_streamed, AccelMode, LoadError, Partition, RenderOptions};
+use crate::{all_cores, load_frame_bytes, new_scene, render_streamed, AccelMode, LoadError, Partition, RenderOptions};
 use crate::{render_with_progress, HostScene, StreamError, Streamed};
 use clap::Parser;
 use octrace_core::accel::OctreeConfig;
@@ -48,9 +49,11 @@ pub struct Args {
     pub out: Option<PathBuf>,
     /// Map the image onto a 256-entry colour table (written as an indexed
     /// image): scan (the thesis's hash-scan table), dither (6×6×6 cube,
-    /// ordered), coarse (dither with outlines around objects), gray.
-    #[arg(long, value_name = "MODE", default_value = "none", value_parser = parse_palette)]
-    pub palette: PaletteMode,
+    /// ordered), coarse (dither with outlines around objects), gray; none
+    /// (the default) keeps truecolour. An animated GIF takes scan unless
+    /// another table is given.
+    #[arg(long, value_name = "MODE", value_parser = parse_palette)]
+    pub palette: Option<PaletteMode>,
     /// Preview a panel: the pixels as a display of this format shows them
     /// (the firmware's OCTRACE_COLOR): rgb888; rgb565 (written back as
     /// RGB); mono, gray2 and gray4, one bit, 4 and 16 grays, dithered (an
@@ -98,6 +101,17 @@ pub struct Args {
     /// the palette and their rows.
     #[arg(long, value_name = "I/N")]
     pub part: Option<PartSpec>,
+    /// For a scene with FRAMES: render frame K alone, from scratch, as a
+    /// still image. Without it an animation is written whole: an animated
+    /// GIF (OUT.gif), an APNG (OUT.png) or one file a frame (a name with
+    /// %d or %04d).
+    #[arg(long, value_name = "K")]
+    pub frame: Option<u32>,
+    /// Render every frame of an animation whole, instead of re-tracing only
+    /// the pixels the motion can change (the same images; for benchmarks
+    /// and checks).
+    #[arg(long)]
+    pub no_coherence: bool,
     /// Print nothing but errors.
     #[arg(long, short)]
     pub quiet: bool,
@@ -308,7 +322,12 @@ fn preview(
 fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     match &args.command {
         Some(Command::Convert { input, output, format }) => return convert(input, output, *format),
-        Some(Command::Merge { output, parts, format }) => return merge(output, parts, *format),
+        Some(Command::Merge { output, parts, format }) => {
+            return match parts.first().is_some_and(|p| is_frame_file(p)) {
+                true => merge_frames(output, parts),
+                false => merge(output, parts, *format),
+            }
+        }
         // run() serves the studio and talks to boards (both need stdout)
         // instead of calling this.
         Some(Command::Studio(_) | Command::Board(_)) => return Ok(()),
@@ -319,10 +338,26 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     };
     let mut scene = new_scene();
     let scene_bytes = std::fs::read(scene_path).map_err(|e| CliError::read(scene_path, e))?;
-    let loaded = load_bytes(&scene_path.display().to_string(), &scene_bytes, &mut scene).map_err(|e| match e {
+    let frame = args.frame.unwrap_or(0);
+    let name = scene_path.display().to_string();
+    let loaded = load_frame_bytes(&name, &scene_bytes, frame, &mut scene).map_err(|e| match e {
         LoadError::Io(e) => CliError::read(scene_path, e),
         LoadError::Scene(errors) => CliError::Scene { file: scene_path.display().to_string(), errors },
     })?;
+    match (loaded.frames, args.frame) {
+        (None, Some(_)) => {
+            return Err(CliError::Invalid(format!("--frame: {name} is no animation (it has no FRAMES)")))
+        }
+        (Some(frames), Some(k)) if k >= frames.count => {
+            return Err(CliError::Invalid(format!(
+                "--frame {k}: {name} has {} frame{}, 0 to {}",
+                frames.count,
+                if frames.count == 1 { "" } else { "s" },
+                frames.count - 1
+            )))
+        }
+        _ => {}
+    }
     let out = match (&args.out, &loaded.imagefile) {
         (Some(o), _) => o.clone(),
         (None, Some(f)) => PathBuf::from(f),
@@ -333,7 +368,8 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
             )))
         }
     };
-    if args.color != PanelColor::Rgb888 && args.palette != PaletteMode::None {
+    let palette = args.palette.unwrap_or(PaletteMode::None);
+    if args.color != PanelColor::Rgb888 && palette != PaletteMode::None {
         return Err(CliError::Invalid("--color and --palette both choose the pixels: give one".into()));
     }
     if args.dither.is_some() && args.color.panel().is_none() {
@@ -349,10 +385,36 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
             out.display()
         )));
     }
+    let options = |(w, h)| RenderOptions {
+        size: Some((w, h)),
+        accel: args.accel,
+        octree: OctreeConfig { max_objects: args.max_objects, max_depth: args.max_depth, ..crate::OCTREE },
+        threads: args.threads.map_or_else(all_cores, |n| n as usize),
+        partition: args.partition,
+        light_buffer: crate::LIGHT_BUFFER,
+    };
+    let raster = scene.view().settings.raster;
+    let (w, h) = args.size.unwrap_or((raster[0], raster[1]));
+    if let (Some(frames), None) = (loaded.frames, args.frame) {
+        if args.color != PanelColor::Rgb888 {
+            return Err(CliError::Invalid("--color previews one panel: give --frame K".into()));
+        }
+        let request = Request {
+            scene_path,
+            bytes: &scene_bytes,
+            frames,
+            out: &out,
+            palette: args.palette,
+            format: args.format,
+            part: args.part,
+            size: (w, h),
+            options: AnimationOptions { render: options((w, h)), coherence: !args.no_coherence },
+            quiet: args.quiet,
+        };
+        return animate(&request, stderr);
+    }
     let format = output_format(args.format, &out)?;
-    let view = scene.view();
-    let (w, h) = args.size.unwrap_or((view.settings.raster[0], view.settings.raster[1]));
-    let palette_mode = if args.color == PanelColor::Dither { PaletteMode::Dither } else { args.palette };
+    let palette_mode = if args.color == PanelColor::Dither { PaletteMode::Dither } else { palette };
     let (rows, text) = match args.part {
         Some(spec) => {
             let (rows, text) = part_of(spec, palette_mode, args.color, &scene_bytes, (w, h), format)?;
@@ -361,14 +423,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         None => (0..h, None),
     };
     let started = Instant::now();
-    let options = RenderOptions {
-        size: Some((w, h)),
-        accel: args.accel,
-        octree: OctreeConfig { max_objects: args.max_objects, max_depth: args.max_depth, ..crate::OCTREE },
-        threads: args.threads.map_or_else(all_cores, |n| n as usize),
-        partition: args.partition,
-        light_buffer: crate::LIGHT_BUFFER,
-    };
+    let options = options((w, h));
     if previewed(args.color) {
         let dithering = args.dither.unwrap_or_default();
         return preview(&scene, &options, args.color, dithering, format, &out, args.quiet, stderr);

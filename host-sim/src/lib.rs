@@ -6,6 +6,7 @@
 //! a streamed render ([`render_streamed`]) holds a few bands of rows, never
 //! the image, and hands every row to its sink once, in order.
 
+pub mod animation;
 mod arguments;
 pub mod board;
 pub mod cli;
@@ -24,7 +25,7 @@ use octrace_core::accel::{
     self, Accelerator, BuildReport, LightBuffer, LightBufferReport, LightBufferStore, LightBuffered, Naive, Octree,
     OctreeConfig, Traversal,
 };
-use octrace_core::parse::{parse_bytes, ParseError};
+use octrace_core::parse::{parse_frame_bytes, ParseError};
 use octrace_core::profile::Host;
 use octrace_core::profile::Profile;
 use octrace_core::scene::{CameraError, Scene};
@@ -63,15 +64,22 @@ impl std::fmt::Display for LoadError {
 pub struct Loaded {
     /// The scene's IMAGEFILE, if any.
     pub imagefile: Option<String>,
+    /// Its FRAMES, if it is an animation.
+    pub frames: Option<octrace_core::scene::Frames>,
 }
 
 /// Parses scene `text` (bytes, UTF-8 checked) into `scene`; errors are
 /// formatted with `name` in front.
 pub fn load_bytes(name: &str, bytes: &[u8], scene: &mut HostScene) -> Result<Loaded, LoadError> {
+    load_frame_bytes(name, bytes, 0, scene)
+}
+
+/// [`load_bytes`] of frame `frame` of an animation (a scene with FRAMES).
+pub fn load_frame_bytes(name: &str, bytes: &[u8], frame: u32, scene: &mut HostScene) -> Result<Loaded, LoadError> {
     let mut errors = Vec::new();
     let mut on_error = |e: ParseError<'_>| errors.push(format!("{name}:{e}"));
-    match parse_bytes(bytes, scene, &mut on_error) {
-        Ok(parsed) => Ok(Loaded { imagefile: parsed.imagefile.map(str::to_owned) }),
+    match parse_frame_bytes(bytes, scene, frame, &mut on_error) {
+        Ok(parsed) => Ok(Loaded { imagefile: parsed.imagefile.map(str::to_owned), frames: parsed.frames }),
         Err(_) => Err(LoadError::Scene(errors)),
     }
 }

@@ -6,7 +6,10 @@
 //! fig5_1 is also kept in each 256-colour mode (`fig5_1-scan.png`, …, indexed
 //! PNGs), the README's palette gallery, and at 128×64 on each panel of few
 //! levels and with each dithering (`fig5_1-mono.png`, `fig5_1-mono-bayer.png`,
-//! …: host-sim's `--color` preview files, byte for byte), its panel gallery.
+//! …: host-sim's `--color` preview files, byte for byte), its panel gallery;
+//! each animation (`scenes/anim_*.txt`) as the animated GIF `host-sim
+//! scenes/anim_….txt OUT.gif` writes (`docs/gallery/anim_….gif`, byte for
+//! byte).
 //!
 //! Re-bless after an intended change of the images:
 //!
@@ -17,7 +20,7 @@ use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
 use octrace_images::formats::{self, Format, Image};
 use octrace_images::palette::{self, PaletteMode};
-use octrace_tests::{blessing, repo, scenes};
+use octrace_tests::{animations, blessing, repo, scenes};
 
 #[test]
 fn every_scene_matches_its_golden_image() {
@@ -116,6 +119,43 @@ fn fig5_1_on_every_panel_matches_its_golden_image() {
             Err(e) => failures.push(format!("{}: {e}", golden.display())),
         }
     }
+    assert!(
+        failures.is_empty(),
+        "{}\n(re-bless with OCTRACE_BLESS=1 cargo test -p octrace-tests --test golden)",
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn every_animation_matches_its_golden_gif() {
+    let gallery = repo().join("docs/gallery");
+    let dir = std::env::temp_dir().join(format!("octrace-golden-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut failures = Vec::new();
+    for (name, path) in animations() {
+        let out = dir.join(format!("{name}.gif"));
+        let mut stderr = Vec::new();
+        let code = host_sim::run(
+            ["host-sim".as_ref(), path.as_os_str(), out.as_os_str(), "-q".as_ref()],
+            &mut Vec::new(),
+            &mut stderr,
+        );
+        assert_eq!(code, 0, "{name}: {}", String::from_utf8_lossy(&stderr));
+        let made = std::fs::read(&out).unwrap();
+        let golden = gallery.join(format!("{name}.gif"));
+        if blessing() {
+            std::fs::write(&golden, &made).unwrap();
+            println!("blessed {}", golden.display());
+            continue;
+        }
+        match std::fs::read(&golden) {
+            Err(e) => failures.push(format!("{name}: cannot read {}: {e}", golden.display())),
+            Ok(expected) if expected != made => failures.push(format!("{name}: differs from {}", golden.display())),
+            Ok(_) => println!("{name}: identical"),
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(!animations().is_empty(), "scenes/ holds animations");
     assert!(
         failures.is_empty(),
         "{}\n(re-bless with OCTRACE_BLESS=1 cargo test -p octrace-tests --test golden)",

@@ -22,6 +22,7 @@ pub(crate) mod naive;
 mod octree;
 
 pub use choice::{prepare, Prepared};
+pub(crate) use light_buffer::RAY_SLACK;
 pub use light_buffer::{
     LightBuffer, LightBufferError, LightBufferReport, LightBufferStore, LightBuffered, MAX_CELLS_A_SIDE,
 };

@@ -2,10 +2,11 @@
 //! core that loaded it; it draws as an image, directly or progressively.
 
 use crate::accel::{AccelMode, Accelerator, BuildReport, LightBuffer, LightBufferError};
+use crate::animation::{Coherence, Motion};
 use crate::panel::{Dithered, Dithering, TracedColor};
 use crate::profile::Profile;
 use crate::render::{Progressive, Renderer};
-use crate::scene::{CameraError, SceneView};
+use crate::scene::{CameraError, Frames, SceneView};
 use crate::shade::Stats;
 use core::cell::{Cell, RefCell};
 use core::fmt;
@@ -29,6 +30,8 @@ pub struct LoadedScene<'r, P: Profile> {
     pub(super) screen_lists: RefCell<Option<ScreenLists<'r>>>,
     pub(super) first_hits: bool,
     pub(super) stats: Cell<Stats>,
+    /// FRAMES, for an animation.
+    pub(super) frames: Option<Frames>,
 }
 
 impl<P: Profile> fmt::Debug for LoadedScene<'_, P> {
@@ -157,13 +160,8 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         f: impl FnOnce(&mut Renderer<'_, SceneAccelerator<'r, P>>) -> R,
     ) -> Result<R, CameraError> {
         let accelerator = self.accelerator();
-        // Another draw of this scene holds the mailbox or the lists (only if
-        // a display draws from inside a draw): render without, same image.
-        let mut mailbox = self.mailbox.try_borrow_mut();
-        let mut screen_lists = self.screen_lists.try_borrow_mut();
-        let lists = screen_lists.as_deref_mut().ok().and_then(|lists| lists.as_mut());
-        let lists = lists.map(|(bounds, positions)| (&mut **bounds, &mut **positions));
-        let mailbox = mailbox.as_deref_mut().ok().map(|words| &mut **words);
+        let (mut mailbox, mut screen_lists) = (self.mailbox.try_borrow_mut(), self.screen_lists.try_borrow_mut());
+        let (mailbox, lists) = room_of(&mut mailbox, &mut screen_lists);
         let mut renderer = renderer_in(self.view, &accelerator, size, mailbox, lists)?;
         let result = f(&mut renderer);
         let mut total = self.stats.get();
@@ -187,6 +185,67 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// What building the octree produced, if the mode uses one.
     pub fn octree_report(&self) -> Option<&BuildReport> {
         self.octree.as_ref().map(|(_, report)| report)
+    }
+
+    /// The scene's FRAMES, if it is an animation (loaded at one of its
+    /// frames: [`Raytracer::load_frame`](super::Raytracer::load_frame)).
+    pub fn frames(&self) -> Option<Frames> {
+        self.frames
+    }
+
+    /// Draws frame `frame` of an animation, this scene loaded at that
+    /// frame, into `target` (of `coherence`'s size), re-tracing only the
+    /// tiles [`Coherence::plan`] left to trace (call it first) and drawing
+    /// only their runs of pixels: after the frame before it in the loop
+    /// (or at the first frame, everything), `target` shows the frame as a
+    /// whole draw would. An example is [`Coherence`]'s.
+    pub fn draw_changes<D>(
+        &self,
+        motion: &Motion<'_>,
+        frame: u32,
+        coherence: &Coherence<'_>,
+        target: &mut D,
+    ) -> Result<Stats, DrawError<D::Error>>
+    where
+        D: DrawTarget,
+        D::Color: From<Rgb888>,
+    {
+        self.draw_bands(motion, frame, coherence, 0..coherence.bands(), target)
+    }
+
+    /// [`LoadedScene::draw_changes`] of the bands `bands` only, with one
+    /// renderer in the room of the loading core: on a board whose cores
+    /// share the frame, `bands` takes the next band no core has taken yet
+    /// (the other cores trace theirs with [`Coherence::trace_band`] and a
+    /// renderer of their own, [`SharedScene::renderer`]).
+    pub fn draw_bands<D>(
+        &self,
+        motion: &Motion<'_>,
+        frame: u32,
+        coherence: &Coherence<'_>,
+        bands: impl IntoIterator<Item = u32>,
+        target: &mut D,
+    ) -> Result<Stats, DrawError<D::Error>>
+    where
+        D: DrawTarget,
+        D::Color: From<Rgb888>,
+    {
+        let accelerator = self.accelerator();
+        // As `with_renderer`, here: the renderer's room is borrowed no
+        // longer than `motion` lives.
+        let (mut mailbox, mut screen_lists) = (self.mailbox.try_borrow_mut(), self.screen_lists.try_borrow_mut());
+        let (mailbox, lists) = room_of(&mut mailbox, &mut screen_lists);
+        let mut renderer =
+            renderer_in(self.view, &accelerator, coherence.size(), mailbox, lists).map_err(DrawError::Camera)?;
+        let mut stats = Stats::default();
+        let result = bands.into_iter().try_for_each(|band| {
+            stats.add(&coherence.draw_band(&mut renderer, motion, frame, band, target)?);
+            Ok(())
+        });
+        let mut total = self.stats.get();
+        total.add(&stats);
+        self.stats.set(total);
+        result.map(|()| stats).map_err(DrawError::Target)
     }
 
     /// The counters of every draw so far.
@@ -271,6 +330,18 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
 /// A renderer over `view` for an image of `size`, with a mailbox and screen
 /// lists where given. Inlined: a board's renderer is made in place.
 #[inline(always)]
+/// The loading core's room out of its cells: none of what another draw of
+/// the scene holds (only if a display draws from inside a draw: the render
+/// goes without, the same image).
+fn room_of<'g, 'r>(
+    mailbox: &'g mut Result<core::cell::RefMut<'_, &'r mut [u32]>, core::cell::BorrowMutError>,
+    screen_lists: &'g mut Result<core::cell::RefMut<'_, Option<ScreenLists<'r>>>, core::cell::BorrowMutError>,
+) -> (Option<&'g mut [u32]>, Option<ScreenLists<'g>>) {
+    let lists = screen_lists.as_deref_mut().ok().and_then(|lists| lists.as_mut());
+    let lists = lists.map(|(bounds, positions)| (&mut **bounds, &mut **positions));
+    (mailbox.as_deref_mut().ok().map(|words| &mut **words), lists)
+}
+
 pub(super) fn renderer_in<'a, A: Accelerator>(
     view: SceneView<'a>,
     accel: &'a A,

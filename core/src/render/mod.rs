@@ -32,6 +32,7 @@ pub use progressive::{Progressive, ProgressiveError, TracedUnit, Unit};
 pub use split::{interleaved_rows, Tiles};
 
 use crate::accel::{Accelerator, Hit, Mailbox};
+use crate::motion::{Lookout, RayKind};
 use crate::scene::{Camera, CameraError, CameraRay, Color, ObjectId, RayCursor, SceneView, Stride, MAX_SIDE};
 use crate::shade::{Scratch, Stats, Tracer};
 use core::ops::Range;
@@ -224,13 +225,35 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         PixelSample { color: Rgb888::new(encoded[0], encoded[1], encoded[2]), object }
     }
 
+    /// Watches the frames to come while tracing (an animation traced with
+    /// coherence), or stops (`None`).
+    pub(crate) fn set_lookout(&mut self, lookout: Option<Lookout<'a>>) {
+        self.scratch.lookout = lookout;
+    }
+
+    /// The pixel at (`x`, `y`) and its clean count under the lookout, if
+    /// below `bound` (else `bound`).
+    pub(crate) fn watched_pixel(&mut self, x: u32, y: u32, bound: u32) -> (PixelSample, u32) {
+        if let Some(lookout) = &mut self.scratch.lookout {
+            lookout.start(bound);
+        }
+        let pixel = self.pixel(x, y);
+        (pixel, self.scratch.lookout.map_or(bound, |l| l.clean))
+    }
+
     /// The colour and object of sample (`sx`, `sy`) of pixel (`x`, `y`).
     #[inline]
     fn sample(&mut self, x: u32, y: u32, sx: u32, sy: u32) -> (Color, Option<ObjectId>) {
         let mut ray = self.camera.next_ray(&mut self.cursor, x, y, sx, sy);
         match self.first_hit(&mut ray, x, y, sx, sy) {
-            // Shown by the lists to miss: the ray itself is never made.
-            Some(None) => self.tracer.missed(&mut self.scratch),
+            // Shown by the lists to miss: the ray itself is made only for
+            // the lookout.
+            Some(None) => {
+                if let Some(lookout) = &mut self.scratch.lookout {
+                    lookout.ray(ray.get(&self.camera), None, RayKind::Primary);
+                }
+                self.tracer.missed(&mut self.scratch)
+            }
             first => self.tracer.trace(*ray.get(&self.camera), first, &mut self.scratch),
         }
     }

@@ -14,11 +14,13 @@
 //! a `static` costs no flash.
 
 mod camera;
+mod motion;
 mod normalize;
 mod surface;
 
 pub use camera::{Camera, CameraError, View, MAX_SAMPLES, MAX_SIDE};
 pub(crate) use camera::{CameraRay, Projection, RayCursor, Stride};
+pub use motion::{displacement_at, Frames};
 pub use normalize::{Normalization, WorldPoint, WorldValue};
 pub use surface::{Color, Surface, SurfaceEntry};
 
@@ -311,10 +313,10 @@ impl<C: SceneCapacities> Scene<C> {
     }
 
     /// Evaluates the patch whose control points were set, pushing its
-    /// triangles (room checked beforehand with [`Scene::check_room`]);
-    /// returns how many were made, or the capacity that ran out (the
-    /// first triangle that did not fit ends the patch: none is dropped
-    /// silently).
+    /// triangles moved by `shift` (room checked beforehand with
+    /// [`Scene::check_room`]); returns how many were made, or the capacity
+    /// that ran out (the first triangle that did not fit ends the patch:
+    /// none is dropped silently).
     pub(crate) fn push_bspline(
         &mut self,
         order: u32,
@@ -322,14 +324,23 @@ impl<C: SceneCapacities> Scene<C> {
         cols: u32,
         samples: [u32; 2],
         surface: u16,
+        shift: Vec3,
     ) -> Result<usize, CapacityError> {
         let points = core::mem::replace(&mut self.control_points, C::ControlPoints::EMPTY);
         let mut made = Ok(0);
         let first = self.objects.as_slice().len() as u32;
         if let Some(patch) = crate::shapes::Bspline::new(order, rows, cols, points.as_slice()) {
             patch.triangles(samples[0], samples[1], surface, |t| {
+                // Moved corners keep their edges, so the same normal: a
+                // triangle that was made is made again once moved.
+                let corners = t.triangle.polygon.corners.map(|c| c + shift);
+                let moved = match shift == Vec3::ZERO {
+                    true => Some(t.triangle),
+                    false => crate::shapes::Triangle::new(corners, surface),
+                };
+                let Some(triangle) = moved else { return };
                 if let Ok(count) = &mut made {
-                    match self.push_shape(SmoothTriangle { patch: first, ..t }) {
+                    match self.push_shape(SmoothTriangle { triangle, patch: first, ..t }) {
                         Ok(()) => *count += 1,
                         Err(e) => made = Err(e),
                     }
@@ -504,15 +515,15 @@ mod tests {
         // the one that does not fit is an error, not a triangle dropped.
         let mut scene: Scene<Patch31> = Scene::new();
         scene.set_control_points(grid()).unwrap();
-        let e = scene.push_bspline(3, 3, 3, [5, 5], 0).unwrap_err();
+        let e = scene.push_bspline(3, 3, 3, [5, 5], 0, Vec3::ZERO).unwrap_err();
         assert_eq!((e.kind, e.capacity), (CapacityKind::BsplineTriangles, 31));
         let mut scene: Scene<Objects31> = Scene::new();
         scene.set_control_points(grid()).unwrap();
-        let e = scene.push_bspline(3, 3, 3, [5, 5], 0).unwrap_err();
+        let e = scene.push_bspline(3, 3, 3, [5, 5], 0, Vec3::ZERO).unwrap_err();
         assert_eq!((e.kind, e.capacity), (CapacityKind::Objects, 31));
         // 2 · 4 · 3 = 24 fit.
         let mut scene: Scene<Patch31> = Scene::new();
         scene.set_control_points(grid()).unwrap();
-        assert_eq!(scene.push_bspline(3, 3, 3, [5, 4], 0), Ok(24));
+        assert_eq!(scene.push_bspline(3, 3, 3, [5, 4], 0, Vec3::ZERO), Ok(24));
     }
 }

@@ -20,6 +20,7 @@ use crate::math::{
     leading_zeros, mul_u32_wide, mul_wide, pow_unit, reciprocal_start, shr_saturating_u32, shr_signed_to_u32, Dir,
     Scalar, Unit, Vec3, UNIT_ONE,
 };
+use crate::motion::{Lookout, RayKind};
 use crate::scene::{Color, ObjectId, SceneView};
 use crate::shapes::{Leaving, Ray};
 
@@ -74,11 +75,14 @@ pub(crate) struct Scratch<'m> {
     /// it is tried before any walk (`u32::MAX`: none). Any blocker gives the
     /// same answer, so this cannot change an image.
     blockers: [u32; BLOCKER_SLOTS],
+    /// In an animation traced with coherence, what sees every segment of
+    /// the ray tree (`None`: a still picture, or a frame traced whole).
+    pub lookout: Option<Lookout<'m>>,
 }
 
 impl<'m> Scratch<'m> {
     pub fn new(mailbox: Mailbox<'m>) -> Scratch<'m> {
-        Scratch { stats: Stats::default(), mailbox, blockers: [u32::MAX; BLOCKER_SLOTS] }
+        Scratch { stats: Stats::default(), mailbox, blockers: [u32::MAX; BLOCKER_SLOTS], lookout: None }
     }
 }
 
@@ -89,6 +93,7 @@ struct Pending {
     start: Option<RayStart>,
     depth: u32,
     weight: Scalar,
+    kind: RayKind,
 }
 
 /// Traces rays through a scene with a given accelerator.
@@ -195,7 +200,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         let mut traced = 0;
         // The ray being traced; its first child follows it directly, the
         // other waits on the stack (depth first, as a recursion would go).
-        let mut p = Pending { ray, start: None, depth: 0, weight: Scalar::ONE };
+        let mut p = Pending { ray, start: None, depth: 0, weight: Scalar::ONE, kind: RayKind::Primary };
         loop {
             if traced == MAX_RAYS_PER_SAMPLE {
                 scratch.stats.truncated += 1 + stack.len() as u64;
@@ -214,6 +219,9 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             };
             if p.depth == 0 {
                 first_object = hit.map(|h| self.scene.written_object(h.object));
+            }
+            if let Some(lookout) = &mut scratch.lookout {
+                lookout.ray(&p.ray, hit.map(|h| h.t), p.kind);
             }
             let mut next = None;
             match hit {
@@ -286,6 +294,9 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             };
             let start = RayStart { object: hit.object, leaving };
             let t_max = Scalar::from_bits((distance.to_bits() - 1).max(0));
+            if let Some(lookout) = &mut scratch.lookout {
+                lookout.shadow(shadow_from, light.position);
+            }
             if self.occluded(
                 &shadow,
                 t_max,
@@ -313,7 +324,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             return [None, None];
         }
         // The direction is made only for a ray that will be traced.
-        let child = |dir: &dyn Fn() -> Dir, k: Scalar| {
+        let child = |dir: &dyn Fn() -> Dir, k: Scalar, kind: RayKind| {
             (k.to_bits() > 0).then(|| {
                 let dir = dir();
                 Pending {
@@ -321,10 +332,11 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
                     start: Some(RayStart { object: hit.object, leaving: leaving_along(geometric, dir) }),
                     depth: p.depth + 1,
                     weight: mul(p.weight, k),
+                    kind,
                 }
             })
         };
-        [child(&|| p.ray.dir, t), child(&|| to_eye.reflect_about(normal), r)]
+        [child(&|| p.ray.dir, t, RayKind::Transmitted), child(&|| to_eye.reflect_about(normal), r, RayKind::Reflected)]
     }
 
     /// Whether anything blocks `shadow` to light `light` before `t_max`,

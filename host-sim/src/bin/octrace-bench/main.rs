@@ -7,8 +7,9 @@
 //! `criterion` (the octree's subdivision criterion), `parallel` (threads
 //! and partitions), `palette` (the 256-colour modes), `panels` (every
 //! dithering on every panel of few levels, issue 42's measure),
-//! `spheres600` (naive against dda on 600 random spheres at 800×600). No
-//! argument: all. Times are wall-clock on one thread
+//! `spheres600` (naive against dda on 600 random spheres at 800×600),
+//! `animation` (frame-to-frame coherence on anim_fig5_1, `animation.rs`).
+//! No argument: all. Times are wall-clock on one thread
 //! (except in `parallel`), the best of several runs; the machine is printed
 //! first so every table says where it came from.
 
@@ -20,6 +21,9 @@ use octrace_core::accel::OctreeConfig;
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
+
+mod animation;
+mod panels;
 
 fn machine() -> String {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
@@ -48,14 +52,18 @@ fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (Duration, T) {
     (best, last.expect("at least one run"))
 }
 
-fn ms(d: Duration) -> String {
+pub(crate) fn ms(d: Duration) -> String {
     format!("{:.1} ms", d.as_secs_f64() * 1e3)
 }
 
 fn scene_files(dir: &Path) -> Vec<PathBuf> {
     let mut v: Vec<PathBuf> =
         std::fs::read_dir(dir).map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect()).unwrap_or_default();
-    v.retain(|p| p.extension().is_some_and(|x| x == "txt"));
+    // The stills: the animations (`anim_*`) have a table of their own.
+    v.retain(|p| {
+        p.extension().is_some_and(|x| x == "txt")
+            && !p.file_stem().is_some_and(|s| s.to_string_lossy().starts_with("anim_"))
+    });
     v.sort();
     v
 }
@@ -72,10 +80,11 @@ enum Table {
     Palette,
     Panels,
     Spheres600,
+    Animation,
 }
 
 impl Table {
-    const ALL: [Table; 9] = [
+    const ALL: [Table; 10] = [
         Table::Scenes,
         Table::Table51,
         Table::Table52,
@@ -85,6 +94,7 @@ impl Table {
         Table::Palette,
         Table::Panels,
         Table::Spheres600,
+        Table::Animation,
     ];
 
     /// Its name on the command line.
@@ -99,6 +109,7 @@ impl Table {
             Table::Palette => "palette",
             Table::Panels => "panels",
             Table::Spheres600 => "spheres600",
+            Table::Animation => "animation",
         }
     }
 
@@ -119,15 +130,16 @@ impl Table {
             }
             Table::Parallel => parallel(dir),
             Table::Palette => palette_table(dir),
-            Table::Panels => panels_table(dir),
+            Table::Panels => panels::table(dir),
             Table::Spheres600 => spheres600(dir),
+            Table::Animation => animation::table(dir),
         }
     }
 }
 
 /// Why octrace-bench stopped before its tables were done.
 #[derive(Debug)]
-enum BenchError {
+pub(crate) enum BenchError {
     /// A table it does not know was asked for.
     UnknownTable(String),
     /// A scene it measures did not load.
@@ -162,7 +174,7 @@ impl fmt::Display for BenchError {
 
 impl std::error::Error for BenchError {}
 
-fn load(path: &Path) -> Result<Box<HostScene>, BenchError> {
+pub(crate) fn load(path: &Path) -> Result<Box<HostScene>, BenchError> {
     let mut scene = new_scene();
     load_file(path, &mut scene).map_err(|error| BenchError::Scene { path: path.to_owned(), error })?;
     Ok(scene)
@@ -465,54 +477,6 @@ fn palette_table(dir: &Path) -> Result<(), BenchError> {
         print!(" {:.1} ns |", c.as_nanos() as f64 / pixels);
     }
     println!("\n");
-    Ok(())
-}
-
-/// Every scene at 128×64 on every panel of few levels by every dithering:
-/// issue 42's measure (what the eye sees of the picture through a blur of
-/// one pixel, [`octrace_images::panel::seen_psnr`]), and each method's cost
-/// per pixel on this machine.
-fn panels_table(dir: &Path) -> Result<(), BenchError> {
-    use octrace_core::panel::{Dithering, Panel};
-    use octrace_core::render::PanelColor;
-    use octrace_images::panel;
-    let mut renders = Vec::new();
-    for path in scene_files(dir) {
-        let name = path.file_stem().unwrap_or_default().to_string_lossy().into_owned();
-        let scene = load(&path)?;
-        let options = RenderOptions { size: Some((128, 64)), threads: all_cores(), ..Default::default() };
-        if let Ok(rendered) = render(&scene, &options) {
-            renders.push((name, rendered.image));
-        }
-    }
-    for shown in Panel::ALL {
-        let against = match shown {
-            Panel::BlackWhiteRed => "the render's RGB (capped by the colours three inks cannot mix)",
-            _ => "the render's gray",
-        };
-        println!(
-            "### `--color {}` at 128×64: dB against {against}, blurred by σ = 1 pixel
-",
-            PanelColor::from(shown)
-        );
-        let methods =
-            Dithering::ALL.map(|d| format!("{d}{}", if d == Dithering::default() { " (default)" } else { "" }));
-        println!("| scene | {} |", methods.join(" | "));
-        println!("| --- |{}", " ---: |".repeat(methods.len()));
-        let mut cost = [Duration::ZERO; Dithering::ALL.len()];
-        for (name, image) in &renders {
-            print!("| {name} |");
-            for (i, dithering) in Dithering::ALL.into_iter().enumerate() {
-                let (time, preview) = best_of(5, || panel::dithered(image, shown, dithering));
-                cost[i] += time;
-                print!(" {:.2} |", panel::seen_psnr(image, &preview.to_rgb(), shown));
-            }
-            println!();
-        }
-        let pixels = (renders.len() * 128 * 64) as f64;
-        let cost: Vec<String> = cost.iter().map(|c| format!("{:.1} ns", c.as_nanos() as f64 / pixels)).collect();
-        println!("| cost per pixel | {} |\n", cost.join(" | "));
-    }
     Ok(())
 }
 
