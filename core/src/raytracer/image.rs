@@ -362,31 +362,62 @@ mod tests {
         assert!(again.0[0].iter().all(|c| c.is_some()));
     }
 
+    /// A 12×8 gray panel that keeps the last colour drawn at each pixel.
+    struct Overdrawn([[Option<Gray4>; 12]; 8]);
+
+    impl OriginDimensions for Overdrawn {
+        fn size(&self) -> Size {
+            Size::new(12, 8)
+        }
+    }
+
+    impl DrawTarget for Overdrawn {
+        type Color = Gray4;
+        type Error = core::convert::Infallible;
+
+        fn draw_iter<I: IntoIterator<Item = Pixel<Gray4>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
+            for Pixel(p, c) in pixels {
+                self.0[p.y as usize][p.x as usize] = Some(c);
+            }
+            Ok(())
+        }
+    }
+
+    /// `scene`'s 12×8 picture, dithered by Bayer.
+    fn ordered<P: Profile>(scene: &LoadedScene<'_, P>) -> [[Option<Gray4>; 12]; 8] {
+        let mut grid = Grid::<Gray4, 12, 8>([[None; 12]; 8]);
+        scene.image_for(&grid).dithered(Dithering::Bayer).draw(&mut grid).unwrap();
+        grid.0
+    }
+
     #[test]
     fn a_progressive_panel_ends_in_the_ordered_picture() {
         let mut raytracer = Raytracer::<Board16K>::new();
         let scene = raytracer.load(SCENE).unwrap();
-        /// Keeps the last colour drawn at each pixel.
-        struct Overdrawn([[Option<Gray4>; 12]; 8]);
-        impl OriginDimensions for Overdrawn {
-            fn size(&self) -> Size {
-                Size::new(12, 8)
-            }
-        }
-        impl DrawTarget for Overdrawn {
-            type Color = Gray4;
-            type Error = core::convert::Infallible;
-            fn draw_iter<I: IntoIterator<Item = Pixel<Gray4>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
-                for Pixel(p, c) in pixels {
-                    self.0[p.y as usize][p.x as usize] = Some(c);
-                }
-                Ok(())
-            }
-        }
         let mut progressive = Overdrawn([[None; 12]; 8]);
         scene.draw_progressive(&Progressive::new(Size::new(12, 8), 4), &mut progressive).unwrap();
-        let mut ordered = Grid::<Gray4, 12, 8>([[None; 12]; 8]);
-        scene.image_for(&ordered).dithered(Dithering::Bayer).draw(&mut ordered).unwrap();
-        assert_eq!(progressive.0, ordered.0);
+        assert_eq!(progressive.0, ordered(&scene));
+    }
+
+    #[test]
+    fn an_animated_panel_shows_each_frames_ordered_picture() {
+        use crate::animation::{Coherence, Key, Motion, Track};
+        use core::sync::atomic::AtomicU8;
+        let text = "FRAMES 4\nRASTER 12 8\nBACKGROUND .4 .4 .4\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\n\
+                    LIGHT 10 5 5 5\nSPHERE 1 2 0 0 -4\nSPHERE 1 0.5 -3 2 0 MOVE 0 0 0 0  3 1.5 0 0\n";
+        let counts: [AtomicU8; Coherence::tiles_for(12, 8, 4)] = [const { AtomicU8::new(0) }; 6];
+        let coherence = Coherence::new(&counts, Size::new(12, 8), 4).unwrap();
+        let (mut tracks, mut keys, mut displacements) = ([Track::EMPTY; 1], [Key::default(); 2], [[0; 3]; 4]);
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let first = raytracer.load_frame(text, 0).unwrap();
+        let frames = first.frames().unwrap();
+        let motion = Motion::read(text, frames, &first.view(), 0, &mut tracks, &mut keys, &mut displacements).unwrap();
+        let mut panel = Overdrawn([[None; 12]; 8]);
+        for frame in frames.all().chain(frames.all()) {
+            let scene = raytracer.load_frame(text, frame).unwrap();
+            coherence.plan();
+            scene.draw_changes(&motion, frame, &coherence, &mut panel).unwrap();
+            assert_eq!(panel.0, ordered(&scene), "frame {frame}");
+        }
     }
 }

@@ -199,6 +199,12 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// only their runs of pixels: after the frame before it in the loop
     /// (or at the first frame, everything), `target` shows the frame as a
     /// whole draw would. An example is [`Coherence`]'s.
+    ///
+    /// A panel of few levels (`BinaryColor`, `Gray2`, `Gray4`,
+    /// [`BlackWhiteRed`](crate::panel::BlackWhiteRed)) is dithered by
+    /// [`Dithering::Bayer`], whose pixels depend on nothing but themselves
+    /// (error diffusion would carry a change across the whole image): it
+    /// shows the frame as a whole draw with that method would.
     pub fn draw_changes<D>(
         &self,
         motion: &Motion<'_>,
@@ -208,7 +214,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     ) -> Result<Stats, DrawError<D::Error>>
     where
         D: DrawTarget,
-        D::Color: From<Rgb888>,
+        D::Color: TracedColor,
     {
         self.draw_bands(motion, frame, coherence, 0..coherence.bands(), target)
     }
@@ -219,6 +225,30 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// (the other cores trace theirs with [`Coherence::trace_band`] and a
     /// renderer of their own, [`SharedScene::renderer`]).
     pub fn draw_bands<D>(
+        &self,
+        motion: &Motion<'_>,
+        frame: u32,
+        coherence: &Coherence<'_>,
+        bands: impl IntoIterator<Item = u32>,
+        target: &mut D,
+    ) -> Result<Stats, DrawError<D::Error>>
+    where
+        D: DrawTarget,
+        D::Color: TracedColor,
+    {
+        match D::Color::PANEL {
+            None => self.draw_bands_converted(motion, frame, coherence, bands, target),
+            Some(_) => {
+                // Bayer keeps no rows: no room is wanting.
+                let mut ordered = Dithered::new(target, Dithering::Bayer, &mut []).map_err(DrawError::ErrorRow)?;
+                self.draw_bands_converted(motion, frame, coherence, bands, &mut ordered)
+            }
+        }
+    }
+
+    /// [`LoadedScene::draw_bands`] into a target that takes the traced
+    /// colours converted.
+    fn draw_bands_converted<D>(
         &self,
         motion: &Motion<'_>,
         frame: u32,
