@@ -159,6 +159,8 @@ impl<P: Profile, C: TracedColor> TracedImage<'_, '_, P, C> {
         rows: Option<&mut [i16]>,
     ) -> Result<(), DrawError<D::Error>> {
         let mut shifted = Shifted { target, offset: Point::zero() - area.top_left };
+        // The pixels there are: the rows a ditherer is set up for.
+        let area = &area.intersection(&self.bounding_box());
         match (C::PANEL, rows) {
             (None, _) => self.scene.render_area(self.size, area, &mut shifted),
             (Some(_), Some(rows)) => self.draw_dithered(area, &mut shifted, rows),
@@ -342,6 +344,14 @@ mod tests {
             // keeps the whole image's pattern there.
             assert_eq!(drawn, dithered_by_hand::<BinaryColor, 12, 8>(dithering, area), "{dithering:?}");
         }
+        // An area reaching past the image: what there is of it.
+        let beyond = Rectangle::new(Point::new(5, 3), Size::new(8, 6));
+        let mut part = Grid::<BinaryColor, 8, 6>([[None; 8]; 6]);
+        scene.image::<BinaryColor>(Size::new(12, 8)).draw_sub_image(&mut part, &beyond).unwrap();
+        let drawn: Vec<BinaryColor> = part.0[..5].iter().flat_map(|row| row[..7].iter().map(|c| c.unwrap())).collect();
+        let inside = Rectangle::new(Point::new(5, 3), Size::new(7, 5));
+        assert_eq!(drawn, dithered_by_hand::<BinaryColor, 12, 8>(Dithering::FsPe, inside));
+        assert_eq!(part.0.iter().flatten().filter(|c| c.is_some()).count(), 35);
     }
 
     #[test]
