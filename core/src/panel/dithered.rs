@@ -67,6 +67,30 @@ where
         Dithered::across(display, dithering, area.top_left.x, area.size.width, rows)
     }
 
+    /// `display`, each pixel dithered on its own by [`Dithering::Bayer`]:
+    /// for drawing in any order (a progressive order's passes, an
+    /// animation's changed tiles), with no rows kept.
+    ///
+    /// ```
+    /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::{BinaryColor, Rgb888}, prelude::*};
+    /// use octrace_core::panel::Dithered;
+    ///
+    /// let mut display = MockDisplay::<BinaryColor>::new();
+    /// let mut ordered = Dithered::ordered(&mut display);
+    /// // Half gray, a pixel at a time in any order: lit where the 4×4
+    /// // Bayer threshold is below half (0 at (0, 0)), not where above (8 at (1, 0)).
+    /// ordered.draw_iter([Pixel(Point::new(1, 0), Rgb888::new(128, 128, 128))])?;
+    /// ordered.draw_iter([Pixel(Point::new(0, 0), Rgb888::new(128, 128, 128))])?;
+    /// assert_eq!(display.get_pixel(Point::new(0, 0)), Some(BinaryColor::On));
+    /// assert_eq!(display.get_pixel(Point::new(1, 0)), Some(BinaryColor::Off));
+    /// # Ok::<(), core::convert::Infallible>(())
+    /// ```
+    pub fn ordered(display: &'t mut D) -> Dithered<'t, 'static, D> {
+        let area = display.bounding_box();
+        let ditherer = D::Color::PANEL.map(|panel| Ditherer::ordered(panel, area.top_left, area.size.width));
+        Dithered { display, ditherer, next_row: None }
+    }
+
     /// `display`, its rows dithered across the `width` columns from
     /// `left`.
     pub(crate) fn across(

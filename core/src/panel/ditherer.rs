@@ -62,6 +62,16 @@ impl<'b> Ditherer<'b> {
         let needed = if dithering.diffuses() { panel.error_words(width) } else { 0 };
         let given = rows.len();
         let rows = rows.get_mut(..needed).ok_or(ErrorRowTooShort { needed, given })?;
+        Ok(Ditherer::with_rows(panel, dithering, top_left, width, rows))
+    }
+
+    /// A ditherer by [`Dithering::Bayer`], which keeps no rows.
+    pub(super) fn ordered(panel: Panel, top_left: Point, width: u32) -> Ditherer<'static> {
+        Ditherer::with_rows(panel, Dithering::Bayer, top_left, width, &mut [])
+    }
+
+    /// A ditherer over `rows`, as many as it needs.
+    fn with_rows(panel: Panel, dithering: Dithering, top_left: Point, width: u32, rows: &'b mut [i16]) -> Self {
         let mut ditherer = Ditherer {
             panel,
             dithering,
@@ -72,7 +82,7 @@ impl<'b> Ditherer<'b> {
             channels: [Accumulators::default(); 2],
         };
         ditherer.restart(top_left.y);
-        Ok(ditherer)
+        ditherer
     }
 
     /// The panel it dithers for.

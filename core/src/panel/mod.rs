@@ -60,7 +60,9 @@
 //! To draw an image's rows in several calls, or from several cores, with
 //! the whole image's dither, send its rows in order through one
 //! [`Dithered`] target, which carries the error from each band of rows to
-//! the next.
+//! the next. Drawn in no order at all (a progressive order's passes, an
+//! animation's changed tiles), a panel is dithered by Bayer
+//! ([`Dithered::ordered`]): `draw_progressive` and `draw_changes` do so.
 //!
 //! # One bit
 //!

@@ -238,11 +238,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     {
         match D::Color::PANEL {
             None => self.draw_bands_converted(motion, frame, coherence, bands, target),
-            Some(_) => {
-                // Bayer keeps no rows: no room is wanting.
-                let mut ordered = Dithered::new(target, Dithering::Bayer, &mut []).map_err(DrawError::ErrorRow)?;
-                self.draw_bands_converted(motion, frame, coherence, bands, &mut ordered)
-            }
+            Some(_) => self.draw_bands_converted(motion, frame, coherence, bands, &mut Dithered::ordered(target)),
         }
     }
 
@@ -335,8 +331,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         let drawn = match D::Color::PANEL {
             None => self.with_renderer(order.size(), |renderer| order.render_unchecked(renderer, target)),
             Some(_) => {
-                // Bayer keeps no rows: no room is wanting.
-                let mut ordered = Dithered::new(target, Dithering::Bayer, &mut []).map_err(DrawError::ErrorRow)?;
+                let mut ordered = Dithered::ordered(target);
                 self.with_renderer(order.size(), |renderer| order.render_unchecked(renderer, &mut ordered))
             }
         };
