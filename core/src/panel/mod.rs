@@ -18,7 +18,7 @@
 //! let mut display = MockDisplay::<BinaryColor>::new();
 //! Image::new(&scene.image_for(&display), Point::zero()).draw(&mut display)?;
 //! let lit = display.affected_area().points().filter(|&p| display.get_pixel(p) == Some(BinaryColor::On)).count();
-//! // 0.45 is gray 180 (the default gamma 2.2), 70 % of 64 × 64.
+//! // 0.45 shows as gray 177 (the default gamma 2.2): 69 % of 64 × 64 lit.
 //! assert!((2800..=2950).contains(&lit), "{lit}");
 //! # Ok::<(), Box<dyn core::error::Error>>(())
 //! ```
@@ -110,7 +110,8 @@
 //!         self.0.bounding_box()
 //!     }
 //! }
-//! // Then: Image::new(&scene.image_for(&Tri(&mut epd)), Point::zero()).draw(&mut Tri(&mut epd))
+//! // Then: let mut panel = Tri(&mut epd);
+//! //       Image::new(&scene.image_for(&panel), Point::zero()).draw(&mut panel)?;
 //! ```
 //!
 //! Invariants: integers only, so the same colours in the same order give
@@ -259,6 +260,17 @@ impl Panel {
         }
     }
 
+    /// Division by the step in 1/16 gray, each panel's made when the crate
+    /// compiles: a panel known only when the program runs must not bring
+    /// the division back.
+    const fn step_divisor(self) -> Divisor {
+        match self {
+            Panel::Mono | Panel::BlackWhiteRed => const { Divisor::new(16 * 255) },
+            Panel::Gray2 => const { Divisor::new(16 * 85) },
+            Panel::Gray4 => const { Divisor::new(16 * 17) },
+        }
+    }
+
     /// A gray panel's value of `level`, 0 to 255.
     fn gray_value(self, level: u8) -> i32 {
         level as i32 * self.step()
@@ -272,16 +284,10 @@ impl Panel {
             Panel::Mono => (v >= 128 << 4) as u8,
             gray => {
                 let (step, top) = (gray.step() << 4, gray.levels() as i32 - 1);
-                // Each panel's divisor made when it compiles: a panel known
-                // only when the program runs must not bring the division back.
-                let by_step = match gray {
-                    Panel::Gray2 => const { Divisor::new(16 * 85) },
-                    _ => const { Divisor::new(16 * 17) },
-                };
                 match v + step / 2 {
                     x if x <= 0 => 0,
                     x if x >= top * step => top as u8,
-                    x => by_step.quotient(x as u32) as u8,
+                    x => gray.step_divisor().quotient(x as u32) as u8,
                 }
             }
         }
@@ -562,7 +568,7 @@ mod tests {
         // Every divisor used, over all it divides: gray values and level
         // steps in 1/16 gray up to 4096, and the projection's sums of three
         // values below 768.
-        for (d, below) in [(255, 4097), (16 * 85, 4097), (16 * 17, 4097), (3, 768)] {
+        for (d, below) in [(255, 4097), (16 * 255, 4097), (16 * 85, 4097), (16 * 17, 4097), (3, 768)] {
             for x in 0..below {
                 assert_eq!(Divisor::new(d).quotient(x), x / d, "{x} / {d}");
             }
