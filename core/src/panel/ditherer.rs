@@ -414,6 +414,41 @@ mod tests {
     }
 
     #[test]
+    fn the_accumulators_stay_far_from_saturating_on_hostile_pictures() {
+        // Noise, noise at the extremes, saturated colours, one-pixel
+        // stripes and checkers, ramps: the largest accumulator stays under
+        // half of what an i16 holds, so saturation never changes a level.
+        let mut next = crate::test_rng::seeded(0xd17_4e55);
+        let width = 96u32;
+        let pictures: [&dyn Fn(u32, u32, u64) -> Rgb888; 6] = [
+            &|_, _, r| Rgb888::new(r as u8, (r >> 8) as u8, (r >> 16) as u8),
+            &|_, _, r| gray(if r & 1 == 0 { 0 } else { 255 }),
+            &|_, _, r| [Rgb888::new(0, 0, 255), Rgb888::new(0, 255, 0), Rgb888::new(255, 0, 255)][(r % 3) as usize],
+            &|x, _, _| gray(if x % 2 == 0 { 0 } else { 255 }),
+            &|x, y, _| if (x + y) % 2 == 0 { Rgb888::new(0, 255, 255) } else { Rgb888::new(255, 0, 0) },
+            &|x, y, _| Rgb888::new((x * 255 / 95) as u8, (y * 4) as u8, 128),
+        ];
+        let mut largest = 0;
+        for picture in pictures {
+            for panel in Panel::ALL {
+                for dithering in [Dithering::FsPe, Dithering::FloydSteinberg] {
+                    let mut rows = std::vec![0i16; panel.error_words(width)];
+                    let mut ditherer = Ditherer::new(panel, dithering, Point::zero(), width, &mut rows).unwrap();
+                    for y in 0..64 {
+                        for x in 0..width {
+                            assert!(ditherer.next(picture(x, y, next())) < panel.levels());
+                        }
+                        let row_largest = ditherer.rows.iter().map(|v| v.unsigned_abs()).max().unwrap_or(0);
+                        largest = largest.max(row_largest);
+                    }
+                }
+            }
+        }
+        std::println!("largest accumulator: {largest}");
+        assert!(largest < 1 << 14, "an accumulator reached {largest}");
+    }
+
+    #[test]
     fn restart_forgets_the_error() {
         let colors = [gray(100); 24];
         let mut rows = [0i16; 6];
