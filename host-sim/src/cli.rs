@@ -272,20 +272,18 @@ fn part_of(
     Ok((rows, info.to_string()))
 }
 
-/// `--color rgb565|mono|gray2|gray4|bwr`: a panel's preview, converted or
-/// dithered from the whole image (panels are small; every other image
-/// streams).
-#[allow(clippy::too_many_arguments)]
+/// `--color rgb565|mono|gray2|gray4|bwr [--dither METHOD]`: a panel's
+/// preview, converted or dithered from the whole image (panels are small;
+/// every other image streams).
 fn preview(
     scene: &HostScene,
     options: &RenderOptions,
-    color: PanelColor,
-    dithering: Dithering,
+    args: &Args,
     format: Format,
     out: &Path,
-    quiet: bool,
     stderr: &mut dyn Write,
 ) -> Result<(), CliError> {
+    let (color, dithering) = (args.color, args.dither.unwrap_or_default());
     let started = Instant::now();
     // The parser rejects a camera that cannot be set up; a scene built by
     // hand may not.
@@ -295,7 +293,7 @@ fn preview(
         panel_preview(&rendered.image, color, dithering).unwrap_or_else(|| Image::Rgb(rendered.image.clone()));
     write_atomically(out, |f| write_preview(&preview, color, format, f).map_err(std::io::Error::other))
         .map_err(|e| CliError::write(out, e))?;
-    if !quiet {
+    if !args.quiet {
         let (image, stats) = (&rendered.image, rendered.stats);
         let _ = writeln!(
             stderr,
@@ -425,8 +423,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     let started = Instant::now();
     let options = options((w, h));
     if previewed(args.color) {
-        let dithering = args.dither.unwrap_or_default();
-        return preview(&scene, &options, args.color, dithering, format, &out, args.quiet, stderr);
+        return preview(&scene, &options, args, format, &out, stderr);
     }
     // `coarse` outlines need the objects of the row above a part.
     let render_rows = match palette_mode {
