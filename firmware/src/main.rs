@@ -216,9 +216,9 @@ fn draw_dithered(scene: &LoadedScene<'static, Profile>, file: HostFile) -> bool 
     draw_into(scene, &mut dithered)
 }
 
-/// Draws the scene into `display` as an embedded-graphics image, a panel
-/// of few levels dithered in a row of error diffusion's the size of its
-/// width (less stack than the image's own).
+/// Draws the scene into `display` as an embedded-graphics image; a panel
+/// of few levels keeps error diffusion's row, exactly as wide as the
+/// panel, in this frame (less stack than the image's own 512 bytes).
 #[cfg(not(any(board = "lm3s6965evb", board = "mps2-an521")))]
 fn draw_into<D: DrawTarget>(scene: &LoadedScene<'static, Profile>, display: &mut D) -> bool
 where
