@@ -32,7 +32,9 @@ use octrace_core::render::Handoff;
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
 use octrace_link::board::Board;
 use octrace_link::{Decoder, Panel, PixelFormat, Sink};
-use octrace_pico_st7789::{board, both_cores, panel};
+use octrace_pico::board;
+use octrace_pico::both_cores;
+use octrace_pico_st7789::panel;
 use panic_halt as _;
 use rp2040_hal as hal;
 use usb_device::class_prelude::UsbBusAllocator;
@@ -40,7 +42,7 @@ use usb_device::prelude::*;
 use usbd_serial::SerialPort;
 
 // The render path runs from SRAM (build.rs): copied there at boot.
-octrace_pico_st7789::copy_code_into_sram!();
+octrace_pico::copy_code_into_sram!();
 
 /// The second-stage loader for the Pico's W25Q16JV flash (see memory.x).
 #[link_section = ".boot2"]
@@ -97,12 +99,13 @@ const STALLED_AFTER_US: u64 = 1_000_000;
 
 #[entry]
 fn main() -> ! {
-    let board::Board { mut display, mut core1, timer, usb, mut resets } =
-        board::start(PANEL_BUFFER.take(), CORE1_STACK.take().unwrap());
+    let board::Board { mut core1, pins, clocks, timer, mut resets, peripherals } =
+        board::start(CORE1_STACK.take().unwrap());
+    let mut display = panel::init(peripherals.spi1, pins, &mut resets, &clocks, timer, PANEL_BUFFER.take());
 
     // The USB serial port, served by its interrupt from here on.
     let bus: &'static UsbBusAllocator<UsbBus> = cortex_m::singleton!(: UsbBusAllocator<UsbBus> =
-        UsbBusAllocator::new(UsbBus::new(usb.regs, usb.dpram, usb.clock, true, &mut resets)))
+        UsbBusAllocator::new(UsbBus::new(peripherals.usbctrl_regs, peripherals.usbctrl_dpram, clocks.usb_clock, true, &mut resets)))
     .unwrap();
     let serial = SerialPort::new(bus);
     let strings = StringDescriptors::default().manufacturer("octrace").product("octrace live").serial_number("1");

@@ -1,79 +1,28 @@
-//! Both cores trace a scene: core 1 runs what core 0 hands it, core 0
-//! drives the panel.
+//! Both cores trace a scene, core 0 presents it: [`draw`] is the picture
+//! row by row, [`draw_progressive`] in a progressive order. Each core takes
+//! the next piece no core has taken (under the chip's lock) and traces it
+//! with a renderer of its own; core 1 (a [`SecondCore`] job) hands its
+//! pieces over in a [`Handoff`] ring; core 0 presents every piece in
+//! order. Each waits for the other with `wfe`, woken by the other's `sev`.
 //!
-//! [`SecondCore::start`] starts core 1 once, in a loop that waits for jobs.
-//! [`SecondCore::scope`] runs a job on core 1 while core 0 does its own
-//! part, and returns only when both are done, so a job may borrow anything
-//! core 0 has (like `std::thread::scope`). [`draw`] is the picture: each
-//! core takes the next row no core has taken (under the chip's lock) and
-//! traces it with a renderer of its own; core 1 hands its rows over in a
-//! [`Handoff`] ring; core 0 sends every row to the panel in order. Each
-//! waits for the other with `wfe`, woken by the other's `sev`.
-//!
-//! Invariants: `JOB` is null or points at core 0's `&mut dyn FnMut()` for
-//! the job, which core 0 keeps alive until core 1 has set `JOB` back to
-//! null; panics abort (`panic = "abort"`, `panic-halt`), so core 0 never
-//! leaves a scope early by unwinding.
+//! Invariants: any split of the pieces between the cores gives the same
+//! bits as one core; core 0 presents the pieces in their order, so a
+//! display fed row by row sees the rows top to bottom.
 
+use crate::second_core::SecondCore;
 use core::cell::Cell;
 use core::ops::ControlFlow;
-use core::ptr;
-use core::sync::atomic::{AtomicBool, AtomicPtr, Ordering};
+use core::sync::atomic::{AtomicBool, Ordering};
 use cortex_m::asm::{sev, wfe};
 use critical_section::Mutex;
-use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
-use embedded_graphics::prelude::*;
-use embedded_graphics::primitives::Rectangle;
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{OriginDimensions, Point, Size};
+use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
+use embedded_graphics_core::primitives::Rectangle;
+use embedded_graphics_core::Pixel;
 use octrace_core::profile::Profile;
 use octrace_core::render::{Handoff, Progressive, Renderer, Unit};
 use octrace_core::{LoadedScene, RendererRoom, SceneAccelerator};
-use rp2040_hal::multicore::{Core, Error as SpawnError, StackAllocation};
-
-/// Core 0's job for core 1, or null.
-static JOB: AtomicPtr<()> = AtomicPtr::new(ptr::null_mut());
-
-/// Core 1, waiting for jobs.
-pub struct SecondCore {
-    _started: (),
-}
-
-impl SecondCore {
-    /// Starts core 1 on `stack`, waiting for jobs.
-    pub fn start(core1: &mut Core<'_>, stack: StackAllocation) -> Result<SecondCore, SpawnError> {
-        core1.spawn(stack, || loop {
-            let job = JOB.load(Ordering::Acquire).cast::<&mut (dyn FnMut() + Send)>();
-            if job.is_null() {
-                wfe();
-                continue;
-            }
-            // SAFETY: core 0 keeps the job alive, and touches it not, until
-            // JOB is null again (see `scope`).
-            unsafe { (*job)() };
-            JOB.store(ptr::null_mut(), Ordering::Release);
-            sev();
-        })?;
-        Ok(SecondCore { _started: () })
-    }
-
-    /// Runs `job` on core 1 while `here` runs on core 0, and returns what
-    /// `here` returns once `job` is done too.
-    pub fn scope<R>(&mut self, job: impl FnOnce() + Send, here: impl FnOnce() -> R) -> R {
-        let mut job = Some(job);
-        let mut call = || {
-            if let Some(job) = job.take() {
-                job();
-            }
-        };
-        let mut erased: &mut (dyn FnMut() + Send) = &mut call;
-        JOB.store(ptr::from_mut(&mut erased).cast(), Ordering::Release);
-        sev();
-        let result = here();
-        while !JOB.load(Ordering::Acquire).is_null() {
-            wfe();
-        }
-        result
-    }
-}
 
 /// Why a picture stopped before its end.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -88,19 +37,21 @@ pub enum Unfinished {
 
 /// Traces `scene` into `display` with both cores, row by row, core 1
 /// rendering in `room` (its own mailbox and screen lists) and handing rows
-/// over through `ring`. `each_row` sees every row as it goes to the panel,
-/// in order, and may stop the picture there.
+/// over through `ring`; each row goes to the display in its colour (`From<Rgb888>`)
+/// in one `fill_contiguous`. `each_row` sees every row as it goes to the
+/// panel, in order, and may stop the picture there.
 pub fn draw<P, D, const LEN: usize, const SLOTS: usize>(
     core1: &mut SecondCore,
     scene: &LoadedScene<'_, P>,
     room: &mut RendererRoom<P>,
     ring: &Handoff<LEN, SLOTS>,
     display: &mut D,
-    mut each_row: impl FnMut(u32, &[Rgb565]) -> ControlFlow<()>,
+    mut each_row: impl FnMut(u32, &[D::Color]) -> ControlFlow<()>,
 ) -> Result<(), Unfinished>
 where
     P: Profile,
-    D: DrawTarget<Color = Rgb565>,
+    D: DrawTarget,
+    D::Color: From<Rgb888>,
 {
     let size = display.bounding_box().size;
     let width = size.width.min(LEN as u32);
@@ -113,7 +64,7 @@ where
         traced
     };
     let present = |y: &u32, colors: &[Rgb888]| {
-        let mut line = [Rgb565::BLACK; LEN];
+        let mut line = [D::Color::from(Rgb888::BLACK); LEN];
         let line = &mut line[..colors.len()];
         for (pixel, &color) in line.iter_mut().zip(colors) {
             *pixel = color.into();
@@ -143,7 +94,8 @@ pub fn draw_progressive<P, D, const LEN: usize, const SLOTS: usize>(
 ) -> Result<(), Unfinished>
 where
     P: Profile,
-    D: DrawTarget<Color = Rgb565>,
+    D: DrawTarget,
+    D::Color: From<Rgb888>,
 {
     if order.size() != display.bounding_box().size || order.max_unit_pixels() > LEN {
         return Err(Unfinished::Panel);
@@ -291,16 +243,19 @@ fn receive<const LEN: usize, const SLOTS: usize>(
     len
 }
 
-/// A display of `Rgb565` taking the progressive order's `Rgb888` blocks.
+/// A display taking the progressive order's `Rgb888` blocks in its own colour.
 struct Converted<'d, D>(&'d mut D);
 
-impl<D: DrawTarget<Color = Rgb565>> OriginDimensions for Converted<'_, D> {
+impl<D: DrawTarget> OriginDimensions for Converted<'_, D> {
     fn size(&self) -> Size {
         self.0.bounding_box().size
     }
 }
 
-impl<D: DrawTarget<Color = Rgb565>> DrawTarget for Converted<'_, D> {
+impl<D: DrawTarget> DrawTarget for Converted<'_, D>
+where
+    D::Color: From<Rgb888>,
+{
     type Color = Rgb888;
     type Error = D::Error;
 

@@ -1,8 +1,8 @@
 //! Copying the code `sram-code.x` places in SRAM (all of it and its
 //! constants, or the render path with or without the parser, as
-//! `OCTRACE_CODE_IN` says) from flash before anything else runs: a firmware
-//! whose linker script places code there says
-//! `octrace_pico_st7789::copy_code_into_sram!();` once.
+//! `OCTRACE_CODE_IN` says; `octrace-pico-build` writes the script) from
+//! flash before anything else runs: a firmware whose linker script places
+//! code there says `octrace_pico::copy_code_into_sram!();` once.
 //!
 //! Invariants: `__pre_init` is the first code cortex-m-rt's reset handler
 //! calls, before `.bss` and `.data` are set up, so it touches no RAM but
