@@ -16,10 +16,6 @@ fn main() {
     let placement = CodePlacement::from_env().unwrap_or_else(|e| fail(e));
     link(&[("octrace-pico-st7789", placement), ("octrace-pico-live", CodePlacement::RenderInSram)])
         .unwrap_or_else(|e| fail(e));
-    println!("cargo::rustc-check-cfg=cfg(code_in_sram)");
-    if placement.copies_code() {
-        println!("cargo:rustc-cfg=code_in_sram");
-    }
 
     // The embedded-scene firmware's pixel order: row by row (the default,
     // the faster), or progressive (the whole panel in coarse blocks at

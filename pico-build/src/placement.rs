@@ -7,7 +7,9 @@
 //!
 //! Invariants: `memory.x` includes `code-placement.x`, which [`link`]
 //! writes into a folder of its own for each firmware, so that each links
-//! with its own placement.
+//! with its own placement; every placement defines the copy's bounds (an
+//! empty copy for code left in flash), so every firmware expands
+//! `copy_code_into_sram!` whatever its placement.
 
 use crate::{out_dir, write, BuildError};
 
@@ -74,28 +76,19 @@ impl CodePlacement {
         )
     }
 
-    /// Whether it copies code into SRAM (the firmware then expands
-    /// `octrace_pico::copy_code_into_sram!`).
-    pub fn copies_code(self) -> bool {
-        self != CodePlacement::Flash
-    }
-
-    /// The input sections `sram-code.x` copies, or none.
-    fn copied(self) -> Option<String> {
+    /// The input sections `sram-code.x` copies (none for code left in flash).
+    fn copied(self) -> String {
         match self {
-            CodePlacement::AllInSram => Some("*(.text .text.*); *(.rodata .rodata.*);".to_owned()),
-            CodePlacement::LoadAndRenderInSram => Some(format!("*({RENDER_PATH} {LOADER});")),
-            CodePlacement::RenderInSram => Some(format!("*({RENDER_PATH});")),
-            CodePlacement::Flash => None,
+            CodePlacement::AllInSram => "*(.text .text.*); *(.rodata .rodata.*);".to_owned(),
+            CodePlacement::LoadAndRenderInSram => format!("*({RENDER_PATH} {LOADER});"),
+            CodePlacement::RenderInSram => format!("*({RENDER_PATH});"),
+            CodePlacement::Flash => String::new(),
         }
     }
 
     /// The linker script `memory.x` includes for a firmware so placed.
     fn script(self) -> String {
-        match self.copied() {
-            Some(copied) => SRAM_CODE_X.replace("COPIED", &copied),
-            None => "/* The code runs in place from flash, through the XIP cache. */\n".to_owned(),
-        }
+        SRAM_CODE_X.replace("COPIED", &self.copied())
     }
 }
 
@@ -125,8 +118,8 @@ mod tests {
         let load = CodePlacement::LoadAndRenderInSram.script();
         assert!(load.contains(".text.*octrace_core*parse*") && load.contains(".text.*both_cores*"), "{load}");
         assert!(CodePlacement::AllInSram.script().contains("*(.rodata .rodata.*);"));
-        assert!(!CodePlacement::Flash.script().contains("SECTIONS"));
-        assert!(!CodePlacement::Flash.copies_code());
+        let flash = CodePlacement::Flash.script();
+        assert!(!flash.contains(".text.*") && flash.contains("__sram_code_end"), "{flash}");
         for (placement, _) in CodePlacement::ALL {
             assert!(!placement.script().contains("COPIED"), "{placement:?}");
         }

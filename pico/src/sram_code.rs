@@ -1,8 +1,9 @@
 //! Copying the code `sram-code.x` places in SRAM (all of it and its
 //! constants, or the render path with or without the parser, as
 //! `OCTRACE_CODE_IN` says; `octrace-pico-build` writes the script) from
-//! flash before anything else runs: a firmware whose linker script places
-//! code there says `octrace_pico::copy_code_into_sram!();` once.
+//! flash before anything else runs: every firmware linked with that
+//! crate's `link` says `octrace_pico::copy_code_into_sram!();` once (with
+//! the code left in flash, the copy is empty).
 //!
 //! Invariants: `__pre_init` is the first code cortex-m-rt's reset handler
 //! calls, before `.bss` and `.data` are set up, so it touches no RAM but

@@ -23,7 +23,7 @@ use octrace_pico_st7789::panel;
 use panic_halt as _;
 use rp2040_hal as hal;
 
-#[cfg(code_in_sram)]
+// What build.rs places in SRAM (OCTRACE_CODE_IN), copied there at boot.
 octrace_pico::copy_code_into_sram!();
 
 /// The second-stage loader for the Pico's W25Q16JV flash; the boot ROM
