@@ -130,6 +130,7 @@ pub mod accel;
 pub mod capacity;
 pub mod math;
 pub mod palette;
+pub mod panel;
 pub mod parse;
 pub mod profile;
 mod raytracer;

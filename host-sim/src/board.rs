@@ -12,6 +12,7 @@ use crate::cli::{output_format, panel_preview, parse_format, progress_bar, same_
 use crate::exit::CliError;
 use crate::{all_cores, load_bytes, new_scene, render_with_progress, LoadError, RenderOptions, RgbImage};
 use embedded_graphics_core::pixelcolor::RgbColor;
+use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
 use octrace_images::formats::{self, Format, Image};
 use octrace_link::{Decoder, Message, Panel, PixelFormat, Reason, VERSION};
@@ -671,7 +672,7 @@ fn host_render(file: &str, text: &[u8], panel: Panel) -> Result<RgbImage, CliErr
     let color = match panel.format {
         PixelFormat::Rgb565 => PanelColor::Rgb565,
     };
-    Ok(match panel_preview(&rendered.image, color) {
+    Ok(match panel_preview(&rendered.image, color, Dithering::default()) {
         Some(preview) => preview.to_rgb(),
         None => rendered.image,
     })

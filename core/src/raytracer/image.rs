@@ -1,13 +1,14 @@
 //! A loaded scene as an embedded-graphics image: drawn whole or in part,
-//! traced as the display takes its rows.
+//! traced as the display takes its rows, dithered onto a panel of few
+//! levels.
 
+use crate::panel::{Dithered, Dithering, ErrorRowTooShort, TracedColor, IMAGE_ERROR_WORDS};
 use crate::profile::Profile;
 use crate::scene::CameraError;
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Dimensions, OriginDimensions, Point, Size};
 use embedded_graphics_core::image::ImageDrawable;
-use embedded_graphics_core::pixelcolor::{PixelColor, Rgb888};
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
 
@@ -20,6 +21,10 @@ use super::LoadedScene;
 pub enum DrawError<E> {
     /// The camera cannot be set up for this size (see [`CameraError`]).
     Camera(CameraError),
+    /// Error diffusion has no room for the image's rows (an image wider
+    /// than [`IMAGE_ERROR_WORDS`] allows, drawn without storage of its
+    /// own).
+    ErrorRow(ErrorRowTooShort),
     /// The display's own error.
     Target(E),
 }
@@ -28,6 +33,7 @@ impl<E: fmt::Display> fmt::Display for DrawError<E> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             DrawError::Camera(e) => write!(f, "{e}"),
+            DrawError::ErrorRow(e) => write!(f, "{e}"),
             DrawError::Target(e) => write!(f, "the display failed: {e}"),
         }
     }
@@ -36,9 +42,14 @@ impl<E: fmt::Display> fmt::Display for DrawError<E> {
 impl<E: fmt::Debug + fmt::Display> core::error::Error for DrawError<E> {}
 
 /// A traced scene as an embedded-graphics image, `size` pixels in the colour
-/// `C` (any colour that converts from `Rgb888`: `Rgb565`, `Gray4`, …), like
-/// `tinybmp::Bmp<C>`. Each draw traces the pixels as the display takes
-/// them, one scanline at a time: no framebuffer.
+/// `C`, like `tinybmp::Bmp<C>`. Each draw traces the pixels as the display
+/// takes them, one scanline at a time: no framebuffer.
+///
+/// A truecolour `C` (`Rgb565`, `Rgb888`, …) takes each pixel converted; a
+/// panel of few levels (`BinaryColor`, `Gray2`, `Gray4`,
+/// [`BlackWhiteRed`](crate::panel::BlackWhiteRed)) takes it dithered, by
+/// [`Dithering::FsPe`] unless [`TracedImage::dithered`] says otherwise (see
+/// [`panel`](crate::panel): a sub-image is dithered as an image of its own).
 ///
 /// ```
 /// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb565, prelude::*};
@@ -53,12 +64,17 @@ impl<E: fmt::Debug + fmt::Display> core::error::Error for DrawError<E> {}
 pub struct TracedImage<'s, 'r, P: Profile, C> {
     pub(super) scene: &'s LoadedScene<'r, P>,
     pub(super) size: Size,
+    pub(super) dithering: Dithering,
     pub(super) color: core::marker::PhantomData<C>,
 }
 
 impl<P: Profile, C> fmt::Debug for TracedImage<'_, '_, P, C> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("TracedImage").field("size", &self.size).field("scene", self.scene).finish()
+        f.debug_struct("TracedImage")
+            .field("size", &self.size)
+            .field("dithering", &self.dithering)
+            .field("scene", self.scene)
+            .finish()
     }
 }
 
@@ -70,12 +86,106 @@ impl<P: Profile, C> Clone for TracedImage<'_, '_, P, C> {
 
 impl<P: Profile, C> Copy for TracedImage<'_, '_, P, C> {}
 
-impl<P: Profile, C: PixelColor + From<Rgb888>> TracedImage<'_, '_, P, C> {
+impl<P: Profile, C> TracedImage<'_, '_, P, C> {
+    /// The image dithered by `dithering` on a panel of few levels (a
+    /// truecolour display ignores it).
+    ///
+    /// ```
+    /// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::BinaryColor, prelude::*};
+    /// use octrace_core::{panel::Dithering, profile::Board16K, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load("BACKGROUND 0.5 0.5 0.5\n")?;
+    /// let mut display = MockDisplay::<BinaryColor>::new();
+    /// let image = scene.image_for(&display).dithered(Dithering::Bayer);
+    /// Image::new(&image, Point::zero()).draw(&mut display)?;
+    /// // Ordered: the same 4×4 pattern all over.
+    /// assert_eq!(display.get_pixel(Point::new(1, 2)), display.get_pixel(Point::new(41, 62)));
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn dithered(self, dithering: Dithering) -> Self {
+        TracedImage { dithering, ..self }
+    }
+
+    /// How it is dithered on a panel of few levels.
+    pub fn dithering(&self) -> Dithering {
+        self.dithering
+    }
+}
+
+impl<P: Profile, C: TracedColor> TracedImage<'_, '_, P, C> {
     /// Draws the image at the origin of `target`, telling a camera that
-    /// cannot be set up (a zero size) apart from the display's errors;
+    /// cannot be set up (a zero size), or an image too wide for the error
+    /// row on the stack, apart from the display's errors;
     /// [`ImageDrawable::draw`] draws nothing then.
     pub fn try_draw<D: DrawTarget<Color = C>>(&self, target: &mut D) -> Result<(), DrawError<D::Error>> {
-        self.scene.draw_area(self.size, &Rectangle::new(Point::zero(), self.size), Point::zero(), target)
+        self.draw_area(&self.bounding_box(), target, None)
+    }
+
+    /// [`TracedImage::try_draw`] with error diffusion's rows in `rows`
+    /// (at least [`Panel::error_words`](crate::panel::Panel::error_words)
+    /// of the image's width) instead of on the draw's stack: for an image
+    /// wider than [`IMAGE_ERROR_WORDS`] allows, or a board short of stack.
+    ///
+    /// ```
+    /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Gray4, prelude::*};
+    /// use octrace_core::{panel::Panel, profile::Board16K, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load("BACKGROUND 0.5 0.5 0.5\n")?;
+    /// let mut display = MockDisplay::<Gray4>::new();
+    /// let mut rows = [0i16; Panel::Gray4.error_words(64)];
+    /// scene.image_for(&display).try_draw_with(&mut display, &mut rows)?;
+    ///
+    /// let mut on_the_stack = MockDisplay::<Gray4>::new();
+    /// scene.image_for(&on_the_stack).try_draw(&mut on_the_stack)?;
+    /// assert_eq!(display, on_the_stack);
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn try_draw_with<D: DrawTarget<Color = C>>(
+        &self,
+        target: &mut D,
+        rows: &mut [i16],
+    ) -> Result<(), DrawError<D::Error>> {
+        self.draw_area(&self.bounding_box(), target, Some(rows))
+    }
+
+    /// Draws `area` of the image with its top-left pixel at the origin of
+    /// `target`, dithered for a panel in `rows` or on the stack.
+    fn draw_area<D: DrawTarget<Color = C>>(
+        &self,
+        area: &Rectangle,
+        target: &mut D,
+        rows: Option<&mut [i16]>,
+    ) -> Result<(), DrawError<D::Error>> {
+        let mut shifted = Shifted { target, offset: Point::zero() - area.top_left };
+        match (C::PANEL, rows) {
+            (None, _) => self.scene.render_area(self.size, area, &mut shifted),
+            (Some(_), Some(rows)) => self.draw_dithered(area, &mut shifted, rows),
+            (Some(_), None) => self.draw_dithered_on_stack(area, &mut shifted),
+        }
+    }
+
+    /// Draws `area` dithered, its error row on this frame. Not inlined: a
+    /// truecolour draw never holds the row.
+    #[inline(never)]
+    fn draw_dithered_on_stack<D: DrawTarget<Color = C>>(
+        &self,
+        area: &Rectangle,
+        target: &mut D,
+    ) -> Result<(), DrawError<D::Error>> {
+        self.draw_dithered(area, target, &mut [0; IMAGE_ERROR_WORDS])
+    }
+
+    fn draw_dithered<D: DrawTarget<Color = C>>(
+        &self,
+        area: &Rectangle,
+        target: &mut D,
+        rows: &mut [i16],
+    ) -> Result<(), DrawError<D::Error>> {
+        let (left, width) = (area.top_left.x, area.size.width);
+        let mut dithered = Dithered::across(target, self.dithering, left, width, rows).map_err(DrawError::ErrorRow)?;
+        self.scene.render_area(self.size, area, &mut dithered)
     }
 }
 
@@ -85,7 +195,7 @@ impl<P: Profile, C> OriginDimensions for TracedImage<'_, '_, P, C> {
     }
 }
 
-impl<P: Profile, C: PixelColor + From<Rgb888>> ImageDrawable for TracedImage<'_, '_, P, C> {
+impl<P: Profile, C: TracedColor> ImageDrawable for TracedImage<'_, '_, P, C> {
     type Color = C;
 
     fn draw<D: DrawTarget<Color = C>>(&self, target: &mut D) -> Result<(), D::Error> {
@@ -93,8 +203,8 @@ impl<P: Profile, C: PixelColor + From<Rgb888>> ImageDrawable for TracedImage<'_,
     }
 
     fn draw_sub_image<D: DrawTarget<Color = C>>(&self, target: &mut D, area: &Rectangle) -> Result<(), D::Error> {
-        match self.scene.draw_area(self.size, area, Point::zero(), target) {
-            Ok(()) | Err(DrawError::Camera(_)) => Ok(()),
+        match self.draw_area(area, target, None) {
+            Ok(()) | Err(DrawError::Camera(_) | DrawError::ErrorRow(_)) => Ok(()),
             Err(DrawError::Target(e)) => Err(e),
         }
     }

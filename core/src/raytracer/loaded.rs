@@ -2,6 +2,7 @@
 //! core that loaded it; it draws as an image, directly or progressively.
 
 use crate::accel::{AccelMode, Accelerator, BuildReport, LightBuffer, LightBufferError};
+use crate::panel::{Dithered, Dithering, TracedColor};
 use crate::profile::Profile;
 use crate::render::{Progressive, Renderer};
 use crate::scene::{CameraError, SceneView};
@@ -9,11 +10,10 @@ use crate::shade::Stats;
 use core::cell::{Cell, RefCell};
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::geometry::Size;
 use embedded_graphics_core::pixelcolor::Rgb888;
 use embedded_graphics_core::primitives::Rectangle;
 
-use super::image::Shifted;
 use super::{light_buffer, DrawError, SceneAccelerator, ScreenLists, SharedScene, TracedImage};
 
 /// A scene ready to trace, borrowed from its [`Raytracer`](super::Raytracer).
@@ -202,7 +202,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
 
     /// The scene as an image of `size` pixels in the colour `C`.
     pub fn image<C>(&self, size: Size) -> TracedImage<'_, 'r, P, C> {
-        TracedImage { scene: self, size, color: core::marker::PhantomData }
+        TracedImage { scene: self, size, dithering: Dithering::default(), color: core::marker::PhantomData }
     }
 
     /// The scene as an image as large as `target`, in its colour: what
@@ -216,6 +216,11 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// blocks first, then finer, until it is exactly the picture
     /// [`LoadedScene::image`] draws. Every pixel is traced once; the
     /// drawing streams (no framebuffer), in a few calls a pass.
+    ///
+    /// A panel of few levels (`BinaryColor`, `Gray2`, `Gray4`,
+    /// [`BlackWhiteRed`](crate::panel::BlackWhiteRed)) is dithered by
+    /// [`Dithering::Bayer`] in every pass, the one method that needs no
+    /// order: the last pass is then the image with that method.
     ///
     /// ```
     /// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb565, prelude::*};
@@ -236,28 +241,28 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     pub fn draw_progressive<D>(&self, order: &Progressive, target: &mut D) -> Result<(), DrawError<D::Error>>
     where
         D: DrawTarget,
-        D::Color: From<Rgb888>,
+        D::Color: TracedColor,
     {
-        let drawn = self.with_renderer(order.size(), |renderer| order.render_unchecked(renderer, target));
+        let drawn = match D::Color::PANEL {
+            None => self.with_renderer(order.size(), |renderer| order.render_unchecked(renderer, target)),
+            Some(_) => {
+                // Bayer keeps no rows: no room is wanting.
+                let mut ordered = Dithered::new(target, Dithering::Bayer, &mut []).map_err(DrawError::ErrorRow)?;
+                self.with_renderer(order.size(), |renderer| order.render_unchecked(renderer, &mut ordered))
+            }
+        };
         drawn.map_err(DrawError::Camera)?.map_err(DrawError::Target)?;
         Ok(())
     }
 
-    /// Renders `area` of an image of `size` into `target`, with the pixel at
-    /// `area`'s top-left corner going to `at`.
-    pub(super) fn draw_area<D>(
-        &self,
-        size: Size,
-        area: &Rectangle,
-        at: Point,
-        target: &mut D,
-    ) -> Result<(), DrawError<D::Error>>
+    /// Renders `area` of an image of `size` into `target`, in the image's
+    /// coordinates.
+    pub(super) fn render_area<D>(&self, size: Size, area: &Rectangle, target: &mut D) -> Result<(), DrawError<D::Error>>
     where
         D: DrawTarget,
         D::Color: From<Rgb888>,
     {
-        let mut shifted = Shifted { target, offset: at - area.top_left };
-        let drawn = self.with_renderer(size, |renderer| renderer.render_rect(area, &mut shifted));
+        let drawn = self.with_renderer(size, |renderer| renderer.render_rect(area, target));
         drawn.map_err(DrawError::Camera)?.map_err(DrawError::Target)?;
         Ok(())
     }

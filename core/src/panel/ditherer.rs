@@ -1,0 +1,262 @@
+//! The [`Ditherer`]: one region of an image, its pixels in raster order,
+//! each given its panel level at once.
+//!
+//! Invariants: a level is always below the panel's [`Panel::levels`]; the
+//! error rows are `channels × width` `i16`s of the caller's storage, all
+//! zero at the region's top; the same pixels in the same order give the
+//! same levels on every target.
+
+use super::black_white_red::project;
+use super::diffusion::Accumulators;
+use super::{BlackWhiteRed, Dithering, ErrorRowTooShort, Panel};
+use embedded_graphics_core::geometry::Point;
+use embedded_graphics_core::pixelcolor::Rgb888;
+
+/// Dithers a region of an image `width` pixels wide, its pixels given in
+/// raster order (rows top to bottom, each left to right), into a panel's
+/// levels, each at once: the state a dithered draw keeps. Error diffusion
+/// needs a row of accumulators per channel, `i16`s in storage the caller
+/// owns ([`Panel::error_words`]); ordered dithering and the nearest level
+/// need none.
+///
+/// What octrace's images and [`Dithered`](super::Dithered) are made of;
+/// use it directly to dither pixels of your own, a finished image say.
+///
+/// ```
+/// use embedded_graphics::{pixelcolor::Rgb888, prelude::*};
+/// use octrace_core::panel::{Ditherer, Dithering, Panel};
+///
+/// // A 4×2 region of 25 % gray on a one-bit panel: 2 of the 8 pixels lit.
+/// let mut rows = [0i16; Panel::Mono.error_words(4)];
+/// let mut ditherer = Ditherer::new(Panel::Mono, Dithering::FsPe, Point::zero(), 4, &mut rows)?;
+/// let lit = (0..8).filter(|_| ditherer.next(Rgb888::new(64, 64, 64)) == 1).count();
+/// assert_eq!(lit, 2);
+/// assert_eq!(ditherer.position(), Point::new(0, 2));
+/// # Ok::<(), octrace_core::panel::ErrorRowTooShort>(())
+/// ```
+#[derive(Debug)]
+pub struct Ditherer<'b> {
+    panel: Panel,
+    dithering: Dithering,
+    /// The region's left column and the next pixel.
+    left: i32,
+    position: Point,
+    width: u32,
+    /// The next row's accumulators, a row per channel, in Q4.
+    rows: &'b mut [i16],
+    channels: [Accumulators; 2],
+}
+
+impl<'b> Ditherer<'b> {
+    /// A ditherer for the region of `width` pixels a row from `top_left`
+    /// (in the image's coordinates, which ordered dithering's pattern
+    /// follows), its error rows in `rows`: at least
+    /// [`Panel::error_words`]`(width)` for error diffusion.
+    pub fn new(
+        panel: Panel,
+        dithering: Dithering,
+        top_left: Point,
+        width: u32,
+        rows: &'b mut [i16],
+    ) -> Result<Self, ErrorRowTooShort> {
+        let needed = if dithering.diffuses() { panel.error_words(width) } else { 0 };
+        let given = rows.len();
+        let rows = rows.get_mut(..needed).ok_or(ErrorRowTooShort { needed, given })?;
+        let mut ditherer = Ditherer {
+            panel,
+            dithering,
+            left: top_left.x,
+            position: top_left,
+            width,
+            rows,
+            channels: [Accumulators::default(); 2],
+        };
+        ditherer.restart(top_left.y);
+        Ok(ditherer)
+    }
+
+    /// The panel it dithers for.
+    pub fn panel(&self) -> Panel {
+        self.panel
+    }
+
+    /// The method.
+    pub fn dithering(&self) -> Dithering {
+        self.dithering
+    }
+
+    /// The region's width.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// The region's left column.
+    pub(super) fn left(&self) -> i32 {
+        self.left
+    }
+
+    /// Where the next pixel is.
+    pub fn position(&self) -> Point {
+        self.position
+    }
+
+    /// Starts the region again at row `top`, with no error carried.
+    pub fn restart(&mut self, top: i32) {
+        self.rows.fill(0);
+        self.channels = [Accumulators::default(); 2];
+        self.position = Point::new(self.left, top);
+    }
+
+    /// The level of the next pixel, which shows `color`.
+    #[inline]
+    pub fn next(&mut self, color: Rgb888) -> u8 {
+        let column = self.position.x.abs_diff(self.left);
+        let level = match self.dithering {
+            // (A region of no columns has no pixels: whatever comes is cut.)
+            _ if column >= self.width => self.panel.level_at(Dithering::Nearest, self.position, color),
+            Dithering::FsPe => self.diffuse(column as usize, color, true),
+            Dithering::FloydSteinberg => self.diffuse(column as usize, color, false),
+            Dithering::Bayer | Dithering::Nearest => self.panel.level_at(self.dithering, self.position, color),
+        };
+        self.position.x = self.position.x.saturating_add(1);
+        if column + 1 == self.width {
+            if self.dithering.diffuses() {
+                self.end_row();
+            }
+            self.position = Point::new(self.left, self.position.y + 1);
+        }
+        level
+    }
+
+    /// The level of the pixel at column `x` of the region by error
+    /// diffusion, its errors spread; `pure`: FS-PE's pure error too.
+    #[inline]
+    fn diffuse(&mut self, x: usize, color: Rgb888, pure: bool) -> u8 {
+        let pure = pure as i32;
+        match self.panel {
+            Panel::BlackWhiteRed => {
+                let [red, rest] = project(color);
+                let (red_row, rest_row) = self.rows.split_at_mut(self.width as usize);
+                let [red_channel, rest_channel] = &mut self.channels;
+                let v = [red_channel.value(red_row, x, red), rest_channel.value(rest_row, x, rest)];
+                let shown = BlackWhiteRed::nearest_mixed(v[0], v[1], 255 << 4);
+                let [o_red, o_rest] = shown.red_and_rest();
+                red_channel.push(red_row, x, v[0] - (o_red << 4), pure * (red - o_red));
+                rest_channel.push(rest_row, x, v[1] - (o_rest << 4), pure * (rest - o_rest));
+                shown as u8
+            }
+            gray => {
+                let value = super::luma(color) as i32;
+                let channel = &mut self.channels[0];
+                let v = channel.value(self.rows, x, value);
+                let level = gray.gray_level_of_q4(v);
+                let shown = gray.gray_value(level);
+                channel.push(self.rows, x, v - (shown << 4), pure * (value - shown));
+                level
+            }
+        }
+    }
+
+    /// Closes the row of every channel in use.
+    fn end_row(&mut self) {
+        let width = self.width as usize;
+        for (channel, row) in self.channels.iter_mut().zip(self.rows.chunks_exact_mut(width)) {
+            channel.end_row(row, width - 1);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use std::vec::Vec;
+
+    /// Every level of a `width`-wide picture of `colors`, dithered.
+    fn dither(panel: Panel, dithering: Dithering, width: u32, colors: &[Rgb888]) -> Vec<u8> {
+        let mut rows = std::vec![0i16; panel.error_words(width)];
+        let mut ditherer = Ditherer::new(panel, dithering, Point::zero(), width, &mut rows).unwrap();
+        colors.iter().map(|&c| ditherer.next(c)).collect()
+    }
+
+    fn gray(v: u8) -> Rgb888 {
+        Rgb888::new(v, v, v)
+    }
+
+    #[test]
+    fn too_little_storage_is_an_error_naming_what_is_needed() {
+        let mut rows = [0i16; 9];
+        let e = Ditherer::new(Panel::BlackWhiteRed, Dithering::FsPe, Point::zero(), 5, &mut rows).unwrap_err();
+        assert_eq!(e, ErrorRowTooShort { needed: 10, given: 9 });
+        // Ordered dithering needs none.
+        assert!(Ditherer::new(Panel::BlackWhiteRed, Dithering::Bayer, Point::zero(), 5, &mut []).is_ok());
+    }
+
+    #[test]
+    fn a_flat_tone_keeps_its_mean_on_every_panel() {
+        // 40×40 of one gray: the mean level shown is the gray's, within
+        // what leaves at the edges.
+        for panel in [Panel::Mono, Panel::Gray2, Panel::Gray4] {
+            for dithering in Dithering::ALL {
+                for v in [3u8, 16, 54, 75, 128, 182, 250] {
+                    let levels = dither(panel, dithering, 40, &[gray(v); 1600]);
+                    let mean: f64 =
+                        levels.iter().map(|&l| panel.gray_value(l) as f64).sum::<f64>() / levels.len() as f64;
+                    // The nearest level is off by half a step at most; a 4×4
+                    // pattern has 17 tones, a 32nd of a step from any value.
+                    let allowed = match dithering {
+                        Dithering::Nearest => panel.step() as f64 / 2.0,
+                        Dithering::Bayer => panel.step() as f64 / 32.0,
+                        _ => 2.5,
+                    };
+                    assert!((mean - v as f64).abs() <= allowed, "{panel:?} {dithering:?} {v}: {mean}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn diffusion_has_no_dead_zone_near_a_level() {
+        // Gray 3 on one bit: a few lit pixels, not all black (model-based
+        // diffusion without the FS loop shows 1 to 16 as black).
+        let lit = dither(Panel::Mono, Dithering::FsPe, 64, &[gray(3); 64 * 64]).iter().filter(|&&l| l == 1).count();
+        assert!((40..=56).contains(&lit), "{lit} of 4096 lit, for 48 expected");
+    }
+
+    #[test]
+    fn the_levels_are_the_panels() {
+        let ramp: Vec<Rgb888> = (0..=255u8).flat_map(|v| [gray(v), Rgb888::new(v, 255 - v, v / 2)]).collect();
+        for panel in Panel::ALL {
+            for dithering in Dithering::ALL {
+                assert!(dither(panel, dithering, 32, &ramp).iter().all(|&l| l < panel.levels()), "{panel:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn black_white_red_mixes_a_pink_from_all_three() {
+        // (255, 128, 128): half red, half white, no black.
+        let pink = Rgb888::new(255, 128, 128);
+        for dithering in [Dithering::FsPe, Dithering::FloydSteinberg, Dithering::Bayer] {
+            let levels = dither(Panel::BlackWhiteRed, dithering, 32, &[pink; 32 * 32]);
+            let count = |c: BlackWhiteRed| levels.iter().filter(|&&l| l == c as u8).count();
+            let (white, red) = (count(BlackWhiteRed::White), count(BlackWhiteRed::Red));
+            assert!((500..=530).contains(&white) && (494..=524).contains(&red), "{dithering:?}: {white} {red}");
+        }
+        // A blue it cannot show becomes a dark gray (its projection), not red.
+        let levels = dither(Panel::BlackWhiteRed, Dithering::FsPe, 32, &[Rgb888::new(0, 0, 255); 32 * 32]);
+        assert!(levels.iter().all(|&l| l != BlackWhiteRed::Red as u8));
+    }
+
+    #[test]
+    fn restart_forgets_the_error() {
+        let colors = [gray(100); 24];
+        let mut rows = [0i16; 6];
+        let mut ditherer = Ditherer::new(Panel::Mono, Dithering::FsPe, Point::new(2, 5), 6, &mut rows).unwrap();
+        let first: Vec<u8> = colors.iter().map(|&c| ditherer.next(c)).collect();
+        assert_eq!(ditherer.position(), Point::new(2, 9));
+        ditherer.restart(5);
+        let again: Vec<u8> = colors.iter().map(|&c| ditherer.next(c)).collect();
+        assert_eq!(first, again);
+    }
+}
