@@ -33,8 +33,9 @@ const VARIABLE: &str = "OCTRACE_SCENE";
 /// }
 /// ```
 pub fn embed_scene(default: &str) -> Result<(), BuildError> {
-    let manifest: PathBuf =
-        std::env::var_os("CARGO_MANIFEST_DIR").map(Into::into).ok_or(BuildError::NotInBuildScript("CARGO_MANIFEST_DIR"))?;
+    let manifest: PathBuf = std::env::var_os("CARGO_MANIFEST_DIR")
+        .map(Into::into)
+        .ok_or(BuildError::NotInBuildScript("CARGO_MANIFEST_DIR"))?;
     println!("cargo:rerun-if-env-changed={VARIABLE}");
     let scene = std::env::var(VARIABLE).unwrap_or_else(|_| default.to_owned());
     let path = manifest.join(&scene);
@@ -80,7 +81,8 @@ mod tests {
         let path = std::path::Path::new("scene.txt");
         let walked = scene_source("many", path, &format!("SURFACE 1 1 1 1 1 1 1 0 0 0 1 0 0\n{spheres}")).unwrap();
         assert!(walked.contains("light_buffer_lights: 1"), "{walked}");
-        let few = scene_source("few", path, "SURFACE 1 1 1 1 1 1 1 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nLIGHT 1 0 10 10\n").unwrap();
+        let few = scene_source("few", path, "SURFACE 1 1 1 1 1 1 1 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nLIGHT 1 0 10 10\n")
+            .unwrap();
         assert!(!few.contains("light_buffer"), "{few}");
         assert!(few.contains("pub const SCENE_TEXT: &str = include_str!(\"scene.txt\");"), "{few}");
     }

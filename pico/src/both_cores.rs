@@ -16,10 +16,10 @@ use core::sync::atomic::{AtomicBool, Ordering};
 use cortex_m::asm::{sev, wfe};
 use critical_section::Mutex;
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{OriginDimensions, Point, Size};
+use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
 use embedded_graphics_core::primitives::Rectangle;
-use embedded_graphics_core::Pixel;
+use octrace_core::panel::{Dithered, Dithering, TracedColor, IMAGE_ERROR_WORDS};
 use octrace_core::profile::Profile;
 use octrace_core::render::{Handoff, Progressive, Renderer, Unit};
 use octrace_core::{LoadedScene, RendererRoom, SceneAccelerator};
@@ -37,41 +37,44 @@ pub enum Unfinished {
 
 /// Traces `scene` into `display` with both cores, row by row, core 1
 /// rendering in `room` (its own mailbox and screen lists) and handing rows
-/// over through `ring`; each row goes to the display in its colour (`From<Rgb888>`)
-/// in one `fill_contiguous`. `each_row` sees every row as it goes to the
-/// panel, in order, and may stop the picture there.
+/// over through `ring`, which holds at least a row of the display. Each row
+/// goes to the display in one `fill_contiguous`, in its colour: dithered
+/// onto a panel of few levels as the scene's image dithers it
+/// (`image_for`: the method its colour type calls for, the error carried
+/// from row to row), converted for any other. `each_row` sees every row as
+/// traced (in `Rgb888`) as it goes to the display, in order, and may stop
+/// the picture there.
 pub fn draw<P, D, const LEN: usize, const SLOTS: usize>(
     core1: &mut SecondCore,
     scene: &LoadedScene<'_, P>,
     room: &mut RendererRoom<P>,
     ring: &Handoff<LEN, SLOTS>,
     display: &mut D,
-    mut each_row: impl FnMut(u32, &[D::Color]) -> ControlFlow<()>,
+    mut each_row: impl FnMut(u32, &[Rgb888]) -> ControlFlow<()>,
 ) -> Result<(), Unfinished>
 where
     P: Profile,
     D: DrawTarget,
-    D::Color: From<Rgb888>,
+    D::Color: TracedColor,
 {
     let size = display.bounding_box().size;
-    let width = size.width.min(LEN as u32);
+    if size.width as usize > LEN {
+        return Err(Unfinished::Panel);
+    }
+    let mut error_rows = [0; IMAGE_ERROR_WORDS];
+    let mut display = Dithered::new(display, Dithering::default(), &mut error_rows).map_err(|_| Unfinished::Panel)?;
     let trace = |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, y: &u32, colors: &mut [Rgb888]| {
         let mut traced = 0;
-        for (color, pixel) in colors.iter_mut().zip(renderer.row(*y, 0..width)) {
+        for (color, pixel) in colors.iter_mut().zip(renderer.row(*y, 0..size.width)) {
             *color = pixel.color;
             traced += 1;
         }
         traced
     };
     let present = |y: &u32, colors: &[Rgb888]| {
-        let mut line = [D::Color::from(Rgb888::BLACK); LEN];
-        let line = &mut line[..colors.len()];
-        for (pixel, &color) in line.iter_mut().zip(colors) {
-            *pixel = color.into();
-        }
-        let area = Rectangle::new(Point::new(0, *y as i32), Size::new(width, 1));
-        display.fill_contiguous(&area, line.iter().copied()).map_err(|_| Unfinished::Panel)?;
-        match each_row(*y, line) {
+        let area = Rectangle::new(Point::new(0, *y as i32), Size::new(size.width, 1));
+        display.fill_contiguous(&area, colors.iter().copied()).map_err(|_| Unfinished::Panel)?;
+        match each_row(*y, colors) {
             ControlFlow::Continue(()) => Ok(()),
             ControlFlow::Break(()) => Err(Unfinished::Stopped),
         }
@@ -81,9 +84,11 @@ where
 
 /// Traces `scene` into `display` with both cores in the progressive
 /// `order` (the whole panel in coarse blocks first, then finer: the same
-/// picture as [`draw`] at the end), each core taking the next unit, core 1
-/// tracing in `room` and handing its colours over through `ring`, which
-/// holds `order.max_unit_pixels()`.
+/// picture as [`draw`] at the end on a truecolour display; on a panel of
+/// few levels, ordered (Bayer) dithering, the one method a block order
+/// keeps), each core taking the next unit, core 1 tracing in `room` and
+/// handing its colours over through `ring`, which holds
+/// `order.max_unit_pixels()`.
 pub fn draw_progressive<P, D, const LEN: usize, const SLOTS: usize>(
     core1: &mut SecondCore,
     scene: &LoadedScene<'_, P>,
@@ -95,17 +100,18 @@ pub fn draw_progressive<P, D, const LEN: usize, const SLOTS: usize>(
 where
     P: Profile,
     D: DrawTarget,
-    D::Color: From<Rgb888>,
+    D::Color: TracedColor,
 {
     if order.size() != display.bounding_box().size || order.max_unit_pixels() > LEN {
         return Err(Unfinished::Panel);
     }
+    let mut display = Dithered::new(display, Dithering::Bayer, &mut []).map_err(|_| Unfinished::Panel)?;
     let trace = |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, unit: &Unit, colors: &mut [Rgb888]| {
         unit.trace(renderer, colors).map_or(0, |traced| traced.colors().len())
     };
     let present = |unit: &Unit, colors: &[Rgb888]| {
         let traced = unit.with_colors(colors).map_err(|_| Unfinished::Panel)?;
-        traced.draw(&mut Converted(display)).map_err(|_| Unfinished::Panel)
+        traced.draw(&mut display).map_err(|_| Unfinished::Panel)
     };
     share(core1, scene, room, ring, order.size(), || order.units(), trace, present)
 }
@@ -241,33 +247,4 @@ fn receive<const LEN: usize, const SLOTS: usize>(
     // The slot is free again: wake core 1 if it waits for it.
     sev();
     len
-}
-
-/// A display taking the progressive order's `Rgb888` blocks in its own colour.
-struct Converted<'d, D>(&'d mut D);
-
-impl<D: DrawTarget> OriginDimensions for Converted<'_, D> {
-    fn size(&self) -> Size {
-        self.0.bounding_box().size
-    }
-}
-
-impl<D: DrawTarget> DrawTarget for Converted<'_, D>
-where
-    D::Color: From<Rgb888>,
-{
-    type Color = Rgb888;
-    type Error = D::Error;
-
-    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb888>>>(&mut self, pixels: I) -> Result<(), D::Error> {
-        self.0.draw_iter(pixels.into_iter().map(|Pixel(at, color)| Pixel(at, color.into())))
-    }
-
-    fn fill_contiguous<I: IntoIterator<Item = Rgb888>>(&mut self, area: &Rectangle, colors: I) -> Result<(), D::Error> {
-        self.0.fill_contiguous(area, colors.into_iter().map(Into::into))
-    }
-
-    fn fill_solid(&mut self, area: &Rectangle, color: Rgb888) -> Result<(), D::Error> {
-        self.0.fill_solid(area, color.into())
-    }
 }

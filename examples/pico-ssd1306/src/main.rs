@@ -11,14 +11,16 @@
 #![no_std]
 #![no_main]
 
-use embedded_graphics::image::Image;
+use core::ops::ControlFlow;
 use embedded_graphics::pixelcolor::BinaryColor;
 use embedded_graphics::prelude::*;
 use embedded_hal::digital::OutputPin;
 use hal::entry;
 use hal::multicore::Stack;
-use octrace_core::{ConstStaticCell, Raytracer};
+use octrace_core::render::Handoff;
+use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
 use octrace_pico::board::{self, Board};
+use octrace_pico::both_cores;
 use panic_halt as _;
 use rp2040_hal as hal;
 
@@ -44,8 +46,14 @@ use scene::{SceneProfile, SCENE_TEXT};
 /// Room for the scene, its octree and the mailbox.
 static RAYTRACER: ConstStaticCell<Raytracer<SceneProfile>> = ConstStaticCell::new(Raytracer::new());
 
-/// Core 1's stack: it builds the light buffer while core 0 builds the octree.
+/// Core 1's own mailbox and screen lists.
+static CORE1_ROOM: ConstStaticCell<RendererRoom<SceneProfile>> = ConstStaticCell::new(RendererRoom::new());
+
+/// Core 1's stack: 16 KiB (the render needs a few).
 static CORE1_STACK: Stack<4096> = Stack::new();
+
+/// Core 1's rows on their way to the panel's buffer: it may trace four ahead.
+static RING: Handoff<{ panel::WIDTH }, 4> = Handoff::new();
 
 #[entry]
 fn main() -> ! {
@@ -62,7 +70,8 @@ fn main() -> ! {
     let drawn = match loaded {
         Ok(scene) => {
             let Ok(()) = led.set_high();
-            let drawn = Image::new(&scene.image_for(&display), Point::zero()).draw(&mut display);
+            let each_row = |_, _: &_| ControlFlow::Continue(());
+            let drawn = both_cores::draw(&mut core1, &scene, CORE1_ROOM.take(), &RING, &mut display, each_row);
             let Ok(()) = led.set_low();
             drawn.is_ok()
         }

@@ -23,6 +23,8 @@ use core::cell::RefCell;
 use core::ops::ControlFlow;
 use core::time::Duration;
 use critical_section::Mutex;
+use embedded_graphics::pixelcolor::Rgb565;
+use embedded_graphics::prelude::*;
 use hal::multicore::Stack;
 use hal::pac::interrupt;
 use hal::usb::UsbBus;
@@ -144,9 +146,14 @@ fn main() -> ! {
         let start = timer.get_counter();
         let Ok(Some(drawing)) = board.answer(received, raytracer, &mut host) else { continue };
         let mut rows = 0u16;
-        let drawn = both_cores::draw(&mut core1, drawing.scene(), room, &ROWS, &mut display, |y, row| {
+        let drawn = both_cores::draw(&mut core1, drawing.scene(), room, &ROWS, &mut display, |y, traced| {
             rows = y as u16 + 1;
-            if drawing.send_row(y as u16, row, &mut host).is_err() {
+            // The row as the panel shows it.
+            let mut row = [Rgb565::BLACK; panel::WIDTH as usize];
+            for (pixel, &color) in row.iter_mut().zip(traced) {
+                *pixel = color.into();
+            }
+            if drawing.send_row(y as u16, &row[..traced.len()], &mut host).is_err() {
                 return ControlFlow::Break(());
             }
             // Between rows, without waiting: a new frame stops the picture.
