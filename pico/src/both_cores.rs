@@ -61,8 +61,6 @@ where
     if size.width as usize > LEN {
         return Err(Unfinished::Panel);
     }
-    let mut error_rows = [0; IMAGE_ERROR_WORDS];
-    let mut display = Dithered::new(display, Dithering::default(), &mut error_rows).map_err(|_| Unfinished::Panel)?;
     let trace = |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, y: &u32, colors: &mut [Rgb888]| {
         let mut traced = 0;
         for (color, pixel) in colors.iter_mut().zip(renderer.row(*y, 0..size.width)) {
@@ -71,13 +69,29 @@ where
         }
         traced
     };
+    let mut each_row = |y: &u32, colors: &[Rgb888]| match each_row(*y, colors) {
+        ControlFlow::Continue(()) => Ok(()),
+        ControlFlow::Break(()) => Err(Unfinished::Stopped),
+    };
+    let row = |y: &u32| Rectangle::new(Point::new(0, *y as i32), Size::new(size.width, 1));
+    // Known when it compiles: a truecolour display links no dithering.
+    if D::Color::PANEL.is_none() {
+        let present = |y: &u32, colors: &[Rgb888]| {
+            let mut line = [D::Color::from(Rgb888::BLACK); LEN];
+            let line = &mut line[..colors.len()];
+            for (pixel, &color) in line.iter_mut().zip(colors) {
+                *pixel = color.into();
+            }
+            display.fill_contiguous(&row(y), line.iter().copied()).map_err(|_| Unfinished::Panel)?;
+            each_row(y, colors)
+        };
+        return share(core1, scene, room, ring, size, || 0..size.height, trace, present);
+    }
+    let mut error_rows = [0; IMAGE_ERROR_WORDS];
+    let mut dithered = Dithered::new(display, Dithering::default(), &mut error_rows).map_err(|_| Unfinished::Panel)?;
     let present = |y: &u32, colors: &[Rgb888]| {
-        let area = Rectangle::new(Point::new(0, *y as i32), Size::new(size.width, 1));
-        display.fill_contiguous(&area, colors.iter().copied()).map_err(|_| Unfinished::Panel)?;
-        match each_row(*y, colors) {
-            ControlFlow::Continue(()) => Ok(()),
-            ControlFlow::Break(()) => Err(Unfinished::Stopped),
-        }
+        dithered.fill_contiguous(&row(y), colors.iter().copied()).map_err(|_| Unfinished::Panel)?;
+        each_row(y, colors)
     };
     share(core1, scene, room, ring, size, || 0..size.height, trace, present)
 }
