@@ -2,14 +2,14 @@
 //! least 16 KiB left for core 0's stack) and where each firmware's code
 //! runs: in place in flash through the XIP cache, or copied into SRAM at
 //! boot (`sram-code.x`, filled in with the input sections a
-//! [`CodePlacement`] copies; `octrace_pico::copy_code_into_sram!` copies
+//! [`CodePlacement`] copies; `octrace_pico::boot!` copies
 //! them).
 //!
 //! Invariants: `memory.x` includes `code-placement.x`, which [`link`]
 //! writes into a folder of its own for each firmware, so that each links
 //! with its own placement; every placement defines the copy's bounds (an
 //! empty copy for code left in flash), so every firmware expands
-//! `copy_code_into_sram!` whatever its placement.
+//! `octrace_pico::boot!` whatever its placement.
 
 use crate::{out_dir, write, BuildError};
 

@@ -4,10 +4,10 @@
 //! other ways, at build time), and running its ELF on the emulated Pico
 //! (`emulator/`), for the bit-exactness tests and the Pico benchmark.
 //!
-//! A template's builds share one target directory (`target/pico-st7789/`,
-//! `target/pico-ssd1306/`, apart from a developer's own): build one scene
-//! at a time; each ELF is copied out under the build's name, so runs may
-//! overlap.
+//! The templates' builds share one target directory (`target/pico/`, apart
+//! from a developer's own, so their dependencies are built once): build one
+//! scene at a time; each ELF is copied out under the template's and the
+//! build's name, so runs may overlap.
 
 use crate::repo;
 use std::path::{Path, PathBuf};
@@ -29,7 +29,7 @@ impl Template {
     /// Every template, the ST7789 first.
     pub const ALL: [Template; 2] = [Template::St7789, Template::Ssd1306];
 
-    /// Its folder in `examples/`, and its target directory's name.
+    /// Its folder in `examples/`.
     pub fn name(self) -> &'static str {
         match self {
             Template::St7789 => "pico-st7789",
@@ -57,10 +57,11 @@ impl Template {
     fn dir(self) -> PathBuf {
         repo().join("examples").join(self.name())
     }
+}
 
-    fn target_dir(self) -> PathBuf {
-        repo().join("target").join(self.name())
-    }
+/// Where the templates are built.
+fn target_dir() -> PathBuf {
+    repo().join("target/pico")
 }
 
 /// The scene the template embeds when `OCTRACE_SCENE` is not set.
@@ -109,7 +110,7 @@ pub fn build(build: &Build<'_>) -> Result<PathBuf, String> {
     if template == Template::Ssd1306 && build.order != "rows" {
         return Err(format!("{}: the SSD1306 template draws rows only, not {}", build.name(), build.order));
     }
-    let dir = template.target_dir();
+    let dir = target_dir();
     let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
     // The template's .cargo/config.toml (target, linker script) is found
     // from the working directory.
@@ -144,7 +145,7 @@ pub fn build(build: &Build<'_>) -> Result<PathBuf, String> {
             String::from_utf8_lossy(&out.stderr)
         ));
     }
-    let elf = dir.join(format!("{}.elf", build.name()));
+    let elf = dir.join(format!("{}-{}.elf", template.name(), build.name()));
     std::fs::copy(dir.join("thumbv6m-none-eabi/release").join(template.binary()), &elf)
         .map_err(|e| format!("cannot copy the ELF to {}: {e}", elf.display()))?;
     Ok(elf)

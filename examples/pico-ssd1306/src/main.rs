@@ -26,14 +26,8 @@ use rp2040_hal as hal;
 
 mod panel;
 
-// What build.rs places in SRAM (OCTRACE_CODE_IN), copied there at boot.
-octrace_pico::copy_code_into_sram!();
-
-/// The second-stage loader for the Pico's W25Q16JV flash; the boot ROM
-/// runs it from the first 256 bytes of flash (octrace-pico-build's memory.x).
-#[link_section = ".boot2"]
-#[used]
-static BOOT2: [u8; 256] = rp2040_boot2::BOOT_LOADER_W25Q080;
+// boot2, and what build.rs places in SRAM (OCTRACE_CODE_IN) copied there at boot.
+octrace_pico::boot!();
 
 /// The scene (`SCENE_TEXT`, in flash) and a capacity profile that holds
 /// exactly what it needs (`SceneProfile`), from `build.rs`: set

@@ -43,13 +43,8 @@ use usb_device::class_prelude::UsbBusAllocator;
 use usb_device::prelude::*;
 use usbd_serial::SerialPort;
 
-// The render path runs from SRAM (build.rs): copied there at boot.
-octrace_pico::copy_code_into_sram!();
-
-/// The second-stage loader for the Pico's W25Q16JV flash (see memory.x).
-#[link_section = ".boot2"]
-#[used]
-static BOOT2: [u8; 256] = rp2040_boot2::BOOT_LOADER_W25Q080;
+// boot2, and what build.rs places in SRAM (OCTRACE_CODE_IN) copied there at boot.
+octrace_pico::boot!();
 
 /// What the board says it is (octrace-link's `board` answer).
 const FIRMWARE: &str = concat!("octrace-pico-live ", env!("CARGO_PKG_VERSION"));
