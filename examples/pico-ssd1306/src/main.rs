@@ -1,12 +1,14 @@
 //! octrace on a Raspberry Pi Pico with a 128×64 SSD1306 OLED: a scene
-//! embedded in flash is parsed on the board and traced into the `ssd1306`
-//! crate's buffer in the panel's one-bit look, then sent to the panel over
-//! I2C. The Pico's LED is lit while it traces. Pins and wiring are in
-//! README.md.
+//! embedded in flash is parsed on the board and traced by both cores into
+//! the `ssd1306` crate's buffer in the panel's one-bit look (octrace's
+//! dither for a `BinaryColor` display), then sent to the panel over I2C.
+//! The Pico's LED is lit while it traces. Pins and wiring are in README.md.
 //!
-//! Invariants: the scene, its octree and the mailbox live in one static
-//! cell (all zero bits, so in `.bss`: no flash, no copy on the stack); the
-//! image takes the panel's size and colour, and so its look.
+//! Invariants: the scene, its octree and core 0's mailbox live in one
+//! static cell, core 1's mailbox and lists in another (all zero bits, so in
+//! `.bss`: no flash, no copy on the stack); the image takes the panel's
+//! size and colour, and so its look; any split of the rows between the
+//! cores gives the same bits as one core.
 
 #![no_std]
 #![no_main]
@@ -37,7 +39,7 @@ mod scene {
 }
 use scene::{SceneProfile, SCENE_TEXT};
 
-/// Room for the scene, its octree and the mailbox.
+/// Room for the scene, its octree and core 0's mailbox and lists.
 static RAYTRACER: ConstStaticCell<Raytracer<SceneProfile>> = ConstStaticCell::new(Raytracer::new());
 
 /// Core 1's own mailbox and screen lists.
@@ -56,10 +58,10 @@ fn main() -> ! {
     let mut led = pins.gpio25.into_push_pull_output();
 
     // octrace: parse and index the scene (the light buffer on core 1 while
-    // core 0 builds the octree), then trace it into the panel's buffer at
-    // the panel's size, in its colour. A scene the board cannot trace
-    // (check it with host-sim, whose errors name the line and column)
-    // lights the whole panel.
+    // core 0 builds the octree), then trace it at the panel's size with
+    // both cores, core 0 putting each row into the panel's buffer in its
+    // colour. A scene the board cannot trace (check it with host-sim, whose
+    // errors name the line and column) lights the whole panel.
     let loaded = RAYTRACER.take().load_on_two_cores(SCENE_TEXT, |beside, here| core1.scope(beside, here));
     let drawn = match loaded {
         Ok(scene) => {
