@@ -27,8 +27,6 @@ mod config {
 }
 
 use embedded_graphics_core::geometry::Size;
-#[cfg(board = "lm3s6965evb")]
-use embedded_graphics_core::image::ImageDrawable;
 use octrace_core::render::PanelColor;
 use octrace_core::{ConstStaticCell, LoadedScene, Raytracer};
 use semihosting::exit;
@@ -197,7 +195,7 @@ fn draw_on(scene: &LoadedScene<'static, Profile>, file: HostFile) -> bool {
 fn draw_on(scene: &LoadedScene<'_, Profile>, mut panel: ssd0323::Ssd0323) -> bool {
     debug_assert!(config::WIRE == PanelColor::Gray4);
     let image = scene.image(Size::new(config::WIDTH, config::HEIGHT)).dithered(config::DITHERING);
-    image.draw(&mut panel).is_ok()
+    image.try_draw_with(&mut panel, &mut [0; config::ERROR_WORDS]).is_ok()
 }
 
 /// Draws the scene into a display of colour `C`. Not inlined: each colour's

@@ -84,10 +84,15 @@ pub struct Run {
 }
 
 impl Run {
-    /// The peak stack the firmware reports (`peak stack: N bytes`).
+    /// The peak stack the firmware reports.
     pub fn peak_stack(&self) -> Option<u64> {
-        self.output.lines().find_map(|l| l.strip_prefix("peak stack: ")?.strip_suffix(" bytes")?.parse().ok())
+        peak_stack(&self.output)
     }
+}
+
+/// The peak stack a firmware's output reports (`peak stack: N bytes`).
+fn peak_stack(output: &str) -> Option<u64> {
+    output.lines().find_map(|l| l.strip_prefix("peak stack: ")?.strip_suffix(" bytes")?.parse().ok())
 }
 
 impl Firmware {
@@ -241,6 +246,13 @@ pub struct Measurement {
     pub flash: u64,
     /// Static RAM: data + bss.
     pub static_ram: u64,
+}
+
+impl Measurement {
+    /// The peak stack the firmware reports.
+    pub fn peak_stack(&self) -> Option<u64> {
+        peak_stack(&self.output)
+    }
 }
 
 impl Firmware {

@@ -9,6 +9,7 @@
 //! nearest point of the triangle in RGB ([`project`]), and the dither runs
 //! on the two values `r` and `m`.
 
+use super::Divisor;
 use embedded_graphics_core::pixelcolor::{PixelColor, Rgb888, RgbColor};
 
 /// A pixel of a black/white/red e-paper panel. embedded-graphics has no
@@ -116,7 +117,7 @@ pub(super) fn project(color: Rgb888) -> [i32; 2] {
     }
     // Outside (more green and blue than red): the edges black–red (m = 0),
     // red–white (r = 255) and black–white (r = m).
-    let t = ((r + m2 + 1) / 3).clamp(0, 255);
+    let t = (Divisor::BY_3.quotient((r + m2 + 1) as u32) as i32).clamp(0, 255);
     let edges = [[r, 0], [255, ((m2 + 1) >> 1).min(255)], [t, t]];
     let distance = |[er, em]: [i32; 2]| 2 * (er - r).pow(2) + (2 * em - m2).pow(2);
     let mut best = edges[0];

@@ -44,10 +44,12 @@
 //!   embedded-graphics converts a colour (`From<Rgb888>`).
 //!
 //! Error diffusion keeps a row of `i16` accumulators per channel
-//! ([`Panel::error_words`]: 256 bytes for a 128-wide one-bit panel); an
-//! image keeps [`IMAGE_ERROR_WORDS`] on the draw's stack (1.6 KiB: rows up
-//! to 800 pixels wide, 400 on black/white/red), or uses storage the caller
-//! gives ([`TracedImage::try_draw_with`](crate::TracedImage::try_draw_with)).
+//! ([`Panel::error_words`]: 256 bytes for a 128-wide one-bit panel). An
+//! image keeps it on the draw's stack, 512 bytes for up to 256 words (a
+//! one-bit or gray panel up to 256 pixels wide, black/white/red up to 128),
+//! else [`IMAGE_ERROR_WORDS`] (1.6 KiB: rows up to 800 pixels, 400 on
+//! black/white/red), or uses storage the caller gives
+//! ([`TracedImage::try_draw_with`](crate::TracedImage::try_draw_with)).
 //!
 //! # Sub-images, bands and other orders
 //!
@@ -213,7 +215,7 @@ impl Panel {
     fn nearest(self, color: Rgb888) -> u8 {
         match self {
             Panel::BlackWhiteRed => BlackWhiteRed::from(color) as u8,
-            gray => ((luma(color) as u32 * (gray.levels() as u32 - 1) + 127) / 255) as u8,
+            gray => Divisor::BY_255.quotient(luma(color) as u32 * (gray.levels() as u32 - 1) + 127) as u8,
         }
     }
 
@@ -239,7 +241,8 @@ impl Panel {
             }
             gray => {
                 let scaled = luma(color) as u32 * (gray.levels() as u32 - 1);
-                let (level, fraction) = (scaled / 255, scaled % 255);
+                let level = Divisor::BY_255.quotient(scaled);
+                let fraction = scaled - 255 * level;
                 (level + (fraction * 32 > bar) as u32) as u8
             }
         }
@@ -266,8 +269,18 @@ impl Panel {
         match self {
             Panel::Mono => (v >= 128 << 4) as u8,
             gray => {
-                let step = gray.step() << 4;
-                ((v + step / 2) / step).clamp(0, gray.levels() as i32 - 1) as u8
+                let (step, top) = (gray.step() << 4, gray.levels() as i32 - 1);
+                // Each panel's divisor made when it compiles: a panel known
+                // only when the program runs must not bring the division back.
+                let by_step = match gray {
+                    Panel::Gray2 => const { Divisor::new(16 * 85) },
+                    _ => const { Divisor::new(16 * 17) },
+                };
+                match v + step / 2 {
+                    x if x <= 0 => 0,
+                    x if x >= top * step => top as u8,
+                    x => by_step.quotient(x as u32) as u8,
+                }
             }
         }
     }
@@ -328,9 +341,10 @@ impl fmt::Display for Dithering {
     }
 }
 
-/// The error row a [`TracedImage`](crate::TracedImage) keeps on the stack
-/// of its draw for error diffusion, in `i16`s: rows up to 800 pixels wide
-/// (400 on black/white/red). A wider image needs
+/// The longest error row a [`TracedImage`](crate::TracedImage) keeps on
+/// the stack of its draw for error diffusion, in `i16`s: rows up to 800
+/// pixels wide (400 on black/white/red; a row of up to 256 words takes
+/// only 512 bytes). A wider image needs
 /// [`TracedImage::try_draw_with`](crate::TracedImage::try_draw_with).
 pub const IMAGE_ERROR_WORDS: usize = 800;
 
@@ -443,6 +457,32 @@ impl fmt::Display for ErrorRowTooShort {
 
 impl core::error::Error for ErrorRowTooShort {}
 
+/// Division by a constant `d` as a multiply and a shift: a Cortex-M0, which
+/// has no divide instruction, would call a routine of some 50 instructions
+/// for each pixel. Exact (and without overflow) for `x` up to 4096 with `d`
+/// from 255 to 4080 (gray values, level steps in 1/16 gray), and for `x`
+/// below 768 with `d` = 3 (the black/white/red projection's third).
+#[derive(Clone, Copy, Debug)]
+struct Divisor {
+    /// ceil(2^24 / d): its excess over 2^24 / d is under 1 / x.
+    reciprocal: u32,
+}
+
+impl Divisor {
+    const BY_255: Divisor = Divisor::new(255);
+    const BY_3: Divisor = Divisor::new(3);
+
+    const fn new(d: u32) -> Divisor {
+        Divisor { reciprocal: (1 << 24) / d + 1 }
+    }
+
+    /// `x / d`, rounded down.
+    #[inline]
+    const fn quotient(self, x: u32) -> u32 {
+        (x * self.reciprocal) >> 24
+    }
+}
+
 /// The gray of `color`, 0 to 255: BT.601 luma as embedded-graphics computes
 /// it (and [`palette::Gray`](crate::palette::Gray)).
 #[inline]
@@ -513,6 +553,18 @@ mod tests {
             seen[b as usize] = true;
         }
         assert!(seen.iter().all(|&s| s));
+    }
+
+    #[test]
+    fn quotients_are_exact_where_they_are_taken() {
+        // Every divisor used, over all it divides: gray values and level
+        // steps in 1/16 gray up to 4096, and the projection's sums of three
+        // values below 768.
+        for (d, below) in [(255, 4097), (16 * 85, 4097), (16 * 17, 4097), (3, 768)] {
+            for x in 0..below {
+                assert_eq!(Divisor::new(d).quotient(x), x / d, "{x} / {d}");
+            }
+        }
     }
 
     #[test]

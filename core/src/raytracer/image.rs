@@ -162,21 +162,27 @@ impl<P: Profile, C: TracedColor> TracedImage<'_, '_, P, C> {
         match (C::PANEL, rows) {
             (None, _) => self.scene.render_area(self.size, area, &mut shifted),
             (Some(_), Some(rows)) => self.draw_dithered(area, &mut shifted, rows),
-            (Some(_), None) => self.draw_dithered_on_stack(area, &mut shifted),
+            // A small panel's row in a small frame.
+            (Some(panel), None) if panel.error_words(area.size.width) <= SMALL_ERROR_WORDS => {
+                self.draw_dithered_on_stack::<SMALL_ERROR_WORDS, _>(area, &mut shifted)
+            }
+            (Some(_), None) => self.draw_dithered_on_stack::<IMAGE_ERROR_WORDS, _>(area, &mut shifted),
         }
     }
 
-    /// Draws `area` dithered, its error row on this frame. Not inlined: a
-    /// truecolour draw never holds the row.
+    /// Draws `area` dithered, its error row of `WORDS` on this frame. Not
+    /// inlined: a truecolour draw never holds the row.
     #[inline(never)]
-    fn draw_dithered_on_stack<D: DrawTarget<Color = C>>(
+    fn draw_dithered_on_stack<const WORDS: usize, D: DrawTarget<Color = C>>(
         &self,
         area: &Rectangle,
         target: &mut D,
     ) -> Result<(), DrawError<D::Error>> {
-        self.draw_dithered(area, target, &mut [0; IMAGE_ERROR_WORDS])
+        self.draw_dithered(area, target, &mut [0; WORDS])
     }
 
+    /// Not inlined: one copy of the render loop whatever frame the row is in.
+    #[inline(never)]
     fn draw_dithered<D: DrawTarget<Color = C>>(
         &self,
         area: &Rectangle,
@@ -209,6 +215,10 @@ impl<P: Profile, C: TracedColor> ImageDrawable for TracedImage<'_, '_, P, C> {
         }
     }
 }
+
+/// The error row of a panel image up to 256 `i16`s wide (a one-bit 128×64
+/// OLED needs 128) takes only this much of the draw's stack (512 bytes).
+const SMALL_ERROR_WORDS: usize = 256;
 
 /// A target seen shifted by `offset`: a sub-image's pixels land at the
 /// target's origin.
@@ -246,9 +256,16 @@ impl<D: DrawTarget> DrawTarget for Shifted<'_, D> {
 mod tests {
     use super::super::tests::{Grid, SCENE};
     use super::*;
+    use crate::panel::Ditherer;
     use crate::profile::Board16K;
+    use crate::render::Progressive;
     use crate::Raytracer;
-    use embedded_graphics_core::pixelcolor::{Gray4, Rgb565};
+    use embedded_graphics_core::pixelcolor::{BinaryColor, Gray4, Rgb565, Rgb888};
+    use embedded_graphics_core::primitives::PointsIter;
+    use std::string::ToString;
+    use std::vec::Vec;
+
+    extern crate std;
 
     #[test]
     fn an_image_sized_from_its_target_draws_every_pixel_once() {
@@ -274,5 +291,102 @@ mod tests {
         for y in 0..3 {
             assert_eq!(part.0[y], whole.0[y + 2][4..9], "row {y}");
         }
+    }
+
+    /// The scene's truecolour pixels at `W`×`H`, dithered by `dithering`
+    /// onto `C`'s panel over the rectangle `area`, as a ditherer alone gives
+    /// them.
+    fn dithered_by_hand<C: TracedColor, const W: usize, const H: usize>(
+        dithering: Dithering,
+        area: Rectangle,
+    ) -> Vec<C> {
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let scene = raytracer.load(SCENE).unwrap();
+        let mut truecolour = Grid::<Rgb888, W, H>([[None; W]; H]);
+        scene.image_for(&truecolour).draw(&mut truecolour).unwrap();
+        let panel = C::PANEL.unwrap();
+        let mut rows = std::vec![0; panel.error_words(area.size.width)];
+        let mut ditherer = Ditherer::new(panel, dithering, area.top_left, area.size.width, &mut rows).unwrap();
+        area.points().map(|p| C::from_level(ditherer.next(truecolour.0[p.y as usize][p.x as usize].unwrap()))).collect()
+    }
+
+    #[test]
+    fn a_panel_image_is_its_pixels_dithered_in_raster_order() {
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let scene = raytracer.load(SCENE).unwrap();
+        for dithering in Dithering::ALL {
+            let mut grid = Grid::<BinaryColor, 12, 8>([[None; 12]; 8]);
+            scene.image_for(&grid).dithered(dithering).draw(&mut grid).unwrap();
+            let whole = Rectangle::new(Point::zero(), Size::new(12, 8));
+            let drawn: Vec<BinaryColor> = grid.0.iter().flatten().map(|c| c.unwrap()).collect();
+            assert_eq!(drawn, dithered_by_hand::<BinaryColor, 12, 8>(dithering, whole), "{dithering:?}");
+        }
+        // A row of more than 256 words: the larger frame, the same picture.
+        let mut wide = Grid::<Gray4, 300, 2>([[None; 300]; 2]);
+        scene.image_for(&wide).draw(&mut wide).unwrap();
+        let drawn: Vec<Gray4> = wide.0.iter().flatten().map(|c| c.unwrap()).collect();
+        let whole = Rectangle::new(Point::zero(), Size::new(300, 2));
+        assert_eq!(drawn, dithered_by_hand::<Gray4, 300, 2>(Dithering::FsPe, whole));
+    }
+
+    #[test]
+    fn a_dithered_sub_image_is_dithered_as_an_image_of_its_own() {
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let scene = raytracer.load(SCENE).unwrap();
+        let area = Rectangle::new(Point::new(3, 2), Size::new(6, 4));
+        for dithering in Dithering::ALL {
+            let mut part = Grid::<BinaryColor, 6, 4>([[None; 6]; 4]);
+            scene.image::<BinaryColor>(Size::new(12, 8)).dithered(dithering).draw_sub_image(&mut part, &area).unwrap();
+            let drawn: Vec<BinaryColor> = part.0.iter().flatten().map(|c| c.unwrap()).collect();
+            // Its own raster order from the area's corner; ordered dithering
+            // keeps the whole image's pattern there.
+            assert_eq!(drawn, dithered_by_hand::<BinaryColor, 12, 8>(dithering, area), "{dithering:?}");
+        }
+    }
+
+    #[test]
+    fn an_image_too_wide_for_the_stack_needs_storage_of_its_own() {
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let scene = raytracer.load(SCENE).unwrap();
+        let mut wide = Grid::<BinaryColor, 801, 1>([[None; 801]; 1]);
+        let image = scene.image_for(&wide);
+        let e = image.try_draw(&mut wide).unwrap_err();
+        assert_eq!(e, DrawError::ErrorRow(ErrorRowTooShort { needed: 801, given: IMAGE_ERROR_WORDS }));
+        assert_eq!(e.to_string(), "error diffusion needs a row of 801 accumulators here, but was given room for 800");
+        image.draw(&mut wide).unwrap();
+        assert!(wide.0[0].iter().all(|c| c.is_none()), "nothing drawn");
+        // Bayer keeps no row; with the caller's storage, diffusion draws.
+        image.dithered(Dithering::Bayer).try_draw(&mut wide).unwrap();
+        let mut again = Grid::<BinaryColor, 801, 1>([[None; 801]; 1]);
+        image.try_draw_with(&mut again, &mut [0; 801]).unwrap();
+        assert!(again.0[0].iter().all(|c| c.is_some()));
+    }
+
+    #[test]
+    fn a_progressive_panel_ends_in_the_ordered_picture() {
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let scene = raytracer.load(SCENE).unwrap();
+        /// Keeps the last colour drawn at each pixel.
+        struct Overdrawn([[Option<Gray4>; 12]; 8]);
+        impl OriginDimensions for Overdrawn {
+            fn size(&self) -> Size {
+                Size::new(12, 8)
+            }
+        }
+        impl DrawTarget for Overdrawn {
+            type Color = Gray4;
+            type Error = core::convert::Infallible;
+            fn draw_iter<I: IntoIterator<Item = Pixel<Gray4>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
+                for Pixel(p, c) in pixels {
+                    self.0[p.y as usize][p.x as usize] = Some(c);
+                }
+                Ok(())
+            }
+        }
+        let mut progressive = Overdrawn([[None; 12]; 8]);
+        scene.draw_progressive(&Progressive::new(Size::new(12, 8), 4), &mut progressive).unwrap();
+        let mut ordered = Grid::<Gray4, 12, 8>([[None; 12]; 8]);
+        scene.image_for(&ordered).dithered(Dithering::Bayer).draw(&mut ordered).unwrap();
+        assert_eq!(progressive.0, ordered.0);
     }
 }

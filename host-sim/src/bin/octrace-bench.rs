@@ -5,8 +5,10 @@
 //! Tables: `scenes` (every scene, naive), `table51` (the thesis's Table 5.1),
 //! `table52` (Table 5.2), `scaling` (random spheres, N = 10 … 100,000),
 //! `criterion` (the octree's subdivision criterion), `parallel` (threads
-//! and partitions), `palette` (the 256-colour modes), `spheres600` (naive against
-//! dda on 600 random spheres at 800×600). No argument: all. Times are wall-clock on one thread
+//! and partitions), `palette` (the 256-colour modes), `panels` (every
+//! dithering on every panel of few levels, issue 42's measure),
+//! `spheres600` (naive against dda on 600 random spheres at 800×600). No
+//! argument: all. Times are wall-clock on one thread
 //! (except in `parallel`), the best of several runs; the machine is printed
 //! first so every table says where it came from.
 
@@ -68,11 +70,12 @@ enum Table {
     Scaling,
     Parallel,
     Palette,
+    Panels,
     Spheres600,
 }
 
 impl Table {
-    const ALL: [Table; 8] = [
+    const ALL: [Table; 9] = [
         Table::Scenes,
         Table::Table51,
         Table::Table52,
@@ -80,6 +83,7 @@ impl Table {
         Table::Scaling,
         Table::Parallel,
         Table::Palette,
+        Table::Panels,
         Table::Spheres600,
     ];
 
@@ -93,6 +97,7 @@ impl Table {
             Table::Scaling => "scaling",
             Table::Parallel => "parallel",
             Table::Palette => "palette",
+            Table::Panels => "panels",
             Table::Spheres600 => "spheres600",
         }
     }
@@ -114,6 +119,7 @@ impl Table {
             }
             Table::Parallel => parallel(dir),
             Table::Palette => palette_table(dir),
+            Table::Panels => panels_table(dir),
             Table::Spheres600 => spheres600(dir),
         }
     }
@@ -459,6 +465,54 @@ fn palette_table(dir: &Path) -> Result<(), BenchError> {
         print!(" {:.1} ns |", c.as_nanos() as f64 / pixels);
     }
     println!("\n");
+    Ok(())
+}
+
+/// Every scene at 128×64 on every panel of few levels by every dithering:
+/// issue 42's measure (what the eye sees of the picture through a blur of
+/// one pixel, [`octrace_images::panel::seen_psnr`]), and each method's cost
+/// per pixel on this machine.
+fn panels_table(dir: &Path) -> Result<(), BenchError> {
+    use octrace_core::panel::{Dithering, Panel};
+    use octrace_core::render::PanelColor;
+    use octrace_images::panel;
+    let mut renders = Vec::new();
+    for path in scene_files(dir) {
+        let name = path.file_stem().unwrap_or_default().to_string_lossy().into_owned();
+        let scene = load(&path)?;
+        let options = RenderOptions { size: Some((128, 64)), threads: all_cores(), ..Default::default() };
+        if let Ok(rendered) = render(&scene, &options) {
+            renders.push((name, rendered.image));
+        }
+    }
+    for shown in Panel::ALL {
+        let against = match shown {
+            Panel::BlackWhiteRed => "the render's RGB (capped by the colours three inks cannot mix)",
+            _ => "the render's gray",
+        };
+        println!(
+            "### `--color {}` at 128×64: dB against {against}, blurred by σ = 1 pixel
+",
+            PanelColor::from(shown)
+        );
+        let methods =
+            Dithering::ALL.map(|d| format!("{d}{}", if d == Dithering::default() { " (default)" } else { "" }));
+        println!("| scene | {} |", methods.join(" | "));
+        println!("| --- |{}", " ---: |".repeat(methods.len()));
+        let mut cost = [Duration::ZERO; Dithering::ALL.len()];
+        for (name, image) in &renders {
+            print!("| {name} |");
+            for (i, dithering) in Dithering::ALL.into_iter().enumerate() {
+                let (time, preview) = best_of(5, || panel::dithered(image, shown, dithering));
+                cost[i] += time;
+                print!(" {:.2} |", panel::seen_psnr(image, &preview.to_rgb(), shown));
+            }
+            println!();
+        }
+        let pixels = (renders.len() * 128 * 64) as f64;
+        let cost: Vec<String> = cost.iter().map(|c| format!("{:.1} ns", c.as_nanos() as f64 / pixels)).collect();
+        println!("| cost per pixel | {} |\n", cost.join(" | "));
+    }
     Ok(())
 }
 
