@@ -352,9 +352,6 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     }
 }
 
-/// A renderer over `view` for an image of `size`, with a mailbox and screen
-/// lists where given. Inlined: a board's renderer is made in place.
-#[inline(always)]
 /// The loading core's room out of its cells: none of what another draw of
 /// the scene holds (only if a display draws from inside a draw: the render
 /// goes without, the same image).
@@ -367,6 +364,9 @@ fn room_of<'g, 'r>(
     (mailbox.as_deref_mut().ok().map(|words| &mut **words), lists)
 }
 
+/// A renderer over `view` for an image of `size`, with a mailbox and screen
+/// lists where given. Inlined: a board's renderer is made in place.
+#[inline(always)]
 pub(super) fn renderer_in<'a, A: Accelerator>(
     view: SceneView<'a>,
     accel: &'a A,
