@@ -38,6 +38,8 @@ import { buildBootrom, codeLetters, MISSING_FUNCTION_BREAKPOINT } from './bootro
 import { functionAt, parseElf } from './elf.mjs';
 import { correctInstructions } from './armv6m.mjs';
 import { ST7789 } from './st7789.mjs';
+import { I2cController } from './i2c.mjs';
+import { wireOled } from './oled.mjs';
 import { RunError } from './errors.mjs';
 import { installBus, machineMemory, peek16 } from './bus.mjs';
 import { CoreSio, InterCoreFifos } from './sio.mjs';
@@ -65,6 +67,7 @@ const CHECK_EVERY = 0xfffff;
 const XIP_CTRL_SLOT = 0x14000;
 const SSI_SLOT = 0x18000;
 const PSM_SLOT = 0x40010;
+const I2C_SLOTS = [0x40044, 0x40048];
 const PSM_FRCE_OFF = 0x04;
 const PSM_PROC1 = 1 << 16;
 
@@ -76,12 +79,13 @@ export class Pico {
   /**
    * `segments` ({ loadAddress, data }, as an ELF's) are loaded as built;
    * `source` names them in messages, `functions` (an ELF's symbols) name
-   * where a core is. `panel`: the ST7789's options (null: no panel).
+   * where a core is. `panel`: the ST7789's options (null: no panel);
+   * `oled`: the SSD1306 module's on I2C0 (oled.mjs; null: none).
    * `onBreakpoint(core, code)`: returns true for a BKPT or UDF it handles
    * (tests); any other ends the run. `flashStatusRegister2`: the flash
    * chip's at power-on (QE set, as the Pico's).
    */
-  constructor({ segments, source, functions = [], panel = null, onBreakpoint = () => false, flashStatusRegister2 } = {}) {
+  constructor({ segments, source, functions = [], panel = null, oled = null, onBreakpoint = () => false, flashStatusRegister2 } = {}) {
     const rp2040 = new RP2040();
     this.rp2040 = rp2040;
     this.clock = rp2040.clock;
@@ -164,6 +168,28 @@ export class Pico {
     /** The ST7789 on SPI1 (null without one), and the times the run's phases are told by. */
     this.panel = panel ? new ST7789(panel) : null;
     this.events = this.panel ? this.wirePanel(this.panel) : null;
+    // Both I2C controllers with what rp2040js's lack (i2c.mjs), and the SSD1306 module on I2C0.
+    this.i2c = I2C_SLOTS.map((slot, k) => {
+      const controller = new I2cController(rp2040, k, rp2040.i2c[k].irq, { nanosPerCycle: NANOS_PER_CYCLE });
+      rp2040.i2c[k] = rp2040.peripherals[slot] = controller;
+      return controller;
+    });
+    this.oled = oled ? wireOled(this.i2c[0], rp2040.gpio, now, oled) : null;
+  }
+
+  /**
+   * The panel the firmware drives, as run.mjs writes it: the ST7789 if it
+   * took a command, else the SSD1306 if it took a transfer, else the first
+   * wired (null: none is). Its name, size, picture (8-bit RGB), why it is
+   * dark (or null), and how many writes it has taken.
+   */
+  get display() {
+    if (!this.panel && !this.oled) return null;
+    const st7789 = this.panel && { name: 'ST7789', panel: this.panel, writes: () => this.events.memoryWrites };
+    const ssd1306 = this.oled && { name: 'SSD1306', panel: this.oled.panel, writes: () => this.oled.panel.dataBytes };
+    const talkedTo = (st7789 && this.panel.counts.size > 0 && st7789) || (ssd1306 && this.oled.events.transfers > 0 && ssd1306);
+    const { name, panel, writes } = talkedTo || st7789 || ssd1306;
+    return { name, width: panel.width, height: panel.height, picture: () => panel.picture(), darkBecause: panel.darkBecause, writes };
   }
 
   /** A Pico running the ELF `bytes` read from `path`. */
@@ -458,7 +484,7 @@ export class Pico {
         located: true,
       });
     }
-    onProgress(this.time, this.events?.memoryWrites ?? 0);
+    onProgress(this.time, this.display?.writes() ?? 0);
   }
 
   breakpoint(k, code) {
@@ -521,6 +547,7 @@ export class Pico {
    * run never got there.
    */
   phases() {
+    if (this.display?.name === 'SSD1306') return { ...this.oled.phases(), total: this.time };
     const { backlightOn, pictureStart, lastPixel, fullPanel } = this.events ?? {};
     const picture = backlightOn != null && pictureStart != null && lastPixel > pictureStart;
     return {

@@ -10,7 +10,8 @@
 //! | `OCTRACE_SCENE` | a scene in `scenes/` (name without `.txt`) | `fig5_1` |
 //! | `OCTRACE_SIZE` | `WxH` (on `lm3s6965evb` at most the panel's 128x64, an even width) | `160x128`; `128x64` on `lm3s6965evb` |
 //! | `OCTRACE_ACCEL` | `auto`, `naive`, `octree`, `dda` | `auto` |
-//! | `OCTRACE_COLOR` | `rgb888`, `rgb565`, `dither` (1-byte indices into the 6×6×6 cube), `gray4` (1 byte a pixel, the level 0 to 15); only `gray4` on `lm3s6965evb` | `rgb888`; `gray4` on `lm3s6965evb` |
+//! | `OCTRACE_COLOR` | `rgb888`, `rgb565`, `dither` (1-byte indices into the 6×6×6 cube), and the panels of few levels, 1 byte a pixel holding the level: `mono` (0, 1), `gray2` (0 to 3), `gray4` (0 to 15), `bwr` (0 black, 1 white, 2 red); only `gray4` on `lm3s6965evb` | `rgb888`; `gray4` on `lm3s6965evb` |
+//! | `OCTRACE_DITHER` | how `mono`, `gray2`, `gray4` and `bwr` are dithered: `fs-pe`, `fs`, `bayer`, `nearest` | `fs-pe` |
 //! | `OCTRACE_TECHNIQUES` | `auto` (every technique whose RAM fits beside the deepest octree that fits, and for a scene walked in an octree the light buffer in flash instead of the shadow shafts), `none`, or a comma list of `first-hits`, `shadow-shafts`, `light-buffer` (built here, kept in flash), `light-buffer-ram` (built by the board, in RAM; each still only where it fits) | `auto` |
 //! | `OCTRACE_OUT` | host file the pixels are written to; on `lm3s6965evb` the PNG of the panel's screen that the runner grabs | `octrace-out.raw`; `screen.png` on `lm3s6965evb` |
 //!
@@ -29,6 +30,7 @@
 
 use octrace_core::accel::OctreeConfig;
 use octrace_core::capacity::{CapacityKind, Counts};
+use octrace_core::panel::Dithering;
 use octrace_core::parse::count;
 use octrace_core::profile::{light_buffer_words, needed_with_light_buffer, ProfileText};
 use octrace_core::render::PanelColor;
@@ -153,6 +155,16 @@ fn main() {
             fail(format!("OCTRACE_COLOR={color}: expected {}", names.join(", ")))
         }
     };
+    let dithering = var("OCTRACE_DITHER", Dithering::default().name());
+    let Some(dithering) = Dithering::from_name(&dithering) else {
+        let names: Vec<&str> = Dithering::ALL.iter().map(|d| d.name()).collect();
+        fail(format!("OCTRACE_DITHER={dithering}: expected {}", names.join(", ")))
+    };
+    // Error diffusion's row for the panel's width, on the draw's stack.
+    let error_words = match wire.panel() {
+        Some(panel) if dithering.diffuses() => panel.error_words(w),
+        _ => 0,
+    };
     let output = var("OCTRACE_OUT", if oled { "screen.png" } else { "octrace-out.raw" });
     if output.contains(['\0', '\n']) {
         fail("OCTRACE_OUT: a path without NUL or newline".to_owned());
@@ -223,6 +235,12 @@ fn main() {
     writeln!(config, "pub const HEIGHT: u32 = {h};").unwrap();
     writeln!(config, "pub const ACCEL: octrace_core::AccelMode = octrace_core::AccelMode::{accel:?};").unwrap();
     writeln!(config, "pub const WIRE: crate::PanelColor = crate::PanelColor::{wire:?};").unwrap();
+    writeln!(
+        config,
+        "pub const DITHERING: octrace_core::panel::Dithering = octrace_core::panel::Dithering::{dithering:?};"
+    )
+    .unwrap();
+    writeln!(config, "pub const ERROR_WORDS: usize = {error_words};").unwrap();
     if !oled {
         // The guest writes this file; on the OLED board the runner does.
         writeln!(config, "pub const OUTPUT: &str = {:?};", format!("{output}\0")).unwrap();

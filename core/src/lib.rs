@@ -3,7 +3,9 @@
 //! text ([`parse`]) into fixed-capacity arenas ([`scene`], sized by a
 //! [`profile`](mod@profile)), optionally indexed by an octree ([`accel`]),
 //! and rendered pixel by pixel ([`render`]) into any embedded-graphics
-//! `DrawTarget`, in truecolour or through a 256-colour [`palette`].
+//! `DrawTarget`, in truecolour, through a 256-colour [`palette`], or
+//! dithered onto a [`panel`] of few levels (a one-bit OLED, gray OLEDs,
+//! e-paper).
 //!
 //! # From scene text to a display
 //!
@@ -132,6 +134,7 @@ pub mod capacity;
 pub mod math;
 mod motion;
 pub mod palette;
+pub mod panel;
 pub mod parse;
 pub mod profile;
 mod raytracer;

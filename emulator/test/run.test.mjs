@@ -83,8 +83,18 @@ test('a run out of time says where it was', () => {
   assert.match(result.stderr, /still running after 1250000 cycles \(0\.01 s at 125 MHz\), in 0x1000040. on core 0/);
 });
 
+test('--display ssd1306 wires the SSD1306 module alone: a firmware that never talks to it leaves it dark, 128x64', () => {
+  const result = run(firmware(sleep), '--json', '--display', 'ssd1306');
+  assert.equal(result.status, 0, result.stderr);
+  const report = JSON.parse(result.stdout);
+  assert.deepEqual([report.display, report.panel], ['SSD1306', '128x64']);
+  assert.match(report.dark, /display is off/);
+  assert.equal(report.cycles.render, null, 'the LED never lit');
+});
+
 test('bad arguments exit 2 with the usage', () => {
-  for (const args of [[], ['a.elf', 'b.elf'], ['a.elf', '--panel', '240'], ['a.elf', '--out', 'x.bmp'], ['a.elf', '--max-seconds', '0']]) {
+  const cases = [[], ['a.elf', 'b.elf'], ['a.elf', '--panel', '240'], ['a.elf', '--out', 'x.bmp'], ['a.elf', '--max-seconds', '0'], ['a.elf', '--display', 'lcd']];
+  for (const args of cases) {
     const result = spawnSync(process.execPath, [RUN, ...args], { encoding: 'utf8' });
     assert.equal(result.status, 2, `${args.join(' ')}: ${result.stderr}`);
     assert.match(result.stderr, /usage: node run\.mjs ELF/);

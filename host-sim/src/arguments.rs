@@ -1,5 +1,5 @@
 //! The command line's values that more than one command reads: the names
-//! of the vocabularies (accel, color, palette, format), sizes, and the
+//! of the vocabularies (accel, color, dither, palette, format), sizes, and the
 //! image file to write (its format, and never the scene file itself).
 //!
 //! Invariant: every name is parsed from its vocabulary's own list (`ALL`
@@ -7,6 +7,7 @@
 //! without a change here.
 
 use crate::exit::CliError;
+use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
 use octrace_core::scene::MAX_SIDE;
 use octrace_core::AccelMode;
@@ -22,6 +23,11 @@ pub(crate) fn parse_accel(text: &str) -> Result<AccelMode, String> {
 /// A `--color` name: the core's [`PanelColor`] vocabulary.
 pub(crate) fn parse_color(text: &str) -> Result<PanelColor, String> {
     parse_name(text, &PanelColor::ALL, PanelColor::name)
+}
+
+/// A `--dither` name: the core's [`Dithering`] vocabulary.
+pub(crate) fn parse_dithering(text: &str) -> Result<Dithering, String> {
+    parse_name(text, &Dithering::ALL, Dithering::name)
 }
 
 /// A `--palette` name: [`PaletteMode`]'s vocabulary.

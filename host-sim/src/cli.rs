@@ -1,7 +1,8 @@
 //! The `host-sim` command line.
 
 use crate::animation::{animate, is_frame_file, merge_frames, AnimationOptions, Request};
-use crate::arguments::{output_format, parse_accel, parse_color, parse_format, parse_palette, parse_size, same_file};
+use crate::arguments::{output_format, parse_accel, parse_color, parse_dithering, parse_format, parse_palette};
+use crate::arguments::{parse_size, same_file};
 use crate::output::{panel_preview, write_atomically, FileSink};
 use crate::parts::{self, MergeError, PartInfo, PartSpec};
 use crate::terminal::progress_bar;
@@ -9,6 +10,7 @@ use crate::{all_cores, load_frame_bytes, new_scene, render_streamed, AccelMode, 
 use crate::{render_with_progress, HostScene, StreamError, Streamed};
 use clap::Parser;
 use octrace_core::accel::OctreeConfig;
+use octrace_core::panel::{Dithering, Panel};
 use octrace_core::render::PanelColor;
 use octrace_images::formats::{self, Format, FormatError, Header, Image};
 use octrace_images::palette::PaletteMode;
@@ -54,10 +56,16 @@ pub struct Args {
     pub palette: Option<PaletteMode>,
     /// Preview a panel: the pixels as a display of this format shows them
     /// (the firmware's OCTRACE_COLOR): rgb888; rgb565 (written back as
-    /// RGB); gray4, 16 levels (an 8-bit gray PNG, level × 17); dither (as
-    /// --palette dither).
+    /// RGB); mono, gray2 and gray4, one bit, 4 and 16 grays, dithered (an
+    /// 8-bit gray PNG of the levels' grays); bwr, black/white/red e-paper,
+    /// dithered (an indexed image); dither (as --palette dither).
     #[arg(long, value_name = "COLOR", default_value = "rgb888", value_parser = parse_color)]
     pub color: PanelColor,
+    /// How mono, gray2, gray4 and bwr are dithered: fs-pe (the default,
+    /// Floyd–Steinberg with pure-error feedback), fs (Floyd–Steinberg),
+    /// bayer (ordered, 4×4), nearest (none: each pixel's nearest level).
+    #[arg(long, value_name = "METHOD", value_parser = parse_dithering)]
+    pub dither: Option<Dithering>,
     /// The file format; by default from OUT's extension (png, tga, ras), or
     /// PNG when OUT has none. Any other extension is refused without it.
     #[arg(long, value_parser = parse_format)]
@@ -150,11 +158,17 @@ pub enum Command {
     Board(crate::board::BoardArgs),
 }
 
-/// Writes a panel preview: gray4 as an 8-bit gray PNG (level × 17) where
-/// the format is PNG, else as a 16-entry gray colour table.
+/// Whether `color` is previewed from the finished image (not streamed).
+fn previewed(color: PanelColor) -> bool {
+    !matches!(color, PanelColor::Rgb888 | PanelColor::Dither)
+}
+
+/// Writes a panel preview: a gray panel's as an 8-bit gray PNG (each
+/// level's gray) where the format is PNG, else as its colour table.
 fn write_preview(preview: &Image, color: PanelColor, format: Format, out: &mut dyn Write) -> Result<(), FormatError> {
-    match (color, format) {
-        (PanelColor::Gray4, Format::Png) => formats::write_gray_png(preview, out),
+    let gray = matches!(color.panel(), Some(Panel::Mono | Panel::Gray2 | Panel::Gray4));
+    match format {
+        Format::Png if gray => formats::write_gray_png(preview, out),
         _ => formats::write(preview, format, out),
     }
 }
@@ -224,7 +238,7 @@ fn part_of(
     if format == Format::Ras {
         return refuse("parts are PNG or Targa files (a Sun raster has no room for the part's metadata)".into());
     }
-    if matches!(color, PanelColor::Rgb565 | PanelColor::Gray4) {
+    if previewed(color) {
         return refuse("a --color preview is written whole: render it without --part".into());
     }
     if palette_mode == PaletteMode::Scan {
@@ -258,30 +272,32 @@ fn part_of(
     Ok((rows, info.to_string()))
 }
 
-/// `--color rgb565|gray4`: a panel's preview, converted from the whole
-/// image (panels are small; every other image streams).
+/// `--color rgb565|mono|gray2|gray4|bwr [--dither METHOD]`: a panel's
+/// preview, converted or dithered from the whole image (panels are small;
+/// every other image streams).
 fn preview(
     scene: &HostScene,
     options: &RenderOptions,
-    color: PanelColor,
+    args: &Args,
     format: Format,
     out: &Path,
-    quiet: bool,
     stderr: &mut dyn Write,
 ) -> Result<(), CliError> {
+    let (color, dithering) = (args.color, args.dither.unwrap_or_default());
     let started = Instant::now();
     // The parser rejects a camera that cannot be set up; a scene built by
     // hand may not.
     let rendered = render_with_progress(scene, options, &|_| {})
         .map_err(|e| CliError::Invalid(format!("cannot set up the camera: {e}")))?;
-    let preview = panel_preview(&rendered.image, color).unwrap_or_else(|| Image::Rgb(rendered.image.clone()));
+    let preview =
+        panel_preview(&rendered.image, color, dithering).unwrap_or_else(|| Image::Rgb(rendered.image.clone()));
     write_atomically(out, |f| write_preview(&preview, color, format, f).map_err(std::io::Error::other))
         .map_err(|e| CliError::write(out, e))?;
-    if !quiet {
+    if !args.quiet {
         let (image, stats) = (&rendered.image, rendered.stats);
         let _ = writeln!(
             stderr,
-            "{}x{} in {:.3} s ({}, {} threads): {} rays, {} shadow rays, {} cells -> {} ({} panel)",
+            "{}x{} in {:.3} s ({}, {} threads): {} rays, {} shadow rays, {} cells -> {} ({} panel{})",
             image.width,
             image.height,
             started.elapsed().as_secs_f64(),
@@ -291,7 +307,11 @@ fn preview(
             stats.shadow_rays,
             stats.cells,
             out.display(),
-            color.name()
+            color.name(),
+            match color.panel() {
+                Some(_) => format!(", {}", dithering.name()),
+                None => String::new(),
+            }
         );
     }
     Ok(())
@@ -350,6 +370,13 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     if args.color != PanelColor::Rgb888 && palette != PaletteMode::None {
         return Err(CliError::Invalid("--color and --palette both choose the pixels: give one".into()));
     }
+    if args.dither.is_some() && args.color.panel().is_none() {
+        let panels: Vec<&str> = PanelColor::ALL.iter().filter(|c| c.panel().is_some()).map(|c| c.name()).collect();
+        return Err(CliError::Invalid(format!(
+            "--dither chooses how a panel of few levels is dithered: give it with --color {}",
+            panels.join("|")
+        )));
+    }
     if same_file(scene_path, &out) {
         return Err(CliError::Invalid(format!(
             "refusing to overwrite the scene file {} with the image",
@@ -395,8 +422,8 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     };
     let started = Instant::now();
     let options = options((w, h));
-    if matches!(args.color, PanelColor::Rgb565 | PanelColor::Gray4) {
-        return preview(&scene, &options, args.color, format, &out, args.quiet, stderr);
+    if previewed(args.color) {
+        return preview(&scene, &options, args, format, &out, stderr);
     }
     // `coarse` outlines need the objects of the row above a part.
     let render_rows = match palette_mode {
@@ -506,14 +533,14 @@ mod tests {
     }
 
     fn one_pixel_preview(rgb: [u8; 3], color: PanelColor) -> Option<Image> {
-        panel_preview(&RgbImage { width: 1, height: 1, data: rgb.to_vec() }, color)
+        panel_preview(&RgbImage { width: 1, height: 1, data: rgb.to_vec() }, color, Dithering::Nearest)
     }
 
     #[test]
     fn gray4_preview_is_the_panels_level_times_17() {
         for rgb in [[0, 0, 0], [255, 255, 255], [255, 0, 0], [0, 255, 0], [0, 0, 255], [8, 9, 10], [200, 17, 90]] {
             let expected = gray4_by_hand(rgb[0].into(), rgb[1].into(), rgb[2].into());
-            let preview = one_pixel_preview(rgb, PanelColor::Gray4).expect("gray4 is converted");
+            let preview = one_pixel_preview(rgb, PanelColor::Gray4).expect("gray4 is previewed");
             assert_eq!(preview.to_rgb().data, [expected; 3], "{rgb:?}");
             let mut png = Vec::new();
             write_preview(&preview, PanelColor::Gray4, Format::Png, &mut png).unwrap();
@@ -535,22 +562,57 @@ mod tests {
     }
 
     #[test]
-    fn color_and_palette_together_are_refused() {
-        let dir = tempfile_dir();
+    fn a_dithered_preview_is_the_core_ditherers_levels() {
+        // A 16×4 ramp: each level the core gives, written as its gray (one
+        // bit as 0 and 255).
+        let data: Vec<u8> = (0..64u32).flat_map(|i| [(i * 4) as u8; 3]).collect();
+        let image = RgbImage { width: 16, height: 4, data };
+        for color in [PanelColor::Mono, PanelColor::Gray2, PanelColor::Gray4] {
+            let panel = color.panel().unwrap();
+            let mut rows = vec![0; 16];
+            let mut ditherer =
+                octrace_core::panel::Ditherer::new(panel, Dithering::FsPe, Default::default(), 16, &mut rows).unwrap();
+            let expected: Vec<u8> = image
+                .data
+                .chunks(3)
+                .map(|p| panel.color(ditherer.next(embedded_graphics_core::pixelcolor::Rgb888::new(p[0], p[1], p[2]))))
+                .map(|c| embedded_graphics_core::pixelcolor::RgbColor::r(&c))
+                .collect();
+            let preview = panel_preview(&image, color, Dithering::FsPe).unwrap();
+            let mut png = Vec::new();
+            write_preview(&preview, color, Format::Png, &mut png).unwrap();
+            let mut decoder = png::Decoder::new(std::io::Cursor::new(&png)).read_info().unwrap();
+            assert_eq!(decoder.info().color_type, png::ColorType::Grayscale, "{color}");
+            let mut gray = vec![0; decoder.output_buffer_size().unwrap()];
+            decoder.next_frame(&mut gray).unwrap();
+            assert_eq!(gray, expected, "{color}");
+        }
+    }
+
+    /// What host-sim prints when it refuses fig5_1 at 4×4 with `options`
+    /// (exit 2, nothing written).
+    fn refusal(options: &[&str]) -> String {
+        let dir = std::env::temp_dir().join(format!("host-sim-cli-{}-{}", std::process::id(), options.join("")));
+        std::fs::create_dir_all(&dir).unwrap();
         let out = dir.join("x.png");
         let mut stderr = Vec::new();
         let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/fig5_1.txt");
         let args =
-            ["host-sim", scene, out.to_str().unwrap(), "--color", "gray4", "--palette", "dither", "--size", "4x4"];
+            ["host-sim", scene, out.to_str().unwrap(), "--size", "4x4"].into_iter().chain(options.iter().copied());
         assert_eq!(run(args, &mut Vec::new(), &mut stderr), EXIT_SCENE);
-        assert!(String::from_utf8_lossy(&stderr).contains("give one"));
         assert!(!out.exists());
         let _ = std::fs::remove_dir_all(dir);
+        String::from_utf8_lossy(&stderr).into_owned()
     }
 
-    fn tempfile_dir() -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("host-sim-cli-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    #[test]
+    fn dither_without_a_panel_is_refused() {
+        let said = refusal(&["--color", "rgb565", "--dither", "bayer"]);
+        assert!(said.contains("--color mono|gray2|gray4|bwr"), "{said}");
+    }
+
+    #[test]
+    fn color_and_palette_together_are_refused() {
+        assert!(refusal(&["--color", "gray4", "--palette", "dither"]).contains("give one"));
     }
 }

@@ -9,6 +9,7 @@
 use crate::{RgbImage, NO_OBJECT};
 use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
 use octrace_core::palette::{Coarse, Dither, Gray, Quantizer, Scan};
+use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
 use octrace_core::scene::ObjectId;
 use octrace_images::formats::{Format, FormatError, Header, Image, RowWriter};
@@ -18,13 +19,14 @@ use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Seek, Write};
 use std::path::{Path, PathBuf};
 
-/// What a `color` panel shows of `image` ([`octrace_images::panel`]), or
-/// `None` for the colours that need no conversion.
-pub(crate) fn panel_preview(image: &RgbImage, color: PanelColor) -> Option<Image> {
-    match color {
-        PanelColor::Rgb888 | PanelColor::Dither => None,
-        PanelColor::Rgb565 => Some(Image::Rgb(panel::rgb565(image))),
-        PanelColor::Gray4 => Some(panel::gray4(image)),
+/// What a `color` panel shows of `image` ([`octrace_images::panel`]),
+/// dithered by `dithering` if it has few levels, or `None` for the colours
+/// that need no conversion.
+pub(crate) fn panel_preview(image: &RgbImage, color: PanelColor, dithering: Dithering) -> Option<Image> {
+    match (color, color.panel()) {
+        (_, Some(shown)) => Some(panel::dithered(image, shown, dithering)),
+        (PanelColor::Rgb565, None) => Some(Image::Rgb(panel::rgb565(image))),
+        _ => None,
     }
 }
 

@@ -12,6 +12,7 @@
 //! `docs/studio/`.
 
 use host_sim::{load_bytes, new_scene, render, RenderOptions, RgbImage};
+use octrace_core::panel::Dithering;
 use octrace_images::palette::{self, PaletteMode};
 use octrace_tests::board::{fits, open_pty, RunningBoard};
 use octrace_tests::webdriver::{http, http_with_head, Browser};
@@ -183,7 +184,9 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
     assert_same("placed sphere", browser.canvas_rgb("image"), &expected.image);
 
     // Each display mode: the 256-colour modes are host-sim --palette, the
-    // panels are embedded-graphics' own conversions at the panel size.
+    // panels host-sim's --color previews at the panel size (embedded-graphics'
+    // conversion for rgb565; the panels of few levels dithered by the
+    // chosen method, bayer for the last).
     for (code, mode) in
         [(1, PaletteMode::Scan), (2, PaletteMode::Dither), (3, PaletteMode::Coarse), (4, PaletteMode::Gray)]
     {
@@ -195,25 +198,34 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
         let shown = palette::apply(&expected.image, &expected.objects, mode).to_rgb();
         assert_same(mode.name(), browser.canvas_rgb("image"), &shown);
     }
-    for (code, name) in [(5, "rgb565"), (6, "gray4")] {
+    for (code, name, dither) in
+        [(5, "rgb565", None), (6, "gray4", None), (7, "mono", None), (9, "bwr", None), (7, "mono", Some("bayer"))]
+    {
+        // The method's code is its place in the core's list.
+        let method = dither.map_or(Dithering::default(), |d| Dithering::from_name(d).unwrap());
+        let method_code = Dithering::ALL.iter().position(|&d| d == method).unwrap();
         browser.run(&format!(
             "document.getElementById('panel-size').value = '40x30';
+             document.getElementById('dither').value = '{method_code}';
              const d = document.getElementById('display'); d.value = '{code}';
              d.dispatchEvent(new Event('change')); return true;"
         ));
         browser.wait_for(
             &format!(
                 "document.getElementById('image').dataset.display === '{code}'
+                 && document.getElementById('image').dataset.dither === '{method_code}'
                  && document.getElementById('image').dataset.state === 'done'"
             ),
             60,
         );
-        // host-sim --size 40x30 --color NAME, as a Targa (RGB, or gray as
-        // a colour table).
+        // host-sim --size 40x30 --color NAME [--dither METHOD], as a Targa
+        // (RGB, or a colour table).
         let out = dir.path().join(format!("{name}.tga"));
         let args = ["host-sim", scene_path.to_str().unwrap(), out.to_str().unwrap(), "--size", "40x30"];
+        let dither = dither.map(|d| ["--dither", d]).into_iter().flatten();
         let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
-        let code = host_sim::run(args.into_iter().chain(["--color", name, "--quiet"]), &mut stdout, &mut stderr);
+        let args = args.into_iter().chain(["--color", name, "--quiet"]).chain(dither);
+        let code = host_sim::run(args, &mut stdout, &mut stderr);
         assert_eq!(code, 0, "{}", String::from_utf8_lossy(&stderr));
         let panel = octrace_images::formats::read(&std::fs::read(&out).unwrap()).expect("host-sim's preview").to_rgb();
         assert_same(name, browser.canvas_rgb("image"), &panel);

@@ -3,6 +3,7 @@
 
 use crate::accel::{AccelMode, Accelerator, BuildReport, LightBuffer, LightBufferError};
 use crate::animation::{Coherence, Motion};
+use crate::panel::{Dithered, Dithering, TracedColor};
 use crate::profile::Profile;
 use crate::render::{Progressive, Renderer};
 use crate::scene::{CameraError, Frames, SceneView};
@@ -10,11 +11,10 @@ use crate::shade::Stats;
 use core::cell::{Cell, RefCell};
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::geometry::Size;
 use embedded_graphics_core::pixelcolor::Rgb888;
 use embedded_graphics_core::primitives::Rectangle;
 
-use super::image::Shifted;
 use super::{light_buffer, DrawError, SceneAccelerator, ScreenLists, SharedScene, TracedImage};
 
 /// A scene ready to trace, borrowed from its [`Raytracer`](super::Raytracer).
@@ -199,6 +199,12 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// only their runs of pixels: after the frame before it in the loop
     /// (or at the first frame, everything), `target` shows the frame as a
     /// whole draw would. An example is [`Coherence`]'s.
+    ///
+    /// A panel of few levels (`BinaryColor`, `Gray2`, `Gray4`,
+    /// [`BlackWhiteRed`](crate::panel::BlackWhiteRed)) is dithered by
+    /// [`Dithering::Bayer`], whose pixels depend on nothing but themselves
+    /// (error diffusion would carry a change across the whole image): it
+    /// shows the frame as a whole draw with that method would.
     pub fn draw_changes<D>(
         &self,
         motion: &Motion<'_>,
@@ -208,7 +214,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     ) -> Result<Stats, DrawError<D::Error>>
     where
         D: DrawTarget,
-        D::Color: From<Rgb888>,
+        D::Color: TracedColor,
     {
         self.draw_bands(motion, frame, coherence, 0..coherence.bands(), target)
     }
@@ -219,6 +225,26 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// (the other cores trace theirs with [`Coherence::trace_band`] and a
     /// renderer of their own, [`SharedScene::renderer`]).
     pub fn draw_bands<D>(
+        &self,
+        motion: &Motion<'_>,
+        frame: u32,
+        coherence: &Coherence<'_>,
+        bands: impl IntoIterator<Item = u32>,
+        target: &mut D,
+    ) -> Result<Stats, DrawError<D::Error>>
+    where
+        D: DrawTarget,
+        D::Color: TracedColor,
+    {
+        match D::Color::PANEL {
+            None => self.draw_bands_converted(motion, frame, coherence, bands, target),
+            Some(_) => self.draw_bands_converted(motion, frame, coherence, bands, &mut Dithered::ordered(target)),
+        }
+    }
+
+    /// [`LoadedScene::draw_bands`] into a target that takes the traced
+    /// colours converted.
+    fn draw_bands_converted<D>(
         &self,
         motion: &Motion<'_>,
         frame: u32,
@@ -261,7 +287,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
 
     /// The scene as an image of `size` pixels in the colour `C`.
     pub fn image<C>(&self, size: Size) -> TracedImage<'_, 'r, P, C> {
-        TracedImage { scene: self, size, color: core::marker::PhantomData }
+        TracedImage { scene: self, size, dithering: Dithering::default(), color: core::marker::PhantomData }
     }
 
     /// The scene as an image as large as `target`, in its colour: what
@@ -275,6 +301,11 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// blocks first, then finer, until it is exactly the picture
     /// [`LoadedScene::image`] draws. Every pixel is traced once; the
     /// drawing streams (no framebuffer), in a few calls a pass.
+    ///
+    /// A panel of few levels (`BinaryColor`, `Gray2`, `Gray4`,
+    /// [`BlackWhiteRed`](crate::panel::BlackWhiteRed)) is dithered by
+    /// [`Dithering::Bayer`] in every pass, the one method that needs no
+    /// order: the last pass is then the image with that method.
     ///
     /// ```
     /// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb565, prelude::*};
@@ -295,36 +326,32 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     pub fn draw_progressive<D>(&self, order: &Progressive, target: &mut D) -> Result<(), DrawError<D::Error>>
     where
         D: DrawTarget,
-        D::Color: From<Rgb888>,
+        D::Color: TracedColor,
     {
-        let drawn = self.with_renderer(order.size(), |renderer| order.render_unchecked(renderer, target));
+        let drawn = match D::Color::PANEL {
+            None => self.with_renderer(order.size(), |renderer| order.render_unchecked(renderer, target)),
+            Some(_) => {
+                let mut ordered = Dithered::ordered(target);
+                self.with_renderer(order.size(), |renderer| order.render_unchecked(renderer, &mut ordered))
+            }
+        };
         drawn.map_err(DrawError::Camera)?.map_err(DrawError::Target)?;
         Ok(())
     }
 
-    /// Renders `area` of an image of `size` into `target`, with the pixel at
-    /// `area`'s top-left corner going to `at`.
-    pub(super) fn draw_area<D>(
-        &self,
-        size: Size,
-        area: &Rectangle,
-        at: Point,
-        target: &mut D,
-    ) -> Result<(), DrawError<D::Error>>
+    /// Renders `area` of an image of `size` into `target`, in the image's
+    /// coordinates.
+    pub(super) fn render_area<D>(&self, size: Size, area: &Rectangle, target: &mut D) -> Result<(), DrawError<D::Error>>
     where
         D: DrawTarget,
         D::Color: From<Rgb888>,
     {
-        let mut shifted = Shifted { target, offset: at - area.top_left };
-        let drawn = self.with_renderer(size, |renderer| renderer.render_rect(area, &mut shifted));
+        let drawn = self.with_renderer(size, |renderer| renderer.render_rect(area, target));
         drawn.map_err(DrawError::Camera)?.map_err(DrawError::Target)?;
         Ok(())
     }
 }
 
-/// A renderer over `view` for an image of `size`, with a mailbox and screen
-/// lists where given. Inlined: a board's renderer is made in place.
-#[inline(always)]
 /// The loading core's room out of its cells: none of what another draw of
 /// the scene holds (only if a display draws from inside a draw: the render
 /// goes without, the same image).
@@ -337,6 +364,9 @@ fn room_of<'g, 'r>(
     (mailbox.as_deref_mut().ok().map(|words| &mut **words), lists)
 }
 
+/// A renderer over `view` for an image of `size`, with a mailbox and screen
+/// lists where given. Inlined: a board's renderer is made in place.
+#[inline(always)]
 pub(super) fn renderer_in<'a, A: Accelerator>(
     view: SceneView<'a>,
     accel: &'a A,

@@ -1,7 +1,7 @@
-//! The board behind octrace's Pico firmwares: a Raspberry Pi Pico with a
-//! Waveshare Pico-LCD-1.3 panel ([`panel`]), started the same way for each
-//! ([`board`]), and octrace's picture traced by both of its cores
-//! ([`both_cores`]). `src/main.rs` draws a scene embedded at build time,
+//! The board behind octrace's ST7789 firmwares: a Raspberry Pi Pico with a
+//! Waveshare Pico-LCD-1.3 panel ([`panel`]), started, core 1 waiting for
+//! jobs and both cores tracing by `octrace-pico`, which every Pico template
+//! shares. `src/main.rs` draws a scene embedded at build time,
 //! `src/bin/live.rs` the scenes a host sends over USB.
 //!
 //! Invariants: no heap; every static the firmwares need is theirs, handed
@@ -9,7 +9,4 @@
 
 #![no_std]
 
-pub mod board;
-pub mod both_cores;
 pub mod panel;
-pub mod sram_code;

@@ -17,18 +17,14 @@ use hal::entry;
 use hal::multicore::Stack;
 use octrace_core::render::{Handoff, Progressive};
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
-use octrace_pico_st7789::{board, both_cores, panel};
+use octrace_pico::board::{self, Board};
+use octrace_pico::both_cores;
+use octrace_pico_st7789::panel;
 use panic_halt as _;
 use rp2040_hal as hal;
 
-#[cfg(code_in_sram)]
-octrace_pico_st7789::copy_code_into_sram!();
-
-/// The second-stage loader for the Pico's W25Q16JV flash; the boot ROM
-/// runs it from the first 256 bytes of flash (see memory.x).
-#[link_section = ".boot2"]
-#[used]
-static BOOT2: [u8; 256] = rp2040_boot2::BOOT_LOADER_W25Q080;
+// boot2, and what build.rs places in SRAM (OCTRACE_CODE_IN) copied there at boot.
+octrace_pico::boot!();
 
 /// The scene (`SCENE_TEXT`, in flash) and a capacity profile that holds
 /// exactly what it needs (`SceneProfile`), from `build.rs`: set
@@ -61,8 +57,8 @@ static PANEL_BUFFER: ConstStaticCell<[u8; 512]> = ConstStaticCell::new([0; 512])
 
 #[entry]
 fn main() -> ! {
-    let board = board::start(PANEL_BUFFER.take(), CORE1_STACK.take().unwrap());
-    let (mut display, mut core1) = (board.display, board.core1);
+    let Board { mut core1, pins, clocks, timer, mut resets, peripherals } = board::start(CORE1_STACK.take().unwrap());
+    let mut display = panel::init(peripherals.spi1, pins, &mut resets, &clocks, timer, PANEL_BUFFER.take());
 
     // octrace: parse and index the scene, then trace it into the panel at
     // the panel's size with both cores. A scene the board cannot trace

@@ -19,6 +19,7 @@ use crate::output::panel_preview;
 use crate::terminal::progress_bar;
 use crate::{all_cores, load_bytes, new_scene, render_with_progress, LoadError, RenderOptions, RgbImage};
 use embedded_graphics_core::pixelcolor::RgbColor;
+use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
 use octrace_images::formats::{self, Format, Image};
 use octrace_link::{Panel, PixelFormat, Reason, VERSION};
@@ -317,7 +318,7 @@ fn host_render(file: &str, text: &[u8], panel: Panel) -> Result<RgbImage, CliErr
     let color = match panel.format {
         PixelFormat::Rgb565 => PanelColor::Rgb565,
     };
-    Ok(match panel_preview(&rendered.image, color) {
+    Ok(match panel_preview(&rendered.image, color, Dithering::default()) {
         Some(preview) => preview.to_rgb(),
         None => rendered.image,
     })

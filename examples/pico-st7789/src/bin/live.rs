@@ -23,6 +23,8 @@ use core::cell::RefCell;
 use core::ops::ControlFlow;
 use core::time::Duration;
 use critical_section::Mutex;
+use embedded_graphics::pixelcolor::Rgb565;
+use embedded_graphics::prelude::*;
 use hal::multicore::Stack;
 use hal::pac::interrupt;
 use hal::usb::UsbBus;
@@ -32,20 +34,17 @@ use octrace_core::render::Handoff;
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
 use octrace_link::board::Board;
 use octrace_link::{Decoder, Panel, PixelFormat, Sink};
-use octrace_pico_st7789::{board, both_cores, panel};
+use octrace_pico::board;
+use octrace_pico::both_cores;
+use octrace_pico_st7789::panel;
 use panic_halt as _;
 use rp2040_hal as hal;
 use usb_device::class_prelude::UsbBusAllocator;
 use usb_device::prelude::*;
 use usbd_serial::SerialPort;
 
-// The render path runs from SRAM (build.rs): copied there at boot.
-octrace_pico_st7789::copy_code_into_sram!();
-
-/// The second-stage loader for the Pico's W25Q16JV flash (see memory.x).
-#[link_section = ".boot2"]
-#[used]
-static BOOT2: [u8; 256] = rp2040_boot2::BOOT_LOADER_W25Q080;
+// boot2, and what build.rs places in SRAM (OCTRACE_CODE_IN) copied there at boot.
+octrace_pico::boot!();
 
 /// What the board says it is (octrace-link's `board` answer).
 const FIRMWARE: &str = concat!("octrace-pico-live ", env!("CARGO_PKG_VERSION"));
@@ -97,12 +96,13 @@ const STALLED_AFTER_US: u64 = 1_000_000;
 
 #[entry]
 fn main() -> ! {
-    let board::Board { mut display, mut core1, timer, usb, mut resets } =
-        board::start(PANEL_BUFFER.take(), CORE1_STACK.take().unwrap());
+    let board::Board { mut core1, pins, clocks, timer, mut resets, peripherals } =
+        board::start(CORE1_STACK.take().unwrap());
+    let mut display = panel::init(peripherals.spi1, pins, &mut resets, &clocks, timer, PANEL_BUFFER.take());
 
     // The USB serial port, served by its interrupt from here on.
     let bus: &'static UsbBusAllocator<UsbBus> = cortex_m::singleton!(: UsbBusAllocator<UsbBus> =
-        UsbBusAllocator::new(UsbBus::new(usb.regs, usb.dpram, usb.clock, true, &mut resets)))
+        UsbBusAllocator::new(UsbBus::new(peripherals.usbctrl_regs, peripherals.usbctrl_dpram, clocks.usb_clock, true, &mut resets)))
     .unwrap();
     let serial = SerialPort::new(bus);
     let strings = StringDescriptors::default().manufacturer("octrace").product("octrace live").serial_number("1");
@@ -141,9 +141,14 @@ fn main() -> ! {
         let start = timer.get_counter();
         let Ok(Some(drawing)) = board.answer(received, raytracer, &mut host) else { continue };
         let mut rows = 0u16;
-        let drawn = both_cores::draw(&mut core1, drawing.scene(), room, &ROWS, &mut display, |y, row| {
+        let drawn = both_cores::draw(&mut core1, drawing.scene(), room, &ROWS, &mut display, |y, traced| {
             rows = y as u16 + 1;
-            if drawing.send_row(y as u16, row, &mut host).is_err() {
+            // The row as the panel shows it.
+            let mut row = [Rgb565::BLACK; panel::WIDTH as usize];
+            for (pixel, &color) in row.iter_mut().zip(traced) {
+                *pixel = color.into();
+            }
+            if drawing.send_row(y as u16, &row[..traced.len()], &mut host).is_err() {
                 return ControlFlow::Break(());
             }
             // Between rows, without waiting: a new frame stops the picture.

@@ -5,9 +5,11 @@
 //! Tables: `scenes` (every scene, naive), `table51` (the thesis's Table 5.1),
 //! `table52` (Table 5.2), `scaling` (random spheres, N = 10 … 100,000),
 //! `criterion` (the octree's subdivision criterion), `parallel` (threads
-//! and partitions), `palette` (the 256-colour modes), `spheres600` (naive against
-//! dda on 600 random spheres at 800×600), `animation` (frame-to-frame coherence on
-//! anim_fig5_1, `animation.rs`). No argument: all. Times are wall-clock on one thread
+//! and partitions), `palette` (the 256-colour modes), `panels` (every
+//! dithering on every panel of few levels, issue 42's measure),
+//! `spheres600` (naive against dda on 600 random spheres at 800×600),
+//! `animation` (frame-to-frame coherence on anim_fig5_1, `animation.rs`).
+//! No argument: all. Times are wall-clock on one thread
 //! (except in `parallel`), the best of several runs; the machine is printed
 //! first so every table says where it came from.
 
@@ -21,6 +23,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 mod animation;
+mod panels;
 
 fn machine() -> String {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
@@ -75,12 +78,13 @@ enum Table {
     Scaling,
     Parallel,
     Palette,
+    Panels,
     Spheres600,
     Animation,
 }
 
 impl Table {
-    const ALL: [Table; 9] = [
+    const ALL: [Table; 10] = [
         Table::Scenes,
         Table::Table51,
         Table::Table52,
@@ -88,6 +92,7 @@ impl Table {
         Table::Scaling,
         Table::Parallel,
         Table::Palette,
+        Table::Panels,
         Table::Spheres600,
         Table::Animation,
     ];
@@ -102,6 +107,7 @@ impl Table {
             Table::Scaling => "scaling",
             Table::Parallel => "parallel",
             Table::Palette => "palette",
+            Table::Panels => "panels",
             Table::Spheres600 => "spheres600",
             Table::Animation => "animation",
         }
@@ -124,6 +130,7 @@ impl Table {
             }
             Table::Parallel => parallel(dir),
             Table::Palette => palette_table(dir),
+            Table::Panels => panels::table(dir),
             Table::Spheres600 => spheres600(dir),
             Table::Animation => animation::table(dir),
         }

@@ -40,8 +40,8 @@ export async function loadOctrace() {
       const out = call(x.studio_trace_frame);
       return { traced: new DataView(out.buffer).getUint32(0, true), data: out.subarray(4) };
     },
-    display(render, mode, w, h) { put(render); return call(x.studio_display, mode, w, h); },
-    encode(render, mode, format, w, h) { put(render); return call(x.studio_encode, mode, format, w, h); },
+    display(render, mode, dither, w, h) { put(render); return call(x.studio_display, mode, dither, w, h); },
+    encode(render, mode, dither, format, w, h) { put(render); return call(x.studio_encode, mode, dither, format, w, h); },
     decode(bytes) {
       put(bytes);
       const out = call(x.studio_decode);

@@ -344,11 +344,12 @@ function main() {
   function showDisplay() {
     const r = state.lastRender;
     if (!r) return;
-    const mode = Number($('display').value);
-    const rgb = state.octrace.display(r.data, mode, r.width, r.height);
+    const mode = Number($('display').value), dither = Number($('dither').value);
+    const rgb = state.octrace.display(r.data, mode, dither, r.width, r.height);
     imageCanvas.width = r.width; imageCanvas.height = r.height;
     putRgb(imageCanvas, rgb, r.width, r.height);
     imageCanvas.dataset.display = String(mode);
+    imageCanvas.dataset.dither = String(dither);
   }
 
   $('display').addEventListener('change', () => {
@@ -362,14 +363,16 @@ function main() {
     }
     render();
   });
+  // The method changes the look of the same render.
+  $('dither').addEventListener('change', showDisplay);
 
   // ---------------------------------------------------------------- image --
 
   function saveImage(format) {
     const r = state.lastRender;
     if (!r) { setStatus('render first'); return; }
-    const mode = Number($('display').value);
-    const bytes = state.octrace.encode(r.data, mode, format, r.width, r.height);
+    const mode = Number($('display').value), dither = Number($('dither').value);
+    const bytes = state.octrace.encode(r.data, mode, dither, format, r.width, r.height);
     const name = (state.sceneName.replace(/.*[\\/]/, '').replace(/\.[^.]*$/, '') || 'image') + ['.png', '.tga', '.ras'][format];
     const link = document.createElement('a');
     link.href = URL.createObjectURL(new Blob([bytes], { type: 'application/octet-stream' }));
@@ -489,7 +492,7 @@ function main() {
 
   // Exposed for scripts and the browser tests.
   Object.assign(state, { render, saveScene, setText, setTool, saveImage, undo, redo, project, editor,
-    imageBytes: (mode, format) => state.octrace.encode(state.lastRender.data, mode, format, state.lastRender.width, state.lastRender.height) });
+    imageBytes: (mode, format) => state.octrace.encode(state.lastRender.data, mode, Number($('dither').value), format, state.lastRender.width, state.lastRender.height) });
 
   (async () => {
     try {

@@ -1,79 +1,28 @@
-//! Both cores trace a scene: core 1 runs what core 0 hands it, core 0
-//! drives the panel.
+//! Both cores trace a scene, core 0 presents it: [`draw`] is the picture
+//! row by row, [`draw_progressive`] in a progressive order. Each core takes
+//! the next piece no core has taken (under the chip's lock) and traces it
+//! with a renderer of its own; core 1 (a [`SecondCore`] job) hands its
+//! pieces over in a [`Handoff`] ring; core 0 presents every piece in
+//! order. Each waits for the other with `wfe`, woken by the other's `sev`.
 //!
-//! [`SecondCore::start`] starts core 1 once, in a loop that waits for jobs.
-//! [`SecondCore::scope`] runs a job on core 1 while core 0 does its own
-//! part, and returns only when both are done, so a job may borrow anything
-//! core 0 has (like `std::thread::scope`). [`draw`] is the picture: each
-//! core takes the next row no core has taken (under the chip's lock) and
-//! traces it with a renderer of its own; core 1 hands its rows over in a
-//! [`Handoff`] ring; core 0 sends every row to the panel in order. Each
-//! waits for the other with `wfe`, woken by the other's `sev`.
-//!
-//! Invariants: `JOB` is null or points at core 0's `&mut dyn FnMut()` for
-//! the job, which core 0 keeps alive until core 1 has set `JOB` back to
-//! null; panics abort (`panic = "abort"`, `panic-halt`), so core 0 never
-//! leaves a scope early by unwinding.
+//! Invariants: any split of the pieces between the cores gives the same
+//! bits as one core; core 0 presents the pieces in their order, so a
+//! display fed row by row sees the rows top to bottom.
 
+use crate::second_core::SecondCore;
 use core::cell::Cell;
 use core::ops::ControlFlow;
-use core::ptr;
-use core::sync::atomic::{AtomicBool, AtomicPtr, Ordering};
+use core::sync::atomic::{AtomicBool, Ordering};
 use cortex_m::asm::{sev, wfe};
 use critical_section::Mutex;
-use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
-use embedded_graphics::prelude::*;
-use embedded_graphics::primitives::Rectangle;
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
+use embedded_graphics_core::primitives::Rectangle;
+use octrace_core::panel::{Dithered, Dithering, TracedColor, IMAGE_ERROR_WORDS};
 use octrace_core::profile::Profile;
 use octrace_core::render::{Handoff, Progressive, Renderer, Unit};
 use octrace_core::{LoadedScene, RendererRoom, SceneAccelerator};
-use rp2040_hal::multicore::{Core, Error as SpawnError, StackAllocation};
-
-/// Core 0's job for core 1, or null.
-static JOB: AtomicPtr<()> = AtomicPtr::new(ptr::null_mut());
-
-/// Core 1, waiting for jobs.
-pub struct SecondCore {
-    _started: (),
-}
-
-impl SecondCore {
-    /// Starts core 1 on `stack`, waiting for jobs.
-    pub fn start(core1: &mut Core<'_>, stack: StackAllocation) -> Result<SecondCore, SpawnError> {
-        core1.spawn(stack, || loop {
-            let job = JOB.load(Ordering::Acquire).cast::<&mut (dyn FnMut() + Send)>();
-            if job.is_null() {
-                wfe();
-                continue;
-            }
-            // SAFETY: core 0 keeps the job alive, and touches it not, until
-            // JOB is null again (see `scope`).
-            unsafe { (*job)() };
-            JOB.store(ptr::null_mut(), Ordering::Release);
-            sev();
-        })?;
-        Ok(SecondCore { _started: () })
-    }
-
-    /// Runs `job` on core 1 while `here` runs on core 0, and returns what
-    /// `here` returns once `job` is done too.
-    pub fn scope<R>(&mut self, job: impl FnOnce() + Send, here: impl FnOnce() -> R) -> R {
-        let mut job = Some(job);
-        let mut call = || {
-            if let Some(job) = job.take() {
-                job();
-            }
-        };
-        let mut erased: &mut (dyn FnMut() + Send) = &mut call;
-        JOB.store(ptr::from_mut(&mut erased).cast(), Ordering::Release);
-        sev();
-        let result = here();
-        while !JOB.load(Ordering::Acquire).is_null() {
-            wfe();
-        }
-        result
-    }
-}
 
 /// Why a picture stopped before its end.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -88,51 +37,72 @@ pub enum Unfinished {
 
 /// Traces `scene` into `display` with both cores, row by row, core 1
 /// rendering in `room` (its own mailbox and screen lists) and handing rows
-/// over through `ring`. `each_row` sees every row as it goes to the panel,
-/// in order, and may stop the picture there.
+/// over through `ring`, which holds at least a row of the display. Each row
+/// goes to the display in one `fill_contiguous`, in its colour: dithered
+/// onto a panel of few levels as the scene's image dithers it
+/// (`image_for`: the method its colour type calls for, the error carried
+/// from row to row), converted for any other. `each_row` sees every row as
+/// traced (in `Rgb888`) as it goes to the display, in order, and may stop
+/// the picture there.
 pub fn draw<P, D, const LEN: usize, const SLOTS: usize>(
     core1: &mut SecondCore,
     scene: &LoadedScene<'_, P>,
     room: &mut RendererRoom<P>,
     ring: &Handoff<LEN, SLOTS>,
     display: &mut D,
-    mut each_row: impl FnMut(u32, &[Rgb565]) -> ControlFlow<()>,
+    mut each_row: impl FnMut(u32, &[Rgb888]) -> ControlFlow<()>,
 ) -> Result<(), Unfinished>
 where
     P: Profile,
-    D: DrawTarget<Color = Rgb565>,
+    D: DrawTarget,
+    D::Color: TracedColor,
 {
     let size = display.bounding_box().size;
-    let width = size.width.min(LEN as u32);
+    if size.width as usize > LEN {
+        return Err(Unfinished::Panel);
+    }
     let trace = |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, y: &u32, colors: &mut [Rgb888]| {
         let mut traced = 0;
-        for (color, pixel) in colors.iter_mut().zip(renderer.row(*y, 0..width)) {
+        for (color, pixel) in colors.iter_mut().zip(renderer.row(*y, 0..size.width)) {
             *color = pixel.color;
             traced += 1;
         }
         traced
     };
+    let mut each_row = |y: &u32, colors: &[Rgb888]| match each_row(*y, colors) {
+        ControlFlow::Continue(()) => Ok(()),
+        ControlFlow::Break(()) => Err(Unfinished::Stopped),
+    };
+    let row = |y: &u32| Rectangle::new(Point::new(0, *y as i32), Size::new(size.width, 1));
+    // Known when it compiles: a truecolour display links no dithering.
+    if D::Color::PANEL.is_none() {
+        let present = |y: &u32, colors: &[Rgb888]| {
+            let mut line = [D::Color::from(Rgb888::BLACK); LEN];
+            let line = &mut line[..colors.len()];
+            for (pixel, &color) in line.iter_mut().zip(colors) {
+                *pixel = color.into();
+            }
+            display.fill_contiguous(&row(y), line.iter().copied()).map_err(|_| Unfinished::Panel)?;
+            each_row(y, colors)
+        };
+        return share(core1, scene, room, ring, size, || 0..size.height, trace, present);
+    }
+    let mut error_rows = [0; IMAGE_ERROR_WORDS];
+    let mut dithered = Dithered::new(display, Dithering::default(), &mut error_rows).map_err(|_| Unfinished::Panel)?;
     let present = |y: &u32, colors: &[Rgb888]| {
-        let mut line = [Rgb565::BLACK; LEN];
-        let line = &mut line[..colors.len()];
-        for (pixel, &color) in line.iter_mut().zip(colors) {
-            *pixel = color.into();
-        }
-        let area = Rectangle::new(Point::new(0, *y as i32), Size::new(width, 1));
-        display.fill_contiguous(&area, line.iter().copied()).map_err(|_| Unfinished::Panel)?;
-        match each_row(*y, line) {
-            ControlFlow::Continue(()) => Ok(()),
-            ControlFlow::Break(()) => Err(Unfinished::Stopped),
-        }
+        dithered.fill_contiguous(&row(y), colors.iter().copied()).map_err(|_| Unfinished::Panel)?;
+        each_row(y, colors)
     };
     share(core1, scene, room, ring, size, || 0..size.height, trace, present)
 }
 
 /// Traces `scene` into `display` with both cores in the progressive
 /// `order` (the whole panel in coarse blocks first, then finer: the same
-/// picture as [`draw`] at the end), each core taking the next unit, core 1
-/// tracing in `room` and handing its colours over through `ring`, which
-/// holds `order.max_unit_pixels()`.
+/// picture as [`draw`] at the end on a truecolour display; on a panel of
+/// few levels, ordered (Bayer) dithering, the one method a block order
+/// keeps), each core taking the next unit, core 1 tracing in `room` and
+/// handing its colours over through `ring`, which holds
+/// `order.max_unit_pixels()`.
 pub fn draw_progressive<P, D, const LEN: usize, const SLOTS: usize>(
     core1: &mut SecondCore,
     scene: &LoadedScene<'_, P>,
@@ -143,17 +113,19 @@ pub fn draw_progressive<P, D, const LEN: usize, const SLOTS: usize>(
 ) -> Result<(), Unfinished>
 where
     P: Profile,
-    D: DrawTarget<Color = Rgb565>,
+    D: DrawTarget,
+    D::Color: TracedColor,
 {
     if order.size() != display.bounding_box().size || order.max_unit_pixels() > LEN {
         return Err(Unfinished::Panel);
     }
+    let mut display = Dithered::new(display, Dithering::Bayer, &mut []).map_err(|_| Unfinished::Panel)?;
     let trace = |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, unit: &Unit, colors: &mut [Rgb888]| {
         unit.trace(renderer, colors).map_or(0, |traced| traced.colors().len())
     };
     let present = |unit: &Unit, colors: &[Rgb888]| {
         let traced = unit.with_colors(colors).map_err(|_| Unfinished::Panel)?;
-        traced.draw(&mut Converted(display)).map_err(|_| Unfinished::Panel)
+        traced.draw(&mut display).map_err(|_| Unfinished::Panel)
     };
     share(core1, scene, room, ring, order.size(), || order.units(), trace, present)
 }
@@ -289,30 +261,4 @@ fn receive<const LEN: usize, const SLOTS: usize>(
     // The slot is free again: wake core 1 if it waits for it.
     sev();
     len
-}
-
-/// A display of `Rgb565` taking the progressive order's `Rgb888` blocks.
-struct Converted<'d, D>(&'d mut D);
-
-impl<D: DrawTarget<Color = Rgb565>> OriginDimensions for Converted<'_, D> {
-    fn size(&self) -> Size {
-        self.0.bounding_box().size
-    }
-}
-
-impl<D: DrawTarget<Color = Rgb565>> DrawTarget for Converted<'_, D> {
-    type Color = Rgb888;
-    type Error = D::Error;
-
-    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb888>>>(&mut self, pixels: I) -> Result<(), D::Error> {
-        self.0.draw_iter(pixels.into_iter().map(|Pixel(at, color)| Pixel(at, color.into())))
-    }
-
-    fn fill_contiguous<I: IntoIterator<Item = Rgb888>>(&mut self, area: &Rectangle, colors: I) -> Result<(), D::Error> {
-        self.0.fill_contiguous(area, colors.into_iter().map(Into::into))
-    }
-
-    fn fill_solid(&mut self, area: &Rectangle, color: Rgb888) -> Result<(), D::Error> {
-        self.0.fill_solid(area, color.into())
-    }
 }
