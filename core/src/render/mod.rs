@@ -234,6 +234,10 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     /// The pixel at (`x`, `y`) and its clean count under the lookout, if
     /// below `bound` (else `bound`).
     pub(crate) fn watched_pixel(&mut self, x: u32, y: u32, bound: u32) -> (PixelSample, u32) {
+        if !A::FOLLOWS_MOTION {
+            // Nothing watched the rays: the pixel is traced again next frame.
+            return (self.pixel(x, y), 0);
+        }
         if let Some(lookout) = &mut self.scratch.lookout {
             lookout.start(bound);
         }
@@ -249,7 +253,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
             // Shown by the lists to miss: the ray itself is made only for
             // the lookout.
             Some(None) => {
-                if let Some(lookout) = &mut self.scratch.lookout {
+                if let Some(lookout) = self.scratch.lookout.as_mut().filter(|_| A::FOLLOWS_MOTION) {
                     lookout.ray(ray.get(&self.camera), None, RayKind::Primary);
                 }
                 self.tracer.missed(&mut self.scratch)

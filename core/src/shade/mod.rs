@@ -220,7 +220,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             if p.depth == 0 {
                 first_object = hit.map(|h| self.scene.written_object(h.object));
             }
-            if let Some(lookout) = &mut scratch.lookout {
+            if let Some(lookout) = scratch.lookout.as_mut().filter(|_| A::FOLLOWS_MOTION) {
                 lookout.ray(&p.ray, hit.map(|h| h.t), p.kind);
             }
             let mut next = None;
@@ -294,7 +294,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             };
             let start = RayStart { object: hit.object, leaving };
             let t_max = Scalar::from_bits((distance.to_bits() - 1).max(0));
-            if let Some(lookout) = &mut scratch.lookout {
+            if let Some(lookout) = scratch.lookout.as_mut().filter(|_| A::FOLLOWS_MOTION) {
                 lookout.shadow(shadow_from, light.position);
             }
             if self.occluded(
