@@ -11,6 +11,10 @@
 //! among the objects seen around their pixel, nearest first, instead of
 //! walking the accelerator (`first_hit.rs`): the same hits.
 //!
+//! A render can be stopped inside a pixel ([`Renderer::pixel_until`] and a
+//! [`Stop`], asked every few rays): a pixel stopped gives nothing, one
+//! that completes gives the same bits as [`Renderer::pixel`].
+//!
 //! A pixel with SAMPLES n is the mean of its n² sample colours, each clamped
 //! to [0, 1] first (an over-bright highlight does not bleed into its
 //! neighbours), then gamma-corrected and rounded. Its object is the one hit
@@ -22,6 +26,7 @@ mod handoff;
 mod panel;
 mod progressive;
 mod split;
+mod stop;
 
 use first_hit::FirstHits;
 pub use first_hit::ScreenBound;
@@ -30,10 +35,11 @@ pub use handoff::{Handoff, SlotBusy, Taken};
 pub use panel::PanelColor;
 pub use progressive::{Progressive, ProgressiveError, TracedUnit, Unit};
 pub use split::{interleaved_rows, Tiles};
+pub use stop::{Stop, Stopped, RAYS_BETWEEN_POLLS};
 
 use crate::accel::{Accelerator, Hit, Mailbox};
 use crate::scene::{Camera, CameraError, CameraRay, Color, ObjectId, RayCursor, SceneView, Stride, MAX_SIDE};
-use crate::shade::{Scratch, Stats, Tracer};
+use crate::shade::{Poll, Scratch, Stats, Tracer, Unpolled};
 use core::ops::Range;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
@@ -93,6 +99,9 @@ pub struct Renderer<'a, A> {
     scratch: Scratch<'a>,
     /// Camera rays' objects by where they are seen, when given storage.
     first_hits: Option<FirstHits<'a>>,
+    /// Rays a [`Stop`] lets be traced before it is asked again: counted
+    /// across pixels.
+    rays_before_poll: u32,
 }
 
 impl<A> core::fmt::Debug for Renderer<'_, A> {
@@ -125,6 +134,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
             last_encoded: [0; 3],
             scratch: Scratch::new(Mailbox::none()),
             first_hits: None,
+            rays_before_poll: 0,
         };
         renderer.gamma.fill(s.gamma);
         Ok(renderer)
@@ -207,13 +217,71 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     // driver's) small on a board.
     #[inline(never)]
     pub fn pixel(&mut self, x: u32, y: u32) -> PixelSample {
+        match self.pixel_polled(x, y, &mut Unpolled) {
+            Ok(pixel) => pixel,
+            Err(never) => match never {},
+        }
+    }
+
+    /// [`Renderer::pixel`], asking `stop` every [`RAYS_BETWEEN_POLLS`]
+    /// rays (counted on from the last pixel asked for this way) whether to
+    /// go on: [`Stopped`] as soon as it says so, even inside the pixel's
+    /// ray tree, or the very pixel [`Renderer::pixel`] gives. A stopped
+    /// pixel may be asked for again; it is traced from its start.
+    ///
+    /// ```
+    /// use octrace_core::render::{Renderer, Stopped, RAYS_BETWEEN_POLLS};
+    /// use octrace_core::{profile::Board16K, Raytracer};
+    ///
+    /// // Two facing mirrors with the eye between them: each of the pixel's
+    /// // samples bounces thousands of times, its light asked at each.
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load(
+    ///     "VIEWPOINT 0 0 0 ORIGIN 0 0 -1 RDEPTH 1000000 SAMPLES 4 LIGHT 1 0 1 0\n\
+    ///      RECTANGLE 1 -5 -5 -3 5 -5 -3 5 5 -3 -5 5 -3\n\
+    ///      RECTANGLE 1 -5 -5 3 -5 5 3 5 5 3 5 -5 3\n\
+    ///      SURFACE 1 0.01 0.01 0.01 0 0 0 0 0 0 0 1 0\n",
+    /// )?;
+    /// let accelerator = scene.accelerator();
+    /// let mut renderer = Renderer::with_size(scene.view(), &accelerator, 4, 4)?;
+    ///
+    /// // A board's stop: a flag its serial line's interrupt sets, say.
+    /// let stop_now = core::sync::atomic::AtomicBool::new(false);
+    /// let mut asked = 0;
+    /// let mut stop = || {
+    ///     asked += 1;
+    ///     if asked == 10 {
+    ///         stop_now.store(true, core::sync::atomic::Ordering::Relaxed);
+    ///     }
+    ///     stop_now.load(core::sync::atomic::Ordering::Relaxed)
+    /// };
+    /// assert_eq!(renderer.pixel_until(2, 2, &mut stop), Err(Stopped));
+    /// // Stopped after its tenth ask: inside the pixel's first sample.
+    /// assert!(renderer.stats().rays + renderer.stats().shadow_rays <= 10 * RAYS_BETWEEN_POLLS as u64);
+    ///
+    /// // Never stopped: the pixel's bits, as if nothing were asked.
+    /// let pixel = renderer.pixel_until(2, 2, &mut || false)?;
+    /// assert_eq!(pixel, renderer.pixel(2, 2));
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    #[inline(never)]
+    pub fn pixel_until<S: Stop>(&mut self, x: u32, y: u32, stop: &mut S) -> Result<PixelSample, Stopped> {
+        let mut polling = stop::Polling { stop, left: self.rays_before_poll, stopped: false };
+        let pixel = self.pixel_polled(x, y, &mut polling);
+        self.rays_before_poll = polling.left;
+        pixel
+    }
+
+    /// The pixel at (`x`, `y`), `poll` asked before each of its rays.
+    #[inline(always)]
+    fn pixel_polled<Q: Poll>(&mut self, x: u32, y: u32, poll: &mut Q) -> Result<PixelSample, Q::Stopped> {
         let n = self.camera.samples();
         let (mean, object) = if n == 1 {
             // One sample (the common case on a board): no loops, no sums.
-            let (c, object) = self.sample(x, y, 0, 0);
+            let (c, object) = self.sample(x, y, 0, 0, poll)?;
             (Color::from_bits(c.bits().map(|v| v.clamp(0, 1 << 16))), object)
         } else {
-            self.mean_of_samples(n, x, y)
+            self.mean_of_samples(n, x, y, poll)?
         };
         // Neighbouring pixels mostly differ by a level or none: the search
         // starts at the last pixel's (the same bits from any start).
@@ -221,29 +289,46 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         let encoded =
             [self.gamma.encode_near(mean.r, r), self.gamma.encode_near(mean.g, g), self.gamma.encode_near(mean.b, b)];
         self.last_encoded = encoded;
-        PixelSample { color: Rgb888::new(encoded[0], encoded[1], encoded[2]), object }
+        Ok(PixelSample { color: Rgb888::new(encoded[0], encoded[1], encoded[2]), object })
     }
 
     /// The colour and object of sample (`sx`, `sy`) of pixel (`x`, `y`).
     #[inline]
-    fn sample(&mut self, x: u32, y: u32, sx: u32, sy: u32) -> (Color, Option<ObjectId>) {
+    fn sample<Q: Poll>(
+        &mut self,
+        x: u32,
+        y: u32,
+        sx: u32,
+        sy: u32,
+        poll: &mut Q,
+    ) -> Result<(Color, Option<ObjectId>), Q::Stopped> {
         let mut ray = self.camera.next_ray(&mut self.cursor, x, y, sx, sy);
-        match self.first_hit(&mut ray, x, y, sx, sy) {
+        let seen = match self.first_hit(&mut ray, x, y, sx, sy) {
             // Shown by the lists to miss: the ray itself is never made.
-            Some(None) => self.tracer.missed(&mut self.scratch),
-            first => self.tracer.trace(*ray.get(&self.camera), first, &mut self.scratch),
-        }
+            Some(None) if poll.go_on() => self.tracer.missed(&mut self.scratch),
+            Some(None) => (Color::BLACK, None),
+            first => self.tracer.trace(*ray.get(&self.camera), first, &mut self.scratch, poll),
+        };
+        // A stopped sample's colour is partial: never used.
+        poll.stopped()?;
+        Ok(seen)
     }
 
     /// The mean of the `n`² samples of pixel (`x`, `y`) (channels clamped to
     /// 0..1 first, rounded to nearest) and the object hit by the middle one.
-    fn mean_of_samples(&mut self, n: u32, x: u32, y: u32) -> (Color, Option<ObjectId>) {
+    fn mean_of_samples<Q: Poll>(
+        &mut self,
+        n: u32,
+        x: u32,
+        y: u32,
+        poll: &mut Q,
+    ) -> Result<(Color, Option<ObjectId>), Q::Stopped> {
         let mut object = None;
         // At most 16² samples of at most 2^16 each: the sums fit a u32.
         let mut sum = [0u32; 3];
         for sy in 0..n {
             for sx in 0..n {
-                let (c, o) = self.sample(x, y, sx, sy);
+                let (c, o) = self.sample(x, y, sx, sy, poll)?;
                 if sx == n / 2 && sy == n / 2 {
                     object = o;
                 }
@@ -253,7 +338,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
             }
         }
         let count = n * n;
-        (Color::from_bits(sum.map(|s| ((s + count / 2) / count) as i32)), object)
+        Ok((Color::from_bits(sum.map(|s| ((s + count / 2) / count) as i32)), object))
     }
 
     /// The pixels of row `y` for the columns `xs`, traced lazily.
