@@ -1,10 +1,10 @@
-//! The software board: the board's side of octrace-link
-//! (`octrace_link::board`) on this machine, behind a pseudo-terminal, run as
-//! the live firmware runs it on a Pico: frames in byte by byte, each
+//! The software board: the board's loop of octrace-link
+//! (`octrace_link::board::Link`, the one the live firmware runs on a Pico)
+//! on this machine, behind a pseudo-terminal: frames in byte by byte, each
 //! answered, a scene's rows rendered one after the other and sent as they
-//! are drawn, a frame from the host stopping a drawing between rows. The
-//! tests of `host-sim board` (tests/tests/board.rs) talk to it as they will
-//! to the emulated Pico.
+//! are drawn, a frame from the host stopping a drawing between two rays.
+//! The tests of `host-sim board` (tests/tests/board.rs) talk to it as they
+//! will to the emulated Pico.
 //!
 //!     software-board [--profile board16k|board64k|host] [--panel WxH] [--max-scene BYTES]
 //!
@@ -17,11 +17,11 @@ use octrace_core::accel::Mailbox;
 use octrace_core::profile::{Board16K, Board64K, Host, Profile};
 use octrace_core::render::Renderer;
 use octrace_core::Raytracer;
-use octrace_link::board::Board;
-use octrace_link::{Decoder, Panel, PixelFormat, OVERHEAD};
+use octrace_link::board::{Line, Link};
+use octrace_link::{Panel, PixelFormat, OVERHEAD};
 use std::collections::VecDeque;
 use std::fs::File;
-use std::io::{Read, Write};
+use std::io::{ErrorKind, Read, Write};
 use std::sync::mpsc::{self, Receiver, TryRecvError};
 use std::time::{Duration, Instant};
 
@@ -59,23 +59,17 @@ fn options() -> Result<Options, String> {
     Ok(options)
 }
 
-/// The bytes a host sends, from a thread reading the pseudo-terminal.
-struct Line {
+/// The pseudo-terminal as the board's line: the bytes a host sends, from
+/// a thread reading it; what the board sends, written without waiting.
+struct Pty {
     chunks: Receiver<Vec<u8>>,
     bytes: VecDeque<u8>,
+    out: File,
+    started: Instant,
 }
 
-impl Line {
-    /// The next byte, waiting for it.
-    fn wait(&mut self) -> Option<u8> {
-        while self.bytes.is_empty() {
-            self.bytes.extend(self.chunks.recv().ok()?);
-        }
-        self.bytes.pop_front()
-    }
-
-    /// The next byte if one has come.
-    fn poll(&mut self) -> Option<u8> {
+impl Line for Pty {
+    fn read(&mut self) -> Option<u8> {
         while self.bytes.is_empty() {
             match self.chunks.try_recv() {
                 Ok(chunk) => self.bytes.extend(chunk),
@@ -84,54 +78,59 @@ impl Line {
         }
         self.bytes.pop_front()
     }
+
+    fn write(&mut self, bytes: &[u8]) -> usize {
+        // Non-blocking: a full terminal takes nothing.
+        match self.out.write(bytes) {
+            Ok(n) => n,
+            Err(e) if e.kind() == ErrorKind::WouldBlock => {
+                std::thread::sleep(Duration::from_millis(1));
+                0
+            }
+            // No host has the terminal open: what it would get is lost.
+            Err(_) => bytes.len(),
+        }
+    }
+
+    fn discard(&mut self) {
+        // What the terminal holds already is the host's.
+    }
+
+    fn now_us(&mut self) -> u64 {
+        self.started.elapsed().as_micros() as u64
+    }
+
+    fn sleep(&mut self) -> bool {
+        match self.chunks.recv() {
+            Ok(chunk) => {
+                self.bytes.extend(chunk);
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    fn alive(&mut self) {}
 }
 
-/// Answers frames until the line ends, as a firmware's main loop does.
-fn serve<P: Profile>(options: &Options, line: &mut Line, out: &mut File) {
-    let mut decoder = Decoder::new(vec![0u8; options.max_scene + OVERHEAD + 1]);
-    let board = Board::new(options.panel, FIRMWARE, &decoder);
+/// Answers frames until the line ends, as the live firmware's main loop
+/// does (on one core).
+fn serve<P: Profile>(options: &Options, line: &mut Pty) {
+    let mut link = Link::new(options.panel, FIRMWARE, vec![0u8; options.max_scene + OVERHEAD + 1]);
     let mut raytracer = Box::new(Raytracer::<P>::new());
     let (width, height) = (u32::from(options.panel.width), u32::from(options.panel.height));
     let mut row = vec![Rgb565::default(); width as usize];
-    // A frame came while drawing: answered next.
-    let mut pending = false;
-    loop {
-        if !pending {
-            let Some(byte) = line.wait() else { return };
-            if decoder.push(byte).is_none() {
-                continue;
-            }
-        }
-        pending = false;
-        let Some(received) = decoder.received() else { continue };
-        let started = Instant::now();
-        // A host that went away while the board wrote is not waited for.
-        let Ok(Some(drawing)) = board.answer(received, &mut *raytracer, out) else { continue };
-        let scene = drawing.scene();
-        let accelerator = scene.accelerator();
-        let Ok(renderer) = Renderer::with_size(scene.view(), &accelerator, width, height) else {
-            let _ = drawing.cancel(0, out);
-            continue;
-        };
-        let mut mailbox = vec![0u32; Mailbox::words_for(scene.view().object_count())];
-        let mut renderer = renderer.with_mailbox(&mut mailbox);
-        let mut drawn = 0;
-        let mut sent = true;
-        while drawn < height && sent && !pending {
-            for (pixel, sample) in row.iter_mut().zip(renderer.row(drawn, 0..width)) {
-                *pixel = sample.color.into();
-            }
-            sent = drawing.send_row(drawn as u16, &row, out).is_ok();
-            drawn += 1;
-            while let (false, Some(byte)) = (pending, line.poll()) {
-                pending = decoder.push(byte).is_some();
-            }
-        }
-        let _ = match pending {
-            true => drawing.cancel(drawn as u16, out),
-            false => drawing.finish(Some(started.elapsed()), out),
-        };
-    }
+    while link
+        .serve(line, &mut raytracer, |drawing, rows| {
+            let scene = drawing.scene();
+            let accelerator = scene.accelerator();
+            let Ok(renderer) = Renderer::with_size(scene.view(), &accelerator, width, height) else { return 0 };
+            let mut mailbox = vec![0u32; Mailbox::words_for(scene.view().object_count())];
+            let mut renderer = renderer.with_mailbox(&mut mailbox);
+            rows.draw_on_one_core(drawing, &mut renderer, &mut row)
+        })
+        .is_some()
+    {}
 }
 
 fn main() {
@@ -139,7 +138,7 @@ fn main() {
         eprintln!("software-board: {e}");
         std::process::exit(2);
     });
-    let (mut controller, path) = octrace_tests::board::open_pty().unwrap_or_else(|e| {
+    let (controller, path) = octrace_tests::board::open_pty().unwrap_or_else(|e| {
         eprintln!("software-board: cannot open a pseudo-terminal: {e}");
         std::process::exit(1);
     });
@@ -155,7 +154,7 @@ fn main() {
                     }
                 }
                 // No host has the device open (EIO once one closed it): wait for the next.
-                _ => std::thread::sleep(Duration::from_millis(10)),
+                _ => std::thread::sleep(Duration::from_millis(1)),
             }
         }
     });
@@ -167,11 +166,14 @@ fn main() {
     });
     println!("serial: {}", path.display());
     let _ = std::io::stdout().flush();
-    let mut line = Line { chunks: received, bytes: VecDeque::new() };
+    let out = controller.try_clone().expect("a third handle on the pseudo-terminal");
+    rustix::fs::fcntl_setfl(&out, rustix::fs::OFlags::NONBLOCK | rustix::fs::OFlags::RDWR)
+        .expect("the pseudo-terminal takes O_NONBLOCK");
+    let mut line = Pty { chunks: received, bytes: VecDeque::new(), out, started: Instant::now() };
     match options.profile.as_str() {
-        "board16k" => serve::<Board16K>(&options, &mut line, &mut controller),
-        "board64k" => serve::<Board64K>(&options, &mut line, &mut controller),
-        "host" => serve::<Host>(&options, &mut line, &mut controller),
+        "board16k" => serve::<Board16K>(&options, &mut line),
+        "board64k" => serve::<Board64K>(&options, &mut line),
+        "host" => serve::<Host>(&options, &mut line),
         other => {
             eprintln!("software-board: unknown profile {other} (board16k, board64k, host)");
             std::process::exit(2);
