@@ -23,6 +23,9 @@ pub struct Board {
     pub display: Panel,
     pub core1: SecondCore,
     pub timer: Timer,
+    /// The watchdog, ticking (the clocks' set-up starts its tick) but not
+    /// started.
+    pub watchdog: Watchdog,
     /// The USB controller and its clock, untouched.
     pub usb: UsbParts,
     pub resets: pac::RESETS,
@@ -78,6 +81,7 @@ pub fn start(panel_buffer: &'static mut [u8], core1_stack: StackAllocation) -> B
         display,
         core1,
         timer,
+        watchdog,
         usb: UsbParts { regs: peripherals.USBCTRL_REGS, dpram: peripherals.USBCTRL_DPRAM, clock: clocks.usb_clock },
         resets: peripherals.RESETS,
     }
