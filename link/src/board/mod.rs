@@ -47,8 +47,8 @@
 //!     // `serve` checked the camera at the panel's size.
 //!     let Ok(mut renderer) = Renderer::with_size(scene.view(), &accelerator, 8, 4) else { return 0 };
 //!     renderer.set_mailbox(&mut mailbox);
-//!     // Each row to the panel too, on a board.
-//!     rows.draw_on_one_core(drawing, &mut renderer, &mut row)
+//!     // Each row to the panel (here: nowhere) and to the host.
+//!     rows.draw_on_one_core(drawing, &mut renderer, &mut row, |_y, _pixels| {})
 //! }) {
 //!     assert_ne!(served, Served::Stalled);
 //! }
@@ -108,7 +108,10 @@ impl<'a> Board<'a> {
 
     /// Answers what the decoder `received`: a refusal is sent back, a
     /// hello gets the board's description, a scene is loaded into
-    /// `raytracer` and gets its errors, or a [`Drawing`] to render.
+    /// `raytracer` and gets its errors, or a [`Drawing`] to render. `Err`
+    /// when `sink` failed; a scene that loaded is handed back even when
+    /// its `drawing` message was not taken (the panel still shows it; the
+    /// sink's next writes say whether the host gets the rows).
     pub fn answer<'r, P: Profile, S: Sink + ?Sized>(
         &self,
         received: Result<Frame<'_>, Refusal>,
@@ -177,7 +180,8 @@ impl<'a> Board<'a> {
             send_error(tag, 0, 0, None, &e, sink)?;
             return Message::Rejected { errors: 1 }.encode(tag, sink).map(|()| None);
         }
-        Message::Drawing { panel: self.panel, pixels }.encode(tag, sink)?;
+        // Not taken: the rows are not either (see `answer`).
+        let _ = Message::Drawing { panel: self.panel, pixels }.encode(tag, sink);
         Ok(Some(Drawing { scene, tag, pixels, panel: self.panel }))
     }
 }
