@@ -17,8 +17,7 @@
 //! serial device it serves. The tests ask the board what it is (panel,
 //! profile, longest scene) and choose their scenes by it.
 
-use embedded_graphics_core::pixelcolor::RgbColor;
-use octrace_link::{encode_raw, Kind, Message, PixelFormat, Reason, Refusal, VERSION};
+use octrace_link::{encode_raw, Kind, Message, Panel, Reason, Refusal, VERSION};
 use octrace_tests::board::{fits, lights, open_pty, wedging_scene, RawHost, RunningBoard};
 use octrace_tests::{host_sim_preview_of, repo};
 use std::ffi::OsStr;
@@ -49,18 +48,12 @@ fn host_sim_board(args: &[&OsStr]) -> Run {
 /// written is host-sim's preview of the panel.
 fn draws_host_sims_picture(board: &RunningBoard, panel: &str, name: &str, dir: &Path) {
     let scene = repo().join("scenes").join(format!("{name}.txt"));
-    draws_host_sims_picture_of(board, panel, &scene, dir);
-}
-
-/// [`draws_host_sims_picture`] for the scene file `scene`.
-fn draws_host_sims_picture_of(board: &RunningBoard, panel: &str, scene: &Path, dir: &Path) {
-    let name = scene.file_stem().unwrap().to_string_lossy();
     let out = dir.join(format!("{name}-board.png"));
     let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str(), out.as_os_str(), "--check".as_ref()]);
     assert_eq!(run.code, 0, "{name}: {}", run.stderr);
     assert!(run.stderr.contains("--check: bit-identical to host-sim's rgb565 render"), "{name}: {}", run.stderr);
     let expected = dir.join(format!("{name}-host.png"));
-    host_sim_preview_of(scene, &expected, panel, "rgb565").unwrap();
+    host_sim_preview_of(&scene, &expected, panel, "rgb565").unwrap();
     let (got, want) = (read_rgb(&out), read_rgb(&expected));
     assert_eq!((got.width, got.height), (want.width, want.height), "{name}");
     assert!(got.data == want.data, "{name}: the board's picture differs from host-sim's");
@@ -324,6 +317,12 @@ fn answer_bound_us() -> u64 {
     }
 }
 
+/// A scene quick to draw on the emulated Pico (a small sphere; most of the
+/// panel background): what the tests draw after what they put the board
+/// through.
+const QUICK_SCENE: &str = "VIEWPOINT 0 0 10\nLIGHT 10 5 5 5\nSPHERE 1 0.6 0 0 0\n\
+                           SURFACE 1 .1 .1 .1 .7 .2 .2 .3 .3 .3 10 0 0\n";
+
 /// Sends `message` with `tag` from `host`.
 fn send(host: &mut RawHost, message: Message<'_>, tag: u16) {
     let mut frame = Vec::new();
@@ -332,16 +331,41 @@ fn send(host: &mut RawHost, message: Message<'_>, tag: u16) {
 }
 
 /// Every frame from the board up to and with `last` (its tag and kind), as
-/// (tag, kind); a frame that does not read is (0, Refused).
+/// (tag, kind), rows left out; a frame that does not read is (0, Refused).
 fn answers_until(host: &mut RawHost, last: (u16, Kind)) -> Vec<(u16, Kind)> {
     let mut answers = Vec::new();
     let came = host.receive_until(Duration::from_secs(120), &mut |received| {
         let answer = received.map_or((0, Kind::Refused), |frame| (frame.tag, frame.message.kind()));
-        answers.push(answer);
+        if answer.1 != Kind::Row {
+            answers.push(answer);
+        }
         answer == last
     });
     assert!(came, "no {last:?} within 2 minutes; came: {answers:?}");
     answers
+}
+
+/// Whether the board's `panel` shows host-sim's picture of scene `text` (at
+/// the panel's size, in its format).
+fn panel_shows(board: &mut RunningBoard, panel: Panel, text: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, expected, picture) =
+        (dir.path().join("scene.txt"), dir.path().join("host.png"), dir.path().join("panel.png"));
+    std::fs::write(&scene, text).unwrap();
+    let size = format!("{}x{}", panel.width, panel.height);
+    host_sim_preview_of(&scene, &expected, &size, "rgb565").unwrap();
+    assert_eq!(board.command(&format!("panel {}", picture.display())), "ok");
+    let (got, want) = (read_rgb(&picture), read_rgb(&expected));
+    let differing = got.data.chunks(3).zip(want.data.chunks(3)).filter(|(a, b)| a != b).count();
+    assert_eq!(differing, 0, "pixels of the panel that differ from host-sim's picture");
+}
+
+/// The board draws scene `text` for `host` (without the rows' pixels) to
+/// the end, and its `panel` shows host-sim's picture of it.
+fn draws_on_the_panel(board: &mut RunningBoard, panel: Panel, host: &mut RawHost, text: &str, tag: u16) {
+    send(host, Message::Scene { pixels: false, text: text.as_bytes() }, tag);
+    assert_eq!(answers_until(host, (tag, Kind::Done)), [(tag, Kind::Drawing), (tag, Kind::Done)]);
+    panel_shows(board, panel, text);
 }
 
 /// Sends the wedging scene (without its rows' pixels) with `tag` and waits
@@ -393,10 +417,7 @@ fn a_hello_during_a_drawing_of_hours_a_pixel_is_answered_within_50_ms_and_the_ne
         assert!(fed + 2_000 >= left, "fed: {left} µs left, then {fed} µs after {} µs", last.now - first.now);
     }
     hello_is_answered_at_once(&mut board, &mut host, 0x3e0);
-    drop(host);
-    let dir = tempfile::tempdir().unwrap();
-    let size = format!("{}x{}", description.panel.width, description.panel.height);
-    draws_host_sims_picture(&board, &size, "fig5_1", dir.path());
+    draws_on_the_panel(&mut board, description.panel, &mut host, QUICK_SCENE, 0x3e2);
     // Waiting for the host, the board stops its watchdog.
     assert_eq!(board.times().watchdog_left, None);
     assert!(board.alive());
@@ -404,7 +425,7 @@ fn a_hello_during_a_drawing_of_hours_a_pixel_is_answered_within_50_ms_and_the_ne
 
 #[test]
 fn a_burst_of_frames_beyond_the_input_ring_mid_pixel_is_answered_frame_by_frame() {
-    let board = board();
+    let mut board = board();
     let description = board.describe();
     let mut host = RawHost::open(&board.port);
     start_wedging_drawing(&mut host, &description, 1);
@@ -414,35 +435,15 @@ fn a_burst_of_frames_beyond_the_input_ring_mid_pixel_is_answered_frame_by_frame(
     for tag in 100..250 {
         Message::Hello.encode(tag, &mut burst).unwrap();
     }
-    let text = std::fs::read(repo().join("scenes/fig5_1.txt")).unwrap();
-    Message::Scene { pixels: true, text: &text }.encode(300, &mut burst).unwrap();
-    assert!(burst.len() > 1024 + text.len());
+    Message::Scene { pixels: false, text: QUICK_SCENE.as_bytes() }.encode(300, &mut burst).unwrap();
+    assert!(burst.len() > 1024 + QUICK_SCENE.len());
     host.send(&burst);
-    let mut kinds = Vec::new();
-    let panel = description.panel;
-    let mut picture = vec![0u8; panel.width as usize * panel.height as usize * 3];
-    let done = host.receive_until(Duration::from_secs(300), &mut |received| {
-        let frame = received.expect("the board's frames read");
-        if let Message::Row { y, pixels } = frame.message {
-            let row = &mut picture[y as usize * panel.width as usize * 3..][..panel.width as usize * 3];
-            for (rgb, color) in row.chunks_exact_mut(3).zip(PixelFormat::Rgb565.colors(pixels)) {
-                rgb.copy_from_slice(&[color.r(), color.g(), color.b()]);
-            }
-            return false;
-        }
-        kinds.push((frame.tag, frame.message.kind()));
-        (frame.tag, frame.message.kind()) == (300, Kind::Done)
-    });
-    assert!(done, "the scene after the burst is drawn: {kinds:?}");
+    let answers = answers_until(&mut host, (300, Kind::Done));
     let hellos: Vec<(u16, Kind)> = (100..250).map(|tag| (tag, Kind::Board)).collect();
-    assert_eq!(kinds[0], (1, Kind::Cancelled));
-    assert_eq!(kinds[1..151], hellos[..]);
-    assert_eq!(kinds[151..], [(300, Kind::Drawing), (300, Kind::Done)]);
-    let dir = tempfile::tempdir().unwrap();
-    let expected = dir.path().join("fig5_1-host.png");
-    let size = format!("{}x{}", panel.width, panel.height);
-    host_sim_preview_of(&repo().join("scenes/fig5_1.txt"), &expected, &size, "rgb565").unwrap();
-    assert!(read_rgb(&expected).data == picture, "the board's picture differs from host-sim's");
+    assert_eq!(answers[0], (1, Kind::Cancelled));
+    assert_eq!(answers[1..151], hellos[..]);
+    assert_eq!(answers[151..], [(300, Kind::Drawing), (300, Kind::Done)]);
+    panel_shows(&mut board, description.panel, QUICK_SCENE);
 }
 
 /// Asks `host`'s board for `tag`'s hello once it takes bytes again, and
@@ -469,30 +470,19 @@ fn stale_bytes_before_hello(host: &mut RawHost, tag: u16) -> u64 {
 #[test]
 fn a_host_that_stops_reading_loses_the_rest_of_the_answer_not_the_picture_and_gets_the_next_answer_whole() {
     let mut board = board();
-    let description = board.describe();
+    let panel = board.describe().panel;
     let mut host = RawHost::open(&board.port);
     let since = board.times().now;
     // The host stops reading; its scene, with every row's pixels, comes.
     assert_eq!(board.command("hold"), "ok");
-    let text = std::fs::read(repo().join("scenes/fig5_1.txt")).unwrap();
-    send(&mut host, Message::Scene { pixels: true, text: &text }, 5);
+    send(&mut host, Message::Scene { pixels: true, text: QUICK_SCENE.as_bytes() }, 5);
     board.wait_idle_after(since, Duration::from_secs(600));
     // The panel shows the whole picture all the same.
-    let dir = tempfile::tempdir().unwrap();
-    let panel = dir.path().join("panel.png");
-    assert_eq!(board.command(&format!("panel {}", panel.display())), "ok");
-    let expected = dir.path().join("fig5_1-host.png");
-    let size = format!("{}x{}", description.panel.width, description.panel.height);
-    host_sim_preview_of(&repo().join("scenes/fig5_1.txt"), &expected, &size, "rgb565").unwrap();
-    let (got, want) = (read_rgb(&panel), read_rgb(&expected));
-    let differing = got.data.chunks(3).zip(want.data.chunks(3)).filter(|(a, b)| a != b).count();
-    assert_eq!(differing, 0, "pixels of the panel that differ from host-sim's picture");
+    panel_shows(&mut board, panel, QUICK_SCENE);
     // Reading again: the next answer, after no more than the USB device held.
     assert_eq!(board.command("release"), "ok");
     let stale = stale_bytes_before_hello(&mut host, 6);
     assert!(stale <= 256, "{stale} bytes of the dropped answer came before the next");
-    drop(host);
-    draws_host_sims_picture(&board, &size, "fig5_1", dir.path());
 }
 
 #[test]
@@ -521,10 +511,11 @@ fn an_error_flood_is_answered_whole_and_one_not_read_leaves_the_next_answer_whol
     assert!(answered, "the flood ends with rejected");
     assert_eq!(rejected, Some(errors));
     assert!(errors as usize >= lines / 2, "{errors} errors in {lines} lines");
-    // Again, to a host that stops reading.
+    // A flood (kilobytes of errors: more than the board's ring and its USB
+    // device hold) to a host that stops reading.
     let since = board.times().now;
     assert_eq!(board.command("hold"), "ok");
-    send(&mut host, Message::Scene { pixels: false, text: text.as_bytes() }, 8);
+    send(&mut host, Message::Scene { pixels: false, text: line.repeat(400).as_bytes() }, 8);
     board.wait_idle_after(since, Duration::from_secs(600));
     assert_eq!(board.command("release"), "ok");
     let stale = stale_bytes_before_hello(&mut host, 9);
@@ -545,26 +536,19 @@ fn a_host_gone_mid_drawing_leaves_a_board_that_answers_the_next_at_once() {
     let mut host = RawHost::open(&board.port);
     assert_eq!(board.command("release"), "ok");
     hello_is_answered_at_once(&mut board, &mut host, 0x10);
-    drop(host);
-    let dir = tempfile::tempdir().unwrap();
-    let size = format!("{}x{}", description.panel.width, description.panel.height);
-    draws_host_sims_picture(&board, &size, "fig5_1", dir.path());
+    draws_on_the_panel(&mut board, description.panel, &mut host, QUICK_SCENE, 0x12);
 }
 
 #[test]
 fn a_scene_of_exactly_the_longest_the_board_takes_is_drawn() {
-    let board = board();
+    let mut board = board();
     let description = board.describe();
-    let dir = tempfile::tempdir().unwrap();
-    let mut text = std::fs::read_to_string(repo().join("scenes/fig5_1.txt")).unwrap();
     // A comment fills it up to the board's longest scene, to the byte.
-    let room = description.max_scene as usize - text.len();
-    text += &format!("/*{}*/", "x".repeat(room - 4));
+    let room = description.max_scene as usize - QUICK_SCENE.len();
+    let text = format!("{QUICK_SCENE}/*{}*/", "x".repeat(room - 4));
     assert_eq!(text.len(), description.max_scene as usize);
-    let scene = dir.path().join("longest.txt");
-    std::fs::write(&scene, &text).unwrap();
-    let size = format!("{}x{}", description.panel.width, description.panel.height);
-    draws_host_sims_picture_of(&board, &size, &scene, dir.path());
+    let mut host = RawHost::open(&board.port);
+    draws_on_the_panel(&mut board, description.panel, &mut host, &text, 0x20);
 }
 
 #[test]
