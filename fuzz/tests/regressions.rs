@@ -88,3 +88,35 @@ fn link_seeds_are_current() {
         );
     }
 }
+
+#[test]
+fn board_loop_regressions_and_seeds() {
+    let seeds = all_files("board-loop-seeds");
+    assert!(seeds.len() >= 4, "the board loop's seed corpus is missing");
+    // The link's seeds too, as more inputs (read as pieces, they are
+    // other streams).
+    for path in all_files("regressions/board_loop").iter().chain(&seeds).chain(&all_files("link-seeds")) {
+        println!("{}", path.display());
+        octrace_fuzz::check_board_loop(&fs::read(path).expect("readable input"));
+    }
+}
+
+/// The board loop's seeds are what today's encoder writes (re-bless with
+/// OCTRACE_BLESS=1).
+#[test]
+fn board_loop_seeds_are_current() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("board-loop-seeds");
+    let bless = std::env::var_os("OCTRACE_BLESS").is_some_and(|v| v != "0");
+    for (name, bytes) in octrace_fuzz::board_loop_seeds() {
+        let path = dir.join(name);
+        if bless {
+            fs::create_dir_all(&dir).unwrap();
+            fs::write(&path, &bytes).unwrap();
+        }
+        assert!(
+            fs::read(&path).is_ok_and(|kept| kept == bytes),
+            "{} is not current: OCTRACE_BLESS=1 rewrites it",
+            path.display()
+        );
+    }
+}
