@@ -31,8 +31,8 @@ thread_local! {
 }
 
 /// The host's bytes, each piece readable after so many polls; what the
-/// board writes, taken at once (or held while `holding`); a clock the
-/// board's signs of life move on.
+/// board writes, taken at once (or held while `holding`); a clock that
+/// moves 100 µs each time it is read.
 struct SimulatedLine {
     pieces: VecDeque<(u32, Vec<u8>)>,
     readable: VecDeque<u8>,
@@ -70,6 +70,7 @@ impl Line for SimulatedLine {
     fn discard(&mut self) {}
 
     fn now_us(&mut self) -> u64 {
+        self.clock_us += 100;
         self.clock_us
     }
 
@@ -86,7 +87,6 @@ impl Line for SimulatedLine {
 
     fn alive(&mut self) {
         self.polls += 1;
-        self.clock_us += 100;
     }
 }
 

@@ -29,7 +29,7 @@ pub use crate::exit::{CliError, EXIT_IO, EXIT_MISMATCH, EXIT_SCENE, EXIT_STOPPED
 /// from host-sim's (`board --check`), 130 stopped by Ctrl-C.
 /// Nothing is written unless the whole image renders: the image goes to a
 /// temporary file that is renamed into place at the end. Ctrl-C stops a
-/// render within a few rays, even inside a pixel that takes hours, and
+/// render before its next ray, even inside a pixel that takes hours, and
 /// leaves no file.
 #[derive(Parser, Debug)]
 #[command(
@@ -529,7 +529,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
 static CTRL_C: AtomicBool = AtomicBool::new(false);
 
 /// The flag Ctrl-C sets, its handler installed on the first call: a render
-/// that asks it stops within a few rays and writes nothing. A process
+/// that asks it stops before its next ray and writes nothing. A process
 /// that has a handler already (the studio's, in a test that ran it) keeps
 /// it, and Ctrl-C ends it as before.
 fn ctrl_c() -> &'static AtomicBool {

@@ -117,9 +117,9 @@ pub struct RenderOptions {
     /// every object).
     pub light_buffer: u32,
     /// Once set (host-sim's Ctrl-C), a streamed render ([`render_streamed`])
-    /// stops within a few rays, inside the pixels it traces, with
-    /// [`StreamError::Stopped`]; asked every few rays. The renders into
-    /// memory ([`render`] and the others) never stop.
+    /// stops before its next ray, inside the pixels it traces, with
+    /// [`StreamError::Stopped`]. The renders into memory ([`render`] and
+    /// the others) never stop.
     pub stop: Option<&'static AtomicBool>,
 }
 

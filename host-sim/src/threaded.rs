@@ -7,7 +7,7 @@
 //! Invariants: every piece is rendered once; a band is handed to the sink
 //! only when all its pieces are in, and bands in order; a panicking worker
 //! is counted out so the writer never waits for it; once the render's stop
-//! is set (Ctrl-C), every worker stops within a few rays, inside a pixel,
+//! is set (Ctrl-C), every worker stops before its next ray, inside a pixel,
 //! and no band after is written.
 
 use crate::{Partition, RenderOptions, RowSink, StreamError, NO_OBJECT, TILE_SIDE};

@@ -208,6 +208,57 @@ impl Drop for RunningBoard {
     }
 }
 
+/// The dearest scene `board` holds: exactly its longest text, as many of
+/// each kind of object as it holds (and of lights and surfaces), all of
+/// them around the origin and filling the view from just outside them, so
+/// that every ray meets the bounds of every object (one octree leaf, one
+/// light-buffer cell), 16² samples, mirrors and glass: its pixels are the
+/// dearest the board can be given from the first, each ray the longest
+/// between two of its polls.
+pub fn dearest_scene(board: &BoardDescription) -> String {
+    let holds = |name: &str| board.capacities.iter().find(|(n, _)| n == name).map_or(0, |(_, n)| *n as usize);
+    let mut objects = holds("objects");
+    let mut take = |kind: &str| {
+        let count = holds(kind).min(objects);
+        objects -= count;
+        count
+    };
+    let surfaces = holds("surfaces").max(1);
+    let mut text = String::from("VIEWPOINT 0 0 3.5\nORIGIN 0 0 0\nRDEPTH 1000000\nSAMPLES 16\n");
+    for light in 0..holds("lights") {
+        text += &format!("LIGHT 1 {} {} 9\n", light % 3 * 4, light / 3 * 4);
+    }
+    // Each object a little off the last, all around the origin.
+    let mut surface = 0;
+    let mut next = || {
+        surface += 1;
+        (surface - 1) % surfaces + 1
+    };
+    let at = |i: usize| (i % 10) as f64 / 50.0;
+    for i in 0..take("spheres") {
+        text += &format!("SPHERE {} 2 {} {} 0\n", next(), at(i), at(i / 10));
+    }
+    for i in 0..take("boxes") {
+        text += &format!("BOX {} {} 0 0 1.5 1.5 1.5\n", next(), at(i));
+    }
+    for i in 0..take("superquadrics") {
+        text += &format!("SUPERQUADRIC {} 3.5 0 {} 0 1.8 1.8 1.8\n", next(), at(i));
+    }
+    for i in 0..take("triangles") {
+        text += &format!("TRIANGLE {} -3 -3 {} 3 -3 0 0 3 0\n", next(), at(i));
+    }
+    for i in 0..take("rectangles") {
+        let (s, z) = (next(), at(i) - 0.5);
+        text += &format!("RECTANGLE {s} -3 -3 {z} 3 -3 {z} 3 3 {z} -3 3 {z}\n");
+    }
+    for n in 1..=surfaces {
+        text += &format!("SURFACE {n} .05 .05 .05 .3 .3 .3 .2 .2 .2 10 .5 .4\n");
+    }
+    let room = (board.max_scene as usize).checked_sub(text.len() + 4);
+    let room = room.unwrap_or_else(|| panic!("the dearest scene is {} bytes: longer than the board takes", text.len()));
+    text + "/*" + &"x".repeat(room) + "*/"
+}
+
 /// How many lights `board` holds.
 pub fn lights(board: &BoardDescription) -> u32 {
     board.capacities.iter().find(|(name, _)| name == "lights").map_or(0, |(_, n)| *n)

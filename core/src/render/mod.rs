@@ -12,7 +12,7 @@
 //! walking the accelerator (`first_hit.rs`): the same hits.
 //!
 //! A render can be stopped inside a pixel ([`Renderer::pixel_until`] and a
-//! [`Stop`], asked every few rays): a pixel stopped gives nothing, one
+//! [`Stop`], asked before every ray): a pixel stopped gives nothing, one
 //! that completes gives the same bits as [`Renderer::pixel`].
 //!
 //! A pixel with SAMPLES n is the mean of its n² sample colours, each clamped
@@ -35,7 +35,7 @@ pub use handoff::{Handoff, SlotBusy, Taken};
 pub use panel::PanelColor;
 pub use progressive::{Progressive, ProgressiveError, TracedUnit, Unit};
 pub use split::{interleaved_rows, Tiles};
-pub use stop::{Stop, Stopped, RAYS_BETWEEN_POLLS};
+pub use stop::{Stop, Stopped};
 
 use crate::accel::{Accelerator, Hit, Mailbox};
 use crate::scene::{Camera, CameraError, CameraRay, Color, ObjectId, RayCursor, SceneView, Stride, MAX_SIDE};
@@ -98,10 +98,17 @@ pub struct Renderer<'a, A> {
     last_encoded: [u8; 3],
     scratch: Scratch<'a>,
     /// Camera rays' objects by where they are seen, when given storage.
-    first_hits: Option<FirstHits<'a>>,
-    /// Rays a [`Stop`] lets be traced before it is asked again: counted
-    /// across pixels.
-    rays_before_poll: u32,
+    first_hits: ScreenLists<'a>,
+}
+
+/// A renderer's screen lists: none, their room until the first camera ray
+/// fills it (asking the pixel's stop before each object, as before each
+/// ray: the lists of hundreds of objects take a board a few hundred
+/// milliseconds), or the lists.
+enum ScreenLists<'a> {
+    None,
+    Room(&'a mut [ScreenBound], &'a mut [u16]),
+    Lists(FirstHits<'a>),
 }
 
 impl<A> core::fmt::Debug for Renderer<'_, A> {
@@ -133,8 +140,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
             gamma: GammaTable { thresholds: [0; 255] },
             last_encoded: [0; 3],
             scratch: Scratch::new(Mailbox::none()),
-            first_hits: None,
-            rays_before_poll: 0,
+            first_hits: ScreenLists::None,
         };
         renderer.gamma.fill(s.gamma);
         Ok(renderer)
@@ -186,20 +192,52 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
 
     /// [`Renderer::with_first_hits`] in place.
     pub fn set_first_hits(&mut self, bounds: &'a mut [ScreenBound], positions: &'a mut [u16]) {
-        if self.tracer.accel().first_hits_by_screen() {
-            self.first_hits = FirstHits::new(self.tracer.scene(), &self.camera, bounds, positions);
+        if self.tracer.accel().first_hits_by_screen()
+            && FirstHits::fit(self.tracer.scene(), &self.camera, bounds, positions)
+        {
+            self.first_hits = ScreenLists::Room(bounds, positions);
         }
     }
 
-    /// The camera ray's hit from the screen lists, if the renderer has them.
+    /// Fills the screen lists' room, `poll` asked before each object: false
+    /// if it said stop (the next camera ray fills it again).
+    #[cold]
+    #[inline(never)]
+    fn fill_first_hits<Q: Poll>(&mut self, poll: &mut Q) -> bool {
+        let scene = self.tracer.scene();
+        let ScreenLists::Room(bounds, _) = &mut self.first_hits else { return true };
+        if !FirstHits::project(scene, &self.camera, bounds, poll) {
+            return false;
+        }
+        if let ScreenLists::Room(bounds, positions) = core::mem::replace(&mut self.first_hits, ScreenLists::None) {
+            self.first_hits =
+                FirstHits::new(scene.object_count(), bounds, positions).map_or(ScreenLists::None, ScreenLists::Lists);
+        }
+        true
+    }
+
+    /// The camera ray's hit from the screen lists, if the renderer has them
+    /// (filled by the first ray, `poll` asked before each object).
     #[inline]
-    fn first_hit(&mut self, ray: &mut CameraRay, x: u32, y: u32, sx: u32, sy: u32) -> Option<Option<Hit>> {
+    fn first_hit<Q: Poll>(
+        &mut self,
+        ray: &mut CameraRay,
+        [x, y, sx, sy]: [u32; 4],
+        poll: &mut Q,
+    ) -> Option<Option<Hit>> {
         // Asked first: for an accelerator that never allows the lists (the
         // naive modes) the whole path folds away, a board's cycles too.
         if !self.tracer.accel().first_hits_by_screen() {
             return None;
         }
-        self.first_hits.as_mut()?.nearest(self.tracer.scene(), A::KINDS, &self.camera, ray, [x, y, sx, sy])
+        if let ScreenLists::Room(..) = self.first_hits {
+            // Stopped: the caller's next ask says so too.
+            if !self.fill_first_hits(poll) {
+                return None;
+            }
+        }
+        let ScreenLists::Lists(hits) = &mut self.first_hits else { return None };
+        hits.nearest(self.tracer.scene(), A::KINDS, &self.camera, ray, [x, y, sx, sy])
     }
 
     /// Counters since the renderer was made.
@@ -223,14 +261,14 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         }
     }
 
-    /// [`Renderer::pixel`], asking `stop` every [`RAYS_BETWEEN_POLLS`]
-    /// rays (counted on from the last pixel asked for this way) whether to
-    /// go on: [`Stopped`] as soon as it says so, even inside the pixel's
-    /// ray tree, or the very pixel [`Renderer::pixel`] gives. A stopped
-    /// pixel may be asked for again; it is traced from its start.
+    /// [`Renderer::pixel`], asking `stop` before every ray (and, at the
+    /// renderer's first pixel, before each object of its screen lists)
+    /// whether to go on: [`Stopped`] as soon as it says so, even inside the
+    /// pixel's ray tree, or the very pixel [`Renderer::pixel`] gives. A
+    /// stopped pixel may be asked for again; it is traced from its start.
     ///
     /// ```
-    /// use octrace_core::render::{Renderer, Stopped, RAYS_BETWEEN_POLLS};
+    /// use octrace_core::render::{Renderer, Stopped};
     /// use octrace_core::{profile::Board16K, Raytracer};
     ///
     /// // Two facing mirrors with the eye between them: each of the pixel's
@@ -256,8 +294,8 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     ///     stop_now.load(core::sync::atomic::Ordering::Relaxed)
     /// };
     /// assert_eq!(renderer.pixel_until(2, 2, &mut stop), Err(Stopped));
-    /// // Stopped after its tenth ask: inside the pixel's first sample.
-    /// assert!(renderer.stats().rays + renderer.stats().shadow_rays <= 10 * RAYS_BETWEEN_POLLS as u64);
+    /// // Stopped at its tenth ask: nine rays into the pixel's first sample.
+    /// assert_eq!(renderer.stats().rays + renderer.stats().shadow_rays, 9);
     ///
     /// // Never stopped: the pixel's bits, as if nothing were asked.
     /// let pixel = renderer.pixel_until(2, 2, &mut || false)?;
@@ -266,10 +304,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     /// ```
     #[inline(never)]
     pub fn pixel_until<S: Stop>(&mut self, x: u32, y: u32, stop: &mut S) -> Result<PixelSample, Stopped> {
-        let mut polling = stop::Polling { stop, left: self.rays_before_poll, stopped: false };
-        let pixel = self.pixel_polled(x, y, &mut polling);
-        self.rays_before_poll = polling.left;
-        pixel
+        self.pixel_polled(x, y, &mut stop::Polling { stop, stopped: false })
     }
 
     /// The pixel at (`x`, `y`), `poll` asked before each of its rays.
@@ -303,7 +338,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         poll: &mut Q,
     ) -> Result<(Color, Option<ObjectId>), Q::Stopped> {
         let mut ray = self.camera.next_ray(&mut self.cursor, x, y, sx, sy);
-        let seen = match self.first_hit(&mut ray, x, y, sx, sy) {
+        let seen = match self.first_hit(&mut ray, [x, y, sx, sy], poll) {
             // Shown by the lists to miss: the ray itself is never made.
             Some(None) if poll.go_on() => self.tracer.missed(&mut self.scratch),
             Some(None) => (Color::BLACK, None),

@@ -1,28 +1,24 @@
-//! Stopping a render inside a pixel: the caller's [`Stop`], asked every
-//! [`RAYS_BETWEEN_POLLS`] rays (shadow rays included), so that even a
-//! pixel whose ray tree takes hours ends within a few rays of the ask.
+//! Stopping a render inside a pixel: the caller's [`Stop`], asked before
+//! every ray (primary, reflected, transmitted and shadow rays) and before
+//! each object of the screen lists' set-up, so that even a pixel whose ray
+//! tree takes hours ends within one ray of the ask.
 //!
 //! Invariants: a pixel either completes with exactly the bits it has
-//! without a `Stop`, or gives [`Stopped`] and nothing of it is drawn; the
-//! count of rays since the last ask runs on across pixels (a row of cheap
-//! pixels is asked as often as one dear pixel); a caller that asks for no
-//! `Stop` runs the render path without any of it (`shade::Unpolled`).
+//! without a `Stop`, or gives [`Stopped`] and nothing of it is drawn; a
+//! caller that asks for no `Stop` runs the render path without any of it
+//! (`shade::Unpolled`: the same code as before `Stop` existed).
 
 use crate::shade::Poll;
 use core::fmt;
 
-/// Rays traced (primary, reflected, transmitted and shadow rays) between
-/// two asks of a [`Stop`]: few enough that the dearest four rays of the
-/// largest scene a Pico's live firmware holds take well under 50 ms there,
-/// many enough that a board's check (a ring and a register) costs it no
-/// measurable time (see BENCHMARKS.md).
-pub const RAYS_BETWEEN_POLLS: u32 = 4;
-
-/// What a caller asks a render whether to stop by, every
-/// [`RAYS_BETWEEN_POLLS`] rays ([`Renderer::pixel_until`]): any
-/// `FnMut() -> bool` is one, true to stop. It may do a board's chores as
-/// well (read the serial line, feed a watchdog); it is asked from inside a
-/// pixel, on the rendering core.
+/// What a caller asks a render whether to stop by, before every ray
+/// ([`Renderer::pixel_until`]): any `FnMut() -> bool` is one, true to stop.
+/// Asked that often, it must be cheap: the dearest ray of the largest
+/// scene a Pico holds takes it about 15 ms, an ordinary one a few
+/// microseconds, so a board reads its clock and looks at its serial line
+/// once a millisecond at most (octrace-link's `board::Rows::poll` does).
+/// It may do a board's chores when it looks (feed a watchdog); it is asked
+/// from inside a pixel, on the rendering core.
 ///
 /// [`Renderer::pixel_until`]: super::Renderer::pixel_until
 pub trait Stop {
@@ -50,11 +46,9 @@ impl fmt::Display for Stopped {
 
 impl core::error::Error for Stopped {}
 
-/// A [`Stop`] asked every [`RAYS_BETWEEN_POLLS`] rays: `left` is how many
-/// rays may still be traced before the next ask.
+/// A [`Stop`] asked before each ray, until it says stop.
 pub(super) struct Polling<'s, S> {
     pub(super) stop: &'s mut S,
-    pub(super) left: u32,
     pub(super) stopped: bool,
 }
 
@@ -63,15 +57,7 @@ impl<S: Stop> Poll for Polling<'_, S> {
 
     #[inline]
     fn go_on(&mut self) -> bool {
-        if self.stopped {
-            return false;
-        }
-        if self.left > 0 {
-            self.left -= 1;
-            return true;
-        }
-        self.stopped = self.stop.stop();
-        self.left = RAYS_BETWEEN_POLLS - 1;
+        self.stopped = self.stopped || self.stop.stop();
         !self.stopped
     }
 
@@ -89,21 +75,20 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_stop_is_asked_once_every_so_many_rays_and_a_true_stops_the_next_ray() {
+    fn a_stop_is_asked_before_every_ray_and_a_true_stops_the_next_for_good() {
         let mut asked = 0;
         let mut stop = || {
             asked += 1;
             asked == 3
         };
-        let mut polling = Polling { stop: &mut stop, left: 0, stopped: false };
+        let mut polling = Polling { stop: &mut stop, stopped: false };
         let mut traced = 0;
         while polling.go_on() {
             traced += 1;
         }
         assert_eq!(polling.stopped(), Err(Stopped));
         assert!(!polling.go_on(), "stopped for good");
-        // Asked before rays 1, 1 + K and 1 + 2K: the third says stop.
-        assert_eq!(traced, 2 * RAYS_BETWEEN_POLLS);
+        assert_eq!(traced, 2, "asked before rays 1, 2 and 3: the third says stop");
         assert_eq!(std::format!("{Stopped}"), "the render was stopped before the pixel was complete");
     }
 

@@ -114,8 +114,7 @@ where
     draw_rows(core1, scene, room, ring, display, each_row, || false, trace)
 }
 
-/// [`draw`], stopped inside a pixel: core 0 asks `stop` between rays
-/// (every [`RAYS_BETWEEN_POLLS`](octrace_core::render::RAYS_BETWEEN_POLLS))
+/// [`draw`], stopped inside a pixel: core 0 asks `stop` before every ray
 /// and while it waits for core 1's rows, core 1 a flag core 0 sets when
 /// `stop` says so; core 1 wakes core 0 at each of its asks, so that core 0
 /// asks at least as often while it waits. A row stopped is not drawn:

@@ -68,7 +68,7 @@ mod ring;
 mod serve;
 
 pub use ring::Ring;
-pub use serve::{Line, Link, Rows, Served, Stalled, SLOWEST_HOST_BYTES_PER_SECOND, STALL_GRACE_US};
+pub use serve::{Line, Link, Rows, Served, Stalled, POLL_PERIOD_US, SLOWEST_HOST_BYTES_PER_SECOND, STALL_GRACE_US};
 
 use crate::cobs::Sink;
 use crate::decoder::{Decoder, Frame};

@@ -34,6 +34,13 @@ use octrace_core::Raytracer;
 /// [`SLOWEST_HOST_BYTES_PER_SECOND`]: a second.
 pub const STALL_GRACE_US: u64 = 1_000_000;
 
+/// How often a drawing reads the line at most: every millisecond of the
+/// board's clock. [`Rows::poll`] is asked before every ray; between two
+/// reads it only looks at the clock, so that the asks cost a drawing
+/// nothing it can measure, and a frame stops it within a millisecond and a
+/// ray.
+pub const POLL_PERIOD_US: u64 = 1_000;
+
 /// The slowest a host may take an answer and still get all of it: 16 KiB a
 /// second (a USB full-speed port takes a megabyte; a drawing's rows with
 /// pixels are a few tens of KiB a second on a Pico).
@@ -140,7 +147,8 @@ impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
             Err(Stalled) => return Some(Served::Stalled),
             Ok(Some(drawing)) => drawing,
         };
-        let mut rows = Rows { output: &mut output, decoder: &mut self.decoder, pending: &mut self.pending };
+        let mut rows =
+            Rows { output: &mut output, decoder: &mut self.decoder, pending: &mut self.pending, read_at_us: start };
         let drawn = draw(&drawing, &mut rows).min(drawing.panel().height);
         // Every row drawn is done, even if a frame came with the last.
         let closed = match drawn == drawing.panel().height {
@@ -163,6 +171,8 @@ pub struct Rows<'o, 'l, L, B> {
     output: &'o mut Output<'l, L>,
     decoder: &'o mut Decoder<B>,
     pending: &'o mut bool,
+    /// When [`Rows::poll`] last read the line.
+    read_at_us: u64,
 }
 
 impl<L, B> core::fmt::Debug for Rows<'_, '_, L, B> {
@@ -172,13 +182,18 @@ impl<L, B> core::fmt::Debug for Rows<'_, '_, L, B> {
 }
 
 impl<L: Line, B: AsRef<[u8]> + AsMut<[u8]>> Rows<'_, '_, L, B> {
-    /// Reads what the host has sent, up to the end of a frame: true once a
-    /// frame has come, when the drawing stops (it is answered next). Called
-    /// between rays on the core that owns the line (every
-    /// [`RAYS_BETWEEN_POLLS`](octrace_core::render::RAYS_BETWEEN_POLLS)
-    /// rays, as a [`Stop`](octrace_core::render::Stop)); it tells the
-    /// [`Line`] the board is [alive](Line::alive).
+    /// Whether a frame has come from the host, when the drawing stops (it
+    /// is answered next): asked before every ray on the core that owns the
+    /// line (as a [`Stop`](octrace_core::render::Stop)). Every
+    /// [`POLL_PERIOD_US`] at most it reads what the host has
+    /// sent, up to the end of a frame, and tells the [`Line`] the board is
+    /// [alive](Line::alive); between, it only reads the clock.
     pub fn poll(&mut self) -> bool {
+        let now = self.output.line.now_us();
+        if *self.pending || now.wrapping_sub(self.read_at_us) < POLL_PERIOD_US {
+            return *self.pending;
+        }
+        self.read_at_us = now;
         self.output.line.alive();
         take_input(self.output.line, self.decoder, self.pending)
     }
@@ -333,9 +348,9 @@ mod tests {
     const SCENE: &[u8] = b"SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n";
 
     /// A host at the end of a simulated line: bytes it sends become
-    /// readable once the board has polled `after` times; it takes what the
-    /// board writes at `bytes_per_second` (None: at once) through a ring of
-    /// 48 bytes, on a clock that the board's polls and waits move on.
+    /// readable once the board has given `after` signs of life; it takes
+    /// what the board writes at `bytes_per_second` (None: at once) through a
+    /// ring of 48 bytes, on a clock that moves 100 µs each time it is read.
     struct Wire {
         sent: VecDeque<(u32, Vec<u8>)>,
         readable: VecDeque<u8>,
@@ -422,6 +437,7 @@ mod tests {
         }
 
         fn now_us(&mut self) -> u64 {
+            self.clock_us += 100;
             self.clock_us
         }
 
@@ -438,7 +454,6 @@ mod tests {
 
         fn alive(&mut self) {
             self.polls += 1;
-            self.clock_us += 10;
         }
     }
 
@@ -489,7 +504,8 @@ mod tests {
             for y in 0..PANEL.height {
                 rows.send(drawing, y, &[Rgb565::default(); 4]);
             }
-            assert!(rows.poll(), "the hello has come");
+            // Read within a millisecond.
+            assert!((0..20).any(|_| rows.poll()), "the hello has come");
             PANEL.height
         });
         assert_eq!(served, Some(Served::Drawn { rows: PANEL.height }));

@@ -12,8 +12,9 @@
 //! and the watchdog), so the port answers the host while a picture is
 //! traced. While `INPUT` is full the interrupt is masked and the host waits
 //! (its bytes stay in the port); reading makes room and unmasks it. A frame
-//! from the host while drawing stops the picture within a few rays on both
-//! cores, and is answered next. The watchdog runs while the board works on
+//! from the host while drawing stops the picture within a millisecond and a
+//! ray on both cores, and is answered next. The watchdog runs while the
+//! board works on
 //! a frame (fed at every poll of a drawing and every wait for the host) and
 //! is stopped while it sleeps waiting for one: a board wedged at work
 //! resets itself. Nothing the host sends can make the board panic.
@@ -92,9 +93,12 @@ static INPUT: Mutex<RefCell<Ring<1024>>> = Mutex::new(RefCell::new(Ring::new()))
 static OUTPUT: Mutex<RefCell<Ring<1024>>> = Mutex::new(RefCell::new(Ring::new()));
 
 /// The longest the board works on a frame without a sign of life before
-/// its watchdog resets it: two seconds, eight times the longest stretch
-/// without one (loading the largest scene it holds; see README.md).
-const WATCHDOG_US: u32 = 2_000_000;
+/// its watchdog resets it: eight seconds, nearly the RP2040's longest
+/// (8.39 s). The longest stretch without one is loading a scene, which is
+/// not polled: 4.6 s for the dearest scene this firmware holds (every
+/// object of every kind, all overlapping; README.md); a drawing gives one
+/// every millisecond.
+const WATCHDOG_US: u32 = 8_000_000;
 
 #[entry]
 fn main() -> ! {
