@@ -14,7 +14,7 @@ use core::fmt;
 /// What a caller asks a render whether to stop by, before every ray
 /// ([`Renderer::pixel_until`]): any `FnMut() -> bool` is one, true to stop.
 /// Asked that often, it must be cheap: the dearest ray of the largest
-/// scene a Pico holds takes it about 15 ms, an ordinary one a few
+/// scene a Pico holds takes it about 15 ms, an ordinary one some ten
 /// microseconds, so a board reads its clock and looks at its serial line
 /// once a millisecond at most (octrace-link's `board::Rows::poll` does).
 /// It may do a board's chores when it looks (feed a watchdog); it is asked

@@ -69,9 +69,10 @@ pub trait Line {
     /// False when no byte will ever come (a host's test, at its end).
     fn sleep(&mut self) -> bool;
 
-    /// The board is at work: called at every poll of a drawing, at every
-    /// piece of an answer written and at every turn of a wait for the host
-    /// to take it (a firmware feeds its watchdog here).
+    /// The board is at work: called each time a drawing reads the line (at
+    /// most every [`POLL_PERIOD_US`]), at every piece of an answer written
+    /// and at every turn of a wait for the host to take it (a firmware
+    /// feeds its watchdog here).
     fn alive(&mut self);
 }
 
@@ -141,6 +142,8 @@ impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
         // drawn: parse, index and render.
         let start = line.now_us();
         let mut output = Output { line, waited_us: 0, taken: 0, stalled: false };
+        // There: a frame just ended, or ended while the last scene was drawn
+        // and nothing was pushed since.
         let received = self.decoder.received()?;
         let drawing = match self.board.answer(received, raytracer, &mut output) {
             Ok(None) => return Some(Served::Answered),

@@ -14,10 +14,10 @@
 //! (its bytes stay in the port); reading makes room and unmasks it. A frame
 //! from the host while drawing stops the picture within a millisecond and a
 //! ray on both cores, and is answered next. The watchdog runs while the
-//! board works on
-//! a frame (fed at every poll of a drawing and every wait for the host) and
-//! is stopped while it sleeps waiting for one: a board wedged at work
-//! resets itself. Nothing the host sends can make the board panic.
+//! board works on a frame (fed each time a drawing reads the port, every
+//! millisecond, and at every write to and wait for the host) and is
+//! stopped while it sleeps waiting for one: a board wedged at work resets
+//! itself. Nothing the host sends can make the board panic.
 
 #![no_std]
 #![no_main]
