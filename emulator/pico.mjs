@@ -31,7 +31,9 @@
 // every cycle counted is one an emulated core spent (the ROM stand-in's,
 // boot2's and flash stalls too); a firmware that faults, stops in an endless
 // loop, touches what the emulator does not model, or outlives its cycle
-// budget ends the run with a RunError naming the core and where it was.
+// budget ends the run with a RunError naming the core and where it was; one
+// whose watchdog runs out ends it with a WatchdogReset (a real Pico resets:
+// the serial serve starts a new machine, see serial.mjs).
 
 import { RP2040, GPIOPinState } from 'rp2040js';
 import { buildBootrom, codeLetters, MISSING_FUNCTION_BREAKPOINT } from './bootrom.mjs';
@@ -40,7 +42,7 @@ import { correctInstructions } from './armv6m.mjs';
 import { ST7789 } from './st7789.mjs';
 import { I2cController } from './i2c.mjs';
 import { wireOled } from './oled.mjs';
-import { RunError } from './errors.mjs';
+import { RunError, WatchdogReset } from './errors.mjs';
 import { installBus, machineMemory, peek16 } from './bus.mjs';
 import { CoreSio, InterCoreFifos } from './sio.mjs';
 import { CorePpb } from './ppb.mjs';
@@ -48,7 +50,7 @@ import { W25Q16JV } from './flash-chip.mjs';
 import { Ssi } from './ssi.mjs';
 import { XipCache, XipControl } from './xip.mjs';
 
-export { RunError };
+export { RunError, WatchdogReset };
 
 const FLASH_BASE = 0x10000000;
 const SRAM_BASE = 0x20000000;
@@ -70,6 +72,7 @@ const PSM_SLOT = 0x40010;
 const I2C_SLOTS = [0x40044, 0x40048];
 const PSM_FRCE_OFF = 0x04;
 const PSM_PROC1 = 1 << 16;
+const WATCHDOG_SLOT = 0x40058;
 
 /** The Pico-LCD-1.3's wiring: SPI1 on GP10 (clock) and GP11 (data); the panel's control lines. */
 export const WIRING = { clock: 10, data: 11, chipSelect: 9, dataCommand: 8, reset: 12, backlight: 13 };
@@ -162,6 +165,11 @@ export class Pico {
     const stall = (cycles) => (this.cores[this.current].cycles += cycles);
     rp2040.peripherals[XIP_CTRL_SLOT] = new XipControl(rp2040, this.xip, now, stall);
     this.watchPsm(rp2040.peripherals[PSM_SLOT]);
+    this.watchdog = rp2040.peripherals[WATCHDOG_SLOT];
+    this.watchdog.onWatchdogTrigger = () => {
+      const why = this.watchdog.reason & 2 ? 'was triggered' : 'ran out';
+      throw new WatchdogReset(`the watchdog ${why} at ${(this.clockCycles() / CLOCK_HZ).toFixed(6)} s: the board resets`);
+    };
 
     this.attach(0);
     this.startCore1(0);
@@ -298,7 +306,8 @@ export class Pico {
       return this.loop(maxCycles, until, onProgress);
     } catch (error) {
       if (error instanceof RunError && !error.located) {
-        throw new RunError(`${error.message} (${this.whereAll()})`, { located: true });
+        // The same class (a WatchdogReset stays one), located.
+        throw new error.constructor(`${error.message} (${this.whereAll()})`, { located: true });
       }
       throw error;
     } finally {
@@ -515,6 +524,16 @@ export class Pico {
   whereAll() {
     const running = [0, 1].filter((k) => !this.held[k] && (k === 0 || this.core1Ran));
     return running.map((k) => this.where(k)).join(' and ');
+  }
+
+  /**
+   * The watchdog: null while it is stopped, else the microseconds left
+   * before it resets the board (RP2040-E1: its counter runs at twice the
+   * tick, as rp2040js models).
+   */
+  watchdogLeft() {
+    const timer = this.watchdog.timer;
+    return this.watchdog.enable ? Math.floor(timer.counter / 2) : null;
   }
 
   /** How many cores ran firmware: 2 once core 1 left the boot ROM. */

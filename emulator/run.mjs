@@ -19,7 +19,9 @@
 // standard output and serves the firmware's USB serial port there until
 // standard input closes or the process is signalled (`host-sim board PATH
 // scene.txt` then talks to it). With --out, the panel's picture is written
-// each time the firmware waits for the host again.
+// each time the firmware waits for the host again. Its standard input's
+// lines are commands for tests (hold, release, times: see serial.mjs); a
+// watchdog that runs out resets the board, which starts again.
 //
 // Exit codes: 0 the run ended with both cores asleep and the picture written
 // (or, with --serial, the serve ended); 1 the firmware or the ELF did
@@ -168,14 +170,18 @@ if (values.json) {
 
 /** --serial: serves the board on a pseudo-terminal, then exits. */
 async function serve() {
-  let pico;
   let drawn = -1;
   try {
-    pico = Pico.fromElf(readFileSync(elfPath), elfPath, wired);
-    await serveSerial(pico, {
+    const elf = readFileSync(elfPath);
+    await serveSerial(() => Pico.fromElf(elf, elfPath, wired), {
       input: process.stdin,
+      answer: (line) => console.log(line),
       onPath: (path) => console.log(path),
-      onIdle: () => {
+      writePanel: (pico, path) => {
+        const display = pico.display;
+        writeAtomically(path, encodePng(display.width, display.height, display.picture()));
+      },
+      onIdle: (pico) => {
         const display = pico.display;
         const writes = display.writes();
         if (values.out !== undefined && writes !== drawn) {

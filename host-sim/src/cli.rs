@@ -7,7 +7,7 @@ use crate::output::{panel_preview, write_atomically, FileSink};
 use crate::parts::{self, MergeError, PartInfo, PartSpec};
 use crate::terminal::progress_bar;
 use crate::{all_cores, load_frame_bytes, new_scene, render_streamed, AccelMode, LoadError, Partition, RenderOptions};
-use crate::{render_with_progress, HostScene, StreamError, Streamed};
+use crate::{Canvas, HostScene, StreamError, Streamed};
 use clap::Parser;
 use octrace_core::accel::OctreeConfig;
 use octrace_core::panel::{Dithering, Panel};
@@ -16,9 +16,11 @@ use octrace_images::formats::{self, Format, FormatError, Header, Image};
 use octrace_images::palette::PaletteMode;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Once;
 use std::time::Instant;
 
-pub use crate::exit::{CliError, EXIT_IO, EXIT_MISMATCH, EXIT_SCENE};
+pub use crate::exit::{CliError, EXIT_IO, EXIT_MISMATCH, EXIT_SCENE, EXIT_STOPPED};
 
 /// Render an octrace scene file to an image (PNG, Targa or Sun raster), in
 /// truecolour or with a 256-entry colour table.
@@ -26,9 +28,11 @@ pub use crate::exit::{CliError, EXIT_IO, EXIT_MISMATCH, EXIT_SCENE};
 /// Exit codes: 0 success, 1 a file could not be read or written (or a
 /// board could not be talked to), 2 the scene or the arguments are invalid
 /// (every error is printed as file:line:col), 3 a board's picture differs
-/// from host-sim's (`board --check`).
+/// from host-sim's (`board --check`), 130 stopped by Ctrl-C.
 /// Nothing is written unless the whole image renders: the image goes to a
-/// temporary file that is renamed into place at the end.
+/// temporary file that is renamed into place at the end. Ctrl-C stops a
+/// render before its next ray, even inside a pixel that takes hours, and
+/// leaves no file.
 #[derive(Parser, Debug)]
 #[command(
     name = "host-sim",
@@ -285,16 +289,21 @@ fn preview(
 ) -> Result<(), CliError> {
     let (color, dithering) = (args.color, args.dither.unwrap_or_default());
     let started = Instant::now();
-    // The parser rejects a camera that cannot be set up; a scene built by
-    // hand may not.
-    let rendered = render_with_progress(scene, options, &|_| {})
-        .map_err(|e| CliError::Invalid(format!("cannot set up the camera: {e}")))?;
-    let preview =
-        panel_preview(&rendered.image, color, dithering).unwrap_or_else(|| Image::Rgb(rendered.image.clone()));
+    let (w, h) = options.size.unwrap_or((scene.view().settings.raster[0], scene.view().settings.raster[1]));
+    let mut canvas = Canvas::new(w, h);
+    let rendered = match render_streamed(scene, options, 0..h, &|_| {}, &mut canvas) {
+        Ok(rendered) => rendered,
+        Err(StreamError::Stopped) => return Err(CliError::Stopped),
+        // The parser rejects a camera that cannot be set up; a scene built
+        // by hand may not.
+        Err(e) => return Err(CliError::Invalid(format!("cannot set up the camera: {e}"))),
+    };
+    let image = canvas.image;
+    let preview = panel_preview(&image, color, dithering).unwrap_or_else(|| Image::Rgb(image.clone()));
     write_atomically(out, |f| write_preview(&preview, color, format, f).map_err(std::io::Error::other))
         .map_err(|e| CliError::write(out, e))?;
     if !args.quiet {
-        let (image, stats) = (&rendered.image, rendered.stats);
+        let (image, stats) = (&image, rendered.stats);
         let _ = writeln!(
             stderr,
             "{}x{} in {:.3} s ({}, {} threads): {} rays, {} shadow rays, {} cells -> {} ({} panel{})",
@@ -390,6 +399,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         threads: args.threads.map_or_else(all_cores, |n| n as usize),
         partition: args.partition,
         light_buffer: crate::LIGHT_BUFFER,
+        stop: None,
     };
     let raster = scene.view().settings.raster;
     let (w, h) = args.size.unwrap_or((raster[0], raster[1]));
@@ -421,7 +431,9 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         None => (0..h, None),
     };
     let started = Instant::now();
-    let options = options((w, h));
+    // Ctrl-C stops a still before its next ray (an animation's frames are
+    // each written whole, and Ctrl-C ends it as any program).
+    let options = RenderOptions { stop: Some(ctrl_c()), ..options((w, h)) };
     if previewed(args.color) {
         return preview(&scene, &options, args, format, &out, stderr);
     }
@@ -463,6 +475,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         b.finish_and_clear();
     }
     let rendered = match (outcome, written) {
+        (Some(Err(StreamError::Stopped)), _) => return Err(CliError::Stopped),
         // The parser rejects a camera that cannot be set up; a scene built
         // by hand may not.
         (Some(Err(e)), _) => return Err(CliError::Invalid(e.to_string())),
@@ -517,6 +530,21 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         }
     }
     Ok(())
+}
+
+/// Set by Ctrl-C, once this process has its handler ([`ctrl_c`]).
+static CTRL_C: AtomicBool = AtomicBool::new(false);
+
+/// The flag Ctrl-C sets, its handler installed on the first call: a render
+/// that asks it stops before its next ray and writes nothing. A process
+/// that has a handler already (the studio's, in a test that ran it) keeps
+/// it, and Ctrl-C ends it as before.
+fn ctrl_c() -> &'static AtomicBool {
+    static INSTALL: Once = Once::new();
+    INSTALL.call_once(|| {
+        let _ = ctrlc::set_handler(|| CTRL_C.store(true, Ordering::SeqCst));
+    });
+    &CTRL_C
 }
 
 #[cfg(test)]

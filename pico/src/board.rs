@@ -26,6 +26,9 @@ pub struct Board {
     /// it), `usb_clock` at 48 MHz.
     pub clocks: ClocksManager,
     pub timer: Timer,
+    /// The watchdog, ticking (the clocks' set-up starts its tick) but not
+    /// started.
+    pub watchdog: Watchdog,
     pub resets: pac::RESETS,
     /// The peripherals a panel or a host link takes, untouched.
     pub peripherals: Peripherals,
@@ -74,6 +77,7 @@ pub fn start(core1_stack: StackAllocation) -> Board {
         pins,
         clocks,
         timer,
+        watchdog,
         resets: peripherals.RESETS,
         peripherals: Peripherals {
             spi0: peripherals.SPI0,

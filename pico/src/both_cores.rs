@@ -31,7 +31,7 @@ pub enum Unfinished {
     Camera,
     /// The panel refused a row, or the order is not the panel's.
     Panel,
-    /// `each_row` asked to stop.
+    /// `each_row` or the caller's ask said stop.
     Stopped,
 }
 
@@ -50,7 +50,69 @@ pub fn draw<P, D, const LEN: usize, const SLOTS: usize>(
     room: &mut RendererRoom<P>,
     ring: &Handoff<LEN, SLOTS>,
     display: &mut D,
+    each_row: impl FnMut(u32, &[Rgb888]) -> ControlFlow<()>,
+) -> Result<(), Unfinished>
+where
+    P: Profile,
+    D: DrawTarget,
+    D::Color: TracedColor,
+{
+    let width = display.bounding_box().size.width;
+    let trace = |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, y: &u32, colors: &mut [Rgb888], _: Asked<'_>| {
+        let mut traced = 0;
+        for (color, pixel) in colors.iter_mut().zip(renderer.row(*y, 0..width)) {
+            *color = pixel.color;
+            traced += 1;
+        }
+        Some(traced)
+    };
+    draw_rows(core1, scene, room, ring, display, each_row, || false, trace)
+}
+
+/// [`draw`], stopped inside a pixel: core 0 asks `stop` before every ray
+/// and while it waits for core 1's rows, core 1 a flag core 0 sets when
+/// `stop` says so; core 1 wakes core 0 at each of its asks, so that core 0
+/// asks at least as often while it waits. A row stopped is not drawn:
+/// `Err(Unfinished::Stopped)` after the rows before it.
+pub fn draw_until<P, D, const LEN: usize, const SLOTS: usize>(
+    core1: &mut SecondCore,
+    scene: &LoadedScene<'_, P>,
+    room: &mut RendererRoom<P>,
+    ring: &Handoff<LEN, SLOTS>,
+    display: &mut D,
+    each_row: impl FnMut(u32, &[Rgb888]) -> ControlFlow<()>,
+    stop: impl FnMut() -> bool,
+) -> Result<(), Unfinished>
+where
+    P: Profile,
+    D: DrawTarget,
+    D::Color: TracedColor,
+{
+    let width = display.bounding_box().size.width;
+    let trace =
+        |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, y: &u32, colors: &mut [Rgb888], mut stop: Asked<'_>| {
+            for (x, color) in (0..width).zip(colors.iter_mut()) {
+                *color = renderer.pixel_until(x, *y, &mut stop).ok()?.color;
+            }
+            Some(width.min(colors.len() as u32) as usize)
+        };
+    draw_rows(core1, scene, room, ring, display, each_row, stop, trace)
+}
+
+/// How a core asks whether to stop, inside a piece it traces.
+type Asked<'s> = &'s mut dyn FnMut() -> bool;
+
+/// The rows of [`draw`] and [`draw_until`], each traced by `trace`.
+#[allow(clippy::too_many_arguments)]
+fn draw_rows<'r, P, D, const LEN: usize, const SLOTS: usize>(
+    core1: &mut SecondCore,
+    scene: &LoadedScene<'r, P>,
+    room: &mut RendererRoom<P>,
+    ring: &Handoff<LEN, SLOTS>,
+    display: &mut D,
     mut each_row: impl FnMut(u32, &[Rgb888]) -> ControlFlow<()>,
+    stop: impl FnMut() -> bool,
+    trace: impl Fn(&mut Renderer<'_, SceneAccelerator<'r, P>>, &u32, &mut [Rgb888], Asked<'_>) -> Option<usize> + Sync,
 ) -> Result<(), Unfinished>
 where
     P: Profile,
@@ -61,14 +123,6 @@ where
     if size.width as usize > LEN {
         return Err(Unfinished::Panel);
     }
-    let trace = |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, y: &u32, colors: &mut [Rgb888]| {
-        let mut traced = 0;
-        for (color, pixel) in colors.iter_mut().zip(renderer.row(*y, 0..size.width)) {
-            *color = pixel.color;
-            traced += 1;
-        }
-        traced
-    };
     let mut each_row = |y: &u32, colors: &[Rgb888]| match each_row(*y, colors) {
         ControlFlow::Continue(()) => Ok(()),
         ControlFlow::Break(()) => Err(Unfinished::Stopped),
@@ -85,7 +139,7 @@ where
             display.fill_contiguous(&row(y), line.iter().copied()).map_err(|_| Unfinished::Panel)?;
             each_row(y, colors)
         };
-        return share(core1, scene, room, ring, size, || 0..size.height, trace, present);
+        return share(core1, scene, room, ring, size, || 0..size.height, trace, present, stop);
     }
     let mut error_rows = [0; IMAGE_ERROR_WORDS];
     let mut dithered = Dithered::new(display, Dithering::default(), &mut error_rows).map_err(|_| Unfinished::Panel)?;
@@ -93,7 +147,7 @@ where
         dithered.fill_contiguous(&row(y), colors.iter().copied()).map_err(|_| Unfinished::Panel)?;
         each_row(y, colors)
     };
-    share(core1, scene, room, ring, size, || 0..size.height, trace, present)
+    share(core1, scene, room, ring, size, || 0..size.height, trace, present, stop)
 }
 
 /// Traces `scene` into `display` with both cores in the progressive
@@ -120,14 +174,15 @@ where
         return Err(Unfinished::Panel);
     }
     let mut display = Dithered::new(display, Dithering::Bayer, &mut []).map_err(|_| Unfinished::Panel)?;
-    let trace = |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, unit: &Unit, colors: &mut [Rgb888]| {
-        unit.trace(renderer, colors).map_or(0, |traced| traced.colors().len())
-    };
+    let trace =
+        |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, unit: &Unit, colors: &mut [Rgb888], _: Asked<'_>| {
+            Some(unit.trace(renderer, colors).map_or(0, |traced| traced.colors().len()))
+        };
     let present = |unit: &Unit, colors: &[Rgb888]| {
         let traced = unit.with_colors(colors).map_err(|_| Unfinished::Panel)?;
         traced.draw(&mut display).map_err(|_| Unfinished::Panel)
     };
-    share(core1, scene, room, ring, order.size(), || order.units(), trace, present)
+    share(core1, scene, room, ring, order.size(), || order.units(), trace, present, || false)
 }
 
 /// Both cores trace the pieces (rows, or a progressive order's units) of
@@ -135,7 +190,9 @@ where
 /// yet taken (a core that finds its pieces cheap, or has less else to do,
 /// takes more of them); core 1 hands its pieces over through `ring`, and
 /// core 0 presents every piece, in order. `trace` fills a piece's colours
-/// and says how many; `present` shows them, or stops the picture.
+/// and says how many, or None when the core's ask said stop; `present`
+/// shows them, or stops the picture. Core 0 asks `stop` (inside its pieces
+/// and while it waits for core 1's), core 1 the flag core 0 sets then.
 ///
 /// Why not halves: core 0 also presents every piece (the colours' format,
 /// the panel's commands, the bus), 4 to 5 % of its time on the Pico, and
@@ -149,8 +206,9 @@ fn share<'r, P, T, I, const LEN: usize, const SLOTS: usize>(
     ring: &Handoff<LEN, SLOTS>,
     size: Size,
     pieces: impl Fn() -> I + Sync,
-    trace: impl Fn(&mut Renderer<'_, SceneAccelerator<'r, P>>, &T, &mut [Rgb888]) -> usize + Sync,
+    trace: impl Fn(&mut Renderer<'_, SceneAccelerator<'r, P>>, &T, &mut [Rgb888], Asked<'_>) -> Option<usize> + Sync,
     mut present: impl FnMut(&T, &[Rgb888]) -> Result<(), Unfinished>,
+    mut stop_asked: impl FnMut() -> bool,
 ) -> Result<(), Unfinished>
 where
     P: Profile,
@@ -187,13 +245,27 @@ where
                 }
                 wfe();
             }
-            let traced = trace(&mut renderer, &piece, &mut colors);
+            // Each ask wakes core 0, which asks its own (it may be waiting
+            // for this piece).
+            let mut asked = || {
+                sev();
+                stop.load(Ordering::Acquire)
+            };
+            let Some(traced) = trace(&mut renderer, &piece, &mut colors, &mut asked) else { return };
             // Free, so published.
             let _ = ring.send(number, colors[..traced].iter().copied());
             sev();
         }
     };
     let core0_part = || {
+        let mut asked = || {
+            let stopped = stop_asked();
+            if stopped {
+                stop.store(true, Ordering::Release);
+                sev();
+            }
+            stopped
+        };
         let presented = scene.with_renderer(size, |renderer| {
             let mut own = [Rgb888::BLACK; LEN];
             let mut handed = [Rgb888::BLACK; LEN];
@@ -206,13 +278,16 @@ where
                 // slot frees up for the piece core 1 takes next.
                 if ring.holds(shown) {
                     let Some((piece, number)) = to_show.next() else { break };
-                    let handed_len = receive(ring, number, &mut handed);
+                    let handed_len = receive(ring, number, &mut handed, &mut asked)?;
                     present(&piece, &handed[..handed_len])?;
                     shown += 1;
                     continue;
                 }
                 let number = take_next();
-                let traced = to_trace.find(|&(_, n)| n == number).map(|(piece, _)| trace(renderer, &piece, &mut own));
+                let traced = match to_trace.find(|&(_, n)| n == number) {
+                    Some((piece, _)) => Some(trace(renderer, &piece, &mut own, &mut asked).ok_or(Unfinished::Stopped)?),
+                    None => None,
+                };
                 // The pieces from `shown` up to this one are core 1's.
                 for (piece, n) in to_show.by_ref() {
                     match traced {
@@ -221,7 +296,7 @@ where
                             break;
                         }
                         _ => {
-                            let handed_len = receive(ring, n, &mut handed);
+                            let handed_len = receive(ring, n, &mut handed, &mut asked)?;
                             present(&piece, &handed[..handed_len])?;
                         }
                     }
@@ -241,15 +316,18 @@ where
 }
 
 /// Core 1's piece `number` from `ring` into `colors`, once it is there;
-/// returns how many colours it has.
+/// returns how many colours it has. `asked` is asked at each wake-up
+/// meanwhile: stopped, the piece may never come.
 fn receive<const LEN: usize, const SLOTS: usize>(
     ring: &Handoff<LEN, SLOTS>,
     number: u32,
     colors: &mut [Rgb888],
-) -> usize {
+    asked: Asked<'_>,
+) -> Result<usize, Unfinished> {
     let handed = loop {
         match ring.take(number) {
             Some(handed) => break handed,
+            None if asked() => return Err(Unfinished::Stopped),
             None => wfe(),
         }
     };
@@ -260,5 +338,5 @@ fn receive<const LEN: usize, const SLOTS: usize>(
     }
     // The slot is free again: wake core 1 if it waits for it.
     sev();
-    len
+    Ok(len)
 }

@@ -42,7 +42,16 @@ fn scene_files() -> Vec<(String, PathBuf)> {
 /// Writes host-sim's preview of a panel, as its user asks for it:
 /// `host-sim scenes/SCENE.txt OUT --size WxH --color COLOR --quiet`.
 pub fn host_sim_preview(scene: &str, out: &std::path::Path, size: &str, color: &str) -> Result<(), String> {
-    let path = repo().join("scenes").join(format!("{scene}.txt"));
+    host_sim_preview_of(&repo().join("scenes").join(format!("{scene}.txt")), out, size, color)
+}
+
+/// [`host_sim_preview`] of the scene file at `path`.
+pub fn host_sim_preview_of(
+    path: &std::path::Path,
+    out: &std::path::Path,
+    size: &str,
+    color: &str,
+) -> Result<(), String> {
     let args = [
         "host-sim".as_ref(),
         path.as_os_str(),

@@ -3,7 +3,8 @@
 //! octrace-core compiled to WebAssembly; these tests check that what it
 //! shows is host-sim's image bit for bit, that a user can place, render and
 //! save with the mouse, that "Send to board" shows a board's errors and
-//! picture, and that the server keeps its security rules.
+//! picture, that a render or draft of hours a pixel is stopped by the next
+//! at once, and that the server keeps its security rules.
 //!
 //! The board is the software board, or the command `OCTRACE_BOARD_COMMAND` names
 //! (as in tests/tests/board.rs: [`RunningBoard::for_tests`]).
@@ -14,7 +15,7 @@
 use host_sim::{load_bytes, new_scene, render, RenderOptions, RgbImage};
 use octrace_core::panel::Dithering;
 use octrace_images::palette::{self, PaletteMode};
-use octrace_tests::board::{fits, open_pty, RunningBoard};
+use octrace_tests::board::{fits, open_pty, wedging_scene, RunningBoard};
 use octrace_tests::webdriver::{http, http_with_head, Browser};
 use octrace_tests::{host_sim_preview, repo, scenes};
 use std::ffi::OsStr;
@@ -346,6 +347,62 @@ fn the_canvas_is_host_sims_image_for_every_scene() {
         latencies[latencies.len() / 2]
     );
     assert!(latencies.iter().all(|&l| l > 0.0), "latencies are measured");
+}
+
+#[test]
+fn a_render_or_draft_of_hours_a_pixel_is_stopped_by_the_next_at_once() {
+    let binary = host_sim_binary();
+    let studio = Studio::start(&binary, None);
+    let browser = Browser::start((1200, 800));
+    browser.goto(&studio.url);
+    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+    let wedge = with_raster(&wedging_scene(8), 16, 12);
+    let next = with_raster(&std::fs::read_to_string(repo().join("scenes/fig5_1.txt")).expect("fig5_1"), 64, 48);
+    for parallel in [false, true] {
+        browser.run(&format!("document.getElementById('parallel').checked = {parallel}; return true;"));
+        // Its draft and its render start, and would take hours.
+        set_text(&browser, &wedge);
+        std::thread::sleep(Duration::from_millis(300));
+        browser.run("document.getElementById('image').dataset.state = 'stale'; return true;");
+        browser.click("#render");
+        browser.wait_for("document.getElementById('image').dataset.state === 'rendering'", 10);
+        std::thread::sleep(Duration::from_millis(300));
+        // The next scene's draft and render come as if nothing ran before.
+        let started = Instant::now();
+        set_text(&browser, &next);
+        browser.wait_for(
+            "document.getElementById('draft').dataset.state === 'done' && \
+             document.getElementById('draft').dataset.seq === String(studio.draftSeq)",
+            30,
+        );
+        render_and_wait(&browser);
+        let elapsed = started.elapsed();
+        assert_same(
+            &format!("fig5_1 after the wedge (parallel: {parallel})"),
+            browser.canvas_rgb("image"),
+            &host_render(&next, None).image,
+        );
+        assert!(elapsed < Duration::from_secs(30), "the next draft and render took {elapsed:?}");
+    }
+    // An animation's players too: a frame of hours a pixel, its draft and
+    // render under way, is stopped by the next text, whose frames come at
+    // once (the draft's player is the draft's worker pair).
+    let dir = tempfile::tempdir().expect("a directory");
+    let animation = dir.path().join("animation.txt");
+    let animated =
+        with_raster(&std::fs::read_to_string(repo().join("scenes/anim_fig5_1.txt")).expect("anim_fig5_1"), 64, 48);
+    std::fs::write(&animation, &animated).expect("the animation");
+    set_text(&browser, &format!("FRAMES 2\n{wedge}"));
+    browser.run(
+        "const s = document.getElementById('frame'); s.value = '1'; s.dispatchEvent(new Event('input')); return true;",
+    );
+    std::thread::sleep(Duration::from_millis(300));
+    let started = Instant::now();
+    set_text(&browser, &animated);
+    slide_to(&browser, 1);
+    let elapsed = started.elapsed();
+    assert_same("frame 1 after the wedge's", browser.canvas_rgb("image"), &host_frame(&animation, 1, None));
+    assert!(elapsed < Duration::from_secs(30), "the next frame took {elapsed:?}");
 }
 
 #[test]

@@ -249,6 +249,12 @@ pub trait Accelerator {
     /// every object once anyway.
     const USES_MAILBOX: bool = true;
 
+    /// Whether the tracer watches its rays against an animation's motion,
+    /// so that a frame re-traces only what changes
+    /// ([`crate::animation::Coherence`]). False links none of that code:
+    /// every frame is then traced whole (the same pictures).
+    const FOLLOWS_MOTION: bool = true;
+
     /// Whether the renderer may find camera rays' hits in its screen-space
     /// lists (see [`Renderer::with_first_hits`](crate::render::Renderer::with_first_hits))
     /// instead of asking [`Accelerator::nearest`]: the same hits. False for

@@ -65,14 +65,22 @@ impl core::error::Error for CoherenceError {}
 /// ([`Coherence::draw_band`] into a display, or [`Coherence::trace_band`]),
 /// on one core or several, each with a renderer of its own over the
 /// frame's scene: only the tiles that can have changed are traced, and
-/// only their runs of pixels drawn.
+/// only their runs of pixels drawn. The scene's profile says
+/// `coherence: true` ([`Profile::COHERENCE`](crate::profile::Profile::COHERENCE));
+/// under one that does not, every tile is traced each frame (the same
+/// pictures, none of the watching code linked).
 ///
 /// ```
 /// use core::sync::atomic::AtomicU8;
 /// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*};
 /// use octrace_core::animation::{Coherence, Key, Motion, Track};
-/// use octrace_core::{profile::Board16K, Raytracer};
+/// use octrace_core::Raytracer;
 ///
+/// octrace_core::profile! {
+///     /// Two spheres, one moving; frames re-trace only what changes.
+///     struct Moving { spheres: 2, surfaces: 1, lights: 1 }
+///     coherence: true
+/// }
 /// let text = "FRAMES 4\nRASTER 16 16\nBACKGROUND 0 0 1\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\n\
 ///             LIGHT 10 5 5 5\nSPHERE 1 2 0 0 -4\nSPHERE 1 0.5 -3 2 0 MOVE 0 0 0 0  3 1.5 0 0\n";
 /// const TILES: usize = Coherence::tiles_for(16, 16, 4);
@@ -80,7 +88,7 @@ impl core::error::Error for CoherenceError {}
 /// let coherence = Coherence::new(&COUNTS, Size::new(16, 16), 4)?;
 /// let (mut tracks, mut keys, mut displacements) = ([Track::EMPTY; 1], [Key::default(); 2], [[0; 3]; 4]);
 ///
-/// let mut raytracer = Raytracer::<Board16K>::new();
+/// let mut raytracer = Raytracer::<Moving>::new();
 /// let mut panel = MockDisplay::<Rgb888>::new();
 /// panel.set_allow_overdraw(true);
 /// let first = raytracer.load_frame(text, 0)?;
@@ -281,5 +289,59 @@ impl<'s> Coherence<'s> {
         self.trace_band(renderer, motion, frame, band, &mut |line, pixels| {
             target.fill_contiguous(line, pixels.map(|p| p.color.into()))
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::animation::{Key, Track};
+    use crate::profile::{Board16K, Profile};
+    use crate::Raytracer;
+    use embedded_graphics::image::Image;
+    use embedded_graphics::mock_display::MockDisplay;
+    use embedded_graphics::pixelcolor::Rgb888;
+    use embedded_graphics::prelude::*;
+
+    const TEXT: &str = "FRAMES 4\nRASTER 16 16\nBACKGROUND 0 0 1\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\n\
+                        LIGHT 10 5 5 5\nSPHERE 1 2 0 0 -4\nSPHERE 1 0.5 -3 2 0 MOVE 0 0 0 0  3 1.5 0 0\n";
+
+    /// Plays `TEXT` under profile `P`: each frame's tiles traced, and
+    /// each panel checked against the frame drawn whole.
+    fn play<P: Profile>() -> std::vec::Vec<usize> {
+        let counts = [const { AtomicU8::new(0) }; 16];
+        let coherence = Coherence::new(&counts, Size::new(16, 16), 4).unwrap();
+        let (mut tracks, mut keys, mut displacements) = ([Track::EMPTY; 1], [Key::default(); 2], [[0; 3]; 4]);
+        let mut raytracer = std::boxed::Box::new(Raytracer::<P>::new());
+        let first = raytracer.load_frame(TEXT, 0).unwrap();
+        let frames = first.frames().unwrap();
+        let view = first.view();
+        let motion = Motion::read(TEXT, frames, &view, 0, &mut tracks, &mut keys, &mut displacements).unwrap();
+        let mut panel = MockDisplay::<Rgb888>::new();
+        panel.set_allow_overdraw(true);
+        let mut traced = std::vec::Vec::new();
+        for frame in frames.all() {
+            let scene = raytracer.load_frame(TEXT, frame).unwrap();
+            traced.push(coherence.plan());
+            scene.draw_changes(&motion, frame, &coherence, &mut panel).unwrap();
+            let mut whole = MockDisplay::<Rgb888>::new();
+            Image::new(&scene.image(Size::new(16, 16)), Point::zero()).draw(&mut whole).unwrap();
+            assert_eq!(panel, whole, "frame {frame}");
+        }
+        traced
+    }
+
+    crate::profile! {
+        /// Board16K's two spheres, with coherence.
+        struct Moving { spheres: 2, surfaces: 1, lights: 1 }
+        coherence: true
+    }
+
+    #[test]
+    fn a_profile_without_coherence_traces_every_tile_of_every_frame() {
+        assert_eq!(play::<Board16K>(), [16; 4]);
+        let with = play::<Moving>();
+        assert!(with[0] == 16 && with[1..].iter().all(|&t| t < 16), "{with:?}");
     }
 }

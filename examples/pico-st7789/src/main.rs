@@ -57,7 +57,8 @@ static PANEL_BUFFER: ConstStaticCell<[u8; 512]> = ConstStaticCell::new([0; 512])
 
 #[entry]
 fn main() -> ! {
-    let Board { mut core1, pins, clocks, timer, mut resets, peripherals } = board::start(CORE1_STACK.take().unwrap());
+    let Board { mut core1, pins, clocks, timer, mut resets, peripherals, .. } =
+        board::start(CORE1_STACK.take().unwrap());
     let mut display = panel::init(peripherals.spi1, pins, &mut resets, &clocks, timer, PANEL_BUFFER.take());
 
     // octrace: parse and index the scene, then trace it into the panel at

@@ -4,7 +4,9 @@
 // (editor.js), the scene model (model.js), the wireframe view (view.js), the
 // tools (tools.js), the panel (panel.js), the board (board.js) and the time
 // controls of an animation (time.js). worker.js renders with its own octrace
-// module.
+// module: the page's thread never traces, so that a scene of hours a pixel
+// cannot freeze it, and a render or draft is stopped at once, inside its
+// pixel, by terminating its workers when the next one starts.
 
 import { loadOctrace } from './octrace.js';
 import { createEditor } from './editor.js';
@@ -156,12 +158,50 @@ function main() {
 
   // ---------------------------------------------------------------- draft --
 
-  const draftWorker = new Worker('worker.js', { type: 'module' });
-  draftWorker.onmessage = (event) => {
-    const m = event.data;
-    if (m.seq !== state.draftSeq) return; // superseded
-    if (m.type === 'draft-errors') { $('draft-status').textContent = 'scene has errors'; return; }
-    if (m.type !== 'draft') return;
+  /** A worker for requests of which only the newest matters, and a spare
+   *  already loading: a request still running when the next is sent is
+   *  stopped at once (its worker terminated, the spare takes over), so a
+   *  scene of hours a pixel never holds the next up. `send(message,
+   *  answer)` hands the worker's messages to `answer` till it returns true
+   *  (the request is finished); `stop()` ends the request running, if any.
+   *  A worker that finished keeps its state: time.js's players keep the
+   *  frame they traced last. */
+  function workerPair() {
+    const start = () => {
+      const worker = new Worker('worker.js', { type: 'module' });
+      worker.onmessage = (event) => { if (worker === current && answer(event.data)) busy = false; };
+      return worker;
+    };
+    let current = start(), spare = start(), busy = false, answer = () => true;
+    const stop = () => {
+      if (!busy) return;
+      current.terminate();
+      current = spare;
+      spare = start();
+      busy = false;
+    };
+    const send = (message, answerWith) => {
+      stop();
+      busy = true;
+      answer = answerWith;
+      current.postMessage(message);
+    };
+    return { send, stop };
+  }
+
+  // The draft's worker: the text's drafts and, for an animation, the
+  // frames time.js's player draws at the draft's size, one history of
+  // requests, so that no draft runs on after a newer one is asked for.
+  const drafts = workerPair();
+  const sendDraft = drafts.send;
+  /** A text draft's message; true once it is finished. */
+  function draftMessage(m) {
+    if (m.type === 'draft-errors' || m.type === 'error') {
+      if (m.seq === state.draftSeq) $('draft-status').textContent = 'scene has errors';
+      return true;
+    }
+    if (m.type !== 'draft') return false;
+    if (m.seq !== state.draftSeq) return m.final; // superseded
     const canvas = $('draft');
     canvas.width = m.width; canvas.height = m.height;
     putRgb(canvas, m.data.subarray(0, 3 * m.width * m.height), m.width, m.height);
@@ -173,10 +213,12 @@ function main() {
       canvas.dataset.frame = String(m.frame);
       $('draft-status').textContent = `${m.width}×${m.height}, ${latency.toFixed(0)} ms after the last change`;
     }
-  };
+    return m.final;
+  }
   function scheduleDraft() {
     // Playing, the next frame's draft is of the text as it is then.
     if (state.playing) return;
+    app.time.textChanged();
     clearTimeout(state.draftTimer);
     const changedAt = performance.now();
     $('draft').dataset.state = 'pending';
@@ -184,11 +226,12 @@ function main() {
     state.draftTimer = setTimeout(() => {
       state.draftSeq += 1;
       state.draftSent = changedAt;
-      draftWorker.postMessage({ type: 'draft', seq: state.draftSeq, text: editor.text(), frame: state.frame, width: 160, height: 120, progressive: true });
+      sendDraft({ type: 'draft', seq: state.draftSeq, text: editor.text(), frame: state.frame, width: 160, height: 120, progressive: true }, draftMessage);
     }, 25);
   }
-  /** The draft drawn elsewhere (time.js's player): a later draft of the
-   *  text's is not to replace it. */
+  /** The draft is time.js's player's from now on (it sends its frame
+   *  with `sendDraft`): a text draft asked for or running is not to
+   *  replace it. */
   function draftDrawn() {
     clearTimeout(state.draftTimer);
     state.draftSeq += 1;
@@ -257,17 +300,7 @@ function main() {
     };
     let used;
     try {
-      if ($('parallel').checked) {
-        used = await renderParallel(editor.text(), frame, accel, width, height, place, () => job === renderJob);
-      } else {
-        used = state.octrace.prepare(accel, width, height);
-        // Bands of rows, yielding between them so progress shows.
-        for (let y = 0; y < height && job === renderJob; y += 8) {
-          const h = Math.min(8, height - y);
-          place(0, y, width, h, state.octrace.render(0, y, width, h));
-          await new Promise((r) => setTimeout(r, 0));
-        }
-      }
+      used = await renderOnWorkers(editor.text(), frame, accel, width, height, place, () => job === renderJob);
     } catch (e) {
       for (const w of workers) w.terminate();
       imageCanvas.dataset.state = 'error';
@@ -278,7 +311,7 @@ function main() {
     const seconds = (performance.now() - started) / 1000;
     state.lastRender = { width, height, data };
     showDisplay();
-    const how = $('parallel').checked ? `, ${workers.length} workers, ${$('partition').value}` : '';
+    const how = $('parallel').checked ? `, ${workers.length} workers, ${$('partition').value}` : ', one worker';
     const which = loaded.frames ? `frame ${frame}: ` : '';
     setStatus(`done: ${which}${width}×${height} in ${seconds.toFixed(2)} s (${used}${how})`);
     state.lastSeconds = seconds;
@@ -288,11 +321,16 @@ function main() {
 
   /** Renders frame `frame` of `source` on Web Workers: 32×32 tiles handed
    *  out as workers become free, or the thesis's four equal rectangles
-   *  (quarter i to worker i mod n). */
-  function renderParallel(source, frame, accel, width, height, place, current) {
-    const count = Math.max(1, Math.min(16, Number($('workers').value) || 4));
+   *  (quarter i to worker i mod n); without "parallel", one worker renders
+   *  bands of 8 rows in order. A render started next terminates them
+   *  (`render`): they stop at once, inside the pixel they trace. */
+  function renderOnWorkers(source, frame, accel, width, height, place, current) {
+    const parallel = $('parallel').checked;
+    const count = parallel ? Math.max(1, Math.min(16, Number($('workers').value) || 4)) : 1;
     const pieces = [];
-    if ($('partition').value === 'equal4') {
+    if (!parallel) {
+      for (let y = 0; y < height; y += 8) pieces.push({ x: 0, y, width, height: Math.min(8, height - y) });
+    } else if ($('partition').value === 'equal4') {
       const left = width >> 1, top = height >> 1;
       for (const [x, y, w, h] of [[0, 0, left, top], [left, 0, width - left, top], [0, top, left, height - top], [left, top, width - left, height - top]]) {
         if (w > 0 && h > 0) pieces.push({ x, y, width: w, height: h });
@@ -304,7 +342,7 @@ function main() {
     }
     return new Promise((resolve, reject) => {
       let next = 0, finished = 0, used = '';
-      const equal4 = $('partition').value === 'equal4';
+      const equal4 = parallel && $('partition').value === 'equal4';
       const queues = Array.from({ length: count }, (_, i) => pieces.filter((_, j) => j % count === i));
       const give = (worker, index) => {
         const piece = equal4 ? queues[index].shift() : pieces[next++];
@@ -441,8 +479,8 @@ function main() {
 
   // ----------------------------------------------- view, tools and panel --
 
-  const app = { state, $, editor, api, frameChanged, scheduleDraft, draftDrawn, showFrame, single, setSingle,
-    replaceStatement, appendStatement, showBoardErrors, putRgb, setStatus };
+  const app = { state, $, editor, api, frameChanged, scheduleDraft, workerPair, sendDraft, draftDrawn, showFrame,
+    single, setSingle, replaceStatement, appendStatement, showBoardErrors, putRgb, setStatus };
   app.view = createView(state, $('wire'));
   app.tools = createTools(app);
   app.panel = createPanel(app);

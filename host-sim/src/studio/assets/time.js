@@ -3,10 +3,13 @@
 // slider), and play, every frame in turn at the animation's rate at most. A
 // still scene hides them.
 //
-// Two workers are the players, one for the draft and one for the render
-// when one is shown: each keeps its last frame and the core's coherence, so
-// the next frame forward re-traces only what moved, and a frame is the frame
-// traced whole, bit for bit (host-sim --frame K).
+// Two workers are the players: the draft's (studio.js's `sendDraft`, which
+// also draws the text's drafts) and the render's when one is shown. Each
+// keeps its last frame and the core's coherence, so the next frame forward
+// re-traces only what moved, and a frame is the frame traced whole, bit for
+// bit (host-sim --frame K). A frame asked for while another is traced stops
+// that one at once (its worker terminated, a spare takes over, tracing the
+// next frame whole): no frame runs on after a newer one is asked for.
 
 const DRAFT = [160, 120];
 
@@ -22,21 +25,19 @@ export function createTime(app) {
   /** Playing: the timer of the next frame, and when it is due (on a clock
    *  of its own, so that the rate holds; a late frame moves it on). */
   let timer = 0, due = 0;
-  /** The frame being traced, and the one to trace after it (the slider
-   *  moved on meanwhile), if any. */
-  let busy = false, wanted = null;
-  const player = () => {
-    const worker = new Worker('worker.js', { type: 'module' });
-    worker.onmessage = (event) => worker.answer(event.data);
-    return worker;
-  };
-  const players = { draft: player(), render: player() };
+  /** The number of the last frame asked for: an answer to an earlier one
+   *  is not shown. */
+  let asked = 0;
+  const renderPlayer = app.workerPair();
 
-  /** Frame `frame` of the text at `width`×`height`, traced by `worker`. */
-  function trace(worker, frame, [width, height]) {
+  /** Frame `frame` of the text at `width`×`height`, traced by `send` (a
+   *  worker pair's). */
+  function trace(send, frame, [width, height]) {
     return new Promise((resolve, reject) => {
-      worker.answer = (m) => (m.type === 'frame' ? resolve(m) : reject(new Error(m.message)));
-      worker.postMessage({ type: 'frame', text: app.editor.text(), frame, width, height });
+      send({ type: 'frame', text: app.editor.text(), frame, width, height }, (m) => {
+        if (m.type === 'frame') resolve(m); else reject(new Error(m.message));
+        return true;
+      });
     });
   }
 
@@ -64,29 +65,32 @@ export function createTime(app) {
   }
 
   /** Shows frame `frame`: its wireframe and errors at once, then its draft
-   *  and, if one is shown, its render, once traced; then the frame the
-   *  slider moved to meanwhile, or, playing, the next when its time comes.
-   *  A frame with errors stops there. */
+   *  and, if one is shown, its render, once traced; then, playing, the next
+   *  when its time comes. A frame with errors stops there. */
   async function go(frame) {
-    if (busy) { wanted = frame; return; }
+    const mine = ++asked;
     state.frame = frame;
     slider.value = String(frame);
     showLabel();
     if (app.frameChanged().errors) {
       stop();
+      renderPlayer.stop();
       $('draft-status').textContent = `frame ${frame} has errors`;
       return;
     }
-    busy = true;
-    const asked = performance.now(), playing = state.playing;
+    const started = performance.now(), playing = state.playing;
     const render = state.lastRender;
+    app.draftDrawn();
+    if (!render) renderPlayer.stop();
     try {
       const [draft, image] = await Promise.all([
-        trace(players.draft, frame, DRAFT),
-        render ? trace(players.render, frame, [render.width, render.height]) : null,
+        trace(app.sendDraft, frame, DRAFT),
+        render ? trace(renderPlayer.send, frame, [render.width, render.height]) : null,
       ]);
-      const ms = performance.now() - asked;
-      app.draftDrawn();
+      // A newer frame was asked for (then this one was stopped, and does not
+      // come here) or only its render was still traced.
+      if (mine !== asked) return;
+      const ms = performance.now() - started;
       const canvas = $('draft');
       canvas.width = draft.width; canvas.height = draft.height;
       app.putRgb(canvas, draft.data, draft.width, draft.height);
@@ -105,14 +109,9 @@ export function createTime(app) {
         timer = setTimeout(() => go((frame + 1) % frames.count), due - now);
       }
     } catch (e) {
+      if (mine !== asked) return;
       stop();
       $('draft-status').textContent = `frame ${frame}: ${e.message}`;
-    }
-    busy = false;
-    if (wanted !== null) {
-      const next = wanted;
-      wanted = null;
-      go(next);
     }
   }
 
@@ -135,8 +134,15 @@ export function createTime(app) {
     button.title = 'Play (Space)';
   }
 
+  /** The text changed while paused: the frame being traced, if any, is
+   *  of the old text (the text's draft takes the draft's worker over). */
+  function textChanged() {
+    asked += 1;
+    renderPlayer.stop();
+  }
+
   const toggle = () => (state.playing ? stop() : play());
   button.onclick = toggle;
   slider.addEventListener('input', () => { stop(); go(Number(slider.value)); });
-  return { scene, stop, toggle };
+  return { scene, stop, toggle, textChanged };
 }
