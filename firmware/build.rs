@@ -37,7 +37,7 @@ use octrace_core::render::PanelColor;
 use octrace_core::AccelMode;
 use std::env;
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// What each board's RAM holds besides the stack, and how its octree is
 /// built: on the micro:bit at most 4 levels of 8 objects a leaf (fewer
@@ -84,7 +84,8 @@ fn main() {
     let board = match (board.as_str(), target.as_str()) {
         ("microbit", "thumbv6m-none-eabi") => Board {
             name: "microbit",
-            static_ram: 9 * 1024,
+            // What its linker script leaves beside the stack.
+            static_ram: ram_length(&manifest.join("memory-microbit.x")),
             config: OctreeConfig { max_objects: 8, max_depth: 4, ..OctreeConfig::DEFAULT },
         },
         ("mps2-an385", "thumbv7m-none-eabi") => {
@@ -289,6 +290,23 @@ fn light_buffer_in_flash(text: &str) -> Vec<u32> {
 /// with errors needs what it counts, and the board then reports its errors.
 fn needs(text: &str, accel: AccelMode, config: &OctreeConfig, light_cells: u32) -> Counts {
     needed_with_light_buffer(text, accel, config, light_cells, &mut |_| {}).unwrap_or_else(|_| count(text))
+}
+
+/// The `RAM` region's length in `memory_x` (bytes, or with a K suffix):
+/// what the statics have, read from the linker script that places them.
+fn ram_length(memory_x: &Path) -> usize {
+    let text = std::fs::read_to_string(memory_x).unwrap_or_else(|e| fail(format!("{}: {e}", memory_x.display())));
+    let length = text
+        .lines()
+        .find(|line| line.trim_start().starts_with("RAM "))
+        .and_then(|line| line.split("LENGTH =").nth(1))
+        .map(str::trim);
+    let bytes = match length {
+        Some(kib) if kib.ends_with('K') => kib.trim_end_matches('K').parse::<usize>().ok().map(|k| k * 1024),
+        Some(bytes) => bytes.parse().ok(),
+        None => None,
+    };
+    bytes.unwrap_or_else(|| fail(format!("{}: no `RAM : ORIGIN = …, LENGTH = N` line", memory_x.display())))
 }
 
 /// What a board may spend memory on beyond the scene to render faster
