@@ -152,6 +152,12 @@ impl<'s> Coherence<'s> {
         self.side
     }
 
+    /// The most pixels of a row a run of tiles hands over at once
+    /// ([`Coherence::trace_band`]): what a buffer for one must hold.
+    pub fn longest_row(&self) -> u32 {
+        (RUN_TILES as u32 * self.side).min(self.size.width)
+    }
+
     /// Rows of tiles (bands), each [`Coherence::side`] rows of pixels
     /// high (the last may be lower): the units cores share.
     pub fn bands(&self) -> u32 {
