@@ -8,8 +8,10 @@
 // Options: --out FILE (default panel.png), --panel WxH (the panel's size,
 // default 240x240, the Pico-LCD-1.3), --panel-offset X,Y (where it starts in
 // the controller's 240x320 memory, default 0,0), --max-seconds S (emulated
-// time before giving up, default 120), --json (the report as JSON on
-// standard output), --quiet.
+// time before giving up, default 120), --contention on|off (whether two
+// masters on one port of the bus fabric wait for each other, as on the
+// chip: default on; off measures what the contention costs), --json (the
+// report as JSON on standard output), --quiet.
 //
 // --serial: the board as a serial device (serial.mjs), for the live
 // firmware: prints the path of a pseudo-terminal on its first line of
@@ -32,8 +34,8 @@ import { encodePng, writeAtomically } from './png.mjs';
 import { serveSerial } from './serial.mjs';
 
 const USAGE =
-  'usage: node run.mjs ELF [--out FILE.png] [--panel WxH] [--panel-offset X,Y] [--max-seconds S] [--json] [--quiet]\n' +
-  '       node run.mjs ELF --serial [--out FILE.png] [--panel WxH] [--panel-offset X,Y]';
+  'usage: node run.mjs ELF [--out FILE.png] [--panel WxH] [--panel-offset X,Y] [--max-seconds S] [--contention on|off] [--json] [--quiet]\n' +
+  '       node run.mjs ELF --serial [--out FILE.png] [--panel WxH] [--panel-offset X,Y] [--contention on|off]';
 
 function usage(message) {
   console.error(`octrace-pico-emulator: ${message}\n${USAGE}`);
@@ -58,6 +60,7 @@ try {
       panel: { type: 'string', default: '240x240' },
       'panel-offset': { type: 'string', default: '0,0' },
       'max-seconds': { type: 'string', default: '120' },
+      contention: { type: 'string', default: 'on' },
       json: { type: 'boolean', default: false },
       quiet: { type: 'boolean', default: false },
     },
@@ -76,6 +79,10 @@ const maxSeconds = Number(values['max-seconds']);
 if (!(maxSeconds > 0)) {
   usage(`--max-seconds ${values['max-seconds']}: expected a positive number`);
 }
+if (values.contention !== 'on' && values.contention !== 'off') {
+  usage(`--contention ${values.contention}: expected on or off`);
+}
+const contention = values.contention === 'on';
 if (values.out !== undefined && !values.out.toLowerCase().endsWith('.png')) {
   usage(`--out ${values.out}: the picture is written as PNG: name a .png file`);
 }
@@ -89,7 +96,7 @@ const seconds = (cycles) => (cycles / CLOCK_HZ).toFixed(3);
 let report;
 try {
   const elf = readFileSync(elfPath);
-  const pico = Pico.fromElf(elf, elfPath, { panel: { width, height, offsetX, offsetY } });
+  const pico = Pico.fromElf(elf, elfPath, { panel: { width, height, offsetX, offsetY }, contention });
   pico.run({
     maxCycles: maxSeconds * CLOCK_HZ,
     onProgress: progress
@@ -111,6 +118,7 @@ try {
     cycles: pico.phases(),
     coreCycles,
     xipCache: pico.cacheStatistics(),
+    busFabric: pico.fabric.statistics(),
   };
 } catch (error) {
   if (progress) process.stderr.write('\r\x1b[K');
@@ -130,6 +138,10 @@ if (values.json) {
   const { startUp, parseAndIndex, render, firstFullPanel, total } = report.cycles;
   const cores = report.coreCycles.slice(0, report.cores);
   const cache = report.xipCache;
+  const fabric = report.busFabric;
+  const contested = Object.entries(fabric.ports)
+    .filter(([, { contested }]) => contested > 0)
+    .map(([port, { contested }]) => `${port} ${count(contested)}`);
   console.error(
     [
       `${elfPath} on an emulated Raspberry Pi Pico (${report.cores === 2 ? 'both Cortex-M0+ cores' : 'one Cortex-M0+ core'} at 125 MHz):`,
@@ -139,9 +151,13 @@ if (values.json) {
       row('first full panel (from the picture\'s start)', firstFullPanel),
       row('in all', total),
       ...cores.map(
-        ({ core, busy, waiting, flashStall }) =>
-          `  core ${core}: ${count(busy)} cycles busy (${count(flashStall)} of them stalled on flash), ${count(waiting)} waiting`,
+        ({ core, busy, waiting, flashStall, busStall }) =>
+          `  core ${core}: ${count(busy)} cycles busy (${count(flashStall)} of them stalled on flash, ` +
+          `${count(busStall)} on the other core at the bus), ${count(waiting)} waiting`,
       ),
+      fabric.contention
+        ? `  bus fabric: contested accesses ${contested.length > 0 ? contested.join(', ') : 'none'}`
+        : '  bus fabric: contention off (no master waits for another)',
       `  XIP cache: ${count(cache.accesses)} flash reads, ${count(cache.misses)} misses` +
         (cache.lineReadCycles === null ? '' : ` (${cache.lineReadCycles} cycles a line read)`) +
         `, ${count(cache.stallCycles)} cycles stalled`,
@@ -155,7 +171,7 @@ async function serve() {
   let pico;
   let drawn = -1;
   try {
-    pico = Pico.fromElf(readFileSync(elfPath), elfPath, { panel: { width, height, offsetX, offsetY } });
+    pico = Pico.fromElf(readFileSync(elfPath), elfPath, { panel: { width, height, offsetX, offsetY }, contention });
     await serveSerial(pico, {
       input: process.stdin,
       onPath: (path) => console.log(path),

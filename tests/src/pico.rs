@@ -135,11 +135,15 @@ pub struct Cycles {
     pub total: u64,
     /// How many cores ran the firmware.
     pub cores: u64,
-    /// Each core's cycles: busy (of them stalled on a flash cache miss) and
-    /// waiting (asleep).
+    /// Each core's cycles: busy (of them stalled on a flash cache miss, and
+    /// on the other core at the bus fabric) and waiting (asleep).
     pub busy: [u64; 2],
     pub stalled: [u64; 2],
+    pub bus_stalled: [u64; 2],
     pub waiting: [u64; 2],
+    /// Accesses to the striped SRAM banks (SRAM0 to SRAM3) that waited for
+    /// the other core (BUSCTRL's contested events, summed).
+    pub striped_contested: u64,
     /// The XIP cache: flash reads, misses.
     pub flash_reads: u64,
     pub cache_misses: u64,
@@ -152,8 +156,23 @@ impl Cycles {
     }
 }
 
-/// Runs `elf` on the emulated Pico; the panel's picture goes to `png`.
+/// Whether the emulated Pico's two cores wait for each other on the bus
+/// fabric (as on the chip), or each goes at full speed (what the contention
+/// costs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Contention {
+    On,
+    Off,
+}
+
+/// Runs `elf` on the emulated Pico, its cores contending for the bus as on
+/// the chip; the panel's picture goes to `png`.
 pub fn run(elf: &Path, png: &Path) -> Result<Cycles, String> {
+    run_with(elf, png, Contention::On)
+}
+
+/// Runs `elf` on the emulated Pico with or without the bus's contention.
+pub fn run_with(elf: &Path, png: &Path, contention: Contention) -> Result<Cycles, String> {
     let emulator = repo().join("emulator");
     if !emulator.join("node_modules/rp2040js").is_dir() {
         return Err(format!("the emulator is not installed: run `npm ci` in {}", emulator.display()));
@@ -164,6 +183,8 @@ pub fn run(elf: &Path, png: &Path) -> Result<Cycles, String> {
         .arg("--out")
         .arg(png)
         .arg("--json")
+        .arg("--contention")
+        .arg(if contention == Contention::On { "on" } else { "off" })
         .output()
         .map_err(|e| format!("cannot run node: {e}"))?;
     if !out.status.success() {
@@ -181,6 +202,9 @@ pub fn run(elf: &Path, png: &Path) -> Result<Cycles, String> {
     };
     let phase = |key: &str| number(&report["cycles"][key], key);
     let core = |k: usize, key: &str| number(&report["coreCycles"][k][key], key);
+    let ports = &report["busFabric"]["ports"];
+    let striped_contested =
+        ["sram0", "sram1", "sram2", "sram3"].iter().map(|bank| ports[bank]["contested"].as_u64().unwrap_or(0)).sum();
     Ok(Cycles {
         start_up: phase("startUp")?,
         parse_and_index: phase("parseAndIndex")?,
@@ -190,7 +214,9 @@ pub fn run(elf: &Path, png: &Path) -> Result<Cycles, String> {
         cores: number(&report["cores"], "cores")?,
         busy: [core(0, "busy")?, core(1, "busy")?],
         stalled: [core(0, "flashStall")?, core(1, "flashStall")?],
+        bus_stalled: [core(0, "busStall")?, core(1, "busStall")?],
         waiting: [core(0, "waiting")?, core(1, "waiting")?],
+        striped_contested,
         flash_reads: number(&report["xipCache"]["accesses"], "accesses")?,
         cache_misses: number(&report["xipCache"]["misses"], "misses")?,
     })

@@ -2,19 +2,23 @@
 //! each scene, runs it on the emulated Pico and prints Markdown tables (the
 //! ones in BENCHMARKS.md): the cycles to parse and index the scene and to
 //! render it into the 240×240 panel on both cores, the seconds from scene
-//! text to picture at 125 MHz, the firmware's flash and the SRAM it takes
-//! (its statics, and the code copied there at boot); then
-//! each core's busy and waiting cycles, and the flash cache's reads, misses
-//! and stalls.
+//! text to picture at 125 MHz, the same without the bus fabric's
+//! contention (each build runs twice: the cores waiting for each other at
+//! the SRAM banks as on the chip, and not), the firmware's flash and the
+//! SRAM it takes (its statics, and the code copied there at boot); then
+//! each core's busy and waiting cycles, its stalls on flash and on the
+//! other core, the contested accesses to the striped banks, and the flash
+//! cache's reads and misses.
 //!
 //!     cargo run --release -p octrace-tests --bin pico-bench [--code-in parse-and-render|render|sram|flash] [--order rows|progressive] [scene...]
 //!
-//! Cycles are the emulator's: rp2040js's Cortex-M0+ timings, both cores in
-//! lockstep, the flash behind its XIP cache with the QSPI reads of the
-//! firmware's own boot2 (`emulator/`).
+//! Cycles are the emulator's: the Cortex-M0+'s timings, both cores in
+//! lockstep on the bus fabric, the flash behind its XIP cache with the QSPI
+//! reads of the firmware's own boot2 (`emulator/`, whose README says what
+//! it leaves out).
 
 use octrace_tests::firmware::Sizes;
-use octrace_tests::pico::{self, Build, Cycles, CLOCK_HZ};
+use octrace_tests::pico::{self, Build, Contention, Cycles, CLOCK_HZ};
 
 const USAGE: &str =
     "usage: pico-bench [--code-in parse-and-render|render|sram|flash] [--order rows|progressive] [scene...]";
@@ -47,8 +51,17 @@ fn main() {
     for scene in &scenes {
         let build = Build { scene, code_in: &code_in, order: &order };
         let measured = pico::build(&build).and_then(|elf| {
-            let cycles = pico::run(&elf, &dir.path().join("panel.png"))?;
-            Ok((cycles, Sizes::of(&elf)?, pico::sram_code_bytes(&elf)?))
+            // Both runs at once: they share nothing but the ELF.
+            let (with, without) = std::thread::scope(|s| {
+                let run = |contention, png: &str| {
+                    let (elf, png) = (&elf, dir.path().join(png));
+                    s.spawn(move || pico::run_with(elf, &png, contention))
+                };
+                let with = run(Contention::On, "with.png");
+                let without = run(Contention::Off, "without.png");
+                (with.join().expect("a run's thread"), without.join().expect("a run's thread"))
+            });
+            Ok((with?, without?, Sizes::of(&elf)?, pico::sram_code_bytes(&elf)?))
         });
         match measured {
             Ok(row) => rows.push((build.name(), row)),
@@ -61,16 +74,18 @@ fn main() {
 
     let seconds = |cycles: u64| cycles as f64 / CLOCK_HZ;
     let millions = |cycles: u64| cycles as f64 / 1e6;
-    println!("| build | parse and index | render | scene to picture at 125 MHz | whole panel drawn once | flash | SRAM: statics + code |");
-    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: |");
-    for (name, (c, sizes, sram_code)) in &rows {
+    println!("| build | parse and index | render | scene to picture at 125 MHz | without contention | whole panel drawn once | flash | SRAM: statics + code |");
+    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    for (name, (c, free, sizes, sram_code)) in &rows {
         println!(
-            "| {name} | {:.1} M cycles ({:.3} s) | {:.1} M cycles ({:.2} s) | **{:.2} s** | {:.3} s | {:.1} KiB | {:.1} + {:.1} KiB |",
+            "| {name} | {:.1} M cycles ({:.3} s) | {:.1} M cycles ({:.2} s) | **{:.2} s** | {:.2} s (+{:.1} %) | {:.3} s | {:.1} KiB | {:.1} + {:.1} KiB |",
             millions(c.parse_and_index),
             seconds(c.parse_and_index),
             millions(c.render),
             seconds(c.render),
             c.to_picture_seconds(),
+            free.to_picture_seconds(),
+            100.0 * (c.to_picture_seconds() / free.to_picture_seconds() - 1.0),
             seconds(c.first_full_panel),
             (sizes.text + sizes.data) as f64 / 1024.0,
             (sizes.data + sizes.bss) as f64 / 1024.0,
@@ -78,18 +93,23 @@ fn main() {
         );
     }
     println!();
-    println!("| build | core 0 busy (of it on flash misses) | core 0 waiting | core 1 busy (on flash misses) | core 1 waiting | flash reads | cache misses |");
-    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: |");
-    for (name, (c, _, _)) in &rows {
-        let Cycles { busy, stalled, waiting, .. } = c;
+    println!(
+        "| build | core 0 busy (on flash; on core 1) | core 0 waiting | core 1 busy (on flash; on core 0) | core 1 waiting | contested SRAM0-3 accesses | flash reads | cache misses |"
+    );
+    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    for (name, (c, _, _, _)) in &rows {
+        let Cycles { busy, stalled, bus_stalled, waiting, .. } = c;
         println!(
-            "| {name} | {:.1} M ({:.1} M) | {:.1} M | {:.1} M ({:.1} M) | {:.1} M | {:.1} M | {:.2} M |",
+            "| {name} | {:.1} M ({:.1} M; {:.1} M) | {:.1} M | {:.1} M ({:.1} M; {:.1} M) | {:.1} M | {:.1} M | {:.1} M | {:.2} M |",
             millions(busy[0]),
             millions(stalled[0]),
+            millions(bus_stalled[0]),
             millions(waiting[0]),
             millions(busy[1]),
             millions(stalled[1]),
+            millions(bus_stalled[1]),
             millions(waiting[1]),
+            millions(c.striped_contested),
             millions(c.flash_reads),
             millions(c.cache_misses),
         );
