@@ -46,6 +46,7 @@ import { W25Q16JV } from './flash-chip.mjs';
 import { Ssi } from './ssi.mjs';
 import { XipCache, XipControl } from './xip.mjs';
 import { BusCtrl, BusFabric } from './fabric.mjs';
+import { completeRegisters } from './usb-serial.mjs';
 
 export { RunError };
 
@@ -172,6 +173,7 @@ export class Pico {
     rp2040.peripherals[XIP_CTRL_SLOT] = new XipControl(rp2040, this.xip, now, stall);
     rp2040.peripherals[BUSCTRL_SLOT] = new BusCtrl(rp2040, this.fabric);
     this.watchPsm(rp2040.peripherals[PSM_SLOT]);
+    completeRegisters(rp2040.usbCtrl);
     // rp2040js's DMA would copy outside the bus fabric (and around the XIP cache): not modelled.
     for (const channel of rp2040.dma.channels) {
       channel.start = () => {

@@ -18,7 +18,8 @@
 // standard output and serves the firmware's USB serial port there until
 // standard input closes or the process is signalled (`host-sim board PATH
 // scene.txt` then talks to it). With --out, the panel's picture is written
-// each time the firmware waits for the host again.
+// each time the firmware waits for the host again; with --json, the report
+// follows the path on standard output once the serve ends.
 //
 // Exit codes: 0 the run ended with both cores asleep and the picture written
 // (or, with --serial, the serve ended); 1 the firmware or the ELF did
@@ -35,7 +36,7 @@ import { serveSerial } from './serial.mjs';
 
 const USAGE =
   'usage: node run.mjs ELF [--out FILE.png] [--panel WxH] [--panel-offset X,Y] [--max-seconds S] [--contention on|off] [--json] [--quiet]\n' +
-  '       node run.mjs ELF --serial [--out FILE.png] [--panel WxH] [--panel-offset X,Y] [--contention on|off]';
+  '       node run.mjs ELF --serial [--out FILE.png] [--panel WxH] [--panel-offset X,Y] [--contention on|off] [--json]';
 
 function usage(message) {
   console.error(`octrace-pico-emulator: ${message}\n${USAGE}`);
@@ -104,22 +105,8 @@ try {
       : undefined,
   });
   if (progress) process.stderr.write('\r\x1b[K');
-  const panel = pico.panel;
-  writeAtomically(out, encodePng(width, height, panel.picture()));
-  const coreCycles = pico.coreCycles();
-  report = {
-    elf: elfPath,
-    out,
-    panel: `${width}x${height}`,
-    dark: panel.darkBecause,
-    clockHz: CLOCK_HZ,
-    cores: pico.coresUsed,
-    instructions: coreCycles[0].instructions + coreCycles[1].instructions,
-    cycles: pico.phases(),
-    coreCycles,
-    xipCache: pico.cacheStatistics(),
-    busFabric: pico.fabric.statistics(),
-  };
+  writeAtomically(out, encodePng(width, height, pico.panel.picture()));
+  report = runReport(pico, out);
 } catch (error) {
   if (progress) process.stderr.write('\r\x1b[K');
   if (error instanceof RunError || error instanceof ElfError || error instanceof PanelError || error.code === 'ENOENT') {
@@ -166,7 +153,25 @@ if (values.json) {
   );
 }
 
-/** --serial: serves the board on a pseudo-terminal, then exits. */
+/** What the run took and did: the report `--json` prints. */
+function runReport(pico, out) {
+  const coreCycles = pico.coreCycles();
+  return {
+    elf: elfPath,
+    out,
+    panel: `${width}x${height}`,
+    dark: pico.panel.darkBecause,
+    clockHz: CLOCK_HZ,
+    cores: pico.coresUsed,
+    instructions: coreCycles[0].instructions + coreCycles[1].instructions,
+    cycles: pico.phases(),
+    coreCycles,
+    xipCache: pico.cacheStatistics(),
+    busFabric: pico.fabric.statistics(),
+  };
+}
+
+/** --serial: serves the board on a pseudo-terminal, then exits (with --json, printing the report). */
 async function serve() {
   let pico;
   let drawn = -1;
@@ -190,5 +195,6 @@ async function serve() {
     }
     throw error;
   }
+  if (values.json) console.log(JSON.stringify(runReport(pico, values.out ?? null), null, 2));
   process.exit(0);
 }

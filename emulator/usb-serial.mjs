@@ -37,8 +37,12 @@ const KEPT_AT_RESET = [
   [0x88, 0xf8],
 ];
 
-/** Completes rp2040js's USB controller with the registers it leaves out. */
-function completeRegisters(usb) {
+/**
+ * Completes rp2040js's USB controller with the registers it leaves out:
+ * once, when the machine is made (a firmware touches them with or without
+ * a host on the bus).
+ */
+export function completeRegisters(usb) {
   const kept = new Map(KEPT_AT_RESET);
   const read = usb.readUint32.bind(usb);
   const write = usb.writeUint32.bind(usb);
@@ -64,7 +68,6 @@ export class UsbSerialHost {
   constructor(rp2040, { onDeviceBytes = () => {}, onConnected = () => {} } = {}) {
     const usb = rp2040.usbCtrl;
     this.usb = usb;
-    completeRegisters(usb);
     this.cdc = new USBCDC(usb);
     this.queue = []; // Uint8Arrays from the host, oldest first
     this.queued = 0; // bytes in `queue`

@@ -107,8 +107,11 @@ fn main() {
         named_walk: false,
         first_hits: true,
     };
-    let source =
-        format!("/// The scene, from `{scene}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n{profile}");
+    let name = path.file_stem().map_or_else(|| scene.clone(), |stem| stem.to_string_lossy().into_owned());
+    let source = format!(
+        "/// The scene, from `{scene}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n\
+         /// Its file's name, without the extension.\npub const SCENE_NAME: &str = {name:?};\n{profile}"
+    );
     std::fs::write(out.join("scene.rs"), source).expect("write scene.rs into OUT_DIR");
 }
 

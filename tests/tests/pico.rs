@@ -3,14 +3,18 @@
 //! Raspberry Pi Pico with its ST7789 panel, both cores tracing, shows
 //! exactly host-sim's `--size 240x240 --color rgb565` picture; and so does
 //! its progressive order (`OCTRACE_ORDER=progressive`), whose first coarse
-//! panel comes within 0.1 s of the picture's start.
+//! panel comes within 0.1 s of the picture's start. fig5_1's firmware is
+//! then asked on its USB serial port what it measured (what a user with a
+//! real Pico reads, `pico-compare`): its TIMER's time from scene to picture
+//! is the emulator's count within the timer's and the phases' edges, and
+//! its bus counters count the contention the emulator counted.
 //!
 //! Needs Node and the emulator's packages (`npm ci` in
 //! `emulator/`; the test command does it); set
 //! `OCTRACE_SKIP_FIRMWARE=1` to skip where they cannot be installed.
 
 use octrace_tests::host_sim_preview;
-use octrace_tests::pico::{self, Build, DEFAULT_CODE_IN};
+use octrace_tests::pico::{self, Build, Report, DEFAULT_CODE_IN};
 use std::path::Path;
 
 /// The thesis's first figure (naive, no octree), 200 spheres in an
@@ -37,6 +41,30 @@ fn read_rgb_png(path: &Path) -> (u32, u32, Vec<u8>) {
     (frame.width, frame.height, pixels)
 }
 
+/// The firmware's own measure of its scene against the emulator's count:
+/// its TIMER ticks each microsecond (125 cycles) and it reads it just after
+/// the panel's set-up and just after its last row, where the emulator's
+/// phases start at the backlight and end at the last pixel's byte, so the
+/// two agree within a few hundred microseconds; its bus counters cover the
+/// load and the render, the emulator's the whole run (start-up too, where
+/// the cores barely meet).
+fn reported_as_the_emulator_counted(name: &str, report: &Report, cycles: &pico::Cycles) {
+    assert_eq!(report.scene, "fig5_1", "{name}: {report:?}");
+    assert!(report.firmware.starts_with("octrace-pico-st7789 "), "{name}: {report:?}");
+    let (board, emulator) = (report.to_picture_seconds(), cycles.to_picture_seconds());
+    assert!(
+        (board - emulator).abs() < 300e-6,
+        "{name}: the firmware measured {board} s, the emulator counted {emulator} s"
+    );
+    let counted: u64 = report.load_contested.iter().chain(&report.render_contested).sum();
+    assert!(
+        counted <= cycles.striped_contested && counted * 100 >= cycles.striped_contested * 99,
+        "{name}: the firmware counted {counted} contested accesses, the emulator {}",
+        cycles.striped_contested
+    );
+    println!("{name}: reported {board:.6} s and {counted} contested accesses; the emulator counted {emulator:.6} s");
+}
+
 #[test]
 fn the_pico_template_shows_host_sims_picture() {
     if std::env::var_os("OCTRACE_SKIP_FIRMWARE").is_some_and(|v| v != "0") {
@@ -47,21 +75,32 @@ fn the_pico_template_shows_host_sims_picture() {
     // One build at a time (they share a target directory), then the runs
     // side by side.
     let elves: Vec<_> = BUILDS.iter().map(|build| pico::build(build).unwrap_or_else(|e| panic!("{e}"))).collect();
+    // The first build (fig5_1, as a user builds it) serves its USB port too.
     let runs: Vec<_> = std::thread::scope(|s| {
         let handles: Vec<_> = BUILDS
             .iter()
             .zip(&elves)
-            .map(|(build, elf)| {
+            .enumerate()
+            .map(|(i, (build, elf))| {
                 let panel = dir.path().join(format!("{}-panel.png", build.name()));
-                s.spawn(move || (pico::run(elf, &panel), panel))
+                s.spawn(move || {
+                    let run = match i {
+                        0 => pico::run_reporting(elf, &panel).map(|(cycles, report)| (cycles, Some(report))),
+                        _ => pico::run(elf, &panel).map(|cycles| (cycles, None)),
+                    };
+                    (run, panel)
+                })
             })
             .collect();
         handles.into_iter().map(|h| h.join().expect("the run's thread")).collect()
     });
 
-    for (build, (cycles, panel)) in BUILDS.iter().zip(runs) {
+    for (build, (run, panel)) in BUILDS.iter().zip(runs) {
         let name = build.name();
-        let cycles = cycles.unwrap_or_else(|e| panic!("{name}: {e}"));
+        let (cycles, report) = run.unwrap_or_else(|e| panic!("{name}: {e}"));
+        if let Some(report) = report {
+            reported_as_the_emulator_counted(&name, &report, &cycles);
+        }
         let preview = dir.path().join(format!("{name}-host-sim.png"));
         host_sim_preview(build.scene, &preview, "240x240", "rgb565").unwrap_or_else(|e| panic!("{e}"));
 

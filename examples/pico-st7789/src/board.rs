@@ -23,6 +23,8 @@ pub struct Board {
     pub display: Panel,
     pub core1: SecondCore,
     pub timer: Timer,
+    /// The bus fabric's control and performance counters, untouched.
+    pub busctrl: pac::BUSCTRL,
     /// The USB controller and its clock, untouched.
     pub usb: UsbParts,
     pub resets: pac::RESETS,
@@ -78,6 +80,7 @@ pub fn start(panel_buffer: &'static mut [u8], core1_stack: StackAllocation) -> B
         display,
         core1,
         timer,
+        busctrl: peripherals.BUSCTRL,
         usb: UsbParts { regs: peripherals.USBCTRL_REGS, dpram: peripherals.USBCTRL_DPRAM, clock: clocks.usb_clock },
         resets: peripherals.RESETS,
     }

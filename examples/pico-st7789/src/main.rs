@@ -2,21 +2,33 @@
 //! board and traced by both cores straight into an ST7789 panel (Waveshare
 //! Pico-LCD-1.3, 240×240) through `mipidsi`. No heap, no framebuffer: the
 //! panel's own memory holds the picture. Pins and wiring are in README.md.
+//! Once the picture is drawn, the Pico is a USB serial port that answers
+//! anything it is sent with what it measured: the load's and the render's
+//! microseconds by its TIMER and their contested accesses to the SRAM
+//! banks (`measure::Report`; `pico-compare` sets them beside the emulated
+//! Pico's).
 //!
 //! Invariants: the scene, its octree and core 0's mailbox live in one static
 //! cell, core 1's mailbox and lists in another (all zero bits, so in `.bss`:
 //! no flash, no copy on the stack); the image takes the panel's size; any
-//! split of the rows between the cores gives the same bits as one core.
+//! split of the rows between the cores gives the same bits as one core;
+//! USB starts after the picture, so it takes nothing from it.
 
 #![no_std]
 #![no_main]
 
+use core::cell::RefCell;
+use core::fmt::Write;
+use critical_section::Mutex;
 use embedded_graphics::pixelcolor::Rgb565;
 use embedded_graphics::prelude::*;
 use hal::entry;
 use hal::multicore::Stack;
+use hal::pac::{self, interrupt};
 use octrace_core::render::{Handoff, Progressive};
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
+use octrace_pico_st7789::measure::{Meter, Report};
+use octrace_pico_st7789::usb::{self, SerialDevice};
 use octrace_pico_st7789::{board, both_cores, panel};
 use panic_halt as _;
 use rp2040_hal as hal;
@@ -36,7 +48,7 @@ static BOOT2: [u8; 256] = rp2040_boot2::BOOT_LOADER_W25Q080;
 mod scene {
     include!(concat!(env!("OUT_DIR"), "/scene.rs"));
 }
-use scene::{SceneProfile, SCENE_TEXT};
+use scene::{SceneProfile, SCENE_NAME, SCENE_TEXT};
 
 /// Room for the scene, its octree and core 0's mailbox and lists.
 static RAYTRACER: ConstStaticCell<Raytracer<SceneProfile>> = ConstStaticCell::new(Raytracer::new());
@@ -59,10 +71,22 @@ static RING: Handoff<{ PROGRESSIVE.max_unit_pixels() }, 4> = Handoff::new();
 /// The panel's bus buffer.
 static PANEL_BUFFER: ConstStaticCell<[u8; 512]> = ConstStaticCell::new([0; 512]);
 
+/// The line the USB port answers with, and how much of its current answer
+/// the port has taken: owned by the USB interrupt.
+struct Answering {
+    device: SerialDevice,
+    line: heapless::String<192>,
+    sent: usize,
+}
+
+static ANSWERING: Mutex<RefCell<Option<Answering>>> = Mutex::new(RefCell::new(None));
+
 #[entry]
 fn main() -> ! {
-    let board = board::start(PANEL_BUFFER.take(), CORE1_STACK.take().unwrap());
+    let mut board = board::start(PANEL_BUFFER.take(), CORE1_STACK.take().unwrap());
     let (mut display, mut core1) = (board.display, board.core1);
+    let mut meter = Meter::new(board.timer, board.busctrl);
+    meter.start();
 
     // octrace: parse and index the scene, then trace it into the panel at
     // the panel's size with both cores. A scene the board cannot trace
@@ -70,6 +94,7 @@ fn main() -> ! {
     // leaves the panel red.
     // The light buffer is built on core 1 while core 0 builds the octree.
     let loaded = RAYTRACER.take().load_on_two_cores(SCENE_TEXT, |beside, here| core1.scope(beside, here));
+    let load = meter.split();
     let drawn = match loaded {
         #[cfg(not(progressive_order))]
         Ok(scene) => {
@@ -83,10 +108,45 @@ fn main() -> ! {
         }
         Err(_) => false,
     };
+    let render = meter.split();
     if !drawn {
         display.clear(Rgb565::RED).unwrap();
     }
+
+    // What was measured, answered on USB to anything the host sends.
+    let mut line = heapless::String::new();
+    let firmware = concat!(env!("CARGO_BIN_NAME"), " ", env!("CARGO_PKG_VERSION"));
+    let report = Report { firmware, scene: SCENE_NAME, load, render };
+    // 192 bytes hold the longest report (ten-digit counts and times).
+    let _ = write!(line, "{report}\r\n");
+    let device = usb::serial_device(board.usb, &mut board.resets, "octrace report");
+    // Nothing to send until the host asks.
+    let sent = line.len();
+    critical_section::with(|cs| ANSWERING.borrow_ref_mut(cs).replace(Answering { device, line, sent }));
+    // SAFETY: the handler only touches what the critical section guards.
+    unsafe { pac::NVIC::unmask(pac::Interrupt::USBCTRL_IRQ) };
     loop {
         cortex_m::asm::wfi();
     }
+}
+
+/// Serves the USB device; a byte from the host starts the answer (again,
+/// once the last one is out), which goes out as the port takes it.
+#[interrupt]
+fn USBCTRL_IRQ() {
+    critical_section::with(|cs| {
+        let mut answering = ANSWERING.borrow_ref_mut(cs);
+        let Some(Answering { device: (device, serial), line, sent }) = answering.as_mut() else { return };
+        device.poll(&mut [serial]);
+        let mut asked = [0u8; 64];
+        // Asked again once the last answer is out: an answer is never cut by a restart.
+        if matches!(serial.read(&mut asked), Ok(read) if read > 0) && *sent == line.len() {
+            *sent = 0;
+        }
+        if let Some(rest) = line.as_bytes().get(*sent..).filter(|rest| !rest.is_empty()) {
+            if let Ok(written) = serial.write(rest) {
+                *sent += written;
+            }
+        }
+    });
 }

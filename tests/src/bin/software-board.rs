@@ -18,7 +18,7 @@ use octrace_core::profile::{Board16K, Board64K, Host, Profile};
 use octrace_core::render::Renderer;
 use octrace_core::Raytracer;
 use octrace_link::board::Board;
-use octrace_link::{Decoder, Panel, PixelFormat, OVERHEAD};
+use octrace_link::{Counters, Decoder, Panel, PixelFormat, Timing, OVERHEAD};
 use std::collections::VecDeque;
 use std::fs::File;
 use std::io::{Read, Write};
@@ -107,6 +107,7 @@ fn serve<P: Profile>(options: &Options, line: &mut Line, out: &mut File) {
         let started = Instant::now();
         // A host that went away while the board wrote is not waited for.
         let Ok(Some(drawing)) = board.answer(received, &mut *raytracer, out) else { continue };
+        let loaded = Instant::now();
         let scene = drawing.scene();
         let accelerator = scene.accelerator();
         let Ok(renderer) = Renderer::with_size(scene.view(), &accelerator, width, height) else {
@@ -129,7 +130,14 @@ fn serve<P: Profile>(options: &Options, line: &mut Line, out: &mut File) {
         }
         let _ = match pending {
             true => drawing.cancel(drawn as u16, out),
-            false => drawing.finish(Some(started.elapsed()), out),
+            false => {
+                // By the host's clock; it has no counters.
+                let (elapsed, render) = (started.elapsed(), loaded.elapsed());
+                let load = Some(elapsed - render);
+                let timing =
+                    Timing { elapsed: Some(elapsed), load, render: Some(render), counters: Counters::new(&[]) };
+                drawing.finish(&timing, out)
+            }
         };
     }
 }

@@ -25,19 +25,17 @@ use core::time::Duration;
 use critical_section::Mutex;
 use hal::multicore::Stack;
 use hal::pac::interrupt;
-use hal::usb::UsbBus;
 use hal::{entry, pac, Timer};
 use heapless::Deque;
 use octrace_core::render::Handoff;
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
 use octrace_link::board::Board;
-use octrace_link::{Decoder, Panel, PixelFormat, Sink};
+use octrace_link::{Counter, Counters, Decoder, Panel, PixelFormat, Sink, Timing};
+use octrace_pico_st7789::measure::{self, Meter, Span};
+use octrace_pico_st7789::usb::{self, SerialDevice};
 use octrace_pico_st7789::{board, both_cores, panel};
 use panic_halt as _;
 use rp2040_hal as hal;
-use usb_device::class_prelude::UsbBusAllocator;
-use usb_device::prelude::*;
-use usbd_serial::SerialPort;
 
 // The render path runs from SRAM (build.rs): copied there at boot.
 octrace_pico_st7789::copy_code_into_sram!();
@@ -83,8 +81,7 @@ static PANEL_BUFFER: ConstStaticCell<[u8; 512]> = ConstStaticCell::new([0; 512])
 static FRAME_BUFFER: ConstStaticCell<[u8; 32 * 1024]> = ConstStaticCell::new([0; 32 * 1024]);
 
 /// The USB device and its serial port, owned by the USB interrupt.
-type Usb = (UsbDevice<'static, UsbBus>, SerialPort<'static, UsbBus>);
-static USB: Mutex<RefCell<Option<Usb>>> = Mutex::new(RefCell::new(None));
+static USB: Mutex<RefCell<Option<SerialDevice>>> = Mutex::new(RefCell::new(None));
 
 /// Bytes from the host, not yet read by the main loop; and bytes for the
 /// host, not yet taken by the USB device.
@@ -97,23 +94,12 @@ const STALLED_AFTER_US: u64 = 1_000_000;
 
 #[entry]
 fn main() -> ! {
-    let board::Board { mut display, mut core1, timer, usb, mut resets } =
+    let board::Board { mut display, mut core1, timer, busctrl, usb, mut resets } =
         board::start(PANEL_BUFFER.take(), CORE1_STACK.take().unwrap());
 
     // The USB serial port, served by its interrupt from here on.
-    let bus: &'static UsbBusAllocator<UsbBus> = cortex_m::singleton!(: UsbBusAllocator<UsbBus> =
-        UsbBusAllocator::new(UsbBus::new(usb.regs, usb.dpram, usb.clock, true, &mut resets)))
-    .unwrap();
-    let serial = SerialPort::new(bus);
-    let strings = StringDescriptors::default().manufacturer("octrace").product("octrace live").serial_number("1");
-    let device = UsbDeviceBuilder::new(bus, UsbVidPid(0x16c0, 0x27dd))
-        .strings(&[strings])
-        .unwrap()
-        .max_packet_size_0(64)
-        .unwrap()
-        .device_class(usbd_serial::USB_CLASS_CDC)
-        .build();
-    critical_section::with(|cs| USB.borrow_ref_mut(cs).replace((device, serial)));
+    let device = usb::serial_device(usb, &mut resets, "octrace live");
+    critical_section::with(|cs| USB.borrow_ref_mut(cs).replace(device));
     // SAFETY: the handler only touches what the critical sections guard.
     unsafe { pac::NVIC::unmask(pac::Interrupt::USBCTRL_IRQ) };
 
@@ -124,6 +110,7 @@ fn main() -> ! {
     let raytracer = RAYTRACER.take();
     let room = CORE1_ROOM.take();
     let mut host = Host { timer, stalled: false };
+    let mut meter = Meter::new(timer, busctrl);
     // A frame that came while drawing, to be answered next.
     let mut pending = false;
     loop {
@@ -137,9 +124,10 @@ fn main() -> ! {
         let Some(received) = decoder.received() else { continue };
         host.stalled = false;
         // The board's time from the whole scene received to the last row
-        // drawn: parse, index and render.
-        let start = timer.get_counter();
+        // drawn: the load (parse and index), then the render.
+        meter.start();
         let Ok(Some(drawing)) = board.answer(received, raytracer, &mut host) else { continue };
+        let load = meter.split();
         let mut rows = 0u16;
         let drawn = both_cores::draw(&mut core1, drawing.scene(), room, &ROWS, &mut display, |y, row| {
             rows = y as u16 + 1;
@@ -157,8 +145,20 @@ fn main() -> ! {
         });
         let answered = match drawn {
             Ok(()) => {
-                let elapsed = Duration::from_micros((timer.get_counter() - start).to_micros());
-                drawing.finish(Some(elapsed), &mut host)
+                let render = meter.split();
+                let counters = core::array::from_fn::<_, 4, _>(|bank| Counter {
+                    name: measure::EVENTS[bank],
+                    load: load.contested[bank],
+                    render: render.contested[bank],
+                });
+                let micros = |span: Span| Some(Duration::from_micros(span.micros));
+                let timing = Timing {
+                    elapsed: Some(Duration::from_micros(load.micros + render.micros)),
+                    load: micros(load),
+                    render: micros(render),
+                    counters: Counters::new(&counters),
+                };
+                drawing.finish(&timing, &mut host)
             }
             Err(_) => drawing.cancel(rows, &mut host),
         };
