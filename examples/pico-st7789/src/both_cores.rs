@@ -15,6 +15,7 @@
 //! null; panics abort (`panic = "abort"`, `panic-halt`), so core 0 never
 //! leaves a scope early by unwinding.
 
+use crate::bank_stack::{self, on_bank_stack};
 use core::cell::Cell;
 use core::ops::ControlFlow;
 use core::ptr;
@@ -32,26 +33,36 @@ use rp2040_hal::multicore::{Core, Error as SpawnError, StackAllocation};
 /// Core 0's job for core 1, or null.
 static JOB: AtomicPtr<()> = AtomicPtr::new(ptr::null_mut());
 
+/// Core 1 for good: each job core 0 hands it, run to its end.
+fn core1_loop() -> ! {
+    loop {
+        let job = JOB.load(Ordering::Acquire).cast::<&mut (dyn FnMut() + Send)>();
+        if job.is_null() {
+            wfe();
+            continue;
+        }
+        // SAFETY: core 0 keeps the job alive, and touches it not, until
+        // JOB is null again (see `scope`).
+        unsafe { (*job)() };
+        JOB.store(ptr::null_mut(), Ordering::Release);
+        sev();
+    }
+}
+
 /// Core 1, waiting for jobs.
 pub struct SecondCore {
     _started: (),
 }
 
 impl SecondCore {
-    /// Starts core 1 on `stack`, waiting for jobs.
+    /// Starts core 1 on `stack`, waiting for jobs; both cores' bank stacks
+    /// guarded.
     pub fn start(core1: &mut Core<'_>, stack: StackAllocation) -> Result<SecondCore, SpawnError> {
-        core1.spawn(stack, || loop {
-            let job = JOB.load(Ordering::Acquire).cast::<&mut (dyn FnMut() + Send)>();
-            if job.is_null() {
-                wfe();
-                continue;
-            }
-            // SAFETY: core 0 keeps the job alive, and touches it not, until
-            // JOB is null again (see `scope`).
-            unsafe { (*job)() };
-            JOB.store(ptr::null_mut(), Ordering::Release);
-            sev();
+        core1.spawn(stack, || {
+            bank_stack::guard();
+            core1_loop()
         })?;
+        bank_stack::guard();
         Ok(SecondCore { _started: () })
     }
 
@@ -215,7 +226,7 @@ where
                 }
                 wfe();
             }
-            let traced = trace(&mut renderer, &piece, &mut colors);
+            let traced = on_bank_stack(|| trace(&mut renderer, &piece, &mut colors));
             // Free, so published.
             let _ = ring.send(number, colors[..traced].iter().copied());
             sev();
@@ -240,7 +251,9 @@ where
                     continue;
                 }
                 let number = take_next();
-                let traced = to_trace.find(|&(_, n)| n == number).map(|(piece, _)| trace(renderer, &piece, &mut own));
+                let traced = to_trace
+                    .find(|&(_, n)| n == number)
+                    .map(|(piece, _)| on_bank_stack(|| trace(renderer, &piece, &mut own)));
                 // The pieces from `shown` up to this one are core 1's.
                 for (piece, n) in to_show.by_ref() {
                     match traced {

@@ -10,6 +10,7 @@
 
 #![no_std]
 
+pub mod bank_stack;
 pub mod board;
 pub mod both_cores;
 pub mod measure;

@@ -78,7 +78,7 @@ static ROWS: Handoff<{ panel::WIDTH as usize }, 4> = Handoff::new();
 static PANEL_BUFFER: ConstStaticCell<[u8; 512]> = ConstStaticCell::new([0; 512]);
 
 /// A received frame, the scene's text in it: the longest scene the board takes.
-static FRAME_BUFFER: ConstStaticCell<[u8; 32 * 1024]> = ConstStaticCell::new([0; 32 * 1024]);
+static FRAME_BUFFER: ConstStaticCell<[u8; 24 * 1024]> = ConstStaticCell::new([0; 24 * 1024]);
 
 /// The USB device and its serial port, owned by the USB interrupt.
 static USB: Mutex<RefCell<Option<SerialDevice>>> = Mutex::new(RefCell::new(None));
