@@ -13,3 +13,9 @@ export class RunError extends Error {
     this.located = located;
   }
 }
+
+/**
+ * The firmware let its watchdog run out (or triggered it): a real Pico
+ * resets. A run ends with it; a serial serve starts the board again.
+ */
+export class WatchdogReset extends RunError {}

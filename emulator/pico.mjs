@@ -31,14 +31,18 @@
 // every cycle counted is one an emulated core spent (the ROM stand-in's,
 // boot2's and flash stalls too); a firmware that faults, stops in an endless
 // loop, touches what the emulator does not model, or outlives its cycle
-// budget ends the run with a RunError naming the core and where it was.
+// budget ends the run with a RunError naming the core and where it was; one
+// whose watchdog runs out ends it with a WatchdogReset (a real Pico resets:
+// the serial serve starts a new machine, see serial.mjs).
 
 import { RP2040, GPIOPinState } from 'rp2040js';
 import { buildBootrom, codeLetters, MISSING_FUNCTION_BREAKPOINT } from './bootrom.mjs';
 import { functionAt, parseElf } from './elf.mjs';
 import { correctInstructions } from './armv6m.mjs';
 import { ST7789 } from './st7789.mjs';
-import { RunError } from './errors.mjs';
+import { I2cController } from './i2c.mjs';
+import { wireOled } from './oled.mjs';
+import { RunError, WatchdogReset } from './errors.mjs';
 import { installBus, machineMemory, peek16 } from './bus.mjs';
 import { CoreSio, InterCoreFifos } from './sio.mjs';
 import { CorePpb } from './ppb.mjs';
@@ -48,7 +52,7 @@ import { XipCache, XipControl } from './xip.mjs';
 import { BusCtrl, BusFabric } from './fabric.mjs';
 import { completeRegisters } from './usb-serial.mjs';
 
-export { RunError };
+export { RunError, WatchdogReset };
 
 const FLASH_BASE = 0x10000000;
 const SRAM_BASE = 0x20000000;
@@ -68,8 +72,10 @@ const XIP_CTRL_SLOT = 0x14000;
 const BUSCTRL_SLOT = 0x40030;
 const SSI_SLOT = 0x18000;
 const PSM_SLOT = 0x40010;
+const I2C_SLOTS = [0x40044, 0x40048];
 const PSM_FRCE_OFF = 0x04;
 const PSM_PROC1 = 1 << 16;
+const WATCHDOG_SLOT = 0x40058;
 
 /** The Pico-LCD-1.3's wiring: SPI1 on GP10 (clock) and GP11 (data); the panel's control lines. */
 export const WIRING = { clock: 10, data: 11, chipSelect: 9, dataCommand: 8, reset: 12, backlight: 13 };
@@ -79,7 +85,8 @@ export class Pico {
   /**
    * `segments` ({ loadAddress, data }, as an ELF's) are loaded as built;
    * `source` names them in messages, `functions` (an ELF's symbols) name
-   * where a core is. `panel`: the ST7789's options (null: no panel).
+   * where a core is. `panel`: the ST7789's options (null: no panel);
+   * `oled`: the SSD1306 module's on I2C0 (oled.mjs; null: none).
    * `onBreakpoint(core, code)`: returns true for a BKPT or UDF it handles
    * (tests); any other ends the run. `flashStatusRegister2`: the flash
    * chip's at power-on (QE set, as the Pico's). `contention`: whether
@@ -91,6 +98,7 @@ export class Pico {
     source,
     functions = [],
     panel = null,
+    oled = null,
     onBreakpoint = () => false,
     flashStatusRegister2,
     contention = true,
@@ -180,12 +188,39 @@ export class Pico {
         throw new RunError(`DMA channel ${channel.index} started: the emulator does not model the DMA on the bus fabric`);
       };
     }
+    this.watchdog = rp2040.peripherals[WATCHDOG_SLOT];
+    this.watchdog.onWatchdogTrigger = () => {
+      const why = this.watchdog.reason & 2 ? 'was triggered' : 'ran out';
+      throw new WatchdogReset(`the watchdog ${why} at ${(this.clockCycles() / CLOCK_HZ).toFixed(6)} s: the board resets`);
+    };
 
     this.attach(0);
     this.startCore1(0);
     /** The ST7789 on SPI1 (null without one), and the times the run's phases are told by. */
     this.panel = panel ? new ST7789(panel) : null;
     this.events = this.panel ? this.wirePanel(this.panel) : null;
+    // Both I2C controllers with what rp2040js's lack (i2c.mjs), and the SSD1306 module on I2C0.
+    this.i2c = I2C_SLOTS.map((slot, k) => {
+      const controller = new I2cController(rp2040, k, rp2040.i2c[k].irq, { nanosPerCycle: NANOS_PER_CYCLE });
+      rp2040.i2c[k] = rp2040.peripherals[slot] = controller;
+      return controller;
+    });
+    this.oled = oled ? wireOled(this.i2c[0], rp2040.gpio, now, oled) : null;
+  }
+
+  /**
+   * The panel the firmware drives, as run.mjs writes it: the ST7789 if it
+   * took a command, else the SSD1306 if it took a transfer, else the first
+   * wired (null: none is). Its name, size, picture (8-bit RGB), why it is
+   * dark (or null), and how many writes it has taken.
+   */
+  get display() {
+    if (!this.panel && !this.oled) return null;
+    const st7789 = this.panel && { name: 'ST7789', panel: this.panel, writes: () => this.events.memoryWrites };
+    const ssd1306 = this.oled && { name: 'SSD1306', panel: this.oled.panel, writes: () => this.oled.panel.dataBytes };
+    const talkedTo = (st7789 && this.panel.counts.size > 0 && st7789) || (ssd1306 && this.oled.events.transfers > 0 && ssd1306);
+    const { name, panel, writes } = talkedTo || st7789 || ssd1306;
+    return { name, width: panel.width, height: panel.height, picture: () => panel.picture(), darkBecause: panel.darkBecause, writes };
   }
 
   /** A Pico running the ELF `bytes` read from `path`. */
@@ -295,7 +330,8 @@ export class Pico {
       return this.loop(maxCycles, until, onProgress);
     } catch (error) {
       if (error instanceof RunError && !error.located) {
-        throw new RunError(`${error.message} (${this.whereAll()})`, { located: true });
+        // The same class (a WatchdogReset stays one), located.
+        throw new error.constructor(`${error.message} (${this.whereAll()})`, { located: true });
       }
       throw error;
     } finally {
@@ -481,7 +517,7 @@ export class Pico {
         located: true,
       });
     }
-    onProgress(this.time, this.events?.memoryWrites ?? 0);
+    onProgress(this.time, this.display?.writes() ?? 0);
   }
 
   breakpoint(k, code) {
@@ -512,6 +548,16 @@ export class Pico {
   whereAll() {
     const running = [0, 1].filter((k) => !this.held[k] && (k === 0 || this.core1Ran));
     return running.map((k) => this.where(k)).join(' and ');
+  }
+
+  /**
+   * The watchdog: null while it is stopped, else the microseconds left
+   * before it resets the board (RP2040-E1: its counter runs at twice the
+   * tick, as rp2040js models).
+   */
+  watchdogLeft() {
+    const timer = this.watchdog.timer;
+    return this.watchdog.enable ? Math.floor(timer.counter / 2) : null;
   }
 
   /** How many cores ran firmware: 2 once core 1 left the boot ROM. */
@@ -545,6 +591,7 @@ export class Pico {
    * run never got there.
    */
   phases() {
+    if (this.display?.name === 'SSD1306') return { ...this.oled.phases(), total: this.time };
     const { backlightOn, pictureStart, lastPixel, fullPanel } = this.events ?? {};
     const picture = backlightOn != null && pictureStart != null && lastPixel > pictureStart;
     return {

@@ -1,17 +1,20 @@
 #!/usr/bin/env node
-// Runs a Pico firmware ELF on the emulated Pico with its ST7789 panel and
-// writes the picture the panel shows as a PNG. As the template's cargo
-// runner (see README.md):
+// Runs a Pico firmware ELF on the emulated Pico with its panel (an ST7789 on
+// SPI1 as examples/pico-st7789 wires it, an SSD1306 module on I2C0 as
+// examples/pico-ssd1306 does) and writes the picture the panel shows as a
+// PNG. As a template's cargo runner (see README.md):
 //
 //   CARGO_TARGET_THUMBV6M_NONE_EABI_RUNNER="node emulator/run.mjs" cargo run --release [-- OPTIONS]
 //
-// Options: --out FILE (default panel.png), --panel WxH (the panel's size,
-// default 240x240, the Pico-LCD-1.3), --panel-offset X,Y (where it starts in
-// the controller's 240x320 memory, default 0,0), --max-seconds S (emulated
-// time before giving up, default 120), --contention on|off (whether two
-// masters on one port of the bus fabric wait for each other, as on the
-// chip: default on; off measures what the contention costs), --json (the
-// report as JSON on standard output), --quiet.
+// Options: --out FILE (default panel.png), --display auto|st7789|ssd1306
+// (which panel is wired; auto, the default, wires both and writes the one
+// the firmware talks to), --panel WxH (the ST7789 panel's size, default
+// 240x240, the Pico-LCD-1.3), --panel-offset X,Y (where it starts in the
+// controller's 240x320 memory, default 0,0), --max-seconds S (emulated time
+// before giving up, default 120), --contention on|off (whether two masters
+// on one port of the bus fabric wait for each other, as on the chip:
+// default on; off measures what the contention costs), --json (the report
+// as JSON on standard output), --quiet.
 //
 // --serial: the board as a serial device (serial.mjs), for the live
 // firmware: prints the path of a pseudo-terminal on its first line of
@@ -19,7 +22,10 @@
 // standard input closes or the process is signalled (`host-sim board PATH
 // scene.txt` then talks to it). With --out, the panel's picture is written
 // each time the firmware waits for the host again; with --json, the report
-// follows the path on standard output once the serve ends.
+// follows the path on standard output once the serve ends. Its standard
+// input's lines are commands for tests (hold, release, times: see
+// serial.mjs); a watchdog that runs out resets the board, which starts
+// again.
 //
 // Exit codes: 0 the run ended with both cores asleep and the picture written
 // (or, with --serial, the serve ended); 1 the firmware or the ELF did
@@ -31,12 +37,13 @@ import { parseArgs } from 'node:util';
 import { CLOCK_HZ, Pico, RunError } from './pico.mjs';
 import { ElfError } from './elf.mjs';
 import { PanelError } from './st7789.mjs';
+import { PanelError as OledError } from './ssd1306.mjs';
 import { encodePng, writeAtomically } from './png.mjs';
 import { serveSerial } from './serial.mjs';
 
 const USAGE =
-  'usage: node run.mjs ELF [--out FILE.png] [--panel WxH] [--panel-offset X,Y] [--max-seconds S] [--contention on|off] [--json] [--quiet]\n' +
-  '       node run.mjs ELF --serial [--out FILE.png] [--panel WxH] [--panel-offset X,Y] [--contention on|off] [--json]';
+  'usage: node run.mjs ELF [--out FILE.png] [--display auto|st7789|ssd1306] [--panel WxH] [--panel-offset X,Y] [--max-seconds S] [--contention on|off] [--json] [--quiet]\n' +
+  '       node run.mjs ELF --serial [--out FILE.png] [--display auto|st7789|ssd1306] [--panel WxH] [--panel-offset X,Y] [--contention on|off] [--json]';
 
 function usage(message) {
   console.error(`octrace-pico-emulator: ${message}\n${USAGE}`);
@@ -58,6 +65,7 @@ try {
     options: {
       out: { type: 'string' },
       serial: { type: 'boolean', default: false },
+      display: { type: 'string', default: 'auto' },
       panel: { type: 'string', default: '240x240' },
       'panel-offset': { type: 'string', default: '0,0' },
       'max-seconds': { type: 'string', default: '120' },
@@ -83,7 +91,16 @@ if (!(maxSeconds > 0)) {
 if (values.contention !== 'on' && values.contention !== 'off') {
   usage(`--contention ${values.contention}: expected on or off`);
 }
-const contention = values.contention === 'on';
+const DISPLAYS = ['auto', 'st7789', 'ssd1306'];
+if (!DISPLAYS.includes(values.display)) {
+  usage(`--display ${values.display}: expected one of ${DISPLAYS.join(', ')}`);
+}
+/** The machine's options: the panels wired (the ST7789 with its size and place, the SSD1306 module, as --display asks) and the contention. */
+const wired = {
+  panel: values.display === 'ssd1306' ? null : { width, height, offsetX, offsetY },
+  oled: values.display === 'st7789' ? null : {},
+  contention: values.contention === 'on',
+};
 if (values.out !== undefined && !values.out.toLowerCase().endsWith('.png')) {
   usage(`--out ${values.out}: the picture is written as PNG: name a .png file`);
 }
@@ -97,7 +114,7 @@ const seconds = (cycles) => (cycles / CLOCK_HZ).toFixed(3);
 let report;
 try {
   const elf = readFileSync(elfPath);
-  const pico = Pico.fromElf(elf, elfPath, { panel: { width, height, offsetX, offsetY }, contention });
+  const pico = Pico.fromElf(elf, elfPath, wired);
   pico.run({
     maxCycles: maxSeconds * CLOCK_HZ,
     onProgress: progress
@@ -105,11 +122,12 @@ try {
       : undefined,
   });
   if (progress) process.stderr.write('\r\x1b[K');
-  writeAtomically(out, encodePng(width, height, pico.panel.picture()));
+  const display = pico.display;
+  writeAtomically(out, encodePng(display.width, display.height, display.picture()));
   report = runReport(pico, out);
 } catch (error) {
   if (progress) process.stderr.write('\r\x1b[K');
-  if (error instanceof RunError || error instanceof ElfError || error instanceof PanelError || error.code === 'ENOENT') {
+  if (expected(error)) {
     console.error(`octrace-pico-emulator: ${error.message}`);
     process.exit(1);
   }
@@ -122,7 +140,7 @@ if (values.json) {
   const count = (n) => n.toLocaleString('en');
   const row = (what, cycles) =>
     `  ${what.padEnd(44)} ${cycles === null ? 'never reached' : `${count(cycles).padStart(13)} cycles  ${seconds(cycles)} s`}`;
-  const { startUp, parseAndIndex, render, firstFullPanel, total } = report.cycles;
+  const { startUp, parseAndIndex, render, transfer, firstFullPanel, total } = report.cycles;
   const cores = report.coreCycles.slice(0, report.cores);
   const cache = report.xipCache;
   const fabric = report.busFabric;
@@ -134,7 +152,8 @@ if (values.json) {
       `${elfPath} on an emulated Raspberry Pi Pico (${report.cores === 2 ? 'both Cortex-M0+ cores' : 'one Cortex-M0+ core'} at 125 MHz):`,
       row('start-up (clocks, panel set-up and clear)', startUp),
       row('parse and index the scene', parseAndIndex),
-      row('render into the panel', render),
+      row(transfer === undefined ? 'render into the panel' : 'render (the LED lit)', render),
+      ...(transfer === undefined ? [] : [row('the picture to the panel over I2C', transfer)]),
       row('first full panel (from the picture\'s start)', firstFullPanel),
       row('in all', total),
       ...cores.map(
@@ -148,19 +167,21 @@ if (values.json) {
       `  XIP cache: ${count(cache.accesses)} flash reads, ${count(cache.misses)} misses` +
         (cache.lineReadCycles === null ? '' : ` (${cache.lineReadCycles} cycles a line read)`) +
         `, ${count(cache.stallCycles)} cycles stalled`,
-      report.dark ? `the panel is dark: ${report.dark}` : `the panel's ${report.panel} picture: ${out}`,
+      report.dark ? `the ${report.display} panel is dark: ${report.dark}` : `the ${report.display} panel's ${report.panel} picture: ${out}`,
     ].join('\n'),
   );
 }
 
 /** What the run took and did: the report `--json` prints. */
 function runReport(pico, out) {
+  const display = pico.display;
   const coreCycles = pico.coreCycles();
   return {
     elf: elfPath,
     out,
-    panel: `${width}x${height}`,
-    dark: pico.panel.darkBecause,
+    display: display.name,
+    panel: `${display.width}x${display.height}`,
+    dark: display.darkBecause,
     clockHz: CLOCK_HZ,
     cores: pico.coresUsed,
     instructions: coreCycles[0].instructions + coreCycles[1].instructions,
@@ -173,23 +194,29 @@ function runReport(pico, out) {
 
 /** --serial: serves the board on a pseudo-terminal, then exits (with --json, printing the report). */
 async function serve() {
-  let pico;
+  let pico; // the board serving now (a new one after each watchdog reset)
   let drawn = -1;
   try {
-    pico = Pico.fromElf(readFileSync(elfPath), elfPath, { panel: { width, height, offsetX, offsetY }, contention });
-    await serveSerial(pico, {
+    const elf = readFileSync(elfPath);
+    await serveSerial(() => (pico = Pico.fromElf(elf, elfPath, wired)), {
       input: process.stdin,
+      answer: (line) => console.log(line),
       onPath: (path) => console.log(path),
-      onIdle: () => {
-        const writes = pico.events.memoryWrites;
+      writePanel: (pico, path) => {
+        const display = pico.display;
+        writeAtomically(path, encodePng(display.width, display.height, display.picture()));
+      },
+      onIdle: (pico) => {
+        const display = pico.display;
+        const writes = display.writes();
         if (values.out !== undefined && writes !== drawn) {
           drawn = writes;
-          writeAtomically(values.out, encodePng(width, height, pico.panel.picture()));
+          writeAtomically(values.out, encodePng(display.width, display.height, display.picture()));
         }
       },
     });
   } catch (error) {
-    if (error instanceof RunError || error instanceof ElfError || error instanceof PanelError || error.code === 'ENOENT') {
+    if (expected(error)) {
       console.error(`octrace-pico-emulator: ${error.message}`);
       process.exit(1);
     }
@@ -197,4 +224,9 @@ async function serve() {
   }
   if (values.json) console.log(JSON.stringify(runReport(pico, values.out ?? null), null, 2));
   process.exit(0);
+}
+
+/** What a run ends with for the firmware's or the ELF's doing (exit 1), not the emulator's own failure. */
+function expected(error) {
+  return [RunError, ElfError, PanelError, OledError].some((kind) => error instanceof kind) || error.code === 'ENOENT';
 }

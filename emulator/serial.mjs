@@ -11,31 +11,59 @@
 // own: a scene takes the seconds it would take a real Pico (slower, here,
 // in wall time), and nothing waits in between.
 //
-// Invariants: bytes pass unchanged and in order both ways; the panel's
-// picture is written (when asked) each time the firmware goes back to
-// waiting after drawing; a RunError (a fault, an endless loop) ends the
-// serve with exit code 1, after the terminal is closed.
+// Standard input carries commands, a line each, for tests that play a
+// host the terminal cannot: `hold` (the host stops taking the board's
+// bytes, as when no program reads the port), `release` (it takes them
+// again), `times` (the board's clock in microseconds when the host last
+// handed it bytes, when it last sent some, now, and how long its watchdog
+// has left: `-` for never or stopped; then 1 if it waits for the host, both
+// cores asleep, else 0), `panel PATH` (the panel's picture now, as a PNG
+// file). Each is answered with a line on standard output (`ok`, or `times
+// IN OUT NOW WATCHDOG IDLE`).
+//
+// A watchdog that runs out resets the board: the serve says so on
+// standard error and starts a new machine from the ELF (its RAM cleared,
+// as at power-on), which the host sees enumerate again; bytes in flight
+// are lost, as on a real reset.
+//
+// Invariants: bytes pass unchanged and in order both ways (while the host
+// takes them); the panel's picture is written (when asked) each time the
+// firmware goes back to waiting after drawing; any other RunError (a
+// fault, an endless loop) ends the serve with exit code 1, after the
+// terminal is closed.
 
 import { spawn } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { UsbSerialHost } from './usb-serial.mjs';
+import { CLOCK_HZ, WatchdogReset } from './pico.mjs';
 
 /** A millisecond of the board's time between the event loop's turns. */
 const SLICE_CYCLES = 125_000;
 
 /**
- * Serves `pico` on a new pseudo-terminal until `input` (a readable stream:
- * standard input) ends or the process is signalled. `onPath(path)` gets the
- * terminal's path once it is open; `onIdle()` runs each time the firmware
- * waits for the host again. Resolves when the serve ends; rejects with the
- * machine's RunError.
+ * Serves the machine `makePico()` makes on a new pseudo-terminal until
+ * `input` (a readable stream: standard input, its lines commands) ends or
+ * the process is signalled; `answer(line)` writes a command's answer.
+ * `onPath(path)` gets the terminal's path once it is open; `onIdle(pico)`
+ * runs each time the firmware waits for the host again; `writePanel(pico,
+ * path)` writes the panel's picture. Resolves when the serve ends; rejects
+ * with the machine's RunError.
  */
-export function serveSerial(pico, { input, onPath, onIdle = () => {} }) {
+export function serveSerial(makePico, { input, answer, onPath, onIdle = () => {}, writePanel }) {
   return new Promise((resolve, reject) => {
     const bridge = spawn('python3', [fileURLToPath(new URL('./pty-bridge.py', import.meta.url))], {
       stdio: ['pipe', 'pipe', 'inherit'],
     });
-    const host = new UsbSerialHost(pico.rp2040, { onDeviceBytes: (bytes) => bridge.stdin.write(bytes) });
+    let pico;
+    let host;
+    const start = () => {
+      pico = makePico();
+      host = new UsbSerialHost(pico.rp2040, {
+        onDeviceBytes: (bytes) => bridge.stdin.write(bytes),
+        now: () => Math.floor(pico.clockCycles() / (CLOCK_HZ / 1e6)),
+      });
+    };
+    start();
     let ended = false;
     let idle = false;
     let pathLine = '';
@@ -53,12 +81,16 @@ export function serveSerial(pico, { input, onPath, onIdle = () => {} }) {
       try {
         reason = pico.run({ until: pico.time + SLICE_CYCLES });
       } catch (error) {
-        end(error);
-        return;
+        if (!(error instanceof WatchdogReset)) {
+          end(error);
+          return;
+        }
+        process.stderr.write(`octrace-pico-emulator: ${error.message}; it starts again\n`);
+        start();
       }
       if (reason === 'idle') {
         idle = true;
-        onIdle();
+        onIdle(pico);
       } else {
         setImmediate(slice);
       }
@@ -69,6 +101,36 @@ export function serveSerial(pico, { input, onPath, onIdle = () => {} }) {
         setImmediate(slice);
       }
     };
+    const commands = {
+      hold: () => (host.hold(), 'ok'),
+      release: () => {
+        host.release();
+        wake();
+        return 'ok';
+      },
+      times: () => {
+        const left = pico.watchdogLeft();
+        const time = (t) => (t === null ? '-' : String(t));
+        return `times ${time(host.lastIn)} ${time(host.lastOut)} ${time(host.now())} ${time(left)} ${idle ? 1 : 0}`;
+      },
+      panel: (path) => {
+        if (!path) return 'panel needs a path';
+        writePanel(pico, path);
+        return 'ok';
+      },
+    };
+    let pending = '';
+    input.on('data', (chunk) => {
+      pending += chunk.toString('utf8');
+      let newline;
+      while ((newline = pending.indexOf('\n')) >= 0) {
+        const [command, argument] = pending.slice(0, newline).trim().split(/\s+(.*)/);
+        pending = pending.slice(newline + 1);
+        if (command === '') continue;
+        const run = Object.hasOwn(commands, command) ? commands[command] : null;
+        answer(run ? run(argument) : `unknown command '${command}' (hold, release, times, panel PATH)`);
+      }
+    });
     bridge.stdout.on('data', (chunk) => {
       if (pathLine !== null) {
         // The bridge's first line is the terminal's path; bytes follow.
@@ -86,7 +148,6 @@ export function serveSerial(pico, { input, onPath, onIdle = () => {} }) {
     bridge.on('exit', (code) => end(code === 0 || ended ? null : new Error(`the pseudo-terminal bridge ended (exit ${code})`)));
     bridge.on('error', (error) => end(new Error(`cannot start the pseudo-terminal bridge (python3): ${error.message}`)));
     input.on('end', () => end(null));
-    input.resume();
     for (const signal of ['SIGINT', 'SIGTERM']) {
       process.once(signal, () => end(null));
     }

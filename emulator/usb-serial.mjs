@@ -19,15 +19,24 @@
 // back; what they control is not modelled (the bytes the host exchanges
 // do not depend on it).
 //
+// A host program may also stop reading the port (or close it): a real
+// host's USB stack then stops taking IN transfers, and the device's data
+// waits in its endpoint. `hold()` does that: each IN transfer the firmware
+// arms on the data endpoint waits, unanswered, until `release()`.
+//
 // Invariants: bytes reach the firmware in the order `write` was given
 // them, at most one OUT transfer is held at a time on an endpoint, and a held transfer is
-// answered as soon as bytes arrive.
+// answered as soon as bytes arrive; while held, no byte of the firmware's
+// reaches the host, and released, they come in the order it sent them.
 
 import { USBCDC } from 'rp2040js';
 
 /** USBCTRL_REGS offsets rp2040js leaves out (see above). */
 const READ_ONLY = new Set([0x48, 0x5c, 0x8c, 0x98]); // SOF_RD, BUFF_CPU_SHOULD_HANDLE, INTR, INTS
 const USB_MUXING = 0x74;
+/** DPRAM: EP0_IN_BUFFER_CONTROL, the first of the endpoints' buffer controls (IN, then OUT, 8 bytes an endpoint). */
+const BUFFER_CONTROLS = 0x80;
+const BUFFER_AVAILABLE = 1 << 10;
 /** Registers kept here, with their values after reset: USB_MUXING, USBPHY_DIRECT, _OVERRIDE, _TRIM, LINESTATE_TUNING. */
 const KEPT_AT_RESET = [
   [USB_MUXING, 0],
@@ -63,12 +72,29 @@ export class UsbSerialHost {
   /**
    * Attaches to `rp2040`'s USB controller. `onDeviceBytes(Uint8Array)`
    * receives what the firmware sends; `onConnected()` fires once the
-   * device is configured and its control lines are up.
+   * device is configured and its control lines are up. `now()` is the
+   * board's clock in microseconds, for `lastIn` and `lastOut`.
    */
-  constructor(rp2040, { onDeviceBytes = () => {}, onConnected = () => {} } = {}) {
+  constructor(rp2040, { onDeviceBytes = () => {}, onConnected = () => {}, now = () => 0 } = {}) {
     const usb = rp2040.usbCtrl;
     this.usb = usb;
+    this.now = now;
     this.cdc = new USBCDC(usb);
+    /** The board's time when the host last handed it bytes, and when it last sent some (null: never). */
+    this.lastIn = null;
+    this.lastOut = null;
+    /** IN transfers armed on the data endpoint while held: [offset, value] of their buffer control, oldest first. */
+    this.heldWrites = null;
+    const armed = usb.DPRAMUpdated.bind(usb);
+    this.armWrite = armed;
+    usb.DPRAMUpdated = (offset, value) => {
+      const inControl = BUFFER_CONTROLS + 8 * this.cdc.inEndpoint;
+      if (this.heldWrites && this.cdc.inEndpoint > 0 && offset === inControl && value & BUFFER_AVAILABLE) {
+        this.heldWrites.push([offset, value]);
+        return;
+      }
+      armed(offset, value);
+    };
     this.queue = []; // Uint8Arrays from the host, oldest first
     this.queued = 0; // bytes in `queue`
     // The OUT transfers the firmware armed and waits on: size by endpoint.
@@ -76,7 +102,10 @@ export class UsbSerialHost {
     // endpoint before enumeration tells which one it is.
     this.heldReads = new Map();
     this.connected = false;
-    this.cdc.onSerialData = (bytes) => onDeviceBytes(bytes);
+    this.cdc.onSerialData = (bytes) => {
+      this.lastOut = now();
+      onDeviceBytes(bytes);
+    };
     this.cdc.onDeviceConnected = () => {
       this.connected = true;
       onConnected();
@@ -102,6 +131,18 @@ export class UsbSerialHost {
     this.queue.push(Uint8Array.from(bytes));
     this.queued += bytes.length;
     this.answerHeldRead();
+  }
+
+  /** The host stops taking what the firmware sends (a program that stops reading the port, or closes it). */
+  hold() {
+    this.heldWrites ??= [];
+  }
+
+  /** The host takes what the firmware sends again, what waited first. */
+  release() {
+    const held = this.heldWrites ?? [];
+    this.heldWrites = null;
+    for (const [offset, value] of held) this.armWrite(offset, value);
   }
 
   /** How many bytes wait for the firmware to take them. */
@@ -130,6 +171,7 @@ export class UsbSerialHost {
     }
     this.queued -= packet.length;
     this.heldReads.delete(endpoint);
+    this.lastIn = this.now();
     this.usb.endpointReadDone(endpoint, packet);
   }
 }

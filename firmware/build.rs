@@ -10,7 +10,8 @@
 //! | `OCTRACE_SCENE` | a scene in `scenes/` (name without `.txt`) | `fig5_1` |
 //! | `OCTRACE_SIZE` | `WxH` (on `lm3s6965evb` at most the panel's 128x64, an even width) | `160x128`; `128x64` on `lm3s6965evb` |
 //! | `OCTRACE_ACCEL` | `auto`, `naive`, `octree`, `dda` | `auto` |
-//! | `OCTRACE_COLOR` | `rgb888`, `rgb565`, `dither` (1-byte indices into the 6×6×6 cube), `gray4` (1 byte a pixel, the level 0 to 15); only `gray4` on `lm3s6965evb` | `rgb888`; `gray4` on `lm3s6965evb` |
+//! | `OCTRACE_COLOR` | `rgb888`, `rgb565`, `dither` (1-byte indices into the 6×6×6 cube), and the panels of few levels, 1 byte a pixel holding the level: `mono` (0, 1), `gray2` (0 to 3), `gray4` (0 to 15), `bwr` (0 black, 1 white, 2 red); only `gray4` on `lm3s6965evb` | `rgb888`; `gray4` on `lm3s6965evb` |
+//! | `OCTRACE_DITHER` | how `mono`, `gray2`, `gray4` and `bwr` are dithered: `fs-pe`, `fs`, `bayer`, `nearest` | `fs-pe` |
 //! | `OCTRACE_TECHNIQUES` | `auto` (every technique whose RAM fits beside the deepest octree that fits, and for a scene walked in an octree the light buffer in flash instead of the shadow shafts), `none`, or a comma list of `first-hits`, `shadow-shafts`, `light-buffer` (built here, kept in flash), `light-buffer-ram` (built by the board, in RAM; each still only where it fits) | `auto` |
 //! | `OCTRACE_OUT` | host file the pixels are written to; on `lm3s6965evb` the PNG of the panel's screen that the runner grabs | `octrace-out.raw`; `screen.png` on `lm3s6965evb` |
 //!
@@ -29,13 +30,14 @@
 
 use octrace_core::accel::OctreeConfig;
 use octrace_core::capacity::{CapacityKind, Counts};
+use octrace_core::panel::Dithering;
 use octrace_core::parse::count;
 use octrace_core::profile::{light_buffer_words, needed_with_light_buffer, ProfileText};
 use octrace_core::render::PanelColor;
 use octrace_core::AccelMode;
 use std::env;
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// What each board's RAM holds besides the stack, and how its octree is
 /// built: on the micro:bit at most 4 levels of 8 objects a leaf (fewer
@@ -82,7 +84,8 @@ fn main() {
     let board = match (board.as_str(), target.as_str()) {
         ("microbit", "thumbv6m-none-eabi") => Board {
             name: "microbit",
-            static_ram: 9 * 1024,
+            // What its linker script leaves beside the stack.
+            static_ram: ram_length(&manifest.join("memory-microbit.x")),
             config: OctreeConfig { max_objects: 8, max_depth: 4, ..OctreeConfig::DEFAULT },
         },
         ("mps2-an385", "thumbv7m-none-eabi") => {
@@ -152,6 +155,16 @@ fn main() {
             let names: Vec<&str> = PanelColor::ALL.iter().map(|c| c.name()).collect();
             fail(format!("OCTRACE_COLOR={color}: expected {}", names.join(", ")))
         }
+    };
+    let dithering = var("OCTRACE_DITHER", Dithering::default().name());
+    let Some(dithering) = Dithering::from_name(&dithering) else {
+        let names: Vec<&str> = Dithering::ALL.iter().map(|d| d.name()).collect();
+        fail(format!("OCTRACE_DITHER={dithering}: expected {}", names.join(", ")))
+    };
+    // Error diffusion's row for the panel's width, on the draw's stack.
+    let error_words = match wire.panel() {
+        Some(panel) if dithering.diffuses() => panel.error_words(w),
+        _ => 0,
     };
     let output = var("OCTRACE_OUT", if oled { "screen.png" } else { "octrace-out.raw" });
     if output.contains(['\0', '\n']) {
@@ -223,6 +236,12 @@ fn main() {
     writeln!(config, "pub const HEIGHT: u32 = {h};").unwrap();
     writeln!(config, "pub const ACCEL: octrace_core::AccelMode = octrace_core::AccelMode::{accel:?};").unwrap();
     writeln!(config, "pub const WIRE: crate::PanelColor = crate::PanelColor::{wire:?};").unwrap();
+    writeln!(
+        config,
+        "pub const DITHERING: octrace_core::panel::Dithering = octrace_core::panel::Dithering::{dithering:?};"
+    )
+    .unwrap();
+    writeln!(config, "pub const ERROR_WORDS: usize = {error_words};").unwrap();
     if !oled {
         // The guest writes this file; on the OLED board the runner does.
         writeln!(config, "pub const OUTPUT: &str = {:?};", format!("{output}\0")).unwrap();
@@ -271,6 +290,23 @@ fn light_buffer_in_flash(text: &str) -> Vec<u32> {
 /// with errors needs what it counts, and the board then reports its errors.
 fn needs(text: &str, accel: AccelMode, config: &OctreeConfig, light_cells: u32) -> Counts {
     needed_with_light_buffer(text, accel, config, light_cells, &mut |_| {}).unwrap_or_else(|_| count(text))
+}
+
+/// The `RAM` region's length in `memory_x` (bytes, or with a K suffix):
+/// what the statics have, read from the linker script that places them.
+fn ram_length(memory_x: &Path) -> usize {
+    let text = std::fs::read_to_string(memory_x).unwrap_or_else(|e| fail(format!("{}: {e}", memory_x.display())));
+    let length = text
+        .lines()
+        .find(|line| line.trim_start().starts_with("RAM "))
+        .and_then(|line| line.split("LENGTH =").nth(1))
+        .map(str::trim);
+    let bytes = match length {
+        Some(kib) if kib.ends_with('K') => kib.trim_end_matches('K').parse::<usize>().ok().map(|k| k * 1024),
+        Some(bytes) => bytes.parse().ok(),
+        None => None,
+    };
+    bytes.unwrap_or_else(|| fail(format!("{}: no `RAM : ORIGIN = …, LENGTH = N` line", memory_x.display())))
 }
 
 /// What a board may spend memory on beyond the scene to render faster

@@ -3,7 +3,9 @@
 //! text ([`parse`]) into fixed-capacity arenas ([`scene`], sized by a
 //! [`profile`](mod@profile)), optionally indexed by an octree ([`accel`]),
 //! and rendered pixel by pixel ([`render`]) into any embedded-graphics
-//! `DrawTarget`, in truecolour or through a 256-colour [`palette`].
+//! `DrawTarget`, in truecolour, through a 256-colour [`palette`], or
+//! dithered onto a [`panel`] of few levels (a one-bit OLED, gray OLEDs,
+//! e-paper).
 //!
 //! # From scene text to a display
 //!
@@ -127,9 +129,12 @@
 extern crate alloc;
 
 pub mod accel;
+pub mod animation;
 pub mod capacity;
 pub mod math;
+mod motion;
 pub mod palette;
+pub mod panel;
 pub mod parse;
 pub mod profile;
 mod raytracer;

@@ -72,6 +72,13 @@ pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
     /// uses them in every mode but [`AccelMode::Naive`](crate::AccelMode::Naive)
     /// asked for by name, which stays the thesis's test of every object.
     const FIRST_HITS: bool = false;
+    /// Whether an animation's frames re-trace only what the motion can
+    /// change ([`crate::animation`]'s coherence): the tracer then watches
+    /// every ray of a frame against the motion to come (`coherence: true`
+    /// in [`profile!`](crate::profile!)). Without it none of that code is
+    /// linked and an animation's every frame is traced whole (the same
+    /// pictures), so a board that draws stills pays nothing for it.
+    const COHERENCE: bool = false;
     /// Room for the screen lists: a bound for each object when
     /// [`Profile::FIRST_HITS`], else none.
     type ScreenBounds: Arena<ScreenBound> + Send;
@@ -97,7 +104,9 @@ pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
 /// them); the crate re-exports all it needs. A last `named_walk: false`
 /// leaves out the hash table only the thesis's walk needs (see
 /// [`Profile::NAMED_WALK`]); a last `first_hits: true` gives camera rays
-/// the screen lists (see [`Profile::FIRST_HITS`]).
+/// the screen lists (see [`Profile::FIRST_HITS`]); a last `coherence: true`
+/// lets an animation re-trace only what changes (see
+/// [`Profile::COHERENCE`]).
 ///
 /// ```
 /// octrace_core::profile! {
@@ -115,6 +124,7 @@ macro_rules! profile {
         $(octree: { $($octree_field:ident : $octree_value:expr),* $(,)? })?
         $(named_walk: $named_walk:literal)?
         $(first_hits: $first_hits:literal)?
+        $(coherence: $coherence:literal)?
     ) => {
         $(#[$meta])*
         #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -132,6 +142,7 @@ macro_rules! profile {
                 type MailboxWords = p::Vec<u32, { <$name as $crate::profile::Profile>::COUNTS.mailbox_words() }>;
                 const NAMED_WALK: bool = p::given_or(&[$($named_walk)?], true);
                 const FIRST_HITS: bool = p::given_or(&[$($first_hits)?], false);
+                const COHERENCE: bool = p::given_or(&[$($coherence)?], false);
                 type ScreenBounds = p::Vec<
                     p::ScreenBound,
                     { p::ScreenBound::if_wanted(<$name as $crate::profile::Profile>::FIRST_HITS, <$name as $crate::profile::Profile>::COUNTS.objects) },
@@ -482,6 +493,7 @@ mod host {
         type Octree = Octree<Host, { MAX_DEPTH as usize + 1 }>;
         type MailboxWords = HeapArena<u32, { Host::COUNTS.mailbox_words() }>;
         const FIRST_HITS: bool = true;
+        const COHERENCE: bool = true;
         type ScreenBounds = HeapArena<ScreenBound, { Host::COUNTS.objects }>;
         type ScreenPositions = HeapArena<u16, { ScreenBound::positions_for(Host::COUNTS.objects) }>;
         type LightBufferWords = HeapArena<u32, { Host::COUNTS.light_buffer_words }>;

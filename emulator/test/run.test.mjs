@@ -5,7 +5,7 @@
 
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawnSync } from 'node:child_process';
+import { spawn, spawnSync } from 'node:child_process';
 import { existsSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { dirname, join } from 'node:path';
@@ -83,8 +83,69 @@ test('a run out of time says where it was', () => {
   assert.match(result.stderr, /still running after 1250000 cycles \(0\.01 s at 125 MHz\), in 0x1000040. on core 0/);
 });
 
+test('--display ssd1306 wires the SSD1306 module alone: a firmware that never talks to it leaves it dark, 128x64', () => {
+  const result = run(firmware(sleep), '--json', '--display', 'ssd1306');
+  assert.equal(result.status, 0, result.stderr);
+  const report = JSON.parse(result.stdout);
+  assert.deepEqual([report.display, report.panel], ['SSD1306', '128x64']);
+  assert.match(report.dark, /display is off/);
+  assert.equal(report.cycles.render, null, 'the LED never lit');
+});
+
+/** Starts the watchdog with `micros` µs (LOAD is twice that: RP2040-E1), then counts in r0 for ever. */
+const wedged = (micros) => (t) =>
+  t
+    .ldrConst(1, 0x40058000) // WATCHDOG
+    .ldrConst(2, 2 * micros)
+    .str(2, 1, 4) // LOAD
+    .ldrConst(2, 1 << 30)
+    .str(2, 1, 0) // CTRL: ENABLE
+    .label('loop')
+    .addsImm(0, 1)
+    .b('loop');
+
+test('a firmware whose watchdog runs out is reset: the run ends saying when', () => {
+  const result = run(firmware(wedged(1000)), '--max-seconds', '1');
+  assert.equal(result.status, 1, result.stderr);
+  assert.match(result.stderr, /the watchdog ran out at 0\.001\d* s: the board resets \(0x1000040. on core 0\)/);
+  assert.ok(!result.wrote);
+});
+
+test('served as a serial board, a firmware whose watchdog runs out starts again', async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'pico-run-'));
+  const path = join(dir, 'firmware.elf');
+  writeFileSync(path, firmware(wedged(1000)));
+  const serve = spawn(process.execPath, [RUN, path, '--serial'], { stdio: ['pipe', 'pipe', 'pipe'] });
+  try {
+    let stderr = '';
+    const restarts = () => (stderr.match(/the watchdog ran out at .*: the board resets \(.*\); it starts again/g) ?? []).length;
+    await new Promise((resolve, reject) => {
+      serve.stderr.on('data', (chunk) => {
+        stderr += chunk;
+        if (restarts() >= 2) resolve();
+      });
+      serve.on('exit', (code) => reject(new Error(`the serve ended (exit ${code}): ${stderr}`)));
+    });
+    // A command's answer: the new machine's clock.
+    const answer = await new Promise((resolve) => {
+      let stdout = '';
+      serve.stdout.on('data', (chunk) => {
+        stdout += chunk;
+        const line = stdout.split('\n').find((l) => l.startsWith('times '));
+        if (line) resolve(line);
+      });
+      serve.stdin.write('times\n');
+    });
+    assert.match(answer, /^times - - \d+ (\d+|-) [01]$/);
+  } finally {
+    serve.stdin.end();
+    rmSync(dir, { recursive: true, force: true });
+  }
+});
+
 test('bad arguments exit 2 with the usage', () => {
-  for (const args of [[], ['a.elf', 'b.elf'], ['a.elf', '--panel', '240'], ['a.elf', '--out', 'x.bmp'], ['a.elf', '--max-seconds', '0']]) {
+  const cases = [[], ['a.elf', 'b.elf'], ['a.elf', '--panel', '240'], ['a.elf', '--out', 'x.bmp'], ['a.elf', '--max-seconds', '0'], ['a.elf', '--display', 'lcd']];
+  for (const args of cases) {
     const result = spawnSync(process.execPath, [RUN, ...args], { encoding: 'utf8' });
     assert.equal(result.status, 2, `${args.join(' ')}: ${result.stderr}`);
     assert.match(result.stderr, /usage: node run\.mjs ELF/);

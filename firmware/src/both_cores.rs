@@ -3,7 +3,8 @@
 //! (core 0's in its `Raytracer`, core 1's in a `RendererRoom`) over the one
 //! scene, shared with `LoadedScene::share`; core 0 alone writes to the
 //! display, in row order, taking core 1's rows from a `Handoff` ring: no
-//! heap, no lock.
+//! heap, no lock. A panel of few levels is dithered as one picture, every
+//! row going through one `Dithered` target in order.
 //!
 //! Invariants: core 1 starts only after the shared scene is published (and
 //! never touches the scene's `Raytracer` or semihosting).
@@ -13,8 +14,8 @@ use core::cell::UnsafeCell;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
-use embedded_graphics_core::pixelcolor::Rgb888;
 use embedded_graphics_core::primitives::Rectangle;
+use octrace_core::panel::{Dithered, TracedColor};
 use octrace_core::render::{interleaved_rows, Handoff};
 use octrace_core::{ConstStaticCell, LoadedScene, RendererRoom, SharedScene};
 
@@ -71,8 +72,11 @@ const CPUWAIT: *mut u32 = 0x5002_1118 as *mut u32;
 pub fn draw<D>(scene: &LoadedScene<'static, Profile>, display: &mut D) -> Result<[u64; 2], D::Error>
 where
     D: DrawTarget,
-    D::Color: From<Rgb888>,
+    D::Color: TracedColor,
 {
+    let mut rows = [0; config::ERROR_WORDS];
+    // Sized for the display by the build script.
+    let Ok(mut display) = Dithered::new(display, config::DITHERING, &mut rows) else { crate::semihosting::exit(3) };
     // SAFETY: core 1 is still held in reset: nothing else reads `SHARED`.
     unsafe { *SHARED.scene.get() = Some(scene.share()) };
     SHARED.ready.store(true, Ordering::Release);
@@ -88,13 +92,13 @@ where
         for y in 0..size.height {
             let area = Rectangle::new(Point::new(0, y as i32), Size::new(size.width, 1));
             if y % 2 == 0 {
-                display.fill_contiguous(&area, renderer.row(y, 0..size.width).map(|p| p.color.into()))?;
+                display.fill_contiguous(&area, renderer.row(y, 0..size.width).map(|p| p.color))?;
                 continue;
             }
             octrace_wait_until(y, true);
             // Held, so taken: the row's colours, its slot freed after.
             if let Some(row) = RING.take(y) {
-                display.fill_contiguous(&area, row.map(Into::into))?;
+                display.fill_contiguous(&area, row)?;
             }
         }
         Ok(renderer.stats().rays)

@@ -3,18 +3,22 @@
 //! streams it to the panel. It holds one small chunk of bytes, never a
 //! framebuffer.
 //!
-//! Four pixel formats: `Rgb888` (3 bytes a pixel), `Rgb565` (2 bytes, big
+//! Pixel formats: `Rgb888` (3 bytes a pixel), `Rgb565` (2 bytes, big
 //! endian, as common SPI displays take it), `PaletteIndex` (1 byte, an
-//! entry of the display's 256-colour table) and `Gray4` (1 byte, the level
-//! 0 to 15).
+//! entry of the display's 256-colour table), and a byte a pixel holding
+//! the level of a panel of few levels: `BinaryColor` (0 or 1), `Gray2`
+//! (0 to 3), `Gray4` (0 to 15), `BlackWhiteRed` (0 black, 1 white, 2 red).
 
 use crate::semihosting::HostFile;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{OriginDimensions, Size};
-use embedded_graphics_core::pixelcolor::{Gray4, GrayColor, IntoStorage, PixelColor, Rgb565, Rgb888, RgbColor};
+use embedded_graphics_core::pixelcolor::{
+    BinaryColor, Gray2, Gray4, GrayColor, IntoStorage, PixelColor, Rgb565, Rgb888, RgbColor,
+};
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
 use octrace_core::palette::PaletteIndex;
+use octrace_core::panel::BlackWhiteRed;
 
 /// How a colour goes on the wire.
 pub trait WireColor: PixelColor {
@@ -36,10 +40,31 @@ impl WireColor for PaletteIndex {
     }
 }
 
+impl WireColor for BinaryColor {
+    const BYTES: usize = 1;
+    fn encode(self, out: &mut [u8]) {
+        out[0] = self.is_on() as u8;
+    }
+}
+
+impl WireColor for Gray2 {
+    const BYTES: usize = 1;
+    fn encode(self, out: &mut [u8]) {
+        out[0] = self.luma();
+    }
+}
+
 impl WireColor for Gray4 {
     const BYTES: usize = 1;
     fn encode(self, out: &mut [u8]) {
         out[0] = self.luma();
+    }
+}
+
+impl WireColor for BlackWhiteRed {
+    const BYTES: usize = 1;
+    fn encode(self, out: &mut [u8]) {
+        out[0] = self as u8;
     }
 }
 

@@ -27,8 +27,6 @@ mod config {
 }
 
 use embedded_graphics_core::geometry::Size;
-#[cfg(not(board = "mps2-an521"))]
-use embedded_graphics_core::image::ImageDrawable;
 use octrace_core::render::PanelColor;
 use octrace_core::{ConstStaticCell, LoadedScene, Raytracer};
 use semihosting::exit;
@@ -51,8 +49,9 @@ use {
 use {
     display::{StreamDisplay, WireColor},
     embedded_graphics_core::draw_target::DrawTarget,
-    embedded_graphics_core::pixelcolor::{Gray4, Rgb565, Rgb888},
+    embedded_graphics_core::pixelcolor::{BinaryColor, Gray2, Gray4, Rgb565, Rgb888},
     octrace_core::palette::{Dither, PaletteIndex, Quantized},
+    octrace_core::panel::{BlackWhiteRed, TracedColor},
     semihosting::HostFile,
 };
 
@@ -181,7 +180,10 @@ fn draw_on(scene: &LoadedScene<'static, Profile>, file: HostFile) -> bool {
     match config::WIRE {
         PanelColor::Rgb888 => draw::<Rgb888>(scene, file),
         PanelColor::Rgb565 => draw::<Rgb565>(scene, file),
+        PanelColor::Mono => draw::<BinaryColor>(scene, file),
+        PanelColor::Gray2 => draw::<Gray2>(scene, file),
         PanelColor::Gray4 => draw::<Gray4>(scene, file),
+        PanelColor::Bwr => draw::<BlackWhiteRed>(scene, file),
         PanelColor::Dither => draw_dithered(scene, file),
     }
 }
@@ -192,14 +194,15 @@ fn draw_on(scene: &LoadedScene<'static, Profile>, file: HostFile) -> bool {
 #[inline(never)]
 fn draw_on(scene: &LoadedScene<'_, Profile>, mut panel: ssd0323::Ssd0323) -> bool {
     debug_assert!(config::WIRE == PanelColor::Gray4);
-    scene.image(Size::new(config::WIDTH, config::HEIGHT)).draw(&mut panel).is_ok()
+    let image = scene.image(Size::new(config::WIDTH, config::HEIGHT)).dithered(config::DITHERING);
+    image.try_draw_with(&mut panel, &mut [0; config::ERROR_WORDS]).is_ok()
 }
 
 /// Draws the scene into a display of colour `C`. Not inlined: each colour's
 /// instance keeps its frame to itself.
 #[cfg(not(board = "lm3s6965evb"))]
 #[inline(never)]
-fn draw<C: WireColor + From<Rgb888>>(scene: &LoadedScene<'static, Profile>, file: HostFile) -> bool {
+fn draw<C: WireColor + TracedColor>(scene: &LoadedScene<'static, Profile>, file: HostFile) -> bool {
     let mut display = StreamDisplay::<C>::new(file, Size::new(config::WIDTH, config::HEIGHT));
     draw_into(scene, &mut display)
 }
@@ -213,20 +216,23 @@ fn draw_dithered(scene: &LoadedScene<'static, Profile>, file: HostFile) -> bool 
     draw_into(scene, &mut dithered)
 }
 
-/// Draws the scene into `display` as an embedded-graphics image.
+/// Draws the scene into `display` as an embedded-graphics image; a panel
+/// of few levels keeps error diffusion's row, exactly as wide as the
+/// panel, in this frame (less stack than the image's own 512 bytes).
 #[cfg(not(any(board = "lm3s6965evb", board = "mps2-an521")))]
 fn draw_into<D: DrawTarget>(scene: &LoadedScene<'static, Profile>, display: &mut D) -> bool
 where
-    D::Color: From<Rgb888>,
+    D::Color: TracedColor,
 {
-    scene.image_for(display).draw(display).is_ok()
+    let mut rows = [0; config::ERROR_WORDS];
+    scene.image_for(display).dithered(config::DITHERING).try_draw_with(display, &mut rows).is_ok()
 }
 
 /// Draws the scene into `display` with both cores.
 #[cfg(board = "mps2-an521")]
 fn draw_into<D: DrawTarget>(scene: &LoadedScene<'static, Profile>, display: &mut D) -> bool
 where
-    D::Color: From<Rgb888>,
+    D::Color: TracedColor,
 {
     match both_cores::draw(scene, display) {
         Ok([core0, core1]) => {

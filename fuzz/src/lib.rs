@@ -2,10 +2,12 @@
 //! libFuzzer's inputs, and `tests/regressions.rs` calls them on every kept
 //! reproducer (on stable Rust, in CI). A check panics on a finding.
 
+mod board;
 mod link;
 mod parse;
 mod render;
 
+pub use board::{check_board_loop, seeds as board_loop_seeds};
 pub use link::{check_link, seeds as link_seeds};
 pub use parse::check_parse;
 pub use render::check_render;

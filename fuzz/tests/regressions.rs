@@ -69,13 +69,12 @@ fn link_regressions_and_seeds() {
     }
 }
 
-/// The link's seeds are what today's encoder writes (a change of the
-/// protocol changes them: re-bless with OCTRACE_BLESS=1).
-#[test]
-fn link_seeds_are_current() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("link-seeds");
+/// The files of `dir` are `seeds` (a change of the protocol changes them:
+/// re-bless with OCTRACE_BLESS=1).
+fn seeds_are_current(dir: &str, seeds: Vec<(&str, Vec<u8>)>) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
     let bless = std::env::var_os("OCTRACE_BLESS").is_some_and(|v| v != "0");
-    for (name, bytes) in octrace_fuzz::link_seeds() {
+    for (name, bytes) in seeds {
         let path = dir.join(name);
         if bless {
             fs::create_dir_all(&dir).unwrap();
@@ -87,4 +86,28 @@ fn link_seeds_are_current() {
             path.display()
         );
     }
+}
+
+/// The link's seeds are what today's encoder writes.
+#[test]
+fn link_seeds_are_current() {
+    seeds_are_current("link-seeds", octrace_fuzz::link_seeds());
+}
+
+#[test]
+fn board_loop_regressions_and_seeds() {
+    let seeds = all_files("board-loop-seeds");
+    assert!(seeds.len() >= 4, "the board loop's seed corpus is missing");
+    // The link's seeds too, as more inputs (read as pieces, they are
+    // other streams).
+    for path in all_files("regressions/board_loop").iter().chain(&seeds).chain(&all_files("link-seeds")) {
+        println!("{}", path.display());
+        octrace_fuzz::check_board_loop(&fs::read(path).expect("readable input"));
+    }
+}
+
+/// The board loop's seeds are what today's encoder writes.
+#[test]
+fn board_loop_seeds_are_current() {
+    seeds_are_current("board-loop-seeds", octrace_fuzz::board_loop_seeds());
 }

@@ -1,22 +1,26 @@
 //! The `host-sim` command line.
 
-use crate::output::{write_atomically, FileSink};
+use crate::animation::{animate, is_frame_file, merge_frames, AnimationOptions, Request};
+use crate::arguments::{output_format, parse_accel, parse_color, parse_dithering, parse_format, parse_palette};
+use crate::arguments::{parse_size, same_file};
+use crate::output::{panel_preview, write_atomically, FileSink};
 use crate::parts::{self, MergeError, PartInfo, PartSpec};
-use crate::{all_cores, load_bytes, new_scene, render_streamed, AccelMode, LoadError, Partition, RenderOptions};
-use crate::{render_with_progress, HostScene, RgbImage, StreamError, Streamed};
+use crate::terminal::progress_bar;
+use crate::{all_cores, load_frame_bytes, new_scene, render_streamed, AccelMode, LoadError, Partition, RenderOptions};
+use crate::{Canvas, HostScene, StreamError, Streamed};
 use clap::Parser;
-use indicatif::{ProgressBar, ProgressStyle};
 use octrace_core::accel::OctreeConfig;
+use octrace_core::panel::{Dithering, Panel};
 use octrace_core::render::PanelColor;
-use octrace_core::scene::MAX_SIDE;
 use octrace_images::formats::{self, Format, FormatError, Header, Image};
 use octrace_images::palette::PaletteMode;
-use octrace_images::panel;
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Once;
 use std::time::Instant;
 
-pub use crate::exit::{CliError, EXIT_IO, EXIT_MISMATCH, EXIT_SCENE};
+pub use crate::exit::{CliError, EXIT_IO, EXIT_MISMATCH, EXIT_SCENE, EXIT_STOPPED};
 
 /// Render an octrace scene file to an image (PNG, Targa or Sun raster), in
 /// truecolour or with a 256-entry colour table.
@@ -24,9 +28,11 @@ pub use crate::exit::{CliError, EXIT_IO, EXIT_MISMATCH, EXIT_SCENE};
 /// Exit codes: 0 success, 1 a file could not be read or written (or a
 /// board could not be talked to), 2 the scene or the arguments are invalid
 /// (every error is printed as file:line:col), 3 a board's picture differs
-/// from host-sim's (`board --check`).
+/// from host-sim's (`board --check`), 130 stopped by Ctrl-C.
 /// Nothing is written unless the whole image renders: the image goes to a
-/// temporary file that is renamed into place at the end.
+/// temporary file that is renamed into place at the end. Ctrl-C stops a
+/// render before its next ray, even inside a pixel that takes hours, and
+/// leaves no file.
 #[derive(Parser, Debug)]
 #[command(
     name = "host-sim",
@@ -47,15 +53,23 @@ pub struct Args {
     pub out: Option<PathBuf>,
     /// Map the image onto a 256-entry colour table (written as an indexed
     /// image): scan (the thesis's hash-scan table), dither (6×6×6 cube,
-    /// ordered), coarse (dither with outlines around objects), gray.
-    #[arg(long, value_name = "MODE", default_value = "none", value_parser = parse_palette)]
-    pub palette: PaletteMode,
+    /// ordered), coarse (dither with outlines around objects), gray; none
+    /// (the default) keeps truecolour. An animated GIF takes scan unless
+    /// another table is given.
+    #[arg(long, value_name = "MODE", value_parser = parse_palette)]
+    pub palette: Option<PaletteMode>,
     /// Preview a panel: the pixels as a display of this format shows them
     /// (the firmware's OCTRACE_COLOR): rgb888; rgb565 (written back as
-    /// RGB); gray4, 16 levels (an 8-bit gray PNG, level × 17); dither (as
-    /// --palette dither).
+    /// RGB); mono, gray2 and gray4, one bit, 4 and 16 grays, dithered (an
+    /// 8-bit gray PNG of the levels' grays); bwr, black/white/red e-paper,
+    /// dithered (an indexed image); dither (as --palette dither).
     #[arg(long, value_name = "COLOR", default_value = "rgb888", value_parser = parse_color)]
     pub color: PanelColor,
+    /// How mono, gray2, gray4 and bwr are dithered: fs-pe (the default,
+    /// Floyd–Steinberg with pure-error feedback), fs (Floyd–Steinberg),
+    /// bayer (ordered, 4×4), nearest (none: each pixel's nearest level).
+    #[arg(long, value_name = "METHOD", value_parser = parse_dithering)]
+    pub dither: Option<Dithering>,
     /// The file format; by default from OUT's extension (png, tga, ras), or
     /// PNG when OUT has none. Any other extension is refused without it.
     #[arg(long, value_parser = parse_format)]
@@ -91,6 +105,17 @@ pub struct Args {
     /// the palette and their rows.
     #[arg(long, value_name = "I/N")]
     pub part: Option<PartSpec>,
+    /// For a scene with FRAMES: render frame K alone, from scratch, as a
+    /// still image. Without it an animation is written whole: an animated
+    /// GIF (OUT.gif), an APNG (OUT.png) or one file a frame (a name with
+    /// %d or %04d).
+    #[arg(long, value_name = "K")]
+    pub frame: Option<u32>,
+    /// Render every frame of an animation whole, instead of re-tracing only
+    /// the pixels the motion can change (the same images; for benchmarks
+    /// and checks).
+    #[arg(long)]
+    pub no_coherence: bool,
     /// Print nothing but errors.
     #[arg(long, short)]
     pub quiet: bool,
@@ -137,64 +162,19 @@ pub enum Command {
     Board(crate::board::BoardArgs),
 }
 
-/// What a `color` panel shows of `image` ([`octrace_images::panel`]), or
-/// `None` for the colours that need no conversion.
-pub(crate) fn panel_preview(image: &RgbImage, color: PanelColor) -> Option<Image> {
-    match color {
-        PanelColor::Rgb888 | PanelColor::Dither => None,
-        PanelColor::Rgb565 => Some(Image::Rgb(panel::rgb565(image))),
-        PanelColor::Gray4 => Some(panel::gray4(image)),
-    }
+/// Whether `color` is previewed from the finished image (not streamed).
+fn previewed(color: PanelColor) -> bool {
+    !matches!(color, PanelColor::Rgb888 | PanelColor::Dither)
 }
 
-/// Writes a panel preview: gray4 as an 8-bit gray PNG (level × 17) where
-/// the format is PNG, else as a 16-entry gray colour table.
+/// Writes a panel preview: a gray panel's as an 8-bit gray PNG (each
+/// level's gray) where the format is PNG, else as its colour table.
 fn write_preview(preview: &Image, color: PanelColor, format: Format, out: &mut dyn Write) -> Result<(), FormatError> {
-    match (color, format) {
-        (PanelColor::Gray4, Format::Png) => formats::write_gray_png(preview, out),
+    let gray = matches!(color.panel(), Some(Panel::Mono | Panel::Gray2 | Panel::Gray4));
+    match format {
+        Format::Png if gray => formats::write_gray_png(preview, out),
         _ => formats::write(preview, format, out),
     }
-}
-
-/// An `--accel` name: the core's [`AccelMode`] vocabulary.
-fn parse_accel(text: &str) -> Result<AccelMode, String> {
-    parse_name(text, &AccelMode::ALL, AccelMode::name)
-}
-
-/// A `--color` name: the core's [`PanelColor`] vocabulary.
-fn parse_color(text: &str) -> Result<PanelColor, String> {
-    parse_name(text, &PanelColor::ALL, PanelColor::name)
-}
-
-/// A `--palette` name: [`PaletteMode`]'s vocabulary.
-fn parse_palette(text: &str) -> Result<PaletteMode, String> {
-    parse_name(text, &PaletteMode::ALL, PaletteMode::name)
-}
-
-/// A `--format` name: [`Format`]'s vocabulary.
-pub(crate) fn parse_format(text: &str) -> Result<Format, String> {
-    parse_name(text, &Format::ALL, Format::name)
-}
-
-/// The one of `all` that `text` names (case-insensitive).
-fn parse_name<T: Copy>(text: &str, all: &[T], name: fn(T) -> &'static str) -> Result<T, String> {
-    all.iter().copied().find(|&v| name(v).eq_ignore_ascii_case(text)).ok_or_else(|| {
-        let names: Vec<&str> = all.iter().map(|&v| name(v)).collect();
-        format!("expected one of {}", names.join(", "))
-    })
-}
-
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WxH (for example 160x128), found `{s}`"))?;
-    let dim = |v: &str| -> Result<u32, String> {
-        let n: u32 = v.parse().map_err(|_| format!("`{v}` is not a whole number"))?;
-        if (1..=MAX_SIDE).contains(&n) {
-            Ok(n)
-        } else {
-            Err(format!("{n} is outside 1 to {MAX_SIDE}"))
-        }
-    };
-    Ok((dim(w)?, dim(h)?))
 }
 
 pub fn run<I, T>(args: I, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i32
@@ -226,30 +206,6 @@ where
             e.exit_code()
         }
     }
-}
-
-/// The format to write `path` in: the one asked for, else the one its
-/// extension names, else (no extension) PNG. Any other extension is refused
-/// before anything is rendered: a PNG named `.bmp` would mislead whatever
-/// opens it.
-pub(crate) fn output_format(asked: Option<Format>, path: &Path) -> Result<Format, CliError> {
-    if let Some(format) = asked {
-        return Ok(format);
-    }
-    let Some(extension) = path.extension() else {
-        return Ok(Format::Png);
-    };
-    Format::from_path(path).ok_or_else(|| {
-        let names: Vec<&str> = Format::ALL.iter().map(|f| f.name()).collect();
-        CliError::Invalid(format!(
-            "cannot write {}: `.{}` is not a format host-sim writes; it writes {} \
-             (chosen by the extension, or by --format <{}>)",
-            path.display(),
-            extension.to_string_lossy(),
-            names.join(", "),
-            names.join("|"),
-        ))
-    })
 }
 
 fn convert(input: &Path, output: &Path, format: Option<Format>) -> Result<(), CliError> {
@@ -286,7 +242,7 @@ fn part_of(
     if format == Format::Ras {
         return refuse("parts are PNG or Targa files (a Sun raster has no room for the part's metadata)".into());
     }
-    if matches!(color, PanelColor::Rgb565 | PanelColor::Gray4) {
+    if previewed(color) {
         return refuse("a --color preview is written whole: render it without --part".into());
     }
     if palette_mode == PaletteMode::Scan {
@@ -320,30 +276,37 @@ fn part_of(
     Ok((rows, info.to_string()))
 }
 
-/// `--color rgb565|gray4`: a panel's preview, converted from the whole
-/// image (panels are small; every other image streams).
+/// `--color rgb565|mono|gray2|gray4|bwr [--dither METHOD]`: a panel's
+/// preview, converted or dithered from the whole image (panels are small;
+/// every other image streams).
 fn preview(
     scene: &HostScene,
     options: &RenderOptions,
-    color: PanelColor,
+    args: &Args,
     format: Format,
     out: &Path,
-    quiet: bool,
     stderr: &mut dyn Write,
 ) -> Result<(), CliError> {
+    let (color, dithering) = (args.color, args.dither.unwrap_or_default());
     let started = Instant::now();
-    // The parser rejects a camera that cannot be set up; a scene built by
-    // hand may not.
-    let rendered = render_with_progress(scene, options, &|_| {})
-        .map_err(|e| CliError::Invalid(format!("cannot set up the camera: {e}")))?;
-    let preview = panel_preview(&rendered.image, color).unwrap_or_else(|| Image::Rgb(rendered.image.clone()));
+    let (w, h) = options.size.unwrap_or((scene.view().settings.raster[0], scene.view().settings.raster[1]));
+    let mut canvas = Canvas::new(w, h);
+    let rendered = match render_streamed(scene, options, 0..h, &|_| {}, &mut canvas) {
+        Ok(rendered) => rendered,
+        Err(StreamError::Stopped) => return Err(CliError::Stopped),
+        // The parser rejects a camera that cannot be set up; a scene built
+        // by hand may not.
+        Err(e) => return Err(CliError::Invalid(format!("cannot set up the camera: {e}"))),
+    };
+    let image = canvas.image;
+    let preview = panel_preview(&image, color, dithering).unwrap_or_else(|| Image::Rgb(image.clone()));
     write_atomically(out, |f| write_preview(&preview, color, format, f).map_err(std::io::Error::other))
         .map_err(|e| CliError::write(out, e))?;
-    if !quiet {
-        let (image, stats) = (&rendered.image, rendered.stats);
+    if !args.quiet {
+        let (image, stats) = (&image, rendered.stats);
         let _ = writeln!(
             stderr,
-            "{}x{} in {:.3} s ({}, {} threads): {} rays, {} shadow rays, {} cells -> {} ({} panel)",
+            "{}x{} in {:.3} s ({}, {} threads): {} rays, {} shadow rays, {} cells -> {} ({} panel{})",
             image.width,
             image.height,
             started.elapsed().as_secs_f64(),
@@ -353,7 +316,11 @@ fn preview(
             stats.shadow_rays,
             stats.cells,
             out.display(),
-            color.name()
+            color.name(),
+            match color.panel() {
+                Some(_) => format!(", {}", dithering.name()),
+                None => String::new(),
+            }
         );
     }
     Ok(())
@@ -362,7 +329,12 @@ fn preview(
 fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     match &args.command {
         Some(Command::Convert { input, output, format }) => return convert(input, output, *format),
-        Some(Command::Merge { output, parts, format }) => return merge(output, parts, *format),
+        Some(Command::Merge { output, parts, format }) => {
+            return match parts.first().is_some_and(|p| is_frame_file(p)) {
+                true => merge_frames(output, parts),
+                false => merge(output, parts, *format),
+            }
+        }
         // run() serves the studio and talks to boards (both need stdout)
         // instead of calling this.
         Some(Command::Studio(_) | Command::Board(_)) => return Ok(()),
@@ -373,10 +345,26 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     };
     let mut scene = new_scene();
     let scene_bytes = std::fs::read(scene_path).map_err(|e| CliError::read(scene_path, e))?;
-    let loaded = load_bytes(&scene_path.display().to_string(), &scene_bytes, &mut scene).map_err(|e| match e {
+    let frame = args.frame.unwrap_or(0);
+    let name = scene_path.display().to_string();
+    let loaded = load_frame_bytes(&name, &scene_bytes, frame, &mut scene).map_err(|e| match e {
         LoadError::Io(e) => CliError::read(scene_path, e),
         LoadError::Scene(errors) => CliError::Scene { file: scene_path.display().to_string(), errors },
     })?;
+    match (loaded.frames, args.frame) {
+        (None, Some(_)) => {
+            return Err(CliError::Invalid(format!("--frame: {name} is no animation (it has no FRAMES)")))
+        }
+        (Some(frames), Some(k)) if k >= frames.count => {
+            return Err(CliError::Invalid(format!(
+                "--frame {k}: {name} has {} frame{}, 0 to {}",
+                frames.count,
+                if frames.count == 1 { "" } else { "s" },
+                frames.count - 1
+            )))
+        }
+        _ => {}
+    }
     let out = match (&args.out, &loaded.imagefile) {
         (Some(o), _) => o.clone(),
         (None, Some(f)) => PathBuf::from(f),
@@ -387,8 +375,16 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
             )))
         }
     };
-    if args.color != PanelColor::Rgb888 && args.palette != PaletteMode::None {
+    let palette = args.palette.unwrap_or(PaletteMode::None);
+    if args.color != PanelColor::Rgb888 && palette != PaletteMode::None {
         return Err(CliError::Invalid("--color and --palette both choose the pixels: give one".into()));
+    }
+    if args.dither.is_some() && args.color.panel().is_none() {
+        let panels: Vec<&str> = PanelColor::ALL.iter().filter(|c| c.panel().is_some()).map(|c| c.name()).collect();
+        return Err(CliError::Invalid(format!(
+            "--dither chooses how a panel of few levels is dithered: give it with --color {}",
+            panels.join("|")
+        )));
     }
     if same_file(scene_path, &out) {
         return Err(CliError::Invalid(format!(
@@ -396,10 +392,37 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
             out.display()
         )));
     }
+    let options = |(w, h)| RenderOptions {
+        size: Some((w, h)),
+        accel: args.accel,
+        octree: OctreeConfig { max_objects: args.max_objects, max_depth: args.max_depth, ..crate::OCTREE },
+        threads: args.threads.map_or_else(all_cores, |n| n as usize),
+        partition: args.partition,
+        light_buffer: crate::LIGHT_BUFFER,
+        stop: None,
+    };
+    let raster = scene.view().settings.raster;
+    let (w, h) = args.size.unwrap_or((raster[0], raster[1]));
+    if let (Some(frames), None) = (loaded.frames, args.frame) {
+        if args.color != PanelColor::Rgb888 {
+            return Err(CliError::Invalid("--color previews one panel: give --frame K".into()));
+        }
+        let request = Request {
+            scene_path,
+            bytes: &scene_bytes,
+            frames,
+            out: &out,
+            palette: args.palette,
+            format: args.format,
+            part: args.part,
+            size: (w, h),
+            options: AnimationOptions { render: options((w, h)), coherence: !args.no_coherence },
+            quiet: args.quiet,
+        };
+        return animate(&request, stderr);
+    }
     let format = output_format(args.format, &out)?;
-    let view = scene.view();
-    let (w, h) = args.size.unwrap_or((view.settings.raster[0], view.settings.raster[1]));
-    let palette_mode = if args.color == PanelColor::Dither { PaletteMode::Dither } else { args.palette };
+    let palette_mode = if args.color == PanelColor::Dither { PaletteMode::Dither } else { palette };
     let (rows, text) = match args.part {
         Some(spec) => {
             let (rows, text) = part_of(spec, palette_mode, args.color, &scene_bytes, (w, h), format)?;
@@ -408,16 +431,11 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         None => (0..h, None),
     };
     let started = Instant::now();
-    let options = RenderOptions {
-        size: Some((w, h)),
-        accel: args.accel,
-        octree: OctreeConfig { max_objects: args.max_objects, max_depth: args.max_depth, ..crate::OCTREE },
-        threads: args.threads.map_or_else(all_cores, |n| n as usize),
-        partition: args.partition,
-        light_buffer: crate::LIGHT_BUFFER,
-    };
-    if matches!(args.color, PanelColor::Rgb565 | PanelColor::Gray4) {
-        return preview(&scene, &options, args.color, format, &out, args.quiet, stderr);
+    // Ctrl-C stops a still before its next ray (an animation's frames are
+    // each written whole, and Ctrl-C ends it as any program).
+    let options = RenderOptions { stop: Some(ctrl_c()), ..options((w, h)) };
+    if previewed(args.color) {
+        return preview(&scene, &options, args, format, &out, stderr);
     }
     // `coarse` outlines need the objects of the row above a part.
     let render_rows = match palette_mode {
@@ -457,6 +475,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         b.finish_and_clear();
     }
     let rendered = match (outcome, written) {
+        (Some(Err(StreamError::Stopped)), _) => return Err(CliError::Stopped),
         // The parser rejects a camera that cannot be set up; a scene built
         // by hand may not.
         (Some(Err(e)), _) => return Err(CliError::Invalid(e.to_string())),
@@ -513,40 +532,25 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     Ok(())
 }
 
-/// A progress bar of `total` steps on stderr, if it is a terminal and
-/// the run is not `quiet`.
-pub(crate) fn progress_bar(total: u64, quiet: bool) -> Option<ProgressBar> {
-    if quiet || !std::io::stderr().is_terminal() {
-        return None;
-    }
-    let bar = ProgressBar::new(total);
-    bar.set_style(
-        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}%, eta {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    Some(bar)
-}
+/// Set by Ctrl-C, once this process has its handler ([`ctrl_c`]).
+static CTRL_C: AtomicBool = AtomicBool::new(false);
 
-/// Whether two paths name the same existing file.
-pub(crate) fn same_file(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => false,
-    }
+/// The flag Ctrl-C sets, its handler installed on the first call: a render
+/// that asks it stops before its next ray and writes nothing. A process
+/// that has a handler already (the studio's, in a test that ran it) keeps
+/// it, and Ctrl-C ends it as before.
+fn ctrl_c() -> &'static AtomicBool {
+    static INSTALL: Once = Once::new();
+    INSTALL.call_once(|| {
+        let _ = ctrlc::set_handler(|| CTRL_C.store(true, Ordering::SeqCst));
+    });
+    &CTRL_C
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn sizes() {
-        assert_eq!(parse_size("160x128"), Ok((160, 128)));
-        assert_eq!(parse_size("8X8"), Ok((8, 8)));
-        assert!(parse_size("0x5").is_err());
-        assert!(parse_size("12").is_err());
-        assert!(parse_size("20000x5").is_err());
-    }
+    use crate::RgbImage;
 
     /// Every 8-bit gray a gray4 panel can show, written out apart from
     /// embedded-graphics: luma by ITU-R BT.601 in 8 bits, rounded to 16
@@ -557,14 +561,14 @@ mod tests {
     }
 
     fn one_pixel_preview(rgb: [u8; 3], color: PanelColor) -> Option<Image> {
-        panel_preview(&RgbImage { width: 1, height: 1, data: rgb.to_vec() }, color)
+        panel_preview(&RgbImage { width: 1, height: 1, data: rgb.to_vec() }, color, Dithering::Nearest)
     }
 
     #[test]
     fn gray4_preview_is_the_panels_level_times_17() {
         for rgb in [[0, 0, 0], [255, 255, 255], [255, 0, 0], [0, 255, 0], [0, 0, 255], [8, 9, 10], [200, 17, 90]] {
             let expected = gray4_by_hand(rgb[0].into(), rgb[1].into(), rgb[2].into());
-            let preview = one_pixel_preview(rgb, PanelColor::Gray4).expect("gray4 is converted");
+            let preview = one_pixel_preview(rgb, PanelColor::Gray4).expect("gray4 is previewed");
             assert_eq!(preview.to_rgb().data, [expected; 3], "{rgb:?}");
             let mut png = Vec::new();
             write_preview(&preview, PanelColor::Gray4, Format::Png, &mut png).unwrap();
@@ -586,22 +590,57 @@ mod tests {
     }
 
     #[test]
-    fn color_and_palette_together_are_refused() {
-        let dir = tempfile_dir();
+    fn a_dithered_preview_is_the_core_ditherers_levels() {
+        // A 16×4 ramp: each level the core gives, written as its gray (one
+        // bit as 0 and 255).
+        let data: Vec<u8> = (0..64u32).flat_map(|i| [(i * 4) as u8; 3]).collect();
+        let image = RgbImage { width: 16, height: 4, data };
+        for color in [PanelColor::Mono, PanelColor::Gray2, PanelColor::Gray4] {
+            let panel = color.panel().unwrap();
+            let mut rows = vec![0; 16];
+            let mut ditherer =
+                octrace_core::panel::Ditherer::new(panel, Dithering::FsPe, Default::default(), 16, &mut rows).unwrap();
+            let expected: Vec<u8> = image
+                .data
+                .chunks(3)
+                .map(|p| panel.color(ditherer.next(embedded_graphics_core::pixelcolor::Rgb888::new(p[0], p[1], p[2]))))
+                .map(|c| embedded_graphics_core::pixelcolor::RgbColor::r(&c))
+                .collect();
+            let preview = panel_preview(&image, color, Dithering::FsPe).unwrap();
+            let mut png = Vec::new();
+            write_preview(&preview, color, Format::Png, &mut png).unwrap();
+            let mut decoder = png::Decoder::new(std::io::Cursor::new(&png)).read_info().unwrap();
+            assert_eq!(decoder.info().color_type, png::ColorType::Grayscale, "{color}");
+            let mut gray = vec![0; decoder.output_buffer_size().unwrap()];
+            decoder.next_frame(&mut gray).unwrap();
+            assert_eq!(gray, expected, "{color}");
+        }
+    }
+
+    /// What host-sim prints when it refuses fig5_1 at 4×4 with `options`
+    /// (exit 2, nothing written).
+    fn refusal(options: &[&str]) -> String {
+        let dir = std::env::temp_dir().join(format!("host-sim-cli-{}-{}", std::process::id(), options.join("")));
+        std::fs::create_dir_all(&dir).unwrap();
         let out = dir.join("x.png");
         let mut stderr = Vec::new();
         let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/fig5_1.txt");
         let args =
-            ["host-sim", scene, out.to_str().unwrap(), "--color", "gray4", "--palette", "dither", "--size", "4x4"];
+            ["host-sim", scene, out.to_str().unwrap(), "--size", "4x4"].into_iter().chain(options.iter().copied());
         assert_eq!(run(args, &mut Vec::new(), &mut stderr), EXIT_SCENE);
-        assert!(String::from_utf8_lossy(&stderr).contains("give one"));
         assert!(!out.exists());
         let _ = std::fs::remove_dir_all(dir);
+        String::from_utf8_lossy(&stderr).into_owned()
     }
 
-    fn tempfile_dir() -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("host-sim-cli-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    #[test]
+    fn dither_without_a_panel_is_refused() {
+        let said = refusal(&["--color", "rgb565", "--dither", "bayer"]);
+        assert!(said.contains("--color mono|gray2|gray4|bwr"), "{said}");
+    }
+
+    #[test]
+    fn color_and_palette_together_are_refused() {
+        assert!(refusal(&["--color", "gray4", "--palette", "dither"]).contains("give one"));
     }
 }

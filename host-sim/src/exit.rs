@@ -1,7 +1,8 @@
 //! How a host-sim command fails: [`CliError`], whose exit code is derived in
 //! one place ([`CliError::exit_code`]): 0 done, 1 a file could not be read
 //! or written (or a board talked to), 2 a bad scene or bad arguments, 3 a
-//! board's picture that differs from host-sim's.
+//! board's picture that differs from host-sim's, 130 stopped by Ctrl-C
+//! (128 + SIGINT, as a shell reports a process Ctrl-C ended).
 
 use std::fmt;
 use std::path::Path;
@@ -14,6 +15,8 @@ pub const EXIT_IO: i32 = 1;
 /// Exit code for a board's picture that differs from host-sim's
 /// (`host-sim board --check`).
 pub const EXIT_MISMATCH: i32 = 3;
+/// Exit code for a render Ctrl-C stopped.
+pub const EXIT_STOPPED: i32 = 130;
 
 /// Why a command stopped; printed to stderr as it is displayed.
 #[derive(Debug)]
@@ -27,6 +30,8 @@ pub enum CliError {
     Scene { file: String, errors: Vec<String> },
     /// A board's picture is not host-sim's; the message says how.
     Mismatch(String),
+    /// Ctrl-C stopped the render; nothing was written.
+    Stopped,
 }
 
 impl CliError {
@@ -46,6 +51,7 @@ impl CliError {
             CliError::Io(_) => EXIT_IO,
             CliError::Invalid(_) | CliError::Scene { .. } => EXIT_SCENE,
             CliError::Mismatch(_) => EXIT_MISMATCH,
+            CliError::Stopped => EXIT_STOPPED,
         }
     }
 }
@@ -62,6 +68,7 @@ impl fmt::Display for CliError {
                 }
                 write!(f, "host-sim: {} error(s) in {file}; nothing rendered", errors.len())
             }
+            CliError::Stopped => f.write_str("host-sim: stopped (Ctrl-C); nothing written"),
         }
     }
 }

@@ -6,12 +6,15 @@
 //! a streamed render ([`render_streamed`]) holds a few bands of rows, never
 //! the image, and hands every row to its sink once, in order.
 
+pub mod animation;
+mod arguments;
 pub mod board;
 pub mod cli;
 pub mod exit;
 pub mod output;
 pub mod parts;
 pub mod studio;
+mod terminal;
 mod threaded;
 
 use threaded::stream_threads;
@@ -22,12 +25,13 @@ use octrace_core::accel::{
     self, Accelerator, BuildReport, LightBuffer, LightBufferReport, LightBufferStore, LightBuffered, Naive, Octree,
     OctreeConfig, Traversal,
 };
-use octrace_core::parse::{parse_bytes, ParseError};
+use octrace_core::parse::{parse_frame_bytes, ParseError};
 use octrace_core::profile::Host;
 use octrace_core::profile::Profile;
 use octrace_core::scene::{CameraError, Scene};
 use octrace_core::shade::Stats;
 use std::path::Path;
+use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 /// The host build's scene: a million objects of any mix, heap-backed.
@@ -61,15 +65,22 @@ impl std::fmt::Display for LoadError {
 pub struct Loaded {
     /// The scene's IMAGEFILE, if any.
     pub imagefile: Option<String>,
+    /// Its FRAMES, if it is an animation.
+    pub frames: Option<octrace_core::scene::Frames>,
 }
 
 /// Parses scene `text` (bytes, UTF-8 checked) into `scene`; errors are
 /// formatted with `name` in front.
 pub fn load_bytes(name: &str, bytes: &[u8], scene: &mut HostScene) -> Result<Loaded, LoadError> {
+    load_frame_bytes(name, bytes, 0, scene)
+}
+
+/// [`load_bytes`] of frame `frame` of an animation (a scene with FRAMES).
+pub fn load_frame_bytes(name: &str, bytes: &[u8], frame: u32, scene: &mut HostScene) -> Result<Loaded, LoadError> {
     let mut errors = Vec::new();
     let mut on_error = |e: ParseError<'_>| errors.push(format!("{name}:{e}"));
-    match parse_bytes(bytes, scene, &mut on_error) {
-        Ok(parsed) => Ok(Loaded { imagefile: parsed.imagefile.map(str::to_owned) }),
+    match parse_frame_bytes(bytes, scene, frame, &mut on_error) {
+        Ok(parsed) => Ok(Loaded { imagefile: parsed.imagefile.map(str::to_owned), frames: parsed.frames }),
         Err(_) => Err(LoadError::Scene(errors)),
     }
 }
@@ -100,7 +111,7 @@ pub enum Partition {
 pub const TILE_SIDE: u32 = 32;
 
 /// How to render.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug)]
 pub struct RenderOptions {
     /// Overrides RASTER.
     pub size: Option<(u32, u32)>,
@@ -115,6 +126,11 @@ pub struct RenderOptions {
     /// naive mode asked for by name never has one (the thesis's test of
     /// every object).
     pub light_buffer: u32,
+    /// Once set (host-sim's Ctrl-C), a streamed render ([`render_streamed`])
+    /// stops before its next ray, inside the pixels it traces, with
+    /// [`StreamError::Stopped`]. The renders into memory ([`render`] and
+    /// the others) never stop.
+    pub stop: Option<&'static AtomicBool>,
 }
 
 impl Default for RenderOptions {
@@ -126,6 +142,7 @@ impl Default for RenderOptions {
             threads: 1,
             partition: Partition::Tiles,
             light_buffer: LIGHT_BUFFER,
+            stop: None,
         }
     }
 }
@@ -217,12 +234,14 @@ pub fn render_prebuilt(
 ) -> Result<Rendered, CameraError> {
     let view = scene.view();
     let (w, h) = options.size.unwrap_or((view.settings.raster[0], view.settings.raster[1]));
-    let mut canvas = Canvas { image: RgbImage::new(w, h), objects: vec![NO_OBJECT; w as usize * h as usize] };
-    let streamed = match stream_prebuilt(scene, options, octree, 0..h, progress, &mut canvas) {
+    let mut canvas = Canvas::new(w, h);
+    // Never stopped (see `RenderOptions::stop`).
+    let options = RenderOptions { stop: None, ..*options };
+    let streamed = match stream_prebuilt(scene, &options, octree, 0..h, progress, &mut canvas) {
         Ok(s) => s,
         Err(StreamError::Camera(e)) => return Err(e),
-        // The canvas takes every row.
-        Err(StreamError::Sink(e)) => unreachable!("a canvas refused a row: {e}"),
+        // The canvas takes every row, and nothing stops the render.
+        Err(e @ (StreamError::Sink(_) | StreamError::Stopped)) => unreachable!("a render into memory failed: {e}"),
     };
     let Streamed { stats, accel, build, light_buffer, wall, busy } = streamed;
     Ok(Rendered { image: canvas.image, objects: canvas.objects, stats, accel, build, light_buffer, wall, busy })
@@ -270,6 +289,9 @@ pub enum StreamError {
     Camera(CameraError),
     /// The sink refused a row; the render stopped there.
     Sink(std::io::Error),
+    /// The render's stop was set ([`RenderOptions::stop`]): it stopped
+    /// inside the pixels it traced.
+    Stopped,
 }
 
 impl std::fmt::Display for StreamError {
@@ -277,6 +299,7 @@ impl std::fmt::Display for StreamError {
         match self {
             StreamError::Camera(e) => write!(f, "cannot set up the camera: {e}"),
             StreamError::Sink(e) => write!(f, "{e}"),
+            StreamError::Stopped => f.write_str("the render was stopped"),
         }
     }
 }
@@ -326,7 +349,7 @@ fn stream_prebuilt(
             (mode, stream_lit(view, tree, lights, (w, h), rows, options, progress, sink))
         }
     };
-    let (stats, wall, busy) = job.map_err(StreamError::Sink)?;
+    let (stats, wall, busy) = job?;
     Ok(Streamed { stats, accel, build: None, light_buffer, wall, busy })
 }
 
@@ -344,15 +367,22 @@ fn stream_lit<A: Accelerator + Sync>(
     options: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
     sink: &mut dyn RowSink,
-) -> std::io::Result<(Stats, Duration, Vec<Duration>)> {
+) -> Result<(Stats, Duration, Vec<Duration>), StreamError> {
     let lit = LightBuffered::new(accel, lights.unwrap_or(LightBuffer::NONE));
     stream_threads(view, &lit, size, rows, options, progress, sink)
 }
 
 /// The image and the object of every pixel, filled row by row.
-struct Canvas {
-    image: RgbImage,
+pub(crate) struct Canvas {
+    pub(crate) image: RgbImage,
     objects: Vec<u32>,
+}
+
+impl Canvas {
+    /// A black `w` × `h` image, no object seen.
+    pub(crate) fn new(w: u32, h: u32) -> Canvas {
+        Canvas { image: RgbImage::new(w, h), objects: vec![NO_OBJECT; w as usize * h as usize] }
+    }
 }
 
 impl RowSink for Canvas {

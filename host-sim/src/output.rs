@@ -1,20 +1,34 @@
 //! Streams a render's rows into an image file, truecolour or through a palette mode, holding a row at a
-//! time in memory.
+//! time in memory; and what a panel shows of an image (host-sim's and `host-sim board --check`'s preview).
 //!
 //! Invariants: rows arrive in order, each once. A truecolour file is written as the rows come. An indexed
 //! file's colour table ends at its last entry in use, which is known only at the end, so its indices wait in
 //! a spool file beside the output (1 byte a pixel, on disk, removed when done); `scan` also spools the
 //! image's colours (3 bytes a pixel) while it learns its table, then maps them (the host's two passes).
 
-use crate::NO_OBJECT;
+use crate::{RgbImage, NO_OBJECT};
 use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
 use octrace_core::palette::{Coarse, Dither, Gray, Quantizer, Scan};
+use octrace_core::panel::Dithering;
+use octrace_core::render::PanelColor;
 use octrace_core::scene::ObjectId;
-use octrace_images::formats::{Format, FormatError, Header, RowWriter};
+use octrace_images::formats::{Format, FormatError, Header, Image, RowWriter};
 use octrace_images::palette::PaletteMode;
+use octrace_images::panel;
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Seek, Write};
 use std::path::{Path, PathBuf};
+
+/// What a `color` panel shows of `image` ([`octrace_images::panel`]),
+/// dithered by `dithering` if it has few levels, or `None` for the colours
+/// that need no conversion.
+pub(crate) fn panel_preview(image: &RgbImage, color: PanelColor, dithering: Dithering) -> Option<Image> {
+    match (color, color.panel()) {
+        (_, Some(shown)) => Some(panel::dithered(image, shown, dithering)),
+        (PanelColor::Rgb565, None) => Some(Image::Rgb(panel::rgb565(image))),
+        _ => None,
+    }
+}
 
 /// What a palette mode did to the image, for the report host-sim prints.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -149,24 +149,15 @@ impl fmt::Display for PartInfo {
 impl PartInfo {
     /// The text [`PartInfo`]'s `Display` writes, read back; `None` for anything else.
     pub fn parse(text: &str) -> Option<PartInfo> {
-        let rest = text.strip_prefix(MAGIC)?.strip_prefix(' ')?;
-        let mut fields = rest.split(' ');
-        let mut field = |name: &str| fields.next()?.strip_prefix(name)?.strip_prefix('=');
-        let version = field("version")?.to_owned();
-        let scene = u64::from_str_radix(field("scene")?, 16).ok()?;
-        let (width, height) = field("size")?.split_once('x')?;
-        let palette_name = field("palette")?;
-        let palette = PaletteMode::ALL.into_iter().find(|m| m.name() == palette_name)?;
-        let (start, end) = field("rows")?.split_once("..")?;
-        let (index, count) = field("part")?.split_once('/')?;
-        if fields.next().is_some() {
-            return None;
-        }
+        let mut fields = Fields::after(text, MAGIC)?;
+        let Render { version, scene, width, height, palette } = fields.render()?;
+        let (start, end) = fields.next("rows")?.split_once("..")?;
+        let (index, count) = fields.next("part")?.split_once('/')?;
         let info = PartInfo {
             version,
             scene,
-            width: width.parse().ok()?,
-            height: height.parse().ok()?,
+            width,
+            height,
             palette,
             rows: start.parse().ok()?..end.parse().ok()?,
             index: index.parse().ok()?,
@@ -177,7 +168,48 @@ impl PartInfo {
             && info.rows == band_rows(info.height, info.index, info.count)
             && !info.rows.is_empty()
             && info.width > 0;
-        valid.then_some(info)
+        (fields.end() && valid).then_some(info)
+    }
+}
+
+/// What every piece of a render split across machines says first: who
+/// rendered what, how large, in which palette.
+pub(crate) struct Render {
+    pub version: String,
+    pub scene: u64,
+    pub width: u32,
+    pub height: u32,
+    pub palette: PaletteMode,
+}
+
+/// The `name=value` fields of a metadata line after its magic words, read
+/// in order.
+pub(crate) struct Fields<'a>(std::str::Split<'a, char>);
+
+impl<'a> Fields<'a> {
+    /// The fields of `text`, if it starts with `magic` and a space.
+    pub(crate) fn after(text: &'a str, magic: &str) -> Option<Fields<'a>> {
+        Some(Fields(text.strip_prefix(magic)?.strip_prefix(' ')?.split(' ')))
+    }
+
+    /// The next field's value, if it is `name`'s.
+    pub(crate) fn next(&mut self, name: &str) -> Option<&'a str> {
+        self.0.next()?.strip_prefix(name)?.strip_prefix('=')
+    }
+
+    /// `version`, `scene`, `size` and `palette`.
+    pub(crate) fn render(&mut self) -> Option<Render> {
+        let version = self.next("version")?.to_owned();
+        let scene = u64::from_str_radix(self.next("scene")?, 16).ok()?;
+        let (width, height) = self.next("size")?.split_once('x')?;
+        let palette_name = self.next("palette")?;
+        let palette = PaletteMode::ALL.into_iter().find(|m| m.name() == palette_name)?;
+        Some(Render { version, scene, width: width.parse().ok()?, height: height.parse().ok()?, palette })
+    }
+
+    /// Whether no field is left.
+    pub(crate) fn end(mut self) -> bool {
+        self.0.next().is_none()
     }
 }
 

@@ -6,9 +6,11 @@
 //!
 //! Invariants: every piece is rendered once; a band is handed to the sink
 //! only when all its pieces are in, and bands in order; a panicking worker
-//! is counted out so the writer never waits for it.
+//! is counted out so the writer never waits for it; once the render's stop
+//! is set (Ctrl-C), every worker stops before its next ray, inside a pixel,
+//! and no band after is written.
 
-use crate::{Partition, RenderOptions, RowSink, NO_OBJECT, TILE_SIDE};
+use crate::{Partition, RenderOptions, RowSink, StreamError, NO_OBJECT, TILE_SIDE};
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::pixelcolor::RgbColor;
 use embedded_graphics_core::primitives::Rectangle;
@@ -16,6 +18,7 @@ use octrace_core::accel::{Accelerator, Mailbox};
 use octrace_core::render::{Renderer, ScreenBound, Tiles};
 use octrace_core::scene::SceneView;
 use octrace_core::shade::Stats;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::{Duration, Instant};
 
@@ -82,7 +85,7 @@ struct Window {
     slots: Vec<Slot>,
     /// Threads still rendering.
     alive: usize,
-    /// The sink failed: stop.
+    /// The sink failed, or the render's stop was set: stop.
     abort: bool,
 }
 
@@ -93,7 +96,8 @@ const WINDOW_BYTES: usize = 64 << 20;
 /// Renders `rows` on `options.threads` threads, each with its own renderer
 /// (and mailbox): threads take pieces of the bands in order, at most a
 /// window of bands ahead of the oldest one not yet written, while this
-/// thread hands finished bands to `sink` in order.
+/// thread hands finished bands to `sink` in order. `options.stop`, once
+/// set, stops every thread inside the pixel it traces.
 pub(crate) fn stream_threads<A: Accelerator + Sync>(
     view: SceneView<'_>,
     accel: &A,
@@ -102,7 +106,7 @@ pub(crate) fn stream_threads<A: Accelerator + Sync>(
     options: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
     sink: &mut dyn RowSink,
-) -> std::io::Result<(Stats, Duration, Vec<Duration>)> {
+) -> Result<(Stats, Duration, Vec<Duration>), StreamError> {
     let threads = options.threads.max(1);
     let (bands, pieces) = bands(w, &rows, options.partition);
     let mut pieces_in_band = vec![0usize; bands.len()];
@@ -160,9 +164,14 @@ pub(crate) fn stream_threads<A: Accelerator + Sync>(
             };
             drop(state);
             let began = Instant::now();
-            let tile = Tile::render(&mut renderer, &piece.area);
+            let tile = Tile::render(&mut renderer, &piece.area, options.stop);
             busy += began.elapsed();
             let mut state = lock();
+            let Some(tile) = tile else {
+                state.abort = true;
+                changed.notify_all();
+                return (renderer.stats(), busy);
+            };
             let slot = &mut state.slots[piece.band % window];
             tile.copy_into(slot, bands[piece.band].start, w);
             slot.remaining -= 1;
@@ -173,14 +182,19 @@ pub(crate) fn stream_threads<A: Accelerator + Sync>(
             progress(piece.area.size.width as u64 * piece.area.size.height as u64);
         }
     };
-    let mut writer = || -> std::io::Result<()> {
+    let stopped = || options.stop.is_some_and(|stop| stop.load(Ordering::Relaxed));
+    let mut writer = || -> Result<(), StreamError> {
         for (band, ys) in bands.iter().enumerate() {
             let mut state = lock();
             let index = band % window;
             while state.slots[index].band != band || state.slots[index].remaining > 0 {
+                if state.abort && stopped() {
+                    return Err(StreamError::Stopped);
+                }
                 if state.alive == 0 {
                     // A thread died (its panic is raised when the scope ends).
-                    return Err(std::io::Error::other("the render stopped before the image was complete"));
+                    let stopped = std::io::Error::other("the render stopped before the image was complete");
+                    return Err(StreamError::Sink(stopped));
                 }
                 state = changed.wait(state).unwrap_or_else(|poisoned| poisoned.into_inner());
             }
@@ -192,10 +206,10 @@ pub(crate) fn stream_threads<A: Accelerator + Sync>(
                 sink.row(y, &colors[3 * i * width..3 * (i + 1) * width], &objects[i * width..(i + 1) * width])
             });
             let mut state = lock();
-            if result.is_err() {
+            if let Err(e) = result {
                 state.abort = true;
                 changed.notify_all();
-                return result;
+                return Err(StreamError::Sink(e));
             }
             state.slots[index] = if band + window < bands.len() {
                 slot(band + window, colors, objects)
@@ -231,17 +245,26 @@ struct Tile {
 }
 
 impl Tile {
-    fn render<A: Accelerator>(renderer: &mut Renderer<'_, A>, area: &Rectangle) -> Tile {
+    /// The pixels of `area`; None once `stop` is set (asked between rays).
+    fn render<A: Accelerator>(
+        renderer: &mut Renderer<'_, A>,
+        area: &Rectangle,
+        stop: Option<&AtomicBool>,
+    ) -> Option<Tile> {
         let (x0, y0) = (area.top_left.x as u32, area.top_left.y as u32);
         let count = area.size.width as usize * area.size.height as usize;
         let mut tile = Tile { area: *area, colors: Vec::with_capacity(3 * count), objects: Vec::with_capacity(count) };
         for y in y0..y0 + area.size.height {
-            for p in renderer.row(y, x0..x0 + area.size.width) {
+            for x in x0..x0 + area.size.width {
+                let p = match stop {
+                    None => renderer.pixel(x, y),
+                    Some(stop) => renderer.pixel_until(x, y, &mut || stop.load(Ordering::Relaxed)).ok()?,
+                };
                 tile.colors.extend([p.color.r(), p.color.g(), p.color.b()]);
                 tile.objects.push(p.object.map_or(NO_OBJECT, |o| o.0));
             }
         }
-        tile
+        Some(tile)
     }
 
     /// Copies the tile into the band starting at row `top` of an image

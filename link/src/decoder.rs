@@ -10,7 +10,7 @@
 
 use crate::cobs::BlockDecoder;
 use crate::frame::{RawFrame, Reason, Refusal, OVERHEAD};
-use crate::message::Message;
+use crate::message::{Kind, Message};
 
 /// A message received whole, with the tag of the request it asks or answers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -63,13 +63,42 @@ pub struct Decoder<B> {
     blocks: BlockDecoder,
     /// The frame the last byte ended, and its length on the line.
     ended: Option<(Ended, u32)>,
+    /// The kinds it takes: sent by hosts, by boards, or (None) either.
+    takes_from_hosts: Option<bool>,
 }
 
 impl<B> Decoder<B> {
     /// A decoder keeping frames in `buffer` (`&mut [u8]`, `[u8; N]`,
     /// `Vec<u8>`): a frame longer than it is refused ([`Reason::TooLong`]).
     pub const fn new(buffer: B) -> Decoder<B> {
-        Decoder { buffer, held: 0, unstuffed: 0, length: 0, blocks: BlockDecoder::new(), ended: None }
+        Decoder::taking(buffer, None)
+    }
+
+    const fn taking(buffer: B, takes_from_hosts: Option<bool>) -> Decoder<B> {
+        Decoder { buffer, held: 0, unstuffed: 0, length: 0, blocks: BlockDecoder::new(), ended: None, takes_from_hosts }
+    }
+
+    /// A board's decoder: as [`Decoder::new`], but a frame of a kind that
+    /// boards send is refused as [`Reason::Unexpected`] before its payload
+    /// is read (the protocol checks the kind first).
+    ///
+    /// ```
+    /// use octrace_link::{Decoder, Kind, Message, Reason};
+    ///
+    /// let mut wire = Vec::new();
+    /// Message::Row { y: 0, pixels: &[1, 2, 3] }.encode(9, &mut wire).unwrap();
+    /// let mut decoder = Decoder::for_board([0u8; 64]);
+    /// let refused = wire.iter().find_map(|&byte| decoder.push(byte).map(|r| r.map(|_| ()))).unwrap().unwrap_err();
+    /// assert_eq!((refused.tag, refused.reason), (9, Reason::Unexpected { kind: Kind::Row.byte() }));
+    /// ```
+    pub const fn for_board(buffer: B) -> Decoder<B> {
+        Decoder::taking(buffer, Some(true))
+    }
+
+    /// A host's decoder: a frame of a kind that hosts send is refused as
+    /// [`Reason::Unexpected`], as [`Decoder::for_board`] does the other way.
+    pub const fn for_host(buffer: B) -> Decoder<B> {
+        Decoder::taking(buffer, Some(false))
     }
 }
 
@@ -125,7 +154,13 @@ impl<B: AsRef<[u8]> + AsMut<[u8]>> Decoder<B> {
         Some(match ended {
             Ended::Refused(refusal) => Err(refusal),
             Ended::Held(held) => RawFrame::check(&self.buffer.as_ref()[..held], length).and_then(|raw| {
-                let message = Message::decode(raw.kind, raw.payload);
+                let other_ends = Kind::from_byte(raw.kind)
+                    .zip(self.takes_from_hosts)
+                    .is_some_and(|(kind, from_hosts)| kind.from_host() != from_hosts);
+                let message = match other_ends {
+                    true => Err(Reason::Unexpected { kind: raw.kind }),
+                    false => Message::decode(raw.kind, raw.payload),
+                };
                 message
                     .map(|message| Frame { tag: raw.tag, message })
                     .map_err(|reason| Refusal { tag: raw.tag, reason })
@@ -214,6 +249,30 @@ mod tests {
         encode_raw(VERSION + 1, Kind::Hello.byte(), 0x1234, &[], &mut line).unwrap();
         let wrong = Reason::WrongVersion { expected: VERSION, found: VERSION + 1 };
         assert_eq!(read(&line, 64), [refused(0x1234, wrong)]);
+    }
+
+    #[test]
+    fn each_end_refuses_the_kinds_it_never_receives_before_their_payload() {
+        // Every kind, with a payload that fits no kind's layout.
+        for kind in Kind::ALL {
+            let mut line = Vec::new();
+            encode_raw(VERSION, kind.byte(), 0x4b1d, &[0xff], &mut line).unwrap();
+            let unexpected = refused(0x4b1d, Reason::Unexpected { kind: kind.byte() });
+            let malformed = refused(0x4b1d, Reason::Malformed { kind: kind.byte() });
+            let mut board = Decoder::for_board([0u8; 64]);
+            let mut host = Decoder::for_host([0u8; 64]);
+            let mut either = Decoder::new([0u8; 64]);
+            let read = |decoder: &mut Decoder<[u8; 64]>| {
+                line.iter().find_map(|&b| decoder.push(b).map(|r| r.map(|f| (f.tag, f.message.kind()))))
+            };
+            let (at_board, at_host) = match kind.from_host() {
+                true => (malformed, unexpected),
+                false => (unexpected, malformed),
+            };
+            assert_eq!(read(&mut board), Some(at_board), "{kind} at a board");
+            assert_eq!(read(&mut host), Some(at_host), "{kind} at a host");
+            assert_eq!(read(&mut either), Some(malformed), "{kind} at either");
+        }
     }
 
     #[test]

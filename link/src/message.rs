@@ -161,6 +161,27 @@ pub struct Panel {
 }
 
 impl Panel {
+    /// The longest side of a panel, in pixels: octrace-core's largest image
+    /// side (`octrace_core::scene::MAX_SIDE`), so that a host can render
+    /// what a board draws and compare.
+    pub const MAX_SIDE: u16 = 16384;
+
+    /// Whether both sides are from 1 to [`Panel::MAX_SIDE`], as the protocol
+    /// allows; a host refuses any other panel before it sets anything
+    /// aside for its picture.
+    ///
+    /// ```
+    /// use octrace_link::{Panel, PixelFormat};
+    ///
+    /// let panel = |width, height| Panel { width, height, format: PixelFormat::Rgb565 };
+    /// assert!(panel(240, 240).within_limits());
+    /// assert!(!panel(0, 240).within_limits());
+    /// assert!(!panel(65535, 65535).within_limits());
+    /// ```
+    pub const fn within_limits(&self) -> bool {
+        self.width >= 1 && self.width <= Self::MAX_SIDE && self.height >= 1 && self.height <= Self::MAX_SIDE
+    }
+
     /// The bytes of one of its rows.
     pub const fn row_bytes(&self) -> usize {
         self.width as usize * self.format.bytes_per_pixel()

@@ -90,23 +90,26 @@ pub extern "C" fn studio_render(x: u32, y: u32, width: u32, height: u32) -> u32 
 
 /// The input (a whole render, as `studio_render` writes it) shown in
 /// `display` (0 truecolour, 1 scan, 2 dither, 3 coarse, 4 gray, 5 rgb565,
-/// 6 gray4): the output is its RGB bytes.
+/// 6 gray4, 7 mono, 8 gray2, 9 bwr; the panels of few levels dithered by
+/// `dithering`: 0 fs-pe, 1 fs, 2 bayer, 3 nearest): the output is its RGB
+/// bytes.
 #[no_mangle]
-pub extern "C" fn studio_display(display: u32, width: u32, height: u32) -> u32 {
+pub extern "C" fn studio_display(display: u32, dithering: u32, width: u32, height: u32) -> u32 {
     run(|state| {
-        let display = Display::from_code(display).ok_or(StudioError::BadInput("no such display"))?;
+        let display = Display::from_codes(display, dithering).ok_or(StudioError::BadInput("no such display"))?;
         let (image, objects) = studio::split_render(width, height, &state.input)?;
         state.output = studio::display(&image, &objects, display).to_rgb().data;
         Ok(())
     })
 }
 
-/// The input (a whole render) in `display`, as a file of `format` (0 PNG,
-/// 1 Targa, 2 Sun raster): indexed for the 256-colour displays.
+/// The input (a whole render) in `display` (as `studio_display` takes it),
+/// as a file of `format` (0 PNG, 1 Targa, 2 Sun raster): indexed for the
+/// 256-colour displays.
 #[no_mangle]
-pub extern "C" fn studio_encode(display: u32, format: u32, width: u32, height: u32) -> u32 {
+pub extern "C" fn studio_encode(display: u32, dithering: u32, format: u32, width: u32, height: u32) -> u32 {
     run(|state| {
-        let display = Display::from_code(display).ok_or(StudioError::BadInput("no such display"))?;
+        let display = Display::from_codes(display, dithering).ok_or(StudioError::BadInput("no such display"))?;
         let format = Format::ALL.get(format as usize).copied().ok_or(StudioError::BadInput("no such format"))?;
         let (image, objects) = studio::split_render(width, height, &state.input)?;
         state.output = studio::encode(&studio::display(&image, &objects, display), format)?;

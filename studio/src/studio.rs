@@ -8,6 +8,7 @@ use embedded_graphics_core::pixelcolor::RgbColor;
 use octrace_core::accel::{
     self, Accelerator, LightBufferStore, LightBuffered, Mailbox, Naive, Octree, MAX_CELLS_A_SIDE,
 };
+use octrace_core::panel::{Dithering, Panel};
 use octrace_core::parse::{parse_bytes, ParseError};
 use octrace_core::profile::{Host, Profile};
 use octrace_core::render::{Renderer, ScreenBound};
@@ -25,23 +26,31 @@ pub fn accel_from_code(code: u32) -> Option<AccelMode> {
 }
 
 /// How a finished image is shown: truecolour, one of the four 256-colour
-/// modes, or a panel's colour depth.
+/// modes, a panel's colour depth, or a panel of few levels, dithered.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Display {
     Palette(PaletteMode),
     Rgb565,
-    Gray4,
+    Panel(Panel, Dithering),
 }
+
+/// The panels of few levels in the page's order, from code 6.
+const PANELS: [Panel; 4] = [Panel::Gray4, Panel::Mono, Panel::Gray2, Panel::BlackWhiteRed];
 
 impl Display {
     /// The display numbered `code` by the page: 0 truecolour, 1 scan,
-    /// 2 dither, 3 coarse, 4 gray, 5 rgb565, 6 gray4.
-    pub fn from_code(code: u32) -> Option<Display> {
+    /// 2 dither, 3 coarse, 4 gray, 5 rgb565, 6 gray4, 7 mono, 8 gray2,
+    /// 9 bwr; a panel of few levels dithered by `dithering`, the code of
+    /// its method ([`Dithering::ALL`]'s order: 0 fs-pe, 1 fs, 2 bayer,
+    /// 3 nearest).
+    pub fn from_codes(code: u32, dithering: u32) -> Option<Display> {
         match code {
             0..=4 => Some(Display::Palette(PaletteMode::ALL[code as usize])),
             5 => Some(Display::Rgb565),
-            6 => Some(Display::Gray4),
-            _ => None,
+            _ => {
+                let panel = PANELS.get(code as usize - 6)?;
+                Some(Display::Panel(*panel, *Dithering::ALL.get(dithering as usize)?))
+            }
         }
     }
 }
@@ -205,7 +214,7 @@ pub fn display(image: &RgbImage, objects: &[u32], display: Display) -> Image {
         Display::Palette(mode) => palette::apply(image, objects, mode),
         Display::Rgb565 => Image::Rgb(panel::rgb565(image)),
         // As RGB, so that a saved file is the picture shown whatever the format.
-        Display::Gray4 => Image::Rgb(panel::gray4(image).to_rgb()),
+        Display::Panel(shown, dithering) => Image::Rgb(panel::dithered(image, shown, dithering).to_rgb()),
     }
 }
 
@@ -276,8 +285,13 @@ mod tests {
         }
         let panel = display(&image, &[NO_OBJECT; 2], Display::Rgb565).to_rgb();
         assert_eq!(panel.pixel(0, 0), [255, 130, 8]);
-        let gray = display(&image, &[NO_OBJECT; 2], Display::Gray4).to_rgb();
+        let gray = display(&image, &[NO_OBJECT; 2], Display::from_codes(6, 0).unwrap()).to_rgb();
         assert!(gray.data.chunks(3).all(|p| p[0] == p[1] && p[1] == p[2]));
+        let mono = display(&image, &[NO_OBJECT; 2], Display::from_codes(7, 2).unwrap()).to_rgb();
+        assert!(mono.data.iter().all(|&v| v == 0 || v == 255));
+        assert_eq!(Display::from_codes(9, 3), Some(Display::Panel(Panel::BlackWhiteRed, Dithering::Nearest)));
+        assert_eq!(Display::from_codes(10, 0), None);
+        assert_eq!(Display::from_codes(7, 4), None);
         assert!(decode(b"not an image").is_err());
     }
 }

@@ -5,10 +5,18 @@
 //! pseudo-terminal) or an emulated one, chosen by [`RunningBoard::for_tests`]
 //! — and a raw host that sends it frames the protocol refuses.
 //!
+//! A board's command also takes commands, a line each on its standard
+//! input, answered with a line on its standard output
+//! ([`RunningBoard::command`]): `hold` and `release` (the host stops taking
+//! what the board sends, and takes it again), `times` (the board's clock
+//! when the host last handed it bytes, when it last sent some, now, its
+//! watchdog's time left, and whether it waits for the host:
+//! [`BoardTimes`]) and `panel PATH` (its panel's picture as a PNG file).
+//!
 //! Invariants: a [`RunningBoard`] is ended (by its own process id) when it
 //! is dropped, and its command ends by itself when its standard input
 //! closes, so no board outlives its test; every read of a [`RawHost`]
-//! gives up after its timeout.
+//! and every command gives up after its timeout.
 
 use host_sim::board::{BoardDescription, BoardLink};
 use octrace_link::{Decoder, Frame, Refusal};
@@ -16,8 +24,25 @@ use std::collections::VecDeque;
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read, Write};
 use std::path::PathBuf;
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, ChildStdin, Command, Stdio};
+use std::sync::mpsc::{self, Receiver};
 use std::time::{Duration, Instant};
+
+/// A scene that wedged the board before it could stop inside a pixel:
+/// two facing mirrors with the eye between them (each sample bounces 4,096
+/// times), `lights` lights (up to eight), 16² samples a pixel: a pixel
+/// takes hours on a Pico, seconds on a PC. The format allows all of it.
+pub fn wedging_scene(lights: u32) -> String {
+    let lights = lights.clamp(1, 8);
+    let positions = ["0 1", "0 -1", "1 0", "-1 0", "1 1", "-1 1", "1 -1", "-1 -1"];
+    let mut text = String::from("VIEWPOINT 0 0 0\nORIGIN 0 0 -1\nRDEPTH 1000000\nSAMPLES 16\n");
+    for position in &positions[..lights as usize] {
+        text += &format!("LIGHT 1 {position} 0\n");
+    }
+    text + "RECTANGLE 1 -5 -5 -3 5 -5 -3 5 5 -3 -5 5 -3\n\
+            RECTANGLE 1 -5 -5 3 -5 5 3 5 5 3 5 -5 3\n\
+            SURFACE 1 0.01 0.01 0.01 0.1 0.1 0.1 0 0 0 0 1 0\n"
+}
 
 /// A pseudo-terminal in raw mode (no echo, no line editing): the board's
 /// end (the controller) and the path a host opens.
@@ -42,6 +67,25 @@ pub struct RunningBoard {
     child: Child,
     /// The serial device a host opens.
     pub port: PathBuf,
+    commands: ChildStdin,
+    answers: Receiver<String>,
+}
+
+/// What a board's `times` command answers: microseconds by the board's
+/// clock.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BoardTimes {
+    /// When the host last handed the board bytes.
+    pub last_in: Option<u64>,
+    /// When the board last sent bytes to the host.
+    pub last_out: Option<u64>,
+    /// Now.
+    pub now: u64,
+    /// How long the board's watchdog has left; None when it is stopped or
+    /// the board has none.
+    pub watchdog_left: Option<u64>,
+    /// Whether the board waits for the host (nothing to do).
+    pub idle: bool,
 }
 
 impl RunningBoard {
@@ -57,6 +101,7 @@ impl RunningBoard {
             .spawn()
             .map_err(|e| format!("cannot start {program}: {e}"))?;
         let stdout = child.stdout.take().ok_or("no standard output")?;
+        let commands = child.stdin.take().ok_or("no standard input")?;
         let mut lines = BufReader::new(stdout).lines();
         let port = loop {
             match lines.next() {
@@ -72,9 +117,46 @@ impl RunningBoard {
                 }
             }
         };
-        // The rest of its output goes nowhere, without blocking it.
-        std::thread::spawn(move || lines.for_each(drop));
-        Ok(RunningBoard { child, port })
+        // The rest of its output answers commands, read as it comes.
+        let (send, answers) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in lines.map_while(Result::ok) {
+                let _ = send.send(line);
+            }
+        });
+        Ok(RunningBoard { child, port, commands, answers })
+    }
+
+    /// Sends the board `command` (see the module's documentation) and
+    /// returns its answer.
+    pub fn command(&mut self, command: &str) -> String {
+        writeln!(self.commands, "{command}").and_then(|()| self.commands.flush()).expect("the board takes commands");
+        self.answers.recv_timeout(Duration::from_secs(30)).unwrap_or_else(|e| panic!("no answer to {command}: {e}"))
+    }
+
+    /// The board's `times`.
+    pub fn times(&mut self) -> BoardTimes {
+        let answer = self.command("times");
+        let field = |word: Option<&str>| word.and_then(|w| w.parse::<u64>().ok());
+        let mut words = answer.strip_prefix("times ").unwrap_or_else(|| panic!("times: {answer}")).split(' ');
+        let (last_in, last_out, now, watchdog_left) =
+            (field(words.next()), field(words.next()), field(words.next()), field(words.next()));
+        let idle = words.next() == Some("1");
+        BoardTimes { last_in, last_out, now: now.unwrap_or_else(|| panic!("times: {answer}")), watchdog_left, idle }
+    }
+
+    /// Waits (up to `timeout`) until the board has taken bytes sent after
+    /// `since` (its clock) and has nothing more to do; its times then.
+    pub fn wait_idle_after(&mut self, since: u64, timeout: Duration) -> BoardTimes {
+        let deadline = Instant::now() + timeout;
+        loop {
+            let times = self.times();
+            if times.idle && times.last_in.is_some_and(|t| t > since) {
+                return times;
+            }
+            assert!(Instant::now() < deadline, "the board is still busy after {timeout:?}: {times:?}");
+            std::thread::sleep(Duration::from_millis(50));
+        }
     }
 
     /// The software board with these arguments (`--profile`, `--panel`,
@@ -126,6 +208,62 @@ impl Drop for RunningBoard {
     }
 }
 
+/// The dearest scene `board` holds: exactly its longest text, as many of
+/// each kind of object as it holds (and of lights and surfaces), all of
+/// them around the origin and filling the view from just outside them, so
+/// that every ray meets the bounds of every object (one octree leaf, one
+/// light-buffer cell), 16² samples, mirrors and glass: its pixels are the
+/// dearest the board can be given from the first, each ray the longest
+/// between two of its polls.
+pub fn dearest_scene(board: &BoardDescription) -> String {
+    let holds = |name: &str| board.capacities.iter().find(|(n, _)| n == name).map_or(0, |(_, n)| *n as usize);
+    let mut objects = holds("objects");
+    let mut take = |kind: &str| {
+        let count = holds(kind).min(objects);
+        objects -= count;
+        count
+    };
+    let surfaces = holds("surfaces").max(1);
+    let mut text = String::from("VIEWPOINT 0 0 3.5\nORIGIN 0 0 0\nRDEPTH 1000000\nSAMPLES 16\n");
+    for light in 0..holds("lights") {
+        text += &format!("LIGHT 1 {} {} 9\n", light % 3 * 4, light / 3 * 4);
+    }
+    // Each object a little off the last, all around the origin.
+    let mut surface = 0;
+    let mut next = || {
+        surface += 1;
+        (surface - 1) % surfaces + 1
+    };
+    let at = |i: usize| (i % 10) as f64 / 50.0;
+    for i in 0..take("spheres") {
+        text += &format!("SPHERE {} 2 {} {} 0\n", next(), at(i), at(i / 10));
+    }
+    for i in 0..take("boxes") {
+        text += &format!("BOX {} {} 0 0 1.5 1.5 1.5\n", next(), at(i));
+    }
+    for i in 0..take("superquadrics") {
+        text += &format!("SUPERQUADRIC {} 3.5 0 {} 0 1.8 1.8 1.8\n", next(), at(i));
+    }
+    for i in 0..take("triangles") {
+        text += &format!("TRIANGLE {} -3 -3 {} 3 -3 0 0 3 0\n", next(), at(i));
+    }
+    for i in 0..take("rectangles") {
+        let (s, z) = (next(), at(i) - 0.5);
+        text += &format!("RECTANGLE {s} -3 -3 {z} 3 -3 {z} 3 3 {z} -3 3 {z}\n");
+    }
+    for n in 1..=surfaces {
+        text += &format!("SURFACE {n} .05 .05 .05 .3 .3 .3 .2 .2 .2 10 .5 .4\n");
+    }
+    let room = (board.max_scene as usize).checked_sub(text.len() + 4);
+    let room = room.unwrap_or_else(|| panic!("the dearest scene is {} bytes: longer than the board takes", text.len()));
+    text + "/*" + &"x".repeat(room) + "*/"
+}
+
+/// How many lights `board` holds.
+pub fn lights(board: &BoardDescription) -> u32 {
+    board.capacities.iter().find(|(name, _)| name == "lights").map_or(0, |(_, n)| *n)
+}
+
 /// Whether scene `text` fits what the board holds: its length and every
 /// capacity of its profile.
 pub fn fits(board: &BoardDescription, text: &str) -> bool {
@@ -142,6 +280,8 @@ pub struct RawHost {
     port: Box<dyn serialport::SerialPort>,
     decoder: Decoder<Vec<u8>>,
     unread: VecDeque<u8>,
+    /// Bytes read from the board so far.
+    read: u64,
 }
 
 impl RawHost {
@@ -152,7 +292,13 @@ impl RawHost {
             .timeout(Duration::from_millis(50))
             .open()
             .unwrap_or_else(|e| panic!("cannot open {}: {e}", port.display()));
-        RawHost { port, decoder: Decoder::new(vec![0; 1 << 18]), unread: VecDeque::new() }
+        RawHost { port, decoder: Decoder::for_host(vec![0; 1 << 18]), unread: VecDeque::new(), read: 0 }
+    }
+
+    /// Bytes read from the board so far (up to the end of the last frame
+    /// handed on).
+    pub fn bytes_read(&self) -> u64 {
+        self.read
     }
 
     pub fn send(&mut self, bytes: &[u8]) {
@@ -170,6 +316,7 @@ impl RawHost {
         let deadline = Instant::now() + timeout;
         loop {
             while let Some(byte) = self.unread.pop_front() {
+                self.read += 1;
                 if let Some(received) = self.decoder.push(byte) {
                     if each(received) {
                         return true;

@@ -8,6 +8,7 @@
 //! time.
 
 use crate::repo;
+use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
 use octrace_images::formats::Image;
 use octrace_images::palette::{self, PaletteMode};
@@ -67,6 +68,8 @@ pub struct Firmware {
     pub width: u32,
     pub height: u32,
     pub wire: PanelColor,
+    /// How a panel of few levels is dithered (`OCTRACE_DITHER`).
+    pub dithering: Dithering,
 }
 
 /// What a run printed and wrote.
@@ -81,19 +84,33 @@ pub struct Run {
 }
 
 impl Run {
-    /// The peak stack the firmware reports (`peak stack: N bytes`).
+    /// The peak stack the firmware reports.
     pub fn peak_stack(&self) -> Option<u64> {
-        self.output.lines().find_map(|l| l.strip_prefix("peak stack: ")?.strip_suffix(" bytes")?.parse().ok())
+        peak_stack(&self.output)
     }
+}
+
+/// The peak stack a firmware's output reports (`peak stack: N bytes`).
+fn peak_stack(output: &str) -> Option<u64> {
+    output.lines().find_map(|l| l.strip_prefix("peak stack: ")?.strip_suffix(" bytes")?.parse().ok())
 }
 
 impl Firmware {
     pub fn new(board: Board, scene: &str, width: u32, height: u32, wire: PanelColor) -> Firmware {
-        Firmware { board, scene: scene.to_owned(), width, height, wire }
+        Firmware { board, scene: scene.to_owned(), width, height, wire, dithering: Dithering::default() }
+    }
+
+    /// The same, a panel of few levels dithered by `dithering`.
+    pub fn dithered(self, dithering: Dithering) -> Firmware {
+        Firmware { dithering, ..self }
     }
 
     fn slug(&self) -> String {
-        format!("{}-{}-{}x{}-{}", self.board.machine(), self.scene, self.width, self.height, self.wire.name())
+        let (board, scene, wire) = (self.board.machine(), &self.scene, self.wire.name());
+        match self.wire.panel() {
+            Some(_) => format!("{board}-{scene}-{}x{}-{wire}-{}", self.width, self.height, self.dithering.name()),
+            None => format!("{board}-{scene}-{}x{}-{wire}", self.width, self.height),
+        }
     }
 
     fn target_dir(&self) -> PathBuf {
@@ -121,6 +138,7 @@ impl Firmware {
         cargo.env("OCTRACE_SCENE", &self.scene);
         cargo.env("OCTRACE_SIZE", format!("{}x{}", self.width, self.height));
         cargo.env("OCTRACE_COLOR", self.wire.name());
+        cargo.env("OCTRACE_DITHER", self.dithering.name());
         cargo.env("OCTRACE_OUT", self.output_file());
         let out = cargo.output().map_err(|e| format!("cannot run cargo: {e}"))?;
         if !out.status.success() {
@@ -153,12 +171,14 @@ impl Firmware {
         let options = host_sim::RenderOptions { size: Some((self.width, self.height)), ..Default::default() };
         let rendered = host_sim::render(&scene, &options).map_err(|e| format!("{e:?}"))?;
         let image = rendered.image;
-        Ok(match self.wire {
-            PanelColor::Rgb888 => image.data,
-            PanelColor::Rgb565 => image.data.chunks(3).flat_map(|p| rgb565(p[0], p[1], p[2]).to_be_bytes()).collect(),
-            // host-sim's gray4 preview and dither: their indices are the wire's.
-            PanelColor::Gray4 => indices(panel::gray4(&image))?,
-            PanelColor::Dither => indices(palette::apply(&image, &rendered.objects, PaletteMode::Dither))?,
+        Ok(match (self.wire, self.wire.panel()) {
+            // host-sim's panel previews and dither: their indices are the wire's.
+            (_, Some(shown)) => indices(panel::dithered(&image, shown, self.dithering))?,
+            (PanelColor::Rgb565, None) => {
+                image.data.chunks(3).flat_map(|p| rgb565(p[0], p[1], p[2]).to_be_bytes()).collect()
+            }
+            (PanelColor::Dither, None) => indices(palette::apply(&image, &rendered.objects, PaletteMode::Dither))?,
+            _ => image.data,
         })
     }
 }
@@ -194,7 +214,14 @@ pub fn run_oled_command(scene: &str, out: &Path) -> Result<Run, String> {
     cargo.current_dir(repo().join("firmware"));
     cargo.args(["run", "--release", "--quiet", "--target", "thumbv7m-none-eabi"]);
     cargo.arg("--target-dir").arg(repo().join("target/firmware/lm3s6965evb-run"));
-    for var in ["CARGO_TARGET_DIR", "RUSTFLAGS", "CARGO_ENCODED_RUSTFLAGS", "CARGO_BUILD_TARGET", "OCTRACE_SIZE"] {
+    for var in [
+        "CARGO_TARGET_DIR",
+        "RUSTFLAGS",
+        "CARGO_ENCODED_RUSTFLAGS",
+        "CARGO_BUILD_TARGET",
+        "OCTRACE_SIZE",
+        "OCTRACE_DITHER",
+    ] {
         cargo.env_remove(var);
     }
     cargo.env("OCTRACE_BOARD", "lm3s6965evb");
@@ -219,6 +246,13 @@ pub struct Measurement {
     pub flash: u64,
     /// Static RAM: data + bss.
     pub static_ram: u64,
+}
+
+impl Measurement {
+    /// The peak stack the firmware reports.
+    pub fn peak_stack(&self) -> Option<u64> {
+        peak_stack(&self.output)
+    }
 }
 
 impl Firmware {

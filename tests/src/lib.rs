@@ -13,8 +13,22 @@ pub fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// Every scene file in `scenes/`, sorted by name: (name, path).
+/// Every still scene in `scenes/`, sorted by name: (name, path). The
+/// animations (`anim_*.txt`, see [`animations`]) are not among them.
 pub fn scenes() -> Vec<(String, PathBuf)> {
+    scene_files().into_iter().filter(|(name, _)| !name.starts_with(ANIMATION_PREFIX)).collect()
+}
+
+/// Every animation in `scenes/` (a scene with FRAMES, named `anim_*.txt`),
+/// sorted by name: (name, path).
+pub fn animations() -> Vec<(String, PathBuf)> {
+    scene_files().into_iter().filter(|(name, _)| name.starts_with(ANIMATION_PREFIX)).collect()
+}
+
+/// How the names of the animations in `scenes/` begin.
+const ANIMATION_PREFIX: &str = "anim_";
+
+fn scene_files() -> Vec<(String, PathBuf)> {
     let mut v: Vec<(String, PathBuf)> = std::fs::read_dir(repo().join("scenes"))
         .expect("scenes/ exists")
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -28,7 +42,16 @@ pub fn scenes() -> Vec<(String, PathBuf)> {
 /// Writes host-sim's preview of a panel, as its user asks for it:
 /// `host-sim scenes/SCENE.txt OUT --size WxH --color COLOR --quiet`.
 pub fn host_sim_preview(scene: &str, out: &std::path::Path, size: &str, color: &str) -> Result<(), String> {
-    let path = repo().join("scenes").join(format!("{scene}.txt"));
+    host_sim_preview_of(&repo().join("scenes").join(format!("{scene}.txt")), out, size, color)
+}
+
+/// [`host_sim_preview`] of the scene file at `path`.
+pub fn host_sim_preview_of(
+    path: &std::path::Path,
+    out: &std::path::Path,
+    size: &str,
+    color: &str,
+) -> Result<(), String> {
     let args = [
         "host-sim".as_ref(),
         path.as_os_str(),
@@ -89,4 +112,33 @@ impl Rng {
     pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
     }
+}
+
+/// The first bash block after `<!-- recipe: NAME -->` in docs/distributed.md.
+pub fn recipe(name: &str) -> String {
+    let doc = std::fs::read_to_string(repo().join("docs/distributed.md")).unwrap();
+    let marker = format!("<!-- recipe: {name} -->");
+    let after = &doc[doc.find(&marker).unwrap_or_else(|| panic!("no {marker} in docs/distributed.md"))..];
+    let start = after.find("```bash\n").expect("a bash block") + "```bash\n".len();
+    let end = after[start..].find("```").expect("the block ends");
+    after[start..start + end].to_owned()
+}
+
+/// Runs the recipe `script` with bash in `dir`, with `host_sim` on the PATH
+/// as `host-sim` (in `dir/bin`) and a HOME of its own (GNU parallel keeps
+/// its state there); panics with the script's errors if it fails.
+pub fn run_recipe(script: &str, dir: &std::path::Path, host_sim: &str) {
+    let home = tempfile::tempdir().unwrap();
+    let bin = dir.join("bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    std::os::unix::fs::symlink(host_sim, bin.join("host-sim")).unwrap();
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
+    let output = std::process::Command::new("bash")
+        .args(["-euo", "pipefail", "-c", script])
+        .current_dir(dir)
+        .env("PATH", path)
+        .env("HOME", home.path())
+        .output()
+        .expect("bash runs");
+    assert!(output.status.success(), "the recipe failed:\n{script}\n{}", String::from_utf8_lossy(&output.stderr));
 }

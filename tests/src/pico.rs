@@ -1,17 +1,19 @@
-//! Building the Raspberry Pi Pico template (`examples/pico-st7789`) for a
-//! scene, as its user does (`OCTRACE_SCENE`, and `OCTRACE_CODE_IN` and
-//! `OCTRACE_ORDER` to measure the other ways, at build time), and running
-//! its ELF on the emulated Pico (`emulator/`), for the
-//! bit-exactness tests and the Pico benchmark.
+//! Building a Raspberry Pi Pico template (`examples/pico-st7789`,
+//! `examples/pico-ssd1306`) for a scene, as its user does (`OCTRACE_SCENE`,
+//! and `OCTRACE_CODE_IN` and the ST7789's `OCTRACE_ORDER` to measure the
+//! other ways, at build time), and running its ELF on the emulated Pico
+//! (`emulator/`), for the bit-exactness tests and the Pico benchmark.
 //!
-//! The embedded-scene firmware answers on its USB serial port with what it
-//! measured of its scene by its own TIMER and bus counters ([`Report`]):
-//! [`ask_report`] reads it from a board's port, [`run_reporting`] from the
-//! emulated Pico's beside the emulator's own count.
+//! The ST7789 template's embedded-scene firmware answers on its USB serial
+//! port with what it measured of its scene by its own TIMER and bus
+//! counters ([`Report`]): [`ask_report`] reads it from a board's port,
+//! [`run_reporting`] from the emulated Pico's beside the emulator's own
+//! count.
 //!
-//! The builds share one target directory (`target/pico-st7789/`, apart from
-//! a developer's own): build one scene at a time; each ELF is copied out
-//! under the scene's name, so runs may overlap.
+//! The templates' builds share one target directory (`target/pico/`, apart
+//! from a developer's own, so their dependencies are built once): build one
+//! scene at a time; each ELF is copied out under the template's and the
+//! build's name, so runs may overlap.
 
 use crate::repo;
 use std::io::{BufRead, BufReader, Read, Write};
@@ -23,12 +25,52 @@ use std::time::{Duration, Instant};
 /// The emulated Pico's clock.
 pub const CLOCK_HZ: f64 = 125e6;
 
-fn template() -> PathBuf {
-    repo().join("examples/pico-st7789")
+/// A Pico template of the repository, and the panel it drives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Template {
+    /// `examples/pico-st7789`: a 240×240 ST7789 on SPI, RGB565.
+    St7789,
+    /// `examples/pico-ssd1306`: a 128×64 SSD1306 on I2C, one bit.
+    Ssd1306,
 }
 
+impl Template {
+    /// Every template, the ST7789 first.
+    pub const ALL: [Template; 2] = [Template::St7789, Template::Ssd1306];
+
+    /// Its folder in `examples/`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Template::St7789 => "pico-st7789",
+            Template::Ssd1306 => "pico-ssd1306",
+        }
+    }
+
+    /// Its embedded-scene firmware.
+    fn binary(self) -> &'static str {
+        match self {
+            Template::St7789 => "octrace-pico-st7789",
+            Template::Ssd1306 => "octrace-pico-ssd1306",
+        }
+    }
+
+    /// The panel's size and host-sim's preview of its colours
+    /// (`--size`, `--color`).
+    pub fn panel(self) -> (&'static str, &'static str) {
+        match self {
+            Template::St7789 => ("240x240", "rgb565"),
+            Template::Ssd1306 => ("128x64", "mono"),
+        }
+    }
+
+    fn dir(self) -> PathBuf {
+        repo().join("examples").join(self.name())
+    }
+}
+
+/// Where the templates are built.
 fn target_dir() -> PathBuf {
-    repo().join("target/pico-st7789")
+    repo().join("target/pico")
 }
 
 /// The scene the template embeds when `OCTRACE_SCENE` is not set.
@@ -37,11 +79,12 @@ const DEFAULT_SCENE: &str = "fig5_1";
 /// Where the template's code runs when `OCTRACE_CODE_IN` is not set.
 pub const DEFAULT_CODE_IN: &str = "parse-and-render";
 
-/// How the embedded-scene firmware is built: its scene, where its code runs
-/// (`OCTRACE_CODE_IN`) and its pixel order (`OCTRACE_ORDER`). The default is
-/// the template as a user builds it.
+/// How a template's embedded-scene firmware is built: its scene, where its
+/// code runs (`OCTRACE_CODE_IN`) and its pixel order (`OCTRACE_ORDER`, the
+/// ST7789's). The default is the template as a user builds it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Build<'a> {
+    pub template: Template,
     pub scene: &'a str,
     /// `parse-and-render` (the default), `render`, `sram` or `flash`.
     pub code_in: &'a str,
@@ -50,9 +93,9 @@ pub struct Build<'a> {
 }
 
 impl<'a> Build<'a> {
-    /// The template as a user builds it, with `scenes/SCENE.txt`.
-    pub fn of(scene: &'a str) -> Build<'a> {
-        Build { scene, code_in: DEFAULT_CODE_IN, order: "rows" }
+    /// `template` as a user builds it, with `scenes/SCENE.txt`.
+    pub const fn of(template: Template, scene: &'a str) -> Build<'a> {
+        Build { template, scene, code_in: DEFAULT_CODE_IN, order: "rows" }
     }
 
     /// What the build is named by: the scene, and what differs from the
@@ -72,11 +115,15 @@ impl<'a> Build<'a> {
 /// embedded-scene ELF. The default build is made as a user makes it,
 /// without any variable (and so as `scripts/test-all` built it already).
 pub fn build(build: &Build<'_>) -> Result<PathBuf, String> {
+    let template = build.template;
+    if template == Template::Ssd1306 && build.order != "rows" {
+        return Err(format!("{}: the SSD1306 template draws rows only, not {}", build.name(), build.order));
+    }
     let dir = target_dir();
     let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
     // The template's .cargo/config.toml (target, linker script) is found
     // from the working directory.
-    cargo.current_dir(template());
+    cargo.current_dir(template.dir());
     cargo.args(["build", "--release", "--quiet"]).arg("--target-dir").arg(&dir);
     for var in [
         "CARGO_TARGET_DIR",
@@ -101,13 +148,14 @@ pub fn build(build: &Build<'_>) -> Result<PathBuf, String> {
     let out = cargo.output().map_err(|e| format!("cannot run cargo: {e}"))?;
     if !out.status.success() {
         return Err(format!(
-            "the Pico template ({}) did not build:\n{}",
+            "the Pico template {} ({}) did not build:\n{}",
+            template.name(),
             build.name(),
             String::from_utf8_lossy(&out.stderr)
         ));
     }
-    let elf = dir.join(format!("{}.elf", build.name()));
-    std::fs::copy(dir.join("thumbv6m-none-eabi/release/octrace-pico-st7789"), &elf)
+    let elf = dir.join(format!("{}-{}.elf", template.name(), build.name()));
+    std::fs::copy(dir.join("thumbv6m-none-eabi/release").join(template.binary()), &elf)
         .map_err(|e| format!("cannot copy the ELF to {}: {e}", elf.display()))?;
     Ok(elf)
 }
@@ -130,12 +178,18 @@ pub fn sram_code_bytes(elf: &Path) -> Result<u64, String> {
 /// What one run on the emulated Pico took, in its cycles (125 MHz).
 #[derive(Clone, Copy, Debug)]
 pub struct Cycles {
-    /// Clocks, the panel's set-up and clear, up to the backlight.
+    /// Clocks, the panel's set-up and clear: up to the ST7789's backlight,
+    /// or the end of the SSD1306's clearing transfer.
     pub start_up: u64,
-    /// Parsing and indexing the scene, up to the picture's first row.
+    /// Parsing and indexing the scene, up to the picture's first row (the
+    /// ST7789) or the LED lit (the SSD1306).
     pub parse_and_index: u64,
-    /// Tracing the picture into the panel.
+    /// Tracing the picture into the panel (the SSD1306: into its buffer,
+    /// while the LED is lit).
     pub render: u64,
+    /// The SSD1306's picture sent over I2C, after the render (none for the
+    /// ST7789, which takes its rows as they are traced).
+    pub transfer: Option<u64>,
     /// From the picture's first command until every pixel of the panel has
     /// been written once: the whole panel coarse, in a progressive order.
     pub first_full_panel: u64,
@@ -158,9 +212,10 @@ pub struct Cycles {
 }
 
 impl Cycles {
-    /// From the scene text to the last pixel, in seconds at 125 MHz.
+    /// From the scene text to the last pixel on the panel, in seconds at
+    /// 125 MHz.
     pub fn to_picture_seconds(&self) -> f64 {
-        (self.parse_and_index + self.render) as f64 / CLOCK_HZ
+        (self.parse_and_index + self.render + self.transfer.unwrap_or(0)) as f64 / CLOCK_HZ
     }
 }
 
@@ -226,6 +281,7 @@ fn cycles_of(json: &[u8]) -> Result<Cycles, String> {
         start_up: phase("startUp")?,
         parse_and_index: phase("parseAndIndex")?,
         render: phase("render")?,
+        transfer: report["cycles"].get("transfer").map(|t| number(t, "transfer")).transpose()?,
         first_full_panel: phase("firstFullPanel")?,
         total: phase("total")?,
         cores: number(&report["cores"], "cores")?,

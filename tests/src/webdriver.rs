@@ -25,6 +25,18 @@ pub fn free_port() -> u16 {
 
 /// One HTTP/1.1 request to 127.0.0.1:`port`; returns (status, body).
 pub fn http(port: u16, method: &str, path: &str, headers: &[(&str, &str)], body: &[u8]) -> (u16, Vec<u8>) {
+    let (status, _, body) = http_with_head(port, method, path, headers, body);
+    (status, body)
+}
+
+/// As [`http`], with the response's head (its status line and headers) too.
+pub fn http_with_head(
+    port: u16,
+    method: &str,
+    path: &str,
+    headers: &[(&str, &str)],
+    body: &[u8],
+) -> (u16, String, Vec<u8>) {
     let mut stream = TcpStream::connect(("127.0.0.1", port)).expect("connect");
     stream.set_read_timeout(Some(Duration::from_secs(300))).ok();
     let mut head = format!("{method} {path} HTTP/1.1\r\nContent-Length: {}\r\nConnection: close\r\n", body.len());
@@ -69,7 +81,7 @@ pub fn http(port: u16, method: &str, path: &str, headers: &[(&str, &str)], body:
             stream.read_to_end(&mut body).expect("read");
         }
     }
-    (status, body)
+    (status, head, body)
 }
 
 impl Browser {

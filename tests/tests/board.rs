@@ -3,7 +3,12 @@
 //! with errors answered at each line and column with nothing drawn; a
 //! scene over the board's capacity refused naming it; a transfer cut off
 //! half-way, after which the board takes the next scene; garbage, a wrong
-//! checksum and a wrong version each answered, the board still alive.
+//! checksum and a wrong version each answered, the board still alive; and
+//! what a drawing that takes hours a pixel, a burst of frames, a host that
+//! stops reading, an error flood, a host gone mid-drawing and a scene of the
+//! longest size do to it (issue 41): a hello answered within 50 ms by the
+//! board's clock, every frame answered, the picture still drawn, the next
+//! answer whole.
 //!
 //! The board is the software board (`software-board`: the live firmware's
 //! logic, `octrace_link::board`, behind a pseudo-terminal), or the command
@@ -12,9 +17,9 @@
 //! serial device it serves. The tests ask the board what it is (panel,
 //! profile, longest scene) and choose their scenes by it.
 
-use octrace_link::{encode_raw, Kind, Message, Reason, Refusal, VERSION};
-use octrace_tests::board::{fits, open_pty, RawHost, RunningBoard};
-use octrace_tests::{host_sim_preview, repo};
+use octrace_link::{encode_raw, Kind, Message, Panel, Reason, Refusal, VERSION};
+use octrace_tests::board::{dearest_scene, fits, lights, open_pty, wedging_scene, RawHost, RunningBoard};
+use octrace_tests::{host_sim_preview_of, repo};
 use std::ffi::OsStr;
 use std::path::Path;
 use std::time::Duration;
@@ -50,11 +55,14 @@ fn draws_host_sims_picture(board: &RunningBoard, panel: &str, name: &str, dir: &
     // The board's `done`: its time, and its load's and render's by its clock.
     assert!(run.stderr.contains(" by its clock (load "), "{name}: {}", run.stderr);
     let expected = dir.join(format!("{name}-host.png"));
-    host_sim_preview(name, &expected, panel, "rgb565").unwrap();
-    let read = |path: &Path| octrace_images::formats::read(&std::fs::read(path).unwrap()).unwrap().to_rgb();
-    let (got, want) = (read(&out), read(&expected));
+    host_sim_preview_of(&scene, &expected, panel, "rgb565").unwrap();
+    let (got, want) = (read_rgb(&out), read_rgb(&expected));
     assert_eq!((got.width, got.height), (want.width, want.height), "{name}");
     assert!(got.data == want.data, "{name}: the board's picture differs from host-sim's");
+}
+
+fn read_rgb(path: &Path) -> octrace_images::RgbImage {
+    octrace_images::formats::read(&std::fs::read(path).unwrap()).unwrap().to_rgb()
 }
 
 #[test]
@@ -298,4 +306,392 @@ fn a_board_of_another_version_is_refused_clearly() {
         VERSION + 1
     );
     assert!(run.stderr.starts_with(&want), "{}", run.stderr);
+}
+
+/// A board that departs from the protocol on command (the software board
+/// with `--misbehave HOW`), with a 16 KiB board's profile and a 160×128
+/// panel.
+fn hostile_board(how: &str, more: &[&str]) -> RunningBoard {
+    let mut args = vec!["--profile", "board16k", "--panel", "160x128", "--misbehave", how];
+    args.extend(more);
+    RunningBoard::software(env!("CARGO_BIN_EXE_software-board"), &args)
+}
+
+/// `host-sim board ARGS...` on a thread of its own: its run, or None if it
+/// has not ended within `limit` (a run with no end fails the test instead
+/// of hanging it).
+fn host_sim_board_within(args: &[&OsStr], limit: Duration) -> Option<Run> {
+    let args: Vec<std::ffi::OsString> = args.iter().map(|a| a.to_os_string()).collect();
+    let (done, ended) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let args: Vec<&OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+        let _ = done.send(host_sim_board(&args));
+    });
+    ended.recv_timeout(limit).ok()
+}
+
+#[test]
+fn a_drawing_at_another_panel_than_described_or_beyond_the_protocol_is_refused_and_nothing_is_written() {
+    let scene = repo().join("scenes/fig5_1.txt");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.png");
+    for size in ["0x0", "65535x65535", "128x160"] {
+        let board = hostile_board(&format!("draws-at:{size}"), &[]);
+        let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str(), out.as_os_str(), "--check".as_ref()]);
+        assert_eq!(run.code, 1, "{size}: {}", run.stderr);
+        let want = format!("it draws at {size} rgb565, but described a 160x128 rgb565 panel");
+        assert!(run.stderr.contains(&want), "{size}: {}", run.stderr);
+        assert!(!run.stderr.contains("bit-identical") && !out.exists(), "{size}: {}", run.stderr);
+    }
+    // A board that describes a panel beyond the protocol's sides.
+    let board = RunningBoard::software(env!("CARGO_BIN_EXE_software-board"), &["--panel", "65535x65535"]);
+    let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str(), out.as_os_str(), "--check".as_ref()]);
+    assert_eq!(run.code, 1, "{}", run.stderr);
+    assert!(
+        run.stderr.contains("it describes a 65535x65535 panel; a panel's sides are 1 to 16384 pixels"),
+        "{}",
+        run.stderr
+    );
+}
+
+#[test]
+fn check_exits_3_when_the_boards_picture_differs_by_a_pixel() {
+    let board = hostile_board("wrong-pixel", &[]);
+    let scene = repo().join("scenes/fig5_1.txt");
+    let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str(), "--check".as_ref()]);
+    assert_eq!(run.code, 3, "{}", run.stderr);
+    let want = "host-sim: board --check: 1 of 20480 pixels differ from host-sim's rgb565 render at 160x128";
+    assert!(run.stderr.contains(want), "{}", run.stderr);
+}
+
+#[test]
+fn a_board_that_keeps_sending_errors_is_given_up_at_the_timeout() {
+    let board = hostile_board("errors-every:20", &[]);
+    let scene = repo().join("scenes/fig5_1.txt");
+    let started = std::time::Instant::now();
+    let args = [board.port.as_os_str(), scene.as_os_str(), "--timeout".as_ref(), "2".as_ref()];
+    let run = host_sim_board_within(&args, Duration::from_secs(30)).expect("host-sim board ends");
+    let took = started.elapsed();
+    assert_eq!(run.code, 1, "{}", run.stderr);
+    let want = format!("host-sim: board at {}: the board's answer did not end within 2 s", board.port.display());
+    assert!(run.stderr.starts_with(&want), "{}", run.stderr);
+    assert!(took < Duration::from_secs(10), "{took:?}");
+}
+
+#[test]
+fn a_board_that_reads_slowly_gets_the_whole_scene_within_the_timeout() {
+    // 28 KB of scene (fig5_1 and a comment) at 10 KiB/s, after what the
+    // line holds (about 20 KB): longer than any one write's wait, well
+    // within the timeout.
+    let board = hostile_board("reads-slowly", &["--max-scene", "65536"]);
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("long.txt");
+    let text = std::fs::read_to_string(repo().join("scenes/fig5_1.txt")).unwrap();
+    std::fs::write(&scene, format!("{text}/* {} */\n", "padding ".repeat(3000))).unwrap();
+    let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str(), "--check".as_ref()]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stderr.contains("--check: bit-identical"), "{}", run.stderr);
+}
+
+#[test]
+fn a_boards_text_is_shown_with_its_control_characters_escaped() {
+    let board = hostile_board("escapes", &[]);
+    let run = host_sim_board(&[board.port.as_os_str()]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stdout.contains(": \\u{1b}]0;pwned\\u{7}\\u{1b}[2Joctrace software board"), "{}", run.stdout);
+    let scene = repo().join("scenes/fig5_1.txt");
+    let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str()]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(
+        run.stderr.contains(":1:1: \\u{1b}[2J\\u{1b}[31mred\\u{1b}[0m\\u{a}host-sim: 0 error(s)\n"),
+        "{}",
+        run.stderr
+    );
+    assert!(!run.stdout.contains('\u{1b}') && !run.stderr.contains('\u{1b}'));
+}
+
+#[test]
+fn the_board_reports_every_lines_error_as_host_sim_does() {
+    let board = board();
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("five.txt");
+    std::fs::write(&scene, "x\nx\nx\nx\nx\n").unwrap();
+    let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str()]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    for line in 1..=5 {
+        assert!(run.stderr.contains(&format!("five.txt:{line}:1: unknown keyword `x`")), "line {line}: {}", run.stderr);
+    }
+    assert!(run.stderr.contains("host-sim: 5 error(s) in "), "{}", run.stderr);
+}
+
+/// The longest a board may take, by its own clock, from a hello's last
+/// byte to its answer's while it draws: 50 ms (the protocol's promise).
+/// The software board's clock is this machine's, shared with every other
+/// test: it gets more room for the scheduler's pauses.
+fn answer_bound_us() -> u64 {
+    match std::env::var_os("OCTRACE_BOARD_COMMAND") {
+        Some(_) => 50_000,
+        None => 250_000,
+    }
+}
+
+/// A scene quick to draw on the emulated Pico (a small sphere; most of the
+/// panel background): what the tests draw after what they put the board
+/// through.
+const QUICK_SCENE: &str = "VIEWPOINT 0 0 10\nLIGHT 10 5 5 5\nSPHERE 1 0.6 0 0 0\n\
+                           SURFACE 1 .1 .1 .1 .7 .2 .2 .3 .3 .3 10 0 0\n";
+
+/// Sends `message` with `tag` from `host`.
+fn send(host: &mut RawHost, message: Message<'_>, tag: u16) {
+    let mut frame = Vec::new();
+    message.encode(tag, &mut frame).unwrap();
+    host.send(&frame);
+}
+
+/// Every frame from the board up to and with `last` (its tag and kind), as
+/// (tag, kind), rows left out; a frame that does not read is (0, Refused).
+fn answers_until(host: &mut RawHost, last: (u16, Kind)) -> Vec<(u16, Kind)> {
+    let mut answers = Vec::new();
+    let came = host.receive_until(Duration::from_secs(120), &mut |received| {
+        let answer = received.map_or((0, Kind::Refused), |frame| (frame.tag, frame.message.kind()));
+        if answer.1 != Kind::Row {
+            answers.push(answer);
+        }
+        answer == last
+    });
+    assert!(came, "no {last:?} within 2 minutes; came: {answers:?}");
+    answers
+}
+
+/// Whether the board's `panel` shows host-sim's picture of scene `text` (at
+/// the panel's size, in its format).
+fn panel_shows(board: &mut RunningBoard, panel: Panel, text: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, expected, picture) =
+        (dir.path().join("scene.txt"), dir.path().join("host.png"), dir.path().join("panel.png"));
+    std::fs::write(&scene, text).unwrap();
+    let size = format!("{}x{}", panel.width, panel.height);
+    host_sim_preview_of(&scene, &expected, &size, "rgb565").unwrap();
+    assert_eq!(board.command(&format!("panel {}", picture.display())), "ok");
+    let (got, want) = (read_rgb(&picture), read_rgb(&expected));
+    let differing = got.data.chunks(3).zip(want.data.chunks(3)).filter(|(a, b)| a != b).count();
+    assert_eq!(differing, 0, "pixels of the panel that differ from host-sim's picture");
+}
+
+/// The board draws scene `text` for `host` (without the rows' pixels) to
+/// the end, and its `panel` shows host-sim's picture of it.
+fn draws_on_the_panel(board: &mut RunningBoard, panel: Panel, host: &mut RawHost, text: &str, tag: u16) {
+    send(host, Message::Scene { pixels: false, text: text.as_bytes() }, tag);
+    assert_eq!(answers_until(host, (tag, Kind::Done)), [(tag, Kind::Drawing), (tag, Kind::Done)]);
+    panel_shows(board, panel, text);
+}
+
+/// Sends the wedging scene (without its rows' pixels) with `tag` and waits
+/// for the board to start drawing it.
+fn start_wedging_drawing(host: &mut RawHost, description: &host_sim::board::BoardDescription, tag: u16) {
+    let text = wedging_scene(lights(description));
+    assert!(fits(description, &text), "the wedging scene fits the board");
+    send(host, Message::Scene { pixels: false, text: text.as_bytes() }, tag);
+    assert_eq!(answers_until(host, (tag, Kind::Drawing)), [(tag, Kind::Drawing)]);
+}
+
+/// A hello from `host` while the board draws the wedging scene `drawing`:
+/// answered, after `cancelled` at row 0, within [`answer_bound_us`] of its
+/// arrival by the board's clock.
+fn hello_is_answered_at_once(board: &mut RunningBoard, host: &mut RawHost, drawing: u16) {
+    let hello = drawing + 1;
+    send(host, Message::Hello, hello);
+    let mut cancelled = None;
+    let answered = host.receive_until(Duration::from_secs(120), &mut |received| {
+        let frame = received.expect("the board's frames read");
+        if let Message::Cancelled { rows } = frame.message {
+            cancelled = Some((frame.tag, rows));
+        }
+        (frame.tag, frame.message.kind()) == (hello, Kind::Board)
+    });
+    assert!(answered, "the hello is answered");
+    assert_eq!(cancelled, Some((drawing, 0)), "the drawing stopped inside its first row");
+    let times = board.times();
+    let (came, answered) = (times.last_in.unwrap(), times.last_out.unwrap());
+    assert!(answered > came, "{times:?}");
+    println!("the hello answered {} µs after it came, by the board's clock", answered - came);
+    assert!(answered - came <= answer_bound_us(), "answered {} µs after the hello came", answered - came);
+}
+
+#[test]
+fn a_hello_during_a_drawing_of_hours_a_pixel_is_answered_within_50_ms_and_the_next_scene_is_drawn_bit_exact() {
+    let mut board = board();
+    let description = board.describe();
+    let mut host = RawHost::open(&board.port);
+    start_wedging_drawing(&mut host, &description, 0x3e0);
+    // A board with a watchdog feeds it while it draws: it never runs low.
+    let first = board.times();
+    if let Some(left) = first.watchdog_left {
+        let mut last = first;
+        while last.now < first.now + 20_000 {
+            std::thread::sleep(Duration::from_millis(20));
+            last = board.times();
+        }
+        let fed = last.watchdog_left.expect("the watchdog runs while the board draws");
+        assert!(fed + 2_000 >= left, "fed: {left} µs left, then {fed} µs after {} µs", last.now - first.now);
+    }
+    hello_is_answered_at_once(&mut board, &mut host, 0x3e0);
+    draws_on_the_panel(&mut board, description.panel, &mut host, QUICK_SCENE, 0x3e2);
+    // Waiting for the host, the board stops its watchdog.
+    assert_eq!(board.times().watchdog_left, None);
+    assert!(board.alive());
+}
+
+#[test]
+fn a_burst_of_frames_beyond_the_input_ring_mid_pixel_is_answered_frame_by_frame() {
+    let mut board = board();
+    let description = board.describe();
+    let mut host = RawHost::open(&board.port);
+    start_wedging_drawing(&mut host, &description, 1);
+    // 150 hellos (1.6 KiB: more than the Pico's 1 KiB input ring) and a
+    // scene, in one write.
+    let mut burst = Vec::new();
+    for tag in 100..250 {
+        Message::Hello.encode(tag, &mut burst).unwrap();
+    }
+    Message::Scene { pixels: false, text: QUICK_SCENE.as_bytes() }.encode(300, &mut burst).unwrap();
+    assert!(burst.len() > 1024 + QUICK_SCENE.len());
+    host.send(&burst);
+    let answers = answers_until(&mut host, (300, Kind::Done));
+    let hellos: Vec<(u16, Kind)> = (100..250).map(|tag| (tag, Kind::Board)).collect();
+    assert_eq!(answers[0], (1, Kind::Cancelled));
+    assert_eq!(answers[1..151], hellos[..]);
+    assert_eq!(answers[151..], [(300, Kind::Drawing), (300, Kind::Done)]);
+    panel_shows(&mut board, description.panel, QUICK_SCENE);
+}
+
+/// Asks `host`'s board for `tag`'s hello once it takes bytes again, and
+/// returns how many bytes of earlier answers came before the answer: what
+/// the board's USB device itself held (its endpoint and the serial class's
+/// buffer, 192 bytes on the Pico), no more.
+fn stale_bytes_before_hello(host: &mut RawHost, tag: u16) -> u64 {
+    let before = host.bytes_read();
+    send(host, Message::Hello, tag);
+    let mut answer_len = 0;
+    let answered = host.receive_until(Duration::from_secs(60), &mut |received| match received {
+        Ok(frame) if (frame.tag, frame.message.kind()) == (tag, Kind::Board) => {
+            let mut again = Vec::new();
+            frame.message.encode(frame.tag, &mut again).unwrap();
+            answer_len = again.len() as u64;
+            true
+        }
+        _ => false,
+    });
+    assert!(answered, "the hello is answered");
+    let stale = host.bytes_read() - before - answer_len;
+    println!("{stale} bytes of the dropped answer came before the next");
+    stale
+}
+
+#[test]
+fn a_host_that_stops_reading_loses_the_rest_of_the_answer_not_the_picture_and_gets_the_next_answer_whole() {
+    let mut board = board();
+    let panel = board.describe().panel;
+    let mut host = RawHost::open(&board.port);
+    let since = board.times().now;
+    // The host stops reading; its scene, with every row's pixels, comes.
+    assert_eq!(board.command("hold"), "ok");
+    send(&mut host, Message::Scene { pixels: true, text: QUICK_SCENE.as_bytes() }, 5);
+    board.wait_idle_after(since, Duration::from_secs(600));
+    // The panel shows the whole picture all the same.
+    panel_shows(&mut board, panel, QUICK_SCENE);
+    // Reading again: the next answer, after no more than the USB device held.
+    assert_eq!(board.command("release"), "ok");
+    let stale = stale_bytes_before_hello(&mut host, 6);
+    assert!(stale <= 256, "{stale} bytes of the dropped answer came before the next");
+}
+
+#[test]
+fn an_error_flood_is_answered_whole_and_one_not_read_leaves_the_next_answer_whole() {
+    let mut board = board();
+    let description = board.describe();
+    // The longest scene the board takes, every line an error.
+    let line = "FOO\n";
+    let text = line.repeat(description.max_scene as usize / line.len());
+    let lines = text.len() / line.len();
+    let mut host = RawHost::open(&board.port);
+    send(&mut host, Message::Scene { pixels: false, text: text.as_bytes() }, 7);
+    let mut errors = 0;
+    let mut rejected = None;
+    let answered = host.receive_until(Duration::from_secs(300), &mut |received| {
+        match received.expect("the board's frames read").message {
+            Message::SceneError(error) => {
+                errors += 1;
+                assert!(error.message.starts_with("unknown keyword `FOO`"), "{}", error.message);
+            }
+            Message::Rejected { errors } => rejected = Some(errors),
+            other => panic!("{other:?}"),
+        }
+        rejected.is_some()
+    });
+    assert!(answered, "the flood ends with rejected");
+    assert_eq!(rejected, Some(errors));
+    assert!(errors as usize >= lines / 2, "{errors} errors in {lines} lines");
+    // A flood (kilobytes of errors: more than the board's ring and its USB
+    // device hold) to a host that stops reading.
+    let since = board.times().now;
+    assert_eq!(board.command("hold"), "ok");
+    send(&mut host, Message::Scene { pixels: false, text: line.repeat(400).as_bytes() }, 8);
+    board.wait_idle_after(since, Duration::from_secs(600));
+    assert_eq!(board.command("release"), "ok");
+    let stale = stale_bytes_before_hello(&mut host, 9);
+    assert!(stale <= 256, "{stale} bytes of the dropped answer came before the next");
+    assert!(board.alive());
+}
+
+#[test]
+fn a_host_gone_mid_drawing_leaves_a_board_that_answers_the_next_at_once() {
+    let mut board = board();
+    let description = board.describe();
+    let mut host = RawHost::open(&board.port);
+    start_wedging_drawing(&mut host, &description, 0x10);
+    // The host's program ends: its USB stack stops reading the port.
+    assert_eq!(board.command("hold"), "ok");
+    drop(host);
+    // The next host.
+    let mut host = RawHost::open(&board.port);
+    assert_eq!(board.command("release"), "ok");
+    hello_is_answered_at_once(&mut board, &mut host, 0x10);
+    draws_on_the_panel(&mut board, description.panel, &mut host, QUICK_SCENE, 0x12);
+}
+
+#[test]
+fn a_hello_during_the_dearest_scene_of_the_longest_size_is_answered_within_50_ms() {
+    let mut board = board();
+    let description = board.describe();
+    // The longest text, every capacity full, every ray meeting every object.
+    let text = dearest_scene(&description);
+    assert_eq!(text.len(), description.max_scene as usize);
+    assert!(fits(&description, &text), "the dearest scene fits the board");
+    let mut host = RawHost::open(&board.port);
+    send(&mut host, Message::Scene { pixels: false, text: text.as_bytes() }, 0x20);
+    assert_eq!(answers_until(&mut host, (0x20, Kind::Drawing)), [(0x20, Kind::Drawing)]);
+    // Past the screen lists' set-up (polled too), inside the first pixels.
+    let started = board.times().last_out.expect("the drawing message went out");
+    while board.times().now < started + 500_000 {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    hello_is_answered_at_once(&mut board, &mut host, 0x20);
+    draws_on_the_panel(&mut board, description.panel, &mut host, QUICK_SCENE, 0x22);
+}
+
+#[test]
+fn a_kind_only_boards_send_is_unexpected_at_a_board_whatever_its_payload() {
+    let board = board();
+    let mut host = RawHost::open(&board.port);
+    // A board's description and a row, each with a payload that fits
+    // neither: the kind is checked first.
+    for kind in [Kind::Board, Kind::Row, Kind::Refused] {
+        let mut frame = Vec::new();
+        encode_raw(VERSION, kind.byte(), 0x77, &[0xff], &mut frame).unwrap();
+        assert_eq!(
+            answer_to(&mut host, &frame),
+            Refusal { tag: 0x77, reason: Reason::Unexpected { kind: kind.byte() } }
+        );
+    }
 }

@@ -5,6 +5,7 @@
 //! Needs `qemu-system-arm` (the test command installs it); set
 //! `OCTRACE_SKIP_FIRMWARE=1` to skip where it cannot be installed.
 
+use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
 use octrace_tests::firmware::{qemu_available, run_oled_command, Board, Firmware, Sizes};
 use octrace_tests::host_sim_preview;
@@ -32,22 +33,26 @@ fn boards_render_the_same_bits_as_host_sim() {
         Firmware::new(Board::Microbit, "fig5_3", 160, 128, PanelColor::Rgb565),
         // Arenas sized from each scene at build time: the chessboard's 64
         // rectangles, boxes and superquadrics, mirrors, and glass (2×2
-        // samples) all fit the 16 KiB board.
-        Firmware::new(Board::Microbit, "fig5_5", 64, 48, PanelColor::Rgb565),
-        Firmware::new(Board::Microbit, "fig5_7", 64, 48, PanelColor::Rgb888),
+        // samples) all fit the 16 KiB board; the first two into panels of
+        // few levels, dithered on the Cortex-M0 as on the host (one bit by
+        // FS-PE, four grays by Floyd–Steinberg).
+        Firmware::new(Board::Microbit, "fig5_5", 64, 48, PanelColor::Mono),
+        Firmware::new(Board::Microbit, "fig5_7", 64, 48, PanelColor::Gray2).dithered(Dithering::FloydSteinberg),
         Firmware::new(Board::Microbit, "fig5_8", 64, 48, PanelColor::Rgb888),
         Firmware::new(Board::Microbit, "glass", 48, 36, PanelColor::Rgb888),
         Firmware::new(Board::Mps2An385, "fig5_3", 160, 128, PanelColor::Rgb888),
         // A 256-colour display: indices of the dithered colour cube.
         Firmware::new(Board::Mps2An385, "fig5_1", 160, 128, PanelColor::Dither),
-        // A 16-gray panel, as the OLED's: one level a byte.
+        // A 16-gray panel, as the OLED's: one level a byte, dithered.
         Firmware::new(Board::Mps2An385, "fig5_4", 64, 48, PanelColor::Gray4),
         // Armv8-M Mainline (Cortex-M33, the Pico 2's and nRF5340's core),
         // with the octree and both techniques.
         Firmware::new(Board::Mps2An505, "fig5_5", 160, 128, PanelColor::Rgb565),
-        // Both Cortex-M33s of the AN521, rows dealt out in turn.
+        // Both Cortex-M33s of the AN521, rows dealt out in turn; into
+        // black/white/red e-paper, the two cores' rows dithered as one
+        // picture.
         Firmware::new(Board::Mps2An521, "fig5_3", 160, 128, PanelColor::Rgb565),
-        Firmware::new(Board::Mps2An521, "fig5_1", 64, 48, PanelColor::Dither),
+        Firmware::new(Board::Mps2An521, "fig5_1", 64, 48, PanelColor::Bwr),
         // RISC-V (RV32IMC, as the ESP32-C3), with the octree.
         Firmware::new(Board::Virt, "fig5_3", 160, 128, PanelColor::Rgb888),
         Firmware::new(Board::Virt, "fig5_1", 160, 128, PanelColor::Rgb565),

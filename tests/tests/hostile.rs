@@ -819,3 +819,26 @@ fn row18_output_equal_to_the_scene_is_refused() {
     assert_eq!(std::fs::read_to_string(&scene).unwrap(), text);
     assert_eq!(listing(dir.path()), ["link.png", "s.txt", "sub"]);
 }
+
+/// Row 19: every line's error in one run. After an error the parser
+/// resynchronises at the next statement (a keyword, or a word opening a
+/// line), so no line's error hides behind the one before.
+#[test]
+fn row19_every_lines_error_is_reported() {
+    let at = |r: &Run| -> Vec<String> {
+        r.stderr
+            .lines()
+            .filter_map(|l| l.split_once("scene.txt:").map(|(_, rest)| rest))
+            .map(|l| l.split(": ").next().unwrap().into())
+            .collect()
+    };
+    let r = run(b"x\nx\nx\nx\nx\n");
+    assert_rejected(&r, "5:1", "unknown keyword `x`");
+    assert_eq!(at(&r), ["1:1", "2:1", "3:1", "4:1", "5:1"], "{}", r.stderr);
+    assert!(r.stderr.contains("host-sim: 5 error(s) in "), "{}", r.stderr);
+    // A statement cut short by a keyword on the next line, a bad number, a
+    // bad word opening a line, an unterminated comment.
+    let r = run(b"SPHERE 1 1 0 0\nRDEPTH 2 x\nLIGHT 1 0 5 q\nfoo 1 2\n  3 4\nRDEPTH 3\n/* open\nx\n");
+    assert_rejected(&r, "7:1", "unterminated comment");
+    assert_eq!(at(&r), ["2:1", "2:10", "3:13", "4:1", "6:1", "7:1"], "{}", r.stderr);
+}

@@ -322,16 +322,6 @@ fn part_refuses_what_cannot_be_split() {
     }
 }
 
-/// The first bash block after `<!-- recipe: NAME -->` in docs/distributed.md.
-fn recipe(name: &str) -> String {
-    let doc = std::fs::read_to_string(octrace_tests::repo().join("docs/distributed.md")).unwrap();
-    let marker = format!("<!-- recipe: {name} -->");
-    let after = &doc[doc.find(&marker).unwrap_or_else(|| panic!("no {marker} in docs/distributed.md"))..];
-    let start = after.find("```bash\n").expect("a bash block") + "```bash\n".len();
-    let end = after[start..].find("```").expect("the block ends");
-    after[start..start + end].to_owned()
-}
-
 #[test]
 fn the_gnu_parallel_recipe_gives_the_single_render() {
     let found = Command::new("parallel").arg("--version").output().is_ok_and(|o| o.status.success());
@@ -342,24 +332,11 @@ fn the_gnu_parallel_recipe_gives_the_single_render() {
         println!("SKIPPED: GNU parallel is not installed (apt-get install parallel): the recipe was not run");
         return;
     }
-    let (dir, home) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let dir = tempfile::tempdir().unwrap();
     // The recipe runs `host-sim` on the repository's scenes, from a directory of its own.
-    let bin = dir.path().join("bin");
     std::fs::create_dir_all(dir.path().join("scenes")).unwrap();
-    std::fs::create_dir(&bin).unwrap();
-    std::os::unix::fs::symlink(HOST_SIM, bin.join("host-sim")).unwrap();
     std::fs::copy(scene("fig5_3"), dir.path().join("scenes/fig5_3.txt")).unwrap();
-    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
-    let script = recipe("parallel-local");
-    let output = Command::new("bash")
-        .args(["-euo", "pipefail", "-c", &script])
-        .current_dir(dir.path())
-        .env("PATH", path)
-        // GNU parallel keeps its state in $HOME/.parallel.
-        .env("HOME", home.path())
-        .output()
-        .expect("bash runs");
-    assert!(output.status.success(), "the recipe failed:\n{script}\n{}", String::from_utf8_lossy(&output.stderr));
+    octrace_tests::run_recipe(&octrace_tests::recipe("parallel-local"), dir.path(), HOST_SIM);
     let merged = dir.path().join("fig5_3.png");
     let single = dir.path().join("single.png");
     ok(&[dir.path().join("scenes/fig5_3.txt").as_os_str(), single.as_os_str(), "-q".as_ref()]);

@@ -1,44 +1,61 @@
-//! The Pico proof: the board template a user copies (`examples/pico-st7789`),
-//! built for a scene as its user builds it and run unmodified on an emulated
-//! Raspberry Pi Pico with its ST7789 panel, both cores tracing, shows
-//! exactly host-sim's `--size 240x240 --color rgb565` picture; and so does
-//! its progressive order (`OCTRACE_ORDER=progressive`), whose first coarse
-//! panel comes within 0.1 s of the picture's start. fig5_1's firmware is
-//! then asked on its USB serial port what it measured (what a user with a
-//! real Pico reads, `pico-compare`): its TIMER's time from scene to picture
-//! is the emulator's count within the timer's and the phases' edges, and
-//! its bus counters count the contention the emulator counted.
+//! The Pico proof: each board template a user copies, built for a scene as
+//! its user builds it and run unmodified on an emulated Raspberry Pi Pico,
+//! both cores tracing, shows exactly host-sim's preview of its panel:
+//! `examples/pico-st7789` on its ST7789, host-sim's `--size 240x240 --color
+//! rgb565` (and so does its progressive order, `OCTRACE_ORDER=progressive`,
+//! whose first coarse panel comes within 0.1 s of the picture's start);
+//! `examples/pico-ssd1306` on its SSD1306 over I2C, `--size 128x64 --color
+//! mono`, its picture sent in at least the bus's time at 400 kHz. The
+//! ST7789's fig5_1 firmware is then asked on its USB serial port what it
+//! measured (what a user with a real Pico reads, `pico-compare`): its
+//! TIMER's time from scene to picture is the emulator's count within the
+//! timer's and the phases' edges, and its bus counters count the
+//! contention the emulator counted.
 //!
 //! Needs Node and the emulator's packages (`npm ci` in
 //! `emulator/`; the test command does it); set
 //! `OCTRACE_SKIP_FIRMWARE=1` to skip where they cannot be installed.
 
 use octrace_tests::host_sim_preview;
-use octrace_tests::pico::{self, Build, Report, DEFAULT_CODE_IN};
+use octrace_tests::pico::{self, Build, Report, Template, DEFAULT_CODE_IN};
 use std::path::Path;
 
-/// The thesis's first figure (naive, no octree), 200 spheres in an
-/// octree, and the chessboard of 64 rectangles, as a user builds them; and
-/// the first in the progressive order.
-const BUILDS: [Build<'static>; 4] = [
-    Build { scene: "fig5_1", code_in: DEFAULT_CODE_IN, order: "rows" },
-    Build { scene: "fig5_3", code_in: DEFAULT_CODE_IN, order: "rows" },
-    Build { scene: "fig5_5", code_in: DEFAULT_CODE_IN, order: "rows" },
-    Build { scene: "fig5_1", code_in: DEFAULT_CODE_IN, order: "progressive" },
+/// For each template, the thesis's first figure (naive, no octree), 200
+/// spheres in an octree, and the chessboard of 64 rectangles, as a user
+/// builds them; and the ST7789's first in the progressive order.
+const BUILDS: [Build<'static>; 7] = [
+    Build::of(Template::St7789, "fig5_1"),
+    Build::of(Template::St7789, "fig5_3"),
+    Build::of(Template::St7789, "fig5_5"),
+    Build { template: Template::St7789, scene: "fig5_1", code_in: DEFAULT_CODE_IN, order: "progressive" },
+    Build::of(Template::Ssd1306, "fig5_1"),
+    Build::of(Template::Ssd1306, "fig5_3"),
+    Build::of(Template::Ssd1306, "fig5_5"),
 ];
+
+/// The least an SSD1306's 128×64 picture takes over I2C at 400 kHz: its
+/// 1,024 bytes at 9 clocks each (address and control bytes, START and STOP
+/// come on top), at 125 MHz.
+const OLED_PICTURE_CYCLES: u64 = 1024 * 9 * 125_000_000 / 400_000;
 
 /// The first coarse panel of a progressive order, from the picture's start:
 /// at most 0.1 s at 125 MHz.
 const FIRST_PANEL_CYCLES: u64 = 12_500_000;
 
-fn read_rgb_png(path: &Path) -> (u32, u32, Vec<u8>) {
+/// An 8-bit RGB or gray PNG (host-sim writes a one-bit panel's preview in
+/// gray) as RGB pixels.
+fn read_png_as_rgb(path: &Path) -> (u32, u32, Vec<u8>) {
     let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut reader = png::Decoder::new(std::io::BufReader::new(file)).read_info().expect("a PNG");
     let mut pixels = vec![0; reader.output_buffer_size().expect("a small image")];
     let frame = reader.next_frame(&mut pixels).expect("PNG pixels");
-    assert_eq!((frame.color_type, frame.bit_depth), (png::ColorType::Rgb, png::BitDepth::Eight), "{}", path.display());
     pixels.truncate(frame.buffer_size());
-    (frame.width, frame.height, pixels)
+    let rgb = match (frame.color_type, frame.bit_depth) {
+        (png::ColorType::Rgb, png::BitDepth::Eight) => pixels,
+        (png::ColorType::Grayscale, png::BitDepth::Eight) => pixels.iter().flat_map(|&v| [v, v, v]).collect(),
+        other => panic!("{}: a {other:?} PNG", path.display()),
+    };
+    (frame.width, frame.height, rgb)
 }
 
 /// The firmware's own measure of its scene against the emulator's count:
@@ -66,7 +83,7 @@ fn reported_as_the_emulator_counted(name: &str, report: &Report, cycles: &pico::
 }
 
 #[test]
-fn the_pico_template_shows_host_sims_picture() {
+fn each_pico_template_shows_host_sims_picture() {
     if std::env::var_os("OCTRACE_SKIP_FIRMWARE").is_some_and(|v| v != "0") {
         println!("skipped: OCTRACE_SKIP_FIRMWARE is set");
         return;
@@ -82,7 +99,7 @@ fn the_pico_template_shows_host_sims_picture() {
             .zip(&elves)
             .enumerate()
             .map(|(i, (build, elf))| {
-                let panel = dir.path().join(format!("{}-panel.png", build.name()));
+                let panel = dir.path().join(format!("{}-{}-panel.png", build.template.name(), build.name()));
                 s.spawn(move || {
                     let run = match i {
                         0 => pico::run_reporting(elf, &panel).map(|(cycles, report)| (cycles, Some(report))),
@@ -96,17 +113,18 @@ fn the_pico_template_shows_host_sims_picture() {
     });
 
     for (build, (run, panel)) in BUILDS.iter().zip(runs) {
-        let name = build.name();
+        let name = format!("{} {}", build.template.name(), build.name());
         let (cycles, report) = run.unwrap_or_else(|e| panic!("{name}: {e}"));
         if let Some(report) = report {
             reported_as_the_emulator_counted(&name, &report, &cycles);
         }
-        let preview = dir.path().join(format!("{name}-host-sim.png"));
-        host_sim_preview(build.scene, &preview, "240x240", "rgb565").unwrap_or_else(|e| panic!("{e}"));
+        let preview = dir.path().join(format!("{}-{}-host-sim.png", build.template.name(), build.name()));
+        let (size, color) = build.template.panel();
+        host_sim_preview(build.scene, &preview, size, color).unwrap_or_else(|e| panic!("{e}"));
 
-        let (width, height, shown) = read_rgb_png(&panel);
-        let expected = read_rgb_png(&preview);
-        assert_eq!((width, height), (240, 240), "{name}: the panel's own size");
+        let (width, height, shown) = read_png_as_rgb(&panel);
+        let expected = read_png_as_rgb(&preview);
+        assert_eq!(format!("{width}x{height}"), size, "{name}: the panel's own size");
         let differing = shown.chunks(3).zip(expected.2.chunks(3)).filter(|(a, b)| a != b).count();
         assert_eq!(differing, 0, "{name}: {differing} of {} pixels differ from host-sim's preview", width * height);
         assert_eq!(cycles.cores, 2, "{name}: both cores trace");
@@ -117,11 +135,20 @@ fn the_pico_template_shows_host_sims_picture() {
                 cycles.first_full_panel
             );
         }
+        if build.template == Template::Ssd1306 {
+            let transfer =
+                cycles.transfer.unwrap_or_else(|| panic!("{name}: no transfer of the picture after the LED"));
+            assert!(
+                transfer >= OLED_PICTURE_CYCLES,
+                "{name}: the picture went over I2C in {transfer} cycles, faster than 400 kHz carries it"
+            );
+        }
         println!(
-            "{name}: 240x240 pixels identical; parse and index {} cycles, render {} cycles: {:.2} s at 125 MHz; \
-             whole panel after {} cycles; core 0 busy {}, core 1 busy {} cycles",
+            "{name}: {size} pixels identical; parse and index {} cycles, render {} cycles, transfer {:?} cycles: \
+             {:.2} s at 125 MHz; whole panel after {} cycles; core 0 busy {}, core 1 busy {} cycles",
             cycles.parse_and_index,
             cycles.render,
+            cycles.transfer,
             cycles.to_picture_seconds(),
             cycles.first_full_panel,
             cycles.busy[0],

@@ -51,7 +51,7 @@ fn every_example_loads_and_shows_something() {
 #[test]
 fn every_statement_has_a_row() {
     // The unknown-keyword message lists every statement the parser knows
-    // ("… expected a statement (VIEWPOINT, ORIGIN, …, BSPLINE or SURFACE)"):
+    // ("… expected a statement (VIEWPOINT, ORIGIN, …, FRAMES or MOVE)"):
     // its upper-case words, the unknown one aside.
     let mut scene = new_scene();
     let message = match load_bytes("s", b"xyzzy", &mut scene) {

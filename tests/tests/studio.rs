@@ -3,7 +3,8 @@
 //! octrace-core compiled to WebAssembly; these tests check that what it
 //! shows is host-sim's image bit for bit, that a user can place, render and
 //! save with the mouse, that "Send to board" shows a board's errors and
-//! picture, and that the server keeps its security rules.
+//! picture, that a render or draft of hours a pixel is stopped by the next
+//! at once, and that the server keeps its security rules.
 //!
 //! The board is the software board, or the command `OCTRACE_BOARD_COMMAND` names
 //! (as in tests/tests/board.rs: [`RunningBoard::for_tests`]).
@@ -12,9 +13,10 @@
 //! `docs/studio/`.
 
 use host_sim::{load_bytes, new_scene, render, RenderOptions, RgbImage};
+use octrace_core::panel::Dithering;
 use octrace_images::palette::{self, PaletteMode};
-use octrace_tests::board::{fits, open_pty, RunningBoard};
-use octrace_tests::webdriver::{http, Browser};
+use octrace_tests::board::{fits, open_pty, wedging_scene, RunningBoard};
+use octrace_tests::webdriver::{http, http_with_head, Browser};
 use octrace_tests::{host_sim_preview, repo, scenes};
 use std::ffi::OsStr;
 use std::io::{BufRead, BufReader};
@@ -179,7 +181,9 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
     assert_same("placed sphere", browser.canvas_rgb("image"), &expected.image);
 
     // Each display mode: the 256-colour modes are host-sim --palette, the
-    // panels are embedded-graphics' own conversions at the panel size.
+    // panels host-sim's --color previews at the panel size (embedded-graphics'
+    // conversion for rgb565; the panels of few levels dithered by the
+    // chosen method, bayer for the last).
     for (code, mode) in
         [(1, PaletteMode::Scan), (2, PaletteMode::Dither), (3, PaletteMode::Coarse), (4, PaletteMode::Gray)]
     {
@@ -191,25 +195,34 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
         let shown = palette::apply(&expected.image, &expected.objects, mode).to_rgb();
         assert_same(mode.name(), browser.canvas_rgb("image"), &shown);
     }
-    for (code, name) in [(5, "rgb565"), (6, "gray4")] {
+    for (code, name, dither) in
+        [(5, "rgb565", None), (6, "gray4", None), (7, "mono", None), (9, "bwr", None), (7, "mono", Some("bayer"))]
+    {
+        // The method's code is its place in the core's list.
+        let method = dither.map_or(Dithering::default(), |d| Dithering::from_name(d).unwrap());
+        let method_code = Dithering::ALL.iter().position(|&d| d == method).unwrap();
         browser.run(&format!(
             "document.getElementById('panel-size').value = '40x30';
+             document.getElementById('dither').value = '{method_code}';
              const d = document.getElementById('display'); d.value = '{code}';
              d.dispatchEvent(new Event('change')); return true;"
         ));
         browser.wait_for(
             &format!(
                 "document.getElementById('image').dataset.display === '{code}'
+                 && document.getElementById('image').dataset.dither === '{method_code}'
                  && document.getElementById('image').dataset.state === 'done'"
             ),
             60,
         );
-        // host-sim --size 40x30 --color NAME, as a Targa (RGB, or gray as
-        // a colour table).
+        // host-sim --size 40x30 --color NAME [--dither METHOD], as a Targa
+        // (RGB, or a colour table).
         let out = dir.path().join(format!("{name}.tga"));
         let args = ["host-sim", scene_path.to_str().unwrap(), out.to_str().unwrap(), "--size", "40x30"];
+        let dither = dither.map(|d| ["--dither", d]).into_iter().flatten();
         let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
-        let code = host_sim::run(args.into_iter().chain(["--color", name, "--quiet"]), &mut stdout, &mut stderr);
+        let args = args.into_iter().chain(["--color", name, "--quiet"]).chain(dither);
+        let code = host_sim::run(args, &mut stdout, &mut stderr);
         assert_eq!(code, 0, "{}", String::from_utf8_lossy(&stderr));
         let panel = octrace_images::formats::read(&std::fs::read(&out).unwrap()).expect("host-sim's preview").to_rgb();
         assert_same(name, browser.canvas_rgb("image"), &panel);
@@ -268,6 +281,10 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
     let error: String =
         browser.run("return document.querySelector('#errors li').textContent;").as_str().unwrap().into();
     assert!(error.starts_with("2:10:"), "{error}");
+    // Every line's error, as host-sim and the board report them.
+    set_text(&browser, "x\nx\nx\nx\nx\n");
+    let lines = browser.run("return [...document.querySelectorAll('#errors li')].map((li) => li.dataset.line);");
+    assert_eq!(lines, serde_json::json!(["1", "2", "3", "4", "5"]));
 }
 
 #[test]
@@ -335,6 +352,43 @@ fn the_canvas_is_host_sims_image_for_every_scene() {
 }
 
 #[test]
+fn a_render_or_draft_of_hours_a_pixel_is_stopped_by_the_next_at_once() {
+    let binary = host_sim_binary();
+    let studio = Studio::start(&binary, None);
+    let browser = Browser::start((1200, 800));
+    browser.goto(&studio.url);
+    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+    let wedge = with_raster(&wedging_scene(8), 16, 12);
+    let next = with_raster(&std::fs::read_to_string(repo().join("scenes/fig5_1.txt")).expect("fig5_1"), 64, 48);
+    for parallel in [false, true] {
+        browser.run(&format!("document.getElementById('parallel').checked = {parallel}; return true;"));
+        // Its draft and its render start, and would take hours.
+        set_text(&browser, &wedge);
+        std::thread::sleep(Duration::from_millis(300));
+        browser.run("document.getElementById('image').dataset.state = 'stale'; return true;");
+        browser.click("#render");
+        browser.wait_for("document.getElementById('image').dataset.state === 'rendering'", 10);
+        std::thread::sleep(Duration::from_millis(300));
+        // The next scene's draft and render come as if nothing ran before.
+        let started = Instant::now();
+        set_text(&browser, &next);
+        browser.wait_for(
+            "document.getElementById('draft').dataset.state === 'done' && \
+             document.getElementById('draft').dataset.seq === String(studio.draftSeq)",
+            30,
+        );
+        render_and_wait(&browser);
+        let elapsed = started.elapsed();
+        assert_same(
+            &format!("fig5_1 after the wedge (parallel: {parallel})"),
+            browser.canvas_rgb("image"),
+            &host_render(&next, None).image,
+        );
+        assert!(elapsed < Duration::from_secs(30), "the next draft and render took {elapsed:?}");
+    }
+}
+
+#[test]
 fn the_server_keeps_its_security_rules() {
     let binary = host_sim_binary();
     let dir = tempfile::tempdir().expect("a directory");
@@ -346,19 +400,57 @@ fn the_server_keeps_its_security_rules() {
     let token = format!("token={}", studio.token);
     let with_token = |path: &str| format!("{path}?{token}");
 
-    // With the token and the right Host: the page, its assets and the scene.
+    // With the token and the right Host: the printed address leads to the
+    // page under /TOKEN/, where its assets are too.
+    let (status, head, _) = http_with_head(port, "GET", &with_token("/"), &[], b"");
+    assert_eq!(status, 303, "{head}");
+    assert!(head.lines().any(|l| l == format!("Location: /{}/", studio.token)), "{head}");
     let modules =
         ["/studio.js", "/octrace.js", "/model.js", "/view.js", "/tools.js", "/panel.js", "/board.js", "/worker.js"];
-    for path in ["/", "/studio.css", "/octrace_studio.wasm", "/scene"].into_iter().chain(modules) {
-        let (status, body) = http(port, "GET", &with_token(path), &[], b"");
+    for path in ["/", "/studio.css", "/octrace_studio.wasm"].into_iter().chain(modules) {
+        let (status, head, body) = http_with_head(port, "GET", &format!("/{}{path}", studio.token), &[], b"");
         assert_eq!(status, 200, "{path}");
         assert!(!body.is_empty(), "{path}");
+        // No cookie (a browser would send it to every port of 127.0.0.1),
+        // no address in a Referer, nothing for other sites to embed.
+        assert!(!head.to_ascii_lowercase().contains("set-cookie"), "{path}: {head}");
+        for header in
+            ["Referrer-Policy: no-referrer", "Cross-Origin-Resource-Policy: same-origin", "X-Frame-Options: DENY"]
+        {
+            assert!(head.lines().any(|l| l == header), "{path}: {header} in {head}");
+        }
     }
     let (_, scene) = http(port, "GET", &with_token("/scene"), &[], b"");
     assert_eq!(scene, START.as_bytes());
-    // The token also works as a header or the page's cookie.
+    // The token also works as a header, but never as a cookie, and in the
+    // path only for what the browser loads by address.
     assert_eq!(http(port, "GET", "/scene", &[("X-Studio-Token", &studio.token)], b"").0, 200);
-    assert_eq!(http(port, "GET", "/", &[("Cookie", &format!("studio_token={}", studio.token))], b"").0, 200);
+    let cookie = format!("studio_token={}", studio.token);
+    for (method, path) in [("GET", "/scene"), ("POST", "/board"), ("GET", "/studio.js")] {
+        assert_eq!(http(port, method, path, &[("Cookie", &cookie)], b"RDEPTH 2\n").0, 403, "{method} {path}");
+    }
+    let in_path = format!("/{}/scene", studio.token);
+    assert_eq!(http(port, "PUT", &in_path, &[("If-Match", "*")], b"RDEPTH 2\n").0, 403);
+    assert_eq!(std::fs::read_to_string(&scene_path).unwrap(), START);
+
+    // A browser's request for another site's page, even with the token:
+    // refused (a page on another port of 127.0.0.1 is another origin, but
+    // the same site).
+    let other = format!("http://127.0.0.1:{}", port.wrapping_add(1));
+    for foreign in [
+        [("Origin", other.as_str()), ("Sec-Fetch-Site", "same-site")],
+        [("Origin", "null"), ("Sec-Fetch-Site", "cross-site")],
+        [("Origin", other.as_str()), ("X-Studio-Token", studio.token.as_str())],
+        [("Sec-Fetch-Site", "same-site"), ("X-Studio-Token", studio.token.as_str())],
+    ] {
+        assert_eq!(http(port, "GET", &with_token("/scene"), &foreign, b"").0, 403, "{foreign:?}");
+        assert_eq!(http(port, "PUT", &with_token("/scene"), &foreign, b"RDEPTH 2\n").0, 403, "{foreign:?}");
+    }
+    assert_eq!(std::fs::read_to_string(&scene_path).unwrap(), START);
+    // Its own page's requests pass.
+    let own = format!("http://127.0.0.1:{port}");
+    let own_page = [("Origin", own.as_str()), ("Sec-Fetch-Site", "same-origin")];
+    assert_eq!(http(port, "GET", &with_token("/scene"), &own_page, b"").0, 200);
 
     // No token, a wrong one: refused, even for the page.
     for path in ["/", "/scene", "/octrace_studio.wasm"] {
@@ -385,7 +477,7 @@ fn the_server_keeps_its_security_rules() {
     ] {
         assert_eq!(http(port, "GET", &with_token("/scene"), &[("Host", host)], b"").0, 421, "Host {host}");
     }
-    assert_eq!(http(port, "GET", &with_token("/"), &[("Host", &format!("localhost:{port}"))], b"").0, 200);
+    assert_eq!(http(port, "GET", &with_token("/scene"), &[("Host", &format!("localhost:{port}"))], b"").0, 200);
 
     // Paths that try to leave the assets reach nothing.
     for path in [
@@ -633,7 +725,10 @@ fn send_to_board_shows_the_boards_picture_and_verdict_or_its_errors_in_the_edito
     let preview = octrace_images::formats::read(&std::fs::read(&preview).unwrap()).unwrap().to_rgb();
     assert_same("the board's picture", browser.canvas_rgb("board-image"), &preview);
     // Its rows were counted as they came (the page shows them while they do).
-    let progress = browser.run("return fetch('/board').then((r) => r.json());");
+    let progress = browser.run(
+        "const token = location.pathname.split('/')[1];
+         return fetch('/board', { headers: { 'X-Studio-Token': token } }).then((r) => r.json());",
+    );
     assert_eq!((&progress["rows"], &progress["height"], &progress["busy"]), (&h.into(), &h.into(), &false.into()));
 
     // A scene over the board's capacity (which the page's own core holds):
@@ -682,9 +777,9 @@ fn send_to_board_shows_the_boards_picture_and_verdict_or_its_errors_in_the_edito
     assert_eq!(listed, serde_json::json!(["board"]));
 }
 
-#[test]
-fn the_board_endpoint_keeps_the_security_rules_and_sends_one_at_a_time() {
-    // A board that reads and never answers: what reaches it is seen here.
+/// A board that reads and never answers: its serial device, and how many
+/// bytes reach it, read by read.
+fn listening_board() -> (PathBuf, std::sync::mpsc::Receiver<usize>) {
     let (controller, port) = open_pty().expect("a pseudo-terminal");
     let (bytes, received) = std::sync::mpsc::channel();
     std::thread::spawn(move || {
@@ -702,6 +797,13 @@ fn the_board_endpoint_keeps_the_security_rules_and_sends_one_at_a_time() {
             }
         }
     });
+    (port, received)
+}
+
+#[test]
+fn the_board_endpoint_keeps_the_security_rules_and_sends_one_at_a_time() {
+    // What reaches the board is seen here.
+    let (port, received) = listening_board();
     let binary = host_sim_binary();
     let args = ["--board".as_ref(), port.as_os_str(), "--board-timeout".as_ref(), "3".as_ref()];
     let studio = Studio::start_with(&binary, None, &args);
@@ -756,4 +858,127 @@ fn a_board_that_is_no_serial_port_is_an_error_at_start() {
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains(&format!("--board {} is no serial port", scene.display())), "{stderr}");
+}
+
+/// A page of another program on this machine, served from another port of
+/// 127.0.0.1 (another origin, but the same site to a browser: ports do not
+/// separate sites). It tries the studio's `/board` and `/scene` with all a
+/// browser adds on its own: a form's POST (whose text/plain body is a valid
+/// scene, `RDEPTH 2 /*=*/`) and fetches with credentials. Returns its
+/// port, and the head of every request it got.
+fn hostile_page(studio_port: u16) -> (u16, std::sync::Arc<std::sync::Mutex<Vec<String>>>) {
+    let studio = format!("http://127.0.0.1:{studio_port}");
+    let page = format!(
+        r#"<!doctype html><html><body>
+<iframe name="sink"></iframe>
+<form id="form" method="POST" action="{studio}/board" enctype="text/plain" target="sink">
+<input type="hidden" name="RDEPTH 2 /*" value="*/"></form>
+<script>
+const results = {{}};
+const attempt = async (name, url, init) => {{
+  try {{ const r = await fetch(url, init); results[name] = r.type + ' ' + r.status; }}
+  catch (e) {{ results[name] = 'refused: ' + e.name; }}
+}};
+document.getElementById('form').submit();
+(async () => {{
+  await attempt('POST /board', '{studio}/board', {{ method: 'POST', body: 'RDEPTH 2\n', mode: 'no-cors', credentials: 'include' }});
+  await attempt('GET /scene', '{studio}/scene', {{ credentials: 'include' }});
+  await attempt('GET /scene, no-cors', '{studio}/scene', {{ mode: 'no-cors', credentials: 'include' }});
+  await attempt('PUT /scene', '{studio}/scene', {{ method: 'PUT', body: 'RDEPTH 3\n', headers: {{ 'If-Match': '*' }}, credentials: 'include' }});
+  await attempt('POST /board, a guessed token', '{studio}/board', {{ method: 'POST', body: 'RDEPTH 2\n', headers: {{ 'X-Studio-Token': '0123' }} }});
+  document.body.dataset.results = JSON.stringify(results);
+}})();
+</script></body></html>"#
+    );
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").expect("a port");
+    let port = listener.local_addr().expect("an address").port();
+    let requests = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let seen = std::sync::Arc::clone(&requests);
+    std::thread::spawn(move || {
+        for stream in listener.incoming() {
+            let Ok(mut stream) = stream else { continue };
+            let mut head = Vec::new();
+            let mut byte = [0u8];
+            while !head.ends_with(b"\r\n\r\n") && std::io::Read::read(&mut stream, &mut byte).is_ok_and(|n| n == 1) {
+                head.push(byte[0]);
+            }
+            let head = String::from_utf8_lossy(&head).into_owned();
+            let body = if head.starts_with("GET / ") { page.as_str() } else { "" };
+            let status = if body.is_empty() { "404 Not Found" } else { "200 OK" };
+            let response = format!(
+                "HTTP/1.1 {status}\r\nContent-Type: text/html\r\nContent-Length: {}\r\nConnection: close\r\n\r\n{body}",
+                body.len()
+            );
+            let _ = std::io::Write::write_all(&mut stream, response.as_bytes());
+            seen.lock().expect("the requests").push(head);
+        }
+    });
+    (port, requests)
+}
+
+#[test]
+fn another_local_page_cannot_drive_the_studio_nor_learn_its_token() {
+    let (board_port, received) = listening_board();
+    let dir = tempfile::tempdir().expect("a directory");
+    let scene_path = dir.path().join("s.txt");
+    std::fs::write(&scene_path, START).expect("written");
+    let binary = host_sim_binary();
+    let mut studio = Studio::start_with(&binary, Some(&scene_path), &["--board".as_ref(), board_port.as_os_str()]);
+    let (page_port, requests) = hostile_page(studio.port);
+    assert_ne!(page_port, studio.port);
+    // The user has the studio open; then the browser shows the other page.
+    let browser = Browser::start((1200, 800));
+    browser.goto(&studio.url);
+    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+    browser.goto(&format!("http://127.0.0.1:{page_port}/"));
+    browser.wait_for("document.body.dataset.results", 30);
+    let results = browser.run("return document.body.dataset.results;");
+    // The form's POST went when the page loaded; give it time to arrive.
+    std::thread::sleep(Duration::from_millis(1500));
+
+    // Nothing reached the board, the scene is as it was, and the other
+    // page's server never saw the token.
+    assert!(received.try_recv().is_err(), "a request of the other page reached the board: {results}");
+    assert_eq!(std::fs::read_to_string(&scene_path).unwrap(), START, "{results}");
+    let requests = requests.lock().expect("the requests").clone();
+    assert!(!requests.is_empty(), "the other page was served");
+    for head in &requests {
+        assert!(!head.contains(&studio.token), "the studio's token went to another server:\n{head}");
+    }
+    // The studio refused them, and said so.
+    let (_, stderr) = studio.interrupt();
+    let refused =
+        |what: &str| stderr.lines().filter(|l| l.contains(&format!("refused {what} from another site"))).count();
+    assert!(refused("POST /board") >= 2, "the form and the fetch: {results}\n{stderr}");
+    assert!(refused("GET /scene") >= 2, "both fetches: {results}\n{stderr}");
+    assert!(stderr.contains(&format!("(Origin http://127.0.0.1:{page_port})")), "{stderr}");
+    // The fetches that needed the studio's leave (a PUT, a header) got none.
+    let results: serde_json::Value = serde_json::from_str(results.as_str().expect("JSON")).expect("results");
+    for name in ["GET /scene", "PUT /scene", "POST /board, a guessed token"] {
+        assert!(results[name].as_str().is_some_and(|r| r.starts_with("refused")), "{name}: {results}");
+    }
+}
+
+#[test]
+fn send_to_board_refuses_what_a_hostile_board_answers() {
+    let software = env!("CARGO_BIN_EXE_software-board");
+    let binary = host_sim_binary();
+    let text = std::fs::read(repo().join("scenes/fig5_1.txt")).expect("fig5_1");
+    // A drawing at a panel it did not describe: an error, not "identical"
+    // over no pixel at all.
+    let board = RunningBoard::software(software, &["--panel", "160x128", "--misbehave", "draws-at:0x0"]);
+    let studio = Studio::start_with(&binary, None, &["--board".as_ref(), board.port.as_os_str()]);
+    let (status, body) = http(studio.port, "POST", &format!("/board?token={}", studio.token), &[], &text);
+    let said = String::from_utf8_lossy(&body);
+    assert_eq!(status, 502, "{said}");
+    assert!(said.contains("it draws at 0x0 rgb565, but described a 160x128 rgb565 panel"), "{said}");
+    // Its errors' terminal escapes reach the page escaped.
+    let board = RunningBoard::software(software, &["--panel", "160x128", "--misbehave", "escapes"]);
+    let studio = Studio::start_with(&binary, None, &["--board".as_ref(), board.port.as_os_str()]);
+    let (status, body) = http(studio.port, "POST", &format!("/board?token={}", studio.token), &[], &text);
+    let answer: serde_json::Value = serde_json::from_slice(&body).expect("JSON");
+    assert_eq!(status, 200, "{answer}");
+    let message = answer["errors"][0]["message"].as_str().expect("an error");
+    assert!(message.starts_with("\\u{1b}[2J\\u{1b}[31mred"), "{answer}");
+    assert!(!message.contains('\u{1b}'), "{answer}");
 }

@@ -22,6 +22,7 @@ pub(crate) mod naive;
 mod octree;
 
 pub use choice::{prepare, Prepared};
+pub(crate) use light_buffer::RAY_SLACK;
 pub use light_buffer::{
     LightBuffer, LightBufferError, LightBufferReport, LightBufferStore, LightBuffered, MAX_CELLS_A_SIDE,
 };
@@ -247,6 +248,12 @@ pub trait Accelerator {
     /// tracer then clears before each query); false for one that tests
     /// every object once anyway.
     const USES_MAILBOX: bool = true;
+
+    /// Whether the tracer watches its rays against an animation's motion,
+    /// so that a frame re-traces only what changes
+    /// ([`crate::animation::Coherence`]). False links none of that code:
+    /// every frame is then traced whole (the same pictures).
+    const FOLLOWS_MOTION: bool = true;
 
     /// Whether the renderer may find camera rays' hits in its screen-space
     /// lists (see [`Renderer::with_first_hits`](crate::render::Renderer::with_first_hits))

@@ -207,6 +207,43 @@ pub enum ErrorKind<'a> {
     UpParallel,
     /// The scene needs more of something than the profile holds.
     Capacity(CapacityError),
+    /// A MOVE in a scene that has no FRAMES.
+    MoveWithoutFrames,
+    /// A MOVE that does not follow an object, LIGHT, VIEWPOINT or ORIGIN
+    /// statement: it follows `after` (`None`: nothing; `MOVE`: another MOVE).
+    NothingToMove {
+        /// The keyword of the statement before it.
+        after: Option<&'static str>,
+    },
+    /// A MOVE key whose frame is not after the key before it.
+    FramesOutOfOrder {
+        /// The key's frame.
+        frame: u32,
+        /// The frame of the key before it.
+        previous: u32,
+    },
+    /// A MOVE key at a frame the animation does not have.
+    FrameBeyond {
+        /// The key's frame.
+        frame: u32,
+        /// The animation's frames (FRAMES count).
+        count: u32,
+    },
+    /// A MOVE that takes a coordinate of its statement beyond 10^6 in
+    /// magnitude.
+    MovedOutOfRange {
+        /// The moved statement's keyword.
+        keyword: &'static str,
+        /// The key's frame.
+        frame: u32,
+    },
+    /// A MOVE of VIEWPOINT or ORIGIN that leaves no camera at `frame`.
+    MovedCamera {
+        /// What is wrong with the camera.
+        error: CameraError,
+        /// The frame loaded.
+        frame: u32,
+    },
 }
 
 /// One error in a scene.
@@ -272,6 +309,32 @@ impl fmt::Display for ErrorKind<'_> {
             ErrorKind::EyeAtOrigin => CameraError::EyeAtOrigin.fmt(f),
             ErrorKind::UpParallel => CameraError::UpParallel.fmt(f),
             ErrorKind::Capacity(c) => c.fmt(f),
+            ErrorKind::MoveWithoutFrames => f.write_str(
+                "MOVE in a scene without FRAMES: an animation first says how many frames it has (FRAMES count)",
+            ),
+            ErrorKind::NothingToMove { after } => {
+                f.write_str("MOVE must follow an object, LIGHT, VIEWPOINT or ORIGIN statement")?;
+                match after {
+                    None => f.write_str(", and nothing comes before it"),
+                    Some("MOVE") => f.write_str(": a statement moves by one MOVE, and this one follows another"),
+                    Some(keyword) => write!(f, ", not {keyword}"),
+                }
+            }
+            ErrorKind::FramesOutOfOrder { frame, previous } => {
+                write!(f, "MOVE frames must increase: frame {frame} comes after frame {previous}")
+            }
+            ErrorKind::FrameBeyond { frame, count } => write!(
+                f,
+                "MOVE frame {frame} is beyond the animation: FRAMES gives {count} frame{}, 0 to {}",
+                if *count == 1 { "" } else { "s" },
+                count - 1
+            ),
+            ErrorKind::MovedOutOfRange { keyword, frame } => write!(
+                f,
+                "MOVE takes {keyword} beyond 1e6 at frame {frame}: its coordinates must stay at most 1e6 in magnitude \
+                 in every frame"
+            ),
+            ErrorKind::MovedCamera { error, frame } => write!(f, "at frame {frame}, {error}"),
         }
     }
 }

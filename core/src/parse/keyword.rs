@@ -31,7 +31,9 @@ macro_rules! keywords {
             }
 
             /// How many arguments follow the keyword; for `BSPLINE`, those
-            /// before its 3 × rows × cols control point coordinates.
+            /// before its 3 × rows × cols control point coordinates; for
+            /// `FRAMES` and `MOVE`, the fewest (a rate may follow; more
+            /// keys may follow).
             pub(crate) const fn arity(self) -> usize {
                 match self {
                     $(Keyword::$variant => $arity,)*
@@ -61,6 +63,8 @@ keywords! {
     Rectangle = "RECTANGLE" / 13,
     Bspline = "BSPLINE" / 6,
     Surface = "SURFACE" / 13,
+    Frames = "FRAMES" / 1,
+    Move = "MOVE" / 4,
 }
 
 impl Keyword {
@@ -86,8 +90,10 @@ impl Keyword {
             | Keyword::Background
             | Keyword::Gamma
             | Keyword::Attenuation
-            | Keyword::Samples => true,
+            | Keyword::Samples
+            | Keyword::Frames => true,
             Keyword::Light
+            | Keyword::Move
             | Keyword::Sphere
             | Keyword::Box
             | Keyword::Superquadric
@@ -153,6 +159,8 @@ mod tests {
             "RECTANGLE 1 0 0 0 1 0 0 1 1 0 0 1 0",
             "BSPLINE 1 2 2 2 4 4 0 0 0 1 0 0 0 1 0 1 1 0",
             "SURFACE 1 0.1 0.1 0.1 0.8 0.2 0.2 0.5 0.5 0.5 20 0 0",
+            "FRAMES 48",
+            "MOVE 0 1 2 3",
         ];
         assert_eq!(samples.len(), Keyword::COUNT);
         for (keyword, sample) in Keyword::ALL.into_iter().zip(samples) {
@@ -185,7 +193,7 @@ mod tests {
     fn the_list_names_every_keyword_once() {
         let listed = Listed.to_string();
         assert!(listed.starts_with("VIEWPOINT, ORIGIN, "), "{listed}");
-        assert!(listed.ends_with(", BSPLINE or SURFACE"), "{listed}");
+        assert!(listed.ends_with(", SURFACE, FRAMES or MOVE"), "{listed}");
         let words: std::vec::Vec<&str> = listed.split([',', ' ']).filter(|w| !w.is_empty() && *w != "or").collect();
         assert_eq!(words, Keyword::ALL.map(Keyword::name));
     }

@@ -7,9 +7,10 @@
 //! 2. the *build* reads every statement again, reports every error, and
 //!    stores the objects in normalised space.
 //!
-//! After an error the parser skips to the next keyword and goes on, so one
-//! run reports all errors. A scene with errors is cleared: nothing can be
-//! rendered from it.
+//! After an error the parser skips to where the next statement begins (a
+//! keyword, or a word opening a line) and goes on, so one run reports every
+//! line's error. A scene with errors is cleared: nothing can be rendered
+//! from it.
 //!
 //! No-panic contract: for any input text, [`parse`] returns (it neither
 //! panics nor loops), in time linear in the text's length plus
@@ -18,18 +19,22 @@
 mod error;
 mod keyword;
 mod lexer;
+mod motion;
 mod number;
 mod statement;
 
 pub use error::{ErrorKind, Field, Found, ParseError, Pos, Rule};
+pub(crate) use motion::{for_each_move, frames_of, Mover};
 pub(crate) use number::Decimal;
-pub(crate) use statement::Statement;
+pub(crate) use statement::{Keys, Statement};
 
 use crate::capacity::{Arena, CapacityError, CapacityKind, Counts};
-use crate::scene::{Camera, CameraError, Light, Normalization, Scene, SceneCapacities, SurfaceEntry, WorldPoint};
+use crate::scene::{displacement_at, Camera, CameraError, Frames, Light, Normalization, Scene, SceneCapacities};
+use crate::scene::{SurfaceEntry, WorldPoint};
 use crate::shapes::{AxisAlignedBox, Rectangle, ShapeKind, Sphere, Superquadric, Triangle};
 use core::marker::PhantomData;
 use keyword::Keyword;
+use motion::{for_each_paired, Paired};
 use statement::{Cursor, Patch};
 
 /// What the parse found besides the scene.
@@ -37,6 +42,8 @@ use statement::{Cursor, Patch};
 pub struct Parsed<'a> {
     /// The IMAGEFILE name, if given.
     pub imagefile: Option<&'a str>,
+    /// FRAMES, if given: the scene is an animation.
+    pub frames: Option<Frames>,
 }
 
 /// Which shapes' geometric checks a parse runs. A profile without room for
@@ -82,7 +89,7 @@ impl<C: SceneCapacities> Room for RoomOf<C> {
 }
 
 /// Reads every statement of `text`, handing each (or its error) to `each`;
-/// skips to the next keyword after an error.
+/// after an error, resynchronises at the next statement (see [`recover`]).
 fn for_each_statement<'a, R: Room>(text: &'a str, mut each: impl FnMut(Pos, Result<Statement<'a>, ParseError<'a>>)) {
     let mut cur = Cursor::new(text);
     loop {
@@ -98,26 +105,38 @@ fn for_each_statement<'a, R: Room>(text: &'a str, mut each: impl FnMut(Pos, Resu
             Some(kw) => statement::statement::<R>(&mut cur, kw, token.pos),
             None => Err(ParseError::new(token.pos, ErrorKind::UnknownKeyword(token.text))),
         };
-        let failed = result.is_err();
+        let error_at = result.as_ref().err().map(|e| e.pos);
         each(token.pos, result);
-        if failed {
-            // Recover: drop the offending token unless it starts a statement,
-            // then the numbers that follow; resume at the next word, so an
-            // unknown word right after a bad statement is still reported.
-            let mut first = true;
-            loop {
-                match cur.peek() {
-                    Ok(Some(t))
-                        if (first && Keyword::from_text(t.text).is_none()) || Decimal::parse(t.text).is_some() =>
-                    {
-                        let _ = cur.next();
-                    }
-                    Ok(_) => break,
-                    Err(e) => each(e.pos, Err(e)),
-                }
-                first = false;
+        if let Some(pos) = error_at {
+            recover(&mut cur, pos, &mut |e| each(e.pos, Err(e)));
+        }
+    }
+}
+
+/// After an error at `at`, skips to where the next statement begins: a
+/// keyword, or a word (not a number) that is the first token of its line.
+/// The offending token goes first unless it is a keyword; numbers after it
+/// are the bad statement's (a B-spline's points span lines), whatever line
+/// they are on. So every line that begins with a word is read again as a
+/// statement, and its error, if any, is reported too: five lines of `x`
+/// give five errors. A lexer error met while skipping goes to `lexical`.
+fn recover<'a>(cur: &mut Cursor<'a>, at: Pos, lexical: &mut dyn FnMut(ParseError<'a>)) {
+    let begins_statement = |t: &lexer::Token<'_>| !t.quoted && Keyword::from_text(t.text).is_some();
+    let number = |t: &lexer::Token<'_>| !t.quoted && Decimal::parse(t.text).is_some();
+    loop {
+        match cur.peek() {
+            Ok(None) => return,
+            Ok(Some(t)) if begins_statement(&t) => return,
+            // The offending token, left for recovery by the statement.
+            Ok(Some(t)) if t.pos == at => {}
+            Ok(Some(t)) if !number(&t) && cur.on_a_later_line(t) => return,
+            Ok(Some(_)) => {}
+            Err(e) => {
+                lexical(e);
+                continue;
             }
         }
+        let _ = cur.next();
     }
 }
 
@@ -130,8 +149,19 @@ pub fn parse_bytes<'a, C: SceneCapacities>(
     scene: &mut Scene<C>,
     on_error: &mut dyn FnMut(ParseError<'a>),
 ) -> Result<Parsed<'a>, usize> {
+    parse_frame_bytes(bytes, scene, 0, on_error)
+}
+
+/// [`parse_frame`] from bytes, as [`parse_bytes`] reads them.
+#[inline(never)]
+pub fn parse_frame_bytes<'a, C: SceneCapacities>(
+    bytes: &'a [u8],
+    scene: &mut Scene<C>,
+    frame: u32,
+    on_error: &mut dyn FnMut(ParseError<'a>),
+) -> Result<Parsed<'a>, usize> {
     match core::str::from_utf8(bytes) {
-        Ok(text) => parse(text, scene, on_error),
+        Ok(text) => parse_frame(text, scene, frame, on_error),
         Err(e) => {
             // The valid prefix is UTF-8; its lines end as the lexer's do.
             let good = core::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or_default();
@@ -183,20 +213,58 @@ pub fn parse<'a, C: SceneCapacities>(
     scene: &mut Scene<C>,
     on_error: &mut dyn FnMut(ParseError<'a>),
 ) -> Result<Parsed<'a>, usize> {
+    parse_frame(text, scene, 0, on_error)
+}
+
+/// Parses frame `frame` of an animation (a scene with `FRAMES`): each
+/// statement that a `MOVE` follows stands displaced as its keys say at that
+/// frame. A scene without `FRAMES` is the same at every frame, as
+/// [`parse`] reads it; a frame beyond the last has the last frame's
+/// displacements. Every frame of a scene is normalised alike (from the
+/// extent over all its frames), so frames share their bits.
+///
+/// ```
+/// use octrace_core::{parse::parse_frame, profile::Board16K, scene::Scene};
+///
+/// let text = "FRAMES 5\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\n\
+///             SPHERE 1 1  0 0 0  MOVE 0 0 0 0  4 8 0 0\nSPHERE 1 1  0 3 0\n";
+/// let mut scene = Scene::<Board16K>::new();
+/// let mut x = |frame| {
+///     let parsed = parse_frame(text, &mut scene, frame, &mut |e| panic!("{e}")).unwrap();
+///     assert_eq!(parsed.frames.map(|f| (f.count, f.rate)), Some((5, 24)));
+///     let [moving, still] = [0, 1].map(|i| scene.view().spheres[i].center);
+///     (moving.x - still.x).to_bits()
+/// };
+/// // 2 units a frame, in the scene's normalised units.
+/// let step = x(1) - x(0);
+/// assert_eq!([x(0), x(2), x(4)], [0, 2 * step, 4 * step]);
+/// ```
+pub fn parse_frame<'a, C: SceneCapacities>(
+    text: &'a str,
+    scene: &mut Scene<C>,
+    frame: u32,
+    on_error: &mut dyn FnMut(ParseError<'a>),
+) -> Result<Parsed<'a>, usize> {
     scene.clear();
-    let needed = survey(text, scene);
+    let (needed, frames) = survey(text, scene);
     let mut build = Build {
         scene,
         needed,
-        parsed: Parsed::default(),
+        parsed: Parsed { imagefile: None, frames },
+        frame,
         first: [None; Keyword::COUNT],
+        camera_move: None,
         errors: 0,
         reported_capacity: 0,
         on_error,
     };
-    for_each_statement::<RoomOf<C>>(text, |pos, result| match result {
-        Ok(s) => build.apply(pos, s),
-        Err(e) => build.report(e),
+    for_each_paired::<RoomOf<C>>(text, |paired| match paired {
+        Paired::Statement { pos, statement, moved } => build.apply(pos, statement, moved),
+        Paired::Error(e) => build.report(e),
+        Paired::Stray { pos, after } => match build.parsed.frames {
+            None => build.report(ParseError::new(pos, ErrorKind::MoveWithoutFrames)),
+            Some(_) => build.report(ParseError::new(pos, ErrorKind::NothingToMove { after })),
+        },
     });
     build.check_camera();
     let (errors, parsed) = (build.errors, build.parsed);
@@ -229,44 +297,79 @@ pub fn count(text: &str) -> Counts {
     counts.with_objects()
 }
 
-/// Pass 1: surfaces (sorted by number) and the normalisation; returns what
-/// the scene needs of each capacity.
-fn survey<C: SceneCapacities>(text: &str, scene: &mut Scene<C>) -> Counts {
+/// Pass 1: surfaces (sorted by number), the normalisation and FRAMES;
+/// returns what the scene needs of each capacity, and FRAMES. The extent
+/// is every frame's: a moved statement's box at each of its keys (between
+/// keys it stays within theirs).
+fn survey<C: SceneCapacities>(text: &str, scene: &mut Scene<C>) -> (Counts, Option<Frames>) {
     let mut counts = Counts::ZERO;
-    let mut eye = None;
+    let mut frames = None;
+    let mut eye: Option<(WorldPoint, Option<Keys<'_>>)> = None;
     let mut extent: Option<Extent> = None;
-    let mut add = |lo: WorldPoint, hi: WorldPoint| match &mut extent {
-        Some(e) => e.add(lo, hi),
-        None => extent = Some(Extent { min: lo, max: hi }),
-    };
-    for_each_statement::<RoomOf<C>>(text, |pos, result| {
-        if let Ok(s) = &result {
-            s.count(&mut counts);
-        }
-        match result {
-            Ok(Statement::Viewpoint(p)) => {
-                eye.get_or_insert(p);
+    let mut add = |lo: WorldPoint, hi: WorldPoint, moved: Option<Keys<'_>>| {
+        let mut at = |d: WorldPoint| {
+            let (lo, hi) = ([0, 1, 2].map(|a| lo[a] + d[a]), [0, 1, 2].map(|a| hi[a] + d[a]));
+            match &mut extent {
+                Some(e) => e.add(lo, hi),
+                None => extent = Some(Extent { min: lo, max: hi }),
             }
-            Ok(Statement::Light { position, .. }) => add(position, position),
-            Ok(Statement::Surface { number, surface }) => {
+        };
+        match moved {
+            Some(keys) => keys.offsets().for_each(|(_, d)| at(d)),
+            None => at([0; 3]),
+        }
+    };
+    for_each_paired::<RoomOf<C>>(text, |paired| {
+        let Paired::Statement { pos, statement, moved } = paired else { return };
+        statement.count(&mut counts);
+        let moved = moved.map(|(_, keys)| keys);
+        match statement {
+            Statement::Viewpoint(p) => {
+                eye.get_or_insert((p, moved));
+            }
+            Statement::Light { position, .. } => add(position, position, moved),
+            Statement::Surface { number, surface } => {
                 // A full arena is reported by the build pass.
                 let _ = scene.push_surface(SurfaceEntry { number, line: pos.line, column: pos.column, surface });
             }
-            Ok(s) => {
+            Statement::Frames(f) => {
+                frames.get_or_insert(f);
+            }
+            s => {
                 if let Some((lo, hi)) = s.object_bounds() {
-                    add(lo, hi);
+                    add(lo, hi, moved);
                 }
             }
-            Err(_) => {}
         }
     });
-    let eye = eye.unwrap_or(scene.settings.view.eye);
-    add(eye, eye);
+    let (eye, moved) = eye.unwrap_or((scene.settings.view.eye, None));
+    add(eye, eye, moved);
     scene.sort_surfaces();
     if let Some(e) = extent {
         scene.normalization = Normalization::fit(e.min, e.max);
     }
-    counts.with_objects()
+    (counts.with_objects(), frames)
+}
+
+/// A statement's displacement at the frame being built.
+#[derive(Clone, Copy)]
+struct Offset {
+    /// In world units (Q32.32): the camera's.
+    world: WorldPoint,
+    /// In normalised units (Q16.16, wide): every other statement's.
+    normalised: [i64; 3],
+    /// The normalised displacement at frame 0, where a B-spline patch is
+    /// evaluated.
+    first: [i64; 3],
+}
+
+impl Offset {
+    const NONE: Offset = Offset { world: [0; 3], normalised: [0; 3], first: [0; 3] };
+
+    /// World point `p` displaced.
+    fn world_moved(&self, p: WorldPoint) -> WorldPoint {
+        [0, 1, 2].map(|a| p[a] + self.world[a])
+    }
 }
 
 /// Pass 2 state.
@@ -275,8 +378,12 @@ struct Build<'s, 'a, 'e, C: SceneCapacities> {
     /// What the whole scene needs, for capacity errors.
     needed: Counts,
     parsed: Parsed<'a>,
+    /// The frame being built.
+    frame: u32,
     /// Where each once-only parameter was first given, by keyword.
     first: [Option<Pos>; Keyword::COUNT],
+    /// Where the MOVE of VIEWPOINT or ORIGIN is, if the camera moves.
+    camera_move: Option<Pos>,
     errors: usize,
     /// Bit set of capacities already reported (one error each is enough),
     /// bit `kind as u8`.
@@ -322,17 +429,57 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
         found
     }
 
-    fn apply(&mut self, pos: Pos, s: Statement<'a>) {
+    /// The displacement of `s` at the frame being built, from the MOVE
+    /// that follows it once its keys are checked against FRAMES and the
+    /// format's range (errors reported; none without a MOVE).
+    fn offset(&mut self, s: &Statement<'a>, moved: Option<(Pos, Keys<'a>)>) -> Offset {
+        let Some((at, keys)) = moved else { return Offset::NONE };
+        let Some(frames) = self.parsed.frames else {
+            self.report(ParseError::new(at, ErrorKind::MoveWithoutFrames));
+            return Offset::NONE;
+        };
+        let limit = (number::LIMIT as i64) << 32;
+        let written = s.written_box();
+        for key in keys.iter() {
+            let kind = if key.frame >= frames.count {
+                ErrorKind::FrameBeyond { frame: key.frame, count: frames.count }
+            } else if written
+                .is_some_and(|(lo, hi)| (0..3).any(|a| lo[a] + key.offset[a] < -limit || hi[a] + key.offset[a] > limit))
+            {
+                ErrorKind::MovedOutOfRange { keyword: s.keyword().name(), frame: key.frame }
+            } else {
+                continue;
+            };
+            self.report(ParseError::new(key.pos, kind));
+            return Offset::NONE;
+        }
+        if matches!(s, Statement::Viewpoint(_) | Statement::Origin(_)) {
+            self.camera_move.get_or_insert(at);
+        }
+        let norm = self.scene.normalization;
+        let normalised = || keys.offsets().map(move |(f, d)| (f, d.map(|v| norm.length_wide(v))));
+        Offset {
+            world: displacement_at(keys.offsets(), self.frame),
+            normalised: displacement_at(normalised(), self.frame),
+            first: displacement_at(normalised(), 0),
+        }
+    }
+
+    fn apply(&mut self, pos: Pos, s: Statement<'a>, moved: Option<(Pos, Keys<'a>)>) {
         let keyword = s.keyword();
         if keyword.once_only() && !self.once(keyword, pos) {
             return;
         }
+        let offset = self.offset(&s, moved);
         let norm = self.scene.normalization;
+        let place = |w: WorldPoint| norm.moved(w, offset.normalised);
         let too_small = || ParseError::new(pos, ErrorKind::TooSmall { keyword: keyword.name() });
         let settings = &mut self.scene.settings;
         match s {
-            Statement::Viewpoint(p) => settings.view.eye = p,
-            Statement::Origin(p) => settings.view.look_at = p,
+            Statement::Viewpoint(p) => settings.view.eye = offset.world_moved(p),
+            Statement::Origin(p) => settings.view.look_at = offset.world_moved(p),
+            // Read by the survey; a MOVE comes paired with its statement.
+            Statement::Frames(_) | Statement::Move(_) => {}
             Statement::Upvector(p) => settings.view.up = p,
             Statement::Raster(r) => settings.raster = r,
             Statement::Viewport(v) => settings.view.viewport = Some(v),
@@ -343,7 +490,7 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
             Statement::Attenuation(d) => settings.attenuation = d,
             Statement::Samples(n) => settings.samples = n,
             Statement::Light { brightness, position } => {
-                let light = Light { position: norm.point(position), brightness };
+                let light = Light { position: place(position), brightness };
                 if let Err(e) = self.scene.push_light(light) {
                     self.capacity(pos, e);
                 }
@@ -366,7 +513,7 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
                 if radius.to_bits() <= 0 {
                     return self.report(too_small());
                 }
-                let r = self.scene.push_shape(Sphere::new(norm.point(center), radius, surface));
+                let r = self.scene.push_shape(Sphere::new(place(center), radius, surface));
                 if let Err(e) = r {
                     self.capacity(pos, e);
                 }
@@ -375,8 +522,8 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
                 let Some(surface) = self.surface(keyword, surface, pos) else {
                     return;
                 };
-                let min = norm.point([0, 1, 2].map(|a| center[a] - half[a]));
-                let max = norm.point([0, 1, 2].map(|a| center[a] + half[a]));
+                let min = place([0, 1, 2].map(|a| center[a] - half[a]));
+                let max = place([0, 1, 2].map(|a| center[a] + half[a]));
                 if (0..3).any(|a| min.axis(a) >= max.axis(a)) {
                     return self.report(too_small());
                 }
@@ -395,7 +542,7 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
                     return self.report(too_small());
                 }
                 let power = crate::math::Scalar::from_bits(statement::q32_to_q16(power.to_bits()) as i32);
-                let q = Superquadric::new(norm.point(center), half, power, surface);
+                let q = Superquadric::new(place(center), half, power, surface);
                 if let Err(e) = self.scene.push_shape(q) {
                     self.capacity(pos, e);
                 }
@@ -407,14 +554,14 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
                 if Scene::<C>::capacity_of(ShapeKind::Triangle) == 0 {
                     return self.capacity(pos, Scene::<C>::full(CapacityKind::Triangles, 0));
                 }
-                let Some(t) = Triangle::new(corners.map(|c| norm.point(c)), surface) else {
+                let Some(t) = Triangle::new(corners.map(place), surface) else {
                     return self.report(too_small());
                 };
                 if let Err(e) = self.scene.push_shape(t) {
                     self.capacity(pos, e);
                 }
             }
-            Statement::Bspline(patch) => self.bspline(pos, patch),
+            Statement::Bspline(patch) => self.bspline(pos, patch, offset),
             Statement::Rectangle { surface, corners } => {
                 let Some(surface) = self.surface(keyword, surface, pos) else {
                     return;
@@ -425,7 +572,7 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
                 if Scene::<C>::capacity_of(ShapeKind::Rectangle) == 0 {
                     return self.capacity(pos, Scene::<C>::full(CapacityKind::Rectangles, 0));
                 }
-                let Some(r) = Rectangle::new(corners.map(|c| norm.point(c)), surface) else {
+                let Some(r) = Rectangle::new(corners.map(place), surface) else {
                     return self.report(too_small());
                 };
                 if let Err(e) = self.scene.push_shape(r) {
@@ -436,8 +583,10 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
     }
 
     /// A B-spline patch: its triangles' room is checked as a whole before
-    /// any is made.
-    fn bspline(&mut self, pos: Pos, patch: Patch<'a>) {
+    /// any is made. A moving patch is evaluated where it stands at frame 0
+    /// and its triangles moved from there, whole: it moves rigidly, to the
+    /// bit.
+    fn bspline(&mut self, pos: Pos, patch: Patch<'a>, offset: Offset) {
         let Patch { surface, order, rows, cols, samples, points } = patch;
         let Some(surface) = self.surface(Keyword::Bspline, surface, pos) else {
             return;
@@ -452,17 +601,21 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
             return self.capacity(pos, e);
         }
         let norm = self.scene.normalization;
-        if let Err(e) = self.scene.set_control_points(points.iter().map(|p| norm.point(p))) {
+        if let Err(e) = self.scene.set_control_points(points.iter().map(|p| norm.moved(p, offset.first))) {
             return self.capacity(pos, e);
         }
-        if self.scene.push_bspline(order, rows, cols, samples, surface) == 0 {
-            self.report(ParseError::new(
+        // Both places are within the scene's range: so is their difference.
+        let shift = crate::math::Vec3::from_bits([0, 1, 2].map(|a| (offset.normalised[a] - offset.first[a]) as i32));
+        match self.scene.push_bspline(order, rows, cols, samples, surface, shift) {
+            Ok(0) => self.report(ParseError::new(
                 pos,
                 ErrorKind::Degenerate {
                     keyword: Keyword::Bspline.name(),
                     why: "its control points do not span a surface",
                 },
-            ));
+            )),
+            Ok(_) => {}
+            Err(e) => self.capacity(pos, e),
         }
     }
 
@@ -473,6 +626,10 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
         let view_pos = at(Keyword::Viewpoint).max(at(Keyword::Origin)).unwrap_or(start);
         match Camera::check(&self.scene.settings.view) {
             Ok(()) => {}
+            Err(error) if self.camera_move.is_some() => {
+                let (pos, frame) = (self.camera_move.unwrap_or(view_pos), self.frame);
+                self.report(ParseError::new(pos, ErrorKind::MovedCamera { error, frame }))
+            }
             Err(CameraError::EyeAtOrigin) => self.report(ParseError::new(view_pos, ErrorKind::EyeAtOrigin)),
             Err(CameraError::UpParallel) => {
                 let pos = at(Keyword::Upvector).unwrap_or(view_pos);
@@ -684,6 +841,8 @@ mod tests {
             Keyword::Rectangle => "RECTANGLE 1 0 0 0 1 0 0 1 1 0 0 1 0",
             Keyword::Bspline => "BSPLINE 1 2 2 2 2 2 0 0 0 1 0 0 0 1 0 1 1 0",
             Keyword::Surface => "SURFACE 2 0 0 0 0 0 0 0 0 0 0 0 0",
+            Keyword::Frames => "FRAMES 4 12",
+            Keyword::Move => "LIGHT 1 5 5 5 MOVE 0 1 0 0  3 0 1 0",
         }
     }
 
@@ -691,8 +850,10 @@ mod tests {
     fn parameters_may_be_given_once_and_the_rest_repeat() {
         for keyword in Keyword::ALL {
             let statement = example(keyword);
-            ok(&format!("{SURF}{statement}"));
-            let twice = format!("{SURF}{statement}\n{statement}");
+            // A MOVE needs FRAMES (on the line of the surface).
+            let frames = if keyword == Keyword::Move { "FRAMES 4 " } else { "" };
+            ok(&format!("{SURF}{frames}{statement}"));
+            let twice = format!("{SURF}{frames}{statement}\n{statement}");
             if keyword.once_only() {
                 let name = keyword.name();
                 assert_eq!(one_err(&twice), format!("3:1: {name} is given twice (first on line 2)"));
@@ -720,11 +881,55 @@ mod tests {
     #[test]
     fn recovery_resumes_at_the_next_keyword() {
         // The missing z is reported at the keyword that follows, which is
-        // then read normally.
+        // then read normally, even on the same line.
         let e = errs(&format!("SPHERE 1 1 0 0\n{SURF}RDEPTH 2 RDEPTH 3"));
         assert_eq!(e.len(), 2, "{e:?}");
         assert!(e[0].contains("2:1: expected a number for SPHERE z, found `SURFACE`"), "{e:?}");
         assert!(e[1].contains("RDEPTH is given twice"), "{e:?}");
+    }
+
+    /// Where each error of `text` is, as `line:column`.
+    fn error_positions(text: &str) -> Vec<String> {
+        errs(text).iter().map(|e| e.split(": ").next().unwrap_or_default().to_string()).collect()
+    }
+
+    #[test]
+    fn recovery_reports_every_lines_error() {
+        // An unknown word is its own offending token: the next line's word
+        // is read again as a statement.
+        assert_eq!(error_positions("x\nx\nx\nx\nx\n"), ["1:1", "2:1", "3:1", "4:1", "5:1"]);
+        // A statement cut short by a keyword on the next line: that
+        // statement is read, its own error reported, and the line after.
+        let e = errs("SPHERE 1 1 0 0\nSPHERE 1 -1 0 0 0\nx\n");
+        assert_eq!(e.len(), 3, "{e:?}");
+        assert!(e[0].starts_with("2:1: expected a number for SPHERE z, found `SPHERE`"), "{e:?}");
+        assert!(e[1].starts_with("2:10: SPHERE radius must be > 0"), "{e:?}");
+        assert!(e[2].starts_with("3:1: unknown keyword `x`"), "{e:?}");
+        // A bad number: the rest of its statement is dropped, not the next
+        // line; numbers on the lines after an unknown word are its own.
+        assert_eq!(
+            error_positions("SPHERE 1 y 0 0 0\nx\nLIGHT 1 0 5 q\nx 1 2\n 3 4\nx\n"),
+            ["1:10", "2:1", "3:13", "4:1", "6:1"]
+        );
+        // The offending word opening a line is reported once, as what the
+        // statement did not expect.
+        let e = errs("SPHERE 1 1\nfoo 0 0\nx\n");
+        assert_eq!(e.len(), 2, "{e:?}");
+        assert!(e[0].starts_with("2:1: expected a number for SPHERE x, found `foo`"), "{e:?}");
+        assert!(e[1].starts_with("3:1: unknown keyword `x`"), "{e:?}");
+        // A statement wrong as a whole (reported at its keyword): the next
+        // line's word is still read.
+        assert_eq!(error_positions(&format!("{SURF}TRIANGLE 1 0 0 0 1 1 1 2 2 2\nx\n")), ["2:1", "3:1"]);
+        // A bad control point: the patch's other points, on the lines
+        // after it, are skipped as its own.
+        let patch = "BSPLINE 1 2 3 3 2 2\n0 0 0 1 0 0 2 0 0\n0 1 0 q 1 0 2 1 0\n0 2 0 1 2 0 2 2 0\nx\n";
+        assert_eq!(error_positions(&format!("{SURF}{patch}")), ["4:7", "6:1"]);
+        // An unterminated comment takes the rest of the text: what is in
+        // it is not read, what came before is all reported.
+        assert_eq!(error_positions("x\nSPHERE 1 1 0 /* open\nx\n"), ["1:1", "2:14"]);
+        assert_eq!(error_positions("x\nRDEPTH 2 x\n/* open\nx\n"), ["1:1", "2:10", "3:1"]);
+        // A quoted keyword begins no statement.
+        assert_eq!(error_positions("x \"RDEPTH\" 2\nRDEPTH 2\n"), ["1:1"]);
     }
 
     #[test]
@@ -882,9 +1087,15 @@ mod tests {
             ErrorKind::EyeAtOrigin => 16,
             ErrorKind::UpParallel => 17,
             ErrorKind::Capacity(_) => 18,
+            ErrorKind::MoveWithoutFrames => 19,
+            ErrorKind::NothingToMove { .. } => 20,
+            ErrorKind::FramesOutOfOrder { .. } => 21,
+            ErrorKind::FrameBeyond { .. } => 22,
+            ErrorKind::MovedOutOfRange { .. } => 23,
+            ErrorKind::MovedCamera { .. } => 24,
         }
     }
-    const ERROR_KINDS: usize = 19;
+    const ERROR_KINDS: usize = 25;
 
     #[test]
     fn every_error_kind_reports_its_line_and_column() {
@@ -893,7 +1104,7 @@ mod tests {
         // 0.002; a radius of 0.0001 rounds to nothing, 0.002 does not.
         let wide = "LIGHT 1 -500000 0 0 LIGHT 1 500000 0 0\n";
         assert!(ok(&format!("{wide}{SURF} SPHERE 1 0.002 0 0 0")).view().spheres[0].radius.to_bits() > 0);
-        let cases: [(String, Pos, usize); 19] = [
+        let cases: [(String, Pos, usize); 25] = [
             ("RDEPTH 1\n  /* open\n".into(), at(2, 3), 1),
             ("RDEPTH 1\nIMAGEFILE \"abc\n".into(), at(2, 11), 2),
             ("RDEPTH 1\n  FOO 1".into(), at(2, 3), 3),
@@ -913,6 +1124,12 @@ mod tests {
             ("VIEWPOINT 0 0 1\n ORIGIN 0 0 1".into(), at(2, 2), 16),
             ("\n  UPVECTOR 0 0 -3".into(), at(2, 3), 17),
             (format!("{SURF}{boxes}"), at(34, 1), 18),
+            ("LIGHT 1 0 0 0\n MOVE 0 1 1 1".into(), at(2, 2), 19),
+            ("FRAMES 2\n MOVE 0 1 1 1".into(), at(2, 2), 20),
+            ("FRAMES 9 LIGHT 1 0 0 0\nMOVE 3 0 0 0  3 1 1 1".into(), at(2, 15), 21),
+            ("FRAMES 3 LIGHT 1 0 0 0\nMOVE 0 0 0 0  3 1 1 1".into(), at(2, 15), 22),
+            ("FRAMES 3 LIGHT 1 999999 0 0\nMOVE 0 0 0 0  2 2 0 0".into(), at(2, 15), 23),
+            ("FRAMES 3 VIEWPOINT 0 0 5\n MOVE 0 0 0 -5".into(), at(2, 2), 24),
         ];
         let mut covered = [false; ERROR_KINDS];
         let bad_byte = (b"RDEPTH 2\n\xc3\xa9 \xff".to_vec(), at(2, 3), 0);
@@ -978,6 +1195,32 @@ mod tests {
                  define a profile that holds them with octrace_core::profile! (bspline_triangles: 100, …)"
             ),
             "{e:?}"
+        );
+    }
+
+    #[test]
+    fn a_patch_at_exactly_its_capacity_loads_and_one_triangle_over_is_named() {
+        crate::profile! {
+            struct Exactly32 { bspline_triangles: 32, control_points: 9, surfaces: 1 }
+        }
+        crate::profile! {
+            struct Only31 { bspline_triangles: 31, control_points: 9, surfaces: 1 }
+        }
+        // 2 · 4 · 4 = 32 triangles.
+        let text = format!("{SURF}BSPLINE 1 3 3 3 5 5 {GRID}\n");
+        let mut scene = std::boxed::Box::new(Scene::<Exactly32>::new());
+        let mut errors = Vec::new();
+        let r = parse(&text, &mut scene, &mut |e| errors.push(e.to_string()));
+        assert_eq!((r, errors.len()), (Ok(Parsed::default()), 0), "{errors:?}");
+        assert_eq!(scene.view().bspline_triangles.len(), 32);
+        let mut scene = std::boxed::Box::new(Scene::<Only31>::new());
+        let r = parse(&text, &mut scene, &mut |e| errors.push(e.to_string()));
+        assert_eq!(r, Err(1), "{errors:?}");
+        assert!(
+            errors[0].starts_with(
+                "2:1: too many B-spline triangles: the capacity profile Only31 holds 31 and the scene needs 32"
+            ),
+            "{errors:?}"
         );
     }
 

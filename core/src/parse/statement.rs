@@ -8,7 +8,7 @@ use super::lexer::{Lexer, Token};
 use super::number::{parse_integer, Decimal};
 use crate::capacity::{CapacityKind, Counts};
 use crate::math::isqrt_u128;
-use crate::scene::{Color, Surface, WorldPoint, WorldValue, MAX_SAMPLES, MAX_SIDE};
+use crate::scene::{Color, Frames, Surface, WorldPoint, WorldValue, MAX_SAMPLES, MAX_SIDE};
 use crate::shapes::bspline::{MAX_CONTROL_SIDE, MAX_ORDER, MAX_SAMPLE_SIDE};
 use fixed::types::{I32F32, I48F16};
 
@@ -34,6 +34,8 @@ pub enum Statement<'a> {
     Rectangle { surface: u32, corners: [WorldPoint; 4] },
     Bspline(Patch<'a>),
     Surface { number: u32, surface: Surface },
+    Frames(Frames),
+    Move(Keys<'a>),
 }
 
 /// A B-spline patch: its control points stay in the text (validated), read
@@ -66,6 +68,45 @@ impl<'a> ControlPoints<'a> {
             _ => 0,
         };
         (0..self.count).map(move |_| [number(), number(), number()])
+    }
+}
+
+/// A MOVE's keys as they stand in the scene text, already checked to be
+/// `count` keys (a frame, then a displacement), their frames strictly
+/// increasing: read again when needed, like a patch's control points.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Keys<'a> {
+    lexer: Lexer<'a>,
+    count: u32,
+}
+
+/// One key of a MOVE: at `frame`, the displacement `offset` (world units).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Key {
+    pub frame: u32,
+    /// Where the frame is written, for errors about it.
+    pub pos: Pos,
+    pub offset: WorldPoint,
+}
+
+impl<'a> Keys<'a> {
+    /// The keys, in the order written (frames increasing).
+    pub fn iter(&self) -> impl Iterator<Item = Key> + 'a {
+        let mut lexer = self.lexer;
+        let mut token = move || match lexer.next_token() {
+            Ok(Some(t)) => (t.pos, Decimal::parse(t.text).map_or(0, |d| d.to_q32())),
+            _ => (Pos { line: 1, column: 1 }, 0),
+        };
+        (0..self.count).map(move |_| {
+            let (pos, frame) = token();
+            let offset = [token().1, token().1, token().1];
+            Key { frame: (frame >> 32) as u32, pos, offset }
+        })
+    }
+
+    /// The keys as (frame, displacement) for [`crate::scene::displacement_at`].
+    pub fn offsets(&self) -> impl Iterator<Item = (u32, WorldPoint)> + 'a {
+        self.iter().map(|k| (k.frame, k.offset))
     }
 }
 
@@ -111,7 +152,9 @@ impl Statement<'_> {
             | Statement::Gamma(_)
             | Statement::Attenuation(_)
             | Statement::Samples(_)
-            | Statement::Surface { .. } => None,
+            | Statement::Surface { .. }
+            | Statement::Frames(_)
+            | Statement::Move(_) => None,
         }
     }
 
@@ -143,7 +186,9 @@ impl Statement<'_> {
             | Statement::Background(_)
             | Statement::Gamma(_)
             | Statement::Attenuation(_)
-            | Statement::Samples(_) => return,
+            | Statement::Samples(_)
+            | Statement::Frames(_)
+            | Statement::Move(_) => return,
         };
         let count = counts.get_mut(kind);
         *count = count.saturating_add(1);
@@ -171,6 +216,8 @@ impl Statement<'_> {
             Statement::Rectangle { .. } => Keyword::Rectangle,
             Statement::Bspline(_) => Keyword::Bspline,
             Statement::Surface { .. } => Keyword::Surface,
+            Statement::Frames(_) => Keyword::Frames,
+            Statement::Move(_) => Keyword::Move,
         }
     }
 }
@@ -202,6 +249,12 @@ impl<'a> Cursor<'a> {
         let t = self.peek()?;
         self.take();
         Ok(t)
+    }
+
+    /// Whether `token` (the one peeked) begins a line after the last token
+    /// taken: where a statement may begin again after an error.
+    pub fn on_a_later_line(&self, token: Token<'a>) -> bool {
+        token.pos.line > self.taken_end.line
     }
 
     /// Consumes the peeked token.
@@ -249,6 +302,12 @@ impl<'a> Cursor<'a> {
         } else {
             Err(out_of_range(t, field, rule))
         }
+    }
+
+    /// Whether the next token is a number (more of a statement whose
+    /// length varies: a rate, a key).
+    fn number_follows(&mut self) -> bool {
+        matches!(self.peek(), Ok(Some(t)) if !t.quoted && Decimal::parse(t.text).is_some())
     }
 
     /// An integer from `lo` to `hi`.
@@ -422,6 +481,34 @@ pub fn statement<'a, R: super::Room>(
                     transparency: fixed::types::I16F16::from_bits(transparency),
                 },
             }
+        }
+        Keyword::Frames => {
+            let count = cur.integer(f("count"), 1, Frames::MAX_COUNT as i64)? as u32;
+            let rate = match cur.number_follows() {
+                true => cur.integer(f("rate"), 1, Frames::MAX_RATE as i64)? as u32,
+                false => Frames::DEFAULT_RATE,
+            };
+            Statement::Frames(Frames { count, rate })
+        }
+        Keyword::Move => {
+            // Nothing is peeked after the keyword: the lexer stands at the
+            // first key.
+            let mut keys = Keys { lexer: cur.lexer, count: 0 };
+            let mut previous = None;
+            loop {
+                let at = cur.peek()?.map_or(cur.taken_end, |t| t.pos);
+                let frame = cur.integer(f("frame"), 0, Frames::MAX_COUNT as i64 - 1)? as u32;
+                if let Some(previous) = previous.filter(|&p| frame <= p) {
+                    return Err(ParseError::new(at, ErrorKind::FramesOutOfOrder { frame, previous }));
+                }
+                cur.point(kw, ["dx", "dy", "dz"])?;
+                keys.count += 1;
+                previous = Some(frame);
+                if !cur.number_follows() {
+                    break;
+                }
+            }
+            Statement::Move(keys)
         }
     })
 }

@@ -2,18 +2,19 @@
 //! core that loaded it; it draws as an image, directly or progressively.
 
 use crate::accel::{AccelMode, Accelerator, BuildReport, LightBuffer, LightBufferError};
+use crate::animation::{Coherence, Motion};
+use crate::panel::{Dithered, Dithering, TracedColor};
 use crate::profile::Profile;
 use crate::render::{Progressive, Renderer};
-use crate::scene::{CameraError, SceneView};
+use crate::scene::{CameraError, Frames, SceneView};
 use crate::shade::Stats;
 use core::cell::{Cell, RefCell};
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::geometry::Size;
 use embedded_graphics_core::pixelcolor::Rgb888;
 use embedded_graphics_core::primitives::Rectangle;
 
-use super::image::Shifted;
 use super::{light_buffer, DrawError, SceneAccelerator, ScreenLists, SharedScene, TracedImage};
 
 /// A scene ready to trace, borrowed from its [`Raytracer`](super::Raytracer).
@@ -29,6 +30,8 @@ pub struct LoadedScene<'r, P: Profile> {
     pub(super) screen_lists: RefCell<Option<ScreenLists<'r>>>,
     pub(super) first_hits: bool,
     pub(super) stats: Cell<Stats>,
+    /// FRAMES, for an animation.
+    pub(super) frames: Option<Frames>,
 }
 
 impl<P: Profile> fmt::Debug for LoadedScene<'_, P> {
@@ -157,13 +160,8 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         f: impl FnOnce(&mut Renderer<'_, SceneAccelerator<'r, P>>) -> R,
     ) -> Result<R, CameraError> {
         let accelerator = self.accelerator();
-        // Another draw of this scene holds the mailbox or the lists (only if
-        // a display draws from inside a draw): render without, same image.
-        let mut mailbox = self.mailbox.try_borrow_mut();
-        let mut screen_lists = self.screen_lists.try_borrow_mut();
-        let lists = screen_lists.as_deref_mut().ok().and_then(|lists| lists.as_mut());
-        let lists = lists.map(|(bounds, positions)| (&mut **bounds, &mut **positions));
-        let mailbox = mailbox.as_deref_mut().ok().map(|words| &mut **words);
+        let (mut mailbox, mut screen_lists) = (self.mailbox.try_borrow_mut(), self.screen_lists.try_borrow_mut());
+        let (mailbox, lists) = room_of(&mut mailbox, &mut screen_lists);
         let mut renderer = renderer_in(self.view, &accelerator, size, mailbox, lists)?;
         let result = f(&mut renderer);
         let mut total = self.stats.get();
@@ -189,6 +187,93 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         self.octree.as_ref().map(|(_, report)| report)
     }
 
+    /// The scene's FRAMES, if it is an animation (loaded at one of its
+    /// frames: [`Raytracer::load_frame`](super::Raytracer::load_frame)).
+    pub fn frames(&self) -> Option<Frames> {
+        self.frames
+    }
+
+    /// Draws frame `frame` of an animation, this scene loaded at that
+    /// frame, into `target` (of `coherence`'s size), re-tracing only the
+    /// tiles [`Coherence::plan`] left to trace (call it first) and drawing
+    /// only their runs of pixels: after the frame before it in the loop
+    /// (or at the first frame, everything), `target` shows the frame as a
+    /// whole draw would. An example is [`Coherence`]'s.
+    ///
+    /// A panel of few levels (`BinaryColor`, `Gray2`, `Gray4`,
+    /// [`BlackWhiteRed`](crate::panel::BlackWhiteRed)) is dithered by
+    /// [`Dithering::Bayer`], whose pixels depend on nothing but themselves
+    /// (error diffusion would carry a change across the whole image): it
+    /// shows the frame as a whole draw with that method would.
+    pub fn draw_changes<D>(
+        &self,
+        motion: &Motion<'_>,
+        frame: u32,
+        coherence: &Coherence<'_>,
+        target: &mut D,
+    ) -> Result<Stats, DrawError<D::Error>>
+    where
+        D: DrawTarget,
+        D::Color: TracedColor,
+    {
+        self.draw_bands(motion, frame, coherence, 0..coherence.bands(), target)
+    }
+
+    /// [`LoadedScene::draw_changes`] of the bands `bands` only, with one
+    /// renderer in the room of the loading core: on a board whose cores
+    /// share the frame, `bands` takes the next band no core has taken yet
+    /// (the other cores trace theirs with [`Coherence::trace_band`] and a
+    /// renderer of their own, [`SharedScene::renderer`]).
+    pub fn draw_bands<D>(
+        &self,
+        motion: &Motion<'_>,
+        frame: u32,
+        coherence: &Coherence<'_>,
+        bands: impl IntoIterator<Item = u32>,
+        target: &mut D,
+    ) -> Result<Stats, DrawError<D::Error>>
+    where
+        D: DrawTarget,
+        D::Color: TracedColor,
+    {
+        match D::Color::PANEL {
+            None => self.draw_bands_converted(motion, frame, coherence, bands, target),
+            Some(_) => self.draw_bands_converted(motion, frame, coherence, bands, &mut Dithered::ordered(target)),
+        }
+    }
+
+    /// [`LoadedScene::draw_bands`] into a target that takes the traced
+    /// colours converted.
+    fn draw_bands_converted<D>(
+        &self,
+        motion: &Motion<'_>,
+        frame: u32,
+        coherence: &Coherence<'_>,
+        bands: impl IntoIterator<Item = u32>,
+        target: &mut D,
+    ) -> Result<Stats, DrawError<D::Error>>
+    where
+        D: DrawTarget,
+        D::Color: From<Rgb888>,
+    {
+        let accelerator = self.accelerator();
+        // As `with_renderer`, here: the renderer's room is borrowed no
+        // longer than `motion` lives.
+        let (mut mailbox, mut screen_lists) = (self.mailbox.try_borrow_mut(), self.screen_lists.try_borrow_mut());
+        let (mailbox, lists) = room_of(&mut mailbox, &mut screen_lists);
+        let mut renderer =
+            renderer_in(self.view, &accelerator, coherence.size(), mailbox, lists).map_err(DrawError::Camera)?;
+        let mut stats = Stats::default();
+        let result = bands.into_iter().try_for_each(|band| {
+            stats.add(&coherence.draw_band(&mut renderer, motion, frame, band, target)?);
+            Ok(())
+        });
+        let mut total = self.stats.get();
+        total.add(&stats);
+        self.stats.set(total);
+        result.map(|()| stats).map_err(DrawError::Target)
+    }
+
     /// The counters of every draw so far.
     pub fn stats(&self) -> Stats {
         self.stats.get()
@@ -202,7 +287,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
 
     /// The scene as an image of `size` pixels in the colour `C`.
     pub fn image<C>(&self, size: Size) -> TracedImage<'_, 'r, P, C> {
-        TracedImage { scene: self, size, color: core::marker::PhantomData }
+        TracedImage { scene: self, size, dithering: Dithering::default(), color: core::marker::PhantomData }
     }
 
     /// The scene as an image as large as `target`, in its colour: what
@@ -216,6 +301,11 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// blocks first, then finer, until it is exactly the picture
     /// [`LoadedScene::image`] draws. Every pixel is traced once; the
     /// drawing streams (no framebuffer), in a few calls a pass.
+    ///
+    /// A panel of few levels (`BinaryColor`, `Gray2`, `Gray4`,
+    /// [`BlackWhiteRed`](crate::panel::BlackWhiteRed)) is dithered by
+    /// [`Dithering::Bayer`] in every pass, the one method that needs no
+    /// order: the last pass is then the image with that method.
     ///
     /// ```
     /// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb565, prelude::*};
@@ -236,31 +326,42 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     pub fn draw_progressive<D>(&self, order: &Progressive, target: &mut D) -> Result<(), DrawError<D::Error>>
     where
         D: DrawTarget,
-        D::Color: From<Rgb888>,
+        D::Color: TracedColor,
     {
-        let drawn = self.with_renderer(order.size(), |renderer| order.render_unchecked(renderer, target));
+        let drawn = match D::Color::PANEL {
+            None => self.with_renderer(order.size(), |renderer| order.render_unchecked(renderer, target)),
+            Some(_) => {
+                let mut ordered = Dithered::ordered(target);
+                self.with_renderer(order.size(), |renderer| order.render_unchecked(renderer, &mut ordered))
+            }
+        };
         drawn.map_err(DrawError::Camera)?.map_err(DrawError::Target)?;
         Ok(())
     }
 
-    /// Renders `area` of an image of `size` into `target`, with the pixel at
-    /// `area`'s top-left corner going to `at`.
-    pub(super) fn draw_area<D>(
-        &self,
-        size: Size,
-        area: &Rectangle,
-        at: Point,
-        target: &mut D,
-    ) -> Result<(), DrawError<D::Error>>
+    /// Renders `area` of an image of `size` into `target`, in the image's
+    /// coordinates.
+    pub(super) fn render_area<D>(&self, size: Size, area: &Rectangle, target: &mut D) -> Result<(), DrawError<D::Error>>
     where
         D: DrawTarget,
         D::Color: From<Rgb888>,
     {
-        let mut shifted = Shifted { target, offset: at - area.top_left };
-        let drawn = self.with_renderer(size, |renderer| renderer.render_rect(area, &mut shifted));
+        let drawn = self.with_renderer(size, |renderer| renderer.render_rect(area, target));
         drawn.map_err(DrawError::Camera)?.map_err(DrawError::Target)?;
         Ok(())
     }
+}
+
+/// The loading core's room out of its cells: none of what another draw of
+/// the scene holds (only if a display draws from inside a draw: the render
+/// goes without, the same image).
+fn room_of<'g, 'r>(
+    mailbox: &'g mut Result<core::cell::RefMut<'_, &'r mut [u32]>, core::cell::BorrowMutError>,
+    screen_lists: &'g mut Result<core::cell::RefMut<'_, Option<ScreenLists<'r>>>, core::cell::BorrowMutError>,
+) -> (Option<&'g mut [u32]>, Option<ScreenLists<'g>>) {
+    let lists = screen_lists.as_deref_mut().ok().and_then(|lists| lists.as_mut());
+    let lists = lists.map(|(bounds, positions)| (&mut **bounds, &mut **positions));
+    (mailbox.as_deref_mut().ok().map(|words| &mut **words), lists)
 }
 
 /// A renderer over `view` for an image of `size`, with a mailbox and screen

@@ -10,7 +10,7 @@
 
 use crate::accel::{self, AccelMode, LightBuffer, LightBufferStore, Mailbox, OctreeStore, Prepared, MAX_CELLS_A_SIDE};
 use crate::capacity::Arena;
-use crate::parse::{parse_bytes, ErrorKind, ParseError, Pos};
+use crate::parse::{parse_frame_bytes, ErrorKind, ParseError, Pos};
 use crate::profile::Profile;
 use crate::render::ScreenBound;
 use crate::scene::Scene;
@@ -158,6 +158,33 @@ impl<P: Profile> Raytracer<P> {
         self.load_with(text.as_bytes(), AccelMode::Auto, &mut |_| {})
     }
 
+    /// [`Raytracer::load`] of frame `frame` of an animation (a scene with
+    /// `FRAMES`; see [`parse_frame`](crate::parse::parse_frame)): its
+    /// moving statements stand where their `MOVE` keys put them at that
+    /// frame. [`LoadedScene::frames`] says how many frames it has;
+    /// [`crate::animation`] draws one frame after another re-tracing only
+    /// what moved.
+    ///
+    /// ```
+    /// use embedded_graphics::prelude::*;
+    /// use octrace_core::{profile::Board16K, Raytracer};
+    ///
+    /// let text = "FRAMES 2\nRASTER 8 8\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\n\
+    ///             LIGHT 10 5 5 5 MOVE 0 0 0 0  1 -10 0 0\nSPHERE 1 3 0 0 0\n";
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let first = raytracer.load_frame(text, 0)?.with_renderer(Size::new(8, 8), |r| r.pixel(4, 4).color)?;
+    /// let second = raytracer.load_frame(text, 1)?.with_renderer(Size::new(8, 8), |r| r.pixel(4, 4).color)?;
+    /// assert_ne!(first, second, "the light moved");
+    /// assert_eq!(raytracer.load_frame(text, 1)?.frames().map(|f| f.count), Some(2));
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn load_frame<'t>(&mut self, text: &'t str, frame: u32) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
+        self.load_in(text.as_bytes(), frame, AccelMode::Auto, &mut |_| {}, &mut |beside, here| {
+            here();
+            beside();
+        })
+    }
+
     /// [`Raytracer::load`] from bytes (invalid UTF-8 is an error at its
     /// place), with the accelerator `mode`, handing every error to
     /// `on_error` as it is found. A profile with no room for octree boxes
@@ -169,7 +196,7 @@ impl<P: Profile> Raytracer<P> {
         mode: AccelMode,
         on_error: &mut dyn FnMut(ParseError<'t>),
     ) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
-        self.load_in(text, mode, on_error, &mut |beside, here| {
+        self.load_in(text, 0, mode, on_error, &mut |beside, here| {
             here();
             beside();
         })
@@ -210,7 +237,7 @@ impl<P: Profile> Raytracer<P> {
         both: impl FnOnce(&mut (dyn FnMut() + Send), &mut dyn FnMut()),
     ) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
         let mut both = Some(both);
-        self.load_in(text.as_bytes(), AccelMode::Auto, &mut |_| {}, &mut |beside, here| {
+        self.load_in(text.as_bytes(), 0, AccelMode::Auto, &mut |_| {}, &mut |beside, here| {
             if let Some(both) = both.take() {
                 both(beside, here);
             }
@@ -223,17 +250,18 @@ impl<P: Profile> Raytracer<P> {
     fn load_in<'t>(
         &mut self,
         text: &'t [u8],
+        frame: u32,
         mode: AccelMode,
         on_error: &mut dyn FnMut(ParseError<'t>),
         both: &mut RunBoth<'_>,
     ) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
         let mut first = None;
-        let parsed = parse_bytes(text, &mut self.scene, &mut |e| {
+        let parsed = parse_frame_bytes(text, &mut self.scene, frame, &mut |e| {
             first.get_or_insert(e);
             on_error(e);
         });
-        match (parsed, first) {
-            (Ok(_), _) => {}
+        let frames = match (parsed, first) {
+            (Ok(parsed), _) => parsed.frames,
             (Err(count), Some(first)) => return Err(LoadError { first, count }),
             // Never taken: `parse_bytes` hands every error it counts to the
             // callback. Answered at the file's start rather than by a panic.
@@ -241,7 +269,7 @@ impl<P: Profile> Raytracer<P> {
                 let first = ParseError::new(Pos { line: 1, column: 1 }, ErrorKind::InvalidUtf8);
                 return Err(LoadError { first, count });
             }
-        }
+        };
         let view = self.scene.view();
         let requested = mode;
         // The naive mode asked for by name stays the thesis's test of
@@ -278,6 +306,7 @@ impl<P: Profile> Raytracer<P> {
             screen_lists: RefCell::new(screen_lists),
             first_hits,
             stats: Cell::new(Stats::default()),
+            frames,
         })
     }
 }

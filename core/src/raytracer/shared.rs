@@ -129,6 +129,7 @@ impl<P: Profile> Accelerator for SceneAccelerator<'_, P> {
     const KINDS: ShapeKinds = ShapeKinds::with_room(&P::COUNTS);
     // The octree's mailbox, only if the profile can have an octree.
     const USES_MAILBOX: bool = <P::Octree as OctreeStore>::HAS_BOXES && <P::Octree as Accelerator>::USES_MAILBOX;
+    const FOLLOWS_MOTION: bool = P::COHERENCE;
 
     fn first_hits_by_screen(&self) -> bool {
         P::FIRST_HITS && self.octree().is_none_or(|octree| octree.first_hits_by_screen())

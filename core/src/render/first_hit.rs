@@ -2,8 +2,10 @@
 //! window of the image and the nearest its hit can be (the first-hit idea of
 //! Weghorst, Hooper and Greenberg 1984, kept exact).
 //!
-//! Once per renderer, every object's bounds, widened by the filing margin,
-//! are projected into the camera's offsets ([`Projection::window`]), and the
+//! Once per renderer (at its first pixel, where a caller's stop is asked
+//! before each object, as before each ray), every object's bounds, widened
+//! by the filing margin, are projected into the camera's offsets
+//! ([`Projection::window`]), and the
 //! objects are sorted by a lower bound of the parameter of any hit on them
 //! (the distance from the eye to the widened box). For a band of rows the
 //! objects whose window meets the band are kept, still in that order, and
@@ -23,6 +25,7 @@
 use crate::accel::{Hit, FILING_MARGIN};
 use crate::math::{isqrt, mul_i64_wide};
 use crate::scene::{Camera, CameraRay, ObjectId, Projection, SceneView};
+use crate::shade::Poll;
 use crate::shapes::{Leaving, ShapeKinds};
 
 /// Rows of a band: its objects are chosen once for them all.
@@ -144,29 +147,39 @@ pub(crate) struct FirstHits<'a> {
 }
 
 impl<'a> FirstHits<'a> {
-    /// The bounds of `scene`'s objects seen by `camera`, or `None` when
-    /// `bounds` holds fewer than the objects, `positions` fewer than
-    /// [`ScreenBound::positions_for`] them, or the objects are too many for
-    /// the image to pay for them (or for 16-bit positions).
-    pub fn new(
-        scene: &SceneView<'_>,
-        camera: &Camera,
-        bounds: &'a mut [ScreenBound],
-        positions: &'a mut [u16],
-    ) -> Option<Self> {
+    /// Whether lists of `scene`'s objects seen by `camera` fit `bounds`
+    /// and `positions` (one bound an object, [`ScreenBound::positions_for`]
+    /// positions) and pay: the objects are not too many for the image's
+    /// rays (or for 16-bit positions).
+    pub fn fit(scene: &SceneView<'_>, camera: &Camera, bounds: &[ScreenBound], positions: &[u16]) -> bool {
         let objects = scene.object_count();
         let n = camera.samples() as u64;
-        if objects > MAX_OBJECTS
-            || objects as u64 * MIN_RAYS_PER_OBJECT > camera.width() as u64 * camera.height() as u64 * n * n
-        {
-            return None;
-        }
-        let all = bounds.get_mut(..objects)?;
-        let positions = positions.get_mut(..ScreenBound::positions_for(objects))?;
+        objects <= MAX_OBJECTS
+            && objects as u64 * MIN_RAYS_PER_OBJECT <= camera.width() as u64 * camera.height() as u64 * n * n
+            && bounds.len() >= objects
+            && positions.len() >= ScreenBound::positions_for(objects)
+    }
+
+    /// Projects every object of `scene` seen by `camera` into `bounds`,
+    /// asking `poll` before each (an object's projection costs about what
+    /// a ray does); false if it said stop.
+    pub fn project<Q: Poll>(scene: &SceneView<'_>, camera: &Camera, bounds: &mut [ScreenBound], poll: &mut Q) -> bool {
         let projection = Projection::new(camera);
-        for (slot, id) in all.iter_mut().zip(scene.object_ids()) {
+        for (slot, id) in bounds.iter_mut().zip(scene.object_ids()) {
+            if !poll.go_on() {
+                return false;
+            }
             *slot = ScreenBound::of(scene, &projection, id);
         }
+        true
+    }
+
+    /// The lists over the first `objects` of `bounds`, as
+    /// [`FirstHits::project`] left them, sorted here; `None` where they do
+    /// not [fit](FirstHits::fit).
+    pub fn new(objects: usize, bounds: &'a mut [ScreenBound], positions: &'a mut [u16]) -> Option<Self> {
+        let all = bounds.get_mut(..objects)?;
+        let positions = positions.get_mut(..ScreenBound::positions_for(objects))?;
         crate::sort::sort_by_key(all, |b| (b.near, b.object));
         Some(FirstHits { all, positions, band_start: u32::MAX, band: None, tile_start: u32::MAX, tile: None })
     }
@@ -348,7 +361,11 @@ mod tests {
             let camera = Camera::new(&view.settings.view, &view.normalization, w, h, view.settings.samples).unwrap();
             let mut bounds = vec![ScreenBound::EMPTY; view.object_count()];
             let mut positions = vec![0; ScreenBound::positions_for(view.object_count())];
-            let Some(mut hits) = FirstHits::new(&view, &camera, &mut bounds, &mut positions) else { continue };
+            if !FirstHits::fit(&view, &camera, &bounds, &positions) {
+                continue;
+            }
+            assert!(FirstHits::project(&view, &camera, &mut bounds, &mut crate::shade::Unpolled));
+            let Some(mut hits) = FirstHits::new(view.object_count(), &mut bounds, &mut positions) else { continue };
             let n = camera.samples();
             for y in 0..h {
                 for x in 0..w {

@@ -11,6 +11,10 @@
 //! among the objects seen around their pixel, nearest first, instead of
 //! walking the accelerator (`first_hit.rs`): the same hits.
 //!
+//! A render can be stopped inside a pixel ([`Renderer::pixel_until`] and a
+//! [`Stop`], asked before every ray): a pixel stopped gives nothing, one
+//! that completes gives the same bits as [`Renderer::pixel`].
+//!
 //! A pixel with SAMPLES n is the mean of its n² sample colours, each clamped
 //! to [0, 1] first (an over-bright highlight does not bleed into its
 //! neighbours), then gamma-corrected and rounded. Its object is the one hit
@@ -22,6 +26,7 @@ mod handoff;
 mod panel;
 mod progressive;
 mod split;
+mod stop;
 
 use first_hit::FirstHits;
 pub use first_hit::ScreenBound;
@@ -30,10 +35,12 @@ pub use handoff::{Handoff, SlotBusy, Taken};
 pub use panel::PanelColor;
 pub use progressive::{Progressive, ProgressiveError, TracedUnit, Unit};
 pub use split::{interleaved_rows, Tiles};
+pub use stop::{Stop, Stopped};
 
 use crate::accel::{Accelerator, Hit, Mailbox};
+use crate::motion::{Lookout, RayKind};
 use crate::scene::{Camera, CameraError, CameraRay, Color, ObjectId, RayCursor, SceneView, Stride, MAX_SIDE};
-use crate::shade::{Scratch, Stats, Tracer};
+use crate::shade::{Poll, Scratch, Stats, Tracer, Unpolled};
 use core::ops::Range;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
@@ -92,7 +99,17 @@ pub struct Renderer<'a, A> {
     last_encoded: [u8; 3],
     scratch: Scratch<'a>,
     /// Camera rays' objects by where they are seen, when given storage.
-    first_hits: Option<FirstHits<'a>>,
+    first_hits: ScreenLists<'a>,
+}
+
+/// A renderer's screen lists: none, their room until the first camera ray
+/// fills it (asking the pixel's stop before each object, as before each
+/// ray: the lists of hundreds of objects take a board a few hundred
+/// milliseconds), or the lists.
+enum ScreenLists<'a> {
+    None,
+    Room(&'a mut [ScreenBound], &'a mut [u16]),
+    Lists(FirstHits<'a>),
 }
 
 impl<A> core::fmt::Debug for Renderer<'_, A> {
@@ -124,7 +141,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
             gamma: GammaTable { thresholds: [0; 255] },
             last_encoded: [0; 3],
             scratch: Scratch::new(Mailbox::none()),
-            first_hits: None,
+            first_hits: ScreenLists::None,
         };
         renderer.gamma.fill(s.gamma);
         Ok(renderer)
@@ -176,20 +193,52 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
 
     /// [`Renderer::with_first_hits`] in place.
     pub fn set_first_hits(&mut self, bounds: &'a mut [ScreenBound], positions: &'a mut [u16]) {
-        if self.tracer.accel().first_hits_by_screen() {
-            self.first_hits = FirstHits::new(self.tracer.scene(), &self.camera, bounds, positions);
+        if self.tracer.accel().first_hits_by_screen()
+            && FirstHits::fit(self.tracer.scene(), &self.camera, bounds, positions)
+        {
+            self.first_hits = ScreenLists::Room(bounds, positions);
         }
     }
 
-    /// The camera ray's hit from the screen lists, if the renderer has them.
+    /// Fills the screen lists' room, `poll` asked before each object: false
+    /// if it said stop (the next camera ray fills it again).
+    #[cold]
+    #[inline(never)]
+    fn fill_first_hits<Q: Poll>(&mut self, poll: &mut Q) -> bool {
+        let scene = self.tracer.scene();
+        let ScreenLists::Room(bounds, _) = &mut self.first_hits else { return true };
+        if !FirstHits::project(scene, &self.camera, bounds, poll) {
+            return false;
+        }
+        if let ScreenLists::Room(bounds, positions) = core::mem::replace(&mut self.first_hits, ScreenLists::None) {
+            self.first_hits =
+                FirstHits::new(scene.object_count(), bounds, positions).map_or(ScreenLists::None, ScreenLists::Lists);
+        }
+        true
+    }
+
+    /// The camera ray's hit from the screen lists, if the renderer has them
+    /// (filled by the first ray, `poll` asked before each object).
     #[inline]
-    fn first_hit(&mut self, ray: &mut CameraRay, x: u32, y: u32, sx: u32, sy: u32) -> Option<Option<Hit>> {
+    fn first_hit<Q: Poll>(
+        &mut self,
+        ray: &mut CameraRay,
+        [x, y, sx, sy]: [u32; 4],
+        poll: &mut Q,
+    ) -> Option<Option<Hit>> {
         // Asked first: for an accelerator that never allows the lists (the
         // naive modes) the whole path folds away, a board's cycles too.
         if !self.tracer.accel().first_hits_by_screen() {
             return None;
         }
-        self.first_hits.as_mut()?.nearest(self.tracer.scene(), A::KINDS, &self.camera, ray, [x, y, sx, sy])
+        if let ScreenLists::Room(..) = self.first_hits {
+            // Stopped: the caller's next ask says so too.
+            if !self.fill_first_hits(poll) {
+                return None;
+            }
+        }
+        let ScreenLists::Lists(hits) = &mut self.first_hits else { return None };
+        hits.nearest(self.tracer.scene(), A::KINDS, &self.camera, ray, [x, y, sx, sy])
     }
 
     /// Counters since the renderer was made.
@@ -207,13 +256,68 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     // driver's) small on a board.
     #[inline(never)]
     pub fn pixel(&mut self, x: u32, y: u32) -> PixelSample {
+        match self.pixel_polled(x, y, &mut Unpolled) {
+            Ok(pixel) => pixel,
+            Err(never) => match never {},
+        }
+    }
+
+    /// [`Renderer::pixel`], asking `stop` before every ray (and, at the
+    /// renderer's first pixel, before each object of its screen lists)
+    /// whether to go on: [`Stopped`] as soon as it says so, even inside the
+    /// pixel's ray tree, or the very pixel [`Renderer::pixel`] gives. A
+    /// stopped pixel may be asked for again; it is traced from its start.
+    ///
+    /// ```
+    /// use octrace_core::render::{Renderer, Stopped};
+    /// use octrace_core::{profile::Board16K, Raytracer};
+    ///
+    /// // Two facing mirrors with the eye between them: each of the pixel's
+    /// // samples bounces thousands of times, its light asked at each.
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load(
+    ///     "VIEWPOINT 0 0 0 ORIGIN 0 0 -1 RDEPTH 1000000 SAMPLES 4 LIGHT 1 0 1 0\n\
+    ///      RECTANGLE 1 -5 -5 -3 5 -5 -3 5 5 -3 -5 5 -3\n\
+    ///      RECTANGLE 1 -5 -5 3 -5 5 3 5 5 3 5 -5 3\n\
+    ///      SURFACE 1 0.01 0.01 0.01 0 0 0 0 0 0 0 1 0\n",
+    /// )?;
+    /// let accelerator = scene.accelerator();
+    /// let mut renderer = Renderer::with_size(scene.view(), &accelerator, 4, 4)?;
+    ///
+    /// // A board's stop: a flag its serial line's interrupt sets, say.
+    /// let stop_now = core::sync::atomic::AtomicBool::new(false);
+    /// let mut asked = 0;
+    /// let mut stop = || {
+    ///     asked += 1;
+    ///     if asked == 10 {
+    ///         stop_now.store(true, core::sync::atomic::Ordering::Relaxed);
+    ///     }
+    ///     stop_now.load(core::sync::atomic::Ordering::Relaxed)
+    /// };
+    /// assert_eq!(renderer.pixel_until(2, 2, &mut stop), Err(Stopped));
+    /// // Stopped at its tenth ask: nine rays into the pixel's first sample.
+    /// assert_eq!(renderer.stats().rays + renderer.stats().shadow_rays, 9);
+    ///
+    /// // Never stopped: the pixel's bits, as if nothing were asked.
+    /// let pixel = renderer.pixel_until(2, 2, &mut || false)?;
+    /// assert_eq!(pixel, renderer.pixel(2, 2));
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    #[inline(never)]
+    pub fn pixel_until<S: Stop>(&mut self, x: u32, y: u32, stop: &mut S) -> Result<PixelSample, Stopped> {
+        self.pixel_polled(x, y, &mut stop::Polling { stop, stopped: false })
+    }
+
+    /// The pixel at (`x`, `y`), `poll` asked before each of its rays.
+    #[inline(always)]
+    fn pixel_polled<Q: Poll>(&mut self, x: u32, y: u32, poll: &mut Q) -> Result<PixelSample, Q::Stopped> {
         let n = self.camera.samples();
         let (mean, object) = if n == 1 {
             // One sample (the common case on a board): no loops, no sums.
-            let (c, object) = self.sample(x, y, 0, 0);
+            let (c, object) = self.sample(x, y, 0, 0, poll)?;
             (Color::from_bits(c.bits().map(|v| v.clamp(0, 1 << 16))), object)
         } else {
-            self.mean_of_samples(n, x, y)
+            self.mean_of_samples(n, x, y, poll)?
         };
         // Neighbouring pixels mostly differ by a level or none: the search
         // starts at the last pixel's (the same bits from any start).
@@ -221,29 +325,72 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         let encoded =
             [self.gamma.encode_near(mean.r, r), self.gamma.encode_near(mean.g, g), self.gamma.encode_near(mean.b, b)];
         self.last_encoded = encoded;
-        PixelSample { color: Rgb888::new(encoded[0], encoded[1], encoded[2]), object }
+        Ok(PixelSample { color: Rgb888::new(encoded[0], encoded[1], encoded[2]), object })
+    }
+
+    /// Watches the frames to come while tracing (an animation traced with
+    /// coherence), or stops (`None`).
+    pub(crate) fn set_lookout(&mut self, lookout: Option<Lookout<'a>>) {
+        self.scratch.lookout = lookout;
+    }
+
+    /// The pixel at (`x`, `y`) and its clean count under the lookout, if
+    /// below `bound` (else `bound`).
+    pub(crate) fn watched_pixel(&mut self, x: u32, y: u32, bound: u32) -> (PixelSample, u32) {
+        if !A::FOLLOWS_MOTION {
+            // Nothing watched the rays: the pixel is traced again next frame.
+            return (self.pixel(x, y), 0);
+        }
+        if let Some(lookout) = &mut self.scratch.lookout {
+            lookout.start(bound);
+        }
+        let pixel = self.pixel(x, y);
+        (pixel, self.scratch.lookout.map_or(bound, |l| l.clean))
     }
 
     /// The colour and object of sample (`sx`, `sy`) of pixel (`x`, `y`).
     #[inline]
-    fn sample(&mut self, x: u32, y: u32, sx: u32, sy: u32) -> (Color, Option<ObjectId>) {
+    fn sample<Q: Poll>(
+        &mut self,
+        x: u32,
+        y: u32,
+        sx: u32,
+        sy: u32,
+        poll: &mut Q,
+    ) -> Result<(Color, Option<ObjectId>), Q::Stopped> {
         let mut ray = self.camera.next_ray(&mut self.cursor, x, y, sx, sy);
-        match self.first_hit(&mut ray, x, y, sx, sy) {
-            // Shown by the lists to miss: the ray itself is never made.
-            Some(None) => self.tracer.missed(&mut self.scratch),
-            first => self.tracer.trace(*ray.get(&self.camera), first, &mut self.scratch),
-        }
+        let seen = match self.first_hit(&mut ray, [x, y, sx, sy], poll) {
+            // Shown by the lists to miss: the ray itself is made only for
+            // the lookout.
+            Some(None) if poll.go_on() => {
+                if let Some(lookout) = self.scratch.lookout.as_mut().filter(|_| A::FOLLOWS_MOTION) {
+                    lookout.ray(ray.get(&self.camera), None, RayKind::Primary);
+                }
+                self.tracer.missed(&mut self.scratch)
+            }
+            Some(None) => (Color::BLACK, None),
+            first => self.tracer.trace(*ray.get(&self.camera), first, &mut self.scratch, poll),
+        };
+        // A stopped sample's colour is partial: never used.
+        poll.stopped()?;
+        Ok(seen)
     }
 
     /// The mean of the `n`² samples of pixel (`x`, `y`) (channels clamped to
     /// 0..1 first, rounded to nearest) and the object hit by the middle one.
-    fn mean_of_samples(&mut self, n: u32, x: u32, y: u32) -> (Color, Option<ObjectId>) {
+    fn mean_of_samples<Q: Poll>(
+        &mut self,
+        n: u32,
+        x: u32,
+        y: u32,
+        poll: &mut Q,
+    ) -> Result<(Color, Option<ObjectId>), Q::Stopped> {
         let mut object = None;
         // At most 16² samples of at most 2^16 each: the sums fit a u32.
         let mut sum = [0u32; 3];
         for sy in 0..n {
             for sx in 0..n {
-                let (c, o) = self.sample(x, y, sx, sy);
+                let (c, o) = self.sample(x, y, sx, sy, poll)?;
                 if sx == n / 2 && sy == n / 2 {
                     object = o;
                 }
@@ -253,7 +400,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
             }
         }
         let count = n * n;
-        (Color::from_bits(sum.map(|s| ((s + count / 2) / count) as i32)), object)
+        Ok((Color::from_bits(sum.map(|s| ((s + count / 2) / count) as i32)), object))
     }
 
     /// The pixels of row `y` for the columns `xs`, traced lazily.

@@ -14,11 +14,13 @@
 //! a `static` costs no flash.
 
 mod camera;
+mod motion;
 mod normalize;
 mod surface;
 
 pub use camera::{Camera, CameraError, View, MAX_SAMPLES, MAX_SIDE};
 pub(crate) use camera::{CameraRay, Projection, RayCursor, Stride};
+pub use motion::{displacement_at, Frames};
 pub use normalize::{Normalization, WorldPoint, WorldValue};
 pub use surface::{Color, Surface, SurfaceEntry};
 
@@ -311,16 +313,37 @@ impl<C: SceneCapacities> Scene<C> {
     }
 
     /// Evaluates the patch whose control points were set, pushing its
-    /// triangles (room checked beforehand with [`Scene::check_room`]);
-    /// returns how many were made.
-    pub(crate) fn push_bspline(&mut self, order: u32, rows: u32, cols: u32, samples: [u32; 2], surface: u16) -> usize {
+    /// triangles moved by `shift` (room checked beforehand with
+    /// [`Scene::check_room`]); returns how many were made, or the capacity
+    /// that ran out (the first triangle that did not fit ends the patch:
+    /// none is dropped silently).
+    pub(crate) fn push_bspline(
+        &mut self,
+        order: u32,
+        rows: u32,
+        cols: u32,
+        samples: [u32; 2],
+        surface: u16,
+        shift: Vec3,
+    ) -> Result<usize, CapacityError> {
         let points = core::mem::replace(&mut self.control_points, C::ControlPoints::EMPTY);
-        let mut made = 0;
+        let mut made = Ok(0);
         let first = self.objects.as_slice().len() as u32;
         if let Some(patch) = crate::shapes::Bspline::new(order, rows, cols, points.as_slice()) {
             patch.triangles(samples[0], samples[1], surface, |t| {
-                if self.push_shape(SmoothTriangle { patch: first, ..t }).is_ok() {
-                    made += 1;
+                // Moved corners keep their edges, so the same normal: a
+                // triangle that was made is made again once moved.
+                let corners = t.triangle.polygon.corners.map(|c| c + shift);
+                let moved = match shift == Vec3::ZERO {
+                    true => Some(t.triangle),
+                    false => crate::shapes::Triangle::new(corners, surface),
+                };
+                let Some(triangle) = moved else { return };
+                if let Ok(count) = &mut made {
+                    match self.push_shape(SmoothTriangle { triangle, patch: first, ..t }) {
+                        Ok(()) => *count += 1,
+                        Err(e) => made = Err(e),
+                    }
                 }
             });
         }
@@ -458,5 +481,49 @@ mod tests {
         let s = Sphere::new(Vec3::ZERO, Scalar::ONE, 0);
         scene.push_shape(s).unwrap();
         assert_eq!(scene.view().objects[2].kind(), ShapeKind::Sphere);
+    }
+
+    crate::profile! {
+        /// Room for a 5 × 5 patch's 32 triangles but one.
+        struct Patch31 { bspline_triangles: 31, control_points: 9, surfaces: 1 }
+    }
+    crate::profile! {
+        /// Room for 32 patch triangles, but 31 objects.
+        struct Objects31 { bspline_triangles: 32, objects: 31, control_points: 9, surfaces: 1 }
+    }
+
+    /// A 3 × 3 grid of control points in the plane z = 0.
+    fn grid() -> impl Iterator<Item = Vec3> {
+        (0..9).map(|i| Vec3::from_bits([(i % 3) << 14, (i / 3) << 14, 0]))
+    }
+
+    #[test]
+    fn room_is_checked_to_the_last_object() {
+        let scene: Scene<Patch31> = Scene::new();
+        assert_eq!(scene.check_room(ShapeKind::SmoothTriangle, 31), Ok(()));
+        let e = scene.check_room(ShapeKind::SmoothTriangle, 32).unwrap_err();
+        assert_eq!((e.kind, e.capacity), (CapacityKind::BsplineTriangles, 31));
+        let scene: Scene<Objects31> = Scene::new();
+        assert_eq!(scene.check_room(ShapeKind::SmoothTriangle, 31), Ok(()));
+        let e = scene.check_room(ShapeKind::SmoothTriangle, 32).unwrap_err();
+        assert_eq!((e.kind, e.capacity), (CapacityKind::Objects, 31));
+    }
+
+    #[test]
+    fn a_patch_that_runs_out_of_room_names_the_capacity() {
+        // 2 · 4 · 4 = 32 triangles, pushed without the check beforehand:
+        // the one that does not fit is an error, not a triangle dropped.
+        let mut scene: Scene<Patch31> = Scene::new();
+        scene.set_control_points(grid()).unwrap();
+        let e = scene.push_bspline(3, 3, 3, [5, 5], 0, Vec3::ZERO).unwrap_err();
+        assert_eq!((e.kind, e.capacity), (CapacityKind::BsplineTriangles, 31));
+        let mut scene: Scene<Objects31> = Scene::new();
+        scene.set_control_points(grid()).unwrap();
+        let e = scene.push_bspline(3, 3, 3, [5, 5], 0, Vec3::ZERO).unwrap_err();
+        assert_eq!((e.kind, e.capacity), (CapacityKind::Objects, 31));
+        // 2 · 4 · 3 = 24 fit.
+        let mut scene: Scene<Patch31> = Scene::new();
+        scene.set_control_points(grid()).unwrap();
+        assert_eq!(scene.push_bspline(3, 3, 3, [5, 4], 0, Vec3::ZERO), Ok(24));
     }
 }

@@ -91,6 +91,17 @@ impl Normalization {
         }))
     }
 
+    /// A world point displaced by `offset` (normalised Q16.16 units): the
+    /// displacement is added after the point is normalised, so that every
+    /// point of a moved object moves by the same bits. Within the fitted
+    /// box the sum is in range even where the point alone is not.
+    pub(crate) fn moved(&self, w: WorldPoint, offset: [i64; 3]) -> Vec3 {
+        Vec3::from_bits([0, 1, 2].map(|a| {
+            let v = self.length_wide(w[a] - self.center[a]).saturating_add(offset[a]);
+            v.clamp(i32::MIN as i64, i32::MAX as i64) as i32
+        }))
+    }
+
     /// A normalised distance (Q16.16 raw, ≥ 0) back in world units, Q32.32.
     #[inline]
     pub fn world_distance_q32(&self, d: i64) -> i64 {

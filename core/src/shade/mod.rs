@@ -14,14 +14,21 @@
 //! counted in [`Stats::truncated`], never dropped silently. So the worst-case
 //! time per pixel is `SAMPLES² · MAX_RAYS_PER_SAMPLE · (1 + lights)` ray
 //! queries, each O(objects) in the naive mode.
+//!
+//! A sample can be stopped between any two of its rays, shadow rays
+//! included ([`Poll`], asked before each): the colour of a stopped sample
+//! is partial, and [`Poll::stopped`] says so; one not stopped gives the
+//! same bits whether it was asked or not.
 
 use crate::accel::{Accelerator, Hit, Mailbox, RayStart};
 use crate::math::{
     leading_zeros, mul_u32_wide, mul_wide, pow_unit, reciprocal_start, shr_saturating_u32, shr_signed_to_u32, Dir,
     Scalar, Unit, Vec3, UNIT_ONE,
 };
+use crate::motion::{Lookout, RayKind};
 use crate::scene::{Color, ObjectId, SceneView};
 use crate::shapes::{Leaving, Ray};
+use core::convert::Infallible;
 
 /// Rays traced (not counting shadow rays) for one primary sample at most.
 pub const MAX_RAYS_PER_SAMPLE: u32 = 4096;
@@ -62,6 +69,38 @@ impl Stats {
     }
 }
 
+/// Asked before each ray of a sample (primary, reflected, transmitted or
+/// shadow) whether to go on; the render module's `Stop` is behind it.
+pub(crate) trait Poll {
+    /// Why a sample stopped ([`Infallible`] for [`Unpolled`]).
+    type Stopped;
+
+    /// Whether the sample traces its next ray: once false, false until the
+    /// sample is given up.
+    fn go_on(&mut self) -> bool;
+
+    /// `Err` if a [`Poll::go_on`] said no: the sample's colour is partial.
+    fn stopped(&self) -> Result<(), Self::Stopped>;
+}
+
+/// Never stops: the render path of a caller that does not ask, its checks
+/// compiled away (the tracer's code is the same as without them).
+pub(crate) struct Unpolled;
+
+impl Poll for Unpolled {
+    type Stopped = Infallible;
+
+    #[inline(always)]
+    fn go_on(&mut self) -> bool {
+        true
+    }
+
+    #[inline(always)]
+    fn stopped(&self) -> Result<(), Infallible> {
+        Ok(())
+    }
+}
+
 /// Lights whose last blocker is remembered (light index modulo this).
 const BLOCKER_SLOTS: usize = 8;
 
@@ -74,11 +113,14 @@ pub(crate) struct Scratch<'m> {
     /// it is tried before any walk (`u32::MAX`: none). Any blocker gives the
     /// same answer, so this cannot change an image.
     blockers: [u32; BLOCKER_SLOTS],
+    /// In an animation traced with coherence, what sees every segment of
+    /// the ray tree (`None`: a still picture, or a frame traced whole).
+    pub lookout: Option<Lookout<'m>>,
 }
 
 impl<'m> Scratch<'m> {
     pub fn new(mailbox: Mailbox<'m>) -> Scratch<'m> {
-        Scratch { stats: Stats::default(), mailbox, blockers: [u32::MAX; BLOCKER_SLOTS] }
+        Scratch { stats: Stats::default(), mailbox, blockers: [u32::MAX; BLOCKER_SLOTS], lookout: None }
     }
 }
 
@@ -89,6 +131,7 @@ struct Pending {
     start: Option<RayStart>,
     depth: u32,
     weight: Scalar,
+    kind: RayKind,
 }
 
 /// Traces rays through a scene with a given accelerator.
@@ -183,11 +226,12 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
     // Not inlined: a frame of its own keeps the stack of a small board bounded
     // (inlined into the row loop, its locals and the pending rays multiply).
     #[inline(never)]
-    pub fn trace(
+    pub fn trace<Q: Poll>(
         &self,
         ray: Ray,
         mut first_hit: Option<Option<Hit>>,
         scratch: &mut Scratch<'_>,
+        poll: &mut Q,
     ) -> (Color, Option<ObjectId>) {
         let mut stack: heapless::Vec<Pending, PENDING_RAYS> = heapless::Vec::new();
         let mut color = Color::BLACK;
@@ -195,10 +239,13 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         let mut traced = 0;
         // The ray being traced; its first child follows it directly, the
         // other waits on the stack (depth first, as a recursion would go).
-        let mut p = Pending { ray, start: None, depth: 0, weight: Scalar::ONE };
+        let mut p = Pending { ray, start: None, depth: 0, weight: Scalar::ONE, kind: RayKind::Primary };
         loop {
             if traced == MAX_RAYS_PER_SAMPLE {
                 scratch.stats.truncated += 1 + stack.len() as u64;
+                break;
+            }
+            if !poll.go_on() {
                 break;
             }
             traced += 1;
@@ -215,11 +262,14 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             if p.depth == 0 {
                 first_object = hit.map(|h| self.scene.written_object(h.object));
             }
+            if let Some(lookout) = scratch.lookout.as_mut().filter(|_| A::FOLLOWS_MOTION) {
+                lookout.ray(&p.ray, hit.map(|h| h.t), p.kind);
+            }
             let mut next = None;
             match hit {
                 None => color = color.saturating_add(self.background(p.weight)),
                 Some(hit) => {
-                    let children = self.shade(&p, hit, &mut color, scratch);
+                    let children = self.shade(&p, hit, &mut color, scratch, poll);
                     for &child in children.iter().flatten() {
                         if child.weight.to_bits() <= 0 {
                             continue;
@@ -243,7 +293,14 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
 
     /// Adds the weighted local colour at `hit` to `color` and returns the
     /// transmitted and reflected rays to trace.
-    fn shade(&self, p: &Pending, hit: Hit, color: &mut Color, scratch: &mut Scratch<'_>) -> [Option<Pending>; 2] {
+    fn shade<Q: Poll>(
+        &self,
+        p: &Pending,
+        hit: Hit,
+        color: &mut Color,
+        scratch: &mut Scratch<'_>,
+        poll: &mut Q,
+    ) -> [Option<Pending>; 2] {
         let shape = self.scene.shape(hit.object);
         let point = p.ray.at(hit.t);
         let geometric = shape.normal_at_among(A::KINDS, point);
@@ -273,6 +330,10 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             if cos.to_bits() <= 0 {
                 continue;
             }
+            if !poll.go_on() {
+                // Nothing more of this sample is traced (see `trace`).
+                return [None, None];
+            }
             scratch.stats.shadow_rays += 1;
             let shadow = Ray { origin: shadow_from, dir: light_dir };
             // Shading with the facing normal itself (every shape but a
@@ -286,6 +347,9 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             };
             let start = RayStart { object: hit.object, leaving };
             let t_max = Scalar::from_bits((distance.to_bits() - 1).max(0));
+            if let Some(lookout) = scratch.lookout.as_mut().filter(|_| A::FOLLOWS_MOTION) {
+                lookout.shadow(shadow_from, light.position);
+            }
             if self.occluded(
                 &shadow,
                 t_max,
@@ -313,7 +377,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             return [None, None];
         }
         // The direction is made only for a ray that will be traced.
-        let child = |dir: &dyn Fn() -> Dir, k: Scalar| {
+        let child = |dir: &dyn Fn() -> Dir, k: Scalar, kind: RayKind| {
             (k.to_bits() > 0).then(|| {
                 let dir = dir();
                 Pending {
@@ -321,10 +385,11 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
                     start: Some(RayStart { object: hit.object, leaving: leaving_along(geometric, dir) }),
                     depth: p.depth + 1,
                     weight: mul(p.weight, k),
+                    kind,
                 }
             })
         };
-        [child(&|| p.ray.dir, t), child(&|| to_eye.reflect_about(normal), r)]
+        [child(&|| p.ray.dir, t, RayKind::Transmitted), child(&|| to_eye.reflect_about(normal), r, RayKind::Reflected)]
     }
 
     /// Whether anything blocks `shadow` to light `light` before `t_max`,
@@ -449,8 +514,13 @@ mod shading_tests {
         let eye = view.normalization.point(view.settings.view.eye);
         let tracer = Tracer::new(view, &Naive);
         let mut scratch = Scratch::new(Mailbox::none());
-        let (c, o) = tracer.trace(Ray { origin: eye, dir: -Dir::Z }, None, &mut scratch);
+        let (c, o) = traced(&tracer, Ray { origin: eye, dir: -Dir::Z }, &mut scratch);
         (c, o, scratch.stats)
+    }
+
+    /// What `tracer` sees along `ray`.
+    fn traced(tracer: &Tracer<'_, Naive>, ray: Ray, scratch: &mut Scratch<'_>) -> (Color, Option<ObjectId>) {
+        tracer.trace(ray, None, scratch, &mut Unpolled)
     }
 
     fn approx(c: Color, rgb: [i32; 3]) {
@@ -518,11 +588,11 @@ mod shading_tests {
         let ray = |x: i64| Ray { origin: view.normalization.point([x, 0, 3 << 32]), dir: -Dir::Z };
         let tracer = Tracer::new(view, &Naive);
         let mut alone = Scratch::new(Mailbox::none());
-        let lit = tracer.trace(ray(1 << 31), None, &mut alone).0;
+        let lit = traced(&tracer, ray(1 << 31), &mut alone).0;
         let mut shared = Scratch::new(Mailbox::none());
-        let shadowed = tracer.trace(ray(0), None, &mut shared).0;
+        let shadowed = traced(&tracer, ray(0), &mut shared).0;
         approx(shadowed, [m(100); 3]); // the pole is in shadow: ambient only
-        assert_eq!(tracer.trace(ray(1 << 31), None, &mut shared).0, lit);
+        assert_eq!(traced(&tracer, ray(1 << 31), &mut shared).0, lit);
         assert_ne!(lit, shadowed);
     }
 

@@ -27,20 +27,16 @@ use hal::multicore::Stack;
 use hal::pac::{self, interrupt};
 use octrace_core::render::{Handoff, Progressive};
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
+use octrace_pico::board::{self, Board};
+use octrace_pico::both_cores;
 use octrace_pico_st7789::measure::{Meter, Report};
+use octrace_pico_st7789::panel;
 use octrace_pico_st7789::usb::{self, SerialDevice};
-use octrace_pico_st7789::{board, both_cores, panel};
 use panic_halt as _;
 use rp2040_hal as hal;
 
-#[cfg(code_in_sram)]
-octrace_pico_st7789::copy_code_into_sram!();
-
-/// The second-stage loader for the Pico's W25Q16JV flash; the boot ROM
-/// runs it from the first 256 bytes of flash (see memory.x).
-#[link_section = ".boot2"]
-#[used]
-static BOOT2: [u8; 256] = rp2040_boot2::BOOT_LOADER_W25Q080;
+// boot2, and what build.rs places in SRAM (OCTRACE_CODE_IN) copied there at boot.
+octrace_pico::boot!();
 
 /// The scene (`SCENE_TEXT`, in flash) and a capacity profile that holds
 /// exactly what it needs (`SceneProfile`), from `build.rs`: set
@@ -83,9 +79,10 @@ static ANSWERING: Mutex<RefCell<Option<Answering>>> = Mutex::new(RefCell::new(No
 
 #[entry]
 fn main() -> ! {
-    let mut board = board::start(PANEL_BUFFER.take(), CORE1_STACK.take().unwrap());
-    let (mut display, mut core1) = (board.display, board.core1);
-    let mut meter = Meter::new(board.timer, board.busctrl);
+    let Board { mut core1, pins, clocks, timer, mut resets, peripherals, .. } =
+        board::start(CORE1_STACK.take().unwrap());
+    let mut display = panel::init(peripherals.spi1, pins, &mut resets, &clocks, timer, PANEL_BUFFER.take());
+    let mut meter = Meter::new(timer, peripherals.busctrl);
     meter.start();
 
     // octrace: parse and index the scene, then trace it into the panel at
@@ -119,7 +116,13 @@ fn main() -> ! {
     let report = Report { firmware, scene: SCENE_NAME, load, render };
     // 192 bytes hold the longest report (ten-digit counts and times).
     let _ = write!(line, "{report}\r\n");
-    let device = usb::serial_device(board.usb, &mut board.resets, "octrace report");
+    let device = usb::serial_device(
+        peripherals.usbctrl_regs,
+        peripherals.usbctrl_dpram,
+        clocks.usb_clock,
+        &mut resets,
+        "octrace report",
+    );
     // Nothing to send until the host asks.
     let sent = line.len();
     critical_section::with(|cs| ANSWERING.borrow_ref_mut(cs).replace(Answering { device, line, sent }));

@@ -12,11 +12,12 @@ use embedded_hal::digital::OutputPin;
 use embedded_hal::spi::{ErrorType, SpiBus, MODE_0};
 use embedded_hal_bus::spi::ExclusiveDevice;
 use embedded_hal_nb::spi::FullDuplex;
-use hal::fugit::{HertzU32, RateExtU32};
-use hal::gpio::bank0::{Gpio10, Gpio11, Gpio12, Gpio13, Gpio8, Gpio9};
-use hal::gpio::{FunctionNull, FunctionSioOutput, FunctionSpi, Pin, PullDown};
+use hal::clocks::ClocksManager;
+use hal::fugit::RateExtU32;
+use hal::gpio::bank0::{Gpio10, Gpio11, Gpio12, Gpio8, Gpio9};
+use hal::gpio::{FunctionSioOutput, FunctionSpi, Pin, Pins, PullDown};
 use hal::spi::Enabled;
-use hal::{pac, Spi, Timer};
+use hal::{pac, Clock, Spi, Timer};
 use mipidsi::interface::SpiInterface;
 use mipidsi::models::ST7789;
 use mipidsi::options::ColorInversion;
@@ -95,25 +96,15 @@ impl SpiBus for StreamingBus {
     }
 }
 
-/// The Pico pins the Pico-LCD-1.3 plugs into, as `Pins::new` hands them out.
-pub struct PanelPins {
-    /// SPI1 clock.
-    pub clock: Pin<Gpio10, FunctionNull, PullDown>,
-    /// SPI1 data (MOSI).
-    pub data: Pin<Gpio11, FunctionNull, PullDown>,
-    pub chip_select: Pin<Gpio9, FunctionNull, PullDown>,
-    pub data_command: Pin<Gpio8, FunctionNull, PullDown>,
-    pub reset: Pin<Gpio12, FunctionNull, PullDown>,
-    pub backlight: Pin<Gpio13, FunctionNull, PullDown>,
-}
-
-/// Sets up the panel, clears it to black and turns its backlight on.
+/// Sets up the panel on the Pico-LCD-1.3's pins (README.md: SPI1 clock
+/// GP10, data GP11; chip select GP9, data/command GP8, reset GP12,
+/// backlight GP13), clears it to black and turns its backlight on.
 /// `buffer` batches pixels for the bus (512 bytes is plenty).
 pub fn init(
     spi1: pac::SPI1,
-    pins: PanelPins,
+    pins: Pins,
     resets: &mut pac::RESETS,
-    peripheral_clock: HertzU32,
+    clocks: &ClocksManager,
     mut timer: Timer,
     buffer: &'static mut [u8],
 ) -> Panel {
@@ -121,20 +112,20 @@ pub fn init(
     // carry too: the tracer, not the bus, sets the pace.
     let bus = Spi::<_, _, _, 8>::new(
         spi1,
-        (pins.data.into_function::<FunctionSpi>(), pins.clock.into_function::<FunctionSpi>()),
+        (pins.gpio11.into_function::<FunctionSpi>(), pins.gpio10.into_function::<FunctionSpi>()),
     )
-    .init(resets, peripheral_clock, 31_250_000u32.Hz(), MODE_0);
-    let chip_select = pins.chip_select.into_push_pull_output();
+    .init(resets, clocks.peripheral_clock.freq(), 31_250_000u32.Hz(), MODE_0);
+    let chip_select = pins.gpio9.into_push_pull_output();
     let device = ExclusiveDevice::new(StreamingBus(bus), chip_select, timer).unwrap_or_else(|never| match never {});
-    let interface = SpiInterface::new(device, pins.data_command.into_push_pull_output(), buffer);
+    let interface = SpiInterface::new(device, pins.gpio8.into_push_pull_output(), buffer);
     let mut display = Builder::new(ST7789, interface)
         .display_size(WIDTH, HEIGHT)
         .invert_colors(ColorInversion::Inverted)
-        .reset_pin(pins.reset.into_push_pull_output())
+        .reset_pin(pins.gpio12.into_push_pull_output())
         .init(&mut timer)
         .unwrap_or_else(|_| panic!("the panel did not take its set-up"));
     display.clear(Rgb565::BLACK).unwrap_or_else(|never| match never {});
-    let mut backlight = pins.backlight.into_push_pull_output();
+    let mut backlight = pins.gpio13.into_push_pull_output();
     backlight.set_high().unwrap_or_else(|never| match never {});
     display
 }

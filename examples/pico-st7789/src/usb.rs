@@ -6,7 +6,7 @@
 //! Invariants: made once per firmware (its bus allocator is a static);
 //! the device and port are the caller's to poll, from its USB interrupt.
 
-use crate::board::UsbParts;
+use rp2040_hal::clocks::UsbClock;
 use rp2040_hal::pac;
 use rp2040_hal::usb::UsbBus;
 use usb_device::class_prelude::UsbBusAllocator;
@@ -16,11 +16,18 @@ use usbd_serial::SerialPort;
 /// The USB device and its serial port.
 pub type SerialDevice = (UsbDevice<'static, UsbBus>, SerialPort<'static, UsbBus>);
 
-/// The serial device on the Pico's USB controller, its product string
-/// `product`. Panics only if a firmware made it twice.
-pub fn serial_device(usb: UsbParts, resets: &mut pac::RESETS, product: &'static str) -> SerialDevice {
+/// The serial device on the Pico's USB controller (`regs` and `dpram`,
+/// from [`Peripherals`](octrace_pico::board::Peripherals)), its product
+/// string `product`. Panics only if a firmware made it twice.
+pub fn serial_device(
+    regs: pac::USBCTRL_REGS,
+    dpram: pac::USBCTRL_DPRAM,
+    clock: UsbClock,
+    resets: &mut pac::RESETS,
+    product: &'static str,
+) -> SerialDevice {
     let bus: &'static UsbBusAllocator<UsbBus> = cortex_m::singleton!(: UsbBusAllocator<UsbBus> =
-        UsbBusAllocator::new(UsbBus::new(usb.regs, usb.dpram, usb.clock, true, resets)))
+        UsbBusAllocator::new(UsbBus::new(regs, dpram, clock, true, resets)))
     .unwrap();
     let serial = SerialPort::new(bus);
     let strings = StringDescriptors::default().manufacturer("octrace").product(product).serial_number("1");

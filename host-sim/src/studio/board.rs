@@ -17,7 +17,7 @@ use std::time::{Duration, Instant};
 /// The board the studio sends to, and its send under way.
 pub(crate) struct BoardSender {
     port: String,
-    /// The longest wait for each answer of the board.
+    /// The longest a send may take, answer included.
     timeout: Duration,
     /// Whether a send is under way; set and cleared by [`Claim`].
     busy: AtomicBool,
@@ -127,6 +127,7 @@ fn message(e: CliError) -> String {
     match e {
         CliError::Io(message) | CliError::Invalid(message) | CliError::Mismatch(message) => message,
         CliError::Scene { errors, .. } => errors.join("\n"),
+        CliError::Stopped => "stopped (Ctrl-C)".into(),
     }
 }
 

@@ -28,16 +28,6 @@ impl Request {
     pub(crate) fn query(&self, name: &str) -> Option<&str> {
         self.query.iter().find(|(n, _)| n == name).map(|(_, v)| v.as_str())
     }
-
-    pub(crate) fn cookie(&self, name: &str) -> Option<&str> {
-        self.headers
-            .iter()
-            .filter(|(n, _)| n == "cookie")
-            .flat_map(|(_, v)| v.split(';'))
-            .filter_map(|pair| pair.trim().split_once('='))
-            .find(|(n, _)| *n == name)
-            .map(|(_, v)| v)
-    }
 }
 
 /// Reads one request; on a malformed or oversized one, the status to
@@ -128,6 +118,11 @@ pub(crate) fn same_secret(given: &str, secret: &str) -> bool {
     given.len() == secret.len() && given.bytes().zip(secret.bytes()).fold(0u8, |acc, (a, b)| acc | (a ^ b)) == 0
 }
 
+/// What the page may load and run: its own server's scripts, styles and
+/// module (compiled from there), nothing framed, no form sent anywhere.
+const CONTENT_SECURITY_POLICY: &str = "default-src 'self'; script-src 'self' 'wasm-unsafe-eval'; \
+     style-src 'self'; img-src 'self' data: blob:; frame-ancestors 'none'; base-uri 'none'; form-action 'none'";
+
 pub(crate) struct Response {
     status: u16,
     pub(crate) headers: Vec<(String, String)>,
@@ -146,6 +141,7 @@ impl Response {
     pub(crate) fn write_to(&self, out: &mut impl Write) -> std::io::Result<()> {
         let reason = match self.status {
             200 => "OK",
+            303 => "See Other",
             400 => "Bad Request",
             403 => "Forbidden",
             404 => "Not Found",
@@ -166,10 +162,14 @@ impl Response {
             head.push_str(&format!("{name}: {value}\r\n"));
         }
         // The page is the only client: no caching of a scene or a module
-        // that may have changed, no framing by other sites.
+        // that may have changed; no framing by, embedding in or handle to
+        // other sites' pages; no address (with its token) in a Referer;
+        // scripts and the module from this server alone.
         head.push_str(&format!(
             "Content-Length: {}\r\nCache-Control: no-store\r\nX-Frame-Options: DENY\r\n\
-             X-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
+             X-Content-Type-Options: nosniff\r\nReferrer-Policy: no-referrer\r\n\
+             Cross-Origin-Resource-Policy: same-origin\r\nCross-Origin-Opener-Policy: same-origin\r\n\
+             Content-Security-Policy: {CONTENT_SECURITY_POLICY}\r\nConnection: close\r\n\r\n",
             self.body.len()
         ));
         out.write_all(head.as_bytes())?;
@@ -184,12 +184,11 @@ mod tests {
 
     #[test]
     fn requests_are_parsed() {
-        let raw = b"PUT /scene?token=a%62c HTTP/1.1\r\nHost: 127.0.0.1:9\r\nCookie: x=1; studio_token=t\r\nContent-Length: 3\r\n\r\nabcdef";
+        let raw = b"PUT /scene?token=a%62c HTTP/1.1\r\nHost: 127.0.0.1:9\r\nContent-Length: 3\r\n\r\nabcdef";
         let request = read_request(&mut &raw[..], 10).unwrap();
         assert_eq!((request.method.as_str(), request.path.as_str()), ("PUT", "/scene"));
         assert_eq!(request.query("token"), Some("abc"));
         assert_eq!(request.header("host"), Some("127.0.0.1:9"));
-        assert_eq!(request.cookie("studio_token"), Some("t"));
         assert_eq!(request.body, b"abc");
     }
 

@@ -2,19 +2,26 @@
 //! studio page, which runs octrace-core compiled to WebAssembly.
 //!
 //! Invariants (the security rules): the listener is bound to 127.0.0.1
-//! only; every request must carry the session's token (query `token=`,
-//! header `X-Studio-Token` or the cookie the page gets); a request whose
-//! Host is not this address and port is refused (DNS rebinding); the only
-//! file ever read or written is the scene file named on the command line,
-//! through `GET`/`PUT /scene`, and every other path is an embedded asset or
-//! 404 — no request path reaches the file system; the only serial port
-//! opened is the one `--board` names, through `GET`/`POST /board`.
+//! only; a request whose Host is not this address and port is refused (DNS
+//! rebinding); a request a browser sends for another site's page (its
+//! `Origin` not this server's, or `Sec-Fetch-Site` neither `same-origin`
+//! nor `none`) is refused, and said on stderr; every request carries the
+//! session's token, never in a cookie (a browser sends cookies to every
+//! port of a host): the page and its assets are loaded under `/TOKEN/`
+//! (what the browser loads by address), and everything else gives it in
+//! `X-Studio-Token` (the page's own requests) or `?token=`; the only file
+//! ever read or written is the scene file named on the command line,
+//! through `GET`/`PUT /scene`, and every other path is an embedded asset
+//! or 404 — no request path reaches the file system; no `GET` changes
+//! anything; the only serial port opened is the one `--board` names,
+//! through `POST /board`.
 
 mod board;
 mod http;
 
 use crate::exit::CliError;
 use crate::output::write_atomically;
+use crate::terminal::shown;
 use board::BoardSender;
 use http::{Request, Response};
 use std::io::Write;
@@ -43,9 +50,9 @@ pub struct StudioArgs {
     /// whether it is host-sim's).
     #[arg(long, value_name = "PORT")]
     pub board: Option<PathBuf>,
-    /// Seconds to wait for each answer of the board (a row of a slow scene
-    /// included).
-    #[arg(long, value_name = "SECONDS", default_value_t = 30, value_parser = clap::value_parser!(u64).range(1..=86_400))]
+    /// Seconds a send may take: the board's hello, the scene, and its
+    /// answer (every error, or every row of the drawing).
+    #[arg(long, value_name = "SECONDS", default_value_t = crate::board::DEFAULT_TIMEOUT, value_parser = clap::value_parser!(u64).range(1..=86_400))]
     pub board_timeout: u64,
 }
 
@@ -179,34 +186,64 @@ fn respond(request: &Request, shared: &Shared) -> Response {
     if !request.header("host").is_some_and(|host| shared.hosts.iter().any(|h| h.eq_ignore_ascii_case(host))) {
         return Response::text(421, "this server answers only to its own loopback address");
     }
-    let token_given =
-        request.query("token").or_else(|| request.header("x-studio-token")).or_else(|| request.cookie("studio_token"));
-    if !token_given.is_some_and(|t| http::same_secret(t, &shared.token)) {
+    if let Some(site) = another_site(request, shared) {
+        // Said, so that the user learns a page tried (its text escaped: it
+        // is another site's).
+        eprintln!(
+            "host-sim studio: refused {} {} from another site ({}): only the studio's own page may ask",
+            shown(&request.method),
+            shown(&request.path),
+            shown(&site)
+        );
+        return Response::text(403, "this server answers only its own page");
+    }
+    // The page and its assets, which the browser loads by address, are
+    // under /TOKEN/; every other request names the token itself.
+    let (in_path, route) = match request.path.strip_prefix('/').and_then(|path| path.split_once('/')) {
+        Some((first, _)) if http::same_secret(first, &shared.token) => (true, &request.path[first.len() + 1..]),
+        _ => (false, request.path.as_str()),
+    };
+    let method = request.method.as_str();
+    let named = request.query("token").or_else(|| request.header("x-studio-token"));
+    let token_given = named.is_some_and(|t| http::same_secret(t, &shared.token));
+    if !(token_given || (in_path && matches!(method, "GET" | "HEAD"))) {
         return Response::text(403, "a token is needed: open the address host-sim studio printed");
     }
-    let path = request.path.as_str();
-    match (request.method.as_str(), path) {
+    match (method, route) {
+        // The printed address: the page, under its token.
+        ("GET" | "HEAD", "/") if !in_path => {
+            let mut response = Response::text(303, "the studio's page");
+            response.headers.push(("Location".into(), format!("/{}/", shared.token)));
+            response
+        }
         ("GET", "/scene") => get_scene(shared),
         ("PUT", "/scene") => put_scene(request, shared),
         ("GET", "/board") => with_board(shared, BoardSender::status),
         ("POST", "/board") => with_board(shared, |board| board.send(&scene_name(shared), &request.body)),
-        ("GET", _) | ("HEAD", _) => match ASSETS.iter().find(|(name, _, _)| *name == path) {
-            Some((name, kind, body)) => {
-                let mut response = Response::new(200, kind, body.to_vec());
-                if *name == "/" {
-                    // Later requests (scripts, workers, the module, the
-                    // scene) carry the token as a cookie only this origin
-                    // sends.
-                    response.headers.push((
-                        "Set-Cookie".into(),
-                        format!("studio_token={}; Path=/; HttpOnly; SameSite=Strict", shared.token),
-                    ));
-                }
-                response
-            }
+        ("GET" | "HEAD", _) => match ASSETS.iter().find(|(name, _, _)| *name == route) {
+            Some((_, kind, body)) => Response::new(200, kind, body.to_vec()),
             None => Response::text(404, "no such page"),
         },
         _ => Response::text(405, "method not allowed"),
+    }
+}
+
+/// The other site a browser sent `request` for, if it did: an `Origin`
+/// that is not this server's, or a `Sec-Fetch-Site` other than
+/// `same-origin` and `none` (an address typed or opened by the user).
+/// Ports do not separate sites, so another program's page on 127.0.0.1 is
+/// `same-site`: refused too. A request without these headers is no
+/// browser's, and stands on its token alone.
+fn another_site(request: &Request, shared: &Shared) -> Option<String> {
+    if let Some(origin) = request.header("origin") {
+        let ours = shared.hosts.iter().any(|host| origin.eq_ignore_ascii_case(&format!("http://{host}")));
+        if !ours {
+            return Some(format!("Origin {origin}"));
+        }
+    }
+    match request.header("sec-fetch-site") {
+        None | Some("same-origin" | "none") => None,
+        Some(site) => Some(format!("Sec-Fetch-Site {site}")),
     }
 }
 

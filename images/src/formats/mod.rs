@@ -167,7 +167,7 @@ pub fn write(image: &Image, format: Format, out: &mut dyn Write) -> Result<(), F
 }
 
 /// Writes an indexed image whose colour table is all grays (red, green and blue equal, as
-/// [`crate::panel::gray4`] makes) as an 8-bit grayscale PNG file, the smallest file that holds it.
+/// [`crate::panel::dithered`] makes for a gray panel) as an 8-bit grayscale PNG file, the smallest file that holds it.
 pub fn write_gray_png(image: &Image, out: &mut dyn Write) -> Result<(), FormatError> {
     check(image)?;
     let Image::Indexed { width, height, palette, indices } = image else {

@@ -4,11 +4,19 @@
 //! RAM and peak stack (the table in BENCHMARKS.md).
 //!
 //!     cargo run --release -p octrace-tests --bin firmware-bench [WxH] [scene...]
+//!     cargo run --release -p octrace-tests --bin firmware-bench panels [WxH] [scene...]
+//!
+//! `panels`: the micro:bit drawing into a panel of few levels (`mono`,
+//! `gray2`, `gray4`, `bwr`) by every dithering, at 128×64 (fig5_1 unless
+//! named): instructions a pixel, and what each method costs over the
+//! nearest level (the same render and the same byte a pixel to the display,
+//! so the difference is the method's).
 //!
 //! `qemu-count` is `$OCTRACE_QEMU_COUNT`, else `../shared/tools/qemu-count`
 //! beside the repository. Counts are instructions, exact and repeatable, not
 //! cycles of a real chip.
 
+use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
 use octrace_tests::firmware::{Board, Firmware};
 use octrace_tests::repo;
@@ -16,18 +24,27 @@ use std::path::PathBuf;
 
 fn main() {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let panels = args.first().is_some_and(|a| a == "panels");
+    if panels {
+        args.remove(0);
+    }
+    let default_size = if panels { (128, 64) } else { (160, 128) };
     let (width, height) = match args.first().and_then(|a| a.split_once('x')) {
         Some((w, h)) => {
-            let size = (w.parse().unwrap_or(160), h.parse().unwrap_or(128));
+            let size = (w.parse().unwrap_or(default_size.0), h.parse().unwrap_or(default_size.1));
             args.remove(0);
             size
         }
-        None => (160, 128),
+        None => default_size,
     };
-    let scenes = if args.is_empty() { vec!["fig5_1".to_owned(), "fig5_3".to_owned()] } else { args };
+    let default_scenes: &[&str] = if panels { &["fig5_1"] } else { &["fig5_1", "fig5_3"] };
+    let scenes = if args.is_empty() { default_scenes.iter().map(|s| s.to_string()).collect() } else { args };
     let qemu_count = std::env::var_os("OCTRACE_QEMU_COUNT")
         .map(PathBuf::from)
         .unwrap_or_else(|| repo().join("../shared/tools/qemu-count"));
+    if panels {
+        return panels_table(&scenes, (width, height), &qemu_count);
+    }
 
     println!(
         "| board | scene | size | instructions / pixel | pixels / M instructions | flash | static RAM | peak stack |"
@@ -53,11 +70,7 @@ fn main() {
                         render = cores.iter().map(|&(total, wait)| total - wait).max().unwrap_or(0) as f64;
                         dual_rows.push(dual_row(scene, &cores));
                     }
-                    let stack = m
-                        .output
-                        .lines()
-                        .find_map(|l| l.strip_prefix("peak stack: ")?.strip_suffix(" bytes"))
-                        .unwrap_or("?");
+                    let stack = m.peak_stack().map_or("?".to_owned(), |b| b.to_string());
                     println!(
                         "| {label} | {:.0} | {:.1} | {:.1} KiB | {:.1} KiB | {stack} B |",
                         render / pixels,
@@ -95,6 +108,55 @@ fn main() {
         }
     }
     // A row the harness could not measure is not a figure: the run fails.
+    if failures > 0 {
+        eprintln!("firmware-bench: {failures} measurement(s) failed");
+        std::process::exit(1);
+    }
+}
+
+/// The micro:bit drawing each scene into every panel of few levels by every
+/// dithering.
+fn panels_table(scenes: &[String], (width, height): (u32, u32), qemu_count: &std::path::Path) {
+    println!("| scene | panel | dithering | instructions / pixel | over nearest | flash | static RAM | peak stack |");
+    println!("| --- | --- | --- | ---: | ---: | ---: | ---: | ---: |");
+    let mut failures = 0;
+    for scene in scenes {
+        for color in PanelColor::ALL.into_iter().filter(|c| c.panel().is_some()) {
+            // Nearest last in ALL: measured first here, as the baseline.
+            let mut nearest = None;
+            for dithering in Dithering::ALL.into_iter().rev() {
+                let firmware = Firmware::new(Board::Microbit, scene, width, height, color).dithered(dithering);
+                let label = format!("{scene} {width}×{height} | {color} | {dithering}");
+                let measured = firmware.build().and_then(|elf| firmware.measure(&elf, qemu_count));
+                match measured {
+                    Ok(m) if m.status == 0 => {
+                        let per_pixel = m.render.unwrap_or(m.total) as f64 / (width * height) as f64;
+                        let over = match nearest {
+                            None => {
+                                nearest = Some(per_pixel);
+                                "—".to_owned()
+                            }
+                            Some(base) => format!("{:+.1}", per_pixel - base),
+                        };
+                        let stack = m.peak_stack().map_or("?".to_owned(), |b| b.to_string());
+                        println!(
+                            "| {label} | {per_pixel:.1} | {over} | {:.1} KiB | {:.1} KiB | {stack} B |",
+                            m.flash as f64 / 1024.0,
+                            m.static_ram as f64 / 1024.0,
+                        );
+                    }
+                    Ok(m) => {
+                        println!("| {label} | does not run (exit {}) | | | | |", m.status);
+                        failures += 1;
+                    }
+                    Err(e) => {
+                        println!("| {label} | failed: {} | | | | |", e.lines().next().unwrap_or(""));
+                        failures += 1;
+                    }
+                }
+            }
+        }
+    }
     if failures > 0 {
         eprintln!("firmware-bench: {failures} measurement(s) failed");
         std::process::exit(1);

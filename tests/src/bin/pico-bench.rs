@@ -1,16 +1,17 @@
-//! The Pico benchmark: builds the Pico template (`examples/pico-st7789`) for
-//! each scene, runs it on the emulated Pico and prints Markdown tables (the
-//! ones in BENCHMARKS.md): the cycles to parse and index the scene and to
-//! render it into the 240×240 panel on both cores, the seconds from scene
-//! text to picture at 125 MHz, the same without the bus fabric's
-//! contention (each build runs twice: the cores waiting for each other at
-//! the SRAM banks as on the chip, and not), the firmware's flash and the
-//! SRAM it takes (its statics, and the code copied there at boot); then
-//! each core's busy and waiting cycles, its stalls on flash and on the
-//! other core, the contested accesses to the striped banks, and the flash
-//! cache's reads and misses.
+//! The Pico benchmark: builds a Pico template (`examples/pico-st7789`, the
+//! default, or `examples/pico-ssd1306`) for each scene, runs it on the
+//! emulated Pico and prints Markdown tables (the ones in BENCHMARKS.md):
+//! the cycles to start, to parse and index the scene and to render it into
+//! the panel on both cores (240×240 on the ST7789; 128×64 on the SSD1306,
+//! then sent over I2C), the seconds from scene text to picture at 125 MHz,
+//! the same without the bus fabric's contention (each build runs twice:
+//! the cores waiting for each other at the SRAM banks as on the chip, and
+//! not), the firmware's flash and the SRAM it takes (its statics, and the
+//! code copied there at boot); then each core's busy and waiting cycles,
+//! its stalls on flash and on the other core, the contested accesses to
+//! the striped banks, and the flash cache's reads and misses.
 //!
-//!     cargo run --release -p octrace-tests --bin pico-bench [--code-in parse-and-render|render|sram|flash] [--order rows|progressive] [scene...]
+//!     cargo run --release -p octrace-tests --bin pico-bench [--template pico-st7789|pico-ssd1306] [--code-in parse-and-render|render|sram|flash] [--order rows|progressive] [scene...]
 //!
 //! Cycles are the emulator's: the Cortex-M0+'s timings, both cores in
 //! lockstep on the bus fabric, the flash behind its XIP cache with the QSPI
@@ -18,12 +19,14 @@
 //! it leaves out).
 
 use octrace_tests::firmware::Sizes;
-use octrace_tests::pico::{self, Build, Contention, Cycles, CLOCK_HZ};
+use octrace_tests::pico::{self, Build, Contention, Cycles, Template, CLOCK_HZ};
 
 const USAGE: &str =
-    "usage: pico-bench [--code-in parse-and-render|render|sram|flash] [--order rows|progressive] [scene...]";
+    "usage: pico-bench [--template pico-st7789|pico-ssd1306] [--code-in parse-and-render|render|sram|flash] \
+                     [--order rows|progressive] [scene...]";
 
 fn main() {
+    let mut template = Template::St7789;
     let mut code_in = pico::DEFAULT_CODE_IN.to_owned();
     let mut order = "rows".to_owned();
     let mut scenes = Vec::new();
@@ -38,6 +41,11 @@ fn main() {
                 code_in = value("--code-in", &[pico::DEFAULT_CODE_IN, "render", "sram", "flash"], args.next())
             }
             "--order" => order = value("--order", &["rows", "progressive"], args.next()),
+            "--template" => {
+                let names = Template::ALL.map(Template::name);
+                let name = value("--template", &names, args.next());
+                template = Template::ALL.into_iter().find(|t| t.name() == name).unwrap_or(template);
+            }
             flag if flag.starts_with('-') => usage(&format!("unknown option {flag}")),
             _ => scenes.push(arg),
         }
@@ -49,7 +57,7 @@ fn main() {
     let mut rows = Vec::new();
     let mut failures = 0;
     for scene in &scenes {
-        let build = Build { scene, code_in: &code_in, order: &order };
+        let build = Build { template, scene, code_in: &code_in, order: &order };
         let measured = pico::build(&build).and_then(|elf| {
             // Both runs at once: they share nothing but the ELF.
             let (with, without) = std::thread::scope(|s| {
@@ -74,23 +82,50 @@ fn main() {
 
     let seconds = |cycles: u64| cycles as f64 / CLOCK_HZ;
     let millions = |cycles: u64| cycles as f64 / 1e6;
-    println!("| build | parse and index | render | scene to picture at 125 MHz | without contention | whole panel drawn once | flash | SRAM: statics + code |");
-    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
-    for (name, (c, free, sizes, sram_code)) in &rows {
-        println!(
-            "| {name} | {:.1} M cycles ({:.3} s) | {:.1} M cycles ({:.2} s) | **{:.2} s** | {:.2} s (+{:.1} %) | {:.3} s | {:.1} KiB | {:.1} + {:.1} KiB |",
-            millions(c.parse_and_index),
-            seconds(c.parse_and_index),
-            millions(c.render),
-            seconds(c.render),
-            c.to_picture_seconds(),
-            free.to_picture_seconds(),
-            100.0 * (c.to_picture_seconds() / free.to_picture_seconds() - 1.0),
-            seconds(c.first_full_panel),
+    let sizes_text = |sizes: &Sizes, sram_code: u64| {
+        format!(
+            "{:.1} KiB | {:.1} + {:.1} KiB",
             (sizes.text + sizes.data) as f64 / 1024.0,
             (sizes.data + sizes.bss) as f64 / 1024.0,
-            *sram_code as f64 / 1024.0,
-        );
+            sram_code as f64 / 1024.0
+        )
+    };
+    if template == Template::Ssd1306 {
+        // The picture is traced into the panel's buffer, then sent.
+        println!("| build | start-up | parse and index | render | picture over I2C | scene to picture at 125 MHz | flash | SRAM: statics + code |");
+        println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+        for (name, (c, _, sizes, sram_code)) in &rows {
+            println!(
+                "| {name} | {:.1} M cycles ({:.3} s) | {:.1} M cycles ({:.3} s) | {:.1} M cycles ({:.3} s) | {:.2} M cycles ({:.3} s) | **{:.3} s** | {} |",
+                millions(c.start_up),
+                seconds(c.start_up),
+                millions(c.parse_and_index),
+                seconds(c.parse_and_index),
+                millions(c.render),
+                seconds(c.render),
+                millions(c.transfer.unwrap_or(0)),
+                seconds(c.transfer.unwrap_or(0)),
+                c.to_picture_seconds(),
+                sizes_text(sizes, *sram_code),
+            );
+        }
+    } else {
+        println!("| build | parse and index | render | scene to picture at 125 MHz | without contention | whole panel drawn once | flash | SRAM: statics + code |");
+        println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+        for (name, (c, free, sizes, sram_code)) in &rows {
+            println!(
+                "| {name} | {:.1} M cycles ({:.3} s) | {:.1} M cycles ({:.2} s) | **{:.2} s** | {:.2} s (+{:.1} %) | {:.3} s | {} |",
+                millions(c.parse_and_index),
+                seconds(c.parse_and_index),
+                millions(c.render),
+                seconds(c.render),
+                c.to_picture_seconds(),
+                free.to_picture_seconds(),
+                100.0 * (c.to_picture_seconds() / free.to_picture_seconds() - 1.0),
+                seconds(c.first_full_panel),
+                sizes_text(sizes, *sram_code),
+            );
+        }
     }
     println!();
     println!(

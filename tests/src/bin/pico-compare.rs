@@ -15,7 +15,7 @@
 //! Markdown: paste it into an issue of the repository (the template's
 //! README says how).
 
-use octrace_tests::pico::{self, Build, Report, CLOCK_HZ};
+use octrace_tests::pico::{self, Build, Report, Template, CLOCK_HZ};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -92,7 +92,7 @@ fn contested(report: &Report) -> u64 {
 
 /// One scene: the emulated Pico's report and count, and the board's report.
 fn compare(scene: &str, options: &Options, dir: &Path) -> Result<Row, String> {
-    let elf = pico::build(&Build::of(scene))?;
+    let elf = pico::build(&Build::of(Template::St7789, scene))?;
     eprintln!("pico-compare: {scene}: on the emulated Pico (a minute or so)");
     let (cycles, emulated) = pico::run_reporting(&elf, &dir.join(format!("{scene}.png")))?;
     let board = match &options.port {

@@ -1,28 +1,38 @@
-//! The software board: the board's side of octrace-link
-//! (`octrace_link::board`) on this machine, behind a pseudo-terminal, run as
-//! the live firmware runs it on a Pico: frames in byte by byte, each
+//! The software board: the board's loop of octrace-link
+//! (`octrace_link::board::Link`, the one the live firmware runs on a Pico)
+//! on this machine, behind a pseudo-terminal: frames in byte by byte, each
 //! answered, a scene's rows rendered one after the other and sent as they
-//! are drawn, a frame from the host stopping a drawing between rows. The
-//! tests of `host-sim board` (tests/tests/board.rs) talk to it as they will
-//! to the emulated Pico.
+//! are drawn, a frame from the host stopping a drawing between two rays.
+//! The tests of `host-sim board` (tests/tests/board.rs) talk to it as they
+//! will to the emulated Pico.
 //!
 //!     software-board [--profile board16k|board64k|host] [--panel WxH] [--max-scene BYTES]
+//!                    [--misbehave HOW]
 //!
 //! It prints `serial: PATH`, the device a host opens, then serves until its
-//! standard input closes. Defaults: Board64K, the Pico template's 240×240
+//! standard input closes; its lines are the tests' commands, answered on
+//! standard output as the emulated Pico answers them (`hold`, `release`,
+//! `times`, `panel PATH`: see `octrace_tests::board`), the times by this
+//! process's clock, and no watchdog. Defaults: Board64K, the Pico template's 240×240
 //! RGB565 panel, scenes of up to 16,384 bytes.
+//!
+//! `--misbehave` makes it a hostile board, for the tests of what a host
+//! does with one ([`Misbehaviour`]): `draws-at:WxH`, `wrong-pixel`,
+//! `errors-every:MS`, `reads-slowly`, `escapes`.
 
-use embedded_graphics_core::pixelcolor::Rgb565;
+use embedded_graphics_core::pixelcolor::{Rgb565, RgbColor};
 use octrace_core::accel::Mailbox;
 use octrace_core::profile::{Board16K, Board64K, Host, Profile};
 use octrace_core::render::Renderer;
 use octrace_core::Raytracer;
-use octrace_link::board::Board;
-use octrace_link::{Counters, Decoder, Panel, PixelFormat, Timing, OVERHEAD};
+use octrace_link::board::{Board, Line, Link};
+use octrace_link::{Counters, Decoder, Message, Panel, PixelFormat, SceneError, Timing, OVERHEAD};
 use std::collections::VecDeque;
 use std::fs::File;
-use std::io::{Read, Write};
+use std::io::{ErrorKind, Read, Write};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{self, Receiver, TryRecvError};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 const FIRMWARE: &str = concat!("octrace software board ", env!("CARGO_PKG_VERSION"));
@@ -32,6 +42,82 @@ struct Options {
     profile: String,
     panel: Panel,
     max_scene: usize,
+    misbehave: Option<Misbehaviour>,
+}
+
+/// How a hostile board departs from the protocol or from octrace's board.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Misbehaviour {
+    /// Answers every scene with `drawing` at this panel (not the one its
+    /// hello describes), then `done`, without a row.
+    DrawsAt { width: u16, height: u16 },
+    /// Draws every scene with its first pixel of another colour.
+    WrongPixel,
+    /// Answers every scene with scene errors, one every this many
+    /// milliseconds, never closed by `rejected`.
+    ErrorsEvery(u64),
+    /// Reads its port slowly: 1 KiB every 100 ms (10 KiB/s), so that a
+    /// host's write waits longer than a serial port's own timeout.
+    ReadsSlowly,
+    /// Its firmware's name and its answer to every scene (one error) carry
+    /// terminal escapes.
+    Escapes,
+}
+
+impl Misbehaviour {
+    fn parse(text: &str) -> Result<Misbehaviour, String> {
+        let size = |size: &str| -> Option<(u16, u16)> {
+            let (w, h) = size.split_once('x')?;
+            Some((w.parse().ok()?, h.parse().ok()?))
+        };
+        Ok(match text.split_once(':') {
+            Some(("draws-at", wxh)) => {
+                let (width, height) = size(wxh).ok_or(format!("--misbehave {text}: expected draws-at:WxH"))?;
+                Misbehaviour::DrawsAt { width, height }
+            }
+            Some(("errors-every", ms)) => {
+                Misbehaviour::ErrorsEvery(ms.parse().map_err(|e| format!("--misbehave {text}: {e}"))?)
+            }
+            _ => match text {
+                "wrong-pixel" => Misbehaviour::WrongPixel,
+                "reads-slowly" => Misbehaviour::ReadsSlowly,
+                "escapes" => Misbehaviour::Escapes,
+                _ => {
+                    return Err(format!(
+                        "--misbehave {text}: draws-at:WxH, wrong-pixel, errors-every:MS, reads-slowly or escapes"
+                    ))
+                }
+            },
+        })
+    }
+
+    /// Answers the scene request `tag` as this misbehaviour does, if it
+    /// answers scenes its own way.
+    fn answer_scene(self, tag: u16, pixels: bool, line: &mut Pty) -> bool {
+        let send = |message: Message<'_>, line: &mut Pty| line.send(tag, message);
+        match self {
+            Misbehaviour::DrawsAt { width, height } => {
+                let panel = Panel { width, height, format: PixelFormat::Rgb565 };
+                let _ = send(Message::Drawing { panel, pixels }, line) && send(Message::Done(Timing::NONE), line);
+            }
+            Misbehaviour::ErrorsEvery(ms) => {
+                let error = SceneError { line: 1, column: 1, capacity: None, message: "one more error" };
+                // Until the host says something else (the byte that says so
+                // is dropped: a frame's opening delimiter, which a decoder
+                // that ended its last frame does without), or goes.
+                while line.read().is_none() && send(Message::SceneError(error), line) {
+                    std::thread::sleep(Duration::from_millis(ms));
+                }
+            }
+            Misbehaviour::Escapes => {
+                let message = "\u{1b}[2J\u{1b}[31mred\u{1b}[0m\nhost-sim: 0 error(s)";
+                let error = SceneError { line: 1, column: 1, capacity: None, message };
+                let _ = send(Message::SceneError(error), line) && send(Message::Rejected { errors: 1 }, line);
+            }
+            Misbehaviour::WrongPixel | Misbehaviour::ReadsSlowly => return false,
+        }
+        true
+    }
 }
 
 fn options() -> Result<Options, String> {
@@ -39,6 +125,7 @@ fn options() -> Result<Options, String> {
         profile: "board64k".into(),
         panel: Panel { width: 240, height: 240, format: PixelFormat::Rgb565 },
         max_scene: 16 * 1024,
+        misbehave: None,
     };
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
@@ -53,92 +140,263 @@ fn options() -> Result<Options, String> {
                 options.panel.height = side(h)?;
             }
             "--max-scene" => options.max_scene = value()?.parse().map_err(|e| format!("--max-scene: {e}"))?,
-            _ => return Err(format!("unknown argument {arg} (--profile, --panel, --max-scene)")),
+            "--misbehave" => options.misbehave = Some(Misbehaviour::parse(&value()?)?),
+            _ => return Err(format!("unknown argument {arg} (--profile, --panel, --max-scene, --misbehave)")),
         }
     }
     Ok(options)
 }
 
-/// The bytes a host sends, from a thread reading the pseudo-terminal.
-struct Line {
-    chunks: Receiver<Vec<u8>>,
-    bytes: VecDeque<u8>,
+/// What the tests' commands see and set, shared with the board's loop.
+struct Controls {
+    started: Instant,
+    /// The host takes nothing the board sends.
+    hold: AtomicBool,
+    /// When the host last handed the board bytes, and when the board last
+    /// sent some (µs since `started`; u64::MAX: never).
+    last_in: AtomicU64,
+    last_out: AtomicU64,
+    /// The panel: what the board drew, row-major.
+    panel: Mutex<Vec<Rgb565>>,
+    /// The board waits for the host, in `Line::sleep`.
+    sleeping: AtomicBool,
+    /// Chunks read from the terminal that the board has not taken yet.
+    unread_chunks: AtomicU64,
 }
 
-impl Line {
-    /// The next byte, waiting for it.
-    fn wait(&mut self) -> Option<u8> {
-        while self.bytes.is_empty() {
-            self.bytes.extend(self.chunks.recv().ok()?);
-        }
-        self.bytes.pop_front()
+impl Controls {
+    fn now_us(&self) -> u64 {
+        self.started.elapsed().as_micros() as u64
     }
 
-    /// The next byte if one has come.
-    fn poll(&mut self) -> Option<u8> {
+    /// The answer to one command line.
+    fn answer(&self, command: &str, panel: Panel) -> String {
+        let time = |t: &AtomicU64| match t.load(Ordering::Relaxed) {
+            u64::MAX => "-".to_string(),
+            t => t.to_string(),
+        };
+        match command.split_once(' ').unwrap_or((command, "")) {
+            ("hold", _) => {
+                self.hold.store(true, Ordering::Relaxed);
+                "ok".into()
+            }
+            ("release", _) => {
+                self.hold.store(false, Ordering::Relaxed);
+                "ok".into()
+            }
+            ("times", _) => {
+                // Asleep with nothing on its way: the board sets `sleeping`
+                // false before it counts a chunk taken.
+                let idle = self.sleeping.load(Ordering::SeqCst) && self.unread_chunks.load(Ordering::SeqCst) == 0;
+                let idle = u8::from(idle);
+                format!("times {} {} {} - {idle}", time(&self.last_in), time(&self.last_out), self.now_us())
+            }
+            ("panel", path) if !path.is_empty() => {
+                let mut image = octrace_images::RgbImage::new(panel.width.into(), panel.height.into());
+                let pixels = self.panel.lock().unwrap_or_else(|e| e.into_inner());
+                let colors = pixels.iter().flat_map(|&c| {
+                    let c = embedded_graphics_core::pixelcolor::Rgb888::from(c);
+                    use embedded_graphics_core::pixelcolor::RgbColor;
+                    [c.r(), c.g(), c.b()]
+                });
+                image.data.iter_mut().zip(colors).for_each(|(byte, c)| *byte = c);
+                let written = File::create(path).map_err(|e| e.to_string()).and_then(|mut file| {
+                    let image = octrace_images::formats::Image::Rgb(image);
+                    octrace_images::formats::write(&image, octrace_images::formats::Format::Png, &mut file)
+                        .map_err(|e| e.to_string())
+                });
+                written.map_or_else(|e| format!("panel {path}: {e}"), |()| "ok".into())
+            }
+            _ => format!("unknown command '{command}' (hold, release, times, panel PATH)"),
+        }
+    }
+}
+
+/// The pseudo-terminal as the board's line: the bytes a host sends, from
+/// a thread reading it; what the board sends, written without waiting.
+struct Pty {
+    chunks: Receiver<Vec<u8>>,
+    bytes: VecDeque<u8>,
+    out: File,
+    controls: Arc<Controls>,
+}
+
+impl Pty {
+    /// Sends `message` with `tag` whole (waiting while the host holds);
+    /// false if it cannot be encoded.
+    fn send(&mut self, tag: u16, message: Message<'_>) -> bool {
+        let mut frame = Vec::new();
+        if message.encode(tag, &mut frame).is_err() {
+            return false;
+        }
+        self.send_bytes(&frame);
+        true
+    }
+
+    fn send_bytes(&mut self, mut bytes: &[u8]) {
+        while !bytes.is_empty() {
+            let taken = self.write(bytes);
+            bytes = &bytes[taken..];
+        }
+    }
+
+    /// The next byte from the host, waiting for it; None once the line ends.
+    fn wait(&mut self) -> Option<u8> {
+        loop {
+            if let Some(byte) = self.read() {
+                return Some(byte);
+            }
+            if !self.sleep() {
+                return None;
+            }
+        }
+    }
+}
+
+impl Line for Pty {
+    fn read(&mut self) -> Option<u8> {
         while self.bytes.is_empty() {
             match self.chunks.try_recv() {
-                Ok(chunk) => self.bytes.extend(chunk),
+                Ok(chunk) => {
+                    self.controls.unread_chunks.fetch_sub(1, Ordering::SeqCst);
+                    self.bytes.extend(chunk);
+                }
                 Err(TryRecvError::Empty | TryRecvError::Disconnected) => return None,
             }
         }
         self.bytes.pop_front()
     }
+
+    fn write(&mut self, bytes: &[u8]) -> usize {
+        if self.controls.hold.load(Ordering::Relaxed) {
+            std::thread::sleep(Duration::from_millis(1));
+            return 0;
+        }
+        // Non-blocking: a full terminal takes nothing.
+        match self.out.write(bytes) {
+            Ok(n) => {
+                self.controls.last_out.store(self.controls.now_us(), Ordering::Relaxed);
+                n
+            }
+            Err(e) if e.kind() == ErrorKind::WouldBlock => {
+                std::thread::sleep(Duration::from_millis(1));
+                0
+            }
+            // No host has the terminal open: what it would get is lost.
+            Err(_) => bytes.len(),
+        }
+    }
+
+    fn discard(&mut self) {
+        // What the terminal holds already is the host's.
+    }
+
+    fn now_us(&mut self) -> u64 {
+        self.controls.now_us()
+    }
+
+    fn sleep(&mut self) -> bool {
+        self.controls.sleeping.store(true, Ordering::SeqCst);
+        let chunk = self.chunks.recv();
+        self.controls.sleeping.store(false, Ordering::SeqCst);
+        match chunk {
+            Ok(chunk) => {
+                self.controls.unread_chunks.fetch_sub(1, Ordering::SeqCst);
+                self.bytes.extend(chunk);
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    fn alive(&mut self) {}
 }
 
-/// Answers frames until the line ends, as a firmware's main loop does.
-fn serve<P: Profile>(options: &Options, line: &mut Line, out: &mut File) {
-    let mut decoder = Decoder::new(vec![0u8; options.max_scene + OVERHEAD + 1]);
-    let board = Board::new(options.panel, FIRMWARE, &decoder);
+/// Answers frames until the line ends, as the live firmware's main loop
+/// does (on one core).
+fn serve<P: Profile>(options: &Options, line: &mut Pty, controls: &Controls) {
+    let mut link = Link::new(options.panel, FIRMWARE, vec![0u8; options.max_scene + OVERHEAD + 1]);
     let mut raytracer = Box::new(Raytracer::<P>::new());
     let (width, height) = (u32::from(options.panel.width), u32::from(options.panel.height));
     let mut row = vec![Rgb565::default(); width as usize];
-    // A frame came while drawing: answered next.
-    let mut pending = false;
-    loop {
-        if !pending {
-            let Some(byte) = line.wait() else { return };
-            if decoder.push(byte).is_none() {
-                continue;
+    while link
+        .serve(line, &mut raytracer, |drawing, rows| {
+            let scene = drawing.scene();
+            let accelerator = scene.accelerator();
+            let Ok(renderer) = Renderer::with_size(scene.view(), &accelerator, width, height) else { return 0 };
+            let mut mailbox = vec![0u32; Mailbox::words_for(scene.view().object_count())];
+            let mut renderer = renderer.with_mailbox(&mut mailbox);
+            rows.draw_on_one_core(drawing, &mut renderer, &mut row, |y, pixels| {
+                let mut panel = controls.panel.lock().unwrap_or_else(|e| e.into_inner());
+                let at = usize::from(y) * pixels.len();
+                panel[at..at + pixels.len()].copy_from_slice(pixels);
+            })
+        })
+        .is_some()
+    {}
+}
+
+/// Answers frames as a hostile board does (`--misbehave`): octrace's
+/// board's answers, but with `misbehave`'s departures, one frame at a time
+/// (a frame that comes while it draws waits for the drawing's end).
+fn serve_hostile<P: Profile>(options: &Options, misbehave: Misbehaviour, line: &mut Pty) {
+    let mut decoder = Decoder::new(vec![0u8; options.max_scene + OVERHEAD + 1]);
+    let firmware = match misbehave {
+        Misbehaviour::Escapes => "\u{1b}]0;pwned\u{7}\u{1b}[2Joctrace software board",
+        _ => FIRMWARE,
+    };
+    let board = Board::new(options.panel, firmware, &decoder);
+    let mut raytracer = Box::new(Raytracer::<P>::new());
+    let (width, height) = (u32::from(options.panel.width), u32::from(options.panel.height));
+    let mut row = vec![Rgb565::default(); width as usize];
+    let mut out = Vec::new();
+    while let Some(byte) = line.wait() {
+        if decoder.push(byte).is_none() {
+            continue;
+        }
+        let Some(received) = decoder.received() else { continue };
+        if let Ok(frame) = &received {
+            if let Message::Scene { pixels, .. } = frame.message {
+                if misbehave.answer_scene(frame.tag, pixels, line) {
+                    continue;
+                }
             }
         }
-        pending = false;
-        let Some(received) = decoder.received() else { continue };
         let started = Instant::now();
-        // A host that went away while the board wrote is not waited for.
-        let Ok(Some(drawing)) = board.answer(received, &mut *raytracer, out) else { continue };
+        out.clear();
+        let answered = board.answer(received, &mut *raytracer, &mut out);
         let loaded = Instant::now();
+        line.send_bytes(&out);
+        let Ok(Some(drawing)) = answered else { continue };
         let scene = drawing.scene();
         let accelerator = scene.accelerator();
-        let Ok(renderer) = Renderer::with_size(scene.view(), &accelerator, width, height) else {
-            let _ = drawing.cancel(0, out);
-            continue;
-        };
         let mut mailbox = vec![0u32; Mailbox::words_for(scene.view().object_count())];
-        let mut renderer = renderer.with_mailbox(&mut mailbox);
-        let mut drawn = 0;
-        let mut sent = true;
-        while drawn < height && sent && !pending {
-            for (pixel, sample) in row.iter_mut().zip(renderer.row(drawn, 0..width)) {
-                *pixel = sample.color.into();
-            }
-            sent = drawing.send_row(drawn as u16, &row, out).is_ok();
-            drawn += 1;
-            while let (false, Some(byte)) = (pending, line.poll()) {
-                pending = decoder.push(byte).is_some();
-            }
-        }
-        let _ = match pending {
-            true => drawing.cancel(drawn as u16, out),
-            false => {
+        out.clear();
+        match Renderer::with_size(scene.view(), &accelerator, width, height) {
+            Ok(renderer) => {
+                let mut renderer = renderer.with_mailbox(&mut mailbox);
+                for y in 0..height {
+                    for (pixel, sample) in row.iter_mut().zip(renderer.row(y, 0..width)) {
+                        *pixel = sample.color.into();
+                    }
+                    if y == 0 && misbehave == Misbehaviour::WrongPixel {
+                        row[0] = if row[0] == Rgb565::WHITE { Rgb565::BLACK } else { Rgb565::WHITE };
+                    }
+                    let _ = drawing.send_row(y as u16, &row, &mut out);
+                }
                 // By the host's clock; it has no counters.
                 let (elapsed, render) = (started.elapsed(), loaded.elapsed());
-                let load = Some(elapsed - render);
-                let timing =
-                    Timing { elapsed: Some(elapsed), load, render: Some(render), counters: Counters::new(&[]) };
-                drawing.finish(&timing, out)
+                let timing = Timing {
+                    elapsed: Some(elapsed),
+                    load: Some(elapsed - render),
+                    render: Some(render),
+                    counters: Counters::new(&[]),
+                };
+                let _ = drawing.finish(&timing, &mut out);
             }
-        };
+            Err(_) => _ = drawing.cancel(0, &mut out),
+        }
+        line.send_bytes(&out);
     }
 }
 
@@ -147,40 +405,68 @@ fn main() {
         eprintln!("software-board: {e}");
         std::process::exit(2);
     });
-    let (mut controller, path) = octrace_tests::board::open_pty().unwrap_or_else(|e| {
+    let (controller, path) = octrace_tests::board::open_pty().unwrap_or_else(|e| {
         eprintln!("software-board: cannot open a pseudo-terminal: {e}");
         std::process::exit(1);
     });
+    let panel = options.panel;
+    let controls = Arc::new(Controls {
+        started: Instant::now(),
+        hold: AtomicBool::new(false),
+        last_in: AtomicU64::new(u64::MAX),
+        last_out: AtomicU64::new(u64::MAX),
+        panel: Mutex::new(vec![Rgb565::default(); usize::from(panel.width) * usize::from(panel.height)]),
+        sleeping: AtomicBool::new(false),
+        unread_chunks: AtomicU64::new(0),
+    });
     let mut reader = controller.try_clone().expect("a second handle on the pseudo-terminal");
     let (chunks, received) = mpsc::channel();
+    let slowly = options.misbehave == Some(Misbehaviour::ReadsSlowly);
+    let reading = Arc::clone(&controls);
     std::thread::spawn(move || {
         let mut chunk = [0u8; 4096];
         loop {
-            match reader.read(&mut chunk) {
+            if slowly {
+                std::thread::sleep(Duration::from_millis(100));
+            }
+            let chunk = if slowly { &mut chunk[..1024] } else { &mut chunk[..] };
+            match reader.read(chunk) {
                 Ok(n) if n > 0 => {
+                    reading.last_in.store(reading.now_us(), Ordering::Relaxed);
+                    reading.unread_chunks.fetch_add(1, Ordering::SeqCst);
                     if chunks.send(chunk[..n].to_vec()).is_err() {
                         return;
                     }
                 }
                 // No host has the device open (EIO once one closed it): wait for the next.
-                _ => std::thread::sleep(Duration::from_millis(10)),
+                _ => std::thread::sleep(Duration::from_millis(1)),
             }
         }
     });
-    // The process ends with its standard input, so that it never outlives
-    // the test that started it.
-    std::thread::spawn(|| {
-        let _ = std::io::copy(&mut std::io::stdin(), &mut std::io::sink());
+    // Commands, a line each; the process ends with its standard input, so
+    // that it never outlives the test that started it.
+    let commanded = Arc::clone(&controls);
+    std::thread::spawn(move || {
+        for command in std::io::stdin().lines().map_while(Result::ok) {
+            println!("{}", commanded.answer(command.trim(), panel));
+        }
         std::process::exit(0);
     });
     println!("serial: {}", path.display());
     let _ = std::io::stdout().flush();
-    let mut line = Line { chunks: received, bytes: VecDeque::new() };
-    match options.profile.as_str() {
-        "board16k" => serve::<Board16K>(&options, &mut line, &mut controller),
-        "board64k" => serve::<Board64K>(&options, &mut line, &mut controller),
-        "host" => serve::<Host>(&options, &mut line, &mut controller),
-        other => {
+    let out = controller.try_clone().expect("a third handle on the pseudo-terminal");
+    rustix::fs::fcntl_setfl(&out, rustix::fs::OFlags::NONBLOCK | rustix::fs::OFlags::RDWR)
+        .expect("the pseudo-terminal takes O_NONBLOCK");
+    let mut line = Pty { chunks: received, bytes: VecDeque::new(), out, controls: Arc::clone(&controls) };
+    let hostile = options.misbehave.filter(|&how| how != Misbehaviour::ReadsSlowly);
+    match (options.profile.as_str(), hostile) {
+        ("board16k", Some(how)) => serve_hostile::<Board16K>(&options, how, &mut line),
+        ("board64k", Some(how)) => serve_hostile::<Board64K>(&options, how, &mut line),
+        ("host", Some(how)) => serve_hostile::<Host>(&options, how, &mut line),
+        ("board16k", None) => serve::<Board16K>(&options, &mut line, &controls),
+        ("board64k", None) => serve::<Board64K>(&options, &mut line, &controls),
+        ("host", None) => serve::<Host>(&options, &mut line, &controls),
+        (other, _) => {
             eprintln!("software-board: unknown profile {other} (board16k, board64k, host)");
             std::process::exit(2);
         }

@@ -328,6 +328,7 @@ impl<'a, A> LightBuffered<'a, A> {
 impl<A: Accelerator> Accelerator for LightBuffered<'_, A> {
     const KINDS: ShapeKinds = A::KINDS;
     const USES_MAILBOX: bool = A::USES_MAILBOX;
+    const FOLLOWS_MOTION: bool = A::FOLLOWS_MOTION;
 
     fn first_hits_by_screen(&self) -> bool {
         self.accel.first_hits_by_screen()

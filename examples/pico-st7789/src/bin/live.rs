@@ -7,43 +7,42 @@
 //!
 //! Invariants: the USB device lives in the USB interrupt, which moves bytes
 //! between it and two rings (`INPUT`, `OUTPUT`); the main loop on core 0
-//! only reads `INPUT` and writes `OUTPUT`, so the port answers the host
-//! while a picture is traced. While `INPUT` is full the interrupt is masked
-//! and the host waits (its bytes stay in the port); reading makes room and
-//! unmasks it. A frame from the host while drawing stops the
-//! picture after the current row, and is answered next. A host that stops
-//! reading for `STALLED_AFTER_US` loses what the board would send, never
-//! wedges it. Nothing the host sends can make the board panic: every frame
-//! gets an answer from octrace-link's `Board`.
+//! is octrace-link's board loop (`Link`), which only reads `INPUT` and
+//! writes `OUTPUT` (this file is its `Line`: the rings, the timer, sleep
+//! and the watchdog), so the port answers the host while a picture is
+//! traced. While `INPUT` is full the interrupt is masked and the host waits
+//! (its bytes stay in the port); reading makes room and unmasks it. A frame
+//! from the host while drawing stops the picture within a millisecond and a
+//! ray on both cores, and is answered next. The watchdog runs while the
+//! board works on a frame (fed each time a drawing reads the port, every
+//! millisecond, and at every write to and wait for the host) and is
+//! stopped while it sleeps waiting for one: a board wedged at work resets
+//! itself. Nothing the host sends can make the board panic.
 
 #![no_std]
 #![no_main]
 
 use core::cell::RefCell;
 use core::ops::ControlFlow;
-use core::time::Duration;
 use critical_section::Mutex;
+use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
+use embedded_graphics::prelude::*;
 use hal::multicore::Stack;
 use hal::pac::interrupt;
-use hal::{entry, pac, Timer};
-use heapless::Deque;
+use hal::{entry, pac, Timer, Watchdog};
 use octrace_core::render::Handoff;
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
-use octrace_link::board::Board;
-use octrace_link::{Counter, Counters, Decoder, Panel, PixelFormat, Sink, Timing};
-use octrace_pico_st7789::measure::{self, Meter, Span};
+use octrace_link::board::{Line, Link, Ring};
+use octrace_link::{Panel, PixelFormat};
+use octrace_pico::{board, both_cores};
+use octrace_pico_st7789::measure::{self, Meter};
+use octrace_pico_st7789::panel;
 use octrace_pico_st7789::usb::{self, SerialDevice};
-use octrace_pico_st7789::{board, both_cores, panel};
 use panic_halt as _;
 use rp2040_hal as hal;
 
-// The render path runs from SRAM (build.rs): copied there at boot.
-octrace_pico_st7789::copy_code_into_sram!();
-
-/// The second-stage loader for the Pico's W25Q16JV flash (see memory.x).
-#[link_section = ".boot2"]
-#[used]
-static BOOT2: [u8; 256] = rp2040_boot2::BOOT_LOADER_W25Q080;
+// boot2, and what build.rs places in SRAM (OCTRACE_CODE_IN) copied there at boot.
+octrace_pico::boot!();
 
 /// What the board says it is (octrace-link's `board` answer).
 const FIRMWARE: &str = concat!("octrace-pico-live ", env!("CARGO_PKG_VERSION"));
@@ -85,164 +84,123 @@ static USB: Mutex<RefCell<Option<SerialDevice>>> = Mutex::new(RefCell::new(None)
 
 /// Bytes from the host, not yet read by the main loop; and bytes for the
 /// host, not yet taken by the USB device.
-static INPUT: Mutex<RefCell<Deque<u8, 1024>>> = Mutex::new(RefCell::new(Deque::new()));
-static OUTPUT: Mutex<RefCell<Deque<u8, 1024>>> = Mutex::new(RefCell::new(Deque::new()));
+static INPUT: Mutex<RefCell<Ring<1024>>> = Mutex::new(RefCell::new(Ring::new()));
+static OUTPUT: Mutex<RefCell<Ring<1024>>> = Mutex::new(RefCell::new(Ring::new()));
 
-/// How long the board waits for a host that does not read before it drops
-/// what it sends (a second).
-const STALLED_AFTER_US: u64 = 1_000_000;
+/// The longest the board works on a frame without a sign of life before
+/// its watchdog resets it: eight seconds, nearly the RP2040's longest
+/// (8.39 s). The longest stretch without one is loading a scene, which is
+/// not polled: 4.6 s for the dearest scene this firmware holds (every
+/// object of every kind, all overlapping; README.md); a drawing gives one
+/// every millisecond.
+const WATCHDOG_US: u32 = 8_000_000;
 
 #[entry]
 fn main() -> ! {
-    let board::Board { mut display, mut core1, timer, busctrl, usb, mut resets } =
-        board::start(PANEL_BUFFER.take(), CORE1_STACK.take().unwrap());
+    let board::Board { mut core1, pins, clocks, timer, watchdog, mut resets, peripherals } =
+        board::start(CORE1_STACK.take().unwrap());
+    let mut display = panel::init(peripherals.spi1, pins, &mut resets, &clocks, timer, PANEL_BUFFER.take());
 
     // The USB serial port, served by its interrupt from here on.
-    let device = usb::serial_device(usb, &mut resets, "octrace live");
+    let device = usb::serial_device(
+        peripherals.usbctrl_regs,
+        peripherals.usbctrl_dpram,
+        clocks.usb_clock,
+        &mut resets,
+        "octrace live",
+    );
     critical_section::with(|cs| USB.borrow_ref_mut(cs).replace(device));
     // SAFETY: the handler only touches what the critical sections guard.
     unsafe { pac::NVIC::unmask(pac::Interrupt::USBCTRL_IRQ) };
 
-    let mut decoder = Decoder::new(FRAME_BUFFER.take());
-    let size = display.bounding_box_size();
-    let panel = Panel { width: size.0, height: size.1, format: PixelFormat::Rgb565 };
-    let board = Board::new(panel, FIRMWARE, &decoder);
+    let size = display.size();
+    let panel = Panel { width: size.width as u16, height: size.height as u16, format: PixelFormat::Rgb565 };
+    let mut link = Link::new(panel, FIRMWARE, FRAME_BUFFER.take());
     let raytracer = RAYTRACER.take();
     let room = CORE1_ROOM.take();
-    let mut host = Host { timer, stalled: false };
-    let mut meter = Meter::new(timer, busctrl);
-    // A frame that came while drawing, to be answered next.
-    let mut pending = false;
+    let mut line = UsbLine { timer, watchdog, meter: Meter::new(timer, peripherals.busctrl) };
     loop {
-        if !pending {
-            let byte = next_input_byte();
-            if decoder.push(byte).is_none() {
-                continue;
-            }
-        }
-        pending = false;
-        let Some(received) = decoder.received() else { continue };
-        host.stalled = false;
-        // The board's time from the whole scene received to the last row
-        // drawn: the load (parse and index), then the render.
-        meter.start();
-        let Ok(Some(drawing)) = board.answer(received, raytracer, &mut host) else { continue };
-        let load = meter.split();
-        let mut rows = 0u16;
-        let drawn = both_cores::draw(&mut core1, drawing.scene(), room, &ROWS, &mut display, |y, row| {
-            rows = y as u16 + 1;
-            if drawing.send_row(y as u16, row, &mut host).is_err() {
-                return ControlFlow::Break(());
-            }
-            // Between rows, without waiting: a new frame stops the picture.
-            while let Some(byte) = try_input_byte() {
-                if decoder.push(byte).is_some() {
-                    pending = true;
-                    return ControlFlow::Break(());
-                }
-            }
-            ControlFlow::Continue(())
-        });
-        let answered = match drawn {
-            Ok(()) => {
-                let render = meter.split();
-                let counters = core::array::from_fn::<_, 4, _>(|bank| Counter {
-                    name: measure::EVENTS[bank],
-                    load: load.contested[bank],
-                    render: render.contested[bank],
-                });
-                let micros = |span: Span| Some(Duration::from_micros(span.micros));
-                let timing = Timing {
-                    elapsed: Some(Duration::from_micros(load.micros + render.micros)),
-                    load: micros(load),
-                    render: micros(render),
-                    counters: Counters::new(&counters),
-                };
-                drawing.finish(&timing, &mut host)
-            }
-            Err(_) => drawing.cancel(rows, &mut host),
-        };
-        // A host that stopped reading gets nothing more of this picture.
-        if answered.is_err() {
-            critical_section::with(|cs| OUTPUT.borrow_ref_mut(cs).clear());
-        }
-    }
-}
-
-trait BoundingBoxSize {
-    fn bounding_box_size(&self) -> (u16, u16);
-}
-
-impl<D: embedded_graphics::prelude::OriginDimensions> BoundingBoxSize for D {
-    fn bounding_box_size(&self) -> (u16, u16) {
-        let size = self.size();
-        (size.width as u16, size.height as u16)
-    }
-}
-
-/// The host's side of the port, as octrace-link writes to it: bytes into
-/// `OUTPUT`, waiting while it is full, up to `STALLED_AFTER_US`.
-struct Host {
-    timer: Timer,
-    /// The host stopped reading: what is left of this answer is dropped.
-    stalled: bool,
-}
-
-/// The host did not read what the board sends.
-#[derive(Debug)]
-struct Stalled;
-
-impl Sink for Host {
-    type Error = Stalled;
-
-    fn write_all(&mut self, bytes: &[u8]) -> Result<(), Stalled> {
-        if self.stalled {
-            return Err(Stalled);
-        }
-        let mut rest = bytes;
-        let mut since = self.timer.get_counter();
-        while !rest.is_empty() {
-            let taken = critical_section::with(|cs| {
-                let taken = {
-                    let mut output = OUTPUT.borrow_ref_mut(cs);
-                    let room = output.capacity() - output.len();
-                    let taken = room.min(rest.len());
-                    for &byte in &rest[..taken] {
-                        // Room was checked: never refused.
-                        let _ = output.push_back(byte);
+        link.serve(&mut line, raytracer, |drawing, rows| {
+            let rows = RefCell::new(rows);
+            let mut drawn = 0;
+            let each_row = |y: u32, traced: &[Rgb888]| {
+                if let Ok(mut rows) = rows.try_borrow_mut() {
+                    // The row as the panel shows it.
+                    let mut row = [Rgb565::BLACK; panel::WIDTH as usize];
+                    for (pixel, &color) in row.iter_mut().zip(traced) {
+                        *pixel = color.into();
                     }
-                    taken
-                };
-                // Sent now, whether or not the interrupt is masked.
-                serve_usb(cs);
-                taken
-            });
-            rest = &rest[taken..];
-            if taken > 0 {
-                since = self.timer.get_counter();
-            } else if (self.timer.get_counter() - since).to_micros() > STALLED_AFTER_US {
-                self.stalled = true;
-                return Err(Stalled);
-            }
-        }
-        Ok(())
+                    rows.send(drawing, y as u16, &row[..traced.len()]);
+                }
+                drawn = y as u16 + 1;
+                ControlFlow::Continue(())
+            };
+            // Never borrowed twice: a row is sent between asks.
+            let stop = || rows.try_borrow_mut().map_or(true, |mut rows| rows.poll());
+            let _ = both_cores::draw_until(&mut core1, drawing.scene(), room, &ROWS, &mut display, each_row, stop);
+            drawn
+        });
     }
 }
 
-/// The next byte from the host, sleeping until one comes.
-fn next_input_byte() -> u8 {
-    loop {
-        // With interrupts masked, so that one arriving between the look and
-        // the sleep still wakes the core (WFI wakes on a pending interrupt).
+/// The USB serial port as the board loop's line: the rings, the timer, the
+/// core's sleep, the watchdog and the bus fabric's counters.
+struct UsbLine {
+    timer: Timer,
+    watchdog: Watchdog,
+    meter: Meter,
+}
+
+impl Line for UsbLine {
+    fn read(&mut self) -> Option<u8> {
+        try_input_byte()
+    }
+
+    fn write(&mut self, bytes: &[u8]) -> usize {
+        critical_section::with(|cs| {
+            let taken = OUTPUT.borrow_ref_mut(cs).push(bytes);
+            // Sent now, whether or not the interrupt is masked.
+            serve_usb(cs);
+            taken
+        })
+    }
+
+    fn discard(&mut self) {
+        critical_section::with(|cs| OUTPUT.borrow_ref_mut(cs).clear());
+    }
+
+    fn now_us(&mut self) -> u64 {
+        self.timer.get_counter().ticks()
+    }
+
+    fn sleep(&mut self) -> bool {
+        // Nothing can wedge while the core sleeps for the host, and an
+        // alarm to feed the watchdog would wake it for nothing.
+        self.watchdog.disable();
+        // With interrupts masked, so that a byte arriving between the look
+        // and the sleep still wakes the core (WFI wakes on a pending
+        // interrupt).
         cortex_m::interrupt::disable();
-        let byte = try_input_byte();
-        if byte.is_none() {
+        if critical_section::with(|cs| INPUT.borrow_ref(cs).is_empty()) {
             cortex_m::asm::wfi();
         }
         // SAFETY: enabled again as they were: main runs with interrupts on.
         unsafe { cortex_m::interrupt::enable() };
-        if let Some(byte) = byte {
-            return byte;
+        self.watchdog.start(hal::fugit::MicrosDurationU32::micros(WATCHDOG_US));
+        true
+    }
+
+    fn alive(&mut self) {
+        self.watchdog.feed();
+    }
+
+    fn counter_names(&self) -> &'static [&'static str] {
+        &measure::EVENTS
+    }
+
+    fn take_counts(&mut self, counts: &mut [u32]) {
+        for (count, contested) in counts.iter_mut().zip(self.meter.split().contested) {
+            *count = contested;
         }
     }
 }
@@ -251,8 +209,8 @@ fn next_input_byte() -> u8 {
 fn try_input_byte() -> Option<u8> {
     let (byte, was_full) = critical_section::with(|cs| {
         let mut input = INPUT.borrow_ref_mut(cs);
-        let was_full = input.capacity() - input.len() < 64;
-        (input.pop_front(), was_full)
+        let was_full = input.room() < 64;
+        (input.pop(), was_full)
     });
     // The interrupt stopped reading the port, masked, while the ring was
     // full: there is room again.
@@ -280,11 +238,10 @@ fn serve_usb(cs: critical_section::CriticalSection<'_>) {
     let mut packet = [0u8; 64];
     // Only as much as the ring holds: the rest waits in the device (the
     // host is told to wait), never lost.
-    while input.capacity() - input.len() >= packet.len() {
+    while input.room() >= packet.len() {
         match serial.read(&mut packet) {
-            Ok(read) if read > 0 => packet[..read].iter().for_each(|&byte| {
-                let _ = input.push_back(byte);
-            }),
+            // Room was checked: all of it is taken.
+            Ok(read) if read > 0 => _ = input.push(&packet[..read]),
             _ => break,
         }
     }
@@ -292,18 +249,13 @@ fn serve_usb(cs: critical_section::CriticalSection<'_>) {
     // pending: masked until the main loop has made room, or it would run
     // again at once, for ever (meanwhile the main loop serves the port
     // itself when it sends).
-    if input.capacity() - input.len() < packet.len() {
+    if input.room() < packet.len() {
         pac::NVIC::mask(pac::Interrupt::USBCTRL_IRQ);
     }
     let mut output = OUTPUT.borrow_ref_mut(cs);
     while !output.is_empty() {
-        let (front, _) = output.as_slices();
-        match serial.write(front) {
-            Ok(written) if written > 0 => {
-                for _ in 0..written {
-                    output.pop_front();
-                }
-            }
+        match serial.write(output.front()) {
+            Ok(written) if written > 0 => output.consume(written),
             _ => break,
         }
     }

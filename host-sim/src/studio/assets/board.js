@@ -8,14 +8,14 @@
  *  error); its verdict, `#board-verdict`, in `data-verdict` (identical,
  *  differ, errors, error). */
 export function createBoard(app) {
-  const { $, text, errorItem, goTo, putRgb, setStatus } = app;
+  const { $, text, api, errorItem, goTo, putRgb, setStatus } = app;
   const button = $('send-board'), figure = $('board'), verdict = $('board-verdict'), canvas = $('board-image');
   let port = null, sending = false;
 
   /** Asks the server for its board; without one the button stays disabled
    *  and its title says why. */
   async function connect() {
-    const response = await fetch('/board');
+    const response = await api('/board');
     if (!response.ok) return;
     port = (await response.json()).port;
     button.disabled = false;
@@ -36,12 +36,12 @@ export function createBoard(app) {
     show('sending', '', `sending to ${port}…`);
     // The rows as they arrive (the answer comes when the board is done).
     const poll = setInterval(() => {
-      fetch('/board').then((response) => (response.ok ? response.json() : {})).then((progress) => {
+      api('/board').then((response) => (response.ok ? response.json() : {})).then((progress) => {
         if (sending && progress.height) verdict.textContent = `drawing: ${progress.rows} of ${progress.height} rows`;
       }).catch(() => {});
     }, 250);
     try {
-      const response = await fetch('/board', { method: 'POST', body: text.value });
+      const response = await api('/board', { method: 'POST', body: text.value });
       if (!response.ok) {
         const message = (await response.text()).trim();
         show('error', 'error', message);

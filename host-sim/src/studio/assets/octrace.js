@@ -4,7 +4,8 @@
 
 /** Instantiates the octrace module and wraps its byte-buffer interface. */
 export async function loadOctrace() {
-  const response = await fetch('/octrace_studio.wasm');
+  // Beside this script, under the page's token (see studio.js).
+  const response = await fetch(new URL('octrace_studio.wasm', import.meta.url));
   const { instance } = await WebAssembly.instantiateStreaming(response, {});
   const x = instance.exports;
   const encoder = new TextEncoder(), decoder = new TextDecoder();
@@ -31,8 +32,8 @@ export async function loadOctrace() {
     },
     prepare: (accel, w, h) => decoder.decode(call(x.studio_prepare, accel, w, h)),
     render: (x0, y0, w, h) => call(x.studio_render, x0, y0, w, h),
-    display(render, mode, w, h) { put(render); return call(x.studio_display, mode, w, h); },
-    encode(render, mode, format, w, h) { put(render); return call(x.studio_encode, mode, format, w, h); },
+    display(render, mode, dither, w, h) { put(render); return call(x.studio_display, mode, dither, w, h); },
+    encode(render, mode, dither, format, w, h) { put(render); return call(x.studio_encode, mode, dither, format, w, h); },
     decode(bytes) {
       put(bytes);
       const out = call(x.studio_decode);

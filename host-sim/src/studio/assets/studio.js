@@ -3,7 +3,9 @@
 // image files; this module is the editor and the plumbing, and wires up the
 // scene model (model.js), the wireframe view (view.js), the tools (tools.js),
 // the panel (panel.js) and the board (board.js). worker.js renders with its
-// own octrace module.
+// own octrace module: the page's thread never traces, so that a scene of
+// hours a pixel cannot freeze it, and a render or draft is stopped at once,
+// inside its pixel, by terminating its workers when the next one starts.
 
 import { loadOctrace } from './octrace.js';
 import { objectCentre, parseModel, single as singleIn, statementText } from './model.js';
@@ -36,10 +38,18 @@ function main() {
 
   const storageKey = () => 'octrace-studio:' + state.sceneName;
 
+  // The server's rules: the page and its assets are loaded under /TOKEN/
+  // (so relative addresses carry it), and every other request names the
+  // token in a header, never in a cookie, which a browser would also send
+  // to every other server on this machine.
+  const token = decodeURIComponent(location.pathname.split('/')[1] || '');
+  /** fetch() of the server's `path` (/scene, /board), with the token. */
+  const api = (path, init = {}) => fetch(path, { ...init, headers: { ...init.headers, 'X-Studio-Token': token } });
+
   // ----------------------------------------------------------- scene file --
 
   async function loadScene(preferStored) {
-    const response = await fetch('/scene');
+    const response = await api('/scene');
     if (!response.ok) throw new Error(await response.text());
     const body = await response.text();
     state.version = (response.headers.get('ETag') || '').replaceAll('"', '');
@@ -53,7 +63,7 @@ function main() {
 
   async function saveScene(force) {
     if (!state.writable) { alert('The studio was started without a scene file: nothing to save to.'); return false; }
-    const response = await fetch('/scene', {
+    const response = await api('/scene', {
       method: 'PUT', body: text.value, headers: { 'If-Match': force ? '*' : '"' + state.version + '"' },
     });
     if (response.status === 409) {
@@ -138,23 +148,43 @@ function main() {
 
   // ---------------------------------------------------------------- draft --
 
-  const draftWorker = new Worker('/worker.js', { type: 'module' });
-  draftWorker.onmessage = (event) => {
-    const m = event.data;
+  // The draft worker, and a spare already loading: a draft still running
+  // when the next is asked for is stopped at once (its worker terminated,
+  // the spare takes over), so a scene of hours a pixel never holds the
+  // drafts up.
+  const newDraftWorker = () => {
+    const worker = new Worker('worker.js', { type: 'module' });
+    worker.onmessage = (event) => draftMessage(event.data);
+    return worker;
+  };
+  let draftWorker = newDraftWorker();
+  let spareDraftWorker = newDraftWorker();
+  let draftBusy = false;
+  function sendDraft(message) {
+    if (draftBusy) {
+      draftWorker.terminate();
+      draftWorker = spareDraftWorker;
+      spareDraftWorker = newDraftWorker();
+    }
+    draftBusy = true;
+    draftWorker.postMessage(message);
+  }
+  function draftMessage(m) {
     if (m.seq !== state.draftSeq) return; // superseded
-    if (m.type === 'draft-errors') { $('draft-status').textContent = 'scene has errors'; return; }
+    if (m.type === 'draft-errors') { draftBusy = false; $('draft-status').textContent = 'scene has errors'; return; }
     if (m.type !== 'draft') return;
     const canvas = $('draft');
     canvas.width = m.width; canvas.height = m.height;
     putRgb(canvas, m.data.subarray(0, 3 * m.width * m.height), m.width, m.height);
     if (m.final) {
+      draftBusy = false;
       const latency = performance.now() - state.draftSent;
       state.draftLatency = latency;
       canvas.dataset.state = 'done';
       canvas.dataset.seq = String(m.seq);
       $('draft-status').textContent = `${m.width}×${m.height}, ${latency.toFixed(0)} ms after the last change`;
     }
-  };
+  }
   function scheduleDraft() {
     clearTimeout(state.draftTimer);
     const changedAt = performance.now();
@@ -163,7 +193,7 @@ function main() {
     state.draftTimer = setTimeout(() => {
       state.draftSeq += 1;
       state.draftSent = changedAt;
-      draftWorker.postMessage({ type: 'draft', seq: state.draftSeq, text: text.value, width: 160, height: 120, progressive: true });
+      sendDraft({ type: 'draft', seq: state.draftSeq, text: text.value, width: 160, height: 120, progressive: true });
     }, 25);
   }
 
@@ -223,17 +253,7 @@ function main() {
     };
     let used;
     try {
-      if ($('parallel').checked) {
-        used = await renderParallel(text.value, accel, width, height, place, () => job === renderJob);
-      } else {
-        used = state.octrace.prepare(accel, width, height);
-        // Bands of rows, yielding between them so progress shows.
-        for (let y = 0; y < height && job === renderJob; y += 8) {
-          const h = Math.min(8, height - y);
-          place(0, y, width, h, state.octrace.render(0, y, width, h));
-          await new Promise((r) => setTimeout(r, 0));
-        }
-      }
+      used = await renderOnWorkers(text.value, accel, width, height, place, () => job === renderJob);
     } catch (e) {
       for (const w of workers) w.terminate();
       imageCanvas.dataset.state = 'error';
@@ -244,18 +264,24 @@ function main() {
     const seconds = (performance.now() - started) / 1000;
     state.lastRender = { width, height, data };
     showDisplay();
-    const how = $('parallel').checked ? `, ${workers.length} workers, ${$('partition').value}` : '';
+    const how = $('parallel').checked ? `, ${workers.length} workers, ${$('partition').value}` : ', one worker';
     setStatus(`done: ${width}×${height} in ${seconds.toFixed(2)} s (${used}${how})`);
     state.lastSeconds = seconds;
     imageCanvas.dataset.state = 'done';
   }
 
   /** Renders on Web Workers: 32×32 tiles handed out as workers become free,
-   *  or the thesis's four equal rectangles (quarter i to worker i mod n). */
-  function renderParallel(source, accel, width, height, place, current) {
-    const count = Math.max(1, Math.min(16, Number($('workers').value) || 4));
+   *  or the thesis's four equal rectangles (quarter i to worker i mod n);
+   *  without "parallel", one worker renders bands of 8 rows in order. A
+   *  render started next terminates them (`render`): they stop at once,
+   *  inside the pixel they trace. */
+  function renderOnWorkers(source, accel, width, height, place, current) {
+    const parallel = $('parallel').checked;
+    const count = parallel ? Math.max(1, Math.min(16, Number($('workers').value) || 4)) : 1;
     const pieces = [];
-    if ($('partition').value === 'equal4') {
+    if (!parallel) {
+      for (let y = 0; y < height; y += 8) pieces.push({ x: 0, y, width, height: Math.min(8, height - y) });
+    } else if ($('partition').value === 'equal4') {
       const left = width >> 1, top = height >> 1;
       for (const [x, y, w, h] of [[0, 0, left, top], [left, 0, width - left, top], [0, top, left, height - top], [left, top, width - left, height - top]]) {
         if (w > 0 && h > 0) pieces.push({ x, y, width: w, height: h });
@@ -267,14 +293,14 @@ function main() {
     }
     return new Promise((resolve, reject) => {
       let next = 0, finished = 0, used = '';
-      const equal4 = $('partition').value === 'equal4';
+      const equal4 = parallel && $('partition').value === 'equal4';
       const queues = Array.from({ length: count }, (_, i) => pieces.filter((_, j) => j % count === i));
       const give = (worker, index) => {
         const piece = equal4 ? queues[index].shift() : pieces[next++];
         if (piece) worker.postMessage({ type: 'tile', ...piece });
       };
       for (let i = 0; i < count; i++) {
-        const worker = new Worker('/worker.js', { type: 'module' });
+        const worker = new Worker('worker.js', { type: 'module' });
         workers.push(worker);
         worker.onmessage = (event) => {
           const m = event.data;
@@ -297,11 +323,12 @@ function main() {
   function showDisplay() {
     const r = state.lastRender;
     if (!r) return;
-    const mode = Number($('display').value);
-    const rgb = state.octrace.display(r.data, mode, r.width, r.height);
+    const mode = Number($('display').value), dither = Number($('dither').value);
+    const rgb = state.octrace.display(r.data, mode, dither, r.width, r.height);
     imageCanvas.width = r.width; imageCanvas.height = r.height;
     putRgb(imageCanvas, rgb, r.width, r.height);
     imageCanvas.dataset.display = String(mode);
+    imageCanvas.dataset.dither = String(dither);
   }
 
   $('display').addEventListener('change', () => {
@@ -315,14 +342,16 @@ function main() {
     }
     render();
   });
+  // The method changes the look of the same render.
+  $('dither').addEventListener('change', showDisplay);
 
   // ---------------------------------------------------------------- image --
 
   function saveImage(format) {
     const r = state.lastRender;
     if (!r) { setStatus('render first'); return; }
-    const mode = Number($('display').value);
-    const bytes = state.octrace.encode(r.data, mode, format, r.width, r.height);
+    const mode = Number($('display').value), dither = Number($('dither').value);
+    const bytes = state.octrace.encode(r.data, mode, dither, format, r.width, r.height);
     const name = (state.sceneName.replace(/.*[\\/]/, '').replace(/\.[^.]*$/, '') || 'image') + ['.png', '.tga', '.ras'][format];
     const link = document.createElement('a');
     link.href = URL.createObjectURL(new Blob([bytes], { type: 'application/octet-stream' }));
@@ -390,7 +419,7 @@ function main() {
 
   // ----------------------------------------------- view, tools and panel --
 
-  const app = { state, $, text, textChanged, scheduleDraft, single, setSingle, replaceStatement, appendStatement,
+  const app = { state, $, text, api, textChanged, scheduleDraft, single, setSingle, replaceStatement, appendStatement,
     errorItem, goTo, putRgb, setStatus };
   app.view = createView(state, $('wire'), single);
   app.tools = createTools(app);
@@ -440,7 +469,7 @@ function main() {
 
   // Exposed for scripts and the browser tests.
   Object.assign(state, { render, saveScene, setText, setTool, saveImage, undo, redo, project,
-    imageBytes: (mode, format) => state.octrace.encode(state.lastRender.data, mode, format, state.lastRender.width, state.lastRender.height) });
+    imageBytes: (mode, format) => state.octrace.encode(state.lastRender.data, mode, Number($('dither').value), format, state.lastRender.width, state.lastRender.height) });
 
   (async () => {
     try {

@@ -1,13 +1,13 @@
 // The studio's render worker: its own instance of the octrace module, the
 // scene loaded once, then rectangles rendered on request. Also the draft
-// renderer (a smaller image first, then the draft size).
+// renderer (a smaller image first, then the draft size). The page stops a
+// worker by terminating it, even inside a pixel: a worker never queues
+// work of its own.
 
 import { loadOctrace } from './octrace.js';
 
 let octrace = null;
 const ready = loadOctrace().then((o) => { octrace = o; });
-let pendingDraft = null;
-let drafting = false;
 
 self.onmessage = async (event) => {
   await ready;
@@ -22,36 +22,29 @@ self.onmessage = async (event) => {
       const data = octrace.render(m.x, m.y, m.width, m.height);
       self.postMessage({ type: 'tile', x: m.x, y: m.y, width: m.width, height: m.height, data }, [data.buffer]);
     } else if (m.type === 'draft') {
-      // Only the newest text matters: older requests are dropped.
-      pendingDraft = m;
-      if (!drafting) { drafting = true; setTimeout(drainDrafts, 0); }
+      draft(m);
     }
   } catch (e) {
     self.postMessage({ type: 'error', message: String(e.message || e) });
   }
 };
 
-function drainDrafts() {
-  while (pendingDraft) {
-    const m = pendingDraft;
-    pendingDraft = null;
-    const loaded = octrace.load(m.text);
-    if (loaded.errors) {
-      self.postMessage({ type: 'draft-errors', seq: m.seq, errors: loaded.errors });
-      continue;
-    }
-    // A quarter-size pass first, so something shows at once on big scenes.
-    for (const scale of m.progressive ? [4, 1] : [1]) {
-      const w = Math.max(1, Math.floor(m.width / scale)), h = Math.max(1, Math.floor(m.height / scale));
-      try {
-        octrace.prepare(0, w, h);
-        const data = octrace.render(0, 0, w, h);
-        self.postMessage({ type: 'draft', seq: m.seq, width: w, height: h, final: scale === 1, data }, [data.buffer]);
-      } catch (e) {
-        self.postMessage({ type: 'draft-errors', seq: m.seq, errors: [String(e.message || e)] });
-        break;
-      }
+function draft(m) {
+  const loaded = octrace.load(m.text);
+  if (loaded.errors) {
+    self.postMessage({ type: 'draft-errors', seq: m.seq, errors: loaded.errors });
+    return;
+  }
+  // A quarter-size pass first, so something shows at once on big scenes.
+  for (const scale of m.progressive ? [4, 1] : [1]) {
+    const w = Math.max(1, Math.floor(m.width / scale)), h = Math.max(1, Math.floor(m.height / scale));
+    try {
+      octrace.prepare(0, w, h);
+      const data = octrace.render(0, 0, w, h);
+      self.postMessage({ type: 'draft', seq: m.seq, width: w, height: h, final: scale === 1, data }, [data.buffer]);
+    } catch (e) {
+      self.postMessage({ type: 'draft-errors', seq: m.seq, errors: [String(e.message || e)] });
+      return;
     }
   }
-  drafting = false;
 }

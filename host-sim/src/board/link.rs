@@ -1,56 +1,27 @@
-//! `host-sim board`: a scene sent to a board running octrace's live
-//! firmware over its serial port (octrace-link's protocol,
-//! docs/board-protocol.md); the board's errors printed as host-sim prints
-//! its own, its picture received, written and checked against host-sim's.
+//! The host's side of a conversation with one board over its serial line
+//! (octrace-link's protocol, docs/board-protocol.md): its hello, then a
+//! scene and the answer, each frame checked against what the board said
+//! before.
 //!
-//! Invariants: every wait for the board ends within the timeout; a frame
-//! answering another request (an earlier run's, another host's) is skipped
-//! by its tag; every row of a picture arrives exactly once, in the panel's
-//! format and width, before the board says it is done, or the run fails.
+//! Invariants: the whole conversation, writes included, ends by the link's
+//! deadline (its timeout after it opened), however the board trickles or
+//! floods; a frame answering another request (an earlier run's, another
+//! host's) is skipped by its tag; the board's panel is within the
+//! protocol's limits and every drawing is at that panel, so nothing is set
+//! aside for a picture the board only claims; every row arrives exactly
+//! once, in the panel's format and width, before the board says it is
+//! done; the board's errors are at most as many as the scene can have,
+//! each of a bounded length; the board's text (names, messages) reaches
+//! the caller with its control characters escaped.
 
-use crate::cli::{output_format, panel_preview, parse_format, progress_bar, same_file};
-use crate::exit::CliError;
-use crate::{all_cores, load_bytes, new_scene, render_with_progress, LoadError, RenderOptions, RgbImage};
-use embedded_graphics_core::pixelcolor::RgbColor;
-use octrace_core::render::PanelColor;
-use octrace_images::formats::{self, Format, Image};
-use octrace_link::{Decoder, Message, Panel, PixelFormat, Reason, Timing, VERSION};
+use crate::terminal::shown;
+use octrace_link::{Decoder, Message, Panel, Reason, Timing, VERSION};
 use serialport::SerialPort as _;
 use std::io::{self, Read, Write};
-use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-/// `host-sim board [PORT] [SCENE] [OUT]`.
-#[derive(clap::Args, Debug)]
-pub struct BoardArgs {
-    /// The board's serial port: a serial device (a character device, or a
-    /// port the system lists, such as COM3), which a scene file never is.
-    /// Without it, the serial ports are listed.
-    pub port: Option<PathBuf>,
-    /// The scene file to send. Without it, the board says what it is.
-    pub scene: Option<PathBuf>,
-    /// Where to write the board's picture, received row by row.
-    pub out: Option<PathBuf>,
-    /// Compare the board's picture with host-sim's own render of the scene
-    /// at the panel's size and in its format (as `--size WxH --color
-    /// rgb565`): says "bit-identical", or how many pixels differ (exit 3).
-    #[arg(long)]
-    pub check: bool,
-    /// Seconds to wait for each answer of the board (a row of a slow scene
-    /// included).
-    #[arg(long, value_name = "SECONDS", default_value_t = 30, value_parser = clap::value_parser!(u64).range(1..=86_400))]
-    pub timeout: u64,
-    /// OUT's file format; by default from its extension (png, tga, ras),
-    /// or PNG when it has none.
-    #[arg(long, value_parser = parse_format)]
-    pub format: Option<Format>,
-    /// Print nothing but errors.
-    #[arg(long, short)]
-    pub quiet: bool,
-}
-
-/// A serial line to a board: bytes both ways, reads that give up after a
-/// short while (so that the timeout can be kept).
+/// A serial line to a board: bytes both ways, reads and writes that give
+/// up after a short while (so that the deadline can be kept).
 pub trait Port: Read + Write {
     /// Drops what the board sent before this run.
     fn discard_input(&mut self) -> io::Result<()>;
@@ -98,8 +69,10 @@ impl Write for SerialLine {
         self.0.write(buf)
     }
 
+    /// Nothing to do: what `write` took is the system's. (The device's own
+    /// flush waits until the board has read it all, with no time limit.)
     fn flush(&mut self) -> io::Result<()> {
-        self.0.flush()
+        Ok(())
     }
 }
 
@@ -116,6 +89,11 @@ pub enum LinkError {
     Io(io::Error),
     /// Nothing answered within the timeout.
     Silent(Duration),
+    /// The board's answer began but did not end within the timeout: a
+    /// drawing slower than that, or a board that keeps talking.
+    Unfinished(Duration),
+    /// The board did not read what host-sim sent within the timeout.
+    Unread(Duration),
     /// The board speaks another protocol version.
     Version {
         /// The board's.
@@ -139,6 +117,16 @@ impl std::fmt::Display for LinkError {
             LinkError::Silent(waited) => write!(
                 f,
                 "no answer within {} s (is octrace's live firmware running there? --timeout waits longer)",
+                waited.as_secs_f64()
+            ),
+            LinkError::Unfinished(waited) => write!(
+                f,
+                "the board's answer did not end within {} s (--timeout waits longer for a slow drawing)",
+                waited.as_secs_f64()
+            ),
+            LinkError::Unread(waited) => write!(
+                f,
+                "the board did not read what host-sim sent within {} s (is octrace's live firmware running there?)",
                 waited.as_secs_f64()
             ),
             LinkError::Version { board } => write!(
@@ -211,7 +199,8 @@ pub struct BoardTiming {
     pub load: Option<Duration>,
     /// Drawing it.
     pub render: Option<Duration>,
-    /// Each counter: its name, its count over the load and over the render.
+    /// Each counter: its name (control characters escaped), its count
+    /// over the load and over the render.
     pub counters: Vec<(String, u32, u32)>,
 }
 
@@ -221,7 +210,7 @@ impl BoardTiming {
             elapsed: timing.elapsed,
             load: timing.load,
             render: timing.render,
-            counters: timing.counters.iter().map(|c| (c.name.to_owned(), c.load, c.render)).collect(),
+            counters: timing.counters.iter().map(|c| (shown(c.name), c.load, c.render)).collect(),
         }
     }
 
@@ -267,9 +256,27 @@ pub enum Progress<'a> {
     Row { y: u16, pixels: &'a [u8] },
 }
 
-/// The longest frame host-sim takes from a board: a row of the widest
-/// panel the protocol describes (65,535 pixels of 2 bytes) and more.
+/// The longest frame host-sim takes from a board: a `board` description
+/// of 255 capacities of 255-byte names, and more.
 const MAX_FRAME: usize = 1 << 18;
+
+/// The longest error message host-sim takes from a board, in bytes:
+/// octrace-core's are under 400 (scene text in them is cut to 40
+/// characters), so a longer one is no error of a scene.
+pub(crate) const MAX_MESSAGE: usize = 4096;
+
+/// The most errors a scene of `length` bytes can have: every error but a
+/// few of the whole scene (its camera, its capacities) is at a token of
+/// its own, and a token and the space after it take two bytes.
+pub(crate) fn most_errors(length: usize) -> usize {
+    length / 2 + 64
+}
+
+/// Whether an error of the port only says that nothing could be read or
+/// written yet.
+fn waiting(e: &io::Error) -> bool {
+    matches!(e.kind(), io::ErrorKind::TimedOut | io::ErrorKind::WouldBlock | io::ErrorKind::Interrupted)
+}
 
 /// A conversation with one board.
 pub struct BoardLink<P: Port> {
@@ -279,10 +286,14 @@ pub struct BoardLink<P: Port> {
     input: Vec<u8>,
     taken: usize,
     timeout: Duration,
+    /// When the conversation must be over: `timeout` after the link opened.
+    deadline: Instant,
     last_tag: u16,
     /// Whether the board has answered a request of this link: from then on
     /// every frame it sends is in answer to this link's requests.
     in_step: bool,
+    /// The panel the board described: every drawing is at it.
+    panel: Option<Panel>,
 }
 
 impl BoardLink<SerialLine> {
@@ -295,7 +306,8 @@ impl BoardLink<SerialLine> {
 }
 
 impl<P: Port> BoardLink<P> {
-    /// A link over `port`, waiting at most `timeout` for each answer.
+    /// A link over `port` whose whole conversation (every request sent and
+    /// every answer received) ends within `timeout` from now.
     pub fn new(port: P, timeout: Duration) -> Self {
         // Tags of this run unlike an earlier run's, whose answers may still
         // be on the way.
@@ -307,8 +319,10 @@ impl<P: Port> BoardLink<P> {
             input: Vec::new(),
             taken: 0,
             timeout,
+            deadline: Instant::now() + timeout,
             last_tag,
             in_step: false,
+            panel: None,
         }
     }
 
@@ -318,15 +332,30 @@ impl<P: Port> BoardLink<P> {
         self.last_tag
     }
 
-    /// Sends `message` as the request `tag`.
+    /// Sends `message` as the request `tag`, however slowly the board
+    /// reads, until the deadline.
     fn send(&mut self, tag: u16, message: &Message<'_>) -> Result<(), LinkError> {
-        message.encode(tag, &mut self.port)?;
+        let mut frame = Vec::new();
+        message.encode(tag, &mut frame)?;
+        let mut sent = 0;
+        while sent < frame.len() {
+            if Instant::now() >= self.deadline {
+                return Err(LinkError::Unread(self.timeout));
+            }
+            match self.port.write(&frame[sent..]) {
+                Ok(0) => std::thread::sleep(Duration::from_millis(5)),
+                Ok(n) => sent += n,
+                Err(e) if waiting(&e) => {}
+                Err(e) => return Err(LinkError::Io(e)),
+            }
+        }
         self.port.flush()?;
         Ok(())
     }
 
     /// Asks the board what it is; the first request of a link, which
-    /// brings the board in step whatever it was doing.
+    /// brings the board in step whatever it was doing. A panel beyond the
+    /// protocol's limits is refused here.
     pub fn hello(&mut self) -> Result<BoardDescription, LinkError> {
         self.port.discard_input()?;
         let tag = self.next_tag();
@@ -336,37 +365,70 @@ impl<P: Port> BoardLink<P> {
             Message::Refused(reason) => return Err(refused(reason)),
             other => return Err(unexpected(other.kind(), "the board's description")),
         };
-        Ok(BoardDescription {
+        let Panel { width, height, .. } = info.panel;
+        if !info.panel.within_limits() {
+            return Err(LinkError::Protocol(format!(
+                "it describes a {width}x{height} panel; a panel's sides are 1 to {} pixels",
+                Panel::MAX_SIDE
+            )));
+        }
+        let board = BoardDescription {
             panel: info.panel,
             max_scene: info.max_scene,
-            profile: info.profile.into(),
-            firmware: info.firmware.into(),
-            capacities: info.capacities.iter().map(|c| (c.name.into(), c.count)).collect(),
-        })
+            profile: shown(info.profile),
+            firmware: shown(info.firmware),
+            capacities: info.capacities.iter().map(|c| (shown(c.name), c.count)).collect(),
+        };
+        self.panel = Some(board.panel);
+        Ok(board)
     }
 
-    /// Sends scene `text` (after [`BoardLink::hello`]) and follows the
-    /// drawing, handing each step to `progress`; rows carry their pixels
-    /// if `pixels`.
+    /// Sends scene `text` (after [`BoardLink::hello`], which it asks for
+    /// first if this link has not) and follows the drawing, handing each
+    /// step to `progress`; rows carry their pixels if `pixels`.
     pub fn draw(
         &mut self,
         text: &[u8],
         pixels: bool,
         progress: &mut dyn FnMut(Progress<'_>),
     ) -> Result<Answer, LinkError> {
+        let panel = match self.panel {
+            Some(panel) => panel,
+            None => self.hello()?.panel,
+        };
         let tag = self.next_tag();
         self.send(tag, &Message::Scene { pixels, text })?;
         let mut errors = Vec::new();
-        // The panel and which of its rows have come.
-        let mut drawing: Option<(Panel, Vec<bool>)> = None;
+        // Which rows of the drawing have come, once it began.
+        let mut drawing: Option<Vec<bool>> = None;
         loop {
-            match (self.receive(tag)?, &mut drawing) {
-                (Message::SceneError(e), None) => errors.push(BoardSceneError {
-                    line: e.line,
-                    column: e.column,
-                    capacity: e.capacity.map(|c| (c.name.into(), c.needed, c.holds)),
-                    message: e.message.into(),
-                }),
+            let began = drawing.is_some() || !errors.is_empty();
+            let message = match self.receive(tag) {
+                Err(LinkError::Silent(waited)) if began => return Err(LinkError::Unfinished(waited)),
+                received => received?,
+            };
+            match (message, &mut drawing) {
+                (Message::SceneError(e), None) => {
+                    if errors.len() == most_errors(text.len()) {
+                        return Err(LinkError::Protocol(format!(
+                            "it sent more errors than a scene of {} bytes can have ({})",
+                            text.len(),
+                            errors.len()
+                        )));
+                    }
+                    if e.message.len() > MAX_MESSAGE {
+                        return Err(LinkError::Protocol(format!(
+                            "it sent an error message of {} bytes (octrace's are under {MAX_MESSAGE})",
+                            e.message.len()
+                        )));
+                    }
+                    errors.push(BoardSceneError {
+                        line: e.line,
+                        column: e.column,
+                        capacity: e.capacity.map(|c| (shown(c.name), c.needed, c.holds)),
+                        message: shown(e.message),
+                    });
+                }
                 (Message::Rejected { errors: count }, None) if count as usize == errors.len() && count > 0 => {
                     return Ok(Answer::Rejected(errors));
                 }
@@ -374,14 +436,20 @@ impl<P: Port> BoardLink<P> {
                     let sent = errors.len();
                     return Err(LinkError::Protocol(format!("it counted {count} errors of the scene and sent {sent}")));
                 }
-                (Message::Drawing { panel, pixels: with_pixels }, None) if errors.is_empty() => {
+                (Message::Drawing { panel: drawn, pixels: with_pixels }, None) if errors.is_empty() => {
+                    if drawn != panel {
+                        return Err(LinkError::Protocol(format!(
+                            "it draws at {}x{} {}, but described a {}x{} {} panel",
+                            drawn.width, drawn.height, drawn.format, panel.width, panel.height, panel.format
+                        )));
+                    }
                     if with_pixels != pixels {
                         return Err(LinkError::Protocol(format!("rows with pixels: {with_pixels}, asked: {pixels}")));
                     }
                     progress(Progress::Drawing(panel));
-                    drawing = Some((panel, vec![false; panel.height.into()]));
+                    drawing = Some(vec![false; panel.height.into()]);
                 }
-                (Message::Row { y, pixels: row }, Some((panel, seen))) => {
+                (Message::Row { y, pixels: row }, Some(seen)) => {
                     let bytes = if pixels { panel.row_bytes() } else { 0 };
                     match seen.get_mut(usize::from(y)) {
                         Some(seen) if !*seen && row.len() == bytes => *seen = true,
@@ -394,9 +462,9 @@ impl<P: Port> BoardLink<P> {
                     }
                     progress(Progress::Row { y, pixels: row });
                 }
-                (Message::Done(timing), Some((panel, seen))) => {
+                (Message::Done(timing), Some(seen)) => {
                     return match seen.iter().position(|seen| !seen) {
-                        None => Ok(Answer::Drawn { panel: *panel, timing: BoardTiming::of(&timing) }),
+                        None => Ok(Answer::Drawn { panel, timing: BoardTiming::of(&timing) }),
                         Some(y) => Err(LinkError::Protocol(format!("done without row {y}"))),
                     };
                 }
@@ -407,12 +475,12 @@ impl<P: Port> BoardLink<P> {
         }
     }
 
-    /// The next message answering request `tag`, skipping any other.
+    /// The next message answering request `tag`, skipping any other, by
+    /// the deadline.
     fn receive(&mut self, tag: u16) -> Result<Message<'_>, LinkError> {
-        let deadline = Instant::now() + self.timeout;
         loop {
             if self.taken == self.input.len() {
-                self.fill(deadline)?;
+                self.fill()?;
                 continue;
             }
             let byte = self.input[self.taken];
@@ -447,12 +515,12 @@ impl<P: Port> BoardLink<P> {
         }
     }
 
-    /// Reads what the port has, waiting until `deadline` at most.
-    fn fill(&mut self, deadline: Instant) -> Result<(), LinkError> {
+    /// Reads what the port has, waiting until the deadline at most.
+    fn fill(&mut self) -> Result<(), LinkError> {
         self.input.resize(4096, 0);
         self.taken = 0;
         loop {
-            if Instant::now() >= deadline {
+            if Instant::now() >= self.deadline {
                 self.input.clear();
                 return Err(LinkError::Silent(self.timeout));
             }
@@ -462,11 +530,7 @@ impl<P: Port> BoardLink<P> {
                     self.input.truncate(n);
                     return Ok(());
                 }
-                Err(e)
-                    if matches!(
-                        e.kind(),
-                        io::ErrorKind::TimedOut | io::ErrorKind::WouldBlock | io::ErrorKind::Interrupted
-                    ) => {}
+                Err(e) if waiting(&e) => {}
                 Err(e) => {
                     self.input.clear();
                     return Err(LinkError::Io(e));
@@ -488,273 +552,41 @@ fn unexpected(kind: octrace_link::Kind, awaited: &str) -> LinkError {
     LinkError::Protocol(format!("it sent a {kind} message where {awaited} was due"))
 }
 
-/// Whether `arg` names a serial port: a character device, or a port the
-/// system lists (COM3 on Windows).
-pub(crate) fn is_port(arg: &Path) -> bool {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if std::fs::metadata(arg).is_ok_and(|m| m.file_type().is_char_device()) {
-            return true;
-        }
-    }
-    ports().iter().any(|port| Path::new(&port.port_name) == arg)
-}
-
-/// The serial ports the system lists (none where it cannot list them).
-fn ports() -> Vec<serialport::SerialPortInfo> {
-    // serialport scans /sys/class/tty on Linux and panics where it is missing.
-    if cfg!(target_os = "linux") && !Path::new("/sys/class/tty").is_dir() {
-        return Vec::new();
-    }
-    serialport::available_ports().unwrap_or_default()
-}
-
-/// Each port on a line: its name, and what it is when the system knows.
-pub(crate) fn write_ports(out: &mut dyn Write) -> io::Result<()> {
-    let ports = ports();
-    if ports.is_empty() {
-        return writeln!(
-            out,
-            "no serial ports found (a board with octrace's live firmware shows up as a USB serial port)"
-        );
-    }
-    for port in ports {
-        let what = match port.port_type {
-            serialport::SerialPortType::UsbPort(usb) => {
-                let names = [usb.manufacturer, usb.product].into_iter().flatten().collect::<Vec<_>>().join(" ");
-                let serial = usb.serial_number.map(|s| format!(" (serial {s})")).unwrap_or_default();
-                format!("USB {:04x}:{:04x} {names}{serial}", usb.vid, usb.pid)
-            }
-            serialport::SerialPortType::PciPort => "PCI".into(),
-            serialport::SerialPortType::BluetoothPort => "Bluetooth".into(),
-            serialport::SerialPortType::Unknown => "serial".into(),
-        };
-        writeln!(out, "{}\t{what}", port.port_name)?;
-    }
-    Ok(())
-}
-
-/// Runs `host-sim board`.
-pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Result<(), CliError> {
-    let Some(first) = &args.port else {
-        return write_ports(stdout).map_err(|e| CliError::Io(format!("board: {e}")));
-    };
-    if !is_port(first) {
-        let _ = writeln!(stderr, "host-sim board: the serial ports:");
-        let _ = write_ports(stderr);
-        return Err(CliError::Invalid(format!(
-            "board: {} is no serial port: give the board's port first (host-sim board PORT SCENE [OUT])",
-            first.display()
-        )));
-    }
-    let port = first.display().to_string();
-    let out = args.out.as_ref();
-    let timeout = Duration::from_secs(args.timeout);
-    let Some(scene) = &args.scene else {
-        let mut link = BoardLink::open(&port, timeout).map_err(|e| link_error(&port, e))?;
-        let board = link.hello().map_err(|e| link_error(&port, e))?;
-        return describe(&port, &board, stdout).map_err(|e| CliError::Io(format!("board: {e}")));
-    };
-    if out.is_none() && args.format.is_some() {
-        return Err(CliError::Invalid("board: --format names OUT's format: give OUT".into()));
-    }
-    let format = out.map(|out| output_format(args.format, out)).transpose()?;
-    if let Some(out) = out.filter(|out| same_file(scene, out)) {
-        return Err(CliError::Invalid(format!(
-            "refusing to overwrite the scene file {} with the image",
-            out.display()
-        )));
-    }
-    let text = std::fs::read(scene).map_err(|e| CliError::read(scene, e))?;
-    let file = scene.display().to_string();
-    let pixels = out.is_some() || args.check;
-    let started = Instant::now();
-    let mut bar = None;
-    let sent = send_scene(&port, timeout, &file, &text, pixels, &mut |step| match step {
-        Progress::Drawing(panel) => bar = progress_bar(panel.height.into(), args.quiet),
-        Progress::Row { .. } => {
-            if let Some(bar) = &bar {
-                bar.inc(1);
-            }
-        }
-    });
-    if let Some(bar) = &bar {
-        bar.finish_and_clear();
-    }
-    let (panel, timing, picture) = match sent? {
-        Sent::Rejected(errors) => {
-            let errors = errors.iter().map(|e| e.located(&file)).collect();
-            return Err(CliError::Scene { file, errors });
-        }
-        Sent::Drawn { panel, timing, picture } => (panel, timing, picture),
-    };
-    let (w, h) = (panel.width, panel.height);
-    if !args.quiet {
-        let time = timing.describe(started.elapsed());
-        let _ = writeln!(stderr, "{w}x{h} {} drawn by the board at {port} {time}", panel.format);
-    }
-    let Some(image) = picture else { return Ok(()) };
-    if let (Some(out), Some(format)) = (out, format) {
-        crate::output::write_atomically(out, |f| {
-            formats::write(&Image::Rgb(image.clone()), format, f).map_err(io::Error::other)
-        })
-        .map_err(|e| CliError::write(out, e))?;
-        if !args.quiet {
-            let _ = writeln!(stderr, "the board's picture -> {}", out.display());
-        }
-    }
-    if args.check {
-        let differ = differing_pixels(&file, &text, panel, &image)?;
-        if differ > 0 {
-            return Err(CliError::Mismatch(format!(
-                "board --check: {differ} of {} pixels differ from host-sim's {} render at {w}x{h}",
-                w as usize * h as usize,
-                panel.format
-            )));
-        }
-        if !args.quiet {
-            let _ = writeln!(stderr, "--check: bit-identical to host-sim's {} render at {w}x{h}", panel.format);
-        }
-    }
-    Ok(())
-}
-
-/// A failure to talk to the board at `port`, as host-sim reports it.
-fn link_error(port: &str, e: LinkError) -> CliError {
-    let message = format!("board at {port}: {e}");
-    match e {
-        // The board's own answer to the scene: a scene error in all but name.
-        LinkError::Refused(Reason::TooLong { .. }) => CliError::Invalid(message),
-        _ => CliError::Io(message),
-    }
-}
-
-/// What a board made of a scene sent to it.
-#[derive(Debug)]
-pub(crate) enum Sent {
-    /// The scene's errors, as the board found them; nothing drawn.
-    Rejected(Vec<BoardSceneError>),
-    /// Drawn at the panel's size (`timing` as the board measured it), with
-    /// the picture if its pixels were asked for.
-    Drawn { panel: Panel, timing: BoardTiming, picture: Option<RgbImage> },
-}
-
-/// Sends scene `text` (named `file` in errors) to the board at `port`,
-/// after its hello and a check of the scene's length against what it
-/// takes, and follows the drawing, handing each step to `progress`. Waits
-/// at most `timeout` for each answer. `host-sim board` and the studio send
-/// through this.
-pub(crate) fn send_scene(
-    port: &str,
-    timeout: Duration,
-    file: &str,
-    text: &[u8],
-    pixels: bool,
-    progress: &mut dyn FnMut(Progress<'_>),
-) -> Result<Sent, CliError> {
-    let mut link = BoardLink::open(port, timeout).map_err(|e| link_error(port, e))?;
-    let board = link.hello().map_err(|e| link_error(port, e))?;
-    if text.len() > board.max_scene as usize {
-        return Err(CliError::Invalid(format!(
-            "{file} is {} bytes; the board at {port} takes scenes of at most {} bytes",
-            text.len(),
-            board.max_scene
-        )));
-    }
-    // The picture, assembled as its rows come.
-    let mut picture: Option<(PixelFormat, RgbImage)> = None;
-    let answer = link.draw(text, pixels, &mut |step| {
-        match &step {
-            Progress::Drawing(panel) => {
-                let image = RgbImage::new(panel.width.into(), panel.height.into());
-                picture = pixels.then_some((panel.format, image));
-            }
-            Progress::Row { y, pixels } => {
-                if let Some((format, image)) = &mut picture {
-                    let row = image.data.chunks_exact_mut(3).skip(*y as usize * image.width as usize);
-                    for (rgb, color) in row.zip(format.colors(pixels)) {
-                        rgb.copy_from_slice(&[color.r(), color.g(), color.b()]);
-                    }
-                }
-            }
-        }
-        progress(step);
-    });
-    Ok(match answer.map_err(|e| link_error(port, e))? {
-        Answer::Rejected(errors) => Sent::Rejected(errors),
-        Answer::Drawn { panel, timing } => Sent::Drawn { panel, timing, picture: picture.map(|(_, image)| image) },
-    })
-}
-
-/// How many pixels of the board's `picture` differ from host-sim's render
-/// of the scene at the panel's size, as the panel shows it (`host-sim
-/// SCENE OUT --size WxH --color rgb565`). `host-sim board --check` and the
-/// studio judge the board's picture by this.
-pub(crate) fn differing_pixels(file: &str, text: &[u8], panel: Panel, picture: &RgbImage) -> Result<usize, CliError> {
-    let ours = host_render(file, text, panel)?;
-    Ok(ours.data.chunks_exact(3).zip(picture.data.chunks_exact(3)).filter(|(a, b)| a != b).count())
-}
-
-/// host-sim's render of the scene at the panel's size, as the panel shows
-/// it.
-fn host_render(file: &str, text: &[u8], panel: Panel) -> Result<RgbImage, CliError> {
-    let mismatch = |why: String| CliError::Mismatch(format!("board --check: {why}"));
-    let mut scene = new_scene();
-    load_bytes(file, text, &mut scene).map_err(|e| match e {
-        LoadError::Io(e) => mismatch(format!("host-sim cannot read the scene: {e}")),
-        LoadError::Scene(errors) => {
-            mismatch(format!("the board drew a scene host-sim refuses:\n{}", errors.join("\n")))
-        }
-    })?;
-    let options = RenderOptions {
-        size: Some((panel.width.into(), panel.height.into())),
-        threads: all_cores(),
-        ..RenderOptions::default()
-    };
-    let rendered = render_with_progress(&scene, &options, &|_| {})
-        .map_err(|e| mismatch(format!("host-sim cannot set up the camera: {e}")))?;
-    let color = match panel.format {
-        PixelFormat::Rgb565 => PanelColor::Rgb565,
-    };
-    Ok(match panel_preview(&rendered.image, color) {
-        Some(preview) => preview.to_rgb(),
-        None => rendered.image,
-    })
-}
-
-/// What `host-sim board PORT` prints.
-fn describe(port: &str, board: &BoardDescription, out: &mut dyn Write) -> io::Result<()> {
-    let Panel { width, height, format } = board.panel;
-    writeln!(out, "{port}: {} (protocol version {VERSION})", board.firmware)?;
-    writeln!(out, "panel: {width}x{height} {format}; scenes of at most {} bytes", board.max_scene)?;
-    let capacities: Vec<String> = board.capacities.iter().map(|(name, count)| format!("{name} {count}")).collect();
-    writeln!(out, "profile {}: {}", board.profile, capacities.join(", "))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use octrace_link::SceneError;
+    use octrace_link::{PixelFormat, SceneError};
     use std::collections::VecDeque;
 
     /// A board played by a function: each frame host-sim writes is
-    /// answered with the bytes it returns.
+    /// answered with the bytes it returns. It reads nothing before
+    /// `reads_from` (each write times out, as a serial port's does), and
+    /// once `chatter` is set it sends it again whenever host-sim has read
+    /// all it sent.
     struct Played<F> {
         decoder: Decoder<Vec<u8>>,
         answer: F,
         out: VecDeque<u8>,
+        reads_from: Instant,
+        chatter: Chatter,
     }
+
+    /// What a board keeps sending, how often, and when it last did.
+    type Chatter = std::rc::Rc<std::cell::RefCell<(Vec<u8>, Duration, Instant)>>;
 
     impl<F: FnMut(u16, Message<'_>) -> Vec<u8>> Write for Played<F> {
         fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-            for &byte in buf {
-                if let Some(Ok(frame)) = self.decoder.push(byte) {
-                    let bytes = (self.answer)(frame.tag, frame.message);
-                    self.out.extend(bytes);
-                }
+            if Instant::now() < self.reads_from {
+                std::thread::sleep(Duration::from_millis(5));
+                return Err(io::ErrorKind::TimedOut.into());
             }
-            Ok(buf.len())
+            // A byte at a time: a line that drains slowly.
+            let Some(&byte) = buf.first() else { return Ok(0) };
+            if let Some(Ok(frame)) = self.decoder.push(byte) {
+                let bytes = (self.answer)(frame.tag, frame.message);
+                self.out.extend(bytes);
+            }
+            Ok(1)
         }
 
         fn flush(&mut self) -> io::Result<()> {
@@ -764,6 +596,11 @@ mod tests {
 
     impl<F> Read for Played<F> {
         fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+            let (chatter, every, last) = &mut *self.chatter.borrow_mut();
+            if self.out.is_empty() && !chatter.is_empty() && last.elapsed() >= *every {
+                self.out.extend(chatter.iter());
+                *last = Instant::now();
+            }
             if self.out.is_empty() {
                 std::thread::sleep(Duration::from_millis(1));
                 return Err(io::ErrorKind::TimedOut.into());
@@ -784,8 +621,18 @@ mod tests {
     }
 
     fn played(answer: impl FnMut(u16, Message<'_>) -> Vec<u8>) -> BoardLink<impl Port> {
-        let port = Played { decoder: Decoder::new(vec![0; 4096]), answer, out: VecDeque::new() };
-        BoardLink::new(port, Duration::from_millis(200))
+        BoardLink::new(played_port(answer), Duration::from_millis(200))
+    }
+
+    fn played_port<F: FnMut(u16, Message<'_>) -> Vec<u8>>(answer: F) -> Played<F> {
+        let chatter = std::rc::Rc::new(std::cell::RefCell::new((Vec::new(), Duration::ZERO, Instant::now())));
+        Played {
+            decoder: Decoder::new(vec![0; 4096]),
+            answer,
+            out: VecDeque::new(),
+            reads_from: Instant::now(),
+            chatter,
+        }
     }
 
     fn frames(messages: &[(Message<'_>, u16)]) -> Vec<u8> {
@@ -919,5 +766,116 @@ mod tests {
             frames(&[(Message::Drawing { panel: PANEL, pixels: true }, tag), (Message::Cancelled { rows: 0 }, tag)])
         });
         assert!(matches!(draw(&mut link), Err(LinkError::Cancelled { rows: 0 })));
+    }
+
+    #[test]
+    fn a_panel_beyond_the_protocols_limits_or_another_than_described_is_refused_before_anything_is_kept() {
+        for (width, height) in [(0, 0), (0, 240), (Panel::MAX_SIDE + 1, 1), (65535, 65535)] {
+            let panel = Panel { width, height, format: PixelFormat::Rgb565 };
+            let mut link = played(move |tag, _| {
+                frames(&[(
+                    Message::Board(octrace_link::BoardInfo {
+                        panel,
+                        max_scene: 100,
+                        profile: "P",
+                        firmware: "f",
+                        capacities: octrace_link::Capacities::new(&[]),
+                    }),
+                    tag,
+                )])
+            });
+            let said = link.hello().unwrap_err().to_string();
+            let want = format!("it describes a {width}x{height} panel; a panel's sides are 1 to 16384 pixels");
+            assert!(said.ends_with(&want), "{said}");
+            // A drawing at any panel but the one described.
+            let mut link = drawing_board(move |tag| {
+                frames(&[(Message::Drawing { panel, pixels: true }, tag), (Message::Done(Timing::NONE), tag)])
+            });
+            let said = draw(&mut link).unwrap_err().to_string();
+            let want = format!("it draws at {width}x{height} rgb565, but described a 2x2 rgb565 panel");
+            assert!(said.ends_with(&want), "{said}");
+        }
+    }
+
+    /// A board that describes itself (as `info`), then answers a scene
+    /// with scene errors `message`, one every `every`, and never ends.
+    fn chatty_board(info: Message<'static>, message: &'static str, every: Duration) -> BoardLink<impl Port> {
+        let port = played_port(|_, _| Vec::new());
+        let chatter = port.chatter.clone();
+        let scene = chatter.clone();
+        let mut port = played_port(move |tag, received| match received {
+            Message::Hello => frames(&[(info, tag)]),
+            _ => {
+                let error = SceneError { line: 1, column: 1, capacity: None, message };
+                *scene.borrow_mut() = (frames(&[(Message::SceneError(error), tag)]), every, Instant::now());
+                Vec::new()
+            }
+        });
+        port.chatter = chatter;
+        BoardLink::new(port, Duration::from_millis(300))
+    }
+
+    #[test]
+    fn one_deadline_holds_across_a_board_that_keeps_sending_errors() {
+        let mut link = chatty_board(board_info(), "bad", Duration::from_millis(10));
+        let started = Instant::now();
+        link.hello().unwrap();
+        let said = link.draw("x\n".repeat(1000).as_bytes(), true, &mut |_| {}).unwrap_err();
+        assert!(matches!(said, LinkError::Unfinished(_)), "{said}");
+        assert!(said.to_string().starts_with("the board's answer did not end within 0.3 s"), "{said}");
+        let took = started.elapsed();
+        assert!(took >= Duration::from_millis(300) && took < Duration::from_secs(1), "{took:?}");
+        // Faster than the deadline, more errors than the scene can have.
+        let mut link = chatty_board(board_info(), "bad", Duration::ZERO);
+        let said = link.draw("x\n".repeat(1000).as_bytes(), true, &mut |_| {}).unwrap_err().to_string();
+        assert!(said.ends_with("it sent more errors than a scene of 2000 bytes can have (1064)"), "{said}");
+        // An error longer than any of octrace's.
+        let long: &'static str = "e".repeat(MAX_MESSAGE + 1).leak();
+        let mut link = chatty_board(board_info(), long, Duration::ZERO);
+        let said = link.draw(b"x", true, &mut |_| {}).unwrap_err().to_string();
+        assert!(said.ends_with("it sent an error message of 4097 bytes (octrace's are under 4096)"), "{said}");
+    }
+
+    #[test]
+    fn one_deadline_holds_for_writes_to_a_line_that_drains_slowly_or_not_at_all() {
+        // Nothing read for 100 ms, then a byte at a time: well within 1 s.
+        let mut port = played_port(|tag, _| frames(&[(board_info(), tag)]));
+        port.reads_from = Instant::now() + Duration::from_millis(100);
+        let mut link = BoardLink::new(port, Duration::from_secs(1));
+        assert_eq!(link.hello().unwrap().panel, PANEL);
+        // Nothing read at all: said when the deadline comes.
+        let mut port = played_port(|tag, _| frames(&[(board_info(), tag)]));
+        port.reads_from = Instant::now() + Duration::from_secs(3600);
+        let started = Instant::now();
+        let said = BoardLink::new(port, Duration::from_millis(200)).hello().unwrap_err();
+        assert!(said.to_string().starts_with("the board did not read what host-sim sent within 0.2 s"), "{said}");
+        assert!(started.elapsed() < Duration::from_secs(1), "{:?}", started.elapsed());
+    }
+
+    #[test]
+    fn the_boards_text_comes_with_its_control_characters_escaped() {
+        let info = Message::Board(octrace_link::BoardInfo {
+            panel: PANEL,
+            max_scene: 100,
+            profile: "P\u{1b}]0;title\u{7}",
+            firmware: "\u{1b}[2Jfake\nhost-sim: ok",
+            capacities: octrace_link::Capacities::new(&[octrace_link::Capacity { name: "\u{1b}[31m", count: 1 }]),
+        });
+        let mut link = played(move |tag, message| match message {
+            Message::Hello => frames(&[(info, tag)]),
+            _ => {
+                let need = octrace_link::CapacityNeed { name: "\u{1b}[0m", needed: Some(2), holds: 1 };
+                let error =
+                    SceneError { line: 1, column: 1, capacity: Some(need), message: "\u{1b}[1A\rline 1 is fine" };
+                frames(&[(Message::SceneError(error), tag), (Message::Rejected { errors: 1 }, tag)])
+            }
+        });
+        let board = link.hello().unwrap();
+        assert_eq!(board.firmware, "\\u{1b}[2Jfake\\u{a}host-sim: ok");
+        assert_eq!(board.profile, "P\\u{1b}]0;title\\u{7}");
+        assert_eq!(board.capacities, [("\\u{1b}[31m".to_string(), 1)]);
+        let Answer::Rejected(errors) = link.draw(b"x", true, &mut |_| {}).unwrap() else { panic!("rejected") };
+        assert_eq!(errors[0].message, "\\u{1b}[1A\\u{d}line 1 is fine");
+        assert_eq!(errors[0].capacity, Some(("\\u{1b}[0m".to_string(), Some(2), 1)));
     }
 }

@@ -1,6 +1,9 @@
 //! Each core traces on a stack in an SRAM bank of its own: core 0 in SRAM4,
 //! core 1 in SRAM5 (4 KiB each, RP2040 datasheet 2.6.2), which nothing
-//! else uses (`memory.x` ends the main RAM below them).
+//! else uses (octrace-pico-build's `memory.x` ends the main RAM below
+//! them). [`SecondCore::start`](crate::second_core::SecondCore::start)
+//! guards both banks; [`both_cores`](crate::both_cores) traces each piece
+//! on them.
 //!
 //! Why: the main SRAM is striped word by word across four banks, and both
 //! cores' code and data are spread over all four, so their accesses meet

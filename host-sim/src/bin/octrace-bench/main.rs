@@ -5,8 +5,11 @@
 //! Tables: `scenes` (every scene, naive), `table51` (the thesis's Table 5.1),
 //! `table52` (Table 5.2), `scaling` (random spheres, N = 10 … 100,000),
 //! `criterion` (the octree's subdivision criterion), `parallel` (threads
-//! and partitions), `palette` (the 256-colour modes), `spheres600` (naive against
-//! dda on 600 random spheres at 800×600). No argument: all. Times are wall-clock on one thread
+//! and partitions), `palette` (the 256-colour modes), `panels` (every
+//! dithering on every panel of few levels, issue 42's measure),
+//! `spheres600` (naive against dda on 600 random spheres at 800×600),
+//! `animation` (frame-to-frame coherence on anim_fig5_1, `animation.rs`).
+//! No argument: all. Times are wall-clock on one thread
 //! (except in `parallel`), the best of several runs; the machine is printed
 //! first so every table says where it came from.
 
@@ -18,6 +21,9 @@ use octrace_core::accel::OctreeConfig;
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
+
+mod animation;
+mod panels;
 
 fn machine() -> String {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
@@ -46,14 +52,18 @@ fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (Duration, T) {
     (best, last.expect("at least one run"))
 }
 
-fn ms(d: Duration) -> String {
+pub(crate) fn ms(d: Duration) -> String {
     format!("{:.1} ms", d.as_secs_f64() * 1e3)
 }
 
 fn scene_files(dir: &Path) -> Vec<PathBuf> {
     let mut v: Vec<PathBuf> =
         std::fs::read_dir(dir).map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect()).unwrap_or_default();
-    v.retain(|p| p.extension().is_some_and(|x| x == "txt"));
+    // The stills: the animations (`anim_*`) have a table of their own.
+    v.retain(|p| {
+        p.extension().is_some_and(|x| x == "txt")
+            && !p.file_stem().is_some_and(|s| s.to_string_lossy().starts_with("anim_"))
+    });
     v.sort();
     v
 }
@@ -68,11 +78,13 @@ enum Table {
     Scaling,
     Parallel,
     Palette,
+    Panels,
     Spheres600,
+    Animation,
 }
 
 impl Table {
-    const ALL: [Table; 8] = [
+    const ALL: [Table; 10] = [
         Table::Scenes,
         Table::Table51,
         Table::Table52,
@@ -80,7 +92,9 @@ impl Table {
         Table::Scaling,
         Table::Parallel,
         Table::Palette,
+        Table::Panels,
         Table::Spheres600,
+        Table::Animation,
     ];
 
     /// Its name on the command line.
@@ -93,7 +107,9 @@ impl Table {
             Table::Scaling => "scaling",
             Table::Parallel => "parallel",
             Table::Palette => "palette",
+            Table::Panels => "panels",
             Table::Spheres600 => "spheres600",
+            Table::Animation => "animation",
         }
     }
 
@@ -114,14 +130,16 @@ impl Table {
             }
             Table::Parallel => parallel(dir),
             Table::Palette => palette_table(dir),
+            Table::Panels => panels::table(dir),
             Table::Spheres600 => spheres600(dir),
+            Table::Animation => animation::table(dir),
         }
     }
 }
 
 /// Why octrace-bench stopped before its tables were done.
 #[derive(Debug)]
-enum BenchError {
+pub(crate) enum BenchError {
     /// A table it does not know was asked for.
     UnknownTable(String),
     /// A scene it measures did not load.
@@ -156,7 +174,7 @@ impl fmt::Display for BenchError {
 
 impl std::error::Error for BenchError {}
 
-fn load(path: &Path) -> Result<Box<HostScene>, BenchError> {
+pub(crate) fn load(path: &Path) -> Result<Box<HostScene>, BenchError> {
     let mut scene = new_scene();
     load_file(path, &mut scene).map_err(|error| BenchError::Scene { path: path.to_owned(), error })?;
     Ok(scene)

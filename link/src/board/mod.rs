@@ -1,7 +1,9 @@
-//! The board's side of the protocol on an octrace-core [`Raytracer`]: each
+//! The board's side of the protocol on an octrace-core [`Raytracer`]: the
+//! loop a firmware runs ([`Link`], over its [`Line`]: `serve.rs`), each
 //! received frame answered ([`Board::answer`]), and a scene that loaded
 //! handed back as a [`Drawing`] whose rows the firmware renders its own way
-//! (one core, two, a row at a time) and sends as they are drawn.
+//! (one core, two) and sends as they are drawn; the byte rings a firmware
+//! keeps between its serial port and the loop ([`Ring`]: `ring.rs`).
 //!
 //! Invariants: every frame gets exactly one answer — a [`Message::Board`],
 //! a [`Message::Refused`], the scene's [`Message::SceneError`]s closed by a
@@ -9,77 +11,66 @@
 //! closed by [`Drawing::finish`] or [`Drawing::cancel`] — all with the
 //! frame's tag; a scene with errors draws nothing.
 //!
-//! A firmware's loop, on one core (`Rx` and `Usb` stand for its USB serial
-//! class: bytes in, a [`Sink`] out; the rows go to its panel as well):
+//! A firmware's loop, on one core (`Usb` stands for its serial port and
+//! clock as a [`Line`]; the rows go to its panel as well):
 //!
 //! ```
 //! use embedded_graphics_core::pixelcolor::Rgb565;
 //! use octrace_core::profile::{Board16K, Profile};
 //! use octrace_core::{accel::Mailbox, render::Renderer, Raytracer};
-//! use octrace_link::board::Board;
-//! use octrace_link::{Decoder, Message, Panel, PixelFormat, Timing};
+//! use octrace_link::board::{Line, Link, Served};
+//! use octrace_link::{Decoder, Message, Panel, PixelFormat};
 //! # use std::collections::VecDeque;
-//! # struct Rx(VecDeque<u8>);
-//! # impl Rx { fn next(&mut self) -> Option<u8> { self.0.pop_front() } }
+//! # struct Usb { from_host: VecDeque<u8>, to_host: Vec<u8>, clock: u64 }
+//! # impl Line for Usb {
+//! #     fn read(&mut self) -> Option<u8> { self.from_host.pop_front() }
+//! #     fn write(&mut self, bytes: &[u8]) -> usize { self.to_host.extend_from_slice(bytes); bytes.len() }
+//! #     fn discard(&mut self) {}
+//! #     fn now_us(&mut self) -> u64 { self.clock += 1; self.clock }
+//! #     fn sleep(&mut self) -> bool { !self.from_host.is_empty() }
+//! #     fn alive(&mut self) {}
+//! # }
 //! # let mut host = Vec::new();
 //! # Message::Hello.encode(1, &mut host).unwrap();
 //! # Message::Scene { pixels: true, text: b"BACKGROUND 0 0 1\n" }.encode(2, &mut host).unwrap();
-//! # let mut rx = Rx(host.into());
-//! # let mut usb: Vec<u8> = Vec::new();
+//! # let mut usb = Usb { from_host: host.into(), to_host: Vec::new(), clock: 0 };
 //!
-//! let mut buffer = [0u8; 4096]; // a `static` on a board
-//! let mut decoder = Decoder::new(&mut buffer);
 //! let panel = Panel { width: 8, height: 4, format: PixelFormat::Rgb565 };
-//! let board = Board::new(panel, "my-board 0.1.0", &decoder);
-//! let mut raytracer = Raytracer::<Board16K>::new(); // a `static` too
+//! let mut link = Link::new(panel, "my-board 0.1.0", [0u8; 4096]);
+//! let mut raytracer = Raytracer::<Board16K>::new(); // a `static` on a board
 //! let mut mailbox = [0u32; Mailbox::words_for(Board16K::COUNTS.objects)];
 //! let mut row = [Rgb565::default(); 8];
-//! // Whether a frame came while drawing: it is answered next.
-//! let mut pending = false;
-//! loop {
-//!     if !pending {
-//!         // `rx.next()` waits for a byte on a board; here the bytes run out.
-//!         let Some(byte) = rx.next() else { break };
-//!         if decoder.push(byte).is_none() {
-//!             continue;
-//!         }
-//!     }
-//!     pending = false;
-//!     let Some(received) = decoder.received() else { continue };
-//!     let Some(drawing) = board.answer(received, &mut raytracer, &mut usb).unwrap() else { continue };
+//! // On a board, `serve` never returns None: loop for ever.
+//! while let Some(served) = link.serve(&mut usb, &mut raytracer, |drawing, rows| {
 //!     let scene = drawing.scene();
 //!     let accelerator = scene.accelerator();
-//!     let (width, height) = (panel.width as u32, panel.height as u32);
-//!     // `answer` checked the camera at the panel's size.
-//!     let mut renderer = Renderer::with_size(scene.view(), &accelerator, width, height).unwrap();
+//!     // `serve` checked the camera at the panel's size.
+//!     let Ok(mut renderer) = Renderer::with_size(scene.view(), &accelerator, 8, 4) else { return 0 };
 //!     renderer.set_mailbox(&mut mailbox);
-//!     let mut drawn = 0;
-//!     while drawn < height && !pending {
-//!         for (pixel, sample) in row.iter_mut().zip(renderer.row(drawn, 0..width)) {
-//!             *pixel = sample.color.into();
-//!         }
-//!         // ... the row to the panel, then to the host:
-//!         drawing.send_row(drawn as u16, &row, &mut usb).unwrap();
-//!         drawn += 1;
-//!         // Between rows, without waiting: a frame from the host stops the drawing.
-//!         while let (false, Some(byte)) = (pending, rx.next()) {
-//!             pending = decoder.push(byte).is_some();
-//!         }
-//!     }
-//!     match pending {
-//!         true => drawing.cancel(drawn as u16, &mut usb).unwrap(),
-//!         false => drawing.finish(&Timing::NONE, &mut usb).unwrap(),
-//!     }
+//!     // Each row to the panel (here: nowhere) and to the host.
+//!     rows.draw_on_one_core(drawing, &mut renderer, &mut row, |_y, _pixels| {})
+//! }) {
+//!     assert_ne!(served, Served::Stalled);
 //! }
 //! # let mut buffer = vec![0u8; 1024];
 //! # let mut reader = Decoder::new(&mut buffer);
-//! # let kinds: Vec<_> = usb.iter().filter_map(|&b| reader.push(b).map(|r| r.unwrap().message.kind().name())).collect();
+//! # let kinds: Vec<_> = usb.to_host.iter().filter_map(|&b| reader.push(b).map(|r| r.unwrap().message.kind().name())).collect();
 //! # assert_eq!(kinds, ["board", "drawing", "row", "row", "row", "row", "done"]);
 //! ```
 //!
 //! On two cores, each renders its rows with a `Renderer` of its own over
 //! [`Drawing::scene`]'s view and accelerator (see octrace-core's
-//! `interleaved_rows`), and the core that owns the USB sends them in order.
+//! `interleaved_rows`), the other core stopped through a flag that the
+//! line's core sets when [`Rows::poll`] says so, and the core that owns
+//! the line sends the rows in order.
+
+mod ring;
+mod serve;
+
+pub use ring::Ring;
+pub use serve::{
+    Line, Link, Rows, Served, Stalled, MAX_COUNTERS, POLL_PERIOD_US, SLOWEST_HOST_BYTES_PER_SECOND, STALL_GRACE_US,
+};
 
 use crate::cobs::Sink;
 use crate::decoder::{Decoder, Frame};
@@ -119,7 +110,10 @@ impl<'a> Board<'a> {
 
     /// Answers what the decoder `received`: a refusal is sent back, a
     /// hello gets the board's description, a scene is loaded into
-    /// `raytracer` and gets its errors, or a [`Drawing`] to render.
+    /// `raytracer` and gets its errors, or a [`Drawing`] to render. `Err`
+    /// when `sink` failed; a scene that loaded is handed back even when
+    /// its `drawing` message was not taken (the panel still shows it; the
+    /// sink's next writes say whether the host gets the rows).
     pub fn answer<'r, P: Profile, S: Sink + ?Sized>(
         &self,
         received: Result<Frame<'_>, Refusal>,
@@ -188,7 +182,8 @@ impl<'a> Board<'a> {
             send_error(tag, 0, 0, None, &e, sink)?;
             return Message::Rejected { errors: 1 }.encode(tag, sink).map(|()| None);
         }
-        Message::Drawing { panel: self.panel, pixels }.encode(tag, sink)?;
+        // Not taken: the rows are not either (see `answer`).
+        let _ = Message::Drawing { panel: self.panel, pixels }.encode(tag, sink);
         Ok(Some(Drawing { scene, tag, pixels, panel: self.panel }))
     }
 }

@@ -1,8 +1,11 @@
-//! Copying the code `sram-code.x` places in SRAM (all of it and its
-//! constants, or the render path with or without the parser, as
-//! `OCTRACE_CODE_IN` says) from flash before anything else runs: a firmware
-//! whose linker script places code there says
-//! `octrace_pico_st7789::copy_code_into_sram!();` once.
+//! What runs before `main`, the same for every Pico firmware linked with
+//! `octrace-pico-build`'s `link`, which says `octrace_pico::boot!();` once:
+//! boot2, the second-stage loader for the Pico's W25Q16JV flash
+//! (`rp2040-boot2`'s W25Q080 loader), in the first 256 bytes of flash
+//! where the boot ROM runs it; and the copy of the code `sram-code.x`
+//! places in SRAM (all of it and its constants, or the render path with or
+//! without the parser, as `OCTRACE_CODE_IN` says; an empty copy for code
+//! left in flash) from flash before anything else runs.
 //!
 //! Invariants: `__pre_init` is the first code cortex-m-rt's reset handler
 //! calls, before `.bss` and `.data` are set up, so it touches no RAM but
@@ -12,12 +15,21 @@
 //! macro, expanded in the firmware itself, because only a firmware whose
 //! linker script defines the copy's bounds may hold it.
 
-/// Defines `__pre_init`, which cortex-m-rt's reset handler calls first: it
-/// copies the code `sram-code.x` places in SRAM from its load address in
-/// flash, a word at a time.
+/// boot2, the second-stage loader the boot ROM runs (`memory.x` keeps it at
+/// the start of flash).
+#[doc(hidden)]
+pub use rp2040_boot2::BOOT_LOADER_W25Q080 as BOOT2;
+
+/// Defines the firmware's boot2 (`.boot2`) and `__pre_init`, which
+/// cortex-m-rt's reset handler calls first: it copies the code `sram-code.x`
+/// places in SRAM from its load address in flash, a word at a time.
 #[macro_export]
-macro_rules! copy_code_into_sram {
+macro_rules! boot {
     () => {
+        #[link_section = ".boot2"]
+        #[used]
+        static BOOT2: [u8; 256] = $crate::boot::BOOT2;
+
         core::arch::global_asm!(
             ".section .flash_code.__pre_init, \"ax\"",
             ".global __pre_init",

@@ -1,0 +1,334 @@
+//! Where a ray segment meets a moving object: exact integer tests of a
+//! segment against boxes, and the search for the first frame of the loop at
+//! which a track's box meets a segment.
+//!
+//! Conservative by construction: coordinates are cut to a coarse grid of
+//! 2^[`GRID_BITS`] raw units with the segment's ends rounded to nearest and
+//! the box rounded outward and widened by a whole cell (more than the
+//! rounding of the ends moves any point of the segment), after a widening
+//! of [`WIDENING`] raw units, more than a hit point strays from its object
+//! plus a shadow ray from its segment (the octree's and the light buffer's
+//! bounds). So "no meeting" means no ray along the segment can meet
+//! anything in the box. On the grid every coordinate is below 2^14 in
+//! magnitude, so the slab test's products fit an `i32`.
+
+/// log2 of the grid's cell, in raw Q16.16 units (4 normalised units: the
+/// scene's range is 2^13 of them each way).
+pub(crate) const GRID_BITS: u32 = 18;
+/// How far beyond its bounds an object may be met: the octree's filing
+/// margin and a shadow ray's straying (the light buffer's margin), and a
+/// unit of the end points' own rounding.
+pub(crate) const WIDENING: i32 = (crate::accel::FILING_MARGIN + crate::accel::RAY_SLACK) as i32 + 2;
+
+/// A segment from `p` to `q` on the grid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Segment {
+    p: [i32; 3],
+    q: [i32; 3],
+    /// The segment's own box on the grid, for a quick rejection.
+    lo: [i32; 3],
+    hi: [i32; 3],
+}
+
+/// A raw coordinate on the grid, rounded to nearest. Raw coordinates are
+/// within 2^32 in magnitude (points in the scene's range, or a miss's far
+/// end 2^31 beyond), so cells are within 2^14.
+#[inline]
+fn cell(v: i64) -> i32 {
+    ((v + (1 << (GRID_BITS - 1))) >> GRID_BITS) as i32
+}
+
+impl Segment {
+    /// The segment between raw points `p` and `q`.
+    pub(crate) fn new(p: [i64; 3], q: [i64; 3]) -> Segment {
+        let (p, q) = (p.map(cell), q.map(cell));
+        let lo = [0, 1, 2].map(|a| p[a].min(q[a]));
+        let hi = [0, 1, 2].map(|a| p[a].max(q[a]));
+        Segment { p, q, lo, hi }
+    }
+
+    /// Whether the segment comes near the raw sphere of centre `center` and
+    /// radius `radius`: on the grid, the radius widened and rounded up,
+    /// then by two cells (more than the rounding of the centre and of the
+    /// segment's ends moves them apart).
+    pub(crate) fn near_sphere(&self, center: [i32; 3], radius: i32) -> bool {
+        let c = center.map(|v| cell(i64::from(v)));
+        let r = i64::from((radius.saturating_add(WIDENING) >> GRID_BITS) + 3);
+        if (0..3).any(|a| i64::from(self.hi[a]) < i64::from(c[a]) - r || i64::from(self.lo[a]) > i64::from(c[a]) + r) {
+            return false;
+        }
+        // Cells are below 2^14: squares and their products fit an i64.
+        let d = [0, 1, 2].map(|a| i64::from(self.q[a] - self.p[a]));
+        let w = [0, 1, 2].map(|a| i64::from(c[a] - self.p[a]));
+        let dot = |u: [i64; 3], v: [i64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+        let (dd, wd, ww) = (dot(d, d), dot(w, d), dot(w, w));
+        if wd <= 0 || dd == 0 {
+            return ww <= r * r;
+        }
+        if wd >= dd {
+            let e = [0, 1, 2].map(|a| w[a] - d[a]);
+            return dot(e, e) <= r * r;
+        }
+        // The distance to the line, squared, times |d|²: |w|²·|d|² − (w·d)².
+        ww * dd - wd * wd <= r * r * dd
+    }
+
+    /// Whether the segment surely passes through the raw sphere of centre
+    /// `center` and radius `radius`, well inside it, with both its ends well
+    /// outside: a shadow ray along it is surely blocked by the sphere. On
+    /// the grid, the radius narrowed by four widenings and four cells for
+    /// the line, and widened likewise for the ends: any ray the tracer
+    /// sends along the segment meets the sphere between its ends.
+    pub(crate) fn through_sphere(&self, center: [i32; 3], radius: i32) -> bool {
+        let c = center.map(|v| cell(i64::from(v)));
+        let inner = i64::from((radius.saturating_sub(4 * WIDENING) >> GRID_BITS) - 4);
+        let outer = i64::from((radius.saturating_add(4 * WIDENING) >> GRID_BITS) + 5);
+        if inner <= 0 {
+            return false;
+        }
+        let d = [0, 1, 2].map(|a| i64::from(self.q[a] - self.p[a]));
+        let w = [0, 1, 2].map(|a| i64::from(c[a] - self.p[a]));
+        let e = [0, 1, 2].map(|a| w[a] - d[a]);
+        let dot = |u: [i64; 3], v: [i64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+        let (dd, wd, ww) = (dot(d, d), dot(w, d), dot(w, w));
+        ww > outer * outer && dot(e, e) > outer * outer && wd > 0 && wd < dd && ww * dd - wd * wd <= inner * inner * dd
+    }
+
+    /// Whether the segment comes near the raw box `[lo, hi]`: on the grid,
+    /// the box widened and rounded outward, then by a whole cell.
+    pub(crate) fn meets(&self, lo: [i32; 3], hi: [i32; 3]) -> bool {
+        let lo = lo.map(|v| ((v.saturating_sub(WIDENING)) >> GRID_BITS) - 1);
+        let hi = hi.map(|v| ((v.saturating_add(WIDENING)) >> GRID_BITS) + 2);
+        if (0..3).any(|a| self.hi[a] < lo[a] || self.lo[a] > hi[a]) {
+            return false;
+        }
+        // The parameters where the segment is within each slab, as
+        // fractions num/den with den > 0: it enters at the largest start
+        // and leaves at the smallest end.
+        let (mut enter, mut enter_den, mut leave, mut leave_den) = (0i32, 1i32, 1i32, 1i32);
+        for a in 0..3 {
+            let d = self.q[a] - self.p[a];
+            if d == 0 {
+                // Within the slab on this axis (the box test above).
+                continue;
+            }
+            let (from, to) = (lo[a] - self.p[a], hi[a] - self.p[a]);
+            let (start, end, den) = if d > 0 { (from, to, d) } else { (-to, -from, -d) };
+            if start * enter_den > enter * den {
+                (enter, enter_den) = (start, den);
+            }
+            if end * leave_den < leave * den {
+                (leave, leave_den) = (end, den);
+            }
+            if enter * leave_den > leave * enter_den {
+                return false;
+            }
+        }
+        true
+    }
+}
+
+/// A key of a track: storage for [`Motion::read`](super::Motion::read).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Key {
+    pub(super) frame: u32,
+    /// Whether the displacement differs from the key before (the first
+    /// key: from the last).
+    pub(super) changes: bool,
+}
+
+impl Key {
+    pub(crate) fn new(frame: u32, changes: bool) -> Key {
+        Key { frame, changes }
+    }
+
+    /// The key's frame.
+    pub(crate) fn frame(&self) -> u32 {
+        self.frame
+    }
+}
+
+/// The spans of frames where a track's displacement is monotone, each
+/// from one boundary to the next: frame 0, each key's frame, the last
+/// frame of the `n`.
+fn spans(keys: &[Key], n: u32) -> impl Iterator<Item = (u32, u32)> + '_ {
+    let bounds = move || core::iter::once(0).chain(keys.iter().map(|k| k.frame())).chain(core::iter::once(n - 1));
+    bounds().zip(bounds().skip(1)).filter(|(a, b)| a <= b)
+}
+
+/// A track's objects through the loop: their box at frame 0 (a sphere's
+/// is its centre ± its radius, and then its own test is used at each
+/// frame), the box holding them in every frame, their displacement at each
+/// frame (from frame 0) and the keys that cut the loop into monotone spans.
+pub(crate) struct Sweep<'m> {
+    pub first: [[i32; 3]; 2],
+    pub sphere: bool,
+    pub swept: [[i32; 3]; 2],
+    pub table: &'m [[i32; 3]],
+    pub keys: &'m [Key],
+}
+
+impl Sweep<'_> {
+    /// Whether `segment` comes near the objects in some frame.
+    pub(crate) fn ever_meets(&self, segment: &Segment) -> bool {
+        segment.meets(self.swept[0], self.swept[1])
+    }
+
+    /// A sphere's centre at frame `frame` and its radius, if the track is
+    /// one.
+    fn sphere_at(&self, frame: u32) -> Option<([i32; 3], i32)> {
+        let d = self.table.get(frame as usize).filter(|_| self.sphere)?;
+        let [lo, hi] = self.first;
+        // The box is the centre ± the radius, exactly.
+        let center = [0, 1, 2].map(|a| (lo[a] / 2 + hi[a] / 2 + (lo[a] % 2 + hi[a] % 2) / 2).saturating_add(d[a]));
+        Some((center, hi[0] / 2 - lo[0] / 2 + 1))
+    }
+
+    /// Whether `segment` comes near the objects at frame `frame`.
+    pub(crate) fn meets_at(&self, segment: &Segment, frame: u32) -> bool {
+        match self.sphere_at(frame) {
+            Some((center, radius)) => segment.near_sphere(center, radius),
+            None => self.meets_between(segment, frame, frame),
+        }
+    }
+
+    /// Whether the objects (a sphere) surely block a shadow ray along
+    /// `segment` at frame `frame`.
+    pub(crate) fn blocks_at(&self, segment: &Segment, frame: u32) -> bool {
+        self.sphere_at(frame).is_some_and(|(center, radius)| segment.through_sphere(center, radius))
+    }
+
+    /// The smallest `e` in `1..=limit` such that the objects do not surely
+    /// block `segment` at frame `frame + e` of the loop, if any.
+    pub(crate) fn first_unblocked(&self, segment: &Segment, frame: u32, limit: u32) -> Option<u32> {
+        let n = self.table.len() as u32;
+        (1..=limit.min(n.saturating_sub(1))).find(|&e| !self.blocks_at(segment, (frame + e) % n))
+    }
+
+    /// Whether `segment` comes near the objects in some frame of `a..=b`,
+    /// frames within one monotone span.
+    fn meets_between(&self, segment: &Segment, a: u32, b: u32) -> bool {
+        let (Some(da), Some(db)) = (self.table.get(a as usize), self.table.get(b as usize)) else { return true };
+        let [lo, hi] = self.first;
+        let lo = [0, 1, 2].map(|i| lo[i].saturating_add(da[i].min(db[i])));
+        let hi = [0, 1, 2].map(|i| hi[i].saturating_add(da[i].max(db[i])));
+        segment.meets(lo, hi)
+    }
+
+    /// The smallest `e` in `1..=limit` such that `segment` comes near the
+    /// objects at frame `frame + e` of the loop (after the last frame,
+    /// frame 0 again), if any.
+    pub(crate) fn first_meeting(&self, segment: &Segment, frame: u32, limit: u32) -> Option<u32> {
+        let n = self.table.len() as u32;
+        let limit = limit.min(n.saturating_sub(1));
+        if limit == 0 {
+            return None;
+        }
+        // The frames after `frame` up to the last, then from frame 0.
+        let end = frame.saturating_add(limit);
+        if frame + 1 < n {
+            if let Some(g) = self.first_within(segment, frame + 1, end.min(n - 1)) {
+                return Some(g - frame);
+            }
+        }
+        if end >= n {
+            return self.first_within(segment, 0, end - n).map(|g| g + n - frame);
+        }
+        None
+    }
+
+    /// The first frame of `lo..=hi` at which `segment` comes near the
+    /// objects.
+    fn first_within(&self, segment: &Segment, lo: u32, hi: u32) -> Option<u32> {
+        let n = self.table.len() as u32;
+        for (a, b) in spans(self.keys, n) {
+            let (a, b) = (a.max(lo), b.min(hi));
+            if a > b {
+                continue;
+            }
+            if let Some(g) = self.bisect(segment, a, b) {
+                return Some(g);
+            }
+        }
+        None
+    }
+
+    /// The first frame of `a..=b` (within one span) at which `segment`
+    /// comes near the objects: halves tested by their sweep, left first.
+    fn bisect(&self, segment: &Segment, a: u32, b: u32) -> Option<u32> {
+        // Each step pops one range and pushes two, halving: 2 · 32 levels.
+        let mut stack: heapless::Vec<(u32, u32), 64> = heapless::Vec::new();
+        let _ = stack.push((a, b));
+        while let Some((a, b)) = stack.pop() {
+            if !self.meets_between(segment, a, b) {
+                continue;
+            }
+            if a == b {
+                if self.meets_at(segment, a) {
+                    return Some(a);
+                }
+                continue;
+            }
+            let mid = a + (b - a) / 2;
+            // Room for both: the stack holds at most one range a level.
+            let _ = stack.push((mid + 1, b));
+            let _ = stack.push((a, mid));
+        }
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CELL: i64 = 1 << GRID_BITS;
+
+    fn box_at(c: [i64; 3], half: i64) -> ([i32; 3], [i32; 3]) {
+        (c.map(|v| (v - half) as i32), c.map(|v| (v + half) as i32))
+    }
+
+    #[test]
+    fn a_segment_meets_what_lies_on_it_and_misses_what_is_far() {
+        let s = Segment::new([0, 0, 0], [100 * CELL, 0, 0]);
+        let (lo, hi) = box_at([50 * CELL, 0, 0], CELL);
+        assert!(s.meets(lo, hi));
+        let (lo, hi) = box_at([50 * CELL, 20 * CELL, 0], CELL);
+        assert!(!s.meets(lo, hi));
+        // Beyond its end.
+        let (lo, hi) = box_at([110 * CELL, 0, 0], CELL);
+        assert!(!s.meets(lo, hi));
+        // A diagonal passing a box's corner at a distance.
+        let d = Segment::new([0, 0, 0], [100 * CELL, 100 * CELL, 0]);
+        assert!(d.meets(box_at([50 * CELL, 50 * CELL, 0], CELL).0, box_at([50 * CELL, 50 * CELL, 0], CELL).1));
+        assert!(!d.meets(box_at([50 * CELL, 60 * CELL, 0], CELL).0, box_at([50 * CELL, 60 * CELL, 0], CELL).1));
+    }
+
+    #[test]
+    fn near_misses_within_the_widening_count_as_meetings() {
+        // The box's edge WIDENING − 1 raw units from the segment, off the
+        // grid: rounding must not lose it.
+        let mut next = crate::test_rng::seeded(0x5e9_1e57);
+        for _ in 0..20_000 {
+            let mut r = || (next() as i64 >> 36) % (1 << 29);
+            let p = [r(), r(), r()];
+            let q = [r(), r(), r()];
+            let t = (next() % 1024) as i64;
+            let on = [0, 1, 2].map(|a| p[a] + (q[a] - p[a]) * t / 1024);
+            let gap = WIDENING as i64 - 1;
+            let lo = on.map(|v| (v + gap) as i32);
+            let hi = on.map(|v| (v + gap + 5) as i32);
+            assert!(Segment::new(p, q).meets(lo, hi), "{p:?} {q:?} {on:?}");
+        }
+    }
+
+    #[test]
+    fn the_extremes_fit_the_products() {
+        // A miss's far end beyond the range and a box at the other side.
+        let far = (1i64 << 29) + (1 << 31);
+        let s = Segment::new([-(1 << 29); 3], [far, far, -far]);
+        assert!(!s.meets([1 << 29; 3], [(1 << 29) + 5; 3]));
+        let s = Segment::new([-(1 << 29); 3], [far; 3]);
+        assert!(s.meets([1 << 28; 3], [(1 << 28) + 5; 3]));
+    }
+}

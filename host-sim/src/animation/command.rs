@@ -1,0 +1,285 @@
+//! `host-sim anim.txt OUT` for a scene with FRAMES, and `host-sim merge`
+//! of frame files: the command line's animation side.
+//!
+//! Invariants: nothing is left behind by a run that fails (the GIF or APNG
+//! through a temporary file, frame files each through one, renamed only
+//! once every frame is written); a scene error at any frame is reported as
+//! `file:line:col` with exit code 2, as for a still.
+
+use super::writers::{write_frame_file, ApngWriter, FrameInfo, GifWriter};
+use super::{render_frames, AnimationError, AnimationOptions, AnimationReport, FrameImage, Output};
+use crate::exit::CliError;
+use crate::output::write_atomically;
+use crate::parts::{auto_index, band_rows, scene_hash, PartSpec};
+use crate::terminal::progress_bar;
+use octrace_core::scene::Frames;
+use octrace_images::formats::{Format, FormatError, Image, RowReader};
+use octrace_images::palette::{self, PaletteMode};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// What the command line asks of an animation.
+pub struct Request<'a> {
+    pub scene_path: &'a Path,
+    pub bytes: &'a [u8],
+    pub frames: Frames,
+    pub out: &'a Path,
+    /// `--palette`, if given.
+    pub palette: Option<PaletteMode>,
+    pub format: Option<Format>,
+    pub part: Option<PartSpec>,
+    /// The frames' size.
+    pub size: (u32, u32),
+    pub options: AnimationOptions,
+    pub quiet: bool,
+}
+
+/// Renders the animation `request` asks for and writes it.
+pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliError> {
+    let output = Output::of(request.out).map_err(CliError::Invalid)?;
+    let frames = request.frames;
+    let palette = match (&output, request.palette) {
+        (Output::Gif, None) => PaletteMode::Scan,
+        (Output::Gif, Some(PaletteMode::None)) => {
+            return Err(CliError::Invalid(
+                "a GIF holds 256 colours a frame: give --palette scan, dither, coarse or gray (scan by default)".into(),
+            ))
+        }
+        (_, mode) => mode.unwrap_or(PaletteMode::None),
+    };
+    let range = match (request.part, &output) {
+        (None, _) => frames.all(),
+        (Some(spec), Output::Files(_)) => {
+            if spec.count > frames.count {
+                return Err(CliError::Invalid(format!(
+                    "--part: {} parts of an animation of {} frames: at most {}",
+                    spec.count, frames.count, frames.count
+                )));
+            }
+            let index = match spec.index {
+                Some(i) => i,
+                None => auto_index(spec.count, |name| std::env::var(name).ok())
+                    .map_err(|e| CliError::Invalid(format!("--part: {e}")))?,
+            };
+            band_rows(frames.count, index, spec.count)
+        }
+        (Some(_), _) => {
+            return Err(CliError::Invalid(
+                "--part splits an animation's frames: write them one file a frame ('frames/f%04d.png'), then \
+                 `host-sim merge out.gif frames/f*.png`"
+                    .into(),
+            ))
+        }
+    };
+    let (width, height) = request.size;
+    let started = Instant::now();
+    let bar = progress_bar(u64::from(range.len() as u32), request.quiet);
+    let progress = |_: u64| {};
+    let name = request.scene_path.display().to_string();
+    let scene_error = |e: AnimationError| match e {
+        AnimationError::Scene { frame, errors } => CliError::Scene {
+            file: format!("{name} (frame {frame})"),
+            errors: errors.into_iter().map(|e| format!("{name}:{e}")).collect(),
+        },
+        AnimationError::Setup(message) => CliError::Invalid(message),
+        AnimationError::Write(e) => CliError::write(request.out, e),
+    };
+    let mut outcome: Option<Result<AnimationReport, AnimationError>> = None;
+    let mut render = |each: &mut dyn FnMut(u32, &FrameImage) -> std::io::Result<()>| {
+        let mut counted = |frame: u32, image: &FrameImage| {
+            if let Some(bar) = &bar {
+                bar.inc(1);
+            }
+            each(frame, image)
+        };
+        let result = render_frames(request.bytes, frames, range.clone(), &request.options, &progress, &mut counted);
+        let failed = result.is_err();
+        outcome = Some(result);
+        match failed {
+            true => Err(std::io::Error::other("no animation")),
+            false => Ok(()),
+        }
+    };
+    let info = |frame: u32, width: u32, height: u32| FrameInfo {
+        version: env!("CARGO_PKG_VERSION").into(),
+        scene: scene_hash(request.bytes),
+        width,
+        height,
+        palette,
+        frame,
+        frames,
+    };
+    let written = match &output {
+        Output::Gif => write_atomically(request.out, |f| {
+            let mut gif = GifWriter::new(f, width, height, frames)?;
+            render(&mut |_, frame| gif.frame(&palette::apply(&frame.image, &frame.objects, palette)))?;
+            gif.finish().map(|_| ())
+        }),
+        Output::Apng => write_atomically(request.out, |f| {
+            let mut apng = ApngWriter::new(f, width, height, range.len() as u32, frames)?;
+            render(&mut |_, frame| apng.frame(&palette::apply(&frame.image, &frame.objects, palette)))?;
+            apng.finish()
+        }),
+        Output::Files(pattern) => {
+            let format = crate::arguments::output_format(request.format, &pattern.name(0))?;
+            if format == Format::Ras {
+                return Err(CliError::Invalid(
+                    "frame files are PNG or Targa (a Sun raster has no room for the frame's metadata)".into(),
+                ));
+            }
+            let mut done: Vec<(PathBuf, PathBuf)> = Vec::new();
+            let result = render(&mut |k, frame| {
+                let path = pattern.name(k);
+                let shown = palette::apply(&frame.image, &frame.objects, palette);
+                let tmp = temporary(&path);
+                let write = || -> std::io::Result<()> {
+                    let mut file = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
+                    let info = info(k, frame.image.width, frame.image.height);
+                    write_frame_file(&shown, &info, format, &mut file).map_err(into_io)?;
+                    file.into_inner().map_err(|e| e.into_error())?.sync_all()
+                };
+                let result = write();
+                done.push((tmp, path));
+                result
+            });
+            let mut renamed_paths = Vec::new();
+            let renamed = result.and_then(|()| {
+                done.iter().try_for_each(|(tmp, path)| {
+                    std::fs::rename(tmp, path)?;
+                    renamed_paths.push(path);
+                    Ok(())
+                })
+            });
+            if renamed.is_err() {
+                // A failed run leaves no frame: neither those written nor
+                // those already renamed.
+                done.iter().for_each(|(tmp, _)| drop(std::fs::remove_file(tmp)));
+                renamed_paths.iter().for_each(|path| drop(std::fs::remove_file(path)));
+            }
+            renamed
+        }
+    };
+    if let Some(bar) = &bar {
+        bar.finish_and_clear();
+    }
+    let report = match (outcome, written) {
+        (Some(Err(e)), _) => return Err(scene_error(e)),
+        (_, Err(e)) => return Err(CliError::write(request.out, e)),
+        (Some(Ok(report)), Ok(())) => report,
+        (None, Ok(())) => return Err(CliError::write(request.out, "no frame was rendered")),
+    };
+    if !request.quiet {
+        let share = 100.0 * report.traced as f64 / report.pixels.max(1) as f64;
+        let _ = writeln!(
+            stderr,
+            "{} frames of {} ({} a second) in {:.3} s ({} threads, {}): {:.1} % of the pixels traced, \
+             loading {:.3} s, tracing {:.3} s: {} rays, {} shadow rays -> {}",
+            report.frames,
+            frames.count,
+            frames.rate,
+            started.elapsed().as_secs_f64(),
+            request.options.render.threads,
+            if request.options.coherence { "coherence" } else { "every frame whole" },
+            share,
+            report.loading.as_secs_f64(),
+            report.tracing.as_secs_f64(),
+            report.stats.rays,
+            report.stats.shadow_rays,
+            request.out.display()
+        );
+    }
+    Ok(())
+}
+
+/// A temporary name beside `path`.
+fn temporary(path: &Path) -> PathBuf {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = path.file_name().map_or_else(|| "frame".into(), |n| n.to_string_lossy().into_owned());
+    dir.join(format!(".{name}.{}.tmp", std::process::id()))
+}
+
+fn into_io(e: FormatError) -> std::io::Error {
+    match e {
+        FormatError::Io(e) => e,
+        e => std::io::Error::other(e),
+    }
+}
+
+/// Whether `path` is a frame file (its metadata says so).
+pub fn is_frame_file(path: &Path) -> bool {
+    let Ok(file) = std::fs::File::open(path) else { return false };
+    RowReader::new(file).is_ok_and(|r| r.header().text.as_deref().and_then(FrameInfo::parse).is_some())
+}
+
+/// `host-sim merge OUT FRAMES…`: frame files rendered apart, assembled into
+/// the animation `output` names, bit for bit what a render straight to it
+/// writes.
+pub fn merge_frames(output: &Path, files: &[PathBuf]) -> Result<(), CliError> {
+    let refuse = |message: String| CliError::Invalid(format!("merge: {message}; nothing written"));
+    let kind = Output::of(output).map_err(refuse)?;
+    let mut found: Vec<(FrameInfo, Image)> = Vec::new();
+    for path in files {
+        let name = path.display();
+        let file = std::fs::File::open(path).map_err(|e| CliError::read(path, e))?;
+        let mut reader = RowReader::new(file).map_err(|e| refuse(format!("{name}: {e}")))?;
+        let header = reader.header().clone();
+        let info = header
+            .text
+            .as_deref()
+            .and_then(FrameInfo::parse)
+            .ok_or_else(|| refuse(format!("{name}: not a frame file (no octrace frame metadata in it)")))?;
+        if (header.width, header.height) != (info.width, info.height)
+            || header.palette.is_some() != (info.palette != PaletteMode::None)
+        {
+            return Err(refuse(format!("{name}: the image does not match its metadata")));
+        }
+        let mut data = Vec::new();
+        for _ in 0..header.height {
+            data.extend_from_slice(reader.next_row().map_err(|e| refuse(format!("{name}: {e}")))?);
+        }
+        let image = match header.palette {
+            Some(palette) => Image::Indexed { width: header.width, height: header.height, palette, indices: data },
+            None => Image::Rgb(crate::RgbImage { width: header.width, height: header.height, data }),
+        };
+        if let Some((first, _)) = found.first() {
+            let same = (first.version.as_str(), first.scene, first.width, first.height, first.palette, first.frames)
+                == (info.version.as_str(), info.scene, info.width, info.height, info.palette, info.frames);
+            if !same {
+                return Err(refuse(format!(
+                    "{name} is not a frame of the animation of {} (another scene, size, palette, FRAMES or \
+                     host-sim version)",
+                    files[0].display()
+                )));
+            }
+        }
+        found.push((info, image));
+    }
+    found.sort_by_key(|(info, _)| info.frame);
+    let Some((first, _)) = found.first() else { return Err(refuse("no frames to merge".into())) };
+    let (frames, (width, height)) = (first.frames, (first.width, first.height));
+    for (i, (info, _)) in found.iter().enumerate() {
+        if info.frame != i as u32 {
+            let what = if i > 0 && found[i - 1].0.frame == info.frame { "twice" } else { "missing" };
+            let frame = if what == "twice" { info.frame } else { i as u32 };
+            return Err(refuse(format!("frame {frame} is {what}")));
+        }
+    }
+    if found.len() as u32 != frames.count {
+        return Err(refuse(format!("frames {} to {} are missing", found.len(), frames.count - 1)));
+    }
+    let written = match kind {
+        Output::Gif => write_atomically(output, |f| {
+            let mut gif = GifWriter::new(f, width, height, frames)?;
+            found.iter().try_for_each(|(_, image)| gif.frame(image))?;
+            gif.finish().map(|_| ())
+        }),
+        Output::Apng => write_atomically(output, |f| {
+            let mut apng = ApngWriter::new(f, width, height, frames.count, frames)?;
+            found.iter().try_for_each(|(_, image)| apng.frame(image))?;
+            apng.finish()
+        }),
+        Output::Files(_) => return Err(refuse("merge writes one animation (.gif or .png)".into())),
+    };
+    written.map_err(|e| CliError::Io(format!("merge: cannot write {}: {e}", output.display())))
+}

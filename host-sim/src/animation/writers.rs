@@ -1,0 +1,297 @@
+//! An animation's frames into files: an animated GIF (256 colours a frame
+//! from a palette mode, each frame with its own table), an APNG
+//! (truecolour) or one image file a frame named by
+//! a pattern (`f%04d.png`), each frame file carrying what `host-sim merge`
+//! needs to assemble frames rendered apart.
+//!
+//! Invariants: the frame files of a render and the animation made of them
+//! by `merge` hold the very pixels (and indices) a direct render to the
+//! animation writes; the GIF and APNG loop forever.
+
+use crate::parts::{Fields, Render};
+use octrace_core::scene::Frames;
+use octrace_images::formats::{Format, FormatError, Header, Image, RowWriter};
+use octrace_images::palette::PaletteMode;
+use std::fmt;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Where an animation goes, told from the output path.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Output {
+    /// `out.gif`.
+    Gif,
+    /// `out.png`: an animated PNG.
+    Apng,
+    /// One file a frame, `frames/f%04d.png` (PNG, Targa or Sun raster).
+    Files(FramePattern),
+}
+
+impl Output {
+    /// The output `path` names, or why it names none.
+    pub fn of(path: &Path) -> Result<Output, String> {
+        let text = path.to_string_lossy();
+        if text.contains('%') {
+            return FramePattern::parse(&text).map(Output::Files);
+        }
+        match path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).as_deref() {
+            Some("gif") => Ok(Output::Gif),
+            Some("png") => Ok(Output::Apng),
+            _ => Err(format!(
+                "{text}: an animation is written as an animated GIF (.gif), an APNG (.png) or one file a frame \
+                 (a name with %d, such as 'frames/f%04d.png'); --frame K renders one frame as a still image"
+            )),
+        }
+    }
+}
+
+/// A file name with one frame number in it: `%d`, or `%0Nd` for N digits
+/// (`%%` is a `%`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FramePattern {
+    before: String,
+    width: usize,
+    after: String,
+}
+
+impl FramePattern {
+    /// The pattern `text`, or why it is none.
+    pub fn parse(text: &str) -> Result<FramePattern, String> {
+        let refuse = || format!("{text}: a frame pattern holds one %d or %0Nd (and %% for a %)");
+        let (mut before, mut rest, mut found) = (String::new(), text, None);
+        while let Some(at) = rest.find('%') {
+            before.push_str(&rest[..at]);
+            let spec = &rest[at + 1..];
+            if let Some(after) = spec.strip_prefix('%') {
+                before.push('%');
+                rest = after;
+                continue;
+            }
+            let digits: String = spec.chars().take_while(|c| c.is_ascii_digit()).collect();
+            let after = spec[digits.len()..].strip_prefix('d').ok_or_else(refuse)?;
+            if found.is_some() || (!digits.is_empty() && !digits.starts_with('0')) {
+                return Err(refuse());
+            }
+            let width = if digits.is_empty() { 0 } else { digits.parse().map_err(|_| refuse())? };
+            found = Some((std::mem::take(&mut before), width));
+            rest = after;
+        }
+        before.push_str(rest);
+        let (head, width) = found.ok_or_else(refuse)?;
+        Ok(FramePattern { before: head, width, after: before })
+    }
+
+    /// The file name of frame `frame`.
+    pub fn name(&self, frame: u32) -> PathBuf {
+        PathBuf::from(format!("{}{:0width$}{}", self.before, frame, self.after, width = self.width))
+    }
+}
+
+/// What a frame file says about itself, for `host-sim merge`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FrameInfo {
+    /// The host-sim version that rendered it.
+    pub version: String,
+    /// The scene's hash ([`crate::parts::scene_hash`]).
+    pub scene: u64,
+    pub width: u32,
+    pub height: u32,
+    pub palette: PaletteMode,
+    /// Frame `frame` of the animation's `frames`.
+    pub frame: u32,
+    pub frames: Frames,
+}
+
+const MAGIC: &str = "octrace-frame 1";
+
+impl fmt::Display for FrameInfo {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{MAGIC} version={} scene={:016x} size={}x{} palette={} frame={}/{} rate={}",
+            self.version,
+            self.scene,
+            self.width,
+            self.height,
+            self.palette.name(),
+            self.frame,
+            self.frames.count,
+            self.frames.rate
+        )
+    }
+}
+
+impl FrameInfo {
+    /// The text `Display` writes, read back; `None` for anything else.
+    pub fn parse(text: &str) -> Option<FrameInfo> {
+        let mut fields = Fields::after(text, MAGIC)?;
+        let Render { version, scene, width, height, palette } = fields.render()?;
+        let (frame, count) = fields.next("frame")?.split_once('/')?;
+        let rate = fields.next("rate")?.parse().ok()?;
+        let info = FrameInfo {
+            version,
+            scene,
+            width,
+            height,
+            palette,
+            frame: frame.parse().ok()?,
+            frames: Frames { count: count.parse().ok()?, rate },
+        };
+        let valid = info.frame < info.frames.count && info.width > 0 && info.height > 0;
+        (fields.end() && valid).then_some(info)
+    }
+}
+
+/// GIF's delay a frame, in hundredths of a second: the nearest to the
+/// rate's (GIF cannot say 1/24 s; 24 frames a second show as 25).
+pub fn gif_delay(frames: Frames) -> u16 {
+    ((200 + frames.rate) / (2 * frames.rate)).clamp(1, u16::MAX as u32) as u16
+}
+
+/// An animated GIF being written, a frame at a time, each with its own
+/// colour table (`scan` learns one a frame).
+pub struct GifWriter<W: Write> {
+    encoder: gif::Encoder<W>,
+    delay: u16,
+}
+
+fn gif_error(e: gif::EncodingError) -> std::io::Error {
+    match e {
+        gif::EncodingError::Io(e) => e,
+        e => std::io::Error::other(e),
+    }
+}
+
+impl<W: Write> GifWriter<W> {
+    /// A GIF of `width` × `height` frames at `frames`' rate, looping
+    /// forever.
+    pub fn new(out: W, width: u32, height: u32, frames: Frames) -> std::io::Result<GifWriter<W>> {
+        let (Ok(w), Ok(h)) = (u16::try_from(width), u16::try_from(height)) else {
+            return Err(std::io::Error::other("a GIF is at most 65535 pixels a side"));
+        };
+        let mut encoder = gif::Encoder::new(out, w, h, &[]).map_err(gif_error)?;
+        encoder.set_repeat(gif::Repeat::Infinite).map_err(gif_error)?;
+        Ok(GifWriter { encoder, delay: gif_delay(frames) })
+    }
+
+    /// Appends `frame`, an indexed image.
+    pub fn frame(&mut self, frame: &Image) -> std::io::Result<()> {
+        let Image::Indexed { width, height, indices, .. } = frame else {
+            return Err(std::io::Error::other("a GIF frame has a colour table: render it with --palette"));
+        };
+        let gif_frame = gif::Frame {
+            delay: self.delay,
+            width: *width as u16,
+            height: *height as u16,
+            palette: Some(table(frame)),
+            buffer: std::borrow::Cow::Borrowed(indices),
+            ..gif::Frame::default()
+        };
+        self.encoder.write_frame(&gif_frame).map_err(gif_error)
+    }
+
+    /// Ends the file.
+    pub fn finish(self) -> std::io::Result<W> {
+        self.encoder.into_inner().map_err(gif_error)
+    }
+}
+
+/// An indexed image's colour table as GIF bytes (RGB triples).
+fn table(image: &Image) -> Vec<u8> {
+    match image {
+        Image::Indexed { palette, .. } => palette.iter().flatten().copied().collect(),
+        Image::Rgb(_) => Vec::new(),
+    }
+}
+
+/// An APNG being written, a truecolour frame at a time.
+pub struct ApngWriter<'w, W: Write> {
+    writer: png::Writer<&'w mut W>,
+}
+
+fn png_error(e: png::EncodingError) -> std::io::Error {
+    match e {
+        png::EncodingError::IoError(e) => e,
+        e => std::io::Error::other(e),
+    }
+}
+
+impl<'w, W: Write> ApngWriter<'w, W> {
+    /// An APNG of `count` frames of `width` × `height` at `frames`' rate,
+    /// looping forever.
+    pub fn new(out: &'w mut W, width: u32, height: u32, count: u32, frames: Frames) -> std::io::Result<Self> {
+        let mut encoder = png::Encoder::new(out, width, height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_animated(count, 0).map_err(png_error)?;
+        encoder.set_frame_delay(1, frames.rate as u16).map_err(png_error)?;
+        Ok(ApngWriter { writer: encoder.write_header().map_err(png_error)? })
+    }
+
+    /// Appends `frame` (its colours).
+    pub fn frame(&mut self, frame: &Image) -> std::io::Result<()> {
+        self.writer.write_image_data(&frame.to_rgb().data).map_err(png_error)
+    }
+
+    /// Ends the file.
+    pub fn finish(self) -> std::io::Result<()> {
+        self.writer.finish().map_err(png_error)
+    }
+}
+
+/// Writes `image` as a `format` file carrying `info`.
+pub fn write_frame_file(
+    image: &Image,
+    info: &FrameInfo,
+    format: Format,
+    out: &mut dyn Write,
+) -> Result<(), FormatError> {
+    let (palette, rows): (Option<Vec<[u8; 3]>>, &[u8]) = match image {
+        Image::Indexed { palette, indices, .. } => (Some(palette.clone()), indices),
+        Image::Rgb(rgb) => (None, &rgb.data),
+    };
+    let header = Header { width: info.width, height: info.height, palette, text: Some(info.to_string()) };
+    let row = info.width as usize * header.palette.as_ref().map_or(3, |_| 1);
+    let mut writer = RowWriter::new(format, &header, out)?;
+    for chunk in rows.chunks(row) {
+        writer.write_row(chunk)?;
+    }
+    writer.finish()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn patterns() {
+        let p = FramePattern::parse("frames/f%04d.png").unwrap();
+        assert_eq!(p.name(7), PathBuf::from("frames/f0007.png"));
+        assert_eq!(p.name(12345), PathBuf::from("frames/f12345.png"));
+        assert_eq!(FramePattern::parse("a%d-100%%.tga").unwrap().name(3), PathBuf::from("a3-100%.tga"));
+        for bad in ["f%4d.png", "f%d%d.png", "f%x.png", "f%%.png", "f%0.png"] {
+            assert!(FramePattern::parse(bad).is_err(), "{bad}");
+        }
+        assert_eq!(Output::of(Path::new("a.gif")), Ok(Output::Gif));
+        assert_eq!(Output::of(Path::new("a.PNG")), Ok(Output::Apng));
+        assert!(Output::of(Path::new("a.tga")).unwrap_err().contains("--frame K"));
+    }
+
+    #[test]
+    fn frame_info_reads_back() {
+        let info = FrameInfo {
+            version: "0.1.0".into(),
+            scene: 0xabc,
+            width: 4,
+            height: 3,
+            palette: PaletteMode::Dither,
+            frame: 5,
+            frames: Frames { count: 48, rate: 24 },
+        };
+        assert_eq!(FrameInfo::parse(&info.to_string()), Some(info.clone()));
+        assert_eq!(FrameInfo::parse(&info.to_string().replace("5/48", "48/48")), None);
+        assert_eq!(gif_delay(Frames { count: 1, rate: 24 }), 4);
+        assert_eq!(gif_delay(Frames { count: 1, rate: 10 }), 10);
+        assert_eq!(gif_delay(Frames { count: 1, rate: 1000 }), 1);
+    }
+}

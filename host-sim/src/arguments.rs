@@ -1,0 +1,108 @@
+//! The command line's values that more than one command reads: the names
+//! of the vocabularies (accel, color, dither, palette, format), sizes, and the
+//! image file to write (its format, and never the scene file itself).
+//!
+//! Invariant: every name is parsed from its vocabulary's own list (`ALL`
+//! and `name`), so a new variant is accepted, and listed in the error,
+//! without a change here.
+
+use crate::exit::CliError;
+use octrace_core::panel::Dithering;
+use octrace_core::render::PanelColor;
+use octrace_core::scene::MAX_SIDE;
+use octrace_core::AccelMode;
+use octrace_images::formats::Format;
+use octrace_images::palette::PaletteMode;
+use std::path::Path;
+
+/// An `--accel` name: the core's [`AccelMode`] vocabulary.
+pub(crate) fn parse_accel(text: &str) -> Result<AccelMode, String> {
+    parse_name(text, &AccelMode::ALL, AccelMode::name)
+}
+
+/// A `--color` name: the core's [`PanelColor`] vocabulary.
+pub(crate) fn parse_color(text: &str) -> Result<PanelColor, String> {
+    parse_name(text, &PanelColor::ALL, PanelColor::name)
+}
+
+/// A `--dither` name: the core's [`Dithering`] vocabulary.
+pub(crate) fn parse_dithering(text: &str) -> Result<Dithering, String> {
+    parse_name(text, &Dithering::ALL, Dithering::name)
+}
+
+/// A `--palette` name: [`PaletteMode`]'s vocabulary.
+pub(crate) fn parse_palette(text: &str) -> Result<PaletteMode, String> {
+    parse_name(text, &PaletteMode::ALL, PaletteMode::name)
+}
+
+/// A `--format` name: [`Format`]'s vocabulary.
+pub(crate) fn parse_format(text: &str) -> Result<Format, String> {
+    parse_name(text, &Format::ALL, Format::name)
+}
+
+/// The one of `all` that `text` names (case-insensitive).
+pub(crate) fn parse_name<T: Copy>(text: &str, all: &[T], name: fn(T) -> &'static str) -> Result<T, String> {
+    all.iter().copied().find(|&v| name(v).eq_ignore_ascii_case(text)).ok_or_else(|| {
+        let names: Vec<&str> = all.iter().map(|&v| name(v)).collect();
+        format!("expected one of {}", names.join(", "))
+    })
+}
+
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WxH (for example 160x128), found `{s}`"))?;
+    let dim = |v: &str| -> Result<u32, String> {
+        let n: u32 = v.parse().map_err(|_| format!("`{v}` is not a whole number"))?;
+        if (1..=MAX_SIDE).contains(&n) {
+            Ok(n)
+        } else {
+            Err(format!("{n} is outside 1 to {MAX_SIDE}"))
+        }
+    };
+    Ok((dim(w)?, dim(h)?))
+}
+
+/// The format to write `path` in: the one asked for, else the one its
+/// extension names, else (no extension) PNG. Any other extension is refused
+/// before anything is rendered: a PNG named `.bmp` would mislead whatever
+/// opens it.
+pub(crate) fn output_format(asked: Option<Format>, path: &Path) -> Result<Format, CliError> {
+    if let Some(format) = asked {
+        return Ok(format);
+    }
+    let Some(extension) = path.extension() else {
+        return Ok(Format::Png);
+    };
+    Format::from_path(path).ok_or_else(|| {
+        let names: Vec<&str> = Format::ALL.iter().map(|f| f.name()).collect();
+        CliError::Invalid(format!(
+            "cannot write {}: `.{}` is not a format host-sim writes; it writes {} \
+             (chosen by the extension, or by --format <{}>)",
+            path.display(),
+            extension.to_string_lossy(),
+            names.join(", "),
+            names.join("|"),
+        ))
+    })
+}
+
+/// Whether two paths name the same existing file.
+pub(crate) fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes() {
+        assert_eq!(parse_size("160x128"), Ok((160, 128)));
+        assert_eq!(parse_size("8X8"), Ok((8, 8)));
+        assert!(parse_size("0x5").is_err());
+        assert!(parse_size("12").is_err());
+        assert!(parse_size("20000x5").is_err());
+    }
+}

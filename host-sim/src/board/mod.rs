@@ -1,0 +1,353 @@
+//! `host-sim board`: a scene sent to a board running octrace's live
+//! firmware over its serial port (octrace-link's protocol,
+//! docs/board-protocol.md); the board's errors printed as host-sim prints
+//! its own, its picture received, written and checked against host-sim's.
+//!
+//! Invariants: the conversation with the board (hello, the scene, its
+//! whole answer) ends within the timeout, and what the board says is
+//! checked as [`link`] says; the picture takes memory only as its rows
+//! arrive, never for a size the board only claims; `--check` passes only
+//! when every pixel of the panel was compared and each is host-sim's.
+
+mod link;
+
+pub use link::{
+    Answer, BoardDescription, BoardLink, BoardSceneError, BoardTiming, LinkError, Port, Progress, SerialLine,
+};
+
+use crate::arguments::{output_format, parse_format, same_file};
+use crate::exit::CliError;
+use crate::output::panel_preview;
+use crate::terminal::progress_bar;
+use crate::{all_cores, load_bytes, new_scene, render_with_progress, LoadError, RenderOptions, RgbImage};
+use embedded_graphics_core::pixelcolor::RgbColor;
+use octrace_core::panel::Dithering;
+use octrace_core::render::PanelColor;
+use octrace_images::formats::{self, Format, Image};
+use octrace_link::{Panel, PixelFormat, Reason, VERSION};
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+// A panel the protocol allows is an image host-sim renders.
+const _: () = assert!(Panel::MAX_SIDE as u32 == octrace_core::scene::MAX_SIDE);
+
+/// The seconds a conversation with a board may take unless told otherwise
+/// (`--timeout`, the studio's `--board-timeout`): sixty times what a Pico
+/// takes for the thesis's scenes, and room for an emulated one.
+pub(crate) const DEFAULT_TIMEOUT: u64 = 120;
+
+/// `host-sim board [PORT] [SCENE] [OUT]`.
+#[derive(clap::Args, Debug)]
+pub struct BoardArgs {
+    /// The board's serial port: a serial device (a character device, or a
+    /// port the system lists, such as COM3), which a scene file never is.
+    /// Without it, the serial ports are listed.
+    pub port: Option<PathBuf>,
+    /// The scene file to send. Without it, the board says what it is.
+    pub scene: Option<PathBuf>,
+    /// Where to write the board's picture, received row by row.
+    pub out: Option<PathBuf>,
+    /// Compare the board's picture with host-sim's own render of the scene
+    /// at the panel's size and in its format (as `--size WxH --color
+    /// rgb565`): says "bit-identical", or how many pixels differ (exit 3).
+    #[arg(long)]
+    pub check: bool,
+    /// Seconds the whole conversation with the board may take: its hello,
+    /// sending the scene, and its answer (every error, or every row of the
+    /// drawing).
+    #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_TIMEOUT, value_parser = clap::value_parser!(u64).range(1..=86_400))]
+    pub timeout: u64,
+    /// OUT's file format; by default from its extension (png, tga, ras),
+    /// or PNG when it has none.
+    #[arg(long, value_parser = parse_format)]
+    pub format: Option<Format>,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// Whether `arg` names a serial port: a character device, or a port the
+/// system lists (COM3 on Windows).
+pub(crate) fn is_port(arg: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if std::fs::metadata(arg).is_ok_and(|m| m.file_type().is_char_device()) {
+            return true;
+        }
+    }
+    ports().iter().any(|port| Path::new(&port.port_name) == arg)
+}
+
+/// The serial ports the system lists (none where it cannot list them).
+fn ports() -> Vec<serialport::SerialPortInfo> {
+    // serialport scans /sys/class/tty on Linux and panics where it is missing.
+    if cfg!(target_os = "linux") && !Path::new("/sys/class/tty").is_dir() {
+        return Vec::new();
+    }
+    serialport::available_ports().unwrap_or_default()
+}
+
+/// Each port on a line: its name, and what it is when the system knows.
+pub(crate) fn write_ports(out: &mut dyn Write) -> io::Result<()> {
+    let ports = ports();
+    if ports.is_empty() {
+        return writeln!(
+            out,
+            "no serial ports found (a board with octrace's live firmware shows up as a USB serial port)"
+        );
+    }
+    for port in ports {
+        let what = match port.port_type {
+            serialport::SerialPortType::UsbPort(usb) => {
+                let names = [usb.manufacturer, usb.product].into_iter().flatten().collect::<Vec<_>>().join(" ");
+                let serial = usb.serial_number.map(|s| format!(" (serial {s})")).unwrap_or_default();
+                format!("USB {:04x}:{:04x} {names}{serial}", usb.vid, usb.pid)
+            }
+            serialport::SerialPortType::PciPort => "PCI".into(),
+            serialport::SerialPortType::BluetoothPort => "Bluetooth".into(),
+            serialport::SerialPortType::Unknown => "serial".into(),
+        };
+        writeln!(out, "{}\t{what}", port.port_name)?;
+    }
+    Ok(())
+}
+
+/// Runs `host-sim board`.
+pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Result<(), CliError> {
+    let Some(first) = &args.port else {
+        return write_ports(stdout).map_err(|e| CliError::Io(format!("board: {e}")));
+    };
+    if !is_port(first) {
+        let _ = writeln!(stderr, "host-sim board: the serial ports:");
+        let _ = write_ports(stderr);
+        return Err(CliError::Invalid(format!(
+            "board: {} is no serial port: give the board's port first (host-sim board PORT SCENE [OUT])",
+            first.display()
+        )));
+    }
+    let port = first.display().to_string();
+    let out = args.out.as_ref();
+    let timeout = Duration::from_secs(args.timeout);
+    let Some(scene) = &args.scene else {
+        let mut link = BoardLink::open(&port, timeout).map_err(|e| link_error(&port, e))?;
+        let board = link.hello().map_err(|e| link_error(&port, e))?;
+        return describe(&port, &board, stdout).map_err(|e| CliError::Io(format!("board: {e}")));
+    };
+    if out.is_none() && args.format.is_some() {
+        return Err(CliError::Invalid("board: --format names OUT's format: give OUT".into()));
+    }
+    let format = out.map(|out| output_format(args.format, out)).transpose()?;
+    if let Some(out) = out.filter(|out| same_file(scene, out)) {
+        return Err(CliError::Invalid(format!(
+            "refusing to overwrite the scene file {} with the image",
+            out.display()
+        )));
+    }
+    let text = std::fs::read(scene).map_err(|e| CliError::read(scene, e))?;
+    let file = scene.display().to_string();
+    let pixels = out.is_some() || args.check;
+    let started = Instant::now();
+    let mut bar = None;
+    let sent = send_scene(&port, timeout, &file, &text, pixels, &mut |step| match step {
+        Progress::Drawing(panel) => bar = progress_bar(panel.height.into(), args.quiet),
+        Progress::Row { .. } => {
+            if let Some(bar) = &bar {
+                bar.inc(1);
+            }
+        }
+    });
+    if let Some(bar) = &bar {
+        bar.finish_and_clear();
+    }
+    let (panel, timing, picture) = match sent? {
+        Sent::Rejected(errors) => {
+            let errors = errors.iter().map(|e| e.located(&file)).collect();
+            return Err(CliError::Scene { file, errors });
+        }
+        Sent::Drawn { panel, timing, picture } => (panel, timing, picture),
+    };
+    let (w, h) = (panel.width, panel.height);
+    if !args.quiet {
+        let time = timing.describe(started.elapsed());
+        let _ = writeln!(stderr, "{w}x{h} {} drawn by the board at {port} {time}", panel.format);
+    }
+    let Some(image) = picture else {
+        return match args.check {
+            true => Err(CliError::Mismatch("board --check: the board sent no pixels to compare".into())),
+            false => Ok(()),
+        };
+    };
+    if let (Some(out), Some(format)) = (out, format) {
+        crate::output::write_atomically(out, |f| {
+            formats::write(&Image::Rgb(image.clone()), format, f).map_err(io::Error::other)
+        })
+        .map_err(|e| CliError::write(out, e))?;
+        if !args.quiet {
+            let _ = writeln!(stderr, "the board's picture -> {}", out.display());
+        }
+    }
+    if args.check {
+        let differ = differing_pixels(&file, &text, panel, &image)?;
+        if differ > 0 {
+            return Err(CliError::Mismatch(format!(
+                "board --check: {differ} of {} pixels differ from host-sim's {} render at {w}x{h}",
+                w as usize * h as usize,
+                panel.format
+            )));
+        }
+        if !args.quiet {
+            let _ = writeln!(stderr, "--check: bit-identical to host-sim's {} render at {w}x{h}", panel.format);
+        }
+    }
+    Ok(())
+}
+
+/// A failure to talk to the board at `port`, as host-sim reports it.
+fn link_error(port: &str, e: LinkError) -> CliError {
+    let message = format!("board at {port}: {e}");
+    match e {
+        // The board's own answer to the scene: a scene error in all but name.
+        LinkError::Refused(Reason::TooLong { .. }) => CliError::Invalid(message),
+        _ => CliError::Io(message),
+    }
+}
+
+/// What a board made of a scene sent to it.
+#[derive(Debug)]
+pub(crate) enum Sent {
+    /// The scene's errors, as the board found them; nothing drawn.
+    Rejected(Vec<BoardSceneError>),
+    /// Drawn at the panel's size (`timing` as the board measured it), with
+    /// the picture if its pixels were asked for.
+    Drawn { panel: Panel, timing: BoardTiming, picture: Option<RgbImage> },
+}
+
+/// Sends scene `text` (named `file` in errors) to the board at `port`,
+/// after its hello and a check of the scene's length against what it
+/// takes, and follows the drawing, handing each step to `progress`; all
+/// of it within `timeout`. `host-sim board` and the studio send through
+/// this.
+pub(crate) fn send_scene(
+    port: &str,
+    timeout: Duration,
+    file: &str,
+    text: &[u8],
+    pixels: bool,
+    progress: &mut dyn FnMut(Progress<'_>),
+) -> Result<Sent, CliError> {
+    let mut link = BoardLink::open(port, timeout).map_err(|e| link_error(port, e))?;
+    let board = link.hello().map_err(|e| link_error(port, e))?;
+    if text.len() > board.max_scene as usize {
+        return Err(CliError::Invalid(format!(
+            "{file} is {} bytes; the board at {port} takes scenes of at most {} bytes",
+            text.len(),
+            board.max_scene
+        )));
+    }
+    // The picture's rows in RGB, each kept as it comes: memory follows
+    // what the board sent, not the size it claims.
+    let mut rows: Vec<Vec<u8>> = Vec::new();
+    let answer = link.draw(text, pixels, &mut |step| {
+        match &step {
+            Progress::Drawing(panel) if pixels => rows = vec![Vec::new(); panel.height.into()],
+            Progress::Drawing(_) => {}
+            Progress::Row { y, pixels: row } => {
+                if let Some(rgb) = rows.get_mut(usize::from(*y)) {
+                    *rgb = board.panel.format.colors(row).flat_map(|c| [c.r(), c.g(), c.b()]).collect();
+                }
+            }
+        }
+        progress(step);
+    });
+    Ok(match answer.map_err(|e| link_error(port, e))? {
+        Answer::Rejected(errors) => Sent::Rejected(errors),
+        Answer::Drawn { panel, timing } => {
+            let picture = pixels.then(|| RgbImage {
+                width: panel.width.into(),
+                height: panel.height.into(),
+                data: rows.concat(),
+            });
+            Sent::Drawn { panel, timing, picture }
+        }
+    })
+}
+
+/// How many pixels of the board's `picture` differ from host-sim's render
+/// of the scene at the panel's size, as the panel shows it (`host-sim
+/// SCENE OUT --size WxH --color rgb565`). `host-sim board --check` and the
+/// studio judge the board's picture by this. A picture that is not the
+/// panel's size, or has no pixel, is no picture to judge: an error.
+pub(crate) fn differing_pixels(file: &str, text: &[u8], panel: Panel, picture: &RgbImage) -> Result<usize, CliError> {
+    let pixels = usize::from(panel.width) * usize::from(panel.height);
+    let size = (u32::from(panel.width), u32::from(panel.height));
+    if pixels == 0 || (picture.width, picture.height) != size || picture.data.len() != 3 * pixels {
+        return Err(CliError::Mismatch(format!(
+            "board --check: no pixel to compare: a {}x{} picture ({} bytes) of a {}x{} panel",
+            picture.width,
+            picture.height,
+            picture.data.len(),
+            panel.width,
+            panel.height
+        )));
+    }
+    let ours = host_render(file, text, panel)?;
+    Ok(ours.data.chunks_exact(3).zip(picture.data.chunks_exact(3)).filter(|(a, b)| a != b).count())
+}
+
+/// host-sim's render of the scene at the panel's size, as the panel shows
+/// it.
+fn host_render(file: &str, text: &[u8], panel: Panel) -> Result<RgbImage, CliError> {
+    let mismatch = |why: String| CliError::Mismatch(format!("board --check: {why}"));
+    let mut scene = new_scene();
+    load_bytes(file, text, &mut scene).map_err(|e| match e {
+        LoadError::Io(e) => mismatch(format!("host-sim cannot read the scene: {e}")),
+        LoadError::Scene(errors) => {
+            mismatch(format!("the board drew a scene host-sim refuses:\n{}", errors.join("\n")))
+        }
+    })?;
+    let options = RenderOptions {
+        size: Some((panel.width.into(), panel.height.into())),
+        threads: all_cores(),
+        ..RenderOptions::default()
+    };
+    let rendered = render_with_progress(&scene, &options, &|_| {})
+        .map_err(|e| mismatch(format!("host-sim cannot set up the camera: {e}")))?;
+    let color = match panel.format {
+        PixelFormat::Rgb565 => PanelColor::Rgb565,
+    };
+    Ok(match panel_preview(&rendered.image, color, Dithering::default()) {
+        Some(preview) => preview.to_rgb(),
+        None => rendered.image,
+    })
+}
+
+/// What `host-sim board PORT` prints.
+fn describe(port: &str, board: &BoardDescription, out: &mut dyn Write) -> io::Result<()> {
+    let Panel { width, height, format } = board.panel;
+    writeln!(out, "{port}: {} (protocol version {VERSION})", board.firmware)?;
+    writeln!(out, "panel: {width}x{height} {format}; scenes of at most {} bytes", board.max_scene)?;
+    let capacities: Vec<String> = board.capacities.iter().map(|(name, count)| format!("{name} {count}")).collect();
+    writeln!(out, "profile {}: {}", board.profile, capacities.join(", "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_check_that_compares_no_pixel_fails() {
+        let scene = b"SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\n";
+        let panel = |width, height| Panel { width, height, format: PixelFormat::Rgb565 };
+        let picture = |width, height| RgbImage { width, height, data: vec![0; 3 * (width * height) as usize] };
+        for (board, got) in [(panel(0, 0), picture(0, 0)), (panel(4, 2), picture(2, 4)), (panel(4, 2), picture(4, 1))] {
+            let said = differing_pixels("s.txt", scene, board, &got).unwrap_err();
+            assert!(
+                matches!(&said, CliError::Mismatch(m) if m.starts_with("board --check: no pixel to compare")),
+                "{said}"
+            );
+        }
+        assert!(differing_pixels("s.txt", scene, panel(4, 2), &picture(4, 2)).is_ok());
+    }
+}

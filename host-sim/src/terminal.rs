@@ -1,0 +1,52 @@
+//! What host-sim shows on a terminal: progress bars, and text that comes
+//! from outside (a board's) with its control characters escaped.
+//!
+//! Invariant: text from outside goes through [`shown`] before it reaches a
+//! terminal, a file of messages or the studio's page, so that it cannot
+//! move the cursor, recolour the screen or fake a line of host-sim's own.
+
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+
+/// A progress bar of `total` steps on stderr, if it is a terminal and
+/// the run is not `quiet`.
+pub(crate) fn progress_bar(total: u64, quiet: bool) -> Option<ProgressBar> {
+    if quiet || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = ProgressBar::new(total);
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}%, eta {eta}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    Some(bar)
+}
+
+/// `text` with every control character (a line's end and an escape
+/// included) and byte-order mark written as its Unicode escape (`\u{1b}`),
+/// as octrace-core shows hostile scene text.
+pub(crate) fn shown(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        if c.is_control() || c == '\u{feff}' {
+            out.extend(c.escape_unicode());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn control_characters_are_shown_escaped() {
+        assert_eq!(
+            shown("red \u{1b}[31mtext\n\rhost-sim: ok\u{7}é"),
+            "red \\u{1b}[31mtext\\u{a}\\u{d}host-sim: ok\\u{7}é"
+        );
+        assert_eq!(shown("plain"), "plain");
+    }
+}

@@ -1,0 +1,641 @@
+//! The board's loop, which a firmware runs for ever around its hardware: a
+//! frame read from the line byte by byte, answered, a scene drawn while
+//! the line is watched, each answer written as fast as the host takes it.
+//! The firmware keeps only the hardware: its [`Line`] (the serial port and
+//! its rings, a clock, sleep, a watchdog) and how it renders a drawing's
+//! rows (one core, two).
+//!
+//! Invariants:
+//! - every frame that ends on the line is answered, in the order they came:
+//!   one that ends while a scene is drawn stops the drawing (`cancelled`,
+//!   unless its last row was drawn: `done`), then is answered;
+//! - the bytes of a frame that ends while drawing stay on the line, unread,
+//!   until it is answered (the decoder holds one frame);
+//! - a host that does not take an answer is waited for at most
+//!   [`STALL_GRACE_US`] beyond the time the answer takes at
+//!   [`SLOWEST_HOST_BYTES_PER_SECOND`]; then the rest of that answer is
+//!   dropped, what waits on the line for it too ([`Line::discard`]), and the
+//!   next answer starts whole. A slow host cannot pace a drawing by more;
+//! - a drawing goes on when its host stops taking rows (the panel shows the
+//!   picture); only a frame from the host stops it.
+
+use super::{Board, Drawing, Panel};
+use crate::cobs::Sink;
+use crate::decoder::Decoder;
+use crate::list::{Counter, Counters};
+use crate::message::Timing;
+use core::time::Duration;
+use embedded_graphics_core::pixelcolor::Rgb565;
+use octrace_core::accel::Accelerator;
+use octrace_core::profile::Profile;
+use octrace_core::render::{Renderer, Stopped};
+use octrace_core::Raytracer;
+
+/// How long a board waits for a host that does not take its answer,
+/// beyond what the answer's length allows at
+/// [`SLOWEST_HOST_BYTES_PER_SECOND`]: a second.
+pub const STALL_GRACE_US: u64 = 1_000_000;
+
+/// How often a drawing reads the line at most: every millisecond of the
+/// board's clock. [`Rows::poll`] is asked before every ray; between two
+/// reads it only looks at the clock, so that the asks cost a drawing
+/// nothing it can measure, and a frame stops it within a millisecond and a
+/// ray.
+pub const POLL_PERIOD_US: u64 = 1_000;
+
+/// The slowest a host may take an answer and still get all of it: 16 KiB a
+/// second (a USB full-speed port takes a megabyte; a drawing's rows with
+/// pixels are a few tens of KiB a second on a Pico).
+pub const SLOWEST_HOST_BYTES_PER_SECOND: u64 = 16 * 1024;
+
+/// The board's serial line and the little else of its hardware the loop
+/// needs: what a firmware implements (over its USB serial port's rings, on
+/// a Pico), and a test or fuzz target on a host.
+pub trait Line {
+    /// The next byte from the host, if one has come; never waits.
+    fn read(&mut self) -> Option<u8>;
+
+    /// Takes as many of `bytes` as it has room for on their way to the
+    /// host; never waits.
+    fn write(&mut self, bytes: &[u8]) -> usize;
+
+    /// Drops every byte taken by [`Line::write`] not yet gone to the host:
+    /// the rest of an answer the host did not take.
+    fn discard(&mut self);
+
+    /// Microseconds by the board's clock.
+    fn now_us(&mut self) -> u64;
+
+    /// Nothing to do until the host sends: sleeps until a byte may have
+    /// come (a firmware's `wfi`, its watchdog paused), or returns at once.
+    /// False when no byte will ever come (a host's test, at its end).
+    fn sleep(&mut self) -> bool;
+
+    /// The board is at work: called each time a drawing reads the line (at
+    /// most every [`POLL_PERIOD_US`]), at every piece of an answer written
+    /// and at every turn of a wait for the host to take it (a firmware
+    /// feeds its watchdog here).
+    fn alive(&mut self);
+
+    /// The events the board's hardware counts over a scene's load and its
+    /// render, which the `done` answer reports (a Pico: its bus fabric's
+    /// contested accesses, `sram0_contested`); at most [`MAX_COUNTERS`].
+    /// None by default.
+    fn counter_names(&self) -> &'static [&'static str] {
+        &[]
+    }
+
+    /// Each of [`Line::counter_names`]'s counts since the last call, into
+    /// `counts` (as long as the names), and starts them again: called as a
+    /// scene starts loading, as it starts drawing and once it is drawn.
+    fn take_counts(&mut self, counts: &mut [u32]) {
+        let _ = counts;
+    }
+}
+
+/// The most counters a [`Line`] reports.
+pub const MAX_COUNTERS: usize = 8;
+
+/// What [`Link::serve`] did with a frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Served {
+    /// Answered with a refusal, the board's description or a scene's errors.
+    Answered,
+    /// A scene drawn: `rows` rows, in order; fewer than the panel's height
+    /// when a frame came (it is answered next).
+    Drawn {
+        /// Rows drawn.
+        rows: u16,
+    },
+    /// The host did not take the answer: the rest of it was dropped.
+    Stalled,
+}
+
+/// The board's end of the link: its [`Board`], its decoder (a board's:
+/// [`Decoder::for_board`]) and whether a frame came while it drew.
+#[derive(Debug)]
+pub struct Link<'a, B> {
+    board: Board<'a>,
+    decoder: Decoder<B>,
+    /// A frame ended while a scene was drawn: it is answered next.
+    pending: bool,
+}
+
+impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
+    /// The board drawing on `panel`, running `firmware` (its name and
+    /// version), keeping frames in `buffer` (its length bounds a scene's).
+    pub fn new(panel: Panel, firmware: &'a str, buffer: B) -> Link<'a, B> {
+        let decoder = Decoder::for_board(buffer);
+        Link { board: Board::new(panel, firmware, &decoder), decoder, pending: false }
+    }
+
+    /// What the board says it is.
+    pub fn board(&self) -> &Board<'a> {
+        &self.board
+    }
+
+    /// Waits for the next frame on `line` (sleeping while nothing comes),
+    /// or takes the one that came while the last scene was drawn, and
+    /// answers it; a scene that loads into `raytracer` is drawn by `draw`,
+    /// which renders the rows in its own way, sends each as it is drawn
+    /// ([`Rows::send`]), polls the line between rays ([`Rows::poll`],
+    /// through a [`Stop`](octrace_core::render::Stop)) and returns how many
+    /// rows it drew, in order. None when the line says no byte will come.
+    pub fn serve<P: Profile, L: Line>(
+        &mut self,
+        line: &mut L,
+        raytracer: &mut Raytracer<P>,
+        draw: impl FnOnce(&Drawing<'_, P>, &mut Rows<'_, '_, L, B>) -> u16,
+    ) -> Option<Served> {
+        if !self.pending {
+            loop {
+                match line.read() {
+                    Some(byte) if self.decoder.push(byte).is_some() => break,
+                    Some(_) => {}
+                    None if line.sleep() => {}
+                    None => return None,
+                }
+            }
+        }
+        self.pending = false;
+        // The board's time from the whole frame received to the last row
+        // drawn: parse, index and render; and its counters over each.
+        let names = &line.counter_names()[..line.counter_names().len().min(MAX_COUNTERS)];
+        let (mut load_counts, mut render_counts) = ([0; MAX_COUNTERS], [0; MAX_COUNTERS]);
+        line.take_counts(&mut load_counts[..names.len()]);
+        let start = line.now_us();
+        let mut output = Output { line, waited_us: 0, taken: 0, stalled: false };
+        // There: a frame just ended, or ended while the last scene was drawn
+        // and nothing was pushed since.
+        let received = self.decoder.received()?;
+        let drawing = match self.board.answer(received, raytracer, &mut output) {
+            Ok(None) => return Some(Served::Answered),
+            Err(Stalled) => return Some(Served::Stalled),
+            Ok(Some(drawing)) => drawing,
+        };
+        let loaded = output.line.now_us();
+        output.line.take_counts(&mut load_counts[..names.len()]);
+        let mut rows =
+            Rows { output: &mut output, decoder: &mut self.decoder, pending: &mut self.pending, read_at_us: start };
+        let drawn = draw(&drawing, &mut rows).min(drawing.panel().height);
+        // Every row drawn is done, even if a frame came with the last.
+        let closed = match drawn == drawing.panel().height {
+            true => {
+                let end = output.line.now_us();
+                output.line.take_counts(&mut render_counts[..names.len()]);
+                let counters: [Counter<'_>; MAX_COUNTERS] = core::array::from_fn(|k| Counter {
+                    name: names.get(k).copied().unwrap_or(""),
+                    load: load_counts[k],
+                    render: render_counts[k],
+                });
+                let micros = |from: u64, to: u64| Some(Duration::from_micros(to.saturating_sub(from)));
+                let timing = Timing {
+                    elapsed: micros(start, end),
+                    load: micros(start, loaded),
+                    render: micros(loaded, end),
+                    counters: Counters::new(&counters[..names.len()]),
+                };
+                drawing.finish(&timing, &mut output)
+            }
+            false => drawing.cancel(drawn, &mut output),
+        };
+        Some(match closed {
+            Ok(()) => Served::Drawn { rows: drawn },
+            Err(Stalled) => Served::Stalled,
+        })
+    }
+}
+
+/// What a drawing's renderer sends its rows by and polls the line with:
+/// see [`Link::serve`].
+pub struct Rows<'o, 'l, L, B> {
+    output: &'o mut Output<'l, L>,
+    decoder: &'o mut Decoder<B>,
+    pending: &'o mut bool,
+    /// When [`Rows::poll`] last read the line.
+    read_at_us: u64,
+}
+
+impl<L, B> core::fmt::Debug for Rows<'_, '_, L, B> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Rows").field("pending", &*self.pending).finish_non_exhaustive()
+    }
+}
+
+impl<L: Line, B: AsRef<[u8]> + AsMut<[u8]>> Rows<'_, '_, L, B> {
+    /// Whether a frame has come from the host, when the drawing stops (it
+    /// is answered next): asked before every ray on the core that owns the
+    /// line (as a [`Stop`](octrace_core::render::Stop)). Every
+    /// [`POLL_PERIOD_US`] at most it reads what the host has
+    /// sent, up to the end of a frame, and tells the [`Line`] the board is
+    /// [alive](Line::alive); between, it only reads the clock.
+    pub fn poll(&mut self) -> bool {
+        let now = self.output.line.now_us();
+        if *self.pending || now.wrapping_sub(self.read_at_us) < POLL_PERIOD_US {
+            return *self.pending;
+        }
+        self.read_at_us = now;
+        self.output.line.alive();
+        take_input(self.output.line, self.decoder, self.pending)
+    }
+
+    /// Sends row `y` of `drawing`, its pixels `row` (the panel's width of
+    /// them) if the host asked for them; the line is read while the board
+    /// waits for the host to take it. A host that does not take it is not
+    /// sent the rest of the drawing's answer (the drawing goes on).
+    pub fn send<P: Profile>(&mut self, drawing: &Drawing<'_, P>, y: u16, row: &[Rgb565]) {
+        let mut polled = Polled { output: self.output, decoder: self.decoder, pending: self.pending };
+        // A row the host did not take is dropped with the rest: the panel
+        // still shows it.
+        let _ = drawing.send_row(y, row, &mut polled);
+    }
+
+    /// Draws `drawing` on one core with `renderer` (made at the panel's
+    /// size), a row at a time into `row` (the panel's width of pixels):
+    /// each row shown (`show`: the panel) and sent once drawn, the line
+    /// polled between rays. Returns the rows drawn; fewer than the panel's
+    /// height when a frame came. What a firmware with one core, or a host
+    /// standing in for a board, draws with.
+    pub fn draw_on_one_core<P: Profile, A: Accelerator>(
+        &mut self,
+        drawing: &Drawing<'_, P>,
+        renderer: &mut Renderer<'_, A>,
+        row: &mut [Rgb565],
+        mut show: impl FnMut(u16, &[Rgb565]),
+    ) -> u16 {
+        let panel = drawing.panel();
+        for y in 0..panel.height {
+            for (x, pixel) in (0..u32::from(panel.width)).zip(row.iter_mut()) {
+                match renderer.pixel_until(x, y.into(), &mut || self.poll()) {
+                    Ok(sample) => *pixel = sample.color.into(),
+                    Err(Stopped) => return y,
+                }
+            }
+            show(y, row);
+            self.send(drawing, y, row);
+        }
+        panel.height
+    }
+}
+
+/// Reads bytes from `line` into `decoder` until a frame ends (`pending`);
+/// whether one has.
+fn take_input<L: Line, B: AsRef<[u8]> + AsMut<[u8]>>(
+    line: &mut L,
+    decoder: &mut Decoder<B>,
+    pending: &mut bool,
+) -> bool {
+    while !*pending {
+        match line.read() {
+            Some(byte) => *pending = decoder.push(byte).is_some(),
+            None => break,
+        }
+    }
+    *pending
+}
+
+/// The host did not take an answer in time: the rest of it is dropped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Stalled;
+
+/// One answer on its way to the host, with the time the board has waited
+/// for room and the bytes the line has taken.
+struct Output<'l, L> {
+    line: &'l mut L,
+    waited_us: u64,
+    taken: u64,
+    stalled: bool,
+}
+
+impl<L: Line> Output<'_, L> {
+    /// Writes all of `bytes`, waiting for room (`while_waiting` at each
+    /// turn) within the answer's allowance. Each write is a sign of life: a
+    /// long answer (thousands of errors) keeps a watchdog fed.
+    fn write(&mut self, bytes: &[u8], mut while_waiting: impl FnMut(&mut L)) -> Result<(), Stalled> {
+        self.line.alive();
+        if self.stalled {
+            return Err(Stalled);
+        }
+        let mut rest = bytes;
+        let mut last = None;
+        loop {
+            let taken = self.line.write(rest);
+            rest = &rest[taken..];
+            self.taken += taken as u64;
+            if rest.is_empty() {
+                return Ok(());
+            }
+            let now = self.line.now_us();
+            self.waited_us += last.map_or(0, |last| now.saturating_sub(last));
+            last = Some(now);
+            let allowed = STALL_GRACE_US + self.taken.saturating_mul(1_000_000) / SLOWEST_HOST_BYTES_PER_SECOND;
+            if self.waited_us > allowed {
+                self.stalled = true;
+                self.line.discard();
+                return Err(Stalled);
+            }
+            self.line.alive();
+            while_waiting(self.line);
+        }
+    }
+}
+
+impl<L: Line> Sink for Output<'_, L> {
+    type Error = Stalled;
+
+    fn write_all(&mut self, bytes: &[u8]) -> Result<(), Stalled> {
+        self.write(bytes, |_| {})
+    }
+}
+
+/// An [`Output`] that reads the line while it waits (a drawing's rows: the
+/// decoder is free, the scene's text no longer needed).
+struct Polled<'a, 'l, L, B> {
+    output: &'a mut Output<'l, L>,
+    decoder: &'a mut Decoder<B>,
+    pending: &'a mut bool,
+}
+
+impl<L: Line, B: AsRef<[u8]> + AsMut<[u8]>> Sink for Polled<'_, '_, L, B> {
+    type Error = Stalled;
+
+    fn write_all(&mut self, bytes: &[u8]) -> Result<(), Stalled> {
+        let (decoder, pending) = (&mut *self.decoder, &mut *self.pending);
+        self.output.write(bytes, |line| {
+            take_input(line, decoder, pending);
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::message::{Kind, Message, PixelFormat};
+    use octrace_core::profile::Board64K;
+    use std::boxed::Box;
+    use std::collections::VecDeque;
+    use std::string::{String, ToString};
+    use std::vec::Vec;
+
+    /// Two facing mirrors with the eye between them, eight lights, 16²
+    /// samples: a pixel of it takes hours on a Pico.
+    pub(crate) const WEDGING: &[u8] = b"VIEWPOINT 0 0 0 ORIGIN 0 0 -1 RDEPTH 1000000 SAMPLES 16\n\
+        LIGHT 1 0 1 0 LIGHT 1 0 -1 0 LIGHT 1 1 0 0 LIGHT 1 -1 0 0\n\
+        LIGHT 1 1 1 0 LIGHT 1 -1 1 0 LIGHT 1 1 -1 0 LIGHT 1 -1 -1 0\n\
+        RECTANGLE 1 -5 -5 -3 5 -5 -3 5 5 -3 -5 5 -3\n\
+        RECTANGLE 1 -5 -5 3 -5 5 3 5 5 3 5 -5 3\n\
+        SURFACE 1 0.01 0.01 0.01 0.1 0.1 0.1 0 0 0 0 1 0\n";
+
+    const SCENE: &[u8] = b"SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n";
+
+    /// A host at the end of a simulated line: bytes it sends become
+    /// readable once the board has given `after` signs of life; it takes
+    /// what the board writes at `bytes_per_second` (None: at once) through a
+    /// ring of 48 bytes, on a clock that moves 100 µs each time it is read.
+    struct Wire {
+        sent: VecDeque<(u32, Vec<u8>)>,
+        readable: VecDeque<u8>,
+        /// Signs of life the board gave: polls and writes.
+        polls: u32,
+        ring: VecDeque<u8>,
+        received: Vec<u8>,
+        bytes_per_second: Option<u64>,
+        clock_us: u64,
+        /// When the host last took a byte (its pace).
+        taken_at_us: u64,
+        /// How often the board took its counts: each count is that number
+        /// times ten, plus the counter's index.
+        counts_taken: u32,
+    }
+
+    impl Wire {
+        fn new() -> Wire {
+            Wire {
+                sent: VecDeque::new(),
+                readable: VecDeque::new(),
+                polls: 0,
+                ring: VecDeque::new(),
+                received: Vec::new(),
+                bytes_per_second: None,
+                clock_us: 0,
+                taken_at_us: 0,
+                counts_taken: 0,
+            }
+        }
+
+        /// `message` from the host with `tag`, readable after `after` polls.
+        fn send(&mut self, after: u32, message: Message<'_>, tag: u16) {
+            let mut bytes = Vec::new();
+            message.encode(tag, &mut bytes).unwrap();
+            self.sent.push_back((after, bytes));
+        }
+
+        fn host_reads(&mut self) {
+            match self.bytes_per_second {
+                None => self.received.extend(self.ring.drain(..)),
+                Some(rate) => {
+                    let due = (self.clock_us - self.taken_at_us) * rate / 1_000_000;
+                    for _ in 0..due.min(self.ring.len() as u64) {
+                        self.received.extend(self.ring.pop_front());
+                        self.taken_at_us = self.clock_us;
+                    }
+                }
+            }
+        }
+
+        /// The board's answers as (tag, kind), all read.
+        fn answers(&mut self) -> Vec<(u16, Kind)> {
+            self.host_reads();
+            let mut decoder = Decoder::for_host(std::vec![0u8; 4096]);
+            let mut answers = Vec::new();
+            for &byte in &self.received {
+                if let Some(frame) = decoder.push(byte) {
+                    let frame = frame.expect("the board's frames read");
+                    answers.push((frame.tag, frame.message.kind()));
+                }
+            }
+            answers
+        }
+    }
+
+    impl Line for Wire {
+        fn read(&mut self) -> Option<u8> {
+            while let Some((after, _)) = self.sent.front() {
+                if *after > self.polls {
+                    break;
+                }
+                let (_, bytes) = self.sent.pop_front()?;
+                self.readable.extend(bytes);
+            }
+            self.readable.pop_front()
+        }
+
+        fn write(&mut self, bytes: &[u8]) -> usize {
+            self.host_reads();
+            let taken = bytes.len().min(48 - self.ring.len());
+            self.ring.extend(&bytes[..taken]);
+            taken
+        }
+
+        fn discard(&mut self) {
+            self.ring.clear();
+        }
+
+        fn now_us(&mut self) -> u64 {
+            self.clock_us += 100;
+            self.clock_us
+        }
+
+        fn sleep(&mut self) -> bool {
+            // Nothing readable: the next bytes come now, if any will.
+            match self.sent.front_mut() {
+                Some((after, _)) => {
+                    *after = self.polls;
+                    true
+                }
+                None => false,
+            }
+        }
+
+        fn alive(&mut self) {
+            self.polls += 1;
+        }
+
+        fn counter_names(&self) -> &'static [&'static str] {
+            &["fetches", "stores"]
+        }
+
+        fn take_counts(&mut self, counts: &mut [u32]) {
+            self.counts_taken += 1;
+            for (k, count) in counts.iter_mut().enumerate() {
+                *count = self.counts_taken * 10 + k as u32;
+            }
+        }
+    }
+
+    const PANEL: Panel = Panel { width: 4, height: 3, format: PixelFormat::Rgb565 };
+
+    /// Serves every frame `wire` brings, drawing on one core; what each
+    /// serve did.
+    fn serve_all(wire: &mut Wire) -> Vec<Served> {
+        let mut link = Link::new(PANEL, "test 1", std::vec![0u8; 1024]);
+        let mut raytracer = Box::new(Raytracer::<Board64K>::new());
+        let mut served = Vec::new();
+        while let Some(one) = link.serve(wire, &mut raytracer, |drawing, rows| {
+            let accelerator = drawing.scene().accelerator();
+            let view = drawing.scene().view();
+            let mut renderer =
+                Renderer::with_size(view, &accelerator, PANEL.width.into(), PANEL.height.into()).unwrap();
+            rows.draw_on_one_core(drawing, &mut renderer, &mut [Rgb565::default(); 4], |_, _| {})
+        }) {
+            served.push(one);
+        }
+        served
+    }
+
+    #[test]
+    fn a_hello_stops_a_drawing_inside_its_first_pixel_and_is_answered_next() {
+        let mut wire = Wire::new();
+        wire.send(0, Message::Scene { pixels: false, text: WEDGING }, 1);
+        // The board has polled 50 times inside the first pixel.
+        wire.send(50, Message::Hello, 2);
+        let served = serve_all(&mut wire);
+        assert_eq!(served, [Served::Drawn { rows: 0 }, Served::Answered]);
+        assert_eq!(wire.answers(), [(1, Kind::Drawing), (1, Kind::Cancelled), (2, Kind::Board)]);
+        // The hello was read at the first poll that could: after it, only
+        // the two answers' writes through the 48-byte ring (a pixel of this
+        // scene is millions of polls).
+        assert!(wire.polls <= 50 + 100, "{} polls", wire.polls);
+    }
+
+    #[test]
+    fn done_carries_the_load_and_the_render_by_the_lines_clock_and_counters() {
+        let mut wire = Wire::new();
+        wire.send(0, Message::Scene { pixels: false, text: SCENE }, 1);
+        assert_eq!(serve_all(&mut wire), [Served::Drawn { rows: PANEL.height }]);
+        wire.host_reads();
+        let mut decoder = Decoder::for_host(std::vec![0u8; 4096]);
+        let mut done = None;
+        for &byte in &wire.received {
+            if let Some(Ok(frame)) = decoder.push(byte) {
+                if let Message::Done(timing) = frame.message {
+                    let counters: Vec<Counter<'_>> = timing.counters.iter().collect();
+                    let names: Vec<String> = counters.iter().map(|c| c.name.to_string()).collect();
+                    let counts: Vec<(u32, u32)> = counters.iter().map(|c| (c.load, c.render)).collect();
+                    done = Some((timing.elapsed, timing.load, timing.render, names, counts));
+                }
+            }
+        }
+        let (elapsed, load, render, names, counts) = done.expect("a done answer");
+        let (elapsed, load, render) = (elapsed.unwrap(), load.unwrap(), render.unwrap());
+        assert_eq!(elapsed, load + render);
+        assert!(load > Duration::ZERO && render > Duration::ZERO, "{load:?} {render:?}");
+        assert_eq!(names, ["fetches", "stores"]);
+        // Taken as the scene came (dropped), once loaded, once drawn.
+        assert_eq!(counts, [(20, 30), (21, 31)]);
+    }
+
+    #[test]
+    fn a_frame_with_the_last_row_leaves_the_drawing_done() {
+        let mut wire = Wire::new();
+        wire.send(0, Message::Scene { pixels: true, text: SCENE }, 1);
+        wire.send(0, Message::Hello, 2);
+        let mut link = Link::new(PANEL, "test 1", std::vec![0u8; 1024]);
+        let mut raytracer = Box::new(Raytracer::<Board64K>::new());
+        // Every row drawn and sent, then the poll after the last finds the hello.
+        let served = link.serve(&mut wire, &mut raytracer, |drawing, rows| {
+            for y in 0..PANEL.height {
+                rows.send(drawing, y, &[Rgb565::default(); 4]);
+            }
+            // Read within a millisecond.
+            assert!((0..20).any(|_| rows.poll()), "the hello has come");
+            PANEL.height
+        });
+        assert_eq!(served, Some(Served::Drawn { rows: PANEL.height }));
+        assert_eq!(link.serve(&mut wire, &mut raytracer, |_, _| 0), Some(Served::Answered));
+        let kinds: Vec<Kind> = wire.answers().into_iter().map(|(_, kind)| kind).collect();
+        assert_eq!(kinds, [Kind::Drawing, Kind::Row, Kind::Row, Kind::Row, Kind::Done, Kind::Board]);
+    }
+
+    #[test]
+    fn a_host_that_stops_reading_loses_the_rest_of_the_answer_and_gets_the_next_whole() {
+        let mut wire = Wire::new();
+        wire.bytes_per_second = Some(0);
+        wire.send(0, Message::Scene { pixels: true, text: SCENE }, 1);
+        let served = serve_all(&mut wire);
+        assert_eq!(served, [Served::Stalled]);
+        assert!(wire.ring.is_empty(), "what waited for the host is dropped");
+        // Waited a second, not a second a row.
+        assert!(wire.clock_us < STALL_GRACE_US + 100_000, "{} µs", wire.clock_us);
+        // The host reads again, and asks.
+        wire.bytes_per_second = None;
+        wire.send(wire.polls, Message::Hello, 2);
+        assert_eq!(serve_all(&mut wire), [Served::Answered]);
+        assert_eq!(wire.answers(), [(2, Kind::Board)], "the next answer, whole and alone");
+    }
+
+    #[test]
+    fn a_host_taking_a_byte_a_second_does_not_pace_the_drawing() {
+        let mut wire = Wire::new();
+        wire.bytes_per_second = Some(1);
+        wire.send(0, Message::Scene { pixels: true, text: SCENE }, 1);
+        assert_eq!(serve_all(&mut wire), [Served::Stalled]);
+        assert!(wire.clock_us < STALL_GRACE_US + 100_000, "{} µs", wire.clock_us);
+    }
+
+    #[test]
+    fn a_burst_of_frames_is_answered_frame_by_frame() {
+        let mut wire = Wire::new();
+        for tag in 1..=300 {
+            wire.send(0, Message::Hello, tag);
+        }
+        wire.send(0, Message::Scene { pixels: false, text: SCENE }, 301);
+        let served = serve_all(&mut wire);
+        assert_eq!(served.len(), 301);
+        let answers = wire.answers();
+        assert_eq!(answers.len(), 300 + 2 + PANEL.height as usize);
+        assert!(answers[..300].iter().zip(1..).all(|(&answer, tag)| answer == (tag, Kind::Board)));
+        assert_eq!(answers.last(), Some(&(301, Kind::Done)));
+    }
+}

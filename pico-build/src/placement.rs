@@ -1,0 +1,127 @@
+//! The RP2040's memory map (`memory.x`: boot2, flash, 264 KiB of SRAM, at
+//! least 16 KiB left for core 0's stack) and where each firmware's code
+//! runs: in place in flash through the XIP cache, or copied into SRAM at
+//! boot (`sram-code.x`, filled in with the input sections a
+//! [`CodePlacement`] copies; `octrace_pico::boot!` copies
+//! them).
+//!
+//! Invariants: `memory.x` includes `code-placement.x`, which [`link`]
+//! writes into a folder of its own for each firmware, so that each links
+//! with its own placement; every placement defines the copy's bounds (an
+//! empty copy for code left in flash), so every firmware expands
+//! `octrace_pico::boot!` whatever its placement.
+
+use crate::{out_dir, write, BuildError};
+
+/// The memory map, which `cortex-m-rt`'s `link.x` includes.
+const MEMORY_X: &str = include_str!("../memory.x");
+
+/// The code copied into SRAM; `COPIED` is replaced by the input sections.
+const SRAM_CODE_X: &str = include_str!("../sram-code.x");
+
+/// The variable a user sets to place the code.
+const VARIABLE: &str = "OCTRACE_CODE_IN";
+
+/// The render path's input sections: octrace-core's tracing and indexing,
+/// both cores' loop and core 1's job runner, the compiler's 64-bit helpers.
+const RENDER_PATH: &str = concat!(
+    ".text.*octrace_core*accel* .text.*octrace_core*shapes* .text.*octrace_core*shade* ",
+    ".text.*octrace_core*render* .text.*octrace_core*math* .text.*both_cores* .text.*second_core* ",
+    ".text.__aeabi_* .text.__*di3 .text.__*di4"
+);
+
+/// The loader's: the parser and the scene's set-up.
+const LOADER: &str = ".text.*octrace_core*parse* .text.*octrace_core*scene*";
+
+/// Where a firmware's code runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CodePlacement {
+    /// All of it (and its constants) copied into SRAM at boot: a little
+    /// faster than `RenderInSram` for a small scene, too large beside a
+    /// large one (`OCTRACE_CODE_IN=sram`).
+    AllInSram,
+    /// `RenderInSram` and the loader (the parser, the scene's set-up):
+    /// what runs once the board is up, for 34 KiB more of SRAM than
+    /// `RenderInSram` (`parse-and-render`, the default).
+    LoadAndRenderInSram,
+    /// The render path copied into SRAM at boot (octrace-core's tracing
+    /// and indexing, both cores' loop, the compiler's 64-bit helpers); the
+    /// rest (the parser, USB, the panel's set-up) runs from flash, so that
+    /// SRAM is left to the scene (`render`).
+    RenderInSram,
+    /// All of it in place in flash, through the XIP cache (`flash`).
+    Flash,
+}
+
+impl CodePlacement {
+    /// Every placement with the name `OCTRACE_CODE_IN` gives it, the default first.
+    pub const ALL: [(CodePlacement, &'static str); 4] = [
+        (CodePlacement::LoadAndRenderInSram, "parse-and-render"),
+        (CodePlacement::RenderInSram, "render"),
+        (CodePlacement::AllInSram, "sram"),
+        (CodePlacement::Flash, "flash"),
+    ];
+
+    /// The placement `OCTRACE_CODE_IN` names, `parse-and-render` when it is
+    /// not set.
+    pub fn from_env() -> Result<CodePlacement, BuildError> {
+        println!("cargo:rerun-if-env-changed={VARIABLE}");
+        let Ok(value) = std::env::var(VARIABLE) else { return Ok(CodePlacement::ALL[0].0) };
+        CodePlacement::ALL.iter().find(|(_, name)| *name == value).map(|&(placement, _)| placement).ok_or(
+            BuildError::Variable {
+                name: VARIABLE,
+                value,
+                expected: "`parse-and-render` (the default), `render`, `sram` or `flash`",
+            },
+        )
+    }
+
+    /// The input sections `sram-code.x` copies (none for code left in flash).
+    fn copied(self) -> String {
+        match self {
+            CodePlacement::AllInSram => "*(.text .text.*); *(.rodata .rodata.*);".to_owned(),
+            CodePlacement::LoadAndRenderInSram => format!("*({RENDER_PATH} {LOADER});"),
+            CodePlacement::RenderInSram => format!("*({RENDER_PATH});"),
+            CodePlacement::Flash => String::new(),
+        }
+    }
+
+    /// The linker script `memory.x` includes for a firmware so placed.
+    fn script(self) -> String {
+        SRAM_CODE_X.replace("COPIED", &self.copied())
+    }
+}
+
+/// Puts `memory.x` where the linker finds it, and for each of `binaries`
+/// (a binary's name and where its code runs) its `code-placement.x`.
+pub fn link(binaries: &[(&str, CodePlacement)]) -> Result<(), BuildError> {
+    let out = out_dir()?;
+    for &(binary, placement) in binaries {
+        let dir = out.join(binary);
+        std::fs::create_dir_all(&dir).map_err(|error| BuildError::File { path: dir.display().to_string(), error })?;
+        write(&dir.join("code-placement.x"), &placement.script())?;
+        println!("cargo:rustc-link-arg-bin={binary}=-L{}", dir.display());
+    }
+    write(&out.join("memory.x"), MEMORY_X)?;
+    println!("cargo:rustc-link-search={}", out.display());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_placement_copies_its_sections_and_flash_none() {
+        let render = CodePlacement::RenderInSram.script();
+        assert!(render.contains(".text.*octrace_core*shade*") && !render.contains("parse"), "{render}");
+        let load = CodePlacement::LoadAndRenderInSram.script();
+        assert!(load.contains(".text.*octrace_core*parse*") && load.contains(".text.*both_cores*"), "{load}");
+        assert!(CodePlacement::AllInSram.script().contains("*(.rodata .rodata.*);"));
+        let flash = CodePlacement::Flash.script();
+        assert!(!flash.contains(".text.*") && flash.contains("__sram_code_end"), "{flash}");
+        for (placement, _) in CodePlacement::ALL {
+            assert!(!placement.script().contains("COPIED"), "{placement:?}");
+        }
+    }
+}

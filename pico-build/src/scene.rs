@@ -1,0 +1,104 @@
+//! The firmware's scene: the file `OCTRACE_SCENE` names, checked on the
+//! host with the parser the board runs (its errors fail the build with
+//! their line and column), embedded in flash, with a capacity profile that
+//! holds exactly what it needs, its octree included, so the Pico's RAM
+//! holds just this scene (the linker says so if it does not fit).
+//!
+//! The profile also holds the camera rays' screen lists of first hits,
+//! which render the same picture faster for RAM the Pico has to spare (at
+//! most 28 bytes an object), and for a scene walked in an octree a light
+//! buffer, built in RAM when the scene loads (its shadow rays test only the
+//! objects their direction's cell lists; a scene of a few objects tests
+//! them all, and the buffer does not pay there). The octree's shadow shafts
+//! are left out: on the thesis's scenes they take longer to build than they
+//! save in one picture (BENCHMARKS.md).
+
+use crate::{out_dir, write, BuildError};
+use octrace_core::accel::{OctreeConfig, MAX_CELLS_A_SIDE};
+use octrace_core::profile::{needed_by, needed_with_light_buffer, ProfileText};
+use octrace_core::AccelMode;
+use std::path::PathBuf;
+
+/// The variable a user sets to pick the scene.
+const VARIABLE: &str = "OCTRACE_SCENE";
+
+/// Writes `OUT_DIR/scene.rs`: `SCENE_TEXT`, the scene `OCTRACE_SCENE` names
+/// (a path from the firmware's folder; `default` when it is not set),
+/// `SCENE_NAME`, its file's name without the extension (what a firmware
+/// reports it drew), and
+/// `SceneProfile`, a `profile!` holding exactly what it needs. The firmware
+/// includes it:
+///
+/// ```ignore
+/// mod scene {
+///     include!(concat!(env!("OUT_DIR"), "/scene.rs"));
+/// }
+/// ```
+pub fn embed_scene(default: &str) -> Result<(), BuildError> {
+    let manifest: PathBuf = std::env::var_os("CARGO_MANIFEST_DIR")
+        .map(Into::into)
+        .ok_or(BuildError::NotInBuildScript("CARGO_MANIFEST_DIR"))?;
+    println!("cargo:rerun-if-env-changed={VARIABLE}");
+    let scene = std::env::var(VARIABLE).unwrap_or_else(|_| default.to_owned());
+    let path = manifest.join(&scene);
+    println!("cargo:rerun-if-changed={}", path.display());
+    let text = std::fs::read_to_string(&path)
+        .map_err(|error| BuildError::File { path: format!("{VARIABLE}={scene}"), error })?;
+    let source = scene_source(&scene, &path, &text)?;
+    write(&out_dir()?.join("scene.rs"), &source)
+}
+
+/// `scene.rs` for the scene `name`, read from `path` as `text`.
+fn scene_source(name: &str, path: &std::path::Path, text: &str) -> Result<String, BuildError> {
+    let mut report = |error| eprintln!("{name}:{error}");
+    let failed = |errors| BuildError::Scene { scene: name.to_owned(), errors };
+    // `Raytracer::load` picks the accelerator as `Auto` does, with the
+    // octree `profile!` builds by default.
+    let mut needs = needed_by(text, AccelMode::Auto, &OctreeConfig::DEFAULT, &mut report).map_err(failed)?;
+    if needs.octree_boxes > 0 {
+        needs = needed_with_light_buffer(text, AccelMode::Auto, &OctreeConfig::DEFAULT, MAX_CELLS_A_SIDE, &mut report)
+            .map_err(failed)?;
+    }
+    // `load` walks the octree by 3DDDA: no room for the thesis's hash table.
+    let doc = format!("Exactly what `{name}` needs, its octree included.");
+    let profile = ProfileText {
+        name: "SceneProfile",
+        doc: &doc,
+        counts: &needs,
+        octree: None,
+        named_walk: false,
+        first_hits: true,
+    };
+    let stem = path.file_stem().map_or_else(|| name.to_owned(), |stem| stem.to_string_lossy().into_owned());
+    Ok(format!(
+        "/// The scene, from `{name}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n\
+         /// Its file's name, without the extension (for a firmware that reports what it drew).\n\
+         #[allow(dead_code)]\npub const SCENE_NAME: &str = {stem:?};\n{profile}"
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_scene_walked_in_an_octree_gets_a_light_buffer_and_a_few_objects_none() {
+        let spheres: String =
+            (0..40).map(|k| format!("SPHERE 1 0.5 {} {} 0\n", k % 7, k / 7)).collect::<String>() + "LIGHT 1 0 10 10\n";
+        let path = std::path::Path::new("scene.txt");
+        let walked = scene_source("many", path, &format!("SURFACE 1 1 1 1 1 1 1 0 0 0 1 0 0\n{spheres}")).unwrap();
+        assert!(walked.contains("light_buffer_lights: 1"), "{walked}");
+        let few = scene_source("few", path, "SURFACE 1 1 1 1 1 1 1 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nLIGHT 1 0 10 10\n")
+            .unwrap();
+        assert!(!few.contains("light_buffer"), "{few}");
+        assert!(few.contains("pub const SCENE_TEXT: &str = include_str!(\"scene.txt\");"), "{few}");
+        assert!(few.contains("pub const SCENE_NAME: &str = \"scene\";"), "{few}");
+    }
+
+    #[test]
+    fn a_scene_with_errors_is_refused_with_their_count() {
+        let error = scene_source("bad", std::path::Path::new("bad.txt"), "SPHERE 1 1 0 0\nRASTER 0 0\n").unwrap_err();
+        assert!(matches!(error, BuildError::Scene { errors, .. } if errors >= 1), "{error}");
+        assert!(error.to_string().starts_with("bad: "), "{error}");
+    }
+}

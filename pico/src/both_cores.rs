@@ -1,0 +1,345 @@
+//! Both cores trace a scene, core 0 presents it: [`draw`] is the picture
+//! row by row, [`draw_progressive`] in a progressive order. Each core takes
+//! the next piece no core has taken (under the chip's lock) and traces it
+//! with a renderer of its own; core 1 (a [`SecondCore`] job) hands its
+//! pieces over in a [`Handoff`] ring; core 0 presents every piece in
+//! order. Each waits for the other with `wfe`, woken by the other's `sev`.
+//!
+//! Invariants: any split of the pieces between the cores gives the same
+//! bits as one core; core 0 presents the pieces in their order, so a
+//! display fed row by row sees the rows top to bottom.
+
+use crate::bank_stack::on_bank_stack;
+use crate::second_core::SecondCore;
+use core::cell::Cell;
+use core::ops::ControlFlow;
+use core::sync::atomic::{AtomicBool, Ordering};
+use cortex_m::asm::{sev, wfe};
+use critical_section::Mutex;
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
+use embedded_graphics_core::primitives::Rectangle;
+use octrace_core::panel::{Dithered, Dithering, TracedColor, IMAGE_ERROR_WORDS};
+use octrace_core::profile::Profile;
+use octrace_core::render::{Handoff, Progressive, Renderer, Unit};
+use octrace_core::{LoadedScene, RendererRoom, SceneAccelerator};
+
+/// Why a picture stopped before its end.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unfinished {
+    /// The camera cannot be set up at the panel's size.
+    Camera,
+    /// The panel refused a row, or the order is not the panel's.
+    Panel,
+    /// `each_row` or the caller's ask said stop.
+    Stopped,
+}
+
+/// Traces `scene` into `display` with both cores, row by row, core 1
+/// rendering in `room` (its own mailbox and screen lists) and handing rows
+/// over through `ring`, which holds at least a row of the display. Each row
+/// goes to the display in one `fill_contiguous`, in its colour: dithered
+/// onto a panel of few levels as the scene's image dithers it
+/// (`image_for`: the method its colour type calls for, the error carried
+/// from row to row), converted for any other. `each_row` sees every row as
+/// traced (in `Rgb888`) as it goes to the display, in order, and may stop
+/// the picture there.
+pub fn draw<P, D, const LEN: usize, const SLOTS: usize>(
+    core1: &mut SecondCore,
+    scene: &LoadedScene<'_, P>,
+    room: &mut RendererRoom<P>,
+    ring: &Handoff<LEN, SLOTS>,
+    display: &mut D,
+    each_row: impl FnMut(u32, &[Rgb888]) -> ControlFlow<()>,
+) -> Result<(), Unfinished>
+where
+    P: Profile,
+    D: DrawTarget,
+    D::Color: TracedColor,
+{
+    let width = display.bounding_box().size.width;
+    let trace = |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, y: &u32, colors: &mut [Rgb888], _: Asked<'_>| {
+        let mut traced = 0;
+        for (color, pixel) in colors.iter_mut().zip(renderer.row(*y, 0..width)) {
+            *color = pixel.color;
+            traced += 1;
+        }
+        Some(traced)
+    };
+    draw_rows(core1, scene, room, ring, display, each_row, || false, trace)
+}
+
+/// [`draw`], stopped inside a pixel: core 0 asks `stop` before every ray
+/// and while it waits for core 1's rows, core 1 a flag core 0 sets when
+/// `stop` says so; core 1 wakes core 0 at each of its asks, so that core 0
+/// asks at least as often while it waits. A row stopped is not drawn:
+/// `Err(Unfinished::Stopped)` after the rows before it.
+pub fn draw_until<P, D, const LEN: usize, const SLOTS: usize>(
+    core1: &mut SecondCore,
+    scene: &LoadedScene<'_, P>,
+    room: &mut RendererRoom<P>,
+    ring: &Handoff<LEN, SLOTS>,
+    display: &mut D,
+    each_row: impl FnMut(u32, &[Rgb888]) -> ControlFlow<()>,
+    stop: impl FnMut() -> bool,
+) -> Result<(), Unfinished>
+where
+    P: Profile,
+    D: DrawTarget,
+    D::Color: TracedColor,
+{
+    let width = display.bounding_box().size.width;
+    let trace =
+        |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, y: &u32, colors: &mut [Rgb888], mut stop: Asked<'_>| {
+            for (x, color) in (0..width).zip(colors.iter_mut()) {
+                *color = renderer.pixel_until(x, *y, &mut stop).ok()?.color;
+            }
+            Some(width.min(colors.len() as u32) as usize)
+        };
+    draw_rows(core1, scene, room, ring, display, each_row, stop, trace)
+}
+
+/// How a core asks whether to stop, inside a piece it traces.
+type Asked<'s> = &'s mut dyn FnMut() -> bool;
+
+/// The rows of [`draw`] and [`draw_until`], each traced by `trace`.
+#[allow(clippy::too_many_arguments)]
+fn draw_rows<'r, P, D, const LEN: usize, const SLOTS: usize>(
+    core1: &mut SecondCore,
+    scene: &LoadedScene<'r, P>,
+    room: &mut RendererRoom<P>,
+    ring: &Handoff<LEN, SLOTS>,
+    display: &mut D,
+    mut each_row: impl FnMut(u32, &[Rgb888]) -> ControlFlow<()>,
+    stop: impl FnMut() -> bool,
+    trace: impl Fn(&mut Renderer<'_, SceneAccelerator<'r, P>>, &u32, &mut [Rgb888], Asked<'_>) -> Option<usize> + Sync,
+) -> Result<(), Unfinished>
+where
+    P: Profile,
+    D: DrawTarget,
+    D::Color: TracedColor,
+{
+    let size = display.bounding_box().size;
+    if size.width as usize > LEN {
+        return Err(Unfinished::Panel);
+    }
+    let mut each_row = |y: &u32, colors: &[Rgb888]| match each_row(*y, colors) {
+        ControlFlow::Continue(()) => Ok(()),
+        ControlFlow::Break(()) => Err(Unfinished::Stopped),
+    };
+    let row = |y: &u32| Rectangle::new(Point::new(0, *y as i32), Size::new(size.width, 1));
+    // Known when it compiles: a truecolour display links no dithering.
+    if D::Color::PANEL.is_none() {
+        let present = |y: &u32, colors: &[Rgb888]| {
+            let mut line = [D::Color::from(Rgb888::BLACK); LEN];
+            let line = &mut line[..colors.len()];
+            for (pixel, &color) in line.iter_mut().zip(colors) {
+                *pixel = color.into();
+            }
+            display.fill_contiguous(&row(y), line.iter().copied()).map_err(|_| Unfinished::Panel)?;
+            each_row(y, colors)
+        };
+        return share(core1, scene, room, ring, size, || 0..size.height, trace, present, stop);
+    }
+    let mut error_rows = [0; IMAGE_ERROR_WORDS];
+    let mut dithered = Dithered::new(display, Dithering::default(), &mut error_rows).map_err(|_| Unfinished::Panel)?;
+    let present = |y: &u32, colors: &[Rgb888]| {
+        dithered.fill_contiguous(&row(y), colors.iter().copied()).map_err(|_| Unfinished::Panel)?;
+        each_row(y, colors)
+    };
+    share(core1, scene, room, ring, size, || 0..size.height, trace, present, stop)
+}
+
+/// Traces `scene` into `display` with both cores in the progressive
+/// `order` (the whole panel in coarse blocks first, then finer: the same
+/// picture as [`draw`] at the end on a truecolour display; on a panel of
+/// few levels, ordered (Bayer) dithering, the one method a block order
+/// keeps), each core taking the next unit, core 1 tracing in `room` and
+/// handing its colours over through `ring`, which holds
+/// `order.max_unit_pixels()`.
+pub fn draw_progressive<P, D, const LEN: usize, const SLOTS: usize>(
+    core1: &mut SecondCore,
+    scene: &LoadedScene<'_, P>,
+    room: &mut RendererRoom<P>,
+    ring: &Handoff<LEN, SLOTS>,
+    display: &mut D,
+    order: &Progressive,
+) -> Result<(), Unfinished>
+where
+    P: Profile,
+    D: DrawTarget,
+    D::Color: TracedColor,
+{
+    if order.size() != display.bounding_box().size || order.max_unit_pixels() > LEN {
+        return Err(Unfinished::Panel);
+    }
+    let mut display = Dithered::new(display, Dithering::Bayer, &mut []).map_err(|_| Unfinished::Panel)?;
+    let trace =
+        |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, unit: &Unit, colors: &mut [Rgb888], _: Asked<'_>| {
+            Some(unit.trace(renderer, colors).map_or(0, |traced| traced.colors().len()))
+        };
+    let present = |unit: &Unit, colors: &[Rgb888]| {
+        let traced = unit.with_colors(colors).map_err(|_| Unfinished::Panel)?;
+        traced.draw(&mut display).map_err(|_| Unfinished::Panel)
+    };
+    share(core1, scene, room, ring, order.size(), || order.units(), trace, present, || false)
+}
+
+/// Both cores trace the pieces (rows, or a progressive order's units) of
+/// an image of `size` that `pieces` lists, each taking the next piece not
+/// yet taken (a core that finds its pieces cheap, or has less else to do,
+/// takes more of them); core 1 hands its pieces over through `ring`, and
+/// core 0 presents every piece, in order. `trace` fills a piece's colours
+/// and says how many, or None when the core's ask said stop; `present`
+/// shows them, or stops the picture. Core 0 asks `stop` (inside its pieces
+/// and while it waits for core 1's), core 1 the flag core 0 sets then.
+///
+/// Why not halves: core 0 also presents every piece (the colours' format,
+/// the panel's commands, the bus), 4 to 5 % of its time on the Pico, and
+/// pieces differ in cost (a row of sky against a row of spheres), so fixed
+/// halves left core 1 waiting for 10 M cycles of fig5_3's picture.
+#[allow(clippy::too_many_arguments)]
+fn share<'r, P, T, I, const LEN: usize, const SLOTS: usize>(
+    core1: &mut SecondCore,
+    scene: &LoadedScene<'r, P>,
+    room: &mut RendererRoom<P>,
+    ring: &Handoff<LEN, SLOTS>,
+    size: Size,
+    pieces: impl Fn() -> I + Sync,
+    trace: impl Fn(&mut Renderer<'_, SceneAccelerator<'r, P>>, &T, &mut [Rgb888], Asked<'_>) -> Option<usize> + Sync,
+    mut present: impl FnMut(&T, &[Rgb888]) -> Result<(), Unfinished>,
+    mut stop_asked: impl FnMut() -> bool,
+) -> Result<(), Unfinished>
+where
+    P: Profile,
+    I: Iterator<Item = T>,
+{
+    let stop = AtomicBool::new(false);
+    // The number of the next piece to take: read and advanced under the
+    // chip's lock (ARMv6-M has no atomic read-modify-write).
+    let next = Mutex::new(Cell::new(0u32));
+    let take_next = || {
+        critical_section::with(|cs| {
+            let taken = next.borrow(cs).get();
+            next.borrow(cs).set(taken.saturating_add(1));
+            taken
+        })
+    };
+    let count = pieces().count() as u32;
+    let shared = scene.share();
+    // What a stopped picture left in the ring is not this picture's.
+    ring.clear();
+    let core1_part = || {
+        let Ok(mut renderer) = shared.renderer(room, size) else { return };
+        let mut colors = [Rgb888::BLACK; LEN];
+        let mut pieces = pieces().zip(0u32..);
+        // Asked first: a stopped picture traces no further piece.
+        while !stop.load(Ordering::Acquire) {
+            let number = take_next();
+            let Some((piece, _)) = pieces.find(|&(_, n)| n == number) else { return };
+            // Its slot is free once core 0 has presented the piece SLOTS
+            // before it, which it does without waiting for this core.
+            while !ring.is_free_for(number) {
+                if stop.load(Ordering::Acquire) {
+                    return;
+                }
+                wfe();
+            }
+            // Each ask wakes core 0, which asks its own (it may be waiting
+            // for this piece).
+            let mut asked = || {
+                sev();
+                stop.load(Ordering::Acquire)
+            };
+            let Some(traced) = on_bank_stack(|| trace(&mut renderer, &piece, &mut colors, &mut asked)) else { return };
+            // Free, so published.
+            let _ = ring.send(number, colors[..traced].iter().copied());
+            sev();
+        }
+    };
+    let core0_part = || {
+        let mut asked = || {
+            let stopped = stop_asked();
+            if stopped {
+                stop.store(true, Ordering::Release);
+                sev();
+            }
+            stopped
+        };
+        let presented = scene.with_renderer(size, |renderer| {
+            let mut own = [Rgb888::BLACK; LEN];
+            let mut handed = [Rgb888::BLACK; LEN];
+            // The pieces in order for the panel, and ahead of them core 0's.
+            let (mut to_show, mut to_trace) = (pieces().zip(0u32..), pieces().zip(0u32..));
+            // Every piece before `shown` is on the panel.
+            let mut shown = 0;
+            while shown < count {
+                // Core 1's next piece, if ready, goes to the panel first: its
+                // slot frees up for the piece core 1 takes next.
+                if ring.holds(shown) {
+                    let Some((piece, number)) = to_show.next() else { break };
+                    let handed_len = receive(ring, number, &mut handed, &mut asked)?;
+                    present(&piece, &handed[..handed_len])?;
+                    shown += 1;
+                    continue;
+                }
+                let number = take_next();
+                let traced = match to_trace.find(|&(_, n)| n == number) {
+                    Some((piece, _)) => Some(
+                        on_bank_stack(|| trace(renderer, &piece, &mut own, &mut asked)).ok_or(Unfinished::Stopped)?,
+                    ),
+                    None => None,
+                };
+                // The pieces from `shown` up to this one are core 1's.
+                for (piece, n) in to_show.by_ref() {
+                    match traced {
+                        Some(traced) if n == number => {
+                            present(&piece, &own[..traced])?;
+                            break;
+                        }
+                        _ => {
+                            let handed_len = receive(ring, n, &mut handed, &mut asked)?;
+                            present(&piece, &handed[..handed_len])?;
+                        }
+                    }
+                }
+                shown = number.saturating_add(1).min(count);
+            }
+            Ok(())
+        });
+        let result = presented.map_err(|_| Unfinished::Camera).and_then(|pieces| pieces);
+        if result.is_err() {
+            stop.store(true, Ordering::Release);
+            sev();
+        }
+        result
+    };
+    core1.scope(core1_part, core0_part)
+}
+
+/// Core 1's piece `number` from `ring` into `colors`, once it is there;
+/// returns how many colours it has. `asked` is asked at each wake-up
+/// meanwhile: stopped, the piece may never come.
+fn receive<const LEN: usize, const SLOTS: usize>(
+    ring: &Handoff<LEN, SLOTS>,
+    number: u32,
+    colors: &mut [Rgb888],
+    asked: Asked<'_>,
+) -> Result<usize, Unfinished> {
+    let handed = loop {
+        match ring.take(number) {
+            Some(handed) => break handed,
+            None if asked() => return Err(Unfinished::Stopped),
+            None => wfe(),
+        }
+    };
+    let mut len = 0;
+    for (color, handed) in colors.iter_mut().zip(handed) {
+        *color = handed;
+        len += 1;
+    }
+    // The slot is free again: wake core 1 if it waits for it.
+    sev();
+    Ok(len)
+}

@@ -1,0 +1,378 @@
+//! Animations: every frame traced with frame-to-frame coherence is the
+//! frame traced whole from scratch (`--frame K`), bit for bit, on scenes
+//! built so that each kind of dependence matters: an object seen only in a
+//! mirror, one seen only by its shadow, one passing through another's
+//! shadow, a moving light, a moving viewpoint, a moving B-spline patch, an
+//! object seen only through glass, and anim_fig5_1. Each check also runs
+//! with the tracking of the dependence its scene needs dropped
+//! (`Coherence::ignoring`), and must then fail: the tests see a broken
+//! tracker.
+
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{OriginDimensions, Size};
+use embedded_graphics_core::pixelcolor::Rgb888;
+use embedded_graphics_core::primitives::Rectangle;
+use embedded_graphics_core::Pixel;
+use octrace_core::animation::{Coherence, Dependence, Key, Motion, Track};
+use octrace_core::profile::Host;
+use octrace_core::Raytracer;
+use octrace_tests::repo;
+use std::sync::atomic::AtomicU8;
+
+/// A framebuffer: what a panel shows.
+#[derive(Clone, PartialEq, Eq)]
+struct Panel {
+    size: Size,
+    pixels: Vec<Rgb888>,
+}
+
+impl Panel {
+    fn new(size: Size) -> Panel {
+        Panel { size, pixels: vec![Rgb888::new(1, 2, 3); (size.width * size.height) as usize] }
+    }
+}
+
+impl OriginDimensions for Panel {
+    fn size(&self) -> Size {
+        self.size
+    }
+}
+
+impl DrawTarget for Panel {
+    type Color = Rgb888;
+    type Error = core::convert::Infallible;
+
+    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb888>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
+        for Pixel(p, c) in pixels {
+            self.pixels[(p.y as u32 * self.size.width + p.x as u32) as usize] = c;
+        }
+        Ok(())
+    }
+
+    fn fill_contiguous<I: IntoIterator<Item = Rgb888>>(
+        &mut self,
+        area: &Rectangle,
+        colors: I,
+    ) -> Result<(), Self::Error> {
+        let mut colors = colors.into_iter();
+        for y in area.rows() {
+            for x in area.columns() {
+                if let Some(c) = colors.next() {
+                    self.pixels[(y as u32 * self.size.width + x as u32) as usize] = c;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+const SIZE: Size = Size::new(48, 36);
+
+/// Frame `frame` of `text` traced whole, from scratch.
+fn whole(text: &str, frame: u32) -> Panel {
+    let mut raytracer = Box::new(Raytracer::<Host>::new());
+    let scene = raytracer.load_frame(text, frame).unwrap_or_else(|e| panic!("frame {frame}: {e}"));
+    let mut panel = Panel::new(SIZE);
+    let image = scene.image::<Rgb888>(SIZE);
+    embedded_graphics_core::Drawable::draw(
+        &embedded_graphics::image::Image::new(&image, embedded_graphics_core::geometry::Point::zero()),
+        &mut panel,
+    )
+    .unwrap();
+    panel
+}
+
+/// The loop played twice with coherence (tiles of `side`, `ignored`
+/// dropped): the first frame whose panel is not the frame traced whole,
+/// and the share of pixels re-traced after the first frame.
+fn play(text: &str, side: u32, ignored: Option<Dependence>) -> (Option<u32>, f64) {
+    let counts: Vec<AtomicU8> =
+        (0..Coherence::tiles_for(SIZE.width, SIZE.height, side)).map(|_| AtomicU8::new(0)).collect();
+    let mut coherence = Coherence::new(&counts, SIZE, side).unwrap();
+    if let Some(dependence) = ignored {
+        coherence = coherence.ignoring(dependence);
+    }
+    let mut raytracer = Box::new(Raytracer::<Host>::new());
+    let first = raytracer.load_frame(text, 0).unwrap();
+    let frames = first.frames().expect("an animation");
+    let needs = Motion::needs(text);
+    let (mut tracks, mut keys, mut table) =
+        (vec![Track::EMPTY; needs.tracks], vec![Key::default(); needs.keys], vec![[0; 3]; needs.displacements]);
+    let motion = Motion::read(text, frames, &first.view(), 0, &mut tracks, &mut keys, &mut table).unwrap();
+    let wholes: Vec<Panel> = frames.all().map(|k| whole(text, k)).collect();
+    let mut panel = Panel::new(SIZE);
+    let (mut traced, mut pixels) = (0, 0);
+    for (step, frame) in frames.all().chain(frames.all()).enumerate() {
+        let scene = raytracer.load_frame(text, frame).unwrap();
+        coherence.plan();
+        if step > 0 {
+            traced += coherence.traced_pixels();
+            pixels += u64::from(SIZE.width * SIZE.height);
+        }
+        scene.draw_changes(&motion, frame, &coherence, &mut panel).unwrap();
+        if panel != wholes[frame as usize] {
+            return (Some(frame), 0.0);
+        }
+    }
+    (None, traced as f64 / pixels.max(1) as f64)
+}
+
+const SURFACES: &str = "SURFACE 1 .1 .1 .1 .6 .6 .5 .3 .3 .3 10 0 0\n\
+                        SURFACE 2 .1 0 0 .8 .1 .1 .5 .5 .5 40 0 0\n\
+                        SURFACE 3 0 0 0 .05 .05 .05 1 1 1 100 .9 0\n\
+                        SURFACE 4 0 0 0 .05 .05 .05 .9 .9 .9 100 .05 .85\n";
+const FLOOR: &str = "RECTANGLE 1  -8 -1 6  8 -1 6  8 -1 -10  -8 -1 -10\n";
+const CAMERA: &str = "VIEWPOINT 0 2 9\nORIGIN 0 0 0\nBACKGROUND .1 .15 .2\n";
+
+/// An animation of `frames` frames: `body` after the surfaces.
+fn scene(frames: u32, body: &str) -> String {
+    format!("FRAMES {frames}\n{SURFACES}{body}")
+}
+
+/// Checks `text` is exact with every dependence tracked, and that it is not
+/// with `needed` dropped; returns the share re-traced.
+fn exact_and_needs(name: &str, text: &str, needed: Option<Dependence>) -> f64 {
+    let (wrong, share) = play(text, 4, None);
+    assert_eq!(wrong, None, "{name}: a frame differs from the frame traced whole");
+    if let Some(dependence) = needed {
+        let (broken, _) = play(text, 4, Some(dependence));
+        assert!(broken.is_some(), "{name}: still exact without tracking {dependence:?}: the test cannot see it");
+    }
+    println!("{name}: exact, {:.1} % of the pixels re-traced after the first frame", 100.0 * share);
+    share
+}
+
+#[test]
+fn an_object_seen_only_in_a_mirror() {
+    // The ball moves behind the camera: the mirror shows it.
+    let text = scene(
+        8,
+        &format!(
+            "{CAMERA}LIGHT 10 3 6 8\n{FLOOR}RECTANGLE 3 -4 -1 -3  4 -1 -3  4 4 -3  -4 4 -3\n\
+             SPHERE 2 0.8  -3 0.5 12  MOVE 0 0 0 0  7 6 0 0\n"
+        ),
+    );
+    let share = exact_and_needs("mirror", &text, Some(Dependence::Reflected));
+    assert!(share < 0.9, "the ball only moves in the mirror: {share}");
+}
+
+#[test]
+fn an_object_seen_only_by_its_shadow() {
+    // The ball moves above the picture; its shadow crosses the floor.
+    let text = scene(8, &format!("{CAMERA}LIGHT 12 0 14 2\n{FLOOR}SPHERE 2 0.6  -3 6 0  MOVE 0 0 0 0  7 6 0 -1\n"));
+    exact_and_needs("shadow", &text, Some(Dependence::Shadows));
+}
+
+#[test]
+fn an_object_passing_through_anothers_shadow() {
+    let text = scene(
+        8,
+        &format!(
+            "{CAMERA}LIGHT 12 -2 8 4\n{FLOOR}BOX 1 0 1.5 0  0.6 0.6 0.6\n\
+             SPHERE 2 0.5  -3 -0.5 -1.5  MOVE 0 0 0 0  7 6 0 0\n"
+        ),
+    );
+    exact_and_needs("through a shadow", &text, Some(Dependence::Primary));
+}
+
+#[test]
+fn a_moving_light() {
+    let text = scene(
+        6,
+        &format!("{CAMERA}LIGHT 12 -5 6 4 MOVE 0 0 0 0  5 10 0 -4\n{FLOOR}SPHERE 2 1 0 0 0\nBOX 1 2.5 0 -1 .5 1 .5\n"),
+    );
+    exact_and_needs("light", &text, Some(Dependence::Lights));
+}
+
+#[test]
+fn a_moving_viewpoint() {
+    let text = scene(
+        6,
+        "VIEWPOINT 0 2 9 MOVE 0 0 0 0  5 6 1 -3\nORIGIN 0 0 0\nLIGHT 12 3 6 8\nRECTANGLE 1 -8 -1 6 8 -1 6 8 -1 -10 -8 -1 -10\n\
+         SPHERE 2 1 0 0 0\n",
+    );
+    let share = exact_and_needs("viewpoint", &text, Some(Dependence::Camera));
+    assert!(share > 0.99, "everything, when the viewpoint moves: {share}");
+}
+
+#[test]
+fn a_moving_bspline_patch() {
+    let grid = "-2 0 -2  0 1 -2  2 0 -2   -2 1 0  0 2.5 0  2 1 0   -2 0 2  0 1 2  2 0 2";
+    let text =
+        scene(6, &format!("{CAMERA}LIGHT 12 3 6 8\n{FLOOR}BSPLINE 2 3 3 3 6 6 {grid}  MOVE 0 -2 0 0  5 2 0.5 -1\n"));
+    exact_and_needs("B-spline", &text, Some(Dependence::Primary));
+}
+
+#[test]
+fn an_object_seen_only_through_glass() {
+    // A pane of glass fills the view; the ball moves behind it.
+    let text = scene(
+        6,
+        &format!(
+            "{CAMERA}LIGHT 12 3 6 8\n{FLOOR}BOX 4 0 1 4  9 6 0.2\n\
+             SPHERE 2 0.8  -2 0 -2  MOVE 0 0 0 0  5 4 0 0\n"
+        ),
+    );
+    exact_and_needs("glass", &text, Some(Dependence::Transmitted));
+}
+
+#[test]
+fn anim_fig5_1_is_exact_and_saves_most_of_the_tracing() {
+    let text = std::fs::read_to_string(repo().join("scenes/anim_fig5_1.txt")).unwrap();
+    let share = exact_and_needs("anim_fig5_1", &text, Some(Dependence::Primary));
+    assert!(share < 0.5, "{share}");
+}
+
+/// host-sim's command line as a program (`tests/src/bin/host-sim-cli.rs`).
+const HOST_SIM: &str = env!("CARGO_BIN_EXE_host-sim-cli");
+
+/// Runs host-sim with `args` in `dir`: exit code and standard error.
+fn host_sim(dir: &std::path::Path, args: &[&str]) -> (i32, String) {
+    let output = std::process::Command::new(HOST_SIM)
+        .args(args)
+        .current_dir(dir)
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .env_remove("JOB_COMPLETION_INDEX")
+        .output()
+        .expect("host-sim-cli runs");
+    (output.status.code().unwrap_or(-1), String::from_utf8_lossy(&output.stderr).into_owned())
+}
+
+fn files(dir: &std::path::Path) -> Vec<String> {
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    names
+}
+
+/// A small animation of fig5_1 in `dir` (40×30, the first 8 frames' motion
+/// in 8 frames).
+fn small_animation(dir: &std::path::Path) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(repo().join("scenes/anim_fig5_1.txt")).unwrap();
+    let text = text.replace("FRAMES 48 24", "FRAMES 8 12").replace("RASTER    240 180", "RASTER 40 30");
+    let text = text
+        .replace("MOVE   0    0     0  0", "MOVE   0    0     0  0  7 -3 0 -3 MOVE")
+        .replace("MOVE\n      10", "/* cut */ FRAMES 1 /*");
+    // The scene keeps its first key and gains one at frame 7; the rest of
+    // the path is cut out.
+    let start = text.find("/* cut */").unwrap();
+    let end = text.find("SPHERE 3").unwrap();
+    let text = format!("{}\n{}", &text[..start], &text[end..]);
+    let path = dir.join("anim.txt");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn host_sim_writes_gif_apng_and_frame_files_identical_to_single_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    small_animation(d);
+    for (out, extra) in [("a.gif", &[][..]), ("b.gif", &["--no-coherence"][..]), ("c.gif", &["--threads", "3"][..])] {
+        let args: Vec<&str> = ["anim.txt", out, "-q"].iter().copied().chain(extra.iter().copied()).collect();
+        let (code, err) = host_sim(d, &args);
+        assert_eq!(code, 0, "{err}");
+    }
+    let gif = std::fs::read(d.join("a.gif")).unwrap();
+    assert_eq!(gif, std::fs::read(d.join("b.gif")).unwrap(), "coherence against every frame whole");
+    assert_eq!(gif, std::fs::read(d.join("c.gif")).unwrap(), "one thread against three");
+    // Frame files, truecolour: each the still `--frame K` writes.
+    assert_eq!(host_sim(d, &["anim.txt", "f%02d.png", "-q"]).0, 0);
+    for k in 0..8 {
+        let still = format!("still{k}.png");
+        assert_eq!(host_sim(d, &["anim.txt", &still, "--frame", &k.to_string(), "-q"]).0, 0);
+        let frame = octrace_images::formats::read(&std::fs::read(d.join(format!("f{k:02}.png"))).unwrap()).unwrap();
+        let still = octrace_images::formats::read(&std::fs::read(d.join(still)).unwrap()).unwrap();
+        assert_eq!(frame.to_rgb(), still.to_rgb(), "frame {k}");
+    }
+    // The APNG's frames are the frame files' pixels.
+    assert_eq!(host_sim(d, &["anim.txt", "a.png", "-q"]).0, 0);
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(d.join("a.png")).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    assert_eq!(reader.info().animation_control().map(|a| (a.num_frames, a.num_plays)), Some((8, 0)));
+    let mut buffer = vec![0; reader.output_buffer_size().unwrap()];
+    for k in 0..8 {
+        reader.next_frame(&mut buffer).unwrap();
+        let frame = octrace_images::formats::read(&std::fs::read(d.join(format!("f{k:02}.png"))).unwrap()).unwrap();
+        assert_eq!(buffer, frame.to_rgb().data, "APNG frame {k}");
+    }
+}
+
+#[test]
+fn frames_rendered_apart_merge_into_the_same_gif() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    small_animation(d);
+    assert_eq!(host_sim(d, &["anim.txt", "whole.gif", "--palette", "dither", "-q"]).0, 0);
+    for part in ["1/3", "2/3", "3/3"] {
+        let (code, err) = host_sim(d, &["anim.txt", "p%d.png", "--part", part, "--palette", "dither", "-q"]);
+        assert_eq!(code, 0, "{err}");
+    }
+    let frames: Vec<String> = (0..8).map(|k| format!("p{k}.png")).collect();
+    let mut args = vec!["merge", "merged.gif"];
+    args.extend(frames.iter().rev().map(String::as_str));
+    let (code, err) = host_sim(d, &args);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(std::fs::read(d.join("merged.gif")).unwrap(), std::fs::read(d.join("whole.gif")).unwrap());
+    // A frame missing, or twice: refused, nothing written.
+    let (code, err) = host_sim(d, &["merge", "bad.gif", "p0.png", "p1.png", "p3.png"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("frame 2 is missing"), "{err}");
+    let (code, err) = host_sim(d, &["merge", "bad.gif", "p0.png", "p0.png", "p1.png"]);
+    assert!(code == 2 && err.contains("frame 0 is twice"), "{err}");
+    assert!(!d.join("bad.gif").exists());
+}
+
+#[test]
+fn animation_errors_name_the_place_and_leave_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    small_animation(d);
+    let before = files(d);
+    // A GIF without a colour table, a still format, --frame out of range.
+    for (args, message) in [
+        (&["anim.txt", "x.gif", "--palette", "none"][..], "a GIF holds 256 colours"),
+        (&["anim.txt", "x.tga"][..], "--frame K renders one frame"),
+        (&["anim.txt", "x.png", "--frame", "8"][..], "has 8 frames, 0 to 7"),
+        (&["anim.txt", "x.gif", "--part", "1/2"][..], "--part splits an animation's frames"),
+    ] {
+        let (code, err) = host_sim(d, args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains(message), "{args:?}: {err}");
+    }
+    // A camera lost at frame 3 only: every file of the run goes.
+    let text = std::fs::read_to_string(d.join("anim.txt")).unwrap();
+    let lost = text.replace("ORIGIN    0 0.6 0", "ORIGIN    0 0.6 0 MOVE 0 0 0 0  6 0 2.6 11");
+    std::fs::write(d.join("lost.txt"), lost).unwrap();
+    for out in ["y.gif", "y%d.png"] {
+        let (code, err) = host_sim(d, &["lost.txt", out]);
+        assert_eq!(code, 2, "{err}");
+        // ORIGIN reaches VIEWPOINT within a unit of rounding: no view, or
+        // one along UPVECTOR.
+        assert!(err.contains("lost.txt:9:19: at frame 6, ") && err.contains("(frame 6); nothing rendered"), "{err}");
+    }
+    let mut after = files(d);
+    after.retain(|f| f != "lost.txt");
+    assert_eq!(after, before, "no file left behind");
+}
+
+#[test]
+fn the_gnu_parallel_frames_recipe_gives_the_single_render() {
+    let found = std::process::Command::new("parallel").arg("--version").output().is_ok_and(|o| o.status.success());
+    if !found {
+        assert!(std::env::var("CI").as_deref() != Ok("true"), "GNU parallel is missing (apt-get install parallel)");
+        println!("SKIPPED: GNU parallel is not installed (apt-get install parallel): the recipe was not run");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("scenes")).unwrap();
+    // The recipe's scene, small: quick in CI.
+    let small = small_animation(dir.path());
+    std::fs::rename(&small, dir.path().join("scenes/anim_fig5_1.txt")).unwrap();
+    octrace_tests::run_recipe(&octrace_tests::recipe("parallel-frames"), dir.path(), HOST_SIM);
+    let (code, err) = host_sim(dir.path(), &["scenes/anim_fig5_1.txt", "single.gif", "--palette", "scan", "-q"]);
+    assert_eq!(code, 0, "{err}");
+    let merged = std::fs::read(dir.path().join("anim_fig5_1.gif")).unwrap();
+    assert_eq!(merged, std::fs::read(dir.path().join("single.gif")).unwrap());
+    assert_eq!(files(dir.path()), ["anim_fig5_1.gif", "bin", "scenes", "single.gif"]);
+}
