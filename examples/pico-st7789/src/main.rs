@@ -25,7 +25,9 @@ use embedded_graphics::prelude::*;
 use hal::entry;
 use hal::multicore::Stack;
 use hal::pac::{self, interrupt};
-use octrace_core::render::{Handoff, Progressive};
+use octrace_core::render::Handoff;
+#[cfg(progressive_order)]
+use octrace_core::render::Progressive;
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
 use octrace_pico::board::{self, Board};
 use octrace_pico::both_cores;
@@ -57,12 +59,20 @@ static CORE1_STACK: Stack<4096> = Stack::new();
 
 /// The progressive order (`OCTRACE_ORDER=progressive`): the whole panel in
 /// blocks of 16 first, then 8, then each row of blocks at full resolution.
+#[cfg(progressive_order)]
 const PROGRESSIVE: Progressive =
     Progressive::new(Size::new(panel::WIDTH as u32, panel::HEIGHT as u32), 16).with_finest(8);
 
-/// What core 1 traced, on its way to the panel (a row, or a unit of the
-/// progressive order): it may trace four ahead.
-static RING: Handoff<{ PROGRESSIVE.max_unit_pixels() }, 4> = Handoff::new();
+/// The most pixels core 1 hands over at once: a row, or a unit of the
+/// progressive order (30 KiB for four: only the progressive build keeps
+/// them, so that the rows' leaves core 0's stack the room).
+#[cfg(not(progressive_order))]
+const HANDED_PIXELS: usize = panel::WIDTH as usize;
+#[cfg(progressive_order)]
+const HANDED_PIXELS: usize = PROGRESSIVE.max_unit_pixels();
+
+/// What core 1 traced, on its way to the panel: it may trace four ahead.
+static RING: Handoff<HANDED_PIXELS, 4> = Handoff::new();
 
 /// The panel's bus buffer.
 static PANEL_BUFFER: ConstStaticCell<[u8; 512]> = ConstStaticCell::new([0; 512]);
