@@ -58,13 +58,17 @@ pub extern "C" fn studio_output_len() -> usize {
     STATE.with_borrow(|state| state.output.len())
 }
 
-/// Parses the input as scene text; the output is `W H OBJECTS` (RASTER and
-/// the object count).
+/// Parses frame `frame` of the input, scene text (any frame of a scene
+/// without FRAMES is the scene); the output is `W H OBJECTS FRAMES RATE`
+/// (RASTER, the object count, and the animation's frames and rate, both 0
+/// for a still scene).
 #[no_mangle]
-pub extern "C" fn studio_load() -> u32 {
+pub extern "C" fn studio_load(frame: u32) -> u32 {
     run(|state| {
-        let ((w, h), objects) = state.studio.load(&state.input)?;
-        state.output = format!("{w} {h} {objects}").into_bytes();
+        let loaded = state.studio.load(&state.input, frame)?;
+        let ((w, h), objects) = (loaded.raster, loaded.objects);
+        let (count, rate) = loaded.frames.map_or((0, 0), |f| (f.count, f.rate));
+        state.output = format!("{w} {h} {objects} {count} {rate}").into_bytes();
         Ok(())
     })
 }
@@ -86,6 +90,23 @@ pub extern "C" fn studio_prepare(accel: u32, width: u32, height: u32) -> u32 {
 #[no_mangle]
 pub extern "C" fn studio_render(x: u32, y: u32, width: u32, height: u32) -> u32 {
     run(|state| state.studio.render_rect(x, y, width, height, &mut state.output))
+}
+
+/// Traces the loaded frame whole at the prepared size (`studio_prepare`):
+/// the output is the number of pixels traced (a little-endian `u32`), then
+/// the frame as `studio_render` writes it. The frames of an animation
+/// traced in turn re-trace only what moved (any forward step round the
+/// loop; anything else traces every pixel), with the same bits.
+#[no_mangle]
+pub extern "C" fn studio_trace_frame() -> u32 {
+    run(|state| {
+        let mut frame = Vec::new();
+        let traced = state.studio.trace_frame(&mut frame)?;
+        state.output.clear();
+        state.output.extend(u32::try_from(traced).unwrap_or(u32::MAX).to_le_bytes());
+        state.output.append(&mut frame);
+        Ok(())
+    })
 }
 
 /// The input (a whole render, as `studio_render` writes it) shown in

@@ -1,6 +1,7 @@
 //! octrace-core in the browser: the studio page's WebAssembly module. It
-//! parses scene text, renders any rectangle of the image with the very same
-//! core host-sim uses, maps finished images through the palette modes and
+//! parses scene text (any frame of an animation), renders any rectangle of
+//! the image with the very same core host-sim uses, plays an animation's
+//! frames re-tracing only what moved (`player`, the core's coherence), maps finished images through the palette modes and
 //! panel colours of `octrace-images`, and reads and writes its image files
 //! (host-sim's, as host-sim uses the same crate).
 //!
@@ -13,6 +14,7 @@
 #![deny(unsafe_code)]
 
 mod exports;
+mod player;
 mod studio;
 
-pub use studio::{accel_from_code, Display, Studio, StudioError};
+pub use studio::{accel_from_code, Display, Loaded, Studio, StudioError};

@@ -1,18 +1,20 @@
 //! The studio's state and operations, in safe Rust, independent of how the
 //! page calls them (tests call them directly).
 //!
-//! Invariant: `octree` was built from the current `scene` (it is dropped
-//! whenever the scene is replaced).
+//! Invariants: `octree` was built from the current `scene` (it is dropped
+//! whenever the scene is replaced); `text` and `frame` are what `scene` was
+//! parsed from.
 
+use crate::player::{Player, Shown};
 use embedded_graphics_core::pixelcolor::RgbColor;
 use octrace_core::accel::{
     self, Accelerator, LightBufferStore, LightBuffered, Mailbox, Naive, Octree, MAX_CELLS_A_SIDE,
 };
 use octrace_core::panel::{Dithering, Panel};
-use octrace_core::parse::{parse_bytes, ParseError};
+use octrace_core::parse::{parse_frame_bytes, ParseError};
 use octrace_core::profile::{Host, Profile};
 use octrace_core::render::{Renderer, ScreenBound};
-use octrace_core::scene::Scene;
+use octrace_core::scene::{Frames, Scene};
 use octrace_core::AccelMode;
 use octrace_images::formats::{self, Format, Image};
 use octrace_images::palette::{self, PaletteMode};
@@ -68,6 +70,8 @@ pub enum StudioError {
     BadInput(&'static str),
     /// An image file could not be read or written.
     Image(formats::FormatError),
+    /// An animation's frames cannot be traced one from another: why.
+    Motion(String),
 }
 
 impl fmt::Display for StudioError {
@@ -78,21 +82,38 @@ impl fmt::Display for StudioError {
             StudioError::Camera(why) => write!(f, "cannot set up the camera: {why}"),
             StudioError::BadInput(what) => write!(f, "bad input: {what}"),
             StudioError::Image(e) => write!(f, "{e}"),
+            StudioError::Motion(why) => write!(f, "cannot play the animation: {why}"),
         }
     }
 }
 
 impl std::error::Error for StudioError {}
 
-/// One scene, its octree and the render size.
+/// What [`Studio::load`] found: the scene's RASTER, its objects and, for
+/// an animation, its frames.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Loaded {
+    pub raster: (u32, u32),
+    pub objects: usize,
+    pub frames: Option<Frames>,
+}
+
+/// One scene (a frame of it, for an animation), its octree and the render
+/// size, and the player that traces an animation's frames one after the
+/// other.
 pub struct Studio {
     scene: Box<Scene<Host>>,
     loaded: bool,
+    /// The text the scene was parsed from, and its frame.
+    text: Vec<u8>,
+    frame: u32,
+    frames: Option<Frames>,
     octree: Option<Box<Octree<Host>>>,
     /// The shadow rays' light buffer (none for the naive mode, the
     /// thesis's test of every object), as host-sim builds it.
     lights: LightBufferStore<<Host as Profile>::LightBufferWords>,
     size: (u32, u32),
+    player: Player,
 }
 
 impl Default for Studio {
@@ -100,28 +121,37 @@ impl Default for Studio {
         Studio {
             scene: Box::new(Scene::new()),
             loaded: false,
+            text: Vec::new(),
+            frame: 0,
+            frames: None,
             octree: None,
             lights: LightBufferStore::new(),
             size: (1, 1),
+            player: Player::default(),
         }
     }
 }
 
 impl Studio {
-    /// Parses `text`; on success returns the scene's RASTER and object count.
-    pub fn load(&mut self, text: &[u8]) -> Result<((u32, u32), usize), StudioError> {
+    /// Parses frame `frame` of `text` (for a scene without FRAMES, the
+    /// scene: every frame is the same).
+    pub fn load(&mut self, text: &[u8], frame: u32) -> Result<Loaded, StudioError> {
         self.octree = None;
         self.lights = LightBufferStore::new();
         self.loaded = false;
+        self.text.clear();
+        self.text.extend_from_slice(text);
+        self.frame = frame;
         let mut errors = Vec::new();
         let mut on_error = |e: ParseError<'_>| errors.push(e.to_string());
-        match parse_bytes(text, &mut self.scene, &mut on_error) {
-            Ok(_) => {
+        match parse_frame_bytes(text, &mut self.scene, frame, &mut on_error) {
+            Ok(parsed) => {
                 self.loaded = true;
+                self.frames = parsed.frames;
                 let view = self.scene.view();
                 let raster = (view.settings.raster[0], view.settings.raster[1]);
                 self.size = raster;
-                Ok((raster, view.object_count()))
+                Ok(Loaded { raster, objects: view.object_count(), frames: parsed.frames })
             }
             Err(_) => Err(StudioError::Scene(errors)),
         }
@@ -163,6 +193,30 @@ impl Studio {
             None => self.render_with(&LightBuffered::new(&Naive, lights), rect, out),
             Some(octree) => self.render_with(&LightBuffered::new(octree, lights), rect, out),
         }
+    }
+
+    /// Traces the loaded frame whole, at the prepared size, into `out` as
+    /// [`Studio::render_rect`] writes it; for an animation, re-tracing only
+    /// what can have changed since the frame the player traced last when
+    /// that was an earlier frame of the same text at the same size (the
+    /// core's coherence: the same bits as a frame traced whole). Returns
+    /// how many pixels it traced.
+    pub fn trace_frame(&mut self, out: &mut Vec<u8>) -> Result<u64, StudioError> {
+        if !self.loaded {
+            return Err(StudioError::NoScene);
+        }
+        let text = std::str::from_utf8(&self.text).map_err(|_| StudioError::BadInput("the scene is not UTF-8"))?;
+        let view = self.scene.view();
+        let lights = self.lights.buffer();
+        // A still scene is an animation of one frame that never moves.
+        let frames = self.frames.unwrap_or(Frames { count: 1, rate: Frames::DEFAULT_RATE });
+        let frame = Shown { text, frames, frame: self.frame, size: self.size };
+        let traced = match self.octree.as_deref() {
+            None => self.player.trace(view, &LightBuffered::new(&Naive, lights), &frame),
+            Some(octree) => self.player.trace(view, &LightBuffered::new(octree, lights), &frame),
+        }?;
+        self.player.write(out);
+        Ok(traced)
     }
 
     fn render_with<A: Accelerator>(
@@ -239,7 +293,7 @@ mod tests {
     #[test]
     fn every_mode_renders_the_same_bits_in_any_pieces() {
         let mut studio = Studio::default();
-        assert_eq!(studio.load(SCENE).unwrap(), ((8, 6), 1));
+        assert_eq!(studio.load(SCENE, 0).unwrap(), Loaded { raster: (8, 6), objects: 1, frames: None });
         studio.prepare(AccelMode::Naive, 8, 6).unwrap();
         let mut whole = Vec::new();
         studio.render_rect(0, 0, 8, 6, &mut whole).unwrap();
@@ -259,7 +313,7 @@ mod tests {
     #[test]
     fn errors_come_with_line_and_column() {
         let mut studio = Studio::default();
-        let Err(StudioError::Scene(errors)) = studio.load(b"VIEWPOINT 0 0 5\nSPHERE 1 x 0 0 0\n") else {
+        let Err(StudioError::Scene(errors)) = studio.load(b"VIEWPOINT 0 0 5\nSPHERE 1 x 0 0 0\n", 0) else {
             panic!("the scene has an error")
         };
         assert!(errors[0].starts_with("2:10:"), "{errors:?}");
@@ -269,11 +323,58 @@ mod tests {
     #[test]
     fn rectangles_outside_the_image_are_refused() {
         let mut studio = Studio::default();
-        studio.load(SCENE).unwrap();
+        studio.load(SCENE, 0).unwrap();
         studio.prepare(AccelMode::Naive, 8, 6).unwrap();
         let mut out = Vec::new();
         assert!(studio.render_rect(5, 0, 4, 1, &mut out).is_err());
         assert!(studio.render_rect(u32::MAX, 0, 2, 1, &mut out).is_err());
+    }
+
+    /// `text`'s frame `frame` at `size`, traced whole with `accel`.
+    fn frame_traced_whole(text: &[u8], frame: u32, accel: AccelMode, (w, h): (u32, u32)) -> Vec<u8> {
+        let mut studio = Studio::default();
+        studio.load(text, frame).unwrap();
+        studio.prepare(accel, w, h).unwrap();
+        let mut out = Vec::new();
+        studio.render_rect(0, 0, w, h, &mut out).unwrap();
+        out
+    }
+
+    #[test]
+    fn frames_played_in_turn_are_the_frames_traced_whole_and_retrace_less() {
+        let text = include_bytes!("../../scenes/anim_fig5_1.txt");
+        let (w, h) = (48, 36);
+        let pixels = u64::from(w * h);
+        let mut studio = Studio::default();
+        let mut play = |frame: u32, accel: AccelMode| {
+            let loaded = studio.load(text, frame).unwrap();
+            assert_eq!(loaded.frames.map(|f| (f.count, f.rate)), Some((48, 24)));
+            studio.prepare(accel, w, h).unwrap();
+            let mut out = Vec::new();
+            let traced = studio.trace_frame(&mut out).unwrap();
+            assert_eq!(out, frame_traced_whole(text, frame, AccelMode::Naive, (w, h)), "frame {frame}");
+            traced
+        };
+        assert_eq!(play(0, AccelMode::Dda), pixels, "the first frame is traced whole");
+        // One step, several at once, round the loop past the last frame:
+        // fewer pixels, the same bits, in any mode.
+        let mut retraced = 0;
+        for (frame, accel) in [(1, AccelMode::Dda), (2, AccelMode::Naive), (5, AccelMode::Octree), (47, AccelMode::Dda)]
+        {
+            retraced += play(frame, accel);
+        }
+        for frame in [0, 1] {
+            retraced += play(frame, AccelMode::Auto);
+        }
+        assert!(retraced < 6 * pixels / 2, "{retraced} pixels re-traced in 6 frames of {pixels}");
+        assert_eq!(play(1, AccelMode::Dda), 0, "the frame shown again traces nothing");
+        // Backwards is round the loop: the same bits.
+        play(0, AccelMode::Dda);
+        // Another text starts again from every tile.
+        let other = [&text[..], b"\n/* edited */\n"].concat();
+        studio.load(&other, 1).unwrap();
+        studio.prepare(AccelMode::Dda, w, h).unwrap();
+        assert_eq!(studio.trace_frame(&mut Vec::new()).unwrap(), pixels);
     }
 
     #[test]

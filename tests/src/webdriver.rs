@@ -190,7 +190,13 @@ impl Browser {
 
     /// Types `keys` into the element `css` selects.
     pub fn type_into(&self, css: &str, keys: &str) {
-        let id = element_id(&self.element(css));
+        self.type_into_element(&self.element(css), keys);
+    }
+
+    /// Types `keys` into `element` (a reference, as [`Browser::element`] or
+    /// a script returning an element gives it: one in a shadow root too).
+    pub fn type_into_element(&self, element: &Value, keys: &str) {
+        let id = element_id(element);
         self.session("POST", &format!("/element/{id}/value"), json!({ "text": keys }));
     }
 

@@ -55,9 +55,14 @@ impl Studio {
         Studio::start_with(binary, scene, &[])
     }
 
-    /// `host-sim studio [SCENE] ARGS...`.
+    /// `host-sim studio [SCENE] ARGS...`, run in SCENE's directory (so the
+    /// page names it as a user would, not by a scratch directory's path).
     fn start_with(binary: &Path, scene: Option<&Path>, args: &[&OsStr]) -> Studio {
         let mut command = Command::new(binary);
+        if let Some(directory) = scene.and_then(Path::parent).filter(|d| !d.as_os_str().is_empty()) {
+            command.current_dir(directory);
+        }
+        let scene = scene.map(|path| path.file_name().expect("a file"));
         command.arg("studio").args(scene).args(args).stdout(Stdio::piped()).stderr(Stdio::piped());
         let mut child = command.spawn().expect("host-sim studio starts");
         let mut first = String::new();
@@ -156,7 +161,7 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
     browser.click("#toolbar button[data-tool=sphere]");
     browser.drag("#wire", (0, 40), (0, 10));
     browser.drag("#wire", (0, 0), (40, 0));
-    let text: String = browser.run("return document.getElementById('scene').value;").as_str().unwrap().into();
+    let text = scene_text(&browser);
     assert!(
         text.contains("SPHERE 1 "),
         "a sphere was placed:\n{text}\n{}",
@@ -169,8 +174,7 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
         "const s = document.querySelector('#panel input[data-field=reflection]');
          s.value = '0.25'; s.dispatchEvent(new Event('change')); return true;",
     );
-    browser
-        .wait_for("/SURFACE 1 0\\.1 0\\.1 0\\.1 1 0 0 .* 0\\.25 0/.test(document.getElementById('scene').value)", 10);
+    browser.wait_for("/SURFACE 1 0\\.1 0\\.1 0\\.1 1 0 0 .* 0\\.25 0/.test(studio.editor.text())", 10);
     render_and_wait(&browser);
     screenshot(&browser, "placed");
     browser.click("#save-scene");
@@ -245,12 +249,11 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
     assert_eq!(octrace_images::formats::read(&bytes).expect("indexed PNG"), dithered);
 
     // Undo takes the last edit back; redo restores it.
-    let before: String = browser.run("return document.getElementById('scene').value;").as_str().unwrap().into();
+    let before = scene_text(&browser);
     browser.run("studio.undo(); return true;");
-    let undone: String = browser.run("return document.getElementById('scene').value;").as_str().unwrap().into();
-    assert_ne!(undone, before);
+    assert_ne!(scene_text(&browser), before);
     browser.run("studio.redo(); return true;");
-    assert_eq!(browser.run("return document.getElementById('scene').value;").as_str().unwrap(), before);
+    assert_eq!(scene_text(&browser), before);
 
     // A file changed on disk since it was loaded is not overwritten without
     // asking: declining keeps the other program's text.
@@ -272,8 +275,7 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
     // Unsaved work survives a reload.
     browser.goto(&studio.url);
     browser.wait_for("document.body.dataset.ready === 'true'", 60);
-    let restored: String = browser.run("return document.getElementById('scene').value;").as_str().unwrap().into();
-    assert_eq!(restored, format!("{saved}/* more */\n"));
+    assert_eq!(scene_text(&browser), format!("{saved}/* more */\n"));
 
     // Errors at line and column as you type.
     set_text(&browser, "VIEWPOINT 0 0 5\nSPHERE 1 x 0 0 0\n");
@@ -325,9 +327,6 @@ fn the_canvas_is_host_sims_image_for_every_scene() {
             browser.canvas_rgb("image"),
             &expected.image,
         );
-        if name == "fig5_1" {
-            screenshot(&browser, "studio");
-        }
     }
 
     // The draft while typing on fig5_3 at 160×120: from the last keystroke
@@ -338,8 +337,7 @@ fn the_canvas_is_host_sims_image_for_every_scene() {
     browser.wait_for("document.getElementById('draft').dataset.state === 'done'", 60);
     let mut latencies = Vec::new();
     for _ in 0..11 {
-        browser.run("document.getElementById('scene').focus(); return true;");
-        browser.type_into("#scene", " ");
+        browser.type_into_element(&browser.run("return studio.editor.view.contentDOM;"), " ");
         browser.wait_for("document.getElementById('draft').dataset.state === 'done'", 60);
         latencies.push(browser.run("return studio.draftLatency;").as_f64().expect("a latency"));
     }
@@ -386,6 +384,25 @@ fn a_render_or_draft_of_hours_a_pixel_is_stopped_by_the_next_at_once() {
         );
         assert!(elapsed < Duration::from_secs(30), "the next draft and render took {elapsed:?}");
     }
+    // An animation's players too: a frame of hours a pixel, its draft and
+    // render under way, is stopped by the next text, whose frames come at
+    // once (the draft's player is the draft's worker pair).
+    let dir = tempfile::tempdir().expect("a directory");
+    let animation = dir.path().join("animation.txt");
+    let animated =
+        with_raster(&std::fs::read_to_string(repo().join("scenes/anim_fig5_1.txt")).expect("anim_fig5_1"), 64, 48);
+    std::fs::write(&animation, &animated).expect("the animation");
+    set_text(&browser, &format!("FRAMES 2\n{wedge}"));
+    browser.run(
+        "const s = document.getElementById('frame'); s.value = '1'; s.dispatchEvent(new Event('input')); return true;",
+    );
+    std::thread::sleep(Duration::from_millis(300));
+    let started = Instant::now();
+    set_text(&browser, &animated);
+    slide_to(&browser, 1);
+    let elapsed = started.elapsed();
+    assert_same("frame 1 after the wedge's", browser.canvas_rgb("image"), &host_frame(&animation, 1, None));
+    assert!(elapsed < Duration::from_secs(30), "the next frame took {elapsed:?}");
 }
 
 #[test]
@@ -405,8 +422,20 @@ fn the_server_keeps_its_security_rules() {
     let (status, head, _) = http_with_head(port, "GET", &with_token("/"), &[], b"");
     assert_eq!(status, 303, "{head}");
     assert!(head.lines().any(|l| l == format!("Location: /{}/", studio.token)), "{head}");
-    let modules =
-        ["/studio.js", "/octrace.js", "/model.js", "/view.js", "/tools.js", "/panel.js", "/board.js", "/worker.js"];
+    let modules = [
+        "/studio.js",
+        "/octrace.js",
+        "/editor.js",
+        "/codemirror.js",
+        "/keywords.js",
+        "/model.js",
+        "/view.js",
+        "/tools.js",
+        "/panel.js",
+        "/board.js",
+        "/time.js",
+        "/worker.js",
+    ];
     for path in ["/", "/studio.css", "/octrace_studio.wasm"].into_iter().chain(modules) {
         let (status, head, body) = http_with_head(port, "GET", &format!("/{}{path}", studio.token), &[], b"");
         assert_eq!(status, 200, "{path}");
@@ -549,14 +578,19 @@ fn a_busy_port_is_an_error_not_a_panic() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot listen"), "{}", String::from_utf8_lossy(&out.stderr));
 }
 
-/// Presses `key` (a WebDriver key string) on the page.
+/// Presses `key` (a WebDriver key string) on the page, the focus in none
+/// of its fields (nor in the editor).
 fn press(browser: &Browser, key: &str) {
-    browser.run("document.activeElement && document.activeElement.blur(); return true;");
+    browser.run(
+        "let focused = document.activeElement;
+         while (focused && focused.shadowRoot && focused.shadowRoot.activeElement) focused = focused.shadowRoot.activeElement;
+         if (focused) focused.blur(); return true;",
+    );
     browser.keys(key);
 }
 
 fn scene_text(browser: &Browser) -> String {
-    browser.run("return document.getElementById('scene').value;").as_str().expect("text").to_string()
+    browser.run("return studio.editor.text();").as_str().expect("text").to_string()
 }
 
 #[test]
@@ -651,26 +685,328 @@ fn every_tool_places_its_object_and_selections_move_and_delete() {
     assert_eq!(browser.run("return document.getElementById('help').open;"), true);
 }
 
-/// The page finds statements in the text by their arities (`ARITY` in
-/// model.js); they must be the core's, keyword for keyword.
+/// Runs `script` with `root`, the editor's shadow root, in scope.
+fn in_editor(browser: &Browser, script: &str) -> serde_json::Value {
+    browser.run(&format!("const root = document.getElementById('scene').shadowRoot; {script}"))
+}
+
+/// The texts of the editor's elements `css` selects.
+fn editor_texts(browser: &Browser, css: &str) -> Vec<String> {
+    let texts = in_editor(browser, &format!("return [...root.querySelectorAll('{css}')].map((e) => e.textContent);"));
+    serde_json::from_value(texts).expect("texts")
+}
+
+/// Whatever the page's Content-Security-Policy refused, and its script
+/// errors (the page keeps them in `studio.log`).
+fn page_log(browser: &Browser) -> serde_json::Value {
+    browser.run("return studio.log || [];")
+}
+
+/// The editor as people expect one: line numbers, long lines whole
+/// (scrolled, never wrapped), the format's keywords highlighted — the
+/// core's list (host-sim makes the page's keywords.js from it), every
+/// keyword and nothing else — each error marked at its line and column, one
+/// undo history for typing and the tools' edits, the page's keys in it,
+/// and nothing the page's Content-Security-Policy refuses.
 #[test]
-fn the_pages_statement_arities_are_the_cores() {
-    let model = std::fs::read_to_string(repo().join("host-sim/src/studio/assets/model.js")).expect("model.js");
-    let table = model.split("export const ARITY = {").nth(1).and_then(|rest| rest.split('}').next());
-    let table = table.expect("model.js declares `export const ARITY = { … }`");
-    let mut page: Vec<(String, usize)> = table
-        .split(',')
-        .filter(|entry| !entry.trim().is_empty())
-        .map(|entry| {
-            let (keyword, arity) = entry.split_once(':').unwrap_or_else(|| panic!("`{entry}` is KEYWORD: arity"));
-            (keyword.trim().to_string(), arity.trim().parse().unwrap_or_else(|_| panic!("`{entry}`: a number")))
+fn the_editor_highlights_the_cores_keywords_marks_errors_and_keeps_one_history() {
+    let binary = host_sim_binary();
+    let studio = Studio::start(&binary, None);
+    let browser = Browser::start((1500, 900));
+    browser.goto(&studio.url);
+    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+
+    // Every keyword of the core, in either ASCII case, beside words that
+    // are none: in a comment, quoted, plural, with a non-ASCII letter that
+    // upper-cases to S.
+    let keywords: Vec<&str> = octrace_core::parse::statement_arities().map(|(keyword, _)| keyword).collect();
+    let mut text = String::from("/* SPHERE */ \"BOX\" SPHERES \u{17f}PHERE 1.5e3 -.5 1.2.3 // LIGHT\n");
+    for (i, keyword) in keywords.iter().enumerate() {
+        text += &if i % 2 == 0 { keyword.to_ascii_lowercase() } else { keyword.to_string() };
+        text += "\n";
+    }
+    set_text(&browser, &text);
+    let highlighted: Vec<String> =
+        editor_texts(&browser, ".tok-keyword").iter().map(|k| k.to_ascii_uppercase()).collect();
+    assert_eq!(highlighted, keywords);
+    assert_eq!(editor_texts(&browser, ".tok-comment"), ["/* SPHERE */", "// LIGHT"]);
+    assert_eq!(editor_texts(&browser, ".tok-string"), ["\"BOX\""]);
+    assert_eq!(editor_texts(&browser, ".tok-number"), ["1.5e3", "-.5"]);
+    // Line numbers, one a line.
+    let numbers = editor_texts(&browser, ".cm-lineNumbers .cm-gutterElement");
+    for line in 1..=keywords.len() + 1 {
+        assert!(numbers.contains(&line.to_string()), "line {line} is numbered: {numbers:?}");
+    }
+    // A long line stays one line: as high as a short one, scrolled sideways.
+    set_text(&browser, &format!("RDEPTH 2\nBACKGROUND {}\n", "0.5 ".repeat(120)));
+    let lines = in_editor(
+        &browser,
+        "const lines = [...root.querySelectorAll('.cm-line')].map((l) => l.getBoundingClientRect().height);
+         const scroller = root.querySelector('.cm-scroller');
+         return [lines[0], lines[1], scroller.scrollWidth > scroller.clientWidth];",
+    );
+    assert_eq!((&lines[0], &lines[2]), (&lines[1], &true.into()), "no soft wrapping: {lines}");
+
+    // Each error marked where the core says it is, a MOVE's too, and listed.
+    let text = "VIEWPOINT 0 0 5\nSPHERE 1 x 0 0 0\nFRAMES 3\nLIGHT 1 0 0 0 MOVE 0 1 1 1 MOVE 1 2 2 2\n\
+                LIGHT 1 0 0 0 MOVE 0 1 1 1  1 q 0 0\n";
+    set_text(&browser, text);
+    let listed = browser
+        .run("return [...document.querySelectorAll('#errors li')].map((li) => [li.dataset.line, li.dataset.column]);");
+    let listed: Vec<(String, String)> = serde_json::from_value(listed).expect("the errors");
+    let at: Vec<(usize, usize)> = listed.iter().map(|(l, c)| (l.parse().unwrap(), c.parse().unwrap())).collect();
+    assert_eq!(at, [(2, 10), (4, 28), (5, 31)], "{listed:?}");
+    let words: Vec<String> = at
+        .iter()
+        .map(|&(line, column)| {
+            let line = text.lines().nth(line - 1).expect("a line");
+            line.chars().skip(column - 1).take_while(|c| !c.is_whitespace()).collect()
         })
         .collect();
-    let mut core: Vec<(String, usize)> =
-        octrace_core::parse::statement_arities().map(|(keyword, arity)| (keyword.to_string(), arity)).collect();
-    page.sort();
-    core.sort();
-    assert_eq!(page, core);
+    assert_eq!(words, ["x", "MOVE", "q"]);
+    let marked = in_editor(
+        &browser,
+        "const lines = [...root.querySelectorAll('.cm-line')];
+         return [...root.querySelectorAll('.cm-lintRange-error')].map((e) => [lines.indexOf(e.closest('.cm-line')) + 1, e.textContent]);",
+    );
+    assert_eq!(marked, serde_json::json!([[2, "x"], [4, "MOVE"], [5, "q"]]));
+    assert_eq!(editor_texts(&browser, ".cm-gutter-lint .cm-lint-marker-error").len(), 3, "a mark in the gutter a line");
+
+    // One history: typing, then a tool's edit (the panel's background),
+    // undone in turn by Ctrl+Z outside the editor, and redone by Ctrl+Y.
+    set_text(&browser, START);
+    let content = browser.run("return studio.editor.view.contentDOM;");
+    browser.type_into_element(&content, "RDEPTH 2");
+    let typed = scene_text(&browser);
+    assert!(typed.starts_with(START) && typed.contains("RDEPTH 2"), "{typed}");
+    press(&browser, "\u{E00C}"); // Escape: the scene's panel
+    browser.run(
+        "const i = document.querySelector('#panel input[data-field=\"background r\"]');
+         i.value = '0.5'; i.dispatchEvent(new Event('change')); return true;",
+    );
+    let edited = scene_text(&browser);
+    assert!(edited.contains("BACKGROUND 0.5 0.1 0.15"), "{edited}");
+    press(&browser, "\u{E009}z\u{E009}");
+    assert_eq!(scene_text(&browser), typed, "the panel's edit undone");
+    press(&browser, "\u{E009}z\u{E009}");
+    assert_eq!(scene_text(&browser), START, "the typing undone");
+    press(&browser, "\u{E009}y\u{E009}");
+    assert_eq!(scene_text(&browser), typed, "the typing redone");
+    browser.click("#redo");
+    assert_eq!(scene_text(&browser), edited, "the panel's edit redone");
+
+    // Ctrl+Enter in the editor renders, and adds no line.
+    browser.run("studio.editor.view.focus(); document.getElementById('image').dataset.state = 'stale'; return true;");
+    browser.keys("\u{E009}\u{E007}\u{E009}");
+    browser.wait_for("document.getElementById('image').dataset.state === 'done'", 60);
+    assert_eq!(scene_text(&browser), edited);
+    assert_eq!(page_log(&browser), serde_json::json!([]), "nothing refused, no script error");
+}
+
+/// host-sim's picture of frame `frame` of the scene file `scene`:
+/// `host-sim SCENE OUT.png --frame K [--size WxH]`.
+fn host_frame(scene: &Path, frame: u32, size: Option<&str>) -> RgbImage {
+    let dir = tempfile::tempdir().expect("a directory");
+    let out = dir.path().join("frame.png");
+    let frame = frame.to_string();
+    let mut args = vec!["host-sim", scene.to_str().expect("a path"), out.to_str().expect("a path")];
+    args.extend(["--frame", &frame, "--quiet"]);
+    args.extend(size.iter().flat_map(|size| ["--size", size]));
+    let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
+    let code = host_sim::run(args, &mut stdout, &mut stderr);
+    assert_eq!(code, 0, "{}", String::from_utf8_lossy(&stderr));
+    octrace_images::formats::read(&std::fs::read(&out).expect("the frame")).expect("a PNG").to_rgb()
+}
+
+/// The page's pictures of a frame: the draft, and the render if one is shown.
+const FRAME_PICTURES: &str = "['draft', ...(studio.lastRender ? ['image'] : [])]";
+
+/// Moves the time slider to `frame` and waits for the draft (and the
+/// render, if one is shown) to show it.
+fn slide_to(browser: &Browser, frame: u32) {
+    browser.run(&format!(
+        "for (const id of {FRAME_PICTURES}) document.getElementById(id).dataset.frame = 'stale';
+         const slider = document.getElementById('frame');
+         slider.value = '{frame}'; slider.dispatchEvent(new Event('input')); return true;"
+    ));
+    let shown = format!("{FRAME_PICTURES}.every((id) => document.getElementById(id).dataset.frame === '{frame}')");
+    browser.wait_for(&shown, 120);
+}
+
+/// The share of the render's pixels the page says it traced for its frame.
+fn traced_share(browser: &Browser) -> f64 {
+    let status = browser.run("return document.getElementById('status').textContent;");
+    let status = status.as_str().expect("a status");
+    let share = status.split(", ").nth(1).and_then(|s| s.split(' ').next()).and_then(|n| n.parse().ok());
+    share.unwrap_or_else(|| panic!("a share of pixels traced in {status:?}"))
+}
+
+/// Plays the page's animation for 30 frames, then pauses; returns the frame
+/// it stopped at, once shown. Prints how fast `what` played.
+fn play_and_pause(browser: &Browser, what: &str) -> u32 {
+    let start = browser.run("return studio.frame;").as_u64().expect("a frame");
+    browser.click("#play");
+    browser.wait_for("studio.played && studio.played.length >= 30", 120);
+    browser.click("#play");
+    let shown =
+        format!("{FRAME_PICTURES}.every((id) => document.getElementById(id).dataset.frame === String(studio.frame))");
+    browser.wait_for(&format!("!studio.playing && {shown}"), 60);
+    let frame = browser.run("return studio.frame;").as_u64().expect("a frame");
+    let played = browser.run("return studio.played;");
+    let played = played.as_array().expect("the frames played");
+    let frames: Vec<u64> = played.iter().map(|p| p["frame"].as_u64().expect("a frame")).collect();
+    let in_turn: Vec<u64> = (1..=frames.len() as u64).map(|i| (start + i) % 48).collect();
+    assert_eq!(frames, in_turn, "every frame in turn");
+    assert_eq!(frame, in_turn[in_turn.len() - 1], "paused at the last frame played");
+    // The first frame is traced whole (with the tracker's search of the
+    // loop); the others re-trace what moved.
+    let mut ms: Vec<f64> = played.iter().skip(1).map(|p| p["ms"].as_f64().expect("ms")).collect();
+    let mut shares: Vec<f64> = played.iter().skip(1).map(|p| p["share"].as_f64().expect("a share")).collect();
+    ms.sort_by(f64::total_cmp);
+    shares.sort_by(f64::total_cmp);
+    let shown = |i: usize| played[i]["at"].as_f64().expect("a time");
+    let rate = 1000.0 * (played.len() - 2) as f64 / (shown(played.len() - 1) - shown(1));
+    println!(
+        "anim_fig5_1 played, {what}: {} frames at {rate:.1} a second; the first in {:.1} ms, the others each in \
+         {:.1} ms (median; slowest {:.1} ms), {:.1} % of the draft's pixels traced (median)",
+        played.len(),
+        played[0]["ms"].as_f64().expect("ms"),
+        ms[ms.len() / 2],
+        ms[ms.len() - 1],
+        shares[shares.len() / 2]
+    );
+    frame as u32
+}
+
+/// An animation in the studio: the time controls show for a scene with
+/// FRAMES and not for a still; the frame of the slider is what the render
+/// and the draft show, host-sim's `--frame K` picture bit for bit, reached
+/// forward (re-tracing only what moved), by a jump, backwards or round the
+/// loop; the wireframe and the tools see the objects where they are at that
+/// frame; play goes through the frames in turn, and where it stops is
+/// host-sim's frame too; an error of one frame only (the eye moved onto the
+/// point looked at) is marked at its MOVE when that frame is shown.
+#[test]
+fn the_time_slider_and_play_show_host_sims_frames() {
+    let binary = host_sim_binary();
+    let dir = tempfile::tempdir().expect("a directory");
+    let scene = dir.path().join("anim_fig5_1.txt");
+    std::fs::copy(repo().join("scenes/anim_fig5_1.txt"), &scene).expect("copied");
+    let studio = Studio::start(&binary, Some(&scene));
+    let browser = Browser::start((1500, 900));
+    browser.goto(&studio.url);
+    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+    let controls =
+        browser.run("return [document.getElementById('time').hidden, document.getElementById('frame').max];");
+    assert_eq!(controls, serde_json::json!([false, "47"]));
+
+    // Play the draft alone, then pause: the frames went by in turn, and
+    // the draft shows host-sim's frame.
+    browser.wait_for("document.getElementById('draft').dataset.state === 'done'", 60);
+    let frame = play_and_pause(&browser, "the draft (160x120)");
+    let draft = host_frame(&scene, frame, Some("160x120"));
+    assert_same(&format!("draft of frame {frame}, played to"), browser.canvas_rgb("draft"), &draft);
+    slide_to(&browser, 0);
+    // What the page's module takes for a draft of each frame: traced whole,
+    // and by its player, twice round the loop (loading and indexing the
+    // frame included; printed for BENCHMARKS.md).
+    let timed = browser.run(
+        "const octrace = studio.octrace, text = studio.editor.text(), whole = [], played = [];
+         const time = (k, trace) => { const t = performance.now(); octrace.load(text, k); octrace.prepare(0, 160, 120);
+                                      trace(); return performance.now() - t; };
+         for (let k = 0; k < 48; k++) whole.push(time(k, () => octrace.render(0, 0, 160, 120)));
+         for (let k = 0; k < 96; k++) played.push(time(k % 48, () => octrace.traceFrame()));
+         const median = (all) => all.slice().sort((a, b) => a - b)[all.length >> 1];
+         return [median(whole), played[0], median(played.slice(1))];",
+    );
+    println!(
+        "anim_fig5_1's draft (160x120) in the page's module: a frame traced whole in {:.1} ms (median), \
+         by the player the first in {:.1} ms, the others in {:.1} ms (median)",
+        timed[0].as_f64().expect("ms"),
+        timed[1].as_f64().expect("ms"),
+        timed[2].as_f64().expect("ms")
+    );
+
+    // Frame 0, rendered as any scene is (parallel tiles), and its draft.
+    render_and_wait(&browser);
+    assert_same("frame 0", browser.canvas_rgb("image"), &host_frame(&scene, 0, None));
+    browser.wait_for("document.getElementById('draft').dataset.state === 'done'", 60);
+    assert_same("draft of frame 0", browser.canvas_rgb("draft"), &host_frame(&scene, 0, Some("160x120")));
+    // Then frames forward (re-tracing a small share), a jump, backwards,
+    // and round the loop from the last frame to the first.
+    for (frame, forward) in [(1, false), (2, true), (30, false), (29, false), (47, false), (0, true)] {
+        slide_to(&browser, frame);
+        let share = traced_share(&browser);
+        assert!(!forward || share < 50.0, "frame {frame}: {share} % of the pixels traced");
+        assert_same(&format!("frame {frame}"), browser.canvas_rgb("image"), &host_frame(&scene, frame, None));
+        let draft = host_frame(&scene, frame, Some("160x120"));
+        assert_same(&format!("draft of frame {frame}"), browser.canvas_rgb("draft"), &draft);
+    }
+
+    // Play with the render shown, then pause: the frame shown is host-sim's.
+    let frame = play_and_pause(&browser, "the render (240x180) and the draft (160x120)");
+    assert_same(&format!("frame {frame}, played to"), browser.canvas_rgb("image"), &host_frame(&scene, frame, None));
+    let draft = host_frame(&scene, frame, Some("160x120"));
+    assert_same(&format!("draft of frame {frame}, played to"), browser.canvas_rgb("draft"), &draft);
+    screenshot(&browser, "studio");
+
+    // A render asked for while playing stops the player and stays: the
+    // frame shown then, whole, not replaced by a frame the player was
+    // still tracing.
+    browser.click("#play");
+    browser.wait_for("studio.played && studio.played.length >= 3", 120);
+    render_and_wait(&browser);
+    let frame = browser.run("return studio.frame;").as_u64().expect("a frame") as u32;
+    // Time for a frame the player traced to come, were it still shown.
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    assert_eq!(browser.run("return [studio.playing, studio.frame];"), serde_json::json!([false, frame]));
+    let image = browser.canvas_rgb("image");
+    assert_same(&format!("frame {frame}, rendered while playing"), image, &host_frame(&scene, frame, None));
+
+    // The wireframe shows the red sphere where frame 10 has it (its MOVE's
+    // second key: 0.3 left of and 3 behind where it is written), and the
+    // select tool picks it there.
+    let wire_at = |frame: u32| {
+        slide_to(&browser, frame);
+        browser.run("return document.getElementById('wire').toDataURL();")
+    };
+    let (at_0, at_10) = (wire_at(0), wire_at(10));
+    assert!(at_0 != at_10, "the wireframe follows the frame");
+    assert!(wire_at(0) == at_0, "the wireframe at frame 0 again");
+    wire_at(10);
+    press(&browser, "s");
+    let there = browser.run(
+        "const q = studio.project([-2.6 - 0.3, 0.3, 0.6 - 3.0]); const c = document.getElementById('wire');
+         return [Math.round(q[0] - c.width / 2), Math.round(q[1] - c.height / 2)];",
+    );
+    let (x, y) = (there[0].as_i64().expect("x"), there[1].as_i64().expect("y"));
+    browser.drag("#wire", (x, y), (x, y));
+    let picked = browser.run("const s = studio.model[studio.selection]; return s && [s.keyword, s.args[1]];");
+    assert_eq!(picked, serde_json::json!(["SPHERE", 1.3]), "the red sphere, picked where it is at frame 10");
+
+    // An error at one frame only: the eye moves onto the point looked at
+    // at frame 2, which the page marks at the MOVE when frame 2 is shown.
+    set_text(
+        &browser,
+        "FRAMES 3\nORIGIN 0 0 0\nVIEWPOINT 0 0 5 MOVE 0 0 0 0  2 0 0 -5\nLIGHT 5 3 3 3\n\
+         SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nSPHERE 1 1 0 0 -9\n",
+    );
+    let errors_at = |frame: u32| {
+        slide_to(&browser, frame.saturating_sub(1));
+        browser.run(&format!(
+            "const s = document.getElementById('frame'); s.value = '{frame}'; s.dispatchEvent(new Event('input'));
+             return [...document.querySelectorAll('#errors li')].map((li) => li.textContent);"
+        ))
+    };
+    assert_eq!(errors_at(1), serde_json::json!([]));
+    let errors = errors_at(2);
+    assert!(errors[0].as_str().is_some_and(|e| e.starts_with("3:17: ") && e.contains("frame 2")), "{errors}");
+    assert_eq!(editor_texts(&browser, ".cm-lintRange-error"), ["MOVE"]);
+
+    // A still scene hides the controls.
+    set_text(&browser, START);
+    assert_eq!(browser.run("return document.getElementById('time').hidden;"), true);
+    assert_eq!(page_log(&browser), serde_json::json!([]), "nothing refused, no script error");
 }
 
 /// The software board (or `OCTRACE_BOARD_COMMAND`'s) the studio sends to.
@@ -755,8 +1091,7 @@ fn send_to_board_shows_the_boards_picture_and_verdict_or_its_errors_in_the_edito
             && e[3].as_str().is_some_and(|t| t.starts_with(&want))),
         "{want} in {errors:?}"
     );
-    let cursor = browser
-        .run("const t = document.getElementById('scene'); return [t.selectionStart, document.activeElement === t];");
+    let cursor = browser.run("const v = studio.editor.view; return [v.state.selection.main.head, v.hasFocus];");
     assert_eq!(cursor[0], light.len() * lights as usize, "the cursor is at the error");
     assert_eq!(cursor[1], true, "in the editor");
     let picture = browser.run(

@@ -57,10 +57,15 @@ pub struct StudioArgs {
 }
 
 /// The page, its script and style, and the WebAssembly module, built into
-/// the binary (the module by `build.rs`).
-const ASSETS: [(&str, &str, &[u8]); 11] = [
+/// the binary (the module by `build.rs`; `codemirror.js`, the editor, is
+/// CodeMirror 6 bundled by `studio/editor/build.mjs` and committed). The
+/// keywords' module is made from the core's list (`keywords_module`).
+const ASSETS: [(&str, &str, &[u8]); 14] = [
     ("/", "text/html; charset=utf-8", include_bytes!("assets/index.html")),
     ("/studio.js", "text/javascript; charset=utf-8", include_bytes!("assets/studio.js")),
+    ("/editor.js", "text/javascript; charset=utf-8", include_bytes!("assets/editor.js")),
+    ("/codemirror.js", "text/javascript; charset=utf-8", include_bytes!("assets/codemirror.js")),
+    ("/time.js", "text/javascript; charset=utf-8", include_bytes!("assets/time.js")),
     ("/octrace.js", "text/javascript; charset=utf-8", include_bytes!("assets/octrace.js")),
     ("/model.js", "text/javascript; charset=utf-8", include_bytes!("assets/model.js")),
     ("/view.js", "text/javascript; charset=utf-8", include_bytes!("assets/view.js")),
@@ -220,12 +225,31 @@ fn respond(request: &Request, shared: &Shared) -> Response {
         ("PUT", "/scene") => put_scene(request, shared),
         ("GET", "/board") => with_board(shared, BoardSender::status),
         ("POST", "/board") => with_board(shared, |board| board.send(&scene_name(shared), &request.body)),
+        ("GET" | "HEAD", "/keywords.js") => {
+            Response::new(200, "text/javascript; charset=utf-8", keywords_module().into_bytes())
+        }
         ("GET" | "HEAD", _) => match ASSETS.iter().find(|(name, _, _)| *name == route) {
             Some((_, kind, body)) => Response::new(200, kind, body.to_vec()),
             None => Response::text(404, "no such page"),
         },
         _ => Response::text(405, "method not allowed"),
     }
+}
+
+/// The page's `keywords.js`: the scene format's statement keywords and how
+/// many arguments follow each, from the core's one list
+/// (`parse::statement_arities`), so that the page's editor highlights and
+/// its model finds exactly the statements the core reads.
+fn keywords_module() -> String {
+    let entries: Vec<String> =
+        octrace_core::parse::statement_arities().map(|(keyword, arity)| format!("{keyword}: {arity}")).collect();
+    format!(
+        "// The scene format's statement keywords, each with how many arguments follow it\n\
+         // (for BSPLINE, those before its control points; for FRAMES and MOVE, the fewest):\n\
+         // octrace-core's list (parse::statement_arities), as host-sim serves it.\n\
+         export const ARITY = Object.freeze({{ {} }});\n",
+        entries.join(", ")
+    )
 }
 
 /// The other site a browser sent `request` for, if it did: an `Origin`

@@ -8,7 +8,7 @@
  *  error); its verdict, `#board-verdict`, in `data-verdict` (identical,
  *  differ, errors, error). */
 export function createBoard(app) {
-  const { $, text, api, errorItem, goTo, putRgb, setStatus } = app;
+  const { $, editor, api, showBoardErrors, putRgb, setStatus } = app;
   const button = $('send-board'), figure = $('board'), verdict = $('board-verdict'), canvas = $('board-image');
   let port = null, sending = false;
 
@@ -41,7 +41,7 @@ export function createBoard(app) {
       }).catch(() => {});
     }, 250);
     try {
-      const response = await api('/board', { method: 'POST', body: text.value });
+      const response = await api('/board', { method: 'POST', body: editor.text() });
       if (!response.ok) {
         const message = (await response.text()).trim();
         show('error', 'error', message);
@@ -59,26 +59,18 @@ export function createBoard(app) {
     }
   }
 
-  /** The board's errors join the list (an error the page found too is
-   *  listed once, as the board's); the cursor goes to the first. */
+  /** The board's errors join the page's, listed and marked in the text
+   *  (an error the page found too is listed once, as the board's); the
+   *  cursor goes to the first. */
   function rejected(errors) {
     canvas.width = 0;
     canvas.height = 0;
-    const items = errors.map((e) => {
-      const li = errorItem((e.line ? `${e.line}:${e.column}: ` : '') + e.message, e.line, e.column);
-      li.classList.add('board');
-      li.title = `found by the board at ${port}`;
-      return li;
-    });
-    const said = new Set(items.map((li) => li.textContent));
-    const list = $('errors');
-    for (const li of [...list.children]) if (said.has(li.textContent)) li.remove();
-    list.append(...items);
+    showBoardErrors(errors, `found by the board at ${port}`);
     const message = `the board found ${errors.length} error${errors.length === 1 ? '' : 's'}: nothing drawn`;
     show('rejected', 'errors', message);
     setStatus(message);
     const first = errors.find((e) => e.line);
-    if (first) goTo(first.line, first.column);
+    if (first) editor.goTo(first.line, first.column);
   }
 
   function drawn(answer) {

@@ -1,17 +1,22 @@
 // The scene text as the page sees it: the statements the wireframe draws
-// and the tools edit, with where each is in the text. The octrace module
-// stays the judge of validity; nothing here touches the page.
+// and the tools edit, with where each is in the text, and where a MOVE puts
+// them at a frame. The octrace module stays the judge of validity; nothing
+// here touches the page.
 
-// How many arguments follow each keyword (BSPLINE: before its 3 × rows ×
-// cols control point coordinates). tests/tests/studio.rs checks this table
-// against the core's grammar (octrace_core::parse::statement_arity).
-export const ARITY = {
-  VIEWPOINT: 3, ORIGIN: 3, UPVECTOR: 3, RASTER: 2, VIEWPORT: 2, RDEPTH: 1, IMAGEFILE: 1, LIGHT: 4,
-  BACKGROUND: 3, GAMMA: 1, ATTENUATION: 1, SAMPLES: 1, SPHERE: 5, BOX: 7, SUPERQUADRIC: 8, TRIANGLE: 10,
-  RECTANGLE: 13, BSPLINE: 6, SURFACE: 13, FRAMES: 1, MOVE: 4,
-};
+// How many arguments follow each keyword: the core's list, as host-sim
+// serves it (keywords.js).
+import { ARITY } from './keywords.js';
+
+export { ARITY };
 export const SHAPES = ['SPHERE', 'BOX', 'SUPERQUADRIC', 'TRIANGLE', 'RECTANGLE', 'BSPLINE'];
+/** What a MOVE after it displaces (the format's rule). */
+const MOVABLE = new Set([...SHAPES, 'LIGHT', 'VIEWPOINT', 'ORIGIN']);
+/** A number as the format writes one. */
+export const NUMBER = /^[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?$/;
 
+/** The statements of `source`: each {keyword, args, start, end}; an object,
+ *  LIGHT, VIEWPOINT or ORIGIN followed by a MOVE has `moved`: {keys:
+ *  [[frame, dx, dy, dz], …], start, end} (the MOVE's place in the text). */
 export function parseModel(source) {
   const tokens = [];
   const re = /\/\*[\s\S]*?(\*\/|$)|\/\/[^\n]*|[^\s]+/g;
@@ -28,12 +33,48 @@ export function parseModel(source) {
     if (keyword === 'BSPLINE' && i + 4 < tokens.length) {
       arity += 3 * Number(tokens[i + 3].text) * Number(tokens[i + 4].text) || 0;
     }
-    const args = tokens.slice(i + 1, i + 1 + arity);
+    // The numbers after the fewest are the statement's too: FRAMES's rate,
+    // a MOVE's further keys.
+    let after = i + 1 + arity;
+    while (after < tokens.length && NUMBER.test(tokens[after].text)) after++;
+    const args = tokens.slice(i + 1, after);
     const end = args.length ? args[args.length - 1].end : tokens[i].end;
-    statements.push({ keyword, args: args.map((t) => (keyword === 'IMAGEFILE' ? t.text : Number(t.text))), start: tokens[i].start, end });
-    i += 1 + arity;
+    const statement = { keyword, args: args.map((t) => (keyword === 'IMAGEFILE' ? t.text : Number(t.text))), start: tokens[i].start, end };
+    const before = statements[statements.length - 1];
+    if (keyword === 'MOVE' && before && MOVABLE.has(before.keyword)) {
+      const keys = [];
+      for (let k = 0; k + 4 <= statement.args.length; k += 4) keys.push(statement.args.slice(k, k + 4));
+      before.moved = { keys, start: statement.start, end };
+    }
+    statements.push(statement);
+    i = after;
   }
   return statements;
+}
+
+/** The displacement a MOVE's `keys` give at `frame`: linear between two
+ *  keys, the first key's before it, the last's after it (the core's rule,
+ *  here in floating point: the wireframe's places, not the render's). */
+export function displacementAt(keys, frame) {
+  let before = null;
+  for (const [at, ...value] of keys) {
+    if (at >= frame) {
+      if (!before || at === frame) return value;
+      const t = (frame - before[0]) / (at - before[0]);
+      return value.map((v, a) => before[1][a] + (v - before[1][a]) * t);
+    }
+    before = [at, value];
+  }
+  return before ? before[1] : [0, 0, 0];
+}
+
+/** Statement `s` where its MOVE puts it at `frame` (itself if none). */
+export function placed(s, frame) {
+  if (!s.moved) return s;
+  const d = displacementAt(s.moved.keys, frame);
+  const args = s.args.slice();
+  for (const i of pointArgs(s)) for (let k = 0; k < 3; k++) args[i + k] += d[k];
+  return { ...s, args };
 }
 
 const fmt = (v) => String(Math.round(v * 1000) / 1000);
@@ -48,10 +89,12 @@ export function statementText(keyword, args) {
   return `${keyword} ${args.map((a) => (typeof a === 'number' ? fmt(a) : a)).join(' ')}`;
 }
 
-/** The arguments of the one statement of a kind in `model`, or `fallback`. */
-export function single(model, keyword, fallback) {
+/** The arguments of the one statement of a kind in `model` as written
+ *  (or where its MOVE puts it at `frame`, if given), or `fallback`. */
+export function single(model, keyword, fallback, frame) {
   const s = model.find((x) => x.keyword === keyword);
-  return s && s.args.length === ARITY[keyword] ? s.args : fallback;
+  if (!s || s.args.length !== ARITY[keyword]) return fallback;
+  return frame === undefined ? s.args : placed(s, frame).args;
 }
 
 export const objectCentre = (s) => {
@@ -81,6 +124,7 @@ export const pointArgs = (s) => {
   switch (s.keyword) {
     case 'SPHERE': case 'SUPERQUADRIC': return [2];
     case 'BOX': case 'LIGHT': return [1];
+    case 'VIEWPOINT': case 'ORIGIN': return [0];
     case 'TRIANGLE': return [1, 4, 7];
     case 'RECTANGLE': return [1, 4, 7, 10];
     case 'BSPLINE': return Array.from({ length: (s.args.length - 6) / 3 }, (_, i) => 6 + 3 * i);

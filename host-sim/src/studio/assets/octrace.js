@@ -21,17 +21,25 @@ export async function loadOctrace() {
     return out;
   };
   return {
-    /** {width, height, objects} or {errors: ['line:col: message', …]} */
-    load(text) {
+    /** Frame `frame` (0 for a still) of `text`: {width, height, objects,
+     *  frames, rate} (frames 0 for a still) or {errors: ['line:col: message', …]} */
+    load(text, frame = 0) {
       put(encoder.encode(text));
-      const failed = x.studio_load();
+      const failed = x.studio_load(frame);
       const out = decoder.decode(output());
       if (failed) return { errors: out.split('\n').filter((l) => l) };
-      const [width, height, objects] = out.split(' ').map(Number);
-      return { width, height, objects };
+      const [width, height, objects, frames, rate] = out.split(' ').map(Number);
+      return { width, height, objects, frames, rate };
     },
     prepare: (accel, w, h) => decoder.decode(call(x.studio_prepare, accel, w, h)),
     render: (x0, y0, w, h) => call(x.studio_render, x0, y0, w, h),
+    /** The frame loaded, whole (after `prepare`): {traced, data}, the
+     *  pixels traced (fewer for the next frame of an animation) and the
+     *  frame as `render` gives it. */
+    traceFrame() {
+      const out = call(x.studio_trace_frame);
+      return { traced: new DataView(out.buffer).getUint32(0, true), data: out.subarray(4) };
+    },
     display(render, mode, dither, w, h) { put(render); return call(x.studio_display, mode, dither, w, h); },
     encode(render, mode, dither, format, w, h) { put(render); return call(x.studio_encode, mode, dither, format, w, h); },
     decode(bytes) {

@@ -1,14 +1,17 @@
 // octrace studio: the page. The octrace module (octrace-core compiled to
 // WebAssembly, octrace.js) does all parsing checks, rendering, palettes and
-// image files; this module is the editor and the plumbing, and wires up the
-// scene model (model.js), the wireframe view (view.js), the tools (tools.js),
-// the panel (panel.js) and the board (board.js). worker.js renders with its
-// own octrace module: the page's thread never traces, so that a scene of
-// hours a pixel cannot freeze it, and a render or draft is stopped at once,
-// inside its pixel, by terminating its workers when the next one starts.
+// image files; this module is the plumbing, and wires up the code editor
+// (editor.js), the scene model (model.js), the wireframe view (view.js), the
+// tools (tools.js), the panel (panel.js), the board (board.js) and the time
+// controls of an animation (time.js). worker.js renders with its own octrace
+// module: the page's thread never traces, so that a scene of hours a pixel
+// cannot freeze it, and a render or draft is stopped at once, inside its
+// pixel, by terminating its workers when the next one starts.
 
 import { loadOctrace } from './octrace.js';
+import { createEditor } from './editor.js';
 import { objectCentre, parseModel, single as singleIn, statementText } from './model.js';
+import { createTime } from './time.js';
 import { createView } from './view.js';
 import { createTools } from './tools.js';
 import { createPanel } from './panel.js';
@@ -18,7 +21,7 @@ main();
 
 function main() {
   const $ = (id) => document.getElementById(id);
-  const text = $('scene');
+  const editor = createEditor($('scene'), textChanged);
   const imageCanvas = $('image');
   const state = {
     octrace: null,
@@ -26,15 +29,19 @@ function main() {
     sceneName: '',
     writable: false,
     lastRender: null, // {width, height, data: colours then objects}
-    undoStack: [], redoStack: [],
+    frame: 0, // the frame of an animation shown (time.js)
+    boardErrors: [], // the board's, till the text changes
     tool: 'select', selection: -1, placing: null,
     camera: { yaw: 0.7, pitch: 0.45, distance: 30, target: [0, 0, 0] },
     draftSeq: 0, draftSent: 0, draftTimer: 0,
   };
   // Exposed for scripts and the browser tests.
   window.studio = state;
-  // Script errors are kept for the tests' failure messages.
+  // Script errors, and whatever the Content-Security-Policy refuses, are
+  // kept for the tests.
   window.addEventListener('error', (e) => (state.log = state.log || []).push(['error', e.message, e.lineno]));
+  document.addEventListener('securitypolicyviolation',
+    (e) => (state.log = state.log || []).push(['refused', e.effectiveDirective, e.blockedURI]));
 
   const storageKey = () => 'octrace-studio:' + state.sceneName;
 
@@ -57,14 +64,14 @@ function main() {
     state.writable = response.headers.get('X-Scene-Writable') === 'true';
     $('scene-name').textContent = state.sceneName + (state.writable ? '' : ' (example, not saved)');
     const stored = preferStored ? localStorage.getItem(storageKey()) : null;
-    setText(stored !== null && stored !== body ? stored : body, false);
+    editor.load(stored !== null && stored !== body ? stored : body);
     if (stored !== null && stored !== body) setStatus('unsaved changes restored from this browser');
   }
 
   async function saveScene(force) {
     if (!state.writable) { alert('The studio was started without a scene file: nothing to save to.'); return false; }
     const response = await api('/scene', {
-      method: 'PUT', body: text.value, headers: { 'If-Match': force ? '*' : '"' + state.version + '"' },
+      method: 'PUT', body: editor.text(), headers: { 'If-Match': force ? '*' : '"' + state.version + '"' },
     });
     if (response.status === 409) {
       if (confirm('The scene file changed on disk since it was loaded. Overwrite it with this text?')) {
@@ -83,109 +90,135 @@ function main() {
 
   // ------------------------------------------------------ text and errors --
 
-  /** Replaces the text (a tool or the panel changed the scene). */
-  function setText(value, remember = true) {
-    if (remember && value !== text.value) { state.undoStack.push(text.value); state.redoStack = []; }
-    text.value = value;
-    textChanged();
+  /** Replaces the text: a tool's or the panel's edit, one step of undo. */
+  function setText(value) {
+    editor.edit(value);
   }
 
   let lastKnown = '';
+  /** After every change of the text (the editor calls it). */
   function textChanged() {
-    if (text.value !== lastKnown) {
-      lastKnown = text.value;
-      localStorage.setItem(storageKey(), text.value);
+    if (editor.text() !== lastKnown) {
+      lastKnown = editor.text();
+      localStorage.setItem(storageKey(), lastKnown);
+      state.boardErrors = [];
     }
-    state.model = parseModel(text.value);
+    state.model = parseModel(lastKnown);
     checkErrors();
     drawWire();
     showPanel();
     scheduleDraft();
   }
 
-  function checkErrors() {
-    if (!state.octrace) return;
-    const loaded = state.octrace.load(text.value);
-    const list = $('errors');
-    list.replaceChildren();
-    for (const e of loaded.errors || []) {
-      const [line, column] = e.split(':').map(Number);
-      list.append(errorItem(e, line, column));
-    }
+  /** Another frame is shown (time.js): its errors, its wireframe; returns
+   *  the frame's load (octrace.load's answer). */
+  function frameChanged() {
+    const loaded = checkErrors();
+    drawWire();
     return loaded;
   }
 
-  /** An error of the list: `message` (`line:col: …`); a click goes to
-   *  its line and column (line 0: an error of the whole scene). */
-  function errorItem(message, line, column) {
+  /** Loads the text at the frame shown and lists its errors, and the
+   *  board's, under the editor and at their places in it. */
+  function checkErrors() {
+    if (!state.octrace) return;
+    const loaded = state.octrace.load(editor.text(), state.frame);
+    app.time.scene(loaded);
+    const board = new Set(state.boardErrors.map((e) => e.text));
+    const errors = (loaded.errors || []).filter((e) => !board.has(e)).map((e) => {
+      const [, line, column, message] = /^(\d+):(\d+): ([\s\S]*)$/.exec(e) || [, 0, 0, e];
+      return { text: e, line: Number(line), column: Number(column), message };
+    });
+    errors.push(...state.boardErrors);
+    $('errors').replaceChildren(...errors.map((e) => errorItem(e)));
+    editor.setErrors(errors);
+    return loaded;
+  }
+
+  /** An error of the list (`text`, `line:col: …`; `board` says which
+   *  board found it, if one did); a click goes to its line and column
+   *  (line 0: the whole scene's). */
+  function errorItem({ text, line, column, board }) {
     const li = document.createElement('li');
-    li.textContent = message;
+    li.textContent = text;
     li.dataset.line = String(line);
     li.dataset.column = String(column);
-    if (line > 0) li.onclick = () => goTo(line, column);
+    if (board) { li.classList.add('board'); li.title = board; }
+    if (line > 0) li.onclick = () => editor.goTo(line, column);
     return li;
   }
 
-  function goTo(line, column) {
-    const lines = text.value.split('\n');
-    let at = 0;
-    for (let i = 0; i < line - 1 && i < lines.length; i++) at += lines[i].length + 1;
-    text.focus();
-    text.setSelectionRange(at + column - 1, at + column);
+  /** The errors ({line, column, message}) the board `board` found, listed
+   *  and marked with the page's own till the text changes; an error the
+   *  page found too is listed once, as the board's. */
+  function showBoardErrors(errors, board) {
+    state.boardErrors = errors.map((e) => ({ ...e, text: (e.line ? `${e.line}:${e.column}: ` : '') + e.message, board }));
+    checkErrors();
   }
-
-  let typingUndoTimer = 0, typingBase = null;
-  text.addEventListener('input', () => {
-    // A burst of typing is one undo step.
-    if (typingBase === null) typingBase = lastKnown;
-    clearTimeout(typingUndoTimer);
-    typingUndoTimer = setTimeout(() => {
-      if (typingBase !== text.value) { state.undoStack.push(typingBase); state.redoStack = []; }
-      typingBase = null;
-    }, 600);
-    textChanged();
-  });
 
   // ---------------------------------------------------------------- draft --
 
-  // The draft worker, and a spare already loading: a draft still running
-  // when the next is asked for is stopped at once (its worker terminated,
-  // the spare takes over), so a scene of hours a pixel never holds the
-  // drafts up.
-  const newDraftWorker = () => {
-    const worker = new Worker('worker.js', { type: 'module' });
-    worker.onmessage = (event) => draftMessage(event.data);
-    return worker;
-  };
-  let draftWorker = newDraftWorker();
-  let spareDraftWorker = newDraftWorker();
-  let draftBusy = false;
-  function sendDraft(message) {
-    if (draftBusy) {
-      draftWorker.terminate();
-      draftWorker = spareDraftWorker;
-      spareDraftWorker = newDraftWorker();
-    }
-    draftBusy = true;
-    draftWorker.postMessage(message);
+  /** A worker for requests of which only the newest matters, and a spare
+   *  already loading: a request still running when the next is sent is
+   *  stopped at once (its worker terminated, the spare takes over), so a
+   *  scene of hours a pixel never holds the next up. `send(message,
+   *  answer)` hands the worker's messages to `answer` till it returns true
+   *  (the request is finished); `stop()` ends the request running, if any.
+   *  A worker that finished keeps its state: time.js's players keep the
+   *  frame they traced last. */
+  function workerPair() {
+    const start = () => {
+      const worker = new Worker('worker.js', { type: 'module' });
+      worker.onmessage = (event) => { if (worker === current && answer(event.data)) busy = false; };
+      return worker;
+    };
+    let current = start(), spare = start(), busy = false, answer = () => true;
+    const stop = () => {
+      if (!busy) return;
+      current.terminate();
+      current = spare;
+      spare = start();
+      busy = false;
+    };
+    const send = (message, answerWith) => {
+      stop();
+      busy = true;
+      answer = answerWith;
+      current.postMessage(message);
+    };
+    return { send, stop };
   }
+
+  // The draft's worker: the text's drafts and, for an animation, the
+  // frames time.js's player draws at the draft's size, one history of
+  // requests, so that no draft runs on after a newer one is asked for.
+  const drafts = workerPair();
+  const sendDraft = drafts.send;
+  /** A text draft's message; true once it is finished. */
   function draftMessage(m) {
-    if (m.seq !== state.draftSeq) return; // superseded
-    if (m.type === 'draft-errors') { draftBusy = false; $('draft-status').textContent = 'scene has errors'; return; }
-    if (m.type !== 'draft') return;
+    if (m.type === 'draft-errors' || m.type === 'error') {
+      if (m.seq === state.draftSeq) $('draft-status').textContent = 'scene has errors';
+      return true;
+    }
+    if (m.type !== 'draft') return false;
+    if (m.seq !== state.draftSeq) return m.final; // superseded
     const canvas = $('draft');
     canvas.width = m.width; canvas.height = m.height;
     putRgb(canvas, m.data.subarray(0, 3 * m.width * m.height), m.width, m.height);
     if (m.final) {
-      draftBusy = false;
       const latency = performance.now() - state.draftSent;
       state.draftLatency = latency;
       canvas.dataset.state = 'done';
       canvas.dataset.seq = String(m.seq);
+      canvas.dataset.frame = String(m.frame);
       $('draft-status').textContent = `${m.width}×${m.height}, ${latency.toFixed(0)} ms after the last change`;
     }
+    return m.final;
   }
   function scheduleDraft() {
+    // Playing, the next frame's draft is of the text as it is then.
+    if (state.playing) return;
+    app.time.superseded();
     clearTimeout(state.draftTimer);
     const changedAt = performance.now();
     $('draft').dataset.state = 'pending';
@@ -193,8 +226,15 @@ function main() {
     state.draftTimer = setTimeout(() => {
       state.draftSeq += 1;
       state.draftSent = changedAt;
-      sendDraft({ type: 'draft', seq: state.draftSeq, text: text.value, width: 160, height: 120, progressive: true });
+      sendDraft({ type: 'draft', seq: state.draftSeq, text: editor.text(), frame: state.frame, width: 160, height: 120, progressive: true }, draftMessage);
     }, 25);
+  }
+  /** The draft is time.js's player's from now on (it sends its frame
+   *  with `sendDraft`): a text draft asked for or running is not to
+   *  replace it. */
+  function draftDrawn() {
+    clearTimeout(state.draftTimer);
+    state.draftSeq += 1;
   }
 
   // ---------------------------------------------------------- full render --
@@ -220,10 +260,19 @@ function main() {
 
   let renderJob = 0;
   let workers = [];
-  async function render() {
-    const job = ++renderJob;
+  /** Stops the render under way, if any. */
+  function stopRender() {
+    renderJob += 1;
     for (const w of workers) w.terminate();
     workers = [];
+  }
+  async function render() {
+    // A frame the player still traces would replace this render.
+    app.time.superseded();
+    stopRender();
+    const job = renderJob;
+    // The frame shown now (an animation's; 0 for a still).
+    const frame = state.frame;
     const loaded = checkErrors();
     if (loaded.errors) { setStatus('the scene has errors: nothing rendered'); return; }
     const [width, height] = renderSize() || [loaded.width, loaded.height];
@@ -253,7 +302,7 @@ function main() {
     };
     let used;
     try {
-      used = await renderOnWorkers(text.value, accel, width, height, place, () => job === renderJob);
+      used = await renderOnWorkers(editor.text(), frame, accel, width, height, place, () => job === renderJob);
     } catch (e) {
       for (const w of workers) w.terminate();
       imageCanvas.dataset.state = 'error';
@@ -265,17 +314,19 @@ function main() {
     state.lastRender = { width, height, data };
     showDisplay();
     const how = $('parallel').checked ? `, ${workers.length} workers, ${$('partition').value}` : ', one worker';
-    setStatus(`done: ${width}×${height} in ${seconds.toFixed(2)} s (${used}${how})`);
+    const which = loaded.frames ? `frame ${frame}: ` : '';
+    setStatus(`done: ${which}${width}×${height} in ${seconds.toFixed(2)} s (${used}${how})`);
     state.lastSeconds = seconds;
+    imageCanvas.dataset.frame = String(frame);
     imageCanvas.dataset.state = 'done';
   }
 
-  /** Renders on Web Workers: 32×32 tiles handed out as workers become free,
-   *  or the thesis's four equal rectangles (quarter i to worker i mod n);
-   *  without "parallel", one worker renders bands of 8 rows in order. A
-   *  render started next terminates them (`render`): they stop at once,
-   *  inside the pixel they trace. */
-  function renderOnWorkers(source, accel, width, height, place, current) {
+  /** Renders frame `frame` of `source` on Web Workers: 32×32 tiles handed
+   *  out as workers become free, or the thesis's four equal rectangles
+   *  (quarter i to worker i mod n); without "parallel", one worker renders
+   *  bands of 8 rows in order. A render started next terminates them
+   *  (`render`): they stop at once, inside the pixel they trace. */
+  function renderOnWorkers(source, frame, accel, width, height, place, current) {
     const parallel = $('parallel').checked;
     const count = parallel ? Math.max(1, Math.min(16, Number($('workers').value) || 4)) : 1;
     const pieces = [];
@@ -314,9 +365,19 @@ function main() {
             resolve(used);
           } else give(worker, i);
         };
-        worker.postMessage({ type: 'init', text: source, accel, width, height });
+        worker.postMessage({ type: 'init', text: source, frame, accel, width, height });
       }
     });
+  }
+
+  /** Frame `frame` of the text, whole, as the render (time.js's player
+   *  traced it): shown in the chosen display mode. */
+  function showFrame(frame, width, height, data) {
+    stopRender();
+    state.lastRender = { width, height, data };
+    showDisplay();
+    imageCanvas.dataset.frame = String(frame);
+    imageCanvas.dataset.state = 'done';
   }
 
   /** Shows the last render in the chosen display mode. */
@@ -335,7 +396,7 @@ function main() {
     const size = renderSize();
     const r = state.lastRender;
     if (r && (!size || (size[0] === r.width && size[1] === r.height))) {
-      const loaded = state.octrace.load(text.value);
+      const loaded = state.octrace.load(editor.text(), state.frame);
       const raster = loaded.errors ? null : [loaded.width, loaded.height];
       const wanted = size || raster;
       if (wanted && wanted[0] === r.width && wanted[1] === r.height) { showDisplay(); return; }
@@ -390,13 +451,14 @@ function main() {
   // ------------------------------------------------- statements in text --
 
   function replaceStatement(index, keyword, args) {
-    const s = state.model[index];
-    setText(text.value.slice(0, s.start) + statementText(keyword, args) + text.value.slice(s.end));
+    const s = state.model[index], text = editor.text();
+    setText(text.slice(0, s.start) + statementText(keyword, args) + text.slice(s.end));
   }
 
   function appendStatement(keyword, args) {
-    const sep = text.value.endsWith('\n') || text.value === '' ? '' : '\n';
-    setText(text.value + sep + statementText(keyword, args) + '\n');
+    const text = editor.text();
+    const sep = text.endsWith('\n') || text === '' ? '' : '\n';
+    setText(text + sep + statementText(keyword, args) + '\n');
     return state.model.length - 1;
   }
 
@@ -406,56 +468,57 @@ function main() {
     if (index >= 0) replaceStatement(index, keyword, args); else appendStatement(keyword, args);
   }
 
+  /** Removes statement `index`, and the MOVE that moves it. */
   function deleteStatement(index) {
-    const s = state.model[index];
-    let end = s.end;
-    if (text.value[end] === '\n') end += 1;
-    setText(text.value.slice(0, s.start) + text.value.slice(end));
+    const s = state.model[index], text = editor.text();
+    let end = s.moved ? s.moved.end : s.end;
+    if (text[end] === '\n') end += 1;
     state.selection = -1;
-    textChanged();
+    setText(text.slice(0, s.start) + text.slice(end));
   }
 
   const single = (keyword, fallback) => singleIn(state.model || [], keyword, fallback);
 
   // ----------------------------------------------- view, tools and panel --
 
-  const app = { state, $, text, api, textChanged, scheduleDraft, single, setSingle, replaceStatement, appendStatement,
-    errorItem, goTo, putRgb, setStatus };
-  app.view = createView(state, $('wire'), single);
+  const app = { state, $, editor, api, frameChanged, scheduleDraft, workerPair, sendDraft, draftDrawn, showFrame,
+    single, setSingle, replaceStatement, appendStatement, showBoardErrors, putRgb, setStatus };
+  app.view = createView(state, $('wire'));
   app.tools = createTools(app);
   app.panel = createPanel(app);
   app.board = createBoard(app);
+  app.time = createTime(app);
   const drawWire = app.view.draw, showPanel = app.panel.show, setTool = app.tools.setTool, project = app.view.project;
 
   // -------------------------------------------------------- undo, keys --
 
-  function undo() {
-    if (!state.undoStack.length) return;
-    state.redoStack.push(text.value);
-    text.value = state.undoStack.pop();
-    textChanged();
-  }
-  function redo() {
-    if (!state.redoStack.length) return;
-    state.undoStack.push(text.value);
-    text.value = state.redoStack.pop();
-    textChanged();
-  }
+  // One history, the editor's: typing, the tools' and the panel's edits.
+  const undo = () => editor.undo(), redo = () => editor.redo();
   $('undo').onclick = undo;
   $('redo').onclick = redo;
 
+  // The page's keys, wherever the focus is: caught before the editor sees
+  // them (its Ctrl+Enter would insert a line).
   document.addEventListener('keydown', (e) => {
-    const inText = e.target === text || e.target.tagName === 'INPUT';
     const key = e.key.toLowerCase();
-    if ((e.ctrlKey || e.metaKey) && e.shiftKey && key === 'enter') { e.preventDefault(); app.board.send(); return; }
-    if ((e.ctrlKey || e.metaKey) && key === 'enter') { e.preventDefault(); render(); return; }
-    if ((e.ctrlKey || e.metaKey) && key === 's') { e.preventDefault(); saveScene(false); return; }
-    if (e.key === 'F1') { e.preventDefault(); $('help').showModal(); return; }
-    if (inText) return;
+    const action = !(e.ctrlKey || e.metaKey) ? (e.key === 'F1' ? () => $('help').showModal() : null)
+      : key === 'enter' ? (e.shiftKey ? app.board.send : render)
+        : key === 's' ? () => saveScene(false) : null;
+    if (!action) return;
+    e.preventDefault();
+    e.stopPropagation();
+    action();
+  }, { capture: true });
+  // The view's keys, except in the editor (whose own undo and redo are of
+  // the same history) and in the panel's fields.
+  document.addEventListener('keydown', (e) => {
+    const key = e.key.toLowerCase();
+    if (e.defaultPrevented || e.target === $('scene') || e.target.tagName === 'INPUT') return;
     if ((e.ctrlKey || e.metaKey) && key === 'z') { e.preventDefault(); if (e.shiftKey) redo(); else undo(); return; }
     if ((e.ctrlKey || e.metaKey) && key === 'y') { e.preventDefault(); redo(); return; }
     if ((e.key === 'Delete' || e.key === 'Backspace') && state.selection >= 0) { e.preventDefault(); deleteStatement(state.selection); return; }
     if (e.key === 'Escape') { setTool('select'); return; }
+    if (e.key === ' ' && !['BUTTON', 'SELECT'].includes(e.target.tagName)) { e.preventDefault(); app.time.toggle(); return; }
     const tools = ['sphere', 'box', 'superquadric', 'triangle', 'rectangle', 'bspline', 'viewpoint', 'light'];
     if (key >= '1' && key <= '8') setTool(tools[Number(key) - 1]);
     if (key === 's') setTool('select');
@@ -468,7 +531,7 @@ function main() {
   $('help-close').onclick = () => $('help').close();
 
   // Exposed for scripts and the browser tests.
-  Object.assign(state, { render, saveScene, setText, setTool, saveImage, undo, redo, project,
+  Object.assign(state, { render, saveScene, setText, setTool, saveImage, undo, redo, project, editor,
     imageBytes: (mode, format) => state.octrace.encode(state.lastRender.data, mode, Number($('dither').value), format, state.lastRender.width, state.lastRender.height) });
 
   (async () => {

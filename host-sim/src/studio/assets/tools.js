@@ -1,17 +1,17 @@
 // The tools: select and move objects, orbit and pan the view, and place
 // new objects, lights and the eye with the mouse, each an edit of the text.
 
-import { objectCentre, parseModel, pointArgs, statementText } from './model.js';
+import { objectCentre, parseModel, placed, pointArgs, statementText } from './model.js';
 import { add, scale, sub } from './view.js';
 
 /** Installs the tools on `app.view`'s canvas; `app` is the page (studio.js). */
 export function createTools(app) {
-  const { state, $, text } = app;
+  const { state, $, editor } = app;
   const wire = $('wire');
   const { basis, focal, project, onPlane } = app.view;
   const drawWire = () => app.view.draw();
   const showPanel = () => app.panel.show();
-  const { textChanged, scheduleDraft, setSingle, appendStatement } = app;
+  const { scheduleDraft, setSingle, appendStatement } = app;
 
   const HINTS = {
     select: 'click an object to select it; drag to move it (Shift: up/down); drag empty space to orbit',
@@ -47,7 +47,8 @@ export function createTools(app) {
       let best = -1, bestDistance = 12;
       if (e.button === 0) {
         (state.model || []).forEach((s, i) => {
-          const c = objectCentre(s);
+          // Where it is seen: at the frame shown.
+          const c = objectCentre(placed(s, state.frame));
           const q = c && project(c);
           if (q && Math.hypot(q[0] - x, q[1] - y) < bestDistance) { best = i; bestDistance = Math.hypot(q[0] - x, q[1] - y); }
         });
@@ -55,7 +56,7 @@ export function createTools(app) {
       if (best >= 0) {
         state.selection = best;
         const s = state.model[best];
-        drag = { kind: 'move', x, y, start: objectCentre(s), args: s.args.slice(), base: text.value, shift: e.shiftKey };
+        drag = { kind: 'move', x, y, start: objectCentre(placed(s, state.frame)), statement: s, base: editor.text(), shift: e.shiftKey };
         showPanel();
       } else {
         if (e.button === 0 && state.tool === 'select') state.selection = -1;
@@ -97,20 +98,24 @@ export function createTools(app) {
       state.placing.size = Math.max(0.05, Math.hypot(dx, dy) * unit);
       previewSize();
     } else if (drag.kind === 'move') {
-      const s = state.model[state.selection];
+      // The statement as it was when the drag began, in the text then.
+      const s = drag.statement;
       let delta;
       if (drag.shift) delta = [0, -dy * unit, 0];
       else {
         const a = onPlane(drag.x, drag.y, drag.start[1]), b = onPlane(x, y, drag.start[1]);
         delta = a && b ? sub(b, a) : [0, 0, 0];
       }
-      const args = drag.args.slice();
-      for (const i of pointArgs(s)) for (let k = 0; k < 3; k++) args[i + k] = drag.args[i + k] + delta[k];
-      const before = text.value;
+      const args = s.args.slice();
+      for (const i of pointArgs(s)) for (let k = 0; k < 3; k++) args[i + k] += delta[k];
+      const before = editor.text();
       const t = drag.base;
-      text.value = t.slice(0, s.start) + statementText(s.keyword, args) + t.slice(s.end);
-      state.model = parseModel(text.value);
-      if (before !== text.value) { drag.moved = true; scheduleDraft(); }
+      // A preview, outside the history (the drag's end is one step of it);
+      // not moved, the text as written (a click only selects).
+      const moved = delta.some((d) => d !== 0);
+      editor.edit(moved ? t.slice(0, s.start) + statementText(s.keyword, args) + t.slice(s.end) : t, true);
+      state.model = parseModel(editor.text());
+      if (before !== editor.text()) { drag.moved = true; scheduleDraft(); }
     }
     drawWire();
   });
@@ -119,8 +124,7 @@ export function createTools(app) {
     const d = drag;
     drag = null;
     if (d.kind === 'move' && d.moved) {
-      state.undoStack.push(d.base); state.redoStack = [];
-      textChanged();
+      editor.commit(d.base, editor.text());
       return;
     }
     if (d.kind === 'height' || d.kind === 'flat') pointPlaced();
@@ -173,7 +177,7 @@ export function createTools(app) {
   }
   function previewSize() {
     const [keyword, args] = sizedArgs();
-    state.model = parseModel(text.value);
+    state.model = parseModel(editor.text());
     state.model.push({ keyword, args, start: 0, end: 0 });
   }
   function sizeChosen() {

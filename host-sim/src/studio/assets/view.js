@@ -1,6 +1,9 @@
 // The wireframe view: an orbiting camera of its own over the scene's
-// objects, lights, eye and view frustum, and the mapping between canvas
-// points and the scene that the tools place with.
+// objects, lights, eye and view frustum where they are at the frame shown
+// (`state.frame`), the paths their MOVEs take them on, and the mapping
+// between canvas points and the scene that the tools place with.
+
+import { objectCentre, placed, single } from './model.js';
 
 export const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
 export const add = (a, b) => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
@@ -9,9 +12,11 @@ const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
 const normalize = (a) => scale(a, 1 / (Math.hypot(...a) || 1));
 
-/** The view over `wire` (a canvas) of `state.model`, seen by `state.camera`;
- *  `single(keyword, fallback)` gives the model's one statement of a kind. */
-export function createView(state, wire, single) {
+/** The view over `wire` (a canvas) of `state.model` at frame
+ *  `state.frame`, seen by `state.camera`. */
+export function createView(state, wire) {
+  /** The model's one statement of a kind, where it is at the frame shown. */
+  const at = (keyword, fallback) => single(state.model || [], keyword, fallback, state.frame);
   function basis() {
     const { yaw, pitch } = state.camera;
     const forward = [-Math.cos(pitch) * Math.sin(yaw), -Math.sin(pitch), -Math.cos(pitch) * Math.cos(yaw)];
@@ -67,7 +72,8 @@ export function createView(state, wire, single) {
     line([0, 0, 0], [extent, 0, 0], '#e05555');
     line([0, 0, 0], [0, extent, 0], '#55c055');
     line([0, 0, 0], [0, 0, extent], '#5577ee');
-    const model = state.model || [];
+    const model = (state.model || []).map((s) => placed(s, state.frame));
+    drawPaths(line);
     model.forEach((s, index) => {
       const colour = index === state.selection ? '#ffd54f' : '#b0bec5';
       const a = s.args;
@@ -113,14 +119,27 @@ export function createView(state, wire, single) {
     if (state.placing) drawPlacing(ctx, line);
   }
 
+  /** The path each MOVE takes its statement on: the point it moves by
+   *  (an object's centre, a light, the eye, the point looked at) through
+   *  its keys, between which it moves in straight lines. */
+  function drawPaths(line) {
+    for (const s of state.model || []) {
+      if (!s.moved) continue;
+      const from = s.keyword === 'VIEWPOINT' || s.keyword === 'ORIGIN' ? s.args.slice(0, 3) : objectCentre(s);
+      if (!from) continue;
+      const points = s.moved.keys.map(([, ...d]) => add(from, d));
+      for (let i = 0; i + 1 < points.length; i++) line(points[i], points[i + 1], '#ce93d8');
+    }
+  }
+
   /** The eye, the line of sight and the view frustum to the VIEWPORT at ORIGIN. */
   function drawEye(ctx, line) {
-    const from = single('VIEWPOINT', [0, 0, 10]), to = single('ORIGIN', [0, 0, 0]), upv = single('UPVECTOR', [0, 1, 0]);
-    const [rw, rh] = single('RASTER', [320, 240]);
+    const from = at('VIEWPOINT', [0, 0, 10]), to = at('ORIGIN', [0, 0, 0]), upv = at('UPVECTOR', [0, 1, 0]);
+    const [rw, rh] = at('RASTER', [320, 240]);
     const forward = sub(to, from);
     const distance = Math.hypot(...forward);
     const f = normalize(forward), right = normalize(cross(f, upv)), up = cross(right, f);
-    const viewport = single('VIEWPORT', null);
+    const viewport = at('VIEWPORT', null);
     const halfW = viewport ? viewport[0] / 2 : distance * Math.tan(Math.PI / 6);
     const halfH = viewport ? viewport[1] / 2 : (halfW * rh) / rw;
     const corners = [[-1, -1], [1, -1], [1, 1], [-1, 1]].map(([i, j]) => add(to, add(scale(right, i * halfW), scale(up, j * halfH))));
