@@ -67,8 +67,10 @@ static RAYTRACER: ConstStaticCell<Raytracer<LiveProfile>> = ConstStaticCell::new
 /// Core 1's own mailbox and screen lists.
 static CORE1_ROOM: ConstStaticCell<RendererRoom<LiveProfile>> = ConstStaticCell::new(RendererRoom::new());
 
-/// Core 1's stack: 16 KiB.
-static CORE1_STACK: Stack<4096> = Stack::new();
+/// Core 1's stack: 8 KiB, its job loop and a drawing's renderer (it
+/// traces on SRAM5, `octrace_pico::bank_stack`; this firmware loads every
+/// scene on core 0), so that the scene's text keeps its 32 KiB.
+static CORE1_STACK: Stack<2048> = Stack::new();
 
 /// Core 1's rows on their way to the panel.
 static ROWS: Handoff<{ panel::WIDTH as usize }, 4> = Handoff::new();
@@ -77,7 +79,7 @@ static ROWS: Handoff<{ panel::WIDTH as usize }, 4> = Handoff::new();
 static PANEL_BUFFER: ConstStaticCell<[u8; 512]> = ConstStaticCell::new([0; 512]);
 
 /// A received frame, the scene's text in it: the longest scene the board takes.
-static FRAME_BUFFER: ConstStaticCell<[u8; 24 * 1024]> = ConstStaticCell::new([0; 24 * 1024]);
+static FRAME_BUFFER: ConstStaticCell<[u8; 32 * 1024]> = ConstStaticCell::new([0; 32 * 1024]);
 
 /// The USB device and its serial port, owned by the USB interrupt.
 static USB: Mutex<RefCell<Option<SerialDevice>>> = Mutex::new(RefCell::new(None));
