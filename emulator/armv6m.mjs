@@ -27,13 +27,42 @@
 //   PC as a value is then one too high: `add rN, pc` in a handler (a
 //   compiled `match`'s jump table) read the wrong entry and jumped wild.
 //
+// Timing, where rp2040js 1.4.1 counts other cycles than the Cortex-M0+
+// Technical Reference Manual (ARM DDI 0484C) and the RP2040 datasheet:
+//
+// - PUSH with LR and POP with PC (TRM 3.3, table 3-1: PUSH 1 + N, POP
+//   1 + N, POP and return 3 + N, N the registers in the list): rp2040js
+//   leaves LR and PC out of N, a cycle short each.
+// - Loads and stores on the APB (datasheet 2.1.3, the APB bridge: a read
+//   takes 3 cycles, a write 4): rp2040js charges 4 and 5.
+// - Exception entry: 15 cycles from the interrupt to the handler's first
+//   instruction (TRM 3.6.1, zero wait states); rp2040js charges none.
+//   Exception return: the eight words of the frame loaded as a POP loads
+//   them, a cycle each, beyond the returning BX or POP; rp2040js charges
+//   nothing for them.
+//
+// And, when the core is on the bus fabric (fabric.mjs), its instruction
+// fetches: the M0+ fetches 32 bits at a time, so a word of code is fetched
+// once for the two 16-bit instructions in it, in the last cycle of the
+// instruction before (the cycle the prefetch overlaps); a taken branch,
+// a call, a return or an exception refetches at its target, in its own
+// last cycle; a 32-bit instruction whose second half is in the next word
+// fetches that word in its first cycle. Its loads and stores (the bus
+// counts them) address the bus in the instruction's first cycles, one a
+// cycle (LDM, STM, PUSH and POP one register a cycle), so that none falls
+// in the cycle of the next fetch. Each access is arbitrated there; a
+// stall delays the rest of the instruction.
+//
 // Each corrected instruction is executed here instead of by rp2040js, with
 // the same cycle count (1); every other instruction is rp2040js's own.
 //
 // Invariant: `addWithCarry` and `shiftCarry` are the manual's pseudocode
-// functions of the same names; nothing else is changed. The look at the next
-// instruction is a `peek` (no count, no stall); the fetch that executes it
-// is the core's own read, once.
+// functions of the same names; no result is changed but these
+// instructions'. The look at the next instruction is a `peek` (no count, no
+// stall); the read that executes it is the core's own, once, and the bus
+// takes it for a fetch (`slot` below zero), not for a load.
+
+import { FETCH, NO_PORT, portOf } from './fabric.mjs';
 
 /** The manual's AddWithCarry: sets N, Z, C, V and returns the 32-bit result. */
 function addWithCarry(core, x, y, carryIn) {
@@ -123,28 +152,70 @@ function executeCorrected(core, opcode) {
 // specialising it, costing a tenth of the emulator's speed).
 let executeOriginal = null;
 
+/** TRM 3.6.1: the cycles from an interrupt to its handler's first instruction. */
+export const EXCEPTION_ENTRY_CYCLES = 15;
+/** The exception frame's eight words, loaded a cycle each on return. */
+export const EXCEPTION_RETURN_CYCLES = 8;
+
+const PUSH_WITH_LR = 0xb500;
+const POP_WITH_PC = 0xbd00;
+
 function executeInstruction() {
   if (this.interruptsUpdated && this.checkForInterrupts()) {
     this.waiting = false;
   }
+  const fabric = this.fabric;
+  if (this.entering) {
+    // The exception's frame is stacked: the handler starts 15 cycles on, its first word fetched in the last.
+    this.entering = false;
+    this.cycles += EXCEPTION_ENTRY_CYCLES;
+    if (fabric !== null) fetch(this, this.registers[15] & ~3, this.cycles - 1);
+  }
   const pc = this.registers[15] & ~1;
   const opcode = this.peekInstruction(this.peekContext, pc);
+  const wide = opcode >= 0xe800;
+  if (fabric !== null) {
+    this.slot = wide ? -2 : -1;
+    if (wide && ((pc + 2) & ~3) !== this.fetchedWord) fetch(this, (pc + 2) & ~3, this.cycles);
+  }
+  let cycles;
   if (executeCorrected(this, opcode)) {
     this.readUint16(pc); // the fetch, for what it costs
     this.PC += 2;
     this.cycles += 1;
-    return 1;
+    cycles = 1;
+  } else {
+    // Interrupts were just checked: rp2040js need not look again first.
+    const pending = this.interruptsUpdated;
+    this.interruptsUpdated = false;
+    cycles = executeOriginal.call(this);
+    this.interruptsUpdated ||= pending;
+    // LR pushed and PC popped take their cycle, as every other register does.
+    if ((opcode & 0xff00) === PUSH_WITH_LR || (opcode & 0xff00) === POP_WITH_PC) {
+      this.cycles++;
+      cycles++;
+    }
+    // A WFI with PRIMASK set does not sleep while an interrupt is pending.
+    if (opcode === WFI && this.waiting && this.PM && interruptPending(this)) {
+      this.waiting = false;
+    }
   }
-  // Interrupts were just checked: rp2040js need not look again first.
-  const pending = this.interruptsUpdated;
-  this.interruptsUpdated = false;
-  const cycles = executeOriginal.call(this);
-  this.interruptsUpdated ||= pending;
-  // A WFI with PRIMASK set does not sleep while an interrupt is pending.
-  if (opcode === WFI && this.waiting && this.PM && interruptPending(this)) {
-    this.waiting = false;
+  if (fabric !== null) {
+    // The next instruction's word, unless this one's was it and the flow is sequential.
+    const next = this.registers[15] & ~1;
+    const word = next & ~3;
+    if (word !== this.fetchedWord || next !== pc + (wide ? 4 : 2)) fetch(this, word, this.cycles - 1);
   }
   return cycles;
+}
+
+/** Core `core` fetches the word at `word` in cycle `cycle`, arbitrated by its fabric. */
+function fetch(core, word, cycle) {
+  core.fetchedWord = word;
+  const port = portOf(word >>> 0);
+  if (port === NO_PORT) return;
+  const waited = core.fabric.access(core.busIndex, port, cycle, FETCH);
+  if (waited !== 0) core.cycles += waited;
 }
 
 /**
@@ -153,34 +224,77 @@ function executeInstruction() {
  * instruction is then the one at the (possibly new) PC. `peek(context,
  * address)` reads an instruction without side effects (default: the core's
  * read, with the core as the context); one function for all cores, as the
- * corrected executeInstruction is.
+ * corrected executeInstruction is. With `fabric` (fabric.mjs) and the
+ * core's `busIndex` on it, its fetches are arbitrated there (its loads and
+ * stores are the bus's to arbitrate, bus.mjs).
  */
-export function correctInstructions(core, peek = readInstruction, context = core) {
+export function correctInstructions(core, peek = readInstruction, context = core, { fabric = null, busIndex = 0 } = {}) {
   const prototype = Object.getPrototypeOf(core);
   executeOriginal ??= prototype.executeInstruction;
   checkOriginal ??= prototype.checkForInterrupts;
   entryOriginal ??= prototype.exceptionEntry;
+  returnOriginal ??= prototype.exceptionReturn;
   if (
     prototype.executeInstruction !== executeOriginal ||
     prototype.checkForInterrupts !== checkOriginal ||
-    prototype.exceptionEntry !== entryOriginal
+    prototype.exceptionEntry !== entryOriginal ||
+    prototype.exceptionReturn !== returnOriginal
   ) {
     throw new Error("correctInstructions: a core of another class than the first one's");
   }
   core.peekInstruction = peek;
   core.peekContext = context;
+  core.fabric = fabric;
+  core.busIndex = busIndex;
+  core.fetchedWord = -1;
+  core.slot = 0;
+  core.entering = false;
   core.executeInstruction = executeInstruction;
   core.checkForInterrupts = checkForInterrupts;
   core.exceptionEntry = exceptionEntry;
+  core.exceptionReturn = exceptionReturn;
+  core.cyclesIO = cyclesIO;
 }
 
-// rp2040js's own exceptionEntry, which the corrected one calls.
+// rp2040js's own exceptionEntry and exceptionReturn, which the corrected ones call.
 let entryOriginal = null;
+let returnOriginal = null;
 
-/** rp2040js's exception entry, the handler's address taken as the architecture does: without its Thumb bit. */
+/**
+ * rp2040js's exception entry, the handler's address taken as the
+ * architecture does: without its Thumb bit. The frame's stores are the
+ * bus's from the entry's first cycle; the 15 cycles are counted when the
+ * core next runs (it may be asleep now, its time not yet brought up to the
+ * machine's).
+ */
 function exceptionEntry(exception) {
+  this.slot = 0;
   entryOriginal.call(this, exception);
   this.PC = this.PC & ~1;
+  this.entering = true;
+}
+
+/** rp2040js's exception return, with the eight loads of the frame counted. */
+function exceptionReturn(excReturn) {
+  returnOriginal.call(this, excReturn);
+  this.cycles += EXCEPTION_RETURN_CYCLES;
+}
+
+const APB_BASE = 0x40000000;
+const APB_END = 0x50000000;
+const SIO_BASE = 0xd0000000;
+const SIO_END = 0xe0000000;
+
+/**
+ * The cycles a single load or store to `address` takes beyond its first:
+ * none to the SIO (the IOPORT, 2.3.1), 2 and 3 on the APB (a read in 3, a
+ * write in 4: datasheet 2.1.3), else 1 (AHB-Lite, no wait states).
+ */
+function cyclesIO(address, write = false) {
+  address >>>= 0;
+  if (address >= SIO_BASE && address < SIO_END) return 0;
+  if (address >= APB_BASE && address < APB_END) return write ? 3 : 2;
+  return 1;
 }
 
 // rp2040js's own checkForInterrupts (takes a pending exception, if any may

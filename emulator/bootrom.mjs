@@ -27,14 +27,24 @@
 // lookups with its own versions of exactly that family:
 //
 //   code  ROM function  what calls it
+//   P3    popcount32    __popcountsi2 (u32::count_ones)
+//   R3    reverse32     __rbit (u32::reverse_bits)
+//   L3    clz32         __clzsi2 (u32::leading_zeros on Armv6-M)
+//   T3    ctz32         __ctzsi2 (u32::trailing_zeros)
 //   MS    memset        __aeabi_memset, __aeabi_memclr
 //   S4    memset4       __aeabi_memset4/8, __aeabi_memclr4/8
 //   MC    memcpy        __aeabi_memcpy
 //   C4    memcpy44      __aeabi_memcpy4/8
-//   L3    clz32         __clzsi2 (u32::leading_zeros on Armv6-M)
-//   T3    ctz32         __ctzsi2 (u32::trailing_zeros)
-//   P3    popcount32    __popcountsi2 (u32::count_ones)
-//   R3    reverse32     __rbit (u32::reverse_bits)
+//
+// They cost what the real ROM's (its public source, B2) cost, written here
+// anew: the table in the real one's order (the lookup walks it, 11 cycles
+// a code, and rp2040-hal looks a function up at every call); memset and
+// memcpy reach a word boundary by a byte and a halfword, then fill or copy
+// 16 bytes a turn with four registers (2 cycles a word filled, 3.25 a word
+// copied) and finish with 8, 4, 2 and 1; memcpy of buffers whose
+// alignments differ, and anything under 8 bytes, go a byte at a time; the
+// bit functions in constant time: popcount and bit reversal by halving
+// masks, clz by 16, 8 and 4 bits then a table, ctz by a de Bruijn multiply.
 //
 // Anything else (the flash-programming functions, the soft-float tables,
 // reset to USB boot) is not here: looking it up stops the run with an error
@@ -42,10 +52,9 @@
 //
 // Invariants: the layout of the real ROM's header (initial stack pointer
 // and reset vector at 0x00, magic at 0x10, version at 0x13, 16-bit pointers
-// at 0x14, 0x16, 0x18); the launch protocol is the datasheet's; the copies
-// are word-wise where the real ones are (memset4, memcpy44), byte-wise
-// otherwise, so their costs are of the same order as the real ROM's, not
-// equal to them.
+// at 0x14, 0x16, 0x18); the launch protocol is the datasheet's; the
+// functions' loops take the real ROM's cycles (their entries and short
+// cases within a few cycles of them).
 
 import { Thumb } from './thumb.mjs';
 
@@ -88,110 +97,135 @@ export function codeLetters(key) {
   return `${printable(key & 0xff)}${printable((key >> 8) & 0xff)}`;
 }
 
-// Each function takes its arguments in r0..r2 (AAPCS) and returns in r0.
+// Each function takes its arguments in r0..r2 (AAPCS) and returns in r0;
+// r0-r3 and r12 are the caller's to lose, the rest is pushed and popped.
+// Listed in the real ROM's table order.
 const FUNCTIONS = {
-  // memset(ptr, c, n) -> ptr
-  MS: (t) => storeBytes(t.movs(3, 0).cmpImm(2, 0).bcc('eq', 'ms.done'), 'ms').label('ms.done').bxLr(),
-  // memset4(ptr, c, n) -> ptr, ptr word-aligned
-  S4: (t) =>
-    t.movsImm(3, 0xff)
-      .alu('ands', 1, 3)
-      .lslsImm(3, 1, 8)
-      .alu('orrs', 1, 3)
-      .lslsImm(3, 1, 16)
-      .alu('orrs', 1, 3)
-      .movs(3, 0)
-      .subsImm(2, 4)
-      .bcc('cc', 's4.tail')
-      .label('s4.word')
-      .str(1, 3)
-      .addsImm(3, 4)
-      .subsImm(2, 4)
-      .bcc('cs', 's4.word')
-      .label('s4.tail')
-      .addsImm(2, 4)
-      .bcc('eq', 's4.done')
-      .inline(storeBytes, 's4')
-      .label('s4.done')
-      .bxLr(),
-  // memcpy(dest, src, n) -> dest
-  MC: (t) => copyBytes(t.mov(12, 0).cmpImm(2, 0).bcc('eq', 'mc.done'), 'mc').label('mc.done').mov(0, 12).bxLr(),
-  // memcpy44(dest, src, n) -> dest, both word-aligned
-  C4: (t) =>
-    t.mov(12, 0)
-      .subsImm(2, 4)
-      .bcc('cc', 'c4.tail')
-      .label('c4.word')
-      .ldmia(1, [3])
-      .stmia(0, [3])
-      .subsImm(2, 4)
-      .bcc('cs', 'c4.word')
-      .label('c4.tail')
-      .addsImm(2, 4)
-      .bcc('eq', 'c4.done')
-      .inline(copyBytes, 'c4')
-      .label('c4.done')
-      .mov(0, 12)
-      .bxLr(),
-  // clz32(x): halving steps; 32 for 0
-  L3: (t) => leadingOrTrailing(t, 'l3', 'lsrsImm', 'lslsImm'),
-  // ctz32(x): the same steps from the other end
-  T3: (t) => leadingOrTrailing(t, 't3', 'lslsImm', 'lsrsImm'),
-  // popcount32(x): each bit shifted out into the carry and added
+  // popcount32(x): bits counted in pairs, nibbles, then bytes summed by a multiply
   P3: (t) =>
-    t.movsImm(1, 0)
-      .movsImm(2, 0)
-      .label('p3.bit')
-      .lsrsImm(0, 0, 1)
-      .alu('adcs', 1, 2)
-      .cmpImm(0, 0)
-      .bcc('ne', 'p3.bit')
-      .movs(0, 1)
+    t.ldrConst(1, 0x55555555)
+      .lsrsImm(2, 0, 1)
+      .alu('ands', 2, 1)
+      .subs(0, 0, 2)
+      .ldrConst(1, 0x33333333)
+      .lsrsImm(2, 0, 2)
+      .alu('ands', 2, 1)
+      .alu('ands', 0, 1)
+      .adds(0, 0, 2)
+      .lsrsImm(2, 0, 4)
+      .adds(0, 0, 2)
+      .ldrConst(1, 0x0f0f0f0f)
+      .alu('ands', 0, 1)
+      .ldrConst(1, 0x01010101)
+      .alu('muls', 0, 1)
+      .lsrsImm(0, 0, 24)
       .bxLr(),
-  // reverse32(x): each bit shifted out of x into the bottom of the result
-  R3: (t) =>
-    t.movsImm(1, 0)
-      .movsImm(2, 32)
-      .label('r3.bit')
-      .lsrsImm(0, 0, 1)
-      .alu('adcs', 1, 1)
-      .subsImm(2, 1)
-      .bcc('ne', 'r3.bit')
-      .movs(0, 1)
-      .bxLr(),
+  // reverse32(x): neighbouring bits, pairs and nibbles swapped, then the bytes by REV
+  R3: (t) => {
+    for (const [mask, shift] of [[0x55555555, 1], [0x33333333, 2], [0x0f0f0f0f, 4]]) {
+      t.ldrConst(1, mask).lsrsImm(2, 0, shift).alu('ands', 2, 1).alu('ands', 0, 1).lslsImm(0, 0, shift).alu('orrs', 0, 2);
+    }
+    return t.rev(0, 0).bxLr();
+  },
+  // clz32(x): 16, 8 and 4 bits at a time from the top, the last nibble from a table; 32 for 0
+  L3: (t) => {
+    t.movsImm(1, 28);
+    for (const bits of [16, 8, 4]) {
+      t.lsrsImm(2, 0, bits).bcc('eq', `l3.${bits}`).movs(0, 2).subsImm(1, bits).label(`l3.${bits}`);
+    }
+    t.adr(2, 'l3.table').ldrbReg(0, 2, 0).adds(0, 0, 1).bxLr().align4().label('l3.table');
+    for (const zeros of [4, 3, 2, 2, 1, 1, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0]) t.byte(zeros);
+    return t;
+  },
+  // ctz32(x): the lowest set bit alone, times a de Bruijn word, its top 5 bits into a table; 32 for 0
+  T3: (t) => {
+    t.alu('rsbs', 1, 0).alu('ands', 1, 0).bcc('eq', 't3.zero').ldrConst(2, DE_BRUIJN).alu('muls', 1, 2).lsrsImm(1, 1, 27);
+    t.adr(2, 't3.table').ldrbReg(0, 2, 1).bxLr().label('t3.zero').movsImm(0, 32).bxLr().align4().label('t3.table');
+    for (const position of deBruijnPositions()) t.byte(position);
+    return t;
+  },
+  // memset(ptr, c, n) -> ptr: bytes and a halfword up to a word boundary, then words
+  MS: (t) => {
+    t.mov(12, 0).inline(replicateByte).cmpImm(2, 8).bcc('cc', 'ms.short');
+    t.lsrsImm(3, 0, 1).bcc('cc', 'ms.even').strb(1, 0).addsImm(0, 1).subsImm(2, 1).label('ms.even');
+    t.lsrsImm(3, 0, 2).bcc('cc', 'ms.aligned').strh(1, 0).addsImm(0, 2).subsImm(2, 2).label('ms.aligned');
+    return fillWords(t, 'ms').mov(0, 12).bxLr().label('ms.short').inline(storeBytes, 'ms').mov(0, 12).bxLr();
+  },
+  // memset4(ptr, c, n) -> ptr, ptr word-aligned
+  S4: (t) => fillWords(t.mov(12, 0).inline(replicateByte), 's4').mov(0, 12).bxLr(),
+  // memcpy(dest, src, n) -> dest: words when dest and src share their alignment, else bytes
+  MC: (t) => {
+    t.mov(12, 0).cmpImm(2, 8).bcc('cc', 'mc.short').subs(3, 0, 1).lslsImm(3, 3, 30).bcc('ne', 'mc.short');
+    t.lsrsImm(3, 0, 1).bcc('cc', 'mc.even').ldrb(3, 1).strb(3, 0).addsImm(0, 1).addsImm(1, 1).subsImm(2, 1).label('mc.even');
+    t.lsrsImm(3, 0, 2).bcc('cc', 'mc.aligned').ldrh(3, 1).strh(3, 0).addsImm(0, 2).addsImm(1, 2).subsImm(2, 2);
+    return copyWords(t.label('mc.aligned'), 'mc').mov(0, 12).bxLr().label('mc.short').inline(copyBytes, 'mc').mov(0, 12).bxLr();
+  },
+  // memcpy44(dest, src, n) -> dest, both word-aligned
+  C4: (t) => copyWords(t.mov(12, 0), 'c4').mov(0, 12).bxLr(),
 };
 
-// Stores the byte r1 at r3 onwards, r2 times (r2 > 0).
-function storeBytes(t, prefix) {
-  return t.label(`${prefix}.byte`).strb(1, 3).addsImm(3, 1).subsImm(2, 1).bcc('ne', `${prefix}.byte`);
+/** A de Bruijn sequence of 32: its top 5 bits, shifted by k, differ for every k. */
+const DE_BRUIJN = 0x077cb531;
+
+/** The table of ctz32: the bit's position for each top 5 bits of DE_BRUIJN << position. */
+function deBruijnPositions() {
+  const positions = new Array(32);
+  for (let bit = 0; bit < 32; bit++) positions[((DE_BRUIJN << bit) >>> 27) & 31] = bit;
+  return positions;
 }
 
-// Copies r2 bytes (r2 > 0) from r1 onwards to r0 onwards.
+// r1's low byte in all four bytes of r1 (r3 spent).
+function replicateByte(t) {
+  return t.uxtb(1, 1).lslsImm(3, 1, 8).alu('orrs', 1, 3).lslsImm(3, 1, 16).alu('orrs', 1, 3);
+}
+
+// Stores the pattern r1 from r0 (word-aligned) on, r2 bytes (any number):
+// 16 bytes a turn of four registers (8 cycles: 2 a word), then 8, 4, 2, 1;
+// ends at `${prefix}.done`, r0 past the end.
+function fillWords(t, prefix) {
+  t.movs(3, 1).subsImm(2, 16).bcc('cc', `${prefix}.tail`).push([4, 5]).movs(4, 1).movs(5, 1);
+  t.label(`${prefix}.words`).stmia(0, [1, 3, 4, 5]).subsImm(2, 16).bcc('cs', `${prefix}.words`).pop([4, 5]);
+  t.label(`${prefix}.tail`).lslsImm(2, 2, 29).bcc('cc', `${prefix}.4`).stmia(0, [1, 3]);
+  t.label(`${prefix}.4`).lslsImm(2, 2, 1).bcc('cc', `${prefix}.2`).stmia(0, [1]);
+  t.label(`${prefix}.2`).lslsImm(2, 2, 1).bcc('cc', `${prefix}.1`).strh(1, 0).addsImm(0, 2);
+  return t.label(`${prefix}.1`).lslsImm(2, 2, 1).bcc('cc', `${prefix}.done`).strb(1, 0).label(`${prefix}.done`);
+}
+
+// Copies r2 bytes (any number) from r1 to r0, both word-aligned: 16 bytes
+// a turn of four registers (13 cycles: 3.25 a word), then 8, 4, 2, 1.
+function copyWords(t, prefix) {
+  t.push([4, 5, 6]).subsImm(2, 16).bcc('cc', `${prefix}.tail`);
+  t.label(`${prefix}.words`).ldmia(1, [3, 4, 5, 6]).stmia(0, [3, 4, 5, 6]).subsImm(2, 16).bcc('cs', `${prefix}.words`);
+  t.label(`${prefix}.tail`).lslsImm(2, 2, 29).bcc('cc', `${prefix}.4`).ldmia(1, [3, 4]).stmia(0, [3, 4]);
+  t.label(`${prefix}.4`).lslsImm(2, 2, 1).bcc('cc', `${prefix}.2`).ldmia(1, [3]).stmia(0, [3]);
+  t.label(`${prefix}.2`).lslsImm(2, 2, 1).bcc('cc', `${prefix}.1`).ldrh(3, 1).strh(3, 0).addsImm(1, 2).addsImm(0, 2);
+  t.label(`${prefix}.1`).lslsImm(2, 2, 1).bcc('cc', `${prefix}.done`).ldrb(3, 1).strb(3, 0);
+  return t.label(`${prefix}.done`).pop([4, 5, 6]);
+}
+
+// Stores the byte r1 at r0 onwards, r2 times (any number, r3 spent).
+function storeBytes(t, prefix) {
+  return t
+    .cmpImm(2, 0)
+    .bcc('eq', `${prefix}.bytes.done`)
+    .label(`${prefix}.byte`)
+    .subsImm(2, 1)
+    .strbReg(1, 0, 2)
+    .bcc('ne', `${prefix}.byte`)
+    .label(`${prefix}.bytes.done`);
+}
+
+// Copies r2 bytes (any number) from r1 onwards to r0 onwards, the last first (r3 spent).
 function copyBytes(t, prefix) {
   return t
+    .cmpImm(2, 0)
+    .bcc('eq', `${prefix}.bytes.done`)
     .label(`${prefix}.byte`)
-    .ldrb(3, 1)
-    .strb(3, 0)
-    .addsImm(1, 1)
-    .addsImm(0, 1)
     .subsImm(2, 1)
-    .bcc('ne', `${prefix}.byte`);
-}
-
-// Counts the zero bits at one end of r0 by halving steps: `test` shifts the
-// end's 16, 8, 4, 2, 1 bits down to see whether they are all zero; if so they
-// are counted and `move` shifts them out.
-function leadingOrTrailing(t, prefix, test, move) {
-  t.movsImm(1, 0);
-  for (const bits of [16, 8, 4, 2, 1]) {
-    t[test](2, 0, 32 - bits)
-      .bcc('ne', `${prefix}.${bits}`)
-      .addsImm(1, bits)
-      [move](0, 0, bits)
-      .label(`${prefix}.${bits}`);
-  }
-  // One bit left to test at the end: a zero input counts 32.
-  return t[test](2, 0, 31).bcc('ne', `${prefix}.done`).addsImm(1, 1).label(`${prefix}.done`).movs(0, 1).bxLr();
+    .ldrbReg(3, 1, 2)
+    .strbReg(3, 0, 2)
+    .bcc('ne', `${prefix}.byte`)
+    .label(`${prefix}.bytes.done`);
 }
 
 // Both cores' reset: core 0 boots from flash, core 1 waits to be launched.
@@ -281,18 +315,19 @@ function sleepUntilFifo(t, label, bit) {
 /** The ROM image (4096 words) and where each function is. */
 export function buildBootrom() {
   const t = new Thumb(CODE_START);
-  // rom_table_lookup(table, code): walks (code, address) pairs up to a zero code.
+  // rom_table_lookup(table, code): walks (code, address) pairs up to a zero
+  // code, 11 cycles a pair, as the real ROM's loop.
   const lookup = t.here;
   t.label('lookup')
+    .movsImm(3, 0)
     .ldrh(2, 0)
-    .cmpImm(2, 0)
+    .alu('cmp', 2, 3)
     .bcc('eq', 'lookup.missing')
-    .alu('cmp', 2, 1)
-    .bcc('eq', 'lookup.found')
+    .ldrh(3, 0, 2)
     .addsImm(0, 4)
-    .b('lookup')
-    .label('lookup.found')
-    .ldrh(0, 0, 2)
+    .alu('cmp', 2, 1)
+    .bcc('ne', 'lookup')
+    .movs(0, 3)
     .bxLr()
     .label('lookup.missing')
     .bkpt(MISSING_FUNCTION_BREAKPOINT)

@@ -8,28 +8,45 @@
 // loads straight to rp2040js's blocks; the rest (ROM, USB RAM, peripheral
 // stores with their atomic aliases) is rp2040js's.
 //
+// Every load and store that reaches the crossbar (all but the SIO's and the
+// PPB's) is arbitrated on the bus fabric (fabric.mjs) in its cycle: the
+// instruction's first cycle plus the loads and stores it made before (the
+// core's `slot`, which armv6m.mjs sets below zero for the reads that fetch
+// the instruction itself: those it arbitrates as fetches). A stall delays
+// the rest of the instruction.
+//
 // Invariants: no core access to flash bypasses the XIP cache (rp2040js's own
 // shortcuts to the flash array are never taken for a core); a store to the
 // flash changes no flash byte; a store to the ROM and an unaligned 32-bit
 // access are errors (faults on the chip); `peek16` reads without counting
-// or stalling anything (for the emulator's own look at an instruction).
+// or stalling anything (for the emulator's own look at an instruction);
+// each load or store counts one slot, once (the narrow reads the bus
+// widens count in the word read).
 
 import { RunError } from './errors.mjs';
 import { MPU_GRANULE_BITS, MPU_NO_ACCESS } from './ppb.mjs';
 import { ALIAS_CACHED, CACHE_BYTES } from './xip.mjs';
+import { DATA, NO_PORT, Port, portOf, sramPort } from './fabric.mjs';
 
 const ROM_END = 0x4000;
 const FLASH_BASE = 0x10000000;
 const XIP_END = 0x14000000;
 const XIP_SRAM = 0x15;
 const SRAM_BASE = 0x20000000;
+/** SRAM0 to SRAM3 unstriped, 64 KiB each (datasheet 2.6.2). */
+const UNSTRIPED_BASE = 0x21000000;
+const UNSTRIPED_END = 0x21040000;
 const APB_BASE = 0x40000000;
 const SIO_BASE = 0xd0000000;
 const SIO_END = 0xe0000000;
 const PPB_PAGE = 0xe000e;
 
-/** Routes core `index`'s accesses: rp2040 is rp2040js's chip, xip the cache, sio and ppb this core's own. */
-export function installBus(core, index, { rp2040, xip, sio, ppb }) {
+/**
+ * Routes core `index`'s accesses: rp2040 is rp2040js's chip, xip the
+ * cache, sio and ppb this core's own, fabric the crossbar its loads and
+ * stores are arbitrated on.
+ */
+export function installBus(core, index, { rp2040, xip, sio, ppb, fabric }) {
   const sram = rp2040.sram;
   const sramView = rp2040.sramView;
   const sramEnd = SRAM_BASE + sram.length;
@@ -39,6 +56,13 @@ export function installBus(core, index, { rp2040, xip, sio, ppb }) {
   const xipSramView = new DataView(xip.sram.buffer);
   const tags = xip.tags;
   const accesses = xip.accesses;
+  // A load or store on `port` in its slot of the instruction (a fetch's read, below slot 0, is not one).
+  const arbitrate = (port) => {
+    const slot = core.slot++;
+    if (slot < 0 || port === NO_PORT) return;
+    const waited = fabric.access(index, port, core.cycles + slot, DATA);
+    if (waited !== 0) core.cycles += waited;
+  };
   // An instruction fetch or load from flash: a hit through 0x10 costs a lookup; the rest is the cache's.
   const flashRead = (address) => {
     const offset = address & 0xffffff;
@@ -83,8 +107,11 @@ export function installBus(core, index, { rp2040, xip, sio, ppb }) {
     if (address & 3) unaligned(address, false);
     if (address >= SRAM_BASE && address < sramEnd) {
       checkLoad(address);
+      arbitrate(sramPort(address));
       return sramView.getUint32(address - SRAM_BASE, true);
     }
+    if (address >= UNSTRIPED_BASE && address < UNSTRIPED_END) return readUint32(striped(address));
+    arbitrate(portOf(address));
     if (address >= FLASH_BASE && address < XIP_END) return flashView.getUint32(flashRead(address), true);
     if (address >= SIO_BASE && address < SIO_END) return sio.readUint32(address - SIO_BASE);
     if (address >>> 12 === PPB_PAGE) return ppb.readUint32(address & 0xfff);
@@ -98,9 +125,13 @@ export function installBus(core, index, { rp2040, xip, sio, ppb }) {
 
   const readUint16 = (address) => {
     address >>>= 0;
-    if (address >= FLASH_BASE && address < XIP_END) return flashView.getUint16(flashRead(address), true);
+    if (address >= FLASH_BASE && address < XIP_END) {
+      arbitrate(Port.XIP);
+      return flashView.getUint16(flashRead(address), true);
+    }
     if (address >= SRAM_BASE && address < sramEnd) {
       checkLoad(address);
+      arbitrate(sramPort(address));
       return sramView.getUint16(address - SRAM_BASE, true);
     }
     const word = readUint32(address & ~3);
@@ -111,14 +142,19 @@ export function installBus(core, index, { rp2040, xip, sio, ppb }) {
     address >>>= 0;
     if (address >= SRAM_BASE && address < sramEnd) {
       checkLoad(address);
+      arbitrate(sramPort(address));
       return sram[address - SRAM_BASE];
     }
-    if (address >= FLASH_BASE && address < XIP_END) return flash[flashRead(address)];
+    if (address >= FLASH_BASE && address < XIP_END) {
+      arbitrate(Port.XIP);
+      return flash[flashRead(address)];
+    }
     return (readUint32(address & ~3) >>> ((address & 3) * 8)) & 0xff;
   };
 
   /** A store outside SRAM, of `bits` bits: true when handled here, false for rp2040js to take. */
   const storeElsewhere = (address, value, bits) => {
+    arbitrate(portOf(address));
     if (address >= FLASH_BASE && address < XIP_END) {
       xip.write(address >>> 24, address & 0xffffff, index);
       return true;
@@ -158,7 +194,10 @@ export function installBus(core, index, { rp2040, xip, sio, ppb }) {
     if (address & 3) unaligned(address, true);
     if (address >= SRAM_BASE && address < sramEnd) {
       checkStore(address);
+      arbitrate(sramPort(address));
       sramView.setUint32(address - SRAM_BASE, value, true);
+    } else if (address >= UNSTRIPED_BASE && address < UNSTRIPED_END) {
+      core.writeUint32(striped(address), value);
     } else if (!storeElsewhere(address, value, 32)) {
       rp2040.writeUint32(address, value);
     }
@@ -167,7 +206,10 @@ export function installBus(core, index, { rp2040, xip, sio, ppb }) {
     address >>>= 0;
     if (address >= SRAM_BASE && address < sramEnd) {
       checkStore(address);
+      arbitrate(sramPort(address));
       sramView.setUint16(address - SRAM_BASE, value, true);
+    } else if (address >= UNSTRIPED_BASE && address < UNSTRIPED_END) {
+      core.writeUint16(striped(address), value);
     } else if (!storeElsewhere(address, value & 0xffff, 16)) {
       rp2040.writeUint16(address, value);
     }
@@ -176,11 +218,22 @@ export function installBus(core, index, { rp2040, xip, sio, ppb }) {
     address >>>= 0;
     if (address >= SRAM_BASE && address < sramEnd) {
       checkStore(address);
+      arbitrate(sramPort(address));
       sram[address - SRAM_BASE] = value;
+    } else if (address >= UNSTRIPED_BASE && address < UNSTRIPED_END) {
+      core.writeUint8(striped(address), value);
     } else if (!storeElsewhere(address, value & 0xff, 8)) {
       rp2040.writeUint8(address, value);
     }
   };
+}
+
+/** The striped address of a byte of SRAM0-3's unstriped alias: bank b's word n is the striped word 4n + b. */
+function striped(address) {
+  const offset = address - UNSTRIPED_BASE;
+  const bank = offset >>> 16;
+  const word = (offset & 0xffff) >>> 2;
+  return SRAM_BASE + ((word * 4 + bank) << 2) + (address & 3);
 }
 
 /**

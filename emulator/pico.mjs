@@ -49,6 +49,8 @@ import { CorePpb } from './ppb.mjs';
 import { W25Q16JV } from './flash-chip.mjs';
 import { Ssi } from './ssi.mjs';
 import { XipCache, XipControl } from './xip.mjs';
+import { BusCtrl, BusFabric } from './fabric.mjs';
+import { completeRegisters } from './usb-serial.mjs';
 
 export { RunError, WatchdogReset };
 
@@ -67,6 +69,7 @@ const WFE = 0xbf20;
 const CHECK_EVERY = 0xfffff;
 /** rp2040js's peripherals, by `(address >>> 14) << 2`. */
 const XIP_CTRL_SLOT = 0x14000;
+const BUSCTRL_SLOT = 0x40030;
 const SSI_SLOT = 0x18000;
 const PSM_SLOT = 0x40010;
 const I2C_SLOTS = [0x40044, 0x40048];
@@ -86,9 +89,20 @@ export class Pico {
    * `oled`: the SSD1306 module's on I2C0 (oled.mjs; null: none).
    * `onBreakpoint(core, code)`: returns true for a BKPT or UDF it handles
    * (tests); any other ends the run. `flashStatusRegister2`: the flash
-   * chip's at power-on (QE set, as the Pico's).
+   * chip's at power-on (QE set, as the Pico's). `contention`: whether
+   * masters addressing one port of the bus fabric in one cycle wait for
+   * each other (fabric.mjs; true, as on the chip).
    */
-  constructor({ segments, source, functions = [], panel = null, oled = null, onBreakpoint = () => false, flashStatusRegister2 } = {}) {
+  constructor({
+    segments,
+    source,
+    functions = [],
+    panel = null,
+    oled = null,
+    onBreakpoint = () => false,
+    flashStatusRegister2,
+    contention = true,
+  } = {}) {
     const rp2040 = new RP2040();
     this.rp2040 = rp2040;
     this.clock = rp2040.clock;
@@ -115,6 +129,7 @@ export class Pico {
     /** Set by `stop`: the run returns once the running stretch ends. */
     this.stopping = false;
     this.irqLines = 0;
+    this.fabric = new BusFabric(this.cores, { contention });
 
     // Core 1's rp2040js parts act on `rp2040.core`: give them a view of the chip whose core is core 1.
     const core1View = Object.create(rp2040, {
@@ -129,10 +144,10 @@ export class Pico {
     const sram = { base: SRAM_BASE, bytes: rp2040.sram.length };
     this.ppbs = [new CorePpb(0, rp2040.ppb, sram), new CorePpb(1, ppb1, sram)];
     this.fifos = new InterCoreFifos((irq, level) => rp2040.setInterrupt(irq, level));
-    this.sios = [
-      new CoreSio(0, this.fifos, rp2040.sio, rp2040.sio),
-      new CoreSio(1, this.fifos, rp2040.sio, new rp2040.sio.constructor(core1View)),
-    ];
+    this.sios = [0, 1].map(
+      (k) =>
+        new CoreSio(k, this.fifos, rp2040.sio, k === 0 ? rp2040.sio : new rp2040.sio.constructor(core1View), () => this.cores[k].cycles),
+    );
     // Every IRQ line reaches both cores' NVICs.
     rp2040.setInterrupt = (irq, level) => {
       this.irqLines = level ? this.irqLines | (1 << irq) : this.irqLines & ~(1 << irq);
@@ -166,7 +181,15 @@ export class Pico {
     this.memory = machineMemory(rp2040, this.xip);
     const stall = (cycles) => (this.cores[this.current].cycles += cycles);
     rp2040.peripherals[XIP_CTRL_SLOT] = new XipControl(rp2040, this.xip, now, stall);
+    rp2040.peripherals[BUSCTRL_SLOT] = new BusCtrl(rp2040, this.fabric);
     this.watchPsm(rp2040.peripherals[PSM_SLOT]);
+    completeRegisters(rp2040.usbCtrl);
+    // rp2040js's DMA would copy outside the bus fabric (and around the XIP cache): not modelled.
+    for (const channel of rp2040.dma.channels) {
+      channel.start = () => {
+        throw new RunError(`DMA channel ${channel.index} started: the emulator does not model the DMA on the bus fabric`);
+      };
+    }
     this.watchdog = rp2040.peripherals[WATCHDOG_SLOT];
     this.watchdog.onWatchdogTrigger = () => {
       const why = this.watchdog.reason & 2 ? 'was triggered' : 'ran out';
@@ -216,8 +239,8 @@ export class Pico {
   /** Routes core k's accesses through its own bus and puts the instruction corrections in front of it. */
   attach(k) {
     const core = this.cores[k];
-    installBus(core, k, { rp2040: this.rp2040, xip: this.xip, sio: this.sios[k], ppb: this.ppbs[k] });
-    correctInstructions(core, peek16, this.memory);
+    installBus(core, k, { rp2040: this.rp2040, xip: this.xip, sio: this.sios[k], ppb: this.ppbs[k], fabric: this.fabric });
+    correctInstructions(core, peek16, this.memory, { fabric: this.fabric, busIndex: k });
     // An interrupt's pending state clears as its handler is entered, and
     // stays only while its line is still high (the NVIC's rule; rp2040js
     // keeps a pending bit until the line falls, so an interrupt pended by
@@ -241,6 +264,7 @@ export class Pico {
     core.pendingInterrupts = this.irqLines;
     core.interruptsUpdated = true;
     this.cores[1] = core;
+    this.fabric.forget(1);
     this.held[1] = false;
     this.woke = true;
     this.ppbs[1].reset();
@@ -557,13 +581,14 @@ export class Pico {
     return this.core1Ran ? 2 : 1;
   }
 
-  /** Each core's busy and waiting cycles, and its flash stalls (part of busy). */
+  /** Each core's busy and waiting cycles, and its stalls on flash and on the other core at the bus fabric (part of busy). */
   coreCycles() {
     return [0, 1].map((k) => ({
       core: k,
       busy: this.cores[k].cycles - this.waiting[k],
       waiting: this.waiting[k],
       flashStall: this.xip.stalls[k],
+      busStall: this.fabric.stalls[k],
       instructions: this.instructions[k],
     }));
   }

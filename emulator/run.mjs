@@ -11,8 +11,10 @@
 // the firmware talks to), --panel WxH (the ST7789 panel's size, default
 // 240x240, the Pico-LCD-1.3), --panel-offset X,Y (where it starts in the
 // controller's 240x320 memory, default 0,0), --max-seconds S (emulated time
-// before giving up, default 120), --json (the report as JSON on standard
-// output), --quiet.
+// before giving up, default 120), --contention on|off (whether two masters
+// on one port of the bus fabric wait for each other, as on the chip:
+// default on; off measures what the contention costs), --json (the report
+// as JSON on standard output), --quiet.
 //
 // --frames N: for a firmware that draws frames (an animation), runs until
 // N frames are on the panel and writes each as it was then: --out is then
@@ -26,9 +28,11 @@
 // standard output and serves the firmware's USB serial port there until
 // standard input closes or the process is signalled (`host-sim board PATH
 // scene.txt` then talks to it). With --out, the panel's picture is written
-// each time the firmware waits for the host again. Its standard input's
-// lines are commands for tests (hold, release, times: see serial.mjs); a
-// watchdog that runs out resets the board, which starts again.
+// each time the firmware waits for the host again; with --json, the report
+// follows the path on standard output once the serve ends. Its standard
+// input's lines are commands for tests (hold, release, times: see
+// serial.mjs); a watchdog that runs out resets the board, which starts
+// again.
 //
 // Exit codes: 0 the run ended with both cores asleep and the picture written
 // (with --frames, N frames drawn and written; with --serial, the serve
@@ -47,9 +51,9 @@ import { serveSerial } from './serial.mjs';
 import { framePattern, watchFrames } from './frames.mjs';
 
 const USAGE =
-  'usage: node run.mjs ELF [--out FILE.png] [--display auto|st7789|ssd1306] [--panel WxH] [--panel-offset X,Y] [--max-seconds S] [--json] [--quiet]\n' +
+  'usage: node run.mjs ELF [--out FILE.png] [--display auto|st7789|ssd1306] [--panel WxH] [--panel-offset X,Y] [--max-seconds S] [--contention on|off] [--json] [--quiet]\n' +
   '       node run.mjs ELF --frames N [--out \'DIR/f%03d.png\'] [the options above]\n' +
-  '       node run.mjs ELF --serial [--out FILE.png] [--display auto|st7789|ssd1306] [--panel WxH] [--panel-offset X,Y]';
+  '       node run.mjs ELF --serial [--out FILE.png] [--display auto|st7789|ssd1306] [--panel WxH] [--panel-offset X,Y] [--contention on|off] [--json]';
 
 function usage(message) {
   console.error(`octrace-pico-emulator: ${message}\n${USAGE}`);
@@ -76,6 +80,7 @@ try {
       'panel-offset': { type: 'string', default: '0,0' },
       'max-seconds': { type: 'string', default: '120' },
       frames: { type: 'string' },
+      contention: { type: 'string', default: 'on' },
       json: { type: 'boolean', default: false },
       quiet: { type: 'boolean', default: false },
     },
@@ -94,14 +99,18 @@ const maxSeconds = Number(values['max-seconds']);
 if (!(maxSeconds > 0)) {
   usage(`--max-seconds ${values['max-seconds']}: expected a positive number`);
 }
+if (values.contention !== 'on' && values.contention !== 'off') {
+  usage(`--contention ${values.contention}: expected on or off`);
+}
 const DISPLAYS = ['auto', 'st7789', 'ssd1306'];
 if (!DISPLAYS.includes(values.display)) {
   usage(`--display ${values.display}: expected one of ${DISPLAYS.join(', ')}`);
 }
-/** The panels wired: the ST7789 (with its size and place) and the SSD1306 module, as --display asks. */
+/** The machine's options: the panels wired (the ST7789 with its size and place, the SSD1306 module, as --display asks) and the contention. */
 const wired = {
   panel: values.display === 'ssd1306' ? null : { width, height, offsetX, offsetY },
   oled: values.display === 'st7789' ? null : {},
+  contention: values.contention === 'on',
 };
 if (values.out !== undefined && !values.out.toLowerCase().endsWith('.png')) {
   usage(`--out ${values.out}: the picture is written as PNG: name a .png file`);
@@ -155,21 +164,7 @@ try {
   } else {
     writeAtomically(out, picture());
   }
-  const coreCycles = pico.coreCycles();
-  report = {
-    elf: elfPath,
-    out,
-    ...(frames && { frames: frames.map(({ index, cycles, lit, busy }) => ({ index, out: frameName(index), cycles, lit, busy })) }),
-    display: display.name,
-    panel: `${display.width}x${display.height}`,
-    dark: display.darkBecause,
-    clockHz: CLOCK_HZ,
-    cores: pico.coresUsed,
-    instructions: coreCycles[0].instructions + coreCycles[1].instructions,
-    cycles: pico.phases(),
-    coreCycles,
-    xipCache: pico.cacheStatistics(),
-  };
+  report = runReport(pico, out, frames && frames.map(({ index, cycles, lit, busy }) => ({ index, out: frameName(index), cycles, lit, busy })));
 } catch (error) {
   if (progress) process.stderr.write('\r\x1b[K');
   if (expected(error)) {
@@ -188,6 +183,10 @@ if (values.json) {
   const { startUp, parseAndIndex, render, transfer, firstFullPanel, total } = report.cycles;
   const cores = report.coreCycles.slice(0, report.cores);
   const cache = report.xipCache;
+  const fabric = report.busFabric;
+  const contested = Object.entries(fabric.ports)
+    .filter(([, { contested }]) => contested > 0)
+    .map(([port, { contested }]) => `${port} ${count(contested)}`);
   console.error(
     [
       `${elfPath} on an emulated Raspberry Pi Pico (${report.cores === 2 ? 'both Cortex-M0+ cores' : 'one Cortex-M0+ core'} at 125 MHz):`,
@@ -198,9 +197,13 @@ if (values.json) {
       row('first full panel (from the picture\'s start)', firstFullPanel),
       row('in all', total),
       ...cores.map(
-        ({ core, busy, waiting, flashStall }) =>
-          `  core ${core}: ${count(busy)} cycles busy (${count(flashStall)} of them stalled on flash), ${count(waiting)} waiting`,
+        ({ core, busy, waiting, flashStall, busStall }) =>
+          `  core ${core}: ${count(busy)} cycles busy (${count(flashStall)} of them stalled on flash, ` +
+          `${count(busStall)} on the other core at the bus), ${count(waiting)} waiting`,
       ),
+      fabric.contention
+        ? `  bus fabric: contested accesses ${contested.length > 0 ? contested.join(', ') : 'none'}`
+        : '  bus fabric: contention off (no master waits for another)',
       `  XIP cache: ${count(cache.accesses)} flash reads, ${count(cache.misses)} misses` +
         (cache.lineReadCycles === null ? '' : ` (${cache.lineReadCycles} cycles a line read)`) +
         `, ${count(cache.stallCycles)} cycles stalled`,
@@ -223,12 +226,34 @@ function framesPerSecond(frames) {
   return `  after the first: ${((frames.length - 1) * CLOCK_HZ / after).toFixed(2)} frames a second at 125 MHz`;
 }
 
-/** --serial: serves the board on a pseudo-terminal, then exits. */
+/** What the run took and did: the report `--json` prints. */
+function runReport(pico, out, frames) {
+  const display = pico.display;
+  const coreCycles = pico.coreCycles();
+  return {
+    elf: elfPath,
+    out,
+    ...(frames && { frames }),
+    display: display.name,
+    panel: `${display.width}x${display.height}`,
+    dark: display.darkBecause,
+    clockHz: CLOCK_HZ,
+    cores: pico.coresUsed,
+    instructions: coreCycles[0].instructions + coreCycles[1].instructions,
+    cycles: pico.phases(),
+    coreCycles,
+    xipCache: pico.cacheStatistics(),
+    busFabric: pico.fabric.statistics(),
+  };
+}
+
+/** --serial: serves the board on a pseudo-terminal, then exits (with --json, printing the report). */
 async function serve() {
+  let pico; // the board serving now (a new one after each watchdog reset)
   let drawn = -1;
   try {
     const elf = readFileSync(elfPath);
-    await serveSerial(() => Pico.fromElf(elf, elfPath, wired), {
+    await serveSerial(() => (pico = Pico.fromElf(elf, elfPath, wired)), {
       input: process.stdin,
       answer: (line) => console.log(line),
       onPath: (path) => console.log(path),
@@ -252,6 +277,7 @@ async function serve() {
     }
     throw error;
   }
+  if (values.json) console.log(JSON.stringify(runReport(pico, values.out ?? null), null, 2));
   process.exit(0);
 }
 

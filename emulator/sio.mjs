@@ -14,10 +14,20 @@
 // its VLD, WOF and ROE, and like every IRQ line it reaches both cores'
 // NVICs.
 //
+// The divider (2.3.1.5) computes in 8 cycles while the core runs on: a
+// write of a dividend or divisor starts it and costs the store's one cycle,
+// CSR.READY is clear until 8 cycles after that store, and the quotient and
+// remainder are valid from then on. rp2040js instead charges the 8 cycles
+// to the core on every operand written (16 for a division); here they
+// cost nothing, and a read of QUOTIENT or REMAINDER before the result is
+// valid (undefined on the chip) ends the run with an error, never a value
+// silicon would not give. rp2040-hal's division waits exactly the 8
+// cycles, with four branches.
+//
 // Invariants: core 0's divider and interpolators are rp2040js's own, so a
 // one-core firmware's SIO is today's; core 1 has instances of the same
-// classes acting on core 1 (the divider charges its 8 cycles to the core
-// that started it); a spinlock read claims it for whichever core reads.
+// classes acting on core 1; a spinlock read claims it for whichever core
+// reads.
 
 import { RunError } from './errors.mjs';
 
@@ -28,6 +38,13 @@ const FIFO_RD = 0x058;
 /** The divider (0x060..0x078) and the two interpolators (0x080..0x0fc) are per core. */
 const PER_CORE_FIRST = 0x060;
 const PER_CORE_LAST = 0x0fc;
+const DIV_SDIVISOR = 0x06c;
+const DIV_QUOTIENT = 0x070;
+const DIV_REMAINDER = 0x074;
+const DIV_CSR = 0x078;
+const DIV_CSR_READY = 1 << 0;
+/** Cycles from a divider operand's store to a valid result (2.3.1.5). */
+export const DIVIDER_CYCLES = 8;
 
 const VLD = 1 << 0;
 const RDY = 1 << 1;
@@ -98,10 +115,21 @@ export class CoreSio {
   /**
    * `index`: the core. `shared`: rp2040js's SIO block (GPIO, spinlocks).
    * `own`: the block whose divider and interpolators are this core's
-   * (`shared` itself for core 0).
+   * (`shared` itself for core 0). `now()`: the core's time in cycles, at
+   * the start of the instruction that accesses the SIO.
    */
-  constructor(index, fifos, shared, own) {
-    Object.assign(this, { index, fifos, shared, own });
+  constructor(index, fifos, shared, own, now) {
+    Object.assign(this, { index, fifos, shared, own, now });
+    /** When the divider's result is valid. */
+    this.dividerReadyAt = 0;
+    // rp2040js's division, with its cycles taken back: silicon charges none.
+    const divide = Object.getPrototypeOf(own).updateHardwareDivider;
+    own.updateHardwareDivider = function (signed) {
+      const core = this.rp2040.core;
+      const cycles = core.cycles;
+      divide.call(this, signed);
+      core.cycles = cycles;
+    };
   }
 
   readUint32(offset) {
@@ -116,9 +144,26 @@ export class CoreSio {
         return this.fifos.read(this.index);
     }
     if (offset >= PER_CORE_FIRST && offset <= PER_CORE_LAST) {
-      return this.own.readUint32(offset);
+      return offset >= DIV_QUOTIENT && offset <= DIV_CSR ? this.readDivider(offset) : this.own.readUint32(offset);
     }
     return this.shared.readUint32(offset);
+  }
+
+  /** QUOTIENT, REMAINDER (valid only once ready) or CSR (READY as the time says). */
+  readDivider(offset) {
+    const early = this.dividerReadyAt - this.now();
+    if (offset === DIV_CSR) {
+      const csr = this.own.readUint32(offset);
+      return early > 0 ? csr & ~DIV_CSR_READY : csr;
+    }
+    if (early > 0) {
+      const name = offset === DIV_QUOTIENT ? 'QUOTIENT' : 'REMAINDER';
+      throw new RunError(
+        `core ${this.index} read the divider's ${name} ${DIVIDER_CYCLES - early} cycles after its operand, ` +
+          `before the result is valid (${DIVIDER_CYCLES} cycles, datasheet 2.3.1.5: undefined on the chip)`,
+      );
+    }
+    return this.own.readUint32(offset);
   }
 
   writeUint32(offset, value) {
@@ -135,6 +180,9 @@ export class CoreSio {
     }
     if (offset >= PER_CORE_FIRST && offset <= PER_CORE_LAST) {
       this.own.writeUint32(offset, value);
+      // An operand starts a division; a result written (a saved state put back) is valid at once.
+      if (offset <= DIV_SDIVISOR) this.dividerReadyAt = this.now() + 1 + DIVIDER_CYCLES;
+      else if (offset <= DIV_REMAINDER) this.dividerReadyAt = 0;
       return;
     }
     this.shared.writeUint32(offset, value);

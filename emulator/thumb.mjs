@@ -70,6 +70,8 @@ export class Thumb {
   lslsImm(rd, rm, imm5) { return this.emit((unsigned(imm5, 5, 'shift') << 6) | (low(rm) << 3) | low(rd)); }
   lsrsImm(rd, rm, imm5) { return this.emit(0x0800 | (unsigned(imm5, 5, 'shift') << 6) | (low(rm) << 3) | low(rd)); }
   asrsImm(rd, rm, imm5) { return this.emit(0x1000 | (unsigned(imm5, 5, 'shift') << 6) | (low(rm) << 3) | low(rd)); }
+  uxtb(rd, rm) { return this.emit(0xb2c0 | (low(rm) << 3) | low(rd)); }
+  rev(rd, rm) { return this.emit(0xba00 | (low(rm) << 3) | low(rd)); }
   // Two-register data processing: RDN = RDN op RM.
   alu(op, rdn, rm) {
     const ops = ['ands', 'eors', 'lsls', 'lsrs', 'asrs', 'adcs', 'sbcs', 'rors', 'tst', 'rsbs', 'cmp', 'cmn', 'orrs', 'muls', 'bics', 'mvns'];
@@ -85,9 +87,16 @@ export class Thumb {
   str(rt, rn, offset = 0) { return this.emit(0x6000 | (unsigned(offset / 4, 5, 'offset') << 6) | (low(rn) << 3) | low(rt)); }
   ldrh(rt, rn, offset = 0) { return this.emit(0x8800 | (unsigned(offset / 2, 5, 'offset') << 6) | (low(rn) << 3) | low(rt)); }
   ldrb(rt, rn, offset = 0) { return this.emit(0x7800 | (unsigned(offset, 5, 'offset') << 6) | (low(rn) << 3) | low(rt)); }
+  strh(rt, rn, offset = 0) { return this.emit(0x8000 | (unsigned(offset / 2, 5, 'offset') << 6) | (low(rn) << 3) | low(rt)); }
+  ldrbReg(rt, rn, rm) { return this.emit(0x5c00 | (low(rm) << 6) | (low(rn) << 3) | low(rt)); }
+  strbReg(rt, rn, rm) { return this.emit(0x5400 | (low(rm) << 6) | (low(rn) << 3) | low(rt)); }
   strb(rt, rn, offset = 0) { return this.emit(0x7000 | (unsigned(offset, 5, 'offset') << 6) | (low(rn) << 3) | low(rt)); }
   ldmia(rn, registers) { return this.emit(0xc800 | (low(rn) << 8) | registerList(registers)); }
   stmia(rn, registers) { return this.emit(0xc000 | (low(rn) << 8) | registerList(registers)); }
+  /** PUSH {registers} (low ones), with LR when `lr`. */
+  push(registers, lr = false) { return this.emit(0xb400 | (lr ? 0x100 : 0) | registerList(registers)); }
+  /** POP {registers} (low ones), with PC (a return) when `pc`. */
+  pop(registers, pc = false) { return this.emit(0xbc00 | (pc ? 0x100 : 0) | registerList(registers)); }
 
   /** LDR rt, =value: the constant goes to the pool `bytes()` puts after the code. */
   ldrConst(rt, value) {
@@ -122,8 +131,11 @@ export class Thumb {
     }
     return this.emit(value & 0xffff).emit(value >>> 16);
   }
-  /** Pads with NOPs to a multiple of 4 bytes. */
-  align4() { return this.here % 4 === 0 ? this : this.nop(); }
+  /** Pads with NOPs to a multiple of 4 bytes (after data bytes, with a zero byte). */
+  align4() {
+    if (this.pendingByte !== undefined) this.byte(0);
+    return this.here % 4 === 0 ? this : this.nop();
+  }
   bkpt(imm8) { return this.emit(0xbe00 | unsigned(imm8, 8, 'breakpoint')); }
   /** MRS rd, APSR (32 bits). */
   mrsApsr(rd) { return this.emit(0xf3ef).emit(0x8000 | (low(rd) << 8)); }
@@ -132,6 +144,22 @@ export class Thumb {
   b(label) {
     this.branches.push({ at: this.halves.length, label, cond: null });
     return this.emit(0);
+  }
+  /** ADR rd, label: the address of a word-aligned label at most 1020 bytes ahead. */
+  adr(rd, label) {
+    this.branches.push({ at: this.halves.length, label, cond: 'adr' });
+    return this.emit(0xa000 | (low(rd) << 8));
+  }
+  /** A byte of data (padded to a halfword by the next `byte` or `align4`). */
+  byte(value) {
+    unsigned(value, 8, 'byte');
+    if (this.pendingByte === undefined) {
+      this.pendingByte = value;
+      return this.emit(value);
+    }
+    this.halves[this.halves.length - 1] |= value << 8;
+    this.pendingByte = undefined;
+    return this;
   }
   bcc(cond, label) {
     if (!(cond in COND)) {
@@ -175,7 +203,11 @@ export class Thumb {
         throw new Error(`branch to undefined label ${label}`);
       }
       const offset = (target - (this.base + 2 * at + 4)) >> 1;
-      if (cond === 'bl') {
+      if (cond === 'adr') {
+        const distance = target - ((this.base + 2 * at + 4) & ~3);
+        if (target % 4 !== 0 || distance < 0 || distance > 1020) throw new RangeError(`ADR to ${label}: not a word-aligned label in reach`);
+        this.halves[at] |= distance / 4;
+      } else if (cond === 'bl') {
         if (offset < -(1 << 23) || offset >= 1 << 23) throw new RangeError(`call to ${label} is too far`);
         const s = offset < 0 ? 1 : 0;
         const j1 = (~(offset >> 22) ^ s) & 1;

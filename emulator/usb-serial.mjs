@@ -46,8 +46,12 @@ const KEPT_AT_RESET = [
   [0x88, 0xf8],
 ];
 
-/** Completes rp2040js's USB controller with the registers it leaves out. */
-function completeRegisters(usb) {
+/**
+ * Completes rp2040js's USB controller with the registers it leaves out:
+ * once, when the machine is made (a firmware touches them with or without
+ * a host on the bus).
+ */
+export function completeRegisters(usb) {
   const kept = new Map(KEPT_AT_RESET);
   const read = usb.readUint32.bind(usb);
   const write = usb.writeUint32.bind(usb);
@@ -75,7 +79,6 @@ export class UsbSerialHost {
     const usb = rp2040.usbCtrl;
     this.usb = usb;
     this.now = now;
-    completeRegisters(usb);
     this.cdc = new USBCDC(usb);
     /** The board's time when the host last handed it bytes, and when it last sent some (null: never). */
     this.lastIn = null;

@@ -5,7 +5,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { RP2040 } from 'rp2040js';
-import { buildBootrom, MISSING_FUNCTION_BREAKPOINT } from '../bootrom.mjs';
+import { buildBootrom, codeLetters, MISSING_FUNCTION_BREAKPOINT } from '../bootrom.mjs';
 import { correctInstructions } from '../armv6m.mjs';
 import { Thumb } from '../thumb.mjs';
 
@@ -113,4 +113,37 @@ test('the lookup finds each function by its code, and stops at a code it lacks',
   }
   const flashErase = 'R'.charCodeAt(0) | ('E'.charCodeAt(0) << 8);
   assert.equal(call(rp2040, lookup & ~1, [functions, flashErase]).stopped, MISSING_FUNCTION_BREAKPOINT);
+});
+
+/** The cycles `call` took. */
+function cycles(rp2040, address, args) {
+  const before = rp2040.core.cycles;
+  call(rp2040, address, args);
+  return rp2040.core.cycles - before;
+}
+
+test("the functions cost the real ROM's: 2 cycles a word set and 3.25 a word copied in their loops, the table walked in its order at 11 cycles a code", () => {
+  const { rp2040, rom } = pico();
+  const more = (letters, n, args) => cycles(rp2040, rom.addresses[letters], [BUFFER, ...args, n + 64]) - cycles(rp2040, rom.addresses[letters], [BUFFER, ...args, n]);
+  for (const n of [16, 100]) {
+    assert.equal(more('S4', n, [0x5a]), 16 * 2, `memset4: 16 more words from ${n} bytes`);
+    assert.equal(more('MS', n, [0x5a]), 16 * 2, `memset: the same loop`);
+    assert.equal(more('C4', n, [BUFFER + 0x1000]), 16 * 3.25, `memcpy44: 16 more words from ${n} bytes`);
+    assert.equal(more('MC', n, [BUFFER + 0x1000]), 16 * 3.25, 'memcpy of co-aligned buffers: the same loop');
+  }
+  assert.equal(more('MC', 16, [BUFFER + 0x1001]), 64 * 7, 'memcpy of buffers aligned apart: a byte at a time');
+
+  const functions = rp2040.readUint16(0x14);
+  const order = [];
+  for (let at = functions; rp2040.readUint16(at) !== 0; at += 4) order.push(codeLetters(rp2040.readUint16(at)));
+  assert.deepEqual(order, ['P3', 'R3', 'L3', 'T3', 'MS', 'S4', 'MC', 'C4'], "the real ROM's order");
+  const lookup = rp2040.readUint16(0x18) & ~1;
+  const code = (letters) => letters.charCodeAt(0) | (letters.charCodeAt(1) << 8);
+  const find = (letters) => cycles(rp2040, lookup, [functions, code(letters)]);
+  assert.equal(find('C4') - find('P3'), 7 * 11, 'seven codes further');
+  // The real ROM's, on uniform inputs: popcount 18, reverse 21, clz 13, ctz 12 (its source's table).
+  for (const [letters, most] of [['P3', 23], ['R3', 26], ['L3', 20], ['T3', 16]]) {
+    const worst = Math.max(...words.map((x) => cycles(rp2040, rom.addresses[letters], [x])));
+    assert.ok(worst <= most, `${letters}: ${worst} cycles at worst`);
+  }
 });

@@ -339,5 +339,14 @@ export function delay(t, n) {
   return t.ldrConst(0, n).label(loop).subsImm(0, 1).bcc('ne', loop);
 }
 
+/** rp2040-hal's wait for the divider's result: four branches to the next instruction, 8 cycles. */
+export function dividerWait(t) {
+  for (let i = 0; i < 4; i++) {
+    const next = `divider.${unique++}`;
+    t.b(next).label(next);
+  }
+  return t;
+}
+
 /** Sleeps for good: WFI with nothing to wake it. */
 export const halt = (t) => t.label('halt').wfi().b('halt');

@@ -25,6 +25,7 @@ import {
   fifoPop,
   fifoPush,
   flashImage,
+  dividerWait,
   halt,
   machine,
   spawnCore1,
@@ -249,6 +250,7 @@ test("each core has its own hardware divider: core 1's division does not touch c
     core1: (t) => {
       fifoPop(t, 0);
       t.ldrConst(0, -50 >>> 0).str(0, 7, 0x68).movsImm(0, 3).str(0, 7, 0x6c); // signed -50 / 3
+      dividerWait(t);
       t.ldr(0, 7, 0x74).inline(record, 0).ldr(0, 7, 0x70).inline(record, 0);
       fifoPush(t, 0);
       halt(t);

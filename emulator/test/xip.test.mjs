@@ -153,18 +153,19 @@ test("FLUSH clears every line and takes 1024 cycles; the counters as in the data
 });
 
 test('the QSPI serves one miss at a time: a core missing while the other core waits for its line waits for it too', () => {
+  // Each core's code in a bank of its own (SRAM4, SRAM5): their fetches never meet on the bus fabric.
   const image = flashImage({
     programs: {
       [CORE0_CODE]: (t) => {
-        spawnCore1(t, { entry: 0x20011000, stack: 0x20020000 });
-        t.ldrConst(0, 0x20010001).bx(0);
+        spawnCore1(t, { entry: 0x20041000, stack: 0x20020000 });
+        t.ldrConst(0, 0x20040001).bx(0);
       },
     },
   });
   const { pico, records } = machine(image, {
     sram: {
-      0x20010000: (t) => halt(timedLoad(fifoPush(t.ldrConst(7, 0xd0000000), 0), 0x13004000)),
-      0x20011000: (t) => halt(timedLoad(fifoPop(core1Started(t), 0), 0x13005000)),
+      0x20040000: (t) => halt(timedLoad(fifoPush(t.ldrConst(7, 0xd0000000), 0), 0x13004000)),
+      0x20041000: (t) => halt(timedLoad(fifoPop(core1Started(t), 0), 0x13005000)),
     },
   });
   assert.equal(pico.run({ maxCycles: 1e6 }), 'idle');

@@ -9,7 +9,9 @@
 use octrace_core::profile::Board16K;
 use octrace_core::Raytracer;
 use octrace_link::board::Board;
-use octrace_link::{encode_raw, Decoder, Kind, Message, Panel, PixelFormat, Reason, VERSION};
+use octrace_link::{
+    encode_raw, Counter, Counters, Decoder, Kind, Message, Panel, PixelFormat, Reason, Timing, VERSION,
+};
 use std::cell::RefCell;
 
 /// The buffers of a board with little RAM, a board, and a host.
@@ -91,7 +93,15 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     let answers = [
         frame(Message::Drawing { panel, pixels: true }, 2),
         frame(Message::Row { y: 0, pixels: &[0xF8, 0, 0x07, 0xE0, 0, 0x1F, 0xFF, 0xFF] }, 2),
-        frame(Message::Done { elapsed: Some(std::time::Duration::from_micros(1234)) }, 2),
+        frame(
+            Message::Done(Timing {
+                elapsed: Some(std::time::Duration::from_micros(1234)),
+                load: Some(std::time::Duration::from_micros(34)),
+                render: Some(std::time::Duration::from_micros(1200)),
+                counters: Counters::new(&[Counter { name: "sram0_contested", load: 1, render: 5 }]),
+            }),
+            2,
+        ),
         frame(Message::Cancelled { rows: 1 }, 2),
         frame(Message::Rejected { errors: 1 }, 3),
         frame(Message::Refused(Reason::BadChecksum { sent: 1, computed: 2 }), 0),

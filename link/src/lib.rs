@@ -48,12 +48,15 @@ mod cobs;
 mod crc;
 mod decoder;
 mod frame;
+mod list;
 mod message;
+mod wire;
 
 pub use cobs::{Sink, CHUNK};
 pub use decoder::{Decoder, Frame};
 pub use frame::{encode_raw, Reason, Refusal, OVERHEAD, VERSION};
-pub use message::{BoardInfo, Capacities, Capacity, CapacityNeed, Kind, Message, Panel, PixelFormat, SceneError};
+pub use list::{Capacities, Capacity, Counter, Counters};
+pub use message::{BoardInfo, CapacityNeed, Kind, Message, Panel, PixelFormat, SceneError, Timing};
 
 #[cfg(test)]
 mod tests {

@@ -8,6 +8,8 @@
 
 use crate::cobs::Sink;
 use crate::frame::{FrameWriter, Reason, VERSION};
+use crate::list::{Capacities, Counters};
+use crate::wire::{put_str8, Reader};
 use core::fmt;
 use core::time::Duration;
 use embedded_graphics_core::pixelcolor::raw::RawU16;
@@ -186,68 +188,6 @@ impl Panel {
     }
 }
 
-/// One capacity of a board's profile: its `profile!` field name
-/// (`"spheres"`) and how many it holds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct Capacity<'a> {
-    /// The field's name, as octrace-core's `CapacityKind::field` says it.
-    pub name: &'a str,
-    /// How many the board holds (saturated at `u32::MAX`).
-    pub count: u32,
-}
-
-/// A board's capacities: a list to send, or as received.
-#[derive(Clone, Copy, Debug)]
-pub struct Capacities<'a>(CapacityList<'a>);
-
-#[derive(Clone, Copy, Debug)]
-enum CapacityList<'a> {
-    List(&'a [Capacity<'a>]),
-    /// Checked when decoded: `count` entries of a name and a `u32`.
-    Wire {
-        count: u8,
-        bytes: &'a [u8],
-    },
-}
-
-impl<'a> Capacities<'a> {
-    /// At most 255 of `list` (the count is a byte).
-    pub const fn new(list: &'a [Capacity<'a>]) -> Capacities<'a> {
-        Capacities(CapacityList::List(list))
-    }
-
-    /// Each capacity, in the order sent.
-    pub fn iter(&self) -> impl Iterator<Item = Capacity<'a>> + 'a {
-        let (list, count, mut reader) = match self.0 {
-            CapacityList::List(list) => (&list[..list.len().min(255)], 0, Reader(&[])),
-            CapacityList::Wire { count, bytes } => (&[][..], count, Reader(bytes)),
-        };
-        let received = (0..count).map_while(move |_| Some(Capacity { name: reader.str8()?, count: reader.u32()? }));
-        list.iter().copied().chain(received)
-    }
-
-    /// How many there are.
-    pub fn len(&self) -> usize {
-        match self.0 {
-            CapacityList::List(list) => list.len().min(255),
-            CapacityList::Wire { count, .. } => count as usize,
-        }
-    }
-
-    /// Whether there are none.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-}
-
-impl PartialEq for Capacities<'_> {
-    fn eq(&self, other: &Self) -> bool {
-        self.len() == other.len() && self.iter().eq(other.iter())
-    }
-}
-
-impl Eq for Capacities<'_> {}
-
 /// What a board says of itself, answering [`Message::Hello`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BoardInfo<'a> {
@@ -339,11 +279,8 @@ pub enum Message<'a> {
         /// Its pixels in the panel's format, or none if they were not asked for.
         pixels: &'a [u8],
     },
-    /// Board: every row is drawn.
-    Done {
-        /// How long loading and drawing took, by the board's clock, if it has one.
-        elapsed: Option<Duration>,
-    },
+    /// Board: every row is drawn, and what it measured of the scene.
+    Done(Timing<'a>),
     /// Board: it stopped drawing when another frame came.
     Cancelled {
         /// How many rows were drawn.
@@ -353,7 +290,27 @@ pub enum Message<'a> {
     Refused(Reason),
 }
 
-/// A [`Message::Done`] without a board time on the wire.
+/// What a board measured of a scene it drew ([`Message::Done`]), by its own
+/// clock and hardware counters: a board without a clock sends no times, one
+/// that counts nothing no counters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Timing<'a> {
+    /// From the scene received to its last row drawn: parse, index and render.
+    pub elapsed: Option<Duration>,
+    /// Parsing and indexing the scene.
+    pub load: Option<Duration>,
+    /// Drawing it, its first row to its last.
+    pub render: Option<Duration>,
+    /// What the board's hardware counted over the load and the render.
+    pub counters: Counters<'a>,
+}
+
+impl Timing<'_> {
+    /// A board without a clock or counters.
+    pub const NONE: Timing<'static> = Timing { elapsed: None, load: None, render: None, counters: Counters::new(&[]) };
+}
+
+/// A time missing on the wire.
 const NO_TIME: u64 = u64::MAX;
 /// A [`CapacityNeed`] without the count needed on the wire.
 const NO_COUNT: u32 = u32::MAX;
@@ -369,7 +326,7 @@ impl<'a> Message<'a> {
             Message::Rejected { .. } => Kind::Rejected,
             Message::Drawing { .. } => Kind::Drawing,
             Message::Row { .. } => Kind::Row,
-            Message::Done { .. } => Kind::Done,
+            Message::Done(_) => Kind::Done,
             Message::Cancelled { .. } => Kind::Cancelled,
             Message::Refused(_) => Kind::Refused,
         }
@@ -391,11 +348,7 @@ impl<'a> Message<'a> {
                 w.put(&info.max_scene.to_be_bytes())?;
                 put_str8(&mut w, info.profile)?;
                 put_str8(&mut w, info.firmware)?;
-                w.put(&[info.capacities.len() as u8])?;
-                for capacity in info.capacities.iter() {
-                    put_str8(&mut w, capacity.name)?;
-                    w.put(&capacity.count.to_be_bytes())?;
-                }
+                info.capacities.write(&mut w)?;
             }
             Message::SceneError(e) => put_scene_error(&mut w, e.line, e.column, e.capacity, &e.message)?,
             Message::Rejected { errors } => w.put(&errors.to_be_bytes())?,
@@ -407,11 +360,11 @@ impl<'a> Message<'a> {
                 w.put(&y.to_be_bytes())?;
                 w.put(pixels)?;
             }
-            Message::Done { elapsed } => {
-                // A time too long for the wire is sent as the longest it carries.
-                let micros =
-                    elapsed.map_or(NO_TIME, |t| u64::try_from(t.as_micros()).unwrap_or(u64::MAX).min(NO_TIME - 1));
-                w.put(&micros.to_be_bytes())?;
+            Message::Done(timing) => {
+                for time in [timing.elapsed, timing.load, timing.render] {
+                    put_time(&mut w, time)?;
+                }
+                timing.counters.write(&mut w)?;
             }
             Message::Cancelled { rows } => w.put(&rows.to_be_bytes())?,
             Message::Refused(reason) => put_reason(&mut w, reason)?,
@@ -432,7 +385,7 @@ impl<'a> Message<'a> {
             Kind::Rejected => r.u32().map(|errors| Message::Rejected { errors }),
             Kind::Drawing => read_panel(&mut r).and_then(|panel| Some(Message::Drawing { panel, pixels: r.flag()? })),
             Kind::Row => r.u16().map(|y| Message::Row { y, pixels: r.rest() }),
-            Kind::Done => r.u64().map(|t| Message::Done { elapsed: (t != NO_TIME).then(|| Duration::from_micros(t)) }),
+            Kind::Done => read_timing(&mut r).map(Message::Done),
             Kind::Cancelled => r.u16().map(|rows| Message::Cancelled { rows }),
             Kind::Refused => read_reason(&mut r).map(Message::Refused),
         };
@@ -448,17 +401,6 @@ fn put_panel<S: Sink + ?Sized>(w: &mut FrameWriter<'_, S>, panel: &Panel) -> Res
 
 fn read_panel(r: &mut Reader<'_>) -> Option<Panel> {
     Some(Panel { width: r.u16()?, height: r.u16()?, format: PixelFormat::from_byte(r.u8()?)? })
-}
-
-/// A length byte and at most 255 bytes of `text`, cut at a character's
-/// boundary.
-fn put_str8<S: Sink + ?Sized>(w: &mut FrameWriter<'_, S>, text: &str) -> Result<(), S::Error> {
-    let mut end = text.len().min(255);
-    while !text.is_char_boundary(end) {
-        end -= 1;
-    }
-    w.put(&[end as u8])?;
-    w.put(&text.as_bytes()[..end])
 }
 
 /// A [`Message::SceneError`]'s payload, its message from any `Display`:
@@ -499,15 +441,21 @@ fn read_scene_error<'a>(r: &mut Reader<'a>) -> Option<SceneError<'a>> {
 
 fn read_board<'a>(r: &mut Reader<'a>) -> Option<BoardInfo<'a>> {
     let panel = read_panel(r)?;
-    let (max_scene, profile, firmware, count) = (r.u32()?, r.str8()?, r.str8()?, r.u8()?);
-    // Each entry is checked now, so that iterating cannot fail later.
-    let start = r.0;
-    for _ in 0..count {
-        r.str8()?;
-        r.u32()?;
-    }
-    let bytes = &start[..start.len() - r.0.len()];
-    Some(BoardInfo { panel, max_scene, profile, firmware, capacities: Capacities(CapacityList::Wire { count, bytes }) })
+    let (max_scene, profile, firmware) = (r.u32()?, r.str8()?, r.str8()?);
+    Some(BoardInfo { panel, max_scene, profile, firmware, capacities: Capacities::read(r)? })
+}
+
+/// A time in microseconds, or NO_TIME; one too long for the wire is sent
+/// as the longest it carries.
+fn put_time<S: Sink + ?Sized>(w: &mut FrameWriter<'_, S>, time: Option<Duration>) -> Result<(), S::Error> {
+    let micros = time.map_or(NO_TIME, |t| u64::try_from(t.as_micros()).unwrap_or(u64::MAX).min(NO_TIME - 1));
+    w.put(&micros.to_be_bytes())
+}
+
+fn read_timing<'a>(r: &mut Reader<'a>) -> Option<Timing<'a>> {
+    let mut time = || r.u64().map(|t| (t != NO_TIME).then(|| Duration::from_micros(t)));
+    let (elapsed, load, render) = (time()?, time()?, time()?);
+    Some(Timing { elapsed, load, render, counters: Counters::read(r)? })
 }
 
 /// The codes of [`Reason`]s on the wire. `WrongVersion`'s (1, then the
@@ -557,62 +505,13 @@ fn read_reason(r: &mut Reader<'_>) -> Option<Reason> {
     })
 }
 
-/// Reads a payload front to back; `None` once it runs out.
-#[derive(Clone, Copy)]
-struct Reader<'a>(&'a [u8]);
-
-impl<'a> Reader<'a> {
-    fn take<const N: usize>(&mut self) -> Option<[u8; N]> {
-        let (head, rest) = self.0.split_first_chunk::<N>()?;
-        self.0 = rest;
-        Some(*head)
-    }
-
-    fn u8(&mut self) -> Option<u8> {
-        self.take::<1>().map(|[b]| b)
-    }
-
-    fn u16(&mut self) -> Option<u16> {
-        self.take().map(u16::from_be_bytes)
-    }
-
-    fn u32(&mut self) -> Option<u32> {
-        self.take().map(u32::from_be_bytes)
-    }
-
-    fn u64(&mut self) -> Option<u64> {
-        self.take().map(u64::from_be_bytes)
-    }
-
-    /// A byte that must be 0 or 1.
-    fn flag(&mut self) -> Option<bool> {
-        match self.u8()? {
-            0 => Some(false),
-            1 => Some(true),
-            _ => None,
-        }
-    }
-
-    /// A length byte and that many bytes of UTF-8.
-    fn str8(&mut self) -> Option<&'a str> {
-        let len = self.u8()? as usize;
-        let (text, rest) = self.0.split_at_checked(len)?;
-        self.0 = rest;
-        core::str::from_utf8(text).ok()
-    }
-
-    /// Everything left.
-    fn rest(&mut self) -> &'a [u8] {
-        core::mem::take(&mut self.0)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     extern crate std;
     use super::*;
     use crate::decoder::Decoder;
     use crate::frame::{encode_raw, Refusal};
+    use crate::list::{Capacity, Counter};
     use crate::tests::Rng;
     use std::string::String;
     use std::vec::Vec;
@@ -661,6 +560,15 @@ mod tests {
             let names: Vec<String> = (0..rng.below(20)).map(|_| text(&mut rng, 30)).collect();
             let list: Vec<Capacity<'_>> =
                 names.iter().map(|name| Capacity { name, count: rng.next() as u32 }).collect();
+            let counted: Vec<Counter<'_>> =
+                names.iter().map(|name| Counter { name, load: rng.next() as u32, render: rng.next() as u32 }).collect();
+            let time = |rng: &mut Rng| (rng.below(2) == 1).then(|| Duration::from_micros(rng.below(1 << 40)));
+            let timing = Timing {
+                elapsed: time(&mut rng),
+                load: time(&mut rng),
+                render: time(&mut rng),
+                counters: Counters::new(&counted),
+            };
             let short = &words[..words.floor_char_boundary(rng.below(255) as usize)];
             let info = BoardInfo {
                 panel,
@@ -689,8 +597,8 @@ mod tests {
                 Message::Rejected { errors: rng.next() as u32 },
                 Message::Drawing { panel, pixels: rng.below(2) == 1 },
                 Message::Row { y: rng.next() as u16, pixels: &bytes },
-                Message::Done { elapsed: Some(Duration::from_micros(rng.below(1 << 40))) },
-                Message::Done { elapsed: None },
+                Message::Done(timing),
+                Message::Done(Timing::NONE),
                 Message::Cancelled { rows: rng.next() as u16 },
                 Message::Refused(reasons[rng.below(6) as usize]),
             ];
@@ -712,7 +620,7 @@ mod tests {
             (Message::Hello, 1),
             (Message::Scene { pixels: true, text: b"RASTER 4 2\n" }, 0x1234),
             (Message::Row { y: 1, pixels: &[0xF8, 0, 0x07, 0xE0, 0, 0x1F, 0xFF, 0xFF] }, 0x1234),
-            (Message::Refused(Reason::WrongVersion { expected: 1, found: 2 }), 0x1234),
+            (Message::Refused(Reason::WrongVersion { expected: 2, found: 1 }), 0x1234),
         ];
         for (message, tag) in examples {
             let mut wire = Vec::new();
@@ -760,7 +668,7 @@ mod tests {
     #[test]
     fn a_payload_that_does_not_fit_its_kind_is_malformed() {
         let malformed = |kind: Kind| Err(Refusal { tag: 3, reason: Reason::Malformed { kind: kind.byte() } });
-        let cases: [(Kind, &[u8]); 16] = [
+        let cases: [(Kind, &[u8]); 17] = [
             (Kind::Hello, &[0]),
             (Kind::Scene, &[]),
             (Kind::Scene, &[2, b'x']),
@@ -774,6 +682,7 @@ mod tests {
             (Kind::Drawing, &[0, 1, 0, 1, 1, 2]),
             (Kind::Row, &[7]),
             (Kind::Done, &[0; 9]),
+            (Kind::Done, &[0; 24]),
             (Kind::Cancelled, &[0, 0, 0]),
             (Kind::Refused, &[9, 0]),
             (Kind::Refused, &[1, 1]),
@@ -785,6 +694,7 @@ mod tests {
         assert_eq!(decode_payload(Kind::Board, &[0, 1, 0, 1, 1, 0, 0, 0, 9, 0, 0, 0]), Ok(Kind::Board));
         assert_eq!(decode_payload(Kind::SceneError, &[0, 0, 0, 1, 0, 0, 0, 1, 0, b'a']), Ok(Kind::SceneError));
         assert_eq!(decode_payload(Kind::Refused, &[1, 1, 2]), Ok(Kind::Refused));
+        assert_eq!(decode_payload(Kind::Done, &[0; 25]), Ok(Kind::Done));
     }
 
     #[test]

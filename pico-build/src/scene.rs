@@ -45,10 +45,11 @@ pub enum SceneKind {
 }
 
 /// Writes `OUT_DIR/scene.rs`: `SCENE_TEXT`, the scene `OCTRACE_SCENE` names
-/// (a path from the firmware's folder; `default` when it is not set), and
-/// `SceneProfile`, a `profile!` holding exactly what it needs; `ANIMATED`
-/// and `MOTION` (what an animation's motion needs: none for a still).
-/// Returns what the scene is. The firmware includes it:
+/// (a path from the firmware's folder; `default` when it is not set),
+/// `SCENE_NAME`, its file's name without the extension (what a firmware
+/// reports it drew), and `SceneProfile`, a `profile!` holding exactly what
+/// it needs; `ANIMATED` and `MOTION` (what an animation's motion needs:
+/// none for a still). Returns what the scene is. The firmware includes it:
 ///
 /// ```ignore
 /// mod scene {
@@ -107,8 +108,11 @@ fn scene_source(name: &str, path: &std::path::Path, text: &str) -> Result<(Scene
         coherence: animated,
     };
     let motion = if animated { Motion::needs(text) } else { Default::default() };
+    let stem = path.file_stem().map_or_else(|| name.to_owned(), |stem| stem.to_string_lossy().into_owned());
     let source = format!(
-        "/// The scene, from `{name}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n{profile}\
+        "/// The scene, from `{name}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n\
+         /// Its file's name, without the extension (for a firmware that reports what it drew).\n\
+         #[allow(dead_code)]\npub const SCENE_NAME: &str = {stem:?};\n{profile}\
          /// Whether the scene is an animation the firmware plays.\npub const ANIMATED: bool = {animated};\n\
          /// What its motion needs (`Motion::needs`).\n\
          pub const MOTION: octrace_core::animation::MotionNeeds = octrace_core::animation::MotionNeeds {{ \
@@ -134,6 +138,7 @@ mod tests {
                 .unwrap();
         assert!(!few.contains("light_buffer"), "{few}");
         assert!(few.contains("pub const SCENE_TEXT: &str = include_str!(\"scene.txt\");"), "{few}");
+        assert!(few.contains("pub const SCENE_NAME: &str = \"scene\";"), "{few}");
     }
 
     #[test]

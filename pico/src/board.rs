@@ -48,6 +48,8 @@ pub struct Peripherals {
     pub pio1: pac::PIO1,
     pub usbctrl_regs: pac::USBCTRL_REGS,
     pub usbctrl_dpram: pac::USBCTRL_DPRAM,
+    /// The bus fabric's control and performance counters.
+    pub busctrl: pac::BUSCTRL,
 }
 
 /// Starts the board, core 1 on `core1_stack`. Panics only where the chip
@@ -92,6 +94,7 @@ pub fn start(core1_stack: StackAllocation) -> Board {
             pio1: peripherals.PIO1,
             usbctrl_regs: peripherals.USBCTRL_REGS,
             usbctrl_dpram: peripherals.USBCTRL_DPRAM,
+            busctrl: peripherals.BUSCTRL,
         },
     }
 }

@@ -9,6 +9,7 @@
 //! bits as one core; core 0 presents the pieces in their order, so a
 //! display fed row by row sees the rows top to bottom.
 
+use crate::bank_stack::on_bank_stack;
 use crate::second_core::SecondCore;
 use core::cell::Cell;
 use core::ops::ControlFlow;
@@ -251,7 +252,7 @@ where
                 sev();
                 stop.load(Ordering::Acquire)
             };
-            let Some(traced) = trace(&mut renderer, &piece, &mut colors, &mut asked) else { return };
+            let Some(traced) = on_bank_stack(|| trace(&mut renderer, &piece, &mut colors, &mut asked)) else { return };
             // Free, so published.
             let _ = ring.send(number, colors[..traced].iter().copied());
             sev();
@@ -285,7 +286,9 @@ where
                 }
                 let number = take_next();
                 let traced = match to_trace.find(|&(_, n)| n == number) {
-                    Some((piece, _)) => Some(trace(renderer, &piece, &mut own, &mut asked).ok_or(Unfinished::Stopped)?),
+                    Some((piece, _)) => Some(
+                        on_bank_stack(|| trace(renderer, &piece, &mut own, &mut asked)).ok_or(Unfinished::Stopped)?,
+                    ),
                     None => None,
                 };
                 // The pieces from `shown` up to this one are core 1's.

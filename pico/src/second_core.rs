@@ -9,6 +9,7 @@
 //! null; panics abort (`panic = "abort"`, `panic-halt`), so core 0 never
 //! leaves a scope early by unwinding.
 
+use crate::bank_stack;
 use core::ptr;
 use core::sync::atomic::{AtomicPtr, Ordering};
 use cortex_m::asm::{sev, wfe};
@@ -23,20 +24,25 @@ pub struct SecondCore {
 }
 
 impl SecondCore {
-    /// Starts core 1 on `stack`, waiting for jobs.
+    /// Starts core 1 on `stack`, waiting for jobs; both cores' bank
+    /// stacks guarded ([`bank_stack::guard`]).
     pub fn start(core1: &mut Core<'_>, stack: StackAllocation) -> Result<SecondCore, SpawnError> {
-        core1.spawn(stack, || loop {
-            let job = JOB.load(Ordering::Acquire).cast::<&mut (dyn FnMut() + Send)>();
-            if job.is_null() {
-                wfe();
-                continue;
+        core1.spawn(stack, || {
+            bank_stack::guard();
+            loop {
+                let job = JOB.load(Ordering::Acquire).cast::<&mut (dyn FnMut() + Send)>();
+                if job.is_null() {
+                    wfe();
+                    continue;
+                }
+                // SAFETY: core 0 keeps the job alive, and touches it not,
+                // until JOB is null again (see `scope`).
+                unsafe { (*job)() };
+                JOB.store(ptr::null_mut(), Ordering::Release);
+                sev();
             }
-            // SAFETY: core 0 keeps the job alive, and touches it not, until
-            // JOB is null again (see `scope`).
-            unsafe { (*job)() };
-            JOB.store(ptr::null_mut(), Ordering::Release);
-            sev();
         })?;
+        bank_stack::guard();
         Ok(SecondCore { _started: () })
     }
 

@@ -4,14 +4,23 @@
 //! other ways, at build time), and running its ELF on the emulated Pico
 //! (`emulator/`), for the bit-exactness tests and the Pico benchmark.
 //!
+//! The ST7789 template's embedded-scene firmware answers on its USB serial
+//! port with what it measured of its scene by its own TIMER and bus
+//! counters ([`Report`]): [`ask_report`] reads it from a board's port,
+//! [`run_reporting`] from the emulated Pico's beside the emulator's own
+//! count.
+//!
 //! The templates' builds share one target directory (`target/pico/`, apart
 //! from a developer's own, so their dependencies are built once): build one
 //! scene at a time; each ELF is copied out under the template's and the
 //! build's name, so runs may overlap.
 
 use crate::repo;
+use std::io::{BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Stdio};
+use std::str::FromStr;
+use std::time::{Duration, Instant};
 
 /// The emulated Pico's clock.
 pub const CLOCK_HZ: f64 = 125e6;
@@ -188,11 +197,15 @@ pub struct Cycles {
     pub total: u64,
     /// How many cores ran the firmware.
     pub cores: u64,
-    /// Each core's cycles: busy (of them stalled on a flash cache miss) and
-    /// waiting (asleep).
+    /// Each core's cycles: busy (of them stalled on a flash cache miss, and
+    /// on the other core at the bus fabric) and waiting (asleep).
     pub busy: [u64; 2],
     pub stalled: [u64; 2],
+    pub bus_stalled: [u64; 2],
     pub waiting: [u64; 2],
+    /// Accesses to the striped SRAM banks (SRAM0 to SRAM3) that waited for
+    /// the other core (BUSCTRL's contested events, summed).
+    pub striped_contested: u64,
     /// The XIP cache: flash reads, misses.
     pub flash_reads: u64,
     pub cache_misses: u64,
@@ -206,14 +219,48 @@ impl Cycles {
     }
 }
 
-/// Runs `elf` on the emulated Pico; the panel's picture goes to `png`.
+/// Whether the emulated Pico's two cores wait for each other on the bus
+/// fabric (as on the chip), or each goes at full speed (what the contention
+/// costs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Contention {
+    On,
+    Off,
+}
+
+/// Runs `elf` on the emulated Pico, its cores contending for the bus as on
+/// the chip; the panel's picture goes to `png`.
 pub fn run(elf: &Path, png: &Path) -> Result<Cycles, String> {
-    let report = emulate(elf, png, &[])?;
+    run_with(elf, png, Contention::On)
+}
+
+/// Runs `elf` on the emulated Pico with or without the bus's contention.
+pub fn run_with(elf: &Path, png: &Path, contention: Contention) -> Result<Cycles, String> {
+    let on = if contention == Contention::On { "on" } else { "off" };
+    cycles_of(&emulate(elf, png, &["--contention", on])?)
+}
+
+/// `node emulator/run.mjs ELF`, once the emulator is installed.
+fn emulator(elf: &Path) -> Result<Command, String> {
+    let emulator = repo().join("emulator");
+    if !emulator.join("node_modules/rp2040js").is_dir() {
+        return Err(format!("the emulator is not installed: run `npm ci` in {}", emulator.display()));
+    }
+    let mut command = Command::new("node");
+    command.arg(emulator.join("run.mjs")).arg(elf);
+    Ok(command)
+}
+
+/// The cycles in the emulator's JSON report.
+fn cycles_of(report: &serde_json::Value) -> Result<Cycles, String> {
     let number = |value: &serde_json::Value, what: &str| {
         value.as_u64().ok_or_else(|| format!("the emulator's report has no {what}: {report}"))
     };
     let phase = |key: &str| number(&report["cycles"][key], key);
     let core = |k: usize, key: &str| number(&report["coreCycles"][k][key], key);
+    let ports = &report["busFabric"]["ports"];
+    let striped_contested =
+        ["sram0", "sram1", "sram2", "sram3"].iter().map(|bank| ports[bank]["contested"].as_u64().unwrap_or(0)).sum();
     Ok(Cycles {
         start_up: phase("startUp")?,
         parse_and_index: phase("parseAndIndex")?,
@@ -224,7 +271,9 @@ pub fn run(elf: &Path, png: &Path) -> Result<Cycles, String> {
         cores: number(&report["cores"], "cores")?,
         busy: [core(0, "busy")?, core(1, "busy")?],
         stalled: [core(0, "flashStall")?, core(1, "flashStall")?],
+        bus_stalled: [core(0, "busStall")?, core(1, "busStall")?],
         waiting: [core(0, "waiting")?, core(1, "waiting")?],
+        striped_contested,
         flash_reads: number(&report["xipCache"]["accesses"], "accesses")?,
         cache_misses: number(&report["xipCache"]["misses"], "misses")?,
     })
@@ -274,13 +323,7 @@ pub fn run_frames(elf: &Path, pattern: &Path, count: u32) -> Result<Vec<FrameCyc
 /// Runs `elf` on the emulated Pico (`run.mjs ELF --out OUT --json` and
 /// `more`) and returns its report.
 fn emulate(elf: &Path, out: &Path, more: &[&str]) -> Result<serde_json::Value, String> {
-    let emulator = repo().join("emulator");
-    if !emulator.join("node_modules/rp2040js").is_dir() {
-        return Err(format!("the emulator is not installed: run `npm ci` in {}", emulator.display()));
-    }
-    let output = Command::new("node")
-        .arg(emulator.join("run.mjs"))
-        .arg(elf)
+    let output = emulator(elf)?
         .arg("--out")
         .arg(out)
         .arg("--json")
@@ -296,4 +339,125 @@ fn emulate(elf: &Path, out: &Path, more: &[&str]) -> Result<serde_json::Value, S
         ));
     }
     serde_json::from_slice(&output.stdout).map_err(|e| format!("the emulator's report is not JSON: {e}"))
+}
+
+/// What the embedded-scene firmware measured of its scene, as it answers on
+/// its USB serial port (the template's `measure::Report`): the load (parse
+/// and index) and the render (the renderers' set-up to the last row) in
+/// microseconds by its TIMER, and each one's accesses to SRAM0 to SRAM3
+/// that waited for the other core (BUSCTRL's counters).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Report {
+    /// The firmware's name and version.
+    pub firmware: String,
+    pub scene: String,
+    pub load_us: u64,
+    pub render_us: u64,
+    pub load_contested: [u64; 4],
+    pub render_contested: [u64; 4],
+}
+
+impl Report {
+    /// From the scene text to the last pixel.
+    pub fn to_picture_seconds(&self) -> f64 {
+        (self.load_us + self.render_us) as f64 / 1e6
+    }
+}
+
+impl FromStr for Report {
+    type Err = String;
+
+    /// `NAME VERSION scene=S load_us=N render_us=N load_contested=A,B,C,D render_contested=A,B,C,D`.
+    fn from_str(line: &str) -> Result<Report, String> {
+        let bad = || format!("not a report of the Pico template: {line:?}");
+        let mut words = line.split_whitespace();
+        let firmware = format!("{} {}", words.next().ok_or_else(bad)?, words.next().ok_or_else(bad)?);
+        let fields: Vec<(&str, &str)> =
+            words.map(|word| word.split_once('=').ok_or_else(bad)).collect::<Result<_, _>>()?;
+        let field = |key: &str| fields.iter().find(|(k, _)| *k == key).map(|(_, v)| *v).ok_or_else(bad);
+        let number = |key: &str| field(key)?.parse::<u64>().map_err(|_| bad());
+        let banks = |key: &str| -> Result<[u64; 4], String> {
+            let counts: Vec<u64> =
+                field(key)?.split(',').map(|n| n.parse().map_err(|_| bad())).collect::<Result<_, _>>()?;
+            counts.try_into().map_err(|_| bad())
+        };
+        Ok(Report {
+            firmware,
+            scene: field("scene")?.to_owned(),
+            load_us: number("load_us")?,
+            render_us: number("render_us")?,
+            load_contested: banks("load_contested")?,
+            render_contested: banks("render_contested")?,
+        })
+    }
+}
+
+/// Asks the board serving serial device `port` (a real Pico's USB port, or
+/// the emulated Pico's pseudo-terminal) for its report: opens the port
+/// once it exists, and sends a newline every second until the board
+/// answers, then reads the whole line, for at most `timeout` (the board may
+/// be drawing still).
+pub fn ask_report(port: &Path, timeout: Duration) -> Result<Report, String> {
+    let deadline = Instant::now() + timeout;
+    let mut serial = loop {
+        match serialport::new(port.to_string_lossy(), 115_200).timeout(Duration::from_millis(100)).open() {
+            Ok(serial) => break serial,
+            Err(_) if Instant::now() < deadline => std::thread::sleep(Duration::from_millis(200)),
+            Err(e) => return Err(format!("cannot open {}: {e}", port.display())),
+        }
+    };
+    let mut line = Vec::new();
+    let mut asked = Instant::now() - Duration::from_secs(1);
+    while Instant::now() < deadline {
+        // Asked until it answers (the board may not have read the first ask).
+        if line.is_empty() && asked.elapsed() >= Duration::from_secs(1) {
+            serial.write_all(b"\n").map_err(|e| format!("writing to {}: {e}", port.display()))?;
+            asked = Instant::now();
+        }
+        let mut chunk = [0u8; 256];
+        match serial.read(&mut chunk) {
+            Ok(n) => line.extend_from_slice(&chunk[..n]),
+            Err(e) if e.kind() == std::io::ErrorKind::TimedOut => {}
+            Err(e) => return Err(format!("reading {}: {e}", port.display())),
+        }
+        // A whole line, the last one the board sent (an answer may have been asked twice).
+        if let Some(end) = line.iter().rposition(|&b| b == b'\n') {
+            let text = String::from_utf8_lossy(&line[..end]);
+            let last = text.lines().map(str::trim).rfind(|l| !l.is_empty()).unwrap_or("");
+            return last.parse();
+        }
+    }
+    Err(format!("{} sent no report within {} s", port.display(), timeout.as_secs()))
+}
+
+/// Runs `elf` (the embedded-scene firmware) on the emulated Pico serving
+/// its USB port, asks the firmware for its report, and returns it with the
+/// emulator's own count of the run; the panel's picture goes to `png`.
+pub fn run_reporting(elf: &Path, png: &Path) -> Result<(Cycles, Report), String> {
+    let mut child = emulator(elf)?
+        .arg("--serial")
+        .arg("--out")
+        .arg(png)
+        .arg("--json")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("cannot run node: {e}"))?;
+    let mut stdout = BufReader::new(child.stdout.take().ok_or("no standard output")?);
+    let mut path = String::new();
+    let asked = match stdout.read_line(&mut path) {
+        Ok(n) if n > 0 => ask_report(Path::new(path.trim()), Duration::from_secs(900)),
+        _ => Err("the emulated Pico named no serial device".to_owned()),
+    };
+    // Its standard input closed, the emulator ends and prints its own count.
+    drop(child.stdin.take());
+    let mut json = Vec::new();
+    let read = stdout.read_to_end(&mut json);
+    let out = child.wait_with_output().map_err(|e| format!("the emulator: {e}"))?;
+    if !out.status.success() || read.is_err() {
+        return Err(format!("the emulated Pico ran {}:\n{}", elf.display(), String::from_utf8_lossy(&out.stderr)));
+    }
+    let report = serde_json::from_slice(&json).map_err(|e| format!("the emulator's report is not JSON: {e}"))?;
+    Ok((cycles_of(&report)?, asked?))
 }

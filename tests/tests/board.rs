@@ -52,6 +52,8 @@ fn draws_host_sims_picture(board: &RunningBoard, panel: &str, name: &str, dir: &
     let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str(), out.as_os_str(), "--check".as_ref()]);
     assert_eq!(run.code, 0, "{name}: {}", run.stderr);
     assert!(run.stderr.contains("--check: bit-identical to host-sim's rgb565 render"), "{name}: {}", run.stderr);
+    // The board's `done`: its time, and its load's and render's by its clock.
+    assert!(run.stderr.contains(" by its clock (load "), "{name}: {}", run.stderr);
     let expected = dir.join(format!("{name}-host.png"));
     host_sim_preview_of(&scene, &expected, panel, "rgb565").unwrap();
     let (got, want) = (read_rgb(&out), read_rgb(&expected));

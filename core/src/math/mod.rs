@@ -23,11 +23,19 @@ pub(crate) use wide::{
     sqrt_and_rsqrt_58_62, sqrt_and_rsqrt_estimates_58_62, square_u32_wide, square_wide,
 };
 
-/// Whether this build is for ARMv6-M (Cortex-M0), which has only a
+/// Whether this build is for ARMv6-M (Cortex-M0 and M0+), which has only a
 /// 32×32→32 multiply and no count of leading zeros: there the core takes
 /// part-wise forms of its products where they are cheaper; every form gives
 /// the same bits, and the tests check the part-wise ones on the host.
-pub(crate) const ARMV6M: bool = cfg!(all(target_arch = "arm", not(target_feature = "thumb2")));
+///
+/// Told apart by its atomics: of Rust's Arm targets, ARMv6-M's alone has
+/// no 32-bit compare-and-swap (no LDREX/STREX), where the Cortex-M3, M4 and
+/// M33 (ARMv7-M, ARMv8-M Mainline, with `umull` and `clz`) have it. (Stable
+/// Rust reports no Arm target feature to `cfg`: `target_feature =
+/// "thumb2"` was never set, so every Arm build took the ARMv6-M forms.)
+/// ARMv8-M Baseline (Cortex-M23) lacks the long multiply too but has the
+/// atomics: it takes the general forms.
+pub(crate) const ARMV6M: bool = cfg!(all(target_arch = "arm", not(target_has_atomic = "32")));
 
 /// On ARMv6-M, `part_wise()` when it decides the result; else, and on other
 /// targets, `exact()`: the one shape of every "cheaper form when it can"

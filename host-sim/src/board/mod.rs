@@ -11,7 +11,9 @@
 
 mod link;
 
-pub use link::{Answer, BoardDescription, BoardLink, BoardSceneError, LinkError, Port, Progress, SerialLine};
+pub use link::{
+    Answer, BoardDescription, BoardLink, BoardSceneError, BoardTiming, LinkError, Port, Progress, SerialLine,
+};
 
 use crate::arguments::{output_format, parse_format, same_file};
 use crate::exit::CliError;
@@ -159,19 +161,16 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
-    let (panel, elapsed, picture) = match sent? {
+    let (panel, timing, picture) = match sent? {
         Sent::Rejected(errors) => {
             let errors = errors.iter().map(|e| e.located(&file)).collect();
             return Err(CliError::Scene { file, errors });
         }
-        Sent::Drawn { panel, elapsed, picture } => (panel, elapsed, picture),
+        Sent::Drawn { panel, timing, picture } => (panel, timing, picture),
     };
     let (w, h) = (panel.width, panel.height);
     if !args.quiet {
-        let time = match elapsed {
-            Some(t) => format!("in {:.3} s by its clock", t.as_secs_f64()),
-            None => format!("in {:.3} s here", started.elapsed().as_secs_f64()),
-        };
+        let time = timing.describe(started.elapsed());
         let _ = writeln!(stderr, "{w}x{h} {} drawn by the board at {port} {time}", panel.format);
     }
     let Some(image) = picture else {
@@ -220,9 +219,9 @@ fn link_error(port: &str, e: LinkError) -> CliError {
 pub(crate) enum Sent {
     /// The scene's errors, as the board found them; nothing drawn.
     Rejected(Vec<BoardSceneError>),
-    /// Drawn at the panel's size (`elapsed` by the board's clock), with the
-    /// picture if its pixels were asked for.
-    Drawn { panel: Panel, elapsed: Option<Duration>, picture: Option<RgbImage> },
+    /// Drawn at the panel's size (`timing` as the board measured it), with
+    /// the picture if its pixels were asked for.
+    Drawn { panel: Panel, timing: BoardTiming, picture: Option<RgbImage> },
 }
 
 /// Sends scene `text` (named `file` in errors) to the board at `port`,
@@ -264,13 +263,13 @@ pub(crate) fn send_scene(
     });
     Ok(match answer.map_err(|e| link_error(port, e))? {
         Answer::Rejected(errors) => Sent::Rejected(errors),
-        Answer::Drawn { panel, elapsed } => {
+        Answer::Drawn { panel, timing } => {
             let picture = pixels.then(|| RgbImage {
                 width: panel.width.into(),
                 height: panel.height.into(),
                 data: rows.concat(),
             });
-            Sent::Drawn { panel, elapsed, picture }
+            Sent::Drawn { panel, timing, picture }
         }
     })
 }

@@ -96,8 +96,8 @@ impl BoardSender {
                     .collect();
                 format!("{{\"answer\":\"rejected\",\"errors\":[{}]}}", errors.join(","))
             }
-            Ok(Sent::Drawn { panel, elapsed, picture: Some(picture) }) => {
-                let (seconds, clock) = match elapsed {
+            Ok(Sent::Drawn { panel, timing, picture: Some(picture) }) => {
+                let (seconds, clock) = match timing.elapsed {
                     Some(elapsed) => (elapsed.as_secs_f64(), "board"),
                     None => (started.elapsed().as_secs_f64(), "host"),
                 };

@@ -68,14 +68,16 @@ mod ring;
 mod serve;
 
 pub use ring::Ring;
-pub use serve::{Line, Link, Rows, Served, Stalled, POLL_PERIOD_US, SLOWEST_HOST_BYTES_PER_SECOND, STALL_GRACE_US};
+pub use serve::{
+    Line, Link, Rows, Served, Stalled, MAX_COUNTERS, POLL_PERIOD_US, SLOWEST_HOST_BYTES_PER_SECOND, STALL_GRACE_US,
+};
 
 use crate::cobs::Sink;
 use crate::decoder::{Decoder, Frame};
 use crate::frame::{FrameWriter, Reason, Refusal, VERSION};
-use crate::message::{put_scene_error, BoardInfo, Capacities, Capacity, CapacityNeed, Kind, Message, Panel};
+use crate::list::{Capacities, Capacity};
+use crate::message::{put_scene_error, BoardInfo, CapacityNeed, Kind, Message, Panel, Timing};
 use core::fmt;
-use core::time::Duration;
 use embedded_graphics_core::pixelcolor::{IntoStorage, Rgb565};
 use octrace_core::capacity::CapacityKind;
 use octrace_core::parse::ErrorKind;
@@ -259,10 +261,11 @@ impl<'r, P: Profile> Drawing<'r, P> {
         w.finish()
     }
 
-    /// Every row is drawn: `elapsed` is the board's time for the scene
-    /// (loading and drawing), if it has a clock.
-    pub fn finish<S: Sink + ?Sized>(self, elapsed: Option<Duration>, sink: &mut S) -> Result<(), S::Error> {
-        Message::Done { elapsed }.encode(self.tag, sink)
+    /// Every row is drawn: `timing` is what the board measured of the
+    /// scene (loading and drawing), by its clock and counters if it has
+    /// them ([`Timing::NONE`] if not).
+    pub fn finish<S: Sink + ?Sized>(self, timing: &Timing<'_>, sink: &mut S) -> Result<(), S::Error> {
+        Message::Done(*timing).encode(self.tag, sink)
     }
 
     /// The drawing stops after `rows` rows, because a frame came.
@@ -276,7 +279,9 @@ mod tests {
     extern crate std;
     use super::*;
     use crate::frame::{encode_raw, Reason};
+    use crate::list::{Counter, Counters};
     use crate::message::PixelFormat;
+    use core::time::Duration;
     use embedded_graphics_core::pixelcolor::Rgb888;
     use octrace_core::profile::Board16K;
     use octrace_core::render::Renderer;
@@ -322,7 +327,14 @@ mod tests {
                     let row: Vec<Rgb565> = renderer.row(y, 0..w).map(|p| p.color.into()).collect();
                     drawing.send_row(y as u16, &row, &mut answer).unwrap();
                 }
-                drawing.finish(Some(Duration::from_millis(12)), &mut answer).unwrap();
+                let counters = [Counter { name: "sram0_contested", load: 7, render: 99 }];
+                let timing = Timing {
+                    elapsed: Some(Duration::from_millis(12)),
+                    load: Some(Duration::from_millis(2)),
+                    render: Some(Duration::from_millis(10)),
+                    counters: Counters::new(&counters),
+                };
+                drawing.finish(&timing, &mut answer).unwrap();
             }
         }
         answer
@@ -370,7 +382,14 @@ mod tests {
                     received.extend_from_slice(pixels);
                     rows += 1;
                 }
-                Message::Done { elapsed } => assert_eq!(elapsed, Some(Duration::from_millis(12))),
+                Message::Done(timing) => {
+                    assert_eq!(
+                        (timing.elapsed, timing.render),
+                        (Some(Duration::from_millis(12)), Some(Duration::from_millis(10)))
+                    );
+                    let counters: Vec<_> = timing.counters.iter().collect();
+                    assert_eq!(counters, [Counter { name: "sram0_contested", load: 7, render: 99 }]);
+                }
                 other => panic!("{other:?}"),
             }
         });

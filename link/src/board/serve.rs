@@ -22,6 +22,8 @@
 use super::{Board, Drawing, Panel};
 use crate::cobs::Sink;
 use crate::decoder::Decoder;
+use crate::list::{Counter, Counters};
+use crate::message::Timing;
 use core::time::Duration;
 use embedded_graphics_core::pixelcolor::Rgb565;
 use octrace_core::accel::Accelerator;
@@ -74,7 +76,25 @@ pub trait Line {
     /// and at every turn of a wait for the host to take it (a firmware
     /// feeds its watchdog here).
     fn alive(&mut self);
+
+    /// The events the board's hardware counts over a scene's load and its
+    /// render, which the `done` answer reports (a Pico: its bus fabric's
+    /// contested accesses, `sram0_contested`); at most [`MAX_COUNTERS`].
+    /// None by default.
+    fn counter_names(&self) -> &'static [&'static str] {
+        &[]
+    }
+
+    /// Each of [`Line::counter_names`]'s counts since the last call, into
+    /// `counts` (as long as the names), and starts them again: called as a
+    /// scene starts loading, as it starts drawing and once it is drawn.
+    fn take_counts(&mut self, counts: &mut [u32]) {
+        let _ = counts;
+    }
 }
+
+/// The most counters a [`Line`] reports.
+pub const MAX_COUNTERS: usize = 8;
 
 /// What [`Link::serve`] did with a frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -139,7 +159,10 @@ impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
         }
         self.pending = false;
         // The board's time from the whole frame received to the last row
-        // drawn: parse, index and render.
+        // drawn: parse, index and render; and its counters over each.
+        let names = &line.counter_names()[..line.counter_names().len().min(MAX_COUNTERS)];
+        let (mut load_counts, mut render_counts) = ([0; MAX_COUNTERS], [0; MAX_COUNTERS]);
+        line.take_counts(&mut load_counts[..names.len()]);
         let start = line.now_us();
         let mut output = Output { line, waited_us: 0, taken: 0, stalled: false };
         // There: a frame just ended, or ended while the last scene was drawn
@@ -150,14 +173,29 @@ impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
             Err(Stalled) => return Some(Served::Stalled),
             Ok(Some(drawing)) => drawing,
         };
+        let loaded = output.line.now_us();
+        output.line.take_counts(&mut load_counts[..names.len()]);
         let mut rows =
             Rows { output: &mut output, decoder: &mut self.decoder, pending: &mut self.pending, read_at_us: start };
         let drawn = draw(&drawing, &mut rows).min(drawing.panel().height);
         // Every row drawn is done, even if a frame came with the last.
         let closed = match drawn == drawing.panel().height {
             true => {
-                let elapsed = Duration::from_micros(output.line.now_us().saturating_sub(start));
-                drawing.finish(Some(elapsed), &mut output)
+                let end = output.line.now_us();
+                output.line.take_counts(&mut render_counts[..names.len()]);
+                let counters: [Counter<'_>; MAX_COUNTERS] = core::array::from_fn(|k| Counter {
+                    name: names.get(k).copied().unwrap_or(""),
+                    load: load_counts[k],
+                    render: render_counts[k],
+                });
+                let micros = |from: u64, to: u64| Some(Duration::from_micros(to.saturating_sub(from)));
+                let timing = Timing {
+                    elapsed: micros(start, end),
+                    load: micros(start, loaded),
+                    render: micros(loaded, end),
+                    counters: Counters::new(&counters[..names.len()]),
+                };
+                drawing.finish(&timing, &mut output)
             }
             false => drawing.cancel(drawn, &mut output),
         };
@@ -337,6 +375,7 @@ mod tests {
     use octrace_core::profile::Board64K;
     use std::boxed::Box;
     use std::collections::VecDeque;
+    use std::string::{String, ToString};
     use std::vec::Vec;
 
     /// Two facing mirrors with the eye between them, eight lights, 16²
@@ -365,6 +404,9 @@ mod tests {
         clock_us: u64,
         /// When the host last took a byte (its pace).
         taken_at_us: u64,
+        /// How often the board took its counts: each count is that number
+        /// times ten, plus the counter's index.
+        counts_taken: u32,
     }
 
     impl Wire {
@@ -378,6 +420,7 @@ mod tests {
                 bytes_per_second: None,
                 clock_us: 0,
                 taken_at_us: 0,
+                counts_taken: 0,
             }
         }
 
@@ -458,6 +501,17 @@ mod tests {
         fn alive(&mut self) {
             self.polls += 1;
         }
+
+        fn counter_names(&self) -> &'static [&'static str] {
+            &["fetches", "stores"]
+        }
+
+        fn take_counts(&mut self, counts: &mut [u32]) {
+            self.counts_taken += 1;
+            for (k, count) in counts.iter_mut().enumerate() {
+                *count = self.counts_taken * 10 + k as u32;
+            }
+        }
     }
 
     const PANEL: Panel = Panel { width: 4, height: 3, format: PixelFormat::Rgb565 };
@@ -493,6 +547,33 @@ mod tests {
         // the two answers' writes through the 48-byte ring (a pixel of this
         // scene is millions of polls).
         assert!(wire.polls <= 50 + 100, "{} polls", wire.polls);
+    }
+
+    #[test]
+    fn done_carries_the_load_and_the_render_by_the_lines_clock_and_counters() {
+        let mut wire = Wire::new();
+        wire.send(0, Message::Scene { pixels: false, text: SCENE }, 1);
+        assert_eq!(serve_all(&mut wire), [Served::Drawn { rows: PANEL.height }]);
+        wire.host_reads();
+        let mut decoder = Decoder::for_host(std::vec![0u8; 4096]);
+        let mut done = None;
+        for &byte in &wire.received {
+            if let Some(Ok(frame)) = decoder.push(byte) {
+                if let Message::Done(timing) = frame.message {
+                    let counters: Vec<Counter<'_>> = timing.counters.iter().collect();
+                    let names: Vec<String> = counters.iter().map(|c| c.name.to_string()).collect();
+                    let counts: Vec<(u32, u32)> = counters.iter().map(|c| (c.load, c.render)).collect();
+                    done = Some((timing.elapsed, timing.load, timing.render, names, counts));
+                }
+            }
+        }
+        let (elapsed, load, render, names, counts) = done.expect("a done answer");
+        let (elapsed, load, render) = (elapsed.unwrap(), load.unwrap(), render.unwrap());
+        assert_eq!(elapsed, load + render);
+        assert!(load > Duration::ZERO && render > Duration::ZERO, "{load:?} {render:?}");
+        assert_eq!(names, ["fetches", "stores"]);
+        // Taken as the scene came (dropped), once loaded, once drawn.
+        assert_eq!(counts, [(20, 30), (21, 31)]);
     }
 
     #[test]

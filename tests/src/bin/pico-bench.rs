@@ -4,18 +4,22 @@
 //! the cycles to start, to parse and index the scene and to render it into
 //! the panel on both cores (240×240 on the ST7789; 128×64 on the SSD1306,
 //! then sent over I2C), the seconds from scene text to picture at 125 MHz,
-//! the firmware's flash and the SRAM it takes (its statics, and the code
-//! copied there at boot); then each core's busy and waiting cycles, and the
-//! flash cache's reads, misses and stalls.
+//! the same without the bus fabric's contention (each build runs twice:
+//! the cores waiting for each other at the SRAM banks as on the chip, and
+//! not), the firmware's flash and the SRAM it takes (its statics, and the
+//! code copied there at boot); then each core's busy and waiting cycles,
+//! its stalls on flash and on the other core, the contested accesses to
+//! the striped banks, and the flash cache's reads and misses.
 //!
 //!     cargo run --release -p octrace-tests --bin pico-bench [--template pico-st7789|pico-ssd1306] [--code-in parse-and-render|render|sram|flash] [--order rows|progressive] [scene...]
 //!
-//! Cycles are the emulator's: rp2040js's Cortex-M0+ timings, both cores in
-//! lockstep, the flash behind its XIP cache with the QSPI reads of the
-//! firmware's own boot2 (`emulator/`).
+//! Cycles are the emulator's: the Cortex-M0+'s timings, both cores in
+//! lockstep on the bus fabric, the flash behind its XIP cache with the QSPI
+//! reads of the firmware's own boot2 (`emulator/`, whose README says what
+//! it leaves out).
 
 use octrace_tests::firmware::Sizes;
-use octrace_tests::pico::{self, Build, Cycles, Template, CLOCK_HZ};
+use octrace_tests::pico::{self, Build, Contention, Cycles, Template, CLOCK_HZ};
 
 const USAGE: &str =
     "usage: pico-bench [--template pico-st7789|pico-ssd1306] [--code-in parse-and-render|render|sram|flash] \
@@ -55,8 +59,17 @@ fn main() {
     for scene in &scenes {
         let build = Build { template, scene, code_in: &code_in, order: &order };
         let measured = pico::build(&build).and_then(|elf| {
-            let cycles = pico::run(&elf, &dir.path().join("panel.png"))?;
-            Ok((cycles, Sizes::of(&elf)?, pico::sram_code_bytes(&elf)?))
+            // Both runs at once: they share nothing but the ELF.
+            let (with, without) = std::thread::scope(|s| {
+                let run = |contention, png: &str| {
+                    let (elf, png) = (&elf, dir.path().join(png));
+                    s.spawn(move || pico::run_with(elf, &png, contention))
+                };
+                let with = run(Contention::On, "with.png");
+                let without = run(Contention::Off, "without.png");
+                (with.join().expect("a run's thread"), without.join().expect("a run's thread"))
+            });
+            Ok((with?, without?, Sizes::of(&elf)?, pico::sram_code_bytes(&elf)?))
         });
         match measured {
             Ok(row) => rows.push((build.name(), row)),
@@ -81,7 +94,7 @@ fn main() {
         // The picture is traced into the panel's buffer, then sent.
         println!("| build | start-up | parse and index | render | picture over I2C | scene to picture at 125 MHz | flash | SRAM: statics + code |");
         println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
-        for (name, (c, sizes, sram_code)) in &rows {
+        for (name, (c, _, sizes, sram_code)) in &rows {
             println!(
                 "| {name} | {:.1} M cycles ({:.3} s) | {:.1} M cycles ({:.3} s) | {:.1} M cycles ({:.3} s) | {:.2} M cycles ({:.3} s) | **{:.3} s** | {} |",
                 millions(c.start_up),
@@ -97,34 +110,41 @@ fn main() {
             );
         }
     } else {
-        println!("| build | parse and index | render | scene to picture at 125 MHz | whole panel drawn once | flash | SRAM: statics + code |");
-        println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: |");
-        for (name, (c, sizes, sram_code)) in &rows {
+        println!("| build | parse and index | render | scene to picture at 125 MHz | without contention | whole panel drawn once | flash | SRAM: statics + code |");
+        println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+        for (name, (c, free, sizes, sram_code)) in &rows {
             println!(
-                "| {name} | {:.1} M cycles ({:.3} s) | {:.1} M cycles ({:.2} s) | **{:.2} s** | {:.3} s | {} |",
+                "| {name} | {:.1} M cycles ({:.3} s) | {:.1} M cycles ({:.2} s) | **{:.2} s** | {:.2} s (+{:.1} %) | {:.3} s | {} |",
                 millions(c.parse_and_index),
                 seconds(c.parse_and_index),
                 millions(c.render),
                 seconds(c.render),
                 c.to_picture_seconds(),
+                free.to_picture_seconds(),
+                100.0 * (c.to_picture_seconds() / free.to_picture_seconds() - 1.0),
                 seconds(c.first_full_panel),
                 sizes_text(sizes, *sram_code),
             );
         }
     }
     println!();
-    println!("| build | core 0 busy (of it on flash misses) | core 0 waiting | core 1 busy (on flash misses) | core 1 waiting | flash reads | cache misses |");
-    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: |");
-    for (name, (c, _, _)) in &rows {
-        let Cycles { busy, stalled, waiting, .. } = c;
+    println!(
+        "| build | core 0 busy (on flash; on core 1) | core 0 waiting | core 1 busy (on flash; on core 0) | core 1 waiting | contested SRAM0-3 accesses | flash reads | cache misses |"
+    );
+    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    for (name, (c, _, _, _)) in &rows {
+        let Cycles { busy, stalled, bus_stalled, waiting, .. } = c;
         println!(
-            "| {name} | {:.1} M ({:.1} M) | {:.1} M | {:.1} M ({:.1} M) | {:.1} M | {:.1} M | {:.2} M |",
+            "| {name} | {:.1} M ({:.1} M; {:.1} M) | {:.1} M | {:.1} M ({:.1} M; {:.1} M) | {:.1} M | {:.1} M | {:.1} M | {:.2} M |",
             millions(busy[0]),
             millions(stalled[0]),
+            millions(bus_stalled[0]),
             millions(waiting[0]),
             millions(busy[1]),
             millions(stalled[1]),
+            millions(bus_stalled[1]),
             millions(waiting[1]),
+            millions(c.striped_contested),
             millions(c.flash_reads),
             millions(c.cache_misses),
         );

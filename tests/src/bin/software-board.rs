@@ -26,7 +26,7 @@ use octrace_core::profile::{Board16K, Board64K, Host, Profile};
 use octrace_core::render::Renderer;
 use octrace_core::Raytracer;
 use octrace_link::board::{Board, Line, Link};
-use octrace_link::{Decoder, Message, Panel, PixelFormat, SceneError, OVERHEAD};
+use octrace_link::{Counters, Decoder, Message, Panel, PixelFormat, SceneError, Timing, OVERHEAD};
 use std::collections::VecDeque;
 use std::fs::File;
 use std::io::{ErrorKind, Read, Write};
@@ -98,7 +98,7 @@ impl Misbehaviour {
         match self {
             Misbehaviour::DrawsAt { width, height } => {
                 let panel = Panel { width, height, format: PixelFormat::Rgb565 };
-                let _ = send(Message::Drawing { panel, pixels }, line) && send(Message::Done { elapsed: None }, line);
+                let _ = send(Message::Drawing { panel, pixels }, line) && send(Message::Done(Timing::NONE), line);
             }
             Misbehaviour::ErrorsEvery(ms) => {
                 let error = SceneError { line: 1, column: 1, capacity: None, message: "one more error" };
@@ -365,6 +365,7 @@ fn serve_hostile<P: Profile>(options: &Options, misbehave: Misbehaviour, line: &
         let started = Instant::now();
         out.clear();
         let answered = board.answer(received, &mut *raytracer, &mut out);
+        let loaded = Instant::now();
         line.send_bytes(&out);
         let Ok(Some(drawing)) = answered else { continue };
         let scene = drawing.scene();
@@ -383,7 +384,15 @@ fn serve_hostile<P: Profile>(options: &Options, misbehave: Misbehaviour, line: &
                     }
                     let _ = drawing.send_row(y as u16, &row, &mut out);
                 }
-                let _ = drawing.finish(Some(started.elapsed()), &mut out);
+                // By the host's clock; it has no counters.
+                let (elapsed, render) = (started.elapsed(), loaded.elapsed());
+                let timing = Timing {
+                    elapsed: Some(elapsed),
+                    load: Some(elapsed - render),
+                    render: Some(render),
+                    counters: Counters::new(&[]),
+                };
+                let _ = drawing.finish(&timing, &mut out);
             }
             Err(_) => _ = drawing.cancel(0, &mut out),
         }

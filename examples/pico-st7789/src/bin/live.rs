@@ -29,19 +29,17 @@ use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 use embedded_graphics::prelude::*;
 use hal::multicore::Stack;
 use hal::pac::interrupt;
-use hal::usb::UsbBus;
 use hal::{entry, pac, Timer, Watchdog};
 use octrace_core::render::Handoff;
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
 use octrace_link::board::{Line, Link, Ring};
 use octrace_link::{Panel, PixelFormat};
 use octrace_pico::{board, both_cores};
+use octrace_pico_st7789::measure::{self, Meter};
 use octrace_pico_st7789::panel;
+use octrace_pico_st7789::usb::{self, SerialDevice};
 use panic_halt as _;
 use rp2040_hal as hal;
-use usb_device::class_prelude::UsbBusAllocator;
-use usb_device::prelude::*;
-use usbd_serial::SerialPort;
 
 // boot2, and what build.rs places in SRAM (OCTRACE_CODE_IN) copied there at boot.
 octrace_pico::boot!();
@@ -69,8 +67,10 @@ static RAYTRACER: ConstStaticCell<Raytracer<LiveProfile>> = ConstStaticCell::new
 /// Core 1's own mailbox and screen lists.
 static CORE1_ROOM: ConstStaticCell<RendererRoom<LiveProfile>> = ConstStaticCell::new(RendererRoom::new());
 
-/// Core 1's stack: 16 KiB.
-static CORE1_STACK: Stack<4096> = Stack::new();
+/// Core 1's stack: 8 KiB, its job loop and a drawing's renderer (it
+/// traces on SRAM5, `octrace_pico::bank_stack`; this firmware loads every
+/// scene on core 0), so that the scene's text keeps its 32 KiB.
+static CORE1_STACK: Stack<2048> = Stack::new();
 
 /// Core 1's rows on their way to the panel.
 static ROWS: Handoff<{ panel::WIDTH as usize }, 4> = Handoff::new();
@@ -82,8 +82,7 @@ static PANEL_BUFFER: ConstStaticCell<[u8; 512]> = ConstStaticCell::new([0; 512])
 static FRAME_BUFFER: ConstStaticCell<[u8; 32 * 1024]> = ConstStaticCell::new([0; 32 * 1024]);
 
 /// The USB device and its serial port, owned by the USB interrupt.
-type Usb = (UsbDevice<'static, UsbBus>, SerialPort<'static, UsbBus>);
-static USB: Mutex<RefCell<Option<Usb>>> = Mutex::new(RefCell::new(None));
+static USB: Mutex<RefCell<Option<SerialDevice>>> = Mutex::new(RefCell::new(None));
 
 /// Bytes from the host, not yet read by the main loop; and bytes for the
 /// host, not yet taken by the USB device.
@@ -105,19 +104,14 @@ fn main() -> ! {
     let (mut display, _) = panel::init(peripherals.spi1, pins, &mut resets, &clocks, timer, PANEL_BUFFER.take());
 
     // The USB serial port, served by its interrupt from here on.
-    let bus: &'static UsbBusAllocator<UsbBus> = cortex_m::singleton!(: UsbBusAllocator<UsbBus> =
-        UsbBusAllocator::new(UsbBus::new(peripherals.usbctrl_regs, peripherals.usbctrl_dpram, clocks.usb_clock, true, &mut resets)))
-    .unwrap();
-    let serial = SerialPort::new(bus);
-    let strings = StringDescriptors::default().manufacturer("octrace").product("octrace live").serial_number("1");
-    let device = UsbDeviceBuilder::new(bus, UsbVidPid(0x16c0, 0x27dd))
-        .strings(&[strings])
-        .unwrap()
-        .max_packet_size_0(64)
-        .unwrap()
-        .device_class(usbd_serial::USB_CLASS_CDC)
-        .build();
-    critical_section::with(|cs| USB.borrow_ref_mut(cs).replace((device, serial)));
+    let device = usb::serial_device(
+        peripherals.usbctrl_regs,
+        peripherals.usbctrl_dpram,
+        clocks.usb_clock,
+        &mut resets,
+        "octrace live",
+    );
+    critical_section::with(|cs| USB.borrow_ref_mut(cs).replace(device));
     // SAFETY: the handler only touches what the critical sections guard.
     unsafe { pac::NVIC::unmask(pac::Interrupt::USBCTRL_IRQ) };
 
@@ -126,7 +120,7 @@ fn main() -> ! {
     let mut link = Link::new(panel, FIRMWARE, FRAME_BUFFER.take());
     let raytracer = RAYTRACER.take();
     let room = CORE1_ROOM.take();
-    let mut line = UsbLine { timer, watchdog };
+    let mut line = UsbLine { timer, watchdog, meter: Meter::new(timer, peripherals.busctrl) };
     loop {
         link.serve(&mut line, raytracer, |drawing, rows| {
             let rows = RefCell::new(rows);
@@ -152,10 +146,11 @@ fn main() -> ! {
 }
 
 /// The USB serial port as the board loop's line: the rings, the timer, the
-/// core's sleep and the watchdog.
+/// core's sleep, the watchdog and the bus fabric's counters.
 struct UsbLine {
     timer: Timer,
     watchdog: Watchdog,
+    meter: Meter,
 }
 
 impl Line for UsbLine {
@@ -199,6 +194,16 @@ impl Line for UsbLine {
 
     fn alive(&mut self) {
         self.watchdog.feed();
+    }
+
+    fn counter_names(&self) -> &'static [&'static str] {
+        &measure::EVENTS
+    }
+
+    fn take_counts(&mut self, counts: &mut [u32]) {
+        for (count, contested) in counts.iter_mut().zip(self.meter.split().contested) {
+            *count = contested;
+        }
     }
 }
 
