@@ -12,7 +12,7 @@ use crate::crc::Crc32;
 use core::fmt;
 
 /// The protocol version this crate speaks: the first byte of every frame.
-pub const VERSION: u8 = 1;
+pub const VERSION: u8 = 2;
 
 /// The header's bytes: version, kind, tag (2).
 pub(crate) const HEADER: usize = 4;
@@ -210,12 +210,12 @@ impl<S: Sink + ?Sized> fmt::Write for FrameWriter<'_, S> {
 /// use octrace_link::{encode_raw, Decoder, Reason};
 ///
 /// let mut wire = Vec::new();
-/// encode_raw(2, 0x01, 9, &[], &mut wire).unwrap();
+/// encode_raw(3, 0x01, 9, &[], &mut wire).unwrap();
 /// let mut buffer = [0u8; 64];
 /// let mut decoder = Decoder::new(&mut buffer);
 /// let received = wire.iter().find_map(|&b| decoder.push(b).map(|r| r.map(|f| f.tag)));
 /// let refused = received.unwrap().unwrap_err();
-/// assert_eq!((refused.tag, refused.reason), (9, Reason::WrongVersion { expected: 1, found: 2 }));
+/// assert_eq!((refused.tag, refused.reason), (9, Reason::WrongVersion { expected: 2, found: 3 }));
 /// ```
 pub fn encode_raw<S: Sink + ?Sized>(
     version: u8,

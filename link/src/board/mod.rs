@@ -64,9 +64,12 @@
 //! line's core sets when [`Rows::poll`] says so, and the core that owns
 //! the line sends the rows in order.
 
+mod play;
 mod ring;
 mod serve;
 
+use play::saturate;
+pub use play::{AnimationRoom, Playing, TILE};
 pub use ring::Ring;
 pub use serve::{Line, Link, Rows, Served, Stalled, POLL_PERIOD_US, SLOWEST_HOST_BYTES_PER_SECOND, STALL_GRACE_US};
 
@@ -91,6 +94,8 @@ pub struct Board<'a> {
     panel: Panel,
     max_scene: u32,
     firmware: &'a str,
+    /// What its [`AnimationRoom`] holds (none: it plays no animation).
+    room: play::RoomSizes,
 }
 
 impl<'a> Board<'a> {
@@ -98,7 +103,7 @@ impl<'a> Board<'a> {
     /// holds, running `firmware` (its name and version, for hosts to show).
     pub fn new<B: AsRef<[u8]> + AsMut<[u8]>>(panel: Panel, firmware: &'a str, decoder: &Decoder<B>) -> Board<'a> {
         let max_scene = u32::try_from(decoder.max_scene()).unwrap_or(u32::MAX);
-        Board { panel, max_scene, firmware }
+        Board { panel, max_scene, firmware, room: play::RoomSizes::default() }
     }
 
     /// Its panel.
@@ -180,9 +185,25 @@ impl<'a> Board<'a> {
             send_error(tag, 0, 0, None, &e, sink)?;
             return Message::Rejected { errors: 1 }.encode(tag, sink).map(|()| None);
         }
+        // An animation: its frames, if the board has room to play it.
+        let frames = match play::animated(&scene) {
+            None => 0,
+            Some(frames) => {
+                let short = self.room.short_of(text, self.panel);
+                let mut errors = 0;
+                for need in short.iter().flatten() {
+                    send_error(tag, 0, 0, Some(*need), &play::NoRoom(*need), sink)?;
+                    errors += 1;
+                }
+                if errors > 0 {
+                    return Message::Rejected { errors }.encode(tag, sink).map(|()| None);
+                }
+                frames.count
+            }
+        };
         // Not taken: the rows are not either (see `answer`).
-        let _ = Message::Drawing { panel: self.panel, pixels }.encode(tag, sink);
-        Ok(Some(Drawing { scene, tag, pixels, panel: self.panel }))
+        let _ = Message::Drawing { panel: self.panel, pixels, frames }.encode(tag, sink);
+        Ok(Some(Drawing { scene, tag, pixels, panel: self.panel, playing: None }))
     }
 }
 
@@ -201,9 +222,6 @@ fn send_error<S: Sink + ?Sized>(
     w.finish()
 }
 
-fn saturate(n: usize) -> u32 {
-    u32::try_from(n).unwrap_or(u32::MAX)
-}
 
 /// A scene that loaded, being drawn at the panel's size: render its rows
 /// from [`Drawing::scene`], send each with [`Drawing::send_row`] as it is
@@ -214,6 +232,8 @@ pub struct Drawing<'r, P: Profile> {
     tag: u16,
     pixels: bool,
     panel: Panel,
+    /// The frame of an animation this is, or None for a still.
+    playing: Option<Playing<'r>>,
 }
 
 impl<P: Profile> fmt::Debug for Drawing<'_, P> {
@@ -222,6 +242,7 @@ impl<P: Profile> fmt::Debug for Drawing<'_, P> {
             .field("tag", &self.tag)
             .field("pixels", &self.pixels)
             .field("panel", &self.panel)
+            .field("playing", &self.playing)
             .finish_non_exhaustive()
     }
 }
@@ -242,21 +263,47 @@ impl<'r, P: Profile> Drawing<'r, P> {
         self.pixels
     }
 
+    /// For a frame of an animation, which and how to draw it: only the
+    /// runs its `Coherence` planned, each sent with
+    /// [`Drawing::send_run`]. None for a still, drawn row by row.
+    pub fn playing(&self) -> Option<Playing<'r>> {
+        self.playing
+    }
+
     /// Tells the host row `y` is drawn: `row` is its pixels (the panel's
     /// width of them), sent only if the host asked for them.
     pub fn send_row<S: Sink + ?Sized>(&self, y: u16, row: &[Rgb565], sink: &mut S) -> Result<(), S::Error> {
         let mut w = FrameWriter::begin(sink, VERSION, Kind::Row.byte(), self.tag)?;
         w.put(&y.to_be_bytes())?;
-        if self.pixels {
-            for pixels in row.chunks(32) {
-                let mut bytes = [0u8; 64];
-                for (pair, color) in bytes.chunks_exact_mut(2).zip(pixels) {
-                    pair.copy_from_slice(&color.into_storage().to_be_bytes());
-                }
-                w.put(&bytes[..2 * pixels.len()])?;
-            }
-        }
+        self.put_pixels(&mut w, row)?;
         w.finish()
+    }
+
+    /// Tells the host the pixels `run` of row `y` from column `x` of an
+    /// animation's frame are drawn, sent only if the host asked for them.
+    pub fn send_run<S: Sink + ?Sized>(&self, y: u16, x: u16, run: &[Rgb565], sink: &mut S) -> Result<(), S::Error> {
+        let mut w = FrameWriter::begin(sink, VERSION, Kind::Run.byte(), self.tag)?;
+        let width = u16::try_from(run.len()).unwrap_or(u16::MAX);
+        for field in [y, x, width] {
+            w.put(&field.to_be_bytes())?;
+        }
+        self.put_pixels(&mut w, &run[..usize::from(width)])?;
+        w.finish()
+    }
+
+    /// `pixels` in the panel's format, if the host asked for them.
+    fn put_pixels<S: Sink + ?Sized>(&self, w: &mut FrameWriter<'_, S>, pixels: &[Rgb565]) -> Result<(), S::Error> {
+        if !self.pixels {
+            return Ok(());
+        }
+        for chunk in pixels.chunks(32) {
+            let mut bytes = [0u8; 64];
+            for (pair, color) in bytes.chunks_exact_mut(2).zip(chunk) {
+                pair.copy_from_slice(&color.into_storage().to_be_bytes());
+            }
+            w.put(&bytes[..2 * chunk.len()])?;
+        }
+        Ok(())
     }
 
     /// Every row is drawn: `elapsed` is the board's time for the scene
@@ -364,7 +411,7 @@ mod tests {
         frames(&answer, |frame| {
             assert_eq!(frame.tag, 4);
             match frame.message {
-                Message::Drawing { panel, pixels } => assert_eq!((panel, pixels), (PANEL, true)),
+                Message::Drawing { panel, pixels, frames } => assert_eq!((panel, pixels, frames), (PANEL, true, 0)),
                 Message::Row { y, pixels } => {
                     assert_eq!((y, pixels.len()), (rows, PANEL.row_bytes()));
                     received.extend_from_slice(pixels);
