@@ -519,8 +519,11 @@ mod tests {
     extern crate std;
     use super::*;
     use crate::message::{Kind, Message, PixelFormat};
+    use core::sync::atomic::AtomicU8;
+    use octrace_core::animation::{Key, Track};
     use octrace_core::profile::Board64K;
     use std::boxed::Box;
+    use std::string::ToString;
     use std::collections::VecDeque;
     use std::vec::Vec;
 
@@ -741,5 +744,79 @@ mod tests {
         assert_eq!(answers.len(), 300 + 2 + PANEL.height as usize);
         assert!(answers[..300].iter().zip(1..).all(|(&answer, tag)| answer == (tag, Kind::Board)));
         assert_eq!(answers.last(), Some(&(301, Kind::Done)));
+    }
+
+    const ANIMATION: &[u8] = b"FRAMES 3\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\n\
+        SPHERE 1 1 0 0 0\nSPHERE 1 0.5 -2 0 1 MOVE 0 0 0 0  2 4 0 0\n";
+
+    /// Serves every frame `wire` brings with room for `ANIMATION`.
+    fn play_all(wire: &mut Wire) -> Vec<Served> {
+        let tiles = [const { AtomicU8::new(0) }; 1];
+        let (mut tracks, mut keys, mut displacements) = ([Track::EMPTY; 1], [Key::default(); 2], [[0; 3]; 3]);
+        let room = AnimationRoom { tiles: &tiles, tracks: &mut tracks, keys: &mut keys, displacements: &mut displacements };
+        let mut link = Link::new(PANEL, "test 1", std::vec![0u8; 1024]).with_animations(room);
+        let mut raytracer = Box::new(Raytracer::<Board64K>::new());
+        let mut served = Vec::new();
+        while let Some(one) = link.serve(wire, &mut raytracer, |drawing, rows| {
+            let accelerator = drawing.scene().accelerator();
+            let view = drawing.scene().view();
+            let mut renderer =
+                Renderer::with_size(view, &accelerator, PANEL.width.into(), PANEL.height.into()).unwrap();
+            rows.draw_on_one_core(drawing, &mut renderer, &mut [Rgb565::default(); 4], |_, _| {})
+        }) {
+            served.push(one);
+        }
+        served
+    }
+
+    #[test]
+    fn an_animation_plays_in_a_loop_until_a_hello_stops_it() {
+        let mut wire = Wire::new();
+        wire.send(0, Message::Scene { pixels: true, text: ANIMATION }, 1);
+        wire.send(400, Message::Hello, 2);
+        let served = play_all(&mut wire);
+        let Some(&Served::Played { frames }) = served.first() else { panic!("{served:?}") };
+        assert!(frames >= 4, "round the loop: {frames} frames");
+        assert_eq!(served[1..], [Served::Answered]);
+        wire.host_reads();
+        let mut decoder = Decoder::for_host(std::vec![0u8; 4096]);
+        let (mut drawn, mut runs) = (Vec::new(), 0);
+        let mut kinds = Vec::new();
+        for &byte in &wire.received {
+            let Some(frame) = decoder.push(byte) else { continue };
+            let frame = frame.unwrap();
+            match frame.message {
+                Message::FrameDrawn { frame, traced, .. } => drawn.push((frame, traced)),
+                Message::Run { .. } => runs += 1,
+                other => kinds.push((frame.tag, other.kind())),
+            }
+        }
+        assert_eq!(kinds, [(1, Kind::Drawing), (1, Kind::Stopped), (2, Kind::Board)]);
+        assert_eq!(drawn.len() as u32, frames);
+        let order: Vec<u32> = drawn.iter().map(|&(frame, _)| frame).collect();
+        assert_eq!(order[..4], [0, 1, 2, 0], "the loop's order");
+        // The first frame traces every pixel: a 4x3 panel is one tile.
+        assert_eq!(drawn[0].1, 12);
+        assert!(runs >= 3, "{runs} runs");
+    }
+
+    #[test]
+    fn an_animation_the_room_cannot_hold_is_rejected_naming_each_capacity() {
+        let mut wire = Wire::new();
+        wire.send(0, Message::Scene { pixels: false, text: ANIMATION }, 1);
+        assert_eq!(serve_all(&mut wire), [Served::Answered]);
+        wire.host_reads();
+        let mut decoder = Decoder::for_host(std::vec![0u8; 4096]);
+        let mut named = Vec::new();
+        for &byte in &wire.received {
+            if let Some(Ok(Frame { message: Message::SceneError(e), .. })) = decoder.push(byte) {
+                let need = e.capacity.unwrap();
+                named.push((need.name.to_string(), need.needed, need.holds));
+                assert!(e.message.starts_with(&std::format!("too many {}", need.name)), "{}", e.message);
+            }
+        }
+        let holds = |name: &str, needed| (name.to_string(), Some(needed), 0);
+        assert_eq!(named, [holds("tiles", 1), holds("tracks", 1), holds("keys", 2), holds("displacements", 3)]);
+        assert_eq!(wire.answers().last(), Some(&(1, Kind::Rejected)));
     }
 }
