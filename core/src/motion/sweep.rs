@@ -138,6 +138,9 @@ pub struct Key {
 }
 
 impl Key {
+    /// A placeholder to fill storage with (a `const`, for a `static`).
+    pub const EMPTY: Key = Key { frame: 0, changes: false };
+
     pub(crate) fn new(frame: u32, changes: bool) -> Key {
         Key { frame, changes }
     }

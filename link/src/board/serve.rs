@@ -360,7 +360,8 @@ impl<L: Line, B: AsRef<[u8]> + AsMut<[u8]>> Rows<'_, '_, L, B> {
         }
         for y in 0..panel.height {
             for (x, pixel) in (0..u32::from(panel.width)).zip(row.iter_mut()) {
-                match renderer.pixel_until(x, y.into(), &mut || self.poll()) {
+                let mut stop: Asked<'_> = &mut || self.poll();
+                match renderer.pixel_until(x, y.into(), &mut stop) {
                     Ok(sample) => *pixel = sample.color.into(),
                     Err(Stopped) => return y,
                 }
@@ -385,7 +386,7 @@ impl<L: Line, B: AsRef<[u8]> + AsMut<[u8]>> Rows<'_, '_, L, B> {
         let rows = RefCell::new(self);
         for band in 0..coherence.bands() {
             // Asked while a run's pixels are traced; the run is sent after.
-            let mut stop = || rows.borrow_mut().poll();
+            let mut stop: Asked<'_> = &mut || rows.borrow_mut().poll();
             coherence.trace_band_until(renderer, playing.motion, playing.frame, band, &mut stop, &mut |line, pixels| {
                 let mut width = 0;
                 for (pixel, sample) in row.iter_mut().zip(pixels) {
@@ -404,6 +405,11 @@ impl<L: Line, B: AsRef<[u8]> + AsMut<[u8]>> Rows<'_, '_, L, B> {
         Ok(())
     }
 }
+
+/// How a drawing asks whether to stop, before every ray: one type for
+/// every render path, so that a firmware links the tracer once for its
+/// stills and its animations (octrace-pico's cores ask the same way).
+type Asked<'s> = &'s mut dyn FnMut() -> bool;
 
 /// What came from the host while a scene is drawn: the decoder takes it,
 /// and says whether the drawing stops.
