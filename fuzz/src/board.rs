@@ -13,12 +13,12 @@
 //! animation after 3 frames (it would play until the host sends): then
 //! `stopped`.
 
+use core::sync::atomic::AtomicU8;
 use embedded_graphics_core::pixelcolor::Rgb565;
+use octrace_core::animation::{Key, Track};
 use octrace_core::profile::Board16K;
 use octrace_core::render::Renderer;
 use octrace_core::Raytracer;
-use core::sync::atomic::AtomicU8;
-use octrace_core::animation::{Key, Track};
 use octrace_link::board::{AnimationRoom, Line, Link};
 use octrace_link::{Decoder, Kind, Message, Panel, PixelFormat};
 use std::cell::RefCell;
@@ -255,7 +255,7 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     );
     let hello = frame(Message::Hello, 1);
     let animation = frame(
-        Message::Scene { pixels: true, text: b"FRAMES 3\nSPHERE 1 1 0 0 0 MOVE 0 0 0 0  2 1 0 0\nLIGHT 1 5 5 5\n" },
+        Message::Scene { pixels: true, text: b"FRAMES 3\nSPHERE 1 1 0 0 0 MOVE 0 0 0 0  2 1 0 0\nLIGHT 1 5 5 5\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\n" },
         5,
     );
     vec![

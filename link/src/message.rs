@@ -482,9 +482,10 @@ impl<'a> Message<'a> {
             Kind::Done => r.u64().map(|t| Message::Done { elapsed: time_from_wire(t) }),
             Kind::Cancelled => r.u16().map(|rows| Message::Cancelled { rows }),
             Kind::Run => (|| Some(Message::Run { y: r.u16()?, x: r.u16()?, width: r.u16()?, pixels: r.rest() }))(),
-            Kind::FrameDrawn => (|| {
-                Some(Message::FrameDrawn { frame: r.u32()?, traced: r.u32()?, elapsed: time_from_wire(r.u64()?) })
-            })(),
+            Kind::FrameDrawn => {
+                (|| Some(Message::FrameDrawn { frame: r.u32()?, traced: r.u32()?, elapsed: time_from_wire(r.u64()?) }))(
+                )
+            }
             Kind::Stopped => r.u32().map(|frames| Message::Stopped { frames }),
             Kind::Refused => read_reason(&mut r).map(Message::Refused),
         };

@@ -13,8 +13,8 @@
 use crate::accel::Accelerator;
 use crate::motion::{Dependence, Lookout, Motion, NEVER};
 use crate::render::{PixelSample, Polling, Renderer, Stop, Stopped};
-use crate::shade::{Poll, Unpolled};
 use crate::shade::Stats;
+use crate::shade::{Poll, Unpolled};
 use core::fmt;
 use core::ops::Range;
 use core::sync::atomic::{AtomicU8, Ordering};

@@ -481,7 +481,10 @@ impl<P: Port> BoardLink<P> {
                 Message::Run { y, x, width: run, pixels: bytes } => {
                     let (x0, x1) = (usize::from(x), usize::from(x) + usize::from(run));
                     let row = came.get_mut(usize::from(y)).filter(|_| x1 <= width && run > 0).ok_or_else(|| {
-                        LinkError::Protocol(format!("a run of {run} pixels at ({x}, {y}) on a {}x{} panel", width, panel.height))
+                        LinkError::Protocol(format!(
+                            "a run of {run} pixels at ({x}, {y}) on a {}x{} panel",
+                            width, panel.height
+                        ))
                     })?;
                     let expected = if pixels { usize::from(run) * panel.format.bytes_per_pixel() } else { 0 };
                     if bytes.len() != expected {
@@ -495,7 +498,9 @@ impl<P: Port> BoardLink<P> {
                         touched.push(usize::from(y));
                     }
                     if row[x0..x1].iter().any(|&seen| seen) {
-                        return Err(LinkError::Protocol(format!("a pixel of the run at ({x}, {y}) came twice in a frame")));
+                        return Err(LinkError::Protocol(format!(
+                            "a pixel of the run at ({x}, {y}) came twice in a frame"
+                        )));
                     }
                     row[x0..x1].fill(true);
                     covered += usize::from(run);
@@ -831,7 +836,10 @@ mod tests {
     #[test]
     fn a_drawing_cut_short_by_another_host_is_said() {
         let mut link = drawing_board(|tag| {
-            frames(&[(Message::Drawing { panel: PANEL, pixels: true, frames: 0 }, tag), (Message::Cancelled { rows: 0 }, tag)])
+            frames(&[
+                (Message::Drawing { panel: PANEL, pixels: true, frames: 0 }, tag),
+                (Message::Cancelled { rows: 0 }, tag),
+            ])
         });
         assert!(matches!(draw(&mut link), Err(LinkError::Cancelled { rows: 0 })));
     }
@@ -857,7 +865,10 @@ mod tests {
             assert!(said.ends_with(&want), "{said}");
             // A drawing at any panel but the one described.
             let mut link = drawing_board(move |tag| {
-                frames(&[(Message::Drawing { panel, pixels: true, frames: 0 }, tag), (Message::Done { elapsed: None }, tag)])
+                frames(&[
+                    (Message::Drawing { panel, pixels: true, frames: 0 }, tag),
+                    (Message::Done { elapsed: None }, tag),
+                ])
             });
             let said = draw(&mut link).unwrap_err().to_string();
             let want = format!("it draws at {width}x{height} rgb565, but described a 2x2 rgb565 panel");

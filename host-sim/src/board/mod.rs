@@ -219,8 +219,10 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
 fn write_picture(args: &BoardArgs, image: &RgbImage, stderr: &mut dyn Write) -> Result<(), CliError> {
     let Some(out) = &args.out else { return Ok(()) };
     let format = output_format(args.format, out)?;
-    crate::output::write_atomically(out, |f| formats::write(&Image::Rgb(image.clone()), format, f).map_err(io::Error::other))
-        .map_err(|e| CliError::write(out, e))?;
+    crate::output::write_atomically(out, |f| {
+        formats::write(&Image::Rgb(image.clone()), format, f).map_err(io::Error::other)
+    })
+    .map_err(|e| CliError::write(out, e))?;
     if !args.quiet {
         let _ = writeln!(stderr, "the board's picture -> {}", out.display());
     }
@@ -358,7 +360,9 @@ pub(crate) fn send_scene(
     });
     Ok(match answer.map_err(|e| link_error(port, e))? {
         Answer::Rejected(errors) => Sent::Rejected(errors),
-        Answer::Drawn { panel, elapsed } => Sent::Drawn { panel, elapsed, picture: pixels.then(|| picture(&rows, panel)) },
+        Answer::Drawn { panel, elapsed } => {
+            Sent::Drawn { panel, elapsed, picture: pixels.then(|| picture(&rows, panel)) }
+        }
         Answer::Played { panel, .. } => Sent::Played { panel, frames: pictures },
     })
 }

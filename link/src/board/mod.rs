@@ -222,7 +222,6 @@ fn send_error<S: Sink + ?Sized>(
     w.finish()
 }
 
-
 /// A scene that loaded, being drawn at the panel's size: render its rows
 /// from [`Drawing::scene`], send each with [`Drawing::send_row`] as it is
 /// drawn, and close it with [`Drawing::finish`], or with

@@ -387,20 +387,27 @@ impl<L: Line, B: AsRef<[u8]> + AsMut<[u8]>> Rows<'_, '_, L, B> {
         for band in 0..coherence.bands() {
             // Asked while a run's pixels are traced; the run is sent after.
             let mut stop: Asked<'_> = &mut || rows.borrow_mut().poll();
-            coherence.trace_band_until(renderer, playing.motion, playing.frame, band, &mut stop, &mut |line, pixels| {
-                let mut width = 0;
-                for (pixel, sample) in row.iter_mut().zip(pixels) {
-                    *pixel = sample.color.into();
-                    width += 1;
-                }
-                if width < line.size.width as usize {
-                    return Err(Stopped);
-                }
-                show(line, &row[..width]);
-                let (x, y) = (line.top_left.x as u16, line.top_left.y as u16);
-                rows.borrow_mut().send_run(drawing, y, x, &row[..width]);
-                Ok(())
-            })?;
+            coherence.trace_band_until(
+                renderer,
+                playing.motion,
+                playing.frame,
+                band,
+                &mut stop,
+                &mut |line, pixels| {
+                    let mut width = 0;
+                    for (pixel, sample) in row.iter_mut().zip(pixels) {
+                        *pixel = sample.color.into();
+                        width += 1;
+                    }
+                    if width < line.size.width as usize {
+                        return Err(Stopped);
+                    }
+                    show(line, &row[..width]);
+                    let (x, y) = (line.top_left.x as u16, line.top_left.y as u16);
+                    rows.borrow_mut().send_run(drawing, y, x, &row[..width]);
+                    Ok(())
+                },
+            )?;
         }
         Ok(())
     }
@@ -529,8 +536,8 @@ mod tests {
     use octrace_core::animation::{Key, Track};
     use octrace_core::profile::Board64K;
     use std::boxed::Box;
-    use std::string::ToString;
     use std::collections::VecDeque;
+    use std::string::ToString;
     use std::vec::Vec;
 
     /// Two facing mirrors with the eye between them, eight lights, 16²
@@ -759,7 +766,8 @@ mod tests {
     fn play_all(wire: &mut Wire) -> Vec<Served> {
         let tiles = [const { AtomicU8::new(0) }; 1];
         let (mut tracks, mut keys, mut displacements) = ([Track::EMPTY; 1], [Key::default(); 2], [[0; 3]; 3]);
-        let room = AnimationRoom { tiles: &tiles, tracks: &mut tracks, keys: &mut keys, displacements: &mut displacements };
+        let room =
+            AnimationRoom { tiles: &tiles, tracks: &mut tracks, keys: &mut keys, displacements: &mut displacements };
         let mut link = Link::new(PANEL, "test 1", std::vec![0u8; 1024]).with_animations(room);
         let mut raytracer = Box::new(Raytracer::<Board64K>::new());
         let mut served = Vec::new();

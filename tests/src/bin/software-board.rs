@@ -22,10 +22,10 @@
 
 use embedded_graphics_core::pixelcolor::{Rgb565, RgbColor};
 use octrace_core::accel::Mailbox;
+use octrace_core::animation::{Coherence, Key, Track};
 use octrace_core::profile::{Board16K, Board64K, Host, Profile};
 use octrace_core::render::Renderer;
 use octrace_core::Raytracer;
-use octrace_core::animation::{Coherence, Key, Track};
 use octrace_link::board::{AnimationRoom, Board, Line, Link, TILE};
 use octrace_link::{Decoder, Message, Panel, PixelFormat, SceneError, OVERHEAD};
 use std::collections::VecDeque;
@@ -99,7 +99,8 @@ impl Misbehaviour {
         match self {
             Misbehaviour::DrawsAt { width, height } => {
                 let panel = Panel { width, height, format: PixelFormat::Rgb565 };
-                let _ = send(Message::Drawing { panel, pixels, frames: 0 }, line) && send(Message::Done { elapsed: None }, line);
+                let _ = send(Message::Drawing { panel, pixels, frames: 0 }, line)
+                    && send(Message::Done { elapsed: None }, line);
             }
             Misbehaviour::ErrorsEvery(ms) => {
                 let error = SceneError { line: 1, column: 1, capacity: None, message: "one more error" };

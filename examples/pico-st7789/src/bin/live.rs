@@ -27,6 +27,7 @@
 
 use core::cell::RefCell;
 use core::ops::ControlFlow;
+use core::sync::atomic::AtomicU8;
 use critical_section::Mutex;
 use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 use embedded_graphics::prelude::*;
@@ -34,9 +35,8 @@ use hal::multicore::Stack;
 use hal::pac::interrupt;
 use hal::usb::UsbBus;
 use hal::{entry, pac, Timer, Watchdog};
-use octrace_core::render::Handoff;
-use core::sync::atomic::AtomicU8;
 use octrace_core::animation::{Coherence, Key, Track};
+use octrace_core::render::Handoff;
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
 use octrace_link::board::{AnimationRoom, Line, Link, Ring, TILE};
 use octrace_link::{Panel, PixelFormat};
@@ -78,8 +78,9 @@ static TILE_COUNTS: [AtomicU8; TILES] = [const { AtomicU8::new(0) }; TILES];
 
 /// An animation's motion: its `MOVE`s, their keys, and the frames of each
 /// moving object statement (anim_fig5_1 needs 1, 6 and 48): 2.8 KiB.
-static MOTION: ConstStaticCell<([Track; 8], [Key; 32], [[i32; 3]; 192])> =
-    ConstStaticCell::new(([Track::EMPTY; 8], [Key::EMPTY; 32], [[0; 3]; 192]));
+static TRACKS: ConstStaticCell<[Track; 8]> = ConstStaticCell::new([Track::EMPTY; 8]);
+static KEYS: ConstStaticCell<[Key; 32]> = ConstStaticCell::new([Key::EMPTY; 32]);
+static DISPLACEMENTS: ConstStaticCell<[[i32; 3]; 192]> = ConstStaticCell::new([[0; 3]; 192]);
 
 /// Core 1's own mailbox and screen lists.
 static CORE1_ROOM: ConstStaticCell<RendererRoom<LiveProfile>> = ConstStaticCell::new(RendererRoom::new());
@@ -138,8 +139,12 @@ fn main() -> ! {
 
     let size = display.size();
     let panel = Panel { width: size.width as u16, height: size.height as u16, format: PixelFormat::Rgb565 };
-    let (tracks, keys, displacements) = MOTION.take();
-    let room = AnimationRoom { tiles: &TILE_COUNTS, tracks, keys, displacements };
+    let room = AnimationRoom {
+        tiles: &TILE_COUNTS,
+        tracks: TRACKS.take(),
+        keys: KEYS.take(),
+        displacements: DISPLACEMENTS.take(),
+    };
     let mut link = Link::new(panel, FIRMWARE, FRAME_BUFFER.take()).with_animations(room);
     let raytracer = RAYTRACER.take();
     let room = CORE1_ROOM.take();
@@ -173,7 +178,8 @@ fn main() -> ! {
             };
             // Never borrowed twice: a row is sent between asks.
             let stop = || rows.try_borrow_mut().map_or(true, |mut rows| rows.poll());
-            let _ = both_cores::draw_until(&mut core1, drawing.scene(), &mut *room, &ROWS, &mut display, each_row, stop);
+            let _ =
+                both_cores::draw_until(&mut core1, drawing.scene(), &mut *room, &ROWS, &mut display, each_row, stop);
             drawn
         });
     }
