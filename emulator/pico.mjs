@@ -112,6 +112,8 @@ export class Pico {
     this.core1Ran = false;
     /** Set when a sleeping core wakes or core 1 is reset: a core running alone must look again. */
     this.woke = false;
+    /** Set by `stop`: the run returns once the running stretch ends. */
+    this.stopping = false;
     this.irqLines = 0;
 
     // Core 1's rp2040js parts act on `rp2040.core`: give them a view of the chip whose core is core 1.
@@ -296,8 +298,9 @@ export class Pico {
   }
 
   /**
-   * Runs until both cores sleep with nothing scheduled ('idle') or the
-   * machine's time reaches `until` ('until'). Throws RunError for what a
+   * Runs until both cores sleep with nothing scheduled ('idle'), the
+   * machine's time reaches `until` ('until') or `stop` is called
+   * ('stopped'). Throws RunError for what a
    * real Pico would not have done the same way, or after `maxCycles`.
    * `onProgress(cycles, panelWrites)` is called now and then.
    */
@@ -334,7 +337,20 @@ export class Pico {
         continue;
       }
       if (reason) return reason;
+      if (this.stopping) {
+        this.stopping = false;
+        return 'stopped';
+      }
     }
+  }
+
+  /**
+   * Ends the run (`run` returns 'stopped') after the instruction now
+   * executing: for a watcher that has seen what it waited for (frames.mjs).
+   */
+  stop() {
+    this.stopping = true;
+    this.woke = true;
   }
 
   /**

@@ -14,6 +14,13 @@
 // before giving up, default 120), --json (the report as JSON on standard
 // output), --quiet.
 //
+// --frames N: for a firmware that draws frames (an animation), runs until
+// N frames are on the panel and writes each as it was then: --out is then
+// a pattern with one %d or %0Nd (default panel%03d.png), the frames
+// numbered from 0 in the order drawn. A frame is drawn when the Pico's LED
+// (GP25) goes out, the templates lighting it while they work on a frame
+// (frames.mjs); the report lists each frame's cycles.
+//
 // --serial: the board as a serial device (serial.mjs), for the live
 // firmware: prints the path of a pseudo-terminal on its first line of
 // standard output and serves the firmware's USB serial port there until
@@ -24,7 +31,8 @@
 // watchdog that runs out resets the board, which starts again.
 //
 // Exit codes: 0 the run ended with both cores asleep and the picture written
-// (or, with --serial, the serve ended); 1 the firmware or the ELF did
+// (with --frames, N frames drawn and written; with --serial, the serve
+// ended); 1 the firmware or the ELF did
 // something a real Pico would not survive, or the panel was sent what it
 // does not take (the message says what); 2 bad arguments.
 
@@ -36,9 +44,11 @@ import { PanelError } from './st7789.mjs';
 import { PanelError as OledError } from './ssd1306.mjs';
 import { encodePng, writeAtomically } from './png.mjs';
 import { serveSerial } from './serial.mjs';
+import { framePattern, watchFrames } from './frames.mjs';
 
 const USAGE =
   'usage: node run.mjs ELF [--out FILE.png] [--display auto|st7789|ssd1306] [--panel WxH] [--panel-offset X,Y] [--max-seconds S] [--json] [--quiet]\n' +
+  '       node run.mjs ELF --frames N [--out \'DIR/f%03d.png\'] [the options above]\n' +
   '       node run.mjs ELF --serial [--out FILE.png] [--display auto|st7789|ssd1306] [--panel WxH] [--panel-offset X,Y]';
 
 function usage(message) {
@@ -65,6 +75,7 @@ try {
       panel: { type: 'string', default: '240x240' },
       'panel-offset': { type: 'string', default: '0,0' },
       'max-seconds': { type: 'string', default: '120' },
+      frames: { type: 'string' },
       json: { type: 'boolean', default: false },
       quiet: { type: 'boolean', default: false },
     },
@@ -98,7 +109,19 @@ if (values.out !== undefined && !values.out.toLowerCase().endsWith('.png')) {
 if (values.serial) {
   await serve();
 }
-const out = values.out ?? 'panel.png';
+const frameCount = values.frames === undefined ? null : Number(values.frames);
+if (frameCount !== null && !(Number.isInteger(frameCount) && frameCount > 0)) {
+  usage(`--frames ${values.frames}: expected a whole number of frames, at least 1`);
+}
+const out = values.out ?? (frameCount === null ? 'panel.png' : 'panel%03d.png');
+let frameName = null;
+if (frameCount !== null) {
+  try {
+    frameName = framePattern(out);
+  } catch (error) {
+    usage(`--out ${error.message}, with --frames`);
+  }
+}
 
 const progress = !values.quiet && !values.json && process.stderr.isTTY;
 const seconds = (cycles) => (cycles / CLOCK_HZ).toFixed(3);
@@ -106,19 +129,37 @@ let report;
 try {
   const elf = readFileSync(elfPath);
   const pico = Pico.fromElf(elf, elfPath, wired);
-  pico.run({
+  // Each frame's picture as it was when drawn, written once the run has succeeded.
+  const pictures = [];
+  const picture = () => encodePng(pico.display.width, pico.display.height, pico.display.picture());
+  const frames = frameCount === null ? null : watchFrames(pico, { count: frameCount, onFrame: () => pictures.push(picture()) });
+  const ended = pico.run({
     maxCycles: maxSeconds * CLOCK_HZ,
     onProgress: progress
-      ? (cycles, rows) => process.stderr.write(`\r${seconds(cycles)} s emulated, ${rows} panel writes`)
+      ? (cycles, rows) =>
+          process.stderr.write(
+            `\r${seconds(cycles)} s emulated, ${rows} panel writes` + (frames ? `, ${frames.length} of ${frameCount} frames` : ''),
+          )
       : undefined,
   });
   if (progress) process.stderr.write('\r\x1b[K');
   const display = pico.display;
-  writeAtomically(out, encodePng(display.width, display.height, display.picture()));
+  if (frames && ended !== 'stopped') {
+    throw new RunError(
+      `the firmware went to sleep after drawing ${frames.length} of ${frameCount} frames ` +
+        '(a frame is drawn when the Pico\'s LED, GP25, goes out)',
+    );
+  }
+  if (frames) {
+    pictures.forEach((png, index) => writeAtomically(frameName(index), png));
+  } else {
+    writeAtomically(out, picture());
+  }
   const coreCycles = pico.coreCycles();
   report = {
     elf: elfPath,
     out,
+    ...(frames && { frames: frames.map(({ index, cycles, lit, busy }) => ({ index, out: frameName(index), cycles, lit, busy })) }),
     display: display.name,
     panel: `${display.width}x${display.height}`,
     dark: display.darkBecause,
@@ -163,9 +204,23 @@ if (values.json) {
       `  XIP cache: ${count(cache.accesses)} flash reads, ${count(cache.misses)} misses` +
         (cache.lineReadCycles === null ? '' : ` (${cache.lineReadCycles} cycles a line read)`) +
         `, ${count(cache.stallCycles)} cycles stalled`,
-      report.dark ? `the ${report.display} panel is dark: ${report.dark}` : `the ${report.display} panel's ${report.panel} picture: ${out}`,
+      ...(report.frames ?? []).map(
+        ({ index, out: file, cycles, lit, busy }) =>
+          `  frame ${String(index).padStart(3)}: ${count(cycles).padStart(13)} cycles  ${seconds(cycles)} s ` +
+          `(LED lit ${count(lit)}; busy: core 0 ${count(busy[0])}, core 1 ${count(busy[1])}): ${file}`,
+      ),
+      ...(report.frames?.length > 1 ? [framesPerSecond(report.frames)] : []),
+      report.dark
+        ? `the ${report.display} panel is dark: ${report.dark}`
+        : `the ${report.display} panel's ${report.panel} ${report.frames ? 'frames' : 'picture'}: ${out}`,
     ].join('\n'),
   );
+}
+
+/** The frames a second after the first frame (which loads, and traces everything). */
+function framesPerSecond(frames) {
+  const after = frames.slice(1).reduce((sum, { cycles }) => sum + cycles, 0);
+  return `  after the first: ${((frames.length - 1) * CLOCK_HZ / after).toFixed(2)} frames a second at 125 MHz`;
 }
 
 /** --serial: serves the board on a pseudo-terminal, then exits. */

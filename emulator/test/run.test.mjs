@@ -1,16 +1,16 @@
 // The runner's command line on small firmwares written here: how a run
 // ends (both cores asleep; a fault, an endless loop, a ROM function it
-// lacks, no valid boot2), its exit codes, its report, and that a failed run
-// leaves no picture.
+// lacks, no valid boot2), its exit codes, its report, that a failed run
+// leaves no picture, and --frames: frames told by the LED, each written.
 
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawn, spawnSync } from 'node:child_process';
-import { existsSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { existsSync, mkdtempSync, readdirSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { dirname, join } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { boot2, CORE0_CODE, elf, flashImage } from './firmware.mjs';
+import { boot2, CORE0_CODE, elf, flashImage, SIO } from './firmware.mjs';
 
 const RUN = join(dirname(fileURLToPath(import.meta.url)), '..', 'run.mjs');
 
@@ -24,9 +24,11 @@ function run(elf, ...args) {
   try {
     const path = join(dir, 'firmware.elf');
     writeFileSync(path, elf);
-    const out = join(dir, 'panel.png');
+    const frames = args.includes('--frames');
+    const out = join(dir, frames ? 'f%02d.png' : 'panel.png');
     const result = spawnSync(process.execPath, [RUN, path, '--out', out, ...args], { encoding: 'utf8' });
-    return { status: result.status, stderr: result.stderr, stdout: result.stdout, wrote: existsSync(out) };
+    const written = readdirSync(dir).filter((name) => name.endsWith('.png')).sort();
+    return { status: result.status, stderr: result.stderr, stdout: result.stdout, wrote: existsSync(out), written };
   } finally {
     rmSync(dir, { recursive: true, force: true });
   }
@@ -147,6 +149,60 @@ test('bad arguments exit 2 with the usage', () => {
   const cases = [[], ['a.elf', 'b.elf'], ['a.elf', '--panel', '240'], ['a.elf', '--out', 'x.bmp'], ['a.elf', '--max-seconds', '0'], ['a.elf', '--display', 'lcd']];
   for (const args of cases) {
     const result = spawnSync(process.execPath, [RUN, ...args], { encoding: 'utf8' });
+    assert.equal(result.status, 2, `${args.join(' ')}: ${result.stderr}`);
+    assert.match(result.stderr, /usage: node run\.mjs ELF/);
+  }
+});
+
+const IO_BANK0_GPIO25_CTRL = 0x400140cc;
+const FUNCSEL_SIO = 5;
+const GPIO_OUT_SET = 0x14;
+const GPIO_OUT_CLR = 0x18;
+const GPIO_OE_SET = 0x24;
+
+/** Lights the LED (GP25) and puts it out `times` times, about 3,000 cycles lit and 9,000 dark, then sleeps. */
+function blinking(times) {
+  return firmware((t) => {
+    t.ldrConst(3, IO_BANK0_GPIO25_CTRL).movsImm(1, FUNCSEL_SIO).str(1, 3);
+    t.ldrConst(3, SIO).ldrConst(2, 1 << 25).str(2, 3, GPIO_OE_SET).movsImm(4, times);
+    const wait = (label, cycles) => t.ldrConst(0, cycles / 3).label(label).subsImm(0, 1).bcc('ne', label); // subs 1 + bne 2
+    t.label('frame').str(2, 3, GPIO_OUT_SET);
+    wait('lit', 3000);
+    t.str(2, 3, GPIO_OUT_CLR);
+    wait('dark', 9000);
+    t.subsImm(4, 1).bcc('ne', 'frame').wfi().pool();
+  });
+}
+
+test('--frames N: each time the LED goes out a frame is drawn, written, and timed; the run stops after N', () => {
+  const result = run(blinking(3), '--frames', '2', '--json');
+  assert.equal(result.status, 0, result.stderr);
+  assert.deepEqual(result.written, ['f00.png', 'f01.png']);
+  const { frames } = JSON.parse(result.stdout);
+  assert.deepEqual(
+    frames.map(({ index, out }) => [index, out.slice(-7)]),
+    [
+      [0, 'f00.png'],
+      [1, 'f01.png'],
+    ],
+  );
+  // The first frame runs from the LED lit; the next from the first's end, its dark stretch included
+  // (within what the loops' few flash misses add).
+  const [first, second] = frames;
+  const near = (cycles, expected) => Math.abs(cycles - expected) < 300;
+  assert.ok(near(first.lit, 3000) && first.cycles === first.lit, JSON.stringify(first));
+  assert.ok(near(second.lit, 3000) && near(second.cycles, 12000), JSON.stringify(second));
+  assert.equal(second.busy[0], second.cycles, 'core 0 never slept');
+  assert.equal(second.busy[1], 0, 'core 1 stayed asleep in the ROM');
+});
+
+test('--frames N with fewer drawn, or a pattern without a number, fails and writes no frame', () => {
+  const fewer = run(blinking(3), '--frames', '5');
+  assert.equal(fewer.status, 1, fewer.stderr);
+  assert.match(fewer.stderr, /went to sleep after drawing 3 of 5 frames/);
+  assert.deepEqual(fewer.written, []);
+  for (const args of [['--frames', '0'], ['--frames', '2', '--out', 'panel.png'], ['--frames', '2', '--out', 'f%3d%d.png']]) {
+    const result = spawnSync(process.execPath, [RUN, 'a.elf', ...args], { encoding: 'utf8' });
     assert.equal(result.status, 2, `${args.join(' ')}: ${result.stderr}`);
     assert.match(result.stderr, /usage: node run\.mjs ELF/);
   }

@@ -12,8 +12,8 @@ const DEFAULT_SCENE: &str = "../../scenes/fig5_1.txt";
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     let placement = CodePlacement::from_env().unwrap_or_else(|e| fail(e));
-    link(&[("octrace-pico-ssd1306", placement)]).unwrap_or_else(|e| fail(e));
-    embed_scene(DEFAULT_SCENE).unwrap_or_else(|e| fail(e));
+    let scene = embed_scene(DEFAULT_SCENE).unwrap_or_else(|e| fail(e));
+    link(&[("octrace-pico-ssd1306", placement, scene)]).unwrap_or_else(|e| fail(e));
 }
 
 fn fail(error: BuildError) -> ! {

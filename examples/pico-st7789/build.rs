@@ -3,19 +3,24 @@
 //! a capacity profile sized for it; puts the RP2040's memory map where the
 //! linker finds it, with each firmware's code placement (`OCTRACE_CODE_IN`
 //! for the embedded-scene firmware; the live one's arenas fill the RAM, so
-//! only its render path is copied into SRAM); and reads the embedded-scene
+//! only its render path is copied into SRAM; an animation's tracking goes
+//! with the embedded-scene firmware's); and reads the embedded-scene
 //! firmware's pixel order (`OCTRACE_ORDER`). All but the order is
 //! `octrace-pico-build`'s, which every Pico template shares.
 
-use octrace_pico_build::{embed_scene, link, BuildError, CodePlacement};
+use octrace_pico_build::{embed_scene, link, BuildError, CodePlacement, SceneKind};
 
 const DEFAULT_SCENE: &str = "../../scenes/fig5_1.txt";
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     let placement = CodePlacement::from_env().unwrap_or_else(|e| fail(e));
-    link(&[("octrace-pico-st7789", placement), ("octrace-pico-live", CodePlacement::RenderInSram)])
-        .unwrap_or_else(|e| fail(e));
+    let scene = embed_scene(DEFAULT_SCENE).unwrap_or_else(|e| fail(e));
+    link(&[
+        ("octrace-pico-st7789", placement, scene),
+        ("octrace-pico-live", CodePlacement::RenderInSram, SceneKind::Still),
+    ])
+    .unwrap_or_else(|e| fail(e));
 
     // The embedded-scene firmware's pixel order: row by row (the default,
     // the faster), or progressive (the whole panel in coarse blocks at
@@ -31,8 +36,6 @@ fn main() {
             expected: "`rows` (the default) or `progressive`",
         }),
     }
-
-    embed_scene(DEFAULT_SCENE).unwrap_or_else(|e| fail(e));
 }
 
 fn fail(error: BuildError) -> ! {

@@ -2,7 +2,8 @@
 //! `build.rs` does, in three calls. [`embed_scene`] reads the scene
 //! `OCTRACE_SCENE` names, checks it with the parser the board runs and
 //! writes it into `OUT_DIR/scene.rs` with a capacity profile holding
-//! exactly what it needs; [`link`] puts the RP2040's memory map where the
+//! exactly what it needs, and says whether it is a still or an animation
+//! ([`SceneKind`]); [`link`] puts the RP2040's memory map where the
 //! linker finds it and writes each firmware's code placement
 //! ([`CodePlacement`], `OCTRACE_CODE_IN`).
 //!
@@ -12,8 +13,8 @@
 //!
 //! fn main() {
 //!     let placement = CodePlacement::from_env().unwrap_or_else(|e| fail(e));
-//!     link(&[("my-firmware", placement)]).unwrap_or_else(|e| fail(e));
-//!     embed_scene("../../scenes/fig5_1.txt").unwrap_or_else(|e| fail(e));
+//!     let scene = embed_scene("../../scenes/fig5_1.txt").unwrap_or_else(|e| fail(e));
+//!     link(&[("my-firmware", placement, scene)]).unwrap_or_else(|e| fail(e));
 //! }
 //!
 //! fn fail(error: octrace_pico_build::BuildError) -> ! {
@@ -30,7 +31,7 @@ mod placement;
 mod scene;
 
 pub use placement::{link, CodePlacement};
-pub use scene::embed_scene;
+pub use scene::{embed_scene, SceneKind};
 
 use std::fmt;
 

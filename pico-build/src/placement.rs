@@ -11,7 +11,7 @@
 //! empty copy for code left in flash), so every firmware expands
 //! `octrace_pico::boot!` whatever its placement.
 
-use crate::{out_dir, write, BuildError};
+use crate::{out_dir, write, BuildError, SceneKind};
 
 /// The memory map, which `cortex-m-rt`'s `link.x` includes.
 const MEMORY_X: &str = include_str!("../memory.x");
@@ -29,6 +29,11 @@ const RENDER_PATH: &str = concat!(
     ".text.*octrace_core*render* .text.*octrace_core*math* .text.*both_cores* .text.*second_core* ",
     ".text.__aeabi_* .text.__*di3 .text.__*di4"
 );
+
+/// An animation's, beside the render path: the tracking, the tiles, both
+/// cores' frames (copied only for an animation: in a still they would take
+/// SRAM, linked, never run).
+const ANIMATION: &str = ".text.*octrace_core*motion* .text.*octrace_core*animation* .text.*animation*";
 
 /// The loader's: the parser and the scene's set-up.
 const LOADER: &str = ".text.*octrace_core*parse* .text.*octrace_core*scene*";
@@ -76,30 +81,37 @@ impl CodePlacement {
         )
     }
 
-    /// The input sections `sram-code.x` copies (none for code left in flash).
-    fn copied(self) -> String {
+    /// The input sections `sram-code.x` copies for a firmware drawing
+    /// `kind` (none for code left in flash).
+    fn copied(self, kind: SceneKind) -> String {
+        let render = match kind {
+            SceneKind::Still => RENDER_PATH.to_owned(),
+            SceneKind::Animation => format!("{RENDER_PATH} {ANIMATION}"),
+        };
         match self {
             CodePlacement::AllInSram => "*(.text .text.*); *(.rodata .rodata.*);".to_owned(),
-            CodePlacement::LoadAndRenderInSram => format!("*({RENDER_PATH} {LOADER});"),
-            CodePlacement::RenderInSram => format!("*({RENDER_PATH});"),
+            CodePlacement::LoadAndRenderInSram => format!("*({render} {LOADER});"),
+            CodePlacement::RenderInSram => format!("*({render});"),
             CodePlacement::Flash => String::new(),
         }
     }
 
     /// The linker script `memory.x` includes for a firmware so placed.
-    fn script(self) -> String {
-        SRAM_CODE_X.replace("COPIED", &self.copied())
+    fn script(self, kind: SceneKind) -> String {
+        SRAM_CODE_X.replace("COPIED", &self.copied(kind))
     }
 }
 
 /// Puts `memory.x` where the linker finds it, and for each of `binaries`
-/// (a binary's name and where its code runs) its `code-placement.x`.
-pub fn link(binaries: &[(&str, CodePlacement)]) -> Result<(), BuildError> {
+/// (a binary's name, where its code runs and what it draws: the embedded
+/// scene's kind, or [`SceneKind::Still`] for one that draws pictures) its
+/// `code-placement.x`.
+pub fn link(binaries: &[(&str, CodePlacement, SceneKind)]) -> Result<(), BuildError> {
     let out = out_dir()?;
-    for &(binary, placement) in binaries {
+    for &(binary, placement, kind) in binaries {
         let dir = out.join(binary);
         std::fs::create_dir_all(&dir).map_err(|error| BuildError::File { path: dir.display().to_string(), error })?;
-        write(&dir.join("code-placement.x"), &placement.script())?;
+        write(&dir.join("code-placement.x"), &placement.script(kind))?;
         println!("cargo:rustc-link-arg-bin={binary}=-L{}", dir.display());
     }
     write(&out.join("memory.x"), MEMORY_X)?;
@@ -113,15 +125,25 @@ mod tests {
 
     #[test]
     fn each_placement_copies_its_sections_and_flash_none() {
-        let render = CodePlacement::RenderInSram.script();
+        let render = CodePlacement::RenderInSram.script(SceneKind::Still);
         assert!(render.contains(".text.*octrace_core*shade*") && !render.contains("parse"), "{render}");
-        let load = CodePlacement::LoadAndRenderInSram.script();
+        let load = CodePlacement::LoadAndRenderInSram.script(SceneKind::Still);
         assert!(load.contains(".text.*octrace_core*parse*") && load.contains(".text.*both_cores*"), "{load}");
-        assert!(CodePlacement::AllInSram.script().contains("*(.rodata .rodata.*);"));
-        let flash = CodePlacement::Flash.script();
+        assert!(CodePlacement::AllInSram.script(SceneKind::Still).contains("*(.rodata .rodata.*);"));
+        let flash = CodePlacement::Flash.script(SceneKind::Animation);
         assert!(!flash.contains(".text.*") && flash.contains("__sram_code_end"), "{flash}");
         for (placement, _) in CodePlacement::ALL {
-            assert!(!placement.script().contains("COPIED"), "{placement:?}");
+            for kind in [SceneKind::Still, SceneKind::Animation] {
+                assert!(!placement.script(kind).contains("COPIED"), "{placement:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn an_animation_copies_its_tracking_with_the_render_path_and_a_still_not() {
+        for placement in [CodePlacement::RenderInSram, CodePlacement::LoadAndRenderInSram] {
+            assert!(placement.script(SceneKind::Animation).contains(".text.*octrace_core*motion*"), "{placement:?}");
+            assert!(!placement.script(SceneKind::Still).contains("motion"), "{placement:?}");
         }
     }
 }

@@ -12,27 +12,50 @@
 //! them all, and the buffer does not pay there). The octree's shadow shafts
 //! are left out: on the thesis's scenes they take longer to build than they
 //! save in one picture (BENCHMARKS.md).
+//!
+//! An animation (`FRAMES` of more than one frame, and a `MOVE`) is played
+//! in a loop ([`SceneKind::Animation`]): its profile gets `coherence: true`
+//! (each frame re-traces only what its motion can change), `scene.rs` says
+//! `ANIMATED` and `MOTION` (what its motion needs, `Motion::needs`), and its
+//! profile is sized at frame 0 (a frame whose octree or light buffer needs
+//! more leaves boxes unsplit or fewer cells: the same picture, a little
+//! slower). A still links none of it.
 
 use crate::{out_dir, write, BuildError};
 use octrace_core::accel::{OctreeConfig, MAX_CELLS_A_SIDE};
-use octrace_core::profile::{needed_by, needed_with_light_buffer, ProfileText};
+use octrace_core::animation::Motion;
+use octrace_core::parse::parse;
+use octrace_core::profile::{needed_by, needed_with_light_buffer, Host, ProfileText};
+use octrace_core::scene::Scene;
 use octrace_core::AccelMode;
 use std::path::PathBuf;
 
 /// The variable a user sets to pick the scene.
 const VARIABLE: &str = "OCTRACE_SCENE";
 
+/// What the embedded scene is: what its firmware does with it, and so
+/// where its code runs ([`link`](crate::link) copies an animation's
+/// tracking into SRAM with the render path).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SceneKind {
+    /// Drawn once.
+    Still,
+    /// Played in a loop, each frame re-tracing what its motion changes.
+    Animation,
+}
+
 /// Writes `OUT_DIR/scene.rs`: `SCENE_TEXT`, the scene `OCTRACE_SCENE` names
 /// (a path from the firmware's folder; `default` when it is not set), and
-/// `SceneProfile`, a `profile!` holding exactly what it needs. The firmware
-/// includes it:
+/// `SceneProfile`, a `profile!` holding exactly what it needs; `ANIMATED`
+/// and `MOTION` (what an animation's motion needs: none for a still).
+/// Returns what the scene is. The firmware includes it:
 ///
 /// ```ignore
 /// mod scene {
 ///     include!(concat!(env!("OUT_DIR"), "/scene.rs"));
 /// }
 /// ```
-pub fn embed_scene(default: &str) -> Result<(), BuildError> {
+pub fn embed_scene(default: &str) -> Result<SceneKind, BuildError> {
     let manifest: PathBuf = std::env::var_os("CARGO_MANIFEST_DIR")
         .map(Into::into)
         .ok_or(BuildError::NotInBuildScript("CARGO_MANIFEST_DIR"))?;
@@ -42,12 +65,25 @@ pub fn embed_scene(default: &str) -> Result<(), BuildError> {
     println!("cargo:rerun-if-changed={}", path.display());
     let text = std::fs::read_to_string(&path)
         .map_err(|error| BuildError::File { path: format!("{VARIABLE}={scene}"), error })?;
-    let source = scene_source(&scene, &path, &text)?;
-    write(&out_dir()?.join("scene.rs"), &source)
+    let (kind, source) = scene_source(&scene, &path, &text)?;
+    write(&out_dir()?.join("scene.rs"), &source)?;
+    Ok(kind)
 }
 
-/// `scene.rs` for the scene `name`, read from `path` as `text`.
-fn scene_source(name: &str, path: &std::path::Path, text: &str) -> Result<String, BuildError> {
+/// What the scene `text` is: an animation if it has frames and something
+/// moves (a scene of one frame, or where nothing moves, is drawn once).
+fn kind_of(text: &str) -> SceneKind {
+    let mut parsed = Box::new(Scene::<Host>::new());
+    let frames = parse(text, &mut parsed, &mut |_| {}).ok().and_then(|p| p.frames).map_or(1, |f| f.count);
+    match Motion::needs(text).tracks > 0 && frames > 1 {
+        true => SceneKind::Animation,
+        false => SceneKind::Still,
+    }
+}
+
+/// `scene.rs` for the scene `name`, read from `path` as `text`, and what
+/// the scene is.
+fn scene_source(name: &str, path: &std::path::Path, text: &str) -> Result<(SceneKind, String), BuildError> {
     let mut report = |error| eprintln!("{name}:{error}");
     let failed = |errors| BuildError::Scene { scene: name.to_owned(), errors };
     // `Raytracer::load` picks the accelerator as `Auto` does, with the
@@ -67,7 +103,24 @@ fn scene_source(name: &str, path: &std::path::Path, text: &str) -> Result<String
         named_walk: false,
         first_hits: true,
     };
-    Ok(format!("/// The scene, from `{name}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n{profile}"))
+    let kind = kind_of(text);
+    let animated = kind == SceneKind::Animation;
+    let motion = if animated { Motion::needs(text) } else { Default::default() };
+    // `ProfileText` writes a still's profile; coherence comes last in `profile!`.
+    let profile = profile.to_string();
+    let profile = match profile.strip_suffix("}\n") {
+        Some(fields) if animated => format!("{fields}    coherence: true\n}}\n"),
+        _ => profile,
+    };
+    let source = format!(
+        "/// The scene, from `{name}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n{profile}\
+         /// Whether the scene is an animation the firmware plays.\npub const ANIMATED: bool = {animated};\n\
+         /// What its motion needs (`Motion::needs`).\n\
+         pub const MOTION: octrace_core::animation::MotionNeeds = octrace_core::animation::MotionNeeds {{ \
+         tracks: {}, keys: {}, displacements: {} }};\n",
+        motion.tracks, motion.keys, motion.displacements
+    );
+    Ok((kind, source))
 }
 
 #[cfg(test)]
@@ -79,12 +132,32 @@ mod tests {
         let spheres: String =
             (0..40).map(|k| format!("SPHERE 1 0.5 {} {} 0\n", k % 7, k / 7)).collect::<String>() + "LIGHT 1 0 10 10\n";
         let path = std::path::Path::new("scene.txt");
-        let walked = scene_source("many", path, &format!("SURFACE 1 1 1 1 1 1 1 0 0 0 1 0 0\n{spheres}")).unwrap();
+        let (_, walked) = scene_source("many", path, &format!("SURFACE 1 1 1 1 1 1 1 0 0 0 1 0 0\n{spheres}")).unwrap();
         assert!(walked.contains("light_buffer_lights: 1"), "{walked}");
-        let few = scene_source("few", path, "SURFACE 1 1 1 1 1 1 1 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nLIGHT 1 0 10 10\n")
-            .unwrap();
+        let (_, few) =
+            scene_source("few", path, "SURFACE 1 1 1 1 1 1 1 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nLIGHT 1 0 10 10\n")
+                .unwrap();
         assert!(!few.contains("light_buffer"), "{few}");
         assert!(few.contains("pub const SCENE_TEXT: &str = include_str!(\"scene.txt\");"), "{few}");
+    }
+
+    #[test]
+    fn an_animation_gets_coherence_and_its_motion_and_a_still_neither() {
+        let path = std::path::Path::new("scene.txt");
+        let still = "SURFACE 1 1 1 1 1 1 1 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nLIGHT 1 0 10 10\n";
+        let (kind, source) = scene_source("still", path, still).unwrap();
+        assert_eq!(kind, SceneKind::Still);
+        assert!(!source.contains("coherence") && source.contains("ANIMATED: bool = false"), "{source}");
+        assert!(source.contains("tracks: 0, keys: 0, displacements: 0"), "{source}");
+        // Frames where nothing moves, or a move in one frame, are stills.
+        for text in [format!("FRAMES 4\n{still}"), format!("FRAMES 1\n{still}SPHERE 1 1 3 0 0 MOVE 0 0 0 0\n")] {
+            assert_eq!(scene_source("still", path, &text).unwrap().0, SceneKind::Still, "{text}");
+        }
+        let moving = format!("FRAMES 4\n{still}SPHERE 1 1 3 0 0 MOVE 0 0 0 0  3 0 2 0\n");
+        let (kind, source) = scene_source("moving", path, &moving).unwrap();
+        assert_eq!(kind, SceneKind::Animation);
+        assert!(source.contains("    coherence: true\n}\n") && source.contains("ANIMATED: bool = true"), "{source}");
+        assert!(source.contains("tracks: 1, keys: 2, displacements: 4"), "{source}");
     }
 
     #[test]

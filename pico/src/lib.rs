@@ -1,7 +1,8 @@
 //! octrace on a Raspberry Pi Pico (RP2040), what every Pico template needs
 //! beside its panel: the start-up ([`board`]: clocks, pins, core 1 waiting
 //! for jobs), core 1 as a scoped job runner ([`second_core`]), both cores
-//! tracing a picture for one core to present ([`both_cores`]), and what
+//! tracing a picture for one core to present ([`both_cores`]) or playing
+//! an animation, only its changed runs drawn ([`animation`]), and what
 //! runs before `main`: boot2 and the code copied into SRAM ([`boot!`]).
 //! Its build-script half, `octrace-pico-build`, embeds the scene, sizes its
 //! profile and places the code.
@@ -13,6 +14,7 @@
 
 #![no_std]
 
+pub mod animation;
 pub mod board;
 pub mod boot;
 pub mod both_cores;

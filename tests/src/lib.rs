@@ -52,16 +52,33 @@ pub fn host_sim_preview_of(
     size: &str,
     color: &str,
 ) -> Result<(), String> {
-    let args = [
-        "host-sim".as_ref(),
-        path.as_os_str(),
-        out.as_os_str(),
-        "--size".as_ref(),
-        size.as_ref(),
-        "--color".as_ref(),
-        color.as_ref(),
-        "--quiet".as_ref(),
-    ];
+    host_sim_preview_with(path, out, size, color, &[])
+}
+
+/// [`host_sim_preview`] of frame `frame` of an animation (`--frame K`).
+pub fn host_sim_frame_preview(
+    scene: &str,
+    frame: u32,
+    out: &std::path::Path,
+    size: &str,
+    color: &str,
+) -> Result<(), String> {
+    let path = repo().join("scenes").join(format!("{scene}.txt"));
+    host_sim_preview_with(&path, out, size, color, &["--frame", &frame.to_string()])
+}
+
+/// host-sim's preview of `path` into `out`, with `more` flags.
+fn host_sim_preview_with(
+    path: &std::path::Path,
+    out: &std::path::Path,
+    size: &str,
+    color: &str,
+    more: &[&str],
+) -> Result<(), String> {
+    let flags = ["--size", size, "--color", color, "--quiet"].into_iter().chain(more.iter().copied());
+    let args = [std::ffi::OsStr::new("host-sim"), path.as_os_str(), out.as_os_str()]
+        .into_iter()
+        .chain(flags.map(std::ffi::OsStr::new));
     let mut stderr = Vec::new();
     match host_sim::cli::run(args, &mut Vec::new(), &mut stderr) {
         0 => Ok(()),

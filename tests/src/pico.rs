@@ -208,28 +208,7 @@ impl Cycles {
 
 /// Runs `elf` on the emulated Pico; the panel's picture goes to `png`.
 pub fn run(elf: &Path, png: &Path) -> Result<Cycles, String> {
-    let emulator = repo().join("emulator");
-    if !emulator.join("node_modules/rp2040js").is_dir() {
-        return Err(format!("the emulator is not installed: run `npm ci` in {}", emulator.display()));
-    }
-    let out = Command::new("node")
-        .arg(emulator.join("run.mjs"))
-        .arg(elf)
-        .arg("--out")
-        .arg(png)
-        .arg("--json")
-        .output()
-        .map_err(|e| format!("cannot run node: {e}"))?;
-    if !out.status.success() {
-        return Err(format!(
-            "the emulated Pico ran {} with exit code {:?}:\n{}",
-            elf.display(),
-            out.status.code(),
-            String::from_utf8_lossy(&out.stderr)
-        ));
-    }
-    let report: serde_json::Value =
-        serde_json::from_slice(&out.stdout).map_err(|e| format!("the emulator's report is not JSON: {e}"))?;
+    let report = emulate(elf, png, &[])?;
     let number = |value: &serde_json::Value, what: &str| {
         value.as_u64().ok_or_else(|| format!("the emulator's report has no {what}: {report}"))
     };
@@ -249,4 +228,72 @@ pub fn run(elf: &Path, png: &Path) -> Result<Cycles, String> {
         flash_reads: number(&report["xipCache"]["accesses"], "accesses")?,
         cache_misses: number(&report["xipCache"]["misses"], "misses")?,
     })
+}
+
+/// One frame of an animation drawn on the emulated Pico (`run.mjs
+/// --frames`), in its cycles.
+#[derive(Clone, Debug)]
+pub struct FrameCycles {
+    /// From the end of the frame before (the first: from its start) to
+    /// this one whole on the panel.
+    pub cycles: u64,
+    /// While the board's LED was lit: the frame's work, without waiting
+    /// for its time.
+    pub lit: u64,
+    /// Each core's cycles not asleep in the frame.
+    pub busy: [u64; 2],
+    /// The panel's picture then.
+    pub picture: PathBuf,
+}
+
+/// Runs `elf`, a firmware that plays an animation, on the emulated Pico
+/// until it has drawn `count` frames, each written to `pattern` (one `%d`
+/// or `%0Nd`) with its number in the order drawn.
+pub fn run_frames(elf: &Path, pattern: &Path, count: u32) -> Result<Vec<FrameCycles>, String> {
+    let report = emulate(elf, pattern, &["--frames", &count.to_string()])?;
+    let frames = report["frames"].as_array().ok_or_else(|| format!("the emulator's report has no frames: {report}"))?;
+    frames
+        .iter()
+        .map(|frame| {
+            let number = |value: &serde_json::Value| {
+                value.as_u64().ok_or_else(|| format!("the emulator's report has a frame without its cycles: {frame}"))
+            };
+            Ok(FrameCycles {
+                cycles: number(&frame["cycles"])?,
+                lit: number(&frame["lit"])?,
+                busy: [number(&frame["busy"][0])?, number(&frame["busy"][1])?],
+                picture: frame["out"]
+                    .as_str()
+                    .map(PathBuf::from)
+                    .ok_or_else(|| format!("a frame without its file: {frame}"))?,
+            })
+        })
+        .collect()
+}
+
+/// Runs `elf` on the emulated Pico (`run.mjs ELF --out OUT --json` and
+/// `more`) and returns its report.
+fn emulate(elf: &Path, out: &Path, more: &[&str]) -> Result<serde_json::Value, String> {
+    let emulator = repo().join("emulator");
+    if !emulator.join("node_modules/rp2040js").is_dir() {
+        return Err(format!("the emulator is not installed: run `npm ci` in {}", emulator.display()));
+    }
+    let output = Command::new("node")
+        .arg(emulator.join("run.mjs"))
+        .arg(elf)
+        .arg("--out")
+        .arg(out)
+        .arg("--json")
+        .args(more)
+        .output()
+        .map_err(|e| format!("cannot run node: {e}"))?;
+    if !output.status.success() {
+        return Err(format!(
+            "the emulated Pico ran {} with exit code {:?}:\n{}",
+            elf.display(),
+            output.status.code(),
+            String::from_utf8_lossy(&output.stderr)
+        ));
+    }
+    serde_json::from_slice(&output.stdout).map_err(|e| format!("the emulator's report is not JSON: {e}"))
 }

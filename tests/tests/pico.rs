@@ -5,14 +5,16 @@
 //! rgb565` (and so does its progressive order, `OCTRACE_ORDER=progressive`,
 //! whose first coarse panel comes within 0.1 s of the picture's start);
 //! `examples/pico-ssd1306` on its SSD1306 over I2C, `--size 128x64 --color
-//! mono`, its picture sent in at least the bus's time at 400 kHz.
+//! mono`, its picture sent in at least the bus's time at 400 kHz. The
+//! ST7789 template built for an animation (anim_fig5_1) plays it: each of
+//! its first frames on the panel is host-sim's `--frame K` picture.
 //!
 //! Needs Node and the emulator's packages (`npm ci` in
 //! `emulator/`; the test command does it); set
 //! `OCTRACE_SKIP_FIRMWARE=1` to skip where they cannot be installed.
 
-use octrace_tests::host_sim_preview;
 use octrace_tests::pico::{self, Build, Template, DEFAULT_CODE_IN};
+use octrace_tests::{host_sim_frame_preview, host_sim_preview};
 use std::path::Path;
 
 /// For each template, the thesis's first figure (naive, no octree), 200
@@ -32,6 +34,14 @@ const BUILDS: [Build<'static>; 7] = [
 /// 1,024 bytes at 9 clocks each (address and control bytes, START and STOP
 /// come on top), at 125 MHz.
 const OLED_PICTURE_CYCLES: u64 = 1024 * 9 * 125_000_000 / 400_000;
+
+/// An animation, and how many of its frames are checked: the first (traced
+/// whole) and two that re-trace only what moved, the second after a frame
+/// that did so (enough to see tiles skipped that changed, or counts carried
+/// wrongly from a frame to the next; `tests/tests/animation.rs` plays whole
+/// loops on the host).
+const ANIMATION: Build<'static> = Build::of(Template::St7789, "anim_fig5_1");
+const FRAMES_CHECKED: u32 = 3;
 
 /// The first coarse panel of a progressive order, from the picture's start:
 /// at most 0.1 s at 125 MHz.
@@ -63,7 +73,10 @@ fn each_pico_template_shows_host_sims_picture() {
     // One build at a time (they share a target directory), then the runs
     // side by side.
     let elves: Vec<_> = BUILDS.iter().map(|build| pico::build(build).unwrap_or_else(|e| panic!("{e}"))).collect();
-    let runs: Vec<_> = std::thread::scope(|s| {
+    let animation = pico::build(&ANIMATION).unwrap_or_else(|e| panic!("{e}"));
+    let frames_pattern = dir.path().join(format!("{}-%d.png", ANIMATION.name()));
+    let (runs, frames): (Vec<_>, _) = std::thread::scope(|s| {
+        let frames = s.spawn(|| pico::run_frames(&animation, &frames_pattern, FRAMES_CHECKED));
         let handles: Vec<_> = BUILDS
             .iter()
             .zip(&elves)
@@ -72,7 +85,8 @@ fn each_pico_template_shows_host_sims_picture() {
                 s.spawn(move || (pico::run(elf, &panel), panel))
             })
             .collect();
-        handles.into_iter().map(|h| h.join().expect("the run's thread")).collect()
+        let runs = handles.into_iter().map(|h| h.join().expect("the run's thread")).collect();
+        (runs, frames.join().expect("the animation's thread"))
     });
 
     for (build, (cycles, panel)) in BUILDS.iter().zip(runs) {
@@ -82,11 +96,7 @@ fn each_pico_template_shows_host_sims_picture() {
         let (size, color) = build.template.panel();
         host_sim_preview(build.scene, &preview, size, color).unwrap_or_else(|e| panic!("{e}"));
 
-        let (width, height, shown) = read_png_as_rgb(&panel);
-        let expected = read_png_as_rgb(&preview);
-        assert_eq!(format!("{width}x{height}"), size, "{name}: the panel's own size");
-        let differing = shown.chunks(3).zip(expected.2.chunks(3)).filter(|(a, b)| a != b).count();
-        assert_eq!(differing, 0, "{name}: {differing} of {} pixels differ from host-sim's preview", width * height);
+        assert_same_picture(&name, &panel, &preview, size);
         assert_eq!(cycles.cores, 2, "{name}: both cores trace");
         if build.order == "progressive" {
             assert!(
@@ -115,4 +125,33 @@ fn each_pico_template_shows_host_sims_picture() {
             cycles.busy[1]
         );
     }
+
+    let name = ANIMATION.name();
+    let frames = frames.unwrap_or_else(|e| panic!("{name}: {e}"));
+    assert_eq!(frames.len(), FRAMES_CHECKED as usize, "{name}: the frames drawn");
+    let (size, color) = ANIMATION.template.panel();
+    for (k, frame) in (0..).zip(&frames) {
+        let preview = dir.path().join(format!("{name}-host-sim-{k}.png"));
+        host_sim_frame_preview(ANIMATION.scene, k, &preview, size, color).unwrap_or_else(|e| panic!("{e}"));
+        assert_same_picture(&format!("{name}, frame {k}"), &frame.picture, &preview, size);
+        println!(
+            "{name}, frame {k}: {size} pixels identical; {} cycles ({:.3} s at 125 MHz), core 0 busy {}, core 1 busy {}",
+            frame.cycles,
+            frame.cycles as f64 / pico::CLOCK_HZ,
+            frame.busy[0],
+            frame.busy[1]
+        );
+    }
+    // The frames after the first re-trace only what moved.
+    assert!(frames[1..].iter().all(|f| f.cycles < frames[0].cycles / 2), "{name}: {frames:?}");
+}
+
+/// Asserts the panel's picture `panel` is host-sim's `preview`, pixel for
+/// pixel, at the panel's `size` (`WxH`).
+fn assert_same_picture(name: &str, panel: &Path, preview: &Path, size: &str) {
+    let (width, height, shown) = read_png_as_rgb(panel);
+    let expected = read_png_as_rgb(preview);
+    assert_eq!(format!("{width}x{height}"), size, "{name}: the panel's own size");
+    let differing = shown.chunks(3).zip(expected.2.chunks(3)).filter(|(a, b)| a != b).count();
+    assert_eq!(differing, 0, "{name}: {differing} of {} pixels differ from host-sim's preview", width * height);
 }

@@ -950,6 +950,19 @@ fn the_time_slider_and_play_show_host_sims_frames() {
     assert_same(&format!("draft of frame {frame}, played to"), browser.canvas_rgb("draft"), &draft);
     screenshot(&browser, "studio");
 
+    // A render asked for while playing stops the player and stays: the
+    // frame shown then, whole, not replaced by a frame the player was
+    // still tracing.
+    browser.click("#play");
+    browser.wait_for("studio.played && studio.played.length >= 3", 120);
+    render_and_wait(&browser);
+    let frame = browser.run("return studio.frame;").as_u64().expect("a frame") as u32;
+    // Time for a frame the player traced to come, were it still shown.
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    assert_eq!(browser.run("return [studio.playing, studio.frame];"), serde_json::json!([false, frame]));
+    let image = browser.canvas_rgb("image");
+    assert_same(&format!("frame {frame}, rendered while playing"), image, &host_frame(&scene, frame, None));
+
     // The wireframe shows the red sphere where frame 10 has it (its MOVE's
     // second key: 0.3 left of and 3 behind where it is written), and the
     // select tool picks it there.

@@ -159,6 +159,24 @@ impl<'s> Coherence<'s> {
         self.side
     }
 
+    /// The most pixels of a row a run of tiles hands over at once
+    /// ([`Coherence::trace_band`]): what a buffer for one must hold.
+    ///
+    /// ```
+    /// use core::sync::atomic::AtomicU8;
+    /// use embedded_graphics::prelude::Size;
+    /// use octrace_core::animation::Coherence;
+    ///
+    /// const TILES: usize = Coherence::tiles_for(240, 240, 4);
+    /// static COUNTS: [AtomicU8; TILES] = [const { AtomicU8::new(0) }; TILES];
+    /// // Runs of up to 32 tiles of 4 pixels: 128 pixels of a 240-pixel row.
+    /// assert_eq!(Coherence::new(&COUNTS, Size::new(240, 240), 4)?.longest_row(), 128);
+    /// # Ok::<(), octrace_core::animation::CoherenceError>(())
+    /// ```
+    pub fn longest_row(&self) -> u32 {
+        (RUN_TILES as u32 * self.side).min(self.size.width)
+    }
+
     /// Rows of tiles (bands), each [`Coherence::side`] rows of pixels
     /// high (the last may be lower): the units cores share.
     pub fn bands(&self) -> u32 {

@@ -236,8 +236,38 @@ impl<P: Profile> Raytracer<P> {
         text: &'t str,
         both: impl FnOnce(&mut (dyn FnMut() + Send), &mut dyn FnMut()),
     ) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
+        self.load_frame_on_two_cores(text, 0, both)
+    }
+
+    /// [`Raytracer::load_frame`] on two cores, as
+    /// [`Raytracer::load_on_two_cores`]: a board playing an animation
+    /// loads each frame so.
+    ///
+    /// ```
+    /// use octrace_core::{profile::Board16K, Raytracer};
+    ///
+    /// let text = "FRAMES 2\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5 MOVE 0 0 0 0  1 -10 0 0\nSPHERE 1 3 0 0 0\n";
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load_frame_on_two_cores(text, 1, |beside, here| {
+    ///     std::thread::scope(|scope| {
+    ///         scope.spawn(|| beside());
+    ///         here();
+    ///     })
+    /// })?;
+    /// let moved = scene.view().lights[0].position;
+    /// let mut alone = Raytracer::<Board16K>::new();
+    /// assert_eq!(moved, alone.load_frame(text, 1)?.view().lights[0].position);
+    /// assert_ne!(moved, alone.load_frame(text, 0)?.view().lights[0].position);
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn load_frame_on_two_cores<'t>(
+        &mut self,
+        text: &'t str,
+        frame: u32,
+        both: impl FnOnce(&mut (dyn FnMut() + Send), &mut dyn FnMut()),
+    ) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
         let mut both = Some(both);
-        self.load_in(text.as_bytes(), 0, AccelMode::Auto, &mut |_| {}, &mut |beside, here| {
+        self.load_in(text.as_bytes(), frame, AccelMode::Auto, &mut |_| {}, &mut |beside, here| {
             if let Some(both) = both.take() {
                 both(beside, here);
             }

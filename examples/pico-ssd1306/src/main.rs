@@ -33,7 +33,11 @@ octrace_pico::boot!();
 
 /// The scene (`SCENE_TEXT`, in flash) and a capacity profile that holds
 /// exactly what it needs (`SceneProfile`), from `build.rs`: set
-/// `OCTRACE_SCENE` to your scene's file when you build.
+/// `OCTRACE_SCENE` to your scene's file when you build. Of an animation
+/// (`ANIMATED`, `MOTION`) this template draws the first frame: it does not
+/// play one (`octrace_pico::animation` would, the panel's buffer sent after
+/// each frame).
+#[allow(dead_code)]
 mod scene {
     include!(concat!(env!("OUT_DIR"), "/scene.rs"));
 }

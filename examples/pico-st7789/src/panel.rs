@@ -14,7 +14,7 @@ use embedded_hal_bus::spi::ExclusiveDevice;
 use embedded_hal_nb::spi::FullDuplex;
 use hal::clocks::ClocksManager;
 use hal::fugit::RateExtU32;
-use hal::gpio::bank0::{Gpio10, Gpio11, Gpio12, Gpio8, Gpio9};
+use hal::gpio::bank0::{Gpio10, Gpio11, Gpio12, Gpio25, Gpio8, Gpio9};
 use hal::gpio::{FunctionSioOutput, FunctionSpi, Pin, Pins, PullDown};
 use hal::spi::Enabled;
 use hal::{pac, Clock, Spi, Timer};
@@ -29,6 +29,10 @@ pub const WIDTH: u16 = 240;
 pub const HEIGHT: u16 = 240;
 
 type Output<Id> = Pin<Id, FunctionSioOutput, PullDown>;
+
+/// The Pico's own LED (GP25), off: the embedded-scene firmware lights it
+/// while it works on a picture or a frame (the emulator tells frames by it).
+pub type Led = Output<Gpio25>;
 type SpiPin<Id> = Pin<Id, FunctionSpi, PullDown>;
 type Spi1 = Spi<Enabled, pac::SPI1, (SpiPin<Gpio11>, SpiPin<Gpio10>), 8>;
 
@@ -98,7 +102,8 @@ impl SpiBus for StreamingBus {
 
 /// Sets up the panel on the Pico-LCD-1.3's pins (README.md: SPI1 clock
 /// GP10, data GP11; chip select GP9, data/command GP8, reset GP12,
-/// backlight GP13), clears it to black and turns its backlight on.
+/// backlight GP13), clears it to black and turns its backlight on;
+/// returns it with the Pico's LED, the one pin left that a firmware uses.
 /// `buffer` batches pixels for the bus (512 bytes is plenty).
 pub fn init(
     spi1: pac::SPI1,
@@ -107,7 +112,7 @@ pub fn init(
     clocks: &ClocksManager,
     mut timer: Timer,
     buffer: &'static mut [u8],
-) -> Panel {
+) -> (Panel, Led) {
     // A quarter of the system clock, which jumper wires to a loose panel
     // carry too: the tracer, not the bus, sets the pace.
     let bus = Spi::<_, _, _, 8>::new(
@@ -127,5 +132,5 @@ pub fn init(
     display.clear(Rgb565::BLACK).unwrap_or_else(|never| match never {});
     let mut backlight = pins.gpio13.into_push_pull_output();
     backlight.set_high().unwrap_or_else(|never| match never {});
-    display
+    (display, pins.gpio25.into_push_pull_output())
 }

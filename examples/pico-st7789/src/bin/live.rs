@@ -118,7 +118,7 @@ const WATCHDOG_US: u32 = 8_000_000;
 fn main() -> ! {
     let board::Board { mut core1, pins, clocks, timer, watchdog, mut resets, peripherals } =
         board::start(CORE1_STACK.take().unwrap());
-    let mut display = panel::init(peripherals.spi1, pins, &mut resets, &clocks, timer, PANEL_BUFFER.take());
+    let (mut display, _) = panel::init(peripherals.spi1, pins, &mut resets, &clocks, timer, PANEL_BUFFER.take());
 
     // The USB serial port, served by its interrupt from here on.
     let bus: &'static UsbBusAllocator<UsbBus> = cortex_m::singleton!(: UsbBusAllocator<UsbBus> =

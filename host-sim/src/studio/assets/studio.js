@@ -218,7 +218,7 @@ function main() {
   function scheduleDraft() {
     // Playing, the next frame's draft is of the text as it is then.
     if (state.playing) return;
-    app.time.textChanged();
+    app.time.superseded();
     clearTimeout(state.draftTimer);
     const changedAt = performance.now();
     $('draft').dataset.state = 'pending';
@@ -267,6 +267,8 @@ function main() {
     workers = [];
   }
   async function render() {
+    // A frame the player still traces would replace this render.
+    app.time.superseded();
     stopRender();
     const job = renderJob;
     // The frame shown now (an animation's; 0 for a still).

@@ -134,9 +134,11 @@ export function createTime(app) {
     button.title = 'Play (Space)';
   }
 
-  /** The text changed while paused: the frame being traced, if any, is
-   *  of the old text (the text's draft takes the draft's worker over). */
-  function textChanged() {
+  /** The text changed while paused, or a render was asked for: the frame
+   *  being traced, if any, is not shown (the text's draft takes the draft's
+   *  worker over; a render its canvas). */
+  function superseded() {
+    stop();
     asked += 1;
     renderPlayer.stop();
   }
@@ -144,5 +146,5 @@ export function createTime(app) {
   const toggle = () => (state.playing ? stop() : play());
   button.onclick = toggle;
   slider.addEventListener('input', () => { stop(); go(Number(slider.value)); });
-  return { scene, stop, toggle, textChanged };
+  return { scene, stop, toggle, superseded };
 }

@@ -1,0 +1,337 @@
+//! Both cores play an animation (a scene with `FRAMES` and `MOVE`) in a
+//! loop: each frame is loaded, then only the tiles its motion can change
+//! are traced again (octrace-core's [`Coherence`]) and only their runs of
+//! pixels drawn, so the panel shows each frame exactly as if drawn whole.
+//! Any panel's colour ([`TracedColor`]): a truecolour panel gets each
+//! pixel converted; a panel of few levels gets ordered (Bayer) dithering,
+//! each pixel from its own colour alone, the one method that draws a run
+//! the same whatever was drawn around it (so its frames are not the error
+//! diffusion of its stills).
+//!
+//! Each frame: core 0 loads it (core 1 building its light buffer, if any),
+//! plans its tiles and lists its bands of tiles, most pixels first; then
+//! each core takes the next band no core has taken and traces it with a
+//! renderer of its own. Core 0 draws its runs straight into the panel, and
+//! between them the runs core 1 handed over in a [`Runs`] ring. The LED is
+//! lit while the board works on a frame and goes out once the frame is
+//! whole on the panel; a frame does not start before its time (the scene's
+//! rate: at most that many frames a second).
+//!
+//! Invariants: the tiles' counts are planned once a frame, on core 0,
+//! before either core traces; a band is traced by one core, once a frame;
+//! every run core 1 traced is on the panel before the LED goes out; the
+//! motion is read once, from frame 0, and serves every frame.
+
+use crate::both_cores::Unfinished;
+use crate::second_core::SecondCore;
+use core::cell::Cell;
+use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
+use cortex_m::asm::{sev, wfe};
+use critical_section::Mutex;
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{Dimensions, OriginDimensions, Point, Size};
+use embedded_graphics_core::pixelcolor::Rgb888;
+use embedded_graphics_core::primitives::Rectangle;
+use embedded_graphics_core::Pixel;
+use embedded_hal::digital::OutputPin;
+use octrace_core::animation::{Coherence, Key, Motion, Track};
+use octrace_core::panel::{Dithered, TracedColor};
+use octrace_core::profile::Profile;
+use octrace_core::render::{Handoff, PixelSample};
+use octrace_core::{DrawError, LoadedScene, Raytracer, RendererRoom};
+use rp2040_hal::Timer;
+
+/// The tiles' side, in pixels: a byte of RAM a tile, 3,600 bytes for the
+/// 240×240 panel (BENCHMARKS.md weighs the sides).
+pub const TILE: u32 = 4;
+
+/// The most bands of tiles a panel may have (a panel up to 512 rows high).
+const MOST_BANDS: usize = 128;
+
+/// The widest and highest panel a piece's rectangle can name.
+const MOST_PIXELS: u32 = 1 << 10;
+
+/// Why an animation stopped playing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stopped {
+    /// A frame did not load (check the scene with `host-sim --frame K`,
+    /// whose errors name the line and column).
+    Frame(u32),
+    /// The motion's or the tiles' storage is not the scene's size.
+    Storage,
+    /// A frame could not be drawn.
+    Picture(Unfinished),
+}
+
+/// Storage for an animation's motion ([`Motion::needs`] says how much).
+pub struct MotionRoom<'s> {
+    pub tracks: &'s mut [Track],
+    pub keys: &'s mut [Key],
+    pub displacements: &'s mut [[i32; 3]],
+}
+
+/// Runs of pixels on their way from core 1 to core 0: each piece is one
+/// row of a run of tiles (up to `LEN` pixels) and the rectangle it fills.
+///
+/// Invariant: a piece's rectangle is stored before its colours are
+/// published (the ring's release store), and read after it is seen.
+pub struct Runs<const LEN: usize, const SLOTS: usize> {
+    colors: Handoff<LEN, SLOTS>,
+    /// Each slot's rectangle: x, y and width, 10 bits each.
+    areas: [AtomicU32; SLOTS],
+}
+
+impl<const LEN: usize, const SLOTS: usize> Runs<LEN, SLOTS> {
+    /// Every slot free.
+    pub const fn new() -> Self {
+        Runs { colors: Handoff::new(), areas: [const { AtomicU32::new(0) }; SLOTS] }
+    }
+
+    /// Core 1: traces `pixels` into piece `piece`'s slot, once it is free,
+    /// for `area`; false if `stop` said so first.
+    fn send(
+        &self,
+        piece: u32,
+        area: &Rectangle,
+        pixels: &mut dyn Iterator<Item = PixelSample>,
+        stop: &AtomicBool,
+    ) -> bool {
+        while !self.colors.is_free_for(piece) {
+            if stop.load(Ordering::Acquire) {
+                return false;
+            }
+            wfe();
+        }
+        let (x, y, width) = (area.top_left.x as u32, area.top_left.y as u32, area.size.width);
+        self.areas[piece as usize % SLOTS].store(x | y << 10 | width << 20, Ordering::Relaxed);
+        // Free, so published.
+        let _ = self.colors.send(piece, pixels.map(|p| p.color));
+        sev();
+        true
+    }
+
+    /// Core 0: piece `piece`, if core 1 has sent it, onto `display`.
+    fn present<D>(&self, piece: u32, display: &mut D) -> Option<Result<(), D::Error>>
+    where
+        D: DrawTarget<Color = Rgb888>,
+    {
+        let colors = self.colors.take(piece)?;
+        let area = self.areas[piece as usize % SLOTS].load(Ordering::Relaxed);
+        let (x, y, width) = (area & 0x3ff, area >> 10 & 0x3ff, area >> 20);
+        let row = Rectangle::new(Point::new(x as i32, y as i32), Size::new(width, 1));
+        let drawn = display.fill_contiguous(&row, colors);
+        // The slot is free again: wake core 1 if it waits for it.
+        sev();
+        Some(drawn)
+    }
+}
+
+/// The panel as core 0 draws a frame into it: its own runs as they are
+/// traced, each followed by the runs core 1 has handed over by then.
+struct Panel<'a, D, const LEN: usize, const SLOTS: usize> {
+    display: &'a mut D,
+    runs: &'a Runs<LEN, SLOTS>,
+    /// Core 1's pieces before this one are on the panel.
+    shown: u32,
+}
+
+impl<D: DrawTarget<Color = Rgb888>, const LEN: usize, const SLOTS: usize> Panel<'_, D, LEN, SLOTS> {
+    /// Core 1's pieces handed over so far, onto the panel.
+    fn show_handed(&mut self) -> Result<(), D::Error> {
+        while let Some(drawn) = self.runs.present(self.shown, self.display) {
+            drawn?;
+            self.shown += 1;
+        }
+        Ok(())
+    }
+}
+
+impl<D: DrawTarget<Color = Rgb888>, const LEN: usize, const SLOTS: usize> OriginDimensions
+    for Panel<'_, D, LEN, SLOTS>
+{
+    fn size(&self) -> Size {
+        self.display.bounding_box().size
+    }
+}
+
+impl<D: DrawTarget<Color = Rgb888>, const LEN: usize, const SLOTS: usize> DrawTarget for Panel<'_, D, LEN, SLOTS> {
+    type Color = Rgb888;
+    type Error = D::Error;
+
+    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb888>>>(&mut self, pixels: I) -> Result<(), D::Error> {
+        self.display.draw_iter(pixels)?;
+        self.show_handed()
+    }
+
+    fn fill_contiguous<I: IntoIterator<Item = Rgb888>>(&mut self, area: &Rectangle, colors: I) -> Result<(), D::Error> {
+        self.display.fill_contiguous(area, colors)?;
+        self.show_handed()
+    }
+}
+
+impl<const LEN: usize, const SLOTS: usize> Default for Runs<LEN, SLOTS> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Plays the animation `text` into `display` for ever, with both cores:
+/// the scene loaded in `raytracer` frame after frame, its motion read into
+/// `motion`, the tiles' counts in `counts` ([`Coherence::tiles_for`] of the
+/// panel in tiles of [`TILE`]), core 1 rendering in `room` and handing its
+/// runs over through `runs` (at least [`Coherence::longest_row`]), in the
+/// display's colour as the module says. `led` is lit
+/// while a frame is on its way; `timer` paces the frames. Returns only
+/// when it cannot go on.
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+pub fn play<P, D, L, const LEN: usize, const SLOTS: usize>(
+    core1: &mut SecondCore,
+    raytracer: &mut Raytracer<P>,
+    text: &str,
+    motion: MotionRoom<'_>,
+    counts: &[AtomicU8],
+    room: &mut RendererRoom<P>,
+    runs: &Runs<LEN, SLOTS>,
+    display: &mut D,
+    led: &mut L,
+    timer: &Timer,
+) -> Stopped
+where
+    P: Profile,
+    D: DrawTarget,
+    D::Color: TracedColor,
+    L: OutputPin,
+{
+    let mut display = Dithered::ordered(display);
+    let size = display.bounding_box().size;
+    let Ok(coherence) = Coherence::new(counts, size, TILE) else { return Stopped::Storage };
+    let fits = size.width < MOST_PIXELS && size.height < MOST_PIXELS && coherence.bands() as usize <= MOST_BANDS;
+    if !fits || LEN < coherence.longest_row() as usize {
+        return Stopped::Picture(Unfinished::Panel);
+    }
+    // The motion, read once from frame 0.
+    let (frames, motion) = {
+        let Ok(scene) = raytracer.load_frame(text, 0) else { return Stopped::Frame(0) };
+        let Some(frames) = scene.frames() else { return Stopped::Storage };
+        let MotionRoom { tracks, keys, displacements } = motion;
+        match Motion::read(text, frames, &scene.view(), 0, tracks, keys, displacements) {
+            Ok(motion) => (frames, motion),
+            Err(_) => return Stopped::Storage,
+        }
+    };
+    let period_us = 1_000_000 / u64::from(frames.rate.max(1));
+    let mut frame = 0;
+    loop {
+        let started = timer.get_counter().ticks();
+        let _ = led.set_high();
+        let loaded = raytracer.load_frame_on_two_cores(text, frame, |beside, here| core1.scope(beside, here));
+        let Ok(scene) = loaded else { return Stopped::Frame(frame) };
+        if let Err(unfinished) = draw_frame(core1, &scene, &motion, frame, &coherence, room, runs, &mut display) {
+            return Stopped::Picture(unfinished);
+        }
+        let _ = led.set_low();
+        frame = frames.after(frame);
+        // Not before its time.
+        while timer.get_counter().ticks() < started + period_us {}
+    }
+}
+
+/// Draws frame `frame` of `motion`, `scene` loaded at that frame, after the
+/// frame before it in the loop (or, at first, everything): both cores
+/// trace the planned tiles, core 0 draws every run.
+///
+/// Core 0 checks for core 1's runs after each of its own rows (a run's
+/// row of up to 128 pixels): core 1 may trace `SLOTS` rows ahead.
+#[allow(clippy::too_many_arguments)]
+fn draw_frame<P, D, const LEN: usize, const SLOTS: usize>(
+    core1: &mut SecondCore,
+    scene: &LoadedScene<'_, P>,
+    motion: &Motion<'_>,
+    frame: u32,
+    coherence: &Coherence<'_>,
+    room: &mut RendererRoom<P>,
+    runs: &Runs<LEN, SLOTS>,
+    display: &mut D,
+) -> Result<(), Unfinished>
+where
+    P: Profile,
+    D: DrawTarget<Color = Rgb888>,
+{
+    coherence.plan();
+    // The bands with tiles to trace, most pixels first: the last band
+    // taken is a small one, so neither core waits long for the other.
+    let mut order = [(0u32, 0u16); MOST_BANDS];
+    let mut bands = 0;
+    for band in 0..coherence.bands() {
+        let pixels = coherence.band_pixels(band) as u32;
+        if pixels > 0 {
+            let mut at = bands;
+            while at > 0 && order[at - 1].0 < pixels {
+                order[at] = order[at - 1];
+                at -= 1;
+            }
+            order[at] = (pixels, band as u16);
+            bands += 1;
+        }
+    }
+    let order = &order[..bands];
+    let size = coherence.size();
+    let stop = AtomicBool::new(false);
+    // How many pieces core 1 handed over in all, once it is done.
+    let handed = AtomicU32::new(u32::MAX);
+    // The next band to take, read and advanced under the chip's lock
+    // (ARMv6-M has no atomic read-modify-write).
+    let next = Mutex::new(Cell::new(0usize));
+    let take_next = || {
+        critical_section::with(|cs| {
+            let taken = next.borrow(cs).get();
+            next.borrow(cs).set(taken + 1);
+            order.get(taken).map(|&(_, band)| u32::from(band))
+        })
+    };
+    let shared = scene.share();
+    runs.colors.clear();
+    let core1_part = || {
+        let mut piece = 0;
+        if let Ok(mut renderer) = shared.renderer(room, size) {
+            while let Some(band) = take_next() {
+                let traced = coherence.trace_band(&mut renderer, motion, frame, band, &mut |area, pixels| {
+                    if !runs.send(piece, area, pixels, &stop) {
+                        return Err(());
+                    }
+                    piece += 1;
+                    Ok(())
+                });
+                if traced.is_err() {
+                    break;
+                }
+            }
+        }
+        handed.store(piece, Ordering::Release);
+        sev();
+    };
+    let core0_part = || {
+        let mut panel = Panel { display, runs, shown: 0 };
+        let bands = core::iter::from_fn(take_next);
+        let mut result =
+            scene.draw_bands(motion, frame, coherence, bands, &mut panel).map(|_| ()).map_err(|e| match e {
+                DrawError::Camera(_) => Unfinished::Camera,
+                DrawError::Target(_) | DrawError::ErrorRow(_) => Unfinished::Panel,
+            });
+        // The rest of core 1's.
+        while result.is_ok() {
+            result = panel.show_handed().map_err(|_| Unfinished::Panel);
+            if handed.load(Ordering::Acquire) == panel.shown {
+                break;
+            }
+            wfe();
+        }
+        if result.is_err() {
+            stop.store(true, Ordering::Release);
+            sev();
+        }
+        result
+    };
+    core1.scope(core1_part, core0_part)
+}
