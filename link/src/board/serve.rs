@@ -666,7 +666,11 @@ mod tests {
     /// Serves every frame `wire` brings, drawing on one core; what each
     /// serve did.
     fn serve_all(wire: &mut Wire) -> Vec<Served> {
-        let mut link = Link::new(PANEL, "test 1", std::vec![0u8; 1024]);
+        serve_with(Link::new(PANEL, "test 1", std::vec![0u8; 1024]), wire)
+    }
+
+    /// [`serve_all`] by `link`.
+    fn serve_with(mut link: Link<'_, Vec<u8>>, wire: &mut Wire) -> Vec<Served> {
         let mut raytracer = Box::new(Raytracer::<Board64K>::new());
         let mut served = Vec::new();
         while let Some(one) = link.serve(wire, &mut raytracer, |drawing, rows| {
@@ -768,19 +772,7 @@ mod tests {
         let (mut tracks, mut keys, mut displacements) = ([Track::EMPTY; 1], [Key::default(); 2], [[0; 3]; 3]);
         let room =
             AnimationRoom { tiles: &tiles, tracks: &mut tracks, keys: &mut keys, displacements: &mut displacements };
-        let mut link = Link::new(PANEL, "test 1", std::vec![0u8; 1024]).with_animations(room);
-        let mut raytracer = Box::new(Raytracer::<Board64K>::new());
-        let mut served = Vec::new();
-        while let Some(one) = link.serve(wire, &mut raytracer, |drawing, rows| {
-            let accelerator = drawing.scene().accelerator();
-            let view = drawing.scene().view();
-            let mut renderer =
-                Renderer::with_size(view, &accelerator, PANEL.width.into(), PANEL.height.into()).unwrap();
-            rows.draw_on_one_core(drawing, &mut renderer, &mut [Rgb565::default(); 4], |_, _| {})
-        }) {
-            served.push(one);
-        }
-        served
+        serve_with(Link::new(PANEL, "test 1", std::vec![0u8; 1024]).with_animations(room), wire)
     }
 
     #[test]
