@@ -2,14 +2,18 @@
 //! loop a firmware runs ([`Link`], over its [`Line`]: `serve.rs`), each
 //! received frame answered ([`Board::answer`]), and a scene that loaded
 //! handed back as a [`Drawing`] whose rows the firmware renders its own way
-//! (one core, two) and sends as they are drawn; the byte rings a firmware
-//! keeps between its serial port and the loop ([`Ring`]: `ring.rs`).
+//! (one core, two) and sends as they are drawn; an animation played frame
+//! after frame in the room a firmware gives it ([`AnimationRoom`],
+//! [`Playing`]: `play.rs`); the byte rings a firmware keeps between its
+//! serial port and the loop ([`Ring`]: `ring.rs`).
 //!
 //! Invariants: every frame gets exactly one answer — a [`Message::Board`],
 //! a [`Message::Refused`], the scene's [`Message::SceneError`]s closed by a
 //! [`Message::Rejected`], or a [`Message::Drawing`] whose [`Drawing`] is
-//! closed by [`Drawing::finish`] or [`Drawing::cancel`] — all with the
-//! frame's tag; a scene with errors draws nothing.
+//! closed by [`Drawing::finish`] or [`Drawing::cancel`] (an animation's
+//! frames, each closed by a [`Message::FrameDrawn`], by a
+//! [`Message::Stopped`]) — all with the frame's tag; a scene with errors
+//! draws nothing, nor does an animation its room cannot hold.
 //!
 //! A firmware's loop, on one core (`Usb` stands for its serial port and
 //! clock as a [`Line`]; the rows go to its panel as well):

@@ -17,7 +17,11 @@
 //!   dropped, what waits on the line for it too ([`Line::discard`]), and the
 //!   next answer starts whole. A slow host cannot pace a drawing by more;
 //! - a drawing goes on when its host stops taking rows (the panel shows the
-//!   picture); only a frame from the host stops it.
+//!   picture); only a frame from the host stops it;
+//! - an animation plays until a byte comes from the host (its text is the
+//!   frame the decoder holds, which the next frame's bytes overwrite); each
+//!   frame is loaded from that text, planned, drawn and closed by
+//!   `frame-drawn`, and the animation by `stopped`.
 
 use super::play::{self, AnimationRoom, Playing, TILE};
 use super::{Board, Drawing, Panel};
