@@ -208,6 +208,7 @@ fn main() {
             octree: Some(&config),
             named_walk,
             first_hits: techniques.first_hits,
+            coherence: false,
         };
         let bytes = profile.arena_bytes();
         (config, techniques, counts, bytes)
@@ -260,6 +261,7 @@ fn main() {
         octree: Some(&octree),
         named_walk,
         first_hits: techniques.first_hits,
+        coherence: false,
     };
     write!(config, "{profile}").unwrap();
     writeln!(config, "/// The scene's light buffer, built on the host (empty: none in flash).").unwrap();

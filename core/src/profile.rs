@@ -329,18 +329,19 @@ fn host_scene<'t>(
 /// `OUT_DIR` and the firmware `include!`s it (octrace's firmware and board
 /// templates do). The counts from `needed_by` (feature `alloc`) or
 /// [`parse::count`](crate::parse::count), the octree's criterion when it
-/// is not the default one, and the two options.
+/// is not the default one, and the three options.
 ///
 /// ```
 /// use octrace_core::{accel::OctreeConfig, parse::count, profile::ProfileText};
 ///
 /// let counts = count("SPHERE 1 1 0 0 0\n");
 /// let octree = OctreeConfig { max_depth: 4, ..OctreeConfig::DEFAULT };
-/// let text = ProfileText { name: "Scene", doc: "One sphere.", counts: &counts, octree: Some(&octree), named_walk: false, first_hits: true };
+/// let text = ProfileText { name: "Scene", doc: "One sphere.", counts: &counts, octree: Some(&octree), named_walk: false, first_hits: true, coherence: false };
 /// assert_eq!(
 ///     text.to_string(),
 ///     "octrace_core::profile! {\n    /// One sphere.\n    pub struct Scene { objects: 1, spheres: 1 }\n    \
-///      octree: { max_objects: 4, max_depth: 4, shadow_shafts: false }\n    named_walk: false\n    first_hits: true\n}\n",
+///      octree: { max_objects: 4, max_depth: 4, shadow_shafts: false }\n    named_walk: false\n    first_hits: true\n    \
+///      coherence: false\n}\n",
 /// );
 /// ```
 #[derive(Clone, Copy, Debug)]
@@ -357,6 +358,8 @@ pub struct ProfileText<'a> {
     pub named_walk: bool,
     /// [`Profile::FIRST_HITS`].
     pub first_hits: bool,
+    /// [`Profile::COHERENCE`]: what a firmware that plays animations needs.
+    pub coherence: bool,
 }
 
 impl ProfileText<'_> {
@@ -371,7 +374,7 @@ impl ProfileText<'_> {
     ///
     /// let one = count("SPHERE 1 1 0 0 0\n");
     /// let two = count("SPHERE 1 1 0 0 0\nSPHERE 1 1 3 0 0\n");
-    /// let text = |counts| ProfileText { name: "Scene", doc: "", counts, octree: None, named_walk: false, first_hits: false };
+    /// let text = |counts| ProfileText { name: "Scene", doc: "", counts, octree: None, named_walk: false, first_hits: false, coherence: false };
     /// assert!(text(&two).arena_bytes() > text(&one).arena_bytes());
     /// ```
     pub fn arena_bytes(&self) -> usize {
@@ -418,6 +421,7 @@ impl core::fmt::Display for ProfileText<'_> {
         }
         writeln!(f, "    named_walk: {}", self.named_walk)?;
         writeln!(f, "    first_hits: {}", self.first_hits)?;
+        writeln!(f, "    coherence: {}", self.coherence)?;
         writeln!(f, "}}")
     }
 }

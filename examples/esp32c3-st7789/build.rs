@@ -45,6 +45,7 @@ fn main() {
         octree: None,
         named_walk: false,
         first_hits: true,
+        coherence: false,
     };
     let source =
         format!("/// The scene, from `{scene}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n{profile}");

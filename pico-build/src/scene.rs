@@ -95,6 +95,8 @@ fn scene_source(name: &str, path: &std::path::Path, text: &str) -> Result<(Scene
     }
     // `load` walks the octree by 3DDDA: no room for the thesis's hash table.
     let doc = format!("Exactly what `{name}` needs, its octree included.");
+    let kind = kind_of(text);
+    let animated = kind == SceneKind::Animation;
     let profile = ProfileText {
         name: "SceneProfile",
         doc: &doc,
@@ -102,16 +104,9 @@ fn scene_source(name: &str, path: &std::path::Path, text: &str) -> Result<(Scene
         octree: None,
         named_walk: false,
         first_hits: true,
+        coherence: animated,
     };
-    let kind = kind_of(text);
-    let animated = kind == SceneKind::Animation;
     let motion = if animated { Motion::needs(text) } else { Default::default() };
-    // `ProfileText` writes a still's profile; coherence comes last in `profile!`.
-    let profile = profile.to_string();
-    let profile = match profile.strip_suffix("}\n") {
-        Some(fields) if animated => format!("{fields}    coherence: true\n}}\n"),
-        _ => profile,
-    };
     let source = format!(
         "/// The scene, from `{name}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n{profile}\
          /// Whether the scene is an animation the firmware plays.\npub const ANIMATED: bool = {animated};\n\
@@ -147,7 +142,7 @@ mod tests {
         let still = "SURFACE 1 1 1 1 1 1 1 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nLIGHT 1 0 10 10\n";
         let (kind, source) = scene_source("still", path, still).unwrap();
         assert_eq!(kind, SceneKind::Still);
-        assert!(!source.contains("coherence") && source.contains("ANIMATED: bool = false"), "{source}");
+        assert!(source.contains("    coherence: false\n") && source.contains("ANIMATED: bool = false"), "{source}");
         assert!(source.contains("tracks: 0, keys: 0, displacements: 0"), "{source}");
         // Frames where nothing moves, or a move in one frame, are stills.
         for text in [format!("FRAMES 4\n{still}"), format!("FRAMES 1\n{still}SPHERE 1 1 3 0 0 MOVE 0 0 0 0\n")] {
