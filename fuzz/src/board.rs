@@ -9,13 +9,17 @@
 //! the line (its low six bits, plus one). The control byte's top two bits
 //! say when the piece arrives: at once, after 1, 30 or 2,000 of the
 //! board's polls. A drawing is stopped after 20,000 polls (a scene may take
-//! hours a pixel): it is then `cancelled`, as when a frame comes.
+//! hours a pixel): it is then `cancelled`, as when a frame comes; an
+//! animation after 3 frames (it would play until the host sends): then
+//! `stopped`.
 
+use core::sync::atomic::AtomicU8;
 use embedded_graphics_core::pixelcolor::Rgb565;
+use octrace_core::animation::{Key, Track};
 use octrace_core::profile::Board16K;
 use octrace_core::render::Renderer;
 use octrace_core::Raytracer;
-use octrace_link::board::{Line, Link};
+use octrace_link::board::{AnimationRoom, Line, Link};
 use octrace_link::{Decoder, Kind, Message, Panel, PixelFormat};
 use std::cell::RefCell;
 use std::collections::VecDeque;
@@ -23,6 +27,10 @@ use std::collections::VecDeque;
 /// The board's frame buffer: small, so that frames too long for it come.
 const BUFFER: usize = 600;
 const PANEL: Panel = Panel { width: 4, height: 3, format: PixelFormat::Rgb565 };
+/// Frames after which an animation stops by itself (it would play until
+/// the host sends something).
+const FRAMES_PLAYED: u32 = 3;
+
 /// Polls after which a drawing stops by itself.
 const POLLS_A_DRAWING: u32 = 20_000;
 
@@ -130,7 +138,12 @@ fn serve(data: &[u8], holding_until: u32) -> SimulatedLine {
         held: Vec::new(),
         clock_us: 0,
     };
-    let mut link = Link::new(PANEL, "fuzz", vec![0u8; BUFFER]);
+    let tiles = [const { AtomicU8::new(0) }; 1];
+    let (mut tracks, mut keys, mut displacements) = ([Track::EMPTY; 4], [Key::EMPTY; 16], [[0; 3]; 64]);
+    let room = AnimationRoom { tiles: &tiles, tracks: &mut tracks, keys: &mut keys, displacements: &mut displacements };
+    let mut link = Link::new(PANEL, "fuzz", vec![0u8; BUFFER]).with_animations(room);
+    // Frames of an animation played so far: it is stopped after a few.
+    let mut frames = 0;
     RAYTRACER.with(|raytracer| {
         let mut raytracer = raytracer.borrow_mut();
         while link
@@ -139,8 +152,18 @@ fn serve(data: &[u8], holding_until: u32) -> SimulatedLine {
                 let view = drawing.scene().view();
                 let (w, h) = (u32::from(PANEL.width), u32::from(PANEL.height));
                 let Ok(mut renderer) = Renderer::with_size(view, &accelerator, w, h) else { return 0 };
-                let mut polls = 0;
                 let mut row = [Rgb565::default(); 4];
+                if drawing.playing().is_some_and(|playing| playing.frame == 0) {
+                    frames = 0;
+                }
+                if drawing.playing().is_some() {
+                    frames += 1;
+                    return match frames > FRAMES_PLAYED {
+                        true => 0,
+                        false => rows.draw_on_one_core(drawing, &mut renderer, &mut row, |_, _| {}),
+                    };
+                }
+                let mut polls = 0;
                 let mut budgeted = BudgetedRows { rows, polls: &mut polls };
                 budgeted.draw(drawing, &mut renderer, &mut row)
             })
@@ -199,7 +222,7 @@ pub fn check_board_loop(data: &[u8]) {
         }
         let closing = match kind {
             Kind::Board | Kind::Refused => Some(kind),
-            Kind::Rejected | Kind::Done | Kind::Cancelled => Some(Kind::Done),
+            Kind::Rejected | Kind::Done | Kind::Cancelled | Kind::Stopped => Some(Kind::Done),
             _ => None,
         };
         closings.extend(closing.map(|kind| (frame.tag, kind)));
@@ -231,7 +254,12 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
         3,
     );
     let hello = frame(Message::Hello, 1);
+    let animation = frame(
+        Message::Scene { pixels: true, text: b"FRAMES 3\nSPHERE 1 1 0 0 0 MOVE 0 0 0 0  2 1 0 0\nLIGHT 1 5 5 5\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\n" },
+        5,
+    );
     vec![
+        ("animation-then-late-hello.bin", [as_pieces(&animation, 0), as_pieces(&hello, 2)].concat()),
         ("hello-then-scene.bin", as_pieces(&[&hello[..], &scene].concat(), 0)),
         ("scene-then-late-hello.bin", [as_pieces(&scene, 0), as_pieces(&hello, 2)].concat()),
         ("wedge-then-hello.bin", [as_pieces(&wedge, 0), as_pieces(&hello, 2)].concat()),

@@ -91,7 +91,7 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     let scene_frame = frame(Message::Scene { pixels: true, text: scene }, 2);
     let panel = Panel { width: 4, height: 3, format: PixelFormat::Rgb565 };
     let answers = [
-        frame(Message::Drawing { panel, pixels: true }, 2),
+        frame(Message::Drawing { panel, pixels: true, frames: 0 }, 2),
         frame(Message::Row { y: 0, pixels: &[0xF8, 0, 0x07, 0xE0, 0, 0x1F, 0xFF, 0xFF] }, 2),
         frame(
             Message::Done(Timing {

@@ -31,7 +31,7 @@
 //! // The board answers with the same tag.
 //! let panel = Panel { width: 240, height: 240, format: PixelFormat::Rgb565 };
 //! let mut answer = Vec::new();
-//! Message::Drawing { panel, pixels: true }.encode(frame.tag, &mut answer).unwrap();
+//! Message::Drawing { panel, pixels: true, frames: 0 }.encode(frame.tag, &mut answer).unwrap();
 //! assert!(!answer[1..answer.len() - 1].contains(&0), "0x00 only delimits frames");
 //! ```
 

@@ -73,6 +73,12 @@ kinds! {
     Done = 0x46, "done", false;
     /// Board: the drawing stopped because another frame came.
     Cancelled = 0x47, "cancelled", false;
+    /// Board: a run of pixels of an animation's frame is drawn.
+    Run = 0x48, "run", false;
+    /// Board: every run of an animation's frame is drawn.
+    FrameDrawn = 0x49, "frame-drawn", false;
+    /// Board: the animation stopped because another frame came.
+    Stopped = 0x4A, "stopped", false;
     /// Board: a frame it cannot take, and why.
     Refused = 0x7F, "refused", false;
 }
@@ -265,12 +271,14 @@ pub enum Message<'a> {
         /// How many [`Message::SceneError`]s were sent.
         errors: u32,
     },
-    /// Board: the scene loaded; rows follow.
+    /// Board: the scene loaded; rows follow, or an animation's runs.
     Drawing {
         /// What it is drawn at.
         panel: Panel,
-        /// Whether the rows carry their pixels.
+        /// Whether the rows (or runs) carry their pixels.
         pixels: bool,
+        /// 0 for a still; an animation's frames, played in a loop.
+        frames: u32,
     },
     /// Board: row `y` is drawn.
     Row {
@@ -285,6 +293,33 @@ pub enum Message<'a> {
     Cancelled {
         /// How many rows were drawn.
         rows: u16,
+    },
+    /// Board: `width` pixels of row `y` from column `x` of an animation's
+    /// frame are drawn (the pixels its motion may have changed).
+    Run {
+        /// The row, from 0 at the top.
+        y: u16,
+        /// The run's first column, from 0 at the left.
+        x: u16,
+        /// Its pixels.
+        width: u16,
+        /// Its pixels in the panel's format, or none if they were not asked for.
+        pixels: &'a [u8],
+    },
+    /// Board: frame `frame` of the animation is on the panel, every run
+    /// of it sent.
+    FrameDrawn {
+        /// The frame, from 0 (after the last comes 0 again).
+        frame: u32,
+        /// Pixels traced for it (the others kept their value).
+        traced: u32,
+        /// How long loading and drawing it took, by the board's clock, if it has one.
+        elapsed: Option<Duration>,
+    },
+    /// Board: it stopped playing the animation when another frame came.
+    Stopped {
+        /// How many frames were drawn whole since it began.
+        frames: u32,
     },
     /// Board: it could not take a frame.
     Refused(Reason),
@@ -328,6 +363,9 @@ impl<'a> Message<'a> {
             Message::Row { .. } => Kind::Row,
             Message::Done(_) => Kind::Done,
             Message::Cancelled { .. } => Kind::Cancelled,
+            Message::Run { .. } => Kind::Run,
+            Message::FrameDrawn { .. } => Kind::FrameDrawn,
+            Message::Stopped { .. } => Kind::Stopped,
             Message::Refused(_) => Kind::Refused,
         }
     }
@@ -352,9 +390,10 @@ impl<'a> Message<'a> {
             }
             Message::SceneError(e) => put_scene_error(&mut w, e.line, e.column, e.capacity, &e.message)?,
             Message::Rejected { errors } => w.put(&errors.to_be_bytes())?,
-            Message::Drawing { panel, pixels } => {
+            Message::Drawing { panel, pixels, frames } => {
                 put_panel(&mut w, &panel)?;
                 w.put(&[pixels as u8])?;
+                w.put(&frames.to_be_bytes())?;
             }
             Message::Row { y, pixels } => {
                 w.put(&y.to_be_bytes())?;
@@ -362,11 +401,23 @@ impl<'a> Message<'a> {
             }
             Message::Done(timing) => {
                 for time in [timing.elapsed, timing.load, timing.render] {
-                    put_time(&mut w, time)?;
+                    w.put(&time_on_wire(time).to_be_bytes())?;
                 }
                 timing.counters.write(&mut w)?;
             }
             Message::Cancelled { rows } => w.put(&rows.to_be_bytes())?,
+            Message::Run { y, x, width, pixels } => {
+                for field in [y, x, width] {
+                    w.put(&field.to_be_bytes())?;
+                }
+                w.put(pixels)?;
+            }
+            Message::FrameDrawn { frame, traced, elapsed } => {
+                w.put(&frame.to_be_bytes())?;
+                w.put(&traced.to_be_bytes())?;
+                w.put(&time_on_wire(elapsed).to_be_bytes())?;
+            }
+            Message::Stopped { frames } => w.put(&frames.to_be_bytes())?,
             Message::Refused(reason) => put_reason(&mut w, reason)?,
         }
         w.finish()
@@ -383,14 +434,31 @@ impl<'a> Message<'a> {
             Kind::Board => read_board(&mut r).map(Message::Board),
             Kind::SceneError => read_scene_error(&mut r).map(Message::SceneError),
             Kind::Rejected => r.u32().map(|errors| Message::Rejected { errors }),
-            Kind::Drawing => read_panel(&mut r).and_then(|panel| Some(Message::Drawing { panel, pixels: r.flag()? })),
+            Kind::Drawing => read_panel(&mut r)
+                .and_then(|panel| Some(Message::Drawing { panel, pixels: r.flag()?, frames: r.u32()? })),
             Kind::Row => r.u16().map(|y| Message::Row { y, pixels: r.rest() }),
             Kind::Done => read_timing(&mut r).map(Message::Done),
             Kind::Cancelled => r.u16().map(|rows| Message::Cancelled { rows }),
+            Kind::Run => (|| Some(Message::Run { y: r.u16()?, x: r.u16()?, width: r.u16()?, pixels: r.rest() }))(),
+            Kind::FrameDrawn => {
+                (|| Some(Message::FrameDrawn { frame: r.u32()?, traced: r.u32()?, elapsed: time_from_wire(r.u64()?) }))(
+                )
+            }
+            Kind::Stopped => r.u32().map(|frames| Message::Stopped { frames }),
             Kind::Refused => read_reason(&mut r).map(Message::Refused),
         };
         message.filter(|_| r.0.is_empty()).ok_or(Reason::Malformed { kind })
     }
+}
+
+/// A board's time as the wire carries it: microseconds, the longest it
+/// carries for a longer one, [`NO_TIME`] for none.
+fn time_on_wire(elapsed: Option<Duration>) -> u64 {
+    elapsed.map_or(NO_TIME, |t| u64::try_from(t.as_micros()).unwrap_or(u64::MAX).min(NO_TIME - 1))
+}
+
+fn time_from_wire(micros: u64) -> Option<Duration> {
+    (micros != NO_TIME).then(|| Duration::from_micros(micros))
 }
 
 fn put_panel<S: Sink + ?Sized>(w: &mut FrameWriter<'_, S>, panel: &Panel) -> Result<(), S::Error> {
@@ -445,15 +513,8 @@ fn read_board<'a>(r: &mut Reader<'a>) -> Option<BoardInfo<'a>> {
     Some(BoardInfo { panel, max_scene, profile, firmware, capacities: Capacities::read(r)? })
 }
 
-/// A time in microseconds, or NO_TIME; one too long for the wire is sent
-/// as the longest it carries.
-fn put_time<S: Sink + ?Sized>(w: &mut FrameWriter<'_, S>, time: Option<Duration>) -> Result<(), S::Error> {
-    let micros = time.map_or(NO_TIME, |t| u64::try_from(t.as_micros()).unwrap_or(u64::MAX).min(NO_TIME - 1));
-    w.put(&micros.to_be_bytes())
-}
-
 fn read_timing<'a>(r: &mut Reader<'a>) -> Option<Timing<'a>> {
-    let mut time = || r.u64().map(|t| (t != NO_TIME).then(|| Duration::from_micros(t)));
+    let mut time = || r.u64().map(time_from_wire);
     let (elapsed, load, render) = (time()?, time()?, time()?);
     Some(Timing { elapsed, load, render, counters: Counters::read(r)? })
 }
@@ -595,7 +656,15 @@ mod tests {
                 Message::SceneError(SceneError { capacity: Some(need), ..error }),
                 Message::SceneError(SceneError { capacity: Some(CapacityNeed { needed: None, ..need }), ..error }),
                 Message::Rejected { errors: rng.next() as u32 },
-                Message::Drawing { panel, pixels: rng.below(2) == 1 },
+                Message::Drawing { panel, pixels: rng.below(2) == 1, frames: rng.next() as u32 },
+                Message::Run { y: rng.next() as u16, x: rng.next() as u16, width: rng.next() as u16, pixels: &bytes },
+                Message::FrameDrawn {
+                    frame: rng.next() as u32,
+                    traced: rng.next() as u32,
+                    elapsed: Some(Duration::from_micros(rng.below(1 << 40))),
+                },
+                Message::FrameDrawn { frame: 0, traced: 0, elapsed: None },
+                Message::Stopped { frames: rng.next() as u32 },
                 Message::Row { y: rng.next() as u16, pixels: &bytes },
                 Message::Done(timing),
                 Message::Done(Timing::NONE),
@@ -621,6 +690,7 @@ mod tests {
             (Message::Scene { pixels: true, text: b"RASTER 4 2\n" }, 0x1234),
             (Message::Row { y: 1, pixels: &[0xF8, 0, 0x07, 0xE0, 0, 0x1F, 0xFF, 0xFF] }, 0x1234),
             (Message::Refused(Reason::WrongVersion { expected: 2, found: 1 }), 0x1234),
+            (Message::Run { y: 1, x: 2, width: 2, pixels: &[0xF8, 0, 0x07, 0xE0] }, 0x1234),
         ];
         for (message, tag) in examples {
             let mut wire = Vec::new();
@@ -668,7 +738,7 @@ mod tests {
     #[test]
     fn a_payload_that_does_not_fit_its_kind_is_malformed() {
         let malformed = |kind: Kind| Err(Refusal { tag: 3, reason: Reason::Malformed { kind: kind.byte() } });
-        let cases: [(Kind, &[u8]); 17] = [
+        let cases: [(Kind, &[u8]); 21] = [
             (Kind::Hello, &[0]),
             (Kind::Scene, &[]),
             (Kind::Scene, &[2, b'x']),
@@ -679,11 +749,15 @@ mod tests {
             (Kind::SceneError, &[0, 0, 0, 1, 0, 0, 0, 1, 0, 0xFF]),
             (Kind::SceneError, &[0, 0, 0, 1, 0, 0, 0, 1, 1, 1, b'a', 0, 0]),
             (Kind::Rejected, &[0, 0, 1]),
-            (Kind::Drawing, &[0, 1, 0, 1, 1, 2]),
+            (Kind::Drawing, &[0, 1, 0, 1, 1, 2, 0, 0, 0, 0]),
+            (Kind::Drawing, &[0, 1, 0, 1, 1, 1]),
+            (Kind::Run, &[0, 1, 0, 2, 0]),
+            (Kind::FrameDrawn, &[0; 15]),
             (Kind::Row, &[7]),
             (Kind::Done, &[0; 9]),
             (Kind::Done, &[0; 24]),
             (Kind::Cancelled, &[0, 0, 0]),
+            (Kind::Stopped, &[0, 0, 0]),
             (Kind::Refused, &[9, 0]),
             (Kind::Refused, &[1, 1]),
         ];

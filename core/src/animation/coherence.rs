@@ -12,8 +12,9 @@
 
 use crate::accel::Accelerator;
 use crate::motion::{Dependence, Lookout, Motion, NEVER};
-use crate::render::{PixelSample, Renderer};
+use crate::render::{PixelSample, Polling, Renderer, Stop, Stopped};
 use crate::shade::Stats;
+use crate::shade::{Poll, Unpolled};
 use core::fmt;
 use core::ops::Range;
 use core::sync::atomic::{AtomicU8, Ordering};
@@ -21,6 +22,12 @@ use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::pixelcolor::Rgb888;
 use embedded_graphics_core::primitives::Rectangle;
+
+/// Why a band's trace ended early: its sink's error, or its poll said stop.
+enum Halt<E, S> {
+    Sink(E),
+    Stopped(S),
+}
 
 /// A tile to trace in the frame being drawn.
 const TRACE: u8 = 254;
@@ -254,6 +261,46 @@ impl<'s> Coherence<'s> {
         band: u32,
         each: &mut RunSink<'_, E>,
     ) -> Result<Stats, E> {
+        match self.trace_band_polled(renderer, motion, frame, band, &mut Unpolled, each) {
+            Ok(stats) => Ok(stats),
+            Err(Halt::Sink(e)) => Err(e),
+            Err(Halt::Stopped(never)) => match never {},
+        }
+    }
+
+    /// [`Coherence::trace_band`], asking `stop` before every ray (as
+    /// [`Renderer::pixel_until`] does): [`Stopped`] as soon as it says so.
+    /// The pixels of the run's row handed to `each` end before the stopped
+    /// pixel (`each` is still called; the error that follows says the row
+    /// is cut), and the tiles of that run keep their mark to be traced.
+    pub fn trace_band_until<'a, A: Accelerator, S: Stop, E: From<Stopped>>(
+        &self,
+        renderer: &mut Renderer<'a, A>,
+        motion: &'a Motion<'a>,
+        frame: u32,
+        band: u32,
+        stop: &mut S,
+        each: &mut RunSink<'_, E>,
+    ) -> Result<Stats, E> {
+        let mut polling = Polling { stop, stopped: false };
+        match self.trace_band_polled(renderer, motion, frame, band, &mut polling, each) {
+            Ok(stats) => Ok(stats),
+            Err(Halt::Sink(e)) => Err(e),
+            Err(Halt::Stopped(stopped)) => Err(stopped.into()),
+        }
+    }
+
+    /// [`Coherence::trace_band`] with `poll` asked before every ray.
+    #[inline(always)]
+    fn trace_band_polled<'a, A: Accelerator, Q: Poll, E>(
+        &self,
+        renderer: &mut Renderer<'a, A>,
+        motion: &'a Motion<'a>,
+        frame: u32,
+        band: u32,
+        poll: &mut Q,
+        each: &mut RunSink<'_, E>,
+    ) -> Result<Stats, Halt<E, Q::Stopped>> {
         let before = renderer.stats();
         let lookout = Lookout::new(motion, frame, self.ignored);
         // A camera that moves before the next frame makes every count 0:
@@ -266,17 +313,28 @@ impl<'s> Coherence<'s> {
             let mut clean = [NEVER; RUN_TILES];
             for y in area.rows() {
                 let line = Rectangle::new(Point::new(x0 as i32, y), Size::new(area.size.width, 1));
-                let mut pixels = (x0..x0 + area.size.width).map(|x| {
+                let mut halted = None;
+                let mut pixels = (x0..x0 + area.size.width).map_while(|x| {
                     let tile = ((x - x0) / side) as usize;
-                    if !watching {
-                        clean[tile] = 0;
-                        return renderer.pixel(x, y as u32);
+                    let traced = match watching {
+                        true => renderer.watched_pixel(x, y as u32, clean[tile], poll),
+                        false => renderer.pixel_polled(x, y as u32, poll).map(|pixel| (pixel, 0)),
+                    };
+                    match traced {
+                        Ok((pixel, count)) => {
+                            clean[tile] = count;
+                            Some(pixel)
+                        }
+                        Err(stopped) => {
+                            halted = Some(stopped);
+                            None
+                        }
                     }
-                    let (pixel, count) = renderer.watched_pixel(x, y as u32, clean[tile]);
-                    clean[tile] = count;
-                    pixel
                 });
-                each(&line, &mut pixels)?;
+                each(&line, &mut pixels).map_err(Halt::Sink)?;
+                if let Some(stopped) = halted {
+                    return Err(Halt::Stopped(stopped));
+                }
             }
             for (tile, &count) in tiles.zip(&clean) {
                 let stored = if count == NEVER { FOREVER } else { count.min(u32::from(MOST)) as u8 };

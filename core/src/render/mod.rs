@@ -35,6 +35,7 @@ pub use handoff::{Handoff, SlotBusy, Taken};
 pub use panel::PanelColor;
 pub use progressive::{Progressive, ProgressiveError, TracedUnit, Unit};
 pub use split::{interleaved_rows, Tiles};
+pub(crate) use stop::Polling;
 pub use stop::{Stop, Stopped};
 
 use crate::accel::{Accelerator, Hit, Mailbox};
@@ -310,7 +311,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
 
     /// The pixel at (`x`, `y`), `poll` asked before each of its rays.
     #[inline(always)]
-    fn pixel_polled<Q: Poll>(&mut self, x: u32, y: u32, poll: &mut Q) -> Result<PixelSample, Q::Stopped> {
+    pub(crate) fn pixel_polled<Q: Poll>(&mut self, x: u32, y: u32, poll: &mut Q) -> Result<PixelSample, Q::Stopped> {
         let n = self.camera.samples();
         let (mean, object) = if n == 1 {
             // One sample (the common case on a board): no loops, no sums.
@@ -336,16 +337,24 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
 
     /// The pixel at (`x`, `y`) and its clean count under the lookout, if
     /// below `bound` (else `bound`).
-    pub(crate) fn watched_pixel(&mut self, x: u32, y: u32, bound: u32) -> (PixelSample, u32) {
+    /// `poll` asked before each of its rays.
+    #[inline(always)]
+    pub(crate) fn watched_pixel<Q: Poll>(
+        &mut self,
+        x: u32,
+        y: u32,
+        bound: u32,
+        poll: &mut Q,
+    ) -> Result<(PixelSample, u32), Q::Stopped> {
         if !A::FOLLOWS_MOTION {
             // Nothing watched the rays: the pixel is traced again next frame.
-            return (self.pixel(x, y), 0);
+            return self.pixel_polled(x, y, poll).map(|pixel| (pixel, 0));
         }
         if let Some(lookout) = &mut self.scratch.lookout {
             lookout.start(bound);
         }
-        let pixel = self.pixel(x, y);
-        (pixel, self.scratch.lookout.map_or(bound, |l| l.clean))
+        let pixel = self.pixel_polled(x, y, poll)?;
+        Ok((pixel, self.scratch.lookout.map_or(bound, |l| l.clean)))
     }
 
     /// The colour and object of sample (`sx`, `sy`) of pixel (`x`, `y`).

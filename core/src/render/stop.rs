@@ -47,9 +47,9 @@ impl fmt::Display for Stopped {
 impl core::error::Error for Stopped {}
 
 /// A [`Stop`] asked before each ray, until it says stop.
-pub(super) struct Polling<'s, S> {
-    pub(super) stop: &'s mut S,
-    pub(super) stopped: bool,
+pub(crate) struct Polling<'s, S> {
+    pub(crate) stop: &'s mut S,
+    pub(crate) stopped: bool,
 }
 
 impl<S: Stop> Poll for Polling<'_, S> {

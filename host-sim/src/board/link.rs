@@ -243,8 +243,22 @@ impl BoardTiming {
 pub enum Answer {
     /// It drew the scene at its panel's size, and measured it so.
     Drawn { panel: Panel, timing: BoardTiming },
+    /// It played the animation at its panel's size: the frames followed,
+    /// in order, before host-sim stopped it.
+    Played { panel: Panel, frames: Vec<PlayedFrame> },
     /// The scene has errors (all of them, in the order found); nothing drawn.
     Rejected(Vec<BoardSceneError>),
+}
+
+/// A frame of an animation the board drew whole.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PlayedFrame {
+    /// Which, from 0.
+    pub frame: u32,
+    /// Pixels the board traced for it.
+    pub traced: u32,
+    /// Its time by the board's clock, if it has one.
+    pub elapsed: Option<Duration>,
 }
 
 /// What happens while a board draws.
@@ -254,6 +268,13 @@ pub enum Progress<'a> {
     Drawing(Panel),
     /// Row `y` is drawn: its pixels in the panel's format, if asked for.
     Row { y: u16, pixels: &'a [u8] },
+    /// The scene is an animation of `frames` frames; its runs follow.
+    Playing { panel: Panel, frames: u32 },
+    /// A run of row `y` from column `x` of the frame being played is
+    /// drawn: its pixels in the panel's format, if asked for.
+    Run { y: u16, x: u16, pixels: &'a [u8] },
+    /// A frame is whole: every run of it has come.
+    FrameDrawn(PlayedFrame),
 }
 
 /// The longest frame host-sim takes from a board: a `board` description
@@ -385,11 +406,14 @@ impl<P: Port> BoardLink<P> {
 
     /// Sends scene `text` (after [`BoardLink::hello`], which it asks for
     /// first if this link has not) and follows the drawing, handing each
-    /// step to `progress`; rows carry their pixels if `pixels`.
+    /// step to `progress`; rows carry their pixels if `pixels`. An
+    /// animation is followed for `follow` frames (at least 1), then
+    /// stopped with a hello.
     pub fn draw(
         &mut self,
         text: &[u8],
         pixels: bool,
+        follow: u32,
         progress: &mut dyn FnMut(Progress<'_>),
     ) -> Result<Answer, LinkError> {
         let panel = match self.panel {
@@ -436,7 +460,7 @@ impl<P: Port> BoardLink<P> {
                     let sent = errors.len();
                     return Err(LinkError::Protocol(format!("it counted {count} errors of the scene and sent {sent}")));
                 }
-                (Message::Drawing { panel: drawn, pixels: with_pixels }, None) if errors.is_empty() => {
+                (Message::Drawing { panel: drawn, pixels: with_pixels, frames }, None) if errors.is_empty() => {
                     if drawn != panel {
                         return Err(LinkError::Protocol(format!(
                             "it draws at {}x{} {}, but described a {}x{} {} panel",
@@ -445,6 +469,10 @@ impl<P: Port> BoardLink<P> {
                     }
                     if with_pixels != pixels {
                         return Err(LinkError::Protocol(format!("rows with pixels: {with_pixels}, asked: {pixels}")));
+                    }
+                    if frames > 0 {
+                        progress(Progress::Playing { panel, frames });
+                        return self.follow(tag, panel, pixels, frames, follow.max(1), progress);
                     }
                     progress(Progress::Drawing(panel));
                     drawing = Some(vec![false; panel.height.into()]);
@@ -472,6 +500,101 @@ impl<P: Port> BoardLink<P> {
                 (Message::Refused(reason), _) => return Err(refused(reason)),
                 (other, _) => return Err(unexpected(other.kind(), "the answer to the scene")),
             }
+        }
+    }
+
+    /// Follows the animation of `frames` frames that request `tag` plays
+    /// on `panel` for `follow` frames, then stops it with a hello. Every
+    /// run lies in the panel, of its width's pixels, each pixel at most
+    /// once a frame, and the first frame covers the panel.
+    fn follow(
+        &mut self,
+        tag: u16,
+        panel: Panel,
+        pixels: bool,
+        frames: u32,
+        follow: u32,
+        progress: &mut dyn FnMut(Progress<'_>),
+    ) -> Result<Answer, LinkError> {
+        let width = usize::from(panel.width);
+        // The pixels of each row that came in this frame, a row set aside
+        // only when a run of it comes; and how many came in all.
+        let mut came: Vec<Vec<bool>> = vec![Vec::new(); panel.height.into()];
+        let (mut touched, mut covered) = (Vec::new(), 0usize);
+        let mut played = Vec::new();
+        while played.len() < follow as usize {
+            let message = match self.receive(tag) {
+                Err(LinkError::Silent(waited)) => return Err(LinkError::Unfinished(waited)),
+                received => received?,
+            };
+            match message {
+                Message::Run { y, x, width: run, pixels: bytes } => {
+                    let (x0, x1) = (usize::from(x), usize::from(x) + usize::from(run));
+                    let row = came.get_mut(usize::from(y)).filter(|_| x1 <= width && run > 0).ok_or_else(|| {
+                        LinkError::Protocol(format!(
+                            "a run of {run} pixels at ({x}, {y}) on a {}x{} panel",
+                            width, panel.height
+                        ))
+                    })?;
+                    let expected = if pixels { usize::from(run) * panel.format.bytes_per_pixel() } else { 0 };
+                    if bytes.len() != expected {
+                        return Err(LinkError::Protocol(format!(
+                            "the run at ({x}, {y}) has {} bytes, not {expected}",
+                            bytes.len()
+                        )));
+                    }
+                    if row.is_empty() {
+                        *row = vec![false; width];
+                        touched.push(usize::from(y));
+                    }
+                    if row[x0..x1].iter().any(|&seen| seen) {
+                        return Err(LinkError::Protocol(format!(
+                            "a pixel of the run at ({x}, {y}) came twice in a frame"
+                        )));
+                    }
+                    row[x0..x1].fill(true);
+                    covered += usize::from(run);
+                    progress(Progress::Run { y, x, pixels: bytes });
+                }
+                Message::FrameDrawn { frame, traced, elapsed } => {
+                    let expected = played.last().map_or(0, |last: &PlayedFrame| (last.frame + 1) % frames);
+                    if frame != expected {
+                        return Err(LinkError::Protocol(format!("frame {frame} drawn where frame {expected} was due")));
+                    }
+                    if played.is_empty() && covered != width * usize::from(panel.height) {
+                        return Err(LinkError::Protocol(format!(
+                            "the first frame drew {covered} of the panel's {} pixels",
+                            width * usize::from(panel.height)
+                        )));
+                    }
+                    for y in touched.drain(..) {
+                        came[y].clear();
+                    }
+                    let drawn = PlayedFrame { frame, traced, elapsed };
+                    played.push(drawn);
+                    progress(Progress::FrameDrawn(drawn));
+                }
+                Message::Stopped { frames } => {
+                    return Err(LinkError::Protocol(format!("it stopped playing after {frames} frames unasked")));
+                }
+                Message::Refused(reason) => return Err(refused(reason)),
+                other => return Err(unexpected(other.kind(), "the animation's runs")),
+            }
+        }
+        // Stopped as a host that starts stops it: the answer ends with
+        // `stopped`, then the board describes itself.
+        let hello = self.next_tag();
+        self.send(hello, &Message::Hello)?;
+        loop {
+            match self.receive(tag)? {
+                Message::Run { .. } | Message::FrameDrawn { .. } => {}
+                Message::Stopped { .. } => break,
+                other => return Err(unexpected(other.kind(), "the end of the animation")),
+            }
+        }
+        match self.receive(hello)? {
+            Message::Board(_) => Ok(Answer::Played { panel, frames: played }),
+            other => Err(unexpected(other.kind(), "the board's description")),
         }
     }
 
@@ -665,7 +788,7 @@ mod tests {
 
     fn draw(link: &mut BoardLink<impl Port>) -> Result<Answer, LinkError> {
         link.hello().unwrap();
-        link.draw(b"scene", true, &mut |_| {})
+        link.draw(b"scene", true, 1, &mut |_| {})
     }
 
     #[test]
@@ -684,7 +807,7 @@ mod tests {
         let pixels = [0u8; 4];
         let mut link = drawing_board(|tag| {
             frames(&[
-                (Message::Drawing { panel: PANEL, pixels: true }, tag),
+                (Message::Drawing { panel: PANEL, pixels: true, frames: 0 }, tag),
                 (Message::Row { y: 1, pixels: &pixels }, tag),
                 (Message::Row { y: 0, pixels: &pixels }, tag),
                 (Message::Done(Timing::NONE), tag),
@@ -706,7 +829,7 @@ mod tests {
         ];
         for (rows, said) in cases {
             let mut link = drawing_board(|tag| {
-                let mut messages = vec![(Message::Drawing { panel: PANEL, pixels: true }, tag)];
+                let mut messages = vec![(Message::Drawing { panel: PANEL, pixels: true, frames: 0 }, tag)];
                 messages.extend(rows.iter().map(|&(y, pixels)| (Message::Row { y, pixels }, tag)));
                 messages.push((Message::Done(Timing::NONE), tag));
                 frames(&messages)
@@ -763,7 +886,10 @@ mod tests {
     #[test]
     fn a_drawing_cut_short_by_another_host_is_said() {
         let mut link = drawing_board(|tag| {
-            frames(&[(Message::Drawing { panel: PANEL, pixels: true }, tag), (Message::Cancelled { rows: 0 }, tag)])
+            frames(&[
+                (Message::Drawing { panel: PANEL, pixels: true, frames: 0 }, tag),
+                (Message::Cancelled { rows: 0 }, tag),
+            ])
         });
         assert!(matches!(draw(&mut link), Err(LinkError::Cancelled { rows: 0 })));
     }
@@ -789,7 +915,10 @@ mod tests {
             assert!(said.ends_with(&want), "{said}");
             // A drawing at any panel but the one described.
             let mut link = drawing_board(move |tag| {
-                frames(&[(Message::Drawing { panel, pixels: true }, tag), (Message::Done(Timing::NONE), tag)])
+                frames(&[
+                    (Message::Drawing { panel, pixels: true, frames: 0 }, tag),
+                    (Message::Done(Timing::NONE), tag),
+                ])
             });
             let said = draw(&mut link).unwrap_err().to_string();
             let want = format!("it draws at {width}x{height} rgb565, but described a 2x2 rgb565 panel");
@@ -820,19 +949,19 @@ mod tests {
         let mut link = chatty_board(board_info(), "bad", Duration::from_millis(10));
         let started = Instant::now();
         link.hello().unwrap();
-        let said = link.draw("x\n".repeat(1000).as_bytes(), true, &mut |_| {}).unwrap_err();
+        let said = link.draw("x\n".repeat(1000).as_bytes(), true, 1, &mut |_| {}).unwrap_err();
         assert!(matches!(said, LinkError::Unfinished(_)), "{said}");
         assert!(said.to_string().starts_with("the board's answer did not end within 0.3 s"), "{said}");
         let took = started.elapsed();
         assert!(took >= Duration::from_millis(300) && took < Duration::from_secs(1), "{took:?}");
         // Faster than the deadline, more errors than the scene can have.
         let mut link = chatty_board(board_info(), "bad", Duration::ZERO);
-        let said = link.draw("x\n".repeat(1000).as_bytes(), true, &mut |_| {}).unwrap_err().to_string();
+        let said = link.draw("x\n".repeat(1000).as_bytes(), true, 1, &mut |_| {}).unwrap_err().to_string();
         assert!(said.ends_with("it sent more errors than a scene of 2000 bytes can have (1064)"), "{said}");
         // An error longer than any of octrace's.
         let long: &'static str = "e".repeat(MAX_MESSAGE + 1).leak();
         let mut link = chatty_board(board_info(), long, Duration::ZERO);
-        let said = link.draw(b"x", true, &mut |_| {}).unwrap_err().to_string();
+        let said = link.draw(b"x", true, 1, &mut |_| {}).unwrap_err().to_string();
         assert!(said.ends_with("it sent an error message of 4097 bytes (octrace's are under 4096)"), "{said}");
     }
 
@@ -874,7 +1003,7 @@ mod tests {
         assert_eq!(board.firmware, "\\u{1b}[2Jfake\\u{a}host-sim: ok");
         assert_eq!(board.profile, "P\\u{1b}]0;title\\u{7}");
         assert_eq!(board.capacities, [("\\u{1b}[31m".to_string(), 1)]);
-        let Answer::Rejected(errors) = link.draw(b"x", true, &mut |_| {}).unwrap() else { panic!("rejected") };
+        let Answer::Rejected(errors) = link.draw(b"x", true, 1, &mut |_| {}).unwrap() else { panic!("rejected") };
         assert_eq!(errors[0].message, "\\u{1b}[1A\\u{d}line 1 is fine");
         assert_eq!(errors[0].capacity, Some(("\\u{1b}[0m".to_string(), Some(2), 1)));
     }

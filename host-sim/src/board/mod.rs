@@ -12,14 +12,15 @@
 mod link;
 
 pub use link::{
-    Answer, BoardDescription, BoardLink, BoardSceneError, BoardTiming, LinkError, Port, Progress, SerialLine,
+    Answer, BoardDescription, BoardLink, BoardSceneError, BoardTiming, LinkError, PlayedFrame, Port, Progress,
+    SerialLine,
 };
 
 use crate::arguments::{output_format, parse_format, same_file};
 use crate::exit::CliError;
 use crate::output::panel_preview;
 use crate::terminal::progress_bar;
-use crate::{all_cores, load_bytes, new_scene, render_with_progress, LoadError, RenderOptions, RgbImage};
+use crate::{all_cores, load_frame_bytes, new_scene, render_with_progress, LoadError, RenderOptions, RgbImage};
 use embedded_graphics_core::pixelcolor::RgbColor;
 use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
@@ -36,6 +37,12 @@ const _: () = assert!(Panel::MAX_SIDE as u32 == octrace_core::scene::MAX_SIDE);
 /// (`--timeout`, the studio's `--board-timeout`): sixty times what a Pico
 /// takes for the thesis's scenes, and room for an emulated one.
 pub(crate) const DEFAULT_TIMEOUT: u64 = 120;
+
+/// The frames of an animation `host-sim board` follows (and checks) unless
+/// told otherwise (`--frames`): the first, which traces every pixel, and
+/// two that re-trace only what moved, the second of them from counts a
+/// partly traced frame recorded; a few seconds on the emulated Pico.
+pub(crate) const DEFAULT_FRAMES: u32 = 3;
 
 /// `host-sim board [PORT] [SCENE] [OUT]`.
 #[derive(clap::Args, Debug)]
@@ -58,6 +65,12 @@ pub struct BoardArgs {
     /// drawing).
     #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_TIMEOUT, value_parser = clap::value_parser!(u64).range(1..=86_400))]
     pub timeout: u64,
+    /// Of an animation (a scene with FRAMES), the frames to follow before
+    /// stopping the board with a hello: OUT gets the last of them, and
+    /// --check compares each with `host-sim SCENE --frame K` at the
+    /// panel's size and in its format.
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_FRAMES, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub frames: u32,
     /// OUT's file format; by default from its extension (png, tga, ras),
     /// or PNG when it has none.
     #[arg(long, value_parser = parse_format)]
@@ -138,7 +151,8 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
     if out.is_none() && args.format.is_some() {
         return Err(CliError::Invalid("board: --format names OUT's format: give OUT".into()));
     }
-    let format = out.map(|out| output_format(args.format, out)).transpose()?;
+    // OUT's format, known before the board is asked.
+    out.map(|out| output_format(args.format, out)).transpose()?;
     if let Some(out) = out.filter(|out| same_file(scene, out)) {
         return Err(CliError::Invalid(format!(
             "refusing to overwrite the scene file {} with the image",
@@ -150,13 +164,15 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
     let pixels = out.is_some() || args.check;
     let started = Instant::now();
     let mut bar = None;
-    let sent = send_scene(&port, timeout, &file, &text, pixels, &mut |step| match step {
+    let sent = send_scene(&port, timeout, &file, &text, pixels, args.frames, &mut |step| match step {
         Progress::Drawing(panel) => bar = progress_bar(panel.height.into(), args.quiet),
-        Progress::Row { .. } => {
+        Progress::Playing { .. } => bar = progress_bar(args.frames.into(), args.quiet),
+        Progress::Row { .. } | Progress::FrameDrawn(_) => {
             if let Some(bar) = &bar {
                 bar.inc(1);
             }
         }
+        Progress::Run { .. } => {}
     });
     if let Some(bar) = &bar {
         bar.finish_and_clear();
@@ -167,6 +183,7 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
             return Err(CliError::Scene { file, errors });
         }
         Sent::Drawn { panel, timing, picture } => (panel, timing, picture),
+        Sent::Played { panel, frames } => return played(args, &port, &file, &text, panel, frames, stderr),
     };
     let (w, h) = (panel.width, panel.height);
     if !args.quiet {
@@ -179,17 +196,9 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
             false => Ok(()),
         };
     };
-    if let (Some(out), Some(format)) = (out, format) {
-        crate::output::write_atomically(out, |f| {
-            formats::write(&Image::Rgb(image.clone()), format, f).map_err(io::Error::other)
-        })
-        .map_err(|e| CliError::write(out, e))?;
-        if !args.quiet {
-            let _ = writeln!(stderr, "the board's picture -> {}", out.display());
-        }
-    }
+    write_picture(args, &image, stderr)?;
     if args.check {
-        let differ = differing_pixels(&file, &text, panel, &image)?;
+        let differ = differing_pixels(&file, &text, 0, panel, &image)?;
         if differ > 0 {
             return Err(CliError::Mismatch(format!(
                 "board --check: {differ} of {} pixels differ from host-sim's {} render at {w}x{h}",
@@ -200,6 +209,70 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
         if !args.quiet {
             let _ = writeln!(stderr, "--check: bit-identical to host-sim's {} render at {w}x{h}", panel.format);
         }
+    }
+    Ok(())
+}
+
+/// Writes the board's picture to OUT, if asked.
+fn write_picture(args: &BoardArgs, image: &RgbImage, stderr: &mut dyn Write) -> Result<(), CliError> {
+    let Some(out) = &args.out else { return Ok(()) };
+    let format = output_format(args.format, out)?;
+    crate::output::write_atomically(out, |f| {
+        formats::write(&Image::Rgb(image.clone()), format, f).map_err(io::Error::other)
+    })
+    .map_err(|e| CliError::write(out, e))?;
+    if !args.quiet {
+        let _ = writeln!(stderr, "the board's picture -> {}", out.display());
+    }
+    Ok(())
+}
+
+/// What `host-sim board` says of an animation the board played: each
+/// frame followed, OUT the last, and with `--check` each compared with
+/// `host-sim --frame K`'s.
+fn played(
+    args: &BoardArgs,
+    port: &str,
+    file: &str,
+    text: &[u8],
+    panel: Panel,
+    frames: Vec<(PlayedFrame, Option<RgbImage>)>,
+    stderr: &mut dyn Write,
+) -> Result<(), CliError> {
+    let (w, h) = (panel.width, panel.height);
+    for (frame, _) in frames.iter().filter(|_| !args.quiet) {
+        let time = frame.elapsed.map_or("".into(), |t| format!(" in {:.3} s by its clock", t.as_secs_f64()));
+        let traced = frame.traced;
+        let _ = writeln!(stderr, "frame {} drawn by the board at {port}{time}, {traced} pixels traced", frame.frame);
+    }
+    if let Some((_, Some(last))) = frames.last() {
+        write_picture(args, last, stderr)?;
+    }
+    if !args.check {
+        return Ok(());
+    }
+    for (frame, picture) in &frames {
+        let Some(picture) = picture else {
+            return Err(CliError::Mismatch("board --check: the board sent no pixels to compare".into()));
+        };
+        let differ = differing_pixels(file, text, frame.frame, panel, picture)?;
+        if differ > 0 {
+            return Err(CliError::Mismatch(format!(
+                "board --check: frame {}: {differ} of {} pixels differ from host-sim's --frame {} {} render at {w}x{h}",
+                frame.frame,
+                w as usize * h as usize,
+                frame.frame,
+                panel.format
+            )));
+        }
+    }
+    if !args.quiet {
+        let _ = writeln!(
+            stderr,
+            "--check: {} frames, each bit-identical to host-sim's --frame K {} render at {w}x{h}",
+            frames.len(),
+            panel.format
+        );
     }
     Ok(())
 }
@@ -222,19 +295,23 @@ pub(crate) enum Sent {
     /// Drawn at the panel's size (`timing` as the board measured it), with
     /// the picture if its pixels were asked for.
     Drawn { panel: Panel, timing: BoardTiming, picture: Option<RgbImage> },
+    /// An animation played at the panel's size: the frames followed, each
+    /// with the panel's picture then if its pixels were asked for.
+    Played { panel: Panel, frames: Vec<(PlayedFrame, Option<RgbImage>)> },
 }
 
 /// Sends scene `text` (named `file` in errors) to the board at `port`,
 /// after its hello and a check of the scene's length against what it
-/// takes, and follows the drawing, handing each step to `progress`; all
-/// of it within `timeout`. `host-sim board` and the studio send through
-/// this.
+/// takes, and follows the drawing (an animation for `follow` frames),
+/// handing each step to `progress`; all of it within `timeout`.
+/// `host-sim board` and the studio send through this.
 pub(crate) fn send_scene(
     port: &str,
     timeout: Duration,
     file: &str,
     text: &[u8],
     pixels: bool,
+    follow: u32,
     progress: &mut dyn FnMut(Progress<'_>),
 ) -> Result<Sent, CliError> {
     let mut link = BoardLink::open(port, timeout).map_err(|e| link_error(port, e))?;
@@ -249,37 +326,58 @@ pub(crate) fn send_scene(
     // The picture's rows in RGB, each kept as it comes: memory follows
     // what the board sent, not the size it claims.
     let mut rows: Vec<Vec<u8>> = Vec::new();
-    let answer = link.draw(text, pixels, &mut |step| {
+    // An animation's pictures, one at each frame followed.
+    let mut pictures = Vec::new();
+    let picture = |rows: &[Vec<u8>], panel: Panel| RgbImage {
+        width: panel.width.into(),
+        height: panel.height.into(),
+        data: rows.concat(),
+    };
+    let answer = link.draw(text, pixels, follow, &mut |step| {
         match &step {
-            Progress::Drawing(panel) if pixels => rows = vec![Vec::new(); panel.height.into()],
-            Progress::Drawing(_) => {}
+            Progress::Drawing(panel) | Progress::Playing { panel, .. } if pixels => {
+                rows = vec![Vec::new(); panel.height.into()]
+            }
+            Progress::Drawing(_) | Progress::Playing { .. } => {}
             Progress::Row { y, pixels: row } => {
                 if let Some(rgb) = rows.get_mut(usize::from(*y)) {
                     *rgb = board.panel.format.colors(row).flat_map(|c| [c.r(), c.g(), c.b()]).collect();
                 }
             }
+            Progress::Run { y, x, pixels: run } => {
+                // A row is set aside when a run of it comes.
+                if let Some(rgb) = rows.get_mut(usize::from(*y)) {
+                    rgb.resize(3 * usize::from(board.panel.width), 0);
+                    let colors = board.panel.format.colors(run).flat_map(|c| [c.r(), c.g(), c.b()]);
+                    rgb.iter_mut().skip(3 * usize::from(*x)).zip(colors).for_each(|(byte, c)| *byte = c);
+                }
+            }
+            Progress::FrameDrawn(frame) => pictures.push((*frame, pixels.then(|| picture(&rows, board.panel)))),
         }
         progress(step);
     });
     Ok(match answer.map_err(|e| link_error(port, e))? {
         Answer::Rejected(errors) => Sent::Rejected(errors),
         Answer::Drawn { panel, timing } => {
-            let picture = pixels.then(|| RgbImage {
-                width: panel.width.into(),
-                height: panel.height.into(),
-                data: rows.concat(),
-            });
-            Sent::Drawn { panel, timing, picture }
+            Sent::Drawn { panel, timing, picture: pixels.then(|| picture(&rows, panel)) }
         }
+        Answer::Played { panel, .. } => Sent::Played { panel, frames: pictures },
     })
 }
 
 /// How many pixels of the board's `picture` differ from host-sim's render
-/// of the scene at the panel's size, as the panel shows it (`host-sim
-/// SCENE OUT --size WxH --color rgb565`). `host-sim board --check` and the
-/// studio judge the board's picture by this. A picture that is not the
-/// panel's size, or has no pixel, is no picture to judge: an error.
-pub(crate) fn differing_pixels(file: &str, text: &[u8], panel: Panel, picture: &RgbImage) -> Result<usize, CliError> {
+/// of the scene's frame `frame` (0 for a still) at the panel's size, as
+/// the panel shows it (`host-sim SCENE OUT --size WxH --color rgb565
+/// --frame K`). `host-sim board --check` and the studio judge the board's
+/// picture by this. A picture that is not the panel's size, or has no
+/// pixel, is no picture to judge: an error.
+pub(crate) fn differing_pixels(
+    file: &str,
+    text: &[u8],
+    frame: u32,
+    panel: Panel,
+    picture: &RgbImage,
+) -> Result<usize, CliError> {
     let pixels = usize::from(panel.width) * usize::from(panel.height);
     let size = (u32::from(panel.width), u32::from(panel.height));
     if pixels == 0 || (picture.width, picture.height) != size || picture.data.len() != 3 * pixels {
@@ -292,16 +390,16 @@ pub(crate) fn differing_pixels(file: &str, text: &[u8], panel: Panel, picture: &
             panel.height
         )));
     }
-    let ours = host_render(file, text, panel)?;
+    let ours = host_render(file, text, frame, panel)?;
     Ok(ours.data.chunks_exact(3).zip(picture.data.chunks_exact(3)).filter(|(a, b)| a != b).count())
 }
 
-/// host-sim's render of the scene at the panel's size, as the panel shows
-/// it.
-fn host_render(file: &str, text: &[u8], panel: Panel) -> Result<RgbImage, CliError> {
+/// host-sim's render of the scene's frame `frame` at the panel's size, as
+/// the panel shows it.
+fn host_render(file: &str, text: &[u8], frame: u32, panel: Panel) -> Result<RgbImage, CliError> {
     let mismatch = |why: String| CliError::Mismatch(format!("board --check: {why}"));
     let mut scene = new_scene();
-    load_bytes(file, text, &mut scene).map_err(|e| match e {
+    load_frame_bytes(file, text, frame, &mut scene).map_err(|e| match e {
         LoadError::Io(e) => mismatch(format!("host-sim cannot read the scene: {e}")),
         LoadError::Scene(errors) => {
             mismatch(format!("the board drew a scene host-sim refuses:\n{}", errors.join("\n")))
@@ -342,12 +440,12 @@ mod tests {
         let panel = |width, height| Panel { width, height, format: PixelFormat::Rgb565 };
         let picture = |width, height| RgbImage { width, height, data: vec![0; 3 * (width * height) as usize] };
         for (board, got) in [(panel(0, 0), picture(0, 0)), (panel(4, 2), picture(2, 4)), (panel(4, 2), picture(4, 1))] {
-            let said = differing_pixels("s.txt", scene, board, &got).unwrap_err();
+            let said = differing_pixels("s.txt", scene, 0, board, &got).unwrap_err();
             assert!(
                 matches!(&said, CliError::Mismatch(m) if m.starts_with("board --check: no pixel to compare")),
                 "{said}"
             );
         }
-        assert!(differing_pixels("s.txt", scene, panel(4, 2), &picture(4, 2)).is_ok());
+        assert!(differing_pixels("s.txt", scene, 0, panel(4, 2), &picture(4, 2)).is_ok());
     }
 }

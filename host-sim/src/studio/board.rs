@@ -9,7 +9,7 @@
 //! pixels that differ from host-sim's render at the board's panel size.
 
 use super::http::Response;
-use crate::board::{differing_pixels, send_scene, Progress, Sent};
+use crate::board::{differing_pixels, send_scene, BoardTiming, Progress, Sent};
 use crate::exit::CliError;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::time::{Duration, Instant};
@@ -72,11 +72,25 @@ impl BoardSender {
         self.rows.store(0, Ordering::SeqCst);
         self.height.store(0, Ordering::SeqCst);
         let started = Instant::now();
-        let sent = send_scene(&self.port, self.timeout, name, text, true, &mut |step| match step {
-            Progress::Drawing(panel) => self.height.store(panel.height.into(), Ordering::SeqCst),
+        // An animation: its first frame (the scene as a still), then the
+        // board is stopped.
+        let sent = send_scene(&self.port, self.timeout, name, text, true, 1, &mut |step| match step {
+            Progress::Drawing(panel) | Progress::Playing { panel, .. } => {
+                self.height.store(panel.height.into(), Ordering::SeqCst)
+            }
             Progress::Row { .. } => {
                 self.rows.fetch_add(1, Ordering::SeqCst);
             }
+            Progress::FrameDrawn(_) => self.rows.store(self.height.load(Ordering::SeqCst), Ordering::SeqCst),
+            Progress::Run { .. } => {}
+        });
+        let sent = sent.map(|sent| match sent {
+            Sent::Played { panel, mut frames } if !frames.is_empty() => {
+                let (first, picture) = frames.swap_remove(0);
+                let timing = BoardTiming { elapsed: first.elapsed, load: None, render: None, counters: Vec::new() };
+                Sent::Drawn { panel, timing, picture }
+            }
+            other => other,
         });
         let body = match sent {
             // Not the board's fault: the scene is longer than it takes.
@@ -101,7 +115,7 @@ impl BoardSender {
                     Some(elapsed) => (elapsed.as_secs_f64(), "board"),
                     None => (started.elapsed().as_secs_f64(), "host"),
                 };
-                let (differ, problem) = match differing_pixels(name, text, panel, &picture) {
+                let (differ, problem) = match differing_pixels(name, text, 0, panel, &picture) {
                     Ok(differ) => (differ.to_string(), "null".to_string()),
                     Err(e) => ("null".to_string(), json_string(&message(e))),
                 };
@@ -114,7 +128,7 @@ impl BoardSender {
                     base64(&picture.data)
                 )
             }
-            Ok(Sent::Drawn { picture: None, .. }) => {
+            Ok(Sent::Drawn { picture: None, .. } | Sent::Played { .. }) => {
                 return Response::text(502, &format!("the board at {} drew without its pixels", self.port));
             }
         };

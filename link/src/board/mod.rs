@@ -2,14 +2,18 @@
 //! loop a firmware runs ([`Link`], over its [`Line`]: `serve.rs`), each
 //! received frame answered ([`Board::answer`]), and a scene that loaded
 //! handed back as a [`Drawing`] whose rows the firmware renders its own way
-//! (one core, two) and sends as they are drawn; the byte rings a firmware
-//! keeps between its serial port and the loop ([`Ring`]: `ring.rs`).
+//! (one core, two) and sends as they are drawn; an animation played frame
+//! after frame in the room a firmware gives it ([`AnimationRoom`],
+//! [`Playing`]: `play.rs`); the byte rings a firmware keeps between its
+//! serial port and the loop ([`Ring`]: `ring.rs`).
 //!
 //! Invariants: every frame gets exactly one answer — a [`Message::Board`],
 //! a [`Message::Refused`], the scene's [`Message::SceneError`]s closed by a
 //! [`Message::Rejected`], or a [`Message::Drawing`] whose [`Drawing`] is
-//! closed by [`Drawing::finish`] or [`Drawing::cancel`] — all with the
-//! frame's tag; a scene with errors draws nothing.
+//! closed by [`Drawing::finish`] or [`Drawing::cancel`] (an animation's
+//! frames, each closed by a [`Message::FrameDrawn`], by a
+//! [`Message::Stopped`]) — all with the frame's tag; a scene with errors
+//! draws nothing, nor does an animation its room cannot hold.
 //!
 //! A firmware's loop, on one core (`Usb` stands for its serial port and
 //! clock as a [`Line`]; the rows go to its panel as well):
@@ -64,9 +68,12 @@
 //! line's core sets when [`Rows::poll`] says so, and the core that owns
 //! the line sends the rows in order.
 
+mod play;
 mod ring;
 mod serve;
 
+use play::saturate;
+pub use play::{AnimationRoom, Playing, TILE};
 pub use ring::Ring;
 pub use serve::{
     Line, Link, Rows, Served, Stalled, MAX_COUNTERS, POLL_PERIOD_US, SLOWEST_HOST_BYTES_PER_SECOND, STALL_GRACE_US,
@@ -93,6 +100,8 @@ pub struct Board<'a> {
     panel: Panel,
     max_scene: u32,
     firmware: &'a str,
+    /// What its [`AnimationRoom`] holds (none: it plays no animation).
+    room: play::RoomSizes,
 }
 
 impl<'a> Board<'a> {
@@ -100,7 +109,7 @@ impl<'a> Board<'a> {
     /// holds, running `firmware` (its name and version, for hosts to show).
     pub fn new<B: AsRef<[u8]> + AsMut<[u8]>>(panel: Panel, firmware: &'a str, decoder: &Decoder<B>) -> Board<'a> {
         let max_scene = u32::try_from(decoder.max_scene()).unwrap_or(u32::MAX);
-        Board { panel, max_scene, firmware }
+        Board { panel, max_scene, firmware, room: play::RoomSizes::default() }
     }
 
     /// Its panel.
@@ -182,9 +191,25 @@ impl<'a> Board<'a> {
             send_error(tag, 0, 0, None, &e, sink)?;
             return Message::Rejected { errors: 1 }.encode(tag, sink).map(|()| None);
         }
+        // An animation: its frames, if the board has room to play it.
+        let frames = match play::animated(&scene) {
+            None => 0,
+            Some(frames) => {
+                let short = self.room.short_of(text, self.panel);
+                let mut errors = 0;
+                for need in short.iter().flatten() {
+                    send_error(tag, 0, 0, Some(*need), &play::NoRoom(*need), sink)?;
+                    errors += 1;
+                }
+                if errors > 0 {
+                    return Message::Rejected { errors }.encode(tag, sink).map(|()| None);
+                }
+                frames.count
+            }
+        };
         // Not taken: the rows are not either (see `answer`).
-        let _ = Message::Drawing { panel: self.panel, pixels }.encode(tag, sink);
-        Ok(Some(Drawing { scene, tag, pixels, panel: self.panel }))
+        let _ = Message::Drawing { panel: self.panel, pixels, frames }.encode(tag, sink);
+        Ok(Some(Drawing { scene, tag, pixels, panel: self.panel, playing: None }))
     }
 }
 
@@ -203,10 +228,6 @@ fn send_error<S: Sink + ?Sized>(
     w.finish()
 }
 
-fn saturate(n: usize) -> u32 {
-    u32::try_from(n).unwrap_or(u32::MAX)
-}
-
 /// A scene that loaded, being drawn at the panel's size: render its rows
 /// from [`Drawing::scene`], send each with [`Drawing::send_row`] as it is
 /// drawn, and close it with [`Drawing::finish`], or with
@@ -216,6 +237,8 @@ pub struct Drawing<'r, P: Profile> {
     tag: u16,
     pixels: bool,
     panel: Panel,
+    /// The frame of an animation this is, or None for a still.
+    playing: Option<Playing<'r>>,
 }
 
 impl<P: Profile> fmt::Debug for Drawing<'_, P> {
@@ -224,6 +247,7 @@ impl<P: Profile> fmt::Debug for Drawing<'_, P> {
             .field("tag", &self.tag)
             .field("pixels", &self.pixels)
             .field("panel", &self.panel)
+            .field("playing", &self.playing)
             .finish_non_exhaustive()
     }
 }
@@ -244,21 +268,47 @@ impl<'r, P: Profile> Drawing<'r, P> {
         self.pixels
     }
 
+    /// For a frame of an animation, which and how to draw it: only the
+    /// runs its `Coherence` planned, each sent with
+    /// [`Drawing::send_run`]. None for a still, drawn row by row.
+    pub fn playing(&self) -> Option<Playing<'r>> {
+        self.playing
+    }
+
     /// Tells the host row `y` is drawn: `row` is its pixels (the panel's
     /// width of them), sent only if the host asked for them.
     pub fn send_row<S: Sink + ?Sized>(&self, y: u16, row: &[Rgb565], sink: &mut S) -> Result<(), S::Error> {
         let mut w = FrameWriter::begin(sink, VERSION, Kind::Row.byte(), self.tag)?;
         w.put(&y.to_be_bytes())?;
-        if self.pixels {
-            for pixels in row.chunks(32) {
-                let mut bytes = [0u8; 64];
-                for (pair, color) in bytes.chunks_exact_mut(2).zip(pixels) {
-                    pair.copy_from_slice(&color.into_storage().to_be_bytes());
-                }
-                w.put(&bytes[..2 * pixels.len()])?;
-            }
-        }
+        self.put_pixels(&mut w, row)?;
         w.finish()
+    }
+
+    /// Tells the host the pixels `run` of row `y` from column `x` of an
+    /// animation's frame are drawn, sent only if the host asked for them.
+    pub fn send_run<S: Sink + ?Sized>(&self, y: u16, x: u16, run: &[Rgb565], sink: &mut S) -> Result<(), S::Error> {
+        let mut w = FrameWriter::begin(sink, VERSION, Kind::Run.byte(), self.tag)?;
+        let width = u16::try_from(run.len()).unwrap_or(u16::MAX);
+        for field in [y, x, width] {
+            w.put(&field.to_be_bytes())?;
+        }
+        self.put_pixels(&mut w, &run[..usize::from(width)])?;
+        w.finish()
+    }
+
+    /// `pixels` in the panel's format, if the host asked for them.
+    fn put_pixels<S: Sink + ?Sized>(&self, w: &mut FrameWriter<'_, S>, pixels: &[Rgb565]) -> Result<(), S::Error> {
+        if !self.pixels {
+            return Ok(());
+        }
+        for chunk in pixels.chunks(32) {
+            let mut bytes = [0u8; 64];
+            for (pair, color) in bytes.chunks_exact_mut(2).zip(chunk) {
+                pair.copy_from_slice(&color.into_storage().to_be_bytes());
+            }
+            w.put(&bytes[..2 * chunk.len()])?;
+        }
+        Ok(())
     }
 
     /// Every row is drawn: `timing` is what the board measured of the
@@ -376,7 +426,7 @@ mod tests {
         frames(&answer, |frame| {
             assert_eq!(frame.tag, 4);
             match frame.message {
-                Message::Drawing { panel, pixels } => assert_eq!((panel, pixels), (PANEL, true)),
+                Message::Drawing { panel, pixels, frames } => assert_eq!((panel, pixels, frames), (PANEL, true, 0)),
                 Message::Row { y, pixels } => {
                     assert_eq!((y, pixels.len()), (rows, PANEL.row_bytes()));
                     received.extend_from_slice(pixels);

@@ -17,18 +17,28 @@
 //!   dropped, what waits on the line for it too ([`Line::discard`]), and the
 //!   next answer starts whole. A slow host cannot pace a drawing by more;
 //! - a drawing goes on when its host stops taking rows (the panel shows the
-//!   picture); only a frame from the host stops it.
+//!   picture); only a frame from the host stops it;
+//! - an animation plays until a byte comes from the host (its text is the
+//!   frame the decoder holds, which the next frame's bytes overwrite); each
+//!   frame is loaded from that text, planned, drawn and closed by
+//!   `frame-drawn`, and the animation by `stopped`.
 
+use super::play::{self, AnimationRoom, Playing, TILE};
 use super::{Board, Drawing, Panel};
 use crate::cobs::Sink;
-use crate::decoder::Decoder;
+use crate::decoder::{Decoder, Frame};
 use crate::list::{Counter, Counters};
-use crate::message::Timing;
+use crate::message::{Message, Timing};
+use core::cell::RefCell;
 use core::time::Duration;
+use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::pixelcolor::Rgb565;
+use embedded_graphics_core::primitives::Rectangle;
 use octrace_core::accel::Accelerator;
+use octrace_core::animation::{Coherence, Motion};
 use octrace_core::profile::Profile;
 use octrace_core::render::{Renderer, Stopped};
+use octrace_core::scene::Frames;
 use octrace_core::Raytracer;
 
 /// How long a board waits for a host that does not take its answer,
@@ -107,26 +117,47 @@ pub enum Served {
         /// Rows drawn.
         rows: u16,
     },
+    /// An animation played until the host sent something (it is answered
+    /// next).
+    Played {
+        /// Frames drawn whole.
+        frames: u32,
+    },
     /// The host did not take the answer: the rest of it was dropped.
     Stalled,
 }
 
 /// The board's end of the link: its [`Board`], its decoder (a board's:
-/// [`Decoder::for_board`]) and whether a frame came while it drew.
+/// [`Decoder::for_board`]), whether a frame came while it drew, and its
+/// storage for animations.
 #[derive(Debug)]
 pub struct Link<'a, B> {
     board: Board<'a>,
     decoder: Decoder<B>,
     /// A frame ended while a scene was drawn: it is answered next.
     pending: bool,
+    /// A byte came since the last frame was received: an animation stops,
+    /// its text (that frame, in the decoder) being overwritten.
+    heard: bool,
+    room: AnimationRoom<'a>,
 }
 
 impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
     /// The board drawing on `panel`, running `firmware` (its name and
     /// version), keeping frames in `buffer` (its length bounds a scene's).
+    /// It plays no animation until given room ([`Link::with_animations`]).
     pub fn new(panel: Panel, firmware: &'a str, buffer: B) -> Link<'a, B> {
         let decoder = Decoder::for_board(buffer);
-        Link { board: Board::new(panel, firmware, &decoder), decoder, pending: false }
+        let board = Board::new(panel, firmware, &decoder);
+        Link { board, decoder, pending: false, heard: false, room: AnimationRoom::none() }
+    }
+
+    /// The board plays animations in `room`: an animated scene that does
+    /// not fit it is rejected, naming what runs out.
+    pub fn with_animations(mut self, room: AnimationRoom<'a>) -> Link<'a, B> {
+        self.board.room = room.sizes();
+        self.room = room;
+        self
     }
 
     /// What the board says it is.
@@ -140,12 +171,16 @@ impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
     /// which renders the rows in its own way, sends each as it is drawn
     /// ([`Rows::send`]), polls the line between rays ([`Rows::poll`],
     /// through a [`Stop`](octrace_core::render::Stop)) and returns how many
-    /// rows it drew, in order. None when the line says no byte will come.
+    /// rows it drew, in order. An animation is played in a loop, `draw`
+    /// called for each frame ([`Drawing::playing`]: it draws the planned
+    /// runs, sends each with [`Rows::send_run`], and returns the panel's
+    /// height when the frame is whole), until the host sends a byte. None
+    /// when the line says no byte will come.
     pub fn serve<P: Profile, L: Line>(
         &mut self,
         line: &mut L,
         raytracer: &mut Raytracer<P>,
-        draw: impl FnOnce(&Drawing<'_, P>, &mut Rows<'_, '_, L, B>) -> u16,
+        mut draw: impl FnMut(&Drawing<'_, P>, &mut Rows<'_, '_, L, B>) -> u16,
     ) -> Option<Served> {
         if !self.pending {
             loop {
@@ -157,7 +192,7 @@ impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
                 }
             }
         }
-        self.pending = false;
+        (self.pending, self.heard) = (false, false);
         // The board's time from the whole frame received to the last row
         // drawn: parse, index and render; and its counters over each.
         let names = &line.counter_names()[..line.counter_names().len().min(MAX_COUNTERS)];
@@ -173,10 +208,13 @@ impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
             Err(Stalled) => return Some(Served::Stalled),
             Ok(Some(drawing)) => drawing,
         };
+        if let Some(frames) = play::animated(drawing.scene()) {
+            let (tag, pixels) = (drawing.tag, drawing.pixels);
+            return Some(self.play(&mut output, raytracer, frames, tag, pixels, &mut draw));
+        }
         let loaded = output.line.now_us();
         output.line.take_counts(&mut load_counts[..names.len()]);
-        let mut rows =
-            Rows { output: &mut output, decoder: &mut self.decoder, pending: &mut self.pending, read_at_us: start };
+        let mut rows = Rows { output: &mut output, listener: self.listener(false), read_at_us: start };
         let drawn = draw(&drawing, &mut rows).min(drawing.panel().height);
         // Every row drawn is done, even if a frame came with the last.
         let closed = match drawn == drawing.panel().height {
@@ -204,39 +242,119 @@ impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
             Err(Stalled) => Served::Stalled,
         })
     }
+
+    /// What watches the line while a scene is drawn; `any_byte`: an
+    /// animation's, which stops at the first byte.
+    fn listener(&mut self, any_byte: bool) -> Listener<'_, B> {
+        Listener { decoder: &mut self.decoder, pending: &mut self.pending, heard: &mut self.heard, any_byte }
+    }
+
+    /// Plays the animation of `frames` that the frame just received holds,
+    /// answering it with `tag`: frame after frame in a loop, each loaded
+    /// from the text, planned and drawn by `draw`, then `frame-drawn`,
+    /// until the host sends a byte; then `stopped`.
+    fn play<P: Profile, L: Line>(
+        &mut self,
+        output: &mut Output<'_, L>,
+        raytracer: &mut Raytracer<P>,
+        frames: Frames,
+        tag: u16,
+        pixels: bool,
+        draw: &mut impl FnMut(&Drawing<'_, P>, &mut Rows<'_, '_, L, B>) -> u16,
+    ) -> Served {
+        let panel = self.board.panel;
+        let size = Size::new(panel.width.into(), panel.height.into());
+        let AnimationRoom { tiles, tracks, keys, displacements } = &mut self.room;
+        // The room was checked when the scene was answered, and the text
+        // loaded: a failure here stops the animation before its first frame.
+        let motion = scene_text(&self.decoder).and_then(|text| {
+            let first = raytracer.load_frame(text, 0).ok()?;
+            Motion::read(text, frames, &first.view(), 0, tracks, keys, displacements).ok()
+        });
+        let (Some(motion), Ok(coherence)) = (motion, Coherence::new(tiles, size, TILE)) else {
+            return close(Message::Stopped { frames: 0 }.encode(tag, output), Served::Played { frames: 0 });
+        };
+        let (mut frame, mut drawn) = (0, 0u32);
+        loop {
+            let begun = output.line.now_us();
+            // The text is the frame received, in the decoder, until a byte
+            // comes from the host.
+            let Some(text) = scene_text(&self.decoder).filter(|_| !self.heard) else { break };
+            let Ok(scene) = raytracer.load_frame(text, frame) else { break };
+            coherence.plan();
+            let traced = u32::try_from(coherence.traced_pixels()).unwrap_or(u32::MAX);
+            let playing = Playing { frame, motion: &motion, coherence: &coherence };
+            let drawing = Drawing { scene, tag, pixels, panel, playing: Some(playing) };
+            let listener = Listener {
+                decoder: &mut self.decoder,
+                pending: &mut self.pending,
+                heard: &mut self.heard,
+                any_byte: true,
+            };
+            let mut rows = Rows { output: &mut *output, listener, read_at_us: begun };
+            if draw(&drawing, &mut rows) < panel.height {
+                break;
+            }
+            let elapsed = Some(Duration::from_micros(output.line.now_us().saturating_sub(begun)));
+            // Not taken: the animation goes on on the panel (see Timing).
+            let _ = Message::FrameDrawn { frame, traced, elapsed }.encode(tag, output);
+            drawn = drawn.saturating_add(1);
+            frame = (frame + 1) % frames.count;
+            // A frame that traced nothing asked the line nothing.
+            let (decoder, pending, heard) = (&mut self.decoder, &mut self.pending, &mut self.heard);
+            Listener { decoder, pending, heard, any_byte: true }.take(output.line);
+        }
+        close(Message::Stopped { frames: drawn }.encode(tag, output), Served::Played { frames: drawn })
+    }
+}
+
+/// `served`, unless the answer's last message was not taken.
+fn close(sent: Result<(), Stalled>, served: Served) -> Served {
+    match sent {
+        Ok(()) => served,
+        Err(Stalled) => Served::Stalled,
+    }
+}
+
+/// The scene text of the frame `decoder` received last, while nothing has
+/// been pushed since.
+fn scene_text<B: AsRef<[u8]> + AsMut<[u8]>>(decoder: &Decoder<B>) -> Option<&str> {
+    match decoder.received()? {
+        Ok(Frame { message: Message::Scene { text, .. }, .. }) => core::str::from_utf8(text).ok(),
+        _ => None,
+    }
 }
 
 /// What a drawing's renderer sends its rows by and polls the line with:
 /// see [`Link::serve`].
 pub struct Rows<'o, 'l, L, B> {
     output: &'o mut Output<'l, L>,
-    decoder: &'o mut Decoder<B>,
-    pending: &'o mut bool,
+    listener: Listener<'o, B>,
     /// When [`Rows::poll`] last read the line.
     read_at_us: u64,
 }
 
 impl<L, B> core::fmt::Debug for Rows<'_, '_, L, B> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("Rows").field("pending", &*self.pending).finish_non_exhaustive()
+        f.debug_struct("Rows").field("stops", &self.listener.stops()).finish_non_exhaustive()
     }
 }
 
 impl<L: Line, B: AsRef<[u8]> + AsMut<[u8]>> Rows<'_, '_, L, B> {
-    /// Whether a frame has come from the host, when the drawing stops (it
-    /// is answered next): asked before every ray on the core that owns the
-    /// line (as a [`Stop`](octrace_core::render::Stop)). Every
-    /// [`POLL_PERIOD_US`] at most it reads what the host has
-    /// sent, up to the end of a frame, and tells the [`Line`] the board is
-    /// [alive](Line::alive); between, it only reads the clock.
+    /// Whether the drawing stops for what came from the host (it is
+    /// answered next): a frame that ended, or for an animation any byte.
+    /// Asked before every ray on the core that owns the line (as a
+    /// [`Stop`](octrace_core::render::Stop)). Every [`POLL_PERIOD_US`] at
+    /// most it reads what the host has sent, and tells the [`Line`] the
+    /// board is [alive](Line::alive); between, it only reads the clock.
     pub fn poll(&mut self) -> bool {
         let now = self.output.line.now_us();
-        if *self.pending || now.wrapping_sub(self.read_at_us) < POLL_PERIOD_US {
-            return *self.pending;
+        if self.listener.stops() || now.wrapping_sub(self.read_at_us) < POLL_PERIOD_US {
+            return self.listener.stops();
         }
         self.read_at_us = now;
         self.output.line.alive();
-        take_input(self.output.line, self.decoder, self.pending)
+        self.listener.take(self.output.line)
     }
 
     /// Sends row `y` of `drawing`, its pixels `row` (the panel's width of
@@ -244,54 +362,137 @@ impl<L: Line, B: AsRef<[u8]> + AsMut<[u8]>> Rows<'_, '_, L, B> {
     /// waits for the host to take it. A host that does not take it is not
     /// sent the rest of the drawing's answer (the drawing goes on).
     pub fn send<P: Profile>(&mut self, drawing: &Drawing<'_, P>, y: u16, row: &[Rgb565]) {
-        let mut polled = Polled { output: self.output, decoder: self.decoder, pending: self.pending };
+        let mut polled = Polled { output: self.output, listener: &mut self.listener };
         // A row the host did not take is dropped with the rest: the panel
         // still shows it.
         let _ = drawing.send_row(y, row, &mut polled);
     }
 
+    /// Sends the run `run` of row `y` from column `x` of an animation's
+    /// frame `drawing`, as [`Rows::send`] sends a row.
+    pub fn send_run<P: Profile>(&mut self, drawing: &Drawing<'_, P>, y: u16, x: u16, run: &[Rgb565]) {
+        let mut polled = Polled { output: self.output, listener: &mut self.listener };
+        let _ = drawing.send_run(y, x, run, &mut polled);
+    }
+
     /// Draws `drawing` on one core with `renderer` (made at the panel's
-    /// size), a row at a time into `row` (the panel's width of pixels):
-    /// each row shown (`show`: the panel) and sent once drawn, the line
-    /// polled between rays. Returns the rows drawn; fewer than the panel's
-    /// height when a frame came. What a firmware with one core, or a host
-    /// standing in for a board, draws with.
-    pub fn draw_on_one_core<P: Profile, A: Accelerator>(
+    /// size) into `row` (the panel's width of pixels): a still row by row,
+    /// an animation's frame ([`Drawing::playing`]) run by run, only the
+    /// runs its tiles' plan traces. Each row or run is shown (`show`: the
+    /// panel, given the pixels' rectangle, one row high) and sent once
+    /// drawn, the line polled between rays. Returns the rows drawn, fewer
+    /// than the panel's height when the host sent something (for an
+    /// animation's frame: the panel's height once every run is drawn, else
+    /// 0). What a firmware with one core, or a host standing in for a
+    /// board, draws with.
+    pub fn draw_on_one_core<'a, 'd: 'a, P: Profile, A: Accelerator>(
         &mut self,
-        drawing: &Drawing<'_, P>,
-        renderer: &mut Renderer<'_, A>,
+        drawing: &Drawing<'d, P>,
+        renderer: &mut Renderer<'a, A>,
         row: &mut [Rgb565],
-        mut show: impl FnMut(u16, &[Rgb565]),
+        mut show: impl FnMut(&Rectangle, &[Rgb565]),
     ) -> u16 {
         let panel = drawing.panel();
+        if let Some(playing) = drawing.playing() {
+            return match self.draw_frame(drawing, playing, renderer, row, show) {
+                Ok(()) => panel.height,
+                Err(Stopped) => 0,
+            };
+        }
         for y in 0..panel.height {
             for (x, pixel) in (0..u32::from(panel.width)).zip(row.iter_mut()) {
-                match renderer.pixel_until(x, y.into(), &mut || self.poll()) {
+                let mut stop: Asked<'_> = &mut || self.poll();
+                match renderer.pixel_until(x, y.into(), &mut stop) {
                     Ok(sample) => *pixel = sample.color.into(),
                     Err(Stopped) => return y,
                 }
             }
-            show(y, row);
+            show(&Rectangle::new(Point::new(0, y.into()), Size::new(panel.width.into(), 1)), row);
             self.send(drawing, y, row);
         }
         panel.height
     }
+
+    /// An animation's frame on one core: each band's planned runs traced,
+    /// shown and sent.
+    fn draw_frame<'a, P: Profile, A: Accelerator>(
+        &mut self,
+        drawing: &Drawing<'_, P>,
+        playing: Playing<'a>,
+        renderer: &mut Renderer<'a, A>,
+        row: &mut [Rgb565],
+        mut show: impl FnMut(&Rectangle, &[Rgb565]),
+    ) -> Result<(), Stopped> {
+        let coherence = playing.coherence;
+        let rows = RefCell::new(self);
+        for band in 0..coherence.bands() {
+            // Asked while a run's pixels are traced; the run is sent after.
+            let mut stop: Asked<'_> = &mut || rows.borrow_mut().poll();
+            coherence.trace_band_until(
+                renderer,
+                playing.motion,
+                playing.frame,
+                band,
+                &mut stop,
+                &mut |line, pixels| {
+                    let mut width = 0;
+                    for (pixel, sample) in row.iter_mut().zip(pixels) {
+                        *pixel = sample.color.into();
+                        width += 1;
+                    }
+                    if width < line.size.width as usize {
+                        return Err(Stopped);
+                    }
+                    show(line, &row[..width]);
+                    let (x, y) = (line.top_left.x as u16, line.top_left.y as u16);
+                    rows.borrow_mut().send_run(drawing, y, x, &row[..width]);
+                    Ok(())
+                },
+            )?;
+        }
+        Ok(())
+    }
 }
 
-/// Reads bytes from `line` into `decoder` until a frame ends (`pending`);
-/// whether one has.
-fn take_input<L: Line, B: AsRef<[u8]> + AsMut<[u8]>>(
-    line: &mut L,
-    decoder: &mut Decoder<B>,
-    pending: &mut bool,
-) -> bool {
-    while !*pending {
-        match line.read() {
-            Some(byte) => *pending = decoder.push(byte).is_some(),
-            None => break,
-        }
+/// How a drawing asks whether to stop, before every ray: one type for
+/// every render path, so that a firmware links the tracer once for its
+/// stills and its animations (octrace-pico's cores ask the same way).
+type Asked<'s> = &'s mut dyn FnMut() -> bool;
+
+/// What came from the host while a scene is drawn: the decoder takes it,
+/// and says whether the drawing stops.
+struct Listener<'o, B> {
+    decoder: &'o mut Decoder<B>,
+    /// A frame ended.
+    pending: &'o mut bool,
+    /// A byte came.
+    heard: &'o mut bool,
+    /// Any byte stops the drawing (an animation), not only a frame's end.
+    any_byte: bool,
+}
+
+impl<B> Listener<'_, B> {
+    /// Whether the drawing stops.
+    fn stops(&self) -> bool {
+        *self.pending || (self.any_byte && *self.heard)
     }
-    *pending
+}
+
+impl<B: AsRef<[u8]> + AsMut<[u8]>> Listener<'_, B> {
+    /// Reads bytes from `line` into the decoder until the drawing stops or
+    /// nothing more has come; whether it stops.
+    fn take<L: Line>(&mut self, line: &mut L) -> bool {
+        while !self.stops() {
+            match line.read() {
+                Some(byte) => {
+                    *self.heard = true;
+                    *self.pending = self.decoder.push(byte).is_some();
+                }
+                None => break,
+            }
+        }
+        self.stops()
+    }
 }
 
 /// The host did not take an answer in time: the rest of it is dropped.
@@ -349,20 +550,20 @@ impl<L: Line> Sink for Output<'_, L> {
 }
 
 /// An [`Output`] that reads the line while it waits (a drawing's rows: the
-/// decoder is free, the scene's text no longer needed).
-struct Polled<'a, 'l, L, B> {
+/// decoder is free, the scene's text no longer needed, or an animation's
+/// stopping at the first byte).
+struct Polled<'a, 'l, 'o, L, B> {
     output: &'a mut Output<'l, L>,
-    decoder: &'a mut Decoder<B>,
-    pending: &'a mut bool,
+    listener: &'a mut Listener<'o, B>,
 }
 
-impl<L: Line, B: AsRef<[u8]> + AsMut<[u8]>> Sink for Polled<'_, '_, L, B> {
+impl<L: Line, B: AsRef<[u8]> + AsMut<[u8]>> Sink for Polled<'_, '_, '_, L, B> {
     type Error = Stalled;
 
     fn write_all(&mut self, bytes: &[u8]) -> Result<(), Stalled> {
-        let (decoder, pending) = (&mut *self.decoder, &mut *self.pending);
+        let listener = &mut *self.listener;
         self.output.write(bytes, |line| {
-            take_input(line, decoder, pending);
+            listener.take(line);
         })
     }
 }
@@ -372,6 +573,8 @@ mod tests {
     extern crate std;
     use super::*;
     use crate::message::{Kind, Message, PixelFormat};
+    use core::sync::atomic::AtomicU8;
+    use octrace_core::animation::{Key, Track};
     use octrace_core::profile::Board64K;
     use std::boxed::Box;
     use std::collections::VecDeque;
@@ -519,7 +722,11 @@ mod tests {
     /// Serves every frame `wire` brings, drawing on one core; what each
     /// serve did.
     fn serve_all(wire: &mut Wire) -> Vec<Served> {
-        let mut link = Link::new(PANEL, "test 1", std::vec![0u8; 1024]);
+        serve_with(Link::new(PANEL, "test 1", std::vec![0u8; 1024]), wire)
+    }
+
+    /// [`serve_all`] by `link`.
+    fn serve_with(mut link: Link<'_, Vec<u8>>, wire: &mut Wire) -> Vec<Served> {
         let mut raytracer = Box::new(Raytracer::<Board64K>::new());
         let mut served = Vec::new();
         while let Some(one) = link.serve(wire, &mut raytracer, |drawing, rows| {
@@ -637,5 +844,68 @@ mod tests {
         assert_eq!(answers.len(), 300 + 2 + PANEL.height as usize);
         assert!(answers[..300].iter().zip(1..).all(|(&answer, tag)| answer == (tag, Kind::Board)));
         assert_eq!(answers.last(), Some(&(301, Kind::Done)));
+    }
+
+    const ANIMATION: &[u8] = b"FRAMES 3\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\n\
+        SPHERE 1 1 0 0 0\nSPHERE 1 0.5 -2 0 1 MOVE 0 0 0 0  2 4 0 0\n";
+
+    /// Serves every frame `wire` brings with room for `ANIMATION`.
+    fn play_all(wire: &mut Wire) -> Vec<Served> {
+        let tiles = [const { AtomicU8::new(0) }; 1];
+        let (mut tracks, mut keys, mut displacements) = ([Track::EMPTY; 1], [Key::default(); 2], [[0; 3]; 3]);
+        let room =
+            AnimationRoom { tiles: &tiles, tracks: &mut tracks, keys: &mut keys, displacements: &mut displacements };
+        serve_with(Link::new(PANEL, "test 1", std::vec![0u8; 1024]).with_animations(room), wire)
+    }
+
+    #[test]
+    fn an_animation_plays_in_a_loop_until_a_hello_stops_it() {
+        let mut wire = Wire::new();
+        wire.send(0, Message::Scene { pixels: true, text: ANIMATION }, 1);
+        wire.send(400, Message::Hello, 2);
+        let served = play_all(&mut wire);
+        let Some(&Served::Played { frames }) = served.first() else { panic!("{served:?}") };
+        assert!(frames >= 4, "round the loop: {frames} frames");
+        assert_eq!(served[1..], [Served::Answered]);
+        wire.host_reads();
+        let mut decoder = Decoder::for_host(std::vec![0u8; 4096]);
+        let (mut drawn, mut runs) = (Vec::new(), 0);
+        let mut kinds = Vec::new();
+        for &byte in &wire.received {
+            let Some(frame) = decoder.push(byte) else { continue };
+            let frame = frame.unwrap();
+            match frame.message {
+                Message::FrameDrawn { frame, traced, .. } => drawn.push((frame, traced)),
+                Message::Run { .. } => runs += 1,
+                other => kinds.push((frame.tag, other.kind())),
+            }
+        }
+        assert_eq!(kinds, [(1, Kind::Drawing), (1, Kind::Stopped), (2, Kind::Board)]);
+        assert_eq!(drawn.len() as u32, frames);
+        let order: Vec<u32> = drawn.iter().map(|&(frame, _)| frame).collect();
+        assert_eq!(order[..4], [0, 1, 2, 0], "the loop's order");
+        // The first frame traces every pixel: a 4x3 panel is one tile.
+        assert_eq!(drawn[0].1, 12);
+        assert!(runs >= 3, "{runs} runs");
+    }
+
+    #[test]
+    fn an_animation_the_room_cannot_hold_is_rejected_naming_each_capacity() {
+        let mut wire = Wire::new();
+        wire.send(0, Message::Scene { pixels: false, text: ANIMATION }, 1);
+        assert_eq!(serve_all(&mut wire), [Served::Answered]);
+        wire.host_reads();
+        let mut decoder = Decoder::for_host(std::vec![0u8; 4096]);
+        let mut named = Vec::new();
+        for &byte in &wire.received {
+            if let Some(Ok(Frame { message: Message::SceneError(e), .. })) = decoder.push(byte) {
+                let need = e.capacity.unwrap();
+                named.push((need.name.to_string(), need.needed, need.holds));
+                assert!(e.message.starts_with(&std::format!("too many {}", need.name)), "{}", e.message);
+            }
+        }
+        let holds = |name: &str, needed| (name.to_string(), Some(needed), 0);
+        assert_eq!(named, [holds("tiles", 1), holds("tracks", 1), holds("keys", 2), holds("displacements", 3)]);
+        assert_eq!(wire.answers().last(), Some(&(1, Kind::Rejected)));
     }
 }

@@ -22,15 +22,16 @@
 
 use embedded_graphics_core::pixelcolor::{Rgb565, RgbColor};
 use octrace_core::accel::Mailbox;
+use octrace_core::animation::{Coherence, Key, Track};
 use octrace_core::profile::{Board16K, Board64K, Host, Profile};
 use octrace_core::render::Renderer;
 use octrace_core::Raytracer;
-use octrace_link::board::{Board, Line, Link};
+use octrace_link::board::{AnimationRoom, Board, Line, Link, TILE};
 use octrace_link::{Counters, Decoder, Message, Panel, PixelFormat, SceneError, Timing, OVERHEAD};
 use std::collections::VecDeque;
 use std::fs::File;
 use std::io::{ErrorKind, Read, Write};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, Ordering};
 use std::sync::mpsc::{self, Receiver, TryRecvError};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -98,7 +99,8 @@ impl Misbehaviour {
         match self {
             Misbehaviour::DrawsAt { width, height } => {
                 let panel = Panel { width, height, format: PixelFormat::Rgb565 };
-                let _ = send(Message::Drawing { panel, pixels }, line) && send(Message::Done(Timing::NONE), line);
+                let _ = send(Message::Drawing { panel, pixels, frames: 0 }, line)
+                    && send(Message::Done(Timing::NONE), line);
             }
             Misbehaviour::ErrorsEvery(ms) => {
                 let error = SceneError { line: 1, column: 1, capacity: None, message: "one more error" };
@@ -313,11 +315,19 @@ impl Line for Pty {
 }
 
 /// Answers frames until the line ends, as the live firmware's main loop
-/// does (on one core).
+/// does (on one core), an animation's frames re-tracing only what moved
+/// under a profile with coherence (`--profile host`; the boards' presets
+/// trace every tile of every frame, the same pictures).
 fn serve<P: Profile>(options: &Options, line: &mut Pty, controls: &Controls) {
-    let mut link = Link::new(options.panel, FIRMWARE, vec![0u8; options.max_scene + OVERHEAD + 1]);
-    let mut raytracer = Box::new(Raytracer::<P>::new());
     let (width, height) = (u32::from(options.panel.width), u32::from(options.panel.height));
+    let tiles: Vec<AtomicU8> = (0..Coherence::tiles_for(width, height, TILE)).map(|_| AtomicU8::new(0)).collect();
+    // As much motion as the live firmware holds, and more.
+    let (mut tracks, mut keys, mut displacements) =
+        (vec![Track::EMPTY; 256], vec![Key::default(); 4096], vec![[0; 3]; 1 << 16]);
+    let room = AnimationRoom { tiles: &tiles, tracks: &mut tracks, keys: &mut keys, displacements: &mut displacements };
+    let mut link =
+        Link::new(options.panel, FIRMWARE, vec![0u8; options.max_scene + OVERHEAD + 1]).with_animations(room);
+    let mut raytracer = Box::new(Raytracer::<P>::new());
     let mut row = vec![Rgb565::default(); width as usize];
     while link
         .serve(line, &mut raytracer, |drawing, rows| {
@@ -326,9 +336,9 @@ fn serve<P: Profile>(options: &Options, line: &mut Pty, controls: &Controls) {
             let Ok(renderer) = Renderer::with_size(scene.view(), &accelerator, width, height) else { return 0 };
             let mut mailbox = vec![0u32; Mailbox::words_for(scene.view().object_count())];
             let mut renderer = renderer.with_mailbox(&mut mailbox);
-            rows.draw_on_one_core(drawing, &mut renderer, &mut row, |y, pixels| {
+            rows.draw_on_one_core(drawing, &mut renderer, &mut row, |area, pixels| {
                 let mut panel = controls.panel.lock().unwrap_or_else(|e| e.into_inner());
-                let at = usize::from(y) * pixels.len();
+                let at = area.top_left.y as usize * width as usize + area.top_left.x as usize;
                 panel[at..at + pixels.len()].copy_from_slice(pixels);
             })
         })

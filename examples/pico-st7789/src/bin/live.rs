@@ -3,7 +3,10 @@
 //! scene.txt` (or the studio's "Send to board") sends a scene, and the Pico
 //! answers with its errors at line and column, or draws it on the panel
 //! with both cores (sending the rows back when asked), then waits for the
-//! next. The protocol is octrace-link's (`docs/board-protocol.md`).
+//! next. An animation (a scene with `FRAMES`) is played in a loop on core 0,
+//! each frame re-tracing only the tiles its motion can change and drawing
+//! only their runs (sent back as runs), until the host sends anything. The
+//! protocol is octrace-link's (`docs/board-protocol.md`).
 //!
 //! Invariants: the USB device lives in the USB interrupt, which moves bytes
 //! between it and two rings (`INPUT`, `OUTPUT`); the main loop on core 0
@@ -24,15 +27,17 @@
 
 use core::cell::RefCell;
 use core::ops::ControlFlow;
+use core::sync::atomic::AtomicU8;
 use critical_section::Mutex;
 use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 use embedded_graphics::prelude::*;
 use hal::multicore::Stack;
 use hal::pac::interrupt;
 use hal::{entry, pac, Timer, Watchdog};
+use octrace_core::animation::{Coherence, Key, Track};
 use octrace_core::render::Handoff;
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
-use octrace_link::board::{Line, Link, Ring};
+use octrace_link::board::{AnimationRoom, Line, Link, Ring, TILE};
 use octrace_link::{Panel, PixelFormat};
 use octrace_pico::{board, both_cores};
 use octrace_pico_st7789::measure::{self, Meter};
@@ -55,14 +60,25 @@ octrace_core::profile! {
         spheres: 400, boxes: 32, superquadrics: 32, triangles: 160, rectangles: 160,
         surfaces: 64, lights: 8,
         octree_boxes: 1600, octree_references: 4800,
-        light_buffer_lights: 8, light_buffer_words: 4096,
+        light_buffer_lights: 8, light_buffer_words: 2816,
     }
     named_walk: false
     first_hits: true
+    coherence: true
 }
 
 /// Room for the scene, its octree and core 0's mailbox and lists.
 static RAYTRACER: ConstStaticCell<Raytracer<LiveProfile>> = ConstStaticCell::new(Raytracer::new());
+
+/// An animation's tiles: a byte each, 3,600 for the 240×240 panel.
+const TILES: usize = Coherence::tiles_for(panel::WIDTH as u32, panel::HEIGHT as u32, TILE);
+static TILE_COUNTS: [AtomicU8; TILES] = [const { AtomicU8::new(0) }; TILES];
+
+/// An animation's motion: its `MOVE`s, their keys, and the frames of each
+/// moving object statement (anim_fig5_1 needs 1, 6 and 48): 2.8 KiB.
+static TRACKS: ConstStaticCell<[Track; 8]> = ConstStaticCell::new([Track::EMPTY; 8]);
+static KEYS: ConstStaticCell<[Key; 32]> = ConstStaticCell::new([Key::EMPTY; 32]);
+static DISPLACEMENTS: ConstStaticCell<[[i32; 3]; 192]> = ConstStaticCell::new([[0; 3]; 192]);
 
 /// Core 1's own mailbox and screen lists.
 static CORE1_ROOM: ConstStaticCell<RendererRoom<LiveProfile>> = ConstStaticCell::new(RendererRoom::new());
@@ -117,12 +133,29 @@ fn main() -> ! {
 
     let size = display.size();
     let panel = Panel { width: size.width as u16, height: size.height as u16, format: PixelFormat::Rgb565 };
-    let mut link = Link::new(panel, FIRMWARE, FRAME_BUFFER.take());
+    let room = AnimationRoom {
+        tiles: &TILE_COUNTS,
+        tracks: TRACKS.take(),
+        keys: KEYS.take(),
+        displacements: DISPLACEMENTS.take(),
+    };
+    let mut link = Link::new(panel, FIRMWARE, FRAME_BUFFER.take()).with_animations(room);
     let raytracer = RAYTRACER.take();
     let room = CORE1_ROOM.take();
     let mut line = UsbLine { timer, watchdog, meter: Meter::new(timer, peripherals.busctrl) };
     loop {
         link.serve(&mut line, raytracer, |drawing, rows| {
+            if drawing.playing().is_some() {
+                // An animation's frame: its planned runs, on core 0.
+                let size = display.size();
+                let mut row = [Rgb565::BLACK; panel::WIDTH as usize];
+                let drawn = drawing.scene().with_renderer(size, |renderer| {
+                    rows.draw_on_one_core(drawing, renderer, &mut row, |area, pixels| {
+                        let _ = display.fill_contiguous(area, pixels.iter().copied());
+                    })
+                });
+                return drawn.unwrap_or(0);
+            }
             let rows = RefCell::new(rows);
             let mut drawn = 0;
             let each_row = |y: u32, traced: &[Rgb888]| {
@@ -139,7 +172,8 @@ fn main() -> ! {
             };
             // Never borrowed twice: a row is sent between asks.
             let stop = || rows.try_borrow_mut().map_or(true, |mut rows| rows.poll());
-            let _ = both_cores::draw_until(&mut core1, drawing.scene(), room, &ROWS, &mut display, each_row, stop);
+            let _ =
+                both_cores::draw_until(&mut core1, drawing.scene(), &mut *room, &ROWS, &mut display, each_row, stop);
             drawn
         });
     }
