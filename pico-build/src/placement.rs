@@ -30,6 +30,11 @@ const RENDER_PATH: &str = concat!(
     ".text.__aeabi_* .text.__*di3 .text.__*di4"
 );
 
+/// What the render path's patterns match but only loading runs: the
+/// octree's building and the choice of index, left in flash by `render`
+/// (22 KiB of SRAM, for a load a little slower).
+const INDEX_BUILDING: &str = ".text.*octrace_core*accel*octree*build* .text.*octrace_core*accel*octree*overlap* .text.*octrace_core*accel*choice*";
+
 /// An animation's, beside the render path: the tracking, the tiles, both
 /// cores' frames (copied only for an animation: in a still they would take
 /// SRAM, linked, never run).
@@ -50,9 +55,10 @@ pub enum CodePlacement {
     /// `RenderInSram` (`parse-and-render`, the default).
     LoadAndRenderInSram,
     /// The render path copied into SRAM at boot (octrace-core's tracing
-    /// and indexing, both cores' loop, the compiler's 64-bit helpers); the
-    /// rest (the parser, USB, the panel's set-up) runs from flash, so that
-    /// SRAM is left to the scene (`render`).
+    /// and its index's queries, both cores' loop, the compiler's 64-bit
+    /// helpers); the rest (the parser, the octree's building, USB, the
+    /// panel's set-up) runs from flash, so that SRAM is left to the scene
+    /// (`render`).
     RenderInSram,
     /// All of it in place in flash, through the XIP cache (`flash`).
     Flash,
@@ -96,9 +102,18 @@ impl CodePlacement {
         }
     }
 
+    /// The input sections `sram-code.x` keeps in flash although the
+    /// copied ones match them.
+    fn kept(self) -> String {
+        match self {
+            CodePlacement::RenderInSram => format!("*({INDEX_BUILDING});"),
+            _ => String::new(),
+        }
+    }
+
     /// The linker script `memory.x` includes for a firmware so placed.
     fn script(self, kind: SceneKind) -> String {
-        SRAM_CODE_X.replace("COPIED", &self.copied(kind))
+        SRAM_CODE_X.replace("COPIED", &self.copied(kind)).replace("KEPT", &self.kept())
     }
 }
 
@@ -127,6 +142,9 @@ mod tests {
     fn each_placement_copies_its_sections_and_flash_none() {
         let render = CodePlacement::RenderInSram.script(SceneKind::Still);
         assert!(render.contains(".text.*octrace_core*shade*") && !render.contains("parse"), "{render}");
+        // The octree's building is matched first by the flash's section.
+        let kept = render.find("*octree*build*").expect("kept in flash");
+        assert!(kept < render.find(".sram_code :").unwrap(), "{render}");
         let load = CodePlacement::LoadAndRenderInSram.script(SceneKind::Still);
         assert!(load.contains(".text.*octrace_core*parse*") && load.contains(".text.*both_cores*"), "{load}");
         assert!(CodePlacement::AllInSram.script(SceneKind::Still).contains("*(.rodata .rodata.*);"));
@@ -134,7 +152,8 @@ mod tests {
         assert!(!flash.contains(".text.*") && flash.contains("__sram_code_end"), "{flash}");
         for (placement, _) in CodePlacement::ALL {
             for kind in [SceneKind::Still, SceneKind::Animation] {
-                assert!(!placement.script(kind).contains("COPIED"), "{placement:?}");
+                let script = placement.script(kind);
+                assert!(!script.contains("COPIED") && !script.contains("KEPT"), "{placement:?}");
             }
         }
     }

@@ -22,7 +22,7 @@
 //! every run core 1 traced is on the panel before the LED goes out; the
 //! motion is read once, from frame 0, and serves every frame.
 
-use crate::both_cores::Unfinished;
+use crate::both_cores::{Asked, Unfinished};
 use crate::second_core::SecondCore;
 use core::cell::Cell;
 use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
@@ -37,7 +37,7 @@ use embedded_hal::digital::OutputPin;
 use octrace_core::animation::{Coherence, Key, Motion, Track};
 use octrace_core::panel::{Dithered, TracedColor};
 use octrace_core::profile::Profile;
-use octrace_core::render::{Handoff, PixelSample};
+use octrace_core::render::{Handoff, PixelSample, Stopped as StoppedRay};
 use octrace_core::{DrawError, LoadedScene, Raytracer, RendererRoom};
 use rp2040_hal::Timer;
 
@@ -85,6 +85,13 @@ impl<const LEN: usize, const SLOTS: usize> Runs<LEN, SLOTS> {
     /// Every slot free.
     pub const fn new() -> Self {
         Runs { colors: Handoff::new(), areas: [const { AtomicU32::new(0) }; SLOTS] }
+    }
+
+    /// The ring of colours alone, for a still's rows
+    /// ([`both_cores::draw`](crate::both_cores::draw)): a firmware that
+    /// draws stills and animations keeps one ring for both.
+    pub fn rows(&self) -> &Handoff<LEN, SLOTS> {
+        &self.colors
     }
 
     /// Core 1: traces `pixels` into piece `piece`'s slot, once it is free,
@@ -227,7 +234,9 @@ where
         let _ = led.set_high();
         let loaded = raytracer.load_frame_on_two_cores(text, frame, |beside, here| core1.scope(beside, here));
         let Ok(scene) = loaded else { return Stopped::Frame(frame) };
-        if let Err(unfinished) = draw_frame(core1, &scene, &motion, frame, &coherence, room, runs, &mut display) {
+        coherence.plan();
+        let drawn = draw_frame_until(core1, &scene, &motion, frame, &coherence, room, runs, &mut display, || false);
+        if let Err(unfinished) = drawn {
             return Stopped::Picture(unfinished);
         }
         let _ = led.set_low();
@@ -237,14 +246,21 @@ where
     }
 }
 
-/// Draws frame `frame` of `motion`, `scene` loaded at that frame, after the
-/// frame before it in the loop (or, at first, everything): both cores
-/// trace the planned tiles, core 0 draws every run.
+/// Draws frame `frame` of `motion`, `scene` loaded at that frame and its
+/// tiles planned ([`Coherence::plan`]), after the frame before it in the
+/// loop (or, at first, everything): both cores trace the planned tiles,
+/// core 1 in `room` handing its runs over through `runs`, and core 0 draws
+/// every run into `display` (each row of a run in one `fill_contiguous`).
+/// `stop` is asked on core 0 before every ray it traces; once it says
+/// stop, core 1 stops before its next ray too and the frame ends
+/// [`Unfinished::Stopped`] (the tiles not drawn keep their mark). What
+/// the live firmware draws a frame the host plays with; [`play`] passes a
+/// `stop` that never stops.
 ///
 /// Core 0 checks for core 1's runs after each of its own rows (a run's
 /// row of up to 128 pixels): core 1 may trace `SLOTS` rows ahead.
 #[allow(clippy::too_many_arguments)]
-fn draw_frame<P, D, const LEN: usize, const SLOTS: usize>(
+pub fn draw_frame_until<P, D, S, const LEN: usize, const SLOTS: usize>(
     core1: &mut SecondCore,
     scene: &LoadedScene<'_, P>,
     motion: &Motion<'_>,
@@ -253,17 +269,22 @@ fn draw_frame<P, D, const LEN: usize, const SLOTS: usize>(
     room: &mut RendererRoom<P>,
     runs: &Runs<LEN, SLOTS>,
     display: &mut D,
+    mut stop: S,
 ) -> Result<(), Unfinished>
 where
     P: Profile,
     D: DrawTarget<Color = Rgb888>,
+    S: FnMut() -> bool,
 {
-    coherence.plan();
+    let size = coherence.size();
+    if size != display.bounding_box().size || LEN < coherence.longest_row() as usize {
+        return Err(Unfinished::Panel);
+    }
     // The bands with tiles to trace, most pixels first: the last band
     // taken is a small one, so neither core waits long for the other.
     let mut order = [(0u32, 0u16); MOST_BANDS];
     let mut bands = 0;
-    for band in 0..coherence.bands() {
+    for band in 0..coherence.bands().min(MOST_BANDS as u32) {
         let pixels = coherence.band_pixels(band) as u32;
         if pixels > 0 {
             let mut at = bands;
@@ -276,8 +297,7 @@ where
         }
     }
     let order = &order[..bands];
-    let size = coherence.size();
-    let stop = AtomicBool::new(false);
+    let stopping = AtomicBool::new(false);
     // How many pieces core 1 handed over in all, once it is done.
     let handed = AtomicU32::new(u32::MAX);
     // The next band to take, read and advanced under the chip's lock
@@ -295,14 +315,16 @@ where
     let core1_part = || {
         let mut piece = 0;
         if let Ok(mut renderer) = shared.renderer(room, size) {
+            let mut stop: Asked<'_> = &mut || stopping.load(Ordering::Acquire);
             while let Some(band) = take_next() {
-                let traced = coherence.trace_band(&mut renderer, motion, frame, band, &mut |area, pixels| {
-                    if !runs.send(piece, area, pixels, &stop) {
-                        return Err(());
-                    }
-                    piece += 1;
-                    Ok(())
-                });
+                let traced =
+                    coherence.trace_band_until(&mut renderer, motion, frame, band, &mut stop, &mut |area, pixels| {
+                        if !runs.send(piece, area, pixels, &stopping) {
+                            return Err(StoppedRay);
+                        }
+                        piece += 1;
+                        Ok(())
+                    });
                 if traced.is_err() {
                     break;
                 }
@@ -314,9 +336,12 @@ where
     let core0_part = || {
         let mut panel = Panel { display, runs, shown: 0 };
         let bands = core::iter::from_fn(take_next);
-        let mut result =
-            scene.draw_bands(motion, frame, coherence, bands, &mut panel).map(|_| ()).map_err(|e| match e {
+        let mut result = scene
+            .draw_bands_until(motion, frame, coherence, bands, &mut panel, &mut stop)
+            .map(|_| ())
+            .map_err(|e| match e {
                 DrawError::Camera(_) => Unfinished::Camera,
+                DrawError::Stopped => Unfinished::Stopped,
                 DrawError::Target(_) | DrawError::ErrorRow(_) => Unfinished::Panel,
             });
         // The rest of core 1's.
@@ -328,7 +353,7 @@ where
             wfe();
         }
         if result.is_err() {
-            stop.store(true, Ordering::Release);
+            stopping.store(true, Ordering::Release);
             sev();
         }
         result

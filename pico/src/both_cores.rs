@@ -100,8 +100,10 @@ where
     draw_rows(core1, scene, room, ring, display, each_row, stop, trace)
 }
 
-/// How a core asks whether to stop, inside a piece it traces.
-type Asked<'s> = &'s mut dyn FnMut() -> bool;
+/// How a core asks whether to stop, inside a piece it traces: one type for
+/// every picture and both cores ([`crate::animation`]'s frames too), so
+/// that a firmware links the tracer once.
+pub(crate) type Asked<'s> = &'s mut dyn FnMut() -> bool;
 
 /// The rows of [`draw`] and [`draw_until`], each traced by `trace`.
 #[allow(clippy::too_many_arguments)]

@@ -18,9 +18,7 @@ use crate::shade::{Poll, Unpolled};
 use core::fmt;
 use core::ops::Range;
 use core::sync::atomic::{AtomicU8, Ordering};
-use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
-use embedded_graphics_core::pixelcolor::Rgb888;
 use embedded_graphics_core::primitives::Rectangle;
 
 /// Why a band's trace ended early: its sink's error, or its poll said stop.
@@ -69,7 +67,8 @@ impl core::error::Error for CoherenceError {}
 /// The tiles of an animation's image and what each still holds, over one
 /// byte a tile of the caller's storage ([`Coherence::tiles_for`] of them, a
 /// `const fn`). Each frame: [`Coherence::plan`], then trace the bands
-/// ([`Coherence::draw_band`] into a display, or [`Coherence::trace_band`]),
+/// ([`LoadedScene::draw_bands`](crate::LoadedScene::draw_bands) into a
+/// display, or [`Coherence::trace_band`]),
 /// on one core or several, each with a renderer of its own over the
 /// frame's scene: only the tiles that can have changed are traced, and
 /// only their runs of pixels drawn. The scene's profile says
@@ -346,25 +345,6 @@ impl<'s> Coherence<'s> {
         });
         renderer.set_lookout(None);
         result.map(|()| renderer.stats().since(&before))
-    }
-
-    /// [`Coherence::trace_band`] into a display: each run's row in one
-    /// `fill_contiguous`, nothing else drawn.
-    pub fn draw_band<'a, A: Accelerator, D>(
-        &self,
-        renderer: &mut Renderer<'a, A>,
-        motion: &'a Motion<'a>,
-        frame: u32,
-        band: u32,
-        target: &mut D,
-    ) -> Result<Stats, D::Error>
-    where
-        D: DrawTarget,
-        D::Color: From<Rgb888>,
-    {
-        self.trace_band(renderer, motion, frame, band, &mut |line, pixels| {
-            target.fill_contiguous(line, pixels.map(|p| p.color.into()))
-        })
     }
 }
 

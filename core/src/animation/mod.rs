@@ -39,7 +39,7 @@
 //! [`Coherence::plan`] once a frame on one core; then each core, with a
 //! [`Renderer`](crate::render::Renderer) of its own over the frame's scene
 //! (`LoadedScene::with_renderer`, `SharedScene::renderer`), takes the next
-//! band not yet taken and traces it: [`Coherence::draw_band`] on the core
+//! band not yet taken and traces it: [`LoadedScene::draw_bands`](crate::LoadedScene::draw_bands) on the core
 //! that drives the display, [`Coherence::trace_band`] on the other, which
 //! hands its runs over. The counts are atomics each written by the core
 //! that traced the tile.

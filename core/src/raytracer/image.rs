@@ -4,6 +4,7 @@
 
 use crate::panel::{Dithered, Dithering, ErrorRowTooShort, TracedColor, IMAGE_ERROR_WORDS};
 use crate::profile::Profile;
+use crate::render::Stopped;
 use crate::scene::CameraError;
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -27,6 +28,15 @@ pub enum DrawError<E> {
     ErrorRow(ErrorRowTooShort),
     /// The display's own error.
     Target(E),
+    /// The caller's stop said so
+    /// ([`LoadedScene::draw_bands_until`](crate::LoadedScene::draw_bands_until)).
+    Stopped,
+}
+
+impl<E> From<Stopped> for DrawError<E> {
+    fn from(_: Stopped) -> Self {
+        DrawError::Stopped
+    }
 }
 
 impl<E: fmt::Display> fmt::Display for DrawError<E> {
@@ -35,6 +45,7 @@ impl<E: fmt::Display> fmt::Display for DrawError<E> {
             DrawError::Camera(e) => write!(f, "{e}"),
             DrawError::ErrorRow(e) => write!(f, "{e}"),
             DrawError::Target(e) => write!(f, "the display failed: {e}"),
+            DrawError::Stopped => write!(f, "stopped before the picture's end"),
         }
     }
 }
@@ -212,7 +223,7 @@ impl<P: Profile, C: TracedColor> ImageDrawable for TracedImage<'_, '_, P, C> {
 
     fn draw_sub_image<D: DrawTarget<Color = C>>(&self, target: &mut D, area: &Rectangle) -> Result<(), D::Error> {
         match self.draw_area(area, target, None) {
-            Ok(()) | Err(DrawError::Camera(_) | DrawError::ErrorRow(_)) => Ok(()),
+            Ok(()) | Err(DrawError::Camera(_) | DrawError::ErrorRow(_) | DrawError::Stopped) => Ok(()),
             Err(DrawError::Target(e)) => Err(e),
         }
     }

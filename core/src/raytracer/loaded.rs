@@ -5,7 +5,7 @@ use crate::accel::{AccelMode, Accelerator, BuildReport, LightBuffer, LightBuffer
 use crate::animation::{Coherence, Motion};
 use crate::panel::{Dithered, Dithering, TracedColor};
 use crate::profile::Profile;
-use crate::render::{Progressive, Renderer};
+use crate::render::{Progressive, Renderer, Stop};
 use crate::scene::{CameraError, Frames, SceneView};
 use crate::shade::Stats;
 use core::cell::{Cell, RefCell};
@@ -236,21 +236,42 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         D: DrawTarget,
         D::Color: TracedColor,
     {
-        match D::Color::PANEL {
-            None => self.draw_bands_converted(motion, frame, coherence, bands, target),
-            Some(_) => self.draw_bands_converted(motion, frame, coherence, bands, &mut Dithered::ordered(target)),
-        }
+        self.draw_bands_until(motion, frame, coherence, bands, target, &mut || false)
     }
 
-    /// [`LoadedScene::draw_bands`] into a target that takes the traced
-    /// colours converted.
-    fn draw_bands_converted<D>(
+    /// [`LoadedScene::draw_bands`], asking `stop` before every ray (as
+    /// [`Renderer::pixel_until`] does): [`DrawError::Stopped`] as soon as
+    /// it says so, the run being traced drawn up to the pixel it stopped
+    /// in, and the tiles not drawn kept to be traced.
+    pub fn draw_bands_until<D, S: Stop>(
         &self,
         motion: &Motion<'_>,
         frame: u32,
         coherence: &Coherence<'_>,
         bands: impl IntoIterator<Item = u32>,
         target: &mut D,
+        stop: &mut S,
+    ) -> Result<Stats, DrawError<D::Error>>
+    where
+        D: DrawTarget,
+        D::Color: TracedColor,
+    {
+        match D::Color::PANEL {
+            None => self.draw_bands_converted(motion, frame, coherence, bands, target, stop),
+            Some(_) => self.draw_bands_converted(motion, frame, coherence, bands, &mut Dithered::ordered(target), stop),
+        }
+    }
+
+    /// [`LoadedScene::draw_bands_until`] into a target that takes the
+    /// traced colours converted.
+    fn draw_bands_converted<D, S: Stop>(
+        &self,
+        motion: &Motion<'_>,
+        frame: u32,
+        coherence: &Coherence<'_>,
+        bands: impl IntoIterator<Item = u32>,
+        target: &mut D,
+        stop: &mut S,
     ) -> Result<Stats, DrawError<D::Error>>
     where
         D: DrawTarget,
@@ -265,13 +286,17 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
             renderer_in(self.view, &accelerator, coherence.size(), mailbox, lists).map_err(DrawError::Camera)?;
         let mut stats = Stats::default();
         let result = bands.into_iter().try_for_each(|band| {
-            stats.add(&coherence.draw_band(&mut renderer, motion, frame, band, target)?);
+            let traced =
+                coherence.trace_band_until(&mut renderer, motion, frame, band, stop, &mut |line, pixels| {
+                    target.fill_contiguous(line, pixels.map(|p| p.color.into())).map_err(DrawError::Target)
+                })?;
+            stats.add(&traced);
             Ok(())
         });
         let mut total = self.stats.get();
         total.add(&stats);
         self.stats.set(total);
-        result.map(|()| stats).map_err(DrawError::Target)
+        result.map(|()| stats)
     }
 
     /// The counters of every draw so far.

@@ -3,8 +3,8 @@
 //! scene.txt` (or the studio's "Send to board") sends a scene, and the Pico
 //! answers with its errors at line and column, or draws it on the panel
 //! with both cores (sending the rows back when asked), then waits for the
-//! next. An animation (a scene with `FRAMES`) is played in a loop on core 0,
-//! each frame re-tracing only the tiles its motion can change and drawing
+//! next. An animation (a scene with `FRAMES`) is played in a loop on both
+//! cores, each frame re-tracing only the tiles its motion can change and drawing
 //! only their runs (sent back as runs), until the host sends anything. The
 //! protocol is octrace-link's (`docs/board-protocol.md`).
 //!
@@ -31,14 +31,15 @@ use core::sync::atomic::AtomicU8;
 use critical_section::Mutex;
 use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 use embedded_graphics::prelude::*;
+use embedded_graphics::primitives::Rectangle;
 use hal::multicore::Stack;
 use hal::pac::interrupt;
 use hal::{entry, pac, Timer, Watchdog};
 use octrace_core::animation::{Coherence, Key, Track};
-use octrace_core::render::Handoff;
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
-use octrace_link::board::{AnimationRoom, Line, Link, Ring, TILE};
+use octrace_link::board::{AnimationRoom, Line, Link, Playing, Ring, TILE};
 use octrace_link::{Panel, PixelFormat};
+use octrace_pico::animation::{self, Runs};
 use octrace_pico::{board, both_cores};
 use octrace_pico_st7789::measure::{self, Meter};
 use octrace_pico_st7789::panel;
@@ -60,7 +61,7 @@ octrace_core::profile! {
         spheres: 400, boxes: 32, superquadrics: 32, triangles: 160, rectangles: 160,
         surfaces: 64, lights: 8,
         octree_boxes: 1600, octree_references: 4800,
-        light_buffer_lights: 8, light_buffer_words: 2816,
+        light_buffer_lights: 8, light_buffer_words: 4096,
     }
     named_walk: false
     first_hits: true
@@ -88,8 +89,8 @@ static CORE1_ROOM: ConstStaticCell<RendererRoom<LiveProfile>> = ConstStaticCell:
 /// scene on core 0), so that the scene's text keeps its 32 KiB.
 static CORE1_STACK: Stack<2048> = Stack::new();
 
-/// Core 1's rows on their way to the panel.
-static ROWS: Handoff<{ panel::WIDTH as usize }, 4> = Handoff::new();
+/// Core 1's rows (a still's) or runs (an animation's) on their way to the panel.
+static RUNS: Runs<{ panel::WIDTH as usize }, 4> = Runs::new();
 
 /// The panel's bus buffer.
 static PANEL_BUFFER: ConstStaticCell<[u8; 512]> = ConstStaticCell::new([0; 512]);
@@ -145,18 +146,35 @@ fn main() -> ! {
     let mut line = UsbLine { timer, watchdog, meter: Meter::new(timer, peripherals.busctrl) };
     loop {
         link.serve(&mut line, raytracer, |drawing, rows| {
-            if drawing.playing().is_some() {
-                // An animation's frame: its planned runs, on core 0.
-                let size = display.size();
-                let mut row = [Rgb565::BLACK; panel::WIDTH as usize];
-                let drawn = drawing.scene().with_renderer(size, |renderer| {
-                    rows.draw_on_one_core(drawing, renderer, &mut row, |area, pixels| {
-                        let _ = display.fill_contiguous(area, pixels.iter().copied());
-                    })
-                });
-                return drawn.unwrap_or(0);
-            }
             let rows = RefCell::new(rows);
+            // Never borrowed twice: a row or a run is sent between asks.
+            let stop = || rows.try_borrow_mut().map_or(true, |mut rows| rows.poll());
+            if let Some(playing) = drawing.playing() {
+                // An animation's frame: its planned runs, on both cores,
+                // each shown and sent back whole.
+                let mut panel = SentRuns {
+                    display: &mut display,
+                    sent: |area: &Rectangle, run: &[Rgb565]| {
+                        let (x, y) = (area.top_left.x as u16, area.top_left.y as u16);
+                        if let Ok(mut rows) = rows.try_borrow_mut() {
+                            rows.send_run(drawing, y, x, run);
+                        }
+                    },
+                };
+                let Playing { frame, motion, coherence } = playing;
+                let drawn = animation::draw_frame_until(
+                    &mut core1,
+                    drawing.scene(),
+                    motion,
+                    frame,
+                    coherence,
+                    &mut *room,
+                    &RUNS,
+                    &mut panel,
+                    stop,
+                );
+                return if drawn.is_ok() { drawing.panel().height } else { 0 };
+            }
             let mut drawn = 0;
             let each_row = |y: u32, traced: &[Rgb888]| {
                 if let Ok(mut rows) = rows.try_borrow_mut() {
@@ -170,12 +188,59 @@ fn main() -> ! {
                 drawn = y as u16 + 1;
                 ControlFlow::Continue(())
             };
-            // Never borrowed twice: a row is sent between asks.
-            let stop = || rows.try_borrow_mut().map_or(true, |mut rows| rows.poll());
-            let _ =
-                both_cores::draw_until(&mut core1, drawing.scene(), &mut *room, &ROWS, &mut display, each_row, stop);
+            let _ = both_cores::draw_until(
+                &mut core1,
+                drawing.scene(),
+                &mut *room,
+                RUNS.rows(),
+                &mut display,
+                each_row,
+                stop,
+            );
             drawn
         });
+    }
+}
+
+/// The panel as an animation's frame is drawn into it: each run, whole,
+/// goes to the display as the panel's colours and then to `sent` (the
+/// host); a run cut short (the frame stopped inside it) goes nowhere.
+struct SentRuns<'d, D, F> {
+    display: &'d mut D,
+    sent: F,
+}
+
+impl<D: OriginDimensions, F> OriginDimensions for SentRuns<'_, D, F> {
+    fn size(&self) -> Size {
+        self.display.size()
+    }
+}
+
+impl<D, F> DrawTarget for SentRuns<'_, D, F>
+where
+    D: DrawTarget<Color = Rgb565> + OriginDimensions,
+    F: FnMut(&Rectangle, &[Rgb565]),
+{
+    type Color = Rgb888;
+    type Error = D::Error;
+
+    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb888>>>(&mut self, pixels: I) -> Result<(), D::Error> {
+        self.display.draw_iter(pixels.into_iter().map(|Pixel(at, color)| Pixel(at, color.into())))
+    }
+
+    fn fill_contiguous<I: IntoIterator<Item = Rgb888>>(&mut self, area: &Rectangle, colors: I) -> Result<(), D::Error> {
+        let mut run = [Rgb565::BLACK; panel::WIDTH as usize];
+        let mut width = 0;
+        for (pixel, color) in run.iter_mut().zip(colors) {
+            *pixel = color.into();
+            width += 1;
+        }
+        if width < area.size.width as usize {
+            return Ok(());
+        }
+        self.display.fill_contiguous(area, run[..width].iter().copied())?;
+        (self.sent)(area, &run[..width]);
+        Ok(())
     }
 }
 
