@@ -235,7 +235,17 @@ where
         let loaded = raytracer.load_frame_on_two_cores(text, frame, |beside, here| core1.scope(beside, here));
         let Ok(scene) = loaded else { return Stopped::Frame(frame) };
         coherence.plan();
-        let drawn = draw_frame_until(core1, &scene, &motion, frame, &coherence, room, runs, &mut display, || false);
+        let drawn = draw_frame::<P, _, LEN, SLOTS, false>(
+            core1,
+            &scene,
+            &motion,
+            frame,
+            &coherence,
+            room,
+            runs,
+            &mut display,
+            &mut || false,
+        );
         if let Err(unfinished) = drawn {
             return Stopped::Picture(unfinished);
         }
@@ -253,14 +263,15 @@ where
 /// every run into `display` (each row of a run in one `fill_contiguous`).
 /// `stop` is asked on core 0 before every ray it traces; once it says
 /// stop, core 1 stops before its next ray too and the frame ends
-/// [`Unfinished::Stopped`] (the tiles not drawn keep their mark). What
-/// the live firmware draws a frame the host plays with; [`play`] passes a
-/// `stop` that never stops.
+/// [`Unfinished::Stopped`] (the tiles not drawn keep their mark): how the
+/// live firmware draws each frame of an animation the host sent. [`play`]
+/// draws its frames asking nothing (the same code without the asking:
+/// its tracer is linked once, unpolled, and inlined as a still's).
 ///
 /// Core 0 checks for core 1's runs after each of its own rows (a run's
 /// row of up to 128 pixels): core 1 may trace `SLOTS` rows ahead.
 #[allow(clippy::too_many_arguments)]
-pub fn draw_frame_until<P, D, S, const LEN: usize, const SLOTS: usize>(
+pub fn draw_frame_until<P, D, const LEN: usize, const SLOTS: usize>(
     core1: &mut SecondCore,
     scene: &LoadedScene<'_, P>,
     motion: &Motion<'_>,
@@ -269,12 +280,33 @@ pub fn draw_frame_until<P, D, S, const LEN: usize, const SLOTS: usize>(
     room: &mut RendererRoom<P>,
     runs: &Runs<LEN, SLOTS>,
     display: &mut D,
-    mut stop: S,
+    stop: Asked<'_>,
 ) -> Result<(), Unfinished>
 where
     P: Profile,
     D: DrawTarget<Color = Rgb888>,
-    S: FnMut() -> bool,
+{
+    draw_frame::<P, D, LEN, SLOTS, true>(core1, scene, motion, frame, coherence, room, runs, display, stop)
+}
+
+/// [`draw_frame_until`], asking `stop` only if `ASKED` (known when it
+/// compiles, so that a firmware links one tracer: the asking one, or the
+/// one that asks nothing).
+#[allow(clippy::too_many_arguments)]
+fn draw_frame<P, D, const LEN: usize, const SLOTS: usize, const ASKED: bool>(
+    core1: &mut SecondCore,
+    scene: &LoadedScene<'_, P>,
+    motion: &Motion<'_>,
+    frame: u32,
+    coherence: &Coherence<'_>,
+    room: &mut RendererRoom<P>,
+    runs: &Runs<LEN, SLOTS>,
+    display: &mut D,
+    stop: Asked<'_>,
+) -> Result<(), Unfinished>
+where
+    P: Profile,
+    D: DrawTarget<Color = Rgb888>,
 {
     let size = coherence.size();
     if size != display.bounding_box().size || LEN < coherence.longest_row() as usize {
@@ -316,15 +348,18 @@ where
         let mut piece = 0;
         if let Ok(mut renderer) = shared.renderer(room, size) {
             let mut stop: Asked<'_> = &mut || stopping.load(Ordering::Acquire);
+            let mut send = |area: &Rectangle, pixels: &mut dyn Iterator<Item = PixelSample>| {
+                if !runs.send(piece, area, pixels, &stopping) {
+                    return Err(StoppedRay);
+                }
+                piece += 1;
+                Ok(())
+            };
             while let Some(band) = take_next() {
-                let traced =
-                    coherence.trace_band_until(&mut renderer, motion, frame, band, &mut stop, &mut |area, pixels| {
-                        if !runs.send(piece, area, pixels, &stopping) {
-                            return Err(StoppedRay);
-                        }
-                        piece += 1;
-                        Ok(())
-                    });
+                let traced = match ASKED {
+                    true => coherence.trace_band_until(&mut renderer, motion, frame, band, &mut stop, &mut send),
+                    false => coherence.trace_band(&mut renderer, motion, frame, band, &mut send),
+                };
                 if traced.is_err() {
                     break;
                 }
@@ -336,14 +371,15 @@ where
     let core0_part = || {
         let mut panel = Panel { display, runs, shown: 0 };
         let bands = core::iter::from_fn(take_next);
-        let mut result = scene
-            .draw_bands_until(motion, frame, coherence, bands, &mut panel, &mut stop)
-            .map(|_| ())
-            .map_err(|e| match e {
-                DrawError::Camera(_) => Unfinished::Camera,
-                DrawError::Stopped => Unfinished::Stopped,
-                DrawError::Target(_) | DrawError::ErrorRow(_) => Unfinished::Panel,
-            });
+        let drawn = match ASKED {
+            true => scene.draw_bands_until(motion, frame, coherence, bands, &mut panel, &mut { stop }),
+            false => scene.draw_bands(motion, frame, coherence, bands, &mut panel),
+        };
+        let mut result = drawn.map(|_| ()).map_err(|e| match e {
+            DrawError::Camera(_) => Unfinished::Camera,
+            DrawError::Stopped => Unfinished::Stopped,
+            DrawError::Target(_) | DrawError::ErrorRow(_) => Unfinished::Panel,
+        });
         // The rest of core 1's.
         while result.is_ok() {
             result = panel.show_handed().map_err(|_| Unfinished::Panel);

@@ -22,7 +22,7 @@ use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
 
 /// Why a band's trace ended early: its sink's error, or its poll said stop.
-enum Halt<E, S> {
+pub(crate) enum Halt<E, S> {
     Sink(E),
     Stopped(S),
 }
@@ -291,7 +291,7 @@ impl<'s> Coherence<'s> {
 
     /// [`Coherence::trace_band`] with `poll` asked before every ray.
     #[inline(always)]
-    fn trace_band_polled<'a, A: Accelerator, Q: Poll, E>(
+    pub(crate) fn trace_band_polled<'a, A: Accelerator, Q: Poll, E>(
         &self,
         renderer: &mut Renderer<'a, A>,
         motion: &'a Motion<'a>,

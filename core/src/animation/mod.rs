@@ -44,7 +44,7 @@
 //! hands its runs over. The counts are atomics each written by the core
 //! that traced the tile.
 
-mod coherence;
+pub(crate) mod coherence;
 
 #[doc(hidden)]
 pub use crate::motion::Dependence;

@@ -2,12 +2,14 @@
 //! core that loaded it; it draws as an image, directly or progressively.
 
 use crate::accel::{AccelMode, Accelerator, BuildReport, LightBuffer, LightBufferError};
+use crate::animation::coherence::Halt;
 use crate::animation::{Coherence, Motion};
 use crate::panel::{Dithered, Dithering, TracedColor};
 use crate::profile::Profile;
-use crate::render::{Progressive, Renderer, Stop};
+use crate::render::{Polling, Progressive, Renderer, Stop};
 use crate::scene::{CameraError, Frames, SceneView};
 use crate::shade::Stats;
+use crate::shade::{Poll, Unpolled};
 use core::cell::{Cell, RefCell};
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -236,7 +238,17 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         D: DrawTarget,
         D::Color: TracedColor,
     {
-        self.draw_bands_until(motion, frame, coherence, bands, target, &mut || false)
+        match D::Color::PANEL {
+            None => self.draw_bands_converted(motion, frame, coherence, bands, target, &mut Unpolled),
+            Some(_) => self.draw_bands_converted(
+                motion,
+                frame,
+                coherence,
+                bands,
+                &mut Dithered::ordered(target),
+                &mut Unpolled,
+            ),
+        }
     }
 
     /// [`LoadedScene::draw_bands`], asking `stop` before every ray (as
@@ -256,22 +268,25 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         D: DrawTarget,
         D::Color: TracedColor,
     {
+        let mut polling = Polling { stop, stopped: false };
         match D::Color::PANEL {
-            None => self.draw_bands_converted(motion, frame, coherence, bands, target, stop),
-            Some(_) => self.draw_bands_converted(motion, frame, coherence, bands, &mut Dithered::ordered(target), stop),
+            None => self.draw_bands_converted(motion, frame, coherence, bands, target, &mut polling),
+            Some(_) => {
+                self.draw_bands_converted(motion, frame, coherence, bands, &mut Dithered::ordered(target), &mut polling)
+            }
         }
     }
 
-    /// [`LoadedScene::draw_bands_until`] into a target that takes the
-    /// traced colours converted.
-    fn draw_bands_converted<D, S: Stop>(
+    /// [`LoadedScene::draw_bands`] into a target that takes the traced
+    /// colours converted, `poll` asked before every ray.
+    fn draw_bands_converted<D, Q: Poll>(
         &self,
         motion: &Motion<'_>,
         frame: u32,
         coherence: &Coherence<'_>,
         bands: impl IntoIterator<Item = u32>,
         target: &mut D,
-        stop: &mut S,
+        poll: &mut Q,
     ) -> Result<Stats, DrawError<D::Error>>
     where
         D: DrawTarget,
@@ -286,9 +301,13 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
             renderer_in(self.view, &accelerator, coherence.size(), mailbox, lists).map_err(DrawError::Camera)?;
         let mut stats = Stats::default();
         let result = bands.into_iter().try_for_each(|band| {
-            let traced =
-                coherence.trace_band_until(&mut renderer, motion, frame, band, stop, &mut |line, pixels| {
+            let traced = coherence
+                .trace_band_polled(&mut renderer, motion, frame, band, poll, &mut |line, pixels| {
                     target.fill_contiguous(line, pixels.map(|p| p.color.into())).map_err(DrawError::Target)
+                })
+                .map_err(|halt| match halt {
+                    Halt::Sink(e) => e,
+                    Halt::Stopped(_) => DrawError::Stopped,
                 })?;
             stats.add(&traced);
             Ok(())

@@ -148,7 +148,7 @@ fn main() -> ! {
         link.serve(&mut line, raytracer, |drawing, rows| {
             let rows = RefCell::new(rows);
             // Never borrowed twice: a row or a run is sent between asks.
-            let stop = || rows.try_borrow_mut().map_or(true, |mut rows| rows.poll());
+            let mut stop = || rows.try_borrow_mut().map_or(true, |mut rows| rows.poll());
             if let Some(playing) = drawing.playing() {
                 // An animation's frame: its planned runs, on both cores,
                 // each shown and sent back whole.
@@ -171,7 +171,7 @@ fn main() -> ! {
                     &mut *room,
                     &RUNS,
                     &mut panel,
-                    stop,
+                    &mut stop,
                 );
                 return if drawn.is_ok() { drawing.panel().height } else { 0 };
             }
