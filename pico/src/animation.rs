@@ -187,9 +187,11 @@ impl<const LEN: usize, const SLOTS: usize> Default for Runs<LEN, SLOTS> {
 /// `motion`, the tiles' counts in `counts` ([`Coherence::tiles_for`] of the
 /// panel in tiles of [`TILE`]), core 1 rendering in `room` and handing its
 /// runs over through `runs` (at least [`Coherence::longest_row`]), in the
-/// display's colour as the module says. `led` is lit
-/// while a frame is on its way; `timer` paces the frames. Returns only
-/// when it cannot go on.
+/// display's colour as the module says. `show` puts each frame on the
+/// panel once it is drawn (a buffered display's flush; `|_| Ok(())` for a
+/// panel drawn into directly). `led` is lit while a frame is on its way,
+/// until it is shown; `timer` paces the frames. Returns only when it
+/// cannot go on.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 pub fn play<P, D, L, const LEN: usize, const SLOTS: usize>(
@@ -201,6 +203,7 @@ pub fn play<P, D, L, const LEN: usize, const SLOTS: usize>(
     room: &mut RendererRoom<P>,
     runs: &Runs<LEN, SLOTS>,
     display: &mut D,
+    mut show: impl FnMut(&mut D) -> Result<(), D::Error>,
     led: &mut L,
     timer: &Timer,
 ) -> Stopped
@@ -248,6 +251,9 @@ where
         );
         if let Err(unfinished) = drawn {
             return Stopped::Picture(unfinished);
+        }
+        if show(display.display()).is_err() {
+            return Stopped::Picture(Unfinished::Panel);
         }
         let _ = led.set_low();
         frame = frames.after(frame);

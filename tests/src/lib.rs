@@ -55,7 +55,9 @@ pub fn host_sim_preview_of(
     host_sim_preview_with(path, out, size, color, &[])
 }
 
-/// [`host_sim_preview`] of frame `frame` of an animation (`--frame K`).
+/// [`host_sim_preview`] of frame `frame` of an animation (`--frame K`), as
+/// a board plays it: on a panel of few levels (`color` not `rgb…`), in
+/// ordered dithering (`--dither bayer`), the one method a frame's runs keep.
 pub fn host_sim_frame_preview(
     scene: &str,
     frame: u32,
@@ -64,7 +66,12 @@ pub fn host_sim_frame_preview(
     color: &str,
 ) -> Result<(), String> {
     let path = repo().join("scenes").join(format!("{scene}.txt"));
-    host_sim_preview_with(&path, out, size, color, &["--frame", &frame.to_string()])
+    let frame = frame.to_string();
+    let mut flags = vec!["--frame", &frame];
+    if !color.starts_with("rgb") {
+        flags.extend(["--dither", "bayer"]);
+    }
+    host_sim_preview_with(&path, out, size, color, &flags)
 }
 
 /// host-sim's preview of `path` into `out`, with `more` flags.

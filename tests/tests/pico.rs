@@ -45,7 +45,8 @@ const OLED_PICTURE_CYCLES: u64 = 1024 * 9 * 125_000_000 / 400_000;
 /// that did so (enough to see tiles skipped that changed, or counts carried
 /// wrongly from a frame to the next; `tests/tests/animation.rs` plays whole
 /// loops on the host).
-const ANIMATION: Build<'static> = Build::of(Template::St7789, "anim_fig5_1");
+const ANIMATIONS: [Build<'static>; 2] =
+    [Build::of(Template::St7789, "anim_fig5_1"), Build::of(Template::Ssd1306, "anim_fig5_1")];
 const FRAMES_CHECKED: u32 = 3;
 
 /// The first coarse panel of a progressive order, from the picture's start:
@@ -102,10 +103,17 @@ fn each_pico_template_shows_host_sims_picture() {
     // One build at a time (they share a target directory), then the runs
     // side by side.
     let elves: Vec<_> = BUILDS.iter().map(|build| pico::build(build).unwrap_or_else(|e| panic!("{e}"))).collect();
-    let animation = pico::build(&ANIMATION).unwrap_or_else(|e| panic!("{e}"));
-    let frames_pattern = dir.path().join(format!("{}-%d.png", ANIMATION.name()));
-    let (runs, frames): (Vec<_>, _) = std::thread::scope(|s| {
-        let frames = s.spawn(|| pico::run_frames(&animation, &frames_pattern, FRAMES_CHECKED));
+    let animations: Vec<_> =
+        ANIMATIONS.iter().map(|build| pico::build(build).unwrap_or_else(|e| panic!("{e}"))).collect();
+    let (runs, played): (Vec<_>, Vec<_>) = std::thread::scope(|s| {
+        let frames = s.spawn(|| {
+            (ANIMATIONS.iter().zip(&animations))
+                .map(|(build, elf)| {
+                    let pattern = dir.path().join(format!("{}-{}-%d.png", build.template.name(), build.name()));
+                    pico::run_frames(elf, &pattern, FRAMES_CHECKED)
+                })
+                .collect()
+        });
         // The first build (fig5_1, as a user builds it) serves its USB port too.
         let handles: Vec<_> = BUILDS
             .iter()
@@ -166,24 +174,26 @@ fn each_pico_template_shows_host_sims_picture() {
         );
     }
 
-    let name = ANIMATION.name();
-    let frames = frames.unwrap_or_else(|e| panic!("{name}: {e}"));
-    assert_eq!(frames.len(), FRAMES_CHECKED as usize, "{name}: the frames drawn");
-    let (size, color) = ANIMATION.template.panel();
-    for (k, frame) in (0..).zip(&frames) {
-        let preview = dir.path().join(format!("{name}-host-sim-{k}.png"));
-        host_sim_frame_preview(ANIMATION.scene, k, &preview, size, color).unwrap_or_else(|e| panic!("{e}"));
-        assert_same_picture(&format!("{name}, frame {k}"), &frame.picture, &preview, size);
-        println!(
-            "{name}, frame {k}: {size} pixels identical; {} cycles ({:.3} s at 125 MHz), core 0 busy {}, core 1 busy {}",
-            frame.cycles,
-            frame.cycles as f64 / pico::CLOCK_HZ,
-            frame.busy[0],
-            frame.busy[1]
-        );
+    for (build, frames) in ANIMATIONS.iter().zip(played) {
+        let name = format!("{} {}", build.template.name(), build.name());
+        let frames = frames.unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(frames.len(), FRAMES_CHECKED as usize, "{name}: the frames drawn");
+        let (size, color) = build.template.panel();
+        for (k, frame) in (0..).zip(&frames) {
+            let preview = dir.path().join(format!("{}-{}-host-sim-{k}.png", build.template.name(), build.name()));
+            host_sim_frame_preview(build.scene, k, &preview, size, color).unwrap_or_else(|e| panic!("{e}"));
+            assert_same_picture(&format!("{name}, frame {k}"), &frame.picture, &preview, size);
+            println!(
+                "{name}, frame {k}: {size} pixels identical; {} cycles ({:.3} s at 125 MHz), core 0 busy {}, core 1 busy {}",
+                frame.cycles,
+                frame.cycles as f64 / pico::CLOCK_HZ,
+                frame.busy[0],
+                frame.busy[1]
+            );
+        }
+        // The frames after the first re-trace only what moved.
+        assert!(frames[1..].iter().all(|f| f.cycles < frames[0].cycles / 2), "{name}: {frames:?}");
     }
-    // The frames after the first re-trace only what moved.
-    assert!(frames[1..].iter().all(|f| f.cycles < frames[0].cycles / 2), "{name}: {frames:?}");
 }
 
 /// Asserts the panel's picture `panel` is host-sim's `preview`, pixel for

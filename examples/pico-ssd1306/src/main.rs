@@ -2,11 +2,16 @@
 //! embedded in flash is parsed on the board and traced by both cores into
 //! the `ssd1306` crate's buffer in the panel's one-bit look (octrace's
 //! dither for a `BinaryColor` display), then sent to the panel over I2C.
-//! The Pico's LED is lit while it traces. Pins and wiring are in README.md.
+//! An animation (`FRAMES` and `MOVE`) plays in a loop, each frame
+//! re-tracing only what its motion can change, in ordered dithering (a
+//! pixel's dots depend on it alone), the buffer sent after each frame.
+//! The Pico's LED is lit while it traces (for an animation, until the
+//! frame is on the panel). Pins and wiring are in README.md.
 //!
 //! Invariants: the scene, its octree and core 0's mailbox live in one
 //! static cell, core 1's mailbox and lists in another (all zero bits, so in
-//! `.bss`: no flash, no copy on the stack); the image takes the panel's
+//! `.bss`: no flash, no copy on the stack); so do an animation's motion and
+//! tiles, sized for this scene by `build.rs` (empty for a still); the image takes the panel's
 //! size and colour, and so its look; any split of the rows between the
 //! cores gives the same bits as one core.
 
@@ -14,13 +19,16 @@
 #![no_main]
 
 use core::ops::ControlFlow;
+use core::sync::atomic::AtomicU8;
 use embedded_graphics::pixelcolor::BinaryColor;
 use embedded_graphics::prelude::*;
 use embedded_hal::digital::OutputPin;
 use hal::entry;
 use hal::multicore::Stack;
+use octrace_core::animation::{Coherence, Key, Track};
 use octrace_core::render::Handoff;
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
+use octrace_pico::animation::{self, MotionRoom, Runs, TILE};
 use octrace_pico::board::{self, Board};
 use octrace_pico::both_cores;
 use panic_halt as _;
@@ -33,15 +41,13 @@ octrace_pico::boot!();
 
 /// The scene (`SCENE_TEXT`, in flash) and a capacity profile that holds
 /// exactly what it needs (`SceneProfile`), from `build.rs`: set
-/// `OCTRACE_SCENE` to your scene's file when you build. Of an animation
-/// (`ANIMATED`, `MOTION`) this template draws the first frame: it does not
-/// play one (`octrace_pico::animation` would, the panel's buffer sent after
-/// each frame).
+/// `OCTRACE_SCENE` to your scene's file when you build; for an animation,
+/// `ANIMATED` and what its motion needs (`MOTION`).
 #[allow(dead_code)]
 mod scene {
     include!(concat!(env!("OUT_DIR"), "/scene.rs"));
 }
-use scene::{SceneProfile, SCENE_TEXT};
+use scene::{SceneProfile, ANIMATED, MOTION, SCENE_TEXT};
 
 /// Room for the scene, its octree and core 0's mailbox and lists.
 static RAYTRACER: ConstStaticCell<Raytracer<SceneProfile>> = ConstStaticCell::new(Raytracer::new());
@@ -55,11 +61,50 @@ static CORE1_STACK: Stack<4096> = Stack::new();
 /// Core 1's rows on their way to the panel's buffer: it may trace four ahead.
 static RING: Handoff<{ panel::WIDTH }, 4> = Handoff::new();
 
+/// An animation's motion: its tracks, keys and displacements.
+static TRACKS: ConstStaticCell<[Track; MOTION.tracks]> = ConstStaticCell::new([Track::EMPTY; MOTION.tracks]);
+static KEYS: ConstStaticCell<[Key; MOTION.keys]> = ConstStaticCell::new([Key::EMPTY; MOTION.keys]);
+static DISPLACEMENTS: ConstStaticCell<[[i32; 3]; MOTION.displacements]> =
+    ConstStaticCell::new([[0; 3]; MOTION.displacements]);
+
+/// An animation's tiles, a byte each (none for a still): 512 for the panel.
+const TILES: usize = if ANIMATED { Coherence::tiles_for(panel::WIDTH as u32, panel::HEIGHT as u32, TILE) } else { 0 };
+static COUNTS: [AtomicU8; TILES] = [const { AtomicU8::new(0) }; TILES];
+
+/// An animation's runs from core 1 on their way to the panel's buffer: a
+/// row of up to 32 tiles each, core 1 tracing up to eight ahead.
+static RUNS: Runs<{ panel::WIDTH }, 8> = Runs::new();
+
 #[entry]
 fn main() -> ! {
-    let Board { mut core1, pins, clocks, mut resets, peripherals, .. } = board::start(CORE1_STACK.take().unwrap());
+    let Board { mut core1, pins, clocks, timer, mut resets, peripherals, .. } =
+        board::start(CORE1_STACK.take().unwrap());
     let mut display = panel::init(peripherals.i2c0, pins.gpio4, pins.gpio5, &mut resets, &clocks);
     let mut led = pins.gpio25.into_push_pull_output();
+
+    if ANIMATED {
+        // Frame after frame for ever, each sent to the panel once drawn: it
+        // returns only when a frame cannot be drawn.
+        let motion = MotionRoom { tracks: TRACKS.take(), keys: KEYS.take(), displacements: DISPLACEMENTS.take() };
+        let _: animation::Stopped = animation::play(
+            &mut core1,
+            RAYTRACER.take(),
+            SCENE_TEXT,
+            motion,
+            &COUNTS,
+            CORE1_ROOM.take(),
+            &RUNS,
+            &mut display,
+            |display| display.flush(),
+            &mut led,
+            &timer,
+        );
+        let _ = display.clear(BinaryColor::On);
+        let _ = display.flush();
+        loop {
+            cortex_m::asm::wfi();
+        }
+    }
 
     // octrace: parse and index the scene (the light buffer on core 1 while
     // core 0 builds the octree), then trace it at the panel's size with

@@ -16,8 +16,9 @@ use ssd1306::mode::BufferedGraphicsMode;
 use ssd1306::prelude::*;
 use ssd1306::{I2CDisplayInterface, Ssd1306};
 
-/// The panel's width in pixels.
+/// The panel's width and height in pixels.
 pub const WIDTH: usize = 128;
+pub const HEIGHT: usize = 64;
 
 /// The bus's clock: the SSD1306's fastest.
 const BUS_HZ: u32 = 400_000;

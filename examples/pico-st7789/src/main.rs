@@ -128,6 +128,7 @@ fn main() -> ! {
             CORE1_ROOM.take(),
             &RUNS,
             &mut display,
+            |_| Ok(()),
             &mut led,
             &timer,
         );
