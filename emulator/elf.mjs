@@ -108,3 +108,51 @@ export function functionAt(functions, address) {
   const hex = `0x${(address >>> 0).toString(16).padStart(8, '0')}`;
   return found ? `${found.name} (${hex})` : hex;
 }
+
+/**
+ * The name of the function holding `address` (demangled, `demangle`), or
+ * `?` — by bisection, for a profile's many lookups (`functions` sorted by
+ * address, as `parseElf` gives them).
+ */
+export function functionNameAt(functions, address) {
+  let lo = 0;
+  let hi = functions.length - 1;
+  let found = -1;
+  while (lo <= hi) {
+    const mid = (lo + hi) >> 1;
+    if (functions[mid].address <= address) {
+      found = mid;
+      lo = mid + 1;
+    } else {
+      hi = mid - 1;
+    }
+  }
+  const f = functions[found];
+  if (!f || address >= f.address + Math.max(f.size, 2)) return '?';
+  return (f.demangled ??= demangle(f.name));
+}
+
+/** Rust's legacy mangling (`_ZN` + lengthed parts + `E`) read back, its hash dropped; any other name as it is. */
+export function demangle(name) {
+  const match = /^_?_ZN(.*)E$/.exec(name);
+  if (!match) return name;
+  const parts = [];
+  let rest = match[1];
+  while (rest.length > 0) {
+    const length = /^\d+/.exec(rest);
+    if (!length) return name;
+    parts.push(rest.slice(length[0].length, length[0].length + Number(length[0])));
+    rest = rest.slice(length[0].length + Number(length[0]));
+  }
+  if (parts.length > 1 && /^h[0-9a-f]{16}$/.test(parts.at(-1))) parts.pop();
+  const escapes = { SP: '@', BP: '*', RF: '&', LT: '<', GT: '>', LP: '(', RP: ')', C: ',' };
+  return parts
+    .map((part) =>
+      part
+        .replace(/^_\$/, '$')
+        .replace(/\$([A-Z]{1,2})\$/g, (all, code) => escapes[code] ?? all)
+        .replace(/\$u([0-9a-f]+)\$/g, (_, hex) => String.fromCodePoint(parseInt(hex, 16)))
+        .replace(/\.\./g, '::'),
+    )
+    .join('::');
+}

@@ -37,7 +37,7 @@
 
 import { RP2040, GPIOPinState } from 'rp2040js';
 import { buildBootrom, codeLetters, MISSING_FUNCTION_BREAKPOINT } from './bootrom.mjs';
-import { functionAt, parseElf } from './elf.mjs';
+import { functionAt, functionNameAt, parseElf } from './elf.mjs';
 import { correctInstructions } from './armv6m.mjs';
 import { ST7789 } from './st7789.mjs';
 import { I2cController } from './i2c.mjs';
@@ -67,6 +67,8 @@ const BRANCH_TO_SELF = 0xe7fe;
 const WFE = 0xbf20;
 /** How often (in instructions) the run looks for endless loops, its budget, and reports progress. */
 const CHECK_EVERY = 0xfffff;
+/** How often (in instructions) a profiled run samples where the cores are. */
+const SAMPLE_EVERY = 0xff;
 /** rp2040js's peripherals, by `(address >>> 14) << 2`. */
 const XIP_CTRL_SLOT = 0x14000;
 const BUSCTRL_SLOT = 0x40030;
@@ -118,6 +120,10 @@ export class Pico {
     /** Machine time in cycles: the clock's, which follows the earlier running core. */
     this.time = 0;
     this.steps = 0;
+    /** Instructions between the run's checks (a power of two, less one): fewer while profiling. */
+    this.checkEvery = CHECK_EVERY;
+    /** While profiling: cycles by function, and each core's time at its last sample. */
+    this.profile = null;
     this.current = 0;
     this.cores = [rp2040.core, null];
     this.held = [false, false];
@@ -389,7 +395,7 @@ export class Pico {
     let time = this.time;
     let steps0 = 0;
     let steps1 = 0;
-    let countdown = CHECK_EVERY + 1 - (this.steps & CHECK_EVERY);
+    let countdown = this.checkEvery + 1 - (this.steps & this.checkEvery);
     let reason = null;
     this.woke = false;
     for (;;) {
@@ -419,7 +425,7 @@ export class Pico {
         this.count(1, steps1);
         steps0 = steps1 = 0;
         this.check(maxCycles, onProgress);
-        countdown = CHECK_EVERY + 1;
+        countdown = this.checkEvery + 1;
       }
     }
     this.time = time;
@@ -461,7 +467,7 @@ export class Pico {
     const clock = this.clock;
     let time = this.time;
     let steps = 0;
-    let countdown = CHECK_EVERY + 1 - (this.steps & CHECK_EVERY);
+    let countdown = this.checkEvery + 1 - (this.steps & this.checkEvery);
     let reason = null;
     let watchLaunch = k === 1 && !this.core1Ran;
     this.current = k;
@@ -487,7 +493,7 @@ export class Pico {
         this.count(k, steps);
         steps = 0;
         this.check(maxCycles, onProgress);
-        countdown = CHECK_EVERY + 1;
+        countdown = this.checkEvery + 1;
       }
     }
     this.time = time;
@@ -516,7 +522,46 @@ export class Pico {
     return true;
   }
 
+  /**
+   * From now on, samples where each running core is every 256
+   * instructions and charges the cycles since its last sample to the
+   * function it is in (`profileReport`): a statistical profile, as a
+   * sampling profiler takes on a board, a little slower to run.
+   */
+  startProfile() {
+    this.profile = { cycles: new Map(), last: this.cores.map((core) => core?.cycles ?? 0), checks: 0 };
+    this.checkEvery = SAMPLE_EVERY;
+  }
+
+  sample() {
+    const { cycles, last } = this.profile;
+    for (let k = 0; k < 2; k++) {
+      const core = this.cores[k];
+      if (!core) continue;
+      const spent = core.cycles - last[k];
+      last[k] = core.cycles;
+      if (core.waiting || spent <= 0) continue;
+      const name = functionNameAt(this.functions, core.PC >>> 0);
+      cycles.set(name, (cycles.get(name) ?? 0) + spent);
+    }
+  }
+
+  /** The `top` functions the profile charged most, with their cycles and share of all it charged. */
+  profileReport(top) {
+    const entries = [...(this.profile?.cycles ?? [])];
+    const all = entries.reduce((sum, [, cycles]) => sum + cycles, 0);
+    return entries
+      .sort((a, b) => b[1] - a[1])
+      .slice(0, top)
+      .map(([name, cycles]) => ({ name, cycles, share: all ? cycles / all : 0 }));
+  }
+
   check(maxCycles, onProgress) {
+    if (this.profile) {
+      this.sample();
+      // The other checks at their usual pace.
+      if (++this.profile.checks & (CHECK_EVERY >> 8)) return;
+    }
     for (let k = 0; k < 2; k++) {
       const core = this.cores[k];
       if (core.waiting) continue;

@@ -16,6 +16,12 @@
 // default on; off measures what the contention costs), --json (the report
 // as JSON on standard output), --quiet.
 //
+// --profile N: where the cycles went, by function: each running core's
+// place sampled every 256 instructions, the cycles since charged to the
+// function it is in (the ELF's symbols; inlined code counts as its
+// caller), and the N functions charged most listed after the report (in
+// it, with --json). Not with --serial.
+//
 // --frames N: for a firmware that draws frames (an animation), runs until
 // N frames are on the panel and writes each as it was then: --out is then
 // a pattern with one %d or %0Nd (default panel%03d.png), the frames
@@ -53,6 +59,7 @@ import { framePattern, watchFrames } from './frames.mjs';
 const USAGE =
   'usage: node run.mjs ELF [--out FILE.png] [--display auto|st7789|ssd1306] [--panel WxH] [--panel-offset X,Y] [--max-seconds S] [--contention on|off] [--json] [--quiet]\n' +
   '       node run.mjs ELF --frames N [--out \'DIR/f%03d.png\'] [the options above]\n' +
+  '       node run.mjs ELF --profile N [the options above, or --frames N]: also where the cycles went, by function\n' +
   '       node run.mjs ELF --serial [--out FILE.png] [--display auto|st7789|ssd1306] [--panel WxH] [--panel-offset X,Y] [--contention on|off] [--json]';
 
 function usage(message) {
@@ -81,6 +88,7 @@ try {
       'max-seconds': { type: 'string', default: '120' },
       frames: { type: 'string' },
       contention: { type: 'string', default: 'on' },
+      profile: { type: 'string' },
       json: { type: 'boolean', default: false },
       quiet: { type: 'boolean', default: false },
     },
@@ -115,7 +123,12 @@ const wired = {
 if (values.out !== undefined && !values.out.toLowerCase().endsWith('.png')) {
   usage(`--out ${values.out}: the picture is written as PNG: name a .png file`);
 }
+const profileTop = values.profile === undefined ? null : Number(values.profile);
+if (profileTop !== null && !(Number.isInteger(profileTop) && profileTop > 0)) {
+  usage(`--profile ${values.profile}: expected how many functions to list, at least 1`);
+}
 if (values.serial) {
+  if (profileTop !== null) usage('--profile: not with --serial');
   await serve();
 }
 const frameCount = values.frames === undefined ? null : Number(values.frames);
@@ -142,6 +155,7 @@ try {
   const pictures = [];
   const picture = () => encodePng(pico.display.width, pico.display.height, pico.display.picture());
   const frames = frameCount === null ? null : watchFrames(pico, { count: frameCount, onFrame: () => pictures.push(picture()) });
+  if (profileTop !== null) pico.startProfile();
   const ended = pico.run({
     maxCycles: maxSeconds * CLOCK_HZ,
     onProgress: progress
@@ -165,6 +179,7 @@ try {
     writeAtomically(out, picture());
   }
   report = runReport(pico, out, frames && frames.map(({ index, cycles, lit, busy }) => ({ index, out: frameName(index), cycles, lit, busy })));
+  if (profileTop !== null) report.profile = pico.profileReport(profileTop);
 } catch (error) {
   if (progress) process.stderr.write('\r\x1b[K');
   if (expected(error)) {
@@ -216,6 +231,14 @@ if (values.json) {
       report.dark
         ? `the ${report.display} panel is dark: ${report.dark}`
         : `the ${report.display} panel's ${report.panel} ${report.frames ? 'frames' : 'picture'}: ${out}`,
+      ...(report.profile
+        ? [
+            'where the cycles went (sampled every 256 instructions, by function; inlined code counts as its caller):',
+            ...report.profile.map(
+              ({ name, cycles, share }) => `  ${(100 * share).toFixed(1).padStart(5)} %  ${count(cycles).padStart(13)} cycles  ${name}`,
+            ),
+          ]
+        : []),
     ].join('\n'),
   );
 }

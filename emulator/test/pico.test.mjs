@@ -123,3 +123,28 @@ test('an interrupt pended by software (NVIC ISPR) with its line low is taken onc
   assert.equal(pico.run({ maxCycles: 1e7 }), 'idle');
   assert.deepEqual(values(records, 0), [1, 2], 'the handler once, then the program');
 });
+
+test('a profile charges each function the cycles spent in it', () => {
+  // Core 0 spins 20,000 times in one function, then 60,000 in another.
+  const second = CORE0_CODE + 0x200;
+  const image = flashImage({
+    programs: {
+      [CORE0_CODE]: (t) => delay(t, 20000).ldrConst(1, second | 1).blx(1),
+      [second]: (t) => halt(delay(t, 60000)),
+    },
+  });
+  const functions = [
+    { name: '_ZN4demo5first17h0123456789abcdefE', address: CORE0_CODE, size: 0x100 },
+    { name: '_ZN4demo6second17h0123456789abcdefE', address: second, size: 0x100 },
+  ];
+  const { pico } = machine(image, { functions });
+  pico.startProfile();
+  assert.equal(pico.run(), 'idle');
+  const [most, next] = pico.profileReport(2);
+  assert.deepEqual([most.name, next.name], ['demo::second', 'demo::first']);
+  // A pass of the loop is SUBS and a taken branch, 3 cycles; a sample
+  // charges the cycles since the one before, so the first function also
+  // takes the boot's last stretch (256 instructions, some from flash).
+  assert.ok(Math.abs(most.cycles - 3 * 60000) < 1000, `${most.cycles}`);
+  assert.ok(next.cycles >= 3 * 20000 && next.cycles < 3 * 20000 + 8000, `${next.cycles}`);
+});
