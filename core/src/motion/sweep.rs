@@ -38,6 +38,21 @@ fn cell(v: i64) -> i32 {
     ((v + (1 << (GRID_BITS - 1))) >> GRID_BITS) as i32
 }
 
+/// `u · v` for grid differences (each below 2^15 in magnitude): every
+/// product fits an `i32`, which a Cortex-M0 makes in one instruction
+/// (an `i64` product is a library call there).
+#[inline]
+fn dot(u: [i32; 3], v: [i32; 3]) -> i64 {
+    i64::from(u[0] * v[0]) + i64::from(u[1] * v[1]) + i64::from(u[2] * v[2])
+}
+
+/// `|u|²` for a difference of grid differences (each below 2^16 in
+/// magnitude): every square fits a `u32`.
+#[inline]
+fn squared_length(u: [i32; 3]) -> i64 {
+    u.iter().map(|&x| i64::from(x.unsigned_abs() * x.unsigned_abs())).sum()
+}
+
 impl Segment {
     /// The segment between raw points `p` and `q`.
     pub(crate) fn new(p: [i64; 3], q: [i64; 3]) -> Segment {
@@ -57,17 +72,16 @@ impl Segment {
         if (0..3).any(|a| i64::from(self.hi[a]) < i64::from(c[a]) - r || i64::from(self.lo[a]) > i64::from(c[a]) + r) {
             return false;
         }
-        // Cells are below 2^14: squares and their products fit an i64.
-        let d = [0, 1, 2].map(|a| i64::from(self.q[a] - self.p[a]));
-        let w = [0, 1, 2].map(|a| i64::from(c[a] - self.p[a]));
-        let dot = |u: [i64; 3], v: [i64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+        // Cells are below 2^14: differences below 2^15, their squares and
+        // their products' sums fit an i64.
+        let d = [0, 1, 2].map(|a| self.q[a] - self.p[a]);
+        let w = [0, 1, 2].map(|a| c[a] - self.p[a]);
         let (dd, wd, ww) = (dot(d, d), dot(w, d), dot(w, w));
         if wd <= 0 || dd == 0 {
             return ww <= r * r;
         }
         if wd >= dd {
-            let e = [0, 1, 2].map(|a| w[a] - d[a]);
-            return dot(e, e) <= r * r;
+            return squared_length([0, 1, 2].map(|a| w[a] - d[a])) <= r * r;
         }
         // The distance to the line, squared, times |d|²: |w|²·|d|² − (w·d)².
         ww * dd - wd * wd <= r * r * dd
@@ -83,15 +97,20 @@ impl Segment {
         let c = center.map(|v| cell(i64::from(v)));
         let inner = i64::from((radius.saturating_sub(4 * WIDENING) >> GRID_BITS) - 4);
         let outer = i64::from((radius.saturating_add(4 * WIDENING) >> GRID_BITS) + 5);
-        if inner <= 0 {
+        // Passing within `inner` of the centre, the segment's box meets the
+        // centre's box of that half-side.
+        if inner <= 0
+            || (0..3).any(|a| {
+                i64::from(self.hi[a]) < i64::from(c[a]) - inner || i64::from(self.lo[a]) > i64::from(c[a]) + inner
+            })
+        {
             return false;
         }
-        let d = [0, 1, 2].map(|a| i64::from(self.q[a] - self.p[a]));
-        let w = [0, 1, 2].map(|a| i64::from(c[a] - self.p[a]));
-        let e = [0, 1, 2].map(|a| w[a] - d[a]);
-        let dot = |u: [i64; 3], v: [i64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+        let d = [0, 1, 2].map(|a| self.q[a] - self.p[a]);
+        let w = [0, 1, 2].map(|a| c[a] - self.p[a]);
+        let e = squared_length([0, 1, 2].map(|a| w[a] - d[a]));
         let (dd, wd, ww) = (dot(d, d), dot(w, d), dot(w, w));
-        ww > outer * outer && dot(e, e) > outer * outer && wd > 0 && wd < dd && ww * dd - wd * wd <= inner * inner * dd
+        ww > outer * outer && e > outer * outer && wd > 0 && wd < dd && ww * dd - wd * wd <= inner * inner * dd
     }
 
     /// Whether the segment comes near the raw box `[lo, hi]`: on the grid,
@@ -333,5 +352,15 @@ mod tests {
         assert!(!s.meets([1 << 29; 3], [(1 << 29) + 5; 3]));
         let s = Segment::new([-(1 << 29); 3], [far; 3]);
         assert!(s.meets([1 << 28; 3], [(1 << 28) + 5; 3]));
+        // The spheres' tests at the same extremes (a product past an
+        // `i32` panics here, in a test build), a centre at either end.
+        let s = Segment::new([-far; 3], [far, far, -far]);
+        for center in [[i32::MIN; 3], [i32::MAX; 3], [i32::MAX, i32::MIN, i32::MAX]] {
+            for radius in [1, 1 << 20, i32::MAX] {
+                let _ = (s.near_sphere(center, radius), s.through_sphere(center, radius));
+            }
+        }
+        let s = Segment::new([far; 3], [-far; 3]);
+        assert!(s.near_sphere([0; 3], 1) && !s.near_sphere([i32::MAX, i32::MIN, 0], 1));
     }
 }
