@@ -11,9 +11,9 @@
 //! Invariants: the scene, its octree and core 0's mailbox live in one
 //! static cell, core 1's mailbox and lists in another (all zero bits, so in
 //! `.bss`: no flash, no copy on the stack); so do an animation's motion and
-//! tiles, sized for this scene by `build.rs` (empty for a still); the image takes the panel's
-//! size and colour, and so its look; any split of the rows between the
-//! cores gives the same bits as one core.
+//! tiles, sized for this scene by `build.rs` (empty for a still); the image
+//! takes the panel's size and colour, and so its look; any split of the
+//! rows or tiles between the cores gives the same bits as one core.
 
 #![no_std]
 #![no_main]

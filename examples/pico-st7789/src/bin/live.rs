@@ -4,9 +4,9 @@
 //! answers with its errors at line and column, or draws it on the panel
 //! with both cores (sending the rows back when asked), then waits for the
 //! next. An animation (a scene with `FRAMES`) is played in a loop on both
-//! cores, each frame re-tracing only the tiles its motion can change and drawing
-//! only their runs (sent back as runs), until the host sends anything. The
-//! protocol is octrace-link's (`docs/board-protocol.md`).
+//! cores, each frame re-tracing only the tiles its motion can change and
+//! drawing only their runs (sent back as runs), until the host sends
+//! anything. The protocol is octrace-link's (`docs/board-protocol.md`).
 //!
 //! Invariants: the USB device lives in the USB interrupt, which moves bytes
 //! between it and two rings (`INPUT`, `OUTPUT`); the main loop on core 0
@@ -84,10 +84,11 @@ static DISPLACEMENTS: ConstStaticCell<[[i32; 3]; 192]> = ConstStaticCell::new([[
 /// Core 1's own mailbox and screen lists.
 static CORE1_ROOM: ConstStaticCell<RendererRoom<LiveProfile>> = ConstStaticCell::new(RendererRoom::new());
 
-/// Core 1's stack: 8 KiB, its job loop and a drawing's renderer (it
-/// traces on SRAM5, `octrace_pico::bank_stack`; this firmware loads every
-/// scene on core 0), so that the scene's text keeps its 32 KiB.
-static CORE1_STACK: Stack<2048> = Stack::new();
+/// Core 1's stack: 16 KiB, as the template's: its job loop, a drawing's
+/// renderer, and an animation's bands, which it traces here (a still's
+/// rows it traces on SRAM5, `octrace_pico::bank_stack`; this firmware
+/// loads every scene on core 0).
+static CORE1_STACK: Stack<4096> = Stack::new();
 
 /// Core 1's rows (a still's) or runs (an animation's) on their way to the panel.
 static RUNS: Runs<{ panel::WIDTH as usize }, 4> = Runs::new();
