@@ -16,8 +16,8 @@
 //! queries, each O(objects) in the naive mode.
 //!
 //! A sample can be stopped between any two of its rays, shadow rays
-//! included ([`Poll`], asked before each): the colour of a stopped sample
-//! is partial, and [`Poll::stopped`] says so; one not stopped gives the
+//! included (`Poll`, asked before each): the colour of a stopped sample
+//! is partial, and `Poll::stopped` says so; one not stopped gives the
 //! same bits whether it was asked or not.
 
 use crate::accel::{Accelerator, Hit, Mailbox, RayStart};
