@@ -238,17 +238,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         D: DrawTarget,
         D::Color: TracedColor,
     {
-        match D::Color::PANEL {
-            None => self.draw_bands_converted(motion, frame, coherence, bands, target, &mut Unpolled),
-            Some(_) => self.draw_bands_converted(
-                motion,
-                frame,
-                coherence,
-                bands,
-                &mut Dithered::ordered(target),
-                &mut Unpolled,
-            ),
-        }
+        self.draw_bands_polled(motion, frame, coherence, bands, target, &mut Unpolled)
     }
 
     /// [`LoadedScene::draw_bands`], asking `stop` before every ray (as
@@ -268,17 +258,33 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         D: DrawTarget,
         D::Color: TracedColor,
     {
-        let mut polling = Polling { stop, stopped: false };
+        self.draw_bands_polled(motion, frame, coherence, bands, target, &mut Polling { stop, stopped: false })
+    }
+
+    /// [`LoadedScene::draw_bands`], `poll` asked before every ray: into
+    /// `target` converted, or through ordered dithering for a panel of few
+    /// levels.
+    fn draw_bands_polled<D, Q: Poll>(
+        &self,
+        motion: &Motion<'_>,
+        frame: u32,
+        coherence: &Coherence<'_>,
+        bands: impl IntoIterator<Item = u32>,
+        target: &mut D,
+        poll: &mut Q,
+    ) -> Result<Stats, DrawError<D::Error>>
+    where
+        D: DrawTarget,
+        D::Color: TracedColor,
+    {
         match D::Color::PANEL {
-            None => self.draw_bands_converted(motion, frame, coherence, bands, target, &mut polling),
-            Some(_) => {
-                self.draw_bands_converted(motion, frame, coherence, bands, &mut Dithered::ordered(target), &mut polling)
-            }
+            None => self.draw_bands_converted(motion, frame, coherence, bands, target, poll),
+            Some(_) => self.draw_bands_converted(motion, frame, coherence, bands, &mut Dithered::ordered(target), poll),
         }
     }
 
-    /// [`LoadedScene::draw_bands`] into a target that takes the traced
-    /// colours converted, `poll` asked before every ray.
+    /// [`LoadedScene::draw_bands_polled`] into a target that takes the
+    /// traced colours converted.
     fn draw_bands_converted<D, Q: Poll>(
         &self,
         motion: &Motion<'_>,
