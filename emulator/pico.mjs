@@ -69,6 +69,8 @@ const WFE = 0xbf20;
 const CHECK_EVERY = 0xfffff;
 /** How often (in instructions) a profiled run samples where the cores are. */
 const SAMPLE_EVERY = 0xff;
+/** Samples between a profiled run's other checks, less one: those stay at their usual pace. */
+const SAMPLES_PER_CHECK = (CHECK_EVERY + 1) / (SAMPLE_EVERY + 1) - 1;
 /** rp2040js's peripherals, by `(address >>> 14) << 2`. */
 const XIP_CTRL_SLOT = 0x14000;
 const BUSCTRL_SLOT = 0x40030;
@@ -559,8 +561,7 @@ export class Pico {
   check(maxCycles, onProgress) {
     if (this.profile) {
       this.sample();
-      // The other checks at their usual pace.
-      if (++this.profile.checks & (CHECK_EVERY >> 8)) return;
+      if (++this.profile.checks & SAMPLES_PER_CHECK) return;
     }
     for (let k = 0; k < 2; k++) {
       const core = this.cores[k];
