@@ -149,7 +149,8 @@ mod test_rng;
 
 pub use accel::AccelMode;
 pub use raytracer::{
-    DrawError, LoadError, LoadedScene, Raytracer, RendererRoom, SceneAccelerator, SharedScene, TracedImage,
+    AnimationError, DrawError, Frame, LoadError, LoadedScene, Raytracer, RendererRoom, SceneAccelerator, SharedScene,
+    TracedImage,
 };
 #[cfg(feature = "static-cell")]
 pub use static_cell::ConstStaticCell;

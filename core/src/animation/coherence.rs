@@ -10,22 +10,15 @@
 //! tile (loads and stores only, which a Cortex-M0 has), so cores share one
 //! store without a lock.
 
+use super::player::Playing;
 use crate::accel::Accelerator;
-use crate::motion::{Dependence, Lookout, Motion, NEVER};
-use crate::render::{PixelSample, Polling, Renderer, Stop, Stopped};
-use crate::shade::Stats;
-use crate::shade::{Poll, Unpolled};
-use core::fmt;
+use crate::motion::{Lookout, NEVER};
+use crate::render::{Halt, PixelSample, Renderer};
+use crate::shade::{Poll, Stats};
 use core::ops::Range;
 use core::sync::atomic::{AtomicU8, Ordering};
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
-
-/// Why a band's trace ended early: its sink's error, or its poll said stop.
-pub(crate) enum Halt<E, S> {
-    Sink(E),
-    Stopped(S),
-}
 
 /// A tile to trace in the frame being drawn.
 const TRACE: u8 = 254;
@@ -38,79 +31,31 @@ const MOST: u8 = 253;
 const RUN_TILES: usize = 32;
 
 /// What receives a traced run's row of pixels: the row (a rectangle one
-/// pixel high) and its pixels as they are traced
-/// ([`Coherence::trace_band`]).
-pub type RunSink<'f, E> = dyn FnMut(&Rectangle, &mut dyn Iterator<Item = PixelSample>) -> Result<(), E> + 'f;
+/// pixel high) and its pixels as they are traced.
+pub(crate) type RunSink<'f, E> = dyn FnMut(&Rectangle, &mut dyn Iterator<Item = PixelSample>) -> Result<(), E> + 'f;
 
-/// Why [`Coherence::new`] refused its storage.
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum CoherenceError {
-    /// Fewer counts than tiles: how many the image needs
-    /// ([`Coherence::tiles_for`]).
-    NoRoom {
-        /// Tiles in the image.
-        needed: usize,
-    },
-}
-
-impl fmt::Display for CoherenceError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            CoherenceError::NoRoom { needed } => write!(f, "no room for coherence: the image has {needed} tiles"),
-        }
-    }
-}
-
-impl core::error::Error for CoherenceError {}
-
-/// The tiles of an animation's image and what each still holds, over one
-/// byte a tile of the caller's storage ([`Coherence::tiles_for`] of them, a
-/// `const fn`). Each frame: [`Coherence::plan`], then trace the bands
-/// ([`LoadedScene::draw_bands`](crate::LoadedScene::draw_bands) into a
-/// display, or [`Coherence::trace_band`]),
-/// on one core or several, each with a renderer of its own over the
-/// frame's scene: only the tiles that can have changed are traced, and
-/// only their runs of pixels drawn. The scene's profile says
-/// `coherence: true` ([`Profile::COHERENCE`](crate::profile::Profile::COHERENCE));
-/// under one that does not, every tile is traced each frame (the same
-/// pictures, none of the watching code linked).
+/// The tiles of an animation's image and what each still holds: one byte
+/// a tile, in an [`Animation`](super::Animation)'s room. Each frame
+/// loaded plans which tiles it traces (those whose count ran out); the
+/// frame's draw traces them and records their new counts. Under a profile
+/// without `coherence: true`
+/// ([`Profile::COHERENCE`](crate::profile::Profile::COHERENCE)) every tile
+/// is traced each frame (the same pictures, none of the watching code
+/// linked).
 ///
 /// ```
-/// use core::sync::atomic::AtomicU8;
-/// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*};
-/// use octrace_core::animation::{Coherence, Key, Motion, Track};
-/// use octrace_core::Raytracer;
+/// use embedded_graphics::prelude::*;
+/// use octrace_core::animation::{AnimationNeeds, AnimationRoom};
 ///
-/// octrace_core::profile! {
-///     /// Two spheres, one moving; frames re-trace only what changes.
-///     struct Moving { spheres: 2, surfaces: 1, lights: 1 }
-///     coherence: true
-/// }
-/// let text = "FRAMES 4\nRASTER 16 16\nBACKGROUND 0 0 1\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\n\
-///             LIGHT 10 5 5 5\nSPHERE 1 2 0 0 -4\nSPHERE 1 0.5 -3 2 0 MOVE 0 0 0 0  3 1.5 0 0\n";
-/// const TILES: usize = Coherence::tiles_for(16, 16, 4);
-/// static COUNTS: [AtomicU8; TILES] = [const { AtomicU8::new(0) }; TILES];
-/// let coherence = Coherence::new(&COUNTS, Size::new(16, 16), 4)?;
-/// let (mut tracks, mut keys, mut displacements) = ([Track::EMPTY; 1], [Key::default(); 2], [[0; 3]; 4]);
-///
-/// let mut raytracer = Raytracer::<Moving>::new();
-/// let mut panel = MockDisplay::<Rgb888>::new();
-/// panel.set_allow_overdraw(true);
-/// let first = raytracer.load_frame(text, 0)?;
-/// let frames = first.frames().unwrap();
-/// let motion = Motion::read(text, frames, &first.view(), 0, &mut tracks, &mut keys, &mut displacements)?;
-/// for frame in frames.all() {
-///     let scene = raytracer.load_frame(text, frame)?;
-///     let tiles = coherence.plan();
-///     scene.draw_changes(&motion, frame, &coherence, &mut panel)?;
-///     // The panel shows frame `frame`, as if drawn whole.
-///     let mut whole = MockDisplay::<Rgb888>::new();
-///     Image::new(&scene.image(Size::new(16, 16)), Point::zero()).draw(&mut whole)?;
-///     assert_eq!(panel, whole);
-///     assert!(frame == 0 && tiles == 16 || frame > 0 && tiles < 16, "frame {frame}: {tiles} tiles");
-/// }
-/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// let size = Size::new(240, 240);
+/// let mut room = AnimationRoom::<{ AnimationNeeds::tiles_for(Size::new(240, 240)) }, 0, 0>::new();
+/// let animation = room.animation(size)?;
+/// let tiles = animation.tiles();
+/// // Runs of up to 32 tiles of 4 pixels: 128 pixels of a 240-pixel row.
+/// assert_eq!((tiles.bands(), tiles.longest_row()), (60, 128));
+/// // Nothing loaded yet: every tile is to be traced.
+/// assert_eq!(tiles.traced_pixels(), 240 * 240);
+/// # Ok::<(), octrace_core::animation::NoRoom>(())
 /// ```
 #[derive(Clone, Copy, Debug)]
 pub struct Coherence<'s> {
@@ -118,7 +63,6 @@ pub struct Coherence<'s> {
     size: Size,
     side: u32,
     across: u32,
-    ignored: u8,
 }
 
 impl<'s> Coherence<'s> {
@@ -130,22 +74,15 @@ impl<'s> Coherence<'s> {
     }
 
     /// Coherence for an image of `size` in tiles of `side` × `side` pixels
-    /// over `counts`, every tile to be traced at the first frame.
-    pub fn new(counts: &'s [AtomicU8], size: Size, side: u32) -> Result<Coherence<'s>, CoherenceError> {
+    /// over `counts`, every tile to be traced at the first frame; or how
+    /// many counts it needs.
+    pub(crate) fn new(counts: &'s [AtomicU8], size: Size, side: u32) -> Result<Coherence<'s>, usize> {
         let side = side.max(1);
         let needed = Coherence::tiles_for(size.width, size.height, side);
-        let Some(counts) = counts.get(..needed) else { return Err(CoherenceError::NoRoom { needed }) };
-        let coherence = Coherence { counts, size, side, across: size.width.div_ceil(side), ignored: 0 };
+        let counts = counts.get(..needed).ok_or(needed)?;
+        let coherence = Coherence { counts, size, side, across: size.width.div_ceil(side) };
         coherence.restart();
         Ok(coherence)
-    }
-
-    /// Drops the dependence `dependence` from the tracking: for a test
-    /// that checks its check of exactness fails without it.
-    #[doc(hidden)]
-    pub fn ignoring(mut self, dependence: Dependence) -> Self {
-        self.ignored |= 1 << dependence as u8;
-        self
     }
 
     /// The image's size.
@@ -158,20 +95,8 @@ impl<'s> Coherence<'s> {
         self.side
     }
 
-    /// The most pixels of a row a run of tiles hands over at once
-    /// ([`Coherence::trace_band`]): what a buffer for one must hold.
-    ///
-    /// ```
-    /// use core::sync::atomic::AtomicU8;
-    /// use embedded_graphics::prelude::Size;
-    /// use octrace_core::animation::Coherence;
-    ///
-    /// const TILES: usize = Coherence::tiles_for(240, 240, 4);
-    /// static COUNTS: [AtomicU8; TILES] = [const { AtomicU8::new(0) }; TILES];
-    /// // Runs of up to 32 tiles of 4 pixels: 128 pixels of a 240-pixel row.
-    /// assert_eq!(Coherence::new(&COUNTS, Size::new(240, 240), 4)?.longest_row(), 128);
-    /// # Ok::<(), octrace_core::animation::CoherenceError>(())
-    /// ```
+    /// The most pixels of a row a frame's draw hands a target at once
+    /// (a row of a run of tiles): what a buffer for one must hold.
     pub fn longest_row(&self) -> u32 {
         (RUN_TILES as u32 * self.side).min(self.size.width)
     }
@@ -184,15 +109,15 @@ impl<'s> Coherence<'s> {
 
     /// Every tile is traced in the next frame (the scene or its frame
     /// changed otherwise than by the loop's next step).
-    pub fn restart(&self) {
+    pub(crate) fn restart(&self) {
         self.counts.iter().for_each(|c| c.store(TRACE, Ordering::Relaxed));
     }
 
     /// Steps to the next frame of the loop: a tile whose count ran out is
     /// marked to be traced, the others count one transition less. Returns
-    /// how many tiles the frame traces. Call it once a frame, on one core,
-    /// before any traces.
-    pub fn plan(&self) -> usize {
+    /// how many tiles the frame traces. Once a frame, on one core, before
+    /// any traces.
+    pub(crate) fn plan(&self) -> usize {
         let mut traced = 0;
         for count in self.counts {
             let next = match count.load(Ordering::Relaxed) {
@@ -229,6 +154,13 @@ impl<'s> Coherence<'s> {
         u64::from(area.size.width) * u64::from(area.size.height)
     }
 
+    /// The rectangles of pixels the planned frame traces: each run of
+    /// tiles of each band (what a writer that stores only a frame's
+    /// changes stores).
+    pub fn traced_areas(&self) -> impl Iterator<Item = Rectangle> + '_ {
+        (0..self.bands()).flat_map(move |band| self.runs(band).map(move |tiles| self.area(band, &tiles)))
+    }
+
     /// The runs of tiles of band `band` to trace in the planned frame, as
     /// ranges of tile columns.
     pub fn runs(&self, band: u32) -> impl Iterator<Item = Range<u32>> + '_ {
@@ -248,60 +180,24 @@ impl<'s> Coherence<'s> {
     }
 
     /// Traces the tiles of band `band` that the planned frame traces, frame
-    /// `frame` of `motion` loaded in `renderer`'s scene: each run of tiles
-    /// row by row, handing `each` the run's row (a rectangle one pixel
-    /// high) and its pixels as they are traced; records the tiles' new
-    /// counts. Returns the counters of the traces, or `each`'s error.
-    pub fn trace_band<'a, A: Accelerator, E>(
-        &self,
-        renderer: &mut Renderer<'a, A>,
-        motion: &'a Motion<'a>,
-        frame: u32,
-        band: u32,
-        each: &mut RunSink<'_, E>,
-    ) -> Result<Stats, E> {
-        match self.trace_band_polled(renderer, motion, frame, band, &mut Unpolled, each) {
-            Ok(stats) => Ok(stats),
-            Err(Halt::Sink(e)) => Err(e),
-            Err(Halt::Stopped(never)) => match never {},
-        }
-    }
-
-    /// [`Coherence::trace_band`], asking `stop` before every ray (as
-    /// [`Renderer::pixel_until`] does): [`Stopped`] as soon as it says so.
-    /// The pixels of the run's row handed to `each` end before the stopped
-    /// pixel (`each` is still called; the error that follows says the row
-    /// is cut), and the tiles of that run keep their mark to be traced.
-    pub fn trace_band_until<'a, A: Accelerator, S: Stop, E: From<Stopped>>(
-        &self,
-        renderer: &mut Renderer<'a, A>,
-        motion: &'a Motion<'a>,
-        frame: u32,
-        band: u32,
-        stop: &mut S,
-        each: &mut RunSink<'_, E>,
-    ) -> Result<Stats, E> {
-        let mut polling = Polling { stop, stopped: false };
-        match self.trace_band_polled(renderer, motion, frame, band, &mut polling, each) {
-            Ok(stats) => Ok(stats),
-            Err(Halt::Sink(e)) => Err(e),
-            Err(Halt::Stopped(stopped)) => Err(stopped.into()),
-        }
-    }
-
-    /// [`Coherence::trace_band`] with `poll` asked before every ray.
+    /// `playing.frame` loaded in `renderer`'s scene, `poll` asked before
+    /// every ray: each run of tiles row by row, handing `each` the run's
+    /// row (a rectangle one pixel high) and its pixels as they are traced;
+    /// records the tiles' new counts. Returns the counters of the traces,
+    /// or why it ended early: `each`'s error, or the poll's stop (the
+    /// pixels of the row handed to `each` then end before the stopped
+    /// pixel, and the run's tiles keep their mark to be traced).
     #[inline(always)]
-    pub(crate) fn trace_band_polled<'a, A: Accelerator, Q: Poll, E>(
+    pub(crate) fn trace_band<'a, A: Accelerator, Q: Poll, E>(
         &self,
         renderer: &mut Renderer<'a, A>,
-        motion: &'a Motion<'a>,
-        frame: u32,
+        playing: &Playing<'a>,
         band: u32,
         poll: &mut Q,
         each: &mut RunSink<'_, E>,
     ) -> Result<Stats, Halt<E, Q::Stopped>> {
         let before = renderer.stats();
-        let lookout = Lookout::new(motion, frame, self.ignored);
+        let lookout = Lookout::new(playing.motion, playing.frame, playing.ignored);
         // A camera that moves before the next frame makes every count 0:
         // the pixels are traced as a still's, at a still's cost.
         let watching = !lookout.is_idle();
@@ -351,8 +247,7 @@ impl<'s> Coherence<'s> {
 #[cfg(test)]
 mod tests {
     extern crate std;
-    use super::*;
-    use crate::animation::{Key, Track};
+    use crate::animation::AnimationRoom;
     use crate::profile::{Board16K, Profile};
     use crate::Raytracer;
     use embedded_graphics::image::Image;
@@ -365,24 +260,20 @@ mod tests {
 
     /// Plays `TEXT` under profile `P`: each frame's tiles traced, and
     /// each panel checked against the frame drawn whole.
-    fn play<P: Profile>() -> std::vec::Vec<usize> {
-        let counts = [const { AtomicU8::new(0) }; 16];
-        let coherence = Coherence::new(&counts, Size::new(16, 16), 4).unwrap();
-        let (mut tracks, mut keys, mut displacements) = ([Track::EMPTY; 1], [Key::default(); 2], [[0; 3]; 4]);
+    fn play<P: Profile>() -> std::vec::Vec<u64> {
+        let size = Size::new(16, 16);
+        let mut room = AnimationRoom::<16, 1, 2>::new();
+        let mut animation = room.animation(size).unwrap();
         let mut raytracer = std::boxed::Box::new(Raytracer::<P>::new());
-        let first = raytracer.load_frame(TEXT, 0).unwrap();
-        let frames = first.frames().unwrap();
-        let view = first.view();
-        let motion = Motion::read(TEXT, frames, &view, 0, &mut tracks, &mut keys, &mut displacements).unwrap();
         let mut panel = MockDisplay::<Rgb888>::new();
         panel.set_allow_overdraw(true);
         let mut traced = std::vec::Vec::new();
-        for frame in frames.all() {
-            let scene = raytracer.load_frame(TEXT, frame).unwrap();
-            traced.push(coherence.plan());
-            scene.draw_changes(&motion, frame, &coherence, &mut panel).unwrap();
+        for frame in 0..4 {
+            let loaded = animation.load(&mut raytracer, TEXT, frame).unwrap();
+            traced.push(loaded.tiles().traced_pixels() / 16);
+            loaded.image().try_draw(&mut panel).unwrap();
             let mut whole = MockDisplay::<Rgb888>::new();
-            Image::new(&scene.image(Size::new(16, 16)), Point::zero()).draw(&mut whole).unwrap();
+            Image::new(&loaded.scene().image(size), Point::zero()).draw(&mut whole).unwrap();
             assert_eq!(panel, whole, "frame {frame}");
         }
         traced

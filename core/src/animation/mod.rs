@@ -3,11 +3,15 @@
 //! and every frame bit for bit the frame traced whole.
 //!
 //! A scene with `FRAMES` is an animation; `MOVE` keys displace the
-//! statement before them ([`crate::parse::parse_frame`] loads frame k,
-//! [`Raytracer::load_frame`](crate::Raytracer::load_frame) on a board).
-//! [`Motion`] holds what moves over the whole loop, read once into the
-//! caller's storage; [`Coherence`] holds a byte for each tile of the image
-//! (the caller's too, [`Coherence::tiles_for`] of them, a `const fn`).
+//! statement before them ([`crate::parse::parse_frame`] reads frame k). An
+//! [`Animation`] holds what moves over the whole loop and a byte for each
+//! tile of the image ([`Coherence`]), in storage the caller owns
+//! ([`AnimationRoom`], sized by [`AnimationNeeds`] of the scene: it grows
+//! with the scene's `MOVE`s and keys, not with its frames).
+//! [`Animation::load`] loads a frame (recording the motion as the loader
+//! places a scene it has not seen, and checking every frame's camera
+//! then), and the [`Frame`](crate::Frame) draws as a still does, tracing
+//! only the tiles that can have changed.
 //!
 //! # The invariant (`docs/animation.md` has it at length)
 //!
@@ -28,25 +32,33 @@
 //!
 //! # Memory
 //!
-//! One byte a tile: a 240×240 panel in 4×4 tiles is 3,600 bytes. The
-//! motion: a [`Track`] (44 bytes) for each `MOVE`, a [`Key`] (8 bytes) for
-//! each key, and 12 bytes a frame for each moving object statement
-//! ([`Motion::needs`]). Tracing keeps a run of 32 tiles' counts (128 bytes)
-//! on the stack.
+//! One byte a tile: a 240×240 panel in tiles of [`TILE`] is 3,600 bytes.
+//! The motion: a track (72 bytes) for each `MOVE` and a key (52 bytes) for
+//! each of its keys ([`AnimationNeeds::bytes`]), whatever the number of
+//! frames. Tracing keeps a run of 32 tiles' counts (128 bytes) on the
+//! stack.
 //!
 //! # On two cores
 //!
-//! [`Coherence::plan`] once a frame on one core; then each core, with a
-//! [`Renderer`](crate::render::Renderer) of its own over the frame's scene
-//! (`LoadedScene::with_renderer`, `SharedScene::renderer`), takes the next
-//! band not yet taken and traces it: [`LoadedScene::draw_bands`](crate::LoadedScene::draw_bands) on the core
-//! that drives the display, [`Coherence::trace_band`] on the other, which
-//! hands its runs over. The counts are atomics each written by the core
-//! that traced the tile.
+//! A frame is loaded on one core; then each core, with a renderer of its
+//! own over the frame (the loading core's room, or
+//! [`SharedScene::image`](crate::SharedScene::image) with a
+//! [`RendererRoom`](crate::RendererRoom)), takes the next band of tiles not
+//! yet taken and draws it ([`TracedImage::bands`](crate::TracedImage::bands)).
+//! The counts are atomics each written by the core that traced the tile.
 
 pub(crate) mod coherence;
+mod player;
+mod room;
 
-#[doc(hidden)]
 pub use crate::motion::Dependence;
-pub use crate::motion::{Key, Motion, MotionError, MotionNeeds, Track};
-pub use coherence::{Coherence, CoherenceError, RunSink};
+pub use coherence::Coherence;
+pub use player::Animation;
+pub(crate) use player::Playing;
+#[cfg(feature = "alloc")]
+pub use room::HostAnimationRoom;
+pub use room::{AnimationCapacity, AnimationNeeds, AnimationRoom, NoRoom};
+
+/// The side of the square tiles an animation's image is traced in, in
+/// pixels: chosen by measurement (BENCHMARKS.md, "Animation").
+pub const TILE: u32 = 4;

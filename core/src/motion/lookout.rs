@@ -53,7 +53,7 @@ pub(crate) enum RayKind {
 /// A renderer's lookout over one frame of an animation.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Lookout<'m> {
-    motion: &'m Motion<'m>,
+    motion: Motion<'m>,
     frame: u32,
     /// Transitions before the camera next moves, and a light.
     camera: u32,
@@ -66,7 +66,7 @@ pub(crate) struct Lookout<'m> {
 
 impl<'m> Lookout<'m> {
     /// The lookout over frame `frame` of `motion`.
-    pub(crate) fn new(motion: &'m Motion<'m>, frame: u32, ignored: u8) -> Lookout<'m> {
+    pub(crate) fn new(motion: Motion<'m>, frame: u32, ignored: u8) -> Lookout<'m> {
         let camera = motion.next_change_of(Target::Camera, frame);
         let lights = motion.next_change_of(Target::Light, frame);
         Lookout { motion, frame, camera, lights, ignored, clean: NEVER }

@@ -20,6 +20,8 @@ pub(crate) const GRID_BITS: u32 = 18;
 /// unit of the end points' own rounding.
 pub(crate) const WIDENING: i32 = (crate::accel::FILING_MARGIN + crate::accel::RAY_SLACK) as i32 + 2;
 
+use super::path::{Path, Stretch};
+
 /// A segment from `p` to `q` on the grid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Segment {
@@ -147,47 +149,16 @@ impl Segment {
     }
 }
 
-/// A key of a track: storage for [`Motion::read`](super::Motion::read).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Key {
-    pub(super) frame: u32,
-    /// Whether the displacement differs from the key before (the first
-    /// key: from the last).
-    pub(super) changes: bool,
-}
-
-impl Key {
-    /// A placeholder to fill storage with (a `const`, for a `static`).
-    pub const EMPTY: Key = Key { frame: 0, changes: false };
-
-    pub(crate) fn new(frame: u32, changes: bool) -> Key {
-        Key { frame, changes }
-    }
-
-    /// The key's frame.
-    pub(crate) fn frame(&self) -> u32 {
-        self.frame
-    }
-}
-
-/// The spans of frames where a track's displacement is monotone, each
-/// from one boundary to the next: frame 0, each key's frame, the last
-/// frame of the `n`.
-fn spans(keys: &[Key], n: u32) -> impl Iterator<Item = (u32, u32)> + '_ {
-    let bounds = move || core::iter::once(0).chain(keys.iter().map(|k| k.frame())).chain(core::iter::once(n - 1));
-    bounds().zip(bounds().skip(1)).filter(|(a, b)| a <= b)
-}
-
 /// A track's objects through the loop: their box at frame 0 (a sphere's
 /// is its centre ± its radius, and then its own test is used at each
-/// frame), the box holding them in every frame, their displacement at each
-/// frame (from frame 0) and the keys that cut the loop into monotone spans.
+/// frame), the box holding them in every frame, and their displacement at
+/// each frame (from frame 0), whose keys cut the loop into monotone
+/// stretches.
 pub(crate) struct Sweep<'m> {
     pub first: [[i32; 3]; 2],
     pub sphere: bool,
     pub swept: [[i32; 3]; 2],
-    pub table: &'m [[i32; 3]],
-    pub keys: &'m [Key],
+    pub path: Path<'m>,
 }
 
 impl Sweep<'_> {
@@ -196,10 +167,12 @@ impl Sweep<'_> {
         segment.meets(self.swept[0], self.swept[1])
     }
 
-    /// A sphere's centre at frame `frame` and its radius, if the track is
-    /// one.
-    fn sphere_at(&self, frame: u32) -> Option<([i32; 3], i32)> {
-        let d = self.table.get(frame as usize).filter(|_| self.sphere)?;
+    /// A sphere's centre when displaced by `d` and its radius, if the
+    /// track is one.
+    fn sphere_at(&self, d: [i32; 3]) -> Option<([i32; 3], i32)> {
+        if !self.sphere {
+            return None;
+        }
         let [lo, hi] = self.first;
         // The box is the centre ± the radius, exactly.
         let center = [0, 1, 2].map(|a| (lo[a] / 2 + hi[a] / 2 + (lo[a] % 2 + hi[a] % 2) / 2).saturating_add(d[a]));
@@ -208,32 +181,36 @@ impl Sweep<'_> {
 
     /// Whether `segment` comes near the objects at frame `frame`.
     pub(crate) fn meets_at(&self, segment: &Segment, frame: u32) -> bool {
-        match self.sphere_at(frame) {
+        self.meets_displaced(segment, self.path.at(frame))
+    }
+
+    /// Whether `segment` comes near the objects displaced by `d`.
+    fn meets_displaced(&self, segment: &Segment, d: [i32; 3]) -> bool {
+        match self.sphere_at(d) {
             Some((center, radius)) => segment.near_sphere(center, radius),
-            None => self.meets_between(segment, frame, frame),
+            None => self.meets_between(segment, (d, d)),
         }
     }
 
     /// Whether the objects (a sphere) surely block a shadow ray along
     /// `segment` at frame `frame`.
     pub(crate) fn blocks_at(&self, segment: &Segment, frame: u32) -> bool {
-        self.sphere_at(frame).is_some_and(|(center, radius)| segment.through_sphere(center, radius))
+        self.sphere_at(self.path.at(frame)).is_some_and(|(center, radius)| segment.through_sphere(center, radius))
     }
 
     /// The smallest `e` in `1..=limit` such that the objects do not surely
     /// block `segment` at frame `frame + e` of the loop, if any.
     pub(crate) fn first_unblocked(&self, segment: &Segment, frame: u32, limit: u32) -> Option<u32> {
-        let n = self.table.len() as u32;
+        let n = self.path.frames;
         (1..=limit.min(n.saturating_sub(1))).find(|&e| !self.blocks_at(segment, (frame + e) % n))
     }
 
-    /// Whether `segment` comes near the objects in some frame of `a..=b`,
-    /// frames within one monotone span.
-    fn meets_between(&self, segment: &Segment, a: u32, b: u32) -> bool {
-        let (Some(da), Some(db)) = (self.table.get(a as usize), self.table.get(b as usize)) else { return true };
-        let [lo, hi] = self.first;
-        let lo = [0, 1, 2].map(|i| lo[i].saturating_add(da[i].min(db[i])));
-        let hi = [0, 1, 2].map(|i| hi[i].saturating_add(da[i].max(db[i])));
+    /// Whether `segment` comes near the objects displaced by any amount
+    /// within `lo..=hi` on each axis.
+    fn meets_between(&self, segment: &Segment, (lo, hi): ([i32; 3], [i32; 3])) -> bool {
+        let [first_lo, first_hi] = self.first;
+        let lo = [0, 1, 2].map(|i| first_lo[i].saturating_add(lo[i]));
+        let hi = [0, 1, 2].map(|i| first_hi[i].saturating_add(hi[i]));
         segment.meets(lo, hi)
     }
 
@@ -241,7 +218,7 @@ impl Sweep<'_> {
     /// objects at frame `frame + e` of the loop (after the last frame,
     /// frame 0 again), if any.
     pub(crate) fn first_meeting(&self, segment: &Segment, frame: u32, limit: u32) -> Option<u32> {
-        let n = self.table.len() as u32;
+        let n = self.path.frames;
         let limit = limit.min(n.saturating_sub(1));
         if limit == 0 {
             return None;
@@ -262,31 +239,33 @@ impl Sweep<'_> {
     /// The first frame of `lo..=hi` at which `segment` comes near the
     /// objects.
     fn first_within(&self, segment: &Segment, lo: u32, hi: u32) -> Option<u32> {
-        let n = self.table.len() as u32;
-        for (a, b) in spans(self.keys, n) {
-            let (a, b) = (a.max(lo), b.min(hi));
+        for stretch in self.path.stretches() {
+            let (a, b) = (stretch.from.max(lo), stretch.to.min(hi));
             if a > b {
                 continue;
             }
-            if let Some(g) = self.bisect(segment, a, b) {
+            if let Some(g) = self.bisect(segment, &stretch, a, b) {
                 return Some(g);
             }
         }
         None
     }
 
-    /// The first frame of `a..=b` (within one span) at which `segment`
-    /// comes near the objects: halves tested by their sweep, left first.
-    fn bisect(&self, segment: &Segment, a: u32, b: u32) -> Option<u32> {
+    /// The first frame of `a..=b` (within `stretch`) at which `segment`
+    /// comes near the objects: halves tested by the bounds of their
+    /// displacements (a range none of whose frames the objects come near
+    /// is left whole), left first, and single frames by the objects' own
+    /// test.
+    fn bisect(&self, segment: &Segment, stretch: &Stretch, a: u32, b: u32) -> Option<u32> {
         // Each step pops one range and pushes two, halving: 2 · 32 levels.
         let mut stack: heapless::Vec<(u32, u32), 64> = heapless::Vec::new();
         let _ = stack.push((a, b));
         while let Some((a, b)) = stack.pop() {
-            if !self.meets_between(segment, a, b) {
+            if !self.meets_between(segment, self.path.within(stretch, a, b)) {
                 continue;
             }
             if a == b {
-                if self.meets_at(segment, a) {
+                if self.meets_displaced(segment, self.path.at_in(stretch, a)) {
                     return Some(a);
                 }
                 continue;

@@ -127,6 +127,7 @@ pub use black_white_red::BlackWhiteRed;
 pub use dithered::Dithered;
 pub use ditherer::Ditherer;
 
+use crate::scene::ObjectId;
 use core::fmt;
 use embedded_graphics_core::geometry::Point;
 use embedded_graphics_core::pixelcolor::{
@@ -393,6 +394,14 @@ pub trait TracedColor: PixelColor + From<Rgb888> {
     /// The colour of level `level` of [`TracedColor::PANEL`].
     fn from_level(level: u8) -> Self {
         Self::from(Self::PANEL.map_or(Rgb888::new(0, 0, 0), |panel| panel.color(level)))
+    }
+
+    /// A traced pixel's colour (`color`, the object it sees `object`) in
+    /// this colour: converted, by default.
+    #[inline(always)]
+    fn traced(color: Rgb888, object: Option<ObjectId>) -> Self {
+        let _ = object;
+        Self::from(color)
     }
 }
 

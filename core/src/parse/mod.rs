@@ -24,7 +24,7 @@ mod number;
 mod statement;
 
 pub use error::{ErrorKind, Field, Found, ParseError, Pos, Rule};
-pub(crate) use motion::{for_each_move, frames_of, Mover};
+pub(crate) use motion::{for_each_move, MotionSink, Moved, Mover};
 pub(crate) use number::Decimal;
 pub(crate) use statement::{Keys, Statement};
 
@@ -34,7 +34,7 @@ use crate::scene::{SurfaceEntry, WorldPoint};
 use crate::shapes::{AxisAlignedBox, Rectangle, ShapeKind, Sphere, Superquadric, Triangle};
 use core::marker::PhantomData;
 use keyword::Keyword;
-use motion::{for_each_paired, Paired};
+use motion::{for_each_paired, MovedObjects, Paired};
 use statement::{Cursor, Patch};
 
 /// What the parse found besides the scene.
@@ -160,8 +160,22 @@ pub fn parse_frame_bytes<'a, C: SceneCapacities>(
     frame: u32,
     on_error: &mut dyn FnMut(ParseError<'a>),
 ) -> Result<Parsed<'a>, usize> {
+    parse_recording(bytes, scene, frame, on_error, None)
+}
+
+/// [`parse_frame_bytes`], handing each moving statement to `motion` once
+/// placed, if given; then the camera of every frame is checked, not only
+/// this one's (an animation is refused whole, before any frame plays).
+#[inline(never)]
+pub(crate) fn parse_recording<'a, C: SceneCapacities>(
+    bytes: &'a [u8],
+    scene: &mut Scene<C>,
+    frame: u32,
+    on_error: &mut dyn FnMut(ParseError<'a>),
+    motion: Option<&mut dyn MotionSink>,
+) -> Result<Parsed<'a>, usize> {
     match core::str::from_utf8(bytes) {
-        Ok(text) => parse_frame(text, scene, frame, on_error),
+        Ok(text) => parse_in(text, scene, frame, on_error, motion),
         Err(e) => {
             // The valid prefix is UTF-8; its lines end as the lexer's do.
             let good = core::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or_default();
@@ -245,6 +259,17 @@ pub fn parse_frame<'a, C: SceneCapacities>(
     frame: u32,
     on_error: &mut dyn FnMut(ParseError<'a>),
 ) -> Result<Parsed<'a>, usize> {
+    parse_in(text, scene, frame, on_error, None)
+}
+
+/// [`parse_frame`], and with `motion`, [`parse_recording`]'s.
+fn parse_in<'a, C: SceneCapacities>(
+    text: &'a str,
+    scene: &mut Scene<C>,
+    frame: u32,
+    on_error: &mut dyn FnMut(ParseError<'a>),
+    motion: Option<&mut dyn MotionSink>,
+) -> Result<Parsed<'a>, usize> {
     scene.clear();
     let (needed, frames) = survey(text, scene);
     let mut build = Build {
@@ -254,9 +279,11 @@ pub fn parse_frame<'a, C: SceneCapacities>(
         frame,
         first: [None; Keyword::COUNT],
         camera_move: None,
+        camera_keys: [None; 2],
         errors: 0,
         reported_capacity: 0,
         on_error,
+        motion,
     };
     for_each_paired::<RoomOf<C>>(text, |paired| match paired {
         Paired::Statement { pos, statement, moved } => build.apply(pos, statement, moved),
@@ -373,7 +400,7 @@ impl Offset {
 }
 
 /// Pass 2 state.
-struct Build<'s, 'a, 'e, C: SceneCapacities> {
+struct Build<'s, 'a, 'e, 'm, C: SceneCapacities> {
     scene: &'s mut Scene<C>,
     /// What the whole scene needs, for capacity errors.
     needed: Counts,
@@ -384,14 +411,19 @@ struct Build<'s, 'a, 'e, C: SceneCapacities> {
     first: [Option<Pos>; Keyword::COUNT],
     /// Where the MOVE of VIEWPOINT or ORIGIN is, if the camera moves.
     camera_move: Option<Pos>,
+    /// The eye's and the point looked at's written places and keys, if
+    /// they move (for the check of every frame's camera).
+    camera_keys: [Option<(WorldPoint, Keys<'a>)>; 2],
     errors: usize,
     /// Bit set of capacities already reported (one error each is enough),
     /// bit `kind as u8`.
     reported_capacity: u32,
     on_error: &'e mut dyn FnMut(ParseError<'a>),
+    /// What records the motion, when an animation is loaded.
+    motion: Option<&'m mut dyn MotionSink>,
 }
 
-impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
+impl<'a, C: SceneCapacities> Build<'_, 'a, '_, '_, C> {
     fn report(&mut self, e: ParseError<'a>) {
         self.errors += 1;
         (self.on_error)(e);
@@ -453,8 +485,9 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
             self.report(ParseError::new(key.pos, kind));
             return Offset::NONE;
         }
-        if matches!(s, Statement::Viewpoint(_) | Statement::Origin(_)) {
+        if let Statement::Viewpoint(p) | Statement::Origin(p) = s {
             self.camera_move.get_or_insert(at);
+            self.camera_keys[usize::from(matches!(s, Statement::Origin(_)))] = Some((*p, keys));
         }
         let norm = self.scene.normalization;
         let normalised = || keys.offsets().map(move |(f, d)| (f, d.map(|v| norm.length_wide(v))));
@@ -470,6 +503,34 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
         if keyword.once_only() && !self.once(keyword, pos) {
             return;
         }
+        let Some((_, keys)) = moved.filter(|_| self.motion.is_some()) else { return self.place(pos, s, moved) };
+        let (errors, objects) = (self.errors, self.scene.view().object_count() as u32);
+        let mover = s.mover();
+        self.place(pos, s, moved);
+        // A statement in error (and with it the scene) is not recorded.
+        let (Some(mover), Some(frames), true) = (mover, self.parsed.frames, self.errors == errors) else { return };
+        let view = self.scene.view();
+        let placed = objects..view.object_count() as u32;
+        let objects = (mover == Mover::Object).then(|| {
+            let [mut lo, mut hi] = [[i32::MAX; 3], [i32::MIN; 3]];
+            for id in placed.clone() {
+                let bounds = view.shape(crate::scene::ObjectId(id)).bounds();
+                let (min, max) = (bounds.min.bits(), bounds.max.bits());
+                (lo, hi) = ([0, 1, 2].map(|a| lo[a].min(min[a])), [0, 1, 2].map(|a| hi[a].max(max[a])));
+            }
+            let sphere =
+                placed.len() == 1 && view.shape(crate::scene::ObjectId(placed.start)).kind() == ShapeKind::Sphere;
+            MovedObjects { bounds: [lo, hi], sphere }
+        });
+        let moved = Moved { mover, keys, norm: self.scene.normalization, frames, frame: self.frame, objects };
+        if let Some(motion) = self.motion.as_mut() {
+            motion.moved(&moved);
+        }
+    }
+
+    /// Places statement `s` (at `pos`, moved by `moved`) in the scene.
+    fn place(&mut self, pos: Pos, s: Statement<'a>, moved: Option<(Pos, Keys<'a>)>) {
+        let keyword = s.keyword();
         let offset = self.offset(&s, moved);
         let norm = self.scene.normalization;
         let place = |w: WorldPoint| norm.moved(w, offset.normalised);
@@ -619,12 +680,40 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, C> {
         }
     }
 
+    /// The camera of every frame of an animation that is loaded to play:
+    /// the first frame whose camera cannot be set up is an error at the
+    /// camera's MOVE, naming the frame, so that nothing of it plays.
+    fn check_every_frame(&mut self) {
+        let (Some(frames), Some(pos)) = (self.parsed.frames, self.camera_move) else { return };
+        let mut view = self.scene.settings.view;
+        let mut last = None;
+        for frame in 0..frames.count {
+            for (i, moved) in self.camera_keys.iter().enumerate() {
+                let Some((written, keys)) = moved else { continue };
+                let d = displacement_at(keys.offsets(), frame);
+                let point = [0, 1, 2].map(|a| written[a] + d[a]);
+                match i {
+                    0 => view.eye = point,
+                    _ => view.look_at = point,
+                }
+            }
+            // A camera that stands still is checked once.
+            if last.replace((view.eye, view.look_at)) == Some((view.eye, view.look_at)) {
+                continue;
+            }
+            if let Err(error) = Camera::check(&view) {
+                return self.report(ParseError::new(pos, ErrorKind::MovedCamera { error, frame }));
+            }
+        }
+    }
+
     /// The camera needs VIEWPOINT ≠ ORIGIN and an UPVECTOR off the view line.
     fn check_camera(&mut self) {
         let at = |keyword: Keyword| self.first[keyword as usize];
         let start = Pos { line: 1, column: 1 };
         let view_pos = at(Keyword::Viewpoint).max(at(Keyword::Origin)).unwrap_or(start);
         match Camera::check(&self.scene.settings.view) {
+            Ok(()) if self.motion.is_some() => self.check_every_frame(),
             Ok(()) => {}
             Err(error) if self.camera_move.is_some() => {
                 let (pos, frame) = (self.camera_move.unwrap_or(view_pos), self.frame);

@@ -1,6 +1,7 @@
 //! `MOVE` and the statement it moves: every pass over the text pairs them
 //! the same way ([`for_each_paired`]), so the survey's extent, the build's
-//! placing and the coherence tracker's reading of the motion agree.
+//! placing (which hands each moving statement, once placed, to the
+//! animation's [`MotionSink`]) and the room counted for the motion agree.
 //!
 //! Invariants: each statement is handed over once, in file order, with the
 //! keys of the MOVE right after it if there is one; a MOVE after a
@@ -11,7 +12,7 @@
 use super::error::{ParseError, Pos};
 use super::statement::{Keys, Statement};
 use super::{for_each_statement, AnyRoom, Room};
-use crate::scene::WorldPoint;
+use crate::scene::{Frames, Normalization, WorldPoint};
 
 /// What a MOVE can move: a statement with a place.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -113,44 +114,53 @@ pub(crate) fn for_each_paired<'a, R: Room>(text: &'a str, mut each: impl FnMut(P
     }
 }
 
-/// The first FRAMES of `text`, if any.
-pub(crate) fn frames_of(text: &str) -> Option<crate::scene::Frames> {
-    let mut frames = None;
-    for_each_statement::<AnyRoom>(text, |_, result| {
-        if let Ok(Statement::Frames(f)) = result {
-            frames.get_or_insert(f);
-        }
-    });
-    frames
-}
-
-/// One MOVE of a scene that parsed: what it moves and its keys.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Move<'a> {
+/// A moving statement as the build placed it, for a [`MotionSink`]: what
+/// it moves, its keys, and for objects where they stand.
+pub(crate) struct Moved<'a> {
     pub mover: Mover,
-    /// For an object, its place among the scene's object statements; for a
-    /// light, among its LIGHTs (0 for the first).
-    pub ordinal: u32,
     pub keys: Keys<'a>,
+    /// The scene's normalisation: the keys of objects and lights in
+    /// normalised units, as the build places them (the camera's stay in
+    /// world units).
+    pub norm: Normalization,
+    pub frames: Frames,
+    /// The frame the build placed the statement at.
+    pub frame: u32,
+    /// Objects: their box there, and whether they are one sphere.
+    pub objects: Option<MovedObjects>,
 }
 
-/// Every MOVE of `text` (a scene that parsed), in file order.
-pub(crate) fn for_each_move<'a>(text: &'a str, mut each: impl FnMut(Move<'a>)) {
-    let (mut objects, mut lights) = (0u32, 0u32);
+/// The objects of a moving statement where the build placed them.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct MovedObjects {
+    /// Their bounds together, in normalised raw units.
+    pub bounds: [[i32; 3]; 2],
+    pub sphere: bool,
+}
+
+impl Moved<'_> {
+    /// The keys as `(frame, displacement)` in the units the statement is
+    /// placed in.
+    pub(crate) fn values(&self) -> impl Iterator<Item = (u32, [i64; 3])> + '_ {
+        let normalised = self.mover != Mover::Eye && self.mover != Mover::LookAt;
+        let norm = self.norm;
+        self.keys.offsets().map(move |(f, d)| (f, if normalised { d.map(|v| norm.length_wide(v)) } else { d }))
+    }
+}
+
+/// What a parse that records an animation's motion hands each moving
+/// statement to, once placed (the motion module's recorder): so the motion
+/// is the loaded scene's, read in the same pass.
+pub(crate) trait MotionSink {
+    fn moved(&mut self, moved: &Moved<'_>);
+}
+
+/// The keys of every MOVE of `text` that follows what it can move, in
+/// file order: what an animation's motion takes room for.
+pub(crate) fn for_each_move<'a>(text: &'a str, mut each: impl FnMut(Keys<'a>)) {
     for_each_paired::<AnyRoom>(text, |paired| {
-        let Paired::Statement { statement, moved, .. } = paired else { return };
-        let Some(mover) = statement.mover() else { return };
-        let counter = match mover {
-            Mover::Object => Some(&mut objects),
-            Mover::Light => Some(&mut lights),
-            Mover::Eye | Mover::LookAt => None,
-        };
-        let ordinal = counter.map_or(0, |c| {
-            *c += 1;
-            *c - 1
-        });
-        if let Some((_, keys)) = moved {
-            each(Move { mover, ordinal, keys });
+        if let Paired::Statement { moved: Some((_, keys)), .. } = paired {
+            each(keys);
         }
     });
 }

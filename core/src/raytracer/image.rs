@@ -1,11 +1,15 @@
-//! A loaded scene as an embedded-graphics image: drawn whole or in part,
-//! traced as the display takes its rows, dithered onto a panel of few
-//! levels.
+//! What to draw of a loaded scene or of a frame, and how: an
+//! embedded-graphics image with options (an area, the progressive order, a
+//! frame's bands, the dithering), drawn whole or stopped inside a pixel.
 
-use crate::panel::{Dithered, Dithering, ErrorRowTooShort, TracedColor, IMAGE_ERROR_WORDS};
+use super::draw::{self, Picture, Source};
+use crate::animation::Playing;
+use crate::panel::{Dithering, ErrorRowTooShort, TracedColor};
 use crate::profile::Profile;
-use crate::render::Stopped;
+use crate::render::{Polling, Progressive, Stop, Stopped};
 use crate::scene::CameraError;
+use crate::shade::{Stats, Unpolled};
+use core::cell::RefCell;
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Dimensions, OriginDimensions, Point, Size};
@@ -13,23 +17,19 @@ use embedded_graphics_core::image::ImageDrawable;
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
 
-use super::LoadedScene;
-
-/// Why a [`TracedImage`] could not be drawn with
-/// [`TracedImage::try_draw`].
+/// Why a [`TracedImage`] was not drawn whole.
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DrawError<E> {
     /// The camera cannot be set up for this size (see [`CameraError`]).
     Camera(CameraError),
     /// Error diffusion has no room for the image's rows (an image wider
-    /// than [`IMAGE_ERROR_WORDS`] allows, drawn without storage of its
-    /// own).
+    /// than [`IMAGE_ERROR_WORDS`](crate::panel::IMAGE_ERROR_WORDS) allows, drawn without
+    /// [`TracedImage::error_rows`]).
     ErrorRow(ErrorRowTooShort),
     /// The display's own error.
     Target(E),
-    /// The caller's stop said so
-    /// ([`LoadedScene::draw_bands_until`](crate::LoadedScene::draw_bands_until)).
+    /// The caller's stop said so ([`TracedImage::try_draw_until`]).
     Stopped,
 }
 
@@ -52,15 +52,32 @@ impl<E: fmt::Display> fmt::Display for DrawError<E> {
 
 impl<E: fmt::Debug + fmt::Display> core::error::Error for DrawError<E> {}
 
-/// A traced scene as an embedded-graphics image, `size` pixels in the colour
-/// `C`, like `tinybmp::Bmp<C>`. Each draw traces the pixels as the display
-/// takes them, one scanline at a time: no framebuffer.
+/// What to draw of a loaded scene or of a frame of an animation, and how:
+/// an image `size` pixels in the colour `C`, like `tinybmp::Bmp<C>`. Each
+/// draw traces the pixels as the display takes them, one scanline at a
+/// time: no framebuffer. It is the one way a scene is drawn: as
+/// embedded-graphics draws any image (`Image::new(&image, point)`), or
+/// with [`TracedImage::try_draw`] (which tells why a picture is not whole
+/// and counts the rays) and [`TracedImage::try_draw_until`] (stopped
+/// inside a pixel); what it draws is set by its options:
+///
+/// - the whole picture, or an [`area`](TracedImage::area) of it;
+/// - the [`progressive`](TracedImage::progressive) order: coarse blocks
+///   first;
+/// - for a [`Frame`](crate::Frame) of an animation, the tiles its motion
+///   can have changed, every band of them or the
+///   [`bands`](TracedImage::bands) a core takes one after another;
+/// - on a panel of few levels, the [`dithering`](TracedImage::dithered).
 ///
 /// A truecolour `C` (`Rgb565`, `Rgb888`, …) takes each pixel converted; a
 /// panel of few levels (`BinaryColor`, `Gray2`, `Gray4`,
 /// [`BlackWhiteRed`](crate::panel::BlackWhiteRed)) takes it dithered, by
-/// [`Dithering::FsPe`] unless [`TracedImage::dithered`] says otherwise (see
-/// [`panel`](crate::panel): a sub-image is dithered as an image of its own).
+/// [`Dithering::FsPe`] unless [`TracedImage::dithered`] says otherwise
+/// (see [`panel`](crate::panel): an area is dithered as an image of its
+/// own; the progressive order and a frame's tiles by
+/// [`Dithering::Bayer`], the one method that needs no order).
+/// [`PixelSample`](crate::render::PixelSample) takes each pixel with the
+/// object it sees.
 ///
 /// ```
 /// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb565, prelude::*};
@@ -73,19 +90,27 @@ impl<E: fmt::Debug + fmt::Display> core::error::Error for DrawError<E> {}
 /// display.assert_pattern(&["BBBB", "BBBB"]);
 /// ```
 pub struct TracedImage<'s, 'r, P: Profile, C> {
-    pub(super) scene: &'s LoadedScene<'r, P>,
+    pub(super) source: Source<'s, 'r, P>,
     pub(super) size: Size,
     pub(super) dithering: Dithering,
+    pub(super) picture: Picture<'s>,
+    /// Error diffusion's rows, if the caller gives them.
+    pub(super) rows: Option<&'s RefCell<[i16]>>,
     pub(super) color: core::marker::PhantomData<C>,
 }
 
 impl<P: Profile, C> fmt::Debug for TracedImage<'_, '_, P, C> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let picture = match self.picture {
+            Picture::Area(area) => area,
+            _ => self.bounding_box(),
+        };
         f.debug_struct("TracedImage")
             .field("size", &self.size)
             .field("dithering", &self.dithering)
-            .field("scene", self.scene)
-            .finish()
+            .field("area", &picture)
+            .field("objects", &self.source.view.object_count())
+            .finish_non_exhaustive()
     }
 }
 
@@ -97,7 +122,24 @@ impl<P: Profile, C> Clone for TracedImage<'_, '_, P, C> {
 
 impl<P: Profile, C> Copy for TracedImage<'_, '_, P, C> {}
 
-impl<P: Profile, C> TracedImage<'_, '_, P, C> {
+impl<'s, 'r, P: Profile, C> TracedImage<'s, 'r, P, C> {
+    /// The image of `size` pixels traced from `source`: a frame's
+    /// planned tiles (`playing`), or the whole still.
+    pub(super) fn new(source: Source<'s, 'r, P>, size: Size, playing: Option<Playing<'s>>) -> Self {
+        let picture = match playing {
+            Some(playing) => Picture::Bands(playing, None),
+            None => Picture::Area(Rectangle::new(Point::zero(), size)),
+        };
+        TracedImage {
+            source,
+            size,
+            dithering: Dithering::default(),
+            picture,
+            rows: None,
+            color: core::marker::PhantomData,
+        }
+    }
+
     /// The image dithered by `dithering` on a panel of few levels (a
     /// truecolour display ignores it).
     ///
@@ -122,89 +164,140 @@ impl<P: Profile, C> TracedImage<'_, '_, P, C> {
     pub fn dithering(&self) -> Dithering {
         self.dithering
     }
-}
 
-impl<P: Profile, C: TracedColor> TracedImage<'_, '_, P, C> {
-    /// Draws the image at the origin of `target`, telling a camera that
-    /// cannot be set up (a zero size), or an image too wide for the error
-    /// row on the stack, apart from the display's errors;
-    /// [`ImageDrawable::draw`] draws nothing then.
-    pub fn try_draw<D: DrawTarget<Color = C>>(&self, target: &mut D) -> Result<(), DrawError<D::Error>> {
-        self.draw_area(&self.bounding_box(), target, None)
-    }
-
-    /// [`TracedImage::try_draw`] with error diffusion's rows in `rows`
-    /// (at least [`Panel::error_words`](crate::panel::Panel::error_words)
-    /// of the image's width) instead of on the draw's stack: for an image
-    /// wider than [`IMAGE_ERROR_WORDS`] allows, or a board short of stack.
+    /// A still's pixels in `area` only (in the image's coordinates), drawn
+    /// with the area's top-left pixel at the target's origin: what
+    /// [`ImageDrawable::draw_sub_image`] draws. On a panel of few levels the
+    /// area is dithered as an image of its own.
     ///
     /// ```
+    /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*, primitives::Rectangle};
+    /// use octrace_core::{profile::Board16K, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
+    /// let mut whole = MockDisplay::<Rgb888>::new();
+    /// scene.image::<Rgb888>(Size::new(16, 16)).try_draw(&mut whole)?;
+    /// let mut corner = MockDisplay::<Rgb888>::new();
+    /// let area = Rectangle::new(Point::new(8, 8), Size::new(4, 4));
+    /// scene.image::<Rgb888>(Size::new(16, 16)).area(area).try_draw(&mut corner)?;
+    /// assert_eq!(corner.get_pixel(Point::new(1, 2)), whole.get_pixel(Point::new(9, 10)));
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn area(self, area: Rectangle) -> Self {
+        match self.picture {
+            Picture::Bands(..) => self,
+            _ => TracedImage { picture: Picture::Area(area), ..self },
+        }
+    }
+
+    /// A still whole in the [`Progressive`] order (at the order's size):
+    /// the whole picture in coarse blocks first, then finer, until it is
+    /// exactly the picture drawn row by row. Every pixel is traced once;
+    /// the drawing streams (no framebuffer), in a few calls a pass. On a
+    /// panel of few levels every pass is dithered by [`Dithering::Bayer`]:
+    /// the last pass is then the image with that method.
+    ///
+    /// ```
+    /// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb565, prelude::*};
+    /// use octrace_core::{profile::Board16K, render::Progressive, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
+    /// let mut display = MockDisplay::<Rgb565>::new();
+    /// display.set_allow_overdraw(true); // later passes draw over the coarse blocks
+    /// let order = Progressive::new(display.size(), 16);
+    /// let stats = scene.image_for(&display).progressive(&order).try_draw(&mut display)?;
+    /// assert_eq!(stats.rays, 64 * 64, "every pixel traced once: nothing reflects");
+    ///
+    /// let mut direct = MockDisplay::<Rgb565>::new();
+    /// Image::new(&scene.image_for(&direct), Point::zero()).draw(&mut direct)?;
+    /// assert_eq!(display, direct);
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn progressive(self, order: &'s Progressive) -> Self {
+        match self.picture {
+            Picture::Bands(..) => self,
+            _ => TracedImage { picture: Picture::Progressive(order), ..self },
+        }
+    }
+
+    /// A frame's bands of tiles (rows of tiles, [`TILE`](crate::animation::TILE)
+    /// pixels high), the next one `next` gives until it gives none,
+    /// instead of every band: on a board whose cores share a frame, each
+    /// core draws the next band no core has taken yet. A still ignores it.
+    pub fn bands(self, next: &'s dyn Fn() -> Option<u32>) -> Self {
+        match self.picture {
+            Picture::Bands(playing, _) => TracedImage { picture: Picture::Bands(playing, Some(next)), ..self },
+            _ => self,
+        }
+    }
+
+    /// Error diffusion's rows in `rows` (at least
+    /// [`Panel::error_words`](crate::panel::Panel::error_words) of the
+    /// width drawn) instead of on the draw's stack: for an image wider
+    /// than [`IMAGE_ERROR_WORDS`](crate::panel::IMAGE_ERROR_WORDS) allows, or a board short of stack.
+    ///
+    /// ```
+    /// use core::cell::RefCell;
     /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Gray4, prelude::*};
     /// use octrace_core::{panel::Panel, profile::Board16K, Raytracer};
     ///
     /// let mut raytracer = Raytracer::<Board16K>::new();
     /// let scene = raytracer.load("BACKGROUND 0.5 0.5 0.5\n")?;
     /// let mut display = MockDisplay::<Gray4>::new();
-    /// let mut rows = [0i16; Panel::Gray4.error_words(64)];
-    /// scene.image_for(&display).try_draw_with(&mut display, &mut rows)?;
+    /// let rows = RefCell::new([0i16; Panel::Gray4.error_words(64)]);
+    /// scene.image_for(&display).error_rows(&rows).try_draw(&mut display)?;
     ///
     /// let mut on_the_stack = MockDisplay::<Gray4>::new();
     /// scene.image_for(&on_the_stack).try_draw(&mut on_the_stack)?;
     /// assert_eq!(display, on_the_stack);
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
-    pub fn try_draw_with<D: DrawTarget<Color = C>>(
-        &self,
-        target: &mut D,
-        rows: &mut [i16],
-    ) -> Result<(), DrawError<D::Error>> {
-        self.draw_area(&self.bounding_box(), target, Some(rows))
+    pub fn error_rows(self, rows: &'s RefCell<[i16]>) -> Self {
+        TracedImage { rows: Some(rows), ..self }
+    }
+}
+
+impl<P: Profile, C: TracedColor> TracedImage<'_, '_, P, C> {
+    /// Draws what the image is set to into `target`; returns the counters
+    /// of its rays, or why the picture is not whole: a camera that cannot
+    /// be set up (a zero size), an image too wide for the error row on the
+    /// stack, the display's error ([`ImageDrawable::draw`] tells only the
+    /// last).
+    pub fn try_draw<D: DrawTarget<Color = C>>(&self, target: &mut D) -> Result<Stats, DrawError<D::Error>> {
+        draw::draw(self, target, &mut Unpolled)
     }
 
-    /// Draws `area` of the image with its top-left pixel at the origin of
-    /// `target`, dithered for a panel in `rows` or on the stack.
-    fn draw_area<D: DrawTarget<Color = C>>(
+    /// [`TracedImage::try_draw`], asking `stop` before every ray (as
+    /// [`Renderer::pixel_until`](crate::render::Renderer::pixel_until)
+    /// does): [`DrawError::Stopped`] as soon as it says so, the row being
+    /// traced handed to the target up to the pixel it stopped in (a
+    /// frame's tiles not drawn are kept to be traced).
+    ///
+    /// ```
+    /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*};
+    /// use octrace_core::{profile::Board16K, DrawError, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
+    /// let mut display = MockDisplay::<Rgb888>::new();
+    /// let mut asked = 0;
+    /// let stopped = scene.image::<Rgb888>(Size::new(8, 8)).try_draw_until(&mut display, &mut || {
+    ///     asked += 1;
+    ///     asked > 20
+    /// });
+    /// assert_eq!(stopped, Err(DrawError::Stopped));
+    /// // Two rows of 8 and the first pixels of the third.
+    /// assert_eq!(display.affected_area().size, Size::new(8, 3));
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn try_draw_until<D: DrawTarget<Color = C>, S: Stop>(
         &self,
-        area: &Rectangle,
         target: &mut D,
-        rows: Option<&mut [i16]>,
-    ) -> Result<(), DrawError<D::Error>> {
-        let mut shifted = Shifted { target, offset: Point::zero() - area.top_left };
-        // The pixels there are: the rows a ditherer is set up for.
-        let area = &area.intersection(&self.bounding_box());
-        match (C::PANEL, rows) {
-            (None, _) => self.scene.render_area(self.size, area, &mut shifted),
-            (Some(_), Some(rows)) => self.draw_dithered(area, &mut shifted, rows),
-            // A small panel's row in a small frame.
-            (Some(panel), None) if panel.error_words(area.size.width) <= SMALL_ERROR_WORDS => {
-                self.draw_dithered_on_stack::<SMALL_ERROR_WORDS, _>(area, &mut shifted)
-            }
-            (Some(_), None) => self.draw_dithered_on_stack::<IMAGE_ERROR_WORDS, _>(area, &mut shifted),
-        }
-    }
-
-    /// Draws `area` dithered, its error row of `WORDS` on this frame. Not
-    /// inlined: a truecolour draw never holds the row.
-    #[inline(never)]
-    fn draw_dithered_on_stack<const WORDS: usize, D: DrawTarget<Color = C>>(
-        &self,
-        area: &Rectangle,
-        target: &mut D,
-    ) -> Result<(), DrawError<D::Error>> {
-        self.draw_dithered(area, target, &mut [0; WORDS])
-    }
-
-    /// Not inlined: one copy of the render loop whatever frame the row is in.
-    #[inline(never)]
-    fn draw_dithered<D: DrawTarget<Color = C>>(
-        &self,
-        area: &Rectangle,
-        target: &mut D,
-        rows: &mut [i16],
-    ) -> Result<(), DrawError<D::Error>> {
-        let (left, width) = (area.top_left.x, area.size.width);
-        let mut dithered = Dithered::across(target, self.dithering, left, width, rows).map_err(DrawError::ErrorRow)?;
-        self.scene.render_area(self.size, area, &mut dithered)
+        stop: &mut S,
+    ) -> Result<Stats, DrawError<D::Error>> {
+        draw::draw(self, target, &mut Polling { stop, stopped: false })
     }
 }
 
@@ -218,20 +311,16 @@ impl<P: Profile, C: TracedColor> ImageDrawable for TracedImage<'_, '_, P, C> {
     type Color = C;
 
     fn draw<D: DrawTarget<Color = C>>(&self, target: &mut D) -> Result<(), D::Error> {
-        self.draw_sub_image(target, &self.bounding_box())
-    }
-
-    fn draw_sub_image<D: DrawTarget<Color = C>>(&self, target: &mut D, area: &Rectangle) -> Result<(), D::Error> {
-        match self.draw_area(area, target, None) {
-            Ok(()) | Err(DrawError::Camera(_) | DrawError::ErrorRow(_) | DrawError::Stopped) => Ok(()),
+        match self.try_draw(target) {
+            Ok(_) | Err(DrawError::Camera(_) | DrawError::ErrorRow(_) | DrawError::Stopped) => Ok(()),
             Err(DrawError::Target(e)) => Err(e),
         }
     }
-}
 
-/// The error row of a panel image up to 256 `i16`s wide (a one-bit 128×64
-/// OLED needs 128) takes only this much of the draw's stack (512 bytes).
-const SMALL_ERROR_WORDS: usize = 256;
+    fn draw_sub_image<D: DrawTarget<Color = C>>(&self, target: &mut D, area: &Rectangle) -> Result<(), D::Error> {
+        ImageDrawable::draw(&self.area(*area), target)
+    }
+}
 
 /// A target seen shifted by `offset`: a sub-image's pixels land at the
 /// target's origin.
@@ -269,10 +358,10 @@ impl<D: DrawTarget> DrawTarget for Shifted<'_, D> {
 mod tests {
     use super::super::tests::{Grid, SCENE};
     use super::*;
-    use crate::panel::Ditherer;
+    use crate::panel::{Ditherer, IMAGE_ERROR_WORDS};
     use crate::profile::Board16K;
     use crate::render::Progressive;
-    use crate::Raytracer;
+    use crate::{LoadedScene, Raytracer};
     use embedded_graphics_core::pixelcolor::{BinaryColor, Gray4, Rgb565, Rgb888};
     use embedded_graphics_core::primitives::PointsIter;
     use std::string::ToString;
@@ -379,7 +468,8 @@ mod tests {
         // Bayer keeps no row; with the caller's storage, diffusion draws.
         image.dithered(Dithering::Bayer).try_draw(&mut wide).unwrap();
         let mut again = Grid::<BinaryColor, 801, 1>([[None; 801]; 1]);
-        image.try_draw_with(&mut again, &mut [0; 801]).unwrap();
+        let rows = RefCell::new([0; 801]);
+        image.error_rows(&rows).try_draw(&mut again).unwrap();
         assert!(again.0[0].iter().all(|c| c.is_some()));
     }
 
@@ -416,29 +506,24 @@ mod tests {
         let mut raytracer = Raytracer::<Board16K>::new();
         let scene = raytracer.load(SCENE).unwrap();
         let mut progressive = Overdrawn([[None; 12]; 8]);
-        scene.draw_progressive(&Progressive::new(Size::new(12, 8), 4), &mut progressive).unwrap();
+        let order = Progressive::new(Size::new(12, 8), 4);
+        scene.image_for(&progressive).progressive(&order).try_draw(&mut progressive).unwrap();
         assert_eq!(progressive.0, ordered(&scene));
     }
 
     #[test]
     fn an_animated_panel_shows_each_frames_ordered_picture() {
-        use crate::animation::{Coherence, Key, Motion, Track};
-        use core::sync::atomic::AtomicU8;
+        use crate::animation::AnimationRoom;
         let text = "FRAMES 4\nRASTER 12 8\nBACKGROUND .4 .4 .4\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\n\
                     LIGHT 10 5 5 5\nSPHERE 1 2 0 0 -4\nSPHERE 1 0.5 -3 2 0 MOVE 0 0 0 0  3 1.5 0 0\n";
-        let counts: [AtomicU8; Coherence::tiles_for(12, 8, 4)] = [const { AtomicU8::new(0) }; 6];
-        let coherence = Coherence::new(&counts, Size::new(12, 8), 4).unwrap();
-        let (mut tracks, mut keys, mut displacements) = ([Track::EMPTY; 1], [Key::default(); 2], [[0; 3]; 4]);
+        let mut room = AnimationRoom::<6, 1, 2>::new();
+        let mut animation = room.animation(Size::new(12, 8)).unwrap();
         let mut raytracer = Raytracer::<Board16K>::new();
-        let first = raytracer.load_frame(text, 0).unwrap();
-        let frames = first.frames().unwrap();
-        let motion = Motion::read(text, frames, &first.view(), 0, &mut tracks, &mut keys, &mut displacements).unwrap();
         let mut panel = Overdrawn([[None; 12]; 8]);
-        for frame in frames.all().chain(frames.all()) {
-            let scene = raytracer.load_frame(text, frame).unwrap();
-            coherence.plan();
-            scene.draw_changes(&motion, frame, &coherence, &mut panel).unwrap();
-            assert_eq!(panel.0, ordered(&scene), "frame {frame}");
+        for frame in (0..4).chain(0..4) {
+            let loaded = animation.load(&mut raytracer, text, frame).unwrap();
+            loaded.image_for(&panel).try_draw(&mut panel).unwrap();
+            assert_eq!(panel.0, ordered(loaded.scene()), "frame {frame}");
         }
     }
 }

@@ -1,23 +1,18 @@
 //! A loaded scene: its view, accelerator, light buffer and the room of the
-//! core that loaded it; it draws as an image, directly or progressively.
+//! core that loaded it; it draws as an image ([`TracedImage`]).
 
 use crate::accel::{AccelMode, Accelerator, BuildReport, LightBuffer, LightBufferError};
-use crate::animation::coherence::Halt;
-use crate::animation::{Coherence, Motion};
-use crate::panel::{Dithered, Dithering, TracedColor};
 use crate::profile::Profile;
-use crate::render::{Polling, Progressive, Renderer, Stop};
+use crate::render::Renderer;
 use crate::scene::{CameraError, Frames, SceneView};
 use crate::shade::Stats;
-use crate::shade::{Poll, Unpolled};
-use core::cell::{Cell, RefCell};
+use core::cell::Cell;
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::Size;
-use embedded_graphics_core::pixelcolor::Rgb888;
-use embedded_graphics_core::primitives::Rectangle;
 
-use super::{light_buffer, DrawError, SceneAccelerator, ScreenLists, SharedScene, TracedImage};
+use super::draw::Source;
+use super::{light_buffer, RendererRoom, SceneAccelerator, ScreenLists, SharedScene, TracedImage};
 
 /// A scene ready to trace, borrowed from its [`Raytracer`](super::Raytracer).
 pub struct LoadedScene<'r, P: Profile> {
@@ -26,10 +21,8 @@ pub struct LoadedScene<'r, P: Profile> {
     pub(super) octree: Option<(&'r P::Octree, BuildReport)>,
     /// The shadow rays' light buffer (none buffered without room for one).
     pub(super) lights: LightBuffer<'r>,
-    pub(super) mailbox: RefCell<&'r mut [u32]>,
-    /// The camera rays' screen lists (bounds and positions), if they are
-    /// used.
-    pub(super) screen_lists: RefCell<Option<ScreenLists<'r>>>,
+    /// The loading core's renderers' room.
+    pub(super) room: &'r RendererRoom<P>,
     pub(super) first_hits: bool,
     pub(super) stats: Cell<Stats>,
     /// FRAMES, for an animation.
@@ -161,21 +154,25 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         size: Size,
         f: impl FnOnce(&mut Renderer<'_, SceneAccelerator<'r, P>>) -> R,
     ) -> Result<R, CameraError> {
-        let accelerator = self.accelerator();
-        let (mut mailbox, mut screen_lists) = (self.mailbox.try_borrow_mut(), self.screen_lists.try_borrow_mut());
-        let (mailbox, lists) = room_of(&mut mailbox, &mut screen_lists);
-        let mut renderer = renderer_in(self.view, &accelerator, size, mailbox, lists)?;
-        let result = f(&mut renderer);
-        let mut total = self.stats.get();
-        total.add(&renderer.stats());
-        self.stats.set(total);
-        Ok(result)
+        self.source().with_renderer(size, f)
+    }
+
+    /// Where this scene's draws get their renderer: the loading core's
+    /// room, the counters added to [`LoadedScene::stats`].
+    pub(super) fn source(&self) -> Source<'_, 'r, P> {
+        Source {
+            view: self.view,
+            accelerator: self.accelerator(),
+            first_hits: self.first_hits,
+            room: self.room,
+            stats: Some(&self.stats),
+        }
     }
 
     /// What another core needs to render this scene with a [`Renderer`] of
     /// its own: see [`SharedScene`].
     pub fn share(&self) -> SharedScene<'r, P> {
-        SharedScene { view: self.view, accelerator: self.accelerator(), first_hits: self.first_hits }
+        SharedScene { view: self.view, accelerator: self.accelerator(), first_hits: self.first_hits, playing: None }
     }
 
     /// Whether camera rays find their hits in the screen lists
@@ -195,135 +192,6 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         self.frames
     }
 
-    /// Draws frame `frame` of an animation, this scene loaded at that
-    /// frame, into `target` (of `coherence`'s size), re-tracing only the
-    /// tiles [`Coherence::plan`] left to trace (call it first) and drawing
-    /// only their runs of pixels: after the frame before it in the loop
-    /// (or at the first frame, everything), `target` shows the frame as a
-    /// whole draw would. An example is [`Coherence`]'s.
-    ///
-    /// A panel of few levels (`BinaryColor`, `Gray2`, `Gray4`,
-    /// [`BlackWhiteRed`](crate::panel::BlackWhiteRed)) is dithered by
-    /// [`Dithering::Bayer`], whose pixels depend on nothing but themselves
-    /// (error diffusion would carry a change across the whole image): it
-    /// shows the frame as a whole draw with that method would.
-    pub fn draw_changes<D>(
-        &self,
-        motion: &Motion<'_>,
-        frame: u32,
-        coherence: &Coherence<'_>,
-        target: &mut D,
-    ) -> Result<Stats, DrawError<D::Error>>
-    where
-        D: DrawTarget,
-        D::Color: TracedColor,
-    {
-        self.draw_bands(motion, frame, coherence, 0..coherence.bands(), target)
-    }
-
-    /// [`LoadedScene::draw_changes`] of the bands `bands` only, with one
-    /// renderer in the room of the loading core: on a board whose cores
-    /// share the frame, `bands` takes the next band no core has taken yet
-    /// (the other cores trace theirs with [`Coherence::trace_band`] and a
-    /// renderer of their own, [`SharedScene::renderer`]).
-    pub fn draw_bands<D>(
-        &self,
-        motion: &Motion<'_>,
-        frame: u32,
-        coherence: &Coherence<'_>,
-        bands: impl IntoIterator<Item = u32>,
-        target: &mut D,
-    ) -> Result<Stats, DrawError<D::Error>>
-    where
-        D: DrawTarget,
-        D::Color: TracedColor,
-    {
-        self.draw_bands_polled(motion, frame, coherence, bands, target, &mut Unpolled)
-    }
-
-    /// [`LoadedScene::draw_bands`], asking `stop` before every ray (as
-    /// [`Renderer::pixel_until`] does): [`DrawError::Stopped`] as soon as
-    /// it says so, the run being traced drawn up to the pixel it stopped
-    /// in, and the tiles not drawn kept to be traced.
-    pub fn draw_bands_until<D, S: Stop>(
-        &self,
-        motion: &Motion<'_>,
-        frame: u32,
-        coherence: &Coherence<'_>,
-        bands: impl IntoIterator<Item = u32>,
-        target: &mut D,
-        stop: &mut S,
-    ) -> Result<Stats, DrawError<D::Error>>
-    where
-        D: DrawTarget,
-        D::Color: TracedColor,
-    {
-        self.draw_bands_polled(motion, frame, coherence, bands, target, &mut Polling { stop, stopped: false })
-    }
-
-    /// [`LoadedScene::draw_bands`], `poll` asked before every ray: into
-    /// `target` converted, or through ordered dithering for a panel of few
-    /// levels.
-    fn draw_bands_polled<D, Q: Poll>(
-        &self,
-        motion: &Motion<'_>,
-        frame: u32,
-        coherence: &Coherence<'_>,
-        bands: impl IntoIterator<Item = u32>,
-        target: &mut D,
-        poll: &mut Q,
-    ) -> Result<Stats, DrawError<D::Error>>
-    where
-        D: DrawTarget,
-        D::Color: TracedColor,
-    {
-        match D::Color::PANEL {
-            None => self.draw_bands_converted(motion, frame, coherence, bands, target, poll),
-            Some(_) => self.draw_bands_converted(motion, frame, coherence, bands, &mut Dithered::ordered(target), poll),
-        }
-    }
-
-    /// [`LoadedScene::draw_bands_polled`] into a target that takes the
-    /// traced colours converted.
-    fn draw_bands_converted<D, Q: Poll>(
-        &self,
-        motion: &Motion<'_>,
-        frame: u32,
-        coherence: &Coherence<'_>,
-        bands: impl IntoIterator<Item = u32>,
-        target: &mut D,
-        poll: &mut Q,
-    ) -> Result<Stats, DrawError<D::Error>>
-    where
-        D: DrawTarget,
-        D::Color: From<Rgb888>,
-    {
-        let accelerator = self.accelerator();
-        // As `with_renderer`, here: the renderer's room is borrowed no
-        // longer than `motion` lives.
-        let (mut mailbox, mut screen_lists) = (self.mailbox.try_borrow_mut(), self.screen_lists.try_borrow_mut());
-        let (mailbox, lists) = room_of(&mut mailbox, &mut screen_lists);
-        let mut renderer =
-            renderer_in(self.view, &accelerator, coherence.size(), mailbox, lists).map_err(DrawError::Camera)?;
-        let mut stats = Stats::default();
-        let result = bands.into_iter().try_for_each(|band| {
-            let traced = coherence
-                .trace_band_polled(&mut renderer, motion, frame, band, poll, &mut |line, pixels| {
-                    target.fill_contiguous(line, pixels.map(|p| p.color.into())).map_err(DrawError::Target)
-                })
-                .map_err(|halt| match halt {
-                    Halt::Sink(e) => e,
-                    Halt::Stopped(_) => DrawError::Stopped,
-                })?;
-            stats.add(&traced);
-            Ok(())
-        });
-        let mut total = self.stats.get();
-        total.add(&stats);
-        self.stats.set(total);
-        result.map(|()| stats)
-    }
-
     /// The counters of every draw so far.
     pub fn stats(&self) -> Stats {
         self.stats.get()
@@ -335,9 +203,10 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         Size::new(w, h)
     }
 
-    /// The scene as an image of `size` pixels in the colour `C`.
+    /// The scene as an image of `size` pixels in the colour `C`: what to
+    /// draw of it, and how ([`TracedImage`]).
     pub fn image<C>(&self, size: Size) -> TracedImage<'_, 'r, P, C> {
-        TracedImage { scene: self, size, dithering: Dithering::default(), color: core::marker::PhantomData }
+        TracedImage::new(self.source(), size, None)
     }
 
     /// The scene as an image as large as `target`, in its colour: what
@@ -345,73 +214,6 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     pub fn image_for<D: DrawTarget>(&self, target: &D) -> TracedImage<'_, 'r, P, D::Color> {
         self.image(target.bounding_box().size)
     }
-
-    /// Draws the scene as an image of `order`'s size at the origin of
-    /// `target`, in the [`Progressive`] order: the whole picture in coarse
-    /// blocks first, then finer, until it is exactly the picture
-    /// [`LoadedScene::image`] draws. Every pixel is traced once; the
-    /// drawing streams (no framebuffer), in a few calls a pass.
-    ///
-    /// A panel of few levels (`BinaryColor`, `Gray2`, `Gray4`,
-    /// [`BlackWhiteRed`](crate::panel::BlackWhiteRed)) is dithered by
-    /// [`Dithering::Bayer`] in every pass, the one method that needs no
-    /// order: the last pass is then the image with that method.
-    ///
-    /// ```
-    /// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb565, prelude::*};
-    /// use octrace_core::{profile::Board16K, render::Progressive, Raytracer};
-    ///
-    /// let mut raytracer = Raytracer::<Board16K>::new();
-    /// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
-    /// let mut display = MockDisplay::<Rgb565>::new();
-    /// display.set_allow_overdraw(true); // later passes draw over the coarse blocks
-    /// scene.draw_progressive(&Progressive::new(display.size(), 16), &mut display)?;
-    /// assert_eq!(scene.stats().rays, 64 * 64, "every pixel traced once: nothing reflects");
-    ///
-    /// let mut direct = MockDisplay::<Rgb565>::new();
-    /// Image::new(&scene.image_for(&direct), Point::zero()).draw(&mut direct)?;
-    /// assert_eq!(display, direct);
-    /// # Ok::<(), Box<dyn core::error::Error>>(())
-    /// ```
-    pub fn draw_progressive<D>(&self, order: &Progressive, target: &mut D) -> Result<(), DrawError<D::Error>>
-    where
-        D: DrawTarget,
-        D::Color: TracedColor,
-    {
-        let drawn = match D::Color::PANEL {
-            None => self.with_renderer(order.size(), |renderer| order.render_unchecked(renderer, target)),
-            Some(_) => {
-                let mut ordered = Dithered::ordered(target);
-                self.with_renderer(order.size(), |renderer| order.render_unchecked(renderer, &mut ordered))
-            }
-        };
-        drawn.map_err(DrawError::Camera)?.map_err(DrawError::Target)?;
-        Ok(())
-    }
-
-    /// Renders `area` of an image of `size` into `target`, in the image's
-    /// coordinates.
-    pub(super) fn render_area<D>(&self, size: Size, area: &Rectangle, target: &mut D) -> Result<(), DrawError<D::Error>>
-    where
-        D: DrawTarget,
-        D::Color: From<Rgb888>,
-    {
-        let drawn = self.with_renderer(size, |renderer| renderer.render_rect(area, target));
-        drawn.map_err(DrawError::Camera)?.map_err(DrawError::Target)?;
-        Ok(())
-    }
-}
-
-/// The loading core's room out of its cells: none of what another draw of
-/// the scene holds (only if a display draws from inside a draw: the render
-/// goes without, the same image).
-fn room_of<'g, 'r>(
-    mailbox: &'g mut Result<core::cell::RefMut<'_, &'r mut [u32]>, core::cell::BorrowMutError>,
-    screen_lists: &'g mut Result<core::cell::RefMut<'_, Option<ScreenLists<'r>>>, core::cell::BorrowMutError>,
-) -> (Option<&'g mut [u32]>, Option<ScreenLists<'g>>) {
-    let lists = screen_lists.as_deref_mut().ok().and_then(|lists| lists.as_mut());
-    let lists = lists.map(|(bounds, positions)| (&mut **bounds, &mut **positions));
-    (mailbox.as_deref_mut().ok().map(|words| &mut **words), lists)
 }
 
 /// A renderer over `view` for an image of `size`, with a mailbox and screen

@@ -10,7 +10,7 @@
 
 use crate::accel::{self, AccelMode, LightBuffer, LightBufferStore, Mailbox, OctreeStore, Prepared, MAX_CELLS_A_SIDE};
 use crate::capacity::Arena;
-use crate::parse::{parse_frame_bytes, ErrorKind, ParseError, Pos};
+use crate::parse::{parse_recording, ErrorKind, MotionSink, ParseError, Pos};
 use crate::profile::Profile;
 use crate::render::ScreenBound;
 use crate::scene::Scene;
@@ -18,10 +18,13 @@ use crate::shade::Stats;
 use core::cell::{Cell, RefCell};
 use core::fmt;
 
+mod animated;
+mod draw;
 mod image;
 mod loaded;
 mod shared;
 
+pub use animated::{AnimationError, Frame};
 pub use image::{DrawError, TracedImage};
 pub use loaded::LoadedScene;
 pub use shared::{SceneAccelerator, SharedScene};
@@ -61,6 +64,12 @@ pub struct Raytracer<P: Profile> {
 /// # let _ = room;
 /// ```
 pub struct RendererRoom<P: Profile> {
+    /// Borrowed by one renderer at a time: a draw's, for its length.
+    room: RefCell<Room<P>>,
+}
+
+/// What a [`RendererRoom`] holds.
+struct Room<P: Profile> {
     mailbox: P::MailboxWords,
     screen_bounds: P::ScreenBounds,
     screen_positions: P::ScreenPositions,
@@ -69,13 +78,16 @@ pub struct RendererRoom<P: Profile> {
 impl<P: Profile> RendererRoom<P> {
     /// Empty room: a constant of all-zero bits.
     pub const fn new() -> Self {
-        RendererRoom {
+        let room = Room {
             mailbox: P::MailboxWords::EMPTY,
             screen_bounds: P::ScreenBounds::EMPTY,
             screen_positions: P::ScreenPositions::EMPTY,
-        }
+        };
+        RendererRoom { room: RefCell::new(room) }
     }
+}
 
+impl<P: Profile> Room<P> {
     /// The room cleared for a scene of `objects` objects: its mailbox, and
     /// its screen lists when the scene's camera rays use them.
     fn prepare(&mut self, objects: usize, first_hits: bool) -> (&mut [u32], Option<ScreenLists<'_>>) {
@@ -179,10 +191,7 @@ impl<P: Profile> Raytracer<P> {
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
     pub fn load_frame<'t>(&mut self, text: &'t str, frame: u32) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
-        self.load_in(text.as_bytes(), frame, AccelMode::Auto, &mut |_| {}, &mut |beside, here| {
-            here();
-            beside();
-        })
+        self.load_in(text.as_bytes(), frame, AccelMode::Auto, &mut |_| {}, &mut one_core, None)
     }
 
     /// [`Raytracer::load`] from bytes (invalid UTF-8 is an error at its
@@ -196,10 +205,7 @@ impl<P: Profile> Raytracer<P> {
         mode: AccelMode,
         on_error: &mut dyn FnMut(ParseError<'t>),
     ) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
-        self.load_in(text, 0, mode, on_error, &mut |beside, here| {
-            here();
-            beside();
-        })
+        self.load_in(text, 0, mode, on_error, &mut one_core, None)
     }
 
     /// [`Raytracer::load`] on two cores: the light buffer is built on the
@@ -266,30 +272,29 @@ impl<P: Profile> Raytracer<P> {
         frame: u32,
         both: impl FnOnce(&mut (dyn FnMut() + Send), &mut dyn FnMut()),
     ) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
-        let mut both = Some(both);
-        self.load_in(text.as_bytes(), frame, AccelMode::Auto, &mut |_| {}, &mut |beside, here| {
-            if let Some(both) = both.take() {
-                both(beside, here);
-            }
-        })
+        self.load_in(text.as_bytes(), frame, AccelMode::Auto, &mut |_| {}, &mut once(both), None)
     }
 
-    /// Parses `text` and indexes it; `both(beside, here)` runs the two
-    /// jobs of the indexing that are apart (the light buffer, the octree)
-    /// and returns once both are done.
-    fn load_in<'t>(
+    /// Parses frame `frame` of `text` and indexes it; `both(beside,
+    /// here)` runs the two jobs of the indexing that are apart (the light
+    /// buffer, the octree) and returns once both are done. With `motion`,
+    /// each moving statement is handed to it once placed, and the camera of
+    /// every frame is checked (an animation loaded to play).
+    pub(super) fn load_in<'t>(
         &mut self,
         text: &'t [u8],
         frame: u32,
         mode: AccelMode,
         on_error: &mut dyn FnMut(ParseError<'t>),
         both: &mut RunBoth<'_>,
+        motion: Option<&mut dyn MotionSink>,
     ) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
         let mut first = None;
-        let parsed = parse_frame_bytes(text, &mut self.scene, frame, &mut |e| {
+        let mut report = |e: ParseError<'t>| {
             first.get_or_insert(e);
             on_error(e);
-        });
+        };
+        let parsed = parse_recording(text, &mut self.scene, frame, &mut report, motion);
         let frames = match (parsed, first) {
             (Ok(parsed), _) => parsed.frames,
             (Err(count), Some(first)) => return Err(LoadError { first, count }),
@@ -326,14 +331,12 @@ impl<P: Profile> Raytracer<P> {
         let octree = report.map(|report| (&self.octree, report));
         let lights = if built { self.light_buffer.buffer() } else { LightBuffer::NONE };
         let first_hits = P::FIRST_HITS && requested != AccelMode::Naive;
-        let (mailbox, screen_lists) = self.room.prepare(view.object_count(), first_hits);
         Ok(LoadedScene {
             view,
             mode,
             octree,
             lights,
-            mailbox: RefCell::new(mailbox),
-            screen_lists: RefCell::new(screen_lists),
+            room: &self.room,
             first_hits,
             stats: Cell::new(Stats::default()),
             frames,
@@ -342,7 +345,26 @@ impl<P: Profile> Raytracer<P> {
 }
 
 /// Runs its first job on another core (or after) and its second here.
-type RunBoth<'a> = dyn FnMut(&mut (dyn FnMut() + Send), &mut dyn FnMut()) + 'a;
+pub(super) type RunBoth<'a> = dyn FnMut(&mut (dyn FnMut() + Send), &mut dyn FnMut()) + 'a;
+
+/// Both jobs on this core, the second first.
+pub(super) fn one_core(beside: &mut (dyn FnMut() + Send), here: &mut dyn FnMut()) {
+    here();
+    beside();
+}
+
+/// A caller's `both` (see [`Raytracer::load_on_two_cores`]) as a
+/// [`RunBoth`], run once.
+pub(super) fn once(
+    both: impl FnOnce(&mut (dyn FnMut() + Send), &mut dyn FnMut()),
+) -> impl FnMut(&mut (dyn FnMut() + Send), &mut dyn FnMut()) {
+    let mut both = Some(both);
+    move |beside, here| {
+        if let Some(both) = both.take() {
+            both(beside, here);
+        }
+    }
+}
 
 /// Whether profile `P` serves lights with a light buffer (else none of its
 /// code is linked).

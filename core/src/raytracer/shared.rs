@@ -2,6 +2,7 @@
 //! accelerator over only the shape kinds and structures its profile holds.
 
 use crate::accel::{naive, Accelerator, Hit, LightBuffer, Mailbox, OctreeStore, RayStart};
+use crate::animation::Playing;
 use crate::math::Scalar;
 use crate::profile::Profile;
 use crate::render::Renderer;
@@ -10,13 +11,18 @@ use crate::shapes::{Ray, ShapeKinds};
 use core::fmt;
 use embedded_graphics_core::geometry::Size;
 
+use super::draw::Source;
 use super::loaded::renderer_in;
-use super::{light_buffer, RendererRoom};
+use super::{light_buffer, RendererRoom, TracedImage};
 
 /// What another core needs to render a [`LoadedScene`](super::LoadedScene)
-/// ([`LoadedScene::share`](super::LoadedScene::share)): its objects, its accelerator and whether its
-/// camera rays use the screen lists. `Copy`, read-only and `Send`: hand it
-/// to the other core when you start it.
+/// ([`LoadedScene::share`](super::LoadedScene::share)) or a
+/// [`Frame`](super::Frame) ([`Frame::share`](super::Frame::share)): its
+/// objects, its accelerator, whether its camera rays use the screen lists,
+/// and a frame's tiles. `Copy`, read-only and `Send`: hand it to the other
+/// core when you start it; there, draw it with [`SharedScene::image`] in a
+/// [`RendererRoom`] of that core's, or trace pixels with a
+/// [`SharedScene::renderer`].
 ///
 /// ```
 /// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*};
@@ -51,6 +57,8 @@ pub struct SharedScene<'r, P: Profile> {
     pub(super) view: SceneView<'r>,
     pub(super) accelerator: SceneAccelerator<'r, P>,
     pub(super) first_hits: bool,
+    /// A frame's motion and planned tiles.
+    pub(super) playing: Option<Playing<'r>>,
 }
 
 impl<P: Profile> Clone for SharedScene<'_, P> {
@@ -85,8 +93,18 @@ impl<'r, P: Profile> SharedScene<'r, P> {
         room: &'a mut RendererRoom<P>,
         size: Size,
     ) -> Result<Renderer<'a, SceneAccelerator<'r, P>>, CameraError> {
-        let (mailbox, lists) = room.prepare(self.view.object_count(), self.first_hits);
+        let (mailbox, lists) = room.room.get_mut().prepare(self.view.object_count(), self.first_hits);
         renderer_in(self.view, &self.accelerator, size, Some(mailbox), lists)
+    }
+
+    /// The scene (a frame's tiles, if shared from a [`Frame`](super::Frame))
+    /// as an image of `size` pixels in the colour `C`, drawn in `room`:
+    /// another core's draw, as [`LoadedScene::image`](super::LoadedScene::image) is the loading
+    /// core's.
+    pub fn image<'s, C>(&'s self, room: &'s RendererRoom<P>, size: Size) -> TracedImage<'s, 'r, P, C> {
+        let source =
+            Source { view: self.view, accelerator: self.accelerator, first_hits: self.first_hits, room, stats: None };
+        TracedImage::new(source, size, self.playing)
     }
 }
 

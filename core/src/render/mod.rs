@@ -35,11 +35,12 @@ pub use handoff::{Handoff, SlotBusy, Taken};
 pub use panel::PanelColor;
 pub use progressive::{Progressive, ProgressiveError, TracedUnit, Unit};
 pub use split::{interleaved_rows, Tiles};
-pub(crate) use stop::Polling;
+pub(crate) use stop::{Halt, Polling};
 pub use stop::{Stop, Stopped};
 
 use crate::accel::{Accelerator, Hit, Mailbox};
 use crate::motion::{Lookout, RayKind};
+use crate::panel::TracedColor;
 use crate::scene::{Camera, CameraError, CameraRay, Color, ObjectId, RayCursor, SceneView, Stride, MAX_SIDE};
 use crate::shade::{Poll, Scratch, Stats, Tracer, Unpolled};
 use core::ops::Range;
@@ -69,6 +70,25 @@ pub struct PixelSample {
     /// The object the pixel's (centre) primary ray hits, as the scene file
     /// wrote it (see [`SceneView::written_object`]); `None` for background.
     pub object: Option<ObjectId>,
+}
+
+/// A sample as a colour: a target of `PixelSample`s takes each pixel's
+/// colour and the object it sees (a desktop's image keeps both).
+impl embedded_graphics_core::pixelcolor::PixelColor for PixelSample {
+    type Raw = ();
+}
+
+/// A colour alone: a sample that sees no object.
+impl From<Rgb888> for PixelSample {
+    fn from(color: Rgb888) -> Self {
+        PixelSample { color, object: None }
+    }
+}
+
+impl TracedColor for PixelSample {
+    fn traced(color: Rgb888, object: Option<ObjectId>) -> Self {
+        PixelSample { color, object }
+    }
 }
 
 /// Renders one scene through one accelerator. A renderer holds the mutable
@@ -422,7 +442,13 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     /// ray is a sum, as after a step (the jump's change of direction is
     /// kept by the walk, not the renderer), so a row walked every b-th
     /// pixel costs what a row does.
-    pub(crate) fn pixel_on(&mut self, walk: &mut Walk, x: u32, y: u32) -> PixelSample {
+    pub(crate) fn pixel_on<Q: Poll>(
+        &mut self,
+        walk: &mut Walk,
+        x: u32,
+        y: u32,
+        poll: &mut Q,
+    ) -> Result<PixelSample, Q::Stopped> {
         let along = x.wrapping_sub(walk.last[0]);
         if y == walk.last[1] && along > 1 && along <= MAX_SIDE {
             let stride = match walk.jump {
@@ -433,14 +459,17 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
             self.cursor.skip(&stride);
         }
         walk.last = [x, y];
-        self.pixel(x, y)
+        match Q::ASKS {
+            true => self.pixel_polled(x, y, poll),
+            false => Ok(self.pixel(x, y)),
+        }
     }
 
     /// Renders the whole image.
     pub fn render<D>(&mut self, target: &mut D) -> Result<Stats, D::Error>
     where
         D: DrawTarget,
-        D::Color: From<Rgb888>,
+        D::Color: TracedColor,
     {
         self.render_rect(&Rectangle::new(Point::zero(), self.size()), target)
     }
@@ -449,7 +478,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     pub fn render_rows<D>(&mut self, rows: Range<u32>, target: &mut D) -> Result<Stats, D::Error>
     where
         D: DrawTarget,
-        D::Color: From<Rgb888>,
+        D::Color: TracedColor,
     {
         let h = self.camera.height();
         let (start, end) = (rows.start.min(h), rows.end.min(h));
@@ -463,7 +492,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     pub fn render_rect<D>(&mut self, rect: &Rectangle, target: &mut D) -> Result<Stats, D::Error>
     where
         D: DrawTarget,
-        D::Color: From<Rgb888>,
+        D::Color: TracedColor,
     {
         let image = Rectangle::new(Point::zero(), self.size());
         let r = rect.intersection(&image);
@@ -472,7 +501,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         for y in r.top_left.y as u32..r.top_left.y as u32 + r.size.height {
             let line = Rectangle::new(Point::new(x0 as i32, y as i32), Size::new(r.size.width, 1));
             let pixels = self.row(y, x0..x0 + r.size.width);
-            target.fill_contiguous(&line, pixels.map(|p| p.color.into()))?;
+            target.fill_contiguous(&line, pixels.map(|p| D::Color::traced(p.color, p.object)))?;
         }
         Ok(self.scratch.stats.since(&before))
     }

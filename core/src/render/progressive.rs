@@ -74,10 +74,10 @@
 //! # Ok::<(), Box<dyn core::error::Error>>(())
 //! ```
 
-use super::{Renderer, Walk};
+use super::{Halt, Renderer, Walk};
 use crate::accel::Accelerator;
 use crate::scene::MAX_SIDE;
-use crate::shade::Stats;
+use crate::shade::{Poll, Stats, Unpolled};
 use core::convert::Infallible;
 use core::fmt;
 use core::ops::Range;
@@ -255,19 +255,26 @@ impl Progressive {
         D::Color: From<Rgb888>,
     {
         check_size(renderer.size(), self.size)?;
-        self.render_unchecked(renderer, target).map_err(ProgressiveError::Target)
+        match self.render_polled(renderer, target, &mut Unpolled) {
+            Ok(stats) => Ok(stats),
+            Err(Halt::Sink(e)) => Err(ProgressiveError::Target(e)),
+            Err(Halt::Stopped(never)) => match never {},
+        }
     }
 
-    /// [`Progressive::render`] with a renderer of the order's size.
-    pub(crate) fn render_unchecked<A, D>(
+    /// [`Progressive::render`] with a renderer of the order's size, `poll`
+    /// asked before every ray.
+    pub(crate) fn render_polled<A, D, Q>(
         &self,
         renderer: &mut Renderer<'_, A>,
         target: &mut D,
-    ) -> Result<Stats, D::Error>
+        poll: &mut Q,
+    ) -> Result<Stats, Halt<D::Error, Q::Stopped>>
     where
         A: Accelerator,
         D: DrawTarget,
         D::Color: From<Rgb888>,
+        Q: Poll,
     {
         let before = renderer.stats();
         let mut chunk = [Rgb888::new(0, 0, 0); CHUNK_BLOCKS];
@@ -275,25 +282,37 @@ impl Progressive {
             let mut walk = Walk::NEW;
             for run in unit.runs() {
                 let y = run.y;
+                let mut pixel = |x| renderer.pixel_on(&mut walk, x, y, poll).map(|p| p.color).map_err(Halt::Stopped);
                 // Blocks drawn alone, and single pixels, stream as traced.
                 if run.solid() {
                     for (block, x) in (0..).zip(run.columns()) {
-                        let color = renderer.pixel_on(&mut walk, x, y).color;
-                        target.fill_solid(&run.block_area(block), color.into())?;
+                        let color = pixel(x)?;
+                        target.fill_solid(&run.block_area(block), color.into()).map_err(Halt::Sink)?;
                     }
                 } else if run.block == 1 {
                     // Every pixel traced, even for a display that stops
-                    // short (one smaller than the image).
-                    let mut colors = run.columns().map(|x| renderer.pixel_on(&mut walk, x, y).color);
-                    target.fill_contiguous(&run.area, colors.by_ref().map(Into::into))?;
+                    // short (one smaller than the image); one stopped cuts
+                    // the run there.
+                    let mut halted = None;
+                    let mut colors = run.columns().map_while(|x| match pixel(x) {
+                        Ok(color) => Some(color),
+                        Err(stopped) => {
+                            halted = Some(stopped);
+                            None
+                        }
+                    });
+                    target.fill_contiguous(&run.area, colors.by_ref().map(Into::into)).map_err(Halt::Sink)?;
                     colors.for_each(drop);
+                    if let Some(stopped) = halted {
+                        return Err(stopped);
+                    }
                 } else {
                     for part in run.parts(CHUNK_BLOCKS as u32) {
                         let colors = &mut chunk[..(part.blocks as usize).min(CHUNK_BLOCKS)];
                         for (slot, x) in colors.iter_mut().zip(part.columns()) {
-                            *slot = renderer.pixel_on(&mut walk, x, y).color;
+                            *slot = pixel(x)?;
                         }
-                        part.draw(colors, target)?;
+                        part.draw(colors, target).map_err(Halt::Sink)?;
                     }
                 }
             }
@@ -398,7 +417,8 @@ impl Unit {
         for run in self.runs() {
             // The columns first: when they end, no slot is taken.
             for (x, slot) in run.columns().zip(slots.by_ref()) {
-                *slot = renderer.pixel_on(&mut walk, x, run.y).color.into();
+                let Ok(pixel) = renderer.pixel_on(&mut walk, x, run.y, &mut Unpolled);
+                *slot = pixel.color.into();
             }
         }
         Ok(TracedUnit { unit: *self, colors })

@@ -46,6 +46,13 @@ impl fmt::Display for Stopped {
 
 impl core::error::Error for Stopped {}
 
+/// Why a draw ended before its picture did: its target's error, or its
+/// poll said stop.
+pub(crate) enum Halt<E, S> {
+    Sink(E),
+    Stopped(S),
+}
+
 /// A [`Stop`] asked before each ray, until it says stop.
 pub(crate) struct Polling<'s, S> {
     pub(crate) stop: &'s mut S,

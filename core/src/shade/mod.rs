@@ -75,6 +75,10 @@ pub(crate) trait Poll {
     /// Why a sample stopped ([`Infallible`] for [`Unpolled`]).
     type Stopped;
 
+    /// Whether it asks anything: false, a caller's loop may run the
+    /// unpolled path itself.
+    const ASKS: bool = true;
+
     /// Whether the sample traces its next ray: once false, false until the
     /// sample is given up.
     fn go_on(&mut self) -> bool;
@@ -89,6 +93,8 @@ pub(crate) struct Unpolled;
 
 impl Poll for Unpolled {
     type Stopped = Infallible;
+
+    const ASKS: bool = false;
 
     #[inline(always)]
     fn go_on(&mut self) -> bool {

@@ -1,0 +1,206 @@
+//! An animation being played: its motion and its tiles' coherence in one
+//! place, over storage the caller owns ([`AnimationRoom`](super::AnimationRoom)).
+//! The loader records the motion into it as it places a new scene
+//! (`Animation::load`, in `raytracer/`), and steps its tiles from the
+//! frame shown to the one loaded.
+//!
+//! Invariants: the tracks and keys hold the motion of the text
+//! `loaded.fingerprint` names, recorded when it was first loaded (and
+//! every frame's camera checked then); the tiles' counts are those after
+//! frame `loaded.frame`, whatever order frames are asked in (a jump of s
+//! frames is s steps of the loop, capped where every count has run out);
+//! each object track keeps its displacement at that frame.
+
+use super::coherence::Coherence;
+use super::room::{AnimationCapacity, AnimationNeeds, NoRoom};
+use crate::motion::{Dependence, Key, Motion, MotionNeeds, Recorder, Track};
+use crate::scene::Frames;
+use core::sync::atomic::AtomicU8;
+use embedded_graphics_core::geometry::Size;
+
+/// After this many steps every count has run out (the longest kept is 253)
+/// but a tile's that nothing can change: stepping further changes nothing.
+const LONGEST_STEP: u32 = 255;
+
+/// An animation: what moves over its loop and what each tile of the image
+/// still shows, in the caller's storage ([`AnimationRoom`](super::AnimationRoom) on a board,
+/// [`HostAnimationRoom`](super::HostAnimationRoom) on a desktop). Load
+/// each frame with [`Animation::load`] (it records the motion of a scene it
+/// has not seen, checking the camera of every frame, and otherwise steps
+/// its tiles on), then draw the [`Frame`](crate::Frame) as a still is
+/// drawn: only its tiles the motion can have changed are traced.
+///
+/// ```
+/// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*};
+/// use octrace_core::animation::{AnimationNeeds, AnimationRoom};
+/// use octrace_core::Raytracer;
+///
+/// octrace_core::profile! {
+///     /// Two spheres, one moving; frames re-trace only what changes.
+///     struct Moving { spheres: 2, surfaces: 1, lights: 1 }
+///     coherence: true
+/// }
+/// let text = "FRAMES 4\nRASTER 16 16\nBACKGROUND 0 0 1\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\n\
+///             LIGHT 10 5 5 5\nSPHERE 1 2 0 0 -4\nSPHERE 1 0.5 -3 2 0 MOVE 0 0 0 0  3 1.5 0 0\n";
+/// const NEEDS: AnimationNeeds = AnimationNeeds { tiles: AnimationNeeds::tiles_for(Size::new(16, 16)), tracks: 1, keys: 2 };
+/// let mut room = AnimationRoom::<{ NEEDS.tiles }, { NEEDS.tracks }, { NEEDS.keys }>::new();
+/// let mut animation = room.animation(Size::new(16, 16))?;
+/// let mut raytracer = Raytracer::<Moving>::new();
+/// let mut panel = MockDisplay::<Rgb888>::new();
+/// panel.set_allow_overdraw(true);
+/// for frame in 0..4 {
+///     let loaded = animation.load(&mut raytracer, text, frame)?;
+///     let traced = loaded.tiles().traced_pixels();
+///     loaded.image_for(&panel).try_draw(&mut panel)?;
+///     // The panel shows frame `frame`, as if drawn whole.
+///     let mut whole = MockDisplay::<Rgb888>::new();
+///     Image::new(&loaded.scene().image(Size::new(16, 16)), Point::zero()).draw(&mut whole)?;
+///     assert_eq!(panel, whole);
+///     assert!(frame == 0 && traced == 256 || frame > 0 && traced < 256, "frame {frame}: {traced} pixels");
+/// }
+/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// ```
+#[derive(Debug)]
+pub struct Animation<'s> {
+    tracks: &'s mut [Track],
+    keys: &'s mut [Key],
+    coherence: Coherence<'s>,
+    /// What its storage holds.
+    room: AnimationNeeds,
+    loaded: Option<Loaded>,
+    /// Dependences the tracker drops, by a test only.
+    ignored: u8,
+}
+
+/// The scene an animation holds the motion of, and the frame its tiles are
+/// at.
+#[derive(Clone, Copy, Debug)]
+struct Loaded {
+    fingerprint: u64,
+    frames: Frames,
+    tracks: usize,
+    keys: usize,
+    frame: u32,
+}
+
+/// What a frame's draw needs of its animation: the motion, the tiles
+/// planned, the frame; read-only, shared by the cores that draw it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Playing<'a> {
+    pub motion: Motion<'a>,
+    pub coherence: Coherence<'a>,
+    pub frame: u32,
+    pub ignored: u8,
+}
+
+impl<'s> Animation<'s> {
+    /// An animation over `tiles`, `tracks` and `keys` on an image of
+    /// `size` in tiles of `side`.
+    pub(crate) fn new(
+        tiles: &'s [AtomicU8],
+        tracks: &'s mut [Track],
+        keys: &'s mut [Key],
+        size: Size,
+        side: u32,
+    ) -> Result<Animation<'s>, NoRoom> {
+        let room = AnimationNeeds { tiles: tiles.len(), tracks: tracks.len(), keys: keys.len() };
+        let coherence = Coherence::new(tiles, size, side).map_err(|needed| NoRoom {
+            what: AnimationCapacity::Tiles,
+            needed,
+            holds: tiles.len(),
+        })?;
+        Ok(Animation { tracks, keys, coherence, room, loaded: None, ignored: 0 })
+    }
+
+    /// What its storage holds.
+    pub fn room(&self) -> AnimationNeeds {
+        self.room
+    }
+
+    /// The tiles of the image and what the frame loaded last traces of
+    /// them (every tile, at the first).
+    pub fn tiles(&self) -> &Coherence<'s> {
+        &self.coherence
+    }
+
+    /// The loaded scene's frames (a still scene is one frame), and the
+    /// frame loaded last.
+    pub fn frames(&self) -> Option<(Frames, u32)> {
+        self.loaded.map(|l| (l.frames, l.frame))
+    }
+
+    /// Forgets what the image shows: the next frame loaded traces every
+    /// tile (for a display something else drew over).
+    pub fn restart(&mut self) {
+        self.coherence.restart();
+    }
+
+    /// Drops the dependence `dependence` from the tracking: for a test
+    /// that checks its check of exactness fails without it.
+    #[doc(hidden)]
+    pub fn ignoring(mut self, dependence: Dependence) -> Self {
+        self.ignored |= 1 << dependence as u8;
+        self
+    }
+
+    /// Whether `text` is the scene whose motion it holds.
+    pub(crate) fn holds(&self, text: &[u8]) -> bool {
+        self.loaded.is_some_and(|l| l.fingerprint == fingerprint(text))
+    }
+
+    /// A recorder of `text`'s motion into the storage, or what it lacks.
+    pub(crate) fn recorder(&mut self, text: &[u8]) -> Result<Recorder<'_>, NoRoom> {
+        let needs = core::str::from_utf8(text).map(MotionNeeds::of).unwrap_or_default();
+        let needs = AnimationNeeds { tiles: 0, tracks: needs.tracks, keys: needs.keys };
+        if let Some(short) = needs.beyond(&self.room).into_iter().flatten().next() {
+            return Err(short);
+        }
+        self.loaded = None;
+        Ok(Recorder::new(self.tracks, self.keys))
+    }
+
+    /// `text`'s motion recorded (`tracks` tracks, `keys` keys) from frame
+    /// `frame` of its `frames`: every tile is traced next.
+    pub(crate) fn recorded(&mut self, text: &[u8], frames: Frames, (tracks, keys): (usize, usize), frame: u32) {
+        self.loaded = Some(Loaded { fingerprint: fingerprint(text), frames, tracks, keys, frame });
+        self.coherence.restart();
+        self.keep(frame);
+    }
+
+    /// Steps the tiles from the frame loaded last to `frame`, forward round
+    /// the loop.
+    pub(crate) fn step_to(&mut self, frame: u32) {
+        let Some(loaded) = &mut self.loaded else { return };
+        let count = loaded.frames.count.max(1);
+        let steps = (frame % count + count - loaded.frame % count) % count;
+        loaded.frame = frame;
+        for _ in 0..steps.min(LONGEST_STEP) {
+            self.coherence.plan();
+        }
+        self.keep(frame);
+    }
+
+    /// The object tracks keep their displacements at `frame`.
+    fn keep(&mut self, frame: u32) {
+        if let Some(l) = self.loaded {
+            Motion::at_frame(&mut self.tracks[..l.tracks], &self.keys[..l.keys], l.frames, frame);
+        }
+    }
+
+    /// What a draw of the frame loaded needs.
+    pub(crate) fn playing(&self) -> Playing<'_> {
+        let (frames, tracks, keys, frame) = match self.loaded {
+            Some(l) => (l.frames, l.tracks, l.keys, l.frame),
+            None => (Frames { count: 1, rate: Frames::DEFAULT_RATE }, 0, 0, 0),
+        };
+        let motion = Motion::new(frames, &self.tracks[..tracks], &self.keys[..keys], frame);
+        Playing { motion, coherence: self.coherence, frame, ignored: self.ignored }
+    }
+}
+
+/// A fingerprint of a scene's text (64-bit FNV-1a and the length): a
+/// text edited between two frames is another animation.
+fn fingerprint(text: &[u8]) -> u64 {
+    let hash = text.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3));
+    hash ^ (text.len() as u64).rotate_left(32)
+}

@@ -1,0 +1,255 @@
+//! What every draw of a loaded scene runs, whichever picture its
+//! [`TracedImage`] asks for: a renderer from the draw's source (the
+//! loading core's room, or another core's), then an area of a still, the
+//! progressive order, or a frame's bands of tiles, into the target
+//! converted or dithered. The one place a change to how pictures and
+//! frames are traced goes.
+//!
+//! Invariants: one renderer a draw, its counters added to the loaded
+//! scene's; a draw asked to stop ends within a ray, having drawn only
+//! pixels that are the picture's (a frame's tiles not drawn keep their
+//! mark to be traced); a draw that asks nothing runs the tracer without
+//! any of the asking.
+
+use super::image::Shifted;
+use super::loaded::renderer_in;
+use super::{DrawError, RendererRoom, SceneAccelerator, TracedImage};
+use crate::animation::Playing;
+use crate::panel::{Dithered, TracedColor, IMAGE_ERROR_WORDS};
+use crate::profile::Profile;
+use crate::render::{Halt, Progressive, Renderer};
+use crate::scene::{CameraError, SceneView};
+use crate::shade::{Poll, Stats};
+use core::cell::Cell;
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{Dimensions, Point, Size};
+use embedded_graphics_core::primitives::Rectangle;
+
+/// Where a draw's renderer comes from: a scene's view and accelerator,
+/// and the room its renderer traces in.
+pub(super) struct Source<'s, 'r, P: Profile> {
+    pub view: SceneView<'r>,
+    pub accelerator: SceneAccelerator<'r, P>,
+    pub first_hits: bool,
+    pub room: &'s RendererRoom<P>,
+    /// The loaded scene's counters, which each draw adds to.
+    pub stats: Option<&'s Cell<Stats>>,
+}
+
+impl<P: Profile> Clone for Source<'_, '_, P> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<P: Profile> Copy for Source<'_, '_, P> {}
+
+impl<'r, P: Profile> Source<'_, 'r, P> {
+    /// Runs `f` with a renderer of an image of `size` in the source's room
+    /// (none of it if a draw holds it already: only a display that draws
+    /// from inside a draw; the render goes without, the same image).
+    pub(super) fn with_renderer<R>(
+        &self,
+        size: Size,
+        f: impl FnOnce(&mut Renderer<'_, SceneAccelerator<'r, P>>) -> R,
+    ) -> Result<R, CameraError> {
+        let mut room = self.room.room.try_borrow_mut();
+        let (mailbox, lists) = match room.as_deref_mut() {
+            Ok(room) => {
+                let (mailbox, lists) = room.prepare(self.view.object_count(), self.first_hits);
+                (Some(mailbox), lists)
+            }
+            Err(_) => (None, None),
+        };
+        let mut renderer = renderer_in(self.view, &self.accelerator, size, mailbox, lists)?;
+        let result = f(&mut renderer);
+        if let Some(stats) = self.stats {
+            let mut total = stats.get();
+            total.add(&renderer.stats());
+            stats.set(total);
+        }
+        Ok(result)
+    }
+}
+
+/// What an image draws.
+#[derive(Clone, Copy)]
+pub(super) enum Picture<'s> {
+    /// A still's pixels in this rectangle (of the image), with its top-left
+    /// pixel at the target's origin.
+    Area(Rectangle),
+    /// A still whole, in the progressive order.
+    Progressive(&'s Progressive),
+    /// A frame's planned tiles: every band, or the next band `next` gives
+    /// until it gives none.
+    Bands(Playing<'s>, Option<&'s dyn Fn() -> Option<u32>>),
+}
+
+/// Draws `image` into `target`, `poll` asked before every ray.
+pub(super) fn draw<P, C, D, Q>(
+    image: &TracedImage<'_, '_, P, C>,
+    target: &mut D,
+    poll: &mut Q,
+) -> Result<Stats, DrawError<D::Error>>
+where
+    P: Profile,
+    C: TracedColor,
+    D: DrawTarget<Color = C>,
+    Q: Poll,
+{
+    match image.picture {
+        Picture::Bands(playing, next) => match C::PANEL {
+            // Ordered dithering, which needs no order: a changed tile
+            // draws the same whatever was drawn around it.
+            Some(_) => bands(image, &playing, next, &mut Dithered::ordered(target), poll),
+            None => bands(image, &playing, next, target, poll),
+        },
+        Picture::Progressive(order) => drawn(image.source.with_renderer(order.size(), |renderer| match C::PANEL {
+            // Bayer too: the one method a block order keeps.
+            Some(_) => order.render_polled(renderer, &mut Dithered::ordered(target), poll),
+            None => order.render_polled(renderer, target, poll),
+        })),
+        Picture::Area(area) => {
+            let mut shifted = Shifted { target, offset: Point::zero() - area.top_left };
+            // The pixels there are: the rows a ditherer is set up for.
+            let area = area.intersection(&image.bounding_box());
+            match (C::PANEL, image.rows) {
+                (None, _) => drawn(image.source.with_renderer(image.size, |r| rows(r, &area, &mut shifted, poll))),
+                (Some(_), Some(given)) => match given.try_borrow_mut() {
+                    Ok(mut given) => dithered(image, &area, &mut shifted, &mut given, poll),
+                    Err(_) => dithered_on_stack::<IMAGE_ERROR_WORDS, _, _, _, _>(image, &area, &mut shifted, poll),
+                },
+                // A small panel's row in a small frame.
+                (Some(panel), None) if panel.error_words(area.size.width) <= SMALL_ERROR_WORDS => {
+                    dithered_on_stack::<SMALL_ERROR_WORDS, _, _, _, _>(image, &area, &mut shifted, poll)
+                }
+                (Some(_), None) => dithered_on_stack::<IMAGE_ERROR_WORDS, _, _, _, _>(image, &area, &mut shifted, poll),
+            }
+        }
+    }
+}
+
+/// What a renderer's draw ended with, as a draw's result.
+fn drawn<E, S>(drawn: Result<Result<Stats, Halt<E, S>>, CameraError>) -> Result<Stats, DrawError<E>> {
+    match drawn {
+        Ok(Ok(stats)) => Ok(stats),
+        Ok(Err(Halt::Sink(e))) => Err(DrawError::Target(e)),
+        Ok(Err(Halt::Stopped(_))) => Err(DrawError::Stopped),
+        Err(e) => Err(DrawError::Camera(e)),
+    }
+}
+
+/// The error row of a panel image up to 256 `i16`s wide (a one-bit 128×64
+/// OLED needs 128) takes only this much of the draw's stack (512 bytes).
+const SMALL_ERROR_WORDS: usize = 256;
+
+/// A frame's bands (every one, or those `next` gives) into `target`:
+/// each planned run of tiles row by row, in one `fill_contiguous` a row.
+fn bands<P, C, D, Q>(
+    image: &TracedImage<'_, '_, P, C>,
+    playing: &Playing<'_>,
+    next: Option<&dyn Fn() -> Option<u32>>,
+    target: &mut D,
+    poll: &mut Q,
+) -> Result<Stats, DrawError<D::Error>>
+where
+    P: Profile,
+    D: DrawTarget,
+    D::Color: TracedColor,
+    Q: Poll,
+{
+    let coherence = playing.coherence;
+    let mut all = 0..coherence.bands();
+    let mut taken = || match next {
+        Some(next) => next(),
+        None => all.next(),
+    };
+    drawn(image.source.with_renderer(coherence.size(), |renderer| {
+        let mut stats = Stats::default();
+        while let Some(band) = taken() {
+            stats.add(&coherence.trace_band(renderer, playing, band, poll, &mut |line, pixels| {
+                target.fill_contiguous(line, pixels.map(|p| D::Color::traced(p.color, p.object)))
+            })?);
+        }
+        Ok(stats)
+    }))
+}
+
+/// The rows of `area` (of the image) into `target`, each in one
+/// `fill_contiguous`; a row stopped inside is handed over up to the
+/// stopped pixel. Returns the counters of the rows.
+fn rows<A, D, Q>(
+    renderer: &mut Renderer<'_, A>,
+    area: &Rectangle,
+    target: &mut D,
+    poll: &mut Q,
+) -> Result<Stats, Halt<D::Error, Q::Stopped>>
+where
+    A: crate::accel::Accelerator,
+    D: DrawTarget,
+    D::Color: TracedColor,
+    Q: Poll,
+{
+    if !Q::ASKS {
+        // Nothing asked: the renderer's own loop, as fast as a still's.
+        return renderer.render_rect(area, target).map_err(Halt::Sink);
+    }
+    let before = renderer.stats();
+    let x0 = area.top_left.x as u32;
+    for y in area.rows() {
+        let line = Rectangle::new(Point::new(x0 as i32, y), Size::new(area.size.width, 1));
+        let mut halted = None;
+        let pixels = (x0..x0 + area.size.width).map_while(|x| match renderer.pixel_polled(x, y as u32, poll) {
+            Ok(p) => Some(D::Color::traced(p.color, p.object)),
+            Err(stopped) => {
+                halted = Some(stopped);
+                None
+            }
+        });
+        target.fill_contiguous(&line, pixels).map_err(Halt::Sink)?;
+        if let Some(stopped) = halted {
+            return Err(Halt::Stopped(stopped));
+        }
+    }
+    Ok(renderer.stats().since(&before))
+}
+
+/// A still's `area` dithered, its error row of `WORDS` on this frame. Not
+/// inlined: a truecolour draw never holds the row.
+#[inline(never)]
+fn dithered_on_stack<const WORDS: usize, P, C, D, Q>(
+    image: &TracedImage<'_, '_, P, C>,
+    area: &Rectangle,
+    target: &mut D,
+    poll: &mut Q,
+) -> Result<Stats, DrawError<D::Error>>
+where
+    P: Profile,
+    C: TracedColor,
+    D: DrawTarget<Color = C>,
+    Q: Poll,
+{
+    dithered(image, area, target, &mut [0; WORDS], poll)
+}
+
+/// A still's `area` dithered across its width, error diffusion's rows in
+/// `rows`. Not inlined: one copy of the render loop whatever frame the
+/// row is in.
+#[inline(never)]
+fn dithered<P, C, D, Q>(
+    image: &TracedImage<'_, '_, P, C>,
+    area: &Rectangle,
+    target: &mut D,
+    rows: &mut [i16],
+    poll: &mut Q,
+) -> Result<Stats, DrawError<D::Error>>
+where
+    P: Profile,
+    C: TracedColor,
+    D: DrawTarget<Color = C>,
+    Q: Poll,
+{
+    let (left, width) = (area.top_left.x, area.size.width);
+    let mut dithered = Dithered::across(target, image.dithering, left, width, rows).map_err(DrawError::ErrorRow)?;
+    drawn(image.source.with_renderer(image.size, |renderer| self::rows(renderer, area, &mut dithered, poll)))
+}
