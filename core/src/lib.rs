@@ -147,10 +147,9 @@ mod sort;
 #[cfg(test)]
 mod test_rng;
 
-pub use accel::AccelMode;
+pub use accel::{AccelMode, SceneAccelerator};
 pub use raytracer::{
-    AnimationError, DrawError, Frame, LoadError, LoadedScene, Raytracer, RendererRoom, SceneAccelerator, SharedScene,
-    TracedImage,
+    AnimationError, DrawError, Frame, LoadError, LoadedScene, Raytracer, RendererRoom, SharedScene, TracedImage,
 };
 #[cfg(feature = "static-cell")]
 pub use static_cell::ConstStaticCell;

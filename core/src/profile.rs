@@ -26,7 +26,8 @@
 //! Invariants: a profile's arena types are exactly its [`Profile::COUNTS`];
 //! its octree walks at most `OCTREE.max_depth + 1` frames deep.
 
-use crate::accel::{OctreeCapacities, OctreeConfig, OctreeStore};
+pub use crate::accel::linked::Linked;
+use crate::accel::OctreeConfig;
 use crate::capacity::{Arena, Counts};
 use crate::render::ScreenBound;
 use crate::scene::SceneCapacities;
@@ -36,10 +37,12 @@ use crate::{
     AccelMode,
 };
 
-/// Everything one build holds: a scene's arenas, an octree's, and a mailbox.
-/// Implement it with [`profile!`](crate::profile!). The octree is `Sync` and
-/// a renderer's room `Send`, so that the cores of a board can share a scene
-/// and each render in room of its own ([`SharedScene`](crate::SharedScene)).
+/// Everything one build holds and links: a scene's arenas, an octree's, a
+/// mailbox, and what its tracer links ([`Linked`]: the octree, the screen
+/// lists, the light buffer, coherence). Implement it with
+/// [`profile!`](crate::profile!). The octree is `Sync` and a renderer's
+/// room `Send`, so that the cores of a board can share a scene and each
+/// render in room of its own ([`SharedScene`](crate::SharedScene)).
 ///
 /// ```
 /// use octrace_core::profile::{Board16K, Board64K, Profile};
@@ -48,13 +51,11 @@ use crate::{
 /// assert_eq!(Board16K::OCTREE.max_depth, 3);
 /// assert!(Board64K::COUNTS.objects > Board16K::COUNTS.objects);
 /// ```
-pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
+pub trait Profile: SceneCapacities + Linked {
     /// What the profile holds.
     const COUNTS: Counts;
     /// How the octree is built (its depth also bounds the walk's stack).
     const OCTREE: OctreeConfig;
-    /// The octree, with a walk as deep as [`Profile::OCTREE`] allows.
-    type Octree: OctreeStore + Sync;
     /// One bit per object: an object filed in several octree boxes is then
     /// tested once per ray.
     type MailboxWords: Arena<u32> + Send;
@@ -64,26 +65,11 @@ pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
     /// [`profile!`](crate::profile!)) saves that RAM; its scenes asked for
     /// that walk are walked by 3DDDA (the same image) and say so.
     const NAMED_WALK: bool = true;
-    /// Whether camera rays find their hits among the objects seen around
-    /// their pixel (see [`Renderer::with_first_hits`](crate::render::Renderer::with_first_hits)):
-    /// the same image, for a [`ScreenBound`] (24 bytes) an object and
-    /// [`ScreenBound::positions_for`] them (2 bytes each) of RAM (`first_hits: true` in
-    /// [`profile!`](crate::profile!)). [`Raytracer`](crate::Raytracer) then
-    /// uses them in every mode but [`AccelMode::Naive`](crate::AccelMode::Naive)
-    /// asked for by name, which stays the thesis's test of every object.
-    const FIRST_HITS: bool = false;
-    /// Whether an animation's frames re-trace only what the motion can
-    /// change ([`crate::animation`]'s coherence): the tracer then watches
-    /// every ray of a frame against the motion to come (`coherence: true`
-    /// in [`profile!`](crate::profile!)). Without it none of that code is
-    /// linked and an animation's every frame is traced whole (the same
-    /// pictures), so a board that draws stills pays nothing for it.
-    const COHERENCE: bool = false;
     /// Room for the screen lists: a bound for each object when
-    /// [`Profile::FIRST_HITS`], else none.
+    /// [`Linked::FIRST_HITS`], else none.
     type ScreenBounds: Arena<ScreenBound> + Send;
     /// And for the lists' positions: [`ScreenBound::positions_for`] the
-    /// objects when [`Profile::FIRST_HITS`], else none.
+    /// objects when [`Linked::FIRST_HITS`], else none.
     type ScreenPositions: Arena<u16> + Send;
     /// RAM for the shadow rays' light buffer
     /// ([`LightBuffer`](crate::accel::LightBuffer)), which
@@ -104,9 +90,14 @@ pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
 /// them); the crate re-exports all it needs. A last `named_walk: false`
 /// leaves out the hash table only the thesis's walk needs (see
 /// [`Profile::NAMED_WALK`]); a last `first_hits: true` gives camera rays
-/// the screen lists (see [`Profile::FIRST_HITS`]); a last `coherence: true`
-/// lets an animation re-trace only what changes (see
-/// [`Profile::COHERENCE`]).
+/// the screen lists (see [`Linked::FIRST_HITS`]: the same image, for a
+/// [`ScreenBound`] (24 bytes) an object and [`ScreenBound::positions_for`]
+/// them (2 bytes each) of RAM, used in every mode but
+/// [`AccelMode::Naive`](crate::AccelMode::Naive) asked for by name, which
+/// stays the thesis's test of every object); a last `coherence: true` lets
+/// an animation re-trace only what changes (see [`Linked::COHERENCE`]:
+/// without it none of that code is linked, and a board that draws stills
+/// pays nothing for it).
 ///
 /// ```
 /// octrace_core::profile! {
@@ -138,20 +129,24 @@ macro_rules! profile {
                 const COUNTS: p::Counts = p::Counts { $($field: $value,)* ..p::Counts::ZERO }.with_objects();
                 const OCTREE: p::OctreeConfig =
                     p::OctreeConfig { $($($octree_field: $octree_value,)*)? ..p::OctreeConfig::DEFAULT };
-                type Octree = p::Octree<$name, { <$name as $crate::profile::Profile>::OCTREE.max_depth as usize + 1 }>;
                 type MailboxWords = p::Vec<u32, { <$name as $crate::profile::Profile>::COUNTS.mailbox_words() }>;
                 const NAMED_WALK: bool = p::given_or(&[$($named_walk)?], true);
-                const FIRST_HITS: bool = p::given_or(&[$($first_hits)?], false);
-                const COHERENCE: bool = p::given_or(&[$($coherence)?], false);
                 type ScreenBounds = p::Vec<
                     p::ScreenBound,
-                    { p::ScreenBound::if_wanted(<$name as $crate::profile::Profile>::FIRST_HITS, <$name as $crate::profile::Profile>::COUNTS.objects) },
+                    { p::ScreenBound::if_wanted(<$name as p::Linked>::FIRST_HITS, <$name as $crate::profile::Profile>::COUNTS.objects) },
                 >;
                 type ScreenPositions = p::Vec<
                     u16,
-                    { p::ScreenBound::if_wanted(<$name as $crate::profile::Profile>::FIRST_HITS, p::ScreenBound::positions_for(<$name as $crate::profile::Profile>::COUNTS.objects)) },
+                    { p::ScreenBound::if_wanted(<$name as p::Linked>::FIRST_HITS, p::ScreenBound::positions_for(<$name as $crate::profile::Profile>::COUNTS.objects)) },
                 >;
                 type LightBufferWords = p::Vec<u32, { <$name as $crate::profile::Profile>::COUNTS.light_buffer_words }>;
+            }
+
+            impl p::Linked for $name {
+                type Octree = p::Octree<$name, { <$name as $crate::profile::Profile>::OCTREE.max_depth as usize + 1 }>;
+                const FIRST_HITS: bool = p::given_or(&[$($first_hits)?], false);
+                const COHERENCE: bool = p::given_or(&[$($coherence)?], false);
+                const LIGHT_BUFFER: bool = <$name as $crate::profile::Profile>::COUNTS.light_buffer_lights > 0;
             }
 
             // 16-bit indices: their top two values are markers.
@@ -356,9 +351,9 @@ pub struct ProfileText<'a> {
     pub octree: Option<&'a OctreeConfig>,
     /// [`Profile::NAMED_WALK`].
     pub named_walk: bool,
-    /// [`Profile::FIRST_HITS`].
+    /// [`Linked::FIRST_HITS`].
     pub first_hits: bool,
-    /// [`Profile::COHERENCE`]: what a firmware that plays animations needs.
+    /// [`Linked::COHERENCE`]: what a firmware that plays animations needs.
     pub coherence: bool,
 }
 
@@ -429,6 +424,7 @@ impl core::fmt::Display for ProfileText<'_> {
 /// What [`profile!`](crate::profile!) expands to; not a public API.
 #[doc(hidden)]
 pub mod __private {
+    pub use crate::accel::linked::Linked;
     pub use crate::accel::{HashEntry, Octree, OctreeCapacities, OctreeConfig, OctreeNode, ShadowShaft};
     pub use crate::capacity::Counts;
     pub use crate::render::ScreenBound;
@@ -473,7 +469,7 @@ pub struct Host;
 #[cfg(feature = "alloc")]
 mod host {
     use super::{Host, Profile};
-    use crate::accel::{HashEntry, Octree, OctreeCapacities, OctreeConfig, OctreeNode, ShadowShaft, MAX_DEPTH};
+    use crate::accel::{HashEntry, Linked, Octree, OctreeCapacities, OctreeConfig, OctreeNode, ShadowShaft, MAX_DEPTH};
     use crate::capacity::{Counts, HeapArena};
     use crate::render::ScreenBound;
 
@@ -494,13 +490,17 @@ mod host {
         .with_every_shape(MILLION);
         // RAM is plenty: shadow shafts on.
         const OCTREE: OctreeConfig = OctreeConfig { shadow_shafts: true, ..OctreeConfig::DEFAULT };
-        type Octree = Octree<Host, { MAX_DEPTH as usize + 1 }>;
         type MailboxWords = HeapArena<u32, { Host::COUNTS.mailbox_words() }>;
-        const FIRST_HITS: bool = true;
-        const COHERENCE: bool = true;
         type ScreenBounds = HeapArena<ScreenBound, { Host::COUNTS.objects }>;
         type ScreenPositions = HeapArena<u16, { ScreenBound::positions_for(Host::COUNTS.objects) }>;
         type LightBufferWords = HeapArena<u32, { Host::COUNTS.light_buffer_words }>;
+    }
+
+    impl Linked for Host {
+        type Octree = Octree<Host, { MAX_DEPTH as usize + 1 }>;
+        const FIRST_HITS: bool = true;
+        const COHERENCE: bool = true;
+        const LIGHT_BUFFER: bool = true;
     }
 
     crate::__shape_kinds!(crate::__scene_capacities! { Host, HeapArena });

@@ -18,6 +18,7 @@
 
 mod choice;
 mod light_buffer;
+pub(crate) mod linked;
 pub(crate) mod naive;
 mod octree;
 
@@ -26,6 +27,9 @@ pub(crate) use light_buffer::RAY_SLACK;
 pub use light_buffer::{
     LightBuffer, LightBufferError, LightBufferReport, LightBufferStore, LightBuffered, MAX_CELLS_A_SIDE,
 };
+pub(crate) use linked::uses_mailbox;
+pub(crate) use linked::Linked;
+pub use linked::SceneAccelerator;
 pub use naive::Naive;
 pub(crate) use octree::FILING_MARGIN;
 pub use octree::{
@@ -35,7 +39,7 @@ pub use octree::{
 
 use crate::math::Scalar;
 use crate::scene::{ObjectId, SceneView};
-use crate::shapes::{Leaving, Ray, ShapeKinds};
+use crate::shapes::{Leaving, Ray};
 
 /// How a scene's rays find their objects: the choice a user makes (host-sim's
 /// `--accel`, the firmware's `OCTRACE_ACCEL`). Every mode gives the same
@@ -238,31 +242,10 @@ impl<'m> Mailbox<'m> {
     }
 }
 
-/// An intersection strategy over a scene.
+/// An intersection strategy over a scene: the nearest hit, and any hit for
+/// shadow rays. What a build links around it (the shape kinds, the
+/// mailbox, the screen lists, coherence) is its profile's ([`Linked`]).
 pub trait Accelerator {
-    /// The shape kinds its scenes can hold (a profile's): the tracer
-    /// dispatches on these only, so a build links no other kind's code.
-    const KINDS: ShapeKinds = ShapeKinds::ALL;
-
-    /// Whether its queries mark objects in the [`Mailbox`] (which the
-    /// tracer then clears before each query); false for one that tests
-    /// every object once anyway.
-    const USES_MAILBOX: bool = true;
-
-    /// Whether the tracer watches its rays against an animation's motion,
-    /// so that a frame re-traces only what changes
-    /// ([`crate::animation::Coherence`]). False links none of that code:
-    /// every frame is then traced whole (the same pictures).
-    const FOLLOWS_MOTION: bool = true;
-
-    /// Whether the renderer may find camera rays' hits in its screen-space
-    /// lists (see [`Renderer::with_first_hits`](crate::render::Renderer::with_first_hits))
-    /// instead of asking [`Accelerator::nearest`]: the same hits. False for
-    /// the naive mode, which stays the thesis's test of every object.
-    fn first_hits_by_screen(&self) -> bool {
-        false
-    }
-
     /// The nearest hit along `ray` (`t > 0`), ties to the earlier object.
     fn nearest(
         &self,
@@ -301,6 +284,45 @@ pub trait Accelerator {
     ) -> bool {
         let _ = light;
         self.occluded(scene, ray, t_max, start, mailbox)
+    }
+}
+
+/// A reference to an accelerator answers as it does.
+impl<A: Accelerator + ?Sized> Accelerator for &A {
+    #[inline]
+    fn nearest(
+        &self,
+        scene: &SceneView<'_>,
+        ray: &Ray,
+        start: Option<RayStart>,
+        mailbox: &mut Mailbox<'_>,
+    ) -> Option<Hit> {
+        (**self).nearest(scene, ray, start, mailbox)
+    }
+
+    #[inline]
+    fn occluded(
+        &self,
+        scene: &SceneView<'_>,
+        ray: &Ray,
+        t_max: Scalar,
+        start: Option<RayStart>,
+        mailbox: &mut Mailbox<'_>,
+    ) -> bool {
+        (**self).occluded(scene, ray, t_max, start, mailbox)
+    }
+
+    #[inline]
+    fn occluded_toward(
+        &self,
+        scene: &SceneView<'_>,
+        ray: &Ray,
+        t_max: Scalar,
+        light: usize,
+        start: Option<RayStart>,
+        mailbox: &mut Mailbox<'_>,
+    ) -> bool {
+        (**self).occluded_toward(scene, ray, t_max, light, start, mailbox)
     }
 }
 

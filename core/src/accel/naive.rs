@@ -12,8 +12,6 @@ use crate::shapes::{Ray, ShapeKinds};
 pub struct Naive;
 
 impl Accelerator for Naive {
-    const USES_MAILBOX: bool = false;
-
     fn nearest(&self, scene: &SceneView<'_>, ray: &Ray, start: Option<RayStart>, _: &mut Mailbox<'_>) -> Option<Hit> {
         nearest(ShapeKinds::ALL, scene, ray, start)
     }

@@ -10,9 +10,8 @@
 //! tile (loads and stores only, which a Cortex-M0 has), so cores share one
 //! store without a lock.
 
-use super::player::Playing;
-use crate::accel::Accelerator;
-use crate::motion::{Lookout, NEVER};
+use crate::accel::Linked;
+use crate::motion::NEVER;
 use crate::render::{Halt, PixelSample, Renderer};
 use crate::shade::{Poll, Stats};
 use core::ops::Range;
@@ -179,29 +178,24 @@ impl<'s> Coherence<'s> {
         })
     }
 
-    /// Traces the tiles of band `band` that the planned frame traces, frame
-    /// `playing.frame` loaded in `renderer`'s scene, `poll` asked before
-    /// every ray: each run of tiles row by row, handing `each` the run's
+    /// Traces the tiles of band `band` that the planned frame traces with
+    /// `renderer` (over the frame's scene, watching the motion to come
+    /// when it has a lookout), `poll` asked before every ray: each run of tiles row by row, handing `each` the run's
     /// row (a rectangle one pixel high) and its pixels as they are traced;
     /// records the tiles' new counts. Returns the counters of the traces,
     /// or why it ended early: `each`'s error, or the poll's stop (the
     /// pixels of the row handed to `each` then end before the stopped
     /// pixel, and the run's tiles keep their mark to be traced).
     #[inline(always)]
-    pub(crate) fn trace_band<'a, A: Accelerator, Q: Poll, E>(
+    pub(crate) fn trace_band<L: Linked, Q: Poll, E>(
         &self,
-        renderer: &mut Renderer<'a, A>,
-        playing: &Playing<'a>,
+        renderer: &mut Renderer<'_, L>,
         band: u32,
         poll: &mut Q,
         each: &mut RunSink<'_, E>,
     ) -> Result<Stats, Halt<E, Q::Stopped>> {
         let before = renderer.stats();
-        let lookout = Lookout::new(playing.motion, playing.frame, playing.ignored);
-        // A camera that moves before the next frame makes every count 0:
-        // the pixels are traced as a still's, at a still's cost.
-        let watching = !lookout.is_idle();
-        renderer.set_lookout(watching.then_some(lookout));
+        let watching = renderer.is_watching();
         let result = self.runs(band).try_for_each(|tiles| {
             let area = self.area(band, &tiles);
             let (x0, side) = (area.top_left.x as u32, self.side);
@@ -239,7 +233,6 @@ impl<'s> Coherence<'s> {
             }
             Ok(())
         });
-        renderer.set_lookout(None);
         result.map(|()| renderer.stats().since(&before))
     }
 }

@@ -13,7 +13,7 @@
 
 use super::coherence::Coherence;
 use super::room::{AnimationCapacity, AnimationNeeds, NoRoom};
-use crate::motion::{Dependence, Key, Motion, MotionNeeds, Recorder, Track};
+use crate::motion::{Dependence, Key, Lookout, Motion, MotionNeeds, Recorder, Track};
 use crate::scene::Frames;
 use core::sync::atomic::AtomicU8;
 use embedded_graphics_core::geometry::Size;
@@ -195,6 +195,16 @@ impl<'s> Animation<'s> {
         };
         let motion = Motion::new(frames, &self.tracks[..tracks], &self.keys[..keys], frame);
         Playing { motion, coherence: self.coherence, frame, ignored: self.ignored }
+    }
+}
+
+impl<'a> Playing<'a> {
+    /// The lookout a renderer of the frame watches the motion to come
+    /// with; none when the camera moves before the next frame (every count
+    /// is then 0: the pixels are traced as a still's, at a still's cost).
+    pub(crate) fn lookout(&self) -> Option<Lookout<'a>> {
+        let lookout = Lookout::new(self.motion, self.frame, self.ignored);
+        (!lookout.is_idle()).then_some(lookout)
     }
 }
 

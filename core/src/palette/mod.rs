@@ -24,7 +24,7 @@ pub use dither::{Coarse, Dither, BAYER_8X8, CUBE_LEVELS};
 pub use gray::Gray;
 pub use scan::{Scan, CLOSE_ENOUGH};
 
-use crate::accel::Accelerator;
+use crate::accel::Linked;
 use crate::render::Renderer;
 use crate::scene::ObjectId;
 use crate::shade::Stats;
@@ -76,27 +76,26 @@ pub trait Quantizer {
 ///
 /// ```
 /// use embedded_graphics::{mock_display::MockDisplay, prelude::*, primitives::Rectangle};
-/// use octrace_core::{accel::Naive, parse::parse, profile::Board16K, render::Renderer, scene::Scene};
+/// use octrace_core::{profile::Board16K, Raytracer};
 /// use octrace_core::palette::{render_indexed, Dither, PaletteIndex, Quantizer};
 ///
-/// let mut scene = Scene::<Board16K>::new();
-/// parse("RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nUPVECTOR 0 1 0\nBACKGROUND 0 0 1\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n", &mut scene, &mut |e| panic!("{e}")).unwrap();
-/// let mut renderer = Renderer::new(scene.view(), &Naive)?;
+/// let mut raytracer = Raytracer::<Board16K>::new();
+/// let scene = raytracer.load("RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nUPVECTOR 0 1 0\nBACKGROUND 0 0 1\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n")?;
 /// let mut display = MockDisplay::<PaletteIndex>::new();
-/// render_indexed(&mut renderer, 0..8, &mut Dither, &mut display)?;
+/// scene.with_renderer(scene.raster(), |renderer| render_indexed(renderer, 0..8, &mut Dither, &mut display))??;
 /// assert_eq!(display.affected_area(), Rectangle::new(Point::zero(), Size::new(8, 8)));
 /// let corner = display.get_pixel(Point::zero()).unwrap();
 /// assert_eq!(Dither.table()[corner.0 as usize].b(), 255, "the blue background");
 /// # Ok::<(), Box<dyn core::error::Error>>(())
 /// ```
-pub fn render_indexed<A, Q, D>(
-    renderer: &mut Renderer<'_, A>,
+pub fn render_indexed<L, Q, D>(
+    renderer: &mut Renderer<'_, L>,
     rows: Range<u32>,
     quantizer: &mut Q,
     target: &mut D,
 ) -> Result<Stats, D::Error>
 where
-    A: Accelerator,
+    L: Linked,
     Q: Quantizer,
     D: DrawTarget<Color = PaletteIndex>,
 {
@@ -122,14 +121,14 @@ where
 ///
 /// ```
 /// use embedded_graphics::{mock_display::MockDisplay, prelude::*};
-/// use octrace_core::{accel::Naive, parse::parse, profile::Board16K, render::Renderer, scene::Scene};
+/// use octrace_core::{profile::Board16K, Raytracer};
 /// use octrace_core::palette::{Gray, PaletteIndex, Quantized, Quantizer};
 ///
-/// let mut scene = Scene::<Board16K>::new();
-/// parse("RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nUPVECTOR 0 1 0\nBACKGROUND 0 0 1\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n", &mut scene, &mut |e| panic!("{e}")).unwrap();
+/// let mut raytracer = Raytracer::<Board16K>::new();
+/// let scene = raytracer.load("RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nUPVECTOR 0 1 0\nBACKGROUND 0 0 1\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n")?;
 /// let mut gray = Gray;
 /// let mut target = Quantized { display: MockDisplay::<PaletteIndex>::new(), quantizer: &mut gray };
-/// Renderer::new(scene.view(), &Naive)?.render(&mut target)?;
+/// scene.image(scene.raster()).try_draw(&mut target)?;
 /// let corner = target.display.get_pixel(Point::zero()).unwrap();
 /// let centre = target.display.get_pixel(Point::new(4, 4)).unwrap();
 /// assert_ne!(corner, centre, "the sphere stands out from the background");
@@ -226,10 +225,11 @@ mod tests {
         parse(text, &mut scene, &mut |e| panic!("{e}")).unwrap();
         let view = scene.view();
         let mut direct = Mock { pixels: [[None; 6]; 4] };
-        let mut renderer = Renderer::new(view, &crate::accel::Naive).unwrap();
+        let naive = crate::accel::SceneAccelerator::<Board16K>::new(None, crate::accel::LightBuffer::NONE);
+        let mut renderer = Renderer::new(view, &naive).unwrap();
         render_indexed(&mut renderer, 0..4, &mut Dither, &mut direct).unwrap();
         let mut through = Quantized { display: Mock { pixels: [[None; 6]; 4] }, quantizer: &mut Dither };
-        Renderer::new(view, &crate::accel::Naive).unwrap().render(&mut through).unwrap();
+        Renderer::new(view, &naive).unwrap().render(&mut through).unwrap();
         assert_eq!(direct.pixels, through.display.pixels);
         assert!(direct.pixels.iter().flatten().all(|p| p.is_some()));
         // Single pixels go through the quantizer too.

@@ -13,8 +13,10 @@
 
 use super::image::Shifted;
 use super::loaded::renderer_in;
-use super::{DrawError, RendererRoom, SceneAccelerator, TracedImage};
+use super::{DrawError, RendererRoom, TracedImage};
+use crate::accel::SceneAccelerator;
 use crate::animation::Playing;
+use crate::motion::Lookout;
 use crate::panel::{Dithered, TracedColor, IMAGE_ERROR_WORDS};
 use crate::profile::Profile;
 use crate::render::{Halt, Progressive, Renderer};
@@ -47,11 +49,13 @@ impl<P: Profile> Copy for Source<'_, '_, P> {}
 impl<'r, P: Profile> Source<'_, 'r, P> {
     /// Runs `f` with a renderer of an image of `size` in the source's room
     /// (none of it if a draw holds it already: only a display that draws
-    /// from inside a draw; the render goes without, the same image).
+    /// from inside a draw; the render goes without, the same image),
+    /// watching the motion to come with `lookout` if given.
     pub(super) fn with_renderer<R>(
         &self,
         size: Size,
-        f: impl FnOnce(&mut Renderer<'_, SceneAccelerator<'r, P>>) -> R,
+        lookout: Option<Lookout<'_>>,
+        f: impl FnOnce(&mut Renderer<'_, P>) -> R,
     ) -> Result<R, CameraError> {
         let mut room = self.room.room.try_borrow_mut();
         let (mailbox, lists) = match room.as_deref_mut() {
@@ -62,6 +66,7 @@ impl<'r, P: Profile> Source<'_, 'r, P> {
             Err(_) => (None, None),
         };
         let mut renderer = renderer_in(self.view, &self.accelerator, size, mailbox, lists)?;
+        renderer.set_lookout(lookout);
         let result = f(&mut renderer);
         if let Some(stats) = self.stats {
             let mut total = stats.get();
@@ -104,17 +109,21 @@ where
             Some(_) => bands(image, &playing, next, &mut Dithered::ordered(target), poll),
             None => bands(image, &playing, next, target, poll),
         },
-        Picture::Progressive(order) => drawn(image.source.with_renderer(order.size(), |renderer| match C::PANEL {
-            // Bayer too: the one method a block order keeps.
-            Some(_) => order.render_polled(renderer, &mut Dithered::ordered(target), poll),
-            None => order.render_polled(renderer, target, poll),
-        })),
+        Picture::Progressive(order) => {
+            drawn(image.source.with_renderer(order.size(), None, |renderer| match C::PANEL {
+                // Bayer too: the one method a block order keeps.
+                Some(_) => order.render_polled(renderer, &mut Dithered::ordered(target), poll),
+                None => order.render_polled(renderer, target, poll),
+            }))
+        }
         Picture::Area(area) => {
             let mut shifted = Shifted { target, offset: Point::zero() - area.top_left };
             // The pixels there are: the rows a ditherer is set up for.
             let area = area.intersection(&image.bounding_box());
             match (C::PANEL, image.rows) {
-                (None, _) => drawn(image.source.with_renderer(image.size, |r| rows(r, &area, &mut shifted, poll))),
+                (None, _) => {
+                    drawn(image.source.with_renderer(image.size, None, |r| rows(r, &area, &mut shifted, poll)))
+                }
                 (Some(_), Some(given)) => match given.try_borrow_mut() {
                     Ok(mut given) => dithered(image, &area, &mut shifted, &mut given, poll),
                     Err(_) => dithered_on_stack::<IMAGE_ERROR_WORDS, _, _, _, _>(image, &area, &mut shifted, poll),
@@ -164,10 +173,10 @@ where
         Some(next) => next(),
         None => all.next(),
     };
-    drawn(image.source.with_renderer(coherence.size(), |renderer| {
+    drawn(image.source.with_renderer(coherence.size(), playing.lookout(), |renderer| {
         let mut stats = Stats::default();
         while let Some(band) = taken() {
-            stats.add(&coherence.trace_band(renderer, playing, band, poll, &mut |line, pixels| {
+            stats.add(&coherence.trace_band(renderer, band, poll, &mut |line, pixels| {
                 target.fill_contiguous(line, pixels.map(|p| D::Color::traced(p.color, p.object)))
             })?);
         }
@@ -178,14 +187,14 @@ where
 /// The rows of `area` (of the image) into `target`, each in one
 /// `fill_contiguous`; a row stopped inside is handed over up to the
 /// stopped pixel. Returns the counters of the rows.
-fn rows<A, D, Q>(
-    renderer: &mut Renderer<'_, A>,
+fn rows<L, D, Q>(
+    renderer: &mut Renderer<'_, L>,
     area: &Rectangle,
     target: &mut D,
     poll: &mut Q,
 ) -> Result<Stats, Halt<D::Error, Q::Stopped>>
 where
-    A: crate::accel::Accelerator,
+    L: crate::accel::Linked,
     D: DrawTarget,
     D::Color: TracedColor,
     Q: Poll,
@@ -251,5 +260,5 @@ where
 {
     let (left, width) = (area.top_left.x, area.size.width);
     let mut dithered = Dithered::across(target, image.dithering, left, width, rows).map_err(DrawError::ErrorRow)?;
-    drawn(image.source.with_renderer(image.size, |renderer| self::rows(renderer, area, &mut dithered, poll)))
+    drawn(image.source.with_renderer(image.size, None, |renderer| self::rows(renderer, area, &mut dithered, poll)))
 }

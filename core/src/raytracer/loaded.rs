@@ -1,7 +1,7 @@
 //! A loaded scene: its view, accelerator, light buffer and the room of the
 //! core that loaded it; it draws as an image ([`TracedImage`]).
 
-use crate::accel::{AccelMode, Accelerator, BuildReport, LightBuffer, LightBufferError};
+use crate::accel::{AccelMode, BuildReport, LightBuffer, LightBufferError, Linked, SceneAccelerator};
 use crate::profile::Profile;
 use crate::render::Renderer;
 use crate::scene::{CameraError, Frames, SceneView};
@@ -12,7 +12,7 @@ use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::Size;
 
 use super::draw::Source;
-use super::{light_buffer, RendererRoom, SceneAccelerator, ScreenLists, SharedScene, TracedImage};
+use super::{RendererRoom, ScreenLists, SharedScene, TracedImage};
 
 /// A scene ready to trace, borrowed from its [`Raytracer`](super::Raytracer).
 pub struct LoadedScene<'r, P: Profile> {
@@ -78,7 +78,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
     pub fn accelerator(&self) -> SceneAccelerator<'r, P> {
-        SceneAccelerator { octree: self.octree.as_ref().map(|(octree, _)| *octree), lights: self.lights }
+        SceneAccelerator::new(self.octree.as_ref().map(|(octree, _)| *octree), self.lights)
     }
 
     /// The shadow rays' light buffer: built when the scene loaded if the
@@ -127,7 +127,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
     pub fn use_light_buffer(&mut self, words: &'r [u32]) -> Result<(), LightBufferError> {
-        if !light_buffer::<P>() {
+        if !P::LIGHT_BUFFER {
             return Err(LightBufferError::NoRoom);
         }
         self.lights = LightBuffer::verified(&self.view, words)?;
@@ -149,12 +149,8 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// assert_eq!(pixels, 4);
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
-    pub fn with_renderer<R>(
-        &self,
-        size: Size,
-        f: impl FnOnce(&mut Renderer<'_, SceneAccelerator<'r, P>>) -> R,
-    ) -> Result<R, CameraError> {
-        self.source().with_renderer(size, f)
+    pub fn with_renderer<R>(&self, size: Size, f: impl FnOnce(&mut Renderer<'_, P>) -> R) -> Result<R, CameraError> {
+        self.source().with_renderer(size, None, f)
     }
 
     /// Where this scene's draws get their renderer: the loading core's
@@ -219,13 +215,13 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
 /// A renderer over `view` for an image of `size`, with a mailbox and screen
 /// lists where given. Inlined: a board's renderer is made in place.
 #[inline(always)]
-pub(super) fn renderer_in<'a, A: Accelerator>(
+pub(super) fn renderer_in<'a, L: Linked>(
     view: SceneView<'a>,
-    accel: &'a A,
+    accel: &'a SceneAccelerator<'a, L>,
     size: Size,
     mailbox: Option<&'a mut [u32]>,
     lists: Option<ScreenLists<'a>>,
-) -> Result<Renderer<'a, A>, CameraError> {
+) -> Result<Renderer<'a, L>, CameraError> {
     let mut renderer = Renderer::with_size(view, accel, size.width, size.height)?;
     if let Some(words) = mailbox {
         renderer.set_mailbox(words);

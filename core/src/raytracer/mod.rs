@@ -27,7 +27,7 @@ mod shared;
 pub use animated::{AnimationError, Frame};
 pub use image::{DrawError, TracedImage};
 pub use loaded::LoadedScene;
-pub use shared::{SceneAccelerator, SharedScene};
+pub use shared::SharedScene;
 
 /// Room for one scene of the profile `P`: the scene's arenas, its octree and
 /// a mailbox. On a board, keep it in a `static` (it is all zero bits, so it
@@ -311,7 +311,7 @@ impl<P: Profile> Raytracer<P> {
         // every object, camera rays too; likewise the shadow rays' light
         // buffer.
         let buffered =
-            <P::LightBufferWords as Arena<u32>>::CAPACITY > 0 && light_buffer::<P>() && requested != AccelMode::Naive;
+            <P::LightBufferWords as Arena<u32>>::CAPACITY > 0 && P::LIGHT_BUFFER && requested != AccelMode::Naive;
         let (octree_store, light_buffer) = (&mut self.octree, &mut self.light_buffer);
         let (mut prepared, mut built) = (None, false);
         both(
@@ -364,12 +364,6 @@ pub(super) fn once(
             both(beside, here);
         }
     }
-}
-
-/// Whether profile `P` serves lights with a light buffer (else none of its
-/// code is linked).
-pub(super) const fn light_buffer<P: Profile>() -> bool {
-    P::COUNTS.light_buffer_lights > 0
 }
 
 /// `arena` emptied, then `len` copies of `item`, as many as it holds.

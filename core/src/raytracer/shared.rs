@@ -1,19 +1,17 @@
-//! What other cores render a loaded scene with: the scene shared, and the
-//! accelerator over only the shape kinds and structures its profile holds.
+//! What other cores render a loaded scene with: the scene shared (its
+//! accelerator, and a frame's tiles), drawn in a room of their own.
 
-use crate::accel::{naive, Accelerator, Hit, LightBuffer, Mailbox, OctreeStore, RayStart};
+use crate::accel::SceneAccelerator;
 use crate::animation::Playing;
-use crate::math::Scalar;
 use crate::profile::Profile;
 use crate::render::Renderer;
 use crate::scene::{CameraError, SceneView};
-use crate::shapes::{Ray, ShapeKinds};
 use core::fmt;
 use embedded_graphics_core::geometry::Size;
 
 use super::draw::Source;
 use super::loaded::renderer_in;
-use super::{light_buffer, RendererRoom, TracedImage};
+use super::{RendererRoom, TracedImage};
 
 /// What another core needs to render a [`LoadedScene`](super::LoadedScene)
 /// ([`LoadedScene::share`](super::LoadedScene::share)) or a
@@ -88,11 +86,7 @@ impl<'r, P: Profile> SharedScene<'r, P> {
     /// A renderer of an image of `size` pixels over this scene that writes
     /// only `room`: each core renders with one of its own, and any split of
     /// the image between them gives the same bits as one core.
-    pub fn renderer<'a>(
-        &'a self,
-        room: &'a mut RendererRoom<P>,
-        size: Size,
-    ) -> Result<Renderer<'a, SceneAccelerator<'r, P>>, CameraError> {
+    pub fn renderer<'a>(&'a self, room: &'a mut RendererRoom<P>, size: Size) -> Result<Renderer<'a, P>, CameraError> {
         let (mailbox, lists) = room.room.get_mut().prepare(self.view.object_count(), self.first_hits);
         renderer_in(self.view, &self.accelerator, size, Some(mailbox), lists)
     }
@@ -105,101 +99,5 @@ impl<'r, P: Profile> SharedScene<'r, P> {
         let source =
             Source { view: self.view, accelerator: self.accelerator, first_hits: self.first_hits, room, stats: None };
         TracedImage::new(source, size, self.playing)
-    }
-}
-
-/// What a [`LoadedScene`](super::LoadedScene) renders with ([`LoadedScene::accelerator`](super::LoadedScene::accelerator)):
-/// its octree, or (without one) every object, over only the shape kinds
-/// its profile has room for, and with the screen lists only if the profile
-/// has room for them. Both are decided on the profile's constants, so that
-/// a build without an octree or without the lists links none of their code.
-pub struct SceneAccelerator<'r, P: Profile> {
-    pub(super) octree: Option<&'r P::Octree>,
-    pub(super) lights: LightBuffer<'r>,
-}
-
-impl<P: Profile> Clone for SceneAccelerator<'_, P> {
-    fn clone(&self) -> Self {
-        *self
-    }
-}
-
-impl<P: Profile> Copy for SceneAccelerator<'_, P> {}
-
-impl<P: Profile> fmt::Debug for SceneAccelerator<'_, P> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("SceneAccelerator")
-            .field("octree", &self.octree.is_some())
-            .field("light_buffer", &self.lights)
-            .finish()
-    }
-}
-
-impl<P: Profile> SceneAccelerator<'_, P> {
-    /// The octree, if the profile has room for one and the scene uses it.
-    #[inline(always)]
-    fn octree(&self) -> Option<&P::Octree> {
-        self.octree.filter(|_| <P::Octree as OctreeStore>::HAS_BOXES)
-    }
-}
-
-impl<P: Profile> Accelerator for SceneAccelerator<'_, P> {
-    const KINDS: ShapeKinds = ShapeKinds::with_room(&P::COUNTS);
-    // The octree's mailbox, only if the profile can have an octree.
-    const USES_MAILBOX: bool = <P::Octree as OctreeStore>::HAS_BOXES && <P::Octree as Accelerator>::USES_MAILBOX;
-    const FOLLOWS_MOTION: bool = P::COHERENCE;
-
-    fn first_hits_by_screen(&self) -> bool {
-        P::FIRST_HITS && self.octree().is_none_or(|octree| octree.first_hits_by_screen())
-    }
-
-    #[inline]
-    fn nearest(
-        &self,
-        scene: &SceneView<'_>,
-        ray: &Ray,
-        start: Option<RayStart>,
-        mailbox: &mut Mailbox<'_>,
-    ) -> Option<Hit> {
-        match self.octree() {
-            Some(octree) => octree.nearest(scene, ray, start, mailbox),
-            None => naive::nearest(Self::KINDS, scene, ray, start),
-        }
-    }
-
-    #[inline]
-    fn occluded(
-        &self,
-        scene: &SceneView<'_>,
-        ray: &Ray,
-        t_max: Scalar,
-        start: Option<RayStart>,
-        mailbox: &mut Mailbox<'_>,
-    ) -> bool {
-        match self.octree() {
-            Some(octree) => octree.occluded(scene, ray, t_max, start, mailbox),
-            None => naive::occluded(Self::KINDS, scene, ray, t_max, start, mailbox),
-        }
-    }
-
-    #[inline]
-    fn occluded_toward(
-        &self,
-        scene: &SceneView<'_>,
-        ray: &Ray,
-        t_max: Scalar,
-        light: usize,
-        start: Option<RayStart>,
-        mailbox: &mut Mailbox<'_>,
-    ) -> bool {
-        if light_buffer::<P>() {
-            if let Some(blocked) = self.lights.occluded(scene, Self::KINDS, ray, t_max, light, start, mailbox) {
-                return blocked;
-            }
-        }
-        match self.octree() {
-            Some(octree) => octree.occluded_toward(scene, ray, t_max, light, start, mailbox),
-            None => self.occluded(scene, ray, t_max, start, mailbox),
-        }
     }
 }

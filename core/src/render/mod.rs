@@ -38,7 +38,7 @@ pub use split::{interleaved_rows, Tiles};
 pub(crate) use stop::{Halt, Polling};
 pub use stop::{Stop, Stopped};
 
-use crate::accel::{Accelerator, Hit, Mailbox};
+use crate::accel::{Hit, Linked, Mailbox, SceneAccelerator};
 use crate::motion::{Lookout, RayKind};
 use crate::panel::TracedColor;
 use crate::scene::{Camera, CameraError, CameraRay, Color, ObjectId, RayCursor, SceneView, Stride, MAX_SIDE};
@@ -91,17 +91,22 @@ impl TracedColor for PixelSample {
     }
 }
 
-/// Renders one scene through one accelerator. A renderer holds the mutable
-/// state of one thread (counters, mailbox); to render on several threads,
-/// give each its own renderer over the same scene and accelerator.
+/// Renders one scene through its accelerator, as build `L` links the
+/// tracer (its [`Profile`](crate::profile::Profile)). A renderer holds the
+/// mutable state of one core or thread (counters, mailbox, screen lists);
+/// to render on several, give each its own over the same scene
+/// ([`LoadedScene::with_renderer`](crate::LoadedScene::with_renderer) on
+/// the loading core, [`SharedScene::renderer`](crate::SharedScene::renderer)
+/// on the others). Most draws need none: a scene's
+/// [`TracedImage`](crate::TracedImage) makes its own.
 ///
 /// ```
 /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*};
-/// use octrace_core::{accel::Naive, parse::parse, profile::Board16K, render::Renderer, scene::Scene};
+/// use octrace_core::{profile::Board16K, Raytracer};
 ///
-/// let mut scene = Scene::<Board16K>::new();
-/// parse("RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nUPVECTOR 0 1 0\nBACKGROUND 0 0 1\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n", &mut scene, &mut |e| panic!("{e}")).unwrap();
-/// let mut renderer = Renderer::new(scene.view(), &Naive)?; // RASTER 8 8
+/// let mut raytracer = Raytracer::<Board16K>::new();
+/// let scene = raytracer.load("RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nUPVECTOR 0 1 0\nBACKGROUND 0 0 1\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n")?;
+/// scene.with_renderer(scene.raster(), |renderer| {
 /// let mut display = MockDisplay::<Rgb888>::new();
 /// let stats = renderer.render(&mut display)?;
 /// assert_eq!(stats.rays, 64, "one ray a pixel: nothing reflects");
@@ -109,9 +114,11 @@ impl TracedColor for PixelSample {
 /// // A single pixel, with the object seen through it.
 /// assert!(renderer.pixel(4, 4).object.is_some());
 /// # Ok::<(), Box<dyn core::error::Error>>(())
+/// })?;
+/// # Ok::<(), Box<dyn core::error::Error>>(())
 /// ```
-pub struct Renderer<'a, A> {
-    tracer: Tracer<'a, A>,
+pub struct Renderer<'a, L: Linked> {
+    tracer: Tracer<'a, L>,
     camera: Camera,
     /// The last primary ray's direction: the next one along a row is a sum.
     cursor: RayCursor,
@@ -133,15 +140,15 @@ enum ScreenLists<'a> {
     Lists(FirstHits<'a>),
 }
 
-impl<A> core::fmt::Debug for Renderer<'_, A> {
+impl<L: Linked> core::fmt::Debug for Renderer<'_, L> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.debug_struct("Renderer").field("camera", &self.camera).finish_non_exhaustive()
     }
 }
 
-impl<'a, A: Accelerator> Renderer<'a, A> {
+impl<'a, L: Linked> Renderer<'a, L> {
     /// A renderer at the scene's RASTER size.
-    pub fn new(scene: SceneView<'a>, accel: &'a A) -> Result<Self, CameraError> {
+    pub fn new(scene: SceneView<'a>, accel: &'a SceneAccelerator<'a, L>) -> Result<Self, CameraError> {
         let [w, h] = scene.settings.raster;
         Self::with_size(scene, accel, w, h)
     }
@@ -150,7 +157,12 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     // Not inlined: the set-up's temporaries then live in its own frame, gone
     // before the first pixel, instead of in the caller's for the whole render.
     #[inline(never)]
-    pub fn with_size(scene: SceneView<'a>, accel: &'a A, width: u32, height: u32) -> Result<Self, CameraError> {
+    pub fn with_size(
+        scene: SceneView<'a>,
+        accel: &'a SceneAccelerator<'a, L>,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, CameraError> {
         let s = scene.settings;
         let camera = Camera::new(&s.view, &scene.normalization, width, height, s.samples)?;
         // The table is filled in place: moving a 510-byte table around costs
@@ -170,50 +182,20 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
 
     /// Gives the renderer a mailbox of `words` (one bit per object,
     /// [`Mailbox::words_for`]), so that accelerators filing an object in
-    /// several cells test it once per ray.
-    pub fn with_mailbox(mut self, words: &'a mut [u32]) -> Self {
-        self.set_mailbox(words);
-        self
-    }
-
-    /// [`Renderer::with_mailbox`] in place (no move of the renderer, which
-    /// matters on a board with a few KiB of stack).
-    pub fn set_mailbox(&mut self, words: &'a mut [u32]) {
+    /// several cells test it once per ray; in place (no move of the
+    /// renderer, which matters on a board with a few KiB of stack).
+    pub(crate) fn set_mailbox(&mut self, words: &'a mut [u32]) {
         self.scratch.mailbox = Mailbox::new(words);
     }
 
     /// Gives the renderer room for a [`ScreenBound`] for each of the
-    /// scene's objects and [`ScreenBound::positions_for`] them, so that camera rays find their hits among the objects seen
-    /// around their pixel instead of walking the accelerator, when it
-    /// allows ([`Accelerator::first_hits_by_screen`]: the octree's 3DDDA).
-    /// The same image, faster; too little room leaves the walk.
-    ///
-    /// ```
-    /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888};
-    /// use octrace_core::{accel::Octree, parse::parse, profile::{Board16K, Profile}};
-    /// use octrace_core::{render::{Renderer, ScreenBound}, scene::Scene};
-    ///
-    /// let mut scene = Scene::<Board16K>::new();
-    /// parse("RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSPHERE 1 0.5 2 1 1\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n", &mut scene, &mut |e| panic!("{e}")).unwrap();
-    /// let mut octree = Octree::<Board16K>::new();
-    /// octree.build(&scene.view(), &Board16K::OCTREE);
-    ///
-    /// let mut bounds = [ScreenBound::EMPTY; 2];
-    /// let mut positions = [0; ScreenBound::positions_for(2)];
-    /// let mut listed = MockDisplay::<Rgb888>::new();
-    /// Renderer::new(scene.view(), &octree)?.with_first_hits(&mut bounds, &mut positions).render(&mut listed)?;
-    /// let mut walked = MockDisplay::<Rgb888>::new();
-    /// Renderer::new(scene.view(), &octree)?.render(&mut walked)?;
-    /// assert_eq!(listed, walked);
-    /// # Ok::<(), Box<dyn core::error::Error>>(())
-    /// ```
-    pub fn with_first_hits(mut self, bounds: &'a mut [ScreenBound], positions: &'a mut [u16]) -> Self {
-        self.set_first_hits(bounds, positions);
-        self
-    }
-
-    /// [`Renderer::with_first_hits`] in place.
-    pub fn set_first_hits(&mut self, bounds: &'a mut [ScreenBound], positions: &'a mut [u16]) {
+    /// scene's objects and [`ScreenBound::positions_for`] them, so that
+    /// camera rays find their hits among the objects seen around their
+    /// pixel instead of walking the accelerator, when it allows (the build
+    /// links them, and the scene's octree, if any, is walked by 3DDDA).
+    /// The same image, faster; too little room leaves the walk. A
+    /// [`RendererRoom`](crate::RendererRoom) holds it.
+    pub(crate) fn set_first_hits(&mut self, bounds: &'a mut [ScreenBound], positions: &'a mut [u16]) {
         if self.tracer.accel().first_hits_by_screen()
             && FirstHits::fit(self.tracer.scene(), &self.camera, bounds, positions)
         {
@@ -259,7 +241,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
             }
         }
         let ScreenLists::Lists(hits) = &mut self.first_hits else { return None };
-        hits.nearest(self.tracer.scene(), A::KINDS, &self.camera, ray, [x, y, sx, sy])
+        hits.nearest(self.tracer.scene(), L::KINDS, &self.camera, ray, [x, y, sx, sy])
     }
 
     /// Counters since the renderer was made.
@@ -355,6 +337,11 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         self.scratch.lookout = lookout;
     }
 
+    /// Whether it watches the frames to come.
+    pub(crate) fn is_watching(&self) -> bool {
+        self.scratch.lookout.is_some()
+    }
+
     /// The pixel at (`x`, `y`) and its clean count under the lookout, if
     /// below `bound` (else `bound`).
     /// `poll` asked before each of its rays.
@@ -366,7 +353,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
         bound: u32,
         poll: &mut Q,
     ) -> Result<(PixelSample, u32), Q::Stopped> {
-        if !A::FOLLOWS_MOTION {
+        if !L::COHERENCE {
             // Nothing watched the rays: the pixel is traced again next frame.
             return self.pixel_polled(x, y, poll).map(|pixel| (pixel, 0));
         }
@@ -392,7 +379,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
             // Shown by the lists to miss: the ray itself is made only for
             // the lookout.
             Some(None) if poll.go_on() => {
-                if let Some(lookout) = self.scratch.lookout.as_mut().filter(|_| A::FOLLOWS_MOTION) {
+                if let Some(lookout) = self.scratch.lookout.as_mut().filter(|_| L::COHERENCE) {
                     lookout.ray(ray.get(&self.camera), None, RayKind::Primary);
                 }
                 self.tracer.missed(&mut self.scratch)
@@ -433,7 +420,7 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
     }
 
     /// The pixels of row `y` for the columns `xs`, traced lazily.
-    pub fn row(&mut self, y: u32, xs: Range<u32>) -> impl Iterator<Item = PixelSample> + use<'_, 'a, A> {
+    pub fn row(&mut self, y: u32, xs: Range<u32>) -> impl Iterator<Item = PixelSample> + use<'_, 'a, L> {
         xs.map(move |x| self.pixel(x, y))
     }
 

@@ -75,7 +75,7 @@
 //! ```
 
 use super::{Halt, Renderer, Walk};
-use crate::accel::Accelerator;
+use crate::accel::Linked;
 use crate::scene::MAX_SIDE;
 use crate::shade::{Poll, Stats, Unpolled};
 use core::convert::Infallible;
@@ -244,13 +244,13 @@ impl Progressive {
     /// as they are traced; a row of small blocks is traced up to 32 blocks
     /// at a time into a buffer on the stack, then drawn. Returns the
     /// counters of this call.
-    pub fn render<A, D>(
+    pub fn render<L, D>(
         &self,
-        renderer: &mut Renderer<'_, A>,
+        renderer: &mut Renderer<'_, L>,
         target: &mut D,
     ) -> Result<Stats, ProgressiveError<D::Error>>
     where
-        A: Accelerator,
+        L: Linked,
         D: DrawTarget,
         D::Color: From<Rgb888>,
     {
@@ -264,14 +264,14 @@ impl Progressive {
 
     /// [`Progressive::render`] with a renderer of the order's size, `poll`
     /// asked before every ray.
-    pub(crate) fn render_polled<A, D, Q>(
+    pub(crate) fn render_polled<L, D, Q>(
         &self,
-        renderer: &mut Renderer<'_, A>,
+        renderer: &mut Renderer<'_, L>,
         target: &mut D,
         poll: &mut Q,
     ) -> Result<Stats, Halt<D::Error, Q::Stopped>>
     where
-        A: Accelerator,
+        L: Linked,
         D: DrawTarget,
         D::Color: From<Rgb888>,
         Q: Poll,
@@ -403,9 +403,9 @@ impl Unit {
     /// order of [`Unit::pixels`]: the unit ready to draw. `renderer` traces
     /// the order's size; `colors` holds the unit's pixels (a buffer of
     /// [`Progressive::max_unit_pixels`] holds any unit's).
-    pub fn trace<'c, A: Accelerator, C: From<Rgb888>>(
+    pub fn trace<'c, L: Linked, C: From<Rgb888>>(
         &self,
-        renderer: &mut Renderer<'_, A>,
+        renderer: &mut Renderer<'_, L>,
         colors: &'c mut [C],
     ) -> Result<TracedUnit<'c, C>, ProgressiveError> {
         check_size(renderer.size(), self.size)?;
@@ -628,7 +628,6 @@ impl<E: fmt::Debug + fmt::Display> core::error::Error for ProgressiveError<E> {}
 mod tests {
     extern crate std;
     use super::*;
-    use crate::accel::{Naive, Octree};
     use crate::parse::parse;
     use crate::profile::{Board64K, Profile};
     use crate::scene::Scene;
@@ -821,25 +820,40 @@ mod tests {
 
     /// The direct order's panel and its counters (but the cells, which a
     /// remembered shadow blocker makes depend on the order).
-    fn direct<A: Accelerator>(renderer: &mut Renderer<'_, A>) -> (Vec<Option<Rgb888>>, [u64; 3]) {
+    fn direct<L: Linked>(renderer: &mut Renderer<'_, L>) -> (Vec<Option<Rgb888>>, [u64; 3]) {
         let mut panel = Panel::new(renderer.size());
         let stats = renderer.render(&mut panel).unwrap();
         (panel.pixels, [stats.rays, stats.shadow_rays, stats.truncated])
     }
 
+    crate::profile! {
+        /// Board64K's room, camera rays finding their hits in screen lists.
+        struct Listed {
+            spheres: 320, boxes: 32, superquadrics: 32, triangles: 96, rectangles: 96,
+            bspline_triangles: 32, control_points: 16, surfaces: 64, lights: 8,
+            objects: 512, octree_boxes: 2048, octree_references: 6144,
+        }
+        first_hits: true
+    }
+
     #[test]
     fn one_core_and_two_cores_draw_the_direct_picture() {
+        use crate::accel::{LightBuffer, Linked, OctreeStore, SceneAccelerator};
         let scene = scene();
         let view = scene.view();
-        let mut octree = Octree::<Board64K>::new();
-        octree.build(&view, &Board64K::OCTREE);
+        let mut octree = Box::new(<Listed as Linked>::Octree::EMPTY);
+        octree.build(&view, &Listed::OCTREE);
+        let (octree, naive) = (
+            SceneAccelerator::<Listed>::new(Some(&*octree), LightBuffer::NONE),
+            SceneAccelerator::<Listed>::new(None, LightBuffer::NONE),
+        );
         // 150 wide: runs of more blocks than a single core traces at once.
         for (w, h) in [(29, 19), (16, 16), (3, 11), (40, 7), (150, 6)] {
             let mut bounds = vec![crate::render::ScreenBound::EMPTY; view.object_count()];
             let mut positions = vec![0; crate::render::ScreenBound::positions_for(view.object_count())];
-            let mut listed =
-                Renderer::with_size(view, &octree, w, h).unwrap().with_first_hits(&mut bounds, &mut positions);
-            let mut naive = Renderer::with_size(view, &Naive, w, h).unwrap();
+            let mut listed = Renderer::with_size(view, &octree, w, h).unwrap();
+            listed.set_first_hits(&mut bounds, &mut positions);
+            let mut naive = Renderer::with_size(view, &naive, w, h).unwrap();
             let expected = direct(&mut naive);
             assert_eq!(direct(&mut listed), expected);
             for coarsest in [1, 2, 4, 16] {
@@ -884,7 +898,8 @@ mod tests {
     fn a_short_buffer_or_another_size_is_an_error() {
         let scene = scene();
         let order = Progressive::new(Size::new(12, 10), 4);
-        let mut renderer = Renderer::with_size(scene.view(), &Naive, 12, 10).unwrap();
+        let naive = crate::accel::SceneAccelerator::<Board64K>::new(None, crate::accel::LightBuffer::NONE);
+        let mut renderer = Renderer::with_size(scene.view(), &naive, 12, 10).unwrap();
         let unit = order.units().last().unwrap();
         assert_eq!(unit.pixel_count(), 6 + 12);
         let mut short = [Rgb888::new(0, 0, 0); 17];
@@ -896,7 +911,7 @@ mod tests {
             "a unit of 18 pixels does not fit a colour buffer of 17 (Progressive::max_unit_pixels sizes it)"
         );
         assert_eq!(renderer.stats().rays, 0, "nothing traced");
-        let mut other = Renderer::with_size(scene.view(), &Naive, 12, 11).unwrap();
+        let mut other = Renderer::with_size(scene.view(), &naive, 12, 11).unwrap();
         let error = order.render(&mut other, &mut Panel::new(Size::new(12, 11))).unwrap_err();
         assert_eq!(error, ProgressiveError::Size { renderer: [12, 11], order: [12, 10] });
         assert_eq!(std::format!("{error}"), "the renderer traces 12×11 pixels, the progressive order is for 12×10");

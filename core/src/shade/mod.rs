@@ -20,7 +20,7 @@
 //! is partial, and `Poll::stopped` says so; one not stopped gives the
 //! same bits whether it was asked or not.
 
-use crate::accel::{Accelerator, Hit, Mailbox, RayStart};
+use crate::accel::{uses_mailbox, Accelerator, Hit, Linked, Mailbox, RayStart, SceneAccelerator};
 use crate::math::{
     leading_zeros, mul_u32_wide, mul_wide, pow_unit, reciprocal_start, shr_saturating_u32, shr_signed_to_u32, Dir,
     Scalar, Unit, Vec3, UNIT_ONE,
@@ -140,12 +140,20 @@ struct Pending {
     kind: RayKind,
 }
 
-/// Traces rays through a scene with a given accelerator.
-#[derive(Clone, Copy)]
-pub(crate) struct Tracer<'a, A> {
+/// Traces rays through a scene with its accelerator, as build `L` links
+/// it.
+pub(crate) struct Tracer<'a, L: Linked> {
     scene: SceneView<'a>,
-    accel: &'a A,
+    accel: &'a SceneAccelerator<'a, L>,
 }
+
+impl<L: Linked> Clone for Tracer<'_, L> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<L: Linked> Copy for Tracer<'_, L> {}
 
 /// `num / den` in Q16.16, both Q32.32, rounded to nearest within 2^-17 of
 /// the quotient (relative), saturating (and `i32::MAX` for a zero `den`):
@@ -201,8 +209,8 @@ fn leaving_along(geometric_normal: Dir, dir: Dir) -> Leaving {
     }
 }
 
-impl<'a, A: Accelerator> Tracer<'a, A> {
-    pub fn new(scene: SceneView<'a>, accel: &'a A) -> Self {
+impl<'a, L: Linked> Tracer<'a, L> {
+    pub fn new(scene: SceneView<'a>, accel: &'a SceneAccelerator<'a, L>) -> Self {
         Tracer { scene, accel }
     }
 
@@ -210,7 +218,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         &self.scene
     }
 
-    pub fn accel(&self) -> &'a A {
+    pub fn accel(&self) -> &'a SceneAccelerator<'a, L> {
         self.accel
     }
 
@@ -259,7 +267,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             let hit = match first_hit.take() {
                 Some(hit) => hit,
                 None => {
-                    if A::USES_MAILBOX {
+                    if uses_mailbox::<L>() {
                         scratch.mailbox.clear();
                     }
                     self.accel.nearest(&self.scene, &p.ray, p.start, &mut scratch.mailbox)
@@ -268,7 +276,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             if p.depth == 0 {
                 first_object = hit.map(|h| self.scene.written_object(h.object));
             }
-            if let Some(lookout) = scratch.lookout.as_mut().filter(|_| A::FOLLOWS_MOTION) {
+            if let Some(lookout) = scratch.lookout.as_mut().filter(|_| L::COHERENCE) {
                 lookout.ray(&p.ray, hit.map(|h| h.t), p.kind);
             }
             let mut next = None;
@@ -309,13 +317,13 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
     ) -> [Option<Pending>; 2] {
         let shape = self.scene.shape(hit.object);
         let point = p.ray.at(hit.t);
-        let geometric = shape.normal_at_among(A::KINDS, point);
+        let geometric = shape.normal_at_among(L::KINDS, point);
         // Two-sided: shade with the normal facing the incoming ray (for a
         // B-spline's triangle, its interpolated normal; shadow rays then
         // leave from the smooth surface, see shapes::SmoothTriangle).
         let flipped = geometric.dot_is_positive(p.ray.dir);
         let facing = if flipped { -geometric } else { geometric };
-        let (normal, shadow_from) = shape.shading_among(A::KINDS, point, facing);
+        let (normal, shadow_from) = shape.shading_among(L::KINDS, point, facing);
         let to_eye = -p.ray.dir;
         let surface = self.scene.surface(shape.surface());
         let mut local = surface.ambient;
@@ -353,7 +361,7 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
             };
             let start = RayStart { object: hit.object, leaving };
             let t_max = Scalar::from_bits((distance.to_bits() - 1).max(0));
-            if let Some(lookout) = scratch.lookout.as_mut().filter(|_| A::FOLLOWS_MOTION) {
+            if let Some(lookout) = scratch.lookout.as_mut().filter(|_| L::COHERENCE) {
                 lookout.shadow(shadow_from, light.position);
             }
             if self.occluded(
@@ -411,17 +419,17 @@ impl<'a, A: Accelerator> Tracer<'a, A> {
         blocker: &mut u32,
         mailbox: &mut Mailbox<'_>,
     ) -> bool {
-        if A::USES_MAILBOX {
+        if uses_mailbox::<L>() {
             mailbox.clear();
         }
         if (*blocker as usize) < self.scene.object_count() {
             let object = ObjectId(*blocker);
             let leaving = RayStart::leaving(Some(start), object);
-            if self.scene.shape(object).intersect_among(A::KINDS, shadow, t_max, leaving).is_some() {
+            if self.scene.shape(object).intersect_among(L::KINDS, shadow, t_max, leaving).is_some() {
                 return true;
             }
             // Missed: the walk need not test it again.
-            if A::USES_MAILBOX {
+            if uses_mailbox::<L>() {
                 mailbox.first_visit(*blocker);
             }
         }
@@ -505,7 +513,7 @@ mod tests {
 mod shading_tests {
     extern crate std;
     use super::*;
-    use crate::accel::Naive;
+    use crate::accel::LightBuffer;
     use crate::parse::parse;
     use crate::profile::Board64K;
     use crate::scene::Scene;
@@ -518,14 +526,15 @@ mod shading_tests {
         parse(text, &mut scene, &mut |e| panic!("{e}")).unwrap();
         let view = scene.view();
         let eye = view.normalization.point(view.settings.view.eye);
-        let tracer = Tracer::new(view, &Naive);
+        let accel = SceneAccelerator::<Board64K>::new(None, LightBuffer::NONE);
+        let tracer = Tracer::new(view, &accel);
         let mut scratch = Scratch::new(Mailbox::none());
         let (c, o) = traced(&tracer, Ray { origin: eye, dir: -Dir::Z }, &mut scratch);
         (c, o, scratch.stats)
     }
 
     /// What `tracer` sees along `ray`.
-    fn traced(tracer: &Tracer<'_, Naive>, ray: Ray, scratch: &mut Scratch<'_>) -> (Color, Option<ObjectId>) {
+    fn traced(tracer: &Tracer<'_, Board64K>, ray: Ray, scratch: &mut Scratch<'_>) -> (Color, Option<ObjectId>) {
         tracer.trace(ray, None, scratch, &mut Unpolled)
     }
 
@@ -592,7 +601,8 @@ mod shading_tests {
         parse(&text, &mut scene, &mut |e| panic!("{e}")).unwrap();
         let view = scene.view();
         let ray = |x: i64| Ray { origin: view.normalization.point([x, 0, 3 << 32]), dir: -Dir::Z };
-        let tracer = Tracer::new(view, &Naive);
+        let accel = SceneAccelerator::<Board64K>::new(None, LightBuffer::NONE);
+        let tracer = Tracer::new(view, &accel);
         let mut alone = Scratch::new(Mailbox::none());
         let lit = traced(&tracer, ray(1 << 31), &mut alone).0;
         let mut shared = Scratch::new(Mailbox::none());

@@ -60,6 +60,8 @@ mod build;
 mod cells;
 mod query;
 
+pub(crate) use query::ShadowQuery;
+
 /// How far a shadow ray strays from the segment between its origin and its
 /// light, in Q16.16 raw units, at most. The tracer aims it with
 /// [`Vec3::direction_and_length_estimate`](crate::math::Vec3::direction_and_length_estimate):
@@ -213,25 +215,16 @@ impl<'a> LightBuffer<'a> {
     /// lights that do.
     ///
     /// ```
-    /// use octrace_core::accel::{LightBuffer, LightBuffered, Naive};
+    /// use octrace_core::accel::LightBuffer;
     /// use octrace_core::parse::parse;
     /// use octrace_core::profile::Board64K;
-    /// use octrace_core::render::Renderer;
     /// use octrace_core::scene::Scene;
-    /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888};
     ///
     /// let mut scene = Scene::<Board64K>::new();
     /// parse("RASTER 8 8\nVIEWPOINT 0 0 5\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\nSPHERE 1 0.5 1 1 1\nSPHERE 1 0.3 2 2 2\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n", &mut scene, &mut |e| panic!("{e}")).unwrap();
     /// let mut words = heapless::Vec::<u32, 400>::new();
     /// let buffer = LightBuffer::build(&scene.view(), &mut words, 8);
     /// assert_eq!((buffer.report().lights, buffer.report().cells_a_side), (1, 8));
-    ///
-    /// let mut lit = MockDisplay::<Rgb888>::new();
-    /// Renderer::new(scene.view(), &LightBuffered::new(&Naive, buffer))?.render(&mut lit)?;
-    /// let mut plain = MockDisplay::<Rgb888>::new();
-    /// Renderer::new(scene.view(), &Naive)?.render(&mut plain)?;
-    /// assert_eq!(lit, plain);
-    /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
     pub fn build<W: Arena<u32>>(scene: &SceneView<'_>, words: &'a mut W, cells_a_side: u32) -> LightBuffer<'a> {
         Self::build_with_margin(scene, words, cells_a_side, usize::MAX, MARGIN)
@@ -313,27 +306,45 @@ impl<W: Arena<u32>> LightBufferStore<W> {
 /// answer). See [`LightBuffer::build`].
 #[derive(Clone, Copy, Debug)]
 pub struct LightBuffered<'a, A> {
-    accel: &'a A,
+    accel: A,
     buffer: LightBuffer<'a>,
 }
 
 impl<'a, A> LightBuffered<'a, A> {
-    /// `accel` with `buffer` (built over the same scene) in front of its
-    /// shadow rays.
-    pub fn new(accel: &'a A, buffer: LightBuffer<'a>) -> Self {
+    /// `accel` (an accelerator, or a reference to one) with `buffer`
+    /// (built over the same scene) in front of its shadow rays.
+    pub fn new(accel: A, buffer: LightBuffer<'a>) -> Self {
         LightBuffered { accel, buffer }
+    }
+
+    /// The accelerator behind the buffer.
+    pub fn accel(&self) -> &A {
+        &self.accel
+    }
+
+    /// The buffer.
+    pub fn buffer(&self) -> LightBuffer<'a> {
+        self.buffer
+    }
+}
+
+impl<A: Accelerator> LightBuffered<'_, A> {
+    /// [`Accelerator::occluded_toward`] of the shadow ray `query` asks of,
+    /// the buffer's objects tested over its kinds only (a build's, which
+    /// links no other kind's code).
+    #[inline]
+    pub(crate) fn occluded_toward_among(&self, query: &ShadowQuery<'_, '_>, mailbox: &mut Mailbox<'_>) -> bool {
+        match self.buffer.occluded(query, mailbox) {
+            Some(blocked) => blocked,
+            None => {
+                let ShadowQuery { scene, ray, t_max, light, start, .. } = *query;
+                self.accel.occluded_toward(scene, ray, t_max, light, start, mailbox)
+            }
+        }
     }
 }
 
 impl<A: Accelerator> Accelerator for LightBuffered<'_, A> {
-    const KINDS: ShapeKinds = A::KINDS;
-    const USES_MAILBOX: bool = A::USES_MAILBOX;
-    const FOLLOWS_MOTION: bool = A::FOLLOWS_MOTION;
-
-    fn first_hits_by_screen(&self) -> bool {
-        self.accel.first_hits_by_screen()
-    }
-
     #[inline]
     fn nearest(
         &self,
@@ -367,10 +378,8 @@ impl<A: Accelerator> Accelerator for LightBuffered<'_, A> {
         start: Option<RayStart>,
         mailbox: &mut Mailbox<'_>,
     ) -> bool {
-        match self.buffer.occluded(scene, A::KINDS, ray, t_max, light, start, mailbox) {
-            Some(blocked) => blocked,
-            None => self.accel.occluded_toward(scene, ray, t_max, light, start, mailbox),
-        }
+        let query = ShadowQuery { scene, kinds: ShapeKinds::ALL, ray, t_max, light, start };
+        self.occluded_toward_among(&query, mailbox)
     }
 }
 

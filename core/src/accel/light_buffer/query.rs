@@ -9,23 +9,25 @@ use crate::math::Scalar;
 use crate::scene::{ObjectId, SceneView};
 use crate::shapes::{Leaving, Ray, ShapeKinds};
 
+/// A shadow ray from its origin towards the scene's light `light` as the
+/// tracer aims it (see [`RAY_SLACK`](super::RAY_SLACK)), up to `t_max`,
+/// its objects tested over `kinds`.
+pub(crate) struct ShadowQuery<'q, 'v> {
+    pub scene: &'q SceneView<'v>,
+    pub kinds: ShapeKinds,
+    pub ray: &'q Ray,
+    pub t_max: Scalar,
+    pub light: usize,
+    pub start: Option<RayStart>,
+}
+
 impl LightBuffer<'_> {
-    /// Whether anything blocks `ray`, a shadow ray from its origin towards
-    /// the scene's light `light` as the tracer aims it (see [`RAY_SLACK`](super::RAY_SLACK)),
-    /// before `t_max`; the blocker is left in the mailbox. `None` when the
-    /// light is not buffered: the caller asks its accelerator.
+    /// Whether anything blocks the shadow ray `query` asks of; the blocker
+    /// is left in the mailbox. `None` when the light is not buffered: the
+    /// caller asks its accelerator.
     #[inline]
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn occluded(
-        &self,
-        scene: &SceneView<'_>,
-        kinds: ShapeKinds,
-        ray: &Ray,
-        t_max: Scalar,
-        light: usize,
-        start: Option<RayStart>,
-        mailbox: &mut Mailbox<'_>,
-    ) -> Option<bool> {
+    pub(crate) fn occluded(&self, query: &ShadowQuery<'_, '_>, mailbox: &mut Mailbox<'_>) -> Option<bool> {
+        let ShadowQuery { scene, kinds, ray, t_max, light, start } = *query;
         let ([own, cell], depth) = self.lists(ray.origin.bits(), light)?;
         let shadow = Shadow { scene, kinds, ray, t_max, start, depth };
         // The light's own list is mostly empty.

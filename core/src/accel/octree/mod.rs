@@ -65,7 +65,7 @@ use super::{Accelerator, Hit, Mailbox, RayStart};
 use crate::capacity::{Arena, CapacityKind};
 use crate::math::Scalar;
 use crate::scene::{ObjectId, SceneView};
-use crate::shapes::{Aabb, Ratio, Ray, ShapeKinds};
+use crate::shapes::{Aabb, Ratio, Ray};
 use named::NamedWalk;
 
 impl<C: OctreeCapacities, const FRAMES: usize> core::fmt::Debug for Octree<C, FRAMES> {
@@ -78,25 +78,30 @@ impl<C: OctreeCapacities, const FRAMES: usize> core::fmt::Debug for Octree<C, FR
 /// bounds the depth of a walk (the tree is at most `FRAMES − 1` deep); the
 /// 3DDDA keeps one node index per level on the stack.
 ///
-/// Built over a parsed scene, it is an [`Accelerator`] for a
-/// [`Renderer`](crate::render::Renderer); the image is the same as without it:
+/// Built over a parsed scene, it is an [`Accelerator`]; a loaded scene
+/// traced with it gives the same image as without it (every
+/// [`AccelMode`](crate::AccelMode) does):
 ///
 /// ```
-/// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888};
-/// use octrace_core::{accel::{Naive, Octree}, parse::parse, profile::{Board16K, Profile}};
-/// use octrace_core::{render::Renderer, scene::Scene};
+/// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*};
+/// use octrace_core::{accel::Octree, parse::parse, profile::{Board16K, Profile}};
+/// use octrace_core::{scene::Scene, AccelMode, Raytracer};
 ///
+/// const TEXT: &str = "RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nUPVECTOR 0 1 0\nBACKGROUND 0 0 1\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n";
 /// let mut scene = Scene::<Board16K>::new();
-/// parse("RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nUPVECTOR 0 1 0\nBACKGROUND 0 0 1\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n", &mut scene, &mut |e| panic!("{e}")).unwrap();
+/// parse(TEXT, &mut scene, &mut |e| panic!("{e}")).unwrap();
 /// let mut octree = Octree::<Board16K>::new();
 /// let report = octree.build(&scene.view(), &Board16K::OCTREE);
 /// assert_eq!(report.unsplit, 0, "the arenas were large enough");
 ///
-/// let mut with_octree = MockDisplay::<Rgb888>::new();
-/// Renderer::new(scene.view(), &octree)?.render(&mut with_octree)?;
-/// let mut without = MockDisplay::<Rgb888>::new();
-/// Renderer::new(scene.view(), &Naive)?.render(&mut without)?;
-/// assert_eq!(with_octree, without);
+/// let mut raytracer = Raytracer::<Board16K>::new();
+/// let mut draw = |mode| {
+///     let scene = raytracer.load_with(TEXT.as_bytes(), mode, &mut |e| panic!("{e}")).unwrap();
+///     let mut display = MockDisplay::<Rgb888>::new();
+///     Image::new(&scene.image_for(&display), Point::zero()).draw(&mut display).unwrap();
+///     display
+/// };
+/// assert_eq!(draw(AccelMode::Dda), draw(AccelMode::Naive));
 /// # Ok::<(), Box<dyn core::error::Error>>(())
 /// ```
 pub struct Octree<C: OctreeCapacities, const FRAMES: usize = { MAX_DEPTH as usize + 1 }> {
@@ -204,6 +209,10 @@ pub trait OctreeStore: Accelerator {
     const NAMED_WALK: bool;
     /// Builds the octree over `scene`'s objects (see [`Octree::build`]).
     fn build(&mut self, scene: &SceneView<'_>, config: &OctreeConfig) -> BuildReport;
+
+    /// Whether it is walked by 3DDDA (the thesis's walk stays the thesis's
+    /// for every ray, camera rays included).
+    fn walked_by_dda(&self) -> bool;
 }
 
 impl<C: OctreeCapacities, const FRAMES: usize> OctreeStore for Octree<C, FRAMES> {
@@ -213,6 +222,10 @@ impl<C: OctreeCapacities, const FRAMES: usize> OctreeStore for Octree<C, FRAMES>
 
     fn build(&mut self, scene: &SceneView<'_>, config: &OctreeConfig) -> BuildReport {
         Octree::build(self, scene, config)
+    }
+
+    fn walked_by_dda(&self) -> bool {
+        self.walked_by() == Traversal::Dda
     }
 }
 

@@ -157,13 +157,6 @@ pub(super) fn for_each_leaf<I: Index>(
 // for the query's duration only, instead of two of them sitting in every
 // caller's frame — it matters on a 16 KiB board.
 impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES> {
-    const KINDS: ShapeKinds = C::KINDS;
-
-    /// Only for 3DDDA: the thesis's walk stays the thesis's for every ray.
-    fn first_hits_by_screen(&self) -> bool {
-        self.walked_by() == Traversal::Dda
-    }
-
     #[inline(never)]
     fn nearest(
         &self,

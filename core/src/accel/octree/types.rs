@@ -169,8 +169,9 @@ impl Index for u32 {
 /// The arenas an [`Octree`](super::Octree) is stored in. Every profile implements it;
 /// define one with [`crate::profile!`], which names counts, not these types.
 pub trait OctreeCapacities {
-    /// The shape kinds the profile's scenes can hold: the queries dispatch
-    /// on these only (see [`Accelerator::KINDS`](crate::accel::Accelerator::KINDS)).
+    /// The shape kinds the profile's scenes can hold: the queries and the
+    /// tracer dispatch on these only, so a build links no other kind's
+    /// code.
     const KINDS: ShapeKinds = ShapeKinds::ALL;
     /// The index type (bounds the arenas and the objects it files).
     type Index: Index;
