@@ -8,6 +8,32 @@
 use super::{AccelMode, BuildReport, OctreeConfig, OctreeStore};
 use crate::scene::SceneView;
 
+/// How a loaded scene is indexed: the mode asked for, and the octree's
+/// criterion (`None`: the profile's, [`Profile::OCTREE`](crate::profile::Profile::OCTREE)).
+/// A mode alone is one.
+///
+/// ```
+/// use octrace_core::accel::{Indexing, OctreeConfig};
+/// use octrace_core::AccelMode;
+///
+/// assert_eq!(Indexing::from(AccelMode::Dda), Indexing { mode: AccelMode::Dda, octree: None });
+/// let deep = Indexing { octree: Some(OctreeConfig { max_depth: 16, ..OctreeConfig::DEFAULT }), ..Indexing::default() };
+/// assert_eq!(deep.mode, AccelMode::Auto);
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Indexing {
+    /// The mode asked for.
+    pub mode: AccelMode,
+    /// How the octree is built, if not as the profile says.
+    pub octree: Option<OctreeConfig>,
+}
+
+impl From<AccelMode> for Indexing {
+    fn from(mode: AccelMode) -> Self {
+        Indexing { mode, octree: None }
+    }
+}
+
 /// What [`prepare`] chose and built.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Prepared {

@@ -22,7 +22,7 @@ pub(crate) mod linked;
 pub(crate) mod naive;
 mod octree;
 
-pub use choice::{prepare, Prepared};
+pub use choice::{prepare, Indexing, Prepared};
 pub(crate) use light_buffer::RAY_SLACK;
 pub use light_buffer::{
     LightBuffer, LightBufferError, LightBufferReport, LightBufferStore, LightBuffered, MAX_CELLS_A_SIDE,

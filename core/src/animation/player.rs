@@ -13,6 +13,7 @@
 
 use super::coherence::Coherence;
 use super::room::{AnimationCapacity, AnimationNeeds, NoRoom};
+use crate::accel::Indexing;
 use crate::motion::{Dependence, Key, Lookout, Motion, MotionNeeds, Recorder, Track};
 use crate::scene::Frames;
 use core::sync::atomic::AtomicU8;
@@ -68,6 +69,8 @@ pub struct Animation<'s> {
     /// What its storage holds.
     room: AnimationNeeds,
     loaded: Option<Loaded>,
+    /// How its frames' scenes are indexed.
+    indexing: Indexing,
     /// Dependences the tracker drops, by a test only.
     ignored: u8,
 }
@@ -109,7 +112,19 @@ impl<'s> Animation<'s> {
             needed,
             holds: tiles.len(),
         })?;
-        Ok(Animation { tracks, keys, coherence, room, loaded: None, ignored: 0 })
+        Ok(Animation { tracks, keys, coherence, room, loaded: None, indexing: Indexing::default(), ignored: 0 })
+    }
+
+    /// The animation, its frames' scenes indexed as `indexing` says (an
+    /// [`AccelMode`](crate::AccelMode), or with an octree criterion of its
+    /// own), not as [`Indexing::default`]: the same pictures.
+    pub fn indexed(self, indexing: impl Into<Indexing>) -> Self {
+        Animation { indexing: indexing.into(), ..self }
+    }
+
+    /// How its frames' scenes are indexed.
+    pub(crate) fn indexing(&self) -> Indexing {
+        self.indexing
     }
 
     /// What its storage holds.

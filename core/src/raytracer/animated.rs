@@ -12,7 +12,6 @@ use crate::animation::{Animation, AnimationCapacity, Coherence, NoRoom, Playing}
 use crate::parse::ParseError;
 use crate::profile::Profile;
 use crate::scene::Frames;
-use crate::AccelMode;
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
 
@@ -158,9 +157,10 @@ impl<'s> Animation<'s> {
         both: &mut RunBoth<'_>,
         anew: bool,
     ) -> Result<Frame<'a, 'r, P>, AnimationError<'t>> {
+        let indexing = self.indexing();
         let scene = if anew || !self.holds(text) {
             let mut recorder = self.recorder(text).map_err(AnimationError::NoRoom)?;
-            let scene = raytracer.load_in(text, frame, AccelMode::Auto, on_error, both, Some(&mut recorder))?;
+            let scene = raytracer.load_in(text, frame, &indexing, on_error, both, Some(&mut recorder))?;
             let (fits, counts) = (recorder.fits(), (recorder.track_count, recorder.key_count));
             if !fits {
                 // The room was checked against the text's needs: only a
@@ -177,7 +177,7 @@ impl<'s> Animation<'s> {
             self.recorded(text, frames, counts, frame);
             scene
         } else {
-            let scene = raytracer.load_in(text, frame, AccelMode::Auto, on_error, both, None)?;
+            let scene = raytracer.load_in(text, frame, &indexing, on_error, both, None)?;
             self.step_to(frame);
             scene
         };

@@ -8,7 +8,8 @@
 //! in `.bss`, initialised in place); a [`LoadedScene`] exists only for a
 //! scene that parsed without errors, with its accelerator built.
 
-use crate::accel::{self, AccelMode, LightBuffer, LightBufferStore, Mailbox, OctreeStore, Prepared, MAX_CELLS_A_SIDE};
+use crate::accel::MAX_CELLS_A_SIDE;
+use crate::accel::{self, AccelMode, Indexing, LightBuffer, LightBufferStore, Mailbox, OctreeStore, Prepared};
 use crate::capacity::Arena;
 use crate::parse::{parse_recording, ErrorKind, MotionSink, ParseError, Pos};
 use crate::profile::Profile;
@@ -191,21 +192,22 @@ impl<P: Profile> Raytracer<P> {
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
     pub fn load_frame<'t>(&mut self, text: &'t str, frame: u32) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
-        self.load_in(text.as_bytes(), frame, AccelMode::Auto, &mut |_| {}, &mut one_core, None)
+        self.load_in(text.as_bytes(), frame, &Indexing::default(), &mut |_| {}, &mut one_core, None)
     }
 
     /// [`Raytracer::load`] from bytes (invalid UTF-8 is an error at its
-    /// place), with the accelerator `mode`, handing every error to
+    /// place), indexed as `indexing` says (an [`AccelMode`], or with an
+    /// octree criterion of its own: [`Indexing`]), handing every error to
     /// `on_error` as it is found. A profile with no room for octree boxes
     /// always uses [`AccelMode::Naive`] (same image; no octree code is
     /// linked); [`LoadedScene::mode`] says which mode is in use.
     pub fn load_with<'t>(
         &mut self,
         text: &'t [u8],
-        mode: AccelMode,
+        indexing: impl Into<Indexing>,
         on_error: &mut dyn FnMut(ParseError<'t>),
     ) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
-        self.load_in(text, 0, mode, on_error, &mut one_core, None)
+        self.load_in(text, 0, &indexing.into(), on_error, &mut one_core, None)
     }
 
     /// [`Raytracer::load`] on two cores: the light buffer is built on the
@@ -272,7 +274,7 @@ impl<P: Profile> Raytracer<P> {
         frame: u32,
         both: impl FnOnce(&mut (dyn FnMut() + Send), &mut dyn FnMut()),
     ) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
-        self.load_in(text.as_bytes(), frame, AccelMode::Auto, &mut |_| {}, &mut once(both), None)
+        self.load_in(text.as_bytes(), frame, &Indexing::default(), &mut |_| {}, &mut once(both), None)
     }
 
     /// Parses frame `frame` of `text` and indexes it; `both(beside,
@@ -284,7 +286,7 @@ impl<P: Profile> Raytracer<P> {
         &mut self,
         text: &'t [u8],
         frame: u32,
-        mode: AccelMode,
+        indexing: &Indexing,
         on_error: &mut dyn FnMut(ParseError<'t>),
         both: &mut RunBoth<'_>,
         motion: Option<&mut dyn MotionSink>,
@@ -306,6 +308,7 @@ impl<P: Profile> Raytracer<P> {
             }
         };
         let view = self.scene.view();
+        let (mode, config) = (indexing.mode, indexing.octree.unwrap_or(P::OCTREE));
         let requested = mode;
         // The naive mode asked for by name stays the thesis's test of
         // every object, camera rays too; likewise the shadow rays' light
@@ -321,13 +324,13 @@ impl<P: Profile> Raytracer<P> {
                     built = true;
                 }
             },
-            &mut || prepared = Some(accel::prepare(mode, &view, octree_store, &P::OCTREE)),
+            &mut || prepared = Some(accel::prepare(mode, &view, octree_store, &config)),
         );
         // `both` ran both jobs, unless a caller's broke its promise: then
         // the octree is built now, and the shadow rays go without a buffer
         // (the store may hold an earlier scene's).
         let Prepared { mode, report } =
-            prepared.unwrap_or_else(|| accel::prepare(mode, &view, &mut self.octree, &P::OCTREE));
+            prepared.unwrap_or_else(|| accel::prepare(mode, &view, &mut self.octree, &config));
         let octree = report.map(|report| (&self.octree, report));
         let lights = if built { self.light_buffer.buffer() } else { LightBuffer::NONE };
         let first_hits = P::FIRST_HITS && requested != AccelMode::Naive;
