@@ -65,6 +65,11 @@ impl<'a, 'r, P: Profile> Frame<'a, 'r, P> {
         &self.scene
     }
 
+    /// The frame's scene alone, to draw as a still.
+    pub fn into_scene(self) -> LoadedScene<'r, P> {
+        self.scene
+    }
+
     /// Which frame it is, from 0.
     pub fn number(&self) -> u32 {
         self.playing.frame

@@ -3,9 +3,10 @@
 //! received frame answered ([`Board::answer`]), and a scene that loaded
 //! handed back as a [`Drawing`] whose rows the firmware renders its own way
 //! (one core, two) and sends as they are drawn; an animation played frame
-//! after frame in the room a firmware gives it ([`AnimationRoom`],
-//! [`Playing`]: `play.rs`); the byte rings a firmware keeps between its
-//! serial port and the loop ([`Ring`]: `ring.rs`).
+//! after frame in the [`Animation`] a firmware gives it (its room checked
+//! in `play.rs`; each frame a [`Drawing`] of its own, [`Drawing::frame`]);
+//! the byte rings a firmware keeps between its serial port and the loop
+//! ([`Ring`]: `ring.rs`).
 //!
 //! Invariants: every frame gets exactly one answer — a [`Message::Board`],
 //! a [`Message::Refused`], the scene's [`Message::SceneError`]s closed by a
@@ -13,15 +14,16 @@
 //! closed by [`Drawing::finish`] or [`Drawing::cancel`] (an animation's
 //! frames, each closed by a [`Message::FrameDrawn`], by a
 //! [`Message::Stopped`]) — all with the frame's tag; a scene with errors
-//! draws nothing, nor does an animation its room cannot hold.
+//! draws nothing, nor does an animation its room cannot hold, nor one
+//! whose camera cannot be set up at any of its frames (checked, every
+//! frame, before its `drawing`).
 //!
 //! A firmware's loop, on one core (`Usb` stands for its serial port and
 //! clock as a [`Line`]; the rows go to its panel as well):
 //!
 //! ```
 //! use embedded_graphics_core::pixelcolor::Rgb565;
-//! use octrace_core::profile::{Board16K, Profile};
-//! use octrace_core::{accel::Mailbox, render::Renderer, Raytracer};
+//! use octrace_core::{profile::Board16K, Raytracer};
 //! use octrace_link::board::{Line, Link, Served};
 //! use octrace_link::{Decoder, Message, Panel, PixelFormat};
 //! # use std::collections::VecDeque;
@@ -42,17 +44,11 @@
 //! let panel = Panel { width: 8, height: 4, format: PixelFormat::Rgb565 };
 //! let mut link = Link::new(panel, "my-board 0.1.0", [0u8; 4096]);
 //! let mut raytracer = Raytracer::<Board16K>::new(); // a `static` on a board
-//! let mut mailbox = [0u32; Mailbox::words_for(Board16K::COUNTS.objects)];
 //! let mut row = [Rgb565::default(); 8];
 //! // On a board, `serve` never returns None: loop for ever.
 //! while let Some(served) = link.serve(&mut usb, &mut raytracer, |drawing, rows| {
-//!     let scene = drawing.scene();
-//!     let accelerator = scene.accelerator();
-//!     // `serve` checked the camera at the panel's size.
-//!     let Ok(mut renderer) = Renderer::with_size(scene.view(), &accelerator, 8, 4) else { return 0 };
-//!     renderer.set_mailbox(&mut mailbox);
 //!     // Each row to the panel (here: nowhere) and to the host.
-//!     rows.draw_on_one_core(drawing, &mut renderer, &mut row, |_y, _pixels| {})
+//!     rows.draw_on_one_core(drawing, &mut row, |_area, _pixels| {})
 //! }) {
 //!     assert_ne!(served, Served::Stalled);
 //! }
@@ -62,18 +58,20 @@
 //! # assert_eq!(kinds, ["board", "drawing", "row", "row", "row", "row", "done"]);
 //! ```
 //!
-//! On two cores, each renders its rows with a `Renderer` of its own over
-//! [`Drawing::scene`]'s view and accelerator (see octrace-core's
-//! `interleaved_rows`), the other core stopped through a flag that the
-//! line's core sets when [`Rows::poll`] says so, and the core that owns
-//! the line sends the rows in order.
+//! To play animations, give the link an
+//! [`Animation`](octrace_core::animation::Animation) in a `static`
+//! [`AnimationRoom`](octrace_core::animation::AnimationRoom)
+//! ([`Link::with_animations`]). On two cores, each renders its rows with a
+//! `Renderer` of its own over [`Drawing::scene`] (see octrace-core's
+//! `SharedScene`), or its bands of [`Drawing::frame`], the other core
+//! stopped through a flag that the line's core sets when [`Rows::poll`]
+//! says so, and the core that owns the line sends the rows in order.
 
 mod play;
 mod ring;
 mod serve;
 
 use play::saturate;
-pub use play::{AnimationRoom, Playing, TILE};
 pub use ring::Ring;
 pub use serve::{
     Line, Link, Rows, Served, Stalled, MAX_COUNTERS, POLL_PERIOD_US, SLOWEST_HOST_BYTES_PER_SECOND, STALL_GRACE_US,
@@ -86,11 +84,12 @@ use crate::list::{Capacities, Capacity};
 use crate::message::{put_scene_error, BoardInfo, CapacityNeed, Kind, Message, Panel, Timing};
 use core::fmt;
 use embedded_graphics_core::pixelcolor::{IntoStorage, Rgb565};
+use octrace_core::animation::{Animation, AnimationNeeds};
 use octrace_core::capacity::CapacityKind;
-use octrace_core::parse::ErrorKind;
+use octrace_core::parse::{ErrorKind, ParseError};
 use octrace_core::profile::Profile;
 use octrace_core::scene::SceneCapacities;
-use octrace_core::{AccelMode, LoadedScene, Raytracer};
+use octrace_core::{AccelMode, AnimationError, Frame as AnimationFrame, LoadedScene, Raytracer};
 
 /// What a board is: its panel, the longest scene its decoder holds, its
 /// firmware's name. Its profile and capacities come from the
@@ -100,8 +99,8 @@ pub struct Board<'a> {
     panel: Panel,
     max_scene: u32,
     firmware: &'a str,
-    /// What its [`AnimationRoom`] holds (none: it plays no animation).
-    room: play::RoomSizes,
+    /// What its [`Animation`] holds (none: it plays no animation).
+    room: AnimationNeeds,
 }
 
 impl<'a> Board<'a> {
@@ -109,7 +108,7 @@ impl<'a> Board<'a> {
     /// holds, running `firmware` (its name and version, for hosts to show).
     pub fn new<B: AsRef<[u8]> + AsMut<[u8]>>(panel: Panel, firmware: &'a str, decoder: &Decoder<B>) -> Board<'a> {
         let max_scene = u32::try_from(decoder.max_scene()).unwrap_or(u32::MAX);
-        Board { panel, max_scene, firmware, room: play::RoomSizes::default() }
+        Board { panel, max_scene, firmware, room: AnimationNeeds::default() }
     }
 
     /// Its panel.
@@ -117,16 +116,24 @@ impl<'a> Board<'a> {
         self.panel
     }
 
+    /// The board plays animations in an [`Animation`] that holds `room`.
+    pub fn playing_in(self, room: AnimationNeeds) -> Board<'a> {
+        Board { room, ..self }
+    }
+
     /// Answers what the decoder `received`: a refusal is sent back, a
     /// hello gets the board's description, a scene is loaded into
-    /// `raytracer` and gets its errors, or a [`Drawing`] to render. `Err`
-    /// when `sink` failed; a scene that loaded is handed back even when
-    /// its `drawing` message was not taken (the panel still shows it; the
-    /// sink's next writes say whether the host gets the rows).
+    /// `raytracer` and gets its errors, or a [`Drawing`] to render. A
+    /// scene whose animation fits `animation` (the board's, if it plays
+    /// them) is loaded through it: every frame's camera is checked then.
+    /// `Err` when `sink` failed; a scene that loaded is handed back even
+    /// when its `drawing` message was not taken (the panel still shows
+    /// it; the sink's next writes say whether the host gets the rows).
     pub fn answer<'r, P: Profile, S: Sink + ?Sized>(
         &self,
         received: Result<Frame<'_>, Refusal>,
         raytracer: &'r mut Raytracer<P>,
+        animation: Option<&'r mut Animation<'_>>,
         sink: &mut S,
     ) -> Result<Option<Drawing<'r, P>>, S::Error> {
         let Frame { tag, message } = match received {
@@ -135,7 +142,7 @@ impl<'a> Board<'a> {
         };
         match message {
             Message::Hello => self.hello::<P, S>(tag, sink).map(|()| None),
-            Message::Scene { pixels, text } => self.load(tag, pixels, text, raytracer, sink),
+            Message::Scene { pixels, text } => self.load(Scene { tag, pixels, text }, raytracer, animation, sink),
             other => {
                 let refused = Message::Refused(Reason::Unexpected { kind: other.kind().byte() });
                 refused.encode(tag, sink).map(|()| None)
@@ -157,14 +164,13 @@ impl<'a> Board<'a> {
 
     fn load<'r, P: Profile, S: Sink + ?Sized>(
         &self,
-        tag: u16,
-        pixels: bool,
-        text: &[u8],
+        Scene { tag, pixels, text }: Scene<'_>,
         raytracer: &'r mut Raytracer<P>,
+        animation: Option<&'r mut Animation<'_>>,
         sink: &mut S,
     ) -> Result<Option<Drawing<'r, P>>, S::Error> {
         let mut failed = None;
-        let loaded = raytracer.load_with(text, AccelMode::Auto, &mut |error| {
+        let mut report = |error: ParseError<'_>| {
             if failed.is_none() {
                 let capacity = match error.kind {
                     ErrorKind::Capacity(c) => Some(CapacityNeed {
@@ -177,13 +183,29 @@ impl<'a> Board<'a> {
                 let (line, column) = (error.pos.line, error.pos.column);
                 failed = send_error(tag, line, column, capacity, &error.kind, sink).err();
             }
-        });
+        };
+        // An animation the board has room for loads through it: every
+        // frame's camera is checked before anything plays.
+        let fits = play::short_of(&self.room, text, self.panel).iter().all(Option::is_none);
+        let loaded = match animation.filter(|_| fits) {
+            Some(animation) => match animation.load_with(raytracer, text, &mut report) {
+                Ok(frame) => Ok(frame.into_scene()),
+                Err(AnimationError::Scene(e)) => Err(e.count),
+                // Its room was checked against the scene's needs.
+                Err(AnimationError::NoRoom(short)) => {
+                    let need = play::capacity(&short);
+                    send_error(tag, 0, 0, Some(need), &short, sink)?;
+                    Err(1)
+                }
+            },
+            None => raytracer.load_with(text, AccelMode::Auto, &mut report).map_err(|e| e.count),
+        };
         if let Some(e) = failed {
             return Err(e);
         }
         let scene = match loaded {
             Ok(scene) => scene,
-            Err(e) => return Message::Rejected { errors: saturate(e.count) }.encode(tag, sink).map(|()| None),
+            Err(count) => return Message::Rejected { errors: saturate(count) }.encode(tag, sink).map(|()| None),
         };
         // The parser refuses a camera that cannot be set up; this is the
         // check at the panel's size that a renderer makes.
@@ -195,10 +217,9 @@ impl<'a> Board<'a> {
         let frames = match play::animated(&scene) {
             None => 0,
             Some(frames) => {
-                let short = self.room.short_of(text, self.panel);
                 let mut errors = 0;
-                for need in short.iter().flatten() {
-                    send_error(tag, 0, 0, Some(*need), &play::NoRoom(*need), sink)?;
+                for short in play::short_of(&self.room, text, self.panel).iter().flatten() {
+                    send_error(tag, 0, 0, Some(play::capacity(short)), short, sink)?;
                     errors += 1;
                 }
                 if errors > 0 {
@@ -209,8 +230,16 @@ impl<'a> Board<'a> {
         };
         // Not taken: the rows are not either (see `answer`).
         let _ = Message::Drawing { panel: self.panel, pixels, frames }.encode(tag, sink);
-        Ok(Some(Drawing { scene, tag, pixels, panel: self.panel, playing: None }))
+        Ok(Some(Drawing { shown: Shown::Still(scene), tag, pixels, panel: self.panel }))
     }
+}
+
+/// A scene the host sent: its frame's tag, whether it wants the rows'
+/// pixels, and the text.
+struct Scene<'t> {
+    tag: u16,
+    pixels: bool,
+    text: &'t [u8],
 }
 
 /// Sends one [`Message::SceneError`], its message written by `message`'s
@@ -233,12 +262,17 @@ fn send_error<S: Sink + ?Sized>(
 /// drawn, and close it with [`Drawing::finish`], or with
 /// [`Drawing::cancel`] when a frame comes from the host between rows.
 pub struct Drawing<'r, P: Profile> {
-    scene: LoadedScene<'r, P>,
+    shown: Shown<'r, P>,
     tag: u16,
     pixels: bool,
     panel: Panel,
-    /// The frame of an animation this is, or None for a still.
-    playing: Option<Playing<'r>>,
+}
+
+/// What a drawing draws.
+enum Shown<'r, P: Profile> {
+    Still(LoadedScene<'r, P>),
+    /// A frame of an animation.
+    Frame(AnimationFrame<'r, 'r, P>),
 }
 
 impl<P: Profile> fmt::Debug for Drawing<'_, P> {
@@ -247,15 +281,19 @@ impl<P: Profile> fmt::Debug for Drawing<'_, P> {
             .field("tag", &self.tag)
             .field("pixels", &self.pixels)
             .field("panel", &self.panel)
-            .field("playing", &self.playing)
+            .field("frame", &self.frame().map(AnimationFrame::number))
             .finish_non_exhaustive()
     }
 }
 
 impl<'r, P: Profile> Drawing<'r, P> {
-    /// The loaded scene: its view and accelerator for the renderers.
+    /// The loaded scene: its view and accelerator for the renderers (a
+    /// frame's, for an animation).
     pub fn scene(&self) -> &LoadedScene<'r, P> {
-        &self.scene
+        match &self.shown {
+            Shown::Still(scene) => scene,
+            Shown::Frame(frame) => frame.scene(),
+        }
     }
 
     /// The panel it is drawn at.
@@ -268,11 +306,14 @@ impl<'r, P: Profile> Drawing<'r, P> {
         self.pixels
     }
 
-    /// For a frame of an animation, which and how to draw it: only the
-    /// runs its `Coherence` planned, each sent with
-    /// [`Drawing::send_run`]. None for a still, drawn row by row.
-    pub fn playing(&self) -> Option<Playing<'r>> {
-        self.playing
+    /// For a frame of an animation, the frame: its draw traces only the
+    /// runs its tiles planned, each sent with [`Drawing::send_run`]. None
+    /// for a still, drawn row by row.
+    pub fn frame(&self) -> Option<&AnimationFrame<'r, 'r, P>> {
+        match &self.shown {
+            Shown::Still(_) => None,
+            Shown::Frame(frame) => Some(frame),
+        }
     }
 
     /// Tells the host row `y` is drawn: `row` is its pixels (the panel's
@@ -369,7 +410,7 @@ mod tests {
         let mut answer = Vec::new();
         for byte in host {
             let Some(received) = decoder.push(byte) else { continue };
-            if let Some(drawing) = board.answer(received, raytracer, &mut answer).unwrap() {
+            if let Some(drawing) = board.answer(received, raytracer, None, &mut answer).unwrap() {
                 let (w, h) = (PANEL.width as u32, PANEL.height as u32);
                 let accelerator = drawing.scene().accelerator();
                 let mut renderer = Renderer::with_size(drawing.scene().view(), &accelerator, w, h).unwrap();
@@ -516,7 +557,7 @@ mod tests {
         let mut answer = Vec::new();
         for byte in wire {
             if let Some(received) = decoder.push(byte) {
-                assert!(board.answer(received, &mut raytracer, &mut answer).unwrap().is_none());
+                assert!(board.answer(received, &mut raytracer, None, &mut answer).unwrap().is_none());
             }
         }
         let mut reasons = Vec::new();

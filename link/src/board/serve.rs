@@ -23,21 +23,21 @@
 //!   frame is loaded from that text, planned, drawn and closed by
 //!   `frame-drawn`, and the animation by `stopped`.
 
-use super::play::{self, AnimationRoom, Playing, TILE};
-use super::{Board, Drawing, Panel};
+use super::play;
+use super::{Board, Drawing, Panel, Shown};
 use crate::cobs::Sink;
 use crate::decoder::{Decoder, Frame};
 use crate::list::{Counter, Counters};
 use crate::message::{Message, Timing};
 use core::cell::RefCell;
 use core::time::Duration;
-use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::Rgb565;
 use embedded_graphics_core::primitives::Rectangle;
-use octrace_core::accel::Accelerator;
-use octrace_core::animation::{Coherence, Motion};
+use embedded_graphics_core::Pixel;
+use octrace_core::animation::Animation;
 use octrace_core::profile::Profile;
-use octrace_core::render::{Renderer, Stopped};
 use octrace_core::scene::Frames;
 use octrace_core::Raytracer;
 
@@ -128,8 +128,8 @@ pub enum Served {
 }
 
 /// The board's end of the link: its [`Board`], its decoder (a board's:
-/// [`Decoder::for_board`]), whether a frame came while it drew, and its
-/// storage for animations.
+/// [`Decoder::for_board`]), whether a frame came while it drew, and the
+/// animation it plays animated scenes in.
 #[derive(Debug)]
 pub struct Link<'a, B> {
     board: Board<'a>,
@@ -139,24 +139,26 @@ pub struct Link<'a, B> {
     /// A byte came since the last frame was received: an animation stops,
     /// its text (that frame, in the decoder) being overwritten.
     heard: bool,
-    room: AnimationRoom<'a>,
+    animation: Option<Animation<'a>>,
 }
 
 impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
     /// The board drawing on `panel`, running `firmware` (its name and
     /// version), keeping frames in `buffer` (its length bounds a scene's).
-    /// It plays no animation until given room ([`Link::with_animations`]).
+    /// It plays no animation until given one ([`Link::with_animations`]).
     pub fn new(panel: Panel, firmware: &'a str, buffer: B) -> Link<'a, B> {
         let decoder = Decoder::for_board(buffer);
         let board = Board::new(panel, firmware, &decoder);
-        Link { board, decoder, pending: false, heard: false, room: AnimationRoom::none() }
+        Link { board, decoder, pending: false, heard: false, animation: None }
     }
 
-    /// The board plays animations in `room`: an animated scene that does
-    /// not fit it is rejected, naming what runs out.
-    pub fn with_animations(mut self, room: AnimationRoom<'a>) -> Link<'a, B> {
-        self.board.room = room.sizes();
-        self.room = room;
+    /// The board plays animations in `animation` (an
+    /// [`AnimationRoom`](octrace_core::animation::AnimationRoom)'s, at the
+    /// panel's size): an animated scene that does not fit it is rejected,
+    /// naming what runs out.
+    pub fn with_animations(mut self, animation: Animation<'a>) -> Link<'a, B> {
+        self.board = self.board.playing_in(animation.room());
+        self.animation = Some(animation);
         self
     }
 
@@ -172,7 +174,7 @@ impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
     /// ([`Rows::send`]), polls the line between rays ([`Rows::poll`],
     /// through a [`Stop`](octrace_core::render::Stop)) and returns how many
     /// rows it drew, in order. An animation is played in a loop, `draw`
-    /// called for each frame ([`Drawing::playing`]: it draws the planned
+    /// called for each frame ([`Drawing::frame`]: it draws the planned
     /// runs, sends each with [`Rows::send_run`], and returns the panel's
     /// height when the frame is whole), until the host sends a byte. None
     /// when the line says no byte will come.
@@ -203,7 +205,7 @@ impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
         // There: a frame just ended, or ended while the last scene was drawn
         // and nothing was pushed since.
         let received = self.decoder.received()?;
-        let drawing = match self.board.answer(received, raytracer, &mut output) {
+        let drawing = match self.board.answer(received, raytracer, self.animation.as_mut(), &mut output) {
             Ok(None) => return Some(Served::Answered),
             Err(Stalled) => return Some(Served::Stalled),
             Ok(Some(drawing)) => drawing,
@@ -214,7 +216,14 @@ impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
         }
         let loaded = output.line.now_us();
         output.line.take_counts(&mut load_counts[..names.len()]);
-        let mut rows = Rows { output: &mut output, listener: self.listener(false), read_at_us: start };
+        // Field by field: a scene loaded through the animation borrows it.
+        let listener = Listener {
+            decoder: &mut self.decoder,
+            pending: &mut self.pending,
+            heard: &mut self.heard,
+            any_byte: false,
+        };
+        let mut rows = Rows { output: &mut output, listener, read_at_us: start };
         let drawn = draw(&drawing, &mut rows).min(drawing.panel().height);
         // Every row drawn is done, even if a frame came with the last.
         let closed = match drawn == drawing.panel().height {
@@ -243,16 +252,11 @@ impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
         })
     }
 
-    /// What watches the line while a scene is drawn; `any_byte`: an
-    /// animation's, which stops at the first byte.
-    fn listener(&mut self, any_byte: bool) -> Listener<'_, B> {
-        Listener { decoder: &mut self.decoder, pending: &mut self.pending, heard: &mut self.heard, any_byte }
-    }
-
-    /// Plays the animation of `frames` that the frame just received holds,
-    /// answering it with `tag`: frame after frame in a loop, each loaded
-    /// from the text, planned and drawn by `draw`, then `frame-drawn`,
-    /// until the host sends a byte; then `stopped`.
+    /// Plays the animation of `frames` that the frame just received holds
+    /// (loaded into the board's animation as it was answered, every frame
+    /// checked), answering it with `tag`: frame after frame in a loop, each
+    /// loaded from the text and drawn by `draw`, then `frame-drawn`, until
+    /// the host sends a byte; then `stopped`.
     fn play<P: Profile, L: Line>(
         &mut self,
         output: &mut Output<'_, L>,
@@ -263,15 +267,8 @@ impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
         draw: &mut impl FnMut(&Drawing<'_, P>, &mut Rows<'_, '_, L, B>) -> u16,
     ) -> Served {
         let panel = self.board.panel;
-        let size = Size::new(panel.width.into(), panel.height.into());
-        let AnimationRoom { tiles, tracks, keys, displacements } = &mut self.room;
-        // The room was checked when the scene was answered, and the text
-        // loaded: a failure here stops the animation before its first frame.
-        let motion = scene_text(&self.decoder).and_then(|text| {
-            let first = raytracer.load_frame(text, 0).ok()?;
-            Motion::read(text, frames, &first.view(), 0, tracks, keys, displacements).ok()
-        });
-        let (Some(motion), Ok(coherence)) = (motion, Coherence::new(tiles, size, TILE)) else {
+        // Answered: the board has an animation, which holds this scene.
+        let Some(animation) = self.animation.as_mut() else {
             return close(Message::Stopped { frames: 0 }.encode(tag, output), Served::Played { frames: 0 });
         };
         let (mut frame, mut drawn) = (0, 0u32);
@@ -280,11 +277,9 @@ impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
             // The text is the frame received, in the decoder, until a byte
             // comes from the host.
             let Some(text) = scene_text(&self.decoder).filter(|_| !self.heard) else { break };
-            let Ok(scene) = raytracer.load_frame(text, frame) else { break };
-            coherence.plan();
-            let traced = u32::try_from(coherence.traced_pixels()).unwrap_or(u32::MAX);
-            let playing = Playing { frame, motion: &motion, coherence: &coherence };
-            let drawing = Drawing { scene, tag, pixels, panel, playing: Some(playing) };
+            let Ok(loaded) = animation.load(raytracer, text, frame) else { break };
+            let traced = u32::try_from(loaded.tiles().traced_pixels()).unwrap_or(u32::MAX);
+            let drawing = Drawing { shown: Shown::Frame(loaded), tag, pixels, panel };
             let listener = Listener {
                 decoder: &mut self.decoder,
                 pending: &mut self.pending,
@@ -375,80 +370,96 @@ impl<L: Line, B: AsRef<[u8]> + AsMut<[u8]>> Rows<'_, '_, L, B> {
         let _ = drawing.send_run(y, x, run, &mut polled);
     }
 
-    /// Draws `drawing` on one core with `renderer` (made at the panel's
-    /// size) into `row` (the panel's width of pixels): a still row by row,
-    /// an animation's frame ([`Drawing::playing`]) run by run, only the
-    /// runs its tiles' plan traces. Each row or run is shown (`show`: the
-    /// panel, given the pixels' rectangle, one row high) and sent once
-    /// drawn, the line polled between rays. Returns the rows drawn, fewer
-    /// than the panel's height when the host sent something (for an
-    /// animation's frame: the panel's height once every run is drawn, else
-    /// 0). What a firmware with one core, or a host standing in for a
-    /// board, draws with.
-    pub fn draw_on_one_core<'a, 'd: 'a, P: Profile, A: Accelerator>(
-        &mut self,
-        drawing: &Drawing<'d, P>,
-        renderer: &mut Renderer<'a, A>,
-        row: &mut [Rgb565],
-        mut show: impl FnMut(&Rectangle, &[Rgb565]),
-    ) -> u16 {
-        let panel = drawing.panel();
-        if let Some(playing) = drawing.playing() {
-            return match self.draw_frame(drawing, playing, renderer, row, show) {
-                Ok(()) => panel.height,
-                Err(Stopped) => 0,
-            };
-        }
-        for y in 0..panel.height {
-            for (x, pixel) in (0..u32::from(panel.width)).zip(row.iter_mut()) {
-                let mut stop: Asked<'_> = &mut || self.poll();
-                match renderer.pixel_until(x, y.into(), &mut stop) {
-                    Ok(sample) => *pixel = sample.color.into(),
-                    Err(Stopped) => return y,
-                }
-            }
-            show(&Rectangle::new(Point::new(0, y.into()), Size::new(panel.width.into(), 1)), row);
-            self.send(drawing, y, row);
-        }
-        panel.height
-    }
-
-    /// An animation's frame on one core: each band's planned runs traced,
-    /// shown and sent.
-    fn draw_frame<'a, P: Profile, A: Accelerator>(
+    /// Draws `drawing` on one core into `row` (the panel's width of
+    /// pixels): a still row by row, an animation's frame
+    /// ([`Drawing::frame`]) run by run, only the runs its tiles' plan
+    /// traces. Each whole row or run is shown (`show`: the panel, given the
+    /// pixels' rectangle, one row high) and sent once drawn, the line
+    /// polled between rays. Returns the rows drawn, fewer than the panel's
+    /// height when the host sent something (for an animation's frame: the
+    /// panel's height once every run is drawn, else 0). What a firmware
+    /// with one core, or a host standing in for a board, draws with.
+    pub fn draw_on_one_core<P: Profile>(
         &mut self,
         drawing: &Drawing<'_, P>,
-        playing: Playing<'a>,
-        renderer: &mut Renderer<'a, A>,
         row: &mut [Rgb565],
-        mut show: impl FnMut(&Rectangle, &[Rgb565]),
-    ) -> Result<(), Stopped> {
-        let coherence = playing.coherence;
+        show: impl FnMut(&Rectangle, &[Rgb565]),
+    ) -> u16 {
+        let panel = drawing.panel();
         let rows = RefCell::new(self);
-        for band in 0..coherence.bands() {
-            // Asked while a run's pixels are traced; the run is sent after.
-            let mut stop: Asked<'_> = &mut || rows.borrow_mut().poll();
-            coherence.trace_band_until(
-                renderer,
-                playing.motion,
-                playing.frame,
-                band,
-                &mut stop,
-                &mut |line, pixels| {
-                    let mut width = 0;
-                    for (pixel, sample) in row.iter_mut().zip(pixels) {
-                        *pixel = sample.color.into();
-                        width += 1;
-                    }
-                    if width < line.size.width as usize {
-                        return Err(Stopped);
-                    }
-                    show(line, &row[..width]);
-                    let (x, y) = (line.top_left.x as u16, line.top_left.y as u16);
-                    rows.borrow_mut().send_run(drawing, y, x, &row[..width]);
-                    Ok(())
-                },
-            )?;
+        let mut sent = Sent { rows: &rows, drawing, row, show, whole: 0 };
+        // Asked while a row's pixels are traced; the row is sent after.
+        let mut stop: Asked<'_> = &mut || rows.borrow_mut().poll();
+        match drawing.frame() {
+            Some(frame) => match frame.image().try_draw_until(&mut sent, &mut stop) {
+                Ok(_) => panel.height,
+                Err(_) => 0,
+            },
+            None => {
+                let size = Size::new(panel.width.into(), panel.height.into());
+                let _ = drawing.scene().image(size).try_draw_until(&mut sent, &mut stop);
+                sent.whole
+            }
+        }
+    }
+}
+
+/// The panel as a drawing on one core draws into it: each whole row (a
+/// still's) or run (a frame's) is shown and sent; one cut short by a stop
+/// goes nowhere.
+struct Sent<'x, 'o, 'l, 'd, L, B, P: Profile, F> {
+    rows: &'x RefCell<&'x mut Rows<'o, 'l, L, B>>,
+    drawing: &'x Drawing<'d, P>,
+    row: &'x mut [Rgb565],
+    show: F,
+    /// A still's rows whole so far.
+    whole: u16,
+}
+
+impl<L, B, P: Profile, F> OriginDimensions for Sent<'_, '_, '_, '_, L, B, P, F> {
+    fn size(&self) -> Size {
+        let panel = self.drawing.panel();
+        Size::new(panel.width.into(), panel.height.into())
+    }
+}
+
+impl<L, B, P, F> DrawTarget for Sent<'_, '_, '_, '_, L, B, P, F>
+where
+    L: Line,
+    B: AsRef<[u8]> + AsMut<[u8]>,
+    P: Profile,
+    F: FnMut(&Rectangle, &[Rgb565]),
+{
+    type Color = Rgb565;
+    type Error = core::convert::Infallible;
+
+    /// Never called: a drawing hands over rows and runs whole.
+    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(&mut self, _: I) -> Result<(), Self::Error> {
+        Ok(())
+    }
+
+    fn fill_contiguous<I: IntoIterator<Item = Rgb565>>(
+        &mut self,
+        area: &Rectangle,
+        colors: I,
+    ) -> Result<(), Self::Error> {
+        let mut width = 0;
+        for (pixel, color) in self.row.iter_mut().zip(colors) {
+            *pixel = color;
+            width += 1;
+        }
+        if width < area.size.width as usize {
+            return Ok(());
+        }
+        let run = &self.row[..width];
+        (self.show)(area, run);
+        let (x, y) = (area.top_left.x as u16, area.top_left.y as u16);
+        match self.drawing.frame() {
+            Some(_) => self.rows.borrow_mut().send_run(self.drawing, y, x, run),
+            None => {
+                self.rows.borrow_mut().send(self.drawing, y, run);
+                self.whole = y + 1;
+            }
         }
         Ok(())
     }
@@ -573,8 +584,7 @@ mod tests {
     extern crate std;
     use super::*;
     use crate::message::{Kind, Message, PixelFormat};
-    use core::sync::atomic::AtomicU8;
-    use octrace_core::animation::{Key, Track};
+    use octrace_core::animation::AnimationRoom;
     use octrace_core::profile::Board64K;
     use std::boxed::Box;
     use std::collections::VecDeque;
@@ -730,11 +740,7 @@ mod tests {
         let mut raytracer = Box::new(Raytracer::<Board64K>::new());
         let mut served = Vec::new();
         while let Some(one) = link.serve(wire, &mut raytracer, |drawing, rows| {
-            let accelerator = drawing.scene().accelerator();
-            let view = drawing.scene().view();
-            let mut renderer =
-                Renderer::with_size(view, &accelerator, PANEL.width.into(), PANEL.height.into()).unwrap();
-            rows.draw_on_one_core(drawing, &mut renderer, &mut [Rgb565::default(); 4], |_, _| {})
+            rows.draw_on_one_core(drawing, &mut [Rgb565::default(); 4], |_, _| {})
         }) {
             served.push(one);
         }
@@ -851,11 +857,9 @@ mod tests {
 
     /// Serves every frame `wire` brings with room for `ANIMATION`.
     fn play_all(wire: &mut Wire) -> Vec<Served> {
-        let tiles = [const { AtomicU8::new(0) }; 1];
-        let (mut tracks, mut keys, mut displacements) = ([Track::EMPTY; 1], [Key::default(); 2], [[0; 3]; 3]);
-        let room =
-            AnimationRoom { tiles: &tiles, tracks: &mut tracks, keys: &mut keys, displacements: &mut displacements };
-        serve_with(Link::new(PANEL, "test 1", std::vec![0u8; 1024]).with_animations(room), wire)
+        let mut room = AnimationRoom::<1, 1, 2>::new();
+        let animation = room.animation(Size::new(PANEL.width.into(), PANEL.height.into())).unwrap();
+        serve_with(Link::new(PANEL, "test 1", std::vec![0u8; 1024]).with_animations(animation), wire)
     }
 
     #[test]
@@ -890,6 +894,28 @@ mod tests {
     }
 
     #[test]
+    fn an_animation_whose_camera_breaks_at_a_later_frame_is_rejected_before_drawing() {
+        // The eye moves onto the point looked at at frame 2.
+        let broken = b"FRAMES 3\nVIEWPOINT 0 0 5 MOVE 0 0 0 0  2 0 0 -5\nORIGIN 0 0 0\n\
+            SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 3\n";
+        let mut wire = Wire::new();
+        wire.send(0, Message::Scene { pixels: false, text: broken }, 1);
+        assert_eq!(play_all(&mut wire), [Served::Answered]);
+        wire.host_reads();
+        let mut decoder = Decoder::for_host(std::vec![0u8; 4096]);
+        let mut answers = Vec::new();
+        for &byte in &wire.received {
+            if let Some(Ok(frame)) = decoder.push(byte) {
+                answers.push(match frame.message {
+                    Message::SceneError(e) => std::format!("{}:{}: {}", e.line, e.column, e.message),
+                    other => other.kind().name().to_string(),
+                });
+            }
+        }
+        assert_eq!(answers, ["2:17: at frame 2, VIEWPOINT equals ORIGIN: there is no view direction", "rejected"]);
+    }
+
+    #[test]
     fn an_animation_the_room_cannot_hold_is_rejected_naming_each_capacity() {
         let mut wire = Wire::new();
         wire.send(0, Message::Scene { pixels: false, text: ANIMATION }, 1);
@@ -905,7 +931,7 @@ mod tests {
             }
         }
         let holds = |name: &str, needed| (name.to_string(), Some(needed), 0);
-        assert_eq!(named, [holds("tiles", 1), holds("tracks", 1), holds("keys", 2), holds("displacements", 3)]);
+        assert_eq!(named, [holds("tiles", 1), holds("tracks", 1), holds("keys", 2)]);
         assert_eq!(wire.answers().last(), Some(&(1, Kind::Rejected)));
     }
 }
