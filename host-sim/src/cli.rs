@@ -280,7 +280,7 @@ fn part_of(
 /// preview, converted or dithered from the whole image (panels are small;
 /// every other image streams).
 fn preview(
-    scene: &HostScene,
+    scene: &mut HostScene,
     options: &RenderOptions,
     args: &Args,
     format: Format,
@@ -398,7 +398,6 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         octree: OctreeConfig { max_objects: args.max_objects, max_depth: args.max_depth, ..crate::OCTREE },
         threads: args.threads.map_or_else(all_cores, |n| n as usize),
         partition: args.partition,
-        light_buffer: crate::LIGHT_BUFFER,
         stop: None,
     };
     let raster = scene.view().settings.raster;
@@ -435,7 +434,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     // each written whole, and Ctrl-C ends it as any program).
     let options = RenderOptions { stop: Some(ctrl_c()), ..options((w, h)) };
     if previewed(args.color) {
-        return preview(&scene, &options, args, format, &out, stderr);
+        return preview(&mut scene, &options, args, format, &out, stderr);
     }
     // `coarse` outlines need the objects of the row above a part.
     let render_rows = match palette_mode {
@@ -460,7 +459,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
                 b.inc(pixels);
             }
         };
-        match render_streamed(&scene, &options, render_rows, &progress, &mut sink) {
+        match render_streamed(&mut scene, &options, render_rows, &progress, &mut sink) {
             Ok(streamed) => outcome = Some(Ok(streamed)),
             Err(StreamError::Sink(e)) => return Err(e),
             Err(e) => {

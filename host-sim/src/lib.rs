@@ -21,25 +21,64 @@ use threaded::stream_threads;
 
 pub use octrace_images::{RgbImage, NO_OBJECT};
 
-use octrace_core::accel::{
-    self, Accelerator, BuildReport, LightBuffer, LightBufferReport, LightBufferStore, LightBuffered, Naive, Octree,
-    OctreeConfig, Traversal,
-};
-use octrace_core::parse::{parse_frame_bytes, ParseError};
-use octrace_core::profile::Host;
-use octrace_core::profile::Profile;
-use octrace_core::scene::{CameraError, Scene};
+use octrace_core::accel::{BuildReport, Indexing, LightBufferReport, OctreeConfig};
+use octrace_core::parse::{imagefile, ParseError};
+use octrace_core::profile::{Host, Profile};
+use octrace_core::scene::{CameraError, SceneView};
 use octrace_core::shade::Stats;
+use octrace_core::{LoadedScene, Raytracer};
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-/// The host build's scene: a million objects of any mix, heap-backed.
-pub type HostScene = Scene<Host>;
+/// A scene loaded on the host: the core's [`Raytracer`] holding it, in the
+/// host build (a million objects of any mix, heap-backed), as a board's
+/// holds its scene. Each render indexes it as its options say and traces
+/// the loaded scene, as a board does.
+#[derive(Debug)]
+pub struct HostScene {
+    raytracer: Box<Raytracer<Host>>,
+}
+
+impl HostScene {
+    /// The scene's objects, surfaces, lights and settings.
+    pub fn view(&self) -> SceneView<'_> {
+        self.raytracer.view()
+    }
+
+    /// The raytracer holding it: for an animation's frames.
+    pub(crate) fn raytracer(&mut self) -> &mut Raytracer<Host> {
+        &mut self.raytracer
+    }
+
+    /// The scene indexed as `options` say: its octree and light buffer
+    /// built anew (each build timed apart), no parse.
+    pub(crate) fn index(&mut self, options: &RenderOptions) -> Indexed<'_> {
+        let (mut octree, mut lights) = (Duration::ZERO, Duration::ZERO);
+        let scene = self.raytracer.reindex(options.indexing(), |beside, here| {
+            let started = Instant::now();
+            here();
+            octree = started.elapsed();
+            let started = Instant::now();
+            beside();
+            lights = started.elapsed();
+        });
+        let build = scene.octree_report().map(|report| (*report, octree));
+        let light_buffer = (scene.light_buffer().report().lights > 0).then(|| (scene.light_buffer().report(), lights));
+        Indexed { scene, build, light_buffer }
+    }
+}
+
+/// A scene indexed for a render, and what building its index took.
+pub(crate) struct Indexed<'s> {
+    pub scene: LoadedScene<'s, Host>,
+    pub build: Option<(BuildReport, Duration)>,
+    pub light_buffer: Option<(LightBufferReport, Duration)>,
+}
 
 /// A fresh, empty host scene.
 pub fn new_scene() -> Box<HostScene> {
-    Box::new(Scene::new())
+    Box::new(HostScene { raytracer: Box::new(Raytracer::new()) })
 }
 
 /// Why a scene could not be loaded.
@@ -79,10 +118,13 @@ pub fn load_bytes(name: &str, bytes: &[u8], scene: &mut HostScene) -> Result<Loa
 pub fn load_frame_bytes(name: &str, bytes: &[u8], frame: u32, scene: &mut HostScene) -> Result<Loaded, LoadError> {
     let mut errors = Vec::new();
     let mut on_error = |e: ParseError<'_>| errors.push(format!("{name}:{e}"));
-    match parse_frame_bytes(bytes, scene, frame, &mut on_error) {
-        Ok(parsed) => Ok(Loaded { imagefile: parsed.imagefile.map(str::to_owned), frames: parsed.frames }),
-        Err(_) => Err(LoadError::Scene(errors)),
-    }
+    // Parsed only: each render indexes it as it is asked to.
+    let frames = match scene.raytracer.load_frame_with(bytes, frame, AccelMode::Naive, &mut on_error) {
+        Ok(loaded) => loaded.frames(),
+        Err(_) => return Err(LoadError::Scene(errors)),
+    };
+    let imagefile = std::str::from_utf8(bytes).ok().and_then(imagefile).map(str::to_owned);
+    Ok(Loaded { imagefile, frames })
 }
 
 /// Reads and parses the scene file at `path`.
@@ -122,10 +164,6 @@ pub struct RenderOptions {
     /// number.
     pub threads: usize,
     pub partition: Partition,
-    /// Cells a face side of the shadow rays' light buffer (0: none); the
-    /// naive mode asked for by name never has one (the thesis's test of
-    /// every object).
-    pub light_buffer: u32,
     /// Once set (host-sim's Ctrl-C), a streamed render ([`render_streamed`])
     /// stops before its next ray, inside the pixels it traces, with
     /// [`StreamError::Stopped`]. The renders into memory ([`render`] and
@@ -141,19 +179,17 @@ impl Default for RenderOptions {
             octree: OCTREE,
             threads: 1,
             partition: Partition::Tiles,
-            light_buffer: LIGHT_BUFFER,
             stop: None,
         }
     }
 }
 
-/// A light buffer's words on the host (heap-backed, as large as the
-/// buffer).
-pub type HostLightBuffer = LightBufferStore<<Host as Profile>::LightBufferWords>;
-
-/// Cells a face side of host-sim's light buffers (the finest the core
-/// builds): chosen by measurement, see BENCHMARKS.md.
-pub const LIGHT_BUFFER: u32 = octrace_core::accel::MAX_CELLS_A_SIDE;
+impl RenderOptions {
+    /// How the scene is indexed: the mode, and the octree's criterion.
+    pub fn indexing(&self) -> Indexing {
+        Indexing { mode: self.accel, octree: Some(self.octree) }
+    }
+}
 
 /// Every core of this machine (1 if that cannot be told).
 pub fn all_cores() -> usize {
@@ -180,64 +216,35 @@ pub struct Rendered {
     pub busy: Vec<Duration>,
 }
 
-/// The host's octree.
-pub type HostOctree = Octree<Host>;
-
 /// How host-sim builds octrees unless told otherwise: the host profile's
 /// config (shadow shafts on).
-pub const OCTREE: OctreeConfig = <Host as octrace_core::profile::Profile>::OCTREE;
+pub const OCTREE: OctreeConfig = <Host as Profile>::OCTREE;
 
-/// Builds the octree `mode` walks (none for the naive mode), as the core
-/// chooses it ([`octrace_core::accel::prepare`]).
-pub fn build_octree(scene: &HostScene, mode: AccelMode, config: &OctreeConfig) -> Option<Box<HostOctree>> {
-    let mut octree: Box<HostOctree> = Box::default();
-    accel::prepare(mode, &scene.view(), &mut *octree, config).report.map(|_| octree)
+/// Indexes `scene` as a render in `mode` with the octree `config` does:
+/// the octree's build report and the time the build took, when the mode
+/// walks one.
+pub fn build_octree(scene: &mut HostScene, mode: AccelMode, config: &OctreeConfig) -> Option<(BuildReport, Duration)> {
+    let options = RenderOptions { accel: mode, octree: *config, ..RenderOptions::default() };
+    scene.index(&options).build
 }
 
-/// The octree `options` ask for, with its build report and the time the
-/// build took.
-fn timed_octree(
-    scene: &HostScene,
-    options: &RenderOptions,
-) -> (Option<Box<HostOctree>>, Option<(BuildReport, Duration)>) {
-    let started = Instant::now();
-    let octree = build_octree(scene, options.accel, &options.octree);
-    let build = octree.as_ref().map(|o| (*o.report(), started.elapsed()));
-    (octree, build)
-}
-
-/// Renders a loaded scene into a new image.
-pub fn render(scene: &HostScene, options: &RenderOptions) -> Result<Rendered, CameraError> {
+/// Renders a loaded scene into a new image, indexed as `options` say.
+pub fn render(scene: &mut HostScene, options: &RenderOptions) -> Result<Rendered, CameraError> {
     render_with_progress(scene, options, &|_| {})
 }
 
 /// As [`render`], calling `progress(pixels)` (from any thread) each time a
 /// piece of the image is done.
 pub fn render_with_progress(
-    scene: &HostScene,
+    scene: &mut HostScene,
     options: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<Rendered, CameraError> {
-    let (octree, build) = timed_octree(scene, options);
-    let mut rendered = render_prebuilt(scene, options, octree.as_deref(), progress)?;
-    rendered.build = build;
-    Ok(rendered)
-}
-
-/// Renders with an octree built beforehand (`None`: the naive mode);
-/// `options.accel` and `options.octree` are not used.
-pub fn render_prebuilt(
-    scene: &HostScene,
-    options: &RenderOptions,
-    octree: Option<&HostOctree>,
-    progress: &(dyn Fn(u64) + Sync),
-) -> Result<Rendered, CameraError> {
-    let view = scene.view();
-    let (w, h) = options.size.unwrap_or((view.settings.raster[0], view.settings.raster[1]));
+    let (w, h) = options.size.unwrap_or((scene.view().settings.raster[0], scene.view().settings.raster[1]));
     let mut canvas = Canvas::new(w, h);
     // Never stopped (see `RenderOptions::stop`).
     let options = RenderOptions { stop: None, ..*options };
-    let streamed = match stream_prebuilt(scene, &options, octree, 0..h, progress, &mut canvas) {
+    let streamed = match render_streamed(scene, &options, 0..h, progress, &mut canvas) {
         Ok(s) => s,
         Err(StreamError::Camera(e)) => return Err(e),
         // The canvas takes every row, and nothing stops the render.
@@ -309,67 +316,23 @@ impl std::error::Error for StreamError {}
 /// Renders the rows `rows` of the whole image (`options.size`, else RASTER)
 /// on `options.threads` threads and hands them to `sink` in order, holding
 /// only a few bands of rows at a time: memory follows the width, not the
-/// height. Builds the octree `options.accel` asks for first.
+/// height. Indexes the scene as `options.accel` and `options.octree` ask
+/// first (timed apart from the render).
 pub fn render_streamed(
-    scene: &HostScene,
+    scene: &mut HostScene,
     options: &RenderOptions,
-    rows: std::ops::Range<u32>,
-    progress: &(dyn Fn(u64) + Sync),
-    sink: &mut dyn RowSink,
-) -> Result<Streamed, StreamError> {
-    let (octree, build) = timed_octree(scene, options);
-    let mut streamed = stream_prebuilt(scene, options, octree.as_deref(), rows, progress, sink)?;
-    streamed.build = build;
-    Ok(streamed)
-}
-
-fn stream_prebuilt(
-    scene: &HostScene,
-    options: &RenderOptions,
-    octree: Option<&HostOctree>,
     rows: std::ops::Range<u32>,
     progress: &(dyn Fn(u64) + Sync),
     sink: &mut dyn RowSink,
 ) -> Result<Streamed, StreamError> {
     let view = scene.view();
     let (w, h) = options.size.unwrap_or((view.settings.raster[0], view.settings.raster[1]));
-    // Set-up errors are found once, before any thread starts.
+    // Set-up errors are found once, before anything is built or started.
     view.check_camera(w, h).map_err(StreamError::Camera)?;
     let rows = rows.start.min(h)..rows.end.min(h);
-    // The light buffer, unless the naive mode is asked for by name.
-    let started = Instant::now();
-    let mut store = HostLightBuffer::new();
-    let cells = if options.accel == AccelMode::Naive { 0 } else { options.light_buffer };
-    let lights = (cells > 0).then(|| store.build(&view, cells));
-    let light_buffer = lights.map(|lights| (lights.report(), started.elapsed()));
-    let (accel, job) = match octree {
-        None => (AccelMode::Naive, stream_lit(view, &Naive, lights, (w, h), rows, options, progress, sink)),
-        Some(tree) => {
-            let mode = if tree.walked_by() == Traversal::Named { AccelMode::Octree } else { AccelMode::Dda };
-            (mode, stream_lit(view, tree, lights, (w, h), rows, options, progress, sink))
-        }
-    };
-    let (stats, wall, busy) = job?;
-    Ok(Streamed { stats, accel, build: None, light_buffer, wall, busy })
-}
-
-/// [`stream_threads`] with `accel`, and `lights` in front of its shadow
-/// rays if there is one (an empty buffer otherwise, so that the tracer is
-/// compiled once per accelerator: twice, it no longer inlines the naive
-/// mode's loop, 3 % more instructions on fig5_1).
-#[allow(clippy::too_many_arguments)]
-fn stream_lit<A: Accelerator + Sync>(
-    view: octrace_core::scene::SceneView<'_>,
-    accel: &A,
-    lights: Option<LightBuffer<'_>>,
-    size: (u32, u32),
-    rows: std::ops::Range<u32>,
-    options: &RenderOptions,
-    progress: &(dyn Fn(u64) + Sync),
-    sink: &mut dyn RowSink,
-) -> Result<(Stats, Duration, Vec<Duration>), StreamError> {
-    let lit = LightBuffered::new(accel, lights.unwrap_or(LightBuffer::NONE));
-    stream_threads(view, &lit, size, rows, options, progress, sink)
+    let Indexed { scene, build, light_buffer } = scene.index(options);
+    let (stats, wall, busy) = stream_threads(scene.share(), (w, h), rows, options, progress, sink)?;
+    Ok(Streamed { stats, accel: scene.mode(), build, light_buffer, wall, busy })
 }
 
 /// The image and the object of every pixel, filled row by row.

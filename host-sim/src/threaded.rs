@@ -14,10 +14,10 @@ use crate::{Partition, RenderOptions, RowSink, StreamError, NO_OBJECT, TILE_SIDE
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::pixelcolor::RgbColor;
 use embedded_graphics_core::primitives::Rectangle;
-use octrace_core::accel::{Accelerator, Mailbox};
-use octrace_core::render::{Renderer, ScreenBound, Tiles};
-use octrace_core::scene::SceneView;
+use octrace_core::profile::Host;
+use octrace_core::render::{Renderer, Tiles};
 use octrace_core::shade::Stats;
+use octrace_core::{RendererRoom, SharedScene};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::{Duration, Instant};
@@ -93,14 +93,14 @@ struct Window {
 /// need more): far below the target of 256 MB for a 16384-pixel-wide image.
 const WINDOW_BYTES: usize = 64 << 20;
 
-/// Renders `rows` on `options.threads` threads, each with its own renderer
-/// (and mailbox): threads take pieces of the bands in order, at most a
+/// Renders `rows` of `scene` on `options.threads` threads, each with its
+/// own renderer in a room of its own (mailbox, screen lists), as a board's
+/// other cores do: threads take pieces of the bands in order, at most a
 /// window of bands ahead of the oldest one not yet written, while this
 /// thread hands finished bands to `sink` in order. `options.stop`, once
 /// set, stops every thread inside the pixel it traces.
-pub(crate) fn stream_threads<A: Accelerator + Sync>(
-    view: SceneView<'_>,
-    accel: &A,
+pub(crate) fn stream_threads(
+    scene: SharedScene<'_, Host>,
     (w, h): (u32, u32),
     rows: std::ops::Range<u32>,
     options: &RenderOptions,
@@ -135,11 +135,8 @@ pub(crate) fn stream_threads<A: Accelerator + Sync>(
         }
         let _leaving = Leaving(&lock, &changed);
         let mut busy = Duration::ZERO;
-        let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
-        let Ok(renderer) = Renderer::with_size(view, accel, w, h) else { return (Stats::default(), busy) };
-        let mut bounds = vec![ScreenBound::EMPTY; view.object_count()];
-        let mut positions = vec![0; ScreenBound::positions_for(view.object_count())];
-        let mut renderer = renderer.with_mailbox(&mut words).with_first_hits(&mut bounds, &mut positions);
+        let mut room = RendererRoom::<Host>::new();
+        let Ok(mut renderer) = scene.renderer(&mut room, Size::new(w, h)) else { return (Stats::default(), busy) };
         // Equal4 hands the thesis's rectangles out statically.
         let mut own_next = thread;
         loop {
@@ -246,11 +243,7 @@ struct Tile {
 
 impl Tile {
     /// The pixels of `area`; None once `stop` is set (asked between rays).
-    fn render<A: Accelerator>(
-        renderer: &mut Renderer<'_, A>,
-        area: &Rectangle,
-        stop: Option<&AtomicBool>,
-    ) -> Option<Tile> {
+    fn render(renderer: &mut Renderer<'_, Host>, area: &Rectangle, stop: Option<&AtomicBool>) -> Option<Tile> {
         let (x0, y0) = (area.top_left.x as u32, area.top_left.y as u32);
         let count = area.size.width as usize * area.size.height as usize;
         let mut tile = Tile { area: *area, colors: Vec::with_capacity(3 * count), objects: Vec::with_capacity(count) };

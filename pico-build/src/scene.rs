@@ -16,14 +16,15 @@
 //! An animation (`FRAMES` of more than one frame, and a `MOVE`) is played
 //! in a loop ([`SceneKind::Animation`]): its profile gets `coherence: true`
 //! (each frame re-traces only what its motion can change), `scene.rs` says
-//! `ANIMATED` and `MOTION` (what its motion needs, `Motion::needs`), and its
+//! `ANIMATED` and `MOTION` (what its motion takes, `AnimationNeeds::of`:
+//! the firmware adds the tiles of its panel), and its
 //! profile is sized at frame 0 (a frame whose octree or light buffer needs
 //! more leaves boxes unsplit or fewer cells: the same picture, a little
 //! slower). A still links none of it.
 
 use crate::{out_dir, write, BuildError};
 use octrace_core::accel::{OctreeConfig, MAX_CELLS_A_SIDE};
-use octrace_core::animation::Motion;
+use octrace_core::animation::AnimationNeeds;
 use octrace_core::parse::parse;
 use octrace_core::profile::{needed_by, needed_with_light_buffer, Host, ProfileText};
 use octrace_core::scene::Scene;
@@ -48,8 +49,8 @@ pub enum SceneKind {
 /// (a path from the firmware's folder; `default` when it is not set),
 /// `SCENE_NAME`, its file's name without the extension (what a firmware
 /// reports it drew), and `SceneProfile`, a `profile!` holding exactly what
-/// it needs; `ANIMATED` and `MOTION` (what an animation's motion needs:
-/// none for a still). Returns what the scene is. The firmware includes it:
+/// it needs; `ANIMATED` and `MOTION` (the tracks and keys an animation
+/// takes, an `AnimationNeeds` without tiles: none for a still). Returns what the scene is. The firmware includes it:
 ///
 /// ```ignore
 /// mod scene {
@@ -76,7 +77,7 @@ pub fn embed_scene(default: &str) -> Result<SceneKind, BuildError> {
 fn kind_of(text: &str) -> SceneKind {
     let mut parsed = Box::new(Scene::<Host>::new());
     let frames = parse(text, &mut parsed, &mut |_| {}).ok().and_then(|p| p.frames).map_or(1, |f| f.count);
-    match Motion::needs(text).tracks > 0 && frames > 1 {
+    match AnimationNeeds::of(text, Default::default()).tracks > 0 && frames > 1 {
         true => SceneKind::Animation,
         false => SceneKind::Still,
     }
@@ -107,17 +108,17 @@ fn scene_source(name: &str, path: &std::path::Path, text: &str) -> Result<(Scene
         first_hits: true,
         coherence: animated,
     };
-    let motion = if animated { Motion::needs(text) } else { Default::default() };
+    let motion = if animated { AnimationNeeds::of(text, Default::default()) } else { Default::default() };
     let stem = path.file_stem().map_or_else(|| name.to_owned(), |stem| stem.to_string_lossy().into_owned());
     let source = format!(
         "/// The scene, from `{name}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n\
          /// Its file's name, without the extension (for a firmware that reports what it drew).\n\
          #[allow(dead_code)]\npub const SCENE_NAME: &str = {stem:?};\n{profile}\
          /// Whether the scene is an animation the firmware plays.\npub const ANIMATED: bool = {animated};\n\
-         /// What its motion needs (`Motion::needs`).\n\
-         pub const MOTION: octrace_core::animation::MotionNeeds = octrace_core::animation::MotionNeeds {{ \
-         tracks: {}, keys: {}, displacements: {} }};\n",
-        motion.tracks, motion.keys, motion.displacements
+         /// What its motion takes (`AnimationNeeds::of`): the firmware adds its panel's tiles.\n\
+         pub const MOTION: octrace_core::animation::AnimationNeeds = octrace_core::animation::AnimationNeeds {{ \
+         tiles: 0, tracks: {}, keys: {} }};\n",
+        motion.tracks, motion.keys
     );
     Ok((kind, source))
 }
@@ -148,7 +149,7 @@ mod tests {
         let (kind, source) = scene_source("still", path, still).unwrap();
         assert_eq!(kind, SceneKind::Still);
         assert!(source.contains("    coherence: false\n") && source.contains("ANIMATED: bool = false"), "{source}");
-        assert!(source.contains("tracks: 0, keys: 0, displacements: 0"), "{source}");
+        assert!(source.contains("tiles: 0, tracks: 0, keys: 0"), "{source}");
         // Frames where nothing moves, or a move in one frame, are stills.
         for text in [format!("FRAMES 4\n{still}"), format!("FRAMES 1\n{still}SPHERE 1 1 3 0 0 MOVE 0 0 0 0\n")] {
             assert_eq!(scene_source("still", path, &text).unwrap().0, SceneKind::Still, "{text}");
@@ -157,7 +158,7 @@ mod tests {
         let (kind, source) = scene_source("moving", path, &moving).unwrap();
         assert_eq!(kind, SceneKind::Animation);
         assert!(source.contains("    coherence: true\n}\n") && source.contains("ANIMATED: bool = true"), "{source}");
-        assert!(source.contains("tracks: 1, keys: 2, displacements: 4"), "{source}");
+        assert!(source.contains("tiles: 0, tracks: 1, keys: 2"), "{source}");
     }
 
     #[test]

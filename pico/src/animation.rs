@@ -17,15 +17,15 @@
 //! whole on the panel; a frame does not start before its time (the scene's
 //! rate: at most that many frames a second).
 //!
-//! Invariants: the tiles' counts are planned once a frame, on core 0,
-//! before either core traces; a band is traced by one core, once a frame;
-//! every run core 1 traced is on the panel before the LED goes out; the
-//! motion is read once, from frame 0, and serves every frame.
+//! Invariants: the tiles' counts are planned once a frame (as it loads), on
+//! core 0, before either core traces; a band is traced by one core, once a
+//! frame; every run core 1 traced is on the panel before the LED goes out;
+//! the motion is recorded once, as frame 0 loads, and serves every frame.
 
 use crate::both_cores::{Asked, Unfinished};
 use crate::second_core::SecondCore;
 use core::cell::Cell;
-use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use cortex_m::asm::{sev, wfe};
 use critical_section::Mutex;
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -34,16 +34,12 @@ use embedded_graphics_core::pixelcolor::Rgb888;
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
 use embedded_hal::digital::OutputPin;
-use octrace_core::animation::{Coherence, Key, Motion, Track};
+use octrace_core::animation::Animation;
 use octrace_core::panel::{Dithered, TracedColor};
 use octrace_core::profile::Profile;
-use octrace_core::render::{Handoff, PixelSample, Stopped as StoppedRay};
-use octrace_core::{DrawError, LoadedScene, Raytracer, RendererRoom};
+use octrace_core::render::Handoff;
+use octrace_core::{DrawError, Frame, Raytracer, RendererRoom};
 use rp2040_hal::Timer;
-
-/// The tiles' side, in pixels: a byte of RAM a tile, 3,600 bytes for the
-/// 240×240 panel (BENCHMARKS.md weighs the sides).
-pub const TILE: u32 = 4;
 
 /// The most bands of tiles a panel may have (a panel up to 512 rows high).
 const MOST_BANDS: usize = 128;
@@ -54,20 +50,24 @@ const MOST_PIXELS: u32 = 1 << 10;
 /// Why an animation stopped playing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stopped {
-    /// A frame did not load (check the scene with `host-sim --frame K`,
-    /// whose errors name the line and column).
+    /// A frame did not load: the scene has an error (check it with
+    /// `host-sim`, whose errors name the line, the column and a frame), or
+    /// the animation's room is not the scene's size.
     Frame(u32),
-    /// The motion's or the tiles' storage is not the scene's size.
-    Storage,
     /// A frame could not be drawn.
     Picture(Unfinished),
 }
 
-/// Storage for an animation's motion ([`Motion::needs`] says how much).
-pub struct MotionRoom<'s> {
-    pub tracks: &'s mut [Track],
-    pub keys: &'s mut [Key],
-    pub displacements: &'s mut [[i32; 3]],
+/// What plays an animation on a Pico: both cores (core 1 tracing in its
+/// own room and handing its runs over through `runs`), the raytracer the
+/// frames load into, and the animation (its motion and tiles, at the
+/// panel's size, in an `AnimationRoom` of the firmware's).
+pub struct Player<'a, P: Profile, const LEN: usize, const SLOTS: usize> {
+    pub core1: &'a mut SecondCore,
+    pub raytracer: &'a mut Raytracer<P>,
+    pub animation: Animation<'a>,
+    pub room: &'a mut RendererRoom<P>,
+    pub runs: &'a Runs<LEN, SLOTS>,
 }
 
 /// Runs of pixels on their way from core 1 to core 0: each piece is one
@@ -96,13 +96,7 @@ impl<const LEN: usize, const SLOTS: usize> Runs<LEN, SLOTS> {
 
     /// Core 1: traces `pixels` into piece `piece`'s slot, once it is free,
     /// for `area`; false if `stop` said so first.
-    fn send(
-        &self,
-        piece: u32,
-        area: &Rectangle,
-        pixels: &mut dyn Iterator<Item = PixelSample>,
-        stop: &AtomicBool,
-    ) -> bool {
+    fn send(&self, piece: u32, area: &Rectangle, pixels: impl Iterator<Item = Rgb888>, stop: &AtomicBool) -> bool {
         while !self.colors.is_free_for(piece) {
             if stop.load(Ordering::Acquire) {
                 return false;
@@ -112,7 +106,7 @@ impl<const LEN: usize, const SLOTS: usize> Runs<LEN, SLOTS> {
         let (x, y, width) = (area.top_left.x as u32, area.top_left.y as u32, area.size.width);
         self.areas[piece as usize % SLOTS].store(x | y << 10 | width << 20, Ordering::Relaxed);
         // Free, so published.
-        let _ = self.colors.send(piece, pixels.map(|p| p.color));
+        let _ = self.colors.send(piece, pixels);
         sev();
         true
     }
@@ -182,107 +176,119 @@ impl<const LEN: usize, const SLOTS: usize> Default for Runs<LEN, SLOTS> {
     }
 }
 
-/// Plays the animation `text` into `display` for ever, with both cores:
-/// the scene loaded in `raytracer` frame after frame, its motion read into
-/// `motion`, the tiles' counts in `counts` ([`Coherence::tiles_for`] of the
-/// panel in tiles of [`TILE`]), core 1 rendering in `room` and handing its
-/// runs over through `runs` (at least [`Coherence::longest_row`]), in the
-/// display's colour as the module says. `show` puts each frame on the
-/// panel once it is drawn (a buffered display's flush; `|_| Ok(())` for a
-/// panel drawn into directly). `led` is lit while a frame is on its way,
-/// until it is shown; `timer` paces the frames. Returns only when it
-/// cannot go on.
-#[allow(clippy::too_many_arguments)]
-#[inline(never)]
-pub fn play<P, D, L, const LEN: usize, const SLOTS: usize>(
-    core1: &mut SecondCore,
-    raytracer: &mut Raytracer<P>,
-    text: &str,
-    motion: MotionRoom<'_>,
-    counts: &[AtomicU8],
-    room: &mut RendererRoom<P>,
-    runs: &Runs<LEN, SLOTS>,
-    display: &mut D,
-    mut show: impl FnMut(&mut D) -> Result<(), D::Error>,
-    led: &mut L,
-    timer: &Timer,
-) -> Stopped
-where
-    P: Profile,
-    D: DrawTarget,
-    D::Color: TracedColor,
-    L: OutputPin,
-{
-    let mut display = Dithered::ordered(display);
-    let size = display.bounding_box().size;
-    let Ok(coherence) = Coherence::new(counts, size, TILE) else { return Stopped::Storage };
-    let fits = size.width < MOST_PIXELS && size.height < MOST_PIXELS && coherence.bands() as usize <= MOST_BANDS;
-    if !fits || LEN < coherence.longest_row() as usize {
-        return Stopped::Picture(Unfinished::Panel);
-    }
-    // The motion, read once from frame 0.
-    let (frames, motion) = {
-        let Ok(scene) = raytracer.load_frame(text, 0) else { return Stopped::Frame(0) };
-        let Some(frames) = scene.frames() else { return Stopped::Storage };
-        let MotionRoom { tracks, keys, displacements } = motion;
-        match Motion::read(text, frames, &scene.view(), 0, tracks, keys, displacements) {
-            Ok(motion) => (frames, motion),
-            Err(_) => return Stopped::Storage,
-        }
-    };
-    let period_us = 1_000_000 / u64::from(frames.rate.max(1));
-    let mut frame = 0;
-    loop {
-        let started = timer.get_counter().ticks();
-        let _ = led.set_high();
-        let loaded = raytracer.load_frame_on_two_cores(text, frame, |beside, here| core1.scope(beside, here));
-        let Ok(scene) = loaded else { return Stopped::Frame(frame) };
-        coherence.plan();
-        let drawn = draw_frame::<P, _, LEN, SLOTS, false>(
-            core1,
-            &scene,
-            &motion,
-            frame,
-            &coherence,
-            room,
-            runs,
-            &mut display,
-            &mut || false,
-        );
-        if let Err(unfinished) = drawn {
-            return Stopped::Picture(unfinished);
-        }
-        if show(display.display()).is_err() {
-            return Stopped::Picture(Unfinished::Panel);
-        }
-        let _ = led.set_low();
-        frame = frames.after(frame);
-        // Not before its time.
-        while timer.get_counter().ticks() < started + period_us {}
+/// Core 1's runs as it draws them: each handed over in the next piece of
+/// `runs` (once its slot is free), until `stop` is raised.
+struct Handing<'a, const LEN: usize, const SLOTS: usize> {
+    runs: &'a Runs<LEN, SLOTS>,
+    stop: &'a AtomicBool,
+    size: Size,
+    /// Pieces handed over.
+    pieces: u32,
+}
+
+/// Core 0 raised the stop while core 1 waited for a slot.
+struct Raised;
+
+impl<const LEN: usize, const SLOTS: usize> OriginDimensions for Handing<'_, LEN, SLOTS> {
+    fn size(&self) -> Size {
+        self.size
     }
 }
 
-/// Draws frame `frame` of `motion`, `scene` loaded at that frame and its
-/// tiles planned ([`Coherence::plan`]), after the frame before it in the
-/// loop (or, at first, everything): both cores trace the planned tiles,
+impl<const LEN: usize, const SLOTS: usize> DrawTarget for Handing<'_, LEN, SLOTS> {
+    type Color = Rgb888;
+    type Error = Raised;
+
+    /// Never called: a frame's draw hands over runs.
+    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb888>>>(&mut self, _: I) -> Result<(), Raised> {
+        Ok(())
+    }
+
+    fn fill_contiguous<I: IntoIterator<Item = Rgb888>>(&mut self, area: &Rectangle, colors: I) -> Result<(), Raised> {
+        if !self.runs.send(self.pieces, area, colors.into_iter(), self.stop) {
+            return Err(Raised);
+        }
+        self.pieces += 1;
+        Ok(())
+    }
+}
+
+impl<'a, P: Profile, const LEN: usize, const SLOTS: usize> Player<'a, P, LEN, SLOTS> {
+    /// Plays the animation `text` into `display` for ever, with both cores,
+    /// in the display's colour as the module says. `show` puts each frame
+    /// on the panel once it is drawn (a buffered display's flush; `|_|
+    /// Ok(())` for a panel drawn into directly). `led` is lit while a frame
+    /// is on its way, until it is shown; `timer` paces the frames. Returns
+    /// only when it cannot go on.
+    #[inline(never)]
+    pub fn play<D, L>(
+        mut self,
+        text: &str,
+        display: &mut D,
+        mut show: impl FnMut(&mut D) -> Result<(), D::Error>,
+        led: &mut L,
+        timer: &Timer,
+    ) -> Stopped
+    where
+        D: DrawTarget,
+        D::Color: TracedColor,
+        L: OutputPin,
+    {
+        let mut display = Dithered::ordered(display);
+        let size = display.bounding_box().size;
+        let fits =
+            size.width < MOST_PIXELS && size.height < MOST_PIXELS && size.height.div_ceil(4) as usize <= MOST_BANDS;
+        if !fits || LEN < self.animation.tiles().longest_row() as usize {
+            return Stopped::Picture(Unfinished::Panel);
+        }
+        let mut frame = 0;
+        loop {
+            let started = timer.get_counter().ticks();
+            let _ = led.set_high();
+            let core1 = &mut *self.core1;
+            let loaded =
+                self.animation.load_on_two_cores(self.raytracer, text, frame, |beside, here| core1.scope(beside, here));
+            let Ok(loaded) = loaded else { return Stopped::Frame(frame) };
+            let (frames, period_us) = (loaded.frames(), 1_000_000 / u64::from(loaded.frames().rate.max(1)));
+            let drawn = draw_frame::<P, _, LEN, SLOTS, false>(
+                self.core1,
+                &loaded,
+                self.room,
+                self.runs,
+                &mut display,
+                &mut || false,
+            );
+            if let Err(unfinished) = drawn {
+                return Stopped::Picture(unfinished);
+            }
+            if show(display.display()).is_err() {
+                return Stopped::Picture(Unfinished::Panel);
+            }
+            let _ = led.set_low();
+            frame = frames.after(frame);
+            // Not before its time.
+            while timer.get_counter().ticks() < started + period_us {}
+        }
+    }
+}
+
+/// Draws `frame` (loaded, its tiles planned) after the frame before it in
+/// the loop (or, at first, everything): both cores trace the planned tiles,
 /// core 1 in `room` handing its runs over through `runs`, and core 0 draws
 /// every run into `display` (each row of a run in one `fill_contiguous`).
 /// `stop` is asked on core 0 before every ray it traces; once it says
 /// stop, core 1 stops before its next ray too and the frame ends
 /// [`Unfinished::Stopped`] (the tiles not drawn keep their mark): how the
-/// live firmware draws each frame of an animation the host sent. [`play`]
-/// draws its frames asking nothing (the same code without the asking:
-/// its tracer is linked once, unpolled, and inlined as a still's).
+/// live firmware draws each frame of an animation the host sent.
+/// [`Player::play`] draws its frames asking nothing (the same code
+/// without the asking: its tracer is linked once, unpolled, and inlined as
+/// a still's).
 ///
 /// Core 0 checks for core 1's runs after each of its own rows (a run's
 /// row of up to 128 pixels): core 1 may trace `SLOTS` rows ahead.
-#[allow(clippy::too_many_arguments)]
 pub fn draw_frame_until<P, D, const LEN: usize, const SLOTS: usize>(
     core1: &mut SecondCore,
-    scene: &LoadedScene<'_, P>,
-    motion: &Motion<'_>,
-    frame: u32,
-    coherence: &Coherence<'_>,
+    frame: &Frame<'_, '_, P>,
     room: &mut RendererRoom<P>,
     runs: &Runs<LEN, SLOTS>,
     display: &mut D,
@@ -292,19 +298,15 @@ where
     P: Profile,
     D: DrawTarget<Color = Rgb888>,
 {
-    draw_frame::<P, D, LEN, SLOTS, true>(core1, scene, motion, frame, coherence, room, runs, display, stop)
+    draw_frame::<P, D, LEN, SLOTS, true>(core1, frame, room, runs, display, stop)
 }
 
 /// [`draw_frame_until`], asking `stop` only if `ASKED` (known when it
 /// compiles, so that a firmware links one tracer: the asking one, or the
 /// one that asks nothing).
-#[allow(clippy::too_many_arguments)]
 fn draw_frame<P, D, const LEN: usize, const SLOTS: usize, const ASKED: bool>(
     core1: &mut SecondCore,
-    scene: &LoadedScene<'_, P>,
-    motion: &Motion<'_>,
-    frame: u32,
-    coherence: &Coherence<'_>,
+    frame: &Frame<'_, '_, P>,
     room: &mut RendererRoom<P>,
     runs: &Runs<LEN, SLOTS>,
     display: &mut D,
@@ -314,16 +316,17 @@ where
     P: Profile,
     D: DrawTarget<Color = Rgb888>,
 {
-    let size = coherence.size();
-    if size != display.bounding_box().size || LEN < coherence.longest_row() as usize {
+    let tiles = frame.tiles();
+    let size = tiles.size();
+    if size != display.bounding_box().size || LEN < tiles.longest_row() as usize {
         return Err(Unfinished::Panel);
     }
     // The bands with tiles to trace, most pixels first: the last band
     // taken is a small one, so neither core waits long for the other.
     let mut order = [(0u32, 0u16); MOST_BANDS];
     let mut bands = 0;
-    for band in 0..coherence.bands().min(MOST_BANDS as u32) {
-        let pixels = coherence.band_pixels(band) as u32;
+    for band in 0..tiles.bands().min(MOST_BANDS as u32) {
+        let pixels = tiles.band_pixels(band) as u32;
         if pixels > 0 {
             let mut at = bands;
             while at > 0 && order[at - 1].0 < pixels {
@@ -348,38 +351,26 @@ where
             order.get(taken).map(|&(_, band)| u32::from(band))
         })
     };
-    let shared = scene.share();
+    let shared = frame.share();
     runs.colors.clear();
     let core1_part = || {
-        let mut piece = 0;
-        if let Ok(mut renderer) = shared.renderer(room, size) {
-            let mut stop: Asked<'_> = &mut || stopping.load(Ordering::Acquire);
-            let mut send = |area: &Rectangle, pixels: &mut dyn Iterator<Item = PixelSample>| {
-                if !runs.send(piece, area, pixels, &stopping) {
-                    return Err(StoppedRay);
-                }
-                piece += 1;
-                Ok(())
-            };
-            while let Some(band) = take_next() {
-                let traced = match ASKED {
-                    true => coherence.trace_band_until(&mut renderer, motion, frame, band, &mut stop, &mut send),
-                    false => coherence.trace_band(&mut renderer, motion, frame, band, &mut send),
-                };
-                if traced.is_err() {
-                    break;
-                }
-            }
-        }
-        handed.store(piece, Ordering::Release);
+        // Taken whole (a room is not shared between cores), drawn in here.
+        let room: &mut RendererRoom<P> = room;
+        let mut handing = Handing { runs, stop: &stopping, size, pieces: 0 };
+        let image = shared.image::<Rgb888>(room, size).bands(&take_next);
+        let _ = match ASKED {
+            true => image.try_draw_until(&mut handing, &mut || stopping.load(Ordering::Acquire)),
+            false => image.try_draw(&mut handing),
+        };
+        handed.store(handing.pieces, Ordering::Release);
         sev();
     };
     let core0_part = || {
         let mut panel = Panel { display, runs, shown: 0 };
-        let bands = core::iter::from_fn(take_next);
+        let image = frame.image::<Rgb888>().bands(&take_next);
         let drawn = match ASKED {
-            true => scene.draw_bands_until(motion, frame, coherence, bands, &mut panel, &mut { stop }),
-            false => scene.draw_bands(motion, frame, coherence, bands, &mut panel),
+            true => image.try_draw_until(&mut panel, &mut { stop }),
+            false => image.try_draw(&mut panel),
         };
         let mut result = drawn.map(|_| ()).map_err(|e| match e {
             DrawError::Camera(_) => Unfinished::Camera,

@@ -23,7 +23,7 @@ use embedded_graphics_core::primitives::Rectangle;
 use octrace_core::panel::{Dithered, Dithering, TracedColor, IMAGE_ERROR_WORDS};
 use octrace_core::profile::Profile;
 use octrace_core::render::{Handoff, Progressive, Renderer, Unit};
-use octrace_core::{LoadedScene, RendererRoom, SceneAccelerator};
+use octrace_core::{LoadedScene, RendererRoom};
 
 /// Why a picture stopped before its end.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,7 +59,7 @@ where
     D::Color: TracedColor,
 {
     let width = display.bounding_box().size.width;
-    let trace = |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, y: &u32, colors: &mut [Rgb888], _: Asked<'_>| {
+    let trace = |renderer: &mut Renderer<'_, P>, y: &u32, colors: &mut [Rgb888], _: Asked<'_>| {
         let mut traced = 0;
         for (color, pixel) in colors.iter_mut().zip(renderer.row(*y, 0..width)) {
             *color = pixel.color;
@@ -90,13 +90,12 @@ where
     D::Color: TracedColor,
 {
     let width = display.bounding_box().size.width;
-    let trace =
-        |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, y: &u32, colors: &mut [Rgb888], mut stop: Asked<'_>| {
-            for (x, color) in (0..width).zip(colors.iter_mut()) {
-                *color = renderer.pixel_until(x, *y, &mut stop).ok()?.color;
-            }
-            Some(width.min(colors.len() as u32) as usize)
-        };
+    let trace = |renderer: &mut Renderer<'_, P>, y: &u32, colors: &mut [Rgb888], mut stop: Asked<'_>| {
+        for (x, color) in (0..width).zip(colors.iter_mut()) {
+            *color = renderer.pixel_until(x, *y, &mut stop).ok()?.color;
+        }
+        Some(width.min(colors.len() as u32) as usize)
+    };
     draw_rows(core1, scene, room, ring, display, each_row, stop, trace)
 }
 
@@ -115,7 +114,7 @@ fn draw_rows<'r, P, D, const LEN: usize, const SLOTS: usize>(
     display: &mut D,
     mut each_row: impl FnMut(u32, &[Rgb888]) -> ControlFlow<()>,
     stop: impl FnMut() -> bool,
-    trace: impl Fn(&mut Renderer<'_, SceneAccelerator<'r, P>>, &u32, &mut [Rgb888], Asked<'_>) -> Option<usize> + Sync,
+    trace: impl Fn(&mut Renderer<'_, P>, &u32, &mut [Rgb888], Asked<'_>) -> Option<usize> + Sync,
 ) -> Result<(), Unfinished>
 where
     P: Profile,
@@ -177,10 +176,9 @@ where
         return Err(Unfinished::Panel);
     }
     let mut display = Dithered::new(display, Dithering::Bayer, &mut []).map_err(|_| Unfinished::Panel)?;
-    let trace =
-        |renderer: &mut Renderer<'_, SceneAccelerator<'_, P>>, unit: &Unit, colors: &mut [Rgb888], _: Asked<'_>| {
-            Some(unit.trace(renderer, colors).map_or(0, |traced| traced.colors().len()))
-        };
+    let trace = |renderer: &mut Renderer<'_, P>, unit: &Unit, colors: &mut [Rgb888], _: Asked<'_>| {
+        Some(unit.trace(renderer, colors).map_or(0, |traced| traced.colors().len()))
+    };
     let present = |unit: &Unit, colors: &[Rgb888]| {
         let traced = unit.with_colors(colors).map_err(|_| Unfinished::Panel)?;
         traced.draw(&mut display).map_err(|_| Unfinished::Panel)
@@ -209,7 +207,7 @@ fn share<'r, P, T, I, const LEN: usize, const SLOTS: usize>(
     ring: &Handoff<LEN, SLOTS>,
     size: Size,
     pieces: impl Fn() -> I + Sync,
-    trace: impl Fn(&mut Renderer<'_, SceneAccelerator<'r, P>>, &T, &mut [Rgb888], Asked<'_>) -> Option<usize> + Sync,
+    trace: impl Fn(&mut Renderer<'_, P>, &T, &mut [Rgb888], Asked<'_>) -> Option<usize> + Sync,
     mut present: impl FnMut(&T, &[Rgb888]) -> Result<(), Unfinished>,
     mut stop_asked: impl FnMut() -> bool,
 ) -> Result<(), Unfinished>

@@ -14,6 +14,7 @@
 #![deny(unsafe_code)]
 
 mod exports;
+mod pixels;
 mod player;
 mod studio;
 

@@ -1,120 +1,111 @@
-//! The studio's player: an animation's frames traced one after another, each
-//! re-tracing only the tiles the motion can have changed since the frame
-//! traced before it (the core's [`Coherence`]), into an image it keeps.
+//! The studio's player: an animation's frames traced one after another into
+//! an image it keeps, each re-tracing only the tiles the motion can have
+//! changed since the frame traced before it (the core's
+//! [`Animation`](octrace_core::animation::Animation), whose room it keeps
+//! between calls).
 //!
-//! Invariants: `colours` and `objects` hold frame `shown` of `text` at
-//! `size`, bit for bit the frame traced whole; `counts` are the tiles'
-//! counts after that frame (the coherence's own bytes, kept between calls);
-//! a frame of another text or size starts again from every tile.
+//! Invariants: `colours` and `objects` hold the frame the animation in
+//! `room` was last loaded at, of its text, at `size`, bit for bit the frame
+//! traced whole (nothing is kept while a frame is half traced); another
+//! text, an edited one, or another size starts again from every tile.
 
-use crate::studio::StudioError;
+use crate::pixels::Pixels;
 use embedded_graphics_core::geometry::Size;
-use embedded_graphics_core::pixelcolor::RgbColor;
-use embedded_graphics_core::primitives::Rectangle;
-use octrace_core::accel::{Accelerator, Mailbox};
-use octrace_core::animation::{Coherence, Key, Motion, Track};
-use octrace_core::render::{PixelSample, Renderer, ScreenBound};
-use octrace_core::scene::{Frames, SceneView};
+use octrace_core::animation::{AnimationNeeds, HostAnimationRoom};
+use octrace_core::profile::Host;
+use octrace_core::{AccelMode, AnimationError, Raytracer};
 use octrace_images::NO_OBJECT;
-use std::convert::Infallible;
-use std::sync::atomic::{AtomicU8, Ordering};
 
-/// The side of the tiles re-traced together: host-sim's
-/// (`COHERENCE_TILE`, chosen by measurement; see BENCHMARKS.md).
-const TILE: u32 = 4;
-
-/// After this many transitions every count has run out (the longest kept is
-/// 253) but a tile's that nothing can change: stepping further changes
-/// nothing.
-const LONGEST_STEP: u32 = 255;
-
-/// The frame to trace: frame `frame` of `text` (an animation of `frames`) at
-/// `size`.
-pub(crate) struct Shown<'t> {
-    pub text: &'t str,
-    pub frames: Frames,
-    pub frame: u32,
-    pub size: (u32, u32),
+/// What a trace of a frame could not do, said as the studio says it.
+#[derive(Debug)]
+pub(crate) enum Refused {
+    /// The scene has errors (a camera that cannot be set up at some frame
+    /// among them), each `line:col: message`.
+    Scene(Vec<String>),
+    /// The camera cannot be set up, or the animation's room made: why.
+    Setup(String),
 }
 
-/// The last frame traced, and what its tiles still hold.
+/// The last frame traced, and the animation's room between frames.
 #[derive(Default)]
 pub(crate) struct Player {
-    text: String,
+    room: Option<HostAnimationRoom>,
     size: (u32, u32),
-    shown: Option<u32>,
-    counts: Vec<AtomicU8>,
+    /// The image is the last frame loaded, whole.
+    whole: bool,
     colours: Vec<u8>,
     objects: Vec<u32>,
+    /// The text whose every frame was checked last, and what was found.
+    checked: Option<Checked>,
+}
+
+/// A text whose every frame was checked, and its errors (none: it loads).
+struct Checked {
+    text: Vec<u8>,
+    errors: Result<(), Vec<String>>,
 }
 
 impl Player {
-    /// Traces `frame`, loaded as `view` with `accel`, into the image kept:
-    /// only the tiles whose count ran out on the way from the frame traced
-    /// last (every tile for another text or size). Returns how many pixels
-    /// it traced.
-    pub(crate) fn trace<A: Accelerator>(
-        &mut self,
-        view: SceneView<'_>,
-        accel: &A,
-        frame: &Shown<'_>,
-    ) -> Result<u64, StudioError> {
-        let (w, h) = frame.size;
-        let steps = match self.shown {
-            Some(shown) if self.text == frame.text && self.size == frame.size => {
-                // Forward round the loop from the frame shown.
-                let count = frame.frames.count.max(1);
-                Some(((frame.frame % count + count - shown % count) % count).min(LONGEST_STEP))
-            }
-            _ => None,
+    /// Whether every frame of `text` loads (its camera included): errors
+    /// at line and column; a text checked before is not loaded again.
+    /// Leaves `raytracer` holding frame 0 when it loads it.
+    pub(crate) fn check(&mut self, raytracer: &mut Raytracer<Host>, text: &[u8]) -> Result<(), Vec<String>> {
+        if let Some(checked) = self.checked.as_ref().filter(|checked| checked.text == text) {
+            return checked.errors.clone();
+        }
+        let needs = core::str::from_utf8(text).map_or_else(
+            |_| AnimationNeeds::default(),
+            |t| AnimationNeeds { tiles: 1, ..AnimationNeeds::of(t, Size::new(1, 1)) },
+        );
+        let mut room = HostAnimationRoom::new(needs);
+        let mut errors = Vec::new();
+        let result = match room.animation(Size::new(1, 1)) {
+            Ok(mut animation) => match animation.load_with(raytracer, text, &mut |e| errors.push(e.to_string())) {
+                Ok(_) => Ok(()),
+                Err(AnimationError::Scene(_)) => Err(errors),
+                Err(AnimationError::NoRoom(e)) => Err(vec![e.to_string()]),
+            },
+            Err(e) => Err(vec![e.to_string()]),
         };
-        if steps.is_none() {
-            self.text = frame.text.to_string();
-            self.size = frame.size;
-            self.counts = (0..Coherence::tiles_for(w, h, TILE)).map(|_| AtomicU8::new(0)).collect();
+        self.checked = Some(Checked { text: text.to_vec(), errors: result.clone() });
+        result
+    }
+
+    /// Traces frame `frame` of `text` at `size`, its scenes loaded into
+    /// `raytracer` and indexed by `accel`, into the image kept: only the
+    /// tiles whose count ran out on the way from the frame traced last
+    /// (every tile for another text or size). Returns how many pixels it
+    /// traced.
+    pub(crate) fn trace(
+        &mut self,
+        raytracer: &mut Raytracer<Host>,
+        (text, frame): (&str, u32),
+        accel: AccelMode,
+        size: (u32, u32),
+    ) -> Result<u64, Refused> {
+        let (w, h) = size;
+        let image = Size::new(w, h);
+        let needs = AnimationNeeds::of(text, image);
+        let fits = self.room.as_ref().is_some_and(|room| needs.beyond(&room.room()).iter().all(Option::is_none));
+        if !fits || self.size != size {
+            self.room = Some(HostAnimationRoom::new(needs));
+            self.size = size;
             self.colours = vec![0; 3 * w as usize * h as usize];
             self.objects = vec![NO_OBJECT; w as usize * h as usize];
         }
         // Nothing is shown until this frame is traced whole.
-        self.shown = None;
-        // `Coherence::new` marks every tile to trace: the counts after the
-        // frame shown are put back, then stepped to this frame.
-        let kept: Vec<u8> = self.counts.iter().map(|c| c.load(Ordering::Relaxed)).collect();
-        let coherence =
-            Coherence::new(&self.counts, Size::new(w, h), TILE).map_err(|e| StudioError::Motion(e.to_string()))?;
-        if let Some(steps) = steps {
-            for (count, byte) in self.counts.iter().zip(kept) {
-                count.store(byte, Ordering::Relaxed);
-            }
-            (0..steps).for_each(|_| {
-                coherence.plan();
-            });
-        }
-        let traced = coherence.traced_pixels();
-        let needs = Motion::needs(frame.text);
-        let (mut tracks, mut keys, mut table) =
-            (vec![Track::EMPTY; needs.tracks], vec![Key::default(); needs.keys], vec![[0; 3]; needs.displacements]);
-        let motion = Motion::read(frame.text, frame.frames, &view, frame.frame, &mut tracks, &mut keys, &mut table)
-            .map_err(|e| StudioError::Motion(e.to_string()))?;
-        let objects = view.object_count();
-        let mut words = vec![0u32; Mailbox::words_for(objects)];
-        let mut bounds = vec![ScreenBound::EMPTY; objects];
-        let mut positions = vec![0; ScreenBound::positions_for(objects)];
-        let renderer = Renderer::with_size(view, accel, w, h).map_err(|e| StudioError::Camera(format!("{e:?}")))?;
-        let mut renderer = renderer.with_mailbox(&mut words).with_first_hits(&mut bounds, &mut positions);
-        let (colours, objects) = (&mut self.colours, &mut self.objects);
-        let mut write = |line: &Rectangle, pixels: &mut dyn Iterator<Item = PixelSample>| -> Result<(), Infallible> {
-            let at = line.top_left.y as usize * w as usize + line.top_left.x as usize;
-            for (i, p) in pixels.enumerate() {
-                colours[3 * (at + i)..3 * (at + i) + 3].copy_from_slice(&[p.color.r(), p.color.g(), p.color.b()]);
-                objects[at + i] = p.object.map_or(NO_OBJECT, |o| o.0);
-            }
-            Ok(())
-        };
-        for band in 0..coherence.bands() {
-            let Ok(_) = coherence.trace_band(&mut renderer, &motion, frame.frame, band, &mut write);
-        }
-        self.shown = Some(frame.frame);
+        self.whole = false;
+        let Some(room) = self.room.as_mut() else { return Err(Refused::Setup("no room".into())) };
+        let animation = room.animation(image).map_err(|e| Refused::Setup(e.to_string()))?;
+        let mut animation = animation.indexed(accel);
+        let loaded = animation.load(raytracer, text, frame).map_err(|e| match e {
+            AnimationError::Scene(e) => Refused::Scene(vec![e.to_string()]),
+            AnimationError::NoRoom(e) => Refused::Setup(e.to_string()),
+        })?;
+        let traced = loaded.tiles().traced_pixels();
+        let mut kept = Pixels { colours: &mut self.colours, objects: &mut self.objects, size: image };
+        loaded.image().try_draw(&mut kept).map_err(|e| Refused::Setup(e.to_string()))?;
+        self.whole = true;
         Ok(traced)
     }
 
@@ -122,7 +113,9 @@ impl Player {
     /// colours, then the object under each pixel.
     pub(crate) fn write(&self, out: &mut Vec<u8>) {
         out.clear();
-        out.extend_from_slice(&self.colours);
-        out.extend(self.objects.iter().flat_map(|o| o.to_le_bytes()));
+        if self.whole {
+            out.extend_from_slice(&self.colours);
+            out.extend(self.objects.iter().flat_map(|o| o.to_le_bytes()));
+        }
     }
 }

@@ -1,21 +1,21 @@
 //! The studio's state and operations, in safe Rust, independent of how the
 //! page calls them (tests call them directly).
 //!
-//! Invariants: `octree` was built from the current `scene` (it is dropped
-//! whenever the scene is replaced); `text` and `frame` are what `scene` was
-//! parsed from.
+//! Invariants: the raytracer holds frame `frame` of `text` once `loaded`,
+//! indexed as the last `prepare` said (the player's frames are loaded
+//! into it too, indexed the same); an animation's every frame was checked
+//! when its text was loaded.
 
-use crate::player::{Player, Shown};
-use embedded_graphics_core::pixelcolor::RgbColor;
-use octrace_core::accel::{
-    self, Accelerator, LightBufferStore, LightBuffered, Mailbox, Naive, Octree, MAX_CELLS_A_SIDE,
-};
+use crate::pixels::Pixels;
+use crate::player::{Player, Refused};
+use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::primitives::Rectangle;
 use octrace_core::panel::{Dithering, Panel};
-use octrace_core::parse::{parse_frame_bytes, ParseError};
-use octrace_core::profile::{Host, Profile};
-use octrace_core::render::{Renderer, ScreenBound};
-use octrace_core::scene::{Frames, Scene};
-use octrace_core::AccelMode;
+use octrace_core::parse::ParseError;
+use octrace_core::profile::Host;
+use octrace_core::render::PixelSample;
+use octrace_core::scene::Frames;
+use octrace_core::{AccelMode, Raytracer};
 use octrace_images::formats::{self, Format, Image};
 use octrace_images::palette::{self, PaletteMode};
 use octrace_images::{panel, RgbImage, NO_OBJECT};
@@ -98,20 +98,18 @@ pub struct Loaded {
     pub frames: Option<Frames>,
 }
 
-/// One scene (a frame of it, for an animation), its octree and the render
-/// size, and the player that traces an animation's frames one after the
-/// other.
+/// One scene (a frame of it, for an animation) in the core's raytracer, as
+/// a board holds it, indexed as the page asked, at the render size; and
+/// the player that traces an animation's frames one after the other.
 pub struct Studio {
-    scene: Box<Scene<Host>>,
+    raytracer: Box<Raytracer<Host>>,
     loaded: bool,
     /// The text the scene was parsed from, and its frame.
     text: Vec<u8>,
     frame: u32,
     frames: Option<Frames>,
-    octree: Option<Box<Octree<Host>>>,
-    /// The shadow rays' light buffer (none for the naive mode, the
-    /// thesis's test of every object), as host-sim builds it.
-    lights: LightBufferStore<<Host as Profile>::LightBufferWords>,
+    /// The mode asked for last.
+    accel: AccelMode,
     size: (u32, u32),
     player: Player,
 }
@@ -119,13 +117,12 @@ pub struct Studio {
 impl Default for Studio {
     fn default() -> Self {
         Studio {
-            scene: Box::new(Scene::new()),
+            raytracer: Box::new(Raytracer::new()),
             loaded: false,
             text: Vec::new(),
             frame: 0,
             frames: None,
-            octree: None,
-            lights: LightBufferStore::new(),
+            accel: AccelMode::Auto,
             size: (1, 1),
             player: Player::default(),
         }
@@ -134,118 +131,95 @@ impl Default for Studio {
 
 impl Studio {
     /// Parses frame `frame` of `text` (for a scene without FRAMES, the
-    /// scene: every frame is the same).
+    /// scene: every frame is the same). An animation's every frame is
+    /// checked the first time its text is loaded: a camera that cannot be
+    /// set up at any frame is an error at its line and column.
     pub fn load(&mut self, text: &[u8], frame: u32) -> Result<Loaded, StudioError> {
-        self.octree = None;
-        self.lights = LightBufferStore::new();
         self.loaded = false;
         self.text.clear();
         self.text.extend_from_slice(text);
         self.frame = frame;
+        let frames = self.parse(text, frame)?;
+        if frames.is_some_and(|f| f.count > 1) {
+            self.player.check(&mut self.raytracer, text).map_err(StudioError::Scene)?;
+            // The check loaded frame 0.
+            self.parse(text, frame)?;
+        }
+        self.loaded = true;
+        self.frames = frames;
+        let view = self.raytracer.view();
+        let raster = (view.settings.raster[0], view.settings.raster[1]);
+        self.size = raster;
+        Ok(Loaded { raster, objects: view.object_count(), frames })
+    }
+
+    /// Parses frame `frame` of `text` into the raytracer, indexing nothing
+    /// yet: its FRAMES, or its errors.
+    fn parse(&mut self, text: &[u8], frame: u32) -> Result<Option<Frames>, StudioError> {
         let mut errors = Vec::new();
         let mut on_error = |e: ParseError<'_>| errors.push(e.to_string());
-        match parse_frame_bytes(text, &mut self.scene, frame, &mut on_error) {
-            Ok(parsed) => {
-                self.loaded = true;
-                self.frames = parsed.frames;
-                let view = self.scene.view();
-                let raster = (view.settings.raster[0], view.settings.raster[1]);
-                self.size = raster;
-                Ok(Loaded { raster, objects: view.object_count(), frames: parsed.frames })
-            }
+        match self.raytracer.load_frame_with(text, frame, AccelMode::Naive, &mut on_error) {
+            Ok(scene) => Ok(scene.frames()),
             Err(_) => Err(StudioError::Scene(errors)),
         }
     }
 
-    /// Sets the image size and builds what `accel` needs; returns the mode
-    /// used (never `Auto`).
+    /// Sets the image size and indexes the scene as `accel` says; returns
+    /// the mode used (never `Auto`).
     pub fn prepare(&mut self, accel: AccelMode, width: u32, height: u32) -> Result<AccelMode, StudioError> {
         if !self.loaded {
             return Err(StudioError::NoScene);
         }
-        let view = self.scene.view();
-        view.check_camera(width, height).map_err(|e| StudioError::Camera(format!("{e:?}")))?;
+        self.raytracer.view().check_camera(width, height).map_err(|e| StudioError::Camera(format!("{e:?}")))?;
         self.size = (width, height);
-        let mut octree: Box<Octree<Host>> = Box::default();
-        let prepared = accel::prepare(accel, &view, &mut *octree, &<Host as Profile>::OCTREE);
-        self.octree = prepared.report.map(|_| octree);
-        self.lights = LightBufferStore::new();
-        if accel != AccelMode::Naive {
-            self.lights.build(&view, MAX_CELLS_A_SIDE);
-        }
-        Ok(prepared.mode)
+        self.accel = accel;
+        let scene = self.raytracer.reindex(accel, |beside, here| {
+            here();
+            beside();
+        });
+        Ok(scene.mode())
     }
 
     /// Renders the rectangle at (`x`, `y`) of `width`×`height` pixels into
     /// `out`: its colours (RGB, row-major), then the object under each pixel
     /// (little-endian `u32`, [`NO_OBJECT`] for the background).
     pub fn render_rect(&self, x: u32, y: u32, width: u32, height: u32, out: &mut Vec<u8>) -> Result<(), StudioError> {
-        if !self.loaded {
-            return Err(StudioError::NoScene);
-        }
+        let Some(scene) = self.raytracer.indexed().filter(|_| self.loaded) else { return Err(StudioError::NoScene) };
         let (w, h) = self.size;
         if x.checked_add(width).is_none_or(|r| r > w) || y.checked_add(height).is_none_or(|b| b > h) {
             return Err(StudioError::BadInput("the rectangle is outside the image"));
         }
-        let rect = (x, y, width, height);
-        let lights = self.lights.buffer();
-        match self.octree.as_deref() {
-            None => self.render_with(&LightBuffered::new(&Naive, lights), rect, out),
-            Some(octree) => self.render_with(&LightBuffered::new(octree, lights), rect, out),
-        }
+        let count = width as usize * height as usize;
+        let (mut colours, mut objects) = (vec![0; 3 * count], vec![NO_OBJECT; count]);
+        let mut pixels = Pixels { colours: &mut colours, objects: &mut objects, size: Size::new(width, height) };
+        let area = Rectangle::new(Point::new(x as i32, y as i32), Size::new(width, height));
+        let image = scene.image::<PixelSample>(Size::new(w, h)).area(area);
+        image.try_draw(&mut pixels).map_err(|e| StudioError::Camera(format!("{e:?}")))?;
+        out.clear();
+        out.reserve(7 * count);
+        out.extend_from_slice(&colours);
+        out.extend(objects.iter().flat_map(|o| o.to_le_bytes()));
+        Ok(())
     }
 
     /// Traces the loaded frame whole, at the prepared size, into `out` as
     /// [`Studio::render_rect`] writes it; for an animation, re-tracing only
     /// what can have changed since the frame the player traced last when
-    /// that was an earlier frame of the same text at the same size (the
-    /// core's coherence: the same bits as a frame traced whole). Returns
-    /// how many pixels it traced.
+    /// that was a frame of the same text at the same size (the core's
+    /// coherence: the same bits as a frame traced whole). Returns how many
+    /// pixels it traced.
     pub fn trace_frame(&mut self, out: &mut Vec<u8>) -> Result<u64, StudioError> {
         if !self.loaded {
             return Err(StudioError::NoScene);
         }
         let text = std::str::from_utf8(&self.text).map_err(|_| StudioError::BadInput("the scene is not UTF-8"))?;
-        let view = self.scene.view();
-        let lights = self.lights.buffer();
-        // A still scene is an animation of one frame that never moves.
-        let frames = self.frames.unwrap_or(Frames { count: 1, rate: Frames::DEFAULT_RATE });
-        let frame = Shown { text, frames, frame: self.frame, size: self.size };
-        let traced = match self.octree.as_deref() {
-            None => self.player.trace(view, &LightBuffered::new(&Naive, lights), &frame),
-            Some(octree) => self.player.trace(view, &LightBuffered::new(octree, lights), &frame),
-        }?;
+        let traced =
+            self.player.trace(&mut self.raytracer, (text, self.frame), self.accel, self.size).map_err(|e| match e {
+                Refused::Scene(errors) => StudioError::Scene(errors),
+                Refused::Setup(why) => StudioError::Motion(why),
+            })?;
         self.player.write(out);
         Ok(traced)
-    }
-
-    fn render_with<A: Accelerator>(
-        &self,
-        accel: &A,
-        (x, y, width, height): (u32, u32, u32, u32),
-        out: &mut Vec<u8>,
-    ) -> Result<(), StudioError> {
-        let view = self.scene.view();
-        let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
-        let renderer = Renderer::with_size(view, accel, self.size.0, self.size.1)
-            .map_err(|e| StudioError::Camera(format!("{e:?}")))?;
-        let mut bounds = vec![ScreenBound::EMPTY; view.object_count()];
-        let mut positions = vec![0; ScreenBound::positions_for(view.object_count())];
-        let mut renderer = renderer.with_mailbox(&mut words).with_first_hits(&mut bounds, &mut positions);
-        let count = width as usize * height as usize;
-        out.clear();
-        out.reserve(7 * count);
-        let mut objects = Vec::with_capacity(count);
-        for row in y..y + height {
-            for p in renderer.row(row, x..x + width) {
-                out.extend([p.color.r(), p.color.g(), p.color.b()]);
-                objects.push(p.object.map_or(NO_OBJECT, |o| o.0));
-            }
-        }
-        for o in objects {
-            out.extend(o.to_le_bytes());
-        }
-        Ok(())
     }
 }
 
@@ -375,6 +349,19 @@ mod tests {
         studio.load(&other, 1).unwrap();
         studio.prepare(AccelMode::Dda, w, h).unwrap();
         assert_eq!(studio.trace_frame(&mut Vec::new()).unwrap(), pixels);
+    }
+
+    #[test]
+    fn an_animation_whose_camera_breaks_at_a_later_frame_does_not_load_at_any_frame() {
+        // The eye moves onto the point looked at at frame 2.
+        let text = b"FRAMES 3\nVIEWPOINT 0 0 5 MOVE 0 0 0 0  2 0 0 -5\nORIGIN 0 0 0\n\
+            SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 3\n";
+        let mut studio = Studio::default();
+        for frame in [0, 1] {
+            let Err(StudioError::Scene(errors)) = studio.load(text, frame) else { panic!("frame {frame} loads") };
+            assert_eq!(errors, ["2:17: at frame 2, VIEWPOINT equals ORIGIN: there is no view direction"]);
+        }
+        assert!(matches!(studio.prepare(AccelMode::Naive, 4, 4), Err(StudioError::NoScene)));
     }
 
     #[test]

@@ -169,7 +169,7 @@ impl Firmware {
         let path = repo().join("scenes").join(format!("{}.txt", self.scene));
         host_sim::load_file(&path, &mut scene).map_err(|e| e.to_string())?;
         let options = host_sim::RenderOptions { size: Some((self.width, self.height)), ..Default::default() };
-        let rendered = host_sim::render(&scene, &options).map_err(|e| format!("{e:?}"))?;
+        let rendered = host_sim::render(&mut scene, &options).map_err(|e| format!("{e:?}"))?;
         let image = rendered.image;
         Ok(match (self.wire, self.wire.panel()) {
             // host-sim's panel previews and dither: their indices are the wire's.

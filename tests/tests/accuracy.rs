@@ -22,7 +22,7 @@ fn every_scene_is_within_four_levels_of_the_f64_reference() {
         let expected = reference::parse(&text).unwrap_or_else(|e| panic!("{name}: reference parser: {e}"));
         let mut scene = new_scene();
         load_file(&path, &mut scene).unwrap_or_else(|e| panic!("{name}: {e}"));
-        let image = render(&scene, &RenderOptions::default()).unwrap_or_else(|e| panic!("{name}: {e:?}")).image;
+        let image = render(&mut scene, &RenderOptions::default()).unwrap_or_else(|e| panic!("{name}: {e:?}")).image;
         let (width, height) = expected.raster();
         assert_eq!((image.width, image.height), (width, height), "{name}: size");
         let want = expected.render(width, height);

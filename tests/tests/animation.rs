@@ -5,7 +5,7 @@
 //! shadow, a moving light, a moving viewpoint, a moving B-spline patch, an
 //! object seen only through glass, and anim_fig5_1. Each check also runs
 //! with the tracking of the dependence its scene needs dropped
-//! (`Coherence::ignoring`), and must then fail: the tests see a broken
+//! (`Animation::ignoring`), and must then fail: the tests see a broken
 //! tracker.
 
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -13,11 +13,10 @@ use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::Rgb888;
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
-use octrace_core::animation::{Coherence, Dependence, Key, Motion, Track};
+use octrace_core::animation::{AnimationNeeds, Coherence, Dependence, HostAnimationRoom};
 use octrace_core::profile::Host;
 use octrace_core::Raytracer;
 use octrace_tests::repo;
-use std::sync::atomic::AtomicU8;
 
 /// A framebuffer: what a panel shows.
 #[derive(Clone, PartialEq, Eq)]
@@ -86,30 +85,24 @@ fn whole(text: &str, frame: u32) -> Panel {
 /// dropped): the first frame whose panel is not the frame traced whole,
 /// and the share of pixels re-traced after the first frame.
 fn play(text: &str, side: u32, ignored: Option<Dependence>) -> (Option<u32>, f64) {
-    let counts: Vec<AtomicU8> =
-        (0..Coherence::tiles_for(SIZE.width, SIZE.height, side)).map(|_| AtomicU8::new(0)).collect();
-    let mut coherence = Coherence::new(&counts, SIZE, side).unwrap();
+    let tiles = Coherence::tiles_for(SIZE.width, SIZE.height, side);
+    let mut room = HostAnimationRoom::new(AnimationNeeds { tiles, ..AnimationNeeds::of(text, SIZE) });
+    let mut animation = room.animation_in_tiles(SIZE, side).unwrap();
     if let Some(dependence) = ignored {
-        coherence = coherence.ignoring(dependence);
+        animation = animation.ignoring(dependence);
     }
     let mut raytracer = Box::new(Raytracer::<Host>::new());
-    let first = raytracer.load_frame(text, 0).unwrap();
-    let frames = first.frames().expect("an animation");
-    let needs = Motion::needs(text);
-    let (mut tracks, mut keys, mut table) =
-        (vec![Track::EMPTY; needs.tracks], vec![Key::default(); needs.keys], vec![[0; 3]; needs.displacements]);
-    let motion = Motion::read(text, frames, &first.view(), 0, &mut tracks, &mut keys, &mut table).unwrap();
+    let frames = raytracer.load(text).unwrap().frames().expect("an animation");
     let wholes: Vec<Panel> = frames.all().map(|k| whole(text, k)).collect();
     let mut panel = Panel::new(SIZE);
     let (mut traced, mut pixels) = (0, 0);
     for (step, frame) in frames.all().chain(frames.all()).enumerate() {
-        let scene = raytracer.load_frame(text, frame).unwrap();
-        coherence.plan();
+        let loaded = animation.load(&mut raytracer, text, frame).unwrap();
         if step > 0 {
-            traced += coherence.traced_pixels();
+            traced += loaded.tiles().traced_pixels();
             pixels += u64::from(SIZE.width * SIZE.height);
         }
-        scene.draw_changes(&motion, frame, &coherence, &mut panel).unwrap();
+        loaded.image_for(&panel).try_draw(&mut panel).unwrap();
         if panel != wholes[frame as usize] {
             return (Some(frame), 0.0);
         }
@@ -348,8 +341,9 @@ fn animation_errors_name_the_place_and_leave_no_file() {
         let (code, err) = host_sim(d, &["lost.txt", out]);
         assert_eq!(code, 2, "{err}");
         // ORIGIN reaches VIEWPOINT within a unit of rounding: no view, or
-        // one along UPVECTOR.
-        assert!(err.contains("lost.txt:9:19: at frame 6, ") && err.contains("(frame 6); nothing rendered"), "{err}");
+        // one along UPVECTOR. Found as frame 0 loads, which checks every
+        // frame's camera before any is drawn.
+        assert!(err.contains("lost.txt:9:19: at frame 6, ") && err.contains("(frame 0); nothing rendered"), "{err}");
     }
     let mut after = files(d);
     after.retain(|f| f != "lost.txt");

@@ -12,7 +12,7 @@ use octrace_tests::Rng;
 /// World coordinates (f64) to the scene's normalised fixed point.
 fn normalised(scene: &host_sim::HostScene, p: V3) -> Vec3 {
     let q32 = |v: f64| (v * 4_294_967_296.0).round() as i64;
-    scene.normalization.point([q32(p.x), q32(p.y), q32(p.z)])
+    scene.view().normalization.point([q32(p.x), q32(p.y), q32(p.z)])
 }
 
 #[test]

@@ -29,7 +29,7 @@ fn every_scene_matches_its_golden_image() {
     for (name, path) in scenes() {
         let mut scene = new_scene();
         load_file(&path, &mut scene).unwrap_or_else(|e| panic!("{name}: {e}"));
-        let image = render(&scene, &RenderOptions::default()).unwrap_or_else(|e| panic!("{name}: {e:?}")).image;
+        let image = render(&mut scene, &RenderOptions::default()).unwrap_or_else(|e| panic!("{name}: {e:?}")).image;
         let golden = gallery.join(format!("{name}.png"));
         if blessing() {
             std::fs::create_dir_all(&gallery).unwrap();
@@ -62,7 +62,7 @@ fn fig5_1_in_every_palette_mode_matches_its_golden_image() {
     let gallery = repo().join("docs/gallery");
     let mut scene = new_scene();
     load_file(&repo().join("scenes/fig5_1.txt"), &mut scene).unwrap();
-    let rendered = render(&scene, &RenderOptions::default()).unwrap();
+    let rendered = render(&mut scene, &RenderOptions::default()).unwrap();
     let mut failures = Vec::new();
     for mode in [PaletteMode::Scan, PaletteMode::Dither, PaletteMode::Coarse, PaletteMode::Gray] {
         let image = palette::apply(&rendered.image, &rendered.objects, mode);

@@ -131,7 +131,7 @@ fn assert_flat(img: &host_sim::RgbImage, rgb: [u8; 3]) {
 fn render_lib(text: &str, accel: host_sim::AccelMode) -> host_sim::Rendered {
     let mut scene = host_sim::new_scene();
     host_sim::load_bytes("scene.txt", text.as_bytes(), &mut scene).unwrap_or_else(|e| panic!("{e}"));
-    host_sim::render(&scene, &host_sim::RenderOptions { accel, ..Default::default() }).expect("renders")
+    host_sim::render(&mut scene, &host_sim::RenderOptions { accel, ..Default::default() }).expect("renders")
 }
 
 const MODES: [host_sim::AccelMode; 3] =

@@ -3,9 +3,10 @@
 //! buffer: on every scene in `scenes/`, and on random scenes and rays (the
 //! seed is printed; set `OCTRACE_SEED` to replay one).
 
-use host_sim::{build_octree, load_bytes, load_file, new_scene, render, AccelMode, HostScene, RenderOptions};
+use host_sim::{load_bytes, load_file, new_scene, render, AccelMode, HostScene, RenderOptions};
 use octrace_core::accel::{
-    Accelerator, LightBuffer, LightBuffered, Mailbox, Naive, OctreeConfig, RayStart, Traversal, MAX_CELLS_A_SIDE,
+    prepare, Accelerator, Indexing, LightBuffer, LightBuffered, Mailbox, Naive, Octree, OctreeConfig, RayStart,
+    Traversal, MAX_CELLS_A_SIDE,
 };
 use octrace_core::capacity::Arena;
 use octrace_core::math::{Dir, Scalar, Vec3};
@@ -14,7 +15,12 @@ use octrace_core::scene::ObjectId;
 use octrace_core::shapes::{Leaving, Ray};
 use octrace_tests::{scenes, Rng};
 
-fn image(scene: &HostScene, accel: AccelMode, octree: OctreeConfig, size: Option<(u32, u32)>) -> host_sim::RgbImage {
+fn image(
+    scene: &mut HostScene,
+    accel: AccelMode,
+    octree: OctreeConfig,
+    size: Option<(u32, u32)>,
+) -> host_sim::RgbImage {
     render(scene, &RenderOptions { size, accel, octree, ..Default::default() }).expect("renders").image
 }
 
@@ -29,9 +35,9 @@ fn every_scene_is_identical_in_every_mode() {
         let size = Some((160, 120));
         // The naive mode named has no light buffer; `auto` (naive for a
         // handful of objects) and the octree's walks have one.
-        let naive = image(&scene, AccelMode::Naive, config, size);
+        let naive = image(&mut scene, AccelMode::Naive, config, size);
         for mode in [AccelMode::Auto, AccelMode::Octree, AccelMode::Dda] {
-            let other = image(&scene, mode, config, size);
+            let other = image(&mut scene, mode, config, size);
             let differ = naive.data.chunks(3).zip(other.data.chunks(3)).filter(|(a, b)| a != b).count();
             assert_eq!(differ, 0, "{name}: {} differs from naive in {differ} pixels", mode.name());
         }
@@ -142,9 +148,9 @@ fn random_scenes_are_identical_in_every_mode() {
         }
         let config =
             OctreeConfig { max_objects: 1 + rng.below(6) as usize, max_depth: 1 + rng.below(10), ..host_sim::OCTREE };
-        let naive = image(&scene, AccelMode::Naive, config, None);
+        let naive = image(&mut scene, AccelMode::Naive, config, None);
         for mode in [AccelMode::Octree, AccelMode::Dda] {
-            let other = image(&scene, mode, config, None);
+            let other = image(&mut scene, mode, config, None);
             assert!(naive == other, "round {round}: {} differs from naive ({config:?})\n{text}", mode.name());
         }
     }
@@ -171,7 +177,10 @@ fn random_queries_agree_with_the_naive_mode() {
                 ..host_sim::OCTREE
             };
             let mode = if traversal == Traversal::Dda { AccelMode::Dda } else { AccelMode::Octree };
-            let Some(tree) = build_octree(&scene, mode, &config) else { continue };
+            let mut tree: Box<Octree<Host>> = Box::default();
+            if prepare(mode, &view, &mut *tree, &config).report.is_none() {
+                continue;
+            }
             let cells = 1 << rng.below(MAX_CELLS_A_SIDE.trailing_zeros() + 1);
             let mut arena = <Host as Profile>::LightBufferWords::EMPTY;
             let buffer = LightBuffer::build(&view, &mut arena, cells);
@@ -242,25 +251,24 @@ fn random_queries_agree_with_the_naive_mode() {
 
 #[test]
 fn small_capacities_fall_back_without_changing_the_image() {
-    use octrace_core::parse::parse;
+    use embedded_graphics_core::geometry::Size;
     use octrace_core::profile::Board16K;
-    use octrace_core::render::Renderer;
-    use octrace_core::scene::Scene;
+    use octrace_core::Raytracer;
     // fig5_3's 200 spheres in the 16 KiB board profile: the octree's arenas
     // are small, so boxes stay unsplit; the image must not change.
-    let text = std::fs::read_to_string(octrace_tests::repo().join("scenes/fig5_3.txt")).unwrap();
-    let mut scene: Box<Scene<Board16K>> = Box::default();
-    parse(&text, &mut scene, &mut |e| panic!("{e}")).unwrap();
-    let view = scene.view();
-    let mut tree: Box<octrace_core::accel::Octree<Board16K>> = Box::default();
-    let report = tree
-        .build(&view, &OctreeConfig { max_objects: 1, max_depth: 12, traversal: Traversal::Dda, ..host_sim::OCTREE });
+    let text = std::fs::read(octrace_tests::repo().join("scenes/fig5_3.txt")).unwrap();
+    let mut raytracer: Box<Raytracer<Board16K>> = Box::default();
+    let mut draw = |indexing: Indexing| {
+        let scene = raytracer.load_with(&text, indexing, &mut |e| panic!("{e}")).unwrap();
+        let mut image = host_sim::RgbImage::new(64, 48);
+        scene.image(Size::new(64, 48)).try_draw(&mut image).unwrap();
+        (image, scene.octree_report().copied())
+    };
+    let (a, _) = draw(AccelMode::Naive.into());
+    let config = OctreeConfig { max_objects: 1, max_depth: 12, traversal: Traversal::Dda, ..host_sim::OCTREE };
+    let (b, report) = draw(Indexing { mode: AccelMode::Dda, octree: Some(config) });
+    let report = report.expect("an octree");
     println!("{report:?}");
     assert!(report.unsplit > 0, "the small profile should run out: {report:?}");
-    let mut a = host_sim::RgbImage::new(64, 48);
-    let mut b = host_sim::RgbImage::new(64, 48);
-    Renderer::with_size(view, &Naive, 64, 48).unwrap().render(&mut a).unwrap();
-    let mut words = [0u32; 8];
-    Renderer::with_size(view, &*tree, 64, 48).unwrap().with_mailbox(&mut words).render(&mut b).unwrap();
     assert!(a == b);
 }

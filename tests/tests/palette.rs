@@ -63,7 +63,7 @@ fn every_scene_in_every_mode_and_format() {
         let mut scene = new_scene();
         load_file(&path, &mut scene).unwrap();
         let rendered =
-            render(&scene, &RenderOptions { size: Some((96, 72)), threads: 2, ..Default::default() }).unwrap();
+            render(&mut scene, &RenderOptions { size: Some((96, 72)), threads: 2, ..Default::default() }).unwrap();
         for mode in PaletteMode::ALL {
             let image = palette::apply(&rendered.image, &rendered.objects, mode);
             if let Image::Indexed { palette, .. } = &image {
@@ -108,7 +108,7 @@ fn coarse_outlines_a_bspline_patch_not_its_triangles() {
     // coarse outlines stay few (they once drew the whole triangle mesh).
     let mut scene = new_scene();
     load_file(&octrace_tests::repo().join("scenes/freeform.txt"), &mut scene).unwrap();
-    let rendered = render(&scene, &RenderOptions { size: Some((160, 120)), ..Default::default() }).unwrap();
+    let rendered = render(&mut scene, &RenderOptions { size: Some((160, 120)), ..Default::default() }).unwrap();
     let mut seen: Vec<u32> = rendered.objects.iter().copied().filter(|&o| o != host_sim::NO_OBJECT).collect();
     seen.sort_unstable();
     seen.dedup();
@@ -125,7 +125,7 @@ fn one_colour_and_one_pixel_images() {
     let mut scene = new_scene();
     load_bytes("flat", b"BACKGROUND 0.2 0.4 0.6 RASTER 7 5", &mut scene).unwrap();
     for size in [(7, 5), (1, 1)] {
-        let rendered = render(&scene, &RenderOptions { size: Some(size), ..Default::default() }).unwrap();
+        let rendered = render(&mut scene, &RenderOptions { size: Some(size), ..Default::default() }).unwrap();
         for mode in PaletteMode::ALL {
             let image = palette::apply(&rendered.image, &rendered.objects, mode);
             assert_eq!((image.width(), image.height()), size);
@@ -146,7 +146,7 @@ fn scan_maps_more_than_256_colours_onto_256() {
     let path = octrace_tests::repo().join("scenes/fig5_3.txt");
     let mut scene = new_scene();
     load_file(&path, &mut scene).unwrap();
-    let rendered = render(&scene, &RenderOptions { threads: 2, ..Default::default() }).unwrap();
+    let rendered = render(&mut scene, &RenderOptions { threads: 2, ..Default::default() }).unwrap();
     let truecolour = palette::colors_used(&Image::Rgb(rendered.image.clone()));
     assert!(truecolour > 256, "{truecolour}");
     let scan = palette::apply(&rendered.image, &rendered.objects, PaletteMode::Scan);

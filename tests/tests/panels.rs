@@ -17,7 +17,7 @@ fn renders() -> Vec<(&'static str, RgbImage)> {
             let mut scene = new_scene();
             load_file(&repo().join(format!("scenes/{name}.txt")), &mut scene).unwrap();
             let options = RenderOptions { size: Some((128, 64)), ..Default::default() };
-            (name, render(&scene, &options).unwrap().image)
+            (name, render(&mut scene, &options).unwrap().image)
         })
         .collect()
 }

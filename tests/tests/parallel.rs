@@ -1,10 +1,12 @@
 //! Parallel rendering gives the same bits: any number of threads, either
 //! partition, and the interleaved-row split a dual-core board would use.
 
+use embedded_graphics_core::geometry::Size;
 use embedded_graphics_core::pixelcolor::RgbColor;
-use host_sim::{build_octree, load_file, new_scene, render, render_prebuilt, AccelMode, Partition, RenderOptions};
-use octrace_core::accel::Mailbox;
-use octrace_core::render::{interleaved_rows, Renderer};
+use host_sim::{load_file, new_scene, render, AccelMode, Partition, RenderOptions};
+use octrace_core::profile::Host;
+use octrace_core::render::interleaved_rows;
+use octrace_core::{Raytracer, RendererRoom};
 use octrace_tests::scenes;
 use std::sync::Mutex;
 
@@ -15,11 +17,11 @@ fn every_thread_count_and_partition_gives_the_same_image() {
         load_file(&path, &mut scene).unwrap_or_else(|e| panic!("{name}: {e}"));
         // An odd size, so that tiles and quarters are uneven.
         let base = RenderOptions { size: Some((101, 67)), ..Default::default() };
-        let one = render(&scene, &base).unwrap().image;
+        let one = render(&mut scene, &base).unwrap().image;
         for partition in [Partition::Tiles, Partition::Equal4] {
             for threads in [1, 2, 3, 7] {
                 let options = RenderOptions { threads, partition, ..base };
-                let rendered = render(&scene, &options).unwrap();
+                let rendered = render(&mut scene, &options).unwrap();
                 assert!(rendered.image == one, "{name}: {threads} threads, {partition:?} differ");
                 assert_eq!(rendered.busy.len(), threads);
             }
@@ -32,10 +34,10 @@ fn stats_do_not_depend_on_the_thread_count() {
     let path = octrace_tests::repo().join("scenes/fig5_3.txt");
     let mut scene = new_scene();
     load_file(&path, &mut scene).unwrap();
-    let tree = build_octree(&scene, AccelMode::Dda, &host_sim::OCTREE).unwrap();
-    let options = |threads| RenderOptions { size: Some((96, 64)), threads, ..Default::default() };
-    let one = render_prebuilt(&scene, &options(1), Some(&tree), &|_| {}).unwrap().stats;
-    let four = render_prebuilt(&scene, &options(4), Some(&tree), &|_| {}).unwrap().stats;
+    let options =
+        |threads| RenderOptions { size: Some((96, 64)), accel: AccelMode::Dda, threads, ..Default::default() };
+    let one = render(&mut scene, &options(1)).unwrap().stats;
+    let four = render(&mut scene, &options(4)).unwrap().stats;
     assert_eq!(one, four);
 }
 
@@ -48,16 +50,18 @@ fn two_cores_with_interleaved_rows_give_the_same_image() {
     let mut scene = new_scene();
     load_file(&path, &mut scene).unwrap();
     let (w, h) = (120, 90);
-    let tree = build_octree(&scene, AccelMode::Dda, &host_sim::OCTREE).unwrap();
-    let expected = render(&scene, &RenderOptions { size: Some((w, h)), ..Default::default() }).unwrap().image;
-    let view = scene.view();
+    let expected = render(&mut scene, &RenderOptions { size: Some((w, h)), ..Default::default() }).unwrap().image;
+    let text = std::fs::read(&path).unwrap();
+    let mut raytracer = Box::new(Raytracer::<Host>::new());
+    let loaded = raytracer.load_with(&text, AccelMode::Dda, &mut |e| panic!("{e}")).unwrap();
+    let shared = loaded.share();
     let display = Mutex::new(host_sim::RgbImage::new(w, h));
     std::thread::scope(|s| {
         for core in 0..2 {
-            let (display, tree) = (&display, &tree);
+            let display = &display;
             s.spawn(move || {
-                let mut words = vec![0u32; Mailbox::words_for(view.object_count())];
-                let mut renderer = Renderer::with_size(view, &**tree, w, h).unwrap().with_mailbox(&mut words);
+                let mut room = RendererRoom::<Host>::new();
+                let mut renderer = shared.renderer(&mut room, Size::new(w, h)).unwrap();
                 for y in interleaved_rows(h, core, 2) {
                     let row: Vec<_> = renderer.row(y, 0..w).map(|p| p.color).collect();
                     let mut image = display.lock().unwrap();

@@ -58,7 +58,7 @@ fn streamed_files_equal_the_whole_image_in_every_mode_and_format() {
     load_file(&path, &mut loaded).unwrap();
     // Neither side a multiple of the 32-row bands and tiles.
     let (w, h) = (75, 70);
-    let rendered = render(&loaded, &RenderOptions { size: Some((w, h)), ..Default::default() }).unwrap();
+    let rendered = render(&mut loaded, &RenderOptions { size: Some((w, h)), ..Default::default() }).unwrap();
     let mut expected_files = Vec::new();
     for mode in PaletteMode::ALL {
         let expected = palette::apply(&rendered.image, &rendered.objects, mode);
@@ -87,7 +87,7 @@ fn streamed_files_equal_the_whole_image_in_every_mode_and_format() {
     assert_eq!(files(dir.path()), expected_files);
     // The library's equal4 is the thesis's four rectangles, streamed as one band.
     let equal4 = render(
-        &loaded,
+        &mut loaded,
         &RenderOptions { size: Some((w, h)), threads: 3, partition: Partition::Equal4, ..Default::default() },
     );
     assert_eq!(equal4.unwrap().image, rendered.image);

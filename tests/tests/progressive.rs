@@ -4,9 +4,10 @@
 
 use embedded_graphics_core::geometry::Size;
 use embedded_graphics_core::pixelcolor::Rgb888;
-use host_sim::{build_octree, load_file, new_scene, render, AccelMode, RenderOptions, RgbImage};
-use octrace_core::accel::Mailbox;
-use octrace_core::render::{Progressive, Renderer, ScreenBound};
+use host_sim::{load_file, new_scene, render, AccelMode, RenderOptions, RgbImage};
+use octrace_core::profile::Host;
+use octrace_core::render::Progressive;
+use octrace_core::{Raytracer, RendererRoom};
 use octrace_tests::scenes;
 use std::sync::mpsc;
 
@@ -26,27 +27,18 @@ fn every_scene_ends_as_the_direct_picture_on_one_core_and_on_two() {
     for (name, path) in scenes() {
         let mut scene = new_scene();
         load_file(&path, &mut scene).unwrap_or_else(|e| panic!("{name}: {e}"));
-        let expected = render(&scene, &RenderOptions { size: Some(SIZE), ..Default::default() }).unwrap();
-        let tree = build_octree(&scene, AccelMode::Dda, &host_sim::OCTREE).unwrap();
-        let view = scene.view();
-        // Each core its own mailbox and screen lists, as on a board.
-        let objects = view.object_count();
-        let storage = || {
-            (
-                vec![0u32; Mailbox::words_for(objects)],
-                vec![ScreenBound::EMPTY; objects],
-                vec![0u16; ScreenBound::positions_for(objects)],
-            )
-        };
+        let expected = render(&mut scene, &RenderOptions { size: Some(SIZE), ..Default::default() }).unwrap();
+        let text = std::fs::read(&path).unwrap();
+        let mut raytracer = Box::new(Raytracer::<Host>::new());
+        let loaded = raytracer.load_with(&text, AccelMode::Dda, &mut |e| panic!("{name}: {e}")).unwrap();
+        // Each core its own room (mailbox and screen lists), as on a board.
+        let shared = loaded.share();
         for (coarsest, finest) in ORDERS {
             let order = Progressive::new(Size::new(w, h), coarsest).with_finest(finest);
             let label = format!("{name}, coarsest {coarsest}, finest {finest}");
 
-            let (mut words, mut bounds, mut positions) = storage();
-            let mut renderer = Renderer::with_size(view, &*tree, w, h)
-                .unwrap()
-                .with_mailbox(&mut words)
-                .with_first_hits(&mut bounds, &mut positions);
+            let mut room = RendererRoom::<Host>::new();
+            let mut renderer = shared.renderer(&mut room, Size::new(w, h)).unwrap();
             let mut one = RgbImage::new(w, h);
             let stats = order.render(&mut renderer, &mut one).unwrap();
             assert!(one == expected.image, "{label}: one core's picture differs");
@@ -62,11 +54,8 @@ fn every_scene_ends_as_the_direct_picture_on_one_core_and_on_two() {
             let (to_core0, from_core1) = mpsc::sync_channel::<(usize, Vec<Rgb888>)>(SLOTS);
             let core1_rays = std::thread::scope(|s| {
                 let core1 = s.spawn(|| {
-                    let (mut words, mut bounds, mut positions) = storage();
-                    let mut renderer = Renderer::with_size(view, &*tree, w, h)
-                        .unwrap()
-                        .with_mailbox(&mut words)
-                        .with_first_hits(&mut bounds, &mut positions);
+                    let mut room = RendererRoom::<Host>::new();
+                    let mut renderer = shared.renderer(&mut room, Size::new(w, h)).unwrap();
                     for (index, unit) in order.units().enumerate().skip(1).step_by(2) {
                         let mut slot = vec![Rgb888::new(0, 0, 0); order.max_unit_pixels()];
                         unit.trace(&mut renderer, &mut slot).unwrap();
@@ -74,11 +63,8 @@ fn every_scene_ends_as_the_direct_picture_on_one_core_and_on_two() {
                     }
                     renderer.stats().rays
                 });
-                let (mut words, mut bounds, mut positions) = storage();
-                let mut renderer = Renderer::with_size(view, &*tree, w, h)
-                    .unwrap()
-                    .with_mailbox(&mut words)
-                    .with_first_hits(&mut bounds, &mut positions);
+                let mut room = RendererRoom::<Host>::new();
+                let mut renderer = shared.renderer(&mut room, Size::new(w, h)).unwrap();
                 let mut mine = vec![Rgb888::new(0, 0, 0); order.max_unit_pixels()];
                 for (index, unit) in order.units().enumerate() {
                     if index % 2 == 0 {

@@ -50,7 +50,7 @@ fn scene(s: f64) -> String {
 fn image(s: f64) -> RgbImage {
     let mut sc = new_scene();
     load_bytes("scale", scene(s).as_bytes(), &mut sc).unwrap_or_else(|e| panic!("scale {s}: {e}"));
-    render(&sc, &RenderOptions::default()).unwrap().image
+    render(&mut sc, &RenderOptions::default()).unwrap().image
 }
 
 #[test]

@@ -41,7 +41,7 @@ fn every_example_loads_and_shows_something() {
             panic!("example {} of docs/scene-format.md does not load:\n{e}\n{text}", i + 1);
         }
         let options = RenderOptions { size: Some((16, 12)), ..RenderOptions::default() };
-        let image = render(&scene, &options).expect("the camera is valid").image;
+        let image = render(&mut scene, &options).expect("the camera is valid").image;
         // A lit object fills the middle of each example: not all one colour.
         let corner = image.pixel(0, 0);
         assert!(image.data.chunks(3).any(|p| p != corner), "example {} renders a blank image", i + 1);

@@ -73,14 +73,17 @@ impl<'s> Coherence<'s> {
     }
 
     /// Coherence for an image of `size` in tiles of `side` × `side` pixels
-    /// over `counts`, every tile to be traced at the first frame; or how
-    /// many counts it needs.
-    pub(crate) fn new(counts: &'s [AtomicU8], size: Size, side: u32) -> Result<Coherence<'s>, usize> {
+    /// over `counts` (every tile to be traced at the next frame if
+    /// `restart`, else the counts as they are); or how many counts it
+    /// needs.
+    pub(crate) fn new(counts: &'s [AtomicU8], size: Size, side: u32, restart: bool) -> Result<Coherence<'s>, usize> {
         let side = side.max(1);
         let needed = Coherence::tiles_for(size.width, size.height, side);
         let counts = counts.get(..needed).ok_or(needed)?;
         let coherence = Coherence { counts, size, side, across: size.width.div_ceil(side) };
-        coherence.restart();
+        if restart {
+            coherence.restart();
+        }
         Ok(coherence)
     }
 

@@ -4,12 +4,14 @@
 //! (`Animation::load`, in `raytracer/`), and steps its tiles from the
 //! frame shown to the one loaded.
 //!
-//! Invariants: the tracks and keys hold the motion of the text
-//! `loaded.fingerprint` names, recorded when it was first loaded (and
-//! every frame's camera checked then); the tiles' counts are those after
-//! frame `loaded.frame`, whatever order frames are asked in (a jump of s
-//! frames is s steps of the loop, capped where every count has run out);
-//! each object track keeps its displacement at that frame.
+//! Invariants: while `state.loaded`, the tracks and keys hold the motion
+//! of the text `state.fingerprint` names, recorded when it was first loaded
+//! (and every frame's camera checked then), and the tiles' counts are
+//! those of an image of `state.size` after frame `state.frame`, whatever
+//! order frames are asked in (a jump of s frames is s steps of the loop,
+//! capped where every count has run out); each object track keeps its
+//! displacement at that frame. The state lives in the room, so that an
+//! animation made again from it goes on where the last left off.
 
 use super::coherence::Coherence;
 use super::room::{AnimationCapacity, AnimationNeeds, NoRoom};
@@ -68,22 +70,38 @@ pub struct Animation<'s> {
     coherence: Coherence<'s>,
     /// What its storage holds.
     room: AnimationNeeds,
-    loaded: Option<Loaded>,
+    state: &'s mut State,
     /// How its frames' scenes are indexed.
     indexing: Indexing,
     /// Dependences the tracker drops, by a test only.
     ignored: u8,
 }
 
-/// The scene an animation holds the motion of, and the frame its tiles are
-/// at.
-#[derive(Clone, Copy, Debug)]
-struct Loaded {
+/// What an animation's room holds of it besides its storage: the scene it
+/// holds the motion of, and the frame its tiles are at. All zero bits when
+/// nothing is loaded.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct State {
+    loaded: bool,
     fingerprint: u64,
-    frames: Frames,
-    tracks: usize,
-    keys: usize,
+    /// The image's size the tiles are of.
+    size: [u32; 2],
+    /// FRAMES: count and rate.
+    frames: [u32; 2],
+    tracks: u32,
+    keys: u32,
     frame: u32,
+}
+
+impl State {
+    /// Nothing loaded: a constant of all-zero bits.
+    pub(crate) const EMPTY: State =
+        State { loaded: false, fingerprint: 0, size: [0; 2], frames: [0; 2], tracks: 0, keys: 0, frame: 0 };
+
+    fn frames(&self) -> Frames {
+        let [count, rate] = self.frames;
+        Frames { count, rate }
+    }
 }
 
 /// What a frame's draw needs of its animation: the motion, the tiles
@@ -97,22 +115,25 @@ pub(crate) struct Playing<'a> {
 }
 
 impl<'s> Animation<'s> {
-    /// An animation over `tiles`, `tracks` and `keys` on an image of
-    /// `size` in tiles of `side`.
+    /// An animation over `tiles`, `tracks`, `keys` and `state` on an
+    /// image of `size` in tiles of `side`: where the last one made over
+    /// them left off, at the same size; else with nothing loaded.
     pub(crate) fn new(
-        tiles: &'s [AtomicU8],
-        tracks: &'s mut [Track],
-        keys: &'s mut [Key],
+        (tiles, tracks, keys, state): (&'s [AtomicU8], &'s mut [Track], &'s mut [Key], &'s mut State),
         size: Size,
         side: u32,
     ) -> Result<Animation<'s>, NoRoom> {
         let room = AnimationNeeds { tiles: tiles.len(), tracks: tracks.len(), keys: keys.len() };
-        let coherence = Coherence::new(tiles, size, side).map_err(|needed| NoRoom {
+        let went_on = state.loaded && state.size == [size.width, size.height];
+        let coherence = Coherence::new(tiles, size, side, !went_on).map_err(|needed| NoRoom {
             what: AnimationCapacity::Tiles,
             needed,
             holds: tiles.len(),
         })?;
-        Ok(Animation { tracks, keys, coherence, room, loaded: None, indexing: Indexing::default(), ignored: 0 })
+        if !went_on {
+            *state = State::EMPTY;
+        }
+        Ok(Animation { tracks, keys, coherence, room, state, indexing: Indexing::default(), ignored: 0 })
     }
 
     /// The animation, its frames' scenes indexed as `indexing` says (an
@@ -141,7 +162,7 @@ impl<'s> Animation<'s> {
     /// The loaded scene's frames (a still scene is one frame), and the
     /// frame loaded last.
     pub fn frames(&self) -> Option<(Frames, u32)> {
-        self.loaded.map(|l| (l.frames, l.frame))
+        self.state.loaded.then(|| (self.state.frames(), self.state.frame))
     }
 
     /// Forgets what the image shows: the next frame loaded traces every
@@ -160,7 +181,7 @@ impl<'s> Animation<'s> {
 
     /// Whether `text` is the scene whose motion it holds.
     pub(crate) fn holds(&self, text: &[u8]) -> bool {
-        self.loaded.is_some_and(|l| l.fingerprint == fingerprint(text))
+        self.state.loaded && self.state.fingerprint == fingerprint(text)
     }
 
     /// A recorder of `text`'s motion into the storage, or what it lacks.
@@ -170,14 +191,23 @@ impl<'s> Animation<'s> {
         if let Some(short) = needs.beyond(&self.room).into_iter().flatten().next() {
             return Err(short);
         }
-        self.loaded = None;
+        self.state.loaded = false;
         Ok(Recorder::new(self.tracks, self.keys))
     }
 
     /// `text`'s motion recorded (`tracks` tracks, `keys` keys) from frame
     /// `frame` of its `frames`: every tile is traced next.
     pub(crate) fn recorded(&mut self, text: &[u8], frames: Frames, (tracks, keys): (usize, usize), frame: u32) {
-        self.loaded = Some(Loaded { fingerprint: fingerprint(text), frames, tracks, keys, frame });
+        let size = self.coherence.size();
+        *self.state = State {
+            loaded: true,
+            fingerprint: fingerprint(text),
+            size: [size.width, size.height],
+            frames: [frames.count, frames.rate],
+            tracks: tracks as u32,
+            keys: keys as u32,
+            frame,
+        };
         self.coherence.restart();
         self.keep(frame);
     }
@@ -185,10 +215,12 @@ impl<'s> Animation<'s> {
     /// Steps the tiles from the frame loaded last to `frame`, forward round
     /// the loop.
     pub(crate) fn step_to(&mut self, frame: u32) {
-        let Some(loaded) = &mut self.loaded else { return };
-        let count = loaded.frames.count.max(1);
-        let steps = (frame % count + count - loaded.frame % count) % count;
-        loaded.frame = frame;
+        if !self.state.loaded {
+            return;
+        }
+        let count = self.state.frames[0].max(1);
+        let steps = (frame % count + count - self.state.frame % count) % count;
+        self.state.frame = frame;
         for _ in 0..steps.min(LONGEST_STEP) {
             self.coherence.plan();
         }
@@ -197,16 +229,18 @@ impl<'s> Animation<'s> {
 
     /// The object tracks keep their displacements at `frame`.
     fn keep(&mut self, frame: u32) {
-        if let Some(l) = self.loaded {
-            Motion::at_frame(&mut self.tracks[..l.tracks], &self.keys[..l.keys], l.frames, frame);
+        let s = *self.state;
+        if s.loaded {
+            Motion::at_frame(&mut self.tracks[..s.tracks as usize], &self.keys[..s.keys as usize], s.frames(), frame);
         }
     }
 
     /// What a draw of the frame loaded needs.
     pub(crate) fn playing(&self) -> Playing<'_> {
-        let (frames, tracks, keys, frame) = match self.loaded {
-            Some(l) => (l.frames, l.tracks, l.keys, l.frame),
-            None => (Frames { count: 1, rate: Frames::DEFAULT_RATE }, 0, 0, 0),
+        let s = *self.state;
+        let (frames, tracks, keys, frame) = match s.loaded {
+            true => (s.frames(), s.tracks as usize, s.keys as usize, s.frame),
+            false => (Frames { count: 1, rate: Frames::DEFAULT_RATE }, 0, 0, 0),
         };
         let motion = Motion::new(frames, &self.tracks[..tracks], &self.keys[..keys], frame);
         Playing { motion, coherence: self.coherence, frame, ignored: self.ignored }

@@ -8,7 +8,7 @@
 //! grows with its `MOVE`s and their keys, never with its frames.
 
 use super::coherence::Coherence;
-use super::player::Animation;
+use super::player::{Animation, State};
 use super::TILE;
 use crate::motion::{Key, MotionNeeds, Track};
 use core::fmt;
@@ -137,6 +137,7 @@ pub struct AnimationRoom<const TILES: usize, const TRACKS: usize, const KEYS: us
     tiles: [AtomicU8; TILES],
     tracks: [Track; TRACKS],
     keys: [Key; KEYS],
+    state: State,
 }
 
 impl<const TILES: usize, const TRACKS: usize, const KEYS: usize> AnimationRoom<TILES, TRACKS, KEYS> {
@@ -146,13 +147,14 @@ impl<const TILES: usize, const TRACKS: usize, const KEYS: usize> AnimationRoom<T
             tiles: [const { AtomicU8::new(0) }; TILES],
             tracks: [Track::EMPTY; TRACKS],
             keys: [Key::EMPTY; KEYS],
+            state: State::EMPTY,
         }
     }
 
-    /// An animation in this room on an image of `size`, or what its tiles
-    /// lack.
+    /// An animation in this room on an image of `size` (where the last one
+    /// made in it left off, at the same size), or what its tiles lack.
     pub fn animation(&mut self, size: Size) -> Result<Animation<'_>, NoRoom> {
-        Animation::new(&self.tiles, &mut self.tracks, &mut self.keys, size, TILE)
+        Animation::new((&self.tiles, &mut self.tracks, &mut self.keys, &mut self.state), size, TILE)
     }
 }
 
@@ -192,6 +194,7 @@ pub struct HostAnimationRoom {
     tiles: alloc::vec::Vec<AtomicU8>,
     tracks: alloc::vec::Vec<Track>,
     keys: alloc::vec::Vec<Key>,
+    state: State,
 }
 
 #[cfg(feature = "alloc")]
@@ -202,19 +205,25 @@ impl HostAnimationRoom {
             tiles: (0..needs.tiles).map(|_| AtomicU8::new(0)).collect(),
             tracks: alloc::vec![Track::EMPTY; needs.tracks],
             keys: alloc::vec![Key::EMPTY; needs.keys],
+            state: State::EMPTY,
         }
     }
 
-    /// An animation in this room on an image of `size`, or what its tiles
-    /// lack.
+    /// What it holds.
+    pub fn room(&self) -> AnimationNeeds {
+        AnimationNeeds { tiles: self.tiles.len(), tracks: self.tracks.len(), keys: self.keys.len() }
+    }
+
+    /// An animation in this room on an image of `size` (where the last one
+    /// made in it left off, at the same size), or what its tiles lack.
     pub fn animation(&mut self, size: Size) -> Result<Animation<'_>, NoRoom> {
-        Animation::new(&self.tiles, &mut self.tracks, &mut self.keys, size, TILE)
+        self.animation_in_tiles(size, TILE)
     }
 
     /// [`HostAnimationRoom::animation`] in tiles of `side` pixels a side
     /// (the room holding as many): for a benchmark that weighs the sides.
     #[doc(hidden)]
     pub fn animation_in_tiles(&mut self, size: Size, side: u32) -> Result<Animation<'_>, NoRoom> {
-        Animation::new(&self.tiles, &mut self.tracks, &mut self.keys, size, side)
+        Animation::new((&self.tiles, &mut self.tracks, &mut self.keys, &mut self.state), size, side)
     }
 }

@@ -302,6 +302,23 @@ fn parse_in<'a, C: SceneCapacities>(
     Ok(parsed)
 }
 
+/// The IMAGEFILE of `text`, if it names one (its first, as the parser
+/// reads it; a scene with errors may name one too).
+///
+/// ```
+/// assert_eq!(octrace_core::parse::imagefile("RASTER 8 8 IMAGEFILE ball.png SPHERE 1 1 0 0 0"), Some("ball.png"));
+/// assert_eq!(octrace_core::parse::imagefile("RASTER 8 8"), None);
+/// ```
+pub fn imagefile(text: &str) -> Option<&str> {
+    let mut found = None;
+    for_each_statement::<AnyRoom>(text, |_, result| {
+        if let Ok(Statement::Imagefile(name)) = result {
+            found.get_or_insert(name);
+        }
+    });
+    found
+}
+
 /// What `text` needs of each capacity, counting its valid statements (a
 /// B-spline patch at its full grid of triangles): the counts a profile for
 /// this scene holds, but for the octree's, which depend on the build (see

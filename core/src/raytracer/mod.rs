@@ -14,7 +14,7 @@ use crate::capacity::Arena;
 use crate::parse::{parse_recording, ErrorKind, MotionSink, ParseError, Pos};
 use crate::profile::Profile;
 use crate::render::ScreenBound;
-use crate::scene::Scene;
+use crate::scene::{Frames, Scene, SceneView};
 use crate::shade::Stats;
 use core::cell::{Cell, RefCell};
 use core::fmt;
@@ -49,6 +49,12 @@ pub struct Raytracer<P: Profile> {
     /// The first core's renderer's own room.
     room: RendererRoom<P>,
     light_buffer: LightBufferStore<P::LightBufferWords>,
+    /// The scene's FRAMES, count and rate (0 frames: none).
+    frames: [u32; 2],
+    /// How the scene was last indexed: its mode (`Auto`: not indexed since
+    /// it loaded), whether its light buffer was built, and whether its
+    /// camera rays use the screen lists.
+    indexed: (AccelMode, bool, bool),
 }
 
 /// Room for one core's [`Renderer`](crate::render::Renderer) over a profile's scenes: a mailbox and
@@ -162,6 +168,8 @@ impl<P: Profile> Raytracer<P> {
             octree: P::Octree::EMPTY,
             room: RendererRoom::new(),
             light_buffer: LightBufferStore::new(),
+            frames: [0; 2],
+            indexed: (AccelMode::Auto, false, false),
         }
     }
 
@@ -207,7 +215,19 @@ impl<P: Profile> Raytracer<P> {
         indexing: impl Into<Indexing>,
         on_error: &mut dyn FnMut(ParseError<'t>),
     ) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
-        self.load_in(text, 0, &indexing.into(), on_error, &mut one_core, None)
+        self.load_frame_with(text, 0, indexing, on_error)
+    }
+
+    /// [`Raytracer::load_with`] of frame `frame` of an animation
+    /// ([`Raytracer::load_frame`]).
+    pub fn load_frame_with<'t>(
+        &mut self,
+        text: &'t [u8],
+        frame: u32,
+        indexing: impl Into<Indexing>,
+        on_error: &mut dyn FnMut(ParseError<'t>),
+    ) -> Result<LoadedScene<'_, P>, LoadError<'t>> {
+        self.load_in(text, frame, &indexing.into(), on_error, &mut one_core, None)
     }
 
     /// [`Raytracer::load`] on two cores: the light buffer is built on the
@@ -297,8 +317,9 @@ impl<P: Profile> Raytracer<P> {
             on_error(e);
         };
         let parsed = parse_recording(text, &mut self.scene, frame, &mut report, motion);
-        let frames = match (parsed, first) {
-            (Ok(parsed), _) => parsed.frames,
+        (self.frames, self.indexed) = ([0; 2], (AccelMode::Auto, false, false));
+        match (parsed, first) {
+            (Ok(parsed), _) => self.frames = parsed.frames.map_or([0; 2], |f| [f.count, f.rate]),
             (Err(count), Some(first)) => return Err(LoadError { first, count }),
             // Never taken: `parse_bytes` hands every error it counts to the
             // callback. Answered at the file's start rather than by a panic.
@@ -307,6 +328,39 @@ impl<P: Profile> Raytracer<P> {
                 return Err(LoadError { first, count });
             }
         };
+        Ok(self.index(indexing, both))
+    }
+
+    /// The scene last loaded (empty if none did), indexed again as
+    /// `indexing` says, with no parse: what a desktop that renders one
+    /// scene in several ways (modes, octree criteria) does. `both` runs the
+    /// two jobs of the indexing, as [`Raytracer::load_on_two_cores`]'s
+    /// does: on two threads, or in turn (and timed apart).
+    ///
+    /// ```
+    /// use octrace_core::{profile::Board64K, AccelMode, Raytracer};
+    ///
+    /// let text = "SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\nSPHERE 1 1 3 0 0\n";
+    /// let mut raytracer = Raytracer::<Board64K>::new();
+    /// assert_eq!(raytracer.load(text)?.mode(), AccelMode::Naive);
+    /// let scene = raytracer.reindex(AccelMode::Dda, |beside, here| {
+    ///     here();
+    ///     beside();
+    /// });
+    /// assert_eq!((scene.mode(), scene.view().object_count()), (AccelMode::Dda, 2));
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn reindex(
+        &mut self,
+        indexing: impl Into<Indexing>,
+        both: impl FnOnce(&mut (dyn FnMut() + Send), &mut dyn FnMut()),
+    ) -> LoadedScene<'_, P> {
+        self.index(&indexing.into(), &mut once(both))
+    }
+
+    /// The scene last loaded, indexed as `indexing` says; `both` runs the
+    /// two jobs that are apart (the light buffer, the octree).
+    fn index(&mut self, indexing: &Indexing, both: &mut RunBoth<'_>) -> LoadedScene<'_, P> {
         let view = self.scene.view();
         let (mode, config) = (indexing.mode, indexing.octree.unwrap_or(P::OCTREE));
         let requested = mode;
@@ -329,13 +383,40 @@ impl<P: Profile> Raytracer<P> {
         // `both` ran both jobs, unless a caller's broke its promise: then
         // the octree is built now, and the shadow rays go without a buffer
         // (the store may hold an earlier scene's).
-        let Prepared { mode, report } =
-            prepared.unwrap_or_else(|| accel::prepare(mode, &view, &mut self.octree, &config));
-        let octree = report.map(|report| (&self.octree, report));
-        let lights = if built { self.light_buffer.buffer() } else { LightBuffer::NONE };
+        let Prepared { mode, .. } = prepared.unwrap_or_else(|| accel::prepare(mode, &view, &mut self.octree, &config));
         let first_hits = P::FIRST_HITS && requested != AccelMode::Naive;
-        Ok(LoadedScene {
-            view,
+        self.indexed = (mode, built, first_hits);
+        self.scene_indexed()
+    }
+
+    /// The scene last loaded, as it was last indexed (by a load, or
+    /// [`Raytracer::reindex`]), if it was: another look at it with nothing
+    /// built again, for a desktop that draws it in pieces.
+    ///
+    /// ```
+    /// use octrace_core::{profile::Board16K, AccelMode, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// assert!(raytracer.indexed().is_none());
+    /// raytracer.load_with(b"SPHERE 1 1 0 0 0\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\n", AccelMode::Dda, &mut |_| {})?;
+    /// assert_eq!(raytracer.indexed().map(|scene| scene.mode()), Some(AccelMode::Dda));
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn indexed(&self) -> Option<LoadedScene<'_, P>> {
+        (self.indexed.0 != AccelMode::Auto).then(|| self.scene_indexed())
+    }
+
+    /// The scene as `indexed` says it was indexed.
+    fn scene_indexed(&self) -> LoadedScene<'_, P> {
+        let (mode, built, first_hits) = self.indexed;
+        let octree = mode.traversal().map(|_| (&self.octree, *self.octree.report()));
+        let lights = if built { self.light_buffer.buffer() } else { LightBuffer::NONE };
+        let frames = match self.frames {
+            [0, _] => None,
+            [count, rate] => Some(Frames { count, rate }),
+        };
+        LoadedScene {
+            view: self.scene.view(),
             mode,
             octree,
             lights,
@@ -343,7 +424,13 @@ impl<P: Profile> Raytracer<P> {
             first_hits,
             stats: Cell::new(Stats::default()),
             frames,
-        })
+        }
+    }
+
+    /// The scene last loaded (empty if none did, or the last load failed):
+    /// its objects, surfaces, lights and settings.
+    pub fn view(&self) -> SceneView<'_> {
+        self.scene.view()
     }
 }
 

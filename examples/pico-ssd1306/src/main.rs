@@ -19,16 +19,15 @@
 #![no_main]
 
 use core::ops::ControlFlow;
-use core::sync::atomic::AtomicU8;
 use embedded_graphics::pixelcolor::BinaryColor;
 use embedded_graphics::prelude::*;
 use embedded_hal::digital::OutputPin;
 use hal::entry;
 use hal::multicore::Stack;
-use octrace_core::animation::{Coherence, Key, Track};
+use octrace_core::animation::{AnimationNeeds, AnimationRoom};
 use octrace_core::render::Handoff;
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
-use octrace_pico::animation::{self, MotionRoom, Runs, TILE};
+use octrace_pico::animation::{self, Player, Runs};
 use octrace_pico::board::{self, Board};
 use octrace_pico::both_cores;
 use panic_halt as _;
@@ -61,15 +60,16 @@ static CORE1_STACK: Stack<4096> = Stack::new();
 /// Core 1's rows on their way to the panel's buffer: it may trace four ahead.
 static RING: Handoff<{ panel::WIDTH }, 4> = Handoff::new();
 
-/// An animation's motion: its tracks, keys and displacements.
-static TRACKS: ConstStaticCell<[Track; MOTION.tracks]> = ConstStaticCell::new([Track::EMPTY; MOTION.tracks]);
-static KEYS: ConstStaticCell<[Key; MOTION.keys]> = ConstStaticCell::new([Key::EMPTY; MOTION.keys]);
-static DISPLACEMENTS: ConstStaticCell<[[i32; 3]; MOTION.displacements]> =
-    ConstStaticCell::new([[0; 3]; MOTION.displacements]);
+/// What the scene's animation takes on the panel: a byte a tile (512),
+/// and its motion (`build.rs` counted it); none for a still.
+const ANIMATION: AnimationNeeds = AnimationNeeds {
+    tiles: if ANIMATED { AnimationNeeds::tiles_for(Size::new(panel::WIDTH as u32, panel::HEIGHT as u32)) } else { 0 },
+    ..MOTION
+};
 
-/// An animation's tiles, a byte each (none for a still): 512 for the panel.
-const TILES: usize = if ANIMATED { Coherence::tiles_for(panel::WIDTH as u32, panel::HEIGHT as u32, TILE) } else { 0 };
-static COUNTS: [AtomicU8; TILES] = [const { AtomicU8::new(0) }; TILES];
+/// The animation's room: its tiles and motion.
+static ANIMATION_ROOM: ConstStaticCell<AnimationRoom<{ ANIMATION.tiles }, { ANIMATION.tracks }, { ANIMATION.keys }>> =
+    ConstStaticCell::new(AnimationRoom::new());
 
 /// An animation's runs from core 1 on their way to the panel's buffer: a
 /// row of up to 32 tiles each, core 1 tracing up to eight ahead.
@@ -85,20 +85,12 @@ fn main() -> ! {
     if ANIMATED {
         // Frame after frame for ever, each sent to the panel once drawn: it
         // returns only when a frame cannot be drawn.
-        let motion = MotionRoom { tracks: TRACKS.take(), keys: KEYS.take(), displacements: DISPLACEMENTS.take() };
-        let _: animation::Stopped = animation::play(
-            &mut core1,
-            RAYTRACER.take(),
-            SCENE_TEXT,
-            motion,
-            &COUNTS,
-            CORE1_ROOM.take(),
-            &RUNS,
-            &mut display,
-            |display| display.flush(),
-            &mut led,
-            &timer,
-        );
+        if let Ok(animation) = ANIMATION_ROOM.take().animation(display.size()) {
+            let (raytracer, room) = (RAYTRACER.take(), CORE1_ROOM.take());
+            let player = Player { core1: &mut core1, raytracer, animation, room, runs: &RUNS };
+            let _: animation::Stopped =
+                player.play(SCENE_TEXT, &mut display, |display| display.flush(), &mut led, &timer);
+        }
         let _ = display.clear(BinaryColor::On);
         let _ = display.flush();
         loop {

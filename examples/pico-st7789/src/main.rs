@@ -23,7 +23,6 @@
 
 use core::cell::RefCell;
 use core::fmt::Write;
-use core::sync::atomic::AtomicU8;
 use critical_section::Mutex;
 use embedded_graphics::pixelcolor::Rgb565;
 use embedded_graphics::prelude::*;
@@ -31,12 +30,12 @@ use embedded_hal::digital::OutputPin;
 use hal::entry;
 use hal::multicore::Stack;
 use hal::pac::{self, interrupt};
-use octrace_core::animation::{Coherence, Key, Track};
+use octrace_core::animation::{AnimationNeeds, AnimationRoom};
 use octrace_core::render::Handoff;
 #[cfg(progressive_order)]
 use octrace_core::render::Progressive;
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
-use octrace_pico::animation::{self, MotionRoom, Runs, TILE};
+use octrace_pico::animation::{self, Player, Runs};
 use octrace_pico::board::{self, Board};
 use octrace_pico::both_cores;
 use octrace_pico_st7789::measure::{Meter, Report};
@@ -82,19 +81,20 @@ const HANDED_PIXELS: usize = PROGRESSIVE.max_unit_pixels();
 /// What core 1 traced, on its way to the panel: it may trace four ahead.
 static RING: Handoff<HANDED_PIXELS, 4> = Handoff::new();
 
-/// An animation's motion: its tracks, keys and displacements.
-static TRACKS: ConstStaticCell<[Track; MOTION.tracks]> = ConstStaticCell::new([Track::EMPTY; MOTION.tracks]);
-static KEYS: ConstStaticCell<[Key; MOTION.keys]> = ConstStaticCell::new([Key::EMPTY; MOTION.keys]);
-static DISPLACEMENTS: ConstStaticCell<[[i32; 3]; MOTION.displacements]> =
-    ConstStaticCell::new([[0; 3]; MOTION.displacements]);
+/// What the scene's animation takes on the panel: a byte a tile, and its
+/// motion (`build.rs` counted it); none for a still.
+const ANIMATION: AnimationNeeds = AnimationNeeds {
+    tiles: if ANIMATED { AnimationNeeds::tiles_for(Size::new(panel::WIDTH as u32, panel::HEIGHT as u32)) } else { 0 },
+    ..MOTION
+};
 
-/// An animation's tiles, a byte each (none for a still).
-const TILES: usize = if ANIMATED { Coherence::tiles_for(panel::WIDTH as u32, panel::HEIGHT as u32, TILE) } else { 0 };
-static COUNTS: [AtomicU8; TILES] = [const { AtomicU8::new(0) }; TILES];
+/// The animation's room: its tiles and motion.
+static ANIMATION_ROOM: ConstStaticCell<AnimationRoom<{ ANIMATION.tiles }, { ANIMATION.tracks }, { ANIMATION.keys }>> =
+    ConstStaticCell::new(AnimationRoom::new());
 
 /// An animation's runs from core 1 on their way to the panel: a row of 32
 /// tiles each, core 1 tracing up to eight ahead.
-static RUNS: Runs<{ 32 * TILE as usize }, 8> = Runs::new();
+static RUNS: Runs<{ 32 * octrace_core::animation::TILE as usize }, 8> = Runs::new();
 
 /// The panel's bus buffer.
 static PANEL_BUFFER: ConstStaticCell<[u8; 512]> = ConstStaticCell::new([0; 512]);
@@ -118,20 +118,10 @@ fn main() -> ! {
     if ANIMATED {
         // Frame after frame for ever: it returns only when a frame cannot
         // be drawn.
-        let motion = MotionRoom { tracks: TRACKS.take(), keys: KEYS.take(), displacements: DISPLACEMENTS.take() };
-        let _: animation::Stopped = animation::play(
-            &mut core1,
-            raytracer,
-            SCENE_TEXT,
-            motion,
-            &COUNTS,
-            CORE1_ROOM.take(),
-            &RUNS,
-            &mut display,
-            |_| Ok(()),
-            &mut led,
-            &timer,
-        );
+        if let Ok(animation) = ANIMATION_ROOM.take().animation(display.size()) {
+            let player = Player { core1: &mut core1, raytracer, animation, room: CORE1_ROOM.take(), runs: &RUNS };
+            let _: animation::Stopped = player.play(SCENE_TEXT, &mut display, |_| Ok(()), &mut led, &timer);
+        }
         display.clear(Rgb565::RED).unwrap();
         loop {
             cortex_m::asm::wfi();

@@ -15,30 +15,38 @@ mod writers;
 pub use command::{animate, is_frame_file, merge_frames, Request};
 pub use writers::{FrameInfo, FramePattern, Output};
 
-use crate::{build_octree, HostLightBuffer, HostScene, RenderOptions, RgbImage, NO_OBJECT};
-use embedded_graphics_core::geometry::Size;
+use crate::threaded::stream_threads;
+use crate::{load_frame_bytes, RenderOptions, RgbImage, RowSink, StreamError, NO_OBJECT};
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::RgbColor;
-use octrace_core::accel::{Accelerator, LightBuffer, LightBuffered, Mailbox, Naive};
-use octrace_core::animation::{Coherence, Key, Motion, RunSink, Track};
-use octrace_core::parse::{parse_frame_bytes, ParseError};
-use octrace_core::render::{PixelSample, Renderer, ScreenBound};
-use octrace_core::scene::{Frames, SceneView};
+use embedded_graphics_core::primitives::Rectangle;
+use embedded_graphics_core::Pixel;
+use octrace_core::animation::{AnimationNeeds, HostAnimationRoom};
+use octrace_core::profile::Host;
+use octrace_core::render::PixelSample;
+use octrace_core::scene::Frames;
 use octrace_core::shade::Stats;
-use octrace_core::AccelMode;
-use std::sync::atomic::{AtomicU32, AtomicU8, Ordering};
+use octrace_core::{AnimationError as Refused, Frame, RendererRoom};
+use std::cell::Cell;
+use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-/// The side of the tiles whose pixels are re-traced together: chosen by
-/// measurement (BENCHMARKS.md, "Animation").
-pub const COHERENCE_TILE: u32 = 4;
+/// The side of the tiles whose pixels are re-traced together: the core's
+/// (chosen by measurement, BENCHMARKS.md, "Animation").
+pub const COHERENCE_TILE: u32 = octrace_core::animation::TILE;
 
-/// One frame's image: its colours and the object seen through each pixel.
+/// One frame's image: its colours and the object seen through each pixel,
+/// and the rectangles traced for it (the tiles the motion can have changed
+/// since the frame before; every pixel for the first frame, or without
+/// coherence): outside them the frame is the frame before, bit for bit.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct FrameImage {
     pub image: RgbImage,
     /// [`NO_OBJECT`] for background.
     pub objects: Vec<u32>,
+    pub traced: Vec<Rectangle>,
 }
 
 /// What rendering the frames did.
@@ -80,7 +88,8 @@ pub struct AnimationOptions {
 
 /// Renders frames `frames` of the animation `bytes` (a scene with FRAMES:
 /// `count` of them), handing each to `each` in order; `progress(pixels)`
-/// after each band traced.
+/// after each band traced. Every frame's camera is checked before the
+/// first is rendered.
 pub fn render_frames(
     bytes: &[u8],
     count: Frames,
@@ -91,58 +100,80 @@ pub fn render_frames(
 ) -> Result<AnimationReport, AnimationError> {
     let mut report = AnimationReport::default();
     let mut scene = crate::new_scene();
-    let mut current: Option<FrameImage> = None;
-    // The size, the tiles' counts and the motion (its storage), from the
-    // first frame.
-    load(bytes, frames.start, &mut scene)?;
-    let raster = scene.view().settings.raster;
-    let (w, h) = options.render.size.unwrap_or((raster[0], raster[1]));
-    let counts: Vec<AtomicU8> = (0..Coherence::tiles_for(w, h, COHERENCE_TILE)).map(|_| AtomicU8::new(0)).collect();
-    let coherence =
-        Coherence::new(&counts, Size::new(w, h), COHERENCE_TILE).map_err(|e| AnimationError::Setup(e.to_string()))?;
-    let text = std::str::from_utf8(bytes).unwrap_or_default();
-    let needs = Motion::needs(text);
-    let (mut tracks, mut keys, mut table) =
-        (vec![Track::EMPTY; needs.tracks], vec![Key::default(); needs.keys], vec![[0; 3]; needs.displacements]);
-    let motion = match options.coherence {
-        true => Some(
-            Motion::read(text, count, &scene.view(), frames.start, &mut tracks, &mut keys, &mut table)
-                .map_err(|e| AnimationError::Setup(e.to_string()))?,
-        ),
-        false => None,
+    let text = std::str::from_utf8(bytes).map_err(|e| AnimationError::Setup(e.to_string()))?;
+    let _ = count;
+    // The size from the scene's RASTER, then the motion and the tiles: the
+    // animation loaded whole once, every frame checked.
+    let raster = match load_frame_bytes("", bytes, frames.start, &mut scene) {
+        Ok(_) => scene.view().settings.raster,
+        Err(crate::LoadError::Scene(errors)) => return Err(AnimationError::Scene { frame: frames.start, errors }),
+        Err(crate::LoadError::Io(e)) => return Err(AnimationError::Setup(e.to_string())),
     };
+    let (w, h) = options.render.size.unwrap_or((raster[0], raster[1]));
+    let size = Size::new(w, h);
+    let mut room = HostAnimationRoom::new(AnimationNeeds::of(text, size));
+    let animation = room.animation(size).map_err(|e| AnimationError::Setup(e.to_string()))?;
+    let mut animation = animation.indexed(options.render.indexing());
+    let mut errors = Vec::new();
+    match animation.load_with(scene.raytracer(), bytes, &mut |e| errors.push(e.to_string())) {
+        Ok(first) => first.scene().view().check_camera(w, h).map_err(|e| AnimationError::Setup(e.to_string()))?,
+        Err(Refused::Scene(_)) => return Err(AnimationError::Scene { frame: 0, errors }),
+        Err(Refused::NoRoom(e)) => return Err(AnimationError::Setup(e.to_string())),
+    }
+    let mut current: Option<FrameImage> = None;
+    let whole = Rectangle::new(embedded_graphics_core::geometry::Point::zero(), size);
     for frame in frames {
         let started = Instant::now();
-        load(bytes, frame, &mut scene)?;
-        let view = scene.view();
-        view.check_camera(w, h).map_err(|e| AnimationError::Setup(e.to_string()))?;
         let image = current.get_or_insert_with(|| FrameImage {
             image: RgbImage::new(w, h),
             objects: vec![NO_OBJECT; w as usize * h as usize],
+            traced: Vec::new(),
         });
-        let octree = build_octree(&scene, options.render.accel, &options.render.octree);
-        let mut lights = HostLightBuffer::new();
-        let cells = if options.render.accel == AccelMode::Naive { 0 } else { options.render.light_buffer };
-        let lights = if cells > 0 { lights.build(&view, cells) } else { LightBuffer::NONE };
-        report.loading += started.elapsed();
-        let traced = Instant::now();
-        let watched = motion.as_ref();
-        if watched.is_some() {
-            coherence.plan();
-        } else {
-            coherence.restart();
-        }
-        report.traced += coherence.traced_pixels();
-        let job = Job { view, coherence: &coherence, motion: watched, frame, threads: options.render.threads };
-        let stats = match &octree {
-            Some(tree) => job.run(&LightBuffered::new(&**tree, lights), image, progress),
-            None => job.run(&LightBuffered::new(&Naive, lights), image, progress),
+        let stats = match options.coherence {
+            true => {
+                let loaded = animation.load(scene.raytracer(), text, frame).map_err(|e| match e {
+                    Refused::Scene(e) => AnimationError::Scene { frame, errors: vec![e.to_string()] },
+                    Refused::NoRoom(e) => AnimationError::Setup(e.to_string()),
+                })?;
+                report.loading += started.elapsed();
+                let traced = Instant::now();
+                image.traced = loaded.tiles().traced_areas().collect();
+                report.traced += loaded.tiles().traced_pixels();
+                let stats = draw_frame(&loaded, image, options.render.threads, progress);
+                report.tracing += traced.elapsed();
+                if report.frames == 0 {
+                    report.first_tracing = traced.elapsed();
+                }
+                stats
+            }
+            // Every frame whole, as a still: no watching of the motion.
+            false => {
+                load_frame_bytes("", bytes, frame, &mut scene).map_err(|e| match e {
+                    crate::LoadError::Scene(errors) => AnimationError::Scene { frame, errors },
+                    crate::LoadError::Io(e) => AnimationError::Setup(e.to_string()),
+                })?;
+                let indexed = scene.index(&options.render);
+                report.loading += started.elapsed();
+                let traced = Instant::now();
+                image.traced = vec![whole];
+                report.traced += u64::from(w) * u64::from(h);
+                let rows = 0..h;
+                let mut sink = Whole(image);
+                let streamed =
+                    stream_threads(indexed.scene.share(), (w, h), rows, &options.render, progress, &mut sink);
+                report.tracing += traced.elapsed();
+                if report.frames == 0 {
+                    report.first_tracing = traced.elapsed();
+                }
+                match streamed {
+                    Ok((stats, _, _)) => stats,
+                    Err(StreamError::Camera(e)) => return Err(AnimationError::Setup(e.to_string())),
+                    Err(StreamError::Sink(e)) => return Err(AnimationError::Write(e)),
+                    Err(StreamError::Stopped) => return Err(AnimationError::Setup("stopped".into())),
+                }
+            }
         };
         report.stats.add(&stats);
-        if report.frames == 0 {
-            report.first_tracing = traced.elapsed();
-        }
-        report.tracing += traced.elapsed();
         report.frames += 1;
         report.pixels += u64::from(w) * u64::from(h);
         each(frame, image).map_err(AnimationError::Write)?;
@@ -150,98 +181,106 @@ pub fn render_frames(
     Ok(report)
 }
 
-/// Parses frame `frame` of `bytes` into `scene`.
-fn load(bytes: &[u8], frame: u32, scene: &mut HostScene) -> Result<(), AnimationError> {
-    let mut errors = Vec::new();
-    let mut on_error = |e: ParseError<'_>| errors.push(e.to_string());
-    match parse_frame_bytes(bytes, scene, frame, &mut on_error) {
-        Ok(_) => Ok(()),
-        Err(_) => Err(AnimationError::Scene { frame, errors }),
+/// A frame whole, row by row, into its image.
+struct Whole<'i>(&'i mut FrameImage);
+
+impl RowSink for Whole<'_> {
+    fn row(&mut self, y: u32, colors: &[u8], objects: &[u32]) -> std::io::Result<()> {
+        let (w, y) = (self.0.image.width as usize, y as usize);
+        self.0.image.data[3 * y * w..3 * (y + 1) * w].copy_from_slice(colors);
+        self.0.objects[y * w..(y + 1) * w].copy_from_slice(objects);
+        Ok(())
     }
 }
 
-/// One frame's tracing, shared by the threads.
-struct Job<'a> {
-    view: SceneView<'a>,
-    coherence: &'a Coherence<'a>,
-    /// The motion, when tracing with coherence (else every tile whole).
-    motion: Option<&'a Motion<'a>>,
-    frame: u32,
+/// Draws `frame`'s planned tiles into `image` on `threads` threads, each
+/// drawing the next band of tiles not yet taken with a renderer of its
+/// own (as a board's cores do); `progress(pixels)` after each band.
+fn draw_frame(
+    frame: &Frame<'_, '_, Host>,
+    image: &mut FrameImage,
     threads: usize,
-}
-
-impl Job<'_> {
-    /// Traces the planned tiles into `image` on the threads, each taking
-    /// the next band not yet taken.
-    fn run<A: Accelerator + Sync>(&self, accel: &A, image: &mut FrameImage, progress: &(dyn Fn(u64) + Sync)) -> Stats {
-        let (w, side) = (image.image.width as usize, self.coherence.side() as usize);
-        // Each band's rows, to be written by the thread that traces it.
-        let bands: Vec<Mutex<(&mut [u8], &mut [u32])>> =
-            image.image.data.chunks_mut(3 * w * side).zip(image.objects.chunks_mut(w * side)).map(Mutex::new).collect();
-        let next = AtomicU32::new(0);
-        let worker = || {
-            let objects = self.view.object_count();
-            let mut words = vec![0u32; Mailbox::words_for(objects)];
-            let mut bounds = vec![ScreenBound::EMPTY; objects];
-            let mut positions = vec![0; ScreenBound::positions_for(objects)];
-            let size = self.coherence.size();
-            let Ok(renderer) = Renderer::with_size(self.view, accel, size.width, size.height) else {
-                return Stats::default();
-            };
-            let mut renderer = renderer.with_mailbox(&mut words).with_first_hits(&mut bounds, &mut positions);
-            loop {
-                let band = next.fetch_add(1, Ordering::Relaxed);
-                let Some(rows) = bands.get(band as usize) else { break };
-                let pixels = self.coherence.band_pixels(band);
-                let mut rows = rows.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-                let (colors, objects) = &mut *rows;
-                let top = band as usize * side;
-                let mut write = |line: &embedded_graphics_core::primitives::Rectangle,
-                                 pixels: &mut dyn Iterator<Item = PixelSample>|
-                 -> Result<(), std::convert::Infallible> {
-                    let (x0, y) = (line.top_left.x as usize, line.top_left.y as usize - top);
-                    for (i, p) in pixels.enumerate() {
-                        let at = y * w + x0 + i;
-                        colors[3 * at..3 * at + 3].copy_from_slice(&[p.color.r(), p.color.g(), p.color.b()]);
-                        objects[at] = p.object.map_or(NO_OBJECT, |o| o.0);
-                    }
-                    Ok(())
-                };
-                let traced = match self.motion {
-                    Some(motion) => self.coherence.trace_band(&mut renderer, motion, self.frame, band, &mut write),
-                    None => whole_band(&mut renderer, self.coherence, band, &mut write).map(|()| Stats::default()),
-                };
-                let Ok(_) = traced;
-                progress(pixels);
+    progress: &(dyn Fn(u64) + Sync),
+) -> Stats {
+    let (shared, tiles) = (frame.share(), frame.tiles());
+    let (width, side) = (image.image.width as usize, tiles.side() as usize);
+    // Each band's rows, written by the thread that draws it.
+    let bands: Vec<Mutex<(&mut [u8], &mut [u32])>> = image
+        .image
+        .data
+        .chunks_mut(3 * width * side)
+        .zip(image.objects.chunks_mut(width * side))
+        .map(Mutex::new)
+        .collect();
+    let next = AtomicU32::new(0);
+    let worker = || {
+        let room = RendererRoom::<Host>::new();
+        // The band taken last, reported done as the next is taken.
+        let last = Cell::new(None);
+        let take = || {
+            if let Some(band) = last.take() {
+                progress(tiles.band_pixels(band));
             }
-            renderer.stats()
+            let band = next.fetch_add(1, Ordering::Relaxed);
+            let band = (band < tiles.bands()).then_some(band);
+            last.set(band);
+            band
         };
-        let mut stats = Stats::default();
-        std::thread::scope(|scope| {
-            let handles: Vec<_> = (0..self.threads.max(1)).map(|_| scope.spawn(worker)).collect();
-            for handle in handles {
-                let s = handle.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-                stats.add(&s);
-            }
-        });
-        stats
+        let mut target = Bands { bands: &bands, width, side, size: tiles.size() };
+        shared.image::<PixelSample>(&room, tiles.size()).bands(&take).try_draw(&mut target).unwrap_or_default()
+    };
+    let mut stats = Stats::default();
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..threads.max(1)).map(|_| scope.spawn(worker)).collect();
+        for handle in handles {
+            stats.add(&handle.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)));
+        }
+    });
+    stats
+}
+
+/// A frame's image as its bands of tiles, each behind a lock: each run of
+/// pixels drawn goes to its band's rows.
+struct Bands<'b, 'i> {
+    bands: &'b [Mutex<(&'i mut [u8], &'i mut [u32])>],
+    width: usize,
+    side: usize,
+    size: Size,
+}
+
+impl OriginDimensions for Bands<'_, '_> {
+    fn size(&self) -> Size {
+        self.size
     }
 }
 
-/// Band `band` traced whole, without the lookout's cost: a frame of
-/// `--no-coherence`.
-fn whole_band<A: Accelerator>(
-    renderer: &mut Renderer<'_, A>,
-    coherence: &Coherence<'_>,
-    band: u32,
-    each: &mut RunSink<'_, std::convert::Infallible>,
-) -> Result<(), std::convert::Infallible> {
-    use embedded_graphics_core::geometry::{Point, Size};
-    let (side, size) = (coherence.side(), coherence.size());
-    for y in band * side..((band + 1) * side).min(size.height) {
-        let line =
-            embedded_graphics_core::primitives::Rectangle::new(Point::new(0, y as i32), Size::new(size.width, 1));
-        each(&line, &mut renderer.row(y, 0..size.width))?;
+impl DrawTarget for Bands<'_, '_> {
+    type Color = PixelSample;
+    type Error = std::convert::Infallible;
+
+    fn draw_iter<I: IntoIterator<Item = Pixel<PixelSample>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
+        for Pixel(at, sample) in pixels {
+            let area = Rectangle::new(at, Size::new(1, 1));
+            self.fill_contiguous(&area, [sample])?;
+        }
+        Ok(())
     }
-    Ok(())
+
+    fn fill_contiguous<I: IntoIterator<Item = PixelSample>>(
+        &mut self,
+        area: &Rectangle,
+        samples: I,
+    ) -> Result<(), Self::Error> {
+        let (x0, y) = (area.top_left.x as usize, area.top_left.y as usize);
+        let Some(band) = self.bands.get(y / self.side) else { return Ok(()) };
+        let mut rows = band.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        let (colors, objects) = &mut *rows;
+        let row = y % self.side;
+        for (i, p) in samples.into_iter().take(area.size.width as usize).enumerate() {
+            let at = row * self.width + x0 + i;
+            colors[3 * at..3 * at + 3].copy_from_slice(&[p.color.r(), p.color.g(), p.color.b()]);
+            objects[at] = p.object.map_or(NO_OBJECT, |o| o.0);
+        }
+        Ok(())
+    }
 }

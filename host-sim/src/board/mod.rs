@@ -410,7 +410,7 @@ fn host_render(file: &str, text: &[u8], frame: u32, panel: Panel) -> Result<RgbI
         threads: all_cores(),
         ..RenderOptions::default()
     };
-    let rendered = render_with_progress(&scene, &options, &|_| {})
+    let rendered = render_with_progress(&mut scene, &options, &|_| {})
         .map_err(|e| mismatch(format!("host-sim cannot set up the camera: {e}")))?;
     let color = match panel.format {
         PixelFormat::Rgb565 => PanelColor::Rgb565,

@@ -17,8 +17,9 @@ use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::Rgb888;
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
-use host_sim::{build_octree, load_file, new_scene, AccelMode};
-use octrace_core::render::{Progressive, Renderer};
+use octrace_core::profile::Host;
+use octrace_core::render::Progressive;
+use octrace_core::{AccelMode, Raytracer};
 use octrace_tests::repo;
 
 /// The bus: bits a second, bytes a window command, bytes a pixel.
@@ -98,15 +99,15 @@ fn main() {
         None => Size::new(240, 240),
     };
     let scene_name = args.first().cloned().unwrap_or_else(|| "fig5_1".to_owned());
-    let mut scene = new_scene();
-    if let Err(e) = load_file(&repo().join("scenes").join(format!("{scene_name}.txt")), &mut scene) {
-        eprintln!("progressive-bench: {e}");
+    let text = std::fs::read(repo().join("scenes").join(format!("{scene_name}.txt"))).unwrap_or_else(|e| {
+        eprintln!("progressive-bench: {scene_name}: {e}");
         std::process::exit(1);
-    }
-    let Some(tree) = build_octree(&scene, AccelMode::Dda, &host_sim::OCTREE) else {
-        eprintln!("progressive-bench: no octree for {scene_name}");
+    });
+    let mut raytracer = Box::new(Raytracer::<Host>::new());
+    let scene = raytracer.load_with(&text, AccelMode::Dda, &mut |_| {}).unwrap_or_else(|e| {
+        eprintln!("progressive-bench: {scene_name}: {e}");
         std::process::exit(1);
-    };
+    });
 
     println!(
         "| {}×{} order | first pass: traces | rectangles | pixels | bus | all: rectangles (two cores / one) | pixels | bus | more than direct |",
@@ -129,10 +130,11 @@ fn main() {
         }
         let all = bus.sent;
         // One core, tracing.
-        let mut renderer =
-            Renderer::with_size(scene.view(), &*tree, size.width, size.height).unwrap_or_else(|e| panic!("{e}"));
         let mut bus = Bus { size, sent: Sent::default() };
-        let stats = order.render(&mut renderer, &mut bus).unwrap_or_else(|e| panic!("{e}"));
+        let stats = scene
+            .with_renderer(size, |renderer| order.render(renderer, &mut bus))
+            .unwrap_or_else(|e| panic!("{e}"))
+            .unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(bus.sent.pixels, all.pixels, "one core sends the same pixels");
         assert!(stats.rays >= size.width as u64 * size.height as u64, "every pixel traced");
         let direct = *direct_ms.get_or_insert(all.bus_ms());

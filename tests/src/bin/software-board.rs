@@ -20,18 +20,17 @@
 //! does with one ([`Misbehaviour`]): `draws-at:WxH`, `wrong-pixel`,
 //! `errors-every:MS`, `reads-slowly`, `escapes`.
 
+use embedded_graphics_core::geometry::Size;
 use embedded_graphics_core::pixelcolor::{Rgb565, RgbColor};
-use octrace_core::accel::Mailbox;
-use octrace_core::animation::{Coherence, Key, Track};
+use octrace_core::animation::{AnimationNeeds, HostAnimationRoom};
 use octrace_core::profile::{Board16K, Board64K, Host, Profile};
-use octrace_core::render::Renderer;
 use octrace_core::Raytracer;
-use octrace_link::board::{AnimationRoom, Board, Line, Link, TILE};
+use octrace_link::board::{Board, Line, Link};
 use octrace_link::{Counters, Decoder, Message, Panel, PixelFormat, SceneError, Timing, OVERHEAD};
 use std::collections::VecDeque;
 use std::fs::File;
 use std::io::{ErrorKind, Read, Write};
-use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{self, Receiver, TryRecvError};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -320,23 +319,18 @@ impl Line for Pty {
 /// trace every tile of every frame, the same pictures).
 fn serve<P: Profile>(options: &Options, line: &mut Pty, controls: &Controls) {
     let (width, height) = (u32::from(options.panel.width), u32::from(options.panel.height));
-    let tiles: Vec<AtomicU8> = (0..Coherence::tiles_for(width, height, TILE)).map(|_| AtomicU8::new(0)).collect();
     // As much motion as the live firmware holds, and more.
-    let (mut tracks, mut keys, mut displacements) =
-        (vec![Track::EMPTY; 256], vec![Key::default(); 4096], vec![[0; 3]; 1 << 16]);
-    let room = AnimationRoom { tiles: &tiles, tracks: &mut tracks, keys: &mut keys, displacements: &mut displacements };
+    let size = Size::new(width, height);
+    let mut room =
+        HostAnimationRoom::new(AnimationNeeds { tiles: AnimationNeeds::tiles_for(size), tracks: 256, keys: 4096 });
+    let Ok(animation) = room.animation(size) else { return };
     let mut link =
-        Link::new(options.panel, FIRMWARE, vec![0u8; options.max_scene + OVERHEAD + 1]).with_animations(room);
+        Link::new(options.panel, FIRMWARE, vec![0u8; options.max_scene + OVERHEAD + 1]).with_animations(animation);
     let mut raytracer = Box::new(Raytracer::<P>::new());
     let mut row = vec![Rgb565::default(); width as usize];
     while link
         .serve(line, &mut raytracer, |drawing, rows| {
-            let scene = drawing.scene();
-            let accelerator = scene.accelerator();
-            let Ok(renderer) = Renderer::with_size(scene.view(), &accelerator, width, height) else { return 0 };
-            let mut mailbox = vec![0u32; Mailbox::words_for(scene.view().object_count())];
-            let mut renderer = renderer.with_mailbox(&mut mailbox);
-            rows.draw_on_one_core(drawing, &mut renderer, &mut row, |area, pixels| {
+            rows.draw_on_one_core(drawing, &mut row, |area, pixels| {
                 let mut panel = controls.panel.lock().unwrap_or_else(|e| e.into_inner());
                 let at = area.top_left.y as usize * width as usize + area.top_left.x as usize;
                 panel[at..at + pixels.len()].copy_from_slice(pixels);
@@ -374,26 +368,24 @@ fn serve_hostile<P: Profile>(options: &Options, misbehave: Misbehaviour, line: &
         }
         let started = Instant::now();
         out.clear();
-        let answered = board.answer(received, &mut *raytracer, &mut out);
+        let answered = board.answer(received, &mut *raytracer, None, &mut out);
         let loaded = Instant::now();
         line.send_bytes(&out);
         let Ok(Some(drawing)) = answered else { continue };
-        let scene = drawing.scene();
-        let accelerator = scene.accelerator();
-        let mut mailbox = vec![0u32; Mailbox::words_for(scene.view().object_count())];
         out.clear();
-        match Renderer::with_size(scene.view(), &accelerator, width, height) {
-            Ok(renderer) => {
-                let mut renderer = renderer.with_mailbox(&mut mailbox);
-                for y in 0..height {
-                    for (pixel, sample) in row.iter_mut().zip(renderer.row(y, 0..width)) {
-                        *pixel = sample.color.into();
-                    }
-                    if y == 0 && misbehave == Misbehaviour::WrongPixel {
-                        row[0] = if row[0] == Rgb565::WHITE { Rgb565::BLACK } else { Rgb565::WHITE };
-                    }
-                    let _ = drawing.send_row(y as u16, &row, &mut out);
+        let drawn = drawing.scene().with_renderer(Size::new(width, height), |renderer| {
+            for y in 0..height {
+                for (pixel, sample) in row.iter_mut().zip(renderer.row(y, 0..width)) {
+                    *pixel = sample.color.into();
                 }
+                if y == 0 && misbehave == Misbehaviour::WrongPixel {
+                    row[0] = if row[0] == Rgb565::WHITE { Rgb565::BLACK } else { Rgb565::WHITE };
+                }
+                let _ = drawing.send_row(y as u16, &row, &mut out);
+            }
+        });
+        match drawn {
+            Ok(()) => {
                 // By the host's clock; it has no counters.
                 let (elapsed, render) = (started.elapsed(), loaded.elapsed());
                 let timing = Timing {

@@ -213,6 +213,9 @@ pub trait OctreeStore: Accelerator {
     /// Whether it is walked by 3DDDA (the thesis's walk stays the thesis's
     /// for every ray, camera rays included).
     fn walked_by_dda(&self) -> bool;
+
+    /// What its last build produced.
+    fn report(&self) -> &BuildReport;
 }
 
 impl<C: OctreeCapacities, const FRAMES: usize> OctreeStore for Octree<C, FRAMES> {
@@ -226,6 +229,10 @@ impl<C: OctreeCapacities, const FRAMES: usize> OctreeStore for Octree<C, FRAMES>
 
     fn walked_by_dda(&self) -> bool {
         self.walked_by() == Traversal::Dda
+    }
+
+    fn report(&self) -> &BuildReport {
+        Octree::report(self)
     }
 }
 

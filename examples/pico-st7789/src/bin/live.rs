@@ -27,7 +27,6 @@
 
 use core::cell::RefCell;
 use core::ops::ControlFlow;
-use core::sync::atomic::AtomicU8;
 use critical_section::Mutex;
 use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 use embedded_graphics::prelude::*;
@@ -35,9 +34,9 @@ use embedded_graphics::primitives::Rectangle;
 use hal::multicore::Stack;
 use hal::pac::interrupt;
 use hal::{entry, pac, Timer, Watchdog};
-use octrace_core::animation::{Coherence, Key, Track};
+use octrace_core::animation::{AnimationNeeds, AnimationRoom};
 use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
-use octrace_link::board::{AnimationRoom, Line, Link, Playing, Ring, TILE};
+use octrace_link::board::{Line, Link, Ring};
 use octrace_link::{Panel, PixelFormat};
 use octrace_pico::animation::{self, Runs};
 use octrace_pico::{board, both_cores};
@@ -71,15 +70,16 @@ octrace_core::profile! {
 /// Room for the scene, its octree and core 0's mailbox and lists.
 static RAYTRACER: ConstStaticCell<Raytracer<LiveProfile>> = ConstStaticCell::new(Raytracer::new());
 
-/// An animation's tiles: a byte each, 3,600 for the 240×240 panel.
-const TILES: usize = Coherence::tiles_for(panel::WIDTH as u32, panel::HEIGHT as u32, TILE);
-static TILE_COUNTS: [AtomicU8; TILES] = [const { AtomicU8::new(0) }; TILES];
-
-/// An animation's motion: its `MOVE`s, their keys, and the frames of each
-/// moving object statement (anim_fig5_1 needs 1, 6 and 48): 2.8 KiB.
-static TRACKS: ConstStaticCell<[Track; 8]> = ConstStaticCell::new([Track::EMPTY; 8]);
-static KEYS: ConstStaticCell<[Key; 32]> = ConstStaticCell::new([Key::EMPTY; 32]);
-static DISPLACEMENTS: ConstStaticCell<[[i32; 3]; 192]> = ConstStaticCell::new([[0; 3]; 192]);
+/// What the animations it plays may take: a byte a tile of the 240×240
+/// panel (3,600), and 8 `MOVE`s of 32 keys in all, however many frames
+/// (anim_fig5_1 takes 1 and 6): 5.8 KiB.
+const ANIMATION: AnimationNeeds = AnimationNeeds {
+    tiles: AnimationNeeds::tiles_for(Size::new(panel::WIDTH as u32, panel::HEIGHT as u32)),
+    tracks: 8,
+    keys: 32,
+};
+static ANIMATION_ROOM: ConstStaticCell<AnimationRoom<{ ANIMATION.tiles }, { ANIMATION.tracks }, { ANIMATION.keys }>> =
+    ConstStaticCell::new(AnimationRoom::new());
 
 /// Core 1's own mailbox and screen lists.
 static CORE1_ROOM: ConstStaticCell<RendererRoom<LiveProfile>> = ConstStaticCell::new(RendererRoom::new());
@@ -135,13 +135,10 @@ fn main() -> ! {
 
     let size = display.size();
     let panel = Panel { width: size.width as u16, height: size.height as u16, format: PixelFormat::Rgb565 };
-    let room = AnimationRoom {
-        tiles: &TILE_COUNTS,
-        tracks: TRACKS.take(),
-        keys: KEYS.take(),
-        displacements: DISPLACEMENTS.take(),
-    };
-    let mut link = Link::new(panel, FIRMWARE, FRAME_BUFFER.take()).with_animations(room);
+    let mut link = Link::new(panel, FIRMWARE, FRAME_BUFFER.take());
+    if let Ok(animation) = ANIMATION_ROOM.take().animation(size) {
+        link = link.with_animations(animation);
+    }
     let raytracer = RAYTRACER.take();
     let room = CORE1_ROOM.take();
     let mut line = UsbLine { timer, watchdog, meter: Meter::new(timer, peripherals.busctrl) };
@@ -150,7 +147,7 @@ fn main() -> ! {
             let rows = RefCell::new(rows);
             // Never borrowed twice: a row or a run is sent between asks.
             let mut stop = || rows.try_borrow_mut().map_or(true, |mut rows| rows.poll());
-            if let Some(playing) = drawing.playing() {
+            if let Some(frame) = drawing.frame() {
                 // An animation's frame: its planned runs, on both cores,
                 // each shown and sent back whole.
                 let mut panel = SentRuns {
@@ -162,18 +159,7 @@ fn main() -> ! {
                         }
                     },
                 };
-                let Playing { frame, motion, coherence } = playing;
-                let drawn = animation::draw_frame_until(
-                    &mut core1,
-                    drawing.scene(),
-                    motion,
-                    frame,
-                    coherence,
-                    &mut *room,
-                    &RUNS,
-                    &mut panel,
-                    &mut stop,
-                );
+                let drawn = animation::draw_frame_until(&mut core1, frame, &mut *room, &RUNS, &mut panel, &mut stop);
                 return if drawn.is_ok() { drawing.panel().height } else { 0 };
             }
             let mut drawn = 0;

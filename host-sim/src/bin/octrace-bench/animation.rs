@@ -5,12 +5,16 @@
 //! takes for a 240×240 panel.
 
 use super::{ms, BenchError};
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{OriginDimensions, Size};
+use embedded_graphics_core::pixelcolor::Rgb888;
+use embedded_graphics_core::Pixel;
 use host_sim::animation::{render_frames, AnimationOptions, AnimationReport, FrameImage, COHERENCE_TILE};
 use host_sim::RenderOptions;
-use octrace_core::accel::{Mailbox, Naive};
-use octrace_core::animation::{Coherence, Key, Motion, MotionNeeds, Track};
-use octrace_core::render::Renderer;
+use octrace_core::animation::{AnimationNeeds, Coherence, HostAnimationRoom};
+use octrace_core::profile::Host;
 use octrace_core::scene::Frames;
+use octrace_core::{AccelMode, Raytracer};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
@@ -55,68 +59,68 @@ fn changed(bytes: &[u8], images: &[FrameImage], size: (u32, u32)) -> (f64, f64) 
         let now = &images[k];
         let mask: Vec<bool> = before.image.data.chunks(3).zip(now.image.data.chunks(3)).map(|(a, b)| a != b).collect();
         changed += mask.iter().filter(|&&m| m).count() as u64;
-        let mut scene = host_sim::new_scene();
-        host_sim::load_frame_bytes("", bytes, k as u32, &mut scene).expect("loads");
-        let view = scene.view();
-        let mut words = vec![0; Mailbox::words_for(view.object_count())];
-        let mut renderer = Renderer::with_size(view, &Naive, w, h).expect("a camera").with_mailbox(&mut words);
-        let mut trace = |masked: bool| {
-            let started = Instant::now();
-            for y in 0..h {
-                for x in 0..w {
-                    if !masked || mask[(y * w + x) as usize] {
-                        std::hint::black_box(renderer.pixel(x, y));
+        let mut raytracer = Box::new(Raytracer::<Host>::new());
+        let scene = raytracer.load_frame_with(bytes, k as u32, AccelMode::Naive, &mut |_| {}).expect("loads");
+        let traced = scene.with_renderer(Size::new(w, h), |renderer| {
+            let mut trace = |masked: bool| {
+                let started = Instant::now();
+                for y in 0..h {
+                    for x in 0..w {
+                        if !masked || mask[(y * w + x) as usize] {
+                            std::hint::black_box(renderer.pixel(x, y));
+                        }
                     }
                 }
-            }
-            started.elapsed()
-        };
-        only += trace(true);
-        all += trace(false);
+                started.elapsed()
+            };
+            (trace(true), trace(false))
+        });
+        let (masked, whole) = traced.expect("a camera");
+        only += masked;
+        all += whole;
     }
     let pixels = (images.len() as u64 * u64::from(w) * u64::from(h)) as f64;
     (changed as f64 / pixels, only.as_secs_f64() / all.as_secs_f64())
 }
 
 /// The coherence's share at `size` with tiles of `side`, through the core's
-/// board API (one core), after the first frame.
+/// board API (one core, the naive mode), after the first frame.
 fn share_at(text: &str, size: (u32, u32), side: u32) -> f64 {
-    use core::sync::atomic::AtomicU8;
-    use embedded_graphics_core::geometry::Size;
-    let counts: Vec<AtomicU8> = (0..Coherence::tiles_for(size.0, size.1, side)).map(|_| AtomicU8::new(0)).collect();
-    let coherence = Coherence::new(&counts, Size::new(size.0, size.1), side).expect("room");
-    let mut scene = host_sim::new_scene();
-    host_sim::load_frame_bytes("", text.as_bytes(), 0, &mut scene).expect("loads");
-    let frames = octrace_core::parse::parse_frame(text, &mut scene, 0, &mut |_| {}).expect("loads").frames;
-    let frames = frames.expect("an animation");
-    let needs = Motion::needs(text);
-    let (mut tracks, mut keys, mut table) =
-        (vec![Track::EMPTY; needs.tracks], vec![Key::default(); needs.keys], vec![[0; 3]; needs.displacements]);
-    let motion = Motion::read(text, frames, &scene.view(), 0, &mut tracks, &mut keys, &mut table).expect("room");
+    let image = Size::new(size.0, size.1);
+    let tiles = Coherence::tiles_for(size.0, size.1, side);
+    let mut room = HostAnimationRoom::new(AnimationNeeds { tiles, ..AnimationNeeds::of(text, image) });
+    let mut animation = room.animation_in_tiles(image, side).expect("room").indexed(AccelMode::Naive);
+    let mut raytracer = Box::new(Raytracer::<Host>::new());
+    let frames = raytracer.load(text).expect("loads").frames().expect("an animation");
     let (mut traced, mut pixels) = (0u64, 0u64);
     for frame in frames.all() {
-        let mut scene = host_sim::new_scene();
-        host_sim::load_frame_bytes("", text.as_bytes(), frame, &mut scene).expect("loads");
-        let view = scene.view();
-        coherence.plan();
+        let loaded = animation.load(&mut raytracer, text, frame).expect("loads");
         if frame > 0 {
-            traced += coherence.traced_pixels();
+            traced += loaded.tiles().traced_pixels();
             pixels += u64::from(size.0) * u64::from(size.1);
         }
-        let mut renderer = Renderer::with_size(view, &Naive, size.0, size.1).expect("a camera");
-        for band in 0..coherence.bands() {
-            let _ = coherence.trace_band(&mut renderer, &motion, frame, band, &mut |_, pixels| {
-                pixels.for_each(drop);
-                Ok::<(), ()>(())
-            });
-        }
+        loaded.image().try_draw(&mut Nowhere(image)).expect("draws");
     }
     traced as f64 / pixels as f64
 }
 
-/// Bytes the motion of `needs` takes.
-fn motion_bytes(needs: MotionNeeds) -> usize {
-    needs.tracks * size_of::<Track>() + needs.keys * size_of::<Key>() + needs.displacements * size_of::<[i32; 3]>()
+/// A panel that shows nothing.
+struct Nowhere(Size);
+
+impl OriginDimensions for Nowhere {
+    fn size(&self) -> Size {
+        self.0
+    }
+}
+
+impl DrawTarget for Nowhere {
+    type Color = Rgb888;
+    type Error = std::convert::Infallible;
+
+    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb888>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
+        pixels.into_iter().for_each(drop);
+        Ok(())
+    }
 }
 
 pub(crate) fn table(dir: &Path) -> Result<(), BenchError> {
@@ -191,14 +195,14 @@ pub(crate) fn table(dir: &Path) -> Result<(), BenchError> {
         let share = share_at(&text, (240, 240), side);
         println!("| {side}×{side} | {} | {:.1} % |", Coherence::tiles_for(240, 240, side), 100.0 * share);
     }
-    let needs = Motion::needs(&text);
+    let needs = AnimationNeeds { tiles: 0, ..AnimationNeeds::of(&text, Size::new(240, 240)) };
+    let track = AnimationNeeds { tiles: 0, tracks: 1, keys: 0 }.bytes();
+    let key = AnimationNeeds { tiles: 0, tracks: 0, keys: 1 }.bytes();
     println!(
-        "\nMotion (one track, {} keys, {} frames): {} bytes ({} a track, {} a key, 12 a frame of a moving object).\n",
+        "\nMotion (one track, {} keys, {} frames): {} bytes ({track} a track, {key} a key, whatever the frames).\n",
         needs.keys,
         frames.count,
-        motion_bytes(needs),
-        size_of::<Track>(),
-        size_of::<Key>()
+        needs.bytes()
     );
     Ok(())
 }

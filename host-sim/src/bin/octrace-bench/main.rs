@@ -14,10 +14,10 @@
 //! first so every table says where it came from.
 
 use host_sim::{
-    all_cores, build_octree, load_bytes, load_file, new_scene, render, render_prebuilt, AccelMode, HostScene,
-    LoadError, Partition, RenderOptions,
+    all_cores, build_octree, load_bytes, load_file, new_scene, render, AccelMode, HostScene, LoadError, Partition,
+    RenderOptions,
 };
-use octrace_core::accel::OctreeConfig;
+use octrace_core::accel::{BuildReport, OctreeConfig};
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -181,9 +181,29 @@ pub(crate) fn load(path: &Path) -> Result<Box<HostScene>, BenchError> {
 }
 
 /// Render time (best of `runs`), including the octree build.
-fn time(scene: &HostScene, accel: AccelMode, octree: OctreeConfig, size: Option<(u32, u32)>, runs: usize) -> Duration {
+fn time(
+    scene: &mut HostScene,
+    accel: AccelMode,
+    octree: OctreeConfig,
+    size: Option<(u32, u32)>,
+    runs: usize,
+) -> Duration {
     let options = RenderOptions { size, accel, octree, ..Default::default() };
     best_of(runs, || render(scene, &options).map(|r| r.stats)).0
+}
+
+/// Render time alone (the octree and light buffer built beforehand),
+/// best of `runs`.
+fn render_time(scene: &mut HostScene, options: &RenderOptions, runs: usize) -> Duration {
+    (0..runs).map(|_| render(scene, options).expect("renders").wall).min().expect("a run")
+}
+
+/// The octree `mode` walks with `config`: its report, and its build's
+/// time (best of `runs`).
+fn octree_build(scene: &mut HostScene, mode: AccelMode, config: &OctreeConfig, runs: usize) -> (BuildReport, Duration) {
+    let builds: Vec<_> = (0..runs).map(|_| build_octree(scene, mode, config).expect("an octree")).collect();
+    let fastest = builds.iter().map(|(_, d)| *d).min().expect("a build");
+    (builds[0].0, fastest)
 }
 
 fn scenes_table(dir: &Path) -> Result<(), BenchError> {
@@ -192,16 +212,16 @@ fn scenes_table(dir: &Path) -> Result<(), BenchError> {
     println!("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |");
     for path in scene_files(dir) {
         let name = path.file_stem().unwrap_or_default().to_string_lossy().into_owned();
-        let scene = load(&path)?;
+        let mut scene = load(&path)?;
         let view = scene.view();
-        let [w, h] = view.settings.raster;
+        let ([w, h], objects, lights) = (view.settings.raster, view.object_count(), view.lights.len());
         let naive = RenderOptions { accel: AccelMode::Naive, ..Default::default() };
-        let (time, stats) = best_of(3, || render(&scene, &naive).map(|r| r.stats));
+        let (time, stats) = best_of(3, || render(&mut scene, &naive).map(|r| r.stats));
         let Ok(stats) = stats else { continue };
         println!(
             "| {name} | {w}×{h} | {} | {} | {} | {} | {} | {:.0} |",
-            view.object_count(),
-            view.lights.len(),
+            objects,
+            lights,
             stats.rays,
             stats.shadow_rays,
             ms(time),
@@ -228,11 +248,11 @@ fn table51(dir: &Path) -> Result<(), BenchError> {
         ("freeform", "—", "—", "—", 1),
     ];
     for (name, tn, tf, tr, runs) in rows {
-        let scene = load(&dir.join(format!("{name}.txt")))?;
+        let mut scene = load(&dir.join(format!("{name}.txt")))?;
         let c = host_sim::OCTREE;
-        let naive = time(&scene, AccelMode::Naive, c, None, runs);
-        let octree = time(&scene, AccelMode::Octree, c, None, 3);
-        let dda = time(&scene, AccelMode::Dda, c, None, 3);
+        let naive = time(&mut scene, AccelMode::Naive, c, None, runs);
+        let octree = time(&mut scene, AccelMode::Octree, c, None, 3);
+        let dda = time(&mut scene, AccelMode::Dda, c, None, 3);
         let r = |t: Duration| naive.as_secs_f64() / t.as_secs_f64();
         println!(
             "| {name} | {} | {tn} | {tf} | {tr} | {} | {} | {:.2}× | {} | {:.2}× |",
@@ -252,13 +272,13 @@ fn table52(dir: &Path) -> Result<(), BenchError> {
     println!("### Table 5.2: fig5_4 (24 spheres) by the maximum number of objects per box\n");
     println!("| objects per box | thesis (octree) | octree | dda | boxes | leaves | references | depth |");
     println!("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
-    let scene = load(&dir.join("fig5_4.txt"))?;
+    let mut scene = load(&dir.join("fig5_4.txt"))?;
     let default = host_sim::OCTREE;
     for (max, thesis) in [(2usize, "22:21"), (6, "17:52"), (8, "28:36"), (default.max_objects, "(default)")] {
         let c = OctreeConfig { max_objects: max, ..default };
-        let octree = time(&scene, AccelMode::Octree, c, None, 5);
-        let dda = time(&scene, AccelMode::Dda, c, None, 5);
-        let report = *build_octree(&scene, AccelMode::Dda, &c).map(|o| *o.report()).as_ref().expect("an octree");
+        let octree = time(&mut scene, AccelMode::Octree, c, None, 5);
+        let dda = time(&mut scene, AccelMode::Dda, c, None, 5);
+        let (report, _) = octree_build(&mut scene, AccelMode::Dda, &c, 1);
         println!(
             "| {max} | {thesis} | {} | {} | {} | {} | {} | {} |",
             ms(octree),
@@ -269,7 +289,7 @@ fn table52(dir: &Path) -> Result<(), BenchError> {
             report.depth
         );
     }
-    let naive = time(&scene, AccelMode::Naive, default, None, 5);
+    let naive = time(&mut scene, AccelMode::Naive, default, None, 5);
     println!("\nnaive on the same scene: {}\n", ms(naive));
     Ok(())
 }
@@ -331,16 +351,13 @@ fn scaling() {
         load_bytes("carpet", text.as_bytes(), &mut scene).expect("the carpet parses");
         let c = host_sim::OCTREE;
         let per_px = |d: Duration| format!("{:.0}", d.as_nanos() as f64 / pixels);
-        let naive = if n <= 10_000 { per_px(time(&scene, AccelMode::Naive, c, None, 1)) } else { "—".into() };
-        let walk = |mode| {
-            let tree = build_octree(&scene, mode, &c).expect("an octree");
-            best_of(3, || render_prebuilt(&scene, &RenderOptions::default(), Some(&tree), &|_| {}).map(|r| r.stats)).0
-        };
+        let naive = if n <= 10_000 { per_px(time(&mut scene, AccelMode::Naive, c, None, 1)) } else { "—".into() };
+        let mut walk =
+            |mode| render_time(&mut scene, &RenderOptions { accel: mode, octree: c, ..Default::default() }, 3);
         let octree = walk(AccelMode::Octree);
         let dda = walk(AccelMode::Dda);
         dda_times.push((n, dda));
-        let (build, tree) = best_of(3, || build_octree(&scene, AccelMode::Dda, &c));
-        let report = *tree.expect("an octree").report();
+        let (report, build) = octree_build(&mut scene, AccelMode::Dda, &c, 3);
         println!(
             "| {n} | {naive} | {} | {} | {} | {:.1} MB | {} | {} |",
             per_px(octree),
@@ -366,14 +383,14 @@ fn criterion(dir: &Path) -> Result<(), BenchError> {
     println!("| --- |{}", " ---: |".repeat(combos.len()));
     for path in scene_files(dir) {
         let name = path.file_stem().unwrap_or_default().to_string_lossy().into_owned();
-        let scene = load(&path)?;
+        let mut scene = load(&path)?;
         if scene.view().object_count() <= AccelMode::AUTO_NAIVE_UP_TO {
             continue;
         }
         print!("| {name} |");
         for (m, d) in combos {
             let c = OctreeConfig { max_objects: m, max_depth: d, ..host_sim::OCTREE };
-            print!(" {:.1} |", time(&scene, AccelMode::Dda, c, None, 3).as_secs_f64() * 1e3);
+            print!(" {:.1} |", time(&mut scene, AccelMode::Dda, c, None, 3).as_secs_f64() * 1e3);
         }
         println!();
     }
@@ -409,8 +426,8 @@ fn parallel(dir: &Path) -> Result<(), BenchError> {
         ("fig5_8", load(&dir.join("fig5_8.txt"))?, (800, 600)),
         ("corner", corner_scene, (800, 600)),
     ];
-    for (name, scene, size) in &cases {
-        let tree = build_octree(scene, AccelMode::Dda, &host_sim::OCTREE).expect("an octree");
+    for (name, mut scene, size) in cases {
+        let (scene, size) = (&mut *scene, &size);
         let mut one = None;
         let mut runs = vec![(Partition::Tiles, 1)];
         for threads in [2, 4].into_iter().chain((cores > 4).then_some(cores)) {
@@ -418,11 +435,10 @@ fn parallel(dir: &Path) -> Result<(), BenchError> {
             runs.push((Partition::Equal4, threads));
         }
         for (partition, threads) in runs {
-            let options = RenderOptions { size: Some(*size), threads, partition, ..Default::default() };
-            let rendered = (0..3)
-                .map(|_| render_prebuilt(scene, &options, Some(&tree), &|_| {}).expect("renders"))
-                .min_by_key(|r| r.wall)
-                .expect("three runs");
+            let options =
+                RenderOptions { size: Some(*size), accel: AccelMode::Dda, threads, partition, ..Default::default() };
+            let rendered =
+                (0..3).map(|_| render(scene, &options).expect("renders")).min_by_key(|r| r.wall).expect("three runs");
             let wall = rendered.wall.as_secs_f64();
             let one_thread = *one.get_or_insert(wall);
             let idle: f64 = rendered.busy.iter().map(|b| wall - b.as_secs_f64()).sum::<f64>() / (threads as f64 * wall);
@@ -458,8 +474,8 @@ fn palette_table(dir: &Path) -> Result<(), BenchError> {
     let mut pixels = 0.0;
     for path in scene_files(dir) {
         let name = path.file_stem().unwrap_or_default().to_string_lossy().into_owned();
-        let scene = load(&path)?;
-        let Ok(rendered) = render(&scene, &RenderOptions { threads: all_cores(), ..Default::default() }) else {
+        let mut scene = load(&path)?;
+        let Ok(rendered) = render(&mut scene, &RenderOptions { threads: all_cores(), ..Default::default() }) else {
             continue;
         };
         pixels += (rendered.image.width * rendered.image.height) as f64;
@@ -488,16 +504,15 @@ fn spheres600(dir: &Path) -> Result<(), BenchError> {
     println!("### 600 random spheres at 800×600: naive against dda (one thread, best of 3, alternating)\n");
     println!("| scene | naive | dda render | dda build | render ratio | ratio with build |");
     println!("| --- | ---: | ---: | ---: | ---: | ---: |");
-    let scene = load(&dir.join("spheres600.txt"))?;
+    let mut scene = load(&dir.join("spheres600.txt"))?;
     let c = host_sim::OCTREE;
     let size = Some((800, 600));
-    let (build, tree) = best_of(3, || build_octree(&scene, AccelMode::Dda, &c));
-    let tree = tree.expect("an octree");
-    let options = RenderOptions { size, ..Default::default() };
+    let (_, build) = octree_build(&mut scene, AccelMode::Dda, &c, 3);
+    let options = RenderOptions { size, accel: AccelMode::Dda, octree: c, ..Default::default() };
     let (mut naive, mut render) = (Duration::MAX, Duration::MAX);
     for _ in 0..3 {
-        naive = naive.min(time(&scene, AccelMode::Naive, c, size, 1));
-        render = render.min(best_of(1, || render_prebuilt(&scene, &options, Some(&tree), &|_| {}).map(|r| r.stats)).0);
+        naive = naive.min(time(&mut scene, AccelMode::Naive, c, size, 1));
+        render = render.min(render_time(&mut scene, &options, 1));
     }
     let r = |t: Duration| naive.as_secs_f64() / t.as_secs_f64();
     println!(

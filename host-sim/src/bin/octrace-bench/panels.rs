@@ -19,9 +19,9 @@ pub(crate) fn table(dir: &Path) -> Result<(), BenchError> {
     let mut renders = Vec::new();
     for path in scene_files(dir) {
         let name = path.file_stem().unwrap_or_default().to_string_lossy().into_owned();
-        let scene = load(&path)?;
+        let mut scene = load(&path)?;
         let options = RenderOptions { size: Some((128, 64)), threads: all_cores(), ..Default::default() };
-        if let Ok(rendered) = render(&scene, &options) {
+        if let Ok(rendered) = render(&mut scene, &options) {
             renders.push((name, rendered.image));
         }
     }
