@@ -63,12 +63,6 @@ pub struct Changes {
 }
 
 impl Changes {
-    /// Every pixel of a `width` × `height` frame changed: a first frame.
-    pub fn everything(width: u32, height: u32) -> Changes {
-        let bounds = (width > 0 && height > 0).then_some(Area::whole(width, height));
-        Changes { changed: vec![true; width as usize * height as usize], bounds }
-    }
-
     /// The pixels of `now` (`width` pixels a row, `channels` bytes a
     /// pixel) that differ from `before`, looked for within `retraced` when
     /// given (the areas the coherence re-traced: outside them nothing
@@ -90,6 +84,79 @@ impl Changes {
             }
         }
         changes
+    }
+}
+
+/// A frame after the first: the pixels it changed.
+pub struct Delta {
+    /// Where they lie (`None`: nothing changed).
+    pub bounds: Option<Area>,
+    /// Within `bounds`, row-major: whether each pixel changed, and every
+    /// pixel's colour (RGB).
+    pub changed: Vec<bool>,
+    pub pixels: Vec<u8>,
+}
+
+/// An animation's frames held until the loop is complete (for its colours,
+/// or a colour none of them shows): the first whole, each other
+/// as what it changed.
+pub struct LoopFrames {
+    pub width: u32,
+    pub height: u32,
+    /// The first frame (RGB), and each other's changes.
+    pub first: Vec<u8>,
+    pub later: Vec<Delta>,
+    /// The last frame, whole.
+    current: Vec<u8>,
+}
+
+impl LoopFrames {
+    /// No frame yet, of `width` × `height`.
+    pub fn new(width: u32, height: u32) -> LoopFrames {
+        LoopFrames { width, height, first: Vec::new(), later: Vec::new(), current: Vec::new() }
+    }
+
+    /// Adds the next frame (RGB), `retraced` the areas that can differ
+    /// from the one before (`None`: any).
+    pub fn push(&mut self, frame: &[u8], retraced: Option<&[Area]>) {
+        if self.current.is_empty() {
+            self.first = frame.to_vec();
+            self.current = frame.to_vec();
+            return;
+        }
+        let changes = Changes::between(&self.current, frame, self.width, 3, retraced);
+        let mut delta = Delta { bounds: changes.bounds, changed: Vec::new(), pixels: Vec::new() };
+        if let Some(area) = changes.bounds {
+            for i in area.indices(self.width) {
+                delta.changed.push(changes.changed[i]);
+                delta.pixels.extend_from_slice(&frame[3 * i..3 * i + 3]);
+            }
+        }
+        self.current.copy_from_slice(frame);
+        self.later.push(delta);
+    }
+
+    /// Frames held.
+    pub fn len(&self) -> usize {
+        usize::from(!self.first.is_empty()) + self.later.len()
+    }
+
+    /// Whether no frame is held.
+    pub fn is_empty(&self) -> bool {
+        self.first.is_empty()
+    }
+
+    /// A colour no frame shows (`None` when every one of the 2²⁴ does).
+    pub fn unused_colour(&self) -> Option<[u8; 3]> {
+        let mut seen = vec![0u64; 1 << 18];
+        let pixels = self.first.chunks(3).chain(self.later.iter().flat_map(|d| d.pixels.chunks(3)));
+        for p in pixels {
+            let c = (usize::from(p[0]) << 16) | (usize::from(p[1]) << 8) | usize::from(p[2]);
+            seen[c >> 6] |= 1 << (c & 63);
+        }
+        let (word, bits) = seen.iter().enumerate().find(|(_, &bits)| bits != u64::MAX)?;
+        let c = (word << 6) | (!bits).trailing_zeros() as usize;
+        Some([(c >> 16) as u8, (c >> 8) as u8, c as u8])
     }
 }
 

@@ -122,7 +122,7 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
             gif.finish().map(|_| ())
         }),
         Output::Apng => write_atomically(request.out, |f| {
-            let mut apng = ApngWriter::new(f, width, height, range.len() as u32, frames)?;
+            let mut apng = ApngWriter::new(f, width, height, frames)?;
             render(&mut |_, frame| {
                 // A palette mode's colours can change outside the tiles
                 // re-traced (`scan` learns a table a frame).
@@ -285,7 +285,7 @@ pub fn merge_frames(output: &Path, files: &[PathBuf]) -> Result<(), CliError> {
             gif.finish().map(|_| ())
         }),
         Output::Apng => write_atomically(output, |f| {
-            let mut apng = ApngWriter::new(f, width, height, frames.count, frames)?;
+            let mut apng = ApngWriter::new(f, width, height, frames)?;
             found.iter().try_for_each(|(_, image)| apng.frame(&image.to_rgb().data, None))?;
             apng.finish()
         }),

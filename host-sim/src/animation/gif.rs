@@ -13,8 +13,8 @@
 //! hundredths of a second (rounded), so its frame rate is the scene's on
 //! average; it loops forever.
 
-use super::changes::{Area, Changes};
-use super::quantize::{quantize, LoopFrames, ENTRIES, TRANSPARENT};
+use super::changes::{Area, Changes, LoopFrames};
+use super::quantize::{quantize, ENTRIES, TRANSPARENT};
 use octrace_core::scene::Frames;
 use octrace_images::formats::Image;
 use std::io::Write;

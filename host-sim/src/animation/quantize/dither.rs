@@ -6,7 +6,11 @@
 //! blend into the kept ones. Nothing shimmers where nothing moved.
 //!
 //! The kernel is Sierra's two-row "lite" filter (½ right, ¼ below left,
-//! ¼ below), in raster order, errors in sixteenths of a level.
+//! ¼ below), in raster order, in whole levels, carrying half of each
+//! pixel's error: enough to break the bands between the table's colours,
+//! and much closer to the frame, and much smaller once compressed, than
+//! the whole error (on anim_fig5_1 at 1024×768, 50.7 dB and 1.17 MB
+//! against 45.5 dB and 1.72 MB; BENCHMARKS.md).
 //!
 //! Invariants: integers only (the same indices on every machine); a pixel
 //! outside the area or not flagged as changed keeps its index and colour.
@@ -14,11 +18,9 @@
 use super::table::Nearest;
 use crate::animation::changes::Area;
 
-/// Sixteenths of a level: the errors' unit.
-const UNIT: i32 = 16;
 /// An error is held within this many levels, so a run of colours the
 /// table cannot reach does not pile error up without end.
-const LIMIT: i32 = 48 * UNIT;
+const LIMIT: i32 = 48;
 
 /// One frame's pixels and what is shown of them.
 pub struct Canvas<'a> {
@@ -42,9 +44,9 @@ pub fn diffuse(canvas: &mut Canvas<'_>, area: Area, changed: &[bool], nearest: &
         for x in area.x..area.x + area.width {
             let i = y as usize * canvas.width as usize + x as usize;
             let at = (x - area.x) as usize + 1;
-            let wanted = [0, 1, 2].map(|c| i32::from(canvas.wanted[3 * i + c]) * UNIT + here[at][c]);
+            let wanted = [0, 1, 2].map(|c| i32::from(canvas.wanted[3 * i + c]) + here[at][c]);
             let shown = if changed[i] {
-                let target = wanted.map(|v| ((v + UNIT / 2).div_euclid(UNIT)).clamp(0, 255) as u8);
+                let target = wanted.map(|v| v.clamp(0, 255) as u8);
                 let index = nearest.index(target);
                 let colour = nearest.table()[index as usize];
                 canvas.indices[i] = index;
@@ -54,7 +56,8 @@ pub fn diffuse(canvas: &mut Canvas<'_>, area: Area, changed: &[bool], nearest: &
                 [0, 1, 2].map(|c| canvas.shown[3 * i + c])
             };
             for c in 0..3 {
-                let error = (wanted[c] - i32::from(shown[c]) * UNIT).clamp(-LIMIT, LIMIT);
+                // Half the error, carried on.
+                let error = (wanted[c] - i32::from(shown[c])).clamp(-LIMIT, LIMIT) / 2;
                 let half = error / 2;
                 let quarter = (error - half) / 2;
                 here[at + 1][c] += half;
@@ -72,7 +75,7 @@ mod tests {
     use super::*;
 
     /// A flat colour between two entries is shown as a mix of both whose
-    /// mean is the colour; a pixel not flagged keeps what it showed.
+    /// mean is near the colour; a pixel not flagged keeps what it showed.
     #[test]
     fn a_flat_colour_mixes_to_its_mean_and_kept_pixels_stay() {
         let (w, h) = (16u32, 16u32);
@@ -88,7 +91,7 @@ mod tests {
         assert_eq!((indices[5], &shown[15..18]), (7, &[96; 3][..]));
         let chosen: Vec<u32> = shown.chunks(3).enumerate().filter(|&(i, _)| i != 5).map(|(_, p)| u32::from(p[0])).collect();
         let mean = chosen.iter().sum::<u32>() as f64 / chosen.len() as f64;
-        assert!((mean - 100.0).abs() < 0.6, "{mean}");
+        assert!((mean - 100.0).abs() < 1.5, "{mean}");
         assert!(chosen.iter().any(|&v| v == 96) && chosen.iter().any(|&v| v == 104));
     }
 }

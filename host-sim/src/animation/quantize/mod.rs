@@ -13,7 +13,7 @@
 mod dither;
 pub(crate) mod table;
 
-use super::changes::{Area, Changes};
+use super::changes::{Area, Changes, LoopFrames};
 use dither::{diffuse, Canvas};
 use std::collections::HashMap;
 use table::{distance, table_for, Nearest, Weighted};
@@ -23,86 +23,28 @@ pub const ENTRIES: usize = 255;
 /// The index no table uses: GIF's transparent pixels.
 pub const TRANSPARENT: u8 = 255;
 
-/// A frame after the first: the pixels it changed.
-struct Delta {
-    /// Where they lie (`None`: nothing changed).
-    bounds: Option<Area>,
-    /// Within `bounds`, row-major: whether each pixel changed, and every
-    /// pixel's colour (RGB).
-    changed: Vec<bool>,
-    pixels: Vec<u8>,
-}
-
-/// An animation's frames held for quantizing: the first whole, each other
-/// as what it changed.
-pub struct LoopFrames {
-    width: u32,
-    height: u32,
-    first: Vec<u8>,
-    later: Vec<Delta>,
-    /// The last frame, whole.
-    current: Vec<u8>,
-}
-
-impl LoopFrames {
-    /// No frame yet, of `width` × `height`.
-    pub fn new(width: u32, height: u32) -> LoopFrames {
-        LoopFrames { width, height, first: Vec::new(), later: Vec::new(), current: Vec::new() }
-    }
-
-    /// Adds the next frame (RGB), `retraced` the areas that can differ
-    /// from the one before (`None`: any).
-    pub fn push(&mut self, frame: &[u8], retraced: Option<&[Area]>) {
-        if self.current.is_empty() {
-            self.first = frame.to_vec();
-            self.current = frame.to_vec();
-            return;
-        }
-        let changes = Changes::between(&self.current, frame, self.width, 3, retraced);
-        let mut delta = Delta { bounds: changes.bounds, changed: Vec::new(), pixels: Vec::new() };
-        if let Some(area) = changes.bounds {
-            for i in area.indices(self.width) {
-                delta.changed.push(changes.changed[i]);
-                delta.pixels.extend_from_slice(&frame[3 * i..3 * i + 3]);
+/// Every colour of the loop `frames`, weighted by the pixels and frames it
+/// shows in.
+fn colours(frames: &LoopFrames) -> Vec<Weighted> {
+    let mut weights: HashMap<[u8; 3], u64> = HashMap::new();
+    let mut since = vec![0u32; frames.first.len() / 3];
+    let mut frame = frames.first.clone();
+    for (k, delta) in frames.later.iter().enumerate() {
+        let Some(area) = delta.bounds else { continue };
+        for (j, i) in area.indices(frames.width).enumerate() {
+            if delta.changed[j] {
+                let old = [frame[3 * i], frame[3 * i + 1], frame[3 * i + 2]];
+                *weights.entry(old).or_default() += u64::from(k as u32 + 1 - since[i]);
+                since[i] = k as u32 + 1;
+                frame[3 * i..3 * i + 3].copy_from_slice(&delta.pixels[3 * j..3 * j + 3]);
             }
         }
-        self.current.copy_from_slice(frame);
-        self.later.push(delta);
     }
-
-    /// Frames held.
-    pub fn len(&self) -> usize {
-        usize::from(!self.first.is_empty()) + self.later.len()
+    let count = frames.len() as u32;
+    for (i, p) in frame.chunks(3).enumerate() {
+        *weights.entry([p[0], p[1], p[2]]).or_default() += u64::from(count - since[i]);
     }
-
-    /// Whether no frame is held.
-    pub fn is_empty(&self) -> bool {
-        self.first.is_empty()
-    }
-
-    /// Every colour of the loop, weighted by the pixels and frames it
-    /// shows in.
-    fn colours(&self) -> Vec<Weighted> {
-        let mut weights: HashMap<[u8; 3], u64> = HashMap::new();
-        let mut since = vec![0u32; self.first.len() / 3];
-        let mut frame = self.first.clone();
-        for (k, delta) in self.later.iter().enumerate() {
-            let Some(area) = delta.bounds else { continue };
-            for (j, i) in area.indices(self.width).enumerate() {
-                if delta.changed[j] {
-                    let old = [frame[3 * i], frame[3 * i + 1], frame[3 * i + 2]];
-                    *weights.entry(old).or_default() += u64::from(k as u32 + 1 - since[i]);
-                    since[i] = k as u32 + 1;
-                    frame[3 * i..3 * i + 3].copy_from_slice(&delta.pixels[3 * j..3 * j + 3]);
-                }
-            }
-        }
-        let frames = self.len() as u32;
-        for (i, p) in frame.chunks(3).enumerate() {
-            *weights.entry([p[0], p[1], p[2]]).or_default() += u64::from(frames - since[i]);
-        }
-        weights.into_iter().collect()
-    }
+    weights.into_iter().collect()
 }
 
 /// One frame of the GIF: the area it covers and each pixel's index there
@@ -123,7 +65,7 @@ pub struct Quantized {
 /// Quantizes `frames` for a GIF.
 pub fn quantize(frames: &LoopFrames) -> Quantized {
     let (width, height) = (frames.width, frames.height);
-    let global = table_for(&frames.colours(), ENTRIES);
+    let global = table_for(&colours(frames), ENTRIES);
     let global_nearest = Nearest::new(&global);
     let mut wanted = frames.first.clone();
     let mut shown = vec![0u8; wanted.len()];
@@ -160,9 +102,11 @@ pub fn quantize(frames: &LoopFrames) -> Quantized {
 }
 
 /// A table of the frame's own for `colours`, the frame's new pixels, when
-/// `global` serves them badly: when one made for them has less than half
-/// the squared error and the frame changes enough pixels that the 768
-/// bytes of a table are a small part of it.
+/// `global` serves them badly: when their mean squared distance to it is
+/// over [`OWN_TABLE_ABOVE`] and one made for them halves it, and the frame
+/// changes enough pixels that the 768 bytes of a table are a small part
+/// of it. (A frame's own table costs more than its bytes: every pixel it
+/// changes is drawn anew, none left transparent for keeping its index.)
 fn own_table(colours: &[[u8; 3]], global: &Nearest) -> Option<Nearest> {
     if colours.len() < 4096 {
         return None;
@@ -173,9 +117,18 @@ fn own_table(colours: &[[u8; 3]], global: &Nearest) -> Option<Nearest> {
     let error = |nearest: &Nearest| -> u64 {
         counts.iter().map(|&(c, w)| w * u64::from(distance(c, nearest.table()[nearest.index(c) as usize]))).sum()
     };
+    let served = error(global);
+    if served <= OWN_TABLE_ABOVE * colours.len() as u64 {
+        return None;
+    }
     let own = Nearest::new(&table_for(&counts, ENTRIES));
-    (2 * error(&own) < error(global)).then_some(own)
+    (2 * error(&own) < served).then_some(own)
 }
+
+/// The mean squared distance (over the three channels) of a frame's new
+/// pixels to the loop's table above which a table of the frame's own is
+/// tried: 8, about 44 dB.
+const OWN_TABLE_ABOVE: u64 = 8;
 
 /// The GIF frame of `area` whose pixels showed `before` (RGB, the area's
 /// pixels row by row) and show `shown` now (RGB, the whole image), chosen

@@ -50,6 +50,14 @@ impl Sums {
         self.squares += w * c.iter().map(|&v| u128::from(v) * u128::from(v)).sum::<u128>();
     }
 
+    fn plus(self, other: Sums) -> Sums {
+        Sums {
+            weight: self.weight + other.weight,
+            linear: [0, 1, 2].map(|c| self.linear[c] + other.linear[c]),
+            squares: self.squares + other.squares,
+        }
+    }
+
     fn minus(self, other: Sums) -> Sums {
         Sums {
             weight: self.weight - other.weight,
@@ -105,37 +113,40 @@ fn cut(colours: &mut [Weighted], entries: usize) -> Vec<[u8; 3]> {
             break;
         };
         let (start, end) = (cells[at].start, cells[at].end);
-        let (axis, split) = best_cut(&mut colours[start..end]);
-        let slice = &mut colours[start..end];
-        slice.sort_unstable_by_key(|&(c, _)| (c[axis], c));
-        let (left, right) = slice.split_at(split);
-        cells[at] = Cell { start, end: start + split, error: Sums::of(left).error() };
-        cells.push(Cell { start: start + split, end, error: Sums::of(right).error() });
+        let split = start + cut_box(&mut colours[start..end]);
+        cells[at] = Cell { start, end: split, error: Sums::of(&colours[start..split]).error() };
+        cells.push(Cell { start: split, end, error: Sums::of(&colours[split..end]).error() });
     }
     cells.iter().map(|c| Sums::of(&colours[c.start..c.end]).mean()).collect()
 }
 
-/// The axis and the place (a count of colours, sorted along it) where a
-/// cut most lowers the error of `colours` (at least two distinct).
-fn best_cut(colours: &mut [Weighted]) -> (usize, usize) {
+/// Cuts `colours` (at least two distinct) in two where that most lowers
+/// the error, along one axis between two of its 256 values: the colours
+/// below the cut are moved before the others (each side keeping its
+/// order); returns how many there are.
+fn cut_box(colours: &mut [Weighted]) -> usize {
     let total = Sums::of(colours);
-    let mut best: Option<(u128, usize, usize)> = None;
+    let mut best: Option<(u128, usize, u8)> = None;
     for axis in 0..3 {
-        colours.sort_unstable_by_key(|&(c, _)| (c[axis], c));
+        let mut bins = [Sums::default(); 256];
+        colours.iter().for_each(|&c| bins[usize::from(c.0[axis])].add(c));
         let mut left = Sums::default();
-        for i in 1..colours.len() {
-            left.add(colours[i - 1]);
-            // Cut only between different values along the axis.
-            if colours[i - 1].0[axis] == colours[i].0[axis] {
+        for value in 0..255usize {
+            left = left.plus(bins[value]);
+            if left.weight == 0 || left.weight == total.weight || bins[value + 1].weight == 0 {
                 continue;
             }
             let error = left.error() + total.minus(left).error();
             if best.is_none_or(|(e, _, _)| error < e) {
-                best = Some((error, axis, i));
+                best = Some((error, axis, value as u8 + 1));
             }
         }
     }
-    best.map_or((0, colours.len() / 2), |(_, axis, i)| (axis, i))
+    let Some((_, axis, threshold)) = best else { return colours.len() / 2 };
+    let (below, above): (Vec<Weighted>, Vec<Weighted>) = colours.iter().partition(|c| c.0[axis] < threshold);
+    colours[..below.len()].copy_from_slice(&below);
+    colours[below.len()..].copy_from_slice(&above);
+    below.len()
 }
 
 /// Lloyd's iterations: each colour to its nearest entry, each entry to its
