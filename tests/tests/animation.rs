@@ -308,7 +308,11 @@ fn apng_frames(bytes: &[u8]) -> (Vec<Vec<u8>>, Vec<u32>) {
     let info = reader.info();
     let (w, count) = (info.width as usize, info.animation_control().map(|a| (a.num_frames, a.num_plays)));
     assert_eq!(info.color_type, png::ColorType::Rgb);
-    let key: Option<Vec<u8>> = info.trns.as_ref().map(|t| t.chunks(2).map(|v| v[1]).collect());
+    // The tRNS colour, as 16-bit samples or already cut to 8 bits.
+    let key: Option<Vec<u8>> = info.trns.as_ref().map(|t| match t.len() {
+        6 => t.chunks(2).map(|v| v[1]).collect(),
+        _ => t.to_vec(),
+    });
     let (count, plays) = count.expect("an APNG");
     assert_eq!(plays, 0, "loops forever");
     let mut canvas = vec![0u8; 3 * w * info.height as usize];
