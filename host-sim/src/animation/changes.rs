@@ -78,7 +78,8 @@ impl Changes {
                 let at = i * channels..(i + 1) * channels;
                 if before.get(at.clone()) != now.get(at) {
                     changes.changed[i] = true;
-                    let pixel = Area { x: (i % width as usize) as u32, y: (i / width as usize) as u32, width: 1, height: 1 };
+                    let pixel =
+                        Area { x: (i % width as usize) as u32, y: (i / width as usize) as u32, width: 1, height: 1 };
                     changes.bounds = Some(changes.bounds.map_or(pixel, |b| b.union(pixel)));
                 }
             }
@@ -180,7 +181,10 @@ mod tests {
         assert_eq!(Changes::between(&before, &before, 6, 3, None).bounds, None);
         // A tile past the image's edge is cut to it.
         let edge = [Area { x: 4, y: 2, width: 4, height: 4 }];
-        assert_eq!(Changes::between(&before, &now, 6, 3, Some(&edge)).bounds, Some(Area { x: 4, y: 2, width: 1, height: 1 }));
+        assert_eq!(
+            Changes::between(&before, &now, 6, 3, Some(&edge)).bounds,
+            Some(Area { x: 4, y: 2, width: 1, height: 1 })
+        );
         assert_eq!(Area { x: 1, y: 1, width: 2, height: 1 }.indices(6).collect::<Vec<_>>(), [7, 8]);
     }
 }

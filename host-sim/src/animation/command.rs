@@ -7,7 +7,9 @@
 //! `file:line:col` with exit code 2, as for a still.
 
 use super::writers::{write_frame_file, FrameInfo};
-use super::{render_frames, AnimationError, AnimationOptions, AnimationReport, ApngWriter, FrameImage, GifWriter, Output};
+use super::{
+    render_frames, AnimationError, AnimationOptions, AnimationReport, ApngWriter, FrameImage, GifWriter, Output,
+};
 use crate::exit::CliError;
 use crate::output::write_atomically;
 use crate::parts::{auto_index, band_rows, scene_hash, PartSpec};
@@ -39,18 +41,17 @@ pub struct Request<'a> {
 pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliError> {
     let output = Output::of(request.out).map_err(CliError::Invalid)?;
     let frames = request.frames;
-    let palette = match (&output, request.palette) {
-        (Output::Gif, Some(PaletteMode::None)) => {
-            return Err(CliError::Invalid(
+    let palette =
+        match (&output, request.palette) {
+            (Output::Gif, Some(PaletteMode::None)) => return Err(CliError::Invalid(
                 "a GIF holds 256 colours a frame: leave --palette out for colours chosen for the whole loop, or give \
                  scan, dither, coarse or gray"
                     .into(),
-            ))
-        }
-        // Without --palette, a GIF's colours are chosen from the
-        // truecolour frames of the whole loop.
-        (_, mode) => mode.unwrap_or(PaletteMode::None),
-    };
+            )),
+            // Without --palette, a GIF's colours are chosen from the
+            // truecolour frames of the whole loop.
+            (_, mode) => mode.unwrap_or(PaletteMode::None),
+        };
     let range = match (request.part, &output) {
         (None, _) => frames.all(),
         (Some(spec), Output::Files(_)) => {

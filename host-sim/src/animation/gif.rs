@@ -81,7 +81,12 @@ impl<W: Write> GifWriter<W> {
         let now: Vec<u8> = indices.iter().flat_map(|&i| table.get(usize::from(i)).copied().unwrap_or([0; 3])).collect();
         let frame = match self.written {
             0 => Area::whole(self.width, self.height),
-            _ => Changes::between(&self.shown, &now, self.width, 3, None).bounds.unwrap_or(Area { x: 0, y: 0, width: 1, height: 1 }),
+            _ => Changes::between(&self.shown, &now, self.width, 3, None).bounds.unwrap_or(Area {
+                x: 0,
+                y: 0,
+                width: 1,
+                height: 1,
+            }),
         };
         // A table with room for one more entry: that entry is the
         // transparent pixels', those that did not change.
@@ -155,7 +160,8 @@ fn write<W: Write>(
         top: area.y as u16,
         width: area.width as u16,
         height: area.height as u16,
-        palette: table.map(|t| t.iter().flatten().copied().chain(transparent.map(|_| [0; 3]).into_iter().flatten()).collect()),
+        palette: table
+            .map(|t| t.iter().flatten().copied().chain(transparent.map(|_| [0; 3]).into_iter().flatten()).collect()),
         buffer: std::borrow::Cow::Owned(pixels),
         ..gif::Frame::default()
     };

@@ -79,7 +79,11 @@ pub fn quantize(frames: &LoopFrames) -> Quantized {
     let mut changed = vec![false; indices.len()];
     for delta in &frames.later {
         let Some(area) = delta.bounds else {
-            out.push(GifFrame { area: Area { x: 0, y: 0, width: 1, height: 1 }, indices: vec![TRANSPARENT], table: None });
+            out.push(GifFrame {
+                area: Area { x: 0, y: 0, width: 1, height: 1 },
+                indices: vec![TRANSPARENT],
+                table: None,
+            });
             continue;
         };
         let mut new_colours: Vec<[u8; 3]> = Vec::new();
@@ -92,7 +96,8 @@ pub fn quantize(frames: &LoopFrames) -> Quantized {
         }
         let local = own_table(&new_colours, &global_nearest);
         let nearest = local.as_ref().unwrap_or(&global_nearest);
-        let before: Vec<u8> = area.indices(width).flat_map(|i| [shown[3 * i], shown[3 * i + 1], shown[3 * i + 2]]).collect();
+        let before: Vec<u8> =
+            area.indices(width).flat_map(|i| [shown[3 * i], shown[3 * i + 1], shown[3 * i + 2]]).collect();
         let mut canvas = Canvas { wanted: &wanted, width, shown: &mut shown, indices: &mut indices };
         diffuse(&mut canvas, area, &changed, nearest);
         out.push(changed_frame(area, &before, &shown, &indices, width, local.map(|n| n.table().to_vec())));
@@ -134,17 +139,34 @@ const OWN_TABLE_ABOVE: u64 = 8;
 /// pixels row by row) and show `shown` now (RGB, the whole image), chosen
 /// as `indices`: the smallest area holding every pixel whose colour
 /// changed, the others in it transparent.
-fn changed_frame(area: Area, before: &[u8], shown: &[u8], indices: &[u8], width: u32, table: Option<Vec<[u8; 3]>>) -> GifFrame {
+fn changed_frame(
+    area: Area,
+    before: &[u8],
+    shown: &[u8],
+    indices: &[u8],
+    width: u32,
+    table: Option<Vec<[u8; 3]>>,
+) -> GifFrame {
     let now: Vec<u8> = area.indices(width).flat_map(|i| [shown[3 * i], shown[3 * i + 1], shown[3 * i + 2]]).collect();
     let differs = Changes::between(before, &now, area.width, 3, None);
     let Some(inner) = differs.bounds else {
-        return GifFrame { area: Area { x: area.x, y: area.y, width: 1, height: 1 }, indices: vec![TRANSPARENT], table: None };
+        return GifFrame {
+            area: Area { x: area.x, y: area.y, width: 1, height: 1 },
+            indices: vec![TRANSPARENT],
+            table: None,
+        };
     };
     let indices = inner
         .indices(area.width)
         .map(|j| {
-            let i = (area.y as usize + j / area.width as usize) * width as usize + area.x as usize + j % area.width as usize;
-            if differs.changed[j] { indices[i] } else { TRANSPARENT }
+            let i = (area.y as usize + j / area.width as usize) * width as usize
+                + area.x as usize
+                + j % area.width as usize;
+            if differs.changed[j] {
+                indices[i]
+            } else {
+                TRANSPARENT
+            }
         })
         .collect();
     GifFrame { area: Area { x: area.x + inner.x, y: area.y + inner.y, ..inner }, indices, table }
