@@ -6,7 +6,8 @@
 //! decoded by the browser, meets issue 49's quality target against
 //! `--frame K` (PSNR over RGB, mean over the loop ≥ 45 dB, no frame under
 //! 40 dB), also for anim_colours, whose colours change greatly over its
-//! loop. Small sizes and few frames: the full-size figures are
+//! loop, and a pixel a frame did not change keeps its colour (no
+//! shimmer). Small sizes and few frames: the full-size figures are
 //! `octrace-bench animfiles`'s.
 
 use octrace_images::palette::psnr;
@@ -154,6 +155,15 @@ fn gifs_and_apngs_play_in_chromium_the_apng_exactly_and_the_gif_at_the_target() 
         assert_eq!(gif.repetitions, f64::INFINITY, "{name}: the GIF loops");
         let loop_length: u64 = gif.durations.iter().sum();
         assert_eq!(loop_length, 10_000 * ((100 * u64::from(count) + u64::from(rate) / 2) / u64::from(rate)), "{name}");
+        // Nothing shimmers: a pixel the frame did not change shows what it
+        // showed.
+        for k in 1..frames.len() {
+            let (before, now) = (&frames[k - 1].data, &frames[k].data);
+            let kept = (0..now.len() / 3).filter(|&i| before[3 * i..3 * i + 3] == now[3 * i..3 * i + 3]);
+            let shimmer =
+                kept.filter(|&i| gif.frames[k - 1].data[3 * i..3 * i + 3] != gif.frames[k].data[3 * i..3 * i + 3]);
+            assert_eq!(shimmer.count(), 0, "{name}: frame {k} changes pixels its frame did not");
+        }
         let (mean, worst) = quality(&frames, &gif.frames);
         println!("{name} at {}×{}, {count} frames: GIF {mean:.2} dB mean, {worst:.2} dB worst", size.0, size.1);
         assert!(mean >= 45.0 && worst >= 40.0, "{name}: {mean:.2} dB mean, {worst:.2} dB worst");

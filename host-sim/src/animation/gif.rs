@@ -115,6 +115,9 @@ impl<W: Write> GifWriter<W> {
         if let Some(encoder) = self.encoder {
             return encoder.into_inner().map_err(gif_error);
         }
+        if self.held.is_empty() {
+            return Err(std::io::Error::other("an animation of no frames"));
+        }
         let out = self.out.take().ok_or_else(|| std::io::Error::other("the GIF is already written"))?;
         let quantized = quantize(&self.held);
         // One entry more: the transparent pixels'.
