@@ -29,6 +29,31 @@ pub fn gif_delay(frames: Frames, k: u32) -> u16 {
 }
 
 /// An animated GIF being written, a frame at a time.
+///
+/// ```
+/// use host_sim::animation::{Area, GifWriter};
+/// use host_sim::RgbImage;
+/// use octrace_core::scene::Frames;
+/// use octrace_images::formats::Image;
+///
+/// // A gray square with a white dot that moves one pixel right.
+/// let frame = |x: usize| {
+///     let mut image = RgbImage { width: 8, height: 8, data: vec![90; 8 * 8 * 3] };
+///     image.data[3 * (8 * 4 + x)..][..3].copy_from_slice(&[255; 3]);
+///     Image::Rgb(image)
+/// };
+/// let mut gif = GifWriter::new(Vec::new(), 8, 8, Frames { count: 2, rate: 24 })?;
+/// gif.frame(&frame(2), None)?;
+/// // The second frame traced only row 4 (as the coherence would say).
+/// gif.frame(&frame(3), Some(&[Area { x: 0, y: 4, width: 8, height: 1 }]))?;
+/// let bytes = gif.finish()?;
+/// // Its second image is the two pixels that changed, nothing more.
+/// let mut decoder = gif::DecodeOptions::new().read_info(&bytes[..]).unwrap();
+/// decoder.read_next_frame().unwrap();
+/// let second = decoder.read_next_frame().unwrap().unwrap();
+/// assert_eq!((second.left, second.top, second.width, second.height), (2, 4, 2, 1));
+/// # Ok::<(), std::io::Error>(())
+/// ```
 pub struct GifWriter<W: Write> {
     out: Option<W>,
     width: u32,
