@@ -4,6 +4,14 @@
 //! a table of its own; error diffusion that chooses anew only the pixels a
 //! frame changed ([`dither`]), so what did not move keeps its index.
 //!
+//! Written here, not taken from a crate: of the MIT/Apache ones,
+//! `color_quant` (NeuQuant) and `exoquant` choose colours in floating
+//! point, and `quantette` (Wu's cut, k-means) in floating point too, in
+//! its colour spaces and over threads, so each would have to be proved to
+//! give the same table on every machine; none weighs colours over a loop,
+//! gives a frame its own table, or diffuses error around kept pixels, which
+//! is most of this module. (`gifski` and `imagequant` are AGPL and GPL.)
+//!
 //! Invariants: the indices depend on the frames' pixels alone, in
 //! integers: the same frames give the same file on every machine, however
 //! they were rendered (together with coherence, whole, or apart and
