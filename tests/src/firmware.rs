@@ -290,11 +290,9 @@ impl Firmware {
     pub fn measure(&self, elf: &Path, qemu_count: &Path) -> Result<Measurement, String> {
         let out = match self.board {
             Board::Virt => count_riscv(elf, qemu_count)?,
-            _ => Command::new(qemu_count)
-                .arg(self.board.machine())
-                .arg(elf)
-                .output()
-                .map_err(|e| format!("cannot run {}: {e}", qemu_count.display()))?,
+            _ => Command::new(qemu_count).arg(self.board.machine()).arg(elf).output().map_err(|e| {
+                format!("cannot run {} (set OCTRACE_QEMU_COUNT to qemu-count): {e}", qemu_count.display())
+            })?,
         };
         let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
         let value = |key: &str| text.lines().find_map(|l| l.strip_prefix(key)?.trim().parse::<u64>().ok());
