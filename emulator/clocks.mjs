@@ -52,7 +52,6 @@ export class SystemClock {
     this.nanosPerCycle = 1e9 / this.hz;
     /** The epochs: from `cycles` on, a cycle lasts `nanosPerCycle`; `nanos` is when it starts. */
     this.epochs = [{ cycles: 0, nanos: 0, hz: this.hz, nanosPerCycle: this.nanosPerCycle }];
-    this.fastest = this.hz;
     rp2040.addClockListener((hz) => this.change(hz));
   }
 
@@ -72,7 +71,6 @@ export class SystemClock {
     else this.epochs.push(epoch);
     this.hz = hz;
     this.nanosPerCycle = nanosPerCycle;
-    this.fastest = Math.max(this.fastest, hz);
     this.onChange(hz);
   }
 

@@ -66,7 +66,7 @@ export class Lockstep {
     }
   }
 
-  /** Moves the clock to the start of cycle `target` (the clock is at cycle `time`). */
+  /** Moves the machine's clock to the start of cycle `target`, across any change of clk_sys on the way. */
   tickTo(target) {
     this.clock.tick(this.systemClock.nanosAt(target) - this.clock.nanos);
   }
