@@ -105,7 +105,9 @@ impl Firmware {
         Firmware { dithering, ..self }
     }
 
-    fn slug(&self) -> String {
+    /// What the build is named by: board, scene, size, colours (and the
+    /// dithering of a panel of few levels).
+    pub fn slug(&self) -> String {
         let (board, scene, wire) = (self.board.machine(), &self.scene, self.wire.name());
         match self.wire.panel() {
             Some(_) => format!("{board}-{scene}-{}x{}-{wire}-{}", self.width, self.height, self.dithering.name()),
@@ -255,18 +257,42 @@ impl Measurement {
     }
 }
 
+/// `qemu-count`, the instruction-counting run: `$OCTRACE_QEMU_COUNT`, else
+/// the workplace's `shared/tools/qemu-count` beside the repository.
+pub fn qemu_count() -> PathBuf {
+    std::env::var_os("OCTRACE_QEMU_COUNT")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo().join("../shared/tools/qemu-count"))
+}
+
 impl Firmware {
+    /// Whether its instructions are exact run to run: every board but the
+    /// dual-core one, whose cores' waiting for each other depends on how
+    /// qemu takes turns between them.
+    pub fn counts_exactly(&self) -> bool {
+        self.board != Board::Mps2An521
+    }
+
+    /// Runs the ELF once under `qemu-count` ([`Firmware::measure`]) and
+    /// collects what the display received too: the run the bit-exactness
+    /// test makes, with the instructions counted.
+    pub fn run_measured(&self, elf: &Path, qemu_count: &Path) -> Result<(Run, Measurement), String> {
+        let file = self.output_file();
+        let _ = std::fs::remove_file(&file);
+        let measured = self.measure(elf, qemu_count)?;
+        let pixels = std::fs::read(&file).unwrap_or_default();
+        Ok((Run { status: measured.status, output: measured.output.clone(), pixels }, measured))
+    }
+
     /// Runs the ELF under `qemu-count` (the instruction-counting plugin) and
     /// reads its sizes with `arm-none-eabi-size`. qemu-count runs Arm boards
     /// only: the RISC-V one runs under the same plugin here.
     pub fn measure(&self, elf: &Path, qemu_count: &Path) -> Result<Measurement, String> {
         let out = match self.board {
             Board::Virt => count_riscv(elf, qemu_count)?,
-            _ => Command::new(qemu_count)
-                .arg(self.board.machine())
-                .arg(elf)
-                .output()
-                .map_err(|e| format!("cannot run {}: {e}", qemu_count.display()))?,
+            _ => Command::new(qemu_count).arg(self.board.machine()).arg(elf).output().map_err(|e| {
+                format!("cannot run {} (set OCTRACE_QEMU_COUNT to qemu-count): {e}", qemu_count.display())
+            })?,
         };
         let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
         let value = |key: &str| text.lines().find_map(|l| l.strip_prefix(key)?.trim().parse::<u64>().ok());

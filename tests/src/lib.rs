@@ -2,6 +2,7 @@
 //! in `tests/`).
 
 pub mod board;
+pub mod budgets;
 pub mod firmware;
 pub mod pico;
 pub mod webdriver;

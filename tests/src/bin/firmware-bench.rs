@@ -18,9 +18,7 @@
 
 use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
-use octrace_tests::firmware::{Board, Firmware};
-use octrace_tests::repo;
-use std::path::PathBuf;
+use octrace_tests::firmware::{qemu_count, Board, Firmware};
 
 fn main() {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
@@ -39,9 +37,7 @@ fn main() {
     };
     let default_scenes: &[&str] = if panels { &["fig5_1"] } else { &["fig5_1", "fig5_3"] };
     let scenes = if args.is_empty() { default_scenes.iter().map(|s| s.to_string()).collect() } else { args };
-    let qemu_count = std::env::var_os("OCTRACE_QEMU_COUNT")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| repo().join("../shared/tools/qemu-count"));
+    let qemu_count = qemu_count();
     if panels {
         return panels_table(&scenes, (width, height), &qemu_count);
     }
