@@ -191,7 +191,8 @@ impl RunningBoard {
 
     /// What the board says it is.
     pub fn describe(&self) -> BoardDescription {
-        let mut link = BoardLink::open(&self.port.to_string_lossy(), Duration::from_secs(30)).expect("the port opens");
+        let mut link =
+            BoardLink::open(&self.port.to_string_lossy(), Some(Duration::from_secs(30))).expect("the port opens");
         link.hello().expect("the board answers")
     }
 
