@@ -435,8 +435,8 @@ fn a_board_gone_silent_mid_drawing_is_given_up_saying_what_it_did_last() {
 #[test]
 fn a_board_that_reads_slowly_gets_the_whole_scene_while_it_reads() {
     // 28 KB of scene (fig5_1 and a comment) at 10 KiB/s, after what the
-    // line holds (about 20 KB): longer than any one write's wait, well
-    // within the timeout.
+    // line holds (about 20 KB): longer than any one write's wait, and each
+    // byte the board takes moves the conversation on.
     let board = hostile_board("reads-slowly", &["--max-scene", "65536"]);
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("long.txt");

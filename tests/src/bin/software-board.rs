@@ -116,9 +116,11 @@ impl Misbehaviour {
                 "wrong-pixel" => Misbehaviour::WrongPixel(None),
                 "reads-slowly" => Misbehaviour::ReadsSlowly,
                 "escapes" => Misbehaviour::Escapes,
-                _ => return Err(format!(
+                _ => {
+                    return Err(format!(
                     "--misbehave {text}: draws-at:WxH, wrong-pixel[:CHANNEL], errors-every:MS, reads-slowly or escapes"
-                )),
+                ))
+                }
             },
         })
     }
