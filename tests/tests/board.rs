@@ -377,12 +377,27 @@ fn a_board_that_keeps_sending_errors_is_given_up_by_their_count_or_at_the_timeou
     assert!(run.stderr.contains(want), "{}", run.stderr);
     // Slower, capped: at the cap.
     let board = hostile_board("errors-every:20", &[]);
-    let args = [board.port.as_os_str(), scene.as_os_str(), "--timeout".as_ref(), "2".as_ref()];
+    ends_at_the_cap(&board, &scene, 2);
+}
+
+/// `host-sim board PORT SCENE --timeout SECONDS` to `board` ends at the cap.
+fn ends_at_the_cap(board: &RunningBoard, scene: &Path, seconds: u32) {
+    let seconds = seconds.to_string();
+    let args = [board.port.as_os_str(), scene.as_os_str(), "--timeout".as_ref(), seconds.as_ref()];
     let run = host_sim_board_within(&args, HANG_GUARD).expect("host-sim board ends");
     assert_eq!(run.code, 1, "{}", run.stderr);
-    let want =
-        format!("host-sim: board at {}: the board's answer did not end within 2 s (--timeout)", board.port.display());
+    let want = format!(
+        "host-sim: board at {}: the board's answer did not end within {seconds} s (--timeout)",
+        board.port.display()
+    );
     assert!(run.stderr.starts_with(&want), "{}", run.stderr);
+}
+
+/// The wedging scene for `board`, written in `dir`.
+fn wedge_file(board: &RunningBoard, dir: &Path) -> std::path::PathBuf {
+    let scene = dir.join("wedge.txt");
+    std::fs::write(&scene, wedging_scene(lights(&board.describe()))).unwrap();
+    scene
 }
 
 #[test]
@@ -391,26 +406,15 @@ fn a_drawing_whose_pixel_outlasts_the_silence_allowance_is_followed_while_the_bo
     // word that it is still working, for longer than the 8 s host-sim
     // allows a board to say nothing; host-sim follows it to its cap.
     let board = board();
-    let description = board.describe();
     let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("wedge.txt");
-    std::fs::write(&scene, wedging_scene(lights(&description))).unwrap();
-    let args = [board.port.as_os_str(), scene.as_os_str(), "--timeout".as_ref(), "12".as_ref()];
-    let run = host_sim_board_within(&args, HANG_GUARD).expect("host-sim board ends");
-    assert_eq!(run.code, 1, "{}", run.stderr);
-    let want =
-        format!("host-sim: board at {}: the board's answer did not end within 12 s (--timeout)", board.port.display());
-    assert!(run.stderr.starts_with(&want), "{}", run.stderr);
+    ends_at_the_cap(&board, &wedge_file(&board, dir.path()), 12);
 }
 
 #[test]
 fn a_board_gone_silent_mid_drawing_is_given_up_saying_what_it_did_last() {
     let mut board = board();
-    let description = board.describe();
     let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("wedge.txt");
-    std::fs::write(&scene, wedging_scene(lights(&description))).unwrap();
-    let args: Vec<std::ffi::OsString> = vec![board.port.clone().into(), scene.into()];
+    let args: Vec<std::ffi::OsString> = vec![board.port.clone().into(), wedge_file(&board, dir.path()).into()];
     let run = std::thread::spawn(move || {
         let args: Vec<&OsStr> = args.iter().map(|a| a.as_os_str()).collect();
         host_sim_board(&args)

@@ -361,6 +361,13 @@ mod tests {
         [0; 3].map(|_| (next() as i64 >> 34) % (1 << 29))
     }
 
+    /// A random raw segment of the scene's range, and a point of it.
+    fn segment_and_point(next: &mut impl FnMut() -> u64) -> ([i64; 3], [i64; 3], [i64; 3]) {
+        let (p, q) = (point(next), point(next));
+        let t = (next() % 1025) as i64;
+        (p, q, [0, 1, 2].map(|a| p[a] + (q[a] - p[a]) * t / 1024))
+    }
+
     /// A random unit vector.
     fn direction(next: &mut impl FnMut() -> u64) -> [f64; 3] {
         loop {
@@ -386,9 +393,7 @@ mod tests {
         // cells only just covers for every rounding of the grid.
         let mut next = crate::test_rng::seeded(0x5fe7_e0ed);
         for _ in 0..400_000 {
-            let (p, q) = (point(&mut next), point(&mut next));
-            let t = (next() % 1025) as i64;
-            let on = [0, 1, 2].map(|a| p[a] + (q[a] - p[a]) * t / 1024);
+            let (p, q, on) = segment_and_point(&mut next);
             let r = radius(&mut next);
             let u = direction(&mut next);
             let reach = (r + i64::from(WIDENING) - 3) as f64;
@@ -408,9 +413,7 @@ mod tests {
         // its high end rounded down and widened two).
         let mut next = crate::test_rng::seeded(0x0b0c_5ede);
         for _ in 0..400_000 {
-            let (p, q) = (point(&mut next), point(&mut next));
-            let t = (next() % 1025) as i64;
-            let on = [0, 1, 2].map(|a| p[a] + (q[a] - p[a]) * t / 1024);
+            let (p, q, on) = segment_and_point(&mut next);
             let gap = i64::from(WIDENING) - 1;
             let size = (next() % (1 << 20)) as i64;
             let above = [0; 3].map(|_| next() % 2 == 0);

@@ -16,10 +16,10 @@ use std::fmt;
 use std::time::{Duration, Instant};
 
 /// The longest a board may say nothing that moves the conversation on,
-/// where it can speak: 8 s. A board at work speaks at least every 20 ms of
-/// its clock (a row, a run, or `working`), so this is 400 times that: room
-/// for an emulated board a hundred times slower than a Pico on a busy
-/// machine, and a board gone silent is still reported within 10 s.
+/// where it can speak: 8 s. A board at work speaks at least every 40 ms of
+/// its clock and a ray (a row, a run, or `working`), so this is 200 times
+/// that: room for an emulated board a hundred times slower than a Pico on
+/// a busy machine, and a board gone silent is still reported within 10 s.
 pub const SILENCE: Duration = Duration::from_secs(8);
 
 /// The longest a board may say nothing while it may be loading a scene
