@@ -380,7 +380,11 @@ impl<L: Line, B: AsRef<[u8]> + AsMut<[u8]>> Rows<'_, '_, L, B> {
     }
 
     /// Sends `working` if the line has taken nothing of the answer for
-    /// [`KEEP_ALIVE_US`] (`now`: the clock at this look at the line).
+    /// [`KEEP_ALIVE_US`] (`now`: the clock at this look at the line). Kept
+    /// out of [`Rows::poll`], which a drawing asks before every ray: the
+    /// ask stays as small as it was (asked once a millisecond, this costs
+    /// a call).
+    #[inline(never)]
     fn keep_alive(&mut self, now: u64) {
         let taken = self.output.taken;
         let Some(alive) = &mut self.output.keep_alive else { return };
