@@ -9,7 +9,12 @@
 //! longest size do to it (issue 41): a hello answered within 50 ms by the
 //! board's clock, every frame answered, the picture still drawn, the next
 //! answer whole; an animation played over the link (issue 39): its first
-//! frames each host-sim's `--frame K`, a hello stopping it within 50 ms.
+//! frames each host-sim's `--frame K`, a hello stopping it within 50 ms;
+//! and host-sim's waits (issue 46): a drawing of hours a pixel followed
+//! while the board says it is working, a board gone silent mid-drawing
+//! given up with what it did last, a chatty board ended by its errors'
+//! count. Every wait is for an event (`HANG_GUARD` only guards against a
+//! hang), and every time checked is the board's own clock's.
 //!
 //! The board is the software board (`software-board`: the live firmware's
 //! logic, `octrace_link::board`, behind a pseudo-terminal), or the command
