@@ -350,7 +350,7 @@ fn count_riscv(elf: &Path, qemu_count: &Path) -> Result<std::process::Output, St
     let marker = symbols.lines().find_map(|l| l.strip_suffix(" T bench_marker")).unwrap_or_default();
     let log = elf.with_extension("plugin.log");
     let mut out = Command::new("timeout")
-        .arg(std::env::var("QEMU_TIMEOUT").unwrap_or_else(|_| "300".into()))
+        .arg(std::env::var("QEMU_TIMEOUT").unwrap_or_else(|_| "1800".into()))
         .args(["qemu-system-riscv32", "-machine", "virt", "-bios", "none", "-nographic", "-monitor", "none"])
         .args(["-semihosting-config", "enable=on,target=native", "-d", "plugin", "-D"])
         .arg(&log)

@@ -473,7 +473,7 @@ pub fn run_reporting(elf: &Path, png: &Path) -> Result<(Cycles, Report), String>
     let mut stdout = BufReader::new(child.stdout.take().ok_or("no standard output")?);
     let mut path = String::new();
     let asked = match stdout.read_line(&mut path) {
-        Ok(n) if n > 0 => ask_report(Path::new(path.trim()), Duration::from_secs(900)),
+        Ok(n) if n > 0 => ask_report(Path::new(path.trim()), crate::HANG_GUARD),
         _ => Err("the emulated Pico named no serial device".to_owned()),
     };
     // Its standard input closed, the emulator ends and prints its own count.
