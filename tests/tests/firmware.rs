@@ -5,9 +5,10 @@
 //! flash and static RAM are held to their budgets (`budgets.toml`, section
 //! `firmware`).
 //!
-//! Needs `qemu-system-arm` (the test command installs it) and qemu-count
-//! (`firmware::qemu_count`); set `OCTRACE_SKIP_FIRMWARE=1` to skip where
-//! they cannot be installed.
+//! Needs `qemu-system-arm`, `qemu-system-riscv32` and gcc, which builds
+//! qemu-count's plugin (`firmware/tools/qemu-count`; the test command
+//! installs all three); set `OCTRACE_SKIP_FIRMWARE=1` to skip where they
+//! cannot be installed.
 
 use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;

@@ -12,9 +12,9 @@
 //! nearest level (the same render and the same byte a pixel to the display,
 //! so the difference is the method's).
 //!
-//! `qemu-count` is `$OCTRACE_QEMU_COUNT`, else `../shared/tools/qemu-count`
-//! beside the repository. Counts are instructions, exact and repeatable, not
-//! cycles of a real chip.
+//! The counter is `firmware/tools/qemu-count` (or the program
+//! `$OCTRACE_QEMU_COUNT` names). Counts are instructions, exact and
+//! repeatable, not cycles of a real chip.
 
 use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
