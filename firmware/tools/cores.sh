@@ -14,7 +14,7 @@ symbol() { arm-none-eabi-nm -S "$ELF" | awk -v name="$1" '$4 == name { print $1,
 read -r marker _ < <(symbol bench_marker)
 read -r wait size < <(symbol octrace_wait_until)
 OUT=$(mktemp)
-timeout "${QEMU_TIMEOUT:-600}" "${QEMU[@]}" -plugin "$PLUGIN,out=$OUT,marker=0x$marker,wait=0x$wait-$(printf '0x%x' $((0x$wait + 0x$size)))" \
+timeout "${QEMU_TIMEOUT:-1800}" "${QEMU[@]}" -plugin "$PLUGIN,out=$OUT,marker=0x$marker,wait=0x$wait-$(printf '0x%x' $((0x$wait + 0x$size)))" \
   -kernel "$ELF" >/dev/null
 cat "$OUT"
 rm -f "$OUT"

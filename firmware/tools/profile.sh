@@ -12,7 +12,7 @@ source "$HERE/qemu.sh"
 PLUGIN=$(build_plugin qemu-profile)
 qemu_for "$MACHINE"
 OUT=$(mktemp)
-timeout "${QEMU_TIMEOUT:-600}" "${QEMU[@]}" -plugin "$PLUGIN,out=$OUT" -kernel "$ELF" >/dev/null || true
+timeout "${QEMU_TIMEOUT:-1800}" "${QEMU[@]}" -plugin "$PLUGIN,out=$OUT" -kernel "$ELF" >/dev/null || true
 python3 - "$ELF" "$OUT" "$TOP" <<'PY'
 import bisect, subprocess, sys
 elf, prof, top = sys.argv[1], sys.argv[2], int(sys.argv[3])
