@@ -79,6 +79,15 @@ pub struct Aabb {
 }
 
 impl Aabb {
+    /// The smallest box holding two points.
+    #[inline]
+    pub(crate) fn spanned(a: Vec3, b: Vec3) -> Aabb {
+        Aabb {
+            min: Vec3 { x: a.x.min(b.x), y: a.y.min(b.y), z: a.z.min(b.z) },
+            max: Vec3 { x: a.x.max(b.x), y: a.y.max(b.y), z: a.z.max(b.z) },
+        }
+    }
+
     /// The smallest box holding both.
     pub fn union(self, o: Aabb) -> Aabb {
         Aabb {
