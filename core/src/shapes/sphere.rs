@@ -134,8 +134,22 @@ fn surely_missed(oc: [i32; 3], dir: [i32; 3], t_max: i32, radius: i32) -> bool {
     // ± OFFSET_ERROR; `reach` is ⌊(radius + OFFSET_ERROR + 3)/4⌋.
     let b_high = s >> 14;
     let reach = ((radius >> 2) + (((radius & 3) + OFFSET_ERROR as i32 + 3) >> 2)) as u32;
-    let off = |a: usize| ((oc[a] >> 2).wrapping_sub((dir[a] >> 16).wrapping_mul(b_high))).unsigned_abs() > reach;
-    off(0) || off(1) || off(2)
+    let quarter = [0, 1, 2].map(|a| ((oc[a] >> 2).wrapping_sub((dir[a] >> 16).wrapping_mul(b_high))).unsigned_abs());
+    if quarter.iter().any(|&q| q > reach) {
+        return true;
+    }
+    // Within the radius on every axis, but maybe not within the sphere:
+    // |q_i| ≥ 4·|quarter_i| − 3 − OFFSET_ERROR ≥ 4·v_i, v_i = |quarter_i| −
+    // 2^18 − 1 (when positive), so |q|² ≥ 2^32·Σ c_i² with c_i = ⌊v_i/2^14⌋;
+    // that is above r² once Σ c_i² ≥ (⌊r/2^16⌋ + 1)², and the exact test's
+    // r² − |q|² is then negative (its sums exact for a radius below 2^30).
+    // Each c_i is below 2^15 here (v_i ≤ reach), the sums fit a u32.
+    if !(0..1 << 30).contains(&radius) {
+        return false;
+    }
+    let c = quarter.map(|q| q.saturating_sub((OFFSET_ERROR as u32 >> 2) + 1) >> 14);
+    let r = (radius >> 16) as u32 + 1;
+    c[0] * c[0] + c[1] * c[1] + c[2] * c[2] >= r * r
 }
 
 #[cfg(test)]
@@ -245,8 +259,9 @@ mod tests {
         assert!(hits > 20_000 && near > hits, "{hits} hits, {near} near");
     }
 
-    /// The 64-bit form the pre-test was first written in: the 32-bit one
-    /// must answer as it does for any inputs.
+    /// The pre-test in 64-bit steps, as it was first written (with the
+    /// squared closest approach since): the 32-bit one must answer as it
+    /// does for any inputs.
     fn surely_missed_in_64_bits(oc: [i32; 3], dir: [i32; 3], t_max: i64, radius: i64) -> bool {
         let short = |a: usize| (oc[a] >> 17).wrapping_mul(dir[a] >> 15);
         let estimate = 4 * short(0).wrapping_add(short(1)).wrapping_add(short(2)) as i64;
@@ -255,8 +270,16 @@ mod tests {
         }
         let b_high = (estimate >> 16) as i32;
         let reach = ((radius + OFFSET_ERROR + 3) >> 2) as u32;
-        let off = |a: usize| ((oc[a] >> 2).wrapping_sub((dir[a] >> 16).wrapping_mul(b_high))).unsigned_abs() > reach;
-        off(0) || off(1) || off(2)
+        let quarter =
+            [0, 1, 2].map(|a| ((oc[a] >> 2).wrapping_sub((dir[a] >> 16).wrapping_mul(b_high))).unsigned_abs() as i64);
+        if quarter.iter().any(|&q| q > reach as i64) {
+            return true;
+        }
+        if !(0..1 << 30).contains(&radius) {
+            return false;
+        }
+        let c = quarter.map(|q| (q - (OFFSET_ERROR >> 2) - 1).max(0) >> 14);
+        c.iter().map(|c| c * c).sum::<i64>() >= ((radius >> 16) + 1).pow(2)
     }
 
     #[test]
