@@ -286,7 +286,7 @@ mod tests {
     fn the_pre_test_in_32_bits_answers_as_in_64() {
         let mut next = crate::test_rng::seeded(0x32_64_5f);
         let edges = [0, 1, 2, 3, -1, -4, i32::MAX, i32::MIN, i32::MAX - 3, 1 << 30, -(1 << 30), 1 << 29];
-        let mut word = |next: &mut dyn FnMut() -> u64| match next() % 5 {
+        let word = |next: &mut dyn FnMut() -> u64| match next() % 5 {
             0 => edges[(next() % edges.len() as u64) as usize],
             _ => (next() as i32) >> (next() % 32),
         };
