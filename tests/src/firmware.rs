@@ -124,7 +124,9 @@ impl Firmware {
         self.target_dir().join(format!("{}.raw", self.slug()))
     }
 
-    /// Builds the firmware (release) and returns the ELF.
+    /// Builds the firmware (release) and returns the ELF, kept under the
+    /// build's name: the next build for the same board (which writes the
+    /// same file) can then go on while qemu runs this one.
     pub fn build(&self) -> Result<PathBuf, String> {
         let dir = self.target_dir();
         let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
@@ -146,7 +148,10 @@ impl Firmware {
         if !out.status.success() {
             return Err(format!("firmware build {} failed:\n{}", self.slug(), String::from_utf8_lossy(&out.stderr)));
         }
-        Ok(dir.join(self.board.target()).join("release/octrace-firmware"))
+        let built = dir.join(self.board.target()).join("release/octrace-firmware");
+        let kept = dir.join(format!("{}.elf", self.slug()));
+        std::fs::copy(&built, &kept).map_err(|e| format!("{} -> {}: {e}", built.display(), kept.display()))?;
+        Ok(kept)
     }
 
     /// Runs the ELF in qemu (through the firmware's runner script, which
