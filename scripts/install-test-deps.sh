@@ -16,10 +16,12 @@ TEST_RUST_TARGETS=(thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf t
 TEST_COMMAND_PACKAGES=(
     qemu-system-arm:qemu-system-arm
     qemu-system-riscv32:qemu-system-misc
+    gcc:gcc
     arm-none-eabi-size:binutils-arm-none-eabi
     parallel:parallel
     /usr/bin/chromium:chromium
     /usr/bin/chromedriver:chromium-driver
+    ffprobe:ffmpeg
     node:nodejs
     npm:npm
     python3:python3

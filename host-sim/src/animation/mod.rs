@@ -1,18 +1,26 @@
 //! Animations on the desktop: every frame of a scene with `FRAMES` loaded
 //! and traced in turn, each after the first re-tracing only the tiles the
 //! motion can change (the core's [`Coherence`]) on every thread, then
-//! written as an animated GIF, an APNG or one image file a frame
-//! (`writers.rs`).
+//! written as an animated GIF (`gif.rs`, its colours from `quantize/`), an
+//! APNG (`apng.rs`), both storing only what each frame changed
+//! (`changes.rs`), or one image file a frame (`writers.rs`).
 //!
 //! Invariants: a frame's image is the frame traced whole, bit for bit
 //! (the core's coherence is exact; `--no-coherence` traces every pixel);
 //! any number of threads gives the same bits; the frames reach the writer
 //! in order, each once.
 
+mod apng;
+mod changes;
 mod command;
+mod gif;
+mod quantize;
 mod writers;
 
+pub use apng::ApngWriter;
+pub use changes::Area;
 pub use command::{animate, is_frame_file, merge_frames, Request};
+pub use gif::{gif_delay, GifWriter};
 pub use writers::{FrameInfo, FramePattern, Output};
 
 use crate::threaded::stream_threads;
@@ -46,7 +54,10 @@ pub struct FrameImage {
     pub image: RgbImage,
     /// [`NO_OBJECT`] for background.
     pub objects: Vec<u32>,
-    pub traced: Vec<Rectangle>,
+    /// The areas traced for this frame, where it can differ from the frame
+    /// before (the tiles the coherence re-traced); `None`: anywhere (the
+    /// first frame, or every frame traced whole).
+    pub retraced: Option<Vec<Area>>,
 }
 
 /// What rendering the frames did.
@@ -121,13 +132,12 @@ pub fn render_frames(
         Err(Refused::NoRoom(e)) => return Err(AnimationError::Setup(e.to_string())),
     }
     let mut current: Option<FrameImage> = None;
-    let whole = Rectangle::new(embedded_graphics_core::geometry::Point::zero(), size);
     for frame in frames {
         let started = Instant::now();
         let image = current.get_or_insert_with(|| FrameImage {
             image: RgbImage::new(w, h),
             objects: vec![NO_OBJECT; w as usize * h as usize],
-            traced: Vec::new(),
+            retraced: None,
         });
         let stats = match options.coherence {
             true => {
@@ -137,7 +147,8 @@ pub fn render_frames(
                 })?;
                 report.loading += started.elapsed();
                 let traced = Instant::now();
-                image.traced = loaded.tiles().traced_areas().collect();
+                // The first frame can differ anywhere.
+                image.retraced = (report.frames > 0).then(|| loaded.tiles().traced_areas().map(area).collect());
                 report.traced += loaded.tiles().traced_pixels();
                 let stats = draw_frame(&loaded, image, options.render.threads, progress);
                 report.tracing += traced.elapsed();
@@ -155,7 +166,7 @@ pub fn render_frames(
                 let indexed = scene.index(&options.render);
                 report.loading += started.elapsed();
                 let traced = Instant::now();
-                image.traced = vec![whole];
+                image.retraced = None;
                 report.traced += u64::from(w) * u64::from(h);
                 let rows = 0..h;
                 let mut sink = Whole(image);
@@ -179,6 +190,12 @@ pub fn render_frames(
         each(frame, image).map_err(AnimationError::Write)?;
     }
     Ok(report)
+}
+
+/// A rectangle the coherence re-traced, as the writers take it.
+fn area(traced: Rectangle) -> Area {
+    let (x, y) = (traced.top_left.x as u32, traced.top_left.y as u32);
+    Area { x, y, width: traced.size.width, height: traced.size.height }
 }
 
 /// A frame whole, row by row, into its image.

@@ -13,7 +13,8 @@
 //! [`Message::Rejected`], or a [`Message::Drawing`] whose [`Drawing`] is
 //! closed by [`Drawing::finish`] or [`Drawing::cancel`] (an animation's
 //! frames, each closed by a [`Message::FrameDrawn`], by a
-//! [`Message::Stopped`]) — all with the frame's tag; a scene with errors
+//! [`Message::Stopped`]; a [`Message::Working`] wherever a drawing has
+//! sent nothing for a while) — all with the frame's tag; a scene with errors
 //! draws nothing, nor does an animation its room cannot hold, nor one
 //! whose camera cannot be set up at any of its frames (checked, every
 //! frame, before its `drawing`).
@@ -74,7 +75,8 @@ mod serve;
 use play::saturate;
 pub use ring::Ring;
 pub use serve::{
-    Line, Link, Rows, Served, Stalled, MAX_COUNTERS, POLL_PERIOD_US, SLOWEST_HOST_BYTES_PER_SECOND, STALL_GRACE_US,
+    Line, Link, Rows, Served, Stalled, KEEP_ALIVE_US, MAX_COUNTERS, POLL_PERIOD_US, SLOWEST_HOST_BYTES_PER_SECOND,
+    STALL_GRACE_US,
 };
 
 use crate::cobs::Sink;
