@@ -3,15 +3,18 @@
 use crate::animation::{animate, is_frame_file, merge_frames, AnimationOptions, Request};
 use crate::arguments::{output_format, parse_accel, parse_color, parse_dithering, parse_format, parse_palette};
 use crate::arguments::{parse_size, same_file};
+use crate::options::{all_cores, Partition, RenderOptions};
 use crate::output::{panel_preview, write_atomically, FileSink};
 use crate::parts::{self, MergeError, PartInfo, PartSpec};
+use crate::render::{render_streamed, Streamed};
+use crate::rows::{Canvas, StreamError};
+use crate::scene::{load_frame_bytes, new_scene, HostScene, LoadError};
 use crate::terminal::progress_bar;
-use crate::{all_cores, load_frame_bytes, new_scene, render_streamed, AccelMode, LoadError, Partition, RenderOptions};
-use crate::{Canvas, HostScene, StreamError, Streamed};
 use clap::Parser;
 use octrace_core::accel::OctreeConfig;
 use octrace_core::panel::{Dithering, Panel};
 use octrace_core::render::PanelColor;
+use octrace_core::AccelMode;
 use octrace_images::formats::{self, Format, FormatError, Header, Image};
 use octrace_images::palette::PaletteMode;
 use std::io::Write;
@@ -83,10 +86,10 @@ pub struct Args {
     #[arg(long, value_name = "MODE", default_value = "auto", value_parser = parse_accel)]
     pub accel: AccelMode,
     /// Octree criterion: a box holding more objects than this is subdivided.
-    #[arg(long, value_name = "N", default_value_t = crate::OCTREE.max_objects)]
+    #[arg(long, value_name = "N", default_value_t = crate::options::OCTREE.max_objects)]
     pub max_objects: usize,
     /// Octree criterion: boxes are not subdivided below this depth (at most 18).
-    #[arg(long, value_name = "D", default_value_t = crate::OCTREE.max_depth,
+    #[arg(long, value_name = "D", default_value_t = crate::options::OCTREE.max_depth,
           value_parser = clap::value_parser!(u32).range(0..=18))]
     pub max_depth: u32,
     /// Threads to render on (default: every core). Any number gives the

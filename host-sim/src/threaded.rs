@@ -10,7 +10,8 @@
 //! is set (Ctrl-C), every worker stops before its next ray, inside a pixel,
 //! and no band after is written.
 
-use crate::{Partition, RenderOptions, RowSink, StreamError, NO_OBJECT, TILE_SIDE};
+use crate::options::{Partition, RenderOptions, TILE_SIDE};
+use crate::rows::{RowSink, StreamError};
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::pixelcolor::RgbColor;
 use embedded_graphics_core::primitives::Rectangle;
@@ -18,6 +19,7 @@ use octrace_core::profile::Host;
 use octrace_core::render::{Renderer, Tiles};
 use octrace_core::shade::Stats;
 use octrace_core::{RendererRoom, SharedScene};
+use octrace_images::NO_OBJECT;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::{Duration, Instant};

@@ -67,7 +67,7 @@ where
         }
         Some(traced)
     };
-    draw_rows(core1, scene, room, ring, display, each_row, || false, trace)
+    draw_rows(Cores { core1, scene, room, ring }, display, each_row, || false, trace)
 }
 
 /// [`draw`], stopped inside a pixel: core 0 asks `stop` before every ray
@@ -96,7 +96,7 @@ where
         }
         Some(width.min(colors.len() as u32) as usize)
     };
-    draw_rows(core1, scene, room, ring, display, each_row, stop, trace)
+    draw_rows(Cores { core1, scene, room, ring }, display, each_row, stop, trace)
 }
 
 /// How a core asks whether to stop, inside a piece it traces: one type for
@@ -104,13 +104,18 @@ where
 /// that a firmware links the tracer once.
 pub(crate) type Asked<'s> = &'s mut dyn FnMut() -> bool;
 
+/// What both cores trace a picture of a scene with: core 1, the room its
+/// renderer traces in, and the ring it hands its pieces over in.
+struct Cores<'c, 'r, P: Profile, const LEN: usize, const SLOTS: usize> {
+    core1: &'c mut SecondCore,
+    scene: &'c LoadedScene<'r, P>,
+    room: &'c mut RendererRoom<P>,
+    ring: &'c Handoff<LEN, SLOTS>,
+}
+
 /// The rows of [`draw`] and [`draw_until`], each traced by `trace`.
-#[allow(clippy::too_many_arguments)]
-fn draw_rows<'r, P, D, const LEN: usize, const SLOTS: usize>(
-    core1: &mut SecondCore,
-    scene: &LoadedScene<'r, P>,
-    room: &mut RendererRoom<P>,
-    ring: &Handoff<LEN, SLOTS>,
+fn draw_rows<P, D, const LEN: usize, const SLOTS: usize>(
+    cores: Cores<'_, '_, P, LEN, SLOTS>,
     display: &mut D,
     mut each_row: impl FnMut(u32, &[Rgb888]) -> ControlFlow<()>,
     stop: impl FnMut() -> bool,
@@ -141,7 +146,7 @@ where
             display.fill_contiguous(&row(y), line.iter().copied()).map_err(|_| Unfinished::Panel)?;
             each_row(y, colors)
         };
-        return share(core1, scene, room, ring, size, || 0..size.height, trace, present, stop);
+        return share(cores, size, || 0..size.height, trace, present, stop);
     }
     let mut error_rows = [0; IMAGE_ERROR_WORDS];
     let mut dithered = Dithered::new(display, Dithering::default(), &mut error_rows).map_err(|_| Unfinished::Panel)?;
@@ -149,7 +154,7 @@ where
         dithered.fill_contiguous(&row(y), colors.iter().copied()).map_err(|_| Unfinished::Panel)?;
         each_row(y, colors)
     };
-    share(core1, scene, room, ring, size, || 0..size.height, trace, present, stop)
+    share(cores, size, || 0..size.height, trace, present, stop)
 }
 
 /// Traces `scene` into `display` with both cores in the progressive
@@ -183,7 +188,7 @@ where
         let traced = unit.with_colors(colors).map_err(|_| Unfinished::Panel)?;
         traced.draw(&mut display).map_err(|_| Unfinished::Panel)
     };
-    share(core1, scene, room, ring, order.size(), || order.units(), trace, present, || false)
+    share(Cores { core1, scene, room, ring }, order.size(), || order.units(), trace, present, || false)
 }
 
 /// Both cores trace the pieces (rows, or a progressive order's units) of
@@ -199,12 +204,8 @@ where
 /// the panel's commands, the bus), 4 to 5 % of its time on the Pico, and
 /// pieces differ in cost (a row of sky against a row of spheres), so fixed
 /// halves left core 1 waiting for 10 M cycles of fig5_3's picture.
-#[allow(clippy::too_many_arguments)]
-fn share<'r, P, T, I, const LEN: usize, const SLOTS: usize>(
-    core1: &mut SecondCore,
-    scene: &LoadedScene<'r, P>,
-    room: &mut RendererRoom<P>,
-    ring: &Handoff<LEN, SLOTS>,
+fn share<P, T, I, const LEN: usize, const SLOTS: usize>(
+    cores: Cores<'_, '_, P, LEN, SLOTS>,
     size: Size,
     pieces: impl Fn() -> I + Sync,
     trace: impl Fn(&mut Renderer<'_, P>, &T, &mut [Rgb888], Asked<'_>) -> Option<usize> + Sync,
@@ -215,6 +216,7 @@ where
     P: Profile,
     I: Iterator<Item = T>,
 {
+    let Cores { core1, scene, room, ring } = cores;
     let stop = AtomicBool::new(false);
     // The number of the next piece to take: read and advanced under the
     // chip's lock (ARMv6-M has no atomic read-modify-write).

@@ -45,7 +45,7 @@ struct Run {
 fn host_sim_board(args: &[&OsStr]) -> Run {
     let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
     let args = ["host-sim".as_ref(), "board".as_ref()].into_iter().chain(args.iter().copied());
-    let code = host_sim::run(args, &mut stdout, &mut stderr);
+    let code = host_sim::cli::run(args, &mut stdout, &mut stderr);
     let text = |bytes: Vec<u8>| String::from_utf8_lossy(&bytes).into_owned();
     Run { code, stdout: text(stdout), stderr: text(stderr) }
 }
@@ -99,7 +99,8 @@ fn a_scene_with_errors_is_answered_at_each_line_and_column_and_nothing_is_drawn(
     let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str(), out.as_os_str(), "--check".as_ref()]);
     // Exactly what host-sim prints for the same file.
     let mut stderr = Vec::new();
-    let own = host_sim::run(["host-sim".as_ref(), scene.as_os_str(), out.as_os_str()], &mut Vec::new(), &mut stderr);
+    let own =
+        host_sim::cli::run(["host-sim".as_ref(), scene.as_os_str(), out.as_os_str()], &mut Vec::new(), &mut stderr);
     let own = (own, String::from_utf8_lossy(&stderr).into_owned());
     assert_eq!((run.code, &run.stderr), (own.0, &own.1));
     assert_eq!(run.code, 2);
@@ -790,7 +791,7 @@ fn an_animations_first_frames_are_each_host_sims_frame_and_a_still_is_drawn_afte
     assert_eq!(traced[0], u64::from(description.panel.width) * u64::from(description.panel.height));
     // OUT is the last frame followed: host-sim's frame 2.
     let expected = dir.path().join("frame2.png");
-    let preview = host_sim::run(
+    let preview = host_sim::cli::run(
         [
             "host-sim".as_ref(),
             scene.as_os_str(),

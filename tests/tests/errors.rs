@@ -23,7 +23,7 @@ fn run_bytes(scene: &[u8]) -> Run {
     let out = dir.path().join("out.png");
     let mut stderr = Vec::new();
     let code =
-        host_sim::run(["host-sim".as_ref(), path.as_os_str(), out.as_os_str()], &mut std::io::sink(), &mut stderr);
+        host_sim::cli::run(["host-sim".as_ref(), path.as_os_str(), out.as_os_str()], &mut std::io::sink(), &mut stderr);
     Run { code, stderr: String::from_utf8_lossy(&stderr).into_owned(), out, _dir: dir }
 }
 
@@ -171,7 +171,7 @@ fn run_args(args: &[&std::ffi::OsStr]) -> (i32, String) {
     let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
     let mut all = vec![std::ffi::OsStr::new("host-sim")];
     all.extend_from_slice(args);
-    let code = host_sim::run(all, &mut stdout, &mut stderr);
+    let code = host_sim::cli::run(all, &mut stdout, &mut stderr);
     stdout.extend(stderr);
     (code, String::from_utf8_lossy(&stdout).into_owned())
 }

@@ -135,7 +135,7 @@ fn every_animation_matches_its_golden_gif() {
     for (name, path) in animations() {
         let out = dir.join(format!("{name}.gif"));
         let mut stderr = Vec::new();
-        let code = host_sim::run(
+        let code = host_sim::cli::run(
             ["host-sim".as_ref(), path.as_os_str(), out.as_os_str(), "-q".as_ref()],
             &mut Vec::new(),
             &mut stderr,

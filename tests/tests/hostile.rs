@@ -1,6 +1,6 @@
 //! The hostile-input table (docs/hostile-inputs.md), one test per row: what
 //! octrace does with inputs built to break a parser, a camera, a tracer or a
-//! command line. Every case runs through `host_sim::run` as a user meets it
+//! command line. Every case runs through `host_sim::cli::run` as a user meets it
 //! and asserts the exact outcome: a positioned error, exit code and no output
 //! file; or a valid image of the right size, with its pixels where they are
 //! knowable.
@@ -40,7 +40,7 @@ fn host_sim(args: &[&std::ffi::OsStr]) -> (i32, String) {
     let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
     let mut all = vec![OsString::from("host-sim")];
     all.extend(args.iter().map(OsString::from));
-    let code = host_sim::run(all, &mut stdout, &mut stderr);
+    let code = host_sim::cli::run(all, &mut stdout, &mut stderr);
     stdout.extend(stderr);
     (code, String::from_utf8_lossy(&stdout).into_owned())
 }
@@ -55,7 +55,7 @@ fn run_with(scene: &[u8], extra: &[&str]) -> Run {
     let mut args: Vec<OsString> = vec!["host-sim".into(), path.into(), out.clone().into()];
     args.extend(extra.iter().map(OsString::from));
     let mut stderr = Vec::new();
-    let code = host_sim::run(args, &mut std::io::sink(), &mut stderr);
+    let code = host_sim::cli::run(args, &mut std::io::sink(), &mut stderr);
     Run { code, stderr: String::from_utf8_lossy(&stderr).into_owned(), out, dir }
 }
 

@@ -165,7 +165,7 @@ fn host_sim_writes_and_converts_every_format() {
         let (mut out, mut err) = (Vec::new(), Vec::new());
         let mut all = vec![std::ffi::OsStr::new("host-sim")];
         all.extend_from_slice(args);
-        let code = host_sim::run(all, &mut out, &mut err);
+        let code = host_sim::cli::run(all, &mut out, &mut err);
         assert_eq!(code, 0, "{}", String::from_utf8_lossy(&err));
     };
     for mode in ["none", "scan", "dither", "coarse", "gray"] {
@@ -204,7 +204,7 @@ fn convert_rejects_a_corrupt_file_and_leaves_nothing() {
     std::fs::write(&bad, [0x59, 0xa6, 0x6a, 0x95, 0, 0]).unwrap();
     let out = dir.path().join("out.png");
     let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
-    let code = host_sim::run(
+    let code = host_sim::cli::run(
         ["host-sim".as_ref(), "convert".as_ref(), bad.as_os_str(), out.as_os_str()],
         &mut stdout,
         &mut stderr,

@@ -251,7 +251,7 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
         let dither = dither.map(|d| ["--dither", d]).into_iter().flatten();
         let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
         let args = args.into_iter().chain(["--color", name, "--quiet"]).chain(dither);
-        let code = host_sim::run(args, &mut stdout, &mut stderr);
+        let code = host_sim::cli::run(args, &mut stdout, &mut stderr);
         assert_eq!(code, 0, "{}", String::from_utf8_lossy(&stderr));
         let panel = octrace_images::formats::read(&std::fs::read(&out).unwrap()).expect("host-sim's preview").to_rgb();
         assert_same(name, browser.canvas_rgb("image"), &panel);
@@ -833,7 +833,7 @@ fn host_frame(scene: &Path, frame: u32, size: Option<&str>) -> RgbImage {
     args.extend(["--frame", &frame, "--quiet"]);
     args.extend(size.iter().flat_map(|size| ["--size", size]));
     let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
-    let code = host_sim::run(args, &mut stdout, &mut stderr);
+    let code = host_sim::cli::run(args, &mut stdout, &mut stderr);
     assert_eq!(code, 0, "{}", String::from_utf8_lossy(&stderr));
     octrace_images::formats::read(&std::fs::read(&out).expect("the frame")).expect("a PNG").to_rgb()
 }

@@ -6,10 +6,10 @@
 //! once every frame is written); a scene error at any frame is reported as
 //! `file:line:col` with exit code 2, as for a still.
 
-use super::writers::{write_frame_file, FrameInfo};
-use super::{
-    render_frames, AnimationError, AnimationOptions, AnimationReport, ApngWriter, FrameImage, GifWriter, Output,
-};
+use super::apng::ApngWriter;
+use super::frames::{render_frames, AnimationError, AnimationOptions, AnimationReport, FrameImage};
+use super::gif::GifWriter;
+use super::writers::{write_frame_file, FrameInfo, Output};
 use crate::exit::CliError;
 use crate::output::write_atomically;
 use crate::parts::{auto_index, band_rows, scene_hash, PartSpec};

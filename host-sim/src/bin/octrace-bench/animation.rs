@@ -4,7 +4,7 @@
 //! re-trace at least), a viewpoint that moves, and the memory coherence
 //! takes for a 240×240 panel.
 
-use super::{ms, BenchError};
+use crate::measure::{ms, BenchError};
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::Rgb888;
