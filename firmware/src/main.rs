@@ -195,7 +195,8 @@ fn draw_on(scene: &LoadedScene<'static, Profile>, file: HostFile) -> bool {
 fn draw_on(scene: &LoadedScene<'_, Profile>, mut panel: ssd0323::Ssd0323) -> bool {
     debug_assert!(config::WIRE == PanelColor::Gray4);
     let image = scene.image(Size::new(config::WIDTH, config::HEIGHT)).dithered(config::DITHERING);
-    image.try_draw_with(&mut panel, &mut [0; config::ERROR_WORDS]).is_ok()
+    let rows = core::cell::RefCell::new([0; config::ERROR_WORDS]);
+    image.error_rows(&rows).try_draw(&mut panel).is_ok()
 }
 
 /// Draws the scene into a display of colour `C`. Not inlined: each colour's
@@ -224,8 +225,8 @@ fn draw_into<D: DrawTarget>(scene: &LoadedScene<'static, Profile>, display: &mut
 where
     D::Color: TracedColor,
 {
-    let mut rows = [0; config::ERROR_WORDS];
-    scene.image_for(display).dithered(config::DITHERING).try_draw_with(display, &mut rows).is_ok()
+    let rows = core::cell::RefCell::new([0; config::ERROR_WORDS]);
+    scene.image_for(display).dithered(config::DITHERING).error_rows(&rows).try_draw(display).is_ok()
 }
 
 /// Draws the scene into `display` with both cores.
