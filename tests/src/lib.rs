@@ -3,6 +3,7 @@
 
 pub mod board;
 pub mod firmware;
+pub mod imports;
 pub mod pico;
 pub mod webdriver;
 
