@@ -20,6 +20,7 @@ TEST_COMMAND_PACKAGES=(
     parallel:parallel
     /usr/bin/chromium:chromium
     /usr/bin/chromedriver:chromium-driver
+    ffprobe:ffmpeg
     node:nodejs
     npm:npm
     python3:python3

@@ -54,8 +54,8 @@ pub struct Args {
     /// Map the image onto a 256-entry colour table (written as an indexed
     /// image): scan (the thesis's hash-scan table), dither (6×6×6 cube,
     /// ordered), coarse (dither with outlines around objects), gray; none
-    /// (the default) keeps truecolour. An animated GIF takes scan unless
-    /// another table is given.
+    /// (the default) keeps truecolour. An animated GIF without it gets
+    /// colours chosen for the whole loop (docs/animation.md).
     #[arg(long, value_name = "MODE", value_parser = parse_palette)]
     pub palette: Option<PaletteMode>,
     /// Preview a panel: the pixels as a display of this format shows them

@@ -75,14 +75,41 @@ pub fn dithered(image: &RgbImage, panel: Panel, dithering: Dithering) -> Image {
 /// assert!(panel::seen_psnr(&render, &cut, Panel::Mono) < 13.0);
 /// ```
 pub fn seen_psnr(render: &RgbImage, shown: &RgbImage, panel: Panel) -> f64 {
-    let gray = panel != Panel::BlackWhiteRed;
-    let channels = if gray { 1 } else { 3 };
-    let (w, h) = (render.width as usize, render.height as usize);
-    // The blur is linear: blur the difference.
-    let mut difference: Vec<f64> = match gray {
-        true => pixels(shown).zip(pixels(render)).map(|(s, r)| s.r() as f64 - Gray8::from(r).luma() as f64).collect(),
-        false => shown.data.iter().zip(&render.data).map(|(&s, &r)| s as f64 - r as f64).collect(),
-    };
+    match panel {
+        Panel::BlackWhiteRed => blurred_psnr(render, shown),
+        _ => {
+            let difference: Vec<f64> =
+                pixels(shown).zip(pixels(render)).map(|(s, r)| s.r() as f64 - Gray8::from(r).luma() as f64).collect();
+            blurred_difference_psnr(difference, render.width as usize, render.height as usize, 1)
+        }
+    }
+}
+
+/// How close `shown` looks to `render` for an eye that cannot tell pixels
+/// apart: the PSNR (peak 255, in dB) over every RGB channel between the
+/// two, each blurred by a Gaussian of σ = 1 pixel as [`seen_psnr`] blurs
+/// them.
+///
+/// ```
+/// use octrace_images::{panel, RgbImage};
+///
+/// // Alternate pixels 2 levels above and below a flat colour: 48 dB
+/// // plain, nearly the colour itself once blurred.
+/// let flat = RgbImage { width: 16, height: 16, data: vec![100; 16 * 16 * 3] };
+/// let data = (0..16 * 16 * 3).map(|i| if (i / 3 + i / 48) % 2 == 0 { 98 } else { 102 }).collect();
+/// let checked = RgbImage { width: 16, height: 16, data };
+/// assert!(octrace_images::palette::psnr(&flat, &checked) < 43.0);
+/// assert!(panel::blurred_psnr(&flat, &checked) > 55.0);
+/// ```
+pub fn blurred_psnr(render: &RgbImage, shown: &RgbImage) -> f64 {
+    let difference = shown.data.iter().zip(&render.data).map(|(&s, &r)| s as f64 - r as f64).collect();
+    blurred_difference_psnr(difference, render.width as usize, render.height as usize, 3)
+}
+
+/// The PSNR of a difference of `w` × `h` pixels of `channels` each,
+/// blurred first (the blur is linear: blurring the difference is
+/// differencing the blurred images).
+fn blurred_difference_psnr(mut difference: Vec<f64>, w: usize, h: usize, channels: usize) -> f64 {
     blur(&mut difference, w, h, channels);
     let squared: f64 = difference.iter().map(|d| d * d).sum();
     match squared {

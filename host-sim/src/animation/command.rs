@@ -6,8 +6,10 @@
 //! once every frame is written); a scene error at any frame is reported as
 //! `file:line:col` with exit code 2, as for a still.
 
-use super::writers::{write_frame_file, ApngWriter, FrameInfo, GifWriter};
-use super::{render_frames, AnimationError, AnimationOptions, AnimationReport, FrameImage, Output};
+use super::writers::{write_frame_file, FrameInfo};
+use super::{
+    render_frames, AnimationError, AnimationOptions, AnimationReport, ApngWriter, FrameImage, GifWriter, Output,
+};
 use crate::exit::CliError;
 use crate::output::write_atomically;
 use crate::parts::{auto_index, band_rows, scene_hash, PartSpec};
@@ -39,15 +41,17 @@ pub struct Request<'a> {
 pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliError> {
     let output = Output::of(request.out).map_err(CliError::Invalid)?;
     let frames = request.frames;
-    let palette = match (&output, request.palette) {
-        (Output::Gif, None) => PaletteMode::Scan,
-        (Output::Gif, Some(PaletteMode::None)) => {
-            return Err(CliError::Invalid(
-                "a GIF holds 256 colours a frame: give --palette scan, dither, coarse or gray (scan by default)".into(),
-            ))
-        }
-        (_, mode) => mode.unwrap_or(PaletteMode::None),
-    };
+    let palette =
+        match (&output, request.palette) {
+            (Output::Gif, Some(PaletteMode::None)) => return Err(CliError::Invalid(
+                "a GIF holds 256 colours a frame: leave --palette out for colours chosen for the whole loop, or give \
+                 scan, dither, coarse or gray"
+                    .into(),
+            )),
+            // Without --palette, a GIF's colours are chosen from the
+            // truecolour frames of the whole loop.
+            (_, mode) => mode.unwrap_or(PaletteMode::None),
+        };
     let range = match (request.part, &output) {
         (None, _) => frames.all(),
         (Some(spec), Output::Files(_)) => {
@@ -113,12 +117,19 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
     let written = match &output {
         Output::Gif => write_atomically(request.out, |f| {
             let mut gif = GifWriter::new(f, width, height, frames)?;
-            render(&mut |_, frame| gif.frame(&palette::apply(&frame.image, &frame.objects, palette)))?;
+            render(&mut |_, frame| {
+                gif.frame(&palette::apply(&frame.image, &frame.objects, palette), frame.retraced.as_deref())
+            })?;
             gif.finish().map(|_| ())
         }),
         Output::Apng => write_atomically(request.out, |f| {
-            let mut apng = ApngWriter::new(f, width, height, range.len() as u32, frames)?;
-            render(&mut |_, frame| apng.frame(&palette::apply(&frame.image, &frame.objects, palette)))?;
+            let mut apng = ApngWriter::new(f, width, height, frames)?;
+            render(&mut |_, frame| {
+                // A palette mode's colours can change outside the tiles
+                // re-traced (`scan` learns a table a frame).
+                let retraced = frame.retraced.as_deref().filter(|_| palette == PaletteMode::None);
+                apng.frame(&palette::apply(&frame.image, &frame.objects, palette).to_rgb().data, retraced)
+            })?;
             apng.finish()
         }),
         Output::Files(pattern) => {
@@ -271,12 +282,12 @@ pub fn merge_frames(output: &Path, files: &[PathBuf]) -> Result<(), CliError> {
     let written = match kind {
         Output::Gif => write_atomically(output, |f| {
             let mut gif = GifWriter::new(f, width, height, frames)?;
-            found.iter().try_for_each(|(_, image)| gif.frame(image))?;
+            found.iter().try_for_each(|(_, image)| gif.frame(image, None))?;
             gif.finish().map(|_| ())
         }),
         Output::Apng => write_atomically(output, |f| {
-            let mut apng = ApngWriter::new(f, width, height, frames.count, frames)?;
-            found.iter().try_for_each(|(_, image)| apng.frame(image))?;
+            let mut apng = ApngWriter::new(f, width, height, frames)?;
+            found.iter().try_for_each(|(_, image)| apng.frame(&image.to_rgb().data, None))?;
             apng.finish()
         }),
         Output::Files(_) => return Err(refuse("merge writes one animation (.gif or .png)".into())),

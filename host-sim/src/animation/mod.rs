@@ -1,18 +1,26 @@
 //! Animations on the desktop: every frame of a scene with `FRAMES` loaded
 //! and traced in turn, each after the first re-tracing only the tiles the
 //! motion can change (the core's [`Coherence`]) on every thread, then
-//! written as an animated GIF, an APNG or one image file a frame
-//! (`writers.rs`).
+//! written as an animated GIF (`gif.rs`, its colours from `quantize/`), an
+//! APNG (`apng.rs`), both storing only what each frame changed
+//! (`changes.rs`), or one image file a frame (`writers.rs`).
 //!
 //! Invariants: a frame's image is the frame traced whole, bit for bit
 //! (the core's coherence is exact; `--no-coherence` traces every pixel);
 //! any number of threads gives the same bits; the frames reach the writer
 //! in order, each once.
 
+mod apng;
+mod changes;
 mod command;
+mod gif;
+mod quantize;
 mod writers;
 
+pub use apng::ApngWriter;
+pub use changes::Area;
 pub use command::{animate, is_frame_file, merge_frames, Request};
+pub use gif::{gif_delay, GifWriter};
 pub use writers::{FrameInfo, FramePattern, Output};
 
 use crate::{build_octree, HostLightBuffer, HostScene, RenderOptions, RgbImage, NO_OBJECT};
@@ -39,6 +47,10 @@ pub struct FrameImage {
     pub image: RgbImage,
     /// [`NO_OBJECT`] for background.
     pub objects: Vec<u32>,
+    /// The areas traced for this frame, where it can differ from the frame
+    /// before (the tiles the coherence re-traced); `None`: anywhere (the
+    /// first frame, or every frame traced whole).
+    pub retraced: Option<Vec<Area>>,
 }
 
 /// What rendering the frames did.
@@ -119,6 +131,7 @@ pub fn render_frames(
         let image = current.get_or_insert_with(|| FrameImage {
             image: RgbImage::new(w, h),
             objects: vec![NO_OBJECT; w as usize * h as usize],
+            retraced: None,
         });
         let octree = build_octree(&scene, options.render.accel, &options.render.octree);
         let mut lights = HostLightBuffer::new();
@@ -132,6 +145,7 @@ pub fn render_frames(
         } else {
             coherence.restart();
         }
+        image.retraced = (watched.is_some() && report.frames > 0).then(|| retraced(&coherence));
         report.traced += coherence.traced_pixels();
         let job = Job { view, coherence: &coherence, motion: watched, frame, threads: options.render.threads };
         let stats = match &octree {
@@ -148,6 +162,20 @@ pub fn render_frames(
         each(frame, image).map_err(AnimationError::Write)?;
     }
     Ok(report)
+}
+
+/// The areas of the tiles the planned frame traces: a rectangle a run.
+fn retraced(coherence: &Coherence<'_>) -> Vec<Area> {
+    let side = coherence.side();
+    (0..coherence.bands())
+        .flat_map(|band| coherence.runs(band).map(move |tiles| (band, tiles)))
+        .map(|(band, tiles)| Area {
+            x: tiles.start * side,
+            y: band * side,
+            width: (tiles.end - tiles.start) * side,
+            height: side,
+        })
+        .collect()
 }
 
 /// Parses frame `frame` of `bytes` into `scene`.

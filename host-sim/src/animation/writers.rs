@@ -1,8 +1,7 @@
-//! An animation's frames into files: an animated GIF (256 colours a frame
-//! from a palette mode, each frame with its own table), an APNG
-//! (truecolour) or one image file a frame named by
-//! a pattern (`f%04d.png`), each frame file carrying what `host-sim merge`
-//! needs to assemble frames rendered apart.
+//! Where an animation's frames go: an animated GIF (`gif.rs`), an APNG
+//! (`apng.rs`) or one image file a frame named by a pattern
+//! (`f%04d.png`), each frame file carrying what `host-sim merge` needs to
+//! assemble frames rendered apart.
 //!
 //! Invariants: the frame files of a render and the animation made of them
 //! by `merge` hold the very pixels (and indices) a direct render to the
@@ -142,103 +141,6 @@ impl FrameInfo {
     }
 }
 
-/// GIF's delay a frame, in hundredths of a second: the nearest to the
-/// rate's (GIF cannot say 1/24 s; 24 frames a second show as 25).
-pub fn gif_delay(frames: Frames) -> u16 {
-    ((200 + frames.rate) / (2 * frames.rate)).clamp(1, u16::MAX as u32) as u16
-}
-
-/// An animated GIF being written, a frame at a time, each with its own
-/// colour table (`scan` learns one a frame).
-pub struct GifWriter<W: Write> {
-    encoder: gif::Encoder<W>,
-    delay: u16,
-}
-
-fn gif_error(e: gif::EncodingError) -> std::io::Error {
-    match e {
-        gif::EncodingError::Io(e) => e,
-        e => std::io::Error::other(e),
-    }
-}
-
-impl<W: Write> GifWriter<W> {
-    /// A GIF of `width` × `height` frames at `frames`' rate, looping
-    /// forever.
-    pub fn new(out: W, width: u32, height: u32, frames: Frames) -> std::io::Result<GifWriter<W>> {
-        let (Ok(w), Ok(h)) = (u16::try_from(width), u16::try_from(height)) else {
-            return Err(std::io::Error::other("a GIF is at most 65535 pixels a side"));
-        };
-        let mut encoder = gif::Encoder::new(out, w, h, &[]).map_err(gif_error)?;
-        encoder.set_repeat(gif::Repeat::Infinite).map_err(gif_error)?;
-        Ok(GifWriter { encoder, delay: gif_delay(frames) })
-    }
-
-    /// Appends `frame`, an indexed image.
-    pub fn frame(&mut self, frame: &Image) -> std::io::Result<()> {
-        let Image::Indexed { width, height, indices, .. } = frame else {
-            return Err(std::io::Error::other("a GIF frame has a colour table: render it with --palette"));
-        };
-        let gif_frame = gif::Frame {
-            delay: self.delay,
-            width: *width as u16,
-            height: *height as u16,
-            palette: Some(table(frame)),
-            buffer: std::borrow::Cow::Borrowed(indices),
-            ..gif::Frame::default()
-        };
-        self.encoder.write_frame(&gif_frame).map_err(gif_error)
-    }
-
-    /// Ends the file.
-    pub fn finish(self) -> std::io::Result<W> {
-        self.encoder.into_inner().map_err(gif_error)
-    }
-}
-
-/// An indexed image's colour table as GIF bytes (RGB triples).
-fn table(image: &Image) -> Vec<u8> {
-    match image {
-        Image::Indexed { palette, .. } => palette.iter().flatten().copied().collect(),
-        Image::Rgb(_) => Vec::new(),
-    }
-}
-
-/// An APNG being written, a truecolour frame at a time.
-pub struct ApngWriter<'w, W: Write> {
-    writer: png::Writer<&'w mut W>,
-}
-
-fn png_error(e: png::EncodingError) -> std::io::Error {
-    match e {
-        png::EncodingError::IoError(e) => e,
-        e => std::io::Error::other(e),
-    }
-}
-
-impl<'w, W: Write> ApngWriter<'w, W> {
-    /// An APNG of `count` frames of `width` × `height` at `frames`' rate,
-    /// looping forever.
-    pub fn new(out: &'w mut W, width: u32, height: u32, count: u32, frames: Frames) -> std::io::Result<Self> {
-        let mut encoder = png::Encoder::new(out, width, height);
-        encoder.set_color(png::ColorType::Rgb);
-        encoder.set_depth(png::BitDepth::Eight);
-        encoder.set_animated(count, 0).map_err(png_error)?;
-        encoder.set_frame_delay(1, frames.rate as u16).map_err(png_error)?;
-        Ok(ApngWriter { writer: encoder.write_header().map_err(png_error)? })
-    }
-
-    /// Appends `frame` (its colours).
-    pub fn frame(&mut self, frame: &Image) -> std::io::Result<()> {
-        self.writer.write_image_data(&frame.to_rgb().data).map_err(png_error)
-    }
-
-    /// Ends the file.
-    pub fn finish(self) -> std::io::Result<()> {
-        self.writer.finish().map_err(png_error)
-    }
-}
-
 /// Writes `image` as a `format` file carrying `info`.
 pub fn write_frame_file(
     image: &Image,
@@ -290,8 +192,5 @@ mod tests {
         };
         assert_eq!(FrameInfo::parse(&info.to_string()), Some(info.clone()));
         assert_eq!(FrameInfo::parse(&info.to_string().replace("5/48", "48/48")), None);
-        assert_eq!(gif_delay(Frames { count: 1, rate: 24 }), 4);
-        assert_eq!(gif_delay(Frames { count: 1, rate: 10 }), 10);
-        assert_eq!(gif_delay(Frames { count: 1, rate: 1000 }), 1);
     }
 }

@@ -8,7 +8,9 @@
 //! and partitions), `palette` (the 256-colour modes), `panels` (every
 //! dithering on every panel of few levels, issue 42's measure),
 //! `spheres600` (naive against dda on 600 random spheres at 800×600),
-//! `animation` (frame-to-frame coherence on anim_fig5_1, `animation.rs`).
+//! `animation` (frame-to-frame coherence on anim_fig5_1, `animation.rs`),
+//! `animfiles` (the animations' GIF and APNG against ffmpeg's GIF of the
+//! same frames, `animation_files.rs`; needs ffmpeg).
 //! No argument: all. Times are wall-clock on one thread
 //! (except in `parallel`), the best of several runs; the machine is printed
 //! first so every table says where it came from.
@@ -23,6 +25,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 mod animation;
+mod animation_files;
 mod panels;
 
 fn machine() -> String {
@@ -81,10 +84,11 @@ enum Table {
     Panels,
     Spheres600,
     Animation,
+    AnimationFiles,
 }
 
 impl Table {
-    const ALL: [Table; 10] = [
+    const ALL: [Table; 11] = [
         Table::Scenes,
         Table::Table51,
         Table::Table52,
@@ -95,6 +99,7 @@ impl Table {
         Table::Panels,
         Table::Spheres600,
         Table::Animation,
+        Table::AnimationFiles,
     ];
 
     /// Its name on the command line.
@@ -110,6 +115,7 @@ impl Table {
             Table::Panels => "panels",
             Table::Spheres600 => "spheres600",
             Table::Animation => "animation",
+            Table::AnimationFiles => "animfiles",
         }
     }
 
@@ -133,6 +139,7 @@ impl Table {
             Table::Panels => panels::table(dir),
             Table::Spheres600 => spheres600(dir),
             Table::Animation => animation::table(dir),
+            Table::AnimationFiles => animation_files::table(dir),
         }
     }
 }
@@ -144,6 +151,8 @@ pub(crate) enum BenchError {
     UnknownTable(String),
     /// A scene it measures did not load.
     Scene { path: PathBuf, error: LoadError },
+    /// A tool it runs, or a file it writes, failed: what and why.
+    Tool(String),
 }
 
 impl BenchError {
@@ -168,6 +177,7 @@ impl fmt::Display for BenchError {
                 write!(f, "octrace-bench: cannot read {}: {e}", path.display())
             }
             BenchError::Scene { path, error } => write!(f, "{error}\noctrace-bench: {} does not load", path.display()),
+            BenchError::Tool(message) => write!(f, "octrace-bench: {message}"),
         }
     }
 }
