@@ -10,8 +10,9 @@
 //   boot2 to the top of SRAM (0x20041f00), flushes the XIP cache and enters
 //   boot2 with lr = 0, so boot2 sets up its flash and vectors into the
 //   firmware's table at 0x10000100. (The real ROM first checks boot2's CRC,
-//   which the runner checks before it starts; and it streams boot2 with one
-//   03h command where this one reads it line by line through the cache.)
+//   which the machine checks before it starts, `checkBoot2`; and it streams
+//   boot2 with one 03h command where this one reads it line by line through
+//   the cache.)
 // - Core 1 waits for core 0 to launch it (2.8.2): it empties its RX FIFO,
 //   sends 0, and sleeps in WFE until a word comes. A 0, or anything but 1
 //   where the 1 is due, starts it over (empty, send 0); then each word is
@@ -365,4 +366,24 @@ export function buildBootrom() {
 
 function align4(n) {
   return (n + 3) & ~3;
+}
+
+const BOOT2_BYTES = 256;
+
+/**
+ * The real ROM's check before it runs boot2: the last 4 bytes of flash's
+ * first 256 are the CRC-32 (MPEG-2: MSB first, no reflection, no final
+ * xor) of the 252 before them. An image without a valid boot2 would not
+ * start on a real Pico, so it does not start here: throws `error(message)`.
+ */
+export function checkBoot2(flash, error) {
+  let crc = 0xffffffff;
+  for (let i = 0; i < BOOT2_BYTES - 4; i++) {
+    crc ^= flash[i] << 24;
+    for (let bit = 0; bit < 8; bit++) {
+      crc = crc & 0x80000000 ? (crc << 1) ^ 0x04c11db7 : crc << 1;
+    }
+  }
+  const stored = new DataView(flash.buffer).getUint32(BOOT2_BYTES - 4, true);
+  if (crc >>> 0 !== stored) throw error('no valid boot2 in the first 256 bytes of flash (a real Pico would not start it); see memory.x');
 }

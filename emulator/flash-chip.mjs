@@ -23,10 +23,17 @@
 //                  (address and mode first), until mode bits other than
 //                  M5-4 = 10 end it.
 //
+// Its serial clock (what the SSI makes of clk_sys, `serialClockHz`, set by
+// the SSI before each transfer) is checked against its rating, the
+// datasheet's AC electrical characteristics: fR, 50 MHz, for Read Data
+// (03h); FR, 133 MHz, for every other instruction (the quad reads XIP makes
+// included).
+//
 // Invariants: a command the model does not know, a read framed other than
-// the chip takes it in its present mode, a command while it is busy, or quad
-// I/O without QE is an error naming it, never a guess: on a real board each
-// of these reads garbage. The memory is the emulator's flash array itself.
+// the chip takes it in its present mode, a command while it is busy, quad
+// I/O without QE, or a serial clock faster than the instruction's rating is
+// an error naming it, never a guess: on a real board each of these reads
+// garbage. The memory is the emulator's flash array itself.
 
 import { RunError } from './errors.mjs';
 
@@ -38,6 +45,9 @@ const STATUS_WRITE_SECONDS = 0.01;
 const JEDEC_ID = [0xef, 0x40, 0x15];
 const TRANS_1C1A = 0;
 const TRANS_1C2A = 1;
+/** The fastest serial clock: fR for Read Data (03h), FR for the rest. */
+const READ_DATA_MAX_HZ = 50_000_000;
+const MAX_HZ = 133_000_000;
 
 const hex = (byte) => `${byte.toString(16).padStart(2, '0')}h`;
 
@@ -54,6 +64,17 @@ export class W25Q16JV {
     this.busyUntil = 0;
     this.continuous = false;
     this.command = null;
+    /** The serial clock of the transfer under way (the SSI sets it). */
+    this.serialClockHz = 0;
+  }
+
+  /** Instruction `opcode` at the serial clock the SSI runs: within the chip's rating, or an error. */
+  checkClock(opcode) {
+    const max = opcode === 0x03 ? READ_DATA_MAX_HZ : MAX_HZ;
+    if (this.serialClockHz > max) {
+      const mhz = (hz) => `${+(hz / 1e6).toFixed(3)} MHz`;
+      this.fail(`${hex(opcode)} at a ${mhz(this.serialClockHz)} serial clock: the chip is rated for ${mhz(max)}`);
+    }
   }
 
   fail(message) {
@@ -95,6 +116,7 @@ export class W25Q16JV {
       if (this.busy && out !== 0x05 && out !== 0x35 && out !== 0x15) {
         this.fail(`command ${hex(out)} while a status write is in progress (only status reads are taken)`);
       }
+      this.checkClock(out);
       command.opcode = out;
       return 0xff;
     }
@@ -165,6 +187,8 @@ export class W25Q16JV {
       this.fail('a read while a status write is in progress');
     }
     const framing = `${lanes}-lane data, ${addressBits} address bits, ${waitClocks} wait clocks`;
+    // In continuous read mode the chip is still in its EBh.
+    this.checkClock(instruction ?? 0xeb);
     if (this.continuous) {
       if (instruction !== null) {
         this.fail(`a read with instruction ${hex(instruction)} in continuous read mode (the chip takes it as address bits)`);

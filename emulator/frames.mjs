@@ -22,7 +22,7 @@ export const LED_PIN = 25;
 /**
  * Watches `pico`'s LED for `count` frames: `onFrame(frame)` is called as
  * each ends, with `{ index, cycles, lit, busy: [core 0, core 1], start, end }`
- * (cycles at 125 MHz; start and end from the machine's start), and the run
+ * (cycles of clk_sys; start and end from the machine's start), and the run
  * is stopped (`pico.stop()`) when the last has. Returns the list of frames
  * seen so far (it grows as they end).
  */

@@ -94,12 +94,13 @@ export function i2cPinRole(pin) {
 export class I2cController extends RPI2C {
   /**
    * rp2040js's controller `index` (0 or 1) at the chip's `irq`, timed in
-   * cycles of clk_sys of `nanosPerCycle` each.
+   * cycles of clk_sys, whose length `systemClock.nanosPerCycle` gives
+   * (clocks.mjs: it follows the clock the firmware sets).
    */
-  constructor(rp2040, index, irq, { nanosPerCycle }) {
+  constructor(rp2040, index, irq, { systemClock }) {
     super(rp2040, `I2C${index}`, irq);
     this.index = index;
-    this.nanosPerCycle = nanosPerCycle;
+    this.systemClock = systemClock;
     this.sdaHold = SDA_HOLD_RESET;
     this.spikelen = 0x07;
     /** The devices on this controller's bus, by 7-bit address, and the pins the bus is wired to. */
@@ -227,6 +228,11 @@ export class I2cController extends RPI2C {
     const high = standard ? this.ssClockHighPeriod : this.fsClockHighPeriod;
     const low = standard ? this.ssClockLowPeriod : this.fsClockLowPeriod;
     return { standard, high, low, spike: this.spikelen };
+  }
+
+  /** A cycle of clk_sys (the controller's ic_clk) in nanoseconds, now. */
+  get nanosPerCycle() {
+    return this.systemClock.nanosPerCycle;
   }
 
   /** One SCL period in cycles: high HCNT + SPKLEN + 7, low LCNT + 1. */

@@ -1,22 +1,12 @@
 // A Raspberry Pi Pico running a firmware ELF, with an ST7789 panel on SPI1
-// wired as the Waveshare Pico-LCD-1.3 is: rp2040js's RP2040 with both of its
-// Cortex-M0+ cores at 125 MHz (rp2040js runs one: core 1 is a second
-// rp2040js core on the same bus), this folder's boot ROM stand-in, its
-// corrections to rp2040js's instructions, and the flash as a real Pico has
-// it (the W25Q16JV behind the SSI, the firmware's own boot2, the XIP cache).
-//
-// The cores run in lockstep by cycles: the next instruction is always the
-// one of the core whose time (its cycle count) is lower, core 0 on a tie,
-// and the shared clock (alarms: SPI, timer) follows the earlier of the
-// running cores. A core asleep (WFE, WFI, or core 1 held in reset by the
-// PSM) is carried along at the other's time, counted as waiting; woken by
-// the other core (SEV, an interrupt it caused) or by an alarm, it starts at
-// the end of the instruction or the clock step that woke it. When both
-// sleep, the clock jumps to the next alarm; when none is left, `run`
-// returns 'idle': the firmware waits for the outside world, which a runner
-// may provide (a later serial link: it raises an IRQ line, then calls `run`
-// again) or end the run on. `run({ until })` runs a slice and resumes
-// exactly where it stopped.
+// wired as the Waveshare Pico-LCD-1.3 is (lcd.mjs) and an SSD1306 module on
+// I2C0 (oled.mjs): rp2040js's RP2040 with both of its Cortex-M0+ cores
+// (rp2040js runs one: core 1 is a second rp2040js core on the same bus),
+// run in lockstep by cycles (lockstep.mjs) at the clock the firmware sets
+// (clocks.mjs, with the regulator it needs, vreg.mjs), this folder's boot
+// ROM stand-in, its corrections to rp2040js's instructions, and the flash
+// as a real Pico has it (the W25Q16JV behind the SSI, the firmware's own
+// boot2, the XIP cache).
 //
 // Between the cores: SEV (which rp2040js only logs) sets both cores' event
 // registers and ends the other's WFE; every IRQ line reaches both NVICs;
@@ -30,16 +20,17 @@
 // (both cores from the ROM's reset vector; core 0 through the ELF's boot2);
 // every cycle counted is one an emulated core spent (the ROM stand-in's,
 // boot2's and flash stalls too); a firmware that faults, stops in an endless
-// loop, touches what the emulator does not model, or outlives its cycle
-// budget ends the run with a RunError naming the core and where it was; one
-// whose watchdog runs out ends it with a WatchdogReset (a real Pico resets:
-// the serial serve starts a new machine, see serial.mjs).
+// loop, touches what the emulator does not model, runs the chip outside its
+// rating, or outlives its time budget ends the run with a RunError naming
+// the core and where it was; one whose watchdog runs out ends it with a
+// WatchdogReset (a real Pico resets: the serial serve starts a new machine,
+// see serial.mjs).
 
-import { RP2040, GPIOPinState } from 'rp2040js';
-import { buildBootrom, codeLetters, MISSING_FUNCTION_BREAKPOINT } from './bootrom.mjs';
-import { functionAt, functionNameAt, parseElf } from './elf.mjs';
+import { RP2040 } from 'rp2040js';
+import { buildBootrom, checkBoot2, codeLetters, MISSING_FUNCTION_BREAKPOINT } from './bootrom.mjs';
+import { functionAt, parseElf } from './elf.mjs';
 import { correctInstructions } from './armv6m.mjs';
-import { ST7789 } from './st7789.mjs';
+import { wireLcd } from './lcd.mjs';
 import { I2cController } from './i2c.mjs';
 import { wireOled } from './oled.mjs';
 import { RunError, WatchdogReset } from './errors.mjs';
@@ -51,41 +42,30 @@ import { Ssi } from './ssi.mjs';
 import { XipCache, XipControl } from './xip.mjs';
 import { BusCtrl, BusFabric } from './fabric.mjs';
 import { completeRegisters } from './usb-serial.mjs';
+import { Lockstep } from './lockstep.mjs';
+import { SystemClock } from './clocks.mjs';
+import { Vreg } from './vreg.mjs';
 
 export { RunError, WatchdogReset };
+export { WIRING } from './lcd.mjs';
 
 const FLASH_BASE = 0x10000000;
 const SRAM_BASE = 0x20000000;
-const BOOT2_BYTES = 256;
-export const CLOCK_HZ = 125_000_000;
-const NANOS_PER_CYCLE = 1e9 / CLOCK_HZ;
-const EXC_HARDFAULT = 3;
 /** The exception number of IRQ 0. */
 const FIRST_IRQ = 16;
-const ROM_END = 0x4000;
-const BRANCH_TO_SELF = 0xe7fe;
 const WFE = 0xbf20;
-/** How often (in instructions) the run looks for endless loops, its budget, and reports progress. */
-const CHECK_EVERY = 0xfffff;
-/** How often (in instructions) a profiled run samples where the cores are. */
-const SAMPLE_EVERY = 0xff;
-/** Samples between a profiled run's other checks, less one: those stay at their usual pace. */
-const SAMPLES_PER_CHECK = (CHECK_EVERY + 1) / (SAMPLE_EVERY + 1) - 1;
 /** rp2040js's peripherals, by `(address >>> 14) << 2`. */
 const XIP_CTRL_SLOT = 0x14000;
 const BUSCTRL_SLOT = 0x40030;
 const SSI_SLOT = 0x18000;
 const PSM_SLOT = 0x40010;
 const I2C_SLOTS = [0x40044, 0x40048];
+const VREG_SLOT = 0x40064;
 const PSM_FRCE_OFF = 0x04;
 const PSM_PROC1 = 1 << 16;
 const WATCHDOG_SLOT = 0x40058;
 
-/** The Pico-LCD-1.3's wiring: SPI1 on GP10 (clock) and GP11 (data); the panel's control lines. */
-export const WIRING = { clock: 10, data: 11, chipSelect: 9, dataCommand: 8, reset: 12, backlight: 13 };
-const GPIO_FUNCTION_SPI = 1;
-
-export class Pico {
+export class Pico extends Lockstep {
   /**
    * `segments` ({ loadAddress, data }, as an ELF's) are loaded as built;
    * `source` names them in messages, `functions` (an ELF's symbols) name
@@ -107,6 +87,7 @@ export class Pico {
     flashStatusRegister2,
     contention = true,
   } = {}) {
+    super();
     const rp2040 = new RP2040();
     this.rp2040 = rp2040;
     this.clock = rp2040.clock;
@@ -117,27 +98,23 @@ export class Pico {
     this.rom = buildBootrom();
     rp2040.loadBootrom(this.rom.image); // also erases the flash and resets core 0 into the ROM: load the ELF after it
     loadSegments(rp2040, segments, source);
-    checkBoot2(rp2040.flash, source);
+    checkBoot2(rp2040.flash, (message) => new RunError(`${source}: ${message}`));
 
-    /** Machine time in cycles: the clock's, which follows the earlier running core. */
-    this.time = 0;
-    this.steps = 0;
-    /** Instructions between the run's checks (a power of two, less one): fewer while profiling. */
-    this.checkEvery = CHECK_EVERY;
-    /** While profiling: cycles by function, and each core's time at its last sample. */
-    this.profile = null;
-    this.current = 0;
     this.cores = [rp2040.core, null];
-    this.held = [false, false];
-    this.waiting = [0, 0];
-    this.instructions = [0, 0];
-    this.core1Ran = false;
-    /** Set when a sleeping core wakes or core 1 is reset: a core running alone must look again. */
-    this.woke = false;
-    /** Set by `stop`: the run returns once the running stretch ends. */
-    this.stopping = false;
     this.irqLines = 0;
     this.fabric = new BusFabric(this.cores, { contention });
+    // The core voltage and clk_sys, from their registers: from reset on, the ring oscillator.
+    this.vreg = new Vreg(rp2040, { onVoltage: (volts) => this.systemClock.voltageChanged(volts) });
+    rp2040.peripherals[VREG_SLOT] = this.vreg;
+    this.systemClock = new SystemClock(rp2040, {
+      now: () => this.cores[this.current].cycles,
+      volts: () => this.vreg.volts,
+      onChange: () => {
+        // The running stretch ticked at the old rate; the flash's serial clock changed with clk_sys.
+        this.woke = true;
+        this.ssi.clockChanged();
+      },
+    });
 
     // Core 1's rp2040js parts act on `rp2040.core`: give them a view of the chip whose core is core 1.
     const core1View = Object.create(rp2040, {
@@ -182,8 +159,8 @@ export class Pico {
     });
 
     const now = () => this.clockCycles();
-    this.flashChip = new W25Q16JV(rp2040.flash, () => this.clockCycles() / CLOCK_HZ, { statusRegister2: flashStatusRegister2 });
-    this.ssi = new Ssi(rp2040, this.flashChip, now);
+    this.flashChip = new W25Q16JV(rp2040.flash, () => this.clock.nanos / 1e9, { statusRegister2: flashStatusRegister2 });
+    this.ssi = new Ssi(rp2040, this.flashChip, now, () => this.systemClock.hz);
     rp2040.peripherals[SSI_SLOT] = this.ssi;
     this.xip = new XipCache(this.ssi, this.cores);
     this.memory = machineMemory(rp2040, this.xip);
@@ -201,17 +178,18 @@ export class Pico {
     this.watchdog = rp2040.peripherals[WATCHDOG_SLOT];
     this.watchdog.onWatchdogTrigger = () => {
       const why = this.watchdog.reason & 2 ? 'was triggered' : 'ran out';
-      throw new WatchdogReset(`the watchdog ${why} at ${(this.clockCycles() / CLOCK_HZ).toFixed(6)} s: the board resets`);
+      throw new WatchdogReset(`the watchdog ${why} at ${(this.clock.nanos / 1e9).toFixed(6)} s: the board resets`);
     };
 
     this.attach(0);
     this.startCore1(0);
-    /** The ST7789 on SPI1 (null without one), and the times the run's phases are told by. */
-    this.panel = panel ? new ST7789(panel) : null;
-    this.events = this.panel ? this.wirePanel(this.panel) : null;
+    /** The ST7789 on SPI1 (null without one): the panel, and the times the run's phases are told by. */
+    this.lcd = panel ? wireLcd(rp2040, now, panel) : null;
+    this.panel = this.lcd?.panel ?? null;
+    this.events = this.lcd?.events ?? null;
     // Both I2C controllers with what rp2040js's lack (i2c.mjs), and the SSD1306 module on I2C0.
     this.i2c = I2C_SLOTS.map((slot, k) => {
-      const controller = new I2cController(rp2040, k, rp2040.i2c[k].irq, { nanosPerCycle: NANOS_PER_CYCLE });
+      const controller = new I2cController(rp2040, k, rp2040.i2c[k].irq, { systemClock: this.systemClock });
       rp2040.i2c[k] = rp2040.peripherals[slot] = controller;
       return controller;
     });
@@ -239,9 +217,9 @@ export class Pico {
     return new Pico({ ...options, segments: elf.segments, functions: elf.functions, source: path });
   }
 
-  /** The clock's time in cycles. */
+  /** The machine clock's time in cycles. */
   clockCycles() {
-    return this.clock.nanos / NANOS_PER_CYCLE;
+    return this.systemClock.cyclesAt(this.clock.nanos);
   }
 
   /** Routes core k's accesses through its own bus and puts the instruction corrections in front of it. */
@@ -320,268 +298,6 @@ export class Pico {
     }
   }
 
-  /** Brings an asleep core's time up to `at` (at least), counting the gap as waiting. */
-  settle(j, at) {
-    const core = this.cores[j];
-    if (at > core.cycles) {
-      this.waiting[j] += at - core.cycles;
-      core.cycles = at;
-    }
-  }
-
-  /**
-   * Runs until both cores sleep with nothing scheduled ('idle'), the
-   * machine's time reaches `until` ('until') or `stop` is called
-   * ('stopped'). Throws RunError for what a
-   * real Pico would not have done the same way, or after `maxCycles`.
-   * `onProgress(cycles, panelWrites)` is called now and then.
-   */
-  run({ maxCycles = Infinity, until = Infinity, onProgress = () => {} } = {}) {
-    try {
-      return this.loop(maxCycles, until, onProgress);
-    } catch (error) {
-      if (error instanceof RunError && !error.located) {
-        // The same class (a WatchdogReset stays one), located.
-        throw new error.constructor(`${error.message} (${this.whereAll()})`, { located: true });
-      }
-      throw error;
-    } finally {
-      for (let j = 0; j < 2; j++) {
-        if (this.cores[j].waiting) this.settle(j, this.time);
-      }
-    }
-  }
-
-  loop(maxCycles, until, onProgress) {
-    const cores = this.cores;
-    for (;;) {
-      const awake0 = !cores[0].waiting;
-      const awake1 = !cores[1].waiting;
-      let reason;
-      if (awake0 && awake1) {
-        reason = this.runBoth(until, maxCycles, onProgress);
-      } else if (awake0 || awake1) {
-        reason = this.runAlone(awake0 ? 0 : 1, until, maxCycles, onProgress);
-      } else {
-        if (!this.sleepUntilAlarm()) return 'idle';
-        if (this.time >= until) return 'until';
-        if (this.time > maxCycles) this.check(maxCycles, onProgress);
-        continue;
-      }
-      if (reason) return reason;
-      if (this.stopping) {
-        this.stopping = false;
-        return 'stopped';
-      }
-    }
-  }
-
-  /**
-   * Ends the run (`run` returns 'stopped') after the instruction now
-   * executing: for a watcher that has seen what it waited for (frames.mjs).
-   */
-  stop() {
-    this.stopping = true;
-    this.woke = true;
-  }
-
-  /**
-   * Both cores run: each step is the next instruction of the core that is
-   * behind (core 0 on a tie), and the clock follows the earlier. Returns a
-   * reason to end the run, or null when a core sleeps or core 1 is reset.
-   */
-  runBoth(until, maxCycles, onProgress) {
-    const c0 = this.cores[0];
-    const c1 = this.cores[1];
-    const clock = this.clock;
-    let time = this.time;
-    let steps0 = 0;
-    let steps1 = 0;
-    let countdown = this.checkEvery + 1 - (this.steps & this.checkEvery);
-    let reason = null;
-    this.woke = false;
-    for (;;) {
-      if (c1.cycles < c0.cycles) {
-        this.current = 1;
-        c1.executeInstruction();
-        steps1++;
-        if (!this.core1Ran && c1.PC >= ROM_END) this.core1Ran = true;
-      } else {
-        this.current = 0;
-        c0.executeInstruction();
-        steps0++;
-      }
-      if (c0.waiting || c1.waiting || this.woke) break;
-      const target = c0.cycles < c1.cycles ? c0.cycles : c1.cycles;
-      if (target > time) {
-        clock.tick((target - time) * NANOS_PER_CYCLE);
-        time = target;
-      }
-      if (time >= until) {
-        reason = 'until';
-        break;
-      }
-      if (--countdown === 0) {
-        this.time = time;
-        this.count(0, steps0);
-        this.count(1, steps1);
-        steps0 = steps1 = 0;
-        this.check(maxCycles, onProgress);
-        countdown = this.checkEvery + 1;
-      }
-    }
-    this.time = time;
-    this.count(0, steps0);
-    this.count(1, steps1);
-    if (reason === null) this.follow(this.current);
-    return reason;
-  }
-
-  /**
-   * After core k's instruction that ended a stretch: the clock follows the
-   * earlier running core (or core k, if both now sleep), and a core woken
-   * on the way starts then.
-   */
-  follow(k) {
-    const cores = this.cores;
-    const core = cores[k];
-    let target = core.waiting ? Infinity : core.cycles;
-    const other = cores[1 - k];
-    if (!other.waiting && other.cycles < target) target = other.cycles;
-    if (target === Infinity) target = core.cycles;
-    if (target > this.time) {
-      const asleep0 = cores[0].waiting;
-      const asleep1 = cores[1].waiting;
-      this.clock.tick((target - this.time) * NANOS_PER_CYCLE);
-      this.time = target;
-      if (asleep0 && !cores[0].waiting) this.settle(0, target);
-      if (asleep1 && !cores[1].waiting) this.settle(1, target);
-    }
-  }
-
-  /**
-   * Core k runs while the other sleeps: the same steps as `loop`'s, with
-   * nothing to choose. Returns a reason to end the run, or null when the
-   * other core woke, core 1 was reset, or this one sleeps.
-   */
-  runAlone(k, until, maxCycles, onProgress) {
-    const core = this.cores[k];
-    const clock = this.clock;
-    let time = this.time;
-    let steps = 0;
-    let countdown = this.checkEvery + 1 - (this.steps & this.checkEvery);
-    let reason = null;
-    let watchLaunch = k === 1 && !this.core1Ran;
-    this.current = k;
-    this.woke = false;
-    for (;;) {
-      core.executeInstruction();
-      steps++;
-      if (watchLaunch && core.PC >= ROM_END) {
-        // Core 1 runs outside the ROM: the firmware launched it.
-        this.core1Ran = true;
-        watchLaunch = false;
-      }
-      const t = core.cycles;
-      clock.tick((t - time) * NANOS_PER_CYCLE);
-      time = t;
-      if (core.waiting || this.woke) break;
-      if (time >= until) {
-        reason = 'until';
-        break;
-      }
-      if (--countdown === 0) {
-        this.time = time;
-        this.count(k, steps);
-        steps = 0;
-        this.check(maxCycles, onProgress);
-        countdown = this.checkEvery + 1;
-      }
-    }
-    this.time = time;
-    this.count(k, steps);
-    const j = 1 - k;
-    if (!this.cores[j].waiting) this.settle(j, time);
-    return reason;
-  }
-
-  count(k, steps) {
-    this.steps += steps;
-    this.instructions[k] += steps;
-  }
-
-  /** Both cores asleep: the clock jumps to the next alarm (false when there is none). */
-  sleepUntilAlarm() {
-    const clock = this.clock;
-    if (!clock.nextAlarm) return false;
-    clock.tick(Math.max(0, clock.nextAlarm.nanos - clock.nanos));
-    const time = Math.ceil(clock.nanos / NANOS_PER_CYCLE);
-    if (time * NANOS_PER_CYCLE > clock.nanos) clock.tick(time * NANOS_PER_CYCLE - clock.nanos);
-    this.time = time;
-    for (let j = 0; j < 2; j++) {
-      if (!this.cores[j].waiting) this.settle(j, time);
-    }
-    return true;
-  }
-
-  /**
-   * From now on, samples where each running core is every 256
-   * instructions and charges the cycles since its last sample to the
-   * function it is in (`profileReport`): a statistical profile, as a
-   * sampling profiler takes on a board, a little slower to run.
-   */
-  startProfile() {
-    this.profile = { cycles: new Map(), last: this.cores.map((core) => core?.cycles ?? 0), checks: 0 };
-    this.checkEvery = SAMPLE_EVERY;
-  }
-
-  sample() {
-    const { cycles, last } = this.profile;
-    for (let k = 0; k < 2; k++) {
-      const core = this.cores[k];
-      if (!core) continue;
-      const spent = core.cycles - last[k];
-      last[k] = core.cycles;
-      if (core.waiting || spent <= 0) continue;
-      const name = functionNameAt(this.functions, core.PC >>> 0);
-      cycles.set(name, (cycles.get(name) ?? 0) + spent);
-    }
-  }
-
-  /** The `top` functions the profile charged most, with their cycles and share of all it charged. */
-  profileReport(top) {
-    const entries = [...(this.profile?.cycles ?? [])];
-    const all = entries.reduce((sum, [, cycles]) => sum + cycles, 0);
-    return entries
-      .sort((a, b) => b[1] - a[1])
-      .slice(0, top)
-      .map(([name, cycles]) => ({ name, cycles, share: all ? cycles / all : 0 }));
-  }
-
-  check(maxCycles, onProgress) {
-    if (this.profile) {
-      this.sample();
-      if (++this.profile.checks & SAMPLES_PER_CHECK) return;
-    }
-    for (let k = 0; k < 2; k++) {
-      const core = this.cores[k];
-      if (core.waiting) continue;
-      if (core.IPSR === EXC_HARDFAULT) {
-        throw new RunError(`HardFault at ${this.where(k)}`, { located: true });
-      }
-      // A branch to itself (`b .`, as panic-halt's loop) never ends.
-      if (peek16(this.memory, core.PC & ~1) === BRANCH_TO_SELF) {
-        throw new RunError(`the firmware stopped in an endless loop in ${this.where(k)} (a panic?)`, { located: true });
-      }
-    }
-    if (this.time > maxCycles) {
-      throw new RunError(`still running after ${maxCycles} cycles (${maxCycles / CLOCK_HZ} s at 125 MHz), in ${this.whereAll()}`, {
-        located: true,
-      });
-    }
-    onProgress(this.time, this.display?.writes() ?? 0);
-  }
-
   breakpoint(k, code) {
     if (this.onBreakpoint(k, code)) {
       return;
@@ -645,93 +361,28 @@ export class Pico {
   }
 
   /**
-   * The run's phases in cycles: start-up (clocks, the panel's set-up and
-   * clear, up to the backlight), parse and index (up to the picture's first
-   * command), render (to its last pixel), first full panel (from the
-   * picture's first command until every pixel of the panel has been written
-   * once: the render's length for a top-to-bottom render). Null where the
-   * run never got there.
+   * The clocks the firmware set, as the report gives them: clk_sys now and
+   * each change of it (the cycle it took effect at), clk_peri, the flash's
+   * serial clock (clk_sys / the SSI's divider) and the core voltage.
    */
-  phases() {
-    if (this.display?.name === 'SSD1306') return { ...this.oled.phases(), total: this.time };
-    const { backlightOn, pictureStart, lastPixel, fullPanel } = this.events ?? {};
-    const picture = backlightOn != null && pictureStart != null && lastPixel > pictureStart;
+  clockReport() {
     return {
-      startUp: backlightOn ?? null,
-      parseAndIndex: picture ? pictureStart - backlightOn : null,
-      render: picture ? lastPixel - pictureStart : null,
-      firstFullPanel: picture && fullPanel != null ? fullPanel - pictureStart : null,
-      total: this.time,
+      ...this.systemClock.report(),
+      periHz: this.rp2040.clkPeri,
+      flashHz: this.ssi.serialClockHz,
+      coreVolts: this.vreg.volts,
     };
   }
 
   /**
-   * Connects the panel to SPI1 and its control pins. Returns the times the
-   * run's phases are told by: when the backlight came on (the template turns
-   * it on once the panel is cleared, before it loads the scene), the first
-   * command after that (the picture's first row), the last pixel, when the
-   * whole panel had been written, and how many rows (RAMWRs) the panel has
-   * taken.
+   * The run's phases in cycles, as the panel the firmware drives tells them
+   * (lcd.mjs, oled.mjs; null where the run never got there), and the whole
+   * run's.
    */
-  wirePanel(panel) {
-    const rp2040 = this.rp2040;
-    const gpio = rp2040.gpio;
-    const spi = rp2040.spi[1];
-    const events = { backlightOn: null, pictureStart: null, lastPixel: null, fullPanel: null, memoryWrites: 0 };
-    let chipSelected = false;
-    const level = (pin) => gpio[pin].value === GPIOPinState.High;
-    const now = () => this.clockCycles();
-
-    // Chip select frames bytes; the controller keeps its command across frames.
-    gpio[WIRING.chipSelect].addListener((state) => {
-      chipSelected = state === GPIOPinState.Low;
-    });
-    gpio[WIRING.reset].addListener((state) => {
-      if (state === GPIOPinState.Low) {
-        panel.reset();
-      }
-    });
-    gpio[WIRING.backlight].addListener((state) => {
-      if (state === GPIOPinState.High && events.backlightOn === null) {
-        events.backlightOn = now();
-      }
-    });
-
-    // A byte takes 8 clocks of the bus; the next starts when it is out.
-    const done = rp2040.clock.createAlarm(() => spi.completeTransmit(0));
-    spi.onTransmit = (byte) => {
-      const routed = [WIRING.clock, WIRING.data].every((pin) => gpio[pin].functionSelect === GPIO_FUNCTION_SPI);
-      if (routed && chipSelected) {
-        const dataCommand = level(WIRING.dataCommand);
-        panelReceive(panel, byte, dataCommand);
-        if (!dataCommand && events.backlightOn !== null && events.pictureStart === null) {
-          events.pictureStart = now();
-          panel.startCoverage();
-        }
-        if (panel.command?.name === 'RAMWR') {
-          if (dataCommand) {
-            events.lastPixel = now();
-            if (events.fullPanel === null && events.pictureStart !== null && panel.fullyCovered) events.fullPanel = now();
-          } else {
-            events.memoryWrites++;
-          }
-        }
-      }
-      const hz = spi.clockFrequency;
-      if (!hz) {
-        throw new RunError('SPI1 transmits with no clock (SSPCPSR is 0)');
-      }
-      done.schedule((spi.dataBits * 1e9) / hz);
-    };
-    return events;
-  }
-}
-
-function panelReceive(panel, byte, dataCommand) {
-  try {
-    panel.receive(byte, dataCommand);
-  } catch (error) {
-    throw new RunError(error.message);
+  phases() {
+    const none = { startUp: null, parseAndIndex: null, render: null, firstFullPanel: null };
+    const phases = this.display?.name === 'SSD1306' ? this.oled.phases() : (this.lcd?.phases() ?? none);
+    return { ...phases, total: this.time };
   }
 }
 
@@ -756,24 +407,5 @@ function loadSegments(rp2040, segments, source) {
     } else {
       throw new RunError(`${source}: a segment at 0x${loadAddress.toString(16)} (${data.length} bytes) is in neither flash nor RAM`);
     }
-  }
-}
-
-/**
- * The boot ROM runs boot2 only if its last 4 bytes are the CRC-32 (MPEG-2:
- * MSB first, no reflection, no final xor) of its first 252: an ELF without
- * a valid boot2 would not start on a real Pico, so it does not start here.
- */
-function checkBoot2(flash, source) {
-  let crc = 0xffffffff;
-  for (let i = 0; i < BOOT2_BYTES - 4; i++) {
-    crc ^= flash[i] << 24;
-    for (let bit = 0; bit < 8; bit++) {
-      crc = crc & 0x80000000 ? (crc << 1) ^ 0x04c11db7 : crc << 1;
-    }
-  }
-  const stored = new DataView(flash.buffer).getUint32(BOOT2_BYTES - 4, true);
-  if (crc >>> 0 !== stored) {
-    throw new RunError(`${source}: no valid boot2 in the first 256 bytes of flash (a real Pico would not start it); see memory.x`);
   }
 }

@@ -48,7 +48,7 @@
 
 import { readFileSync } from 'node:fs';
 import { parseArgs } from 'node:util';
-import { CLOCK_HZ, Pico, RunError } from './pico.mjs';
+import { Pico, RunError } from './pico.mjs';
 import { ElfError } from './elf.mjs';
 import { PanelError } from './st7789.mjs';
 import { PanelError as OledError } from './ssd1306.mjs';
@@ -146,7 +146,6 @@ if (frameCount !== null) {
 }
 
 const progress = !values.quiet && !values.json && process.stderr.isTTY;
-const seconds = (cycles) => (cycles / CLOCK_HZ).toFixed(3);
 let report;
 try {
   const elf = readFileSync(elfPath);
@@ -157,11 +156,12 @@ try {
   const frames = frameCount === null ? null : watchFrames(pico, { count: frameCount, onFrame: () => pictures.push(picture()) });
   if (profileTop !== null) pico.startProfile();
   const ended = pico.run({
-    maxCycles: maxSeconds * CLOCK_HZ,
+    maxSeconds,
     onProgress: progress
-      ? (cycles, rows) =>
+      ? (_, rows) =>
           process.stderr.write(
-            `\r${seconds(cycles)} s emulated, ${rows} panel writes` + (frames ? `, ${frames.length} of ${frameCount} frames` : ''),
+            `\r${(pico.clock.nanos / 1e9).toFixed(3)} s emulated, ${rows} panel writes` +
+              (frames ? `, ${frames.length} of ${frameCount} frames` : ''),
           )
       : undefined,
   });
@@ -178,7 +178,15 @@ try {
   } else {
     writeAtomically(out, picture());
   }
-  report = runReport(pico, out, frames && frames.map(({ index, cycles, lit, busy }) => ({ index, out: frameName(index), cycles, lit, busy })));
+  report = runReport(
+    pico,
+    out,
+    frames &&
+      frames.map(({ index, cycles, lit, busy, start, end }) => {
+        const seconds = pico.systemClock.secondsBetween(end - cycles, end);
+        return { index, out: frameName(index), cycles, seconds, lit, busy, start, end };
+      }),
+  );
   if (profileTop !== null) report.profile = pico.profileReport(profileTop);
 } catch (error) {
   if (progress) process.stderr.write('\r\x1b[K');
@@ -193,9 +201,13 @@ if (values.json) {
   console.log(JSON.stringify(report, null, 2));
 } else if (!values.quiet) {
   const count = (n) => n.toLocaleString('en');
-  const row = (what, cycles) =>
-    `  ${what.padEnd(44)} ${cycles === null ? 'never reached' : `${count(cycles).padStart(13)} cycles  ${seconds(cycles)} s`}`;
-  const { startUp, parseAndIndex, render, transfer, firstFullPanel, total } = report.cycles;
+  const row = (what, key) => {
+    const cycles = report.cycles[key];
+    const time = cycles === null ? 'never reached' : `${count(cycles).padStart(13)} cycles  ${report.seconds[key].toFixed(3)} s`;
+    return `  ${what.padEnd(44)} ${time}`;
+  };
+  const { transfer } = report.cycles;
+  const clock = report.clock;
   const cores = report.coreCycles.slice(0, report.cores);
   const cache = report.xipCache;
   const fabric = report.busFabric;
@@ -204,13 +216,15 @@ if (values.json) {
     .map(([port, { contested }]) => `${port} ${count(contested)}`);
   console.error(
     [
-      `${elfPath} on an emulated Raspberry Pi Pico (${report.cores === 2 ? 'both Cortex-M0+ cores' : 'one Cortex-M0+ core'} at 125 MHz):`,
-      row('start-up (clocks, panel set-up and clear)', startUp),
-      row('parse and index the scene', parseAndIndex),
-      row(transfer === undefined ? 'render into the panel' : 'render (the LED lit)', render),
-      ...(transfer === undefined ? [] : [row('the picture to the panel over I2C', transfer)]),
-      row('first full panel (from the picture\'s start)', firstFullPanel),
-      row('in all', total),
+      `${elfPath} on an emulated Raspberry Pi Pico (${report.cores === 2 ? 'both Cortex-M0+ cores' : 'one Cortex-M0+ core'} ` +
+        `at ${mhz(clock.sysHz)}, the clock it set; the flash at ${clock.flashHz === null ? '-' : mhz(clock.flashHz)}, ` +
+        `the core at ${clock.coreVolts.toFixed(2)} V):`,
+      row('start-up (clocks, panel set-up and clear)', 'startUp'),
+      row('parse and index the scene', 'parseAndIndex'),
+      row(transfer === undefined ? 'render into the panel' : 'render (the LED lit)', 'render'),
+      ...(transfer === undefined ? [] : [row('the picture to the panel over I2C', 'transfer')]),
+      row('first full panel (from the picture\'s start)', 'firstFullPanel'),
+      row('in all', 'total'),
       ...cores.map(
         ({ core, busy, waiting, flashStall, busStall }) =>
           `  core ${core}: ${count(busy)} cycles busy (${count(flashStall)} of them stalled on flash, ` +
@@ -223,8 +237,8 @@ if (values.json) {
         (cache.lineReadCycles === null ? '' : ` (${cache.lineReadCycles} cycles a line read)`) +
         `, ${count(cache.stallCycles)} cycles stalled`,
       ...(report.frames ?? []).map(
-        ({ index, out: file, cycles, lit, busy }) =>
-          `  frame ${String(index).padStart(3)}: ${count(cycles).padStart(13)} cycles  ${seconds(cycles)} s ` +
+        ({ index, out: file, cycles, seconds, lit, busy }) =>
+          `  frame ${String(index).padStart(3)}: ${count(cycles).padStart(13)} cycles  ${seconds.toFixed(3)} s ` +
           `(LED lit ${count(lit)}; busy: core 0 ${count(busy[0])}, core 1 ${count(busy[1])}): ${file}`,
       ),
       ...(report.frames?.length > 1 ? [framesPerSecond(report.frames)] : []),
@@ -245,14 +259,24 @@ if (values.json) {
 
 /** The frames a second after the first frame (which loads, and traces everything). */
 function framesPerSecond(frames) {
-  const after = frames.slice(1).reduce((sum, { cycles }) => sum + cycles, 0);
-  return `  after the first: ${((frames.length - 1) * CLOCK_HZ / after).toFixed(2)} frames a second at 125 MHz`;
+  const after = frames.slice(1).reduce((sum, { seconds }) => sum + seconds, 0);
+  return `  after the first: ${((frames.length - 1) / after).toFixed(2)} frames a second`;
 }
 
-/** What the run took and did: the report `--json` prints. */
+function mhz(hz) {
+  return `${+(hz / 1e6).toFixed(3)} MHz`;
+}
+
+/**
+ * What the run took and did: the report `--json` prints. `clockHz` is
+ * clk_sys as the firmware left it (`clock` has its changes, clk_peri, the
+ * flash's serial clock and the core voltage); `seconds` are the phases'
+ * lengths in the Pico's time, each cycle as long as clk_sys made it then.
+ */
 function runReport(pico, out, frames) {
   const display = pico.display;
   const coreCycles = pico.coreCycles();
+  const cycles = pico.phases();
   return {
     elf: elfPath,
     out,
@@ -260,14 +284,36 @@ function runReport(pico, out, frames) {
     display: display.name,
     panel: `${display.width}x${display.height}`,
     dark: display.darkBecause,
-    clockHz: CLOCK_HZ,
+    clockHz: pico.systemClock.hz,
+    clock: pico.clockReport(),
     cores: pico.coresUsed,
     instructions: coreCycles[0].instructions + coreCycles[1].instructions,
-    cycles: pico.phases(),
+    cycles,
+    seconds: phaseSeconds(pico, cycles),
     coreCycles,
     xipCache: pico.cacheStatistics(),
     busFabric: pico.fabric.statistics(),
   };
+}
+
+/**
+ * Each phase's length in seconds. The phases follow each other (start-up
+ * from the machine's start, then parse and index, render, the transfer);
+ * the first full panel starts with the render, the total at 0.
+ */
+function phaseSeconds(pico, cycles) {
+  const clock = pico.systemClock;
+  const seconds = {};
+  let at = 0;
+  for (const key of ['startUp', 'parseAndIndex', 'render', 'transfer']) {
+    if (!(key in cycles)) continue;
+    seconds[key] = cycles[key] === null ? null : clock.secondsBetween(at, at + cycles[key]);
+    at += cycles[key] ?? 0;
+  }
+  const renderStart = (cycles.startUp ?? 0) + (cycles.parseAndIndex ?? 0);
+  seconds.firstFullPanel = cycles.firstFullPanel === null ? null : clock.secondsBetween(renderStart, renderStart + cycles.firstFullPanel);
+  seconds.total = clock.secondsBetween(0, cycles.total);
+  return seconds;
 }
 
 /** --serial: serves the board on a pseudo-terminal, then exits (with --json, printing the report). */

@@ -4,7 +4,7 @@
 // studio's "Send to board", picocom — talks to the emulated board as to a
 // real one on a USB port.
 //
-// The machine runs in slices of SLICE_CYCLES between the event loop's
+// The machine runs in slices of SLICE_SECONDS of its time between the event loop's
 // turns, so that bytes from the terminal reach it while it traces; when
 // both cores sleep with nothing scheduled (the firmware waits for the
 // host), it stops until bytes arrive. Its time is the emulated board's
@@ -35,10 +35,10 @@
 import { spawn } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { UsbSerialHost } from './usb-serial.mjs';
-import { CLOCK_HZ, WatchdogReset } from './pico.mjs';
+import { WatchdogReset } from './pico.mjs';
 
-/** A millisecond of the board's time between the event loop's turns. */
-const SLICE_CYCLES = 125_000;
+/** The board's time between the event loop's turns: a millisecond. */
+const SLICE_SECONDS = 1e-3;
 
 /**
  * Serves the machine `makePico()` makes on a new pseudo-terminal until
@@ -60,7 +60,7 @@ export function serveSerial(makePico, { input, answer, onPath, onIdle = () => {}
       pico = makePico();
       host = new UsbSerialHost(pico.rp2040, {
         onDeviceBytes: (bytes) => bridge.stdin.write(bytes),
-        now: () => Math.floor(pico.clockCycles() / (CLOCK_HZ / 1e6)),
+        now: () => Math.floor(pico.clock.nanos / 1e3),
       });
     };
     start();
@@ -79,7 +79,7 @@ export function serveSerial(makePico, { input, answer, onPath, onIdle = () => {}
       if (ended) return;
       let reason;
       try {
-        reason = pico.run({ until: pico.time + SLICE_CYCLES });
+        reason = pico.run({ until: pico.time + Math.round(SLICE_SECONDS * pico.systemClock.hz) });
       } catch (error) {
         if (!(error instanceof WatchdogReset)) {
           end(error);

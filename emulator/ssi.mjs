@@ -13,10 +13,16 @@
 // RX_SAMPLE_DLY are ignored while SSIENR is 1, as the SSI ignores them;
 // writing SSIENR 0 empties the FIFOs and ends the transfer.
 //
+// The serial clock is clk_sys / SCKDV (BAUDR): the flash chip checks each
+// transfer's against its rating, and an XIP miss lasts that clock's cycles
+// (xip-timing.mjs), so a faster clk_sys at the same divider runs the flash
+// faster and a miss costs the same cycles.
+//
 // Invariants: a transfer the model does not frame (no slave selected, a
 // frame size not a whole number of bytes, RX FIFO overrun, reading an empty
 // RX FIFO, an XIP read with the SSI off) is an error, never a made-up word;
-// everything the flash sees goes through the W25Q16JV model.
+// everything the flash sees goes through the W25Q16JV model, at the serial
+// clock the SSI runs then.
 
 import { BasePeripheral } from 'rp2040js';
 import { RunError } from './errors.mjs';
@@ -62,10 +68,10 @@ const TMOD_EEPROM_READ = 3;
 const CONFIGURATION = new Set([CTRLR0, CTRLR1, BAUDR, RX_SAMPLE_DLY, SPI_CTRLR0]);
 
 export class Ssi extends BasePeripheral {
-  /** `chip`: the flash (W25Q16JV). `now()`: the machine's time in cycles. */
-  constructor(rp2040, chip, now) {
+  /** `chip`: the flash (W25Q16JV). `now()`: the machine's time in cycles; `sysHz()`: clk_sys. */
+  constructor(rp2040, chip, now, sysHz) {
     super(rp2040, 'SSI');
-    Object.assign(this, { chip, now });
+    Object.assign(this, { chip, now, sysHz });
     this.registers = new Map([
       [CTRLR0, 0],
       [CTRLR1, 0],
@@ -101,6 +107,22 @@ export class Ssi extends BasePeripheral {
 
   fail(message) {
     throw new RunError(`SSI: ${message}`);
+  }
+
+  /** clk_sys changed: the serial clock with it, which the next XIP read checks again. */
+  clockChanged() {
+    this.xipReady = false;
+  }
+
+  /** Tells the flash chip the serial clock of the transfer starting. */
+  clockTheChip() {
+    this.chip.serialClockHz = this.sysHz() / serialClockCycles(this.registers.get(BAUDR));
+  }
+
+  /** The flash's serial clock as BAUDR sets it now, in Hz (null while BAUDR stops it). */
+  get serialClockHz() {
+    const divider = this.registers.get(BAUDR) & 0xfffe;
+    return divider === 0 ? null : this.sysHz() / divider;
   }
 
   get ctrlr0() {
@@ -224,6 +246,7 @@ export class Ssi extends BasePeripheral {
       this.chip.select();
       this.selected = true;
     }
+    this.clockTheChip();
     let received = 0;
     for (let shift = frameBits - 8; shift >= 0; shift -= 8) {
       received = (received << 8) | this.chip.exchange((value >>> shift) & 0xff);
@@ -269,6 +292,7 @@ export class Ssi extends BasePeripheral {
       this.fail(`a ${format.instructionBits}-bit instruction (the flash takes 8-bit ones)`);
     }
     const mode = format.addressBits === 32 ? modeSource & 0xff : 0;
+    this.clockTheChip();
     this.chip.read({
       instruction: instruction === null ? null : instruction & 0xff,
       transType: format.transType,

@@ -31,13 +31,15 @@
 use octrace_core::accel::OctreeConfig;
 use octrace_core::capacity::{CapacityKind, Counts};
 use octrace_core::panel::Dithering;
-use octrace_core::parse::count;
+use octrace_core::parse::{count, parse};
+use octrace_core::profile::Host;
 use octrace_core::profile::{light_buffer_words, needed_with_light_buffer, ProfileText};
 use octrace_core::render::PanelColor;
+use octrace_core::scene::Scene;
 use octrace_core::AccelMode;
 use std::env;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// What each board's RAM holds besides the stack, and how its octree is
 /// built: on the micro:bit at most 4 levels of 8 objects a leaf (fewer
@@ -81,11 +83,11 @@ fn main() {
         )),
     };
     let board = var("OCTRACE_BOARD", default_board);
-    let board = match (board.as_str(), target.as_str()) {
+    let mut board = match (board.as_str(), target.as_str()) {
         ("microbit", "thumbv6m-none-eabi") => Board {
             name: "microbit",
-            // What its linker script leaves beside the stack.
-            static_ram: ram_length(&manifest.join("memory-microbit.x")),
+            // Set with the stack, once the colours are known.
+            static_ram: 0,
             config: OctreeConfig { max_objects: 8, max_depth: 4, ..OctreeConfig::DEFAULT },
         },
         ("mps2-an385", "thumbv7m-none-eabi") => {
@@ -117,7 +119,6 @@ fn main() {
     };
     let oled = board.name == "lm3s6965evb";
     let memory = manifest.join(format!("memory-{}.x", board.name));
-    std::fs::copy(&memory, out.join("memory.x")).expect("copy memory.x");
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed={}", memory.display());
     println!("cargo:rustc-check-cfg=cfg(board, values(\"microbit\", \"mps2-an385\", \"mps2-an505\", \"mps2-an521\", \"lm3s6965evb\", \"virt\"))");
@@ -161,6 +162,16 @@ fn main() {
         let names: Vec<&str> = Dithering::ALL.iter().map(|d| d.name()).collect();
         fail(format!("OCTRACE_DITHER={dithering}: expected {}", names.join(", ")))
     };
+    // The linker script: the micro:bit's splits its RAM between the stack
+    // this build needs and the statics.
+    let mut linker_script =
+        std::fs::read_to_string(&memory).unwrap_or_else(|e| fail(format!("{}: {e}", memory.display())));
+    if board.name == "microbit" {
+        let stack = microbit_stack(wire, rdepth(&text));
+        board.static_ram = MICROBIT_RAM - stack;
+        linker_script = linker_script.replace("STACK_BYTES", &stack.to_string());
+    }
+    std::fs::write(out.join("memory.x"), linker_script).expect("write memory.x");
     // Error diffusion's row for the panel's width, on the draw's stack.
     let error_words = match wire.panel() {
         Some(panel) if dithering.diffuses() => panel.error_words(w),
@@ -294,21 +305,32 @@ fn needs(text: &str, accel: AccelMode, config: &OctreeConfig, light_cells: u32) 
     needed_with_light_buffer(text, accel, config, light_cells, &mut |_| {}).unwrap_or_else(|_| count(text))
 }
 
-/// The `RAM` region's length in `memory_x` (bytes, or with a K suffix):
-/// what the statics have, read from the linker script that places them.
-fn ram_length(memory_x: &Path) -> usize {
-    let text = std::fs::read_to_string(memory_x).unwrap_or_else(|e| fail(format!("{}: {e}", memory_x.display())));
-    let length = text
-        .lines()
-        .find(|line| line.trim_start().starts_with("RAM "))
-        .and_then(|line| line.split("LENGTH =").nth(1))
-        .map(str::trim);
-    let bytes = match length {
-        Some(kib) if kib.ends_with('K') => kib.trim_end_matches('K').parse::<usize>().ok().map(|k| k * 1024),
-        Some(bytes) => bytes.parse().ok(),
-        None => None,
-    };
-    bytes.unwrap_or_else(|| fail(format!("{}: no `RAM : ORIGIN = …, LENGTH = N` line", memory_x.display())))
+/// The micro:bit's RAM, which its stack and its statics share.
+const MICROBIT_RAM: usize = 16 * 1024;
+
+/// The micro:bit's stack for a build drawing in `wire` a scene whose rays
+/// go `rdepth` reflections and refractions deep: what the deepest scene
+/// the tests draw of its kind needs, painted and measured (`peak stack`),
+/// with a margin of 300 bytes or more. RGB with RDEPTH 4 at most: 7 KiB
+/// (fig5_5 at 160×128, RDEPTH 4 with first hits: 6,868 bytes). Deeper
+/// rays (glass, RDEPTH 5: 7,128 bytes), a panel of few levels or the
+/// 256-colour palette (their dithering's frames and error row; fig5_5 in
+/// one bit at 64×48: 7,028 bytes): 7.5 KiB. The statics have the rest.
+fn microbit_stack(wire: PanelColor, rdepth: u32) -> usize {
+    match wire {
+        PanelColor::Rgb888 | PanelColor::Rgb565 if rdepth <= 4 => 7 * 1024,
+        _ => 7 * 1024 + 512,
+    }
+}
+
+/// The scene's RDEPTH (the deepest its stack goes); a scene with errors
+/// the deepest there is, and the board then reports its errors.
+fn rdepth(text: &str) -> u32 {
+    let mut scene = Box::new(Scene::<Host>::new());
+    match parse(text, &mut scene, &mut |_| {}) {
+        Ok(_) => scene.view().settings.rdepth,
+        Err(_) => u32::MAX,
+    }
 }
 
 /// What a board may spend memory on beyond the scene to render faster

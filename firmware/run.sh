@@ -3,20 +3,13 @@
 # LM3S6965EVB, where its screen goes) comes from the ELF itself, written
 # there by build.rs. Exits with the guest's semihosting exit code (0 ok,
 # 2 bad scene, 101 panic, 102 HardFault), 124 if it runs longer than
-# QEMU_TIMEOUT seconds (default 600), 4 if the OLED's screen cannot be
+# QEMU_TIMEOUT seconds (default 1800, a hang guard), 4 if the OLED's screen cannot be
 # grabbed (tools/runner.py).
 set -euo pipefail
 here=$(dirname "$0")
+source "$here/tools/qemu.sh"
 elf=$1
 machine=$(python3 "$here/tools/runner.py" info "$elf" machine)
-qemu=(qemu-system-arm -machine "$machine")
-case $machine in
-    lm3s6965evb) exec python3 "$here/tools/runner.py" screen "$elf" ;;
-    mps2-an385) qemu+=(-cpu cortex-m3) ;;
-    # Both cores: the second waits until the firmware releases it.
-    mps2-an521) qemu+=(-smp 2) ;;
-    # No firmware of qemu's own: the ELF starts at the RAM's base.
-    virt) qemu=(qemu-system-riscv32 -machine virt -bios none) ;;
-esac
-exec timeout "${QEMU_TIMEOUT:-600}" "${qemu[@]}" -nographic -monitor none \
-    -semihosting-config enable=on,target=native -kernel "$elf"
+[ "$machine" != lm3s6965evb ] || exec python3 "$here/tools/runner.py" screen "$elf"
+qemu_for "$machine"
+exec timeout "${QEMU_TIMEOUT:-1800}" "${QEMU[@]}" -kernel "$elf"

@@ -16,6 +16,7 @@ TEST_RUST_TARGETS=(thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf t
 TEST_COMMAND_PACKAGES=(
     qemu-system-arm:qemu-system-arm
     qemu-system-riscv32:qemu-system-misc
+    gcc:gcc
     arm-none-eabi-size:binutils-arm-none-eabi
     parallel:parallel
     /usr/bin/chromium:chromium

@@ -66,7 +66,7 @@ pub trait Profile: SceneCapacities + OctreeCapacities + Sized {
     const NAMED_WALK: bool = true;
     /// Whether camera rays find their hits among the objects seen around
     /// their pixel (see [`Renderer::with_first_hits`](crate::render::Renderer::with_first_hits)):
-    /// the same image, for a [`ScreenBound`] (24 bytes) an object and
+    /// the same image, for a [`ScreenBound`] (16 bytes) an object and
     /// [`ScreenBound::positions_for`] them (2 bytes each) of RAM (`first_hits: true` in
     /// [`profile!`](crate::profile!)). [`Raytracer`](crate::Raytracer) then
     /// uses them in every mode but [`AccelMode::Naive`](crate::AccelMode::Naive)

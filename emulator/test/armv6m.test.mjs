@@ -124,7 +124,8 @@ function runOnQemu(image) {
     return execFileSync(
       'qemu-system-arm',
       ['-machine', 'microbit', '-nographic', '-monitor', 'none', '-serial', 'none', '-semihosting-config', 'enable=on,target=native', '-kernel', file],
-      { maxBuffer: 64 << 20, timeout: 60_000 },
+      // Half an hour: only a guard against a hang, on a machine however busy.
+      { maxBuffer: 64 << 20, timeout: 30 * 60_000 },
     );
   } finally {
     rmSync(dir, { recursive: true, force: true });

@@ -53,7 +53,7 @@ function recorder(address, answers = []) {
 function controller({ device = recorder(0x3c), hz = 400_000, routed = true } = {}) {
   const rp2040 = new RP2040();
   rp2040.logger = { debug() {}, info() {}, warn: (c, m) => assert.fail(`${c}: ${m}`), error: (c, m) => assert.fail(`${c}: ${m}`) };
-  const i2c = new I2cController(rp2040, 0, 23, { nanosPerCycle: NANOS_PER_CYCLE });
+  const i2c = new I2cController(rp2040, 0, 23, { systemClock: { nanosPerCycle: NANOS_PER_CYCLE } });
   i2c.attach(device, { sda: 4, scl: 5 });
   if (routed) rp2040.gpio[4].ctrl = rp2040.gpio[5].ctrl = 3;
   const clock = 125_000_000;
@@ -166,6 +166,6 @@ test('GPIO pins carry the controller and line the datasheet gives (I2C0 SDA on G
   assert.deepEqual(i2cPinRole(26), { controller: 1, line: 'SDA' });
   assert.deepEqual(i2cPinRole(7), { controller: 1, line: 'SCL' });
   const rp2040 = new RP2040();
-  const i2c = new I2cController(rp2040, 0, 23, { nanosPerCycle: NANOS_PER_CYCLE });
+  const i2c = new I2cController(rp2040, 0, 23, { systemClock: { nanosPerCycle: NANOS_PER_CYCLE } });
   assert.throws(() => i2c.attach(recorder(0x3c), { sda: 6, scl: 7 }), /GPIO 6 is not I2C0's SDA/);
 });

@@ -52,7 +52,7 @@ test('PUSH and POP take 1 + N cycles, LR and PC counted in N; a POP that returns
       .pop([4, 5], true) // N = 3, and the return
       .label('done'),
   );
-  assert.equal(pico.run({ maxCycles: 1e6 }), 'idle');
+  assert.equal(pico.run({ maxSeconds: 1 }), 'idle');
   const [call, push3, push1, pop1] = gaps(records[0].slice(0, 5));
   assert.equal(call, 3, 'BL');
   assert.deepEqual([push3, push1, pop1], [1 + 3, 1 + 1, 1 + 1]);
@@ -83,7 +83,7 @@ test('a load from the APB takes 3 cycles and a store 4 (datasheet 2.1.3); the SI
       .str(0, 4)
       .inline(record, 0),
   );
-  assert.equal(pico.run({ maxCycles: 1e6 }), 'idle');
+  assert.equal(pico.run({ maxSeconds: 1 }), 'idle');
   assert.deepEqual(gaps(records[0]), [3, 4, 1, 1, 2, 2]);
 });
 
@@ -108,7 +108,7 @@ test("the divider: an operand costs its store's cycle, READY is clear for 8 cycl
       .ldr(0, 7, 0x70) // QUOTIENT
       .inline(record, 0),
   );
-  assert.equal(pico.run({ maxCycles: 1e6 }), 'idle');
+  assert.equal(pico.run({ maxSeconds: 1 }), 'idle');
   assert.equal(gaps(records[0])[0], 2, 'two stores to the SIO, a cycle each: no wait for the divider');
   const [, , notReady, ready, remainder, quotient] = values(records, 0);
   assert.equal(notReady & 1, 0, 'READY clear right after the divisor');
@@ -117,7 +117,7 @@ test("the divider: an operand costs its store's cycle, READY is clear for 8 cycl
 
   // Read too early, the result is undefined on the chip: the run ends.
   const early = fromSram4((t) => divide(t).ldr(0, 7, 0x70));
-  assert.throws(() => early.pico.run({ maxCycles: 1e6 }), (error) => error instanceof RunError && /QUOTIENT 3 cycles after its operand/.test(error.message));
+  assert.throws(() => early.pico.run({ maxSeconds: 1 }), (error) => error instanceof RunError && /QUOTIENT 3 cycles after its operand/.test(error.message));
 });
 
 test('exception entry takes 15 cycles to the handler, and the return the frameâ€™s 8 loads beyond its BX (TRM 3.6.1)', () => {
@@ -136,7 +136,7 @@ test('exception entry takes 15 cycles to the handler, and the return the frameâ€
         .inline(record, 0),
     { [16 + irq]: (t) => t.inline(record, 0).bxLr() },
   );
-  assert.equal(pico.run({ maxCycles: 1e6 }), 'idle');
+  assert.equal(pico.run({ maxSeconds: 1 }), 'idle');
   const [pend, entered, returned] = records[0].map((r) => r.time);
   assert.equal(entered - pend, 1 + 2 + 15, 'the store to the PPB (2), then the entry');
   assert.equal(returned - entered, 1 + 2 + 8, 'BX LR (2) and the frame unstacked');
@@ -154,7 +154,7 @@ test('a word of code is fetched once for the two 16-bit instructions in it, and 
     counts.push(pico.fabric.accesses[3]); // SRAM4's
     return onRecord(k, code);
   };
-  assert.equal(pico.run({ maxCycles: 1e6 }), 'idle');
+  assert.equal(pico.run({ maxSeconds: 1 }), 'idle');
   assert.equal(records[0].length, 3);
   // Between the records: the BKPT's word, then 32 NOPs in 16 words; then the branch, its target's word.
   const [straight, branch] = [counts[1] - counts[0], counts[2] - counts[1]];

@@ -1,24 +1,18 @@
 #!/usr/bin/env bash
 # Instructions executed per function: profile.sh MACHINE ELF [TOP]
-# Builds the qemu-profile plugin (the header comes from the shared
-# qemu-insncount tool's cache), runs the firmware under it and prints the
+# Builds the qemu-profile plugin (once, into target/qemu-plugins/: qemu.sh),
+# runs the firmware under it and prints the
 # functions that executed the most instructions (inlined code counted in the
 # function it was inlined into), with their calls (runs of the first
 # instruction; a loop back to it would count too) and cost per call.
 set -euo pipefail
 HERE=$(cd "$(dirname "$0")" && pwd)
 MACHINE=$1; ELF=$2; TOP=${3:-25}
-CACHE=$HOME/.cache/qemu-insncount
-[ -f "$CACHE/qemu-plugin.h" ] || "$HERE/../../../shared/tools/qemu-insncount/build.sh" >/dev/null
-PLUGIN=$CACHE/libqemu-profile.so
-if [ ! -f "$PLUGIN" ] || [ "$HERE/qemu-profile.c" -nt "$PLUGIN" ]; then
-  gcc -O2 -fPIC -shared -Wall -I"$CACHE" -o "$PLUGIN" "$HERE/qemu-profile.c"
-fi
+source "$HERE/qemu.sh"
+PLUGIN=$(build_plugin qemu-profile)
+qemu_for "$MACHINE"
 OUT=$(mktemp)
-cpu=()
-[ "$MACHINE" = mps2-an385 ] && cpu=(-cpu cortex-m3)
-timeout "${QEMU_TIMEOUT:-600}" qemu-system-arm -machine "$MACHINE" "${cpu[@]}" -nographic -monitor none \
-  -semihosting-config enable=on,target=native -plugin "$PLUGIN,out=$OUT" -kernel "$ELF" >/dev/null || true
+timeout "${QEMU_TIMEOUT:-1800}" "${QEMU[@]}" -plugin "$PLUGIN,out=$OUT" -kernel "$ELF" >/dev/null || true
 python3 - "$ELF" "$OUT" "$TOP" <<'PY'
 import bisect, subprocess, sys
 elf, prof, top = sys.argv[1], sys.argv[2], int(sys.argv[3])

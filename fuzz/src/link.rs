@@ -93,6 +93,7 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     let answers = [
         frame(Message::Drawing { panel, pixels: true, frames: 0 }, 2),
         frame(Message::Row { y: 0, pixels: &[0xF8, 0, 0x07, 0xE0, 0, 0x1F, 0xFF, 0xFF] }, 2),
+        frame(Message::Working { elapsed: Some(std::time::Duration::from_micros(20_000)) }, 2),
         frame(
             Message::Done(Timing {
                 elapsed: Some(std::time::Duration::from_micros(1234)),

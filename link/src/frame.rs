@@ -12,7 +12,7 @@ use crate::crc::Crc32;
 use core::fmt;
 
 /// The protocol version this crate speaks: the first byte of every frame.
-pub const VERSION: u8 = 2;
+pub const VERSION: u8 = 3;
 
 /// The header's bytes: version, kind, tag (2).
 pub(crate) const HEADER: usize = 4;
@@ -207,7 +207,7 @@ impl<S: Sink + ?Sized> fmt::Write for FrameWriter<'_, S> {
 /// with [`Message::encode`](crate::Message::encode).
 ///
 /// ```
-/// use octrace_link::{encode_raw, Decoder, Reason};
+/// use octrace_link::{encode_raw, Decoder, Reason, VERSION};
 ///
 /// let mut wire = Vec::new();
 /// encode_raw(1, 0x01, 9, &[], &mut wire).unwrap();
@@ -215,7 +215,7 @@ impl<S: Sink + ?Sized> fmt::Write for FrameWriter<'_, S> {
 /// let mut decoder = Decoder::new(&mut buffer);
 /// let received = wire.iter().find_map(|&b| decoder.push(b).map(|r| r.map(|f| f.tag)));
 /// let refused = received.unwrap().unwrap_err();
-/// assert_eq!((refused.tag, refused.reason), (9, Reason::WrongVersion { expected: 2, found: 1 }));
+/// assert_eq!((refused.tag, refused.reason), (9, Reason::WrongVersion { expected: VERSION, found: 1 }));
 /// ```
 pub fn encode_raw<S: Sink + ?Sized>(
     version: u8,

@@ -79,6 +79,9 @@ kinds! {
     FrameDrawn = 0x49, "frame-drawn", false;
     /// Board: the animation stopped because another frame came.
     Stopped = 0x4A, "stopped", false;
+    /// Board: it is still working on the request (a drawing that has sent
+    /// nothing for a while).
+    Working = 0x4B, "working", false;
     /// Board: a frame it cannot take, and why.
     Refused = 0x7F, "refused", false;
 }
@@ -321,6 +324,13 @@ pub enum Message<'a> {
         /// How many frames were drawn whole since it began.
         frames: u32,
     },
+    /// Board: it is still working on the request, though it has sent
+    /// nothing else for a while (a pixel may take hours): a host keeps
+    /// waiting.
+    Working {
+        /// Since the request came, by the board's clock, if it has one.
+        elapsed: Option<Duration>,
+    },
     /// Board: it could not take a frame.
     Refused(Reason),
 }
@@ -366,6 +376,7 @@ impl<'a> Message<'a> {
             Message::Run { .. } => Kind::Run,
             Message::FrameDrawn { .. } => Kind::FrameDrawn,
             Message::Stopped { .. } => Kind::Stopped,
+            Message::Working { .. } => Kind::Working,
             Message::Refused(_) => Kind::Refused,
         }
     }
@@ -418,6 +429,7 @@ impl<'a> Message<'a> {
                 w.put(&time_on_wire(elapsed).to_be_bytes())?;
             }
             Message::Stopped { frames } => w.put(&frames.to_be_bytes())?,
+            Message::Working { elapsed } => w.put(&time_on_wire(elapsed).to_be_bytes())?,
             Message::Refused(reason) => put_reason(&mut w, reason)?,
         }
         w.finish()
@@ -445,6 +457,7 @@ impl<'a> Message<'a> {
                 )
             }
             Kind::Stopped => r.u32().map(|frames| Message::Stopped { frames }),
+            Kind::Working => r.u64().map(|micros| Message::Working { elapsed: time_from_wire(micros) }),
             Kind::Refused => read_reason(&mut r).map(Message::Refused),
         };
         message.filter(|_| r.0.is_empty()).ok_or(Reason::Malformed { kind })
@@ -665,6 +678,8 @@ mod tests {
                 },
                 Message::FrameDrawn { frame: 0, traced: 0, elapsed: None },
                 Message::Stopped { frames: rng.next() as u32 },
+                Message::Working { elapsed: Some(Duration::from_micros(rng.below(1 << 40))) },
+                Message::Working { elapsed: None },
                 Message::Row { y: rng.next() as u16, pixels: &bytes },
                 Message::Done(timing),
                 Message::Done(Timing::NONE),
@@ -689,8 +704,9 @@ mod tests {
             (Message::Hello, 1),
             (Message::Scene { pixels: true, text: b"RASTER 4 2\n" }, 0x1234),
             (Message::Row { y: 1, pixels: &[0xF8, 0, 0x07, 0xE0, 0, 0x1F, 0xFF, 0xFF] }, 0x1234),
-            (Message::Refused(Reason::WrongVersion { expected: 2, found: 1 }), 0x1234),
+            (Message::Refused(Reason::WrongVersion { expected: 3, found: 2 }), 0x1234),
             (Message::Run { y: 1, x: 2, width: 2, pixels: &[0xF8, 0, 0x07, 0xE0] }, 0x1234),
+            (Message::Working { elapsed: Some(Duration::from_micros(2_500_000)) }, 0x1234),
         ];
         for (message, tag) in examples {
             let mut wire = Vec::new();
@@ -738,7 +754,7 @@ mod tests {
     #[test]
     fn a_payload_that_does_not_fit_its_kind_is_malformed() {
         let malformed = |kind: Kind| Err(Refusal { tag: 3, reason: Reason::Malformed { kind: kind.byte() } });
-        let cases: [(Kind, &[u8]); 21] = [
+        let cases: [(Kind, &[u8]); 23] = [
             (Kind::Hello, &[0]),
             (Kind::Scene, &[]),
             (Kind::Scene, &[2, b'x']),
@@ -758,6 +774,8 @@ mod tests {
             (Kind::Done, &[0; 24]),
             (Kind::Cancelled, &[0, 0, 0]),
             (Kind::Stopped, &[0, 0, 0]),
+            (Kind::Working, &[0; 7]),
+            (Kind::Working, &[0; 9]),
             (Kind::Refused, &[9, 0]),
             (Kind::Refused, &[1, 1]),
         ];

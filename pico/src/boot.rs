@@ -20,6 +20,10 @@
 #[doc(hidden)]
 pub use rp2040_boot2::BOOT_LOADER_W25Q080 as BOOT2;
 
+/// The divider boot2 gives the flash's serial clock (SSI BAUDR: clk_sys / 2,
+/// the Pico SDK's `PICO_FLASH_SPI_CLKDIV` for the Pico), which XIP keeps.
+pub(crate) const BOOT2_FLASH_DIVIDER: u32 = 2;
+
 /// Defines the firmware's boot2 (`.boot2`) and `__pre_init`, which
 /// cortex-m-rt's reset handler calls first: it copies the code `sram-code.x`
 /// places in SRAM from its load address in flash, a word at a time.

@@ -15,8 +15,10 @@
 //!
 //! Invariants: a [`RunningBoard`] is ended (by its own process id) when it
 //! is dropped, and its command ends by itself when its standard input
-//! closes, so no board outlives its test; every read of a [`RawHost`]
-//! and every command gives up after its timeout.
+//! closes, so no board outlives its test; a board is handed to a test once
+//! it has started and waits for a host; every wait (a [`RawHost`]'s read,
+//! a command's answer) is for an event, and gives up only at its guard
+//! against a hang ([`crate::HANG_GUARD`]).
 
 use host_sim::board::{BoardDescription, BoardLink};
 use octrace_link::{Decoder, Frame, Refusal};
@@ -124,14 +126,23 @@ impl RunningBoard {
                 let _ = send.send(line);
             }
         });
-        Ok(RunningBoard { child, port, commands, answers })
+        let mut board = RunningBoard { child, port, commands, answers };
+        // Started (an emulated board boots first) and waiting for a host.
+        let deadline = Instant::now() + crate::HANG_GUARD;
+        while !board.times().idle {
+            if Instant::now() >= deadline {
+                return Err(format!("{program} never came to wait for a host"));
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        Ok(board)
     }
 
     /// Sends the board `command` (see the module's documentation) and
     /// returns its answer.
     pub fn command(&mut self, command: &str) -> String {
         writeln!(self.commands, "{command}").and_then(|()| self.commands.flush()).expect("the board takes commands");
-        self.answers.recv_timeout(Duration::from_secs(30)).unwrap_or_else(|e| panic!("no answer to {command}: {e}"))
+        self.answers.recv_timeout(crate::HANG_GUARD).unwrap_or_else(|e| panic!("no answer to {command}: {e}"))
     }
 
     /// The board's `times`.
@@ -145,16 +156,22 @@ impl RunningBoard {
         BoardTimes { last_in, last_out, now: now.unwrap_or_else(|| panic!("times: {answer}")), watchdog_left, idle }
     }
 
-    /// Waits (up to `timeout`) until the board has taken bytes sent after
-    /// `since` (its clock) and has nothing more to do; its times then.
-    pub fn wait_idle_after(&mut self, since: u64, timeout: Duration) -> BoardTimes {
-        let deadline = Instant::now() + timeout;
+    /// Waits until the board has taken bytes sent after `since` (its
+    /// clock) and has nothing more to do; its times then.
+    pub fn wait_idle_after(&mut self, since: u64) -> BoardTimes {
+        self.wait_for("to take bytes and be idle", |times| times.idle && times.last_in.is_some_and(|t| t > since))
+    }
+
+    /// Waits until the board's times satisfy `until` (`what` says what, for
+    /// a hang's message); its times then.
+    pub fn wait_for(&mut self, what: &str, until: impl Fn(&BoardTimes) -> bool) -> BoardTimes {
+        let deadline = Instant::now() + crate::HANG_GUARD;
         loop {
             let times = self.times();
-            if times.idle && times.last_in.is_some_and(|t| t > since) {
+            if until(&times) {
                 return times;
             }
-            assert!(Instant::now() < deadline, "the board is still busy after {timeout:?}: {times:?}");
+            assert!(Instant::now() < deadline, "the board never came {what}: {times:?}");
             std::thread::sleep(Duration::from_millis(50));
         }
     }
@@ -191,7 +208,7 @@ impl RunningBoard {
 
     /// What the board says it is.
     pub fn describe(&self) -> BoardDescription {
-        let mut link = BoardLink::open(&self.port.to_string_lossy(), Duration::from_secs(30)).expect("the port opens");
+        let mut link = BoardLink::open(&self.port.to_string_lossy(), None).expect("the port opens");
         link.hello().expect("the board answers")
     }
 
@@ -306,14 +323,10 @@ impl RawHost {
         self.port.flush().expect("the board's port takes bytes");
     }
 
-    /// Hands each frame that comes within `timeout` to `each` until it
-    /// returns true; false if time ran out first.
-    pub fn receive_until(
-        &mut self,
-        timeout: Duration,
-        each: &mut dyn FnMut(Result<Frame<'_>, Refusal>) -> bool,
-    ) -> bool {
-        let deadline = Instant::now() + timeout;
+    /// Hands each frame that comes to `each` until it returns true; false
+    /// if none did within [`crate::HANG_GUARD`] (a hang).
+    pub fn receive_until(&mut self, each: &mut dyn FnMut(Result<Frame<'_>, Refusal>) -> bool) -> bool {
+        let deadline = Instant::now() + crate::HANG_GUARD;
         loop {
             while let Some(byte) = self.unread.pop_front() {
                 self.read += 1;

@@ -105,7 +105,9 @@ impl Firmware {
         Firmware { dithering, ..self }
     }
 
-    fn slug(&self) -> String {
+    /// What the build is named by: board, scene, size, colours (and the
+    /// dithering of a panel of few levels).
+    pub fn slug(&self) -> String {
         let (board, scene, wire) = (self.board.machine(), &self.scene, self.wire.name());
         match self.wire.panel() {
             Some(_) => format!("{board}-{scene}-{}x{}-{wire}-{}", self.width, self.height, self.dithering.name()),
@@ -255,19 +257,43 @@ impl Measurement {
     }
 }
 
+/// The instruction counter: `$OCTRACE_QEMU_COUNT` if set (a program taking
+/// the same arguments and printing the same lines), else the repository's
+/// `firmware/tools/qemu-count` (which builds its qemu plugin with gcc).
+pub fn qemu_count() -> PathBuf {
+    std::env::var_os("OCTRACE_QEMU_COUNT")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo().join("firmware/tools/qemu-count"))
+}
+
 impl Firmware {
-    /// Runs the ELF under `qemu-count` (the instruction-counting plugin) and
-    /// reads its sizes with `arm-none-eabi-size`. qemu-count runs Arm boards
-    /// only: the RISC-V one runs under the same plugin here.
+    /// Whether its instructions are exact run to run: every board but the
+    /// dual-core one, whose cores' waiting for each other depends on how
+    /// qemu takes turns between them.
+    pub fn counts_exactly(&self) -> bool {
+        self.board != Board::Mps2An521
+    }
+
+    /// Runs the ELF once under `qemu-count` ([`Firmware::measure`]) and
+    /// collects what the display received too: the run the bit-exactness
+    /// test makes, with the instructions counted.
+    pub fn run_measured(&self, elf: &Path, qemu_count: &Path) -> Result<(Run, Measurement), String> {
+        let file = self.output_file();
+        let _ = std::fs::remove_file(&file);
+        let measured = self.measure(elf, qemu_count)?;
+        let pixels = std::fs::read(&file).unwrap_or_default();
+        Ok((Run { status: measured.status, output: measured.output.clone(), pixels }, measured))
+    }
+
+    /// Runs the ELF under `qemu-count` (`qemu-count MACHINE ELF`: the guest's
+    /// output, then `insns_total=` and `insns_between_markers=` lines) and
+    /// reads its sizes with `arm-none-eabi-size`.
     pub fn measure(&self, elf: &Path, qemu_count: &Path) -> Result<Measurement, String> {
-        let out = match self.board {
-            Board::Virt => count_riscv(elf, qemu_count)?,
-            _ => Command::new(qemu_count)
-                .arg(self.board.machine())
-                .arg(elf)
-                .output()
-                .map_err(|e| format!("cannot run {}: {e}", qemu_count.display()))?,
-        };
+        let out = Command::new(qemu_count)
+            .arg(self.board.machine())
+            .arg(elf)
+            .output()
+            .map_err(|e| format!("cannot run {}: {e}", qemu_count.display()))?;
         let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
         let value = |key: &str| text.lines().find_map(|l| l.strip_prefix(key)?.trim().parse::<u64>().ok());
         let total = value("insns_total=").ok_or_else(|| format!("no instruction count from qemu-count:\n{text}"))?;
@@ -306,47 +332,6 @@ impl Firmware {
         }
         Ok(cores)
     }
-}
-
-/// `qemu-count`'s run and report for the RISC-V `virt` machine: its plugin
-/// (built by the `qemu-insncount/build.sh` beside it), told the address of
-/// `bench_marker`, on `qemu-system-riscv32`; the same `insns_total=` and
-/// `insns_between_markers=` lines.
-fn count_riscv(elf: &Path, qemu_count: &Path) -> Result<std::process::Output, String> {
-    let run = |command: &mut Command| {
-        let out = command.output().map_err(|e| format!("cannot run {command:?}: {e}"))?;
-        Ok::<_, String>((out.status.success(), String::from_utf8_lossy(&out.stdout).into_owned()))
-    };
-    let build = qemu_count.with_file_name("qemu-insncount").join("build.sh");
-    let (built, plugin) = run(Command::new("bash").arg(&build))?;
-    let plugin = plugin.lines().last().filter(|_| built).ok_or_else(|| format!("{} failed", build.display()))?;
-    let (_, symbols) = run(Command::new("arm-none-eabi-nm").arg(elf))?;
-    let marker = symbols.lines().find_map(|l| l.strip_suffix(" T bench_marker")).unwrap_or_default();
-    let log = elf.with_extension("plugin.log");
-    let mut out = Command::new("timeout")
-        .arg(std::env::var("QEMU_TIMEOUT").unwrap_or_else(|_| "300".into()))
-        .args(["qemu-system-riscv32", "-machine", "virt", "-bios", "none", "-nographic", "-monitor", "none"])
-        .args(["-semihosting-config", "enable=on,target=native", "-d", "plugin", "-D"])
-        .arg(&log)
-        .arg("-plugin")
-        .arg(format!("{plugin},marker=0x{marker}"))
-        .arg("-kernel")
-        .arg(elf)
-        .output()
-        .map_err(|e| format!("cannot run qemu-system-riscv32: {e}"))?;
-    let log = std::fs::read_to_string(&log).map_err(|e| format!("{}: {e}", log.display()))?;
-    let total = log.lines().find_map(|l| l.strip_prefix("insns: ")).unwrap_or_default();
-    // Each marker line ends in `icount=N`: the count when it was reached.
-    let marks: Vec<u64> = log
-        .lines()
-        .filter(|l| l.starts_with("marker"))
-        .filter_map(|l| l.split_whitespace().nth(4)?.strip_prefix("icount=")?.parse().ok())
-        .collect();
-    out.stdout.extend(format!("insns_total={total}\n").bytes());
-    if let [first, second, ..] = marks[..] {
-        out.stdout.extend(format!("insns_between_markers={}\n", second - first).bytes());
-    }
-    Ok(out)
 }
 
 /// An ELF's sections as `arm-none-eabi-size -B` counts them.

@@ -2,12 +2,21 @@
 //! in `tests/`).
 
 pub mod board;
+pub mod budgets;
 pub mod firmware;
 pub mod imports;
 pub mod pico;
 pub mod webdriver;
 
 use std::path::PathBuf;
+use std::time::Duration;
+
+/// The longest a test waits for an event (a board's answer, a browser's
+/// state, a process's word) before it takes the wait for a hang: half an
+/// hour. It only guards against a hang, never times the work: a test
+/// waits for the event itself, and on a machine whose cores are busy with
+/// other work an emulated Pico takes a hundred times a real one's time.
+pub const HANG_GUARD: Duration = Duration::from_secs(30 * 60);
 
 /// The repository root.
 pub fn repo() -> PathBuf {

@@ -22,9 +22,6 @@ use std::process::{Command, Stdio};
 use std::str::FromStr;
 use std::time::{Duration, Instant};
 
-/// The emulated Pico's clock.
-pub const CLOCK_HZ: f64 = 125e6;
-
 /// A Pico template of the repository, and the panel it drives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Template {
@@ -175,12 +172,18 @@ pub fn sram_code_bytes(elf: &Path) -> Result<u64, String> {
         .unwrap_or(0))
 }
 
-/// What one run on the emulated Pico took, in its cycles (125 MHz).
+/// What one run on the emulated Pico took, in its cycles of the system
+/// clock the firmware set.
 #[derive(Clone, Copy, Debug)]
 pub struct Cycles {
+    /// The system clock the firmware set (the emulator's `clockHz`), in Hz.
+    pub clock_hz: f64,
     /// Clocks, the panel's set-up and clear: up to the ST7789's backlight,
     /// or the end of the SSD1306's clearing transfer.
     pub start_up: u64,
+    /// The same in seconds: its first part (the boot ROM, boot2, the copy
+    /// into SRAM, the clocks' set-up) runs before the firmware's clock.
+    pub start_up_seconds: f64,
     /// Parsing and indexing the scene, up to the picture's first row (the
     /// ST7789) or the LED lit (the SSD1306).
     pub parse_and_index: u64,
@@ -212,10 +215,20 @@ pub struct Cycles {
 }
 
 impl Cycles {
+    /// From the scene text to the last pixel on the panel.
+    pub fn to_picture_cycles(&self) -> u64 {
+        self.parse_and_index + self.render + self.transfer.unwrap_or(0)
+    }
+
     /// From the scene text to the last pixel on the panel, in seconds at
-    /// 125 MHz.
+    /// the clock the firmware set.
     pub fn to_picture_seconds(&self) -> f64 {
-        (self.parse_and_index + self.render + self.transfer.unwrap_or(0)) as f64 / CLOCK_HZ
+        self.seconds(self.to_picture_cycles())
+    }
+
+    /// `cycles` in seconds at the clock the firmware set.
+    pub fn seconds(&self, cycles: u64) -> f64 {
+        cycles as f64 / self.clock_hz
     }
 }
 
@@ -258,11 +271,19 @@ fn cycles_of(report: &serde_json::Value) -> Result<Cycles, String> {
     };
     let phase = |key: &str| number(&report["cycles"][key], key);
     let core = |k: usize, key: &str| number(&report["coreCycles"][k][key], key);
+    let clock_hz = report["clockHz"]
+        .as_f64()
+        .filter(|hz| *hz > 0.0)
+        .ok_or_else(|| format!("the emulator's report has no clockHz: {report}"))?;
     let ports = &report["busFabric"]["ports"];
     let striped_contested =
         ["sram0", "sram1", "sram2", "sram3"].iter().map(|bank| ports[bank]["contested"].as_u64().unwrap_or(0)).sum();
     Ok(Cycles {
+        clock_hz,
         start_up: phase("startUp")?,
+        start_up_seconds: report["seconds"]["startUp"]
+            .as_f64()
+            .ok_or_else(|| format!("the emulator's report has no startUp seconds: {report}"))?,
         parse_and_index: phase("parseAndIndex")?,
         render: phase("render")?,
         transfer: report["cycles"].get("transfer").map(|t| number(t, "transfer")).transpose()?,
@@ -286,6 +307,8 @@ pub struct FrameCycles {
     /// From the end of the frame before (the first: from its start) to
     /// this one whole on the panel.
     pub cycles: u64,
+    /// The same in seconds, at the clock the firmware set.
+    pub seconds: f64,
     /// While the board's LED was lit: the frame's work, without waiting
     /// for its time.
     pub lit: u64,
@@ -309,6 +332,9 @@ pub fn run_frames(elf: &Path, pattern: &Path, count: u32) -> Result<Vec<FrameCyc
             };
             Ok(FrameCycles {
                 cycles: number(&frame["cycles"])?,
+                seconds: frame["seconds"]
+                    .as_f64()
+                    .ok_or_else(|| format!("the emulator's report has a frame without its seconds: {frame}"))?,
                 lit: number(&frame["lit"])?,
                 busy: [number(&frame["busy"][0])?, number(&frame["busy"][1])?],
                 picture: frame["out"]
@@ -447,7 +473,7 @@ pub fn run_reporting(elf: &Path, png: &Path) -> Result<(Cycles, Report), String>
     let mut stdout = BufReader::new(child.stdout.take().ok_or("no standard output")?);
     let mut path = String::new();
     let asked = match stdout.read_line(&mut path) {
-        Ok(n) if n > 0 => ask_report(Path::new(path.trim()), Duration::from_secs(900)),
+        Ok(n) if n > 0 => ask_report(Path::new(path.trim()), crate::HANG_GUARD),
         _ => Err("the emulated Pico named no serial device".to_owned()),
     };
     // Its standard input closed, the emulator ends and prints its own count.

@@ -38,7 +38,7 @@ pub fn http_with_head(
     body: &[u8],
 ) -> (u16, String, Vec<u8>) {
     let mut stream = TcpStream::connect(("127.0.0.1", port)).expect("connect");
-    stream.set_read_timeout(Some(Duration::from_secs(300))).ok();
+    stream.set_read_timeout(Some(crate::HANG_GUARD)).ok();
     let mut head = format!("{method} {path} HTTP/1.1\r\nContent-Length: {}\r\nConnection: close\r\n", body.len());
     if !headers.iter().any(|(n, _)| n.eq_ignore_ascii_case("host")) {
         head.push_str(&format!("Host: 127.0.0.1:{port}\r\n"));
@@ -100,7 +100,7 @@ impl Browser {
             .stderr(Stdio::null())
             .spawn()
             .expect("chromedriver starts");
-        let deadline = Instant::now() + Duration::from_secs(30);
+        let deadline = Instant::now() + crate::HANG_GUARD;
         while TcpStream::connect(("127.0.0.1", port)).is_err() {
             assert!(Instant::now() < deadline, "chromedriver did not start listening");
             std::thread::sleep(Duration::from_millis(50));
@@ -169,9 +169,10 @@ impl Browser {
         self.session("POST", "/execute/sync", json!({ "script": script, "args": [] }))
     }
 
-    /// Waits until `condition` (a JavaScript expression) is true.
-    pub fn wait_for(&self, condition: &str, seconds: u64) {
-        let deadline = Instant::now() + Duration::from_secs(seconds);
+    /// Waits until `condition` (a JavaScript expression) is true (up to
+    /// [`crate::HANG_GUARD`]: a hang).
+    pub fn wait_for(&self, condition: &str) {
+        let deadline = Instant::now() + crate::HANG_GUARD;
         while self.run(&format!("return !!({condition});")) != Value::Bool(true) {
             assert!(Instant::now() < deadline, "timed out waiting for {condition}");
             std::thread::sleep(Duration::from_millis(25));

@@ -1,13 +1,19 @@
 //! The board proof: firmware built for emulated boards renders scenes on
 //! the board (parsed there, from the scene text in flash) and the pixels its
-//! display driver receives are bit-identical to host-sim's image.
+//! display driver receives are bit-identical to host-sim's image. The same
+//! runs count the instructions (qemu-count), which with each firmware's
+//! flash and static RAM are held to their budgets (`budgets.toml`, section
+//! `firmware`).
 //!
-//! Needs `qemu-system-arm` (the test command installs it); set
-//! `OCTRACE_SKIP_FIRMWARE=1` to skip where it cannot be installed.
+//! Needs `qemu-system-arm`, `qemu-system-riscv32` and gcc, which builds
+//! qemu-count's plugin (`firmware/tools/qemu-count`; the test command
+//! installs all three); set `OCTRACE_SKIP_FIRMWARE=1` to skip where they
+//! cannot be installed.
 
 use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
-use octrace_tests::firmware::{qemu_available, run_oled_command, Board, Firmware, Sizes};
+use octrace_tests::budgets::Budgets;
+use octrace_tests::firmware::{qemu_available, qemu_count, run_oled_command, Board, Firmware, Sizes};
 use octrace_tests::host_sim_preview;
 
 /// False (the test is skipped) when `OCTRACE_SKIP_FIRMWARE` is set; fails
@@ -57,15 +63,28 @@ fn boards_render_the_same_bits_as_host_sim() {
         Firmware::new(Board::Virt, "fig5_3", 160, 128, PanelColor::Rgb888),
         Firmware::new(Board::Virt, "fig5_1", 160, 128, PanelColor::Rgb565),
     ];
+    let mut budgets = Budgets::load("firmware").unwrap_or_else(|e| panic!("{e}"));
+    let qemu_count = qemu_count();
+    let subjects: Vec<String> = cases.iter().map(Firmware::slug).collect();
     for firmware in cases {
         let name = format!("{} on {}", firmware.scene, firmware.board.machine());
         let elf = firmware.build().unwrap_or_else(|e| panic!("{e}"));
+        let sizes = Sizes::of(&elf).unwrap_or_else(|e| panic!("{name}: {e}"));
         if firmware.board == Board::Microbit {
             // Empty arenas are zero bits: no flash spent on an empty scene.
-            let sizes = Sizes::of(&elf).unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(sizes.data < 1024, "{name}: .data is {} bytes", sizes.data);
         }
-        let run = firmware.run(&elf).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let subject = firmware.slug();
+        budgets.check(&subject, "flash", sizes.text + sizes.data);
+        budgets.check(&subject, "static_ram", sizes.data + sizes.bss);
+        let run = if firmware.counts_exactly() {
+            let (run, measured) = firmware.run_measured(&elf, &qemu_count).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let render = measured.render.unwrap_or_else(|| panic!("{name}: no instructions between the markers"));
+            budgets.check(&subject, "instructions", render);
+            run
+        } else {
+            firmware.run(&elf).unwrap_or_else(|e| panic!("{name}: {e}"))
+        };
         assert_eq!(run.status, 0, "{name}: the board exited with {}:\n{}", run.status, run.output);
         let expected = firmware.expected_pixels().unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(run.pixels.len(), expected.len(), "{name}: byte count\n{}", run.output);
@@ -73,6 +92,7 @@ fn boards_render_the_same_bits_as_host_sim() {
         assert_eq!(differing, 0, "{name}: {differing} bytes differ from host-sim's");
         println!("{name} ({:?}): {} bytes identical; {}", firmware.wire, expected.len(), run.output.trim());
     }
+    budgets.assert_within(&subjects);
 }
 
 /// An 8-bit gray PNG's size and pixels.

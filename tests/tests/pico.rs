@@ -12,12 +12,17 @@
 //! timer's and the phases' edges, and its bus counters count the
 //! contention the emulator counted. The
 //! ST7789 template built for an animation (anim_fig5_1) plays it: each of
-//! its first frames on the panel is host-sim's `--frame K` picture.
+//! its first frames on the panel is host-sim's `--frame K` picture. The
+//! same runs' cycles (each still from scene to picture, each frame), with
+//! each firmware's flash and static RAM, are held to their budgets
+//! (`budgets.toml`, section `pico`).
 //!
 //! Needs Node and the emulator's packages (`npm ci` in
 //! `emulator/`; the test command does it); set
 //! `OCTRACE_SKIP_FIRMWARE=1` to skip where they cannot be installed.
 
+use octrace_tests::budgets::Budgets;
+use octrace_tests::firmware::Sizes;
 use octrace_tests::pico::{self, Build, Report, Template, DEFAULT_CODE_IN};
 use octrace_tests::{host_sim_frame_preview, host_sim_preview};
 use std::path::Path;
@@ -35,10 +40,10 @@ const BUILDS: [Build<'static>; 7] = [
     Build::of(Template::Ssd1306, "fig5_5"),
 ];
 
-/// The least an SSD1306's 128×64 picture takes over I2C at 400 kHz: its
-/// 1,024 bytes at 9 clocks each (address and control bytes, START and STOP
-/// come on top), at 125 MHz.
-const OLED_PICTURE_CYCLES: u64 = 1024 * 9 * 125_000_000 / 400_000;
+/// The least an SSD1306's 128×64 picture takes over I2C at 400 kHz, in
+/// seconds: its 1,024 bytes at 9 clocks each (address and control bytes,
+/// START and STOP come on top).
+const OLED_PICTURE_SECONDS: f64 = 1024.0 * 9.0 / 400e3;
 
 /// An animation, and how many of its frames are checked: the first (traced
 /// whole) and two that re-trace only what moved, the second after a frame
@@ -50,8 +55,8 @@ const ANIMATIONS: [Build<'static>; 2] =
 const FRAMES_CHECKED: u32 = 3;
 
 /// The first coarse panel of a progressive order, from the picture's start:
-/// at most 0.1 s at 125 MHz.
-const FIRST_PANEL_CYCLES: u64 = 12_500_000;
+/// at most 0.1 s.
+const FIRST_PANEL_SECONDS: f64 = 0.1;
 
 /// An 8-bit RGB or gray PNG (host-sim writes a one-bit panel's preview in
 /// gray) as RGB pixels.
@@ -70,7 +75,8 @@ fn read_png_as_rgb(path: &Path) -> (u32, u32, Vec<u8>) {
 }
 
 /// The firmware's own measure of its scene against the emulator's count:
-/// its TIMER ticks each microsecond (125 cycles) and it reads it just after
+/// its TIMER ticks each microsecond (200 cycles at the template's clock,
+/// which the emulator reads from the clock registers) and it reads it just after
 /// the panel's set-up and just after its last row, where the emulator's
 /// phases start at the backlight and end at the last pixel's byte, so the
 /// two agree within a few hundred microseconds; its bus counters cover the
@@ -134,9 +140,19 @@ fn each_pico_template_shows_host_sims_picture() {
         (runs, frames.join().expect("the animation's thread"))
     });
 
+    let mut budgets = Budgets::load("pico").unwrap_or_else(|e| panic!("{e}"));
+    let subject = |build: &Build<'_>| format!("{} {}", build.template.name(), build.name());
+    let subjects: Vec<String> = BUILDS.iter().chain(&ANIMATIONS).map(subject).collect();
+    for (build, elf) in BUILDS.iter().chain(&ANIMATIONS).zip(elves.iter().chain(&animations)) {
+        let sizes = Sizes::of(elf).unwrap_or_else(|e| panic!("{}: {e}", subject(build)));
+        budgets.check(&subject(build), "flash", sizes.text + sizes.data);
+        budgets.check(&subject(build), "static_ram", sizes.data + sizes.bss);
+    }
+
     for (build, (run, panel)) in BUILDS.iter().zip(runs) {
-        let name = format!("{} {}", build.template.name(), build.name());
+        let name = subject(build);
         let (cycles, report) = run.unwrap_or_else(|e| panic!("{name}: {e}"));
+        budgets.check(&name, "to_picture_cycles", cycles.to_picture_cycles());
         if let Some(report) = report {
             reported_as_the_emulator_counted(&name, &report, &cycles);
         }
@@ -148,7 +164,7 @@ fn each_pico_template_shows_host_sims_picture() {
         assert_eq!(cycles.cores, 2, "{name}: both cores trace");
         if build.order == "progressive" {
             assert!(
-                cycles.first_full_panel <= FIRST_PANEL_CYCLES,
+                cycles.seconds(cycles.first_full_panel) <= FIRST_PANEL_SECONDS,
                 "{name}: the whole panel coarse after {} cycles, more than 0.1 s",
                 cycles.first_full_panel
             );
@@ -157,17 +173,18 @@ fn each_pico_template_shows_host_sims_picture() {
             let transfer =
                 cycles.transfer.unwrap_or_else(|| panic!("{name}: no transfer of the picture after the LED"));
             assert!(
-                transfer >= OLED_PICTURE_CYCLES,
+                cycles.seconds(transfer) >= OLED_PICTURE_SECONDS,
                 "{name}: the picture went over I2C in {transfer} cycles, faster than 400 kHz carries it"
             );
         }
         println!(
             "{name}: {size} pixels identical; parse and index {} cycles, render {} cycles, transfer {:?} cycles: \
-             {:.2} s at 125 MHz; whole panel after {} cycles; core 0 busy {}, core 1 busy {} cycles",
+             {:.3} s at {:.0} MHz; whole panel after {} cycles; core 0 busy {}, core 1 busy {} cycles",
             cycles.parse_and_index,
             cycles.render,
             cycles.transfer,
             cycles.to_picture_seconds(),
+            cycles.clock_hz / 1e6,
             cycles.first_full_panel,
             cycles.busy[0],
             cycles.busy[1]
@@ -175,25 +192,26 @@ fn each_pico_template_shows_host_sims_picture() {
     }
 
     for (build, frames) in ANIMATIONS.iter().zip(played) {
-        let name = format!("{} {}", build.template.name(), build.name());
+        let name = subject(build);
         let frames = frames.unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(frames.len(), FRAMES_CHECKED as usize, "{name}: the frames drawn");
+        for (k, frame) in frames.iter().enumerate() {
+            budgets.check(&name, &format!("frame_{k}_cycles"), frame.cycles);
+        }
         let (size, color) = build.template.panel();
         for (k, frame) in (0..).zip(&frames) {
             let preview = dir.path().join(format!("{}-{}-host-sim-{k}.png", build.template.name(), build.name()));
             host_sim_frame_preview(build.scene, k, &preview, size, color).unwrap_or_else(|e| panic!("{e}"));
             assert_same_picture(&format!("{name}, frame {k}"), &frame.picture, &preview, size);
             println!(
-                "{name}, frame {k}: {size} pixels identical; {} cycles ({:.3} s at 125 MHz), core 0 busy {}, core 1 busy {}",
-                frame.cycles,
-                frame.cycles as f64 / pico::CLOCK_HZ,
-                frame.busy[0],
-                frame.busy[1]
+                "{name}, frame {k}: {size} pixels identical; {} cycles ({:.3} s), core 0 busy {}, core 1 busy {}",
+                frame.cycles, frame.seconds, frame.busy[0], frame.busy[1]
             );
         }
         // The frames after the first re-trace only what moved.
         assert!(frames[1..].iter().all(|f| f.cycles < frames[0].cycles / 2), "{name}: {frames:?}");
     }
+    budgets.assert_within(&subjects);
 }
 
 /// Asserts the panel's picture `panel` is host-sim's `preview`, pixel for

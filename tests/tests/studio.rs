@@ -15,13 +15,16 @@
 use host_sim::{load_bytes, new_scene, render, RenderOptions, RgbImage};
 use octrace_core::panel::Dithering;
 use octrace_images::palette::{self, PaletteMode};
+use octrace_link::{BoardInfo, Capacities, Decoder, Kind, Message, Panel, PixelFormat};
 use octrace_tests::board::{fits, open_pty, wedging_scene, RunningBoard};
 use octrace_tests::webdriver::{http, http_with_head, Browser};
-use octrace_tests::{host_sim_preview, repo, scenes};
+use octrace_tests::{host_sim_preview, repo, scenes, HANG_GUARD};
 use std::ffi::OsStr;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// The host-sim binary, built for this test run.
@@ -42,12 +45,15 @@ fn host_sim_binary() -> PathBuf {
     binary
 }
 
-/// A running `host-sim studio`, stopped (Ctrl-C) on drop.
+/// A running `host-sim studio`, stopped (Ctrl-C) on drop, and what it
+/// has written on its standard error so far.
 struct Studio {
     child: Child,
     url: String,
     port: u16,
     token: String,
+    log: std::sync::Arc<std::sync::Mutex<String>>,
+    logging: Option<std::thread::JoinHandle<()>>,
 }
 
 impl Studio {
@@ -73,21 +79,43 @@ impl Studio {
         let (port, token) = rest.split_once("/?token=").expect("port and token");
         let (port, token) = (port.parse().expect("a port"), token.to_string());
         assert!(token.len() >= 32, "a long token: {token}");
-        Studio { child, url, port, token }
+        // Its standard error, read as it comes (a pipe left unread would
+        // stop a studio that says much).
+        let log = std::sync::Arc::new(std::sync::Mutex::new(String::new()));
+        let stderr = child.stderr.take().expect("stderr");
+        let written = std::sync::Arc::clone(&log);
+        let logging = std::thread::spawn(move || {
+            for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+                let mut log = written.lock().expect("the log");
+                log.push_str(&line);
+                log.push('\n');
+            }
+        });
+        Studio { child, url, port, token, log, logging: Some(logging) }
     }
 
-    /// Sends SIGINT (what Ctrl-C sends) and waits for the exit.
+    /// Waits until what the studio has written on its standard error
+    /// satisfies `done`.
+    fn wait_for_log(&self, what: &str, done: impl Fn(&str) -> bool) {
+        let deadline = Instant::now() + HANG_GUARD;
+        while !done(&self.log.lock().expect("the log")) {
+            assert!(Instant::now() < deadline, "the studio never logged {what}");
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+
+    /// Sends SIGINT (what Ctrl-C sends) and waits for the exit; its status
+    /// and all it wrote on its standard error.
     fn interrupt(&mut self) -> (std::process::ExitStatus, String) {
         let status = Command::new("kill").args(["-INT", &self.child.id().to_string()]).status().expect("kill runs");
         assert!(status.success());
-        let deadline = Instant::now() + Duration::from_secs(3);
+        let deadline = Instant::now() + HANG_GUARD;
         loop {
             if let Some(status) = self.child.try_wait().expect("wait") {
-                let mut stderr = String::new();
-                if let Some(mut e) = self.child.stderr.take() {
-                    std::io::Read::read_to_string(&mut e, &mut stderr).ok();
+                if let Some(logging) = self.logging.take() {
+                    logging.join().expect("the log's reader");
                 }
-                return (status, stderr);
+                return (status, self.log.lock().expect("the log").clone());
             }
             assert!(Instant::now() < deadline, "the studio did not stop on SIGINT");
             std::thread::sleep(Duration::from_millis(20));
@@ -139,7 +167,7 @@ fn set_text(browser: &Browser, text: &str) {
 fn render_and_wait(browser: &Browser) {
     browser.run("document.getElementById('image').dataset.state = 'stale'; return true;");
     browser.click("#render");
-    browser.wait_for("document.getElementById('image').dataset.state === 'done'", 300);
+    browser.wait_for("document.getElementById('image').dataset.state === 'done'");
 }
 
 const START: &str = "/* placed with the studio */\nVIEWPOINT 0 4 12\nORIGIN 0 0 0\nRASTER 96 72\n\
@@ -154,7 +182,7 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
     let studio = Studio::start(&binary, Some(&scene_path));
     let browser = Browser::start((1500, 900));
     browser.goto(&studio.url);
-    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+    browser.wait_for("document.body.dataset.ready === 'true'");
 
     // Place a sphere the thesis's way: press on the x–z plane and drag up
     // for its height, then drag for its radius.
@@ -174,11 +202,11 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
         "const s = document.querySelector('#panel input[data-field=reflection]');
          s.value = '0.25'; s.dispatchEvent(new Event('change')); return true;",
     );
-    browser.wait_for("/SURFACE 1 0\\.1 0\\.1 0\\.1 1 0 0 .* 0\\.25 0/.test(studio.editor.text())", 10);
+    browser.wait_for("/SURFACE 1 0\\.1 0\\.1 0\\.1 1 0 0 .* 0\\.25 0/.test(studio.editor.text())");
     render_and_wait(&browser);
     screenshot(&browser, "placed");
     browser.click("#save-scene");
-    browser.wait_for("document.body.dataset.saved", 10);
+    browser.wait_for("document.body.dataset.saved");
     let saved = std::fs::read_to_string(&scene_path).expect("the scene was saved");
     assert!(saved.contains("SPHERE 1 ") && saved.starts_with(START), "saved:\n{saved}");
     let expected = host_render(&saved, None);
@@ -195,7 +223,7 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
             "const d = document.getElementById('display'); d.value = '{code}';
              d.dispatchEvent(new Event('change')); return true;"
         ));
-        browser.wait_for(&format!("document.getElementById('image').dataset.display === '{code}'"), 30);
+        browser.wait_for(&format!("document.getElementById('image').dataset.display === '{code}'"));
         let shown = palette::apply(&expected.image, &expected.objects, mode).to_rgb();
         assert_same(mode.name(), browser.canvas_rgb("image"), &shown);
     }
@@ -211,14 +239,11 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
              const d = document.getElementById('display'); d.value = '{code}';
              d.dispatchEvent(new Event('change')); return true;"
         ));
-        browser.wait_for(
-            &format!(
-                "document.getElementById('image').dataset.display === '{code}'
+        browser.wait_for(&format!(
+            "document.getElementById('image').dataset.display === '{code}'
                  && document.getElementById('image').dataset.dither === '{method_code}'
                  && document.getElementById('image').dataset.state === 'done'"
-            ),
-            60,
-        );
+        ));
         // host-sim --size 40x30 --color NAME [--dither METHOD], as a Targa
         // (RGB, or a colour table).
         let out = dir.path().join(format!("{name}.tga"));
@@ -232,7 +257,7 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
         assert_same(name, browser.canvas_rgb("image"), &panel);
     }
     browser.run("const d = document.getElementById('display'); d.value = '0'; d.dispatchEvent(new Event('change')); return true;");
-    browser.wait_for("document.getElementById('image').dataset.state === 'done' && document.getElementById('image').dataset.display === '0'", 60);
+    browser.wait_for("document.getElementById('image').dataset.state === 'done' && document.getElementById('image').dataset.display === '0'");
 
     // Image files: what the page writes is host-sim's file format, and
     // reading it back shows the same pixels.
@@ -260,7 +285,7 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
     std::fs::write(&scene_path, "/* changed elsewhere */\n").expect("written");
     set_text(&browser, &format!("{saved}/* more */\n"));
     browser.click("#save-scene");
-    let deadline = Instant::now() + Duration::from_secs(10);
+    let deadline = Instant::now() + HANG_GUARD;
     let question = loop {
         if let Some(q) = browser.alert_text() {
             break q;
@@ -274,12 +299,12 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
 
     // Unsaved work survives a reload.
     browser.goto(&studio.url);
-    browser.wait_for("document.body.dataset.ready === 'true'", 60);
+    browser.wait_for("document.body.dataset.ready === 'true'");
     assert_eq!(scene_text(&browser), format!("{saved}/* more */\n"));
 
     // Errors at line and column as you type.
     set_text(&browser, "VIEWPOINT 0 0 5\nSPHERE 1 x 0 0 0\n");
-    browser.wait_for("document.querySelector('#errors li')", 10);
+    browser.wait_for("document.querySelector('#errors li')");
     let error: String =
         browser.run("return document.querySelector('#errors li').textContent;").as_str().unwrap().into();
     assert!(error.starts_with("2:10:"), "{error}");
@@ -295,7 +320,7 @@ fn the_canvas_is_host_sims_image_for_every_scene() {
     let studio = Studio::start(&binary, None);
     let browser = Browser::start((1500, 900));
     browser.goto(&studio.url);
-    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+    browser.wait_for("document.body.dataset.ready === 'true'");
     // Started without --board: no board to send to, and the button says so.
     let send = browser.run("const b = document.getElementById('send-board'); return [b.disabled, b.title];");
     assert_eq!(send[0], true);
@@ -334,11 +359,11 @@ fn the_canvas_is_host_sims_image_for_every_scene() {
     // speed targets live in benchmarks).
     let fig5_3 = std::fs::read_to_string(repo().join("scenes/fig5_3.txt")).expect("fig5_3");
     set_text(&browser, &fig5_3);
-    browser.wait_for("document.getElementById('draft').dataset.state === 'done'", 60);
+    browser.wait_for("document.getElementById('draft').dataset.state === 'done'");
     let mut latencies = Vec::new();
     for _ in 0..11 {
         browser.type_into_element(&browser.run("return studio.editor.view.contentDOM;"), " ");
-        browser.wait_for("document.getElementById('draft').dataset.state === 'done'", 60);
+        browser.wait_for("document.getElementById('draft').dataset.state === 'done'");
         latencies.push(browser.run("return studio.draftLatency;").as_f64().expect("a latency"));
     }
     latencies.sort_by(f64::total_cmp);
@@ -355,7 +380,7 @@ fn a_render_or_draft_of_hours_a_pixel_is_stopped_by_the_next_at_once() {
     let studio = Studio::start(&binary, None);
     let browser = Browser::start((1200, 800));
     browser.goto(&studio.url);
-    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+    browser.wait_for("document.body.dataset.ready === 'true'");
     let wedge = with_raster(&wedging_scene(8), 16, 12);
     let next = with_raster(&std::fs::read_to_string(repo().join("scenes/fig5_1.txt")).expect("fig5_1"), 64, 48);
     for parallel in [false, true] {
@@ -365,28 +390,26 @@ fn a_render_or_draft_of_hours_a_pixel_is_stopped_by_the_next_at_once() {
         std::thread::sleep(Duration::from_millis(300));
         browser.run("document.getElementById('image').dataset.state = 'stale'; return true;");
         browser.click("#render");
-        browser.wait_for("document.getElementById('image').dataset.state === 'rendering'", 10);
+        browser.wait_for("document.getElementById('image').dataset.state === 'rendering'");
         std::thread::sleep(Duration::from_millis(300));
-        // The next scene's draft and render come as if nothing ran before.
-        let started = Instant::now();
+        // The next scene's draft and render come as if nothing ran before
+        // (waited for, as long as a busy machine takes: were the wedge not
+        // stopped, they would not come within hours).
         set_text(&browser, &next);
         browser.wait_for(
             "document.getElementById('draft').dataset.state === 'done' && \
              document.getElementById('draft').dataset.seq === String(studio.draftSeq)",
-            30,
         );
         render_and_wait(&browser);
-        let elapsed = started.elapsed();
         assert_same(
             &format!("fig5_1 after the wedge (parallel: {parallel})"),
             browser.canvas_rgb("image"),
             &host_render(&next, None).image,
         );
-        assert!(elapsed < Duration::from_secs(30), "the next draft and render took {elapsed:?}");
     }
     // An animation's players too: a frame of hours a pixel, its draft and
-    // render under way, is stopped by the next text, whose frames come at
-    // once (the draft's player is the draft's worker pair).
+    // render under way, is stopped by the next text, whose frames come
+    // (the draft's player is the draft's worker pair).
     let dir = tempfile::tempdir().expect("a directory");
     let animation = dir.path().join("animation.txt");
     let animated =
@@ -397,12 +420,9 @@ fn a_render_or_draft_of_hours_a_pixel_is_stopped_by_the_next_at_once() {
         "const s = document.getElementById('frame'); s.value = '1'; s.dispatchEvent(new Event('input')); return true;",
     );
     std::thread::sleep(Duration::from_millis(300));
-    let started = Instant::now();
     set_text(&browser, &animated);
     slide_to(&browser, 1);
-    let elapsed = started.elapsed();
     assert_same("frame 1 after the wedge's", browser.canvas_rgb("image"), &host_frame(&animation, 1, None));
-    assert!(elapsed < Duration::from_secs(30), "the next frame took {elapsed:?}");
 }
 
 #[test]
@@ -604,7 +624,7 @@ fn every_tool_places_its_object_and_selections_move_and_delete() {
     let studio = Studio::start(&binary, Some(&scene_path));
     let browser = Browser::start((1500, 900));
     browser.goto(&studio.url);
-    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+    browser.wait_for("document.body.dataset.ready === 'true'");
 
     // Keys 1–8 choose the tools; the sized ones take a point and a size.
     for (key, keyword) in [("2", "BOX 1 "), ("3", "SUPERQUADRIC 1 4 ")] {
@@ -679,7 +699,7 @@ fn every_tool_places_its_object_and_selections_move_and_delete() {
     octrace_images::formats::write(&image, octrace_images::formats::Format::Tga, &mut bytes).expect("encoded");
     std::fs::write(&file, bytes).expect("written");
     browser.type_into("#load-image", &file.display().to_string());
-    browser.wait_for("document.getElementById('image').dataset.state === 'loaded'", 10);
+    browser.wait_for("document.getElementById('image').dataset.state === 'loaded'");
     assert_same("loaded Targa", browser.canvas_rgb("image"), &image.to_rgb());
     browser.click("#clear");
     assert_eq!(browser.run("return document.getElementById('image').dataset.state;"), "clear");
@@ -716,7 +736,7 @@ fn the_editor_highlights_the_cores_keywords_marks_errors_and_keeps_one_history()
     let studio = Studio::start(&binary, None);
     let browser = Browser::start((1500, 900));
     browser.goto(&studio.url);
-    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+    browser.wait_for("document.body.dataset.ready === 'true'");
 
     // Every keyword of the core, in either ASCII case, beside words that
     // are none: in a comment, quoted, plural, with a non-ASCII letter that
@@ -800,7 +820,7 @@ fn the_editor_highlights_the_cores_keywords_marks_errors_and_keeps_one_history()
     // Ctrl+Enter in the editor renders, and adds no line.
     browser.run("studio.editor.view.focus(); document.getElementById('image').dataset.state = 'stale'; return true;");
     browser.keys("\u{E009}\u{E007}\u{E009}");
-    browser.wait_for("document.getElementById('image').dataset.state === 'done'", 60);
+    browser.wait_for("document.getElementById('image').dataset.state === 'done'");
     assert_eq!(scene_text(&browser), edited);
     assert_eq!(page_log(&browser), serde_json::json!([]), "nothing refused, no script error");
 }
@@ -832,7 +852,7 @@ fn slide_to(browser: &Browser, frame: u32) {
          slider.value = '{frame}'; slider.dispatchEvent(new Event('input')); return true;"
     ));
     let shown = format!("{FRAME_PICTURES}.every((id) => document.getElementById(id).dataset.frame === '{frame}')");
-    browser.wait_for(&shown, 120);
+    browser.wait_for(&shown);
 }
 
 /// The share of the render's pixels the page says it traced for its frame.
@@ -848,11 +868,11 @@ fn traced_share(browser: &Browser) -> f64 {
 fn play_and_pause(browser: &Browser, what: &str) -> u32 {
     let start = browser.run("return studio.frame;").as_u64().expect("a frame");
     browser.click("#play");
-    browser.wait_for("studio.played && studio.played.length >= 30", 120);
+    browser.wait_for("studio.played && studio.played.length >= 30");
     browser.click("#play");
     let shown =
         format!("{FRAME_PICTURES}.every((id) => document.getElementById(id).dataset.frame === String(studio.frame))");
-    browser.wait_for(&format!("!studio.playing && {shown}"), 60);
+    browser.wait_for(&format!("!studio.playing && {shown}"));
     let frame = browser.run("return studio.frame;").as_u64().expect("a frame");
     let played = browser.run("return studio.played;");
     let played = played.as_array().expect("the frames played");
@@ -897,14 +917,14 @@ fn the_time_slider_and_play_show_host_sims_frames() {
     let studio = Studio::start(&binary, Some(&scene));
     let browser = Browser::start((1500, 900));
     browser.goto(&studio.url);
-    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+    browser.wait_for("document.body.dataset.ready === 'true'");
     let controls =
         browser.run("return [document.getElementById('time').hidden, document.getElementById('frame').max];");
     assert_eq!(controls, serde_json::json!([false, "47"]));
 
     // Play the draft alone, then pause: the frames went by in turn, and
     // the draft shows host-sim's frame.
-    browser.wait_for("document.getElementById('draft').dataset.state === 'done'", 60);
+    browser.wait_for("document.getElementById('draft').dataset.state === 'done'");
     let frame = play_and_pause(&browser, "the draft (160x120)");
     let draft = host_frame(&scene, frame, Some("160x120"));
     assert_same(&format!("draft of frame {frame}, played to"), browser.canvas_rgb("draft"), &draft);
@@ -932,7 +952,7 @@ fn the_time_slider_and_play_show_host_sims_frames() {
     // Frame 0, rendered as any scene is (parallel tiles), and its draft.
     render_and_wait(&browser);
     assert_same("frame 0", browser.canvas_rgb("image"), &host_frame(&scene, 0, None));
-    browser.wait_for("document.getElementById('draft').dataset.state === 'done'", 60);
+    browser.wait_for("document.getElementById('draft').dataset.state === 'done'");
     assert_same("draft of frame 0", browser.canvas_rgb("draft"), &host_frame(&scene, 0, Some("160x120")));
     // Then frames forward (re-tracing a small share), a jump, backwards,
     // and round the loop from the last frame to the first.
@@ -956,7 +976,7 @@ fn the_time_slider_and_play_show_host_sims_frames() {
     // frame shown then, whole, not replaced by a frame the player was
     // still tracing.
     browser.click("#play");
-    browser.wait_for("studio.played && studio.played.length >= 3", 120);
+    browser.wait_for("studio.played && studio.played.length >= 3");
     render_and_wait(&browser);
     let frame = browser.run("return studio.frame;").as_u64().expect("a frame") as u32;
     // Time for a frame the player traced to come, were it still shown.
@@ -1031,7 +1051,7 @@ fn board_verdict(browser: &Browser) -> (String, String, String) {
 fn send_to_board(browser: &Browser, how: &dyn Fn(&Browser)) -> (String, String, String) {
     browser.run("document.getElementById('board').dataset.state = 'stale'; return true;");
     how(browser);
-    browser.wait_for("['done', 'rejected', 'error'].includes(document.getElementById('board').dataset.state)", 900);
+    browser.wait_for("['done', 'rejected', 'error'].includes(document.getElementById('board').dataset.state)");
     board_verdict(browser)
 }
 
@@ -1044,7 +1064,7 @@ fn send_to_board_shows_the_boards_picture_and_verdict_or_its_errors_in_the_edito
     let studio = Studio::start_with(&binary, None, &["--board".as_ref(), board.port.as_os_str()]);
     let browser = Browser::start((1500, 900));
     browser.goto(&studio.url);
-    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+    browser.wait_for("document.body.dataset.ready === 'true'");
     assert_eq!(browser.run("return document.getElementById('send-board').disabled;"), false);
 
     // A scene of the thesis the board holds: its picture beside the render,
@@ -1114,42 +1134,108 @@ fn send_to_board_shows_the_boards_picture_and_verdict_or_its_errors_in_the_edito
     assert_eq!(listed, serde_json::json!(["board"]));
 }
 
-/// A board that reads and never answers: its serial device, and how many
-/// bytes reach it, read by read.
-fn listening_board() -> (PathBuf, std::sync::mpsc::Receiver<usize>) {
-    let (controller, port) = open_pty().expect("a pseudo-terminal");
-    let (bytes, received) = std::sync::mpsc::channel();
-    std::thread::spawn(move || {
-        let mut controller = controller;
-        let mut chunk = [0u8; 4096];
-        loop {
-            match std::io::Read::read(&mut controller, &mut chunk) {
-                Ok(n) if n > 0 => {
-                    if bytes.send(n).is_err() {
-                        return;
-                    }
-                }
-                // No host has it open (yet, or any more).
-                _ => std::thread::sleep(Duration::from_millis(10)),
+/// A board the test plays at the end of a pseudo-terminal: it records the
+/// kind of every frame that reaches it; it answers a hello (with a 2×2
+/// panel's description) if `answering`; it answers a scene with
+/// `drawing`, then says it is still working, every 50 ms, while `working`.
+/// Otherwise it says nothing.
+struct ScriptedBoard {
+    port: PathBuf,
+    received: Arc<Mutex<Vec<Kind>>>,
+    working: Arc<AtomicBool>,
+}
+
+impl ScriptedBoard {
+    fn start(answering: bool) -> ScriptedBoard {
+        let (controller, port) = open_pty().expect("a pseudo-terminal");
+        let received = Arc::new(Mutex::new(Vec::new()));
+        let working = Arc::new(AtomicBool::new(true));
+        // The scene's tag, once one came.
+        let scene = Arc::new(Mutex::new(None));
+        let mut writer = controller.try_clone().expect("a second handle");
+        let (keeps, drawing) = (Arc::clone(&working), Arc::clone(&scene));
+        std::thread::spawn(move || loop {
+            let tag = *drawing.lock().expect("the scene's tag");
+            if let Some(tag) = tag.filter(|_| keeps.load(Ordering::SeqCst)) {
+                let mut frame = Vec::new();
+                Message::Working { elapsed: None }.encode(tag, &mut frame).expect("encoded");
+                let _ = std::io::Write::write_all(&mut writer, &frame);
             }
+            std::thread::sleep(Duration::from_millis(50));
+        });
+        let seen = Arc::clone(&received);
+        std::thread::spawn(move || {
+            let mut controller = controller;
+            let mut decoder = Decoder::for_board(vec![0u8; 1 << 16]);
+            let mut chunk = [0u8; 4096];
+            loop {
+                let n = match std::io::Read::read(&mut controller, &mut chunk) {
+                    Ok(n) if n > 0 => n,
+                    // No host has it open (yet, or any more).
+                    _ => {
+                        std::thread::sleep(Duration::from_millis(10));
+                        continue;
+                    }
+                };
+                for &byte in &chunk[..n] {
+                    let Some(Ok(frame)) = decoder.push(byte) else { continue };
+                    seen.lock().expect("the frames").push(frame.message.kind());
+                    let mut answer = Vec::new();
+                    match frame.message {
+                        Message::Hello if answering => {
+                            let panel = Panel { width: 2, height: 2, format: PixelFormat::Rgb565 };
+                            let info = BoardInfo {
+                                panel,
+                                max_scene: 4096,
+                                profile: "scripted",
+                                firmware: "scripted board",
+                                capacities: Capacities::new(&[]),
+                            };
+                            Message::Board(info).encode(frame.tag, &mut answer).expect("encoded");
+                        }
+                        Message::Scene { pixels, .. } => {
+                            let panel = Panel { width: 2, height: 2, format: PixelFormat::Rgb565 };
+                            Message::Drawing { panel, pixels, frames: 0 }
+                                .encode(frame.tag, &mut answer)
+                                .expect("encoded");
+                            *scene.lock().expect("the scene's tag") = Some(frame.tag);
+                        }
+                        _ => {}
+                    }
+                    let _ = std::io::Write::write_all(&mut controller, &answer);
+                }
+            }
+        });
+        ScriptedBoard { port, received, working }
+    }
+
+    /// The kinds of the frames that reached it so far.
+    fn received(&self) -> Vec<Kind> {
+        self.received.lock().expect("the frames").clone()
+    }
+
+    /// Waits until a frame of `kind` has reached it.
+    fn wait_for(&self, kind: Kind) {
+        let deadline = Instant::now() + HANG_GUARD;
+        while !self.received().contains(&kind) {
+            assert!(Instant::now() < deadline, "no {kind} reached the board: {:?}", self.received());
+            std::thread::sleep(Duration::from_millis(10));
         }
-    });
-    (port, received)
+    }
 }
 
 #[test]
 fn the_board_endpoint_keeps_the_security_rules_and_sends_one_at_a_time() {
     // What reaches the board is seen here.
-    let (port, received) = listening_board();
+    let board = ScriptedBoard::start(true);
     let binary = host_sim_binary();
-    let args = ["--board".as_ref(), port.as_os_str(), "--board-timeout".as_ref(), "3".as_ref()];
-    let studio = Studio::start_with(&binary, None, &args);
+    let studio = Studio::start_with(&binary, None, &["--board".as_ref(), board.port.as_os_str()]);
     let port_number = studio.port;
     let token = format!("token={}", studio.token);
     let with_token = |path: &str| format!("{path}?{token}");
 
-    // Without the token, with a wrong one, or from a foreign Host: refused,
-    // and nothing reaches the board.
+    // Without the token, with a wrong one, or from a foreign Host: refused
+    // (answered before anything could reach the board).
     assert_eq!(http(port_number, "POST", "/board", &[], b"RDEPTH 2\n").0, 403);
     assert_eq!(http(port_number, "GET", "/board", &[], b"").0, 403);
     assert_eq!(http(port_number, "POST", "/board?token=0123", &[], b"RDEPTH 2\n").0, 403);
@@ -1158,33 +1244,58 @@ fn the_board_endpoint_keeps_the_security_rules_and_sends_one_at_a_time() {
         assert_eq!(status, 421, "Host {host}");
     }
     assert_eq!(http(port_number, "PUT", &with_token("/board"), &[], b"RDEPTH 2\n").0, 405);
-    std::thread::sleep(Duration::from_millis(300));
-    assert!(received.try_recv().is_err(), "a refused request reached the board");
 
     // With the token: the board is named, and a send reaches it.
     let (status, body) = http(port_number, "GET", &with_token("/board"), &[], b"");
     assert_eq!(status, 200);
     let status_json: serde_json::Value = serde_json::from_slice(&body).expect("JSON");
-    assert_eq!(status_json["port"], port.to_string_lossy().as_ref());
+    assert_eq!(status_json["port"], board.port.to_string_lossy().as_ref());
     assert_eq!(status_json["busy"], false);
     let send = {
         let path = with_token("/board");
         std::thread::spawn(move || http(port_number, "POST", &path, &[], b"RDEPTH 2\n"))
     };
-    received.recv_timeout(Duration::from_secs(10)).expect("the send reached the board");
-    // One send at a time: a second while the first waits is refused as busy.
+    board.wait_for(Kind::Scene);
+    // Its hello and its scene, and nothing of the refused requests before.
+    assert_eq!(board.received(), [Kind::Hello, Kind::Scene]);
+    // One send at a time: a second while the first is under way (the board
+    // says it is still working) is refused as busy, and the page sees the
+    // board's word.
     let (status, body) = http(port_number, "POST", &with_token("/board"), &[], b"RDEPTH 2\n");
     assert_eq!(status, 409, "{}", String::from_utf8_lossy(&body));
     assert!(String::from_utf8_lossy(&body).starts_with("busy"), "{}", String::from_utf8_lossy(&body));
-    let (_, body) = http(port_number, "GET", &with_token("/board"), &[], b"");
-    assert_eq!(serde_json::from_slice::<serde_json::Value>(&body).unwrap()["busy"], true);
-    // The silent board: an error naming it, and the board free again.
+    let deadline = Instant::now() + HANG_GUARD;
+    loop {
+        let (_, body) = http(port_number, "GET", &with_token("/board"), &[], b"");
+        let status: serde_json::Value = serde_json::from_slice(&body).unwrap();
+        assert_eq!(status["busy"], true, "{status}");
+        if status["working"].is_number() {
+            break;
+        }
+        assert!(Instant::now() < deadline, "the board's word never reached the page: {status}");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    // The board falls silent: an error naming it and what it last did, and
+    // the board free again.
+    board.working.store(false, Ordering::SeqCst);
     let (status, body) = send.join().expect("the first send");
     let said = String::from_utf8_lossy(&body);
     assert_eq!(status, 502, "{said}");
-    assert!(said.starts_with(&format!("board at {}: no answer within 3 s", port.display())), "{said}");
+    let want = format!(
+        "board at {}: the board fell silent: nothing for 8 s after it said it was still working",
+        board.port.display()
+    );
+    assert!(said.starts_with(&want), "{said}");
     let (_, body) = http(port_number, "GET", &with_token("/board"), &[], b"");
     assert_eq!(serde_json::from_slice::<serde_json::Value>(&body).unwrap()["busy"], false);
+    // A board that never answers, with a cap on each send: said at the cap.
+    let silent = ScriptedBoard::start(false);
+    let args = ["--board".as_ref(), silent.port.as_os_str(), "--board-timeout".as_ref(), "1".as_ref()];
+    let studio = Studio::start_with(&binary, None, &args);
+    let (status, body) = http(studio.port, "POST", &format!("/board?token={}", studio.token), &[], b"RDEPTH 2\n");
+    let said = String::from_utf8_lossy(&body);
+    assert_eq!(status, 502, "{said}");
+    assert!(said.starts_with(&format!("board at {}: no answer within 1 s", silent.port.display())), "{said}");
 }
 
 #[test]
@@ -1255,7 +1366,8 @@ document.getElementById('form').submit();
 
 #[test]
 fn another_local_page_cannot_drive_the_studio_nor_learn_its_token() {
-    let (board_port, received) = listening_board();
+    let board = ScriptedBoard::start(true);
+    let board_port = board.port.clone();
     let dir = tempfile::tempdir().expect("a directory");
     let scene_path = dir.path().join("s.txt");
     std::fs::write(&scene_path, START).expect("written");
@@ -1266,16 +1378,20 @@ fn another_local_page_cannot_drive_the_studio_nor_learn_its_token() {
     // The user has the studio open; then the browser shows the other page.
     let browser = Browser::start((1200, 800));
     browser.goto(&studio.url);
-    browser.wait_for("document.body.dataset.ready === 'true'", 120);
+    browser.wait_for("document.body.dataset.ready === 'true'");
     browser.goto(&format!("http://127.0.0.1:{page_port}/"));
-    browser.wait_for("document.body.dataset.results", 30);
+    browser.wait_for("document.body.dataset.results");
     let results = browser.run("return document.body.dataset.results;");
-    // The form's POST went when the page loaded; give it time to arrive.
-    std::thread::sleep(Duration::from_millis(1500));
+    // The form's POST went when the page loaded: once the studio has
+    // refused it and the fetch (and said so), nothing of them is on its way.
+    let refused = |log: &str, what: &str| {
+        log.lines().filter(|l| l.contains(&format!("refused {what} from another site"))).count()
+    };
+    studio.wait_for_log("both refusals of POST /board", |log| refused(log, "POST /board") >= 2);
 
     // Nothing reached the board, the scene is as it was, and the other
     // page's server never saw the token.
-    assert!(received.try_recv().is_err(), "a request of the other page reached the board: {results}");
+    assert!(board.received().is_empty(), "a request of the other page reached the board: {results}");
     assert_eq!(std::fs::read_to_string(&scene_path).unwrap(), START, "{results}");
     let requests = requests.lock().expect("the requests").clone();
     assert!(!requests.is_empty(), "the other page was served");
@@ -1284,10 +1400,8 @@ fn another_local_page_cannot_drive_the_studio_nor_learn_its_token() {
     }
     // The studio refused them, and said so.
     let (_, stderr) = studio.interrupt();
-    let refused =
-        |what: &str| stderr.lines().filter(|l| l.contains(&format!("refused {what} from another site"))).count();
-    assert!(refused("POST /board") >= 2, "the form and the fetch: {results}\n{stderr}");
-    assert!(refused("GET /scene") >= 2, "both fetches: {results}\n{stderr}");
+    assert!(refused(&stderr, "POST /board") >= 2, "the form and the fetch: {results}\n{stderr}");
+    assert!(refused(&stderr, "GET /scene") >= 2, "both fetches: {results}\n{stderr}");
     assert!(stderr.contains(&format!("(Origin http://127.0.0.1:{page_port})")), "{stderr}");
     // The fetches that needed the studio's leave (a PUT, a header) got none.
     let results: serde_json::Value = serde_json::from_str(results.as_str().expect("JSON")).expect("results");

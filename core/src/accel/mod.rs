@@ -224,7 +224,9 @@ impl<'m> Mailbox<'m> {
     /// Forgets every visit (call between queries).
     #[inline]
     pub fn clear(&mut self) {
-        if self.overflowed || self.words.len() <= Self::ZERO_ALL_UP_TO {
+        if self.words.len() <= Self::ZERO_ALL_UP_TO {
+            zero_few(self.words);
+        } else if self.overflowed {
             self.words.fill(0);
             self.overflowed = false;
         } else {
@@ -236,6 +238,25 @@ impl<'m> Mailbox<'m> {
         }
         self.touched.clear();
     }
+}
+
+/// Zeroes up to [`Mailbox::ZERO_ALL_UP_TO`] words with a store each: a
+/// slice's `fill` of unknown length is a library call on a Cortex-M0,
+/// dearer than the few words a small scene's mailbox has.
+#[inline(always)]
+fn zero_few(words: &mut [u32]) {
+    macro_rules! lengths {
+        ($($n:literal)*) => {
+            match words.len() {
+                $($n => if let Ok(words) = <&mut [u32; $n]>::try_from(&mut *words) {
+                    *words = [0; $n];
+                },)*
+                _ => words.fill(0),
+            }
+        };
+    }
+    const _: () = assert!(Mailbox::ZERO_ALL_UP_TO == 8);
+    lengths!(1 2 3 4 5 6 7 8)
 }
 
 /// An intersection strategy over a scene.

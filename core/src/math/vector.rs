@@ -193,9 +193,12 @@ impl Vec3 {
         // 1/√len2 ≈ g·2^-e, e = 60 or 61 for len2 in [2^58, 2^62):
         // c·2^30/√len2 = c·g / 2^(e − 30), c·g below 2^61.
         let (len, g, e) = super::sqrt_and_rsqrt_estimates_58_62(len2);
-        let cut = (e - 30) as u32;
+        // Rounded at bit e − 30 (30 or 31): shifts by constants, as a
+        // variable 64-bit shift is a library call on a 32-bit core.
+        debug_assert!(e == 60 || e == 61);
+        let round = |x: u64| if e == 60 { (x + (1 << 29)) >> 30 } else { (x + (1 << 30)) >> 31 };
         let d = Dir::from_bits([0, 1, 2].map(|a| {
-            let m = ((mul_u32_wide(scaled[a], g) + (1 << (cut - 1))) >> cut) as i32;
+            let m = round(mul_u32_wide(scaled[a], g)) as i32;
             if negative[a] {
                 -m
             } else {
@@ -227,7 +230,12 @@ fn scaled_magnitudes(v: [i32; 3]) -> Option<([bool; 3], [u32; 3], i32)> {
 #[inline]
 fn unscaled_length(len: u32, shift: i32) -> Scalar {
     let length = if shift >= 0 {
-        ((len as u64) << shift).min(i32::MAX as u64) as u32
+        // `len << shift` saturated, told by a comparison before the shift.
+        if len <= i32::MAX as u32 >> shift {
+            len << shift
+        } else {
+            i32::MAX as u32
+        }
     } else {
         (len + (1 << (-shift - 1))) >> -shift
     };
@@ -640,6 +648,23 @@ mod tests {
             }
         }
         assert!(rejected > 10_000 && unsure > 10_000, "{rejected} {unsure}");
+    }
+
+    #[test]
+    fn unscaled_lengths_are_the_wide_shifts_saturated() {
+        let mut next = crate::test_rng::seeded(0x1e9_5ca1e);
+        for i in 0..200_000 {
+            let len = (next() as u32 >> 1) >> (next() % 8);
+            // `scaled_magnitudes` gives shifts from −29 (a largest magnitude of 1) to 2.
+            let shift = (next() % 32) as i32 - 29;
+            let wide = if shift >= 0 {
+                ((len as u64) << shift).min(i32::MAX as u64)
+            } else {
+                (len as u64 + (1 << (-shift - 1))) >> -shift
+            };
+            let wide = wide.min(i32::MAX as u64) as i32;
+            assert_eq!(unscaled_length(len, shift).to_bits(), wide, "case {i}: {len} {shift}");
+        }
     }
 
     #[test]

@@ -344,6 +344,144 @@ mod tests {
         }
     }
 
+    /// The distance from raw point `c` to the raw segment `p`–`q`, and
+    /// where along it the nearest point is (0 at `p`, 1 at `q`).
+    fn distance_to_segment(p: [i64; 3], q: [i64; 3], c: [i64; 3]) -> (f64, f64) {
+        let d = [0, 1, 2].map(|a| (q[a] - p[a]) as f64);
+        let w = [0, 1, 2].map(|a| (c[a] - p[a]) as f64);
+        let dd: f64 = d.iter().map(|x| x * x).sum();
+        let t = if dd == 0.0 { 0.0 } else { (0..3).map(|a| w[a] * d[a]).sum::<f64>() / dd };
+        let t = t.clamp(0.0, 1.0);
+        let gap: f64 = (0..3).map(|a| (w[a] - t * d[a]).powi(2)).sum();
+        (gap.sqrt(), t)
+    }
+
+    /// A random raw point of the scene's range (2^29 each way).
+    fn point(next: &mut impl FnMut() -> u64) -> [i64; 3] {
+        [0; 3].map(|_| (next() as i64 >> 34) % (1 << 29))
+    }
+
+    /// A random raw segment of the scene's range, and a point of it.
+    fn segment_and_point(next: &mut impl FnMut() -> u64) -> ([i64; 3], [i64; 3], [i64; 3]) {
+        let (p, q) = (point(next), point(next));
+        let t = (next() % 1025) as i64;
+        (p, q, [0, 1, 2].map(|a| p[a] + (q[a] - p[a]) * t / 1024))
+    }
+
+    /// A random unit vector.
+    fn direction(next: &mut impl FnMut() -> u64) -> [f64; 3] {
+        loop {
+            let v = [0; 3].map(|_| (next() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0);
+            let length = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if (0.1..=1.0).contains(&length) {
+                return v.map(|x| x / length);
+            }
+        }
+    }
+
+    /// A random radius: from under a grid cell to a quarter of the range.
+    fn radius(next: &mut impl FnMut() -> u64) -> i64 {
+        let bits = 10 + next() % 18;
+        (next() % (1 << bits)) as i64 + 1
+    }
+
+    #[test]
+    fn a_sphere_just_within_the_widening_of_a_segment_is_near_it() {
+        // The sphere's surface WIDENING less a few raw units from a point
+        // of the segment (the few: that point's own rounding): at the edge
+        // of the widening the nearness test promises, which its margin of
+        // cells only just covers for every rounding of the grid.
+        let mut next = crate::test_rng::seeded(0x5fe7_e0ed);
+        for _ in 0..400_000 {
+            let (p, q, on) = segment_and_point(&mut next);
+            let r = radius(&mut next);
+            let u = direction(&mut next);
+            let reach = (r + i64::from(WIDENING) - 3) as f64;
+            let c = [0, 1, 2].map(|a| on[a] + (u[a] * reach).round() as i64);
+            let (gap, _) = distance_to_segment(p, q, c);
+            assert!(gap <= (r + i64::from(WIDENING)) as f64, "{gap} {r}");
+            let center = c.map(|v| v as i32);
+            assert!(Segment::new(p, q).near_sphere(center, r as i32), "p {p:?} q {q:?} centre {c:?} radius {r}");
+        }
+    }
+
+    #[test]
+    fn a_box_just_within_the_widening_of_a_segment_on_either_side_is_met() {
+        // Each axis's face of the box WIDENING − 1 raw units beyond a point
+        // of the segment, on its low or its high side: rounding must lose
+        // neither (the box's low end is rounded down and widened a cell,
+        // its high end rounded down and widened two).
+        let mut next = crate::test_rng::seeded(0x0b0c_5ede);
+        for _ in 0..400_000 {
+            let (p, q, on) = segment_and_point(&mut next);
+            let gap = i64::from(WIDENING) - 1;
+            let size = (next() % (1 << 20)) as i64;
+            let above = [0; 3].map(|_| next() % 2 == 0);
+            let lo = [0, 1, 2].map(|a| if above[a] { on[a] + gap } else { on[a] - gap - size } as i32);
+            let hi = [0, 1, 2].map(|a| if above[a] { on[a] + gap + size } else { on[a] - gap } as i32);
+            assert!(Segment::new(p, q).meets(lo, hi), "p {p:?} q {q:?} box {lo:?}..{hi:?}");
+        }
+    }
+
+    #[test]
+    fn a_segment_through_a_sphere_is_said_so_only_well_inside_it_with_its_ends_well_outside() {
+        // Segments passing at any depth in the sphere up to just outside
+        // four widenings within its surface, their ends from just inside
+        // four widenings beyond it to a dozen cells further: where
+        // `through_sphere` says "through", the raw segment passes within
+        // four widenings of the surface, and its ends are at least that far
+        // outside. (Its margins keep about two cells more than that
+        // rounding needs, so a margin three cells narrower fails here, one
+        // cell narrower does not.)
+        let mut next = crate::test_rng::seeded(0x7b0_05ed);
+        let (four, cell) = (4 * i64::from(WIDENING), 1i64 << GRID_BITS);
+        let (mut through, mut cases) = (0, 0);
+        for _ in 0..400_000 {
+            let r = 16 * cell + (next() % (1 << 26)) as i64;
+            let c = point(&mut next);
+            // The line's direction, and the way from the centre to its nearest point.
+            let (u, v) = (direction(&mut next), direction(&mut next));
+            let dot: f64 = (0..3).map(|a| u[a] * v[a]).sum();
+            let side = [0, 1, 2].map(|a| v[a] - dot * u[a]);
+            let length = side.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if length < 0.1 {
+                continue;
+            }
+            let side = side.map(|x| x / length);
+            // At the line's edge (the ends far outside), or at an end's (the
+            // line deep inside), within a few cells of it.
+            let near = |next: &mut dyn FnMut() -> u64, below: i64, above: i64| {
+                (next() % ((below + above) * cell) as u64) as i64 - below * cell
+            };
+            let along = |from_centre: i64, pass: f64| ((from_centre as f64).powi(2) - pass * pass).max(0.0).sqrt();
+            let (pass, before, after) = match next() % 2 {
+                0 => {
+                    let pass = (r - four + near(&mut next, 4, 1)) as f64;
+                    let far = r + four + 6 * cell;
+                    (pass, along(far + near(&mut next, 0, 14), pass), along(far + near(&mut next, 0, 14), pass))
+                }
+                _ => {
+                    let pass = (next() % (r as u64 / 2)) as f64;
+                    let edge = r + four + near(&mut next, 1, 5);
+                    (pass, along(edge, pass), along(r + four + 6 * cell + near(&mut next, 0, 14), pass))
+                }
+            };
+            let (before, after) = if next() % 2 == 0 { (before, after) } else { (after, before) };
+            let at = |along: f64| [0, 1, 2].map(|a| c[a] + (side[a] * pass + u[a] * along).round() as i64);
+            let (p, q) = (at(-before), at(after));
+            cases += 1;
+            if !Segment::new(p, q).through_sphere(c.map(|v| v as i32), r as i32) {
+                continue;
+            }
+            through += 1;
+            let (gap, t) = distance_to_segment(p, q, c);
+            let end = |e: [i64; 3]| distance_to_segment(e, e, c).0;
+            assert!(gap <= (r - four) as f64 && t > 0.0 && t < 1.0, "line: p {p:?} q {q:?} c {c:?} r {r}: {gap}");
+            assert!(end(p) >= (r + four) as f64 && end(q) >= (r + four) as f64, "ends: p {p:?} q {q:?} c {c:?} r {r}");
+        }
+        assert!(through > cases / 50, "{through} of {cases} said through: the cases reach its edges");
+    }
+
     #[test]
     fn the_extremes_fit_the_products() {
         // A miss's far end beyond the range and a box at the other side.

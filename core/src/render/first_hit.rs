@@ -11,7 +11,7 @@
 //! objects whose window meets the band are kept, still in that order, and
 //! of those, for each tile of the band, the ones whose window meets the
 //! tile (both lists as 16-bit positions in the sorted bounds: 2 bytes an
-//! entry, not a bound's 24, which is what lets a 16 KiB board keep them). A camera ray then tests its tile's objects whose window holds its
+//! entry, not a bound's 16, which is what lets a 16 KiB board keep them). A camera ray then tests its tile's objects whose window holds its
 //! offsets, in order, until the next one's bound is beyond the nearest hit
 //! so far.
 //!
@@ -56,12 +56,14 @@ const MAX_OBJECTS: usize = 1 << 16;
 pub struct ScreenBound {
     /// No camera ray hits the object at a smaller parameter (Q16.16 bits).
     near: i32,
-    object: u32,
     /// The camera offsets (half sub-cells from the image centre) of the
-    /// rays that can meet the object: `kx` in `x[0]..=x[1]`, `ky` in
-    /// `y[0]..=y[1]`.
-    x: [i32; 2],
-    y: [i32; 2],
+    /// rays that can meet the object, as [`narrow`] gives them: `narrow(kx)`
+    /// in `x[0]..=x[1]`, `narrow(ky)` in `y[0]..=y[1]`. 16 bytes a bound,
+    /// not 24, are what let a 16 KiB board keep the lists.
+    x: [u16; 2],
+    y: [u16; 2],
+    /// The object's index (below [`MAX_OBJECTS`]).
+    object: u16,
 }
 
 impl ScreenBound {
@@ -87,7 +89,7 @@ impl ScreenBound {
     }
 
     #[inline(never)]
-    fn of(scene: &SceneView<'_>, projection: &Projection, id: ObjectId) -> ScreenBound {
+    fn of(scene: &SceneView<'_>, projection: &Projection, shift: u32, id: ObjectId) -> ScreenBound {
         let bounds = scene.shape(id).bounds();
         let lo = bounds.min.wide().map(|v| v - FILING_MARGIN);
         let hi = bounds.max.wide().map(|v| v + FILING_MARGIN);
@@ -109,8 +111,37 @@ impl ScreenBound {
         // rounding of the point: a few units below the distance.
         let near = (distance - (distance >> 28) - 8).clamp(0, i32::MAX as i64) as i32;
         let [x, y] = projection.window(lo, hi).unwrap_or([[i32::MIN, i32::MAX]; 2]);
-        ScreenBound { near, object: id.0, x, y }
+        let narrow = |[low, high]: [i32; 2]| [low, high].map(|k| narrow(k, shift));
+        // Below MAX_OBJECTS: the cast is exact.
+        ScreenBound { near, object: id.0 as u16, x: narrow(x), y: narrow(y) }
     }
+}
+
+// What a board's RAM pays an object for the lists.
+const _: () = assert!(core::mem::size_of::<ScreenBound>() == 16);
+
+/// A camera offset in 16 bits: shifted right by the lists' [`window_shift`]
+/// (so exactly itself below 2^15 half sub-cells: an image up to 16,383
+/// samples wide), biased by 2^15 and clamped. The floor and the clamp are
+/// monotonic, so a window narrowed so holds every ray offset it held, and
+/// one that met a band or a tile still meets it; unsigned, a board reads
+/// it with one instruction.
+#[inline(always)]
+fn narrow(k: i32, shift: u32) -> u16 {
+    (k >> shift).saturating_add(0x8000).clamp(0, 0xffff) as u16
+}
+
+/// The shift that brings every offset of `camera`'s rays (below `2 · n ·
+/// side` half sub-cells in magnitude, `n` samples a side) within 16 bits:
+/// 0 for any image up to 16,383 samples a side.
+fn window_shift(camera: &Camera) -> u32 {
+    let n = camera.samples();
+    let reach = 2 * n * camera.width().max(camera.height());
+    let mut shift = 0;
+    while reach >> shift >= 0x8000 {
+        shift += 1;
+    }
+    shift
 }
 
 /// Keeps the positions of `from` whose bounds in `all` `keep` admits, in
@@ -144,6 +175,9 @@ pub(crate) struct FirstHits<'a> {
     /// its objects (`None`: too many).
     tile_start: u32,
     tile: Option<usize>,
+    /// The bounds' windows are the camera's offsets shifted right by this
+    /// ([`window_shift`]).
+    shift: u32,
 }
 
 impl<'a> FirstHits<'a> {
@@ -165,23 +199,37 @@ impl<'a> FirstHits<'a> {
     /// a ray does); false if it said stop.
     pub fn project<Q: Poll>(scene: &SceneView<'_>, camera: &Camera, bounds: &mut [ScreenBound], poll: &mut Q) -> bool {
         let projection = Projection::new(camera);
+        let shift = window_shift(camera);
         for (slot, id) in bounds.iter_mut().zip(scene.object_ids()) {
             if !poll.go_on() {
                 return false;
             }
-            *slot = ScreenBound::of(scene, &projection, id);
+            *slot = ScreenBound::of(scene, &projection, shift, id);
         }
         true
     }
 
     /// The lists over the first `objects` of `bounds`, as
-    /// [`FirstHits::project`] left them, sorted here; `None` where they do
-    /// not [fit](FirstHits::fit).
-    pub fn new(objects: usize, bounds: &'a mut [ScreenBound], positions: &'a mut [u16]) -> Option<Self> {
+    /// [`FirstHits::project`] left them for `camera`, sorted here; `None`
+    /// where they do not [fit](FirstHits::fit).
+    pub fn new(
+        objects: usize,
+        camera: &Camera,
+        bounds: &'a mut [ScreenBound],
+        positions: &'a mut [u16],
+    ) -> Option<Self> {
         let all = bounds.get_mut(..objects)?;
         let positions = positions.get_mut(..ScreenBound::positions_for(objects))?;
         crate::sort::sort_by_key(all, |b| (b.near, b.object));
-        Some(FirstHits { all, positions, band_start: u32::MAX, band: None, tile_start: u32::MAX, tile: None })
+        Some(FirstHits {
+            all,
+            positions,
+            band_start: u32::MAX,
+            band: None,
+            tile_start: u32::MAX,
+            tile: None,
+            shift: window_shift(camera),
+        })
     }
 
     /// The nearest hit of `camera`'s ray through sub-cell (`sx`, `sy`) of
@@ -197,8 +245,12 @@ impl<'a> FirstHits<'a> {
         [x, y, sx, sy]: [u32; 4],
     ) -> Option<Option<Hit>> {
         let all = self.all;
+        let (kx, ky) = camera.offsets(x, y, sx, sy);
+        let shift = self.shift;
         let tile = self.tile(camera, x, y)?;
-        Some(nearest(scene, kinds, all, tile, camera, ray, camera.offsets(x, y, sx, sy)))
+        // A ray's offsets need no clamp ([`window_shift`]): `narrow`'s value.
+        let ray_offset = |k: i32| ((k >> shift) + 0x8000) as u16;
+        Some(nearest(scene, kinds, all, tile, camera, ray, (ray_offset(kx), ray_offset(ky))))
     }
 
     /// The positions in the bounds of the objects that camera rays of
@@ -214,9 +266,10 @@ impl<'a> FirstHits<'a> {
             self.band_start = band_start;
             self.tile_start = u32::MAX;
             // The band's offsets: from its last row's last sub-cells up to
-            // its first row's first.
-            let low = camera.offsets(0, band_start.saturating_add(BAND_ROWS - 1), 0, last).1;
-            let high = camera.offsets(0, band_start, 0, 0).1;
+            // its first row's first (shifted as the windows are: a window
+            // that meets the band still does).
+            let low = narrow(camera.offsets(0, band_start.saturating_add(BAND_ROWS - 1), 0, last).1, self.shift);
+            let high = narrow(camera.offsets(0, band_start, 0, 0).1, self.shift);
             // Positions below MAX_OBJECTS: the casts are exact.
             self.band = filter(all, (0..all.len()).map(|p| p as u16), band, |b| b.y[0] <= high && b.y[1] >= low);
         }
@@ -224,17 +277,17 @@ impl<'a> FirstHits<'a> {
             self.tile_start = tile_start;
             // The tile's offsets: from its first column's first sub-cells
             // to its last column's last.
-            let low = camera.offsets(tile_start, 0, 0, 0).0;
-            let high = camera.offsets(tile_start.saturating_add(TILE_COLUMNS - 1), 0, last, 0).0;
+            let low = narrow(camera.offsets(tile_start, 0, 0, 0).0, self.shift);
+            let high = narrow(camera.offsets(tile_start.saturating_add(TILE_COLUMNS - 1), 0, last, 0).0, self.shift);
             self.tile = filter(all, band[..self.band?].iter().copied(), tile, |b| b.x[0] <= high && b.x[1] >= low);
         }
         Some(&tile[..self.tile?])
     }
 }
 
-/// The nearest hit of the camera ray with offsets `(kx, ky)` among the
-/// objects at `tile`'s positions in `all`. The ray is made only when a
-/// window holds the offsets.
+/// The nearest hit of the camera ray with offsets `(kx, ky)` ([`narrow`]ed
+/// as the windows are) among the objects at `tile`'s positions in `all`. The
+/// ray is made only when a window holds the offsets.
 #[inline]
 fn nearest(
     scene: &SceneView<'_>,
@@ -243,7 +296,7 @@ fn nearest(
     tile: &[u16],
     camera: &Camera,
     ray: &mut CameraRay,
-    (kx, ky): (i32, i32),
+    (kx, ky): (u16, u16),
 ) -> Option<Hit> {
     let mut best = Hit::NONE;
     for bound in tile.iter().filter_map(|&p| all.get(p as usize)) {
@@ -256,7 +309,7 @@ fn nearest(
         if let Some(t) =
             scene.intersect_handle(kinds, scene.objects[bound.object as usize], ray.get(camera), best.t, Leaving::No)
         {
-            let hit = Hit { t, object: ObjectId(bound.object) };
+            let hit = Hit { t, object: ObjectId(bound.object as u32) };
             if hit.beats(&best) {
                 best = hit;
             }
@@ -365,7 +418,9 @@ mod tests {
                 continue;
             }
             assert!(FirstHits::project(&view, &camera, &mut bounds, &mut crate::shade::Unpolled));
-            let Some(mut hits) = FirstHits::new(view.object_count(), &mut bounds, &mut positions) else { continue };
+            let Some(mut hits) = FirstHits::new(view.object_count(), &camera, &mut bounds, &mut positions) else {
+                continue;
+            };
             let n = camera.samples();
             for y in 0..h {
                 for x in 0..w {
@@ -385,6 +440,43 @@ mod tests {
         }
         std::println!("{rays} rays; tiles left out {skipped} of {naive_tests} objects");
         assert!(rays > 100_000 && skipped * 3 > naive_tests, "the lists must leave objects out");
+    }
+
+    /// Every camera offset fits 16 bits once shifted, and a window narrowed
+    /// to 16 bits still holds every offset the full one held, for images
+    /// of every size up to the largest.
+    #[test]
+    fn narrowed_windows_keep_every_ray_they_held() {
+        let mut next = crate::test_rng::seeded(0x16_b175);
+        // A window no projection bounds (any ray may meet the box) holds
+        // every offset at every shift.
+        for shift in 0..6 {
+            assert_eq!([i32::MIN, i32::MAX].map(|k| narrow(k, shift)), [0, 0xffff]);
+        }
+        for _ in 0..2_000 {
+            let side = |r: u64| ((1 + (r % crate::scene::MAX_SIDE as u64) as u32) >> (r >> 60)).max(1);
+            let (w, h, n) = (side(next()), side(next()), 1 + (next() % 16) as u32);
+            let view = crate::scene::View::default();
+            let camera = Camera::new(&view, &crate::scene::Normalization::IDENTITY, w, h, n).unwrap();
+            let shift = window_shift(&camera);
+            let corners = [(0, 0, 0, 0), (w - 1, h - 1, n - 1, n - 1), (w - 1, 0, n - 1, 0), (0, h - 1, 0, n - 1)];
+            for (x, y, sx, sy) in corners {
+                let (kx, ky) = camera.offsets(x, y, sx, sy);
+                for k in [kx, ky] {
+                    assert!((k >> shift).unsigned_abs() < 0x8000, "{w}x{h}x{n}: {k} >> {shift}");
+                    assert_eq!(narrow(k, shift) as i32 - 0x8000, k >> shift);
+                }
+            }
+            for _ in 0..20 {
+                let a = (next() as i32) >> (next() % 32);
+                let b = a.saturating_add((next() as i32 >> (next() % 32)).unsigned_abs() as i32);
+                let narrowed = [a, b].map(|k| narrow(k, shift));
+                let (kx, _) = camera.offsets((next() % w as u64) as u32, 0, (next() % n as u64) as u32, 0);
+                if (a..=b).contains(&kx) {
+                    assert!((narrowed[0]..=narrowed[1]).contains(&narrow(kx, shift)), "[{a}, {b}] {kx} {shift}");
+                }
+            }
+        }
     }
 
     /// Windows hold the offsets of every point of their box ahead of the

@@ -212,8 +212,8 @@ impl<'a, A: Accelerator> Renderer<'a, A> {
             return false;
         }
         if let ScreenLists::Room(bounds, positions) = core::mem::replace(&mut self.first_hits, ScreenLists::None) {
-            self.first_hits =
-                FirstHits::new(scene.object_count(), bounds, positions).map_or(ScreenLists::None, ScreenLists::Lists);
+            self.first_hits = FirstHits::new(scene.object_count(), &self.camera, bounds, positions)
+                .map_or(ScreenLists::None, ScreenLists::Lists);
         }
         true
     }

@@ -33,7 +33,7 @@ pub use superquadric::Superquadric;
 pub use triangle::Triangle;
 
 use crate::capacity::{CapacityKind, Counts};
-use crate::math::{Dir, Scalar, Vec3};
+use crate::math::{part_wise_or, Dir, Scalar, Vec3};
 
 /// A ray `origin + t·dir`, `t > 0`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,6 +79,15 @@ pub struct Aabb {
 }
 
 impl Aabb {
+    /// The smallest box holding two points.
+    #[inline]
+    pub(crate) fn spanned(a: Vec3, b: Vec3) -> Aabb {
+        Aabb {
+            min: Vec3 { x: a.x.min(b.x), y: a.y.min(b.y), z: a.z.min(b.z) },
+            max: Vec3 { x: a.x.max(b.x), y: a.y.max(b.y), z: a.z.max(b.z) },
+        }
+    }
+
     /// The smallest box holding both.
     pub fn union(self, o: Aabb) -> Aabb {
         Aabb {
@@ -329,9 +338,12 @@ pub(crate) struct Ratio {
 
 impl Ratio {
     /// `self < o`; numerators within ±2^32 and denominators within 2^30.
+    /// On ARMv6-M from 32-bit products of the operands' top bits when they
+    /// decide ([`coarse_ratio_lt`]): the exact products are two library
+    /// calls there.
     #[inline]
     pub fn lt(self, o: Ratio) -> bool {
-        self.num * o.den < o.num * self.den
+        part_wise_or(|| coarse_ratio_lt(self, o), || self.num * o.den < o.num * self.den)
     }
 
     /// The ratio of a Q16.16 numerator to a Q2.30 denominator, as Q16.16.
@@ -347,6 +359,35 @@ impl Ratio {
     #[inline]
     pub fn le_scalar(self, t: Scalar) -> bool {
         (self.num << 30) < (t.to_bits() as i64 + 1) * self.den
+    }
+}
+
+/// Whether `x < y` (`x.num·y.den < y.num·x.den`) when 32-bit products of
+/// their top bits decide it, else `None` (and for a numerator beyond ±2^33
+/// or a denominator beyond 2^31, outside what the bounds below cover).
+///
+/// Why: with `num = h·2^18 + l` (`|h| ≤ 2^15`, `0 ≤ l < 2^18`) and
+/// `den = k·2^16 + m` (`k < 2^15`, `0 ≤ m < 2^16`), `num·den` is within
+/// `2^15·2^16·2^18 + 2^18·2^15·2^16 + 2^18·2^16 < (2^16 + 1)·2^34` of
+/// `h·k·2^34`, so the difference of the two products is within
+/// `(2^17 + 2)·2^34` of `H·2^34`, `H` the short products' difference (below
+/// 2^31 in magnitude): `H ≤ −(2^17 + 2)` makes it negative, `H ≥ 2^17 + 2`
+/// positive.
+#[inline(always)]
+fn coarse_ratio_lt(x: Ratio, y: Ratio) -> Option<bool> {
+    const SURE: i32 = (1 << 17) + 2;
+    let fits = |r: Ratio| (r.num >> 33 == 0 || r.num >> 33 == -1) && r.den >> 31 == 0;
+    if !fits(x) || !fits(y) {
+        return None;
+    }
+    let short = |n: i64, d: i64| ((n >> 18) as i32) * ((d >> 16) as i32);
+    let h = short(x.num, y.den) - short(y.num, x.den);
+    if h <= -SURE {
+        Some(true)
+    } else if h >= SURE {
+        Some(false)
+    } else {
+        None
     }
 }
 
@@ -373,5 +414,41 @@ pub(crate) mod test_util {
     /// `|a − b|` below `tol` raw units on every axis.
     pub fn close(a: Vec3, b: Vec3, tol: i32) -> bool {
         a.bits().iter().zip(b.bits()).all(|(x, y)| (x - y).abs() <= tol)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The short products decide only as the exact cross products do, for
+    /// numerators of every scale up to ±2^33 and denominators up to 2^31,
+    /// and decide most comparisons of well-separated ratios.
+    #[test]
+    fn coarse_ratio_comparisons_agree_with_the_exact_ones() {
+        let mut next = crate::test_rng::seeded(0x5a7_10c0);
+        let (mut decided, mut undecided) = (0, 0);
+        for i in 0..1_000_000 {
+            let mut ratio = || {
+                let r = next();
+                let num = match r % 7 {
+                    0 => [0, 1, -1, (1 << 33) - 1, -(1 << 33), 1 << 32][(r >> 3) as usize % 6],
+                    // Mostly the scene's distances (the coarse test's case).
+                    _ => (r as i64 >> 30) >> [0, 1, 2, 3, 4, 8, 16, 30][(r >> 61) as usize],
+                };
+                let den = ((r >> 34) as i64 & 0x7fff_ffff) >> [0, 0, 1, 2, 3, 6, 12, 24][((r >> 20) % 8) as usize];
+                Ratio { num, den: den.max(1) }
+            };
+            let (x, y) = (ratio(), ratio());
+            match coarse_ratio_lt(x, y) {
+                Some(lt) => {
+                    let exact = (x.num as i128 * y.den as i128) < (y.num as i128 * x.den as i128);
+                    assert_eq!(lt, exact, "case {i}: {x:?} {y:?}");
+                    decided += 1;
+                }
+                None => undecided += 1,
+            }
+        }
+        assert!(decided > 500_000 && undecided > 10_000, "{decided} {undecided}");
     }
 }

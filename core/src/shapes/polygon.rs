@@ -53,7 +53,14 @@ impl<const N: usize> Polygon<N> {
                 let (a, b) = (corners[i].bits(), corners[(i + 1) % N].bits());
                 (0..3).filter(|&k| a[k] != b[k]).count() <= 1
             })
-            && normal.axis(drop_axis as usize).to_bits().unsigned_abs() == 1 << 30;
+            && normal.axis(drop_axis as usize).to_bits().unsigned_abs() == 1 << 30
+            // Its other two corners within the box of the first and the
+            // third (which a rectangle along the axes has: the intersection
+            // test takes that box for the bounds).
+            && [1, 3].into_iter().all(|i| {
+                let (a, b, c) = (corners[0].bits(), corners[2 % N].bits(), corners[i % N].bits());
+                (0..3).all(|k| a[k].min(b[k]) <= c[k] && c[k] <= a[k].max(b[k]))
+            });
         Some(Polygon { corners, normal, offset: corners[0].dot_dir(normal), drop_axis, along_axes })
     }
 
@@ -108,7 +115,9 @@ impl<const N: usize> Polygon<N> {
         let o = ray.origin.wide();
         let d = ray.dir.bits();
         let p = [0, 1, 2].map(|a| o[a] + (mul_wide(d[a], t as i32) >> 30));
-        let b = self.bounds();
+        // Along the axes, the first and third corners span the bounds (see
+        // `with_normal`): two corners' box instead of the fold over four.
+        let b = if along_axes { Aabb::spanned(self.corners[0], self.corners[2 % N]) } else { self.bounds() };
         let (lo, hi) = (b.min.wide(), b.max.wide());
         let slack = EDGE_TOLERANCE;
         if (0..3).any(|a| p[a] < lo[a] - slack || p[a] > hi[a] + slack) {
@@ -132,11 +141,21 @@ impl<const N: usize> Polygon<N> {
             let cur = self.project(*corner);
             // Points within ±2^29 units, so differences fit an i32.
             let (du, dv) = (cur.0 - prev.0, cur.1 - prev.1);
-            let edge = mul_wide(du, v - prev.1) - mul_wide(dv, u - prev.0);
-            let tolerance = (du.unsigned_abs().max(dv.unsigned_abs()) as i64) << EDGE_TOLERANCE_LOG2;
+            let (across, along) = (v - prev.1, u - prev.0);
             // `−edge < −tolerance` when flipped, without the negation (which
             // the compiler once made a 64-bit multiply by ±1).
-            let outside = if flip { edge > tolerance } else { edge < -tolerance };
+            let outside = match coarse_edge_outside(du, across, dv, along, flip) {
+                Some(outside) => outside,
+                None => {
+                    let edge = mul_wide(du, across) - mul_wide(dv, along);
+                    let tolerance = (du.unsigned_abs().max(dv.unsigned_abs()) as i64) << EDGE_TOLERANCE_LOG2;
+                    if flip {
+                        edge > tolerance
+                    } else {
+                        edge < -tolerance
+                    }
+                }
+            };
             if outside {
                 return false;
             }
@@ -170,6 +189,33 @@ impl<const N: usize> Polygon<N> {
     pub fn bounds(&self) -> Aabb {
         let first = Aabb { min: self.corners[0], max: self.corners[0] };
         self.corners.iter().fold(first, |b, &c| b.union(Aabb { min: c, max: c }))
+    }
+}
+
+/// Whether a point is outside an edge (`edge = du·across − dv·along`
+/// beyond the edge's tolerance, on the side `flip` says) when 32-bit
+/// products of the operands' top bits decide it, else `None`: most points
+/// are far from every edge, and a Cortex-M0 makes each exact product in
+/// parts.
+///
+/// Why: each operand is a difference of points within ±2^29, so within
+/// ±2^30; with `x = h·2^16 + l` (`|h| ≤ 2^14`, `0 ≤ l < 2^16`) a product
+/// `x·y` is within `2^14·2^16·2^16·2 + 2^32 < 2^48` of `h_x·h_y·2^32`, and
+/// the edge within 2^49 of `H·2^32` (`H` the short products' difference,
+/// below 2^29 in magnitude). The tolerance is at most 2^30 << 2 = 2^32. So
+/// `H ≥ 2^17` makes `edge ≥ 0` (inside on the unflipped side), `H ≤
+/// −2^17 − 2` makes `edge < −2^32` (outside); the flipped side mirrors it.
+#[inline(always)]
+fn coarse_edge_outside(du: i32, across: i32, dv: i32, along: i32, flip: bool) -> Option<bool> {
+    const SURE: i32 = 1 << 17;
+    let h = (du >> 16) * (across >> 16) - (dv >> 16) * (along >> 16);
+    let h = if flip { -h } else { h };
+    if h >= SURE {
+        Some(false)
+    } else if h <= -SURE - 2 {
+        Some(true)
+    } else {
+        None
     }
 }
 
@@ -214,6 +260,7 @@ mod tests {
             let normal = [d1[1] * d2[2] - d1[2] * d2[1], d1[2] * d2[0] - d1[0] * d2[2], d1[0] * d2[1] - d1[1] * d2[0]];
             let fast = Polygon::with_normal(corners, normal).unwrap();
             assert!(fast.along_axes);
+            assert_eq!(Aabb::spanned(fast.corners[0], fast.corners[2]), fast.bounds());
             along += 1;
             let general = Polygon { along_axes: false, ..fast };
             let target = [0, 1, 2].map(|k| match k {
@@ -239,5 +286,38 @@ mod tests {
         let tilted =
             [[0, 0, 0], [1 << 16, 0, 0], [1 << 16, 1 << 16, 1 << 16], [0, 1 << 16, 1 << 16]].map(Vec3::from_bits);
         assert!(!Polygon::with_normal(tilted, [0, -1, 1]).unwrap().along_axes);
+    }
+
+    /// The short products' decision agrees with the exact edge test for
+    /// differences of points within ±2^29, on either side, and leaves few
+    /// points to the exact test.
+    #[test]
+    fn the_coarse_edge_test_decides_as_the_exact_one() {
+        let mut next = crate::test_rng::seeded(0xed9e_c0a5);
+        let (mut decided, mut undecided) = (0, 0);
+        for i in 0..500_000 {
+            let mut point = || -> [i32; 2] {
+                let r = next();
+                // Mostly large polygons (the coarse test's case), some small.
+                let cut = [0, 0, 1, 2, 3, 6, 12, 20][(r >> 61) as usize];
+                [((r as i32) >> 2) >> cut, ((r >> 32) as i32 >> 2) >> cut]
+            };
+            let (a, b, p) = (point(), point(), point());
+            let (du, dv) = (b[0] - a[0], b[1] - a[1]);
+            let (across, along) = (p[1] - a[1], p[0] - a[0]);
+            let edge = du as i64 * across as i64 - dv as i64 * along as i64;
+            let tolerance = (du.unsigned_abs().max(dv.unsigned_abs()) as i64) << EDGE_TOLERANCE_LOG2;
+            for flip in [false, true] {
+                let exact = if flip { edge > tolerance } else { edge < -tolerance };
+                match coarse_edge_outside(du, across, dv, along, flip) {
+                    Some(outside) => {
+                        assert_eq!(outside, exact, "case {i}: {a:?} {b:?} {p:?} flip {flip}");
+                        decided += 1;
+                    }
+                    None => undecided += 1,
+                }
+            }
+        }
+        assert!(decided > 500_000 && undecided > 1_000, "{decided} {undecided}");
     }
 }

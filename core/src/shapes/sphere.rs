@@ -33,8 +33,11 @@ impl Sphere {
         Sphere { center, radius, surface }
     }
 
-    /// The exact test, given `oc = origin − center`.
-    #[inline]
+    /// The exact test, given `oc = origin − center`. Not inlined: most
+    /// tests end in [`surely_missed`], and the exact one's frame (a
+    /// Cortex-M0 spills its 64-bit products) then costs only the rays that
+    /// come near.
+    #[inline(never)]
     fn intersect_exactly(&self, oc: Vec3, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
         let b = oc.dot_dir(ray.dir); // the centre lies at parameter −b
         let r = self.radius.to_bits() as i64;
@@ -65,13 +68,16 @@ impl Sphere {
 impl Shape for Sphere {
     const FLAT: bool = false;
 
-    #[inline]
+    // Not inlined: in the object loops' frames its registers would spill
+    // (measured on a Cortex-M0); its own frame is small, the exact test's
+    // kept apart.
+    #[inline(never)]
     fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
         if leaving == Leaving::Outward {
             return None;
         }
         let oc = ray.origin - self.center;
-        if surely_missed(oc.bits(), ray.dir.bits(), t_max.to_bits() as i64, self.radius.to_bits() as i64) {
+        if surely_missed(oc.bits(), ray.dir.bits(), t_max.to_bits(), self.radius.to_bits()) {
             return None;
         }
         self.intersect_exactly(oc, ray, t_max, leaving)
@@ -96,28 +102,54 @@ impl Shape for Sphere {
 /// (centre's parameter out of reach, closest approach off by more than the
 /// radius on one axis), from 32-bit products of the operands' top bits with
 /// their error bounds added. Most rays pass wide of a sphere: on a Cortex-M0,
-/// which lacks a 32×32→64 multiply, this costs a third of the exact path to
-/// the same answer; a near ray goes on to the exact test.
+/// which lacks a 32×32→64 multiply, this costs a fraction of the exact path
+/// to the same answer; a near ray goes on to the exact test.
 ///
 /// The bounds hold for the normalised space's points (|oc_i| ≤ 2^30) and
 /// unit directions (|dir_i| ≤ 2^30 + 2^15), whatever `t_max` and the radius.
+/// Every step is a 32-bit one (the estimate of `b` is `4s`, and each
+/// comparison of it is divided by four exactly), with the answer of the
+/// same comparisons made in 64 bits for any inputs.
 #[inline(always)]
-fn surely_missed(oc: [i32; 3], dir: [i32; 3], t_max: i64, radius: i64) -> bool {
+fn surely_missed(oc: [i32; 3], dir: [i32; 3], t_max: i32, radius: i32) -> bool {
     // oc_i·dir_i = (oc_i >> 17)(dir_i >> 15)·2^32 + what the low bits add;
-    // each short product is below 2^28 in magnitude, their sum below 2^30.
+    // each short product is below 2^28 in magnitude, their sum `s` below
+    // 2^30, and `b` within DOT_ERROR of `4s` (Q16.16).
     let short = |a: usize| (oc[a] >> 17).wrapping_mul(dir[a] >> 15);
-    let estimate = 4 * short(0).wrapping_add(short(1)).wrapping_add(short(2)) as i64;
-    // The centre lies at parameter −b, within DOT_ERROR of −estimate.
-    if -estimate - DOT_ERROR - radius > t_max || -estimate + DOT_ERROR + radius <= 0 {
+    let s = short(0).wrapping_add(short(1)).wrapping_add(short(2));
+    // The centre lies at parameter −b: out of reach when −4s − DOT_ERROR −
+    // radius > t_max, that is −s > ⌊(t_max + DOT_ERROR + radius)/4⌋; behind
+    // when −4s + DOT_ERROR + radius ≤ 0, that is s ≥ ⌈(DOT_ERROR + radius)/4⌉
+    // (DOT_ERROR a multiple of four; the floors of the sums from their
+    // parts' floors and remainders, in 32 bits).
+    let quarter = DOT_ERROR as i32 >> 2;
+    let beyond = (t_max >> 2) + (radius >> 2) + quarter + (((t_max & 3) + (radius & 3)) >> 2);
+    let behind = (radius >> 2) + quarter + (((radius & 3) + 3) >> 2);
+    if s < -beyond || s >= behind {
         return true;
     }
-    // Here |estimate| < 2^32 + 2^20, so `b_high` is within ±(2^16 + 17),
-    // (dir_i >> 16)·b_high within ±(2^30 + 2^18) and q_i's quarter
-    // estimate below 2^31: 32-bit steps. q_i = 4·quarter + (oc_i & 3) ± OFFSET_ERROR.
-    let b_high = (estimate >> 16) as i32;
-    let reach = ((radius + OFFSET_ERROR + 3) >> 2) as u32;
-    let off = |a: usize| ((oc[a] >> 2).wrapping_sub((dir[a] >> 16).wrapping_mul(b_high))).unsigned_abs() > reach;
-    off(0) || off(1) || off(2)
+    // Here |4s| < 2^32 + 2^20, so `b_high` (= ⌊4s / 2^16⌋) is within
+    // ±(2^16 + 17), (dir_i >> 16)·b_high within ±(2^30 + 2^18) and q_i's
+    // quarter estimate below 2^31: 32-bit steps. q_i = 4·quarter + (oc_i & 3)
+    // ± OFFSET_ERROR; `reach` is ⌊(radius + OFFSET_ERROR + 3)/4⌋.
+    let b_high = s >> 14;
+    let reach = ((radius >> 2) + (((radius & 3) + OFFSET_ERROR as i32 + 3) >> 2)) as u32;
+    let quarter = [0, 1, 2].map(|a| ((oc[a] >> 2).wrapping_sub((dir[a] >> 16).wrapping_mul(b_high))).unsigned_abs());
+    if quarter.iter().any(|&q| q > reach) {
+        return true;
+    }
+    // Within the radius on every axis, but maybe not within the sphere:
+    // |q_i| ≥ 4·|quarter_i| − 3 − OFFSET_ERROR ≥ 4·v_i, v_i = |quarter_i| −
+    // 2^18 − 1 (when positive), so |q|² ≥ 2^32·Σ c_i² with c_i = ⌊v_i/2^14⌋;
+    // that is above r² once Σ c_i² ≥ (⌊r/2^16⌋ + 1)², and the exact test's
+    // r² − |q|² is then negative (its sums exact for a radius below 2^30).
+    // Each c_i is below 2^15 here (v_i ≤ reach), the sums fit a u32.
+    if !(0..1 << 30).contains(&radius) {
+        return false;
+    }
+    let c = quarter.map(|q| q.saturating_sub((OFFSET_ERROR as u32 >> 2) + 1) >> 14);
+    let r = (radius >> 16) as u32 + 1;
+    c[0] * c[0] + c[1] * c[1] + c[2] * c[2] >= r * r
 }
 
 #[cfg(test)]
@@ -221,11 +253,56 @@ mod tests {
             let exact = sphere.intersect_exactly(origin - center, &ray, t_max, leaving);
             assert_eq!(sphere.intersect(&ray, t_max, leaving), exact, "case {i}: {sphere:?} {ray:?} {t_max:?}");
             hits += exact.is_some() as u32;
-            near +=
-                (!surely_missed((origin - center).bits(), dir.bits(), t_max.to_bits() as i64, radius.to_bits() as i64))
-                    as u32;
+            near += (!surely_missed((origin - center).bits(), dir.bits(), t_max.to_bits(), radius.to_bits())) as u32;
         }
         // The cases must include hits and near misses, or the test proves nothing.
         assert!(hits > 20_000 && near > hits, "{hits} hits, {near} near");
+    }
+
+    /// The pre-test in 64-bit steps, as it was first written (with the
+    /// squared closest approach since): the 32-bit one must answer as it
+    /// does for any inputs.
+    fn surely_missed_in_64_bits(oc: [i32; 3], dir: [i32; 3], t_max: i64, radius: i64) -> bool {
+        let short = |a: usize| (oc[a] >> 17).wrapping_mul(dir[a] >> 15);
+        let estimate = 4 * short(0).wrapping_add(short(1)).wrapping_add(short(2)) as i64;
+        if -estimate - DOT_ERROR - radius > t_max || -estimate + DOT_ERROR + radius <= 0 {
+            return true;
+        }
+        let b_high = (estimate >> 16) as i32;
+        let reach = ((radius + OFFSET_ERROR + 3) >> 2) as u32;
+        let quarter =
+            [0, 1, 2].map(|a| ((oc[a] >> 2).wrapping_sub((dir[a] >> 16).wrapping_mul(b_high))).unsigned_abs() as i64);
+        if quarter.iter().any(|&q| q > reach as i64) {
+            return true;
+        }
+        if !(0..1 << 30).contains(&radius) {
+            return false;
+        }
+        let c = quarter.map(|q| (q - (OFFSET_ERROR >> 2) - 1).max(0) >> 14);
+        c.iter().map(|c| c * c).sum::<i64>() >= ((radius >> 16) + 1).pow(2)
+    }
+
+    #[test]
+    fn the_pre_test_in_32_bits_answers_as_in_64() {
+        let mut next = crate::test_rng::seeded(0x32_64_5f);
+        let edges = [0, 1, 2, 3, -1, -4, i32::MAX, i32::MIN, i32::MAX - 3, 1 << 30, -(1 << 30), 1 << 29];
+        let word = |next: &mut dyn FnMut() -> u64| match next() % 5 {
+            0 => edges[(next() % edges.len() as u64) as usize],
+            _ => (next() as i32) >> (next() % 32),
+        };
+        let (mut missed, mut kept) = (0, 0);
+        for i in 0..1_000_000 {
+            let oc = [0; 3].map(|_| word(&mut next));
+            let dir = [0; 3].map(|_| word(&mut next));
+            let (t_max, radius) = (word(&mut next), word(&mut next));
+            let wide = surely_missed_in_64_bits(oc, dir, t_max as i64, radius as i64);
+            assert_eq!(surely_missed(oc, dir, t_max, radius), wide, "case {i}: {oc:?} {dir:?} {t_max} {radius}");
+            if wide {
+                missed += 1;
+            } else {
+                kept += 1;
+            }
+        }
+        assert!(missed > 100_000 && kept > 10_000, "{missed} {kept}");
     }
 }

@@ -3,97 +3,50 @@
 //! scene and the answer, each frame checked against what the board said
 //! before.
 //!
-//! Invariants: the whole conversation, writes included, ends by the link's
-//! deadline (its timeout after it opened), however the board trickles or
-//! floods; a frame answering another request (an earlier run's, another
-//! host's) is skipped by its tag; the board's panel is within the
-//! protocol's limits and every drawing is at that panel, so nothing is set
-//! aside for a picture the board only claims; every row arrives exactly
-//! once, in the panel's format and width, before the board says it is
-//! done; the board's errors are at most as many as the scene can have,
-//! each of a bounded length; the board's text (names, messages) reaches
-//! the caller with its control characters escaped.
+//! Invariants: the conversation, writes included, goes on while the board
+//! moves it on and ends once the board stops doing so for the allowance
+//! (`patience.rs`), or at the cap (`--timeout`) if one is set, however the
+//! board trickles or floods; before the board answers this link's hello,
+//! a frame answering another request (an earlier run's, another host's) is
+//! skipped by its tag, a bounded number of them; after, every frame answers
+//! this link's request; the board's panel is within the protocol's limits
+//! and every drawing is at that panel, so nothing is set aside for a
+//! picture the board only claims; every row arrives exactly once, in the
+//! panel's format and width, before the board says it is done; the board's
+//! errors are at most as many as the scene can have, each within the
+//! scene's lines and of a bounded length; the board's text (names,
+//! messages) reaches the caller with its control characters escaped.
 
+use super::answer::{Answer, BoardDescription, BoardSceneError, BoardTiming, PlayedFrame, Progress};
+use super::patience::{Expired, Patience, Step, LOADING, SILENCE};
+use super::port::{Port, SerialLine};
 use crate::terminal::shown;
-use octrace_link::{Decoder, Message, Panel, Reason, Timing, VERSION};
-use serialport::SerialPort as _;
-use std::io::{self, Read, Write};
-use std::time::{Duration, Instant};
-
-/// A serial line to a board: bytes both ways, reads and writes that give
-/// up after a short while (so that the deadline can be kept).
-pub trait Port: Read + Write {
-    /// Drops what the board sent before this run.
-    fn discard_input(&mut self) -> io::Result<()>;
-}
-
-/// A board's serial port, opened for this run alone.
-pub struct SerialLine(Device);
-
-#[cfg(unix)]
-type Device = serialport::TTYPort;
-#[cfg(not(unix))]
-type Device = Box<dyn serialport::SerialPort>;
-
-impl SerialLine {
-    /// Opens `path` exclusively: no other program can open it meanwhile.
-    pub fn open(path: &str) -> io::Result<SerialLine> {
-        // The rate means nothing to a USB serial class or a pseudo-terminal.
-        let builder = serialport::new(path, 115_200).timeout(Duration::from_millis(50));
-        #[cfg(unix)]
-        let device = serialport::TTYPort::open(&builder)?;
-        #[cfg(not(unix))]
-        let device = builder.open()?;
-        Ok(SerialLine(device))
-    }
-}
-
-/// A pseudo-terminal (an emulated board's) stays exclusive after its last
-/// close while its other end is open, which would refuse the next run of
-/// anyone but root: the mode is given up explicitly.
-#[cfg(unix)]
-impl Drop for SerialLine {
-    fn drop(&mut self) {
-        let _ = self.0.set_exclusive(false);
-    }
-}
-
-impl Read for SerialLine {
-    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-        self.0.read(buf)
-    }
-}
-
-impl Write for SerialLine {
-    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        self.0.write(buf)
-    }
-
-    /// Nothing to do: what `write` took is the system's. (The device's own
-    /// flush waits until the board has read it all, with no time limit.)
-    fn flush(&mut self) -> io::Result<()> {
-        Ok(())
-    }
-}
-
-impl Port for SerialLine {
-    fn discard_input(&mut self) -> io::Result<()> {
-        self.0.clear(serialport::ClearBuffer::Input).map_err(io::Error::from)
-    }
-}
+use octrace_link::{Decoder, Message, Panel, Reason, VERSION};
+use std::io;
+use std::time::Duration;
 
 /// Why talking to a board failed.
 #[derive(Debug)]
 pub enum LinkError {
     /// The port could not be opened, read or written.
     Io(io::Error),
-    /// Nothing answered within the timeout.
-    Silent(Duration),
-    /// The board's answer began but did not end within the timeout: a
-    /// drawing slower than that, or a board that keeps talking.
-    Unfinished(Duration),
-    /// The board did not read what host-sim sent within the timeout.
-    Unread(Duration),
+    /// The board said nothing that moved the conversation on for `waited`,
+    /// after `after` (None: it never answered).
+    Silent {
+        /// How long.
+        waited: Duration,
+        /// What it last did, as said to a user.
+        after: Option<String>,
+    },
+    /// The board took nothing host-sim sent for `waited`, after `after`.
+    Unread {
+        /// How long.
+        waited: Duration,
+        /// What it last did.
+        after: String,
+    },
+    /// The conversation did not end within the cap (`--timeout`).
+    TimedOut(Duration),
     /// The board speaks another protocol version.
     Version {
         /// The board's.
@@ -114,21 +67,22 @@ impl std::fmt::Display for LinkError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             LinkError::Io(e) => write!(f, "{e}"),
-            LinkError::Silent(waited) => write!(
+            LinkError::Silent { waited, after: None } => write!(
                 f,
-                "no answer within {} s (is octrace's live firmware running there? --timeout waits longer)",
+                "no answer within {} s (is octrace's live firmware running there?)",
                 waited.as_secs_f64()
             ),
-            LinkError::Unfinished(waited) => write!(
+            LinkError::Silent { waited, after: Some(after) } => {
+                write!(f, "the board fell silent: nothing for {} s after {after}", waited.as_secs_f64())
+            }
+            LinkError::Unread { waited, after } => write!(
                 f,
-                "the board's answer did not end within {} s (--timeout waits longer for a slow drawing)",
+                "the board took nothing host-sim sent for {} s, after {after} (is octrace's live firmware running there?)",
                 waited.as_secs_f64()
             ),
-            LinkError::Unread(waited) => write!(
-                f,
-                "the board did not read what host-sim sent within {} s (is octrace's live firmware running there?)",
-                waited.as_secs_f64()
-            ),
+            LinkError::TimedOut(cap) => {
+                write!(f, "the board's answer did not end within {} s (--timeout)", cap.as_secs_f64())
+            }
             LinkError::Version { board } => write!(
                 f,
                 "the board speaks protocol version {board} and this host-sim version {VERSION}: \
@@ -152,131 +106,6 @@ impl From<io::Error> for LinkError {
     }
 }
 
-/// What a board says it is.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct BoardDescription {
-    pub panel: Panel,
-    /// The longest scene text it takes, in bytes.
-    pub max_scene: u32,
-    /// Its capacity profile's name.
-    pub profile: String,
-    pub firmware: String,
-    /// Its profile's capacities by `profile!` field name.
-    pub capacities: Vec<(String, u32)>,
-}
-
-/// One error of a scene, as the board reported it.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct BoardSceneError {
-    /// From 1; 0 for an error of the whole scene.
-    pub line: u32,
-    pub column: u32,
-    /// For an error of capacity: its `profile!` field name, how many the
-    /// scene needs (when the board knows) and how many the board holds.
-    pub capacity: Option<(String, Option<u32>, u32)>,
-    /// The message, as octrace-core writes it.
-    pub message: String,
-}
-
-impl BoardSceneError {
-    /// `file:line:col: message`, as host-sim prints its own errors.
-    pub fn located(&self, file: &str) -> String {
-        match self.line {
-            0 => format!("{file}: {}", self.message),
-            line => format!("{file}:{line}:{}: {}", self.column, self.message),
-        }
-    }
-}
-
-/// What a board measured of a scene it drew (the protocol's `done`): its
-/// times by its own clock, and what its hardware counted over the load and
-/// the render.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct BoardTiming {
-    /// From the scene received to its last row drawn.
-    pub elapsed: Option<Duration>,
-    /// Parsing and indexing the scene.
-    pub load: Option<Duration>,
-    /// Drawing it.
-    pub render: Option<Duration>,
-    /// Each counter: its name (control characters escaped), its count
-    /// over the load and over the render.
-    pub counters: Vec<(String, u32, u32)>,
-}
-
-impl BoardTiming {
-    fn of(timing: &Timing<'_>) -> BoardTiming {
-        BoardTiming {
-            elapsed: timing.elapsed,
-            load: timing.load,
-            render: timing.render,
-            counters: timing.counters.iter().map(|c| (shown(c.name), c.load, c.render)).collect(),
-        }
-    }
-
-    /// "in 1.850 s by its clock (load 0.011 s, render 1.839 s; sram0_contested 12 + 3456, …)",
-    /// or the host's time when the board has no clock.
-    pub fn describe(&self, here: Duration) -> String {
-        let seconds = |t: Duration| format!("{:.3} s", t.as_secs_f64());
-        let mut text = match self.elapsed {
-            Some(t) => format!("in {} by its clock", seconds(t)),
-            None => format!("in {} here", seconds(here)),
-        };
-        let mut parts = Vec::new();
-        if let (Some(load), Some(render)) = (self.load, self.render) {
-            parts.push(format!("load {}, render {}", seconds(load), seconds(render)));
-        }
-        if !self.counters.is_empty() {
-            let counters: Vec<_> =
-                self.counters.iter().map(|(name, load, render)| format!("{name} {load} + {render}")).collect();
-            parts.push(counters.join(", "));
-        }
-        if !parts.is_empty() {
-            text.push_str(&format!(" ({})", parts.join("; ")));
-        }
-        text
-    }
-}
-
-/// How the board answered a scene.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Answer {
-    /// It drew the scene at its panel's size, and measured it so.
-    Drawn { panel: Panel, timing: BoardTiming },
-    /// It played the animation at its panel's size: the frames followed,
-    /// in order, before host-sim stopped it.
-    Played { panel: Panel, frames: Vec<PlayedFrame> },
-    /// The scene has errors (all of them, in the order found); nothing drawn.
-    Rejected(Vec<BoardSceneError>),
-}
-
-/// A frame of an animation the board drew whole.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct PlayedFrame {
-    /// Which, from 0.
-    pub frame: u32,
-    /// Pixels the board traced for it.
-    pub traced: u32,
-    /// Its time by the board's clock, if it has one.
-    pub elapsed: Option<Duration>,
-}
-
-/// What happens while a board draws.
-#[derive(Debug)]
-pub enum Progress<'a> {
-    /// The scene loaded; its rows follow.
-    Drawing(Panel),
-    /// Row `y` is drawn: its pixels in the panel's format, if asked for.
-    Row { y: u16, pixels: &'a [u8] },
-    /// The scene is an animation of `frames` frames; its runs follow.
-    Playing { panel: Panel, frames: u32 },
-    /// A run of row `y` from column `x` of the frame being played is
-    /// drawn: its pixels in the panel's format, if asked for.
-    Run { y: u16, x: u16, pixels: &'a [u8] },
-    /// A frame is whole: every run of it has come.
-    FrameDrawn(PlayedFrame),
-}
-
 /// The longest frame host-sim takes from a board: a `board` description
 /// of 255 capacities of 255-byte names, and more.
 const MAX_FRAME: usize = 1 << 18;
@@ -293,6 +122,11 @@ pub(crate) fn most_errors(length: usize) -> usize {
     length / 2 + 64
 }
 
+/// The most frames host-sim skips before the board answers its hello (the
+/// tail of an earlier run's answer, which the board's buffers bound to a
+/// few hundred): a board that sends more answers no one.
+const MAX_SKIPPED: u64 = 10_000;
+
 /// Whether an error of the port only says that nothing could be read or
 /// written yet.
 fn waiting(e: &io::Error) -> bool {
@@ -306,43 +140,47 @@ pub struct BoardLink<P: Port> {
     /// Bytes read from the port, and how many of them the decoder has had.
     input: Vec<u8>,
     taken: usize,
-    timeout: Duration,
-    /// When the conversation must be over: `timeout` after the link opened.
-    deadline: Instant,
+    /// How long the link waits for the board now, and for what.
+    patience: Patience,
     last_tag: u16,
     /// Whether the board has answered a request of this link: from then on
     /// every frame it sends is in answer to this link's requests.
     in_step: bool,
+    /// Frames skipped before then.
+    skipped: u64,
     /// The panel the board described: every drawing is at it.
     panel: Option<Panel>,
 }
 
 impl BoardLink<SerialLine> {
-    /// Opens the serial port `path`.
-    pub fn open(path: &str, timeout: Duration) -> Result<Self, LinkError> {
+    /// Opens the serial port `path`; the whole conversation ends within
+    /// `cap`, if one is given.
+    pub fn open(path: &str, cap: Option<Duration>) -> Result<Self, LinkError> {
         let line = SerialLine::open(path)
             .map_err(|e| io::Error::new(e.kind(), format!("cannot open it as a serial port: {e}")))?;
-        Ok(BoardLink::new(line, timeout))
+        Ok(BoardLink::new(line, cap))
     }
 }
 
 impl<P: Port> BoardLink<P> {
-    /// A link over `port` whose whole conversation (every request sent and
-    /// every answer received) ends within `timeout` from now.
-    pub fn new(port: P, timeout: Duration) -> Self {
+    /// A link over `port` that waits for the board while it moves the
+    /// conversation on (see `patience.rs`), and ends it within `cap` from
+    /// now (every request sent and every answer received), if one is given.
+    pub fn new(mut port: P, cap: Option<Duration>) -> Self {
         // Tags of this run unlike an earlier run's, whose answers may still
         // be on the way.
         let clock = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
         let last_tag = (clock.subsec_nanos() ^ std::process::id()) as u16;
+        let patience = Patience::new(port.now(), cap);
         BoardLink {
             port,
             decoder: Decoder::new(vec![0; MAX_FRAME]),
             input: Vec::new(),
             taken: 0,
-            timeout,
-            deadline: Instant::now() + timeout,
+            patience,
             last_tag,
             in_step: false,
+            skipped: 0,
             panel: None,
         }
     }
@@ -353,24 +191,56 @@ impl<P: Port> BoardLink<P> {
         self.last_tag
     }
 
+    /// The board did `step`, moving the conversation on; it may then say
+    /// nothing that does so for `allowance`.
+    fn moved(&mut self, step: Step, allowance: Duration) {
+        let now = self.port.now();
+        self.patience.moved(now, step, allowance);
+    }
+
+    /// The error of a wait that has ended, if it has (`writing`: a wait
+    /// for the board to take what host-sim sends).
+    fn expired(&mut self, writing: bool) -> Option<LinkError> {
+        let now = self.port.now();
+        Some(match self.patience.expired(now)? {
+            Expired::Capped(cap) if self.patience.last() == Step::Opened => {
+                LinkError::Silent { waited: cap, after: None }
+            }
+            Expired::Capped(cap) => LinkError::TimedOut(cap),
+            Expired::Silent { waited, after, idle } if writing => {
+                LinkError::Unread { waited, after: said(after, idle) }
+            }
+            Expired::Silent { waited, after: Step::Opened, .. } => LinkError::Silent { waited, after: None },
+            Expired::Silent { waited, after, idle } => LinkError::Silent { waited, after: Some(said(after, idle)) },
+        })
+    }
+
     /// Sends `message` as the request `tag`, however slowly the board
-    /// reads, until the deadline.
-    fn send(&mut self, tag: u16, message: &Message<'_>) -> Result<(), LinkError> {
+    /// reads (each byte it takes moves the conversation on); once it has
+    /// taken all of it, it does `then`'s step and may say nothing for
+    /// `then`'s allowance.
+    fn send(&mut self, tag: u16, message: &Message<'_>, then: (Step, Duration)) -> Result<(), LinkError> {
         let mut frame = Vec::new();
         message.encode(tag, &mut frame)?;
         let mut sent = 0;
         while sent < frame.len() {
-            if Instant::now() >= self.deadline {
-                return Err(LinkError::Unread(self.timeout));
+            if let Some(e) = self.expired(true) {
+                return Err(e);
             }
             match self.port.write(&frame[sent..]) {
                 Ok(0) => std::thread::sleep(Duration::from_millis(5)),
-                Ok(n) => sent += n,
+                Ok(n) => {
+                    sent += n;
+                    if sent < frame.len() {
+                        self.moved(Step::Took { taken: sent, of: frame.len() }, SILENCE);
+                    }
+                }
                 Err(e) if waiting(&e) => {}
                 Err(e) => return Err(LinkError::Io(e)),
             }
         }
         self.port.flush()?;
+        self.moved(then.0, then.1);
         Ok(())
     }
 
@@ -380,7 +250,8 @@ impl<P: Port> BoardLink<P> {
     pub fn hello(&mut self) -> Result<BoardDescription, LinkError> {
         self.port.discard_input()?;
         let tag = self.next_tag();
-        self.send(tag, &Message::Hello)?;
+        // Nothing from the board yet: silence is no answer.
+        self.send(tag, &Message::Hello, (Step::Opened, SILENCE))?;
         let info = match self.receive(tag)? {
             Message::Board(info) => info,
             Message::Refused(reason) => return Err(refused(reason)),
@@ -401,6 +272,7 @@ impl<P: Port> BoardLink<P> {
             capacities: info.capacities.iter().map(|c| (shown(c.name), c.count)).collect(),
         };
         self.panel = Some(board.panel);
+        self.moved(Step::Described, SILENCE);
         Ok(board)
     }
 
@@ -421,23 +293,27 @@ impl<P: Port> BoardLink<P> {
             None => self.hello()?.panel,
         };
         let tag = self.next_tag();
-        self.send(tag, &Message::Scene { pixels, text })?;
+        self.send(tag, &Message::Scene { pixels, text }, (Step::TookScene, LOADING))?;
+        // An error at the end of the text is on the line after its last.
+        let lines = text.iter().filter(|&&byte| byte == b'\n').count() + 1;
         let mut errors = Vec::new();
-        // Which rows of the drawing have come, once it began.
+        // Which rows of the drawing have come, once it began, and how many.
         let mut drawing: Option<Vec<bool>> = None;
+        let mut drawn = 0;
         loop {
-            let began = drawing.is_some() || !errors.is_empty();
-            let message = match self.receive(tag) {
-                Err(LinkError::Silent(waited)) if began => return Err(LinkError::Unfinished(waited)),
-                received => received?,
-            };
-            match (message, &mut drawing) {
+            match (self.receive(tag)?, &mut drawing) {
                 (Message::SceneError(e), None) => {
                     if errors.len() == most_errors(text.len()) {
                         return Err(LinkError::Protocol(format!(
                             "it sent more errors than a scene of {} bytes can have ({})",
                             text.len(),
                             errors.len()
+                        )));
+                    }
+                    if e.line as usize > lines {
+                        return Err(LinkError::Protocol(format!(
+                            "it sent an error at line {} of a scene of {lines} lines",
+                            e.line
                         )));
                     }
                     if e.message.len() > MAX_MESSAGE {
@@ -452,6 +328,8 @@ impl<P: Port> BoardLink<P> {
                         capacity: e.capacity.map(|c| (shown(c.name), c.needed, c.holds)),
                         message: shown(e.message),
                     });
+                    // Errors are bounded, not progress: the load's wait goes on.
+                    self.patience.idle_frame();
                 }
                 (Message::Rejected { errors: count }, None) if count as usize == errors.len() && count > 0 => {
                     return Ok(Answer::Rejected(errors));
@@ -460,20 +338,23 @@ impl<P: Port> BoardLink<P> {
                     let sent = errors.len();
                     return Err(LinkError::Protocol(format!("it counted {count} errors of the scene and sent {sent}")));
                 }
-                (Message::Drawing { panel: drawn, pixels: with_pixels, frames }, None) if errors.is_empty() => {
-                    if drawn != panel {
+                (Message::Drawing { panel: drawn_at, pixels: with_pixels, frames }, None) if errors.is_empty() => {
+                    if drawn_at != panel {
                         return Err(LinkError::Protocol(format!(
                             "it draws at {}x{} {}, but described a {}x{} {} panel",
-                            drawn.width, drawn.height, drawn.format, panel.width, panel.height, panel.format
+                            drawn_at.width, drawn_at.height, drawn_at.format, panel.width, panel.height, panel.format
                         )));
                     }
                     if with_pixels != pixels {
                         return Err(LinkError::Protocol(format!("rows with pixels: {with_pixels}, asked: {pixels}")));
                     }
                     if frames > 0 {
+                        // It loads the first frame without a word.
+                        self.moved(Step::Playing { frames }, LOADING);
                         progress(Progress::Playing { panel, frames });
                         return self.follow(tag, panel, pixels, frames, follow.max(1), progress);
                     }
+                    self.moved(Step::Began { rows: panel.height }, SILENCE);
                     progress(Progress::Drawing(panel));
                     drawing = Some(vec![false; panel.height.into()]);
                 }
@@ -488,7 +369,13 @@ impl<P: Port> BoardLink<P> {
                         Some(_) => return Err(LinkError::Protocol(format!("row {y} came twice"))),
                         None => return Err(LinkError::Protocol(format!("row {y} of a {}-row panel", panel.height))),
                     }
+                    drawn += 1;
                     progress(Progress::Row { y, pixels: row });
+                    self.moved(Step::Row { y, drawn, rows: panel.height }, SILENCE);
+                }
+                (Message::Working { elapsed }, Some(_)) => {
+                    progress(Progress::Working { elapsed });
+                    self.moved(Step::Working { elapsed }, SILENCE);
                 }
                 (Message::Done(timing), Some(seen)) => {
                     return match seen.iter().position(|seen| !seen) {
@@ -523,11 +410,9 @@ impl<P: Port> BoardLink<P> {
         let (mut touched, mut covered) = (Vec::new(), 0usize);
         let mut played = Vec::new();
         while played.len() < follow as usize {
-            let message = match self.receive(tag) {
-                Err(LinkError::Silent(waited)) => return Err(LinkError::Unfinished(waited)),
-                received => received?,
-            };
-            match message {
+            // The frame the board draws now.
+            let due = played.last().map_or(0, |last: &PlayedFrame| (last.frame + 1) % frames);
+            match self.receive(tag)? {
                 Message::Run { y, x, width: run, pixels: bytes } => {
                     let (x0, x1) = (usize::from(x), usize::from(x) + usize::from(run));
                     let row = came.get_mut(usize::from(y)).filter(|_| x1 <= width && run > 0).ok_or_else(|| {
@@ -555,11 +440,11 @@ impl<P: Port> BoardLink<P> {
                     row[x0..x1].fill(true);
                     covered += usize::from(run);
                     progress(Progress::Run { y, x, pixels: bytes });
+                    self.moved(Step::Run { y, frame: due }, SILENCE);
                 }
                 Message::FrameDrawn { frame, traced, elapsed } => {
-                    let expected = played.last().map_or(0, |last: &PlayedFrame| (last.frame + 1) % frames);
-                    if frame != expected {
-                        return Err(LinkError::Protocol(format!("frame {frame} drawn where frame {expected} was due")));
+                    if frame != due {
+                        return Err(LinkError::Protocol(format!("frame {frame} drawn where frame {due} was due")));
                     }
                     if played.is_empty() && covered != width * usize::from(panel.height) {
                         return Err(LinkError::Protocol(format!(
@@ -573,6 +458,12 @@ impl<P: Port> BoardLink<P> {
                     let drawn = PlayedFrame { frame, traced, elapsed };
                     played.push(drawn);
                     progress(Progress::FrameDrawn(drawn));
+                    // The board loads the next frame without a word.
+                    self.moved(Step::FrameDrawn { frame }, LOADING);
+                }
+                Message::Working { elapsed } => {
+                    progress(Progress::Working { elapsed });
+                    self.moved(Step::Working { elapsed }, SILENCE);
                 }
                 Message::Stopped { frames } => {
                     return Err(LinkError::Protocol(format!("it stopped playing after {frames} frames unasked")));
@@ -582,24 +473,33 @@ impl<P: Port> BoardLink<P> {
             }
         }
         // Stopped as a host that starts stops it: the answer ends with
-        // `stopped`, then the board describes itself.
+        // `stopped`, then the board describes itself. The board may be
+        // loading a frame when the hello comes; what it sends before it
+        // stops is no progress, and bounded.
         let hello = self.next_tag();
-        self.send(hello, &Message::Hello)?;
+        self.send(hello, &Message::Hello, (Step::TookStop, LOADING))?;
+        let mut after_stop = 0u64;
         loop {
             match self.receive(tag)? {
-                Message::Run { .. } | Message::FrameDrawn { .. } => {}
+                Message::Run { .. } | Message::FrameDrawn { .. } | Message::Working { .. } => {}
                 Message::Stopped { .. } => break,
                 other => return Err(unexpected(other.kind(), "the end of the animation")),
             }
+            after_stop += 1;
+            self.patience.idle_frame();
+            if after_stop > MAX_SKIPPED {
+                return Err(LinkError::Protocol(format!("it played on for {after_stop} frames after the hello")));
+            }
         }
+        self.moved(Step::Stopped, SILENCE);
         match self.receive(hello)? {
             Message::Board(_) => Ok(Answer::Played { panel, frames: played }),
             other => Err(unexpected(other.kind(), "the board's description")),
         }
     }
 
-    /// The next message answering request `tag`, skipping any other, by
-    /// the deadline.
+    /// The next message answering request `tag`, skipping (before the
+    /// board is in step) any other, while the wait lasts.
     fn receive(&mut self, tag: u16) -> Result<Message<'_>, LinkError> {
         loop {
             if self.taken == self.input.len() {
@@ -614,8 +514,32 @@ impl<P: Port> BoardLink<P> {
                 // The board's refusal of a frame whose header it could not
                 // trust carries tag 0: once the board is in step with this
                 // link, that frame was this link's.
-                Some(Ok(frame)) => {
-                    frame.tag == tag || (in_step && frame.tag == 0 && matches!(frame.message, Message::Refused(_)))
+                Some(Ok(frame))
+                    if frame.tag == tag
+                        || (in_step && frame.tag == 0 && matches!(frame.message, Message::Refused(_))) =>
+                {
+                    true
+                }
+                // Once in step, the board answers this link's requests in
+                // order: nothing else is due.
+                Some(Ok(frame)) if in_step => {
+                    return Err(LinkError::Protocol(format!(
+                        "it sent a {} message answering request {}, where request {tag}'s answer was due",
+                        frame.message.kind(),
+                        frame.tag
+                    )));
+                }
+                // The tail of an earlier run's answer: a few hundred frames at most.
+                Some(Ok(_)) => {
+                    self.skipped += 1;
+                    self.patience.idle_frame();
+                    if self.skipped > MAX_SKIPPED {
+                        return Err(LinkError::Protocol(format!(
+                            "it sent {} frames answering no request of host-sim's before its hello's answer",
+                            self.skipped
+                        )));
+                    }
+                    false
                 }
                 // A frame of the board's that this host cannot read. Before
                 // the board is in step, it may be the tail of an earlier
@@ -638,14 +562,14 @@ impl<P: Port> BoardLink<P> {
         }
     }
 
-    /// Reads what the port has, waiting until the deadline at most.
+    /// Reads what the port has, while the wait lasts.
     fn fill(&mut self) -> Result<(), LinkError> {
         self.input.resize(4096, 0);
         self.taken = 0;
         loop {
-            if Instant::now() >= self.deadline {
+            if let Some(e) = self.expired(false) {
                 self.input.clear();
-                return Err(LinkError::Silent(self.timeout));
+                return Err(e);
             }
             match self.port.read(&mut self.input) {
                 Ok(0) => std::thread::sleep(Duration::from_millis(5)),
@@ -660,6 +584,15 @@ impl<P: Port> BoardLink<P> {
                 }
             }
         }
+    }
+}
+
+/// What the board last did, as a user reads it, with the frames it sent
+/// since that did not move the conversation on.
+fn said(after: Step, idle: u64) -> String {
+    match idle {
+        0 => after.to_string(),
+        idle => format!("{after}, and {idle} frames since that did not move it on"),
     }
 }
 
@@ -678,36 +611,68 @@ fn unexpected(kind: octrace_link::Kind, awaited: &str) -> LinkError {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use octrace_link::{PixelFormat, SceneError};
+    use octrace_link::{PixelFormat, SceneError, Timing};
+    use std::cell::{Cell, RefCell};
     use std::collections::VecDeque;
+    use std::io::{Read, Write};
+    use std::rc::Rc;
+    use std::time::Instant;
 
-    /// A board played by a function: each frame host-sim writes is
-    /// answered with the bytes it returns. It reads nothing before
-    /// `reads_from` (each write times out, as a serial port's does), and
-    /// once `chatter` is set it sends it again whenever host-sim has read
-    /// all it sent.
+    /// How long a read or write of a serial port waits for the board
+    /// before it gives up: [`SerialLine`]'s.
+    const PORT_WAIT: Duration = Duration::from_millis(50);
+
+    /// A board's answer to a frame: pieces of bytes, each after a pause of
+    /// the board's (the first from the frame's last byte).
+    type Timed = Vec<(Duration, Vec<u8>)>;
+
+    /// What a board keeps sending once set: the bytes, how often, and until
+    /// when (on the board's clock).
+    type Chatter = Rc<RefCell<Option<(Vec<u8>, Duration, Duration)>>>;
+
+    /// A board played by a function, on a clock of its own that only the
+    /// port's waits move (a read with nothing to read, a write the board
+    /// does not take): each frame host-sim writes is answered with the
+    /// pieces it returns, each readable from its time. It takes nothing
+    /// before `reads_from`, then a byte every `byte_every`; once `chatter`
+    /// is set it sends it again and again.
     struct Played<F> {
         decoder: Decoder<Vec<u8>>,
         answer: F,
-        out: VecDeque<u8>,
-        reads_from: Instant,
+        out: VecDeque<(Duration, Vec<u8>)>,
+        clock: Rc<Cell<Duration>>,
+        start: Instant,
+        reads_from: Duration,
+        byte_every: Duration,
         chatter: Chatter,
+        chatter_next: Option<Duration>,
     }
 
-    /// What a board keeps sending, how often, and when it last did.
-    type Chatter = std::rc::Rc<std::cell::RefCell<(Vec<u8>, Duration, Instant)>>;
+    impl<F> Played<F> {
+        /// Waits for what comes next, a port's wait at most.
+        fn wait(&mut self, next: Option<Duration>) {
+            let now = self.clock.get();
+            let step =
+                next.map_or(PORT_WAIT, |next| next.saturating_sub(now).clamp(Duration::from_micros(1), PORT_WAIT));
+            self.clock.set(now + step);
+        }
+    }
 
-    impl<F: FnMut(u16, Message<'_>) -> Vec<u8>> Write for Played<F> {
+    impl<F: FnMut(u16, Message<'_>) -> Timed> Write for Played<F> {
         fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-            if Instant::now() < self.reads_from {
-                std::thread::sleep(Duration::from_millis(5));
+            if self.clock.get() < self.reads_from {
+                self.wait(Some(self.reads_from));
                 return Err(io::ErrorKind::TimedOut.into());
             }
             // A byte at a time: a line that drains slowly.
             let Some(&byte) = buf.first() else { return Ok(0) };
+            self.clock.set(self.clock.get() + self.byte_every);
             if let Some(Ok(frame)) = self.decoder.push(byte) {
-                let bytes = (self.answer)(frame.tag, frame.message);
-                self.out.extend(bytes);
+                let mut at = self.clock.get();
+                for (pause, bytes) in (self.answer)(frame.tag, frame.message) {
+                    at += pause;
+                    self.out.push_back((at, bytes));
+                }
             }
             Ok(1)
         }
@@ -719,43 +684,71 @@ mod tests {
 
     impl<F> Read for Played<F> {
         fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-            let (chatter, every, last) = &mut *self.chatter.borrow_mut();
-            if self.out.is_empty() && !chatter.is_empty() && last.elapsed() >= *every {
-                self.out.extend(chatter.iter());
-                *last = Instant::now();
+            let now = self.clock.get();
+            if let Some((due, piece)) = self.out.front_mut().filter(|(due, _)| *due <= now) {
+                let _ = due;
+                let n = buf.len().min(piece.len());
+                for (slot, byte) in buf.iter_mut().zip(piece.drain(..n)) {
+                    *slot = byte;
+                }
+                if piece.is_empty() {
+                    self.out.pop_front();
+                }
+                return Ok(n);
             }
-            if self.out.is_empty() {
-                std::thread::sleep(Duration::from_millis(1));
-                return Err(io::ErrorKind::TimedOut.into());
+            let chatter = self.chatter.borrow().clone();
+            if let Some((bytes, every, until)) = chatter.filter(|&(_, _, until)| now < until) {
+                let next = *self.chatter_next.get_or_insert(now);
+                if next <= now {
+                    // Before what comes later.
+                    let at = self.out.iter().position(|&(due, _)| due > now).unwrap_or(self.out.len());
+                    self.out.insert(at, (now, bytes));
+                    self.chatter_next = Some(now + every);
+                    return self.read(buf);
+                }
+                let _ = until;
             }
-            let n = buf.len().min(self.out.len());
-            for (slot, byte) in buf.iter_mut().zip(self.out.drain(..n)) {
-                *slot = byte;
-            }
-            Ok(n)
+            let next = self.out.front().map(|&(due, _)| due);
+            let next = match (next, self.chatter_next.filter(|_| self.chatter.borrow().is_some())) {
+                (Some(a), Some(b)) => Some(a.min(b)),
+                (a, b) => a.or(b),
+            };
+            self.wait(next);
+            Err(io::ErrorKind::TimedOut.into())
         }
     }
 
-    impl<F: FnMut(u16, Message<'_>) -> Vec<u8>> Port for Played<F> {
+    impl<F: FnMut(u16, Message<'_>) -> Timed> Port for Played<F> {
         fn discard_input(&mut self) -> io::Result<()> {
-            self.out.clear();
+            let now = self.clock.get();
+            self.out.retain(|&(due, _)| due > now);
             Ok(())
         }
+
+        fn now(&mut self) -> Instant {
+            self.start + self.clock.get()
+        }
     }
 
-    fn played(answer: impl FnMut(u16, Message<'_>) -> Vec<u8>) -> BoardLink<impl Port> {
-        BoardLink::new(played_port(answer), Duration::from_millis(200))
-    }
-
-    fn played_port<F: FnMut(u16, Message<'_>) -> Vec<u8>>(answer: F) -> Played<F> {
-        let chatter = std::rc::Rc::new(std::cell::RefCell::new((Vec::new(), Duration::ZERO, Instant::now())));
+    fn played_port<F: FnMut(u16, Message<'_>) -> Timed>(answer: F) -> Played<F> {
         Played {
             decoder: Decoder::new(vec![0; 4096]),
             answer,
             out: VecDeque::new(),
-            reads_from: Instant::now(),
-            chatter,
+            clock: Rc::new(Cell::new(Duration::ZERO)),
+            start: Instant::now(),
+            reads_from: Duration::ZERO,
+            byte_every: Duration::ZERO,
+            chatter: Rc::new(RefCell::new(None)),
+            chatter_next: None,
         }
+    }
+
+    /// A link to a board played by `answer`, with no cap; and the board's clock.
+    fn played(answer: impl FnMut(u16, Message<'_>) -> Timed) -> (BoardLink<impl Port>, Rc<Cell<Duration>>) {
+        let port = played_port(answer);
+        let clock = port.clock.clone();
+        (BoardLink::new(port, None), clock)
     }
 
     fn frames(messages: &[(Message<'_>, u16)]) -> Vec<u8> {
@@ -764,6 +757,15 @@ mod tests {
             message.encode(*tag, &mut bytes).unwrap();
         }
         bytes
+    }
+
+    /// `bytes`, sent at once.
+    fn at_once(bytes: Vec<u8>) -> Timed {
+        vec![(Duration::ZERO, bytes)]
+    }
+
+    fn seconds(s: u64) -> Duration {
+        Duration::from_secs(s)
     }
 
     const PANEL: Panel = Panel { width: 2, height: 2, format: PixelFormat::Rgb565 };
@@ -778,10 +780,10 @@ mod tests {
         })
     }
 
-    /// A board that answers hello and then each scene with `answer(tag)`.
-    fn drawing_board(mut answer: impl FnMut(u16) -> Vec<u8>) -> BoardLink<impl Port> {
+    /// A board that answers hello at once and then each scene with `answer(tag)`.
+    fn drawing_board(mut answer: impl FnMut(u16) -> Timed) -> (BoardLink<impl Port>, Rc<Cell<Duration>>) {
         played(move |tag, message| match message {
-            Message::Hello => frames(&[(board_info(), tag)]),
+            Message::Hello => at_once(frames(&[(board_info(), tag)])),
             _ => answer(tag),
         })
     }
@@ -791,27 +793,36 @@ mod tests {
         link.draw(b"scene", true, 1, &mut |_| {})
     }
 
+    const PIXELS: [u8; 4] = [0; 4];
+
+    fn drawing_message(frames: u32) -> Message<'static> {
+        Message::Drawing { panel: PANEL, pixels: true, frames }
+    }
+
+    fn row(y: u16) -> Message<'static> {
+        Message::Row { y, pixels: &PIXELS }
+    }
+
     #[test]
     fn what_came_before_the_boards_answer_to_hello_is_skipped() {
-        let mut link = played(|tag, _| {
+        let (mut link, _) = played(|tag, _| {
             let mut bytes = frames(&[(Message::Row { y: 3, pixels: &[] }, tag.wrapping_sub(1))]);
             bytes.extend_from_slice(b"\0garbage\0");
             bytes.extend(frames(&[(Message::Refused(Reason::Undecodable { length: 7 }), 0), (board_info(), tag)]));
-            bytes
+            at_once(bytes)
         });
         assert_eq!(link.hello().unwrap().panel, PANEL);
     }
 
     #[test]
     fn a_drawing_is_followed_to_its_last_row() {
-        let pixels = [0u8; 4];
-        let mut link = drawing_board(|tag| {
-            frames(&[
-                (Message::Drawing { panel: PANEL, pixels: true, frames: 0 }, tag),
-                (Message::Row { y: 1, pixels: &pixels }, tag),
-                (Message::Row { y: 0, pixels: &pixels }, tag),
+        let (mut link, _) = drawing_board(|tag| {
+            at_once(frames(&[
+                (drawing_message(0), tag),
+                (row(1), tag),
+                (row(0), tag),
                 (Message::Done(Timing::NONE), tag),
-            ])
+            ]))
         });
         assert_eq!(draw(&mut link).unwrap(), Answer::Drawn { panel: PANEL, timing: BoardTiming::default() });
     }
@@ -828,11 +839,11 @@ mod tests {
             (&[(1, &pixels)], "done without row 0"),
         ];
         for (rows, said) in cases {
-            let mut link = drawing_board(|tag| {
-                let mut messages = vec![(Message::Drawing { panel: PANEL, pixels: true, frames: 0 }, tag)];
+            let (mut link, _) = drawing_board(|tag| {
+                let mut messages = vec![(drawing_message(0), tag)];
                 messages.extend(rows.iter().map(|&(y, pixels)| (Message::Row { y, pixels }, tag)));
                 messages.push((Message::Done(Timing::NONE), tag));
-                frames(&messages)
+                at_once(frames(&messages))
             });
             let error = draw(&mut link).unwrap_err();
             assert!(matches!(&error, LinkError::Protocol(what) if what == said), "{said}: {error}");
@@ -840,57 +851,241 @@ mod tests {
     }
 
     #[test]
-    fn the_errors_come_all_and_counted() {
+    fn the_errors_come_all_and_counted_each_within_the_scenes_lines() {
         let error = |line| SceneError { line, column: 2, capacity: None, message: "bad" };
-        let mut link = drawing_board(|tag| {
-            frames(&[
+        let (mut link, _) = drawing_board(|tag| {
+            at_once(frames(&[
                 (Message::SceneError(error(1)), tag),
                 (Message::SceneError(error(0)), tag),
                 (Message::Rejected { errors: 2 }, tag),
-            ])
+            ]))
         });
         let Answer::Rejected(errors) = draw(&mut link).unwrap() else { panic!("rejected") };
         let located: Vec<String> = errors.iter().map(|e| e.located("s.txt")).collect();
         assert_eq!(located, ["s.txt:1:2: bad", "s.txt: bad"]);
-        let mut link = drawing_board(|tag| {
-            frames(&[(Message::SceneError(error(1)), tag), (Message::Rejected { errors: 3 }, tag)])
+        let (mut link, _) = drawing_board(|tag| {
+            at_once(frames(&[(Message::SceneError(error(1)), tag), (Message::Rejected { errors: 3 }, tag)]))
         });
         assert!(matches!(draw(&mut link), Err(LinkError::Protocol(_))));
+        // At the line after the text's last (its end), not beyond.
+        for (line, fine) in [(2, true), (3, false)] {
+            let (mut link, _) = drawing_board(move |tag| {
+                at_once(frames(&[(Message::SceneError(error(line)), tag), (Message::Rejected { errors: 1 }, tag)]))
+            });
+            link.hello().unwrap();
+            let answer = link.draw(b"SPHERE\n", true, 1, &mut |_| {});
+            match fine {
+                true => assert!(matches!(answer, Ok(Answer::Rejected(_))), "{answer:?}"),
+                false => {
+                    let said = answer.unwrap_err().to_string();
+                    assert!(said.ends_with("it sent an error at line 3 of a scene of 2 lines"), "{said}");
+                }
+            }
+        }
     }
 
     #[test]
     fn once_in_step_a_refusal_without_a_tag_is_of_our_frame_and_garbage_is_an_error() {
         let checksum = Reason::BadChecksum { sent: 1, computed: 2 };
-        let mut link = drawing_board(|_| frames(&[(Message::Refused(checksum), 0)]));
+        let (mut link, _) = drawing_board(|_| at_once(frames(&[(Message::Refused(checksum), 0)])));
         assert!(matches!(draw(&mut link), Err(LinkError::Refused(reason)) if reason == checksum));
-        let mut link = drawing_board(|_| b"\0garbage\0".to_vec());
+        let (mut link, _) = drawing_board(|_| at_once(b"\0garbage\0".to_vec()));
         assert!(matches!(draw(&mut link), Err(LinkError::Protocol(_))));
     }
 
     #[test]
+    fn once_in_step_an_answer_to_another_request_is_an_error_and_before_only_so_many_are_skipped() {
+        // The hello answered again, with the hello's tag, where the
+        // scene's answer is due.
+        let (mut link, _) = played(|tag, message| match message {
+            Message::Hello => at_once(frames(&[(board_info(), tag)])),
+            _ => at_once(frames(&[(board_info(), tag - 1)])),
+        });
+        let said = draw(&mut link).unwrap_err().to_string();
+        assert!(said.contains("it sent a board message answering request "), "{said}");
+        assert!(said.ends_with("'s answer was due"), "{said}");
+        // Descriptions answering no request of ours, without end, before
+        // the hello's answer: no answer, at most so many skipped.
+        let port = played_port(|_, _| Vec::new());
+        let clock = port.clock.clone();
+        let other = frames(&[(board_info(), 0xfff)]);
+        *port.chatter.borrow_mut() = Some((other, Duration::from_micros(100), seconds(3600)));
+        let mut link = BoardLink::new(port, None);
+        let said = link.hello().unwrap_err().to_string();
+        assert!(
+            said.ends_with("it sent 10001 frames answering no request of host-sim's before its hello's answer"),
+            "{said}"
+        );
+        assert!(clock.get() < seconds(2), "{:?}", clock.get());
+    }
+
+    #[test]
     fn a_board_of_another_version_and_a_silent_one_are_said_as_such() {
-        let mut link = played(|tag, _| {
+        let (mut link, _) = played(|tag, _| {
             let mut bytes = Vec::new();
             octrace_link::encode_raw(VERSION + 1, octrace_link::Kind::Board.byte(), tag, &[], &mut bytes).unwrap();
-            bytes
+            at_once(bytes)
         });
         assert!(matches!(link.hello(), Err(LinkError::Version { board }) if board == VERSION + 1));
         let refusal = Message::Refused(Reason::WrongVersion { expected: 7, found: VERSION });
-        let mut link = played(move |tag, _| frames(&[(refusal, tag)]));
+        let (mut link, _) = played(move |tag, _| at_once(frames(&[(refusal, tag)])));
         assert!(matches!(link.hello(), Err(LinkError::Version { board: 7 })));
-        let mut link = played(|_, _| Vec::new());
+        // Said when the board has been silent for 8 s (the protocol's
+        // allowance), not later.
+        let (mut link, clock) = played(|_, _| Vec::new());
         let silent = link.hello().unwrap_err();
-        assert!(silent.to_string().starts_with("no answer within 0.2 s"), "{silent}");
+        assert!(silent.to_string().starts_with("no answer within 8 s"), "{silent}");
+        assert!(clock.get() >= seconds(8) && clock.get() <= seconds(8) + PORT_WAIT, "{:?}", clock.get());
+    }
+
+    #[test]
+    fn a_board_gone_silent_mid_drawing_is_said_within_10_s_with_what_it_did_last() {
+        let (mut link, clock) = drawing_board(|tag| {
+            vec![(Duration::ZERO, frames(&[(drawing_message(0), tag)])), (seconds(5), frames(&[(row(1), tag)]))]
+        });
+        link.hello().unwrap();
+        let mut rows_at = Vec::new();
+        let said = link
+            .draw(b"scene", true, 1, &mut |step| {
+                if let Progress::Row { .. } = step {
+                    rows_at.push(clock.get());
+                }
+            })
+            .unwrap_err();
+        assert_eq!(said.to_string(), "the board fell silent: nothing for 8 s after row 1 (1 of 2 rows drawn)");
+        // Given up 8 s after the row, with a port's wait at most: within
+        // 10 s of it.
+        let waited = clock.get() - rows_at[0];
+        assert!(waited >= seconds(8) && waited <= seconds(8) + PORT_WAIT, "{waited:?}");
+    }
+
+    #[test]
+    fn a_board_at_a_drawing_of_hours_is_followed_while_it_says_it_is_working_and_not_after() {
+        // An hour a row, `working` every second meanwhile.
+        let chatter: Chatter = Rc::new(RefCell::new(None));
+        let during = chatter.clone();
+        let mut port = played_port(move |tag, message| match message {
+            Message::Hello => at_once(frames(&[(board_info(), tag)])),
+            _ => {
+                let working = frames(&[(Message::Working { elapsed: Some(seconds(1)) }, tag)]);
+                *during.borrow_mut() = Some((working, seconds(1), seconds(7200)));
+                vec![
+                    (Duration::ZERO, frames(&[(drawing_message(0), tag)])),
+                    (seconds(3600), frames(&[(row(0), tag)])),
+                    (seconds(3599), frames(&[(row(1), tag), (Message::Done(Timing::NONE), tag)])),
+                ]
+            }
+        });
+        port.chatter = chatter;
+        let clock = port.clock.clone();
+        let mut link = BoardLink::new(port, None);
+        let mut said_working = 0;
+        link.hello().unwrap();
+        let answer =
+            link.draw(b"scene", true, 1, &mut |step| said_working += matches!(step, Progress::Working { .. }) as u32);
+        assert_eq!(answer.unwrap(), Answer::Drawn { panel: PANEL, timing: BoardTiming::default() });
+        assert!(clock.get() >= seconds(7199), "{:?}", clock.get());
+        assert!(said_working >= 7000, "{said_working}");
+        // The same board, whose word stops after 3 s: given up 8 s later.
+        let chatter: Chatter = Rc::new(RefCell::new(None));
+        let during = chatter.clone();
+        let mut port = played_port(move |tag, message| match message {
+            Message::Hello => at_once(frames(&[(board_info(), tag)])),
+            _ => {
+                let working = frames(&[(Message::Working { elapsed: Some(Duration::from_millis(2500)) }, tag)]);
+                *during.borrow_mut() = Some((working, seconds(1), seconds(3)));
+                at_once(frames(&[(drawing_message(0), tag)]))
+            }
+        });
+        port.chatter = chatter;
+        let clock = port.clock.clone();
+        let mut link = BoardLink::new(port, None);
+        link.hello().unwrap();
+        let said = link.draw(b"scene", true, 1, &mut |_| {}).unwrap_err().to_string();
+        assert_eq!(
+            said,
+            "the board fell silent: nothing for 8 s after it said it was still working, 2.500 s into the scene by its clock"
+        );
+        assert!(clock.get() >= seconds(10) && clock.get() <= seconds(10) + PORT_WAIT, "{:?}", clock.get());
+    }
+
+    #[test]
+    fn a_board_loading_a_scene_is_given_two_minutes_without_a_word() {
+        for (load, drawn) in [(100, true), (121, false)] {
+            let (mut link, clock) = drawing_board(move |tag| {
+                vec![(
+                    seconds(load),
+                    frames(&[
+                        (drawing_message(0), tag),
+                        (row(0), tag),
+                        (row(1), tag),
+                        (Message::Done(Timing::NONE), tag),
+                    ]),
+                )]
+            });
+            let answer = draw(&mut link);
+            match drawn {
+                true => assert!(answer.is_ok(), "{answer:?}"),
+                false => {
+                    let said = answer.unwrap_err().to_string();
+                    let want = "the board fell silent: nothing for 120 s after it took the scene \
+                                (a board loads a scene without a word)";
+                    assert_eq!(said, want);
+                    assert!(clock.get() <= seconds(120) + PORT_WAIT, "{:?}", clock.get());
+                }
+            }
+        }
+    }
+
+    /// `frames`' runs covering the 2×2 panel, then `frame-drawn(frame)`.
+    fn whole_frame(frame: u32, tag: u16) -> Vec<u8> {
+        let run = |y| Message::Run { y, x: 0, width: 2, pixels: &PIXELS };
+        frames(&[(run(0), tag), (run(1), tag), (Message::FrameDrawn { frame, traced: 4, elapsed: None }, tag)])
+    }
+
+    #[test]
+    fn an_animation_is_waited_for_while_it_loads_each_frame_and_no_longer_once_stopped() {
+        // A minute and a half to load each frame.
+        let (mut link, _) = played(|tag, message| match message {
+            Message::Hello if tag == 2 => at_once(frames(&[(board_info(), tag)])),
+            Message::Hello => at_once(frames(&[(Message::Stopped { frames: 2 }, tag - 1), (board_info(), tag)])),
+            _ => vec![
+                (Duration::ZERO, frames(&[(drawing_message(2), tag)])),
+                (seconds(90), whole_frame(0, tag)),
+                (seconds(90), whole_frame(1, tag)),
+            ],
+        });
+        // Tags 2, 3 and 4: the link's hello, the scene, the stopping hello.
+        link.last_tag = 1;
+        link.hello().unwrap();
+        let answer = link.draw(b"scene", true, 2, &mut |_| {}).unwrap();
+        assert!(matches!(answer, Answer::Played { ref frames, .. } if frames.len() == 2), "{answer:?}");
+        // A board that plays on after the hello: no progress, and bounded.
+        let chatter: Chatter = Rc::new(RefCell::new(None));
+        let after_hello = chatter.clone();
+        let mut port = played_port(move |tag, message| match message {
+            Message::Hello if tag == 2 => at_once(frames(&[(board_info(), tag)])),
+            Message::Hello => {
+                let run = frames(&[(Message::Run { y: 0, x: 0, width: 2, pixels: &PIXELS }, tag - 1)]);
+                *after_hello.borrow_mut() = Some((run, Duration::from_micros(100), seconds(3600)));
+                Vec::new()
+            }
+            _ => at_once([frames(&[(drawing_message(2), tag)]), whole_frame(0, tag)].concat()),
+        });
+        port.chatter = chatter;
+        let clock = port.clock.clone();
+        let mut link = BoardLink::new(port, None);
+        link.last_tag = 1;
+        link.hello().unwrap();
+        let said = link.draw(b"scene", true, 1, &mut |_| {}).unwrap_err().to_string();
+        assert!(said.ends_with("it played on for 10001 frames after the hello"), "{said}");
+        assert!(clock.get() < seconds(5), "{:?}", clock.get());
     }
 
     #[test]
     fn a_drawing_cut_short_by_another_host_is_said() {
-        let mut link = drawing_board(|tag| {
-            frames(&[
-                (Message::Drawing { panel: PANEL, pixels: true, frames: 0 }, tag),
-                (Message::Cancelled { rows: 0 }, tag),
-            ])
-        });
+        let (mut link, _) =
+            drawing_board(|tag| at_once(frames(&[(drawing_message(0), tag), (Message::Cancelled { rows: 0 }, tag)])));
         assert!(matches!(draw(&mut link), Err(LinkError::Cancelled { rows: 0 })));
     }
 
@@ -898,8 +1093,8 @@ mod tests {
     fn a_panel_beyond_the_protocols_limits_or_another_than_described_is_refused_before_anything_is_kept() {
         for (width, height) in [(0, 0), (0, 240), (Panel::MAX_SIDE + 1, 1), (65535, 65535)] {
             let panel = Panel { width, height, format: PixelFormat::Rgb565 };
-            let mut link = played(move |tag, _| {
-                frames(&[(
+            let (mut link, _) = played(move |tag, _| {
+                at_once(frames(&[(
                     Message::Board(octrace_link::BoardInfo {
                         panel,
                         max_scene: 100,
@@ -908,17 +1103,17 @@ mod tests {
                         capacities: octrace_link::Capacities::new(&[]),
                     }),
                     tag,
-                )])
+                )]))
             });
             let said = link.hello().unwrap_err().to_string();
             let want = format!("it describes a {width}x{height} panel; a panel's sides are 1 to 16384 pixels");
             assert!(said.ends_with(&want), "{said}");
             // A drawing at any panel but the one described.
-            let mut link = drawing_board(move |tag| {
-                frames(&[
+            let (mut link, _) = drawing_board(move |tag| {
+                at_once(frames(&[
                     (Message::Drawing { panel, pixels: true, frames: 0 }, tag),
                     (Message::Done(Timing::NONE), tag),
-                ])
+                ]))
             });
             let said = draw(&mut link).unwrap_err().to_string();
             let want = format!("it draws at {width}x{height} rgb565, but described a 2x2 rgb565 panel");
@@ -926,59 +1121,96 @@ mod tests {
         }
     }
 
-    /// A board that describes itself (as `info`), then answers a scene
-    /// with scene errors `message`, one every `every`, and never ends.
-    fn chatty_board(info: Message<'static>, message: &'static str, every: Duration) -> BoardLink<impl Port> {
-        let port = played_port(|_, _| Vec::new());
-        let chatter = port.chatter.clone();
+    /// A board that describes itself, then answers a scene with scene
+    /// errors `message`, one every `every`, and never ends; capped at `cap`.
+    fn chatty_board(
+        message: &'static str,
+        every: Duration,
+        cap: Option<Duration>,
+    ) -> (BoardLink<impl Port>, Rc<Cell<Duration>>) {
+        let chatter: Chatter = Rc::new(RefCell::new(None));
         let scene = chatter.clone();
         let mut port = played_port(move |tag, received| match received {
-            Message::Hello => frames(&[(info, tag)]),
+            Message::Hello => at_once(frames(&[(board_info(), tag)])),
             _ => {
                 let error = SceneError { line: 1, column: 1, capacity: None, message };
-                *scene.borrow_mut() = (frames(&[(Message::SceneError(error), tag)]), every, Instant::now());
+                *scene.borrow_mut() = Some((frames(&[(Message::SceneError(error), tag)]), every, seconds(1 << 20)));
                 Vec::new()
             }
         });
         port.chatter = chatter;
-        BoardLink::new(port, Duration::from_millis(300))
+        let clock = port.clock.clone();
+        (BoardLink::new(port, cap), clock)
     }
 
     #[test]
-    fn one_deadline_holds_across_a_board_that_keeps_sending_errors() {
-        let mut link = chatty_board(board_info(), "bad", Duration::from_millis(10));
-        let started = Instant::now();
-        link.hello().unwrap();
-        let said = link.draw("x\n".repeat(1000).as_bytes(), true, 1, &mut |_| {}).unwrap_err();
-        assert!(matches!(said, LinkError::Unfinished(_)), "{said}");
-        assert!(said.to_string().starts_with("the board's answer did not end within 0.3 s"), "{said}");
-        let took = started.elapsed();
-        assert!(took >= Duration::from_millis(300) && took < Duration::from_secs(1), "{took:?}");
-        // Faster than the deadline, more errors than the scene can have.
-        let mut link = chatty_board(board_info(), "bad", Duration::ZERO);
-        let said = link.draw("x\n".repeat(1000).as_bytes(), true, 1, &mut |_| {}).unwrap_err().to_string();
+    fn a_board_that_keeps_sending_errors_ends_by_their_count_the_silence_or_the_cap() {
+        let scene = "x\n".repeat(1000);
+        // Faster than the wait, more errors than the scene can have.
+        let (mut link, _) = chatty_board("bad", Duration::from_millis(10), None);
+        let said = link.draw(scene.as_bytes(), true, 1, &mut |_| {}).unwrap_err().to_string();
         assert!(said.ends_with("it sent more errors than a scene of 2000 bytes can have (1064)"), "{said}");
+        // Slower: errors move nothing on, so the load's two minutes end it.
+        let (mut link, clock) = chatty_board("bad", seconds(1), None);
+        link.hello().unwrap();
+        let sent = clock.get();
+        let said = link.draw(scene.as_bytes(), true, 1, &mut |_| {}).unwrap_err().to_string();
+        let want = "the board fell silent: nothing for 120 s after it took the scene \
+                    (a board loads a scene without a word), and 120 frames since that did not move it on";
+        assert_eq!(said, want);
+        assert!(clock.get() - sent <= seconds(120) + PORT_WAIT, "{:?}", clock.get() - sent);
+        // With a cap: at the cap.
+        let (mut link, clock) = chatty_board("bad", Duration::from_millis(10), Some(Duration::from_millis(300)));
+        let said = link.draw(scene.as_bytes(), true, 1, &mut |_| {}).unwrap_err();
+        assert!(matches!(said, LinkError::TimedOut(_)), "{said}");
+        assert_eq!(said.to_string(), "the board's answer did not end within 0.3 s (--timeout)");
+        assert!(clock.get() >= Duration::from_millis(300) && clock.get() <= Duration::from_millis(350));
         // An error longer than any of octrace's.
         let long: &'static str = "e".repeat(MAX_MESSAGE + 1).leak();
-        let mut link = chatty_board(board_info(), long, Duration::ZERO);
+        let (mut link, _) = chatty_board(long, Duration::ZERO, None);
         let said = link.draw(b"x", true, 1, &mut |_| {}).unwrap_err().to_string();
         assert!(said.ends_with("it sent an error message of 4097 bytes (octrace's are under 4096)"), "{said}");
     }
 
     #[test]
-    fn one_deadline_holds_for_writes_to_a_line_that_drains_slowly_or_not_at_all() {
-        // Nothing read for 100 ms, then a byte at a time: well within 1 s.
-        let mut port = played_port(|tag, _| frames(&[(board_info(), tag)]));
-        port.reads_from = Instant::now() + Duration::from_millis(100);
-        let mut link = BoardLink::new(port, Duration::from_secs(1));
-        assert_eq!(link.hello().unwrap().panel, PANEL);
-        // Nothing read at all: said when the deadline comes.
-        let mut port = played_port(|tag, _| frames(&[(board_info(), tag)]));
-        port.reads_from = Instant::now() + Duration::from_secs(3600);
-        let started = Instant::now();
-        let said = BoardLink::new(port, Duration::from_millis(200)).hello().unwrap_err();
-        assert!(said.to_string().starts_with("the board did not read what host-sim sent within 0.2 s"), "{said}");
-        assert!(started.elapsed() < Duration::from_secs(1), "{:?}", started.elapsed());
+    fn a_board_reading_slowly_is_waited_for_while_it_reads_and_not_when_it_stops() {
+        // A byte every 100 ms: the 1 KB scene takes nearly two minutes.
+        let scene = "x".repeat(1000);
+        let mut port = played_port(|tag, message| match message {
+            Message::Hello => at_once(frames(&[(board_info(), tag)])),
+            _ => at_once(frames(&[
+                (drawing_message(0), tag),
+                (row(0), tag),
+                (row(1), tag),
+                (Message::Done(Timing::NONE), tag),
+            ])),
+        });
+        port.byte_every = Duration::from_millis(100);
+        let clock = port.clock.clone();
+        let mut link = BoardLink::new(port, None);
+        assert!(draw_text(&mut link, &scene).is_ok());
+        assert!(clock.get() > seconds(100), "{:?}", clock.get());
+        // Nothing read at all: said 8 s after the port opened.
+        let mut port = played_port(|tag, _| at_once(frames(&[(board_info(), tag)])));
+        port.reads_from = seconds(3600);
+        let clock = port.clock.clone();
+        let said = BoardLink::new(port, None).hello().unwrap_err().to_string();
+        assert_eq!(
+            said,
+            "the board took nothing host-sim sent for 8 s, after the port was opened (is octrace's live firmware running there?)"
+        );
+        assert!(clock.get() >= seconds(8) && clock.get() <= seconds(8) + PORT_WAIT, "{:?}", clock.get());
+        // Half read, then nothing.
+        let port = played_port(|tag, _| at_once(frames(&[(board_info(), tag)])));
+        let mut link = BoardLink::new(port, None);
+        link.hello().unwrap();
+        link.port.reads_from = seconds(3600);
+        let said = link.draw(scene.as_bytes(), true, 1, &mut |_| {}).unwrap_err().to_string();
+        assert!(said.starts_with("the board took nothing host-sim sent for 8 s, after it described itself"), "{said}");
+    }
+
+    fn draw_text(link: &mut BoardLink<impl Port>, text: &str) -> Result<Answer, LinkError> {
+        link.draw(text.as_bytes(), true, 1, &mut |_| {})
     }
 
     #[test]
@@ -990,13 +1222,13 @@ mod tests {
             firmware: "\u{1b}[2Jfake\nhost-sim: ok",
             capacities: octrace_link::Capacities::new(&[octrace_link::Capacity { name: "\u{1b}[31m", count: 1 }]),
         });
-        let mut link = played(move |tag, message| match message {
-            Message::Hello => frames(&[(info, tag)]),
+        let (mut link, _) = played(move |tag, message| match message {
+            Message::Hello => at_once(frames(&[(info, tag)])),
             _ => {
                 let need = octrace_link::CapacityNeed { name: "\u{1b}[0m", needed: Some(2), holds: 1 };
                 let error =
                     SceneError { line: 1, column: 1, capacity: Some(need), message: "\u{1b}[1A\rline 1 is fine" };
-                frames(&[(Message::SceneError(error), tag), (Message::Rejected { errors: 1 }, tag)])
+                at_once(frames(&[(Message::SceneError(error), tag), (Message::Rejected { errors: 1 }, tag)]))
             }
         });
         let board = link.hello().unwrap();

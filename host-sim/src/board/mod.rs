@@ -4,17 +4,21 @@
 //! its own, its picture received, written and checked against host-sim's.
 //!
 //! Invariants: the conversation with the board (hello, the scene, its
-//! whole answer) ends within the timeout, and what the board says is
-//! checked as [`link`] says; the picture takes memory only as its rows
+//! whole answer) goes on while the board moves it on and ends when it
+//! stops doing so ([`patience`]), or at `--timeout` if given, and what the
+//! board says is checked as [`link`] says; the picture takes memory only as its rows
 //! arrive, never for a size the board only claims; `--check` passes only
 //! when every pixel of the panel was compared and each is host-sim's.
 
+mod answer;
 mod link;
+mod patience;
+mod port;
 
-pub use link::{
-    Answer, BoardDescription, BoardLink, BoardSceneError, BoardTiming, LinkError, PlayedFrame, Port, Progress,
-    SerialLine,
-};
+pub use answer::{Answer, BoardDescription, BoardSceneError, BoardTiming, PlayedFrame, Progress};
+pub use link::{BoardLink, LinkError};
+pub use patience::{LOADING, SILENCE};
+pub use port::{Port, SerialLine};
 
 use crate::arguments::{output_format, parse_format, same_file};
 use crate::exit::CliError;
@@ -32,11 +36,6 @@ use std::time::{Duration, Instant};
 
 // A panel the protocol allows is an image host-sim renders.
 const _: () = assert!(Panel::MAX_SIDE as u32 == octrace_core::scene::MAX_SIDE);
-
-/// The seconds a conversation with a board may take unless told otherwise
-/// (`--timeout`, the studio's `--board-timeout`): sixty times what a Pico
-/// takes for the thesis's scenes, and room for an emulated one.
-pub(crate) const DEFAULT_TIMEOUT: u64 = 120;
 
 /// The frames of an animation `host-sim board` follows (and checks) unless
 /// told otherwise (`--frames`): the first, which traces every pixel, and
@@ -60,11 +59,14 @@ pub struct BoardArgs {
     /// rgb565`): says "bit-identical", or how many pixels differ (exit 3).
     #[arg(long)]
     pub check: bool,
-    /// Seconds the whole conversation with the board may take: its hello,
-    /// sending the scene, and its answer (every error, or every row of the
-    /// drawing).
-    #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_TIMEOUT, value_parser = clap::value_parser!(u64).range(1..=86_400))]
-    pub timeout: u64,
+    /// Seconds the whole conversation with the board may take at most: its
+    /// hello, sending the scene, and its answer (every error, or every row
+    /// of the drawing). Without it, a board is followed as long as it
+    /// keeps drawing (rows, runs, or its word that it is still working),
+    /// and given up when it says nothing for 8 s (120 s while it loads a
+    /// scene).
+    #[arg(long, value_name = "SECONDS", value_parser = clap::value_parser!(u64).range(1..=86_400))]
+    pub timeout: Option<u64>,
     /// Of an animation (a scene with FRAMES), the frames to follow before
     /// stopping the board with a hello: OUT gets the last of them, and
     /// --check compares each with `host-sim SCENE --frame K` at the
@@ -142,7 +144,7 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
     }
     let port = first.display().to_string();
     let out = args.out.as_ref();
-    let timeout = Duration::from_secs(args.timeout);
+    let timeout = args.timeout.map(Duration::from_secs);
     let Some(scene) = &args.scene else {
         let mut link = BoardLink::open(&port, timeout).map_err(|e| link_error(&port, e))?;
         let board = link.hello().map_err(|e| link_error(&port, e))?;
@@ -172,7 +174,7 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
                 bar.inc(1);
             }
         }
-        Progress::Run { .. } => {}
+        Progress::Run { .. } | Progress::Working { .. } => {}
     });
     if let Some(bar) = &bar {
         bar.finish_and_clear();
@@ -303,11 +305,11 @@ pub(crate) enum Sent {
 /// Sends scene `text` (named `file` in errors) to the board at `port`,
 /// after its hello and a check of the scene's length against what it
 /// takes, and follows the drawing (an animation for `follow` frames),
-/// handing each step to `progress`; all of it within `timeout`.
+/// handing each step to `progress`; all of it within `timeout`, if given.
 /// `host-sim board` and the studio send through this.
 pub(crate) fn send_scene(
     port: &str,
-    timeout: Duration,
+    timeout: Option<Duration>,
     file: &str,
     text: &[u8],
     pixels: bool,
@@ -353,6 +355,7 @@ pub(crate) fn send_scene(
                 }
             }
             Progress::FrameDrawn(frame) => pictures.push((*frame, pixels.then(|| picture(&rows, board.panel)))),
+            Progress::Working { .. } => {}
         }
         progress(step);
     });

@@ -4,27 +4,36 @@
 //! and verdict; `GET /board` names the board and how far its drawing is.
 //!
 //! Invariants: one send at a time (another is refused as busy, never
-//! queued, so two never interleave on the port); the errors are the
-//! board's, at the line and column it gave; the verdict is the count of
-//! pixels that differ from host-sim's render at the board's panel size.
+//! queued, so two never interleave on the port); a send waits for the
+//! board as `host-sim board` does (as long as it keeps drawing, or says it
+//! is still working; given up when it falls silent; capped only by
+//! `--board-timeout`); the errors are the board's, at the line and column
+//! it gave; the verdict is the count of pixels that differ from host-sim's
+//! render at the board's panel size.
 
 use super::http::Response;
 use crate::board::{differing_pixels, send_scene, BoardTiming, Progress, Sent};
 use crate::exit::CliError;
-use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 /// The board the studio sends to, and its send under way.
 pub(crate) struct BoardSender {
     port: String,
-    /// The longest a send may take, answer included.
-    timeout: Duration,
+    /// The longest a send may take, answer included, if capped.
+    timeout: Option<Duration>,
     /// Whether a send is under way; set and cleared by [`Claim`].
     busy: AtomicBool,
     /// The drawing under way (or the last): rows received, of how many.
     rows: AtomicU32,
     height: AtomicU32,
+    /// When the board last said it was still working: milliseconds into
+    /// the drawing by its clock ([`NOT_WORKING`]: not in this drawing).
+    working_ms: AtomicU64,
 }
+
+/// `working_ms` of a drawing the board has not said it is working on.
+const NOT_WORKING: u64 = u64::MAX;
 
 /// A send's hold on the board, let go when dropped (a failed send too).
 struct Claim<'a>(&'a AtomicBool);
@@ -36,18 +45,31 @@ impl Drop for Claim<'_> {
 }
 
 impl BoardSender {
-    pub(crate) fn new(port: String, timeout: Duration) -> BoardSender {
-        BoardSender { port, timeout, busy: AtomicBool::new(false), rows: AtomicU32::new(0), height: AtomicU32::new(0) }
+    pub(crate) fn new(port: String, timeout: Option<Duration>) -> BoardSender {
+        BoardSender {
+            port,
+            timeout,
+            busy: AtomicBool::new(false),
+            rows: AtomicU32::new(0),
+            height: AtomicU32::new(0),
+            working_ms: AtomicU64::new(NOT_WORKING),
+        }
     }
 
     pub(crate) fn port(&self) -> &str {
         &self.port
     }
 
-    /// `GET /board`: the port, whether a send is under way, its rows.
+    /// `GET /board`: the port, whether a send is under way, its rows, and
+    /// when the board last said it was still working (seconds into the
+    /// drawing by its clock, or null).
     pub(crate) fn status(&self) -> Response {
+        let working = match self.working_ms.load(Ordering::SeqCst) {
+            NOT_WORKING => "null".to_string(),
+            ms => format!("{:.3}", ms as f64 / 1000.0),
+        };
         let body = format!(
-            "{{\"port\":{},\"busy\":{},\"rows\":{},\"height\":{}}}",
+            "{{\"port\":{},\"busy\":{},\"rows\":{},\"height\":{},\"working\":{working}}}",
             json_string(&self.port),
             self.busy.load(Ordering::SeqCst),
             self.rows.load(Ordering::SeqCst),
@@ -71,6 +93,7 @@ impl BoardSender {
         let _claim = Claim(&self.busy);
         self.rows.store(0, Ordering::SeqCst);
         self.height.store(0, Ordering::SeqCst);
+        self.working_ms.store(NOT_WORKING, Ordering::SeqCst);
         let started = Instant::now();
         // An animation: its first frame (the scene as a still), then the
         // board is stopped.
@@ -82,6 +105,10 @@ impl BoardSender {
                 self.rows.fetch_add(1, Ordering::SeqCst);
             }
             Progress::FrameDrawn(_) => self.rows.store(self.height.load(Ordering::SeqCst), Ordering::SeqCst),
+            Progress::Working { elapsed } => {
+                let ms = elapsed.map_or(0, |t| u64::try_from(t.as_millis()).unwrap_or(u64::MAX));
+                self.working_ms.store(ms.min(NOT_WORKING - 1), Ordering::SeqCst);
+            }
             Progress::Run { .. } => {}
         });
         let sent = sent.map(|sent| match sent {

@@ -50,10 +50,13 @@ pub struct StudioArgs {
     /// whether it is host-sim's).
     #[arg(long, value_name = "PORT")]
     pub board: Option<PathBuf>,
-    /// Seconds a send may take: the board's hello, the scene, and its
-    /// answer (every error, or every row of the drawing).
-    #[arg(long, value_name = "SECONDS", default_value_t = crate::board::DEFAULT_TIMEOUT, value_parser = clap::value_parser!(u64).range(1..=86_400))]
-    pub board_timeout: u64,
+    /// Seconds a send may take at most: the board's hello, the scene, and
+    /// its answer (every error, or every row of the drawing). Without it,
+    /// as `host-sim board`: a board is followed as long as it keeps
+    /// drawing, and given up when it says nothing for 8 s (120 s while it
+    /// loads a scene).
+    #[arg(long, value_name = "SECONDS", value_parser = clap::value_parser!(u64).range(1..=86_400))]
+    pub board_timeout: Option<u64>,
 }
 
 /// The page, its script and style, and the WebAssembly module, built into
@@ -105,7 +108,7 @@ pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) ->
     let board = match &args.board {
         None => None,
         Some(port) if crate::board::is_port(port) => {
-            Some(BoardSender::new(port.display().to_string(), Duration::from_secs(args.board_timeout)))
+            Some(BoardSender::new(port.display().to_string(), args.board_timeout.map(Duration::from_secs)))
         }
         Some(port) => {
             let _ = writeln!(stderr, "host-sim studio: the serial ports:");

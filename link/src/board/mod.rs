@@ -12,7 +12,8 @@
 //! [`Message::Rejected`], or a [`Message::Drawing`] whose [`Drawing`] is
 //! closed by [`Drawing::finish`] or [`Drawing::cancel`] (an animation's
 //! frames, each closed by a [`Message::FrameDrawn`], by a
-//! [`Message::Stopped`]) — all with the frame's tag; a scene with errors
+//! [`Message::Stopped`]; a [`Message::Working`] wherever a drawing has
+//! sent nothing for a while) — all with the frame's tag; a scene with errors
 //! draws nothing, nor does an animation its room cannot hold.
 //!
 //! A firmware's loop, on one core (`Usb` stands for its serial port and
@@ -76,7 +77,8 @@ use play::saturate;
 pub use play::{AnimationRoom, Playing, TILE};
 pub use ring::Ring;
 pub use serve::{
-    Line, Link, Rows, Served, Stalled, MAX_COUNTERS, POLL_PERIOD_US, SLOWEST_HOST_BYTES_PER_SECOND, STALL_GRACE_US,
+    Line, Link, Rows, Served, Stalled, KEEP_ALIVE_US, MAX_COUNTERS, POLL_PERIOD_US, SLOWEST_HOST_BYTES_PER_SECOND,
+    STALL_GRACE_US,
 };
 
 use crate::cobs::Sink;

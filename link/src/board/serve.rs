@@ -18,6 +18,10 @@
 //!   next answer starts whole. A slow host cannot pace a drawing by more;
 //! - a drawing goes on when its host stops taking rows (the panel shows the
 //!   picture); only a frame from the host stops it;
+//! - a drawing that has sent the host nothing for [`KEEP_ALIVE_US`] of the
+//!   board's clock sends `working` at its next look at the line (every
+//!   [`POLL_PERIOD_US`], between rays), so the host hears from a board at
+//!   work at least that often, however long a pixel takes;
 //! - an animation plays until a byte comes from the host (its text is the
 //!   frame the decoder holds, which the next frame's bytes overwrite); each
 //!   frame is loaded from that text, planned, drawn and closed by
@@ -52,6 +56,17 @@ pub const STALL_GRACE_US: u64 = 1_000_000;
 /// nothing it can measure, and a frame stops it within a millisecond and a
 /// ray.
 pub const POLL_PERIOD_US: u64 = 1_000;
+
+/// The longest a drawing goes without a word to the host, by the board's
+/// clock: 40 ms. A drawing that has sent nothing (no row, no run) for this
+/// long sends [`Message::Working`] at its next look at the line, so that a
+/// host can tell a board at work on a pixel of hours from one that is gone
+/// within seconds (docs/board-protocol.md, Timing), even on an emulated
+/// board a hundred times slower than a Pico. A drawing whose rows come
+/// more often sends none: the live firmware's rows of fig5_1 come within
+/// it on both cores (at 20 ms it sent 56 `working`s there, 0.5 % of the
+/// picture's time), fig5_3's all but one.
+pub const KEEP_ALIVE_US: u64 = 40_000;
 
 /// The slowest a host may take an answer and still get all of it: 16 KiB a
 /// second (a USB full-speed port takes a megabyte; a drawing's rows with
@@ -199,7 +214,7 @@ impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
         let (mut load_counts, mut render_counts) = ([0; MAX_COUNTERS], [0; MAX_COUNTERS]);
         line.take_counts(&mut load_counts[..names.len()]);
         let start = line.now_us();
-        let mut output = Output { line, waited_us: 0, taken: 0, stalled: false };
+        let mut output = Output { line, waited_us: 0, taken: 0, stalled: false, keep_alive: None };
         // There: a frame just ended, or ended while the last scene was drawn
         // and nothing was pushed since.
         let received = self.decoder.received()?;
@@ -208,11 +223,13 @@ impl<'a, B: AsRef<[u8]> + AsMut<[u8]>> Link<'a, B> {
             Err(Stalled) => return Some(Served::Stalled),
             Ok(Some(drawing)) => drawing,
         };
+        let loaded = output.line.now_us();
+        output.keep_alive =
+            Some(KeepAlive { tag: drawing.tag, since_us: start, spoke_at_us: loaded, spoken: output.taken });
         if let Some(frames) = play::animated(drawing.scene()) {
             let (tag, pixels) = (drawing.tag, drawing.pixels);
             return Some(self.play(&mut output, raytracer, frames, tag, pixels, &mut draw));
         }
-        let loaded = output.line.now_us();
         output.line.take_counts(&mut load_counts[..names.len()]);
         let mut rows = Rows { output: &mut output, listener: self.listener(false), read_at_us: start };
         let drawn = draw(&drawing, &mut rows).min(drawing.panel().height);
@@ -345,8 +362,9 @@ impl<L: Line, B: AsRef<[u8]> + AsMut<[u8]>> Rows<'_, '_, L, B> {
     /// answered next): a frame that ended, or for an animation any byte.
     /// Asked before every ray on the core that owns the line (as a
     /// [`Stop`](octrace_core::render::Stop)). Every [`POLL_PERIOD_US`] at
-    /// most it reads what the host has sent, and tells the [`Line`] the
-    /// board is [alive](Line::alive); between, it only reads the clock.
+    /// most it reads what the host has sent, tells the [`Line`] the board
+    /// is [alive](Line::alive), and tells the host so too when it has sent
+    /// nothing for [`KEEP_ALIVE_US`]; between, it only reads the clock.
     pub fn poll(&mut self) -> bool {
         let now = self.output.line.now_us();
         if self.listener.stops() || now.wrapping_sub(self.read_at_us) < POLL_PERIOD_US {
@@ -354,7 +372,38 @@ impl<L: Line, B: AsRef<[u8]> + AsMut<[u8]>> Rows<'_, '_, L, B> {
         }
         self.read_at_us = now;
         self.output.line.alive();
-        self.listener.take(self.output.line)
+        if self.listener.take(self.output.line) {
+            return true;
+        }
+        self.keep_alive(now);
+        self.listener.stops()
+    }
+
+    /// Sends `working` if the line has taken nothing of the answer for
+    /// [`KEEP_ALIVE_US`] (`now`: the clock at this look at the line). Kept
+    /// out of [`Rows::poll`], which a drawing asks before every ray: the
+    /// ask stays as small as it was (asked once a millisecond, this costs
+    /// a call).
+    #[inline(never)]
+    fn keep_alive(&mut self, now: u64) {
+        let taken = self.output.taken;
+        let Some(alive) = &mut self.output.keep_alive else { return };
+        if alive.spoken != taken {
+            (alive.spoken, alive.spoke_at_us) = (taken, now);
+            return;
+        }
+        if now.wrapping_sub(alive.spoke_at_us) < KEEP_ALIVE_US {
+            return;
+        }
+        alive.spoke_at_us = now;
+        let (tag, elapsed) = (alive.tag, Duration::from_micros(now.saturating_sub(alive.since_us)));
+        let mut polled = Polled { output: self.output, listener: &mut self.listener };
+        // Not taken: the host has stopped reading, and gets no more of the answer.
+        let _ = Message::Working { elapsed: Some(elapsed) }.encode(tag, &mut polled);
+        let taken = self.output.taken;
+        if let Some(alive) = &mut self.output.keep_alive {
+            alive.spoken = taken;
+        }
     }
 
     /// Sends row `y` of `drawing`, its pixels `row` (the panel's width of
@@ -506,6 +555,22 @@ struct Output<'l, L> {
     waited_us: u64,
     taken: u64,
     stalled: bool,
+    /// While a drawing is answered: what it needs to tell the host it is
+    /// still at work ([`Rows::poll`]).
+    keep_alive: Option<KeepAlive>,
+}
+
+/// A drawing's word to the host when it has sent nothing for a while.
+#[derive(Clone, Copy, Debug)]
+struct KeepAlive {
+    /// The drawing's request.
+    tag: u16,
+    /// When the request came, by the board's clock.
+    since_us: u64,
+    /// When the answer last grew (or the drawing began), as seen at a look
+    /// at the line, and how many bytes the line had taken of it then.
+    spoke_at_us: u64,
+    spoken: u64,
 }
 
 impl<L: Line> Output<'_, L> {
@@ -603,6 +668,8 @@ mod tests {
         polls: u32,
         ring: VecDeque<u8>,
         received: Vec<u8>,
+        /// The clock when each byte of `received` reached the host.
+        received_at: Vec<u64>,
         bytes_per_second: Option<u64>,
         clock_us: u64,
         /// When the host last took a byte (its pace).
@@ -620,6 +687,7 @@ mod tests {
                 polls: 0,
                 ring: VecDeque::new(),
                 received: Vec::new(),
+                received_at: Vec::new(),
                 bytes_per_second: None,
                 clock_us: 0,
                 taken_at_us: 0,
@@ -635,6 +703,7 @@ mod tests {
         }
 
         fn host_reads(&mut self) {
+            let before = self.received.len();
             match self.bytes_per_second {
                 None => self.received.extend(self.ring.drain(..)),
                 Some(rate) => {
@@ -643,6 +712,20 @@ mod tests {
                         self.received.extend(self.ring.pop_front());
                         self.taken_at_us = self.clock_us;
                     }
+                }
+            }
+            self.received_at.resize(self.received.len().max(before), self.clock_us);
+        }
+
+        /// Every frame the host received: its tag, its message's kind, the
+        /// message, and the clock when its last byte came.
+        fn frames(&mut self, mut each: impl FnMut(u16, Message<'_>, u64)) {
+            self.host_reads();
+            let mut decoder = Decoder::for_host(std::vec![0u8; 4096]);
+            for (&byte, &at) in self.received.iter().zip(&self.received_at) {
+                if let Some(frame) = decoder.push(byte) {
+                    let frame = frame.expect("the board's frames read");
+                    each(frame.tag, frame.message, at);
                 }
             }
         }
@@ -678,6 +761,10 @@ mod tests {
             self.host_reads();
             let taken = bytes.len().min(48 - self.ring.len());
             self.ring.extend(&bytes[..taken]);
+            // A host that takes at once has it now.
+            if self.bytes_per_second.is_none() {
+                self.host_reads();
+            }
             taken
         }
 
@@ -749,7 +836,9 @@ mod tests {
         wire.send(50, Message::Hello, 2);
         let served = serve_all(&mut wire);
         assert_eq!(served, [Served::Drawn { rows: 0 }, Served::Answered]);
-        assert_eq!(wire.answers(), [(1, Kind::Drawing), (1, Kind::Cancelled), (2, Kind::Board)]);
+        // The board said it was working while it traced (50 ms): see below.
+        let answers: Vec<_> = wire.answers().into_iter().filter(|&answer| answer != (1, Kind::Working)).collect();
+        assert_eq!(answers, [(1, Kind::Drawing), (1, Kind::Cancelled), (2, Kind::Board)]);
         // The hello was read at the first poll that could: after it, only
         // the two answers' writes through the 48-byte ring (a pixel of this
         // scene is millions of polls).
@@ -869,7 +958,7 @@ mod tests {
         assert_eq!(served[1..], [Served::Answered]);
         wire.host_reads();
         let mut decoder = Decoder::for_host(std::vec![0u8; 4096]);
-        let (mut drawn, mut runs) = (Vec::new(), 0);
+        let (mut drawn, mut runs, mut stopped) = (Vec::new(), 0, None);
         let mut kinds = Vec::new();
         for &byte in &wire.received {
             let Some(frame) = decoder.push(byte) else { continue };
@@ -877,11 +966,18 @@ mod tests {
             match frame.message {
                 Message::FrameDrawn { frame, traced, .. } => drawn.push((frame, traced)),
                 Message::Run { .. } => runs += 1,
+                Message::Stopped { frames } => {
+                    stopped = Some(frames);
+                    kinds.push((frame.tag, Kind::Stopped));
+                }
                 other => kinds.push((frame.tag, other.kind())),
             }
         }
         assert_eq!(kinds, [(1, Kind::Drawing), (1, Kind::Stopped), (2, Kind::Board)]);
         assert_eq!(drawn.len() as u32, frames);
+        // `stopped` counts the frames drawn whole, not the frame it was at
+        // (past the loop's end, the two differ).
+        assert_eq!(stopped, Some(frames), "stopped after {frames} frames drawn");
         let order: Vec<u32> = drawn.iter().map(|&(frame, _)| frame).collect();
         assert_eq!(order[..4], [0, 1, 2, 0], "the loop's order");
         // The first frame traces every pixel: a 4x3 panel is one tile.
@@ -907,5 +1003,84 @@ mod tests {
         let holds = |name: &str, needed| (name.to_string(), Some(needed), 0);
         assert_eq!(named, [holds("tiles", 1), holds("tracks", 1), holds("keys", 2), holds("displacements", 3)]);
         assert_eq!(wire.answers().last(), Some(&(1, Kind::Rejected)));
+    }
+
+    #[test]
+    fn a_drawing_that_sends_nothing_says_it_is_working_every_keep_alive_period_and_no_more() {
+        let mut wire = Wire::new();
+        wire.send(0, Message::Scene { pixels: false, text: WEDGING }, 1);
+        // Long inside the first pixel.
+        wire.send(1_000, Message::Hello, 2);
+        assert_eq!(serve_all(&mut wire), [Served::Drawn { rows: 0 }, Served::Answered]);
+        let mut heard = Vec::new();
+        wire.frames(|tag, message, at| {
+            let elapsed = match message {
+                Message::Working { elapsed } => elapsed,
+                _ => None,
+            };
+            heard.push((tag, message.kind(), at, elapsed));
+        });
+        let kinds: Vec<(u16, Kind)> = heard.iter().map(|&(tag, kind, ..)| (tag, kind)).collect();
+        let working = kinds.iter().filter(|&&kind| kind == (1, Kind::Working)).count();
+        assert_eq!(kinds[0], (1, Kind::Drawing));
+        assert!(kinds[1..=working].iter().all(|&kind| kind == (1, Kind::Working)), "{kinds:?}");
+        assert_eq!(kinds[working + 1..], [(1, Kind::Cancelled), (2, Kind::Board)]);
+        // From `drawing` to `cancelled`, the host never waited more than the
+        // protocol's 40 ms and one look at the line (and a ray: 100 µs on
+        // this clock), nor heard `working` more often than the period.
+        let promised_us = 40_000;
+        assert!(include_str!("../../../docs/board-protocol.md").contains("every 40 ms of its clock"));
+        for pair in heard[..working + 2].windows(2) {
+            let gap = pair[1].2 - pair[0].2;
+            assert!(gap <= promised_us + POLL_PERIOD_US + 200, "{gap} µs without a word: {:?}", pair[1]);
+            if pair[1].1 == Kind::Working {
+                assert!(gap >= KEEP_ALIVE_US, "working after {gap} µs: {:?}", pair[1]);
+            }
+        }
+        assert!(working >= 10, "{working} times working");
+        // Each says how long the board has been at the request, by its clock.
+        let elapsed: Vec<Duration> = heard.iter().filter_map(|&(.., elapsed)| elapsed).collect();
+        assert_eq!(elapsed.len(), working);
+        assert!(elapsed.windows(2).all(|pair| pair[1] >= pair[0] + Duration::from_micros(KEEP_ALIVE_US)));
+    }
+
+    /// [`ANIMATION`]'s room, with a scene whose every pixel takes hours:
+    /// the wedging scene with a light that moves.
+    const WEDGING_ANIMATION: &[u8] = b"FRAMES 2\nVIEWPOINT 0 0 0 ORIGIN 0 0 -1 RDEPTH 1000000 SAMPLES 16\n\
+        LIGHT 1 0 1 0 MOVE 0 0 0 0  1 0 1 1\nLIGHT 1 0 -1 0\n\
+        RECTANGLE 1 -5 -5 -3 5 -5 -3 5 5 -3 -5 5 -3\n\
+        RECTANGLE 1 -5 -5 3 -5 5 3 5 5 3 5 -5 3\n\
+        SURFACE 1 0.01 0.01 0.01 0.1 0.1 0.1 0 0 0 0 1 0\n";
+
+    #[test]
+    fn a_stray_byte_stops_an_animations_frame_inside_its_pixel_and_no_run_cut_short_goes_out() {
+        let mut wire = Wire::new();
+        wire.send(0, Message::Scene { pixels: true, text: WEDGING_ANIMATION }, 1);
+        // One byte that ends no frame, 50 ms into the first pixel; a hello
+        // (whose opening delimiter would end that byte's frame, stopping
+        // any drawing) 10 s of the board's clock later.
+        wire.sent.push_back((50, std::vec![b'x']));
+        wire.send(10_000, Message::Hello, 2);
+        let served = play_all(&mut wire);
+        assert_eq!(served[0], Served::Played { frames: 0 }, "{served:?}");
+        let mut heard = Vec::new();
+        wire.frames(|tag, message, _| {
+            let width = match message {
+                Message::Run { width, .. } => Some(width),
+                _ => None,
+            };
+            heard.push((tag, message.kind(), width));
+        });
+        let stop = heard.iter().position(|&(_, kind, _)| kind == Kind::Stopped).expect("stopped");
+        // No run of the frame went out: the stray byte came in its first
+        // pixel, and a run cut short is not sent.
+        let runs: Vec<_> = heard.iter().filter(|&&(_, kind, _)| kind == Kind::Run).collect();
+        assert!(runs.is_empty(), "runs sent: {runs:?}");
+        // Stopped at the byte, not at the hello: within a look at the line
+        // of it, so after no more than the `working`s of its first 50 ms.
+        let working = heard[..stop].iter().filter(|&&(_, kind, _)| kind == Kind::Working).count();
+        assert!(working <= 3, "stopped after {working} times working: not at the stray byte");
+        assert_eq!(heard[stop].0, 1);
+        assert_eq!(heard.last().map(|&(tag, kind, _)| (tag, kind)), Some((2, Kind::Board)));
     }
 }

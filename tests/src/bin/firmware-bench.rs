@@ -12,15 +12,13 @@
 //! nearest level (the same render and the same byte a pixel to the display,
 //! so the difference is the method's).
 //!
-//! `qemu-count` is `$OCTRACE_QEMU_COUNT`, else `../shared/tools/qemu-count`
-//! beside the repository. Counts are instructions, exact and repeatable, not
-//! cycles of a real chip.
+//! The counter is `firmware/tools/qemu-count` (or the program
+//! `$OCTRACE_QEMU_COUNT` names). Counts are instructions, exact and
+//! repeatable, not cycles of a real chip.
 
 use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
-use octrace_tests::firmware::{Board, Firmware};
-use octrace_tests::repo;
-use std::path::PathBuf;
+use octrace_tests::firmware::{qemu_count, Board, Firmware};
 
 fn main() {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
@@ -39,9 +37,7 @@ fn main() {
     };
     let default_scenes: &[&str] = if panels { &["fig5_1"] } else { &["fig5_1", "fig5_3"] };
     let scenes = if args.is_empty() { default_scenes.iter().map(|s| s.to_string()).collect() } else { args };
-    let qemu_count = std::env::var_os("OCTRACE_QEMU_COUNT")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| repo().join("../shared/tools/qemu-count"));
+    let qemu_count = qemu_count();
     if panels {
         return panels_table(&scenes, (width, height), &qemu_count);
     }

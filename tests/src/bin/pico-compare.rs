@@ -15,7 +15,7 @@
 //! Markdown: paste it into an issue of the repository (the template's
 //! README says how).
 
-use octrace_tests::pico::{self, Build, Report, Template, CLOCK_HZ};
+use octrace_tests::pico::{self, Build, Report, Template};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -83,7 +83,11 @@ fn main() {
         }
     }
     println!();
-    println!("Both at {:.0} MHz; the emulator is `emulator/` of this repository at its commit.", CLOCK_HZ / 1e6);
+    let clocks: Vec<String> = rows.iter().map(|row| format!("{:.0} MHz", row.cycles.clock_hz / 1e6)).collect();
+    println!(
+        "Both at the clock the firmware sets ({}); the emulator is `emulator/` of this repository at its commit.",
+        clocks.first().map_or("none run", String::as_str)
+    );
 }
 
 fn contested(report: &Report) -> u64 {

@@ -12,15 +12,21 @@
 //! It prints `serial: PATH`, the device a host opens, then serves until its
 //! standard input closes; its lines are the tests' commands, answered on
 //! standard output as the emulated Pico answers them (`hold`, `release`,
-//! `times`, `panel PATH`: see `octrace_tests::board`), the times by this
-//! process's clock, and no watchdog. Defaults: Board64K, the Pico template's 240×240
+//! `times`, `panel PATH`: see `octrace_tests::board`), the times by the
+//! board's own clock, and no watchdog. Its clock counts the time it works
+//! (its process's CPU time) and the time it waits on purpose (for the
+//! host's bytes, for room to send), not the time this machine gives other
+//! programs: as an emulated board's clock counts its cycles, so that what
+//! a test measures by it does not depend on how busy the machine is. Defaults: Board64K, the Pico template's 240×240
 //! RGB565 panel, scenes of up to 16,384 bytes.
 //!
 //! `--misbehave` makes it a hostile board, for the tests of what a host
-//! does with one ([`Misbehaviour`]): `draws-at:WxH`, `wrong-pixel`,
-//! `errors-every:MS`, `reads-slowly`, `escapes`.
+//! does with one ([`Misbehaviour`]): `draws-at:WxH`, `wrong-pixel` (or
+//! `wrong-pixel:red`, `:green`, `:blue`), `errors-every:MS`,
+//! `reads-slowly`, `escapes`.
 
-use embedded_graphics_core::pixelcolor::{Rgb565, RgbColor};
+use embedded_graphics_core::pixelcolor::raw::RawU16;
+use embedded_graphics_core::pixelcolor::{IntoStorage, Rgb565, RgbColor};
 use octrace_core::accel::Mailbox;
 use octrace_core::animation::{Coherence, Key, Track};
 use octrace_core::profile::{Board16K, Board64K, Host, Profile};
@@ -52,8 +58,9 @@ enum Misbehaviour {
     /// Answers every scene with `drawing` at this panel (not the one its
     /// hello describes), then `done`, without a row.
     DrawsAt { width: u16, height: u16 },
-    /// Draws every scene with its first pixel of another colour.
-    WrongPixel,
+    /// Draws every scene with its first pixel of another colour: in every
+    /// channel (None), or in one alone (its lowest bit).
+    WrongPixel(Option<Channel>),
     /// Answers every scene with scene errors, one every this many
     /// milliseconds, never closed by `rejected`.
     ErrorsEvery(u64),
@@ -63,6 +70,26 @@ enum Misbehaviour {
     /// Its firmware's name and its answer to every scene (one error) carry
     /// terminal escapes.
     Escapes,
+}
+
+/// A channel of an RGB565 pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Channel {
+    Red,
+    Green,
+    Blue,
+}
+
+impl Channel {
+    /// `pixel` with this channel's lowest bit flipped.
+    fn flip(self, pixel: Rgb565) -> Rgb565 {
+        let bit = match self {
+            Channel::Red => 1 << 11,
+            Channel::Green => 1 << 5,
+            Channel::Blue => 1,
+        };
+        Rgb565::from(RawU16::new(pixel.into_storage() ^ bit))
+    }
 }
 
 impl Misbehaviour {
@@ -79,14 +106,20 @@ impl Misbehaviour {
             Some(("errors-every", ms)) => {
                 Misbehaviour::ErrorsEvery(ms.parse().map_err(|e| format!("--misbehave {text}: {e}"))?)
             }
+            Some(("wrong-pixel", channel)) => Misbehaviour::WrongPixel(Some(match channel {
+                "red" => Channel::Red,
+                "green" => Channel::Green,
+                "blue" => Channel::Blue,
+                _ => return Err(format!("--misbehave {text}: wrong-pixel:red, :green or :blue")),
+            })),
             _ => match text {
-                "wrong-pixel" => Misbehaviour::WrongPixel,
+                "wrong-pixel" => Misbehaviour::WrongPixel(None),
                 "reads-slowly" => Misbehaviour::ReadsSlowly,
                 "escapes" => Misbehaviour::Escapes,
                 _ => {
                     return Err(format!(
-                        "--misbehave {text}: draws-at:WxH, wrong-pixel, errors-every:MS, reads-slowly or escapes"
-                    ))
+                    "--misbehave {text}: draws-at:WxH, wrong-pixel[:CHANNEL], errors-every:MS, reads-slowly or escapes"
+                ))
                 }
             },
         })
@@ -108,7 +141,7 @@ impl Misbehaviour {
                 // is dropped: a frame's opening delimiter, which a decoder
                 // that ended its last frame does without), or goes.
                 while line.read().is_none() && send(Message::SceneError(error), line) {
-                    std::thread::sleep(Duration::from_millis(ms));
+                    line.controls.clone().waiting(|| std::thread::sleep(Duration::from_millis(ms)));
                 }
             }
             Misbehaviour::Escapes => {
@@ -116,7 +149,7 @@ impl Misbehaviour {
                 let error = SceneError { line: 1, column: 1, capacity: None, message };
                 let _ = send(Message::SceneError(error), line) && send(Message::Rejected { errors: 1 }, line);
             }
-            Misbehaviour::WrongPixel | Misbehaviour::ReadsSlowly => return false,
+            Misbehaviour::WrongPixel(_) | Misbehaviour::ReadsSlowly => return false,
         }
         true
     }
@@ -152,6 +185,9 @@ fn options() -> Result<Options, String> {
 /// What the tests' commands see and set, shared with the board's loop.
 struct Controls {
     started: Instant,
+    /// The board's waits on purpose: their total in µs, and when the one
+    /// under way began (µs since `started`).
+    waits: Mutex<(u64, Option<u64>)>,
     /// The host takes nothing the board sends.
     hold: AtomicBool,
     /// When the host last handed the board bytes, and when the board last
@@ -167,8 +203,29 @@ struct Controls {
 }
 
 impl Controls {
+    /// The board's clock, in µs: the process's CPU time and the board's
+    /// waits on purpose.
     fn now_us(&self) -> u64 {
+        let cpu = rustix::time::clock_gettime(rustix::time::ClockId::ProcessCPUTime);
+        let cpu_us = cpu.tv_sec as u64 * 1_000_000 + cpu.tv_nsec as u64 / 1_000;
+        let (waited, since) = *self.waits.lock().unwrap_or_else(|e| e.into_inner());
+        cpu_us + waited + since.map_or(0, |since| self.wall_us().saturating_sub(since))
+    }
+
+    /// µs since the board started, by this machine's clock.
+    fn wall_us(&self) -> u64 {
         self.started.elapsed().as_micros() as u64
+    }
+
+    /// Runs `wait`, a wait of the board's on purpose, its time counted on
+    /// the board's clock.
+    fn waiting<T>(&self, wait: impl FnOnce() -> T) -> T {
+        let began = self.wall_us();
+        self.waits.lock().unwrap_or_else(|e| e.into_inner()).1 = Some(began);
+        let result = wait();
+        let mut waits = self.waits.lock().unwrap_or_else(|e| e.into_inner());
+        *waits = (waits.0 + self.wall_us().saturating_sub(began), None);
+        result
     }
 
     /// The answer to one command line.
@@ -271,7 +328,7 @@ impl Line for Pty {
 
     fn write(&mut self, bytes: &[u8]) -> usize {
         if self.controls.hold.load(Ordering::Relaxed) {
-            std::thread::sleep(Duration::from_millis(1));
+            self.controls.waiting(|| std::thread::sleep(Duration::from_millis(1)));
             return 0;
         }
         // Non-blocking: a full terminal takes nothing.
@@ -281,7 +338,7 @@ impl Line for Pty {
                 n
             }
             Err(e) if e.kind() == ErrorKind::WouldBlock => {
-                std::thread::sleep(Duration::from_millis(1));
+                self.controls.waiting(|| std::thread::sleep(Duration::from_millis(1)));
                 0
             }
             // No host has the terminal open: what it would get is lost.
@@ -299,7 +356,7 @@ impl Line for Pty {
 
     fn sleep(&mut self) -> bool {
         self.controls.sleeping.store(true, Ordering::SeqCst);
-        let chunk = self.chunks.recv();
+        let chunk = self.controls.waiting(|| self.chunks.recv());
         self.controls.sleeping.store(false, Ordering::SeqCst);
         match chunk {
             Ok(chunk) => {
@@ -348,7 +405,8 @@ fn serve<P: Profile>(options: &Options, line: &mut Pty, controls: &Controls) {
 
 /// Answers frames as a hostile board does (`--misbehave`): octrace's
 /// board's answers, but with `misbehave`'s departures, one frame at a time
-/// (a frame that comes while it draws waits for the drawing's end).
+/// (a frame that comes while it draws waits for the drawing's end), each
+/// row sent as it is drawn.
 fn serve_hostile<P: Profile>(options: &Options, misbehave: Misbehaviour, line: &mut Pty) {
     let mut decoder = Decoder::new(vec![0u8; options.max_scene + OVERHEAD + 1]);
     let firmware = match misbehave {
@@ -389,11 +447,18 @@ fn serve_hostile<P: Profile>(options: &Options, misbehave: Misbehaviour, line: &
                     for (pixel, sample) in row.iter_mut().zip(renderer.row(y, 0..width)) {
                         *pixel = sample.color.into();
                     }
-                    if y == 0 && misbehave == Misbehaviour::WrongPixel {
-                        row[0] = if row[0] == Rgb565::WHITE { Rgb565::BLACK } else { Rgb565::WHITE };
+                    if let (0, Misbehaviour::WrongPixel(channel)) = (y, misbehave) {
+                        row[0] = match channel {
+                            None if row[0] == Rgb565::WHITE => Rgb565::BLACK,
+                            None => Rgb565::WHITE,
+                            Some(channel) => channel.flip(row[0]),
+                        };
                     }
+                    out.clear();
                     let _ = drawing.send_row(y as u16, &row, &mut out);
+                    line.send_bytes(&out);
                 }
+                out.clear();
                 // By the host's clock; it has no counters.
                 let (elapsed, render) = (started.elapsed(), loaded.elapsed());
                 let timing = Timing {
@@ -422,6 +487,7 @@ fn main() {
     let panel = options.panel;
     let controls = Arc::new(Controls {
         started: Instant::now(),
+        waits: Mutex::new((0, None)),
         hold: AtomicBool::new(false),
         last_in: AtomicU64::new(u64::MAX),
         last_out: AtomicU64::new(u64::MAX),

@@ -34,10 +34,16 @@ export function createBoard(app) {
     sending = true;
     button.disabled = true;
     show('sending', '', `sending to ${port}…`);
-    // The rows as they arrive (the answer comes when the board is done).
+    // The rows as they arrive (the answer comes when the board is done),
+    // and the board's word that it is still working on a slow stretch: the
+    // server waits as long as the board keeps drawing or says so, and
+    // gives it up when it falls silent, as host-sim board does.
     const poll = setInterval(() => {
       api('/board').then((response) => (response.ok ? response.json() : {})).then((progress) => {
-        if (sending && progress.height) verdict.textContent = `drawing: ${progress.rows} of ${progress.height} rows`;
+        if (!sending || !progress.height) return;
+        const working = typeof progress.working === 'number'
+          ? ` (still working: ${progress.working.toFixed(1)} s by its clock)` : '';
+        verdict.textContent = `drawing: ${progress.rows} of ${progress.height} rows${working}`;
       }).catch(() => {});
     }, 250);
     try {
