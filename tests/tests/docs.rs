@@ -138,5 +138,7 @@ fn the_check_sees_a_missing_file_and_a_missing_heading() {
     .expect("written");
     let broken = broken_links(&page);
     assert_eq!(broken.len(), 2, "{broken:?}");
-    assert!(broken[0].ends_with("missing.md: no such file") && broken[1].ends_with("other.md#nowhere: no such heading"));
+    assert!(
+        broken[0].ends_with("missing.md: no such file") && broken[1].ends_with("other.md#nowhere: no such heading")
+    );
 }

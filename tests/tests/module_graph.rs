@@ -99,3 +99,69 @@ fn no_file_imports_one_that_imports_it_back_in_any_crate() {
     assert!(read > 150, "only {read} modules read");
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
+
+/// The modules a crate root's doc lists in its sentence "Modules, each
+/// using only those before it: `a` (…), `b` (…) …", in its order.
+fn listed_layers(root_text: &str) -> Vec<String> {
+    let doc: Vec<&str> = root_text.lines().filter_map(|l| l.strip_prefix("//!")).map(str::trim).collect();
+    let Some(start) = doc.iter().position(|l| l.starts_with("Modules, each using only those before it:")) else {
+        return Vec::new();
+    };
+    let paragraph = doc[start..].iter().take_while(|l| !l.is_empty()).copied().collect::<Vec<_>>().join(" ");
+    // A layer is a backticked word outside parentheses.
+    let mut layers = Vec::new();
+    let (mut depth, mut word, mut in_tick) = (0, String::new(), false);
+    for c in paragraph.chars() {
+        match c {
+            '(' | '[' => depth += 1,
+            ')' | ']' => depth -= 1,
+            '`' if depth == 0 => {
+                if in_tick {
+                    layers.push(std::mem::take(&mut word));
+                }
+                in_tick = !in_tick;
+            }
+            _ if in_tick => word.push(c),
+            _ => {}
+        }
+    }
+    layers
+}
+
+#[test]
+fn links_layers_are_its_modules_and_each_uses_only_those_before_it() {
+    let root = octrace_tests::repo().join("link/src/lib.rs").canonicalize().expect("link's root");
+    let text = std::fs::read_to_string(&root).expect("link's root");
+    let layers = listed_layers(&text);
+    let mut declared: Vec<String> = text
+        .lines()
+        .map(str::trim)
+        .filter_map(|l| l.strip_prefix("pub mod ").or_else(|| l.strip_prefix("mod ")))
+        .filter_map(|l| l.strip_suffix(';'))
+        .map(String::from)
+        .collect();
+    let mut sorted = layers.clone();
+    sorted.sort();
+    declared.sort();
+    assert_eq!(sorted, declared, "link's crate doc lists {layers:?}; its modules are {declared:?}");
+    let krate = Crate::read(&root).unwrap_or_else(|e| panic!("{e}"));
+    // A module and all below it are one layer (sibling edges join them).
+    let place = |module: &Vec<String>| layers.iter().position(|l| module.len() == 1 && &module[0] == l);
+    let mut wrong = Vec::new();
+    for (from, targets) in krate.sibling_edges() {
+        for target in targets {
+            if let (Some(a), Some(b)) = (place(&from), place(&target)) {
+                if b >= a {
+                    wrong.push(format!("{} uses {}, listed after it", from.join("::"), target.join("::")));
+                }
+            }
+        }
+    }
+    assert!(wrong.is_empty(), "link's layers do not hold:\n{}", wrong.join("\n"));
+}
+
+#[test]
+fn the_layer_list_is_read_from_its_sentence() {
+    let text = "//! Intro `x`.\n//!\n//! Modules, each using only those before it: `a` (the\n//! `z` thing, [`T`]), `b`\n//! and `c`.\n//!\n//! `d`\n";
+    assert_eq!(listed_layers(text), ["a", "b", "c"]);
+}
