@@ -165,3 +165,86 @@ fn the_layer_list_is_read_from_its_sentence() {
     let text = "//! Intro `x`.\n//!\n//! Modules, each using only those before it: `a` (the\n//! `z` thing, [`T`]), `b`\n//! and `c`.\n//!\n//! `d`\n";
     assert_eq!(listed_layers(text), ["a", "b", "c"]);
 }
+
+/// The most lines a Rust file may have before its test module.
+const RUST_LINES: usize = 700;
+/// The most lines a JavaScript file (`.js`, `.mjs`) may have.
+const SCRIPT_LINES: usize = 500;
+
+/// The lines of a Rust file before its test module: the top-level
+/// `#[cfg(test)]` whose item is a `mod`, as the house places it at the
+/// bottom (a whole file when it has none).
+fn lines_before_tests(text: &str) -> usize {
+    let lines: Vec<&str> = text.lines().collect();
+    let is_test_module = |at: usize| {
+        lines[at] == "#[cfg(test)]"
+            && lines[at + 1..]
+                .iter()
+                .find(|l| !l.starts_with("#["))
+                .is_some_and(|l| l.starts_with("mod ") || l.starts_with("pub(crate) mod ") || l.starts_with("pub mod "))
+    };
+    (0..lines.len()).find(|&at| is_test_module(at)).unwrap_or(lines.len())
+}
+
+/// Every Rust and JavaScript file of the repository's own (not `target/`,
+/// `node_modules/` or `.git`), from the repository's root.
+fn source_files(repo: &Path) -> Vec<PathBuf> {
+    let mut found = Vec::new();
+    let mut stack = vec![repo.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
+            let path = entry.expect("an entry").path();
+            let name = path.file_name().and_then(|n| n.to_str()).unwrap_or_default();
+            if path.is_dir() {
+                if !matches!(name, "target" | "node_modules" | ".git") {
+                    stack.push(path);
+                }
+            } else if path.extension().is_some_and(|e| e == "rs" || e == "js" || e == "mjs") {
+                found.push(path);
+            }
+        }
+    }
+    found.sort();
+    found
+}
+
+/// Whether `path` is a package's integration test (a file below a `tests`
+/// folder beside its `Cargo.toml`): a file of tests, with none of its lines
+/// before them.
+fn is_integration_test(path: &Path) -> bool {
+    let is_package = |manifest: PathBuf| std::fs::read_to_string(manifest).is_ok_and(|t| t.contains("[package]"));
+    path.ancestors()
+        .any(|dir| dir.file_name().is_some_and(|n| n == "tests") && is_package(dir.with_file_name("Cargo.toml")))
+}
+
+#[test]
+fn no_rust_file_is_over_700_lines_before_its_tests_and_no_script_over_500() {
+    let repo = octrace_tests::repo().canonicalize().expect("the repository");
+    let files = source_files(&repo);
+    let mut long = Vec::new();
+    for path in &files {
+        let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let shown = path.strip_prefix(&repo).unwrap_or(path).display();
+        if path.extension().is_some_and(|e| e == "rs") {
+            let lines = if is_integration_test(path) { 0 } else { lines_before_tests(&text) };
+            if lines > RUST_LINES {
+                long.push(format!("{shown}: {lines} lines before its tests (at most {RUST_LINES})"));
+            }
+        } else if text.lines().count() > SCRIPT_LINES {
+            long.push(format!("{shown}: {} lines (at most {SCRIPT_LINES})", text.lines().count()));
+        }
+    }
+    assert!(files.len() > 250, "only {} files read", files.len());
+    assert!(long.is_empty(), "files to split by concern:\n{}", long.join("\n"));
+}
+
+#[test]
+fn the_lines_before_tests_end_at_the_test_module() {
+    let text = "//! A.\n#[cfg(test)]\nuse x::y;\nfn a() {}\n\n#[cfg(test)]\n#[allow(dead_code)]\nmod tests {\n}\n";
+    assert_eq!(lines_before_tests(text), 5);
+    assert_eq!(lines_before_tests("fn a() {}\nfn b() {}\n"), 2);
+    let repo = octrace_tests::repo().canonicalize().expect("the repository");
+    assert!(is_integration_test(&repo.join("tests/tests/golden.rs")));
+    assert!(!is_integration_test(&repo.join("tests/src/lib.rs")));
+    assert!(!is_integration_test(&repo.join("core/src/math/vector.rs")));
+}
