@@ -84,7 +84,11 @@ fn no_file_imports_one_that_imports_it_back_in_any_crate() {
         for found in cycles(&krate.sibling_edges()) {
             let modules: Vec<_> =
                 found.iter().map(|m| if m.is_empty() { "crate".into() } else { m.join("::") }).collect();
-            problems.push(format!("{}: a cycle of modules: {}", shown(&repo, &[root.clone()]), modules.join(" → ")));
+            problems.push(format!(
+                "{}: a cycle of modules: {}",
+                shown(&repo, std::slice::from_ref(root)),
+                modules.join(" → ")
+            ));
         }
         for file in krate.path_attributes() {
             problems.push(format!("{}: a #[path] attribute", shown(&repo, &[file])));
