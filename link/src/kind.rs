@@ -46,7 +46,7 @@ macro_rules! kinds {
 }
 
 kinds! {
-    /// Host: who are you? Answered with [`Message::Board`].
+    /// Host: who are you? Answered with [`Message::Board`](crate::Message::Board).
     Hello = 0x01, "hello", true;
     /// Host: draw this scene.
     Scene = 0x02, "scene", true;
