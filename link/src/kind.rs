@@ -89,3 +89,17 @@ impl fmt::Display for Kind {
         f.write_str(self.name())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kinds_and_bytes_agree() {
+        for kind in Kind::ALL {
+            assert_eq!(Kind::from_byte(kind.byte()), Some(kind));
+            assert_eq!(kind.from_host(), kind.byte() < 0x40, "{kind}");
+        }
+        assert_eq!(Kind::from_byte(0x00), None);
+    }
+}
