@@ -19,6 +19,7 @@ mod threaded;
 
 use threaded::stream_threads;
 
+pub use cli::run;
 pub use octrace_images::{RgbImage, NO_OBJECT};
 
 use octrace_core::accel::{
@@ -392,14 +393,4 @@ impl RowSink for Canvas {
         self.objects[y * w..(y + 1) * w].copy_from_slice(objects);
         Ok(())
     }
-}
-
-/// Runs the command line `args` (including the program name); help goes to
-/// `stdout`, diagnostics to `stderr`. Returns the process exit code.
-pub fn run<I, T>(args: I, stdout: &mut dyn std::io::Write, stderr: &mut dyn std::io::Write) -> i32
-where
-    I: IntoIterator<Item = T>,
-    T: Into<std::ffi::OsString> + Clone,
-{
-    cli::run(args, stdout, stderr)
 }
