@@ -10,7 +10,7 @@
 //! is set (Ctrl-C), every worker stops before its next ray, inside a pixel,
 //! and no band after is written.
 
-use crate::{Partition, RenderOptions, RowSink, StreamError, NO_OBJECT, TILE_SIDE};
+use crate::options::{Partition, RenderOptions, RowSink, StreamError, TILE_SIDE};
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::pixelcolor::RgbColor;
 use embedded_graphics_core::primitives::Rectangle;
@@ -18,6 +18,7 @@ use octrace_core::accel::{Accelerator, Mailbox};
 use octrace_core::render::{Renderer, ScreenBound, Tiles};
 use octrace_core::scene::SceneView;
 use octrace_core::shade::Stats;
+use octrace_images::NO_OBJECT;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::{Duration, Instant};

@@ -7,7 +7,7 @@
 //! counts after that frame (the coherence's own bytes, kept between calls);
 //! a frame of another text or size starts again from every tile.
 
-use crate::studio::StudioError;
+use crate::error::StudioError;
 use embedded_graphics_core::geometry::Size;
 use embedded_graphics_core::pixelcolor::RgbColor;
 use embedded_graphics_core::primitives::Rectangle;

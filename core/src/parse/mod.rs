@@ -22,20 +22,20 @@ mod lexer;
 mod motion;
 mod number;
 mod statement;
+mod statements;
 
 pub use error::{ErrorKind, Field, Found, ParseError, Pos, Rule};
 pub(crate) use motion::{for_each_move, frames_of, Mover};
-pub(crate) use number::Decimal;
 pub(crate) use statement::{Keys, Statement};
 
-use crate::capacity::{Arena, CapacityError, CapacityKind, Counts};
+use crate::capacity::{CapacityError, CapacityKind, Counts};
 use crate::scene::{displacement_at, Camera, CameraError, Frames, Light, Normalization, Scene, SceneCapacities};
 use crate::scene::{SurfaceEntry, WorldPoint};
 use crate::shapes::{AxisAlignedBox, Rectangle, ShapeKind, Sphere, Superquadric, Triangle};
-use core::marker::PhantomData;
 use keyword::Keyword;
 use motion::{for_each_paired, Paired};
-use statement::{Cursor, Patch};
+use statement::{AnyRoom, Patch, RoomOf};
+use statements::for_each_statement;
 
 /// What the parse found besides the scene.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -44,17 +44,6 @@ pub struct Parsed<'a> {
     pub imagefile: Option<&'a str>,
     /// FRAMES, if given: the scene is an animation.
     pub frames: Option<Frames>,
-}
-
-/// Which shapes' geometric checks a parse runs. A profile without room for
-/// a kind makes each of its statements a capacity error anyway, so a board
-/// that holds no rectangles (say) skips their checks and links none of that
-/// code; the capacity error still names the first such statement.
-pub(crate) trait Room {
-    /// Rectangles are checked for area, planarity and convexity.
-    const RECTANGLES: bool;
-    /// Triangles are checked for area.
-    const TRIANGLES: bool;
 }
 
 /// Every statement keyword of the format, in the format's order, with how
@@ -70,74 +59,6 @@ pub(crate) trait Room {
 /// ```
 pub fn statement_arities() -> impl Iterator<Item = (&'static str, usize)> {
     Keyword::ALL.into_iter().map(|keyword| (keyword.name(), keyword.arity()))
-}
-
-/// Every check: what [`count`] needs (it holds no scene).
-struct AnyRoom;
-
-impl Room for AnyRoom {
-    const RECTANGLES: bool = true;
-    const TRIANGLES: bool = true;
-}
-
-/// The checks for the shapes the profile `C` has room for.
-struct RoomOf<C>(PhantomData<C>);
-
-impl<C: SceneCapacities> Room for RoomOf<C> {
-    const RECTANGLES: bool = <C::Rectangles as Arena<Rectangle>>::CAPACITY > 0;
-    const TRIANGLES: bool = <C::Triangles as Arena<Triangle>>::CAPACITY > 0;
-}
-
-/// Reads every statement of `text`, handing each (or its error) to `each`;
-/// after an error, resynchronises at the next statement (see [`recover`]).
-fn for_each_statement<'a, R: Room>(text: &'a str, mut each: impl FnMut(Pos, Result<Statement<'a>, ParseError<'a>>)) {
-    let mut cur = Cursor::new(text);
-    loop {
-        let token = match cur.next() {
-            Ok(Some(t)) => t,
-            Ok(None) => return,
-            Err(e) => {
-                each(e.pos, Err(e));
-                continue;
-            }
-        };
-        let result = match Keyword::from_text(token.text).filter(|_| !token.quoted) {
-            Some(kw) => statement::statement::<R>(&mut cur, kw, token.pos),
-            None => Err(ParseError::new(token.pos, ErrorKind::UnknownKeyword(token.text))),
-        };
-        let error_at = result.as_ref().err().map(|e| e.pos);
-        each(token.pos, result);
-        if let Some(pos) = error_at {
-            recover(&mut cur, pos, &mut |e| each(e.pos, Err(e)));
-        }
-    }
-}
-
-/// After an error at `at`, skips to where the next statement begins: a
-/// keyword, or a word (not a number) that is the first token of its line.
-/// The offending token goes first unless it is a keyword; numbers after it
-/// are the bad statement's (a B-spline's points span lines), whatever line
-/// they are on. So every line that begins with a word is read again as a
-/// statement, and its error, if any, is reported too: five lines of `x`
-/// give five errors. A lexer error met while skipping goes to `lexical`.
-fn recover<'a>(cur: &mut Cursor<'a>, at: Pos, lexical: &mut dyn FnMut(ParseError<'a>)) {
-    let begins_statement = |t: &lexer::Token<'_>| !t.quoted && Keyword::from_text(t.text).is_some();
-    let number = |t: &lexer::Token<'_>| !t.quoted && Decimal::parse(t.text).is_some();
-    loop {
-        match cur.peek() {
-            Ok(None) => return,
-            Ok(Some(t)) if begins_statement(&t) => return,
-            // The offending token, left for recovery by the statement.
-            Ok(Some(t)) if t.pos == at => {}
-            Ok(Some(t)) if !number(&t) && cur.on_a_later_line(t) => return,
-            Ok(Some(_)) => {}
-            Err(e) => {
-                lexical(e);
-                continue;
-            }
-        }
-        let _ = cur.next();
-    }
 }
 
 /// Parses `bytes`, reporting invalid UTF-8 as an error at the first bad byte.

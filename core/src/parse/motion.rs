@@ -9,8 +9,9 @@
 //! a stray, at its position.
 
 use super::error::{ParseError, Pos};
+use super::statement::{AnyRoom, Room};
 use super::statement::{Keys, Statement};
-use super::{for_each_statement, AnyRoom, Room};
+use super::statements::for_each_statement;
 use crate::scene::WorldPoint;
 
 /// What a MOVE can move: a statement with a place.

@@ -6,11 +6,42 @@ use super::error::{ErrorKind, Field, Found, ParseError, Pos, Rule};
 use super::keyword::Keyword;
 use super::lexer::{Lexer, Token};
 use super::number::{parse_integer, Decimal};
+use crate::capacity::Arena;
 use crate::capacity::{CapacityKind, Counts};
 use crate::math::isqrt_u128;
+use crate::scene::SceneCapacities;
 use crate::scene::{Color, Frames, Surface, WorldPoint, WorldValue, MAX_SAMPLES, MAX_SIDE};
 use crate::shapes::bspline::{MAX_CONTROL_SIDE, MAX_ORDER, MAX_SAMPLE_SIDE};
+use crate::shapes::{Rectangle, Triangle};
+use core::marker::PhantomData;
 use fixed::types::{I32F32, I48F16};
+
+/// Which shapes' geometric checks a parse runs. A profile without room for
+/// a kind makes each of its statements a capacity error anyway, so a board
+/// that holds no rectangles (say) skips their checks and links none of that
+/// code; the capacity error still names the first such statement.
+pub(crate) trait Room {
+    /// Rectangles are checked for area, planarity and convexity.
+    const RECTANGLES: bool;
+    /// Triangles are checked for area.
+    const TRIANGLES: bool;
+}
+
+/// Every check: what [`count`] needs (it holds no scene).
+pub(crate) struct AnyRoom;
+
+impl Room for AnyRoom {
+    const RECTANGLES: bool = true;
+    const TRIANGLES: bool = true;
+}
+
+/// The checks for the shapes the profile `C` has room for.
+pub(crate) struct RoomOf<C>(PhantomData<C>);
+
+impl<C: SceneCapacities> Room for RoomOf<C> {
+    const RECTANGLES: bool = <C::Rectangles as Arena<Rectangle>>::CAPACITY > 0;
+    const TRIANGLES: bool = <C::Triangles as Arena<Triangle>>::CAPACITY > 0;
+}
 
 /// A statement's content, in world units.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -367,11 +398,7 @@ pub fn q32_to_q16(v: i64) -> i64 {
 
 /// Reads the statement that `keyword` (already consumed) begins.
 /// The shapes' geometric checks run only where `R` has room for them.
-pub fn statement<'a, R: super::Room>(
-    cur: &mut Cursor<'a>,
-    kw: Keyword,
-    at: Pos,
-) -> Result<Statement<'a>, ParseError<'a>> {
+pub fn statement<'a, R: Room>(cur: &mut Cursor<'a>, kw: Keyword, at: Pos) -> Result<Statement<'a>, ParseError<'a>> {
     let f = |name| Field { statement: kw.name(), name };
     let xyz = ["x", "y", "z"];
     Ok(match kw {

@@ -2,10 +2,8 @@
 //! traced as the display takes its rows, dithered onto a panel of few
 //! levels.
 
-use crate::panel::{Dithered, Dithering, ErrorRowTooShort, TracedColor, IMAGE_ERROR_WORDS};
+use crate::panel::{Dithered, Dithering, TracedColor, IMAGE_ERROR_WORDS};
 use crate::profile::Profile;
-use crate::render::Stopped;
-use crate::scene::CameraError;
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Dimensions, OriginDimensions, Point, Size};
@@ -13,44 +11,7 @@ use embedded_graphics_core::image::ImageDrawable;
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
 
-use super::LoadedScene;
-
-/// Why a [`TracedImage`] could not be drawn with
-/// [`TracedImage::try_draw`].
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum DrawError<E> {
-    /// The camera cannot be set up for this size (see [`CameraError`]).
-    Camera(CameraError),
-    /// Error diffusion has no room for the image's rows (an image wider
-    /// than [`IMAGE_ERROR_WORDS`] allows, drawn without storage of its
-    /// own).
-    ErrorRow(ErrorRowTooShort),
-    /// The display's own error.
-    Target(E),
-    /// The caller's stop said so
-    /// ([`LoadedScene::draw_bands_until`](crate::LoadedScene::draw_bands_until)).
-    Stopped,
-}
-
-impl<E> From<Stopped> for DrawError<E> {
-    fn from(_: Stopped) -> Self {
-        DrawError::Stopped
-    }
-}
-
-impl<E: fmt::Display> fmt::Display for DrawError<E> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            DrawError::Camera(e) => write!(f, "{e}"),
-            DrawError::ErrorRow(e) => write!(f, "{e}"),
-            DrawError::Target(e) => write!(f, "the display failed: {e}"),
-            DrawError::Stopped => write!(f, "stopped before the picture's end"),
-        }
-    }
-}
-
-impl<E: fmt::Debug + fmt::Display> core::error::Error for DrawError<E> {}
+use super::{DrawError, LoadedScene};
 
 /// A traced scene as an embedded-graphics image, `size` pixels in the colour
 /// `C`, like `tinybmp::Bmp<C>`. Each draw traces the pixels as the display
@@ -77,6 +38,21 @@ pub struct TracedImage<'s, 'r, P: Profile, C> {
     pub(super) size: Size,
     pub(super) dithering: Dithering,
     pub(super) color: core::marker::PhantomData<C>,
+}
+
+/// A loaded scene's pictures as images (drawn through `embedded-graphics`'
+/// [`Image`](https://docs.rs/embedded-graphics/latest/embedded_graphics/image/struct.Image.html)).
+impl<'r, P: Profile> LoadedScene<'r, P> {
+    /// The scene as an image of `size` pixels in the colour `C`.
+    pub fn image<C>(&self, size: Size) -> TracedImage<'_, 'r, P, C> {
+        TracedImage { scene: self, size, dithering: Dithering::default(), color: core::marker::PhantomData }
+    }
+
+    /// The scene as an image as large as `target`, in its colour: what
+    /// `Image::new(&scene.image_for(&display), Point::zero())` draws.
+    pub fn image_for<D: DrawTarget>(&self, target: &D) -> TracedImage<'_, 'r, P, D::Color> {
+        self.image(target.bounding_box().size)
+    }
 }
 
 impl<P: Profile, C> fmt::Debug for TracedImage<'_, '_, P, C> {
@@ -269,7 +245,7 @@ impl<D: DrawTarget> DrawTarget for Shifted<'_, D> {
 mod tests {
     use super::super::tests::{Grid, SCENE};
     use super::*;
-    use crate::panel::Ditherer;
+    use crate::panel::{Ditherer, ErrorRowTooShort};
     use crate::profile::Board16K;
     use crate::render::Progressive;
     use crate::Raytracer;

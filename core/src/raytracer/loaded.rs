@@ -1,10 +1,10 @@
 //! A loaded scene: its view, accelerator, light buffer and the room of the
 //! core that loaded it; it draws as an image, directly or progressively.
 
-use crate::accel::{AccelMode, Accelerator, BuildReport, LightBuffer, LightBufferError};
+use crate::accel::{AccelMode, BuildReport, LightBuffer, LightBufferError};
 use crate::animation::coherence::Halt;
 use crate::animation::{Coherence, Motion};
-use crate::panel::{Dithered, Dithering, TracedColor};
+use crate::panel::{Dithered, TracedColor};
 use crate::profile::Profile;
 use crate::render::{Polling, Progressive, Renderer, Stop};
 use crate::scene::{CameraError, Frames, SceneView};
@@ -17,7 +17,8 @@ use embedded_graphics_core::geometry::Size;
 use embedded_graphics_core::pixelcolor::Rgb888;
 use embedded_graphics_core::primitives::Rectangle;
 
-use super::{light_buffer, DrawError, SceneAccelerator, ScreenLists, SharedScene, TracedImage};
+use super::shared::renderer_in;
+use super::{light_buffer, DrawError, SceneAccelerator, ScreenLists, SharedScene};
 
 /// A scene ready to trace, borrowed from its [`Raytracer`](super::Raytracer).
 pub struct LoadedScene<'r, P: Profile> {
@@ -335,17 +336,6 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         Size::new(w, h)
     }
 
-    /// The scene as an image of `size` pixels in the colour `C`.
-    pub fn image<C>(&self, size: Size) -> TracedImage<'_, 'r, P, C> {
-        TracedImage { scene: self, size, dithering: Dithering::default(), color: core::marker::PhantomData }
-    }
-
-    /// The scene as an image as large as `target`, in its colour: what
-    /// `Image::new(&scene.image_for(&display), Point::zero())` draws.
-    pub fn image_for<D: DrawTarget>(&self, target: &D) -> TracedImage<'_, 'r, P, D::Color> {
-        self.image(target.bounding_box().size)
-    }
-
     /// Draws the scene as an image of `order`'s size at the origin of
     /// `target`, in the [`Progressive`] order: the whole picture in coarse
     /// blocks first, then finer, until it is exactly the picture
@@ -412,24 +402,4 @@ fn room_of<'g, 'r>(
     let lists = screen_lists.as_deref_mut().ok().and_then(|lists| lists.as_mut());
     let lists = lists.map(|(bounds, positions)| (&mut **bounds, &mut **positions));
     (mailbox.as_deref_mut().ok().map(|words| &mut **words), lists)
-}
-
-/// A renderer over `view` for an image of `size`, with a mailbox and screen
-/// lists where given. Inlined: a board's renderer is made in place.
-#[inline(always)]
-pub(super) fn renderer_in<'a, A: Accelerator>(
-    view: SceneView<'a>,
-    accel: &'a A,
-    size: Size,
-    mailbox: Option<&'a mut [u32]>,
-    lists: Option<ScreenLists<'a>>,
-) -> Result<Renderer<'a, A>, CameraError> {
-    let mut renderer = Renderer::with_size(view, accel, size.width, size.height)?;
-    if let Some(words) = mailbox {
-        renderer.set_mailbox(words);
-    }
-    if let Some((bounds, positions)) = lists {
-        renderer.set_first_hits(bounds, positions);
-    }
-    Ok(renderer)
 }

@@ -18,11 +18,13 @@ use crate::shade::Stats;
 use core::cell::{Cell, RefCell};
 use core::fmt;
 
+mod draw_error;
 mod image;
 mod loaded;
 mod shared;
 
-pub use image::{DrawError, TracedImage};
+pub use draw_error::DrawError;
+pub use image::TracedImage;
 pub use loaded::LoadedScene;
 pub use shared::{SceneAccelerator, SharedScene};
 

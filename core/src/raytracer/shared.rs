@@ -10,8 +10,7 @@ use crate::shapes::{Ray, ShapeKinds};
 use core::fmt;
 use embedded_graphics_core::geometry::Size;
 
-use super::loaded::renderer_in;
-use super::{light_buffer, RendererRoom};
+use super::{light_buffer, RendererRoom, ScreenLists};
 
 /// What another core needs to render a [`LoadedScene`](super::LoadedScene)
 /// ([`LoadedScene::share`](super::LoadedScene::share)): its objects, its accelerator and whether its
@@ -184,4 +183,24 @@ impl<P: Profile> Accelerator for SceneAccelerator<'_, P> {
             None => self.occluded(scene, ray, t_max, start, mailbox),
         }
     }
+}
+
+/// A renderer over `view` for an image of `size`, with a mailbox and screen
+/// lists where given. Inlined: a board's renderer is made in place.
+#[inline(always)]
+pub(super) fn renderer_in<'a, A: Accelerator>(
+    view: SceneView<'a>,
+    accel: &'a A,
+    size: Size,
+    mailbox: Option<&'a mut [u32]>,
+    lists: Option<ScreenLists<'a>>,
+) -> Result<Renderer<'a, A>, CameraError> {
+    let mut renderer = Renderer::with_size(view, accel, size.width, size.height)?;
+    if let Some(words) = mailbox {
+        renderer.set_mailbox(words);
+    }
+    if let Some((bounds, positions)) = lists {
+        renderer.set_first_hits(bounds, positions);
+    }
+    Ok(renderer)
 }

@@ -4,7 +4,7 @@
 //! re-trace at least), a viewpoint that moves, and the memory coherence
 //! takes for a 240×240 panel.
 
-use super::{ms, BenchError};
+use crate::measure::{ms, BenchError};
 use host_sim::animation::{render_frames, AnimationOptions, AnimationReport, FrameImage, COHERENCE_TILE};
 use host_sim::RenderOptions;
 use octrace_core::accel::{Mailbox, Naive};

@@ -6,7 +6,7 @@
 //! frames (`--frame K`), mean and worst over the loop, and through a blur
 //! of one pixel (issue 42's eye).
 
-use super::BenchError;
+use crate::measure::BenchError;
 use host_sim::animation::{render_frames, AnimationOptions, ApngWriter, GifWriter};
 use host_sim::{all_cores, RenderOptions, RgbImage};
 use octrace_core::scene::Frames;

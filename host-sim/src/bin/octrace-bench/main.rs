@@ -16,17 +16,19 @@
 //! first so every table says where it came from.
 
 use host_sim::{
-    all_cores, build_octree, load_bytes, load_file, new_scene, render, render_prebuilt, AccelMode, HostScene,
-    LoadError, Partition, RenderOptions,
+    all_cores, build_octree, load_bytes, new_scene, render, render_prebuilt, AccelMode, HostScene, Partition,
+    RenderOptions,
 };
 use octrace_core::accel::OctreeConfig;
-use std::fmt;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 mod animation;
 mod animation_files;
+mod measure;
 mod panels;
+
+use measure::{best_of, load, ms, scene_files, BenchError};
 
 fn machine() -> String {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
@@ -40,35 +42,6 @@ fn machine() -> String {
         .unwrap_or_else(|| "unknown CPU".into());
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     format!("{cpu}, {cores} cores, {} {}", std::env::consts::OS, std::env::consts::ARCH)
-}
-
-/// The best of `runs` timings of `f`.
-fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (Duration, T) {
-    let mut best = Duration::MAX;
-    let mut last = None;
-    for _ in 0..runs {
-        let t = Instant::now();
-        let r = f();
-        best = best.min(t.elapsed());
-        last = Some(r);
-    }
-    (best, last.expect("at least one run"))
-}
-
-pub(crate) fn ms(d: Duration) -> String {
-    format!("{:.1} ms", d.as_secs_f64() * 1e3)
-}
-
-fn scene_files(dir: &Path) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> =
-        std::fs::read_dir(dir).map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect()).unwrap_or_default();
-    // The stills: the animations (`anim_*`) have a table of their own.
-    v.retain(|p| {
-        p.extension().is_some_and(|x| x == "txt")
-            && !p.file_stem().is_some_and(|s| s.to_string_lossy().starts_with("anim_"))
-    });
-    v.sort();
-    v
 }
 
 /// The tables, in the order a run without arguments prints them.
@@ -120,7 +93,10 @@ impl Table {
     }
 
     fn from_name(name: &str) -> Result<Table, BenchError> {
-        Table::ALL.into_iter().find(|t| t.name() == name).ok_or_else(|| BenchError::UnknownTable(name.to_owned()))
+        Table::ALL.into_iter().find(|t| t.name() == name).ok_or_else(|| BenchError::UnknownTable {
+            name: name.to_owned(),
+            known: Table::ALL.iter().map(|t| t.name()).collect(),
+        })
     }
 
     /// Measures and prints the table, from the scenes in `dir`.
@@ -142,52 +118,6 @@ impl Table {
             Table::AnimationFiles => animation_files::table(dir),
         }
     }
-}
-
-/// Why octrace-bench stopped before its tables were done.
-#[derive(Debug)]
-pub(crate) enum BenchError {
-    /// A table it does not know was asked for.
-    UnknownTable(String),
-    /// A scene it measures did not load.
-    Scene { path: PathBuf, error: LoadError },
-    /// A tool it runs, or a file it writes, failed: what and why.
-    Tool(String),
-}
-
-impl BenchError {
-    /// The process's exit code: 1 for a file that cannot be read, 2 for the
-    /// rest (as host-sim's).
-    fn exit_code(&self) -> i32 {
-        match self {
-            BenchError::Scene { error: LoadError::Io(_), .. } => host_sim::exit::EXIT_IO,
-            _ => host_sim::exit::EXIT_SCENE,
-        }
-    }
-}
-
-impl fmt::Display for BenchError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            BenchError::UnknownTable(name) => {
-                let known: Vec<&str> = Table::ALL.iter().map(|t| t.name()).collect();
-                write!(f, "octrace-bench: unknown table `{name}` (known: {})", known.join(", "))
-            }
-            BenchError::Scene { path, error: LoadError::Io(e) } => {
-                write!(f, "octrace-bench: cannot read {}: {e}", path.display())
-            }
-            BenchError::Scene { path, error } => write!(f, "{error}\noctrace-bench: {} does not load", path.display()),
-            BenchError::Tool(message) => write!(f, "octrace-bench: {message}"),
-        }
-    }
-}
-
-impl std::error::Error for BenchError {}
-
-pub(crate) fn load(path: &Path) -> Result<Box<HostScene>, BenchError> {
-    let mut scene = new_scene();
-    load_file(path, &mut scene).map_err(|error| BenchError::Scene { path: path.to_owned(), error })?;
-    Ok(scene)
 }
 
 /// Render time (best of `runs`), including the octree build.

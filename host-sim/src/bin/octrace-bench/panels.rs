@@ -3,7 +3,7 @@
 //! picture through a blur of one pixel), and each method's cost per pixel
 //! here.
 
-use super::{best_of, load, scene_files, BenchError};
+use crate::measure::{best_of, load, scene_files, BenchError};
 use host_sim::{all_cores, render, RenderOptions};
 use octrace_core::panel::{Dithering, Panel};
 use octrace_core::render::PanelColor;
