@@ -3,7 +3,7 @@
 # of it, with a diagnosis of its own when apt refuses.
 # Sourced by scripts/test-all (and by scripts/test-install-deps.sh, which runs
 # the apt step against a fake apt); it only defines variables and functions.
-# README.md's Tests section names everything listed here (the test checks it).
+# docs/tests.md names everything listed here (scripts/test-install-deps.sh checks it).
 
 # The rustup components and targets the suite builds with (rust-toolchain.toml
 # names the same).
@@ -69,7 +69,7 @@ install_missing_commands() {
         done < <(apt_newer_installed_siblings "$output")
         local remedy=(install --allow-downgrades "${downgrades[@]}" "${packages[@]}")
         if [ ${#downgrades[@]} -eq 0 ] || ! apt-get --simulate -q "${remedy[@]}" >/dev/null 2>&1; then
-            printf '  Once what apt says above is cleared, install them by hand (README.md, section Tests):\n    %s\n' \
+            printf '  Once what apt says above is cleared, install them by hand (docs/tests.md):\n    %s\n' \
                 "${sudo:+sudo }apt-get install ${packages[*]}" >&2
             return 1
         fi

@@ -3,7 +3,7 @@
 # without root and without apt: a fake apt-get, apt-cache, sudo and id on PATH
 # answer as apt did on a Debian 12 machine whose qemu-utils came from
 # bookworm-backports (issue 35), and as it does on other refusals. Also checks
-# that README.md's Tests section names everything the install step installs.
+# that docs/tests.md names everything the install step installs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/install-test-deps.sh
@@ -176,11 +176,11 @@ install_missing_commands octrace-test-present:parallel || status=$?
 succeeded
 [ ! -e "$fake/apt.log" ] || fail "apt was called"
 
-readme_tests="$(awk '/^## Tests$/ { on = 1; next } /^## / { on = 0 } on' README.md)"
+documented="$(awk '/^## What the test command installs$/ { on = 1; next } /^## / { on = 0 } on' docs/tests.md)"
 for name in "${TEST_RUST_COMPONENTS[@]}" "${TEST_RUST_TARGETS[@]}" "${TEST_COMMAND_PACKAGES[@]#*:}" "${TEST_COMMAND_PACKAGES[@]%%:*}"; do
-    grep -qF -- "\`$name\`" <<<"$readme_tests" ||
-        { echo "test-install-deps: README.md's Tests section does not name \`$name\`, which test-all installs" >&2 && failures=$((failures + 1)); }
+    grep -qF -- "\`$name\`" <<<"$documented" ||
+        { echo "test-install-deps: docs/tests.md's list of what the test command installs does not name \`$name\`, which test-all installs" >&2 && failures=$((failures + 1)); }
 done
 
 [ "$failures" -eq 0 ] || exit 1
-echo "test-install-deps: the install step against a fake apt ($cases cases, and one with nothing missing), README.md's list"
+echo "test-install-deps: the install step against a fake apt ($cases cases, and one with nothing missing), docs/tests.md's list"

@@ -9,50 +9,21 @@
 //! 28 bytes an object). The octree's shadow shafts are left
 //! out: on the thesis's scenes they take longer to build than they save in
 //! one picture (BENCHMARKS.md).
+//!
+//! The scene's reading, checking and profile are `octrace-pico-build`'s
+//! `embed_still_scene`, which every board template's build script shares.
 
-use octrace_core::accel::OctreeConfig;
-use octrace_core::profile::{needed_by, ProfileText};
-use octrace_core::AccelMode;
-use std::env;
-use std::path::PathBuf;
+use octrace_pico_build::{embed_still_scene, BuildError};
 
 const DEFAULT_SCENE: &str = "../../scenes/fig5_1.txt";
 
 fn main() {
-    let out = PathBuf::from(env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
-    let manifest = PathBuf::from(env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
     // The memory map and linker scripts come from esp-hal (linkall.x).
     println!("cargo:rerun-if-changed=build.rs");
-
-    println!("cargo:rerun-if-env-changed=OCTRACE_SCENE");
-    let scene = env::var("OCTRACE_SCENE").unwrap_or_else(|_| DEFAULT_SCENE.to_owned());
-    let path = manifest.join(&scene);
-    println!("cargo:rerun-if-changed={}", path.display());
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| fail(&format!("OCTRACE_SCENE={scene}: {e}")));
-    // `Raytracer::load` picks the accelerator as `Auto` does, with the
-    // octree `profile!` builds by default.
-    let needs = needed_by(&text, AccelMode::Auto, &OctreeConfig::DEFAULT, &mut |error| {
-        eprintln!("{scene}:{error}");
-    })
-    .unwrap_or_else(|errors| fail(&format!("{scene}: {errors} error(s); nothing is built from a scene with errors")));
-
-    // `load` walks the octree by 3DDDA: no room for the thesis's hash table.
-    let doc = format!("Exactly what `{scene}` needs, its octree included.");
-    let profile = ProfileText {
-        name: "SceneProfile",
-        doc: &doc,
-        counts: &needs,
-        octree: None,
-        named_walk: false,
-        first_hits: true,
-        coherence: false,
-    };
-    let source =
-        format!("/// The scene, from `{scene}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n{profile}");
-    std::fs::write(out.join("scene.rs"), source).expect("write scene.rs into OUT_DIR");
+    embed_still_scene(DEFAULT_SCENE).unwrap_or_else(|e| fail(e));
 }
 
-fn fail(message: &str) -> ! {
-    eprintln!("octrace-esp32c3-st7789: {message}");
+fn fail(error: BuildError) -> ! {
+    eprintln!("octrace-esp32c3-st7789: {error}");
     std::process::exit(1);
 }

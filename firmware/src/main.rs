@@ -22,9 +22,7 @@ mod semihosting;
 #[cfg(board = "lm3s6965evb")]
 mod ssd0323;
 
-mod config {
-    include!(concat!(env!("OUT_DIR"), "/config.rs"));
-}
+mod config;
 
 use embedded_graphics_core::geometry::Size;
 use octrace_core::render::PanelColor;

@@ -180,6 +180,9 @@ fn write_preview(preview: &Image, color: PanelColor, format: Format, out: &mut d
     }
 }
 
+/// Runs the command line `args` (including the program name); help goes to
+/// `stdout`, diagnostics to `stderr`. Returns the process exit code. The
+/// binary is this call, so tests drive exactly what a user runs.
 pub fn run<I, T>(args: I, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i32
 where
     I: IntoIterator<Item = T>,

@@ -10,7 +10,8 @@
 
 use crate::cobs::BlockDecoder;
 use crate::frame::{RawFrame, Reason, Refusal, OVERHEAD};
-use crate::message::{Kind, Message};
+use crate::kind::Kind;
+use crate::message::Message;
 
 /// A message received whole, with the tag of the request it asks or answers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -174,7 +175,7 @@ mod tests {
     extern crate std;
     use super::*;
     use crate::frame::{encode_raw, VERSION};
-    use crate::message::Kind;
+    use crate::kind::Kind;
     use crate::tests::Rng;
     use std::vec::Vec;
 

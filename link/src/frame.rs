@@ -9,6 +9,7 @@
 
 use crate::cobs::{BlockEncoder, Sink};
 use crate::crc::Crc32;
+use crate::kind::Kind;
 use core::fmt;
 
 /// The protocol version this crate speaks: the first byte of every frame.
@@ -81,11 +82,11 @@ impl fmt::Display for Reason {
             Reason::TooLong { length, max } => {
                 write!(f, "a frame of {length} bytes, longer than the {max} bytes the receiver holds")
             }
-            Reason::Unexpected { kind } => match crate::Kind::from_byte(kind) {
+            Reason::Unexpected { kind } => match Kind::from_byte(kind) {
                 Some(known) => write!(f, "a {known} message, which the receiver does not take"),
                 None => write!(f, "a message of the unknown kind {kind:#04x}"),
             },
-            Reason::Malformed { kind } => match crate::Kind::from_byte(kind) {
+            Reason::Malformed { kind } => match Kind::from_byte(kind) {
                 Some(known) => write!(f, "a {known} message whose payload does not fit its layout"),
                 None => write!(f, "a malformed message of the unknown kind {kind:#04x}"),
             },

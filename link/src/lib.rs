@@ -12,8 +12,10 @@
 //! behaviour; with `std`, every `std::io::Write` is a [`Sink`].
 //!
 //! Modules, each using only those before it: `crc` (CRC-32), `cobs` (the
-//! byte stuffing and the [`Sink`]), `frame` (the header, the CRC and
-//! [`Refusal`]s), `message` ([`Message`] and its payloads), `decoder`
+//! byte stuffing and the [`Sink`]), `kind` (each message's [`Kind`]),
+//! `frame` (the header, the CRC and [`Refusal`]s), `wire` (a payload's
+//! fields as bytes), `list` (the [`Capacities`] and [`Counters`] a message
+//! carries), `message` ([`Message`] and its payloads), `decoder`
 //! ([`Decoder`]) and `board`.
 //!
 //! ```
@@ -48,6 +50,7 @@ mod cobs;
 mod crc;
 mod decoder;
 mod frame;
+mod kind;
 mod list;
 mod message;
 mod wire;
@@ -55,8 +58,9 @@ mod wire;
 pub use cobs::{Sink, CHUNK};
 pub use decoder::{Decoder, Frame};
 pub use frame::{encode_raw, Reason, Refusal, OVERHEAD, VERSION};
+pub use kind::Kind;
 pub use list::{Capacities, Capacity, Counter, Counters};
-pub use message::{BoardInfo, CapacityNeed, Kind, Message, Panel, PixelFormat, SceneError, Timing};
+pub use message::{BoardInfo, CapacityNeed, Message, Panel, PixelFormat, SceneError, Timing};
 
 #[cfg(test)]
 mod tests {

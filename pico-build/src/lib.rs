@@ -5,7 +5,9 @@
 //! exactly what it needs, and says whether it is a still or an animation
 //! ([`SceneKind`]); [`link`] puts the RP2040's memory map where the
 //! linker finds it and writes each firmware's code placement
-//! ([`CodePlacement`], `OCTRACE_CODE_IN`).
+//! ([`CodePlacement`], `OCTRACE_CODE_IN`). A board's firmware that draws
+//! one still and links by its own memory map (the ESP32-C3's, the Pico
+//! 2's) needs [`embed_still_scene`] alone.
 //!
 //! ```no_run
 //! // build.rs of a Pico template
@@ -31,7 +33,7 @@ mod placement;
 mod scene;
 
 pub use placement::{link, CodePlacement};
-pub use scene::{embed_scene, SceneKind};
+pub use scene::{embed_scene, embed_still_scene, SceneKind};
 
 use std::fmt;
 

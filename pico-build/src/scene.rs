@@ -25,6 +25,7 @@
 use crate::{out_dir, write, BuildError};
 use octrace_core::accel::{OctreeConfig, MAX_CELLS_A_SIDE};
 use octrace_core::animation::AnimationNeeds;
+use octrace_core::capacity::Counts;
 use octrace_core::parse::parse;
 use octrace_core::profile::{needed_by, needed_with_light_buffer, Host, ProfileText};
 use octrace_core::scene::Scene;
@@ -58,6 +59,32 @@ pub enum SceneKind {
 /// }
 /// ```
 pub fn embed_scene(default: &str) -> Result<SceneKind, BuildError> {
+    let (scene, path, text) = read_scene(default)?;
+    let (kind, source) = scene_source(&scene, &path, &text)?;
+    write(&out_dir()?.join("scene.rs"), &source)?;
+    Ok(kind)
+}
+
+/// Writes `OUT_DIR/scene.rs` for a firmware that draws one still picture
+/// with the camera rays' first hits alone (no light buffer, no animation):
+/// `SCENE_TEXT`, the scene `OCTRACE_SCENE` names (`default` when it is not
+/// set), and `SceneProfile`, exactly what it needs. The ESP32-C3's and the
+/// Pico 2's templates take it.
+pub fn embed_still_scene(default: &str) -> Result<(), BuildError> {
+    let (scene, path, text) = read_scene(default)?;
+    let needs = needed_by(&text, AccelMode::Auto, &OctreeConfig::DEFAULT, &mut |error| eprintln!("{scene}:{error}"))
+        .map_err(|errors| BuildError::Scene { scene: scene.clone(), errors })?;
+    let doc = format!("Exactly what `{scene}` needs, its octree included.");
+    let profile = profile_text(&doc, &needs, false);
+    let source =
+        format!("/// The scene, from `{scene}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n{profile}");
+    write(&out_dir()?.join("scene.rs"), &source)
+}
+
+/// The scene `OCTRACE_SCENE` names (a path from the firmware's folder;
+/// `default` when it is not set): that name, its path and its text, both
+/// announced to cargo.
+fn read_scene(default: &str) -> Result<(String, PathBuf, String), BuildError> {
     let manifest: PathBuf = std::env::var_os("CARGO_MANIFEST_DIR")
         .map(Into::into)
         .ok_or(BuildError::NotInBuildScript("CARGO_MANIFEST_DIR"))?;
@@ -67,9 +94,15 @@ pub fn embed_scene(default: &str) -> Result<SceneKind, BuildError> {
     println!("cargo:rerun-if-changed={}", path.display());
     let text = std::fs::read_to_string(&path)
         .map_err(|error| BuildError::File { path: format!("{VARIABLE}={scene}"), error })?;
-    let (kind, source) = scene_source(&scene, &path, &text)?;
-    write(&out_dir()?.join("scene.rs"), &source)?;
-    Ok(kind)
+    Ok((scene, path, text))
+}
+
+/// `SceneProfile`, holding `counts`: `Raytracer::load` picks the
+/// accelerator as `Auto` does, with the octree `profile!` builds by
+/// default, and walks it by 3DDDA (no room for the thesis's hash table);
+/// with the camera rays' first hits, and `coherence` for an animation.
+fn profile_text<'a>(doc: &'a str, counts: &'a Counts, coherence: bool) -> ProfileText<'a> {
+    ProfileText { name: "SceneProfile", doc, counts, octree: None, named_walk: false, first_hits: true, coherence }
 }
 
 /// What the scene `text` is: an animation if it has frames and something
@@ -95,19 +128,10 @@ fn scene_source(name: &str, path: &std::path::Path, text: &str) -> Result<(Scene
         needs = needed_with_light_buffer(text, AccelMode::Auto, &OctreeConfig::DEFAULT, MAX_CELLS_A_SIDE, &mut report)
             .map_err(failed)?;
     }
-    // `load` walks the octree by 3DDDA: no room for the thesis's hash table.
     let doc = format!("Exactly what `{name}` needs, its octree included.");
     let kind = kind_of(text);
     let animated = kind == SceneKind::Animation;
-    let profile = ProfileText {
-        name: "SceneProfile",
-        doc: &doc,
-        counts: &needs,
-        octree: None,
-        named_walk: false,
-        first_hits: true,
-        coherence: animated,
-    };
+    let profile = profile_text(&doc, &needs, animated);
     let motion = if animated { AnimationNeeds::of(text, Default::default()) } else { Default::default() };
     let stem = path.file_stem().map_or_else(|| name.to_owned(), |stem| stem.to_string_lossy().into_owned());
     let source = format!(

@@ -12,7 +12,8 @@
 // nothing here dereferences a pointer.
 #![allow(unsafe_code)]
 
-use crate::studio::{self, Display, Studio, StudioError};
+use crate::error::StudioError;
+use crate::studio::{self, Display, Studio};
 use octrace_images::formats::Format;
 use std::cell::RefCell;
 

@@ -13,9 +13,11 @@
 
 #![deny(unsafe_code)]
 
+mod error;
 mod exports;
 mod pixels;
 mod player;
 mod studio;
 
-pub use studio::{accel_from_code, Display, Loaded, Studio, StudioError};
+pub use error::StudioError;
+pub use studio::{accel_from_code, Display, Loaded, Studio};

@@ -6,6 +6,7 @@
 //! into it too, indexed the same); an animation's every frame was checked
 //! when its text was loaded.
 
+use crate::error::StudioError;
 use crate::pixels::Pixels;
 use crate::player::{Player, Refused};
 use embedded_graphics_core::geometry::{Point, Size};
@@ -19,7 +20,6 @@ use octrace_core::{AccelMode, Raytracer};
 use octrace_images::formats::{self, Format, Image};
 use octrace_images::palette::{self, PaletteMode};
 use octrace_images::{panel, RgbImage, NO_OBJECT};
-use std::fmt;
 
 /// The intersection mode the page numbers `code`: 0 auto, 1 naive,
 /// 2 octree, 3 dda (the core's order).
@@ -56,38 +56,6 @@ impl Display {
         }
     }
 }
-
-/// Why an operation could not be done.
-#[derive(Debug)]
-pub enum StudioError {
-    /// The scene text has errors, each `line:col: message`.
-    Scene(Vec<String>),
-    /// No scene is loaded.
-    NoScene,
-    /// The camera cannot be set up or the size is out of range.
-    Camera(String),
-    /// A buffer does not hold what the call needs.
-    BadInput(&'static str),
-    /// An image file could not be read or written.
-    Image(formats::FormatError),
-    /// An animation's frames cannot be traced one from another: why.
-    Motion(String),
-}
-
-impl fmt::Display for StudioError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            StudioError::Scene(errors) => f.write_str(&errors.join("\n")),
-            StudioError::NoScene => f.write_str("no scene is loaded"),
-            StudioError::Camera(why) => write!(f, "cannot set up the camera: {why}"),
-            StudioError::BadInput(what) => write!(f, "bad input: {what}"),
-            StudioError::Image(e) => write!(f, "{e}"),
-            StudioError::Motion(why) => write!(f, "cannot play the animation: {why}"),
-        }
-    }
-}
-
-impl std::error::Error for StudioError {}
 
 /// What [`Studio::load`] found: the scene's RASTER, its objects and, for
 /// an animation, its frames.

@@ -4,6 +4,7 @@
 pub mod board;
 pub mod budgets;
 pub mod firmware;
+pub mod imports;
 pub mod pico;
 pub mod webdriver;
 

@@ -453,8 +453,10 @@ fn the_server_keeps_its_security_rules() {
         "/tools.js",
         "/panel.js",
         "/board.js",
+        "/render.js",
         "/time.js",
         "/worker.js",
+        "/workers.js",
     ];
     for path in ["/", "/studio.css", "/octrace_studio.wasm"].into_iter().chain(modules) {
         let (status, head, body) = http_with_head(port, "GET", &format!("/{}{path}", studio.token), &[], b"");

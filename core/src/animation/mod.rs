@@ -48,16 +48,18 @@
 //! The counts are atomics each written by the core that traced the tile.
 
 pub(crate) mod coherence;
+mod needs;
 mod player;
 mod room;
 
 pub use crate::motion::Dependence;
 pub use coherence::Coherence;
+pub use needs::{AnimationCapacity, AnimationNeeds, NoRoom};
 pub use player::Animation;
 pub(crate) use player::Playing;
+pub use room::AnimationRoom;
 #[cfg(feature = "alloc")]
 pub use room::HostAnimationRoom;
-pub use room::{AnimationCapacity, AnimationNeeds, AnimationRoom, NoRoom};
 
 /// The side of the square tiles an animation's image is traced in, in
 /// pixels: chosen by measurement (BENCHMARKS.md, "Animation").

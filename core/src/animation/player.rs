@@ -14,7 +14,7 @@
 //! animation made again from it goes on where the last left off.
 
 use super::coherence::Coherence;
-use super::room::{AnimationCapacity, AnimationNeeds, NoRoom};
+use super::needs::{AnimationCapacity, AnimationNeeds, NoRoom};
 use crate::accel::Indexing;
 use crate::motion::{Dependence, Key, Lookout, Motion, MotionNeeds, Recorder, Track};
 use crate::scene::Frames;

@@ -1,119 +1,16 @@
-//! What an animation takes: its needs, counted from the scene's text and
-//! the image's size ([`AnimationNeeds`]), and the storage that holds them
-//! ([`AnimationRoom`] in a `static` on a board; [`HostAnimationRoom`] on
-//! the heap).
+//! The storage an animation's needs are held in: [`AnimationRoom`] in a
+//! `static` on a board, [`HostAnimationRoom`] on the heap.
 //!
 //! Invariants: a room holds exactly the counts it is declared with, all
-//! zero bits (a board's `static` lands in `.bss`); what a scene needs
-//! grows with its `MOVE`s and their keys, never with its frames.
+//! zero bits (a board's `static` lands in `.bss`).
 
-use super::coherence::Coherence;
+use super::needs::{AnimationNeeds, NoRoom};
 use super::player::{Animation, State};
 use super::TILE;
-use crate::motion::{Key, MotionNeeds, Track};
+use crate::motion::{Key, Track};
 use core::fmt;
 use core::sync::atomic::AtomicU8;
 use embedded_graphics_core::geometry::Size;
-
-/// What an animation of a scene takes on an image of a given size: a byte
-/// a tile of the image, a track a `MOVE` and its keys. A build script
-/// counts a board's ([`AnimationNeeds::of`], feature-free) and writes the
-/// counts as a constant, which sizes the board's one
-/// [`AnimationRoom`].
-///
-/// ```
-/// use embedded_graphics::prelude::Size;
-/// use octrace_core::animation::AnimationNeeds;
-///
-/// let text = "FRAMES 1000000\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\n\
-///             SPHERE 1 1 0 0 0 MOVE 0 -2 0 0  400000 2 0 0  999999 0 1 0\n";
-/// // A million frames: three keys, not a table of frames.
-/// assert_eq!(AnimationNeeds::of(text, Size::new(240, 240)), AnimationNeeds { tiles: 3600, tracks: 1, keys: 3 });
-/// ```
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct AnimationNeeds {
-    /// A byte for each tile of the image ([`TILE`] pixels a side).
-    pub tiles: usize,
-    /// One for each `MOVE`.
-    pub tracks: usize,
-    /// The keys of all the `MOVE`s.
-    pub keys: usize,
-}
-
-impl AnimationNeeds {
-    /// What `text`'s animation takes on an image of `size` (a scene with
-    /// errors: what its valid `MOVE`s take).
-    pub fn of(text: &str, size: Size) -> AnimationNeeds {
-        let motion = MotionNeeds::of(text);
-        AnimationNeeds { tiles: Self::tiles_for(size), tracks: motion.tracks, keys: motion.keys }
-    }
-
-    /// The tiles of an image of `size`: [`Coherence::tiles_for`] in tiles
-    /// of [`TILE`], a `const fn` (3,600 for a 240×240 panel).
-    pub const fn tiles_for(size: Size) -> usize {
-        Coherence::tiles_for(size.width, size.height, TILE)
-    }
-
-    /// About how many bytes of RAM they take.
-    pub const fn bytes(&self) -> usize {
-        self.tiles + self.tracks * size_of::<Track>() + self.keys * size_of::<Key>()
-    }
-
-    /// Each capacity of `room` that these needs exceed: what it holds and
-    /// what they need.
-    pub fn beyond(&self, room: &AnimationNeeds) -> [Option<NoRoom>; 3] {
-        let short = |what, needed: usize, holds: usize| (needed > holds).then_some(NoRoom { what, needed, holds });
-        [
-            short(AnimationCapacity::Tiles, self.tiles, room.tiles),
-            short(AnimationCapacity::Tracks, self.tracks, room.tracks),
-            short(AnimationCapacity::Keys, self.keys, room.keys),
-        ]
-    }
-}
-
-/// What an [`AnimationRoom`] holds: the vocabulary of its capacities.
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum AnimationCapacity {
-    /// A byte a tile of the image.
-    Tiles,
-    /// A track a `MOVE`.
-    Tracks,
-    /// The `MOVE`s' keys.
-    Keys,
-}
-
-impl AnimationCapacity {
-    /// Its name, as [`AnimationNeeds`]'s field: `tiles`, `tracks`, `keys`.
-    pub const fn name(self) -> &'static str {
-        match self {
-            AnimationCapacity::Tiles => "tiles",
-            AnimationCapacity::Tracks => "tracks",
-            AnimationCapacity::Keys => "keys",
-        }
-    }
-}
-
-/// A capacity of an animation's room that a scene needs more of.
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct NoRoom {
-    /// What runs out.
-    pub what: AnimationCapacity,
-    /// How many the scene needs.
-    pub needed: usize,
-    /// How many the room holds.
-    pub holds: usize,
-}
-
-impl fmt::Display for NoRoom {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let NoRoom { what, needed, holds } = self;
-        write!(f, "too many {} to play this animation: the room holds {holds} and it needs {needed}", what.name())
-    }
-}
-
-impl core::error::Error for NoRoom {}
 
 /// Room for one animation on a board: `TILES` bytes of tiles, `TRACKS`
 /// tracks and `KEYS` keys, all zero bits (a `static` of it costs no

@@ -6,7 +6,7 @@
 //! the same bits on every target and no float ever runs. Absolute error: below
 //! 3·10^-6 for `log2` and a relative 2·10^-6 for `exp2`.
 
-use super::mul_wide;
+use super::{isqrt_u128, mul_wide};
 
 /// log2(1 + i/256) in Q0.32 for i = 0..=256.
 static LOG2_TABLE: [u64; 257] = log2_table();
@@ -39,21 +39,6 @@ const fn log2_table() -> [u64; 257] {
     }
     t[256] = 1 << 32;
     t
-}
-
-/// Floor of the square root of a `u128` (also usable in constants).
-pub const fn isqrt_u128(n: u128) -> u128 {
-    if n < 2 {
-        return n;
-    }
-    let mut x = 1u128 << (128 - n.leading_zeros()).div_ceil(2);
-    loop {
-        let y = (x + n / x) / 2;
-        if y >= x {
-            return x;
-        }
-        x = y;
-    }
 }
 
 const fn exp2_table() -> [u64; 257] {

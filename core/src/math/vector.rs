@@ -88,7 +88,8 @@ pub struct Vec3 {
     pub z: Scalar,
 }
 
-/// A unit vector.
+/// A unit vector (one made by `Dir::from_bits` is the caller's to keep of
+/// unit length).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Dir {
     /// Q2.30, along X.
@@ -99,38 +100,53 @@ pub struct Dir {
     pub z: Unit,
 }
 
+/// What [`Vec3`] and [`Dir`] both have: their components' raw bits and
+/// back, the components widened for exact products, and one by its axis.
+macro_rules! components {
+    ($vector:ident, $component:ident, $format:literal) => {
+        impl $vector {
+            #[doc = concat!("The vector whose components have these raw ", $format, " bits.")]
+            #[inline]
+            pub const fn from_bits(b: [i32; 3]) -> Self {
+                $vector {
+                    x: $component::from_bits(b[0]),
+                    y: $component::from_bits(b[1]),
+                    z: $component::from_bits(b[2]),
+                }
+            }
+
+            #[doc = concat!("The raw ", $format, " bits of the components, for hashing and exact comparisons.")]
+            #[inline]
+            pub const fn bits(self) -> [i32; 3] {
+                [self.x.to_bits(), self.y.to_bits(), self.z.to_bits()]
+            }
+
+            #[doc = concat!("The components widened to `i64` (still ", $format, "), ready for exact products.")]
+            #[inline]
+            pub const fn wide(self) -> [i64; 3] {
+                let b = self.bits();
+                [b[0] as i64, b[1] as i64, b[2] as i64]
+            }
+
+            /// The component along `axis` (0, 1, 2 for X, Y, Z).
+            #[inline]
+            pub fn axis(self, axis: usize) -> $component {
+                match axis {
+                    0 => self.x,
+                    1 => self.y,
+                    _ => self.z,
+                }
+            }
+        }
+    };
+}
+
+components!(Vec3, Scalar, "Q16.16");
+components!(Dir, Unit, "Q2.30");
+
 impl Vec3 {
     /// The origin.
     pub const ZERO: Vec3 = Vec3::from_bits([0; 3]);
-
-    #[inline]
-    /// The vector whose components have these raw Q16.16 bits.
-    pub const fn from_bits(b: [i32; 3]) -> Self {
-        Vec3 { x: Scalar::from_bits(b[0]), y: Scalar::from_bits(b[1]), z: Scalar::from_bits(b[2]) }
-    }
-
-    #[inline]
-    /// The raw Q16.16 bits of the components, for hashing and exact comparisons.
-    pub const fn bits(self) -> [i32; 3] {
-        [self.x.to_bits(), self.y.to_bits(), self.z.to_bits()]
-    }
-
-    /// Components widened to `i64` (still Q16.16).
-    #[inline]
-    pub const fn wide(self) -> [i64; 3] {
-        let b = self.bits();
-        [b[0] as i64, b[1] as i64, b[2] as i64]
-    }
-
-    #[inline]
-    /// The component along `axis` (0, 1, 2 for X, Y, Z).
-    pub fn axis(self, axis: usize) -> Scalar {
-        match axis {
-            0 => self.x,
-            1 => self.y,
-            _ => self.z,
-        }
-    }
 
     /// `self · d` in Q16.16, rounded towards minus infinity.
     #[inline]
@@ -274,25 +290,6 @@ impl Dir {
     /// The unit Z axis.
     pub const Z: Dir = Dir::from_bits([0, 0, 1 << 30]);
 
-    #[inline]
-    /// The direction whose components have these raw Q2.30 bits (the caller keeps it unit length).
-    pub const fn from_bits(b: [i32; 3]) -> Self {
-        Dir { x: Unit::from_bits(b[0]), y: Unit::from_bits(b[1]), z: Unit::from_bits(b[2]) }
-    }
-
-    #[inline]
-    /// The raw Q2.30 bits of the components.
-    pub const fn bits(self) -> [i32; 3] {
-        [self.x.to_bits(), self.y.to_bits(), self.z.to_bits()]
-    }
-
-    #[inline]
-    /// The components widened to `i64`, ready for exact products.
-    pub const fn wide(self) -> [i64; 3] {
-        let b = self.bits();
-        [b[0] as i64, b[1] as i64, b[2] as i64]
-    }
-
     /// The unit vector along the axis `axis` (0, 1, 2), negated if `negative`.
     #[inline]
     pub fn axis_unit(axis: usize, negative: bool) -> Dir {
@@ -300,16 +297,6 @@ impl Dir {
         let mut b = [0; 3];
         b[axis.min(2)] = one;
         Dir::from_bits(b)
-    }
-
-    #[inline]
-    /// The component along `axis` (0, 1, 2 for X, Y, Z).
-    pub fn axis(self, axis: usize) -> Unit {
-        match axis {
-            0 => self.x,
-            1 => self.y,
-            _ => self.z,
-        }
     }
 
     /// `self · o` exactly, in Q4.60.

@@ -9,7 +9,7 @@
 //! nearest point of the triangle in RGB ([`project`]), and the dither runs
 //! on the two values `r` and `m`.
 
-use super::Divisor;
+use super::divisor::Divisor;
 use embedded_graphics_core::pixelcolor::{PixelColor, Rgb888, RgbColor};
 
 /// A pixel of a black/white/red e-paper panel. embedded-graphics has no

@@ -11,21 +11,20 @@
 //! mark to be traced); a draw that asks nothing runs the tracer without
 //! any of the asking.
 
-use super::image::Shifted;
-use super::loaded::renderer_in;
-use super::{DrawError, RendererRoom, TracedImage};
-use crate::accel::SceneAccelerator;
+use super::{DrawError, RendererRoom, ScreenLists};
+use crate::accel::{Linked, SceneAccelerator};
 use crate::animation::Playing;
 use crate::motion::Lookout;
-use crate::panel::{Dithered, TracedColor, IMAGE_ERROR_WORDS};
+use crate::panel::{Dithered, Dithering, TracedColor, IMAGE_ERROR_WORDS};
 use crate::profile::Profile;
 use crate::render::{Halt, Progressive, Renderer};
 use crate::scene::{CameraError, SceneView};
 use crate::shade::{Poll, Stats};
-use core::cell::Cell;
+use core::cell::{Cell, RefCell};
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Dimensions, Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
+use embedded_graphics_core::Pixel;
 
 /// Where a draw's renderer comes from: a scene's view and accelerator,
 /// and the room its renderer traces in.
@@ -77,6 +76,45 @@ impl<'r, P: Profile> Source<'_, 'r, P> {
     }
 }
 
+/// A renderer over `view` for an image of `size`, with a mailbox and screen
+/// lists where given. Inlined: a board's renderer is made in place.
+#[inline(always)]
+pub(super) fn renderer_in<'a, L: Linked>(
+    view: SceneView<'a>,
+    accel: &'a SceneAccelerator<'a, L>,
+    size: Size,
+    mailbox: Option<&'a mut [u32]>,
+    lists: Option<ScreenLists<'a>>,
+) -> Result<Renderer<'a, L>, CameraError> {
+    let mut renderer = Renderer::with_size(view, accel, size.width, size.height)?;
+    if let Some(words) = mailbox {
+        renderer.set_mailbox(words);
+    }
+    if let Some((bounds, positions)) = lists {
+        renderer.set_first_hits(bounds, positions);
+    }
+    Ok(renderer)
+}
+
+/// What a [`TracedImage`](super::TracedImage) asks to be drawn: its
+/// source, its size, its options.
+pub(super) struct Request<'s, 'r, P: Profile> {
+    pub source: Source<'s, 'r, P>,
+    pub size: Size,
+    pub dithering: Dithering,
+    pub picture: Picture<'s>,
+    /// Error diffusion's rows, if the caller gives them.
+    pub rows: Option<&'s RefCell<[i16]>>,
+}
+
+impl<P: Profile> Clone for Request<'_, '_, P> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<P: Profile> Copy for Request<'_, '_, P> {}
+
 /// What an image draws.
 #[derive(Clone, Copy)]
 pub(super) enum Picture<'s> {
@@ -90,9 +128,9 @@ pub(super) enum Picture<'s> {
     Bands(Playing<'s>, Option<&'s dyn Fn() -> Option<u32>>),
 }
 
-/// Draws `image` into `target`, `poll` asked before every ray.
+/// Draws what `image` asks into `target`, `poll` asked before every ray.
 pub(super) fn draw<P, C, D, Q>(
-    image: &TracedImage<'_, '_, P, C>,
+    image: &Request<'_, '_, P>,
     target: &mut D,
     poll: &mut Q,
 ) -> Result<Stats, DrawError<D::Error>>
@@ -119,7 +157,7 @@ where
         Picture::Area(area) => {
             let mut shifted = Shifted { target, offset: Point::zero() - area.top_left };
             // The pixels there are: the rows a ditherer is set up for.
-            let area = area.intersection(&image.bounding_box());
+            let area = area.intersection(&Rectangle::new(Point::zero(), image.size));
             match (C::PANEL, image.rows) {
                 (None, _) => {
                     drawn(image.source.with_renderer(image.size, None, |r| rows(r, &area, &mut shifted, poll)))
@@ -154,8 +192,8 @@ const SMALL_ERROR_WORDS: usize = 256;
 
 /// A frame's bands (every one, or those `next` gives) into `target`:
 /// each planned run of tiles row by row, in one `fill_contiguous` a row.
-fn bands<P, C, D, Q>(
-    image: &TracedImage<'_, '_, P, C>,
+fn bands<P, D, Q>(
+    image: &Request<'_, '_, P>,
     playing: &Playing<'_>,
     next: Option<&dyn Fn() -> Option<u32>>,
     target: &mut D,
@@ -227,7 +265,7 @@ where
 /// inlined: a truecolour draw never holds the row.
 #[inline(never)]
 fn dithered_on_stack<const WORDS: usize, P, C, D, Q>(
-    image: &TracedImage<'_, '_, P, C>,
+    image: &Request<'_, '_, P>,
     area: &Rectangle,
     target: &mut D,
     poll: &mut Q,
@@ -246,7 +284,7 @@ where
 /// row is in.
 #[inline(never)]
 fn dithered<P, C, D, Q>(
-    image: &TracedImage<'_, '_, P, C>,
+    image: &Request<'_, '_, P>,
     area: &Rectangle,
     target: &mut D,
     rows: &mut [i16],
@@ -261,4 +299,36 @@ where
     let (left, width) = (area.top_left.x, area.size.width);
     let mut dithered = Dithered::across(target, image.dithering, left, width, rows).map_err(DrawError::ErrorRow)?;
     drawn(image.source.with_renderer(image.size, None, |renderer| self::rows(renderer, area, &mut dithered, poll)))
+}
+
+/// A target seen shifted by `offset`: a sub-image's pixels land at the
+/// target's origin.
+struct Shifted<'t, D> {
+    target: &'t mut D,
+    offset: Point,
+}
+
+impl<D: DrawTarget> Dimensions for Shifted<'_, D> {
+    fn bounding_box(&self) -> Rectangle {
+        let b = self.target.bounding_box();
+        Rectangle::new(b.top_left - self.offset, b.size)
+    }
+}
+
+impl<D: DrawTarget> DrawTarget for Shifted<'_, D> {
+    type Color = D::Color;
+    type Error = D::Error;
+
+    fn draw_iter<I: IntoIterator<Item = Pixel<D::Color>>>(&mut self, pixels: I) -> Result<(), D::Error> {
+        let offset = self.offset;
+        self.target.draw_iter(pixels.into_iter().map(|Pixel(p, c)| Pixel(p + offset, c)))
+    }
+
+    fn fill_contiguous<I: IntoIterator<Item = D::Color>>(
+        &mut self,
+        area: &Rectangle,
+        colors: I,
+    ) -> Result<(), D::Error> {
+        self.target.fill_contiguous(&Rectangle::new(area.top_left + self.offset, area.size), colors)
+    }
 }

@@ -2,12 +2,12 @@
 //! embedded-graphics image with options (an area, the progressive order, a
 //! frame's bands, the dithering), drawn whole or stopped inside a pixel.
 
-use super::draw::{self, Picture, Source};
+use super::draw::{self, Picture, Request, Source};
+use super::DrawError;
 use crate::animation::Playing;
-use crate::panel::{Dithering, ErrorRowTooShort, TracedColor};
+use crate::panel::{Dithering, TracedColor};
 use crate::profile::Profile;
-use crate::render::{Polling, Progressive, Stop, Stopped};
-use crate::scene::CameraError;
+use crate::render::{Polling, Progressive, Stop};
 use crate::shade::{Stats, Unpolled};
 use core::cell::RefCell;
 use core::fmt;
@@ -15,42 +15,6 @@ use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Dimensions, OriginDimensions, Point, Size};
 use embedded_graphics_core::image::ImageDrawable;
 use embedded_graphics_core::primitives::Rectangle;
-use embedded_graphics_core::Pixel;
-
-/// Why a [`TracedImage`] was not drawn whole.
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum DrawError<E> {
-    /// The camera cannot be set up for this size (see [`CameraError`]).
-    Camera(CameraError),
-    /// Error diffusion has no room for the image's rows (an image wider
-    /// than [`IMAGE_ERROR_WORDS`](crate::panel::IMAGE_ERROR_WORDS) allows, drawn without
-    /// [`TracedImage::error_rows`]).
-    ErrorRow(ErrorRowTooShort),
-    /// The display's own error.
-    Target(E),
-    /// The caller's stop said so ([`TracedImage::try_draw_until`]).
-    Stopped,
-}
-
-impl<E> From<Stopped> for DrawError<E> {
-    fn from(_: Stopped) -> Self {
-        DrawError::Stopped
-    }
-}
-
-impl<E: fmt::Display> fmt::Display for DrawError<E> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            DrawError::Camera(e) => write!(f, "{e}"),
-            DrawError::ErrorRow(e) => write!(f, "{e}"),
-            DrawError::Target(e) => write!(f, "the display failed: {e}"),
-            DrawError::Stopped => write!(f, "stopped before the picture's end"),
-        }
-    }
-}
-
-impl<E: fmt::Debug + fmt::Display> core::error::Error for DrawError<E> {}
 
 /// What to draw of a loaded scene or of a frame of an animation, and how:
 /// an image `size` pixels in the colour `C`, like `tinybmp::Bmp<C>`. Each
@@ -90,26 +54,21 @@ impl<E: fmt::Debug + fmt::Display> core::error::Error for DrawError<E> {}
 /// display.assert_pattern(&["BBBB", "BBBB"]);
 /// ```
 pub struct TracedImage<'s, 'r, P: Profile, C> {
-    pub(super) source: Source<'s, 'r, P>,
-    pub(super) size: Size,
-    pub(super) dithering: Dithering,
-    pub(super) picture: Picture<'s>,
-    /// Error diffusion's rows, if the caller gives them.
-    pub(super) rows: Option<&'s RefCell<[i16]>>,
-    pub(super) color: core::marker::PhantomData<C>,
+    request: Request<'s, 'r, P>,
+    color: core::marker::PhantomData<C>,
 }
 
 impl<P: Profile, C> fmt::Debug for TracedImage<'_, '_, P, C> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let picture = match self.picture {
+        let picture = match self.request.picture {
             Picture::Area(area) => area,
             _ => self.bounding_box(),
         };
         f.debug_struct("TracedImage")
-            .field("size", &self.size)
-            .field("dithering", &self.dithering)
+            .field("size", &self.request.size)
+            .field("dithering", &self.request.dithering)
             .field("area", &picture)
-            .field("objects", &self.source.view.object_count())
+            .field("objects", &self.request.source.view.object_count())
             .finish_non_exhaustive()
     }
 }
@@ -130,14 +89,13 @@ impl<'s, 'r, P: Profile, C> TracedImage<'s, 'r, P, C> {
             Some(playing) => Picture::Bands(playing, None),
             None => Picture::Area(Rectangle::new(Point::zero(), size)),
         };
-        TracedImage {
-            source,
-            size,
-            dithering: Dithering::default(),
-            picture,
-            rows: None,
-            color: core::marker::PhantomData,
-        }
+        let request = Request { source, size, dithering: Dithering::default(), picture, rows: None };
+        TracedImage { request, color: core::marker::PhantomData }
+    }
+
+    /// The image drawing what `request` asks.
+    fn with(self, request: Request<'s, 'r, P>) -> Self {
+        TracedImage { request, ..self }
     }
 
     /// The image dithered by `dithering` on a panel of few levels (a
@@ -157,12 +115,12 @@ impl<'s, 'r, P: Profile, C> TracedImage<'s, 'r, P, C> {
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
     pub fn dithered(self, dithering: Dithering) -> Self {
-        TracedImage { dithering, ..self }
+        self.with(Request { dithering, ..self.request })
     }
 
     /// How it is dithered on a panel of few levels.
     pub fn dithering(&self) -> Dithering {
-        self.dithering
+        self.request.dithering
     }
 
     /// A still's pixels in `area` only (in the image's coordinates), drawn
@@ -185,9 +143,9 @@ impl<'s, 'r, P: Profile, C> TracedImage<'s, 'r, P, C> {
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
     pub fn area(self, area: Rectangle) -> Self {
-        match self.picture {
+        match self.request.picture {
             Picture::Bands(..) => self,
-            _ => TracedImage { picture: Picture::Area(area), ..self },
+            _ => self.with(Request { picture: Picture::Area(area), ..self.request }),
         }
     }
 
@@ -216,9 +174,9 @@ impl<'s, 'r, P: Profile, C> TracedImage<'s, 'r, P, C> {
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
     pub fn progressive(self, order: &'s Progressive) -> Self {
-        match self.picture {
+        match self.request.picture {
             Picture::Bands(..) => self,
-            _ => TracedImage { picture: Picture::Progressive(order), ..self },
+            _ => self.with(Request { picture: Picture::Progressive(order), ..self.request }),
         }
     }
 
@@ -227,8 +185,10 @@ impl<'s, 'r, P: Profile, C> TracedImage<'s, 'r, P, C> {
     /// instead of every band: on a board whose cores share a frame, each
     /// core draws the next band no core has taken yet. A still ignores it.
     pub fn bands(self, next: &'s dyn Fn() -> Option<u32>) -> Self {
-        match self.picture {
-            Picture::Bands(playing, _) => TracedImage { picture: Picture::Bands(playing, Some(next)), ..self },
+        match self.request.picture {
+            Picture::Bands(playing, _) => {
+                self.with(Request { picture: Picture::Bands(playing, Some(next)), ..self.request })
+            }
             _ => self,
         }
     }
@@ -255,7 +215,7 @@ impl<'s, 'r, P: Profile, C> TracedImage<'s, 'r, P, C> {
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
     pub fn error_rows(self, rows: &'s RefCell<[i16]>) -> Self {
-        TracedImage { rows: Some(rows), ..self }
+        self.with(Request { rows: Some(rows), ..self.request })
     }
 }
 
@@ -266,7 +226,7 @@ impl<P: Profile, C: TracedColor> TracedImage<'_, '_, P, C> {
     /// stack, the display's error ([`ImageDrawable::draw`] tells only the
     /// last).
     pub fn try_draw<D: DrawTarget<Color = C>>(&self, target: &mut D) -> Result<Stats, DrawError<D::Error>> {
-        draw::draw(self, target, &mut Unpolled)
+        draw::draw(&self.request, target, &mut Unpolled)
     }
 
     /// [`TracedImage::try_draw`], asking `stop` before every ray (as
@@ -297,13 +257,13 @@ impl<P: Profile, C: TracedColor> TracedImage<'_, '_, P, C> {
         target: &mut D,
         stop: &mut S,
     ) -> Result<Stats, DrawError<D::Error>> {
-        draw::draw(self, target, &mut Polling { stop, stopped: false })
+        draw::draw(&self.request, target, &mut Polling { stop, stopped: false })
     }
 }
 
 impl<P: Profile, C> OriginDimensions for TracedImage<'_, '_, P, C> {
     fn size(&self) -> Size {
-        self.size
+        self.request.size
     }
 }
 
@@ -322,48 +282,17 @@ impl<P: Profile, C: TracedColor> ImageDrawable for TracedImage<'_, '_, P, C> {
     }
 }
 
-/// A target seen shifted by `offset`: a sub-image's pixels land at the
-/// target's origin.
-pub(super) struct Shifted<'t, D> {
-    pub(super) target: &'t mut D,
-    pub(super) offset: Point,
-}
-
-impl<D: DrawTarget> Dimensions for Shifted<'_, D> {
-    fn bounding_box(&self) -> Rectangle {
-        let b = self.target.bounding_box();
-        Rectangle::new(b.top_left - self.offset, b.size)
-    }
-}
-
-impl<D: DrawTarget> DrawTarget for Shifted<'_, D> {
-    type Color = D::Color;
-    type Error = D::Error;
-
-    fn draw_iter<I: IntoIterator<Item = Pixel<D::Color>>>(&mut self, pixels: I) -> Result<(), D::Error> {
-        let offset = self.offset;
-        self.target.draw_iter(pixels.into_iter().map(|Pixel(p, c)| Pixel(p + offset, c)))
-    }
-
-    fn fill_contiguous<I: IntoIterator<Item = D::Color>>(
-        &mut self,
-        area: &Rectangle,
-        colors: I,
-    ) -> Result<(), D::Error> {
-        self.target.fill_contiguous(&Rectangle::new(area.top_left + self.offset, area.size), colors)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::super::tests::{Grid, SCENE};
     use super::*;
-    use crate::panel::{Ditherer, IMAGE_ERROR_WORDS};
+    use crate::panel::{Ditherer, ErrorRowTooShort, IMAGE_ERROR_WORDS};
     use crate::profile::Board16K;
     use crate::render::Progressive;
     use crate::{LoadedScene, Raytracer};
     use embedded_graphics_core::pixelcolor::{BinaryColor, Gray4, Rgb565, Rgb888};
     use embedded_graphics_core::primitives::PointsIter;
+    use embedded_graphics_core::Pixel;
     use std::string::ToString;
     use std::vec::Vec;
 

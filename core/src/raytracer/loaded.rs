@@ -1,7 +1,7 @@
 //! A loaded scene: its view, accelerator, light buffer and the room of the
 //! core that loaded it; it draws as an image ([`TracedImage`]).
 
-use crate::accel::{AccelMode, BuildReport, LightBuffer, LightBufferError, Linked, SceneAccelerator};
+use crate::accel::{AccelMode, BuildReport, LightBuffer, LightBufferError, SceneAccelerator};
 use crate::profile::Profile;
 use crate::render::Renderer;
 use crate::scene::{CameraError, Frames, SceneView};
@@ -12,7 +12,7 @@ use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::Size;
 
 use super::draw::Source;
-use super::{RendererRoom, ScreenLists, SharedScene, TracedImage};
+use super::{RendererRoom, SharedScene, TracedImage};
 
 /// A scene ready to trace, borrowed from its [`Raytracer`](super::Raytracer).
 pub struct LoadedScene<'r, P: Profile> {
@@ -210,24 +210,4 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     pub fn image_for<D: DrawTarget>(&self, target: &D) -> TracedImage<'_, 'r, P, D::Color> {
         self.image(target.bounding_box().size)
     }
-}
-
-/// A renderer over `view` for an image of `size`, with a mailbox and screen
-/// lists where given. Inlined: a board's renderer is made in place.
-#[inline(always)]
-pub(super) fn renderer_in<'a, L: Linked>(
-    view: SceneView<'a>,
-    accel: &'a SceneAccelerator<'a, L>,
-    size: Size,
-    mailbox: Option<&'a mut [u32]>,
-    lists: Option<ScreenLists<'a>>,
-) -> Result<Renderer<'a, L>, CameraError> {
-    let mut renderer = Renderer::with_size(view, accel, size.width, size.height)?;
-    if let Some(words) = mailbox {
-        renderer.set_mailbox(words);
-    }
-    if let Some((bounds, positions)) = lists {
-        renderer.set_first_hits(bounds, positions);
-    }
-    Ok(renderer)
 }

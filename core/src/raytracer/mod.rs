@@ -21,12 +21,14 @@ use core::fmt;
 
 mod animated;
 mod draw;
+mod draw_error;
 mod image;
 mod loaded;
 mod shared;
 
 pub use animated::{AnimationError, Frame};
-pub use image::{DrawError, TracedImage};
+pub use draw_error::DrawError;
+pub use image::TracedImage;
 pub use loaded::LoadedScene;
 pub use shared::SharedScene;
 

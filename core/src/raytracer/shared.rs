@@ -9,8 +9,7 @@ use crate::scene::{CameraError, SceneView};
 use core::fmt;
 use embedded_graphics_core::geometry::Size;
 
-use super::draw::Source;
-use super::loaded::renderer_in;
+use super::draw::{renderer_in, Source};
 use super::{RendererRoom, TracedImage};
 
 /// What another core needs to render a [`LoadedScene`](super::LoadedScene)

@@ -7,7 +7,7 @@
 //! it consistently; each edge is widened by [`EDGE_TOLERANCE`] so that
 //! neighbours whose planes round differently still leave no crack.
 
-use super::{Aabb, Leaving, Ray};
+use super::{Aabb, Leaving, Ray, Shape};
 use crate::math::{div_saturating, mul_wide, Dir, Scalar, Vec3};
 
 /// How far (in Q16.16 raw units, normalised space) a hit may lie outside an
@@ -224,6 +224,45 @@ pub fn cross_of_edges(a: Vec3, b: Vec3, c: Vec3) -> [i64; 3] {
     let e1 = (b - a).wide();
     let e2 = (c - a).wide();
     [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]]
+}
+
+/// A flat shape: a convex polygon and its surface. A TRIANGLE is a
+/// `Flat<3>` ([`Triangle`](super::Triangle)), a RECTANGLE a `Flat<4>`
+/// ([`Rectangle`](super::Rectangle)); each builds its polygon its own way.
+// Public only for `profile!` (arenas of it) and the firmware's RAM
+// estimate; its geometry is the core's own business.
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Flat<const N: usize> {
+    pub polygon: Polygon<N>,
+    pub surface: u16,
+}
+
+impl<const N: usize> Flat<N> {
+    pub fn normal(&self) -> Dir {
+        self.polygon.normal
+    }
+}
+
+impl<const N: usize> Shape for Flat<N> {
+    const FLAT: bool = true;
+
+    #[inline]
+    fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
+        self.polygon.intersect(ray, t_max, leaving)
+    }
+
+    fn normal_at(&self, _: Vec3) -> Dir {
+        self.normal()
+    }
+
+    fn bounds(&self) -> Aabb {
+        self.polygon.bounds()
+    }
+
+    fn surface(&self) -> u16 {
+        self.surface
+    }
 }
 
 #[cfg(test)]

@@ -2,19 +2,11 @@
 //! counter-clockwise seen from the front. Planarity and convexity are checked
 //! when the scene is parsed, in world units.
 
-use super::polygon::Polygon;
-use super::{Aabb, Leaving, Ray, Shape};
-use crate::math::{Dir, Scalar, Vec3};
+use super::polygon::{Flat, Polygon};
+use crate::math::Vec3;
 
 /// A RECTANGLE: a planar convex quadrilateral.
-// Public only for `profile!` (arenas of it) and the firmware's RAM
-// estimate; its geometry is the core's own business.
-#[doc(hidden)]
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Rectangle {
-    pub polygon: Polygon<4>,
-    pub surface: u16,
-}
+pub type Rectangle = Flat<4>;
 
 impl Rectangle {
     /// `None` when the corners span no area at this precision.
@@ -26,37 +18,14 @@ impl Rectangle {
         let normal = [d1[1] * d2[2] - d1[2] * d2[1], d1[2] * d2[0] - d1[0] * d2[2], d1[0] * d2[1] - d1[1] * d2[0]];
         Some(Rectangle { polygon: Polygon::with_normal(corners, normal)?, surface })
     }
-
-    pub fn normal(&self) -> Dir {
-        self.polygon.normal
-    }
-}
-
-impl Shape for Rectangle {
-    const FLAT: bool = true;
-
-    #[inline]
-    fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
-        self.polygon.intersect(ray, t_max, leaving)
-    }
-
-    fn normal_at(&self, _: Vec3) -> Dir {
-        self.normal()
-    }
-
-    fn bounds(&self) -> Aabb {
-        self.polygon.bounds()
-    }
-
-    fn surface(&self) -> u16 {
-        self.surface
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::super::test_util::*;
+    use super::super::{Leaving, Shape};
     use super::*;
+    use crate::math::{Dir, Scalar};
 
     fn floor() -> Rectangle {
         // y = −1, seen from above: counter-clockwise from +y.

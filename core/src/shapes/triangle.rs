@@ -1,19 +1,11 @@
 //! `TRIANGLE s x1 y1 z1 x2 y2 z2 x3 y3 z3`: corners counter-clockwise seen
 //! from the front, front normal (p2 − p1) × (p3 − p1).
 
-use super::polygon::{cross_of_edges, Polygon};
-use super::{Aabb, Leaving, Ray, Shape};
-use crate::math::{Dir, Scalar, Vec3};
+use super::polygon::{cross_of_edges, Flat, Polygon};
+use crate::math::Vec3;
 
 /// A TRIANGLE.
-// Public only for `profile!` (arenas of it) and the firmware's RAM
-// estimate; its geometry is the core's own business.
-#[doc(hidden)]
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Triangle {
-    pub polygon: Polygon<3>,
-    pub surface: u16,
-}
+pub type Triangle = Flat<3>;
 
 impl Triangle {
     /// `None` when the corners are collinear at this precision.
@@ -21,37 +13,14 @@ impl Triangle {
         let normal = cross_of_edges(corners[0], corners[1], corners[2]);
         Some(Triangle { polygon: Polygon::with_normal(corners, normal)?, surface })
     }
-
-    pub fn normal(&self) -> Dir {
-        self.polygon.normal
-    }
-}
-
-impl Shape for Triangle {
-    const FLAT: bool = true;
-
-    #[inline]
-    fn intersect(&self, ray: &Ray, t_max: Scalar, leaving: Leaving) -> Option<Scalar> {
-        self.polygon.intersect(ray, t_max, leaving)
-    }
-
-    fn normal_at(&self, _: Vec3) -> Dir {
-        self.normal()
-    }
-
-    fn bounds(&self) -> Aabb {
-        self.polygon.bounds()
-    }
-
-    fn surface(&self) -> u16 {
-        self.surface
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::super::test_util::*;
+    use super::super::{Leaving, Ray, Shape};
     use super::*;
+    use crate::math::{Dir, Scalar};
 
     fn tri() -> Triangle {
         Triangle::new([p(0, 0, -5), p(4, 0, -5), p(0, 4, -5)], 0).unwrap()

@@ -63,7 +63,7 @@ pub struct StudioArgs {
 /// the binary (the module by `build.rs`; `codemirror.js`, the editor, is
 /// CodeMirror 6 bundled by `studio/editor/build.mjs` and committed). The
 /// keywords' module is made from the core's list (`keywords_module`).
-const ASSETS: [(&str, &str, &[u8]); 14] = [
+const ASSETS: [(&str, &str, &[u8]); 16] = [
     ("/", "text/html; charset=utf-8", include_bytes!("assets/index.html")),
     ("/studio.js", "text/javascript; charset=utf-8", include_bytes!("assets/studio.js")),
     ("/editor.js", "text/javascript; charset=utf-8", include_bytes!("assets/editor.js")),
@@ -75,6 +75,8 @@ const ASSETS: [(&str, &str, &[u8]); 14] = [
     ("/tools.js", "text/javascript; charset=utf-8", include_bytes!("assets/tools.js")),
     ("/panel.js", "text/javascript; charset=utf-8", include_bytes!("assets/panel.js")),
     ("/board.js", "text/javascript; charset=utf-8", include_bytes!("assets/board.js")),
+    ("/render.js", "text/javascript; charset=utf-8", include_bytes!("assets/render.js")),
+    ("/workers.js", "text/javascript; charset=utf-8", include_bytes!("assets/workers.js")),
     ("/worker.js", "text/javascript; charset=utf-8", include_bytes!("assets/worker.js")),
     ("/studio.css", "text/css; charset=utf-8", include_bytes!("assets/studio.css")),
     ("/octrace_studio.wasm", "application/wasm", include_bytes!(concat!(env!("OUT_DIR"), "/octrace_studio.wasm"))),

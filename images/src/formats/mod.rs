@@ -16,139 +16,21 @@
 //! dropped). Anything else, and any malformed file, is a [`FormatError`]: reading never panics, and rejects
 //! declared sizes the file is too short to hold (even fully compressed) before allocating for them.
 
+mod bytes;
+mod error;
+mod image;
 mod png;
 mod rows;
 mod sun_raster;
 mod targa;
 
+pub use error::FormatError;
+pub use image::{Format, Header, Image, TEXT_KEYWORD};
 pub use rows::{RowReader, RowWriter};
 
-use crate::RgbImage;
-use std::fmt;
+use error::invalid;
+use image::check;
 use std::io::Write;
-use std::path::Path;
-
-/// An image file format.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Format {
-    Png,
-    Tga,
-    Ras,
-}
-
-impl Format {
-    /// Every format.
-    pub const ALL: [Format; 3] = [Format::Png, Format::Tga, Format::Ras];
-
-    /// The format named by `path`'s extension (png, tga or ras, any case).
-    pub fn from_path(path: &Path) -> Option<Format> {
-        let extension = path.extension()?.to_str()?.to_ascii_lowercase();
-        Format::ALL.into_iter().find(|f| f.name() == extension)
-    }
-
-    /// The format's usual file name extension, which also names it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Format::Png => "png",
-            Format::Tga => "tga",
-            Format::Ras => "ras",
-        }
-    }
-}
-
-/// An image as a file holds it: pixels, or indices into a palette.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Image {
-    Rgb(RgbImage),
-    /// `indices` row-major, one per pixel.
-    Indexed {
-        width: u32,
-        height: u32,
-        palette: Vec<[u8; 3]>,
-        indices: Vec<u8>,
-    },
-}
-
-impl Image {
-    pub fn width(&self) -> u32 {
-        match self {
-            Image::Rgb(rgb) => rgb.width,
-            Image::Indexed { width, .. } => *width,
-        }
-    }
-
-    pub fn height(&self) -> u32 {
-        match self {
-            Image::Rgb(rgb) => rgb.height,
-            Image::Indexed { height, .. } => *height,
-        }
-    }
-
-    /// The image's pixels; an index outside the palette gives black.
-    pub fn to_rgb(&self) -> RgbImage {
-        match self {
-            Image::Rgb(rgb) => rgb.clone(),
-            Image::Indexed { width, height, palette, indices } => {
-                let pixels = *width as usize * *height as usize;
-                let colour = |i: usize| indices.get(i).and_then(|&index| palette.get(index as usize));
-                let data = (0..pixels).flat_map(|i| *colour(i).unwrap_or(&[0; 3])).collect();
-                RgbImage { width: *width, height: *height, data }
-            }
-        }
-    }
-}
-
-impl From<RgbImage> for Image {
-    fn from(rgb: RgbImage) -> Image {
-        Image::Rgb(rgb)
-    }
-}
-
-/// Why an image could not be read or written.
-#[derive(Debug)]
-pub enum FormatError {
-    /// Writing the file failed.
-    Io(std::io::Error),
-    /// The file ends inside the named part.
-    Truncated(&'static str),
-    /// A kind of file this module does not handle.
-    Unsupported(String),
-    /// A malformed file, or an image that no file can hold as it is.
-    Invalid(String),
-}
-
-impl fmt::Display for FormatError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            FormatError::Io(e) => write!(f, "{e}"),
-            FormatError::Truncated(part) => write!(f, "truncated {part}"),
-            FormatError::Unsupported(what) | FormatError::Invalid(what) => f.write_str(what),
-        }
-    }
-}
-
-impl std::error::Error for FormatError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            FormatError::Io(e) => Some(e),
-            _ => None,
-        }
-    }
-}
-
-impl From<std::io::Error> for FormatError {
-    fn from(e: std::io::Error) -> FormatError {
-        FormatError::Io(e)
-    }
-}
-
-fn invalid<T>(message: String) -> Result<T, FormatError> {
-    Err(FormatError::Invalid(message))
-}
-
-fn unsupported<T>(message: String) -> Result<T, FormatError> {
-    Err(FormatError::Unsupported(message))
-}
 
 /// Writes `image` to `out` as a `format` file.
 pub fn write(image: &Image, format: Format, out: &mut dyn Write) -> Result<(), FormatError> {
@@ -180,33 +62,6 @@ pub fn write_gray_png(image: &Image, out: &mut dyn Write) -> Result<(), FormatEr
     png::write_gray(*width, *height, &gray, out)
 }
 
-/// What a file says before its rows.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Header {
-    pub width: u32,
-    pub height: u32,
-    /// The colour table of an indexed image (rows are then one index a pixel), or `None` for truecolour (rows
-    /// of RGB triples).
-    pub palette: Option<Vec<[u8; 3]>>,
-    /// Text carried in the file: a PNG `tEXt` chunk under [`TEXT_KEYWORD`] or a Targa image ID (at most 255
-    /// bytes). Sun rasters have nowhere to put it.
-    pub text: Option<String>,
-}
-
-impl Header {
-    /// Bytes a pixel takes in a row: 3 (RGB) or 1 (an index).
-    pub(crate) fn bytes_per_pixel(&self) -> usize {
-        if self.palette.is_some() {
-            1
-        } else {
-            3
-        }
-    }
-}
-
-/// The keyword of the PNG `tEXt` chunk that carries [`Header::text`].
-pub const TEXT_KEYWORD: &str = "octrace";
-
 /// Reads an image file of any of the formats, told apart by their content.
 pub fn read(bytes: &[u8]) -> Result<Image, FormatError> {
     let image = if bytes.starts_with(png::SIGNATURE) {
@@ -221,75 +76,11 @@ pub fn read(bytes: &[u8]) -> Result<Image, FormatError> {
     Ok(image)
 }
 
-/// Fails unless `image` is one every format can hold: not empty, the data as long as the size says, at most
-/// 256 palette entries and every index inside the palette.
-fn check(image: &Image) -> Result<(), FormatError> {
-    let (width, height) = (image.width(), image.height());
-    check_size(width, height)?;
-    let (length, per_pixel) = match image {
-        Image::Rgb(rgb) => (rgb.data.len(), 3),
-        Image::Indexed { indices, .. } => (indices.len(), 1),
-    };
-    if length as u64 != u64::from(width) * u64::from(height) * per_pixel {
-        return invalid(format!("{length} bytes of pixel data for a {width}×{height} image"));
-    }
-    if let Image::Indexed { palette, indices, .. } = image {
-        check_palette_length(palette)?;
-        check_indices(indices, palette)?;
-    }
-    Ok(())
-}
-
-/// Fails for an image without pixels.
-fn check_size(width: u32, height: u32) -> Result<(), FormatError> {
-    if width == 0 || height == 0 {
-        return invalid(format!("the image is {width}×{height} pixels"));
-    }
-    Ok(())
-}
-
-/// Fails for a colour table no format holds (more than 256 entries).
-fn check_palette_length(palette: &[[u8; 3]]) -> Result<(), FormatError> {
-    if palette.len() > 256 {
-        return invalid(format!("palette has {} entries, at most 256", palette.len()));
-    }
-    Ok(())
-}
-
-/// Fails for an index past the end of `palette`.
-fn check_indices(indices: &[u8], palette: &[[u8; 3]]) -> Result<(), FormatError> {
-    if let Some(index) = indices.iter().find(|&&i| i as usize >= palette.len()) {
-        return invalid(format!("index {index} is outside the {}-entry palette", palette.len()));
-    }
-    Ok(())
-}
-
-/// The first `n` bytes of `input`, which moves past them.
-fn take<'a>(input: &mut &'a [u8], n: usize, part: &'static str) -> Result<&'a [u8], FormatError> {
-    let (head, rest) = input.split_at_checked(n).ok_or(FormatError::Truncated(part))?;
-    *input = rest;
-    Ok(head)
-}
-
-/// Pixels of `pixel_bytes` bytes each, red, green and blue at `offsets` in each, as RGB (or, as the
-/// offsets are their own inverse, RGB as BGR); other bytes (alpha, padding) are dropped.
-fn pick(pixels: &[u8], pixel_bytes: usize, offsets: [usize; 3]) -> Vec<u8> {
-    pixels.chunks_exact(pixel_bytes).flat_map(|p| offsets.map(|i| p[i])).collect()
-}
-
-/// Where red, green and blue sit in a stored Targa or Sun raster pixel.
-const BGR: [usize; 3] = [2, 1, 0];
-
-fn read_exactly(input: &mut impl std::io::Read, buffer: &mut [u8], part: &'static str) -> Result<(), FormatError> {
-    input.read_exact(buffer).map_err(|e| match e.kind() {
-        std::io::ErrorKind::UnexpectedEof => FormatError::Truncated(part),
-        _ => FormatError::Io(e),
-    })
-}
-
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::RgbImage;
+    use std::path::Path;
 
     pub(crate) fn rgb(width: u32, height: u32) -> Image {
         let data = (0..width * height * 3).map(|i| (i * 37 + 11) as u8).collect();

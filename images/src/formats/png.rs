@@ -3,7 +3,8 @@
 //! Invariant: a declared size is checked against what the file's bytes could inflate to before anything
 //! is allocated for it.
 
-use super::{invalid, unsupported, FormatError, Header, Image, TEXT_KEYWORD};
+use super::error::{invalid, unsupported, FormatError};
+use super::image::{Header, Image, TEXT_KEYWORD};
 use crate::RgbImage;
 use std::io::{BufReader, Write};
 

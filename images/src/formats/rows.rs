@@ -4,10 +4,10 @@
 //! Invariant: a [`RowWriter`] has written exactly the rows it was given, in order, after the header; a
 //! [`RowReader`] hands back rows of exactly `width` pixels, every index inside the palette.
 
-use super::{
-    check_indices, check_palette_length, check_size, invalid, png, read_exactly, sun_raster, targa, unsupported,
-};
-use super::{Format, FormatError, Header, BGR};
+use super::bytes::{read_exactly, BGR};
+use super::error::{invalid, unsupported, FormatError};
+use super::image::{check_indices, check_palette_length, check_size, Format, Header};
+use super::{png, sun_raster, targa};
 use std::io::{BufRead, BufReader, Write};
 
 /// Writes an image a row at a time, top to bottom, so that no more than a row is held: the file's header

@@ -2,7 +2,9 @@
 //!
 //! Invariant: rows are stored padded to an even number of bytes ([`row_padding`]), both ways.
 
-use super::{invalid, pick, read_exactly, take, unsupported, FormatError, Header, Image};
+use super::bytes::{pick, read_exactly, take};
+use super::error::{invalid, unsupported, FormatError};
+use super::image::{Header, Image};
 use crate::RgbImage;
 use std::borrow::Cow;
 

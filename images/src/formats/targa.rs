@@ -3,7 +3,9 @@
 //! Invariant: run-length data is checked to be long enough for the pixels it claims (128 a packet at
 //! most) before they are allocated.
 
-use super::{invalid, pick, read_exactly, take, unsupported, FormatError, Header, Image, BGR};
+use super::bytes::{pick, read_exactly, take, BGR};
+use super::error::{invalid, unsupported, FormatError};
+use super::image::{Header, Image};
 use crate::RgbImage;
 use std::borrow::Cow;
 

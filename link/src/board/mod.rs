@@ -82,8 +82,9 @@ pub use serve::{
 use crate::cobs::Sink;
 use crate::decoder::{Decoder, Frame};
 use crate::frame::{FrameWriter, Reason, Refusal, VERSION};
+use crate::kind::Kind;
 use crate::list::{Capacities, Capacity};
-use crate::message::{put_scene_error, BoardInfo, CapacityNeed, Kind, Message, Panel, Timing};
+use crate::message::{put_scene_error, BoardInfo, CapacityNeed, Message, Panel, Timing};
 use core::fmt;
 use embedded_graphics_core::pixelcolor::{IntoStorage, Rgb565};
 use octrace_core::animation::{Animation, AnimationNeeds};

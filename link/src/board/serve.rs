@@ -648,7 +648,8 @@ impl<L: Line, B: AsRef<[u8]> + AsMut<[u8]>> Sink for Polled<'_, '_, '_, L, B> {
 mod tests {
     extern crate std;
     use super::*;
-    use crate::message::{Kind, Message, PixelFormat};
+    use crate::kind::Kind;
+    use crate::message::{Message, PixelFormat};
     use octrace_core::animation::AnimationRoom;
     use octrace_core::profile::Board64K;
     use std::boxed::Box;

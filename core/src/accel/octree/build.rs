@@ -5,6 +5,7 @@
 //! Invariant: an arena that runs out leaves the box being split a leaf, and
 //! the report says so.
 
+use super::query::for_each_leaf;
 use super::*;
 
 /// Where to put a box's objects and children while building.
@@ -199,7 +200,7 @@ impl<C: OctreeCapacities, const FRAMES: usize> Octree<C, FRAMES> {
         }
         let (nodes, refs, shafts) = (self.nodes.as_slice(), self.refs.as_slice(), self.shafts.as_mut_slice());
         let root = (0, self.root_min, self.root_log2);
-        let (mut clear, mut blockers) = (0, [u32::MAX; shaft::LIGHTS]);
+        let (mut clear, mut blockers) = (0, [u32::MAX; LIGHTS]);
         for_each_leaf(nodes, root, &mut |leaf, lo, log2| {
             let own = nodes[leaf as usize].list(refs);
             let found = shaft::of_leaf::<C>(nodes, refs, scene, root, (lo, log2), own, &mut blockers);

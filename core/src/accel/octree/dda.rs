@@ -265,7 +265,7 @@ mod tests {
     /// (positions round by one), in ray order.
     #[test]
     fn the_walk_visits_every_leaf_the_ray_crosses_in_order() {
-        use super::super::for_each_leaf;
+        use super::super::query::for_each_leaf;
         use super::super::{OctreeConfig, Traversal};
         use crate::math::{Dir, Vec3};
         use crate::parse::parse;

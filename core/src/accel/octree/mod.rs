@@ -39,11 +39,12 @@
 //! stays a leaf (with more objects): slower, never wrong. The
 //! [`BuildReport`] says how often that happened.
 //!
-//! *Files.* `types.rs` the vocabulary (boxes, config, report, capacities),
-//! `build.rs` the build, `hash.rs` the thesis's hash table, `query.rs` the
-//! walks' common loop and the [`Accelerator`] queries, `named.rs` and
-//! `dda.rs` the two walks, `overlap.rs` the exact filing, `shaft.rs` the
-//! shadow shafts; this file the [`Octree`] itself.
+//! *Files.* `types.rs` the vocabulary (boxes, config, report, a leaf's
+//! shadow shafts, capacities), `build.rs` the build, `hash.rs` the thesis's
+//! hash table, `query.rs` the walks' common loop and the [`Accelerator`]
+//! queries, `named.rs` and `dda.rs` the two walks, `overlap.rs` the exact
+//! filing, `shaft.rs` finding the shadow shafts; this file the [`Octree`]
+//! itself.
 
 mod build;
 mod dda;
@@ -55,10 +56,10 @@ mod shaft;
 mod types;
 
 pub use overlap::{overlaps, Cell};
-use query::{any_leaf, for_each_leaf};
-pub use shaft::ShadowShaft;
+use types::LIGHTS;
 pub use types::{
-    BuildReport, HashEntry, Index, OctreeCapacities, OctreeConfig, OctreeNode, Traversal, FILING_MARGIN, MAX_DEPTH,
+    BuildReport, HashEntry, Index, OctreeCapacities, OctreeConfig, OctreeNode, ShadowShaft, Traversal, FILING_MARGIN,
+    MAX_DEPTH,
 };
 
 use super::{Accelerator, Hit, Mailbox, RayStart};
@@ -66,7 +67,6 @@ use crate::capacity::{Arena, CapacityKind};
 use crate::math::Scalar;
 use crate::scene::{ObjectId, SceneView};
 use crate::shapes::{Aabb, Ratio, Ray};
-use named::NamedWalk;
 
 impl<C: OctreeCapacities, const FRAMES: usize> core::fmt::Debug for Octree<C, FRAMES> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
@@ -239,6 +239,7 @@ impl<C: OctreeCapacities, const FRAMES: usize> OctreeStore for Octree<C, FRAMES>
 #[cfg(test)]
 mod tests {
     extern crate std;
+    use super::query::for_each_leaf;
     use super::query::walk_leaves;
     use super::*;
     use crate::math::Dir;

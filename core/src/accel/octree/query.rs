@@ -4,6 +4,7 @@
 //! Invariant: a leaf's hit is final only once it comes before the leaf's
 //! exit, so every mode returns exactly the naive mode's hit.
 
+use super::named::NamedWalk;
 use super::*;
 
 /// Where the ray leaves a leaf: an exact ratio (the thesis's walk) or a
@@ -228,7 +229,7 @@ impl<C: OctreeCapacities, const FRAMES: usize> Accelerator for Octree<C, FRAMES>
         start: Option<RayStart>,
         mailbox: &mut Mailbox<'_>,
     ) -> bool {
-        if Self::SHAFTS && light < shaft::LIGHTS {
+        if Self::SHAFTS && light < LIGHTS {
             if let Some(leaf) = self.leaf_at(ray.origin.wide()) {
                 if self.shafts.as_slice().get(leaf as usize).is_some_and(|s| s.clear(ray.origin.bits(), light)) {
                     mailbox.cells += 1;

@@ -22,36 +22,9 @@
 //! answer, only its cost; lights past the 32nd (the bits of a `u32`), empty
 //! leaves and the leaf that stands for every object get none.
 
-use super::{any_leaf, Index, OctreeCapacities, OctreeNode, FILING_MARGIN};
+use super::query::any_leaf;
+use super::{Index, OctreeCapacities, OctreeNode, ShadowShaft, FILING_MARGIN, LIGHTS};
 use crate::scene::{ObjectId, SceneView};
-
-/// Lights with a bit: one per bit of a leaf's word.
-pub(super) const LIGHTS: usize = 32;
-
-/// A leaf's shadow shafts: the lights (a bit each, the first 32) that shadow
-/// rays starting in its source reach past its own objects with nothing else
-/// near (see [`crate::accel::OctreeCapacities::ShadowShafts`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct ShadowShaft {
-    pub(super) lights: u32,
-    /// The source: where the leaf's objects are inside its box (Q16.16).
-    low: [i32; 3],
-    high: [i32; 3],
-}
-
-// What the README and `OctreeConfig::shadow_shafts` say a box costs.
-const _: () = assert!(core::mem::size_of::<ShadowShaft>() == 28);
-
-impl ShadowShaft {
-    /// No shaft: every shadow ray walks.
-    pub(super) const NONE: ShadowShaft = ShadowShaft { lights: 0, low: [0; 3], high: [0; 3] };
-
-    /// Whether a shadow ray from `origin` to light `light` may skip the walk.
-    #[inline]
-    pub(super) fn clear(&self, origin: [i32; 3], light: usize) -> bool {
-        self.lights >> light & 1 == 1 && (0..3).all(|a| self.low[a] <= origin[a] && origin[a] <= self.high[a])
-    }
-}
 
 /// A leaf's shaft towards a light: its source and the light.
 #[derive(Clone, Copy, Debug)]

@@ -1,7 +1,7 @@
 //! The octree's vocabulary: its boxes, hash entries, walks, build
-//! criterion and report, index types and the capacities a profile gives it.
+//! criterion and report, index types, a leaf's shadow shafts and the
+//! capacities a profile gives it.
 
-use super::ShadowShaft;
 use crate::capacity::{Arena, CapacityKind, Counts};
 use crate::shapes::ShapeKinds;
 
@@ -197,5 +197,33 @@ impl BuildReport {
     /// [`crate::parse::count`] for the scene's).
     pub fn counts(&self) -> Counts {
         Counts { octree_boxes: self.nodes, octree_references: self.peak_references, ..Counts::ZERO }
+    }
+}
+
+/// Lights with a bit: one per bit of a leaf's word.
+pub(super) const LIGHTS: usize = 32;
+
+/// A leaf's shadow shafts: the lights (a bit each, the first 32) that shadow
+/// rays starting in its source reach past its own objects with nothing else
+/// near (see [`crate::accel::OctreeCapacities::ShadowShafts`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ShadowShaft {
+    pub(super) lights: u32,
+    /// The source: where the leaf's objects are inside its box (Q16.16).
+    pub(super) low: [i32; 3],
+    pub(super) high: [i32; 3],
+}
+
+// What the README and `OctreeConfig::shadow_shafts` say a box costs.
+const _: () = assert!(core::mem::size_of::<ShadowShaft>() == 28);
+
+impl ShadowShaft {
+    /// No shaft: every shadow ray walks.
+    pub(super) const NONE: ShadowShaft = ShadowShaft { lights: 0, low: [0; 3], high: [0; 3] };
+
+    /// Whether a shadow ray from `origin` to light `light` may skip the walk.
+    #[inline]
+    pub(super) fn clear(&self, origin: [i32; 3], light: usize) -> bool {
+        self.lights >> light & 1 == 1 && (0..3).all(|a| self.low[a] <= origin[a] && origin[a] <= self.high[a])
     }
 }

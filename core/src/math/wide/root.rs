@@ -1,9 +1,25 @@
 //! Square roots without division: Newton's iteration for 1/√x needs only
 //! products, from a 192-entry table built at compile time. The exact floor
-//! on every target.
+//! on every target. (`isqrt_u128`, with divisions, is for the tables built
+//! at compile time and for a scene's set-up.)
 
 use super::bits::{leading_zeros, shr_saturating_u32, shr_signed_to_u32};
 use super::product::{mul_u32_wide, square_u32_wide};
+
+/// Floor of the square root of a `u128` (also usable in constants).
+pub const fn isqrt_u128(n: u128) -> u128 {
+    if n < 2 {
+        return n;
+    }
+    let mut x = 1u128 << (128 - n.leading_zeros()).div_ceil(2);
+    loop {
+        let y = (x + n / x) / 2;
+        if y >= x {
+            return x;
+        }
+        x = y;
+    }
+}
 
 /// 2^30 / √f at f = m/256 for m from 64 to 256: the end points of 192
 /// intervals, interpolated linearly for the start of Newton's iteration.
@@ -12,7 +28,7 @@ static RSQRT_TABLE: [u32; 193] = {
     let mut i = 0;
     while i < 193 {
         // 2^30/√(m/256) = √(2^60 · 256 / m), rounded down.
-        t[i] = crate::math::isqrt_u128((1u128 << 68) / (i as u128 + 64)) as u32;
+        t[i] = isqrt_u128((1u128 << 68) / (i as u128 + 64)) as u32;
         i += 1;
     }
     t
