@@ -86,6 +86,16 @@ impl<'r, L: Linked> SceneAccelerator<'r, L> {
         SceneAccelerator { lit: LightBuffered::new(Indexed { octree }, lights) }
     }
 
+    /// The shadow rays' light buffer.
+    pub(crate) fn light_buffer(&self) -> LightBuffer<'r> {
+        self.lit.buffer()
+    }
+
+    /// The same octree, `lights` in front of the shadow rays.
+    pub(crate) fn with_light_buffer(self, lights: LightBuffer<'r>) -> Self {
+        SceneAccelerator::new(self.lit.accel().octree, lights)
+    }
+
     /// Whether camera rays may find their hits in a renderer's screen lists:
     /// when the build links them, and its octree (if any) walks by 3DDDA
     /// (the thesis's walk stays the thesis's for every ray).

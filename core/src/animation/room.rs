@@ -4,7 +4,9 @@
 //! Invariants: a room holds exactly the counts it is declared with, all
 //! zero bits (a board's `static` lands in `.bss`).
 
-use super::needs::{AnimationNeeds, NoRoom};
+#[cfg(feature = "alloc")]
+use super::needs::AnimationNeeds;
+use super::needs::NoRoom;
 use super::player::{Animation, State};
 use super::TILE;
 use crate::motion::{Key, Track};

@@ -391,7 +391,9 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, '_, C> {
         true
     }
 
-    /// The surface index for an object, or an error.
+    /// The surface index for an object, or an error. Not inlined: one copy
+    /// for every kind of object that `place` makes.
+    #[inline(never)]
     fn surface(&mut self, keyword: Keyword, number: u32, pos: Pos) -> Option<u16> {
         let found = self.scene.view().surface_index(number);
         if found.is_none() && self.reported_capacity & (1 << CapacityKind::Surfaces as u8) == 0 {
@@ -443,12 +445,18 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, '_, C> {
         if keyword.once_only() && !self.once(keyword, pos) {
             return;
         }
-        let Some((_, keys)) = moved.filter(|_| self.motion.is_some()) else { return self.place(pos, s, moved) };
+        // One call of `place` whether or not the motion is recorded: it is
+        // the parser's largest function, and a board links it once.
+        let recorded = moved.filter(|_| self.motion.is_some()).map(|(_, keys)| keys);
         let (errors, objects) = (self.errors, self.scene.view().object_count() as u32);
-        let mover = s.mover();
+        let mover = recorded.and(s.mover());
         self.place(pos, s, moved);
         // A statement in error (and with it the scene) is not recorded.
-        let (Some(mover), Some(frames), true) = (mover, self.parsed.frames, self.errors == errors) else { return };
+        let (Some(keys), Some(mover), Some(frames), true) =
+            (recorded, mover, self.parsed.frames, self.errors == errors)
+        else {
+            return;
+        };
         let view = self.scene.view();
         let placed = objects..view.object_count() as u32;
         let objects = (mover == Mover::Object).then(|| {

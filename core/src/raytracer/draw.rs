@@ -29,8 +29,8 @@ use embedded_graphics_core::Pixel;
 /// Where a draw's renderer comes from: a scene's view and accelerator,
 /// and the room its renderer traces in.
 pub(super) struct Source<'s, 'r, P: Profile> {
-    pub view: SceneView<'r>,
-    pub accelerator: SceneAccelerator<'r, P>,
+    pub view: &'s SceneView<'r>,
+    pub accelerator: &'s SceneAccelerator<'r, P>,
     pub first_hits: bool,
     pub room: &'s RendererRoom<P>,
     /// The loaded scene's counters, which each draw adds to.
@@ -64,7 +64,7 @@ impl<'r, P: Profile> Source<'_, 'r, P> {
             }
             Err(_) => (None, None),
         };
-        let mut renderer = renderer_in(self.view, &self.accelerator, size, mailbox, lists)?;
+        let mut renderer = renderer_in(*self.view, self.accelerator, size, mailbox, lists)?;
         renderer.set_lookout(lookout);
         let result = f(&mut renderer);
         if let Some(stats) = self.stats {

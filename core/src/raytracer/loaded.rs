@@ -18,9 +18,11 @@ use super::{RendererRoom, SharedScene, TracedImage};
 pub struct LoadedScene<'r, P: Profile> {
     pub(super) view: SceneView<'r>,
     pub(super) mode: AccelMode,
-    pub(super) octree: Option<(&'r P::Octree, BuildReport)>,
-    /// The shadow rays' light buffer (none buffered without room for one).
-    pub(super) lights: LightBuffer<'r>,
+    /// What its octree's build reported, if it has one.
+    pub(super) report: Option<BuildReport>,
+    /// Its octree, if any, and the shadow rays' light buffer (none buffered
+    /// without room for one): what every draw's renderer queries.
+    pub(super) accelerator: SceneAccelerator<'r, P>,
     /// The loading core's renderers' room.
     pub(super) room: &'r RendererRoom<P>,
     pub(super) first_hits: bool,
@@ -34,7 +36,7 @@ impl<P: Profile> fmt::Debug for LoadedScene<'_, P> {
         f.debug_struct("LoadedScene")
             .field("objects", &self.view.object_count())
             .field("mode", &self.mode)
-            .field("octree", &self.octree.map(|(_, report)| report))
+            .field("octree", &self.report)
             .finish_non_exhaustive()
     }
 }
@@ -78,7 +80,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// # Ok::<(), Box<dyn core::error::Error>>(())
     /// ```
     pub fn accelerator(&self) -> SceneAccelerator<'r, P> {
-        SceneAccelerator::new(self.octree.as_ref().map(|(octree, _)| *octree), self.lights)
+        self.accelerator
     }
 
     /// The shadow rays' light buffer: built when the scene loaded if the
@@ -89,7 +91,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// [`LoadedScene::use_light_buffer`] took; else none
     /// ([`LightBuffer::report`] says how many lights it buffers).
     pub fn light_buffer(&self) -> LightBuffer<'r> {
-        self.lights
+        self.accelerator.light_buffer()
     }
 
     /// Uses `words`, a light buffer built beforehand for this scene (its
@@ -130,7 +132,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
         if !P::LIGHT_BUFFER {
             return Err(LightBufferError::NoRoom);
         }
-        self.lights = LightBuffer::verified(&self.view, words)?;
+        self.accelerator = self.accelerator.with_light_buffer(LightBuffer::verified(&self.view, words)?);
         Ok(())
     }
 
@@ -157,8 +159,8 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// room, the counters added to [`LoadedScene::stats`].
     pub(super) fn source(&self) -> Source<'_, 'r, P> {
         Source {
-            view: self.view,
-            accelerator: self.accelerator(),
+            view: &self.view,
+            accelerator: &self.accelerator,
             first_hits: self.first_hits,
             room: self.room,
             stats: Some(&self.stats),
@@ -179,7 +181,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
 
     /// What building the octree produced, if the mode uses one.
     pub fn octree_report(&self) -> Option<&BuildReport> {
-        self.octree.as_ref().map(|(_, report)| report)
+        self.report.as_ref()
     }
 
     /// The scene's FRAMES, if it is an animation (loaded at one of its

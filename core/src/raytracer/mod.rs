@@ -9,7 +9,9 @@
 //! scene that parsed without errors, with its accelerator built.
 
 use crate::accel::MAX_CELLS_A_SIDE;
-use crate::accel::{self, AccelMode, Indexing, LightBuffer, LightBufferStore, Mailbox, OctreeStore, Prepared};
+use crate::accel::{
+    self, AccelMode, Indexing, LightBuffer, LightBufferStore, Mailbox, OctreeStore, Prepared, SceneAccelerator,
+};
 use crate::capacity::Arena;
 use crate::parse::{parse_recording, ErrorKind, MotionSink, ParseError, Pos};
 use crate::profile::Profile;
@@ -411,7 +413,7 @@ impl<P: Profile> Raytracer<P> {
     /// The scene as `indexed` says it was indexed.
     fn scene_indexed(&self) -> LoadedScene<'_, P> {
         let (mode, built, first_hits) = self.indexed;
-        let octree = mode.traversal().map(|_| (&self.octree, *self.octree.report()));
+        let octree = mode.traversal().map(|_| &self.octree);
         let lights = if built { self.light_buffer.buffer() } else { LightBuffer::NONE };
         let frames = match self.frames {
             [0, _] => None,
@@ -420,8 +422,8 @@ impl<P: Profile> Raytracer<P> {
         LoadedScene {
             view: self.scene.view(),
             mode,
-            octree,
-            lights,
+            report: octree.map(|octree| *octree.report()),
+            accelerator: SceneAccelerator::new(octree, lights),
             room: &self.room,
             first_hits,
             stats: Cell::new(Stats::default()),

@@ -96,7 +96,7 @@ impl<'r, P: Profile> SharedScene<'r, P> {
     /// core's.
     pub fn image<'s, C>(&'s self, room: &'s RendererRoom<P>, size: Size) -> TracedImage<'s, 'r, P, C> {
         let source =
-            Source { view: self.view, accelerator: self.accelerator, first_hits: self.first_hits, room, stats: None };
+            Source { view: &self.view, accelerator: &self.accelerator, first_hits: self.first_hits, room, stats: None };
         TracedImage::new(source, size, self.playing)
     }
 }

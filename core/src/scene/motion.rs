@@ -62,18 +62,27 @@ pub fn displacement_at(keys: impl Iterator<Item = (u32, [i64; 3])>, frame: u32) 
     for (at, value) in keys {
         if at >= frame {
             return match before {
-                Some((from, start)) if at > frame => [0, 1, 2].map(|a| {
-                    let span = i128::from(at - from);
-                    let step = (i128::from(value[a]) - i128::from(start[a])) * i128::from(frame - from);
-                    // Between the two values, so it fits an i64.
-                    (i128::from(start[a]) + step.div_euclid(span)) as i64
-                }),
+                Some(from) if at > frame => between(from, (at, value), frame),
                 _ => value,
             };
         }
         before = Some((at, value));
     }
     before.map_or([0; 3], |(_, value)| value)
+}
+
+/// The displacement at `frame`, strictly between the keys `from` and `to`.
+/// Not inlined: one copy of its 128-bit arithmetic whatever the keys'
+/// iterator (a board links it once).
+#[inline(never)]
+fn between(from: (u32, [i64; 3]), to: (u32, [i64; 3]), frame: u32) -> [i64; 3] {
+    let ((from, start), (at, value)) = (from, to);
+    [0, 1, 2].map(|a| {
+        let span = i128::from(at - from);
+        let step = (i128::from(value[a]) - i128::from(start[a])) * i128::from(frame - from);
+        // Between the two values, so it fits an i64.
+        (i128::from(start[a]) + step.div_euclid(span)) as i64
+    })
 }
 
 #[cfg(test)]
