@@ -23,12 +23,14 @@ pub(crate) const NEVER: u32 = u32::MAX;
 /// What a track moves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Target {
+    /// The eye or the point looked at: every pixel depends on them. First,
+    /// so that [`Track::EMPTY`] is all zero bits (a board's room in `.bss`,
+    /// not copied from flash).
+    Camera,
     /// Objects (a statement's: one, or a patch's triangles), in a box.
     Objects,
     /// A light: every point it shades depends on it.
     Light,
-    /// The eye or the point looked at: every pixel depends on them.
-    Camera,
 }
 
 /// One moving statement of an animation: storage for an
