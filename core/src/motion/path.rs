@@ -62,9 +62,17 @@ impl Key {
         Key { frame, changes, at, step, rest, span, reciprocal }
     }
 
-    /// The displacement `t` frames after the key (`t` at most its span).
+    /// Frame `frame` as steps after the key: 0 before it, its span after
+    /// the next key (a stretch before the first key, or after the last,
+    /// stands still).
     #[inline]
-    fn after(&self, t: u32) -> [i32; 3] {
+    pub(super) fn steps_to(&self, frame: u32) -> u32 {
+        frame.saturating_sub(self.frame).min(self.span)
+    }
+
+    /// The displacement `t` frames after the key (`t` at most its span).
+    #[inline(always)]
+    pub(super) fn after(&self, t: u32) -> [i32; 3] {
         if t == 0 {
             return self.at;
         }
@@ -79,8 +87,14 @@ impl Key {
             }
         };
         // |step · t| ≤ |difference| + t, and each partial sum is within a
-        // frame's step of the displacement: all fit an i32.
-        [0, 1, 2].map(|a| self.at[a] + self.step[a] * t as i32 + fraction(self.rest[a]))
+        // frame's step of the displacement: all fit an i32. A loop rather
+        // than an array's `map`, which the tracker's hot paths on a
+        // Cortex-M0+ would call out of line.
+        let mut at = self.at;
+        for (a, at) in at.iter_mut().enumerate() {
+            *at += self.step[a] * t as i32 + fraction(self.rest[a]);
+        }
+        at
     }
 
     /// Bounds on the displacement over `ta..=tb` frames after the key (at
@@ -89,7 +103,7 @@ impl Key {
     /// extremes by at most `tb` raw units; what a search that narrows a
     /// range of frames needs, without a division.
     #[inline]
-    fn within(&self, ta: u32, tb: u32) -> ([i32; 3], [i32; 3]) {
+    pub(super) fn within(&self, ta: u32, tb: u32) -> ([i32; 3], [i32; 3]) {
         let (ta, tb) = (ta as i32, tb as i32);
         let (mut lo, mut hi) = ([0; 3], [0; 3]);
         for a in 0..3 {
@@ -129,16 +143,6 @@ impl Path<'_> {
         }
     }
 
-    /// The displacement at `frame`, one of `stretch`'s.
-    #[inline]
-    pub(crate) fn at_in(&self, stretch: &Stretch, frame: u32) -> [i32; 3] {
-        if frame == self.kept.0 {
-            return self.kept.1;
-        }
-        let key = &self.keys[stretch.key];
-        key.after(frame.saturating_sub(key.frame).min(key.span))
-    }
-
     /// The frames of the loop cut where the displacement stops being
     /// monotone, each with the key it follows from: frame 0 to the first
     /// key (standing at it), from each key to the next, the last key to
@@ -153,12 +157,10 @@ impl Path<'_> {
         first.into_iter().chain(rest).filter(|s| s.from <= s.to)
     }
 
-    /// Bounds on the displacement over frames `a..=b` of `stretch`.
+    /// The key `stretch` follows.
     #[inline]
-    pub(crate) fn within(&self, stretch: &Stretch, a: u32, b: u32) -> ([i32; 3], [i32; 3]) {
-        let key = &self.keys[stretch.key];
-        let t = |f: u32| f.saturating_sub(key.frame).min(key.span);
-        key.within(t(a), t(b))
+    pub(crate) fn key(&self, stretch: &Stretch) -> &Key {
+        &self.keys[stretch.key]
     }
 }
 
@@ -248,7 +250,8 @@ mod tests {
                 assert!(stretch.from <= covered && stretch.from + 1 >= covered, "{stretch:?} after {covered}");
                 covered = stretch.to + 1;
                 let (a, b) = (stretch.from, stretch.to);
-                let (lo, hi) = path.within(&stretch, a, b);
+                let key = path.key(&stretch);
+                let (lo, hi) = key.within(key.steps_to(a), key.steps_to(b));
                 for f in a..=b {
                     let d = path.at(f);
                     assert!((0..3).all(|x| lo[x] <= d[x] && d[x] <= hi[x]), "{f}: {lo:?} {d:?} {hi:?}");

@@ -255,25 +255,34 @@ impl Sweep<'_> {
     /// comes near the objects: halves tested by the bounds of their
     /// displacements (a range none of whose frames the objects come near
     /// is left whole), left first, and single frames by the objects' own
-    /// test.
+    /// test. Counted in steps after the stretch's key, where a frame is
+    /// its key's frame plus its step (or the stretch stands still).
     fn bisect(&self, segment: &Segment, stretch: &Stretch, a: u32, b: u32) -> Option<u32> {
+        let key = self.path.key(stretch);
+        let (ta, tb) = (key.steps_to(a), key.steps_to(b));
+        if ta == tb {
+            // Standing still over a..=b: near at every frame or at none.
+            return self.meets_displaced(segment, key.after(ta)).then_some(a);
+        }
+        // Moving: a..=b are the key's steps ta..=tb, each a frame.
+        let frame_of = |t: u32| a + (t - ta);
         // Each step pops one range and pushes two, halving: 2 · 32 levels.
         let mut stack: heapless::Vec<(u32, u32), 64> = heapless::Vec::new();
-        let _ = stack.push((a, b));
-        while let Some((a, b)) = stack.pop() {
-            if !self.meets_between(segment, self.path.within(stretch, a, b)) {
+        let _ = stack.push((ta, tb));
+        while let Some((ta, tb)) = stack.pop() {
+            if !self.meets_between(segment, key.within(ta, tb)) {
                 continue;
             }
-            if a == b {
-                if self.meets_displaced(segment, self.path.at_in(stretch, a)) {
-                    return Some(a);
+            if ta == tb {
+                if self.meets_displaced(segment, key.after(ta)) {
+                    return Some(frame_of(ta));
                 }
                 continue;
             }
-            let mid = a + (b - a) / 2;
+            let mid = ta + (tb - ta) / 2;
             // Room for both: the stack holds at most one range a level.
-            let _ = stack.push((mid + 1, b));
-            let _ = stack.push((a, mid));
+            let _ = stack.push((mid + 1, tb));
+            let _ = stack.push((ta, mid));
         }
         None
     }
