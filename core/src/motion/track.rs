@@ -72,7 +72,9 @@ pub(crate) struct MotionNeeds {
 
 impl MotionNeeds {
     /// What `text`'s motion takes (a scene with errors: what its valid
-    /// `MOVE`s take).
+    /// `MOVE`s take). Not inlined: a pass of its own over the statements,
+    /// kept out of the player that asks it once a scene.
+    #[inline(never)]
     pub(crate) fn of(text: &str) -> MotionNeeds {
         let mut needs = MotionNeeds::default();
         crate::parse::for_each_move(text, |keys| {

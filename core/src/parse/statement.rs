@@ -569,7 +569,10 @@ fn goes_round_along_axes(v: &[[i128; 3]; 4]) -> bool {
 }
 
 /// A rectangle must have area, be planar (its fourth corner within 2^-10 of
-/// its size from the plane of the others) and be strictly convex.
+/// its size from the plane of the others) and be strictly convex. Not
+/// inlined: one copy for every parse of statements (the scene's, and the
+/// count of its motion), a board's largest check.
+#[inline(never)]
 fn check_quadrilateral(c: &[WorldPoint; 4]) -> Result<(), ErrorKind<'static>> {
     // Work on edge vectors reduced to 24 significant bits: exact enough for
     // tolerance checks, and every product below fits an i128.
