@@ -13,13 +13,13 @@
 //! animation after 3 frames (it would play until the host sends): then
 //! `stopped`.
 
-use core::sync::atomic::AtomicU8;
+use embedded_graphics_core::geometry::Size;
 use embedded_graphics_core::pixelcolor::Rgb565;
-use octrace_core::animation::{Key, Track};
+use octrace_core::animation::AnimationRoom;
 use octrace_core::profile::Board16K;
 use octrace_core::render::Renderer;
 use octrace_core::Raytracer;
-use octrace_link::board::{AnimationRoom, Line, Link};
+use octrace_link::board::{Line, Link};
 use octrace_link::{Decoder, Kind, Message, Panel, PixelFormat};
 use std::cell::RefCell;
 use std::collections::VecDeque;
@@ -138,34 +138,37 @@ fn serve(data: &[u8], holding_until: u32) -> SimulatedLine {
         held: Vec::new(),
         clock_us: 0,
     };
-    let tiles = [const { AtomicU8::new(0) }; 1];
-    let (mut tracks, mut keys, mut displacements) = ([Track::EMPTY; 4], [Key::EMPTY; 16], [[0; 3]; 64]);
-    let room = AnimationRoom { tiles: &tiles, tracks: &mut tracks, keys: &mut keys, displacements: &mut displacements };
-    let mut link = Link::new(PANEL, "fuzz", vec![0u8; BUFFER]).with_animations(room);
+    // A 4×3 panel is one tile; room for four moving statements' keys.
+    let mut room = Box::new(AnimationRoom::<1, 4, 16>::new());
+    let size = Size::new(u32::from(PANEL.width), u32::from(PANEL.height));
+    let animation = room.animation(size).expect("a 4x3 panel's one tile");
+    let mut link = Link::new(PANEL, "fuzz", vec![0u8; BUFFER]).with_animations(animation);
     // Frames of an animation played so far: it is stopped after a few.
     let mut frames = 0;
     RAYTRACER.with(|raytracer| {
         let mut raytracer = raytracer.borrow_mut();
         while link
             .serve(&mut line, &mut raytracer, |drawing, rows| {
-                let accelerator = drawing.scene().accelerator();
-                let view = drawing.scene().view();
-                let (w, h) = (u32::from(PANEL.width), u32::from(PANEL.height));
-                let Ok(mut renderer) = Renderer::with_size(view, &accelerator, w, h) else { return 0 };
                 let mut row = [Rgb565::default(); 4];
-                if drawing.playing().is_some_and(|playing| playing.frame == 0) {
-                    frames = 0;
-                }
-                if drawing.playing().is_some() {
+                if let Some(frame) = drawing.frame() {
+                    if frame.number() == 0 {
+                        frames = 0;
+                    }
                     frames += 1;
                     return match frames > FRAMES_PLAYED {
                         true => 0,
-                        false => rows.draw_on_one_core(drawing, &mut renderer, &mut row, |_, _| {}),
+                        false => rows.draw_on_one_core(drawing, &mut row, |_, _| {}),
                     };
                 }
-                let mut polls = 0;
-                let mut budgeted = BudgetedRows { rows, polls: &mut polls };
-                budgeted.draw(drawing, &mut renderer, &mut row)
+                let (w, h) = (u32::from(PANEL.width), u32::from(PANEL.height));
+                let mut drawn = 0;
+                // A still traced pixel by pixel, stopped after its polls.
+                let _ = drawing.scene().with_renderer(Size::new(w, h), |renderer| {
+                    let mut polls = 0;
+                    let mut budgeted = BudgetedRows { rows, polls: &mut polls };
+                    drawn = budgeted.draw(drawing, renderer, &mut row);
+                });
+                drawn
             })
             .is_some()
         {}
@@ -181,10 +184,10 @@ struct BudgetedRows<'r, 'o, 'l> {
 }
 
 impl BudgetedRows<'_, '_, '_> {
-    fn draw<A: octrace_core::accel::Accelerator>(
+    fn draw(
         &mut self,
         drawing: &octrace_link::board::Drawing<'_, Board16K>,
-        renderer: &mut Renderer<'_, A>,
+        renderer: &mut Renderer<'_, Board16K>,
         row: &mut [Rgb565],
     ) -> u16 {
         for y in 0..PANEL.height {

@@ -61,7 +61,7 @@ pub fn check_link(data: &[u8]) {
             RAYTRACER.with(|raytracer| {
                 let mut raytracer = raytracer.borrow_mut();
                 let received = decoder.received().expect("the frame just read");
-                if let Some(drawing) = board.answer(received, &mut raytracer, &mut answer).unwrap() {
+                if let Some(drawing) = board.answer(received, &mut raytracer, None, &mut answer).unwrap() {
                     drawing.cancel(0, &mut answer).unwrap();
                 }
             });
