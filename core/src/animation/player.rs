@@ -184,15 +184,21 @@ impl<'s> Animation<'s> {
         self.state.loaded && self.state.fingerprint == fingerprint(text)
     }
 
-    /// A recorder of `text`'s motion into the storage, or what it lacks.
-    pub(crate) fn recorder(&mut self, text: &[u8]) -> Result<Recorder<'_>, NoRoom> {
-        let needs = core::str::from_utf8(text).map(MotionNeeds::of).unwrap_or_default();
-        let needs = AnimationNeeds { tiles: 0, tracks: needs.tracks, keys: needs.keys };
+    /// A recorder of `text`'s motion into the storage, and the length of
+    /// its loop (1 for a still); or what the storage lacks.
+    pub(crate) fn recorder(&mut self, text: &[u8]) -> Result<(Recorder<'_>, u32), NoRoom> {
+        let motion = core::str::from_utf8(text).map(MotionNeeds::of).unwrap_or_default();
+        let needs = AnimationNeeds { tiles: 0, tracks: motion.tracks, keys: motion.keys };
         if let Some(short) = needs.beyond(&self.room).into_iter().flatten().next() {
             return Err(short);
         }
         self.state.loaded = false;
-        Ok(Recorder::new(self.tracks, self.keys))
+        Ok((Recorder::new(self.tracks, self.keys), motion.frames.max(1)))
+    }
+
+    /// The length of the loop of the scene it holds.
+    pub(crate) fn loop_length(&self) -> u32 {
+        self.state.frames[0].max(1)
     }
 
     /// `text`'s motion recorded (`tracks` tracks, `keys` keys) from frame

@@ -63,11 +63,12 @@ impl Track {
 }
 
 /// What an animation's motion takes: a track for each `MOVE`, and their
-/// keys.
+/// keys; and the loop's length (FRAMES' count, 1 without).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) struct MotionNeeds {
     pub tracks: usize,
     pub keys: usize,
+    pub frames: u32,
 }
 
 impl MotionNeeds {
@@ -77,11 +78,11 @@ impl MotionNeeds {
     #[inline(never)]
     pub(crate) fn of(text: &str) -> MotionNeeds {
         let mut needs = MotionNeeds::default();
-        crate::parse::for_each_move(text, |keys| {
+        let frames = crate::parse::for_each_move(text, |keys| {
             needs.tracks += 1;
             needs.keys += keys.iter().count();
         });
-        needs
+        MotionNeeds { frames: frames.map_or(1, |f| f.count.max(1)), ..needs }
     }
 }
 

@@ -157,13 +157,18 @@ pub(crate) trait MotionSink {
 }
 
 /// The keys of every MOVE of `text` that follows what it can move, in
-/// file order: what an animation's motion takes room for.
-pub(crate) fn for_each_move<'a>(text: &'a str, mut each: impl FnMut(Keys<'a>)) {
-    for_each_paired::<AnyRoom>(text, |paired| {
-        if let Paired::Statement { moved: Some((_, keys)), .. } = paired {
-            each(keys);
+/// file order: what an animation's motion takes room for. Returns the
+/// scene's FRAMES, if it says (its first, as the parser reads it).
+pub(crate) fn for_each_move<'a>(text: &'a str, mut each: impl FnMut(Keys<'a>)) -> Option<Frames> {
+    let mut frames = None;
+    for_each_paired::<AnyRoom>(text, |paired| match paired {
+        Paired::Statement { moved: Some((_, keys)), .. } => each(keys),
+        Paired::Statement { statement: Statement::Frames(f), .. } => {
+            frames.get_or_insert(f);
         }
+        _ => {}
     });
+    frames
 }
 
 #[cfg(test)]

@@ -163,8 +163,11 @@ impl<'s> Animation<'s> {
         anew: bool,
     ) -> Result<Frame<'a, 'r, P>, AnimationError<'t>> {
         let indexing = self.indexing();
+        // A frame past the loop's end is its frame in the loop (a player
+        // may count on): the scene and the tiles' state agree on it.
         let scene = if anew || !self.holds(text) {
-            let mut recorder = self.recorder(text).map_err(AnimationError::NoRoom)?;
+            let (mut recorder, loop_length) = self.recorder(text).map_err(AnimationError::NoRoom)?;
+            let frame = frame % loop_length;
             let scene = raytracer.load_in(text, frame, &indexing, on_error, both, Some(&mut recorder))?;
             let (fits, counts) = (recorder.fits(), (recorder.track_count, recorder.key_count));
             if !fits {
@@ -182,6 +185,7 @@ impl<'s> Animation<'s> {
             self.recorded(text, frames, counts, frame);
             scene
         } else {
+            let frame = frame % self.loop_length();
             let scene = raytracer.load_in(text, frame, &indexing, on_error, both, None)?;
             self.step_to(frame);
             scene
@@ -228,6 +232,29 @@ mod tests {
         let above = "FRAMES 3\nVIEWPOINT 0 0 5 MOVE 0 0 0 0  1 0 5 -5\nORIGIN 0 0 0\nUPVECTOR 0 1 0\n";
         let Err(AnimationError::Scene(e)) = animation.load(&mut raytracer, above, 0) else { panic!("it loads") };
         assert!(e.to_string().starts_with("2:17: at frame 1, UPVECTOR"), "{e}");
+    }
+
+    #[test]
+    fn a_frame_past_the_loops_end_is_its_frame_in_the_loop() {
+        use embedded_graphics::mock_display::MockDisplay;
+        use embedded_graphics_core::pixelcolor::Rgb888;
+        let text = "FRAMES 3\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\n\
+                    SPHERE 1 1 0 0 0\nSPHERE 1 0.5 -2 0 1 MOVE 0 0 0 0  2 4 0 0\n";
+        let mut room = AnimationRoom::<4, 1, 2>::new();
+        let mut animation = room.animation(Size::new(8, 8)).unwrap();
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let mut shown = MockDisplay::<Rgb888>::new();
+        shown.set_allow_overdraw(true);
+        // Counted on past the end, as a player may, and first loaded there.
+        for frame in [4, 5, 6, 7, 8, 9, 10] {
+            let loaded = animation.load(&mut raytracer, text, frame).unwrap();
+            assert_eq!(loaded.number(), frame % 3);
+            loaded.image().try_draw(&mut shown).unwrap();
+            let mut still = MockDisplay::<Rgb888>::new();
+            let mut alone = Raytracer::<Board16K>::new();
+            alone.load_frame(text, frame % 3).unwrap().image(Size::new(8, 8)).try_draw(&mut still).unwrap();
+            assert_eq!(shown, still, "frame {frame}: the tiles traced are the frame's");
+        }
     }
 
     #[test]
