@@ -11,8 +11,8 @@
 //!   accelerator answers from its light buffer's cells);
 //! - the object a ray starts on is treated as [`RayStart`] says;
 //! - camera rays may be answered by the renderer's screen-space lists
-//!   instead, where [`Accelerator::first_hits_by_screen`] allows: the
-//!   same hits;
+//!   instead, where the scene's accelerator allows it (its octree, if
+//!   any, walked by 3DDDA): the same hits;
 //! - an object is tested at most once per query when the caller provides a
 //!   [`Mailbox`] large enough for the scene (one bit per object).
 

@@ -17,7 +17,7 @@ use crate::math::{mul_wide, Scalar, Vec3};
 use crate::shapes::Ray;
 
 /// One kind of dependence of a pixel on what moves. The tracker follows
-/// them all; a test drops one ([`crate::animation::Coherence::ignoring`])
+/// them all; a test drops one ([`crate::animation::Animation::ignoring`])
 /// to see its check of exactness fail.
 #[doc(hidden)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -14,6 +14,6 @@ mod track;
 
 pub use lookout::Dependence;
 pub(crate) use lookout::{Lookout, RayKind};
-pub use path::Key;
-pub use track::Track;
+pub(crate) use path::Key;
+pub(crate) use track::Track;
 pub(crate) use track::{Motion, MotionNeeds, Recorder, NEVER};

@@ -20,10 +20,10 @@
 const RECIPROCAL_SPANS: u32 = 256;
 
 /// A key of a moving statement: where it is at a frame, and how it moves
-/// to the next key. Storage for an [`Animation`](crate::animation::Animation)
-/// (a constant, [`Key::EMPTY`], fills a `static`).
+/// to the next key. Held in an animation's room
+/// ([`AnimationRoom`](crate::animation::AnimationRoom), all zero bits).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Key {
+pub(crate) struct Key {
     pub(super) frame: u32,
     /// Whether the displacement differs from the key before (the first
     /// key: from the last, the loop's jump back).
@@ -42,7 +42,7 @@ pub struct Key {
 
 impl Key {
     /// A placeholder to fill storage with (a `const`, for a `static`).
-    pub const EMPTY: Key =
+    pub(crate) const EMPTY: Key =
         Key { frame: 0, changes: false, at: [0; 3], step: [0; 3], rest: [0; 3], span: 0, reciprocal: 0 };
 
     /// A key at `frame` whose displacement `at` (from frame 0's) moves to

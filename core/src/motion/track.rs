@@ -33,10 +33,10 @@ pub(crate) enum Target {
     Light,
 }
 
-/// One moving statement of an animation: storage for an
-/// [`Animation`](crate::animation::Animation).
+/// One moving statement of an animation, held in its room
+/// ([`AnimationRoom`](crate::animation::AnimationRoom), all zero bits).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Track {
+pub(crate) struct Track {
     target: Target,
     /// Its keys in the motion's keys: the first, and how many.
     keys: (u32, u32),
@@ -52,7 +52,7 @@ pub struct Track {
 
 impl Track {
     /// A placeholder to fill storage with (a `const`, for a `static`).
-    pub const EMPTY: Track = Track {
+    pub(crate) const EMPTY: Track = Track {
         target: Target::Camera,
         keys: (0, 0),
         first: [[0; 3]; 2],

@@ -49,7 +49,7 @@
 //! one-bit or gray panel up to 256 pixels wide, black/white/red up to 128),
 //! else [`IMAGE_ERROR_WORDS`] (1.6 KiB: rows up to 800 pixels, 400 on
 //! black/white/red), or uses storage the caller gives
-//! ([`TracedImage::try_draw_with`](crate::TracedImage::try_draw_with)).
+//! ([`TracedImage::error_rows`](crate::TracedImage::error_rows)).
 //!
 //! # Sub-images, bands and other orders
 //!
@@ -62,7 +62,8 @@
 //! [`Dithered`] target, which carries the error from each band of rows to
 //! the next. Drawn in no order at all (a progressive order's passes, an
 //! animation's changed tiles), a panel is dithered by Bayer
-//! ([`Dithered::ordered`]): `draw_progressive` and `draw_changes` do so.
+//! ([`Dithered::ordered`]): a [`TracedImage`](crate::TracedImage) drawn
+//! in the progressive order, or a frame's tiles, does so.
 //!
 //! # One bit
 //!
@@ -357,7 +358,7 @@ impl fmt::Display for Dithering {
 /// the stack of its draw for error diffusion, in `i16`s: rows up to 800
 /// pixels wide (400 on black/white/red; a row of up to 256 words takes
 /// only 512 bytes). A wider image needs
-/// [`TracedImage::try_draw_with`](crate::TracedImage::try_draw_with).
+/// [`TracedImage::error_rows`](crate::TracedImage::error_rows).
 pub const IMAGE_ERROR_WORDS: usize = 800;
 
 /// The 4×4 Bayer matrix: thresholds 0 to 15, each once, spread so that

@@ -48,9 +48,9 @@ const MAX_TILE_OBJECTS: usize = 128;
 const MAX_OBJECTS: usize = 1 << 16;
 
 /// What a camera ray needs to know of one object: where in the image its
-/// bounds are seen and how near its hit can be. Storage for
-/// [`Renderer::with_first_hits`](super::Renderer::with_first_hits): one
-/// for each of the scene's objects, beside
+/// bounds are seen and how near its hit can be. Storage in a
+/// [`RendererRoom`](crate::RendererRoom) of a profile with `first_hits`:
+/// one for each of the scene's objects, beside
 /// [`ScreenBound::positions_for`] them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ScreenBound {

@@ -7,7 +7,7 @@
 //! into rows, tiles or threads gives the same bits, and so does any order
 //! ([`Progressive`]: the whole picture in coarse blocks first).
 //!
-//! Given room ([`Renderer::with_first_hits`]), camera rays find their hits
+//! Given room (a profile with `first_hits`, see [`RendererRoom`](crate::RendererRoom)), camera rays find their hits
 //! among the objects seen around their pixel, nearest first, instead of
 //! walking the accelerator (`first_hit.rs`): the same hits.
 //!
