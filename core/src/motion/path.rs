@@ -129,7 +129,12 @@ pub(crate) struct Path<'m> {
     pub kept: (u32, [i32; 3]),
 }
 
-impl Path<'_> {
+impl<'m> Path<'m> {
+    /// Over `keys` of an animation of `frames` frames, no frame kept.
+    pub(crate) fn unkept(keys: &'m [Key], frames: u32) -> Path<'m> {
+        Path { keys, frames, kept: (u32::MAX, [0; 3]) }
+    }
+
     /// The displacement at `frame`, from frame 0's.
     #[inline]
     pub(crate) fn at(&self, frame: u32) -> [i32; 3] {
@@ -236,7 +241,7 @@ mod tests {
             let values = &values[..n];
             let mut keys = [Key::EMPTY; 5];
             path_of(values, &mut keys);
-            let path = Path { keys: &keys[..n], frames, kept: (u32::MAX, [0; 3]) };
+            let path = Path::unkept(&keys[..n], frames);
             let start = displacement_at(values.iter().copied(), 0);
             for f in 0..frames {
                 let d = displacement_at(values.iter().copied(), f);

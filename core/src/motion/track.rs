@@ -51,6 +51,11 @@ pub(crate) struct Track {
 }
 
 impl Track {
+    /// Its keys among the motion's `keys`.
+    fn keys_in<'k>(&self, keys: &'k [Key]) -> &'k [Key] {
+        &keys[self.keys.0 as usize..(self.keys.0 + self.keys.1) as usize]
+    }
+
     /// A placeholder to fill storage with (a `const`, for a `static`).
     pub(crate) const EMPTY: Track = Track {
         target: Target::Camera,
@@ -108,8 +113,7 @@ impl<'s> Motion<'s> {
     /// frame about to be traced, whose displacements the tracker asks most.
     pub(crate) fn at_frame(tracks: &mut [Track], keys: &[Key], frames: Frames, frame: u32) {
         for track in tracks.iter_mut().filter(|t| t.target == Target::Objects) {
-            let keys = &keys[track.keys.0 as usize..(track.keys.0 + track.keys.1) as usize];
-            track.now = Path { keys, frames: frames.count, kept: (u32::MAX, [0; 3]) }.at(frame);
+            track.now = Path::unkept(track.keys_in(keys), frames.count).at(frame);
         }
     }
 
@@ -124,7 +128,7 @@ impl<'s> Motion<'s> {
     }
 
     fn keys_of(&self, track: &Track) -> &'s [Key] {
-        &self.keys[track.keys.0 as usize..(track.keys.0 + track.keys.1) as usize]
+        track.keys_in(self.keys)
     }
 
     /// How many transitions after frame `frame` (in the loop's order, the
@@ -199,13 +203,13 @@ impl MotionSink for Recorder<'_> {
         if let Some(objects) = moved.objects.filter(|_| self.key_count <= self.keys.len()) {
             let keys = &self.keys[first_key..self.key_count];
             // The box where the statement stands, moved back to frame 0.
-            let now = Path { keys, frames: moved.frames.count, kept: (u32::MAX, [0; 3]) }.at(moved.frame);
+            let now = Path::unkept(keys, moved.frames.count).at(moved.frame);
             let [lo, hi] = objects.bounds.map(|corner| [0, 1, 2].map(|a| corner[a].saturating_sub(now[a])));
             // Between keys the displacement lies between theirs: the
             // extremes over the loop are at keys.
             let mut swept = [lo, hi];
             for key in keys {
-                let at = Path { keys, frames: moved.frames.count, kept: (u32::MAX, [0; 3]) }.at(key.frame);
+                let at = key.after(0);
                 for a in 0..3 {
                     swept[0][a] = swept[0][a].min(lo[a].saturating_add(at[a]));
                     swept[1][a] = swept[1][a].max(hi[a].saturating_add(at[a]));

@@ -8,7 +8,7 @@
 //! camera included) is refused at its first load, before any frame.
 
 use super::{LoadError, LoadedScene, Raytracer, RunBoth, SharedScene, TracedImage};
-use crate::animation::{Animation, AnimationCapacity, Coherence, NoRoom, Playing};
+use crate::animation::{Animation, AnimationCapacity, AnimationNeeds, Coherence, NoRoom, Playing};
 use crate::parse::ParseError;
 use crate::profile::Profile;
 use crate::scene::Frames;
@@ -173,13 +173,11 @@ impl<'s> Animation<'s> {
             if !fits {
                 // The room was checked against the text's needs: only a
                 // text unlike any parse could need more.
-                let what =
-                    if counts.0 > self.room().tracks { AnimationCapacity::Tracks } else { AnimationCapacity::Keys };
-                let (needed, holds) = match what {
-                    AnimationCapacity::Tracks => (counts.0, self.room().tracks),
-                    _ => (counts.1, self.room().keys),
-                };
-                return Err(AnimationError::NoRoom(NoRoom { what, needed, holds }));
+                let (needs, room) = (AnimationNeeds { tiles: 0, tracks: counts.0, keys: counts.1 }, self.room());
+                let short = needs.beyond(&room).into_iter().flatten().next();
+                // Not fitting, one of the counts is over the room's.
+                let keys = NoRoom { what: AnimationCapacity::Keys, needed: counts.1, holds: room.keys };
+                return Err(AnimationError::NoRoom(short.unwrap_or(keys)));
             }
             let frames = scene.frames().unwrap_or(Frames { count: 1, rate: Frames::DEFAULT_RATE });
             self.recorded(text, frames, counts, frame);

@@ -97,7 +97,7 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
             }
             each(frame, image)
         };
-        let result = render_frames(request.bytes, frames, range.clone(), &request.options, &progress, &mut counted);
+        let result = render_frames(request.bytes, range.clone(), &request.options, &progress, &mut counted);
         let failed = result.is_err();
         outcome = Some(result);
         match failed {

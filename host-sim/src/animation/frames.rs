@@ -19,7 +19,6 @@ use embedded_graphics_core::Pixel;
 use octrace_core::animation::{AnimationNeeds, HostAnimationRoom};
 use octrace_core::profile::Host;
 use octrace_core::render::PixelSample;
-use octrace_core::scene::Frames;
 use octrace_core::shade::Stats;
 use octrace_core::{AnimationError as Refused, Frame, RendererRoom};
 use octrace_images::{RgbImage, NO_OBJECT};
@@ -69,8 +68,8 @@ pub struct AnimationReport {
 pub enum AnimationError {
     /// The scene has errors at this frame, each `line:col: message`.
     Scene { frame: u32, errors: Vec<String> },
-    /// The camera cannot be set up for the size asked, or the motion not
-    /// read: the message says why.
+    /// The camera cannot be set up for the size asked, or the animation's
+    /// room not made: the message says why.
     Setup(String),
     /// The frames' writer failed.
     Write(std::io::Error),
@@ -84,13 +83,12 @@ pub struct AnimationOptions {
     pub coherence: bool,
 }
 
-/// Renders frames `frames` of the animation `bytes` (a scene with FRAMES:
-/// `count` of them), handing each to `each` in order; `progress(pixels)`
+/// Renders frames `frames` of the animation `bytes` (a scene with FRAMES),
+/// handing each to `each` in order; `progress(pixels)`
 /// after each band traced. Every frame's camera is checked before the
 /// first is rendered.
 pub fn render_frames(
     bytes: &[u8],
-    count: Frames,
     frames: std::ops::Range<u32>,
     options: &AnimationOptions,
     progress: &(dyn Fn(u64) + Sync),
@@ -99,7 +97,6 @@ pub fn render_frames(
     let mut report = AnimationReport::default();
     let mut scene = new_scene();
     let text = std::str::from_utf8(bytes).map_err(|e| AnimationError::Setup(e.to_string()))?;
-    let _ = count;
     // The size from the scene's RASTER, then the motion and the tiles: the
     // animation loaded whole once, every frame checked.
     let raster = match load_frame_bytes("", bytes, frames.start, &mut scene) {

@@ -189,7 +189,8 @@ impl<'a> Board<'a> {
         };
         // An animation the board has room for loads through it: every
         // frame's camera is checked before anything plays.
-        let fits = play::short_of(&self.room, text, self.panel).iter().all(Option::is_none);
+        let shorts = play::short_of(&self.room, text, self.panel);
+        let fits = shorts.iter().all(Option::is_none);
         let loaded = match animation.filter(|_| fits) {
             Some(animation) => match animation.load_with(raytracer, text, &mut report) {
                 Ok(frame) => Ok(frame.into_scene()),
@@ -221,7 +222,7 @@ impl<'a> Board<'a> {
             None => 0,
             Some(frames) => {
                 let mut errors = 0;
-                for short in play::short_of(&self.room, text, self.panel).iter().flatten() {
+                for short in shorts.iter().flatten() {
                     send_error(tag, 0, 0, Some(play::capacity(short)), short, sink)?;
                     errors += 1;
                 }

@@ -26,7 +26,7 @@ fn play(bytes: &[u8], frames: Frames, size: (u32, u32), coherence: bool) -> (Ani
         coherence,
     };
     let mut images = Vec::new();
-    let report = render_frames(bytes, frames, frames.all(), &options, &|_| {}, &mut |_, frame| {
+    let report = render_frames(bytes, frames.all(), &options, &|_| {}, &mut |_, frame| {
         images.push(frame.clone());
         Ok(())
     });

@@ -115,7 +115,7 @@ fn cases(dir: &Path, work: &Path) -> Result<(), BenchError> {
         let mut apng = ApngWriter::new(&mut apng_bytes, size.0, size.1, frames).map_err(io)?;
         let mut images = Vec::new();
         let mut writing = std::time::Duration::ZERO;
-        render_frames(&bytes, frames, frames.all(), &options, &|_| {}, &mut |_, frame| {
+        render_frames(&bytes, frames.all(), &options, &|_| {}, &mut |_, frame| {
             let started = Instant::now();
             gif.frame(&Image::Rgb(frame.image.clone()), frame.retraced.as_deref())?;
             writing += started.elapsed();
