@@ -27,8 +27,10 @@ pub mod formats;
 pub mod palette;
 pub mod panel;
 mod rgb_image;
+mod sample_image;
 
 pub use rgb_image::RgbImage;
+pub use sample_image::SampleImage;
 
 /// What an object buffer holds for a pixel that shows the background: the
 /// object buffers beside a render hold each pixel's `ObjectId`, or this.

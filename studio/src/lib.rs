@@ -15,7 +15,6 @@
 
 mod error;
 mod exports;
-mod pixels;
 mod player;
 mod studio;
 

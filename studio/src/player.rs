@@ -9,12 +9,11 @@
 //! traced whole (nothing is kept while a frame is half traced); another
 //! text, an edited one, or another size starts again from every tile.
 
-use crate::pixels::Pixels;
 use embedded_graphics_core::geometry::Size;
 use octrace_core::animation::{AnimationNeeds, HostAnimationRoom};
 use octrace_core::profile::Host;
 use octrace_core::{AccelMode, AnimationError, Raytracer};
-use octrace_images::NO_OBJECT;
+use octrace_images::{SampleImage, NO_OBJECT};
 
 /// What a trace of a frame could not do, said as the studio says it.
 #[derive(Debug)]
@@ -103,7 +102,7 @@ impl Player {
             AnimationError::NoRoom(e) => Refused::Setup(e.to_string()),
         })?;
         let traced = loaded.tiles().traced_pixels();
-        let mut kept = Pixels { colours: &mut self.colours, objects: &mut self.objects, size: image };
+        let mut kept = SampleImage { colours: &mut self.colours, objects: &mut self.objects, size: image };
         loaded.image().try_draw(&mut kept).map_err(|e| Refused::Setup(e.to_string()))?;
         self.whole = true;
         Ok(traced)

@@ -7,7 +7,6 @@
 //! when its text was loaded.
 
 use crate::error::StudioError;
-use crate::pixels::Pixels;
 use crate::player::{Player, Refused};
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
@@ -19,7 +18,7 @@ use octrace_core::scene::Frames;
 use octrace_core::{AccelMode, Raytracer};
 use octrace_images::formats::{self, Format, Image};
 use octrace_images::palette::{self, PaletteMode};
-use octrace_images::{panel, RgbImage, NO_OBJECT};
+use octrace_images::{panel, RgbImage, SampleImage, NO_OBJECT};
 
 /// The intersection mode the page numbers `code`: 0 auto, 1 naive,
 /// 2 octree, 3 dda (the core's order).
@@ -159,7 +158,7 @@ impl Studio {
         }
         let count = width as usize * height as usize;
         let (mut colours, mut objects) = (vec![0; 3 * count], vec![NO_OBJECT; count]);
-        let mut pixels = Pixels { colours: &mut colours, objects: &mut objects, size: Size::new(width, height) };
+        let mut pixels = SampleImage { colours: &mut colours, objects: &mut objects, size: Size::new(width, height) };
         let area = Rectangle::new(Point::new(x as i32, y as i32), Size::new(width, height));
         let image = scene.image::<PixelSample>(Size::new(w, h)).area(area);
         image.try_draw(&mut pixels).map_err(|e| StudioError::Camera(format!("{e:?}")))?;

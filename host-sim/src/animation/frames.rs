@@ -12,8 +12,7 @@ use crate::rows::{RowSink, StreamError};
 use crate::scene::{load_frame_bytes, new_scene, LoadError};
 use crate::threaded::stream_threads;
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{OriginDimensions, Size};
-use embedded_graphics_core::pixelcolor::RgbColor;
+use embedded_graphics_core::geometry::{OriginDimensions, Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
 use octrace_core::animation::{AnimationNeeds, HostAnimationRoom};
@@ -21,7 +20,7 @@ use octrace_core::profile::Host;
 use octrace_core::render::PixelSample;
 use octrace_core::shade::Stats;
 use octrace_core::{AnimationError as Refused, Frame, RendererRoom};
-use octrace_images::{RgbImage, NO_OBJECT};
+use octrace_images::{RgbImage, SampleImage, NO_OBJECT};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::Mutex;
@@ -272,16 +271,13 @@ impl DrawTarget for Bands<'_, '_> {
         area: &Rectangle,
         samples: I,
     ) -> Result<(), Self::Error> {
-        let (x0, y) = (area.top_left.x as usize, area.top_left.y as usize);
+        // A run of one row, in that row's band.
+        let y = area.top_left.y.max(0) as usize;
         let Some(band) = self.bands.get(y / self.side) else { return Ok(()) };
         let mut rows = band.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-        let (colors, objects) = &mut *rows;
-        let row = y % self.side;
-        for (i, p) in samples.into_iter().take(area.size.width as usize).enumerate() {
-            let at = row * self.width + x0 + i;
-            colors[3 * at..3 * at + 3].copy_from_slice(&[p.color.r(), p.color.g(), p.color.b()]);
-            objects[at] = p.object.map_or(NO_OBJECT, |o| o.0);
-        }
-        Ok(())
+        let (colours, objects) = &mut *rows;
+        let size = Size::new(self.width as u32, self.side as u32);
+        let run = Rectangle::new(Point::new(area.top_left.x, (y % self.side) as i32), area.size);
+        SampleImage { colours, objects, size }.fill_contiguous(&run, samples)
     }
 }
