@@ -106,38 +106,39 @@ fn each_pico_template_shows_host_sims_picture() {
         return;
     }
     let dir = tempfile::tempdir().expect("a temporary directory");
-    // One build at a time (they share a target directory), then the runs
-    // side by side.
-    let elves: Vec<_> = BUILDS.iter().map(|build| pico::build(build).unwrap_or_else(|e| panic!("{e}"))).collect();
-    let animations: Vec<_> =
-        ANIMATIONS.iter().map(|build| pico::build(build).unwrap_or_else(|e| panic!("{e}"))).collect();
-    let (runs, played): (Vec<_>, Vec<_>) = std::thread::scope(|s| {
-        let frames = s.spawn(|| {
-            (ANIMATIONS.iter().zip(&animations))
-                .map(|(build, elf)| {
-                    let pattern = dir.path().join(format!("{}-{}-%d.png", build.template.name(), build.name()));
-                    pico::run_frames(elf, &pattern, FRAMES_CHECKED)
-                })
-                .collect()
-        });
-        // The first build (fig5_1, as a user builds it) serves its USB port too.
-        let handles: Vec<_> = BUILDS
-            .iter()
-            .zip(&elves)
-            .enumerate()
-            .map(|(i, (build, elf))| {
-                let panel = dir.path().join(format!("{}-{}-panel.png", build.template.name(), build.name()));
-                s.spawn(move || {
-                    let run = match i {
-                        0 => pico::run_reporting(elf, &panel).map(|(cycles, report)| (cycles, Some(report))),
-                        _ => pico::run(elf, &panel).map(|cycles| (cycles, None)),
-                    };
-                    (run, panel)
-                })
-            })
-            .collect();
-        let runs = handles.into_iter().map(|h| h.join().expect("the run's thread")).collect();
-        (runs, frames.join().expect("the animation's thread"))
+    // One build at a time (they share a target directory), each run started
+    // as soon as its firmware is built, beside the next build: the
+    // animations first, the longest runs.
+    let (animations, played, elves, runs) = std::thread::scope(|s| {
+        let mut animations = Vec::new();
+        let mut played = Vec::new();
+        for build in &ANIMATIONS {
+            let elf = pico::build(build).unwrap_or_else(|e| panic!("{e}"));
+            let pattern = dir.path().join(format!("{}-{}-%d.png", build.template.name(), build.name()));
+            let run = elf.clone();
+            played.push(s.spawn(move || pico::run_frames(&run, &pattern, FRAMES_CHECKED)));
+            animations.push(elf);
+        }
+        let mut elves = Vec::new();
+        let mut runs = Vec::new();
+        for (i, build) in BUILDS.iter().enumerate() {
+            let elf = pico::build(build).unwrap_or_else(|e| panic!("{e}"));
+            let panel = dir.path().join(format!("{}-{}-panel.png", build.template.name(), build.name()));
+            let run = elf.clone();
+            // The first build (fig5_1, as a user builds it) serves its USB
+            // port too.
+            runs.push(s.spawn(move || {
+                let cycles = match i {
+                    0 => pico::run_reporting(&run, &panel).map(|(cycles, report)| (cycles, Some(report))),
+                    _ => pico::run(&run, &panel).map(|cycles| (cycles, None)),
+                };
+                (cycles, panel)
+            }));
+            elves.push(elf);
+        }
+        let runs: Vec<_> = runs.into_iter().map(|h| h.join().expect("the run's thread")).collect();
+        let played: Vec<_> = played.into_iter().map(|h| h.join().expect("the animation's thread")).collect();
+        (animations, played, elves, runs)
     });
 
     let mut budgets = Budgets::load("pico").unwrap_or_else(|e| panic!("{e}"));
