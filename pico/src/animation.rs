@@ -236,8 +236,9 @@ impl<'a, P: Profile, const LEN: usize, const SLOTS: usize> Player<'a, P, LEN, SL
     {
         let mut display = Dithered::ordered(display);
         let size = display.bounding_box().size;
-        let fits =
-            size.width < MOST_PIXELS && size.height < MOST_PIXELS && self.animation.tiles().bands() as usize <= MOST_BANDS;
+        let fits = size.width < MOST_PIXELS
+            && size.height < MOST_PIXELS
+            && self.animation.tiles().bands() as usize <= MOST_BANDS;
         if !fits || LEN < self.animation.tiles().longest_row() as usize {
             return Stopped::Picture(Unfinished::Panel);
         }
