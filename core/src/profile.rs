@@ -60,7 +60,7 @@ pub trait Profile: SceneCapacities + Linked {
     /// tested once per ray.
     type MailboxWords: Arena<u32> + Send;
     /// Whether the octree keeps the thesis's hash table, which only the
-    /// thesis's walk ([`AccelMode::Octree`](crate::AccelMode::Octree))
+    /// thesis's walk (`AccelMode::Octree`)
     /// reads. A profile without it (`named_walk: false` in
     /// [`profile!`](crate::profile!)) saves that RAM; its scenes asked for
     /// that walk are walked by 3DDDA (the same image) and say so.

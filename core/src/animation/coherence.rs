@@ -38,7 +38,7 @@ pub(crate) type RunSink<'f, E> = dyn FnMut(&Rectangle, &mut dyn Iterator<Item = 
 /// loaded plans which tiles it traces (those whose count ran out); the
 /// frame's draw traces them and records their new counts. Under a profile
 /// without `coherence: true`
-/// ([`Profile::COHERENCE`](crate::profile::Profile::COHERENCE)) every tile
+/// ([`Profile::COHERENCE`](crate::profile::Linked::COHERENCE)) every tile
 /// is traced each frame (the same pictures, none of the watching code
 /// linked).
 ///

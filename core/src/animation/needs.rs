@@ -15,7 +15,7 @@ use embedded_graphics_core::geometry::Size;
 /// a tile of the image, a track a `MOVE` and its keys. A build script
 /// counts a board's ([`AnimationNeeds::of`], feature-free) and writes the
 /// counts as a constant, which sizes the board's one
-/// [`AnimationRoom`].
+/// [`AnimationRoom`](super::AnimationRoom).
 ///
 /// ```
 /// use embedded_graphics::prelude::Size;
@@ -67,7 +67,7 @@ impl AnimationNeeds {
     }
 }
 
-/// What an [`AnimationRoom`] holds: the vocabulary of its capacities.
+/// What an [`AnimationRoom`](super::AnimationRoom) holds: the vocabulary of its capacities.
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AnimationCapacity {

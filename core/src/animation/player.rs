@@ -27,7 +27,7 @@ const LONGEST_STEP: u32 = 255;
 
 /// An animation: what moves over its loop and what each tile of the image
 /// still shows, in the caller's storage ([`AnimationRoom`](super::AnimationRoom) on a board,
-/// [`HostAnimationRoom`](super::HostAnimationRoom) on a desktop). Load
+/// `HostAnimationRoom` on a desktop, feature `alloc`). Load
 /// each frame with [`Animation::load`] (it records the motion of a scene it
 /// has not seen, checking the camera of every frame, and otherwise steps
 /// its tiles on), then draw the [`Frame`](crate::Frame) as a still is

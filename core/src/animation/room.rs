@@ -16,7 +16,7 @@ use embedded_graphics_core::geometry::Size;
 
 /// Room for one animation on a board: `TILES` bytes of tiles, `TRACKS`
 /// tracks and `KEYS` keys, all zero bits (a `static` of it costs no
-/// flash). Size it with the [`AnimationNeeds`] of the scenes it plays,
+/// flash). Size it with the [`AnimationNeeds`](super::AnimationNeeds) of the scenes it plays,
 /// keep it in a `static`, and take it once:
 ///
 /// ```

@@ -174,7 +174,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     }
 
     /// Whether camera rays find their hits in the screen lists
-    /// ([`Profile::FIRST_HITS`]): the same image as the walk's.
+    /// ([`Linked::FIRST_HITS`](crate::profile::Linked::FIRST_HITS)): the same image as the walk's.
     pub fn first_hits(&self) -> bool {
         self.first_hits
     }
