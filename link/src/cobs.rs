@@ -58,48 +58,92 @@ impl<W: std::io::Write + ?Sized> Sink for W {
 /// The longest run of data bytes in one block.
 const MAX_RUN: usize = 254;
 
-/// Encodes a frame's bytes as they come, one block behind: a block is
-/// written once its end is known.
+/// Encodes a frame as it comes, one block behind: a block is written once
+/// its end is known.
 pub(crate) struct BlockEncoder {
     /// The code byte's place, then the block's data bytes.
     block: [u8; MAX_RUN + 1],
     /// Data bytes in `block`.
     run: usize,
+    /// The encoded bytes on their way to the sink.
+    pieces: Pieces,
 }
 
 impl BlockEncoder {
     pub(crate) const fn new() -> BlockEncoder {
-        BlockEncoder { block: [0; MAX_RUN + 1], run: 0 }
+        BlockEncoder { block: [0; MAX_RUN + 1], run: 0, pieces: Pieces { bytes: [0; CHUNK], len: 0 } }
+    }
+
+    /// The delimiter before a frame: it ends whatever half frame the
+    /// receiver holds.
+    pub(crate) fn open<S: Sink + ?Sized>(&mut self, sink: &mut S) -> Result<(), S::Error> {
+        self.pieces.add(&[0], sink)
     }
 
     /// Takes the frame's next bytes.
     pub(crate) fn put<S: Sink + ?Sized>(&mut self, bytes: &[u8], sink: &mut S) -> Result<(), S::Error> {
         for &byte in bytes {
             if byte == 0 {
-                self.flush(sink)?;
+                self.end_block(sink)?;
                 continue;
             }
             self.run += 1;
             self.block[self.run] = byte;
             if self.run == MAX_RUN {
+                self.end_block(sink)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes the last block (its 0x00 is the delimiter's) and the closing
+    /// delimiter, and hands the sink all that is left.
+    pub(crate) fn finish<S: Sink + ?Sized>(&mut self, sink: &mut S) -> Result<(), S::Error> {
+        self.end_block(sink)?;
+        self.pieces.add(&[0], sink)?;
+        self.pieces.flush(sink)
+    }
+
+    /// Writes the block so far with its code and starts the next.
+    fn end_block<S: Sink + ?Sized>(&mut self, sink: &mut S) -> Result<(), S::Error> {
+        // `run` is at most 254: the code is at most 255 and never 0.
+        self.block[0] = (self.run + 1) as u8;
+        let block = &self.block[..self.run + 1];
+        self.run = 0;
+        self.pieces.add(block, sink)
+    }
+}
+
+/// Encoded bytes gathered into whole [`CHUNK`]s for the sink: a run of
+/// zeros (a black row) is a block a byte, but a write a packet, not a byte.
+struct Pieces {
+    bytes: [u8; CHUNK],
+    /// Bytes in `bytes`.
+    len: usize,
+}
+
+impl Pieces {
+    /// Adds `bytes`, handing the sink each [`CHUNK`] filled.
+    fn add<S: Sink + ?Sized>(&mut self, mut bytes: &[u8], sink: &mut S) -> Result<(), S::Error> {
+        while !bytes.is_empty() {
+            let taken = bytes.len().min(CHUNK - self.len);
+            self.bytes[self.len..self.len + taken].copy_from_slice(&bytes[..taken]);
+            self.len += taken;
+            bytes = &bytes[taken..];
+            if self.len == CHUNK {
                 self.flush(sink)?;
             }
         }
         Ok(())
     }
 
-    /// Writes the last block (its 0x00 is the delimiter's).
-    pub(crate) fn finish<S: Sink + ?Sized>(&mut self, sink: &mut S) -> Result<(), S::Error> {
-        self.flush(sink)
-    }
-
-    /// Writes the block so far with its code and starts the next.
+    /// Hands the sink what is gathered, if anything.
     fn flush<S: Sink + ?Sized>(&mut self, sink: &mut S) -> Result<(), S::Error> {
-        // `run` is at most 254: the code is at most 255 and never 0.
-        self.block[0] = (self.run + 1) as u8;
-        let block = &self.block[..self.run + 1];
-        self.run = 0;
-        block.chunks(CHUNK).try_for_each(|chunk| sink.write_all(chunk))
+        let len = core::mem::take(&mut self.len);
+        if len == 0 {
+            return Ok(());
+        }
+        sink.write_all(&self.bytes[..len])
     }
 }
 
@@ -144,24 +188,28 @@ mod tests {
     use super::*;
     use std::vec::Vec;
 
-    /// Collects what the encoder writes.
-    struct Bytes(Vec<u8>, usize);
+    /// Collects what the encoder writes, and the length of each write.
+    struct Bytes(Vec<u8>, Vec<usize>);
 
     impl Sink for Bytes {
         type Error = core::convert::Infallible;
         fn write_all(&mut self, bytes: &[u8]) -> Result<(), Self::Error> {
-            self.1 = self.1.max(bytes.len());
+            self.1.push(bytes.len());
             self.0.extend_from_slice(bytes);
             Ok(())
         }
     }
 
+    /// The encoded blocks of `data` (the closing delimiter checked and left
+    /// out), written in whole chunks but the last.
     fn encode(data: &[u8]) -> Vec<u8> {
-        let mut sink = Bytes(Vec::new(), 0);
+        let mut sink = Bytes(Vec::new(), Vec::new());
         let mut encoder = BlockEncoder::new();
         encoder.put(data, &mut sink).unwrap();
         encoder.finish(&mut sink).unwrap();
-        assert!(sink.1 <= CHUNK, "a write of {} bytes", sink.1);
+        let (last, whole) = sink.1.split_last().expect("a write");
+        assert!(whole.iter().all(|&len| len == CHUNK) && (1..=CHUNK).contains(last), "writes of {:?} bytes", sink.1);
+        assert_eq!(sink.0.pop(), Some(0), "the closing delimiter");
         sink.0
     }
 
@@ -178,6 +226,18 @@ mod tests {
         assert_eq!(encode(&[0, 0]), [1, 1, 1]);
         assert_eq!(encode(&[0x11, 0x22, 0, 0x33]), [3, 0x11, 0x22, 2, 0x33]);
         assert_eq!(encode(&[0x11, 0, 0, 0]), [2, 0x11, 1, 1, 1]);
+    }
+
+    #[test]
+    fn a_run_of_zeros_is_written_a_chunk_at_a_time() {
+        // A black row of a 240-pixel RGB565 panel: a block a byte, 8 writes.
+        let mut sink = Bytes(Vec::new(), Vec::new());
+        let mut encoder = BlockEncoder::new();
+        encoder.open(&mut sink).unwrap();
+        encoder.put(&[0; 480], &mut sink).unwrap();
+        encoder.finish(&mut sink).unwrap();
+        assert_eq!(sink.0.len(), 483);
+        assert_eq!(sink.1, [64, 64, 64, 64, 64, 64, 64, 35]);
     }
 
     #[test]

@@ -148,7 +148,8 @@ impl<'a> RawFrame<'a> {
 
 /// Writes one frame into a [`Sink`] as its payload comes: the delimiter,
 /// the header, the payload, the CRC and the closing delimiter. Holds one
-/// COBS block (255 bytes), never the frame.
+/// COBS block (255 bytes) and one piece for the sink
+/// ([`CHUNK`](crate::CHUNK) bytes), never the frame.
 pub(crate) struct FrameWriter<'s, S: Sink + ?Sized> {
     sink: &'s mut S,
     blocks: BlockEncoder,
@@ -161,9 +162,9 @@ impl<'s, S: Sink + ?Sized> FrameWriter<'s, S> {
     /// Starts a frame of `version` (anything but [`VERSION`] only to test
     /// a receiver's refusal).
     pub(crate) fn begin(sink: &'s mut S, version: u8, kind: u8, tag: u16) -> Result<Self, S::Error> {
-        // The opening delimiter ends whatever half frame the receiver holds.
-        sink.write_all(&[0])?;
-        let mut writer = FrameWriter { sink, blocks: BlockEncoder::new(), crc: Crc32::new(), failed: None };
+        let mut blocks = BlockEncoder::new();
+        blocks.open(sink)?;
+        let mut writer = FrameWriter { sink, blocks, crc: Crc32::new(), failed: None };
         let [tag_hi, tag_lo] = tag.to_be_bytes();
         writer.put(&[version, kind, tag_hi, tag_lo])?;
         Ok(writer)
@@ -189,8 +190,7 @@ impl<'s, S: Sink + ?Sized> FrameWriter<'s, S> {
     pub(crate) fn finish(mut self) -> Result<(), S::Error> {
         let crc = self.crc.value().to_be_bytes();
         self.blocks.put(&crc, self.sink)?;
-        self.blocks.finish(self.sink)?;
-        self.sink.write_all(&[0])
+        self.blocks.finish(self.sink)
     }
 }
 
