@@ -90,9 +90,9 @@ fn three_scenes_in_a_row_are_each_host_sims_picture() {
     let description = board.describe();
     let panel = format!("{}x{}", description.panel.width, description.panel.height);
     let dir = tempfile::tempdir().unwrap();
-    // The cheapest first (each is emulated on the Pico's tests): spheres
-    // with mirrors, the chessboard's rectangles in an octree, the first
-    // figure's.
+    // The cheapest to trace first (the board may be the emulated Pico):
+    // a ring of mirror spheres, a helix of fifty, a mirror sphere over
+    // the chessboard's rectangles.
     let names: Vec<&str> = ["fig5_4", "fig5_2", "fig5_5", "fig5_1", "fig5_8", "fig5_3", "fig5_7"]
         .into_iter()
         .filter(|name| fits(&description, &std::fs::read_to_string(thesis_scene(name)).unwrap()))
