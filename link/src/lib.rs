@@ -6,8 +6,8 @@
 //! `#![no_std]`, no allocation: the [`Decoder`] keeps frames in a buffer
 //! the caller owns, fed one byte at a time; [`Message::encode`] writes a
 //! frame into any [`Sink`] in pieces of at most [`CHUNK`] bytes, holding
-//! one COBS block. With the feature `board`, [`board`] is the board's side
-//! on an octrace-core [`Raytracer`](octrace_core::Raytracer), so that a
+//! one COBS block. With the feature `board`, `board` is the board's side
+//! on an octrace-core `Raytracer`, so that a
 //! firmware is a loop around it and a host test runs exactly the board's
 //! behaviour; with `std`, every `std::io::Write` is a [`Sink`].
 //!

@@ -60,7 +60,7 @@
 //! ```
 //!
 //! To play animations, give the link an
-//! [`Animation`](octrace_core::animation::Animation) in a `static`
+//! [`Animation`] in a `static`
 //! [`AnimationRoom`](octrace_core::animation::AnimationRoom)
 //! ([`Link::with_animations`]). On two cores, each renders its rows with a
 //! `Renderer` of its own over [`Drawing::scene`] (see octrace-core's
