@@ -7,7 +7,7 @@
 //! replaces the board's previous ELF: build and run one configuration at a
 //! time.
 
-use crate::repo;
+use crate::{repo, scene_path};
 use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
 use octrace_images::formats::Image;
@@ -173,7 +173,7 @@ impl Firmware {
     /// format.
     pub fn expected_pixels(&self) -> Result<Vec<u8>, String> {
         let mut scene = host_sim::new_scene();
-        let path = repo().join("scenes").join(format!("{}.txt", self.scene));
+        let path = scene_path(&self.scene);
         host_sim::load_file(&path, &mut scene).map_err(|e| e.to_string())?;
         let options = host_sim::RenderOptions { size: Some((self.width, self.height)), ..Default::default() };
         let rendered = host_sim::render(&mut scene, &options).map_err(|e| format!("{e:?}"))?;

@@ -23,6 +23,11 @@ pub fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
+/// Scene `name` of `scenes/` (`scenes/NAME.txt`).
+pub fn scene_path(name: &str) -> PathBuf {
+    repo().join("scenes").join(format!("{name}.txt"))
+}
+
 /// Every still scene in `scenes/`, sorted by name: (name, path). The
 /// animations (`anim_*.txt`, see [`animations`]) are not among them.
 pub fn scenes() -> Vec<(String, PathBuf)> {
@@ -52,7 +57,7 @@ fn scene_files() -> Vec<(String, PathBuf)> {
 /// Writes host-sim's preview of a panel, as its user asks for it:
 /// `host-sim scenes/SCENE.txt OUT --size WxH --color COLOR --quiet`.
 pub fn host_sim_preview(scene: &str, out: &std::path::Path, size: &str, color: &str) -> Result<(), String> {
-    host_sim_preview_of(&repo().join("scenes").join(format!("{scene}.txt")), out, size, color)
+    host_sim_preview_of(&scene_path(scene), out, size, color)
 }
 
 /// [`host_sim_preview`] of the scene file at `path`.
@@ -75,7 +80,7 @@ pub fn host_sim_frame_preview(
     size: &str,
     color: &str,
 ) -> Result<(), String> {
-    let path = repo().join("scenes").join(format!("{scene}.txt"));
+    let path = scene_path(scene);
     let frame = frame.to_string();
     let mut flags = vec!["--frame", &frame];
     if !color.starts_with("rgb") {

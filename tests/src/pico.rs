@@ -15,7 +15,7 @@
 //! scene at a time; each ELF is copied out under the template's and the
 //! build's name, so runs may overlap.
 
-use crate::repo;
+use crate::{repo, scene_path};
 use std::io::{BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -134,7 +134,7 @@ pub fn build(build: &Build<'_>) -> Result<PathBuf, String> {
         cargo.env_remove(var);
     }
     if build.scene != DEFAULT_SCENE {
-        cargo.env("OCTRACE_SCENE", repo().join("scenes").join(format!("{}.txt", build.scene)));
+        cargo.env("OCTRACE_SCENE", scene_path(build.scene));
     }
     if build.code_in != DEFAULT_CODE_IN {
         cargo.env("OCTRACE_CODE_IN", build.code_in);

@@ -16,7 +16,7 @@ use embedded_graphics_core::Pixel;
 use octrace_core::animation::{AnimationNeeds, Coherence, Dependence, HostAnimationRoom};
 use octrace_core::profile::Host;
 use octrace_core::Raytracer;
-use octrace_tests::repo;
+use octrace_tests::scene_path;
 
 /// A framebuffer: what a panel shows.
 #[derive(Clone, PartialEq, Eq)]
@@ -211,7 +211,7 @@ fn an_object_seen_only_through_glass() {
 
 #[test]
 fn anim_fig5_1_is_exact_and_saves_most_of_the_tracing() {
-    let text = std::fs::read_to_string(repo().join("scenes/anim_fig5_1.txt")).unwrap();
+    let text = std::fs::read_to_string(scene_path("anim_fig5_1")).unwrap();
     let share = exact_and_needs("anim_fig5_1", &text, Some(Dependence::Primary));
     assert!(share < 0.5, "{share}");
 }
@@ -241,7 +241,7 @@ fn files(dir: &std::path::Path) -> Vec<String> {
 /// A small animation of fig5_1 in `dir` (40×30, the first 8 frames' motion
 /// in 8 frames).
 fn small_animation(dir: &std::path::Path) -> std::path::PathBuf {
-    let text = std::fs::read_to_string(repo().join("scenes/anim_fig5_1.txt")).unwrap();
+    let text = std::fs::read_to_string(scene_path("anim_fig5_1")).unwrap();
     let text = text.replace("FRAMES 48 24", "FRAMES 8 12").replace("RASTER    240 180", "RASTER 40 30");
     let text = text
         .replace("MOVE   0    0     0  0", "MOVE   0    0     0  0  7 -3 0 -3 MOVE")

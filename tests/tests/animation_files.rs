@@ -12,7 +12,7 @@
 
 use octrace_images::palette::psnr;
 use octrace_images::RgbImage;
-use octrace_tests::repo;
+use octrace_tests::scene_path;
 use octrace_tests::webdriver::{base64_decode, Browser};
 use serde_json::Value;
 use std::path::Path;
@@ -28,7 +28,7 @@ fn host_sim(dir: &Path, args: &[&str]) {
 /// The scene `name` of scenes/ at `width` × `height`, written into `dir`:
 /// its file's name, its frame count and rate.
 fn small(dir: &Path, name: &str, (width, height): (u32, u32)) -> (String, u32, u32) {
-    let text = std::fs::read_to_string(repo().join(format!("scenes/{name}.txt"))).expect("the scene");
+    let text = std::fs::read_to_string(scene_path(name)).expect("the scene");
     let mut out = String::new();
     let (mut count, mut rate) = (0, 24);
     for line in text.lines() {

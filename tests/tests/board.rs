@@ -25,7 +25,7 @@
 
 use octrace_link::{encode_raw, Kind, Message, Panel, Reason, Refusal, VERSION};
 use octrace_tests::board::{dearest_scene, fits, lights, open_pty, wedging_scene, RawHost, RunningBoard};
-use octrace_tests::{host_sim_preview_of, repo, HANG_GUARD};
+use octrace_tests::{host_sim_preview_of, scene_path, HANG_GUARD};
 use std::ffi::OsStr;
 use std::path::Path;
 use std::time::Duration;
@@ -71,11 +71,6 @@ fn read_rgb(path: &Path) -> octrace_images::RgbImage {
     octrace_images::formats::read(&std::fs::read(path).unwrap()).unwrap().to_rgb()
 }
 
-/// Scene `name` of `scenes/`.
-fn thesis_scene(name: &str) -> std::path::PathBuf {
-    repo().join("scenes").join(format!("{name}.txt"))
-}
-
 /// [`QUICK_SCENE`] written as `quick.txt` in `dir`: what a test draws where
 /// any picture serves (the board's recovery, not its tracing, is checked).
 fn quick_scene_file(dir: &Path) -> std::path::PathBuf {
@@ -95,12 +90,12 @@ fn three_scenes_in_a_row_are_each_host_sims_picture() {
     // the chessboard's rectangles.
     let names: Vec<&str> = ["fig5_4", "fig5_2", "fig5_5", "fig5_1", "fig5_8", "fig5_3", "fig5_7"]
         .into_iter()
-        .filter(|name| fits(&description, &std::fs::read_to_string(thesis_scene(name)).unwrap()))
+        .filter(|name| fits(&description, &std::fs::read_to_string(scene_path(name)).unwrap()))
         .take(3)
         .collect();
     assert_eq!(names.len(), 3, "three of the thesis's scenes fit the board");
     for name in names {
-        draws_host_sims_picture(&board, &panel, &thesis_scene(name), dir.path());
+        draws_host_sims_picture(&board, &panel, &scene_path(name), dir.path());
     }
     assert!(board.alive());
 }
@@ -182,7 +177,7 @@ fn a_transfer_cut_off_half_way_leaves_the_board_taking_the_next_scene() {
 fn a_frame_from_the_host_stops_a_drawing_between_rows() {
     let mut board = board();
     let description = board.describe();
-    let text = std::fs::read(repo().join("scenes/fig5_1.txt")).unwrap();
+    let text = std::fs::read(scene_path("fig5_1")).unwrap();
     // The scene, and a hello right behind it: there when the first row is drawn.
     let mut frames = Vec::new();
     Message::Scene { pixels: false, text: &text }.encode(0x5ce, &mut frames).unwrap();
@@ -284,7 +279,7 @@ fn without_a_port_the_ports_are_listed_and_a_scene_is_not_taken_for_one() {
     let run = host_sim_board(&[]);
     assert_eq!(run.code, 0, "{}", run.stderr);
     assert!(!run.stdout.is_empty());
-    let scene = repo().join("scenes/fig5_1.txt");
+    let scene = scene_path("fig5_1");
     let run = host_sim_board(&[scene.as_os_str()]);
     assert_eq!(run.code, 2);
     assert!(run.stderr.contains("is no serial port: give the board's port first"), "{}", run.stderr);
@@ -293,7 +288,7 @@ fn without_a_port_the_ports_are_listed_and_a_scene_is_not_taken_for_one() {
 #[test]
 fn a_silent_port_is_an_error_naming_it() {
     let (_controller, port) = open_pty().unwrap();
-    let scene = repo().join("scenes/fig5_1.txt");
+    let scene = scene_path("fig5_1");
     let run = host_sim_board(&[port.as_os_str(), scene.as_os_str(), "--timeout".as_ref(), "1".as_ref()]);
     assert_eq!(run.code, 1);
     let want = format!("host-sim: board at {}: no answer within 1 s", port.display());
@@ -353,7 +348,7 @@ fn host_sim_board_within(args: &[&OsStr], limit: Duration) -> Option<Run> {
 
 #[test]
 fn a_drawing_at_another_panel_than_described_or_beyond_the_protocol_is_refused_and_nothing_is_written() {
-    let scene = repo().join("scenes/fig5_1.txt");
+    let scene = scene_path("fig5_1");
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out.png");
     for size in ["0x0", "65535x65535", "128x160"] {
@@ -377,7 +372,7 @@ fn a_drawing_at_another_panel_than_described_or_beyond_the_protocol_is_refused_a
 
 #[test]
 fn check_exits_3_when_the_boards_picture_differs_by_a_pixel_in_any_channel() {
-    let scene = repo().join("scenes/fig5_1.txt");
+    let scene = scene_path("fig5_1");
     // Its first pixel in every channel, or in one alone by its lowest bit.
     for how in ["wrong-pixel", "wrong-pixel:red", "wrong-pixel:green", "wrong-pixel:blue"] {
         let board = hostile_board(how, &[]);
@@ -390,7 +385,7 @@ fn check_exits_3_when_the_boards_picture_differs_by_a_pixel_in_any_channel() {
 
 #[test]
 fn a_board_that_keeps_sending_errors_is_given_up_by_their_count_or_at_the_timeout() {
-    let scene = repo().join("scenes/fig5_1.txt");
+    let scene = scene_path("fig5_1");
     // Errors move nothing on: more than the scene can have end it.
     let board = hostile_board("errors-every:1", &[]);
     let run = host_sim_board_within(&[board.port.as_os_str(), scene.as_os_str()], HANG_GUARD).expect("it ends");
@@ -466,7 +461,7 @@ fn a_board_that_reads_slowly_gets_the_whole_scene_while_it_reads() {
     let board = hostile_board("reads-slowly", &["--max-scene", "65536"]);
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("long.txt");
-    let text = std::fs::read_to_string(repo().join("scenes/fig5_1.txt")).unwrap();
+    let text = std::fs::read_to_string(scene_path("fig5_1")).unwrap();
     std::fs::write(&scene, format!("{text}/* {} */\n", "padding ".repeat(3000))).unwrap();
     let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str(), "--check".as_ref()]);
     assert_eq!(run.code, 0, "{}", run.stderr);
@@ -479,7 +474,7 @@ fn a_boards_text_is_shown_with_its_control_characters_escaped() {
     let run = host_sim_board(&[board.port.as_os_str()]);
     assert_eq!(run.code, 0, "{}", run.stderr);
     assert!(run.stdout.contains(": \\u{1b}]0;pwned\\u{7}\\u{1b}[2Joctrace software board"), "{}", run.stdout);
-    let scene = repo().join("scenes/fig5_1.txt");
+    let scene = scene_path("fig5_1");
     let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str()]);
     assert_eq!(run.code, 2, "{}", run.stderr);
     assert!(

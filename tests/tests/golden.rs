@@ -20,7 +20,7 @@ use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
 use octrace_images::formats::{self, Format, Image};
 use octrace_images::palette::{self, PaletteMode};
-use octrace_tests::{animations, blessing, repo, scenes};
+use octrace_tests::{animations, blessing, repo, scene_path, scenes};
 
 #[test]
 fn every_scene_matches_its_golden_image() {
@@ -61,7 +61,7 @@ fn every_scene_matches_its_golden_image() {
 fn fig5_1_in_every_palette_mode_matches_its_golden_image() {
     let gallery = repo().join("docs/gallery");
     let mut scene = new_scene();
-    load_file(&repo().join("scenes/fig5_1.txt"), &mut scene).unwrap();
+    load_file(&scene_path("fig5_1"), &mut scene).unwrap();
     let rendered = render(&mut scene, &RenderOptions::default()).unwrap();
     let mut failures = Vec::new();
     for mode in [PaletteMode::Scan, PaletteMode::Dither, PaletteMode::Coarse, PaletteMode::Gray] {
@@ -91,7 +91,7 @@ fn fig5_1_in_every_palette_mode_matches_its_golden_image() {
 fn fig5_1_on_every_panel_matches_its_golden_image() {
     let gallery = repo().join("docs/gallery");
     let dir = tempfile::tempdir().unwrap();
-    let scene = repo().join("scenes/fig5_1.txt");
+    let scene = scene_path("fig5_1");
     // Each panel by its default method; one bit by every method.
     let default = Dithering::default();
     let shown = PanelColor::ALL.into_iter().filter(|c| c.panel().is_some()).map(|c| (c, default));

@@ -13,7 +13,7 @@ use octrace_core::math::{Dir, Scalar, Vec3};
 use octrace_core::profile::{Host, Profile};
 use octrace_core::scene::ObjectId;
 use octrace_core::shapes::{Leaving, Ray};
-use octrace_tests::{scenes, Rng};
+use octrace_tests::{scene_path, scenes, Rng};
 
 fn image(
     scene: &mut HostScene,
@@ -256,7 +256,7 @@ fn small_capacities_fall_back_without_changing_the_image() {
     use octrace_core::Raytracer;
     // fig5_3's 200 spheres in the 16 KiB board profile: the octree's arenas
     // are small, so boxes stay unsplit; the image must not change.
-    let text = std::fs::read(octrace_tests::repo().join("scenes/fig5_3.txt")).unwrap();
+    let text = std::fs::read(scene_path("fig5_3")).unwrap();
     let mut raytracer: Box<Raytracer<Board16K>> = Box::default();
     let mut draw = |indexing: Indexing| {
         let scene = raytracer.load_with(&text, indexing, &mut |e| panic!("{e}")).unwrap();

@@ -7,7 +7,7 @@
 use host_sim::{load_bytes, load_file, new_scene, render, RenderOptions};
 use octrace_images::formats::{self, Format, Image};
 use octrace_images::palette::{self, PaletteMode};
-use octrace_tests::scenes;
+use octrace_tests::{scene_path, scenes};
 
 const FORMATS: [Format; 3] = [Format::Png, Format::Tga, Format::Ras];
 
@@ -107,7 +107,7 @@ fn coarse_outlines_a_bspline_patch_not_its_triangles() {
     // patch is one object as written, so the pixels see at most five, and
     // coarse outlines stay few (they once drew the whole triangle mesh).
     let mut scene = new_scene();
-    load_file(&octrace_tests::repo().join("scenes/freeform.txt"), &mut scene).unwrap();
+    load_file(&scene_path("freeform"), &mut scene).unwrap();
     let rendered = render(&mut scene, &RenderOptions { size: Some((160, 120)), ..Default::default() }).unwrap();
     let mut seen: Vec<u32> = rendered.objects.iter().copied().filter(|&o| o != host_sim::NO_OBJECT).collect();
     seen.sort_unstable();
@@ -143,7 +143,7 @@ fn one_colour_and_one_pixel_images() {
 
 #[test]
 fn scan_maps_more_than_256_colours_onto_256() {
-    let path = octrace_tests::repo().join("scenes/fig5_3.txt");
+    let path = scene_path("fig5_3");
     let mut scene = new_scene();
     load_file(&path, &mut scene).unwrap();
     let rendered = render(&mut scene, &RenderOptions { threads: 2, ..Default::default() }).unwrap();
@@ -160,7 +160,7 @@ fn scan_maps_more_than_256_colours_onto_256() {
 #[test]
 fn host_sim_writes_and_converts_every_format() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = octrace_tests::repo().join("scenes/fig5_1.txt");
+    let scene = scene_path("fig5_1");
     let run = |args: &[&std::ffi::OsStr]| {
         let (mut out, mut err) = (Vec::new(), Vec::new());
         let mut all = vec![std::ffi::OsStr::new("host-sim")];

@@ -7,7 +7,7 @@
 use host_sim::{load_file, new_scene, render, RenderOptions};
 use octrace_core::panel::{Dithering, Panel};
 use octrace_images::{panel, RgbImage};
-use octrace_tests::repo;
+use octrace_tests::scene_path;
 
 /// The three scenes of the table at 128×64.
 fn renders() -> Vec<(&'static str, RgbImage)> {
@@ -15,7 +15,7 @@ fn renders() -> Vec<(&'static str, RgbImage)> {
         .into_iter()
         .map(|name| {
             let mut scene = new_scene();
-            load_file(&repo().join(format!("scenes/{name}.txt")), &mut scene).unwrap();
+            load_file(&scene_path(name), &mut scene).unwrap();
             let options = RenderOptions { size: Some((128, 64)), ..Default::default() };
             (name, render(&mut scene, &options).unwrap().image)
         })

@@ -7,7 +7,7 @@ use host_sim::{load_file, new_scene, render, AccelMode, Partition, RenderOptions
 use octrace_core::profile::Host;
 use octrace_core::render::interleaved_rows;
 use octrace_core::{Raytracer, RendererRoom};
-use octrace_tests::scenes;
+use octrace_tests::{scene_path, scenes};
 use std::sync::Mutex;
 
 #[test]
@@ -31,7 +31,7 @@ fn every_thread_count_and_partition_gives_the_same_image() {
 
 #[test]
 fn stats_do_not_depend_on_the_thread_count() {
-    let path = octrace_tests::repo().join("scenes/fig5_3.txt");
+    let path = scene_path("fig5_3");
     let mut scene = new_scene();
     load_file(&path, &mut scene).unwrap();
     let options =
@@ -46,7 +46,7 @@ fn stats_do_not_depend_on_the_thread_count() {
 /// out in turn, each row sent to the display where it belongs.
 #[test]
 fn two_cores_with_interleaved_rows_give_the_same_image() {
-    let path = octrace_tests::repo().join("scenes/fig5_3.txt");
+    let path = scene_path("fig5_3");
     let mut scene = new_scene();
     load_file(&path, &mut scene).unwrap();
     let (w, h) = (120, 90);

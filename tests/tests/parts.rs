@@ -6,6 +6,7 @@
 use host_sim::{load_file, new_scene, render, Partition, RenderOptions};
 use octrace_images::formats::{self, Image};
 use octrace_images::palette::{self, PaletteMode};
+use octrace_tests::scene_path;
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -33,10 +34,6 @@ fn ok(args: &[&OsStr]) {
     assert_eq!(code, 0, "host-sim {args:?}: {err}");
 }
 
-fn scene(name: &str) -> PathBuf {
-    octrace_tests::repo().join("scenes").join(format!("{name}.txt"))
-}
-
 fn read(path: &Path) -> Image {
     formats::read(&std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())))
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
@@ -53,7 +50,7 @@ fn files(dir: &Path) -> Vec<String> {
 #[test]
 fn streamed_files_equal_the_whole_image_in_every_mode_and_format() {
     let dir = tempfile::tempdir().unwrap();
-    let path = scene("fig5_1");
+    let path = scene_path("fig5_1");
     let mut loaded = new_scene();
     load_file(&path, &mut loaded).unwrap();
     // Neither side a multiple of the 32-row bands and tiles.
@@ -123,7 +120,7 @@ fn render_parts(dir: &Path, scene: &Path, parts: &[&str], extension: &str, extra
 #[test]
 fn merged_parts_are_one_render_byte_for_byte() {
     let dir = tempfile::tempdir().unwrap();
-    let path = scene("fig5_1");
+    let path = scene_path("fig5_1");
     for mode in ["none", "dither", "coarse", "gray"] {
         for extension in ["png", "tga"] {
             let whole = dir.path().join(format!("whole-{mode}.png"));
@@ -180,7 +177,7 @@ fn merged_parts_are_one_render_byte_for_byte() {
 #[test]
 fn merge_refuses_parts_that_do_not_fit_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let (fig5_1, fig5_2) = (scene("fig5_1"), scene("fig5_2"));
+    let (fig5_1, fig5_2) = (scene_path("fig5_1"), scene_path("fig5_2"));
     let good = render_parts(dir.path(), &fig5_1, &["1/3", "2/3", "3/3"], "png", &[]);
     let half = render_parts(dir.path(), &fig5_1, &["2/2"], "png", &[]).remove(0);
     let other_dir = |name: &str| {
@@ -267,7 +264,7 @@ fn merge_refuses_parts_that_do_not_fit_and_writes_nothing() {
 #[test]
 fn part_auto_takes_the_index_from_slurm_or_kubernetes() {
     let dir = tempfile::tempdir().unwrap();
-    let path = scene("fig5_1");
+    let path = scene_path("fig5_1");
     let given = render_parts(dir.path(), &path, &["2/3", "3/3"], "png", &[]);
     let out = dir.path().join("auto.png");
     let args = part_args(&path, &out, "auto/3");
@@ -302,7 +299,7 @@ fn part_auto_takes_the_index_from_slurm_or_kubernetes() {
 #[test]
 fn part_refuses_what_cannot_be_split() {
     let dir = tempfile::tempdir().unwrap();
-    let path = scene("fig5_1");
+    let path = scene_path("fig5_1");
     let ras = dir.path().join("part.ras");
     let png = dir.path().join("part.png");
     let cases: [(&Path, &[&str], &str); 5] = [
@@ -335,7 +332,7 @@ fn the_gnu_parallel_recipe_gives_the_single_render() {
     let dir = tempfile::tempdir().unwrap();
     // The recipe runs `host-sim` on the repository's scenes, from a directory of its own.
     std::fs::create_dir_all(dir.path().join("scenes")).unwrap();
-    std::fs::copy(scene("fig5_3"), dir.path().join("scenes/fig5_3.txt")).unwrap();
+    std::fs::copy(scene_path("fig5_3"), dir.path().join("scenes/fig5_3.txt")).unwrap();
     octrace_tests::run_recipe(&octrace_tests::recipe("parallel-local"), dir.path(), HOST_SIM);
     let merged = dir.path().join("fig5_3.png");
     let single = dir.path().join("single.png");

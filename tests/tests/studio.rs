@@ -18,7 +18,7 @@ use octrace_images::palette::{self, PaletteMode};
 use octrace_link::{BoardInfo, Capacities, Decoder, Kind, Message, Panel, PixelFormat};
 use octrace_tests::board::{fits, open_pty, wedging_scene, RunningBoard};
 use octrace_tests::webdriver::{http, http_with_head, Browser};
-use octrace_tests::{host_sim_preview, repo, scenes, HANG_GUARD};
+use octrace_tests::{host_sim_preview, repo, scene_path, scenes, HANG_GUARD};
 use std::ffi::OsStr;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -357,7 +357,7 @@ fn the_canvas_is_host_sims_image_for_every_scene() {
     // The draft while typing on fig5_3 at 160×120: from the last keystroke
     // to the finished draft, measured in the page (reported, not asserted:
     // speed targets live in benchmarks).
-    let fig5_3 = std::fs::read_to_string(repo().join("scenes/fig5_3.txt")).expect("fig5_3");
+    let fig5_3 = std::fs::read_to_string(scene_path("fig5_3")).expect("fig5_3");
     set_text(&browser, &fig5_3);
     browser.wait_for("document.getElementById('draft').dataset.state === 'done'");
     let mut latencies = Vec::new();
@@ -382,7 +382,7 @@ fn a_render_or_draft_of_hours_a_pixel_is_stopped_by_the_next_at_once() {
     browser.goto(&studio.url);
     browser.wait_for("document.body.dataset.ready === 'true'");
     let wedge = with_raster(&wedging_scene(8), 16, 12);
-    let next = with_raster(&std::fs::read_to_string(repo().join("scenes/fig5_1.txt")).expect("fig5_1"), 64, 48);
+    let next = with_raster(&std::fs::read_to_string(scene_path("fig5_1")).expect("fig5_1"), 64, 48);
     for parallel in [false, true] {
         browser.run(&format!("document.getElementById('parallel').checked = {parallel}; return true;"));
         // Its draft and its render start, and would take hours.
@@ -412,8 +412,7 @@ fn a_render_or_draft_of_hours_a_pixel_is_stopped_by_the_next_at_once() {
     // (the draft's player is the draft's worker pair).
     let dir = tempfile::tempdir().expect("a directory");
     let animation = dir.path().join("animation.txt");
-    let animated =
-        with_raster(&std::fs::read_to_string(repo().join("scenes/anim_fig5_1.txt")).expect("anim_fig5_1"), 64, 48);
+    let animated = with_raster(&std::fs::read_to_string(scene_path("anim_fig5_1")).expect("anim_fig5_1"), 64, 48);
     std::fs::write(&animation, &animated).expect("the animation");
     set_text(&browser, &format!("FRAMES 2\n{wedge}"));
     browser.run(
@@ -913,7 +912,7 @@ fn the_time_slider_and_play_show_host_sims_frames() {
     let binary = host_sim_binary();
     let dir = tempfile::tempdir().expect("a directory");
     let scene = dir.path().join("anim_fig5_1.txt");
-    std::fs::copy(repo().join("scenes/anim_fig5_1.txt"), &scene).expect("copied");
+    std::fs::copy(scene_path("anim_fig5_1"), &scene).expect("copied");
     let studio = Studio::start(&binary, Some(&scene));
     let browser = Browser::start((1500, 900));
     browser.goto(&studio.url);
@@ -1069,9 +1068,9 @@ fn send_to_board_shows_the_boards_picture_and_verdict_or_its_errors_in_the_edito
     // the emulated Pico).
     let name = ["fig5_4", "fig5_2", "fig5_1"]
         .into_iter()
-        .find(|name| fits(&description, &std::fs::read_to_string(repo().join(format!("scenes/{name}.txt"))).unwrap()))
+        .find(|name| fits(&description, &std::fs::read_to_string(scene_path(name)).unwrap()))
         .expect("a scene of the thesis fits the board");
-    set_text(&browser, &std::fs::read_to_string(repo().join(format!("scenes/{name}.txt"))).unwrap());
+    set_text(&browser, &std::fs::read_to_string(scene_path(name)).unwrap());
     let (state, verdict, said) = send_to_board(&browser, &|b| b.click("#send-board"));
     assert_eq!((state.as_str(), verdict.as_str(), said.as_str()), ("done", "identical", "identical"), "{name}");
     let dir = tempfile::tempdir().expect("a directory");
@@ -1298,7 +1297,7 @@ fn the_board_endpoint_keeps_the_security_rules_and_sends_one_at_a_time() {
 #[test]
 fn a_board_that_is_no_serial_port_is_an_error_at_start() {
     let binary = host_sim_binary();
-    let scene = repo().join("scenes/fig5_1.txt");
+    let scene = scene_path("fig5_1");
     let out = Command::new(&binary).args(["studio", "--board"]).arg(&scene).output().expect("runs");
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -1411,7 +1410,7 @@ fn another_local_page_cannot_drive_the_studio_nor_learn_its_token() {
 fn send_to_board_refuses_what_a_hostile_board_answers() {
     let software = env!("CARGO_BIN_EXE_software-board");
     let binary = host_sim_binary();
-    let text = std::fs::read(repo().join("scenes/fig5_1.txt")).expect("fig5_1");
+    let text = std::fs::read(scene_path("fig5_1")).expect("fig5_1");
     // A drawing at a panel it did not describe: an error, not "identical"
     // over no pixel at all.
     let board = RunningBoard::software(software, &["--panel", "160x128", "--misbehave", "draws-at:0x0"]);
