@@ -263,9 +263,48 @@ impl<'a> Playing<'a> {
     }
 }
 
-/// A fingerprint of a scene's text (64-bit FNV-1a and the length): a
-/// text edited between two frames is another animation.
+/// A fingerprint of a scene's text: a text edited between two frames is
+/// another animation. Two 32-bit multiplicative hashes of its 4-byte words
+/// with its length: a board hashes its text every frame, and a 32-bit
+/// product is one instruction on a Cortex-M0+ where a 64-bit one (as in
+/// 64-bit FNV) is a library call a byte.
 fn fingerprint(text: &[u8]) -> u64 {
-    let hash = text.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3));
-    hash ^ (text.len() as u64).rotate_left(32)
+    const PRIMES: [u32; 2] = [0x0100_0193, 0x9e37_79b1];
+    let mut lanes = [0x811c_9dc5u32, 0x2f73_2b1d];
+    let words = text.chunks_exact(4);
+    let mut last = [0; 4];
+    last[..words.remainder().len()].copy_from_slice(words.remainder());
+    for word in words.map(|w| [w[0], w[1], w[2], w[3]]).chain([last]) {
+        let word = u32::from_le_bytes(word);
+        for (lane, prime) in lanes.iter_mut().zip(PRIMES) {
+            // The rotation brings the product's high bits, which every
+            // bit of the word reaches, down to where the next word lands.
+            *lane = (*lane ^ word).wrapping_mul(prime).rotate_left(15);
+        }
+    }
+    let length = text.len() as u32;
+    (u64::from(lanes[0] ^ length) << 32) | u64::from(lanes[1].wrapping_add(length))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fingerprint;
+
+    #[test]
+    fn any_one_byte_edit_or_a_byte_more_changes_the_fingerprint() {
+        let text = b"FRAMES 48 12\nSPHERE 1 0.5 0 0 0\nMOVE 0 0 0 0\n  47 1 0 0\n";
+        let original = fingerprint(text);
+        for at in 0..text.len() {
+            for bit in 0..8 {
+                let mut edited = *text;
+                edited[at] ^= 1 << bit;
+                assert_ne!(fingerprint(&edited), original, "byte {at}, bit {bit}");
+            }
+        }
+        for more in 1..8 {
+            let longer: heapless::Vec<u8, 80> = text.iter().copied().chain(core::iter::repeat_n(0, more)).collect();
+            assert_ne!(fingerprint(&longer), original, "{more} zero bytes more");
+        }
+        assert_eq!(fingerprint(text), original);
+    }
 }

@@ -136,11 +136,18 @@ impl<'m> Path<'m> {
     }
 
     /// The displacement at `frame`, from frame 0's.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn at(&self, frame: u32) -> [i32; 3] {
-        if frame == self.kept.0 {
-            return self.kept.1;
+        // The kept frame, asked most, without a call.
+        match frame == self.kept.0 {
+            true => self.kept.1,
+            false => self.searched(frame),
         }
+    }
+
+    /// The displacement at `frame`, from its key.
+    #[inline(never)]
+    fn searched(&self, frame: u32) -> [i32; 3] {
         match self.keys.partition_point(|k| k.frame <= frame).checked_sub(1) {
             Some(k) => self.keys[k].after((frame - self.keys[k].frame).min(self.keys[k].span)),
             // Before the first key: its displacement.
