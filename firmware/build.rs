@@ -29,6 +29,7 @@
 //! (see `memory-*.x`), so an ELF always runs on the board it was built for.
 
 use octrace_core::accel::OctreeConfig;
+use octrace_core::animation::AnimationNeeds;
 use octrace_core::capacity::{CapacityKind, Counts};
 use octrace_core::panel::Dithering;
 use octrace_core::parse::{count, parse};
@@ -209,6 +210,8 @@ fn main() {
     // not fit its RAM otherwise, with every technique that fits beside it
     // (a level less costs more than either technique gains).
     let budget = board.static_ram - OTHER_STATICS;
+    // A scene without a MOVE links none of the interpolation of keys.
+    let motion = AnimationNeeds::of(&text, Default::default()).tracks > 0;
     let plan = |techniques: Techniques, max_depth: u32| {
         let config = OctreeConfig { max_depth, shadow_shafts: techniques.shadow_shafts, ..board.config };
         let counts = needs(&text, accel, &config, techniques.light_buffer);
@@ -220,6 +223,7 @@ fn main() {
             named_walk,
             first_hits: techniques.first_hits,
             coherence: false,
+            motion,
         };
         let bytes = profile.arena_bytes();
         (config, techniques, counts, bytes)
@@ -273,6 +277,7 @@ fn main() {
         named_walk,
         first_hits: techniques.first_hits,
         coherence: false,
+        motion,
     };
     write!(config, "{profile}").unwrap();
     writeln!(config, "/// The scene's light buffer, built on the host (empty: none in flash).").unwrap();

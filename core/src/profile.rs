@@ -97,7 +97,9 @@ pub trait Profile: SceneCapacities + Linked {
 /// stays the thesis's test of every object); a last `coherence: true` lets
 /// an animation re-trace only what changes (see [`Linked::COHERENCE`]:
 /// without it none of that code is linked, and a board that draws stills
-/// pays nothing for it).
+/// pays nothing for it); a last `motion: false` makes a `MOVE` an error
+/// (see [`SceneCapacities::MOTION`](crate::scene::SceneCapacities::MOTION):
+/// a board built for a still links no interpolation of keys).
 ///
 /// ```
 /// octrace_core::profile! {
@@ -116,6 +118,7 @@ macro_rules! profile {
         $(named_walk: $named_walk:literal)?
         $(first_hits: $first_hits:literal)?
         $(coherence: $coherence:literal)?
+        $(motion: $motion:literal)?
     ) => {
         $(#[$meta])*
         #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -155,7 +158,7 @@ macro_rules! profile {
                     && <$name as $crate::profile::Profile>::COUNTS.octree_references < 0xFFFE,
                 "profile!: octree_boxes and octree_references must be below 65534"
             );
-            $crate::__shape_kinds!($crate::__scene_capacities! { $name, p::Vec });
+            $crate::__shape_kinds!($crate::__scene_capacities! { $name, p::Vec, motion: p::given_or(&[$($motion)?], true) });
 
             impl p::OctreeCapacities for $name {
                 const KINDS: p::ShapeKinds = p::ShapeKinds::with_room(&<$name as $crate::profile::Profile>::COUNTS);
@@ -188,7 +191,7 @@ macro_rules! profile {
 macro_rules! __scene_capacities {
     (
         shapes [$($(#[$doc:meta])* $kind:ident($type:ident) in $field:ident: $capacity:ident, $what:literal;)*]
-        $name:ident, $($arena:ident)::+
+        $name:ident, $($arena:ident)::+ $(, motion: $motion:expr)?
     ) => {
         const _: () = {
             type ArenaOf<T, const N: usize> = $($arena)::+<T, N>;
@@ -200,6 +203,7 @@ macro_rules! __scene_capacities {
                 type ControlPoints = ArenaOf<$crate::math::Vec3, { <$name as $crate::profile::Profile>::COUNTS.control_points }>;
                 type Surfaces = ArenaOf<$crate::scene::SurfaceEntry, { <$name as $crate::profile::Profile>::COUNTS.surfaces }>;
                 type Lights = ArenaOf<$crate::scene::Light, { <$name as $crate::profile::Profile>::COUNTS.lights }>;
+                $(const MOTION: bool = $motion;)?
             }
         };
     };
@@ -324,19 +328,19 @@ fn host_scene<'t>(
 /// `OUT_DIR` and the firmware `include!`s it (octrace's firmware and board
 /// templates do). The counts from `needed_by` (feature `alloc`) or
 /// [`parse::count`](crate::parse::count), the octree's criterion when it
-/// is not the default one, and the three options.
+/// is not the default one, and the four options.
 ///
 /// ```
 /// use octrace_core::{accel::OctreeConfig, parse::count, profile::ProfileText};
 ///
 /// let counts = count("SPHERE 1 1 0 0 0\n");
 /// let octree = OctreeConfig { max_depth: 4, ..OctreeConfig::DEFAULT };
-/// let text = ProfileText { name: "Scene", doc: "One sphere.", counts: &counts, octree: Some(&octree), named_walk: false, first_hits: true, coherence: false };
+/// let text = ProfileText { name: "Scene", doc: "One sphere.", counts: &counts, octree: Some(&octree), named_walk: false, first_hits: true, coherence: false, motion: false };
 /// assert_eq!(
 ///     text.to_string(),
 ///     "octrace_core::profile! {\n    /// One sphere.\n    pub struct Scene { objects: 1, spheres: 1 }\n    \
 ///      octree: { max_objects: 4, max_depth: 4, shadow_shafts: false }\n    named_walk: false\n    first_hits: true\n    \
-///      coherence: false\n}\n",
+///      coherence: false\n    motion: false\n}\n",
 /// );
 /// ```
 #[derive(Clone, Copy, Debug)]
@@ -355,6 +359,9 @@ pub struct ProfileText<'a> {
     pub first_hits: bool,
     /// [`Linked::COHERENCE`]: what a firmware that plays animations needs.
     pub coherence: bool,
+    /// [`SceneCapacities::MOTION`](crate::scene::SceneCapacities::MOTION):
+    /// whether its scene may have a `MOVE`.
+    pub motion: bool,
 }
 
 impl ProfileText<'_> {
@@ -369,7 +376,7 @@ impl ProfileText<'_> {
     ///
     /// let one = count("SPHERE 1 1 0 0 0\n");
     /// let two = count("SPHERE 1 1 0 0 0\nSPHERE 1 1 3 0 0\n");
-    /// let text = |counts| ProfileText { name: "Scene", doc: "", counts, octree: None, named_walk: false, first_hits: false, coherence: false };
+    /// let text = |counts| ProfileText { name: "Scene", doc: "", counts, octree: None, named_walk: false, first_hits: false, coherence: false, motion: false };
     /// assert!(text(&two).arena_bytes() > text(&one).arena_bytes());
     /// ```
     pub fn arena_bytes(&self) -> usize {
@@ -417,6 +424,7 @@ impl core::fmt::Display for ProfileText<'_> {
         writeln!(f, "    named_walk: {}", self.named_walk)?;
         writeln!(f, "    first_hits: {}", self.first_hits)?;
         writeln!(f, "    coherence: {}", self.coherence)?;
+        writeln!(f, "    motion: {}", self.motion)?;
         writeln!(f, "}}")
     }
 }

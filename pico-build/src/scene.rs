@@ -75,7 +75,7 @@ pub fn embed_still_scene(default: &str) -> Result<(), BuildError> {
     let needs = needed_by(&text, AccelMode::Auto, &OctreeConfig::DEFAULT, &mut |error| eprintln!("{scene}:{error}"))
         .map_err(|errors| BuildError::Scene { scene: scene.clone(), errors })?;
     let doc = format!("Exactly what `{scene}` needs, its octree included.");
-    let profile = profile_text(&doc, &needs, false);
+    let profile = profile_text(&doc, &needs, false, moves(&text));
     let source =
         format!("/// The scene, from `{scene}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n{profile}");
     write(&out_dir()?.join("scene.rs"), &source)
@@ -100,9 +100,25 @@ fn read_scene(default: &str) -> Result<(String, PathBuf, String), BuildError> {
 /// `SceneProfile`, holding `counts`: `Raytracer::load` picks the
 /// accelerator as `Auto` does, with the octree `profile!` builds by
 /// default, and walks it by 3DDDA (no room for the thesis's hash table);
-/// with the camera rays' first hits, and `coherence` for an animation.
-fn profile_text<'a>(doc: &'a str, counts: &'a Counts, coherence: bool) -> ProfileText<'a> {
-    ProfileText { name: "SceneProfile", doc, counts, octree: None, named_walk: false, first_hits: true, coherence }
+/// with the camera rays' first hits, `coherence` for an animation, and
+/// `motion` for a scene with a `MOVE` (a still's links no interpolation).
+fn profile_text<'a>(doc: &'a str, counts: &'a Counts, coherence: bool, motion: bool) -> ProfileText<'a> {
+    ProfileText {
+        name: "SceneProfile",
+        doc,
+        counts,
+        octree: None,
+        named_walk: false,
+        first_hits: true,
+        coherence,
+        motion,
+    }
+}
+
+/// Whether the scene `text` has a `MOVE` (its frame 0 is placed by it, even
+/// where it is drawn once).
+fn moves(text: &str) -> bool {
+    AnimationNeeds::of(text, Default::default()).tracks > 0
 }
 
 /// What the scene `text` is: an animation if it has frames and something
@@ -131,7 +147,7 @@ fn scene_source(name: &str, path: &std::path::Path, text: &str) -> Result<(Scene
     let doc = format!("Exactly what `{name}` needs, its octree included.");
     let kind = kind_of(text);
     let animated = kind == SceneKind::Animation;
-    let profile = profile_text(&doc, &needs, animated);
+    let profile = profile_text(&doc, &needs, animated, moves(text));
     let motion = if animated { AnimationNeeds::of(text, Default::default()) } else { Default::default() };
     let stem = path.file_stem().map_or_else(|| name.to_owned(), |stem| stem.to_string_lossy().into_owned());
     let source = format!(
@@ -173,15 +189,22 @@ mod tests {
         let (kind, source) = scene_source("still", path, still).unwrap();
         assert_eq!(kind, SceneKind::Still);
         assert!(source.contains("    coherence: false\n") && source.contains("ANIMATED: bool = false"), "{source}");
+        assert!(source.contains("    motion: false\n"), "{source}");
         assert!(source.contains("tiles: 0, tracks: 0, keys: 0"), "{source}");
-        // Frames where nothing moves, or a move in one frame, are stills.
-        for text in [format!("FRAMES 4\n{still}"), format!("FRAMES 1\n{still}SPHERE 1 1 3 0 0 MOVE 0 0 0 0\n")] {
-            assert_eq!(scene_source("still", path, &text).unwrap().0, SceneKind::Still, "{text}");
+        // Frames where nothing moves, or a move in one frame, are stills;
+        // the second still parses its MOVE.
+        for (text, motion) in
+            [(format!("FRAMES 4\n{still}"), false), (format!("FRAMES 1\n{still}SPHERE 1 1 3 0 0 MOVE 0 0 0 0\n"), true)]
+        {
+            let (kind, source) = scene_source("still", path, &text).unwrap();
+            assert_eq!(kind, SceneKind::Still, "{text}");
+            assert!(source.contains(&format!("    motion: {motion}\n")), "{source}");
         }
         let moving = format!("FRAMES 4\n{still}SPHERE 1 1 3 0 0 MOVE 0 0 0 0  3 0 2 0\n");
         let (kind, source) = scene_source("moving", path, &moving).unwrap();
         assert_eq!(kind, SceneKind::Animation);
-        assert!(source.contains("    coherence: true\n}\n") && source.contains("ANIMATED: bool = true"), "{source}");
+        assert!(source.contains("    coherence: true\n    motion: true\n}\n"), "{source}");
+        assert!(source.contains("ANIMATED: bool = true"), "{source}");
         assert!(source.contains("tiles: 0, tracks: 1, keys: 2"), "{source}");
     }
 

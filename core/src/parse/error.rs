@@ -244,6 +244,11 @@ pub enum ErrorKind<'a> {
         /// The frame loaded.
         frame: u32,
     },
+    /// A MOVE in a build whose profile holds no motion.
+    NoMotion {
+        /// The profile's name.
+        profile: &'static str,
+    },
 }
 
 /// One error in a scene.
@@ -335,6 +340,10 @@ impl fmt::Display for ErrorKind<'_> {
                  in every frame"
             ),
             ErrorKind::MovedCamera { error, frame } => write!(f, "at frame {frame}, {error}"),
+            ErrorKind::NoMotion { profile } => write!(
+                f,
+                "MOVE, but this build's profile {profile} holds no motion (built for a still: `motion: false`)"
+            ),
         }
     }
 }

@@ -40,7 +40,15 @@ impl<'a> Lexer<'a> {
     }
 
     fn rest(&self) -> &'a str {
-        &self.src[self.offset..]
+        self.text(self.offset..self.src.len())
+    }
+
+    /// The source's text over `range`, whose ends the lexer stepped to
+    /// (character boundaries): `get`, whose `None` never comes, rather than
+    /// an index whose failure would link a panic's formatting of a
+    /// character into a board's flash.
+    fn text(&self, range: core::ops::Range<usize>) -> &'a str {
+        self.src.get(range).unwrap_or_default()
     }
 
     /// Steps over the ASCII bytes at the offset that `keep` takes, none of
@@ -114,7 +122,7 @@ impl<'a> Lexer<'a> {
                 loop {
                     match self.bump() {
                         Some('"') => {
-                            let text = &self.src[inner..self.offset - 1];
+                            let text = self.text(inner..self.offset - 1);
                             return Ok(Some(Token { text, pos, end: self.pos, quoted: true }));
                         }
                         Some(_) => {}
@@ -134,7 +142,7 @@ impl<'a> Lexer<'a> {
                         _ => break,
                     }
                 }
-                Ok(Some(Token { text: &self.src[start..self.offset], pos, end: self.pos, quoted: false }))
+                Ok(Some(Token { text: self.text(start..self.offset), pos, end: self.pos, quoted: false }))
             }
         }
     }

@@ -408,6 +408,11 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, '_, C> {
     /// format's range (errors reported; none without a MOVE).
     fn offset(&mut self, s: &Statement<'a>, moved: Option<(Pos, Keys<'a>)>) -> Offset {
         let Some((at, keys)) = moved else { return Offset::NONE };
+        if !C::MOTION {
+            // Nothing below is linked into a build for a still.
+            self.report(ParseError::new(at, ErrorKind::NoMotion { profile: C::NAME }));
+            return Offset::NONE;
+        }
         let Some(frames) = self.parsed.frames else {
             self.report(ParseError::new(at, ErrorKind::MoveWithoutFrames));
             return Offset::NONE;
@@ -632,7 +637,7 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, '_, C> {
     /// the first frame whose camera cannot be set up is an error at the
     /// camera's MOVE, naming the frame, so that nothing of it plays.
     fn check_every_frame(&mut self) {
-        let (Some(frames), Some(pos)) = (self.parsed.frames, self.camera_move) else { return };
+        let (Some(frames), Some(pos), true) = (self.parsed.frames, self.camera_move, C::MOTION) else { return };
         let mut view = self.scene.settings.view;
         let mut last = None;
         for frame in 0..frames.count {
@@ -689,6 +694,12 @@ mod tests {
     use std::vec::Vec;
 
     type TestScene = Scene<Board64K>;
+
+    crate::profile! {
+        /// A board's profile for a still: no motion.
+        struct Still { spheres: 1, surfaces: 1, lights: 1 }
+        motion: false
+    }
 
     fn load(text: &str) -> (std::boxed::Box<TestScene>, Result<Parsed<'_>, usize>, Vec<String>) {
         let mut scene = std::boxed::Box::new(TestScene::new());
@@ -1130,9 +1141,10 @@ mod tests {
             ErrorKind::FrameBeyond { .. } => 22,
             ErrorKind::MovedOutOfRange { .. } => 23,
             ErrorKind::MovedCamera { .. } => 24,
+            ErrorKind::NoMotion { .. } => 25,
         }
     }
-    const ERROR_KINDS: usize = 25;
+    const ERROR_KINDS: usize = 26;
 
     #[test]
     fn every_error_kind_reports_its_line_and_column() {
@@ -1177,6 +1189,17 @@ mod tests {
             assert_eq!((e.pos, kind_number(&e.kind)), (pos, kind), "{e}");
             covered[kind] = true;
         }
+        // In a build for a still.
+        let mut still = std::boxed::Box::new(Scene::<Still>::new());
+        let mut errors = Vec::new();
+        let moved = "FRAMES 3 LIGHT 1 0 0 0\n MOVE 0 0 0 0  2 1 0 0";
+        assert_eq!(parse(moved, &mut still, &mut |e| errors.push(e)), Err(1), "{errors:?}");
+        assert_eq!((errors[0].pos, kind_number(&errors[0].kind)), (at(2, 2), 25), "{}", errors[0]);
+        assert_eq!(
+            errors[0].to_string(),
+            "2:2: MOVE, but this build's profile Still holds no motion (built for a still: `motion: false`)"
+        );
+        covered[25] = true;
         assert_eq!(covered, [true; ERROR_KINDS], "an error kind has no case");
     }
 

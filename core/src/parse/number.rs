@@ -163,15 +163,16 @@ impl Decimal {
 /// An integer as the format writes it (optional sign and digits); `None` if
 /// the text is something else. Saturates far beyond any valid value.
 pub fn parse_integer(text: &str) -> Option<i64> {
-    let (negative, digits) = match text.as_bytes().first()? {
-        b'-' => (true, &text[1..]),
-        b'+' => (false, &text[1..]),
-        _ => (false, text),
+    // Bytes, not a sliced `str`: no char-boundary check to panic.
+    let (negative, digits) = match text.as_bytes() {
+        [b'-', digits @ ..] => (true, digits),
+        [b'+', digits @ ..] => (false, digits),
+        digits => (false, digits),
     };
-    if digits.is_empty() || !digits.bytes().all(|c| c.is_ascii_digit()) {
+    if digits.is_empty() || !digits.iter().all(|c| c.is_ascii_digit()) {
         return None;
     }
-    let v = digits.bytes().fold(0i64, |v, c| v.saturating_mul(10).saturating_add((c - b'0') as i64));
+    let v = digits.iter().fold(0i64, |v, &c| v.saturating_mul(10).saturating_add((c - b'0') as i64));
     Some(if negative { -v } else { v })
 }
 

@@ -87,6 +87,11 @@ macro_rules! scene_arenas {
             type Surfaces: Arena<SurfaceEntry>;
             /// Point lights.
             type Lights: Arena<Light>;
+            /// Whether its scenes may move: a profile without motion
+            /// (`motion: false` in [`profile!`](crate::profile!), what a
+            /// board built for a still needs) finds a `MOVE` an error, and
+            /// its build links none of the interpolation of the keys.
+            const MOTION: bool = true;
         }
 
         /// Scene storage sized by the profile `C`.
