@@ -98,7 +98,7 @@ pub trait Profile: SceneCapacities + Linked {
 /// an animation re-trace only what changes (see [`Linked::COHERENCE`]:
 /// without it none of that code is linked, and a board that draws stills
 /// pays nothing for it); a last `motion: false` makes a `MOVE` an error
-/// (see [`SceneCapacities::MOTION`](crate::scene::SceneCapacities::MOTION):
+/// (see [`SceneCapacities::MOTION`]:
 /// a board built for a still links no interpolation of keys).
 ///
 /// ```
@@ -359,7 +359,7 @@ pub struct ProfileText<'a> {
     pub first_hits: bool,
     /// [`Linked::COHERENCE`]: what a firmware that plays animations needs.
     pub coherence: bool,
-    /// [`SceneCapacities::MOTION`](crate::scene::SceneCapacities::MOTION):
+    /// [`SceneCapacities::MOTION`]:
     /// whether its scene may have a `MOVE`.
     pub motion: bool,
 }
