@@ -75,7 +75,8 @@ pub fn embed_still_scene(default: &str) -> Result<(), BuildError> {
     let needs = needed_by(&text, AccelMode::Auto, &OctreeConfig::DEFAULT, &mut |error| eprintln!("{scene}:{error}"))
         .map_err(|errors| BuildError::Scene { scene: scene.clone(), errors })?;
     let doc = format!("Exactly what `{scene}` needs, its octree included.");
-    let profile = profile_text(&doc, &needs, false, moves(&text));
+    let moves = AnimationNeeds::of(&text, Default::default()).tracks > 0;
+    let profile = profile_text(&doc, &needs, false, moves);
     let source =
         format!("/// The scene, from `{scene}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n{profile}");
     write(&out_dir()?.join("scene.rs"), &source)
@@ -115,18 +116,13 @@ fn profile_text<'a>(doc: &'a str, counts: &'a Counts, coherence: bool, motion: b
     }
 }
 
-/// Whether the scene `text` has a `MOVE` (its frame 0 is placed by it, even
-/// where it is drawn once).
-fn moves(text: &str) -> bool {
-    AnimationNeeds::of(text, Default::default()).tracks > 0
-}
-
-/// What the scene `text` is: an animation if it has frames and something
-/// moves (a scene of one frame, or where nothing moves, is drawn once).
-fn kind_of(text: &str) -> SceneKind {
+/// What the scene `text`, whose motion takes `motion`, is: an animation if
+/// it has frames and something moves (a scene of one frame, or where
+/// nothing moves, is drawn once).
+fn kind_of(text: &str, motion: &AnimationNeeds) -> SceneKind {
     let mut parsed = Box::new(Scene::<Host>::new());
     let frames = parse(text, &mut parsed, &mut |_| {}).ok().and_then(|p| p.frames).map_or(1, |f| f.count);
-    match AnimationNeeds::of(text, Default::default()).tracks > 0 && frames > 1 {
+    match motion.tracks > 0 && frames > 1 {
         true => SceneKind::Animation,
         false => SceneKind::Still,
     }
@@ -145,10 +141,14 @@ fn scene_source(name: &str, path: &std::path::Path, text: &str) -> Result<(Scene
             .map_err(failed)?;
     }
     let doc = format!("Exactly what `{name}` needs, its octree included.");
-    let kind = kind_of(text);
+    // Counted once: what the scene is, whether its profile holds motion (a
+    // MOVE places its frame 0 even where it is drawn once), and what an
+    // animation's motion takes.
+    let motion = AnimationNeeds::of(text, Default::default());
+    let kind = kind_of(text, &motion);
     let animated = kind == SceneKind::Animation;
-    let profile = profile_text(&doc, &needs, animated, moves(text));
-    let motion = if animated { AnimationNeeds::of(text, Default::default()) } else { Default::default() };
+    let profile = profile_text(&doc, &needs, animated, motion.tracks > 0);
+    let motion = if animated { motion } else { Default::default() };
     let stem = path.file_stem().map_or_else(|| name.to_owned(), |stem| stem.to_string_lossy().into_owned());
     let source = format!(
         "/// The scene, from `{name}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n\
