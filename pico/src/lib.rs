@@ -4,7 +4,8 @@
 //! tracing a picture for one core to present ([`both_cores`]), each on a
 //! stack in an SRAM bank of its own ([`bank_stack`]), or playing an
 //! animation, only its changed runs drawn ([`animation`]), and what
-//! runs before `main`: boot2 and the code copied into SRAM ([`boot!`]).
+//! runs before `main`: boot2 and the code copied into SRAM ([`boot!`]);
+//! and a delay that sleeps through a panel's set-up ([`sleep`]).
 //! Its build-script half, `octrace-pico-build`, embeds the scene, sizes its
 //! profile and places the code.
 //!
@@ -21,3 +22,4 @@ pub mod board;
 pub mod boot;
 pub mod both_cores;
 pub mod second_core;
+pub mod sleep;

@@ -2,10 +2,12 @@
 //! bit-exactness test and the firmware benchmark.
 //!
 //! Each build is configured by environment variables (see
-//! `firmware/build.rs`) and goes to a target directory per board under
-//! `target/firmware/`, apart from a developer's own builds. A build
-//! replaces the board's previous ELF: build and run one configuration at a
-//! time.
+//! `firmware/build.rs`) and goes to one target directory for every board,
+//! `target/firmware/boards/`, apart from a developer's own builds: the
+//! build script's host crates (the scene's parser among them) are built
+//! once, not once a board. A build replaces the previous ELF of its
+//! target: build one configuration at a time (each ELF is then kept under
+//! its configuration's name, and runs while the next builds).
 
 use crate::{repo, scene_path};
 use octrace_core::panel::Dithering;
@@ -116,7 +118,7 @@ impl Firmware {
     }
 
     fn target_dir(&self) -> PathBuf {
-        repo().join("target/firmware").join(self.board.machine())
+        repo().join("target/firmware/boards")
     }
 
     /// Where the guest writes its pixels.
@@ -125,8 +127,8 @@ impl Firmware {
     }
 
     /// Builds the firmware (release) and returns the ELF, kept under the
-    /// build's name: the next build for the same board (which writes the
-    /// same file) can then go on while qemu runs this one.
+    /// build's name: the next build (which may write the same file) can
+    /// then go on while qemu runs this one.
     pub fn build(&self) -> Result<PathBuf, String> {
         let dir = self.target_dir();
         let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));

@@ -22,6 +22,7 @@ use mipidsi::interface::SpiInterface;
 use mipidsi::models::ST7789;
 use mipidsi::options::ColorInversion;
 use mipidsi::{Builder, Display};
+use octrace_pico::sleep::SleepingDelay;
 use rp2040_hal as hal;
 
 /// The panel's size in pixels.
@@ -116,7 +117,7 @@ pub fn init(
     pins: Pins,
     resets: &mut pac::RESETS,
     clocks: &ClocksManager,
-    mut timer: Timer,
+    timer: Timer,
     buffer: &'static mut [u8],
 ) -> (Panel, Led) {
     let bus = Spi::<_, _, _, 8>::new(
@@ -127,11 +128,12 @@ pub fn init(
     let chip_select = pins.gpio9.into_push_pull_output();
     let device = ExclusiveDevice::new(StreamingBus(bus), chip_select, timer).unwrap_or_else(|never| match never {});
     let interface = SpiInterface::new(device, pins.gpio8.into_push_pull_output(), buffer);
+    // The set-up's 300 ms of waits asleep.
     let mut display = Builder::new(ST7789, interface)
         .display_size(WIDTH, HEIGHT)
         .invert_colors(ColorInversion::Inverted)
         .reset_pin(pins.gpio12.into_push_pull_output())
-        .init(&mut timer)
+        .init(&mut SleepingDelay::new(timer))
         .unwrap_or_else(|_| panic!("the panel did not take its set-up"));
     display.clear(Rgb565::BLACK).unwrap_or_else(|never| match never {});
     let mut backlight = pins.gpio13.into_push_pull_output();
