@@ -22,6 +22,7 @@
 //! frame; every run core 1 traced is on the panel before the LED goes out;
 //! the motion is recorded once, as frame 0 loads, and serves every frame.
 
+use crate::bank_stack::{on_bank_stack, with_both_banks};
 use crate::both_cores::{Asked, Unfinished};
 use crate::second_core::SecondCore;
 use core::cell::Cell;
@@ -205,7 +206,10 @@ impl<const LEN: usize, const SLOTS: usize> DrawTarget for Handing<'_, LEN, SLOTS
     }
 
     fn fill_contiguous<I: IntoIterator<Item = Rgb888>>(&mut self, area: &Rectangle, colors: I) -> Result<(), Raised> {
-        if !self.runs.send(self.pieces, area, colors.into_iter(), self.stop) {
+        // The run's pixels are traced as the ring takes them: on core 1's
+        // bank (and SRAM4 below it), off the striped banks core 0 uses.
+        let (runs, piece, stop) = (self.runs, self.pieces, self.stop);
+        if !on_bank_stack(|| runs.send(piece, area, colors.into_iter(), stop)) {
             return Err(Raised);
         }
         self.pieces += 1;
@@ -359,10 +363,12 @@ where
         let room: &mut RendererRoom<P> = room;
         let mut handing = Handing { runs, stop: &stopping, size, pieces: 0 };
         let image = shared.image::<Rgb888>(room, size).bands(&take_next);
-        let _ = match ASKED {
+        // Core 0 draws into the panel on its main stack, so core 1's runs
+        // may take both banks.
+        let _ = with_both_banks(|| match ASKED {
             true => image.try_draw_until(&mut handing, &mut || stopping.load(Ordering::Acquire)),
             false => image.try_draw(&mut handing),
-        };
+        });
         handed.store(handing.pieces, Ordering::Release);
         sev();
     };

@@ -14,13 +14,21 @@
 //! stack never meets the other core (the emulated Pico's count: fig5_1's
 //! contested accesses 21.6 M -> 6.8 M).
 //!
+//! An animation's frame is traced run by run, each run's pixels as the
+//! ring to core 0 takes them, under the frame's own calls: core 1 traces
+//! them on its bank with SRAM4 below it ([`with_both_banks`]: 8 KiB, the
+//! guard at SRAM4's foot), while core 0, which draws the frame's runs into
+//! the panel, keeps to its main stack.
+//!
 //! Invariants: [`on_bank_stack`] runs its closure to the end on the bank's
 //! stack and puts the stack pointer back, on the core that called it; the
 //! closure may not call `on_bank_stack` again (it would start the same
 //! bank over its own frames); the bank's lowest 32 bytes are an MPU guard
 //! ([`guard`]), so an overflow faults instead of writing into the other
 //! core's bank (core 1's, into SRAM4) or core 0's main stack (core 0's,
-//! below SRAM4).
+//! below SRAM4); inside [`with_both_banks`] on core 1, core 1's guard is
+//! SRAM4's lowest 32 bytes instead, and core 0 does not call
+//! `on_bank_stack`.
 
 use core::arch::asm;
 use rp2040_hal::pac;
@@ -43,7 +51,21 @@ fn bank() -> (usize, usize) {
 /// bytes of its bank (the MPU's default map everywhere else): call once on
 /// each core before [`on_bank_stack`].
 pub fn guard() {
-    let (base, _) = bank();
+    guard_at(bank().0);
+}
+
+/// Runs `f` on core 1 with its bank stack reaching down through SRAM4,
+/// core 0's bank (8 KiB, the guard at SRAM4's foot), then guards its own
+/// bank again. Core 0 must not trace on its bank stack meanwhile.
+pub fn with_both_banks<R>(f: impl FnOnce() -> R) -> R {
+    guard_at(BANKS[0].0);
+    let result = f();
+    guard();
+    result
+}
+
+/// The calling core's MPU faults on any access to the 32 bytes at `base`.
+fn guard_at(base: usize) {
     // SAFETY: only this core's MPU, one region of it; the default map (PRIVDEFENA) stays for the rest.
     let mpu = unsafe { &*pac::PPB::ptr() };
     let guard_subregion = (base >> 5) & 7;
