@@ -54,9 +54,10 @@ pub fn guard() {
     guard_at(bank().0);
 }
 
-/// Runs `f` on core 1 with its bank stack reaching down through SRAM4,
-/// core 0's bank (8 KiB, the guard at SRAM4's foot), then guards its own
-/// bank again. Core 0 must not trace on its bank stack meanwhile.
+/// Runs `f` on core 1 with the guard at SRAM4's foot, so that its bank
+/// stack ([`on_bank_stack`] inside `f`) may reach down through SRAM4,
+/// core 0's bank (8 KiB in all), then guards its own bank again. Core 0
+/// must not trace on its bank stack meanwhile.
 pub fn with_both_banks<R>(f: impl FnOnce() -> R) -> R {
     guard_at(BANKS[0].0);
     let result = f();

@@ -1,7 +1,9 @@
-//! A delay that sleeps core 0 until a timer alarm, where the HAL's `Timer`
-//! reads the counter in a loop: for a panel's set-up waits (an ST7789's
-//! take 300 ms), so that the core draws no current for them and an
-//! emulator jumps over them instead of running 60 M cycles of polling.
+//! A delay that sleeps the core until a timer alarm, where the HAL's
+//! `Timer` reads the counter in a loop: for a panel's set-up waits (an
+//! ST7789's take 300 ms), so that the core draws no current for them and
+//! an emulator jumps over them instead of running 60 M cycles of polling.
+//! Other interrupts wait until a sleep ends: use it where none matters
+//! yet, as in a panel's set-up before the firmware's interrupts start.
 //!
 //! Invariants: interrupts stay masked (PRIMASK) while it sleeps, so the
 //! alarm's interrupt only wakes the core (WFI wakes on a pending interrupt

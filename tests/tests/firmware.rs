@@ -66,9 +66,10 @@ fn boards_render_the_same_bits_as_host_sim() {
     let mut budgets = Budgets::load("firmware").unwrap_or_else(|e| panic!("{e}"));
     let qemu_count = qemu_count();
     let subjects: Vec<String> = cases.iter().map(Firmware::slug).collect();
-    // Builds one after another (they share a target directory); each run, and host-sim's picture for it, on a thread of
-    // its own as soon as its ELF is built, so qemu and the next build share
-    // the cores. Every figure is checked here, once all have run.
+    // Builds one after another (they share a target directory); each run,
+    // and host-sim's picture for it, on a thread of its own as soon as its
+    // ELF is built, so qemu and the next build share the cores. Every
+    // figure is checked here, once all have run.
     std::thread::scope(|scope| {
         let mut runs = Vec::new();
         for firmware in &cases {
