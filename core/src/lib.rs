@@ -79,8 +79,9 @@
 //!
 //! # Features
 //!
-//! - `static-cell` (default): re-exports [`ConstStaticCell`], the cell a
-//!   board keeps its [`Raytracer`] in.
+//! - `static-cell` (default): re-exports
+//!   [`ConstStaticCell`](https://docs.rs/static_cell/2/static_cell/struct.ConstStaticCell.html),
+//!   the cell a board keeps its [`Raytracer`] in.
 //! - `alloc`: the heap-backed `profile::Host` profile, for desktops.
 //! - `defmt`: every error type implements `defmt::Format`, so a board can
 //!   log why a scene did not load or draw.

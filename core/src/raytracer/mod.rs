@@ -37,7 +37,8 @@ pub use shared::SharedScene;
 /// Room for one scene of the profile `P`: the scene's arenas, its octree and
 /// a mailbox. On a board, keep it in a `static` (it is all zero bits, so it
 /// costs no flash) and take it once with the re-exported
-/// [`ConstStaticCell`](crate::ConstStaticCell); on a host, box it.
+/// [`ConstStaticCell`](https://docs.rs/static_cell/2/static_cell/struct.ConstStaticCell.html)
+/// (feature `static-cell`); on a host, box it.
 ///
 /// ```
 /// use octrace_core::{profile::Board16K, ConstStaticCell, Raytracer};
