@@ -73,12 +73,4 @@ impl DelayNs for SleepingDelay {
             NVIC::unpend(ALARM_INTERRUPT);
         });
     }
-
-    fn delay_ms(&mut self, ms: u32) {
-        // 4,294 s at most a sleep: the alarm's count is 32-bit microseconds.
-        for _ in 0..ms / 1_000_000 {
-            self.delay_us(1_000_000_000);
-        }
-        self.delay_us(ms % 1_000_000 * 1000);
-    }
 }
