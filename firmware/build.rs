@@ -211,7 +211,7 @@ fn main() {
     // (a level less costs more than either technique gains).
     let budget = board.static_ram - OTHER_STATICS;
     // A scene without a MOVE links none of the interpolation of keys.
-    let motion = AnimationNeeds::of(&text, Default::default()).tracks > 0;
+    let motion = AnimationNeeds::of(&text, Default::default()).moves();
     let plan = |techniques: Techniques, max_depth: u32| {
         let config = OctreeConfig { max_depth, shadow_shafts: techniques.shadow_shafts, ..board.config };
         let counts = needs(&text, accel, &config, techniques.light_buffer);

@@ -75,8 +75,7 @@ pub fn embed_still_scene(default: &str) -> Result<(), BuildError> {
     let needs = needed_by(&text, AccelMode::Auto, &OctreeConfig::DEFAULT, &mut |error| eprintln!("{scene}:{error}"))
         .map_err(|errors| BuildError::Scene { scene: scene.clone(), errors })?;
     let doc = format!("Exactly what `{scene}` needs, its octree included.");
-    let moves = AnimationNeeds::of(&text, Default::default()).tracks > 0;
-    let profile = profile_text(&doc, &needs, false, moves);
+    let profile = profile_text(&doc, &needs, false, AnimationNeeds::of(&text, Default::default()).moves());
     let source =
         format!("/// The scene, from `{scene}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n{profile}");
     write(&out_dir()?.join("scene.rs"), &source)
@@ -122,7 +121,7 @@ fn profile_text<'a>(doc: &'a str, counts: &'a Counts, coherence: bool, motion: b
 fn kind_of(text: &str, motion: &AnimationNeeds) -> SceneKind {
     let mut parsed = Box::new(Scene::<Host>::new());
     let frames = parse(text, &mut parsed, &mut |_| {}).ok().and_then(|p| p.frames).map_or(1, |f| f.count);
-    match motion.tracks > 0 && frames > 1 {
+    match motion.moves() && frames > 1 {
         true => SceneKind::Animation,
         false => SceneKind::Still,
     }
@@ -147,7 +146,7 @@ fn scene_source(name: &str, path: &std::path::Path, text: &str) -> Result<(Scene
     let motion = AnimationNeeds::of(text, Default::default());
     let kind = kind_of(text, &motion);
     let animated = kind == SceneKind::Animation;
-    let profile = profile_text(&doc, &needs, animated, motion.tracks > 0);
+    let profile = profile_text(&doc, &needs, animated, motion.moves());
     let motion = if animated { motion } else { Default::default() };
     let stem = path.file_stem().map_or_else(|| name.to_owned(), |stem| stem.to_string_lossy().into_owned());
     let source = format!(

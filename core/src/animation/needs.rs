@@ -24,7 +24,9 @@ use embedded_graphics_core::geometry::Size;
 /// let text = "FRAMES 1000000\nSURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\n\
 ///             SPHERE 1 1 0 0 0 MOVE 0 -2 0 0  400000 2 0 0  999999 0 1 0\n";
 /// // A million frames: three keys, not a table of frames.
-/// assert_eq!(AnimationNeeds::of(text, Size::new(240, 240)), AnimationNeeds { tiles: 3600, tracks: 1, keys: 3 });
+/// let needs = AnimationNeeds::of(text, Size::new(240, 240));
+/// assert_eq!(needs, AnimationNeeds { tiles: 3600, tracks: 1, keys: 3 });
+/// assert!(needs.moves());
 /// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct AnimationNeeds {
@@ -42,6 +44,12 @@ impl AnimationNeeds {
     pub fn of(text: &str, size: Size) -> AnimationNeeds {
         let motion = MotionNeeds::of(text);
         AnimationNeeds { tiles: Self::tiles_for(size), tracks: motion.tracks, keys: motion.keys }
+    }
+
+    /// Whether anything moves (the scene has a `MOVE`): what decides a
+    /// profile's [`SceneCapacities::MOTION`](crate::scene::SceneCapacities::MOTION).
+    pub const fn moves(&self) -> bool {
+        self.tracks > 0
     }
 
     /// The tiles of an image of `size`: [`Coherence::tiles_for`] in tiles
