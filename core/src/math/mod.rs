@@ -19,8 +19,8 @@ mod wide;
 pub(crate) use exp_log::{pow_q30, pow_unit};
 pub use vector::{Dir, Vec3};
 pub(crate) use wide::{
-    div_saturating, isqrt, isqrt_u128, leading_zeros, leading_zeros_u32, mul_i64_i32, mul_i64_wide, mul_u32_wide,
-    mul_wide, sqrt_and_rsqrt_58_62, sqrt_and_rsqrt_estimates_58_62, square_u32_wide, square_wide,
+    div_saturating, isqrt, isqrt_u128, leading_zeros, leading_zeros_u32, mul_i64_i32, mul_i64_i32_wide, mul_i64_wide,
+    mul_u32_wide, mul_wide, sqrt_and_rsqrt_58_62, sqrt_and_rsqrt_estimates_58_62, square_u32_wide, square_wide,
 };
 
 /// Whether this build is for ARMv6-M (Cortex-M0 and M0+), which has only a

@@ -6,7 +6,7 @@
 //! in `i128`; the caller widens each box by a margin so that hits reported
 //! a few units off the ideal surface (fixed-point rounding) are still filed.
 
-use crate::math::square_u32_wide;
+use crate::math::{mul_i64_i32_wide, mul_wide, square_u32_wide};
 use crate::shapes::{Polygon, ShapeRef};
 
 /// A closed box `[lo, hi]` in Q16.16 raw units.
@@ -64,29 +64,96 @@ fn polygon_overlaps<const N: usize>(p: &Polygon<N>, cell: &Cell) -> bool {
 
 /// The separating axis test of a convex polygon against a cell whose bounds
 /// it overlaps: the polygon's normal and each edge crossed with each axis.
+/// Coordinates are doubled around the cell's centre so that everything
+/// stays integral. Where they and the cell are below 2^30 (any scene of
+/// ordinary size: a unit is 2^16), the edges' axes are tested in 64 bits,
+/// from 32-bit products, and the normal in 128; otherwise all in 128. The
+/// same answer either way: every sum is exact.
 fn no_separating_axis<const N: usize>(p: &Polygon<N>, cell: &Cell) -> bool {
-    let centre2 = [0, 1, 2].map(|a| cell.lo[a] as i128 + cell.hi[a] as i128);
-    let half2 = [0, 1, 2].map(|a| cell.hi[a] as i128 - cell.lo[a] as i128);
-    let v: [[i128; 3]; N] = core::array::from_fn(|i| {
+    let centre2 = [0, 1, 2].map(|a| cell.lo[a] + cell.hi[a]);
+    let half2 = [0, 1, 2].map(|a| cell.hi[a] - cell.lo[a]);
+    let v: [[i64; 3]; N] = core::array::from_fn(|i| {
         let w = p.corners[i].wide();
-        [0, 1, 2].map(|a| 2 * w[a] as i128 - centre2[a])
+        [0, 1, 2].map(|a| 2 * w[a] - centre2[a])
     });
+    const SMALL: i64 = 1 << 30;
+    let small = |x: &i64| x.abs() < SMALL;
+    if v.iter().flatten().all(small) && half2.iter().all(small) {
+        let v = v.map(|c| c.map(|x| x as i32));
+        no_separating_axis_small(&v, half2.map(|h| h as i32))
+    } else {
+        no_separating_axis_wide(&v.map(|c| c.map(i128::from)), half2.map(i128::from))
+    }
+}
+
+/// [`no_separating_axis`] for coordinates and a cell below 2^30: the
+/// edges' axes first (an edge below 2^31, so each projection is two
+/// products below 2^61), the normal last, in 128 bits. On slices, not
+/// arrays: one copy of the code for every polygon.
+#[inline(never)]
+fn no_separating_axis_small(v: &[[i32; 3]], half2: [i32; 3]) -> bool {
+    let n = v.len();
+    for i in 0..n {
+        let e: [i32; 3] = [0, 1, 2].map(|a| v[(i + 1) % n][a] - v[i][a]);
+        // The edge crossed with axis `a` has no component along `a`, `e[c]`
+        // along `b` and `-e[b]` along `c`.
+        for a in 0..3 {
+            let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+            if e[b] == 0 && e[c] == 0 {
+                continue;
+            }
+            let radius = mul_wide(e[c].abs(), half2[b]) + mul_wide(e[b].abs(), half2[c]);
+            let (mut lo, mut hi) = (i64::MAX, i64::MIN);
+            for corner in v {
+                let projection = mul_wide(corner[b], e[c]) - mul_wide(corner[c], e[b]);
+                (lo, hi) = (lo.min(projection), hi.max(projection));
+            }
+            if lo > radius || hi < -radius {
+                return false;
+            }
+        }
+    }
+    let wide = |c: [i32; 3]| c.map(i64::from);
+    let e1 = wide([0, 1, 2].map(|a| v[1][a] - v[0][a]));
+    let e2 = wide([0, 1, 2].map(|a| v[n - 1][a] - v[0][a]));
+    // Each product below 2^62: the normal's components fit 64 bits (their
+    // magnitudes too).
+    let normal = [0, 1, 2].map(|a| {
+        let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+        e1[b] * e2[c] - e1[c] * e2[b]
+    });
+    let radius: i128 = (0..3).map(|a| mul_i64_i32_wide(normal[a].abs(), half2[a])).sum();
+    // The normal is square to the edges from corner 0 to corners 1 and N-1,
+    // exactly: those three project alike, and the rest are worked out.
+    let projection = |c: [i32; 3]| (0..3).map(|a| mul_i64_i32_wide(normal[a], c[a])).sum::<i128>();
+    let first = projection(v[0]);
+    let (mut lo, mut hi) = (first, first);
+    for &corner in &v[2..n - 1] {
+        let p = projection(corner);
+        (lo, hi) = (lo.min(p), hi.max(p));
+    }
+    !(lo > radius || hi < -radius)
+}
+
+/// [`no_separating_axis`] for any coordinates, in 128 bits.
+#[inline(never)]
+fn no_separating_axis_wide(v: &[[i128; 3]], half2: [i128; 3]) -> bool {
+    let n = v.len();
     let separated = |axis: [i128; 3]| {
         let radius: i128 = (0..3).map(|a| axis[a].abs() * half2[a]).sum();
-        let proj = v.map(|c| dot(c, axis));
-        let lo = proj.iter().copied().min().unwrap_or(0);
-        let hi = proj.iter().copied().max().unwrap_or(0);
+        let proj = v.iter().map(|&c| dot(c, axis));
+        let (lo, hi) = proj.fold((i128::MAX, i128::MIN), |(lo, hi), p| (lo.min(p), hi.max(p)));
         lo > radius || hi < -radius
     };
     let e1 = [0, 1, 2].map(|a| v[1][a] - v[0][a]);
-    let e2 = [0, 1, 2].map(|a| v[N - 1][a] - v[0][a]);
+    let e2 = [0, 1, 2].map(|a| v[n - 1][a] - v[0][a]);
     // Doubled coordinates (≤ 2^33) give cross products within 2^67, and
     // projections within 2^101: well inside i128.
     if separated(cross(e1, e2)) {
         return false;
     }
-    for i in 0..N {
-        let e = [0, 1, 2].map(|a| v[(i + 1) % N][a] - v[i][a]);
+    for i in 0..n {
+        let e = [0, 1, 2].map(|a| v[(i + 1) % n][a] - v[i][a]);
         for unit in [[1, 0, 0], [0, 1, 0], [0, 0, 1]] {
             let axis = cross(e, unit);
             if axis != [0; 3] && separated(axis) {
@@ -173,6 +240,42 @@ mod tests {
             meets += expected as u32;
         }
         assert!((10_000..90_000).contains(&meets), "{meets} cells of 100,000 meet their sphere");
+    }
+
+    #[test]
+    fn a_polygons_test_in_64_bits_is_its_test_in_128() {
+        // Triangles and quadrilaterals (planar or not: the test takes the
+        // corners as given) against cells of every scale, near and across
+        // them, below 2^30 doubled.
+        let mut next = crate::test_rng::seeded(0x0a11_5e9a);
+        let mut below = |bits: u64| (next() % (1 << bits)) as i64 - (1 << (bits - 1));
+        let (mut meets, mut tests) = (0, 0);
+        for round in 0..20_000 {
+            let bits = [12, 20, 26, 28][round % 4];
+            let corner = |below: &mut dyn FnMut(u64) -> i64| [below(bits), below(bits), below(bits)];
+            let triangle: [[i64; 3]; 3] = core::array::from_fn(|_| corner(&mut below));
+            let quad: [[i64; 3]; 4] = core::array::from_fn(|_| corner(&mut below));
+            let lo = corner(&mut below);
+            let half2 = [0, 1, 2].map(|_| below(bits).abs());
+            // Doubled around the cell's centre, as the caller makes them.
+            let around = |c: [i64; 3]| [0, 1, 2].map(|a| 2 * c[a] - (2 * lo[a] + half2[a]));
+            let small = |x: i64| i32::try_from(x).ok().filter(|x| x.abs() < 1 << 30);
+            let fits = |cs: &[[i64; 3]]| cs.iter().flatten().chain(&half2).all(|&x| small(x).is_some());
+            let (t, q) = (triangle.map(around), quad.map(around));
+            if fits(&t) {
+                let expected = no_separating_axis_wide(&t.map(|c| c.map(i128::from)), half2.map(i128::from));
+                let narrow = t.map(|c| c.map(|x| x as i32));
+                assert_eq!(no_separating_axis_small(&narrow, half2.map(|h| h as i32)), expected, "{t:?} {half2:?}");
+                (meets, tests) = (meets + expected as u32, tests + 1);
+            }
+            if fits(&q) {
+                let expected = no_separating_axis_wide(&q.map(|c| c.map(i128::from)), half2.map(i128::from));
+                let narrow = q.map(|c| c.map(|x| x as i32));
+                assert_eq!(no_separating_axis_small(&narrow, half2.map(|h| h as i32)), expected, "{q:?} {half2:?}");
+                (meets, tests) = (meets + expected as u32, tests + 1);
+            }
+        }
+        assert!(tests > 30_000 && meets > tests / 20 && meets < tests * 19 / 20, "{meets} of {tests} met");
     }
 
     #[test]

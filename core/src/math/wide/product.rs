@@ -48,6 +48,17 @@ pub fn mul_i64_i32(a: i64, k: i32) -> i64 {
     }
 }
 
+/// `a · k` exactly, in 128 bits: on ARMv6-M from three 32×32 products
+/// instead of the library's 128-bit multiplication.
+#[inline(always)]
+pub fn mul_i64_i32_wide(a: i64, k: i32) -> i128 {
+    if ARMV6M {
+        mul_i64_i32_wide_by_parts(a, k)
+    } else {
+        a as i128 * k as i128
+    }
+}
+
 /// `a · b` exactly, in 128 bits. Not inlined: 128-bit products are long
 /// code on a 32-bit core, and their callers (a camera's and an object's
 /// set-up) run once per render, not per ray.
@@ -93,6 +104,16 @@ fn mul_i64_i32_by_parts(a: i64, k: i32) -> i64 {
     let low_part = mul_u32_wide_by_parts(low, k.unsigned_abs()) as i64;
     let low_part = if k < 0 { low_part.wrapping_neg() } else { low_part };
     ((high.wrapping_mul(k) as i64) << 32).wrapping_add(low_part)
+}
+
+/// The signed high word's product, and the unsigned low word's (below
+/// 2^63 in magnitude: it fits an i64).
+#[inline(always)]
+fn mul_i64_i32_wide_by_parts(a: i64, k: i32) -> i128 {
+    let (high, low) = ((a >> 32) as i32, a as u32);
+    let low_part = mul_u32_wide_by_parts(low, k.unsigned_abs()) as i64;
+    let low_part = if k < 0 { -low_part } else { low_part };
+    ((mul_wide_by_parts(high, k) as i128) << 32) + low_part as i128
 }
 
 /// Three products: the two middle ones are equal.
@@ -199,6 +220,10 @@ mod tests {
             let wide = ((a as i64) << 29) ^ b as i64;
             assert_eq!(mul_i64_i32_by_parts(wide, y), wide.wrapping_mul(y as i64), "{wide} {y}");
             assert_eq!(mul_i64_i32_by_parts(-wide, y >> 9), (-wide).wrapping_mul((y >> 9) as i64));
+            let full = ((a as i64) << 32 | b as i64) ^ (i as i64).wrapping_mul(0x9e37_79b9_7f4a_7c15u64 as i64);
+            for (n, k) in [(full, y), (wide, y), (full, i32::MIN), (i64::MIN, y), (i64::MAX, i32::MIN)] {
+                assert_eq!(mul_i64_i32_wide_by_parts(n, k), n as i128 * k as i128, "{n} {k}");
+            }
         }
     }
 
