@@ -2,9 +2,10 @@
 //!
 //! A box receives an object when the box meets the object's *surface* (rays
 //! only ever hit surfaces): a box deep inside a sphere or a solid box gets
-//! nothing, which keeps large objects from filling the tree. Tests are exact
-//! in `i128`; the caller widens each box by a margin so that hits reported
-//! a few units off the ideal surface (fixed-point rounding) are still filed.
+//! nothing, which keeps large objects from filling the tree. Tests are
+//! exact (in 64 bits where the values allow, else in `i128`); the caller
+//! widens each box by a margin so that hits reported a few units off the
+//! ideal surface (fixed-point rounding) are still filed.
 
 use crate::math::{mul_i64_i32_wide, mul_wide, square_u32_wide};
 use crate::shapes::{Polygon, ShapeRef};
