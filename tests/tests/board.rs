@@ -437,9 +437,11 @@ fn a_board_gone_silent_mid_drawing_is_given_up_saying_what_it_did_last() {
         host_sim_board(&args)
     });
     // Drawing for 100 ms of the board's clock (it has said it is working
-    // since): then the host takes no more of what it sends.
-    board.wait_for("to draw for 100 ms", |times| {
-        !times.idle && times.last_in.zip(times.last_out).is_some_and(|(came, went)| went >= came + 100_000)
+    // since): then the host takes no more of what it sends. A host-sim that
+    // ended before fails the test at once, with what it said.
+    board.wait_for("to draw for 100 ms, or host-sim board to end", |times| {
+        run.is_finished()
+            || !times.idle && times.last_in.zip(times.last_out).is_some_and(|(came, went)| went >= came + 100_000)
     });
     assert_eq!(board.command("hold"), "ok");
     let run = run.join().expect("host-sim board ends");
