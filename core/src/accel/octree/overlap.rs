@@ -245,6 +245,8 @@ mod tests {
 
     #[test]
     fn a_polygons_test_in_64_bits_is_its_test_in_128() {
+        extern crate std;
+        use std::vec::Vec;
         // Triangles and quadrilaterals (planar or not: the test takes the
         // corners as given) against cells of every scale, near and across
         // them, below 2^30 doubled.
@@ -261,18 +263,15 @@ mod tests {
             // Doubled around the cell's centre, as the caller makes them.
             let around = |c: [i64; 3]| [0, 1, 2].map(|a| 2 * c[a] - (2 * lo[a] + half2[a]));
             let small = |x: i64| i32::try_from(x).ok().filter(|x| x.abs() < 1 << 30);
-            let fits = |cs: &[[i64; 3]]| cs.iter().flatten().chain(&half2).all(|&x| small(x).is_some());
-            let (t, q) = (triangle.map(around), quad.map(around));
-            if fits(&t) {
-                let expected = no_separating_axis_wide(&t.map(|c| c.map(i128::from)), half2.map(i128::from));
-                let narrow = t.map(|c| c.map(|x| x as i32));
-                assert_eq!(no_separating_axis_small(&narrow, half2.map(|h| h as i32)), expected, "{t:?} {half2:?}");
-                (meets, tests) = (meets + expected as u32, tests + 1);
-            }
-            if fits(&q) {
-                let expected = no_separating_axis_wide(&q.map(|c| c.map(i128::from)), half2.map(i128::from));
-                let narrow = q.map(|c| c.map(|x| x as i32));
-                assert_eq!(no_separating_axis_small(&narrow, half2.map(|h| h as i32)), expected, "{q:?} {half2:?}");
+            for corners in [&triangle.map(around)[..], &quad.map(around)[..]] {
+                if !corners.iter().flatten().chain(&half2).all(|&x| small(x).is_some()) {
+                    continue;
+                }
+                let wide: Vec<[i128; 3]> = corners.iter().map(|c| c.map(i128::from)).collect();
+                let narrow: Vec<[i32; 3]> = corners.iter().map(|c| c.map(|x| x as i32)).collect();
+                let expected = no_separating_axis_wide(&wide, half2.map(i128::from));
+                let got = no_separating_axis_small(&narrow, half2.map(|h| h as i32));
+                assert_eq!(got, expected, "{corners:?} {half2:?}");
                 (meets, tests) = (meets + expected as u32, tests + 1);
             }
         }
