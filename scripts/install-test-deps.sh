@@ -22,6 +22,7 @@ TEST_COMMAND_PACKAGES=(
     /usr/bin/chromium:chromium
     /usr/bin/chromedriver:chromium-driver
     ffprobe:ffmpeg
+    ffmpeg:ffmpeg
     node:nodejs
     npm:npm
     python3:python3

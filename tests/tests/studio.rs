@@ -27,22 +27,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-/// The host-sim binary, built for this test run.
+/// The host-sim binary, built for this test run: the tests' copy of its
+/// command line (`host_sim::cli::run`, as `host-sim` is), which cargo has
+/// built with the tests (a `cargo build -p host-sim` here would build the
+/// libraries a second time, with host-sim's features alone).
 fn host_sim_binary() -> PathBuf {
-    let exe = std::env::current_exe().expect("the test's path");
-    // target/<profile>/deps/studio-… → target/<profile>/host-sim, built in
-    // the test's own profile (a stale binary of the other would be tested).
-    let profile_dir = exe.parent().and_then(Path::parent).expect("a target directory");
-    let mut build = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
-    build.args(["build", "-p", "host-sim", "--bin", "host-sim"]).current_dir(repo());
-    if profile_dir.ends_with("release") {
-        build.arg("--release");
-    }
-    let status = build.status().expect("cargo runs");
-    assert!(status.success(), "host-sim builds");
-    let binary = profile_dir.join("host-sim");
-    assert!(binary.exists(), "{} exists", binary.display());
-    binary
+    PathBuf::from(env!("CARGO_BIN_EXE_host-sim-cli"))
 }
 
 /// A running `host-sim studio`, stopped (Ctrl-C) on drop, and what it
