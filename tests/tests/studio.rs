@@ -28,12 +28,10 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// The host-sim binary, built for this test run: the tests' copy of its
-/// command line (`host_sim::cli::run`, as `host-sim` is), which cargo has
-/// built with the tests (a `cargo build -p host-sim` here would build the
+/// command line (`host_sim::cli::run`, as `host-sim` is), which cargo
+/// builds with the tests (a `cargo build -p host-sim` here would build the
 /// libraries a second time, with host-sim's features alone).
-fn host_sim_binary() -> PathBuf {
-    PathBuf::from(env!("CARGO_BIN_EXE_host-sim-cli"))
-}
+const HOST_SIM: &str = env!("CARGO_BIN_EXE_host-sim-cli");
 
 /// A running `host-sim studio`, stopped (Ctrl-C) on drop, and what it
 /// has written on its standard error so far.
@@ -47,14 +45,14 @@ struct Studio {
 }
 
 impl Studio {
-    fn start(binary: &Path, scene: Option<&Path>) -> Studio {
-        Studio::start_with(binary, scene, &[])
+    fn start(scene: Option<&Path>) -> Studio {
+        Studio::start_with(scene, &[])
     }
 
     /// `host-sim studio [SCENE] ARGS...`, run in SCENE's directory (so the
     /// page names it as a user would, not by a scratch directory's path).
-    fn start_with(binary: &Path, scene: Option<&Path>, args: &[&OsStr]) -> Studio {
-        let mut command = Command::new(binary);
+    fn start_with(scene: Option<&Path>, args: &[&OsStr]) -> Studio {
+        let mut command = Command::new(HOST_SIM);
         if let Some(directory) = scene.and_then(Path::parent).filter(|d| !d.as_os_str().is_empty()) {
             command.current_dir(directory);
         }
@@ -165,11 +163,10 @@ const START: &str = "/* placed with the studio */\nVIEWPOINT 0 4 12\nORIGIN 0 0 
 
 #[test]
 fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
-    let binary = host_sim_binary();
     let dir = tempfile::tempdir().expect("a directory");
     let scene_path = dir.path().join("placed.txt");
     std::fs::write(&scene_path, START).expect("scene written");
-    let studio = Studio::start(&binary, Some(&scene_path));
+    let studio = Studio::start(Some(&scene_path));
     let browser = Browser::start((1500, 900));
     browser.goto(&studio.url);
     browser.wait_for("document.body.dataset.ready === 'true'");
@@ -306,8 +303,7 @@ fn a_user_places_a_sphere_renders_and_saves_and_every_view_is_host_sims() {
 
 #[test]
 fn the_canvas_is_host_sims_image_for_every_scene() {
-    let binary = host_sim_binary();
-    let studio = Studio::start(&binary, None);
+    let studio = Studio::start(None);
     let browser = Browser::start((1500, 900));
     browser.goto(&studio.url);
     browser.wait_for("document.body.dataset.ready === 'true'");
@@ -366,8 +362,7 @@ fn the_canvas_is_host_sims_image_for_every_scene() {
 
 #[test]
 fn a_render_or_draft_of_hours_a_pixel_is_stopped_by_the_next_at_once() {
-    let binary = host_sim_binary();
-    let studio = Studio::start(&binary, None);
+    let studio = Studio::start(None);
     let browser = Browser::start((1200, 800));
     browser.goto(&studio.url);
     browser.wait_for("document.body.dataset.ready === 'true'");
@@ -416,12 +411,11 @@ fn a_render_or_draft_of_hours_a_pixel_is_stopped_by_the_next_at_once() {
 
 #[test]
 fn the_server_keeps_its_security_rules() {
-    let binary = host_sim_binary();
     let dir = tempfile::tempdir().expect("a directory");
     let scene_path = dir.path().join("s.txt");
     std::fs::write(&scene_path, START).expect("written");
     std::fs::write(dir.path().join("secret.txt"), "secret").expect("written");
-    let mut studio = Studio::start(&binary, Some(&scene_path));
+    let mut studio = Studio::start(Some(&scene_path));
     let port = studio.port;
     let token = format!("token={}", studio.token);
     let with_token = |path: &str| format!("{path}?{token}");
@@ -581,10 +575,9 @@ fn the_server_keeps_its_security_rules() {
 
 #[test]
 fn a_busy_port_is_an_error_not_a_panic() {
-    let binary = host_sim_binary();
     let taken = std::net::TcpListener::bind("127.0.0.1:0").expect("a port");
     let port = taken.local_addr().unwrap().port();
-    let out = Command::new(&binary).args(["studio", "--port", &port.to_string()]).output().expect("runs");
+    let out = Command::new(HOST_SIM).args(["studio", "--port", &port.to_string()]).output().expect("runs");
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot listen"), "{}", String::from_utf8_lossy(&out.stderr));
 }
@@ -606,11 +599,10 @@ fn scene_text(browser: &Browser) -> String {
 
 #[test]
 fn every_tool_places_its_object_and_selections_move_and_delete() {
-    let binary = host_sim_binary();
     let dir = tempfile::tempdir().expect("a directory");
     let scene_path = dir.path().join("tools.txt");
     std::fs::write(&scene_path, START).expect("scene written");
-    let studio = Studio::start(&binary, Some(&scene_path));
+    let studio = Studio::start(Some(&scene_path));
     let browser = Browser::start((1500, 900));
     browser.goto(&studio.url);
     browser.wait_for("document.body.dataset.ready === 'true'");
@@ -721,8 +713,7 @@ fn page_log(browser: &Browser) -> serde_json::Value {
 /// and nothing the page's Content-Security-Policy refuses.
 #[test]
 fn the_editor_highlights_the_cores_keywords_marks_errors_and_keeps_one_history() {
-    let binary = host_sim_binary();
-    let studio = Studio::start(&binary, None);
+    let studio = Studio::start(None);
     let browser = Browser::start((1500, 900));
     browser.goto(&studio.url);
     browser.wait_for("document.body.dataset.ready === 'true'");
@@ -899,11 +890,10 @@ fn play_and_pause(browser: &Browser, what: &str) -> u32 {
 /// point looked at) is marked at its MOVE when that frame is shown.
 #[test]
 fn the_time_slider_and_play_show_host_sims_frames() {
-    let binary = host_sim_binary();
     let dir = tempfile::tempdir().expect("a directory");
     let scene = dir.path().join("anim_fig5_1.txt");
     std::fs::copy(scene_path("anim_fig5_1"), &scene).expect("copied");
-    let studio = Studio::start(&binary, Some(&scene));
+    let studio = Studio::start(Some(&scene));
     let browser = Browser::start((1500, 900));
     browser.goto(&studio.url);
     browser.wait_for("document.body.dataset.ready === 'true'");
@@ -1045,8 +1035,7 @@ fn send_to_board_shows_the_boards_picture_and_verdict_or_its_errors_in_the_edito
     let board = test_board();
     let description = board.describe();
     let (w, h) = (description.panel.width, description.panel.height);
-    let binary = host_sim_binary();
-    let studio = Studio::start_with(&binary, None, &["--board".as_ref(), board.port.as_os_str()]);
+    let studio = Studio::start_with(None, &["--board".as_ref(), board.port.as_os_str()]);
     let browser = Browser::start((1500, 900));
     browser.goto(&studio.url);
     browser.wait_for("document.body.dataset.ready === 'true'");
@@ -1214,8 +1203,7 @@ impl ScriptedBoard {
 fn the_board_endpoint_keeps_the_security_rules_and_sends_one_at_a_time() {
     // What reaches the board is seen here.
     let board = ScriptedBoard::start(true);
-    let binary = host_sim_binary();
-    let studio = Studio::start_with(&binary, None, &["--board".as_ref(), board.port.as_os_str()]);
+    let studio = Studio::start_with(None, &["--board".as_ref(), board.port.as_os_str()]);
     let port_number = studio.port;
     let token = format!("token={}", studio.token);
     let with_token = |path: &str| format!("{path}?{token}");
@@ -1277,7 +1265,7 @@ fn the_board_endpoint_keeps_the_security_rules_and_sends_one_at_a_time() {
     // A board that never answers, with a cap on each send: said at the cap.
     let silent = ScriptedBoard::start(false);
     let args = ["--board".as_ref(), silent.port.as_os_str(), "--board-timeout".as_ref(), "1".as_ref()];
-    let studio = Studio::start_with(&binary, None, &args);
+    let studio = Studio::start_with(None, &args);
     let (status, body) = http(studio.port, "POST", &format!("/board?token={}", studio.token), &[], b"RDEPTH 2\n");
     let said = String::from_utf8_lossy(&body);
     assert_eq!(status, 502, "{said}");
@@ -1286,9 +1274,8 @@ fn the_board_endpoint_keeps_the_security_rules_and_sends_one_at_a_time() {
 
 #[test]
 fn a_board_that_is_no_serial_port_is_an_error_at_start() {
-    let binary = host_sim_binary();
     let scene = scene_path("fig5_1");
-    let out = Command::new(&binary).args(["studio", "--board"]).arg(&scene).output().expect("runs");
+    let out = Command::new(HOST_SIM).args(["studio", "--board"]).arg(&scene).output().expect("runs");
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains(&format!("--board {} is no serial port", scene.display())), "{stderr}");
@@ -1357,8 +1344,7 @@ fn another_local_page_cannot_drive_the_studio_nor_learn_its_token() {
     let dir = tempfile::tempdir().expect("a directory");
     let scene_path = dir.path().join("s.txt");
     std::fs::write(&scene_path, START).expect("written");
-    let binary = host_sim_binary();
-    let mut studio = Studio::start_with(&binary, Some(&scene_path), &["--board".as_ref(), board_port.as_os_str()]);
+    let mut studio = Studio::start_with(Some(&scene_path), &["--board".as_ref(), board_port.as_os_str()]);
     let (page_port, requests) = hostile_page(studio.port);
     assert_ne!(page_port, studio.port);
     // The user has the studio open; then the browser shows the other page.
@@ -1399,19 +1385,18 @@ fn another_local_page_cannot_drive_the_studio_nor_learn_its_token() {
 #[test]
 fn send_to_board_refuses_what_a_hostile_board_answers() {
     let software = env!("CARGO_BIN_EXE_software-board");
-    let binary = host_sim_binary();
     let text = std::fs::read(scene_path("fig5_1")).expect("fig5_1");
     // A drawing at a panel it did not describe: an error, not "identical"
     // over no pixel at all.
     let board = RunningBoard::software(software, &["--panel", "160x128", "--misbehave", "draws-at:0x0"]);
-    let studio = Studio::start_with(&binary, None, &["--board".as_ref(), board.port.as_os_str()]);
+    let studio = Studio::start_with(None, &["--board".as_ref(), board.port.as_os_str()]);
     let (status, body) = http(studio.port, "POST", &format!("/board?token={}", studio.token), &[], &text);
     let said = String::from_utf8_lossy(&body);
     assert_eq!(status, 502, "{said}");
     assert!(said.contains("it draws at 0x0 rgb565, but described a 160x128 rgb565 panel"), "{said}");
     // Its errors' terminal escapes reach the page escaped.
     let board = RunningBoard::software(software, &["--panel", "160x128", "--misbehave", "escapes"]);
-    let studio = Studio::start_with(&binary, None, &["--board".as_ref(), board.port.as_os_str()]);
+    let studio = Studio::start_with(None, &["--board".as_ref(), board.port.as_os_str()]);
     let (status, body) = http(studio.port, "POST", &format!("/board?token={}", studio.token), &[], &text);
     let answer: serde_json::Value = serde_json::from_slice(&body).expect("JSON");
     assert_eq!(status, 200, "{answer}");
