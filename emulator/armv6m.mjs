@@ -53,98 +53,17 @@
 // in the cycle of the next fetch. Each access is arbitrated there; a
 // stall delays the rest of the instruction.
 //
-// Each corrected instruction is executed here instead of by rp2040js, with
-// the same cycle count (1); every other instruction is rp2040js's own.
+// Each corrected instruction, and each of those a firmware spends nearly
+// all of its time in, is executed by execute.mjs instead of by rp2040js,
+// with rp2040js's cycle counts; every other instruction is rp2040js's own.
 //
-// Invariant: `addWithCarry` and `shiftCarry` are the manual's pseudocode
-// functions of the same names; no result is changed but these
-// instructions'. The look at the next instruction is a `peek` (no count, no
-// stall); the read that executes it is the core's own, once, and the bus
-// takes it for a fetch (`slot` below zero), not for a load.
+// Invariant: no result is changed but the corrected instructions'. The
+// look at the next instruction is a `peek` (no count, no stall); the read
+// that executes it is the core's own, once, and the bus takes it for a
+// fetch (`slot` below zero), not for a load.
 
 import { FETCH, NO_PORT, portOf } from './fabric.mjs';
-
-/** The manual's AddWithCarry: sets N, Z, C, V and returns the 32-bit result. */
-function addWithCarry(core, x, y, carryIn) {
-  const unsignedSum = x + y + carryIn;
-  const signedSum = (x | 0) + (y | 0) + carryIn;
-  const result = unsignedSum >>> 0;
-  core.N = result >= 0x80000000;
-  core.Z = result === 0;
-  core.C = unsignedSum > 0xffffffff;
-  core.V = (result | 0) !== signedSum;
-  return result;
-}
-
-const LSL = 0;
-const LSR = 1;
-const ASR = 2;
-const ROR = 3;
-
-/** The manual's Shift_C for a shift by a register (its bottom byte): result and carry out. */
-function shiftCarry(value, type, amount, carryIn) {
-  if (amount === 0) {
-    return [value, carryIn];
-  }
-  switch (type) {
-    case LSL:
-      if (amount > 32) return [0, false];
-      return [amount === 32 ? 0 : (value << amount) >>> 0, ((value >>> (32 - amount)) & 1) === 1];
-    case LSR:
-      if (amount > 32) return [0, false];
-      return [amount === 32 ? 0 : value >>> amount, ((value >>> (amount - 1)) & 1) === 1];
-    case ASR: {
-      const n = Math.min(amount, 32);
-      const result = n === 32 ? (value & 0x80000000 ? 0xffffffff : 0) : (value | 0) >> n;
-      return [result >>> 0, ((value | 0) >> (n - 1)) & 1 ? true : false];
-    }
-    case ROR: {
-      const n = amount % 32;
-      const result = n === 0 ? value : ((value >>> n) | (value << (32 - n))) >>> 0;
-      return [result, result >= 0x80000000];
-    }
-  }
-  throw new Error(`shift type ${type}`);
-}
-
-// The 16-bit "data processing" encodings 0100 00oo ooMM MDDD, by their
-// opcode field oooo.
-const ADCS = 0b0101;
-const SBCS = 0b0110;
-const SHIFTS = new Map([
-  [0b0010, LSL],
-  [0b0011, LSR],
-  [0b0100, ASR],
-  [0b0111, ROR],
-]);
-
-/** The instructions corrected here, by mnemonic. */
-export const CORRECTED = ['adcs', 'sbcs', 'lsls', 'lsrs', 'asrs', 'rors'];
-
-/** Executes `opcode` if it is one rp2040js gets wrong; false when it is not. */
-function executeCorrected(core, opcode) {
-  if (opcode >> 10 !== 0b010000) {
-    return false;
-  }
-  const operation = (opcode >> 6) & 0xf;
-  const rm = (opcode >> 3) & 7;
-  const rdn = opcode & 7;
-  const registers = core.registers;
-  if (operation === ADCS) {
-    registers[rdn] = addWithCarry(core, registers[rdn], registers[rm], core.C ? 1 : 0);
-  } else if (operation === SBCS) {
-    registers[rdn] = addWithCarry(core, registers[rdn], ~registers[rm] >>> 0, core.C ? 1 : 0);
-  } else if (SHIFTS.has(operation)) {
-    const [result, carry] = shiftCarry(registers[rdn], SHIFTS.get(operation), registers[rm] & 0xff, core.C);
-    registers[rdn] = result;
-    core.N = result >= 0x80000000;
-    core.Z = result === 0;
-    core.C = carry;
-  } else {
-    return false;
-  }
-  return true;
-}
+import { execute } from './execute.mjs';
 
 // rp2040js's own executeInstruction, which the corrected one calls: one for
 // every core (they are of one class). The corrected one is a single
@@ -178,13 +97,8 @@ function executeInstruction() {
     this.slot = wide ? -2 : -1;
     if (wide && ((pc + 2) & ~3) !== this.fetchedWord) fetch(this, (pc + 2) & ~3, this.cycles);
   }
-  let cycles;
-  if (executeCorrected(this, opcode)) {
-    this.readUint16(pc); // the fetch, for what it costs
-    this.PC += 2;
-    this.cycles += 1;
-    cycles = 1;
-  } else {
+  let cycles = execute(this, opcode, pc);
+  if (cycles === 0) {
     // Interrupts were just checked: rp2040js need not look again first.
     const pending = this.interruptsUpdated;
     this.interruptsUpdated = false;

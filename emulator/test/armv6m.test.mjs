@@ -17,7 +17,8 @@ import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { RP2040 } from 'rp2040js';
 import { Thumb } from '../thumb.mjs';
-import { correctInstructions, CORRECTED } from '../armv6m.mjs';
+import { correctInstructions } from '../armv6m.mjs';
+import { CORRECTED } from '../execute.mjs';
 
 // Operands: the edges of every carry and overflow, and of shifts by a register.
 const VALUES = [
@@ -205,5 +206,5 @@ test('rp2040js with its corrections computes what qemu computes, and needs each 
   for (const line of published.values()) console.log(`rp2040js 1.4.1 differs: ${line}`);
   assert.deepEqual(differences(qemu, runOnRp2040js(image, true)), new Map());
   const differing = [...new Set([...published.keys()].map((name) => name.split(' ')[0]))].sort();
-  assert.deepEqual(differing, [...CORRECTED].sort(), 'armv6m.mjs corrects exactly the instructions that differ');
+  assert.deepEqual(differing, [...CORRECTED].sort(), 'execute.mjs corrects exactly the instructions that differ');
 });

@@ -1,0 +1,397 @@
+// The Thumb instructions the emulator executes itself instead of handing
+// them to rp2040js 1.4.1's core: those rp2040js computes wrongly (ADCS,
+// SBCS and the shifts by a register: armv6m.mjs says how), and those a
+// firmware spends nearly all of its time in (the 16-bit data processing,
+// loads and stores, and branches: 97 % of fig5_1's instructions on the
+// ST7789 template). rp2040js finds an instruction by testing its opcode
+// against each encoding in turn, in alphabetical order, about 60 tests
+// before a load from the stack; here a table made once from the opcode
+// names the instruction, which roughly halves the emulator's time.
+//
+// Invariants: every instruction here has rp2040js's results and cycles
+// (1, 2 for a taken branch or a write to the PC, loads and stores 1 plus
+// the core's `cyclesIO`) and makes the same reads and writes through the
+// core, in the same order: the fetch of its opcode first, then its load or
+// store. The corrected ones compute what the Armv6-M Architecture
+// Reference Manual's pseudocode computes (`addWithCarry`, `shiftCarry`);
+// test/execute.test.mjs checks the rest against rp2040js, opcode by
+// opcode, and test/armv6m.test.mjs all of them against qemu. Anything
+// else (32-bit instructions, PUSH, POP, LDM, STM, BX, BLX, hints, system
+// instructions) is rp2040js's: `execute` returns 0 for it.
+
+/** The manual's AddWithCarry: sets N, Z, C, V and returns the 32-bit result. */
+function addWithCarry(core, x, y, carryIn) {
+  const unsignedSum = x + y + carryIn;
+  const signedSum = (x | 0) + (y | 0) + carryIn;
+  const result = unsignedSum >>> 0;
+  core.N = result >= 0x80000000;
+  core.Z = result === 0;
+  core.C = unsignedSum > 0xffffffff;
+  core.V = (result | 0) !== signedSum;
+  return result;
+}
+
+const LSL = 0;
+const LSR = 1;
+const ASR = 2;
+const ROR = 3;
+
+/** The manual's Shift_C for a shift by a register (its bottom byte): sets N, Z, C and returns the result. */
+function shiftCarry(core, value, type, amount) {
+  let result = value;
+  let carry = core.C;
+  if (amount !== 0) {
+    switch (type) {
+      case LSL:
+        result = amount >= 32 ? 0 : (value << amount) >>> 0;
+        carry = amount > 32 ? false : ((value >>> (32 - amount)) & 1) === 1;
+        break;
+      case LSR:
+        result = amount >= 32 ? 0 : value >>> amount;
+        carry = amount > 32 ? false : ((value >>> (amount - 1)) & 1) === 1;
+        break;
+      case ASR: {
+        const n = Math.min(amount, 32);
+        result = n === 32 ? (value & 0x80000000 ? 0xffffffff : 0) : ((value | 0) >> n) >>> 0;
+        carry = (((value | 0) >> (n - 1)) & 1) === 1;
+        break;
+      }
+      case ROR: {
+        const n = amount % 32;
+        result = n === 0 ? value : ((value >>> n) | (value << (32 - n))) >>> 0;
+        carry = result >= 0x80000000;
+        break;
+      }
+    }
+  }
+  core.N = result >= 0x80000000;
+  core.Z = result === 0;
+  core.C = carry;
+  return result;
+}
+
+/** SUBS, CMP: sets N, Z, C, V and returns the 32-bit result of x - y. */
+function subtract(core, x, y) {
+  return addWithCarry(core, x, ~y >>> 0, 1);
+}
+
+/** Sets N and Z from a logical result (as int32 or uint32) and returns it. */
+function logical(core, result) {
+  core.N = result < 0 || result >= 0x80000000;
+  core.Z = result === 0;
+  return result;
+}
+
+// The instructions, by what `execute` switches on.
+const OTHER = 0; // rp2040js's
+const LSLS_IMM = 1;
+const LSRS_IMM = 2;
+const ASRS_IMM = 3;
+const ADDS_REG = 4;
+const SUBS_REG = 5;
+const ADDS_IMM3 = 6;
+const SUBS_IMM3 = 7;
+const MOVS_IMM = 8;
+const CMP_IMM = 9;
+const ADDS_IMM8 = 10;
+const SUBS_IMM8 = 11;
+const ANDS = 12;
+const EORS = 13;
+const LSLS_REG = 14;
+const LSRS_REG = 15;
+const ASRS_REG = 16;
+const ADCS = 17;
+const SBCS = 18;
+const RORS = 19;
+const TST = 20;
+const RSBS = 21;
+const CMP_REG = 22;
+const CMN = 23;
+const ORRS = 24;
+const MULS = 25;
+const BICS = 26;
+const MVNS = 27;
+const ADD_HIGH = 28;
+const CMP_HIGH = 29;
+const MOV_HIGH = 30;
+const LDR_LITERAL = 31;
+const STR_REG = 32;
+const STRH_REG = 33;
+const STRB_REG = 34;
+const LDRSB = 35;
+const LDR_REG = 36;
+const LDRH_REG = 37;
+const LDRB_REG = 38;
+const LDRSH = 39;
+const STR_IMM = 40;
+const LDR_IMM = 41;
+const STRB_IMM = 42;
+const LDRB_IMM = 43;
+const STRH_IMM = 44;
+const LDRH_IMM = 45;
+const STR_SP = 46;
+const LDR_SP = 47;
+const ADR = 48;
+const ADD_SP_TO_REG = 49;
+const ADD_SP = 50;
+const SUB_SP = 51;
+const SXTH = 52;
+const SXTB = 53;
+const UXTH = 54;
+const UXTB = 55;
+const B_COND = 56;
+const B = 57;
+
+/** The 16-bit data-processing instructions 0100 00oo oo.., by oooo. */
+const DATA_PROCESSING = [ANDS, EORS, LSLS_REG, LSRS_REG, ASRS_REG, ADCS, SBCS, RORS, TST, RSBS, CMP_REG, CMN, ORRS, MULS, BICS, MVNS];
+/** The loads and stores by a register, 0101 ooo.: by ooo. */
+const BY_REGISTER = [STR_REG, STRH_REG, STRB_REG, LDRSB, LDR_REG, LDRH_REG, LDRB_REG, LDRSH];
+/** 011B L... and 100. L...: the loads and stores with an immediate offset, by opcode >> 11. */
+const BY_IMMEDIATE = { 0b01100: STR_IMM, 0b01101: LDR_IMM, 0b01110: STRB_IMM, 0b01111: LDRB_IMM, 0b10000: STRH_IMM, 0b10001: LDRH_IMM, 0b10010: STR_SP, 0b10011: LDR_SP };
+const EXTENDS = [SXTH, SXTB, UXTH, UXTB];
+
+/** The instruction `opcode` (its first halfword) is, by the manual's 16-bit Thumb encodings. */
+function decode(opcode) {
+  const top5 = opcode >> 11;
+  if (top5 <= 2) return [LSLS_IMM, LSRS_IMM, ASRS_IMM][top5];
+  if (top5 === 3) return [ADDS_REG, SUBS_REG, ADDS_IMM3, SUBS_IMM3][(opcode >> 9) & 3];
+  if (top5 <= 7) return [MOVS_IMM, CMP_IMM, ADDS_IMM8, SUBS_IMM8][top5 - 4];
+  if (opcode >> 10 === 0b010000) return DATA_PROCESSING[(opcode >> 6) & 0xf];
+  if (opcode >> 8 === 0x44) return ADD_HIGH;
+  if (opcode >> 8 === 0x45) return CMP_HIGH;
+  if (opcode >> 8 === 0x46) return MOV_HIGH;
+  if (top5 === 0b01001) return LDR_LITERAL;
+  if (opcode >> 12 === 0b0101) return BY_REGISTER[(opcode >> 9) & 7];
+  if (top5 in BY_IMMEDIATE) return BY_IMMEDIATE[top5];
+  if (top5 === 0b10100) return ADR;
+  if (top5 === 0b10101) return ADD_SP_TO_REG;
+  if (opcode >> 7 === 0b101100000) return ADD_SP;
+  if (opcode >> 7 === 0b101100001) return SUB_SP;
+  if (opcode >> 8 === 0xb2) return EXTENDS[(opcode >> 6) & 3];
+  if (opcode >> 12 === 0xd && ((opcode >> 8) & 0xf) < 0xe) return B_COND;
+  if (top5 === 0b11100) return B;
+  return OTHER;
+}
+
+/** Each opcode's instruction, decoded once. */
+const KIND = Uint8Array.from({ length: 0x10000 }, (_, opcode) => decode(opcode));
+
+/** The instructions `execute` takes and rp2040js computes alike (the rest of its own are corrections). */
+export const AS_RP2040JS = (opcode) => KIND[opcode] !== OTHER && !CORRECTED_KINDS.includes(KIND[opcode]);
+const CORRECTED_KINDS = [LSLS_REG, LSRS_REG, ASRS_REG, ADCS, SBCS, RORS];
+
+/** Whether condition `cond` (0 to 13) holds for `core`'s flags. */
+function holds(core, cond) {
+  let result;
+  switch (cond >> 1) {
+    case 0: result = core.Z; break;
+    case 1: result = core.C; break;
+    case 2: result = core.N; break;
+    case 3: result = core.V; break;
+    case 4: result = core.C && !core.Z; break;
+    case 5: result = core.N === core.V; break;
+    default: result = core.N === core.V && !core.Z; break;
+  }
+  return cond & 1 ? !result : result;
+}
+
+/**
+ * Executes the 16-bit instruction `opcode` at `pc` on `core`, if it is one
+ * of those this module takes: fetches it through the core, executes it,
+ * counts its cycles and returns them. Returns 0, having done nothing, for
+ * any other.
+ */
+export function execute(core, opcode, pc) {
+  const kind = KIND[opcode];
+  if (kind === OTHER) return 0;
+  core.readUint16(pc); // the fetch, for what it costs
+  const r = core.registers;
+  r[15] += 2;
+  const low0 = opcode & 7;
+  const low3 = (opcode >> 3) & 7;
+  const low6 = (opcode >> 6) & 7;
+  const high8 = (opcode >> 8) & 7;
+  const imm5 = (opcode >> 6) & 0x1f;
+  const imm8 = opcode & 0xff;
+  let cycles = 1;
+  let address;
+  switch (kind) {
+    case LSLS_IMM: {
+      const input = r[low3];
+      if (imm5 !== 0) core.C = ((input >>> (32 - imm5)) & 1) === 1;
+      r[low0] = logical(core, (input << imm5) >>> 0);
+      break;
+    }
+    case LSRS_IMM: {
+      const input = r[low3];
+      core.C = ((input >>> (imm5 === 0 ? 31 : imm5 - 1)) & 1) === 1;
+      r[low0] = logical(core, imm5 === 0 ? 0 : input >>> imm5);
+      break;
+    }
+    case ASRS_IMM: {
+      const input = r[low3] | 0;
+      const n = imm5 === 0 ? 32 : imm5;
+      core.C = ((input >> (n - 1)) & 1) === 1;
+      r[low0] = logical(core, n === 32 ? input >> 31 : input >> n);
+      break;
+    }
+    case ADDS_REG: r[low0] = addWithCarry(core, r[low3], r[low6], 0); break;
+    case SUBS_REG: r[low0] = subtract(core, r[low3], r[low6]); break;
+    case ADDS_IMM3: r[low0] = addWithCarry(core, r[low3], low6, 0); break;
+    case SUBS_IMM3: r[low0] = subtract(core, r[low3], low6); break;
+    case MOVS_IMM: r[high8] = logical(core, imm8); break;
+    case CMP_IMM: subtract(core, r[high8], imm8); break;
+    case ADDS_IMM8: r[high8] = addWithCarry(core, r[high8], imm8, 0); break;
+    case SUBS_IMM8: r[high8] = subtract(core, r[high8], imm8); break;
+    case ANDS: r[low0] = logical(core, r[low0] & r[low3]); break;
+    case EORS: r[low0] = logical(core, r[low0] ^ r[low3]); break;
+    case LSLS_REG: r[low0] = shiftCarry(core, r[low0], LSL, r[low3] & 0xff); break;
+    case LSRS_REG: r[low0] = shiftCarry(core, r[low0], LSR, r[low3] & 0xff); break;
+    case ASRS_REG: r[low0] = shiftCarry(core, r[low0], ASR, r[low3] & 0xff); break;
+    case ADCS: r[low0] = addWithCarry(core, r[low0], r[low3], core.C ? 1 : 0); break;
+    case SBCS: r[low0] = addWithCarry(core, r[low0], ~r[low3] >>> 0, core.C ? 1 : 0); break;
+    case RORS: r[low0] = shiftCarry(core, r[low0], ROR, r[low3] & 0xff); break;
+    case TST: logical(core, r[low0] & r[low3]); break;
+    case RSBS: r[low0] = subtract(core, 0, r[low3]); break;
+    case CMP_REG: subtract(core, r[low0], r[low3]); break;
+    case CMN: addWithCarry(core, r[low0], r[low3], 0); break;
+    case ORRS: r[low0] = logical(core, r[low0] | r[low3]); break;
+    case MULS: r[low0] = logical(core, Math.imul(r[low3], r[low0])); break;
+    case BICS: r[low0] = logical(core, r[low0] & ~r[low3]); break;
+    case MVNS: r[low0] = logical(core, ~r[low3]); break;
+    case ADD_HIGH: {
+      // The PC reads as the instruction's address + 4; a write to it is a branch.
+      const d = ((opcode >> 4) & 8) | low0;
+      const m = (opcode >> 3) & 0xf;
+      const sum = (d === 15 ? r[15] + 2 : r[d]) + (m === 15 ? r[15] + 2 : r[m]);
+      if (d === 15) {
+        r[15] = sum & ~1;
+        cycles++;
+      } else {
+        r[d] = d === 13 ? sum & ~3 : sum;
+      }
+      break;
+    }
+    case CMP_HIGH: subtract(core, r[((opcode >> 4) & 8) | low0], r[(opcode >> 3) & 0xf]); break;
+    case MOV_HIGH: {
+      const d = ((opcode >> 4) & 8) | low0;
+      const m = (opcode >> 3) & 0xf;
+      const value = m === 15 ? r[15] + 2 : r[m];
+      if (d === 15) {
+        r[15] = value & ~1;
+        cycles++;
+      } else {
+        r[d] = d === 13 ? value & ~3 : value;
+      }
+      break;
+    }
+    case LDR_LITERAL:
+      address = ((r[15] + 2) & 0xfffffffc) + (imm8 << 2);
+      cycles += core.cyclesIO(address);
+      r[high8] = core.readUint32(address);
+      break;
+    case STR_REG:
+      address = r[low6] + r[low3];
+      cycles += core.cyclesIO(address, true);
+      core.writeUint32(address, r[low0]);
+      break;
+    case STRH_REG:
+      address = r[low6] + r[low3];
+      cycles += core.cyclesIO(address, true);
+      core.writeUint16(address, r[low0]);
+      break;
+    case STRB_REG:
+      address = r[low6] + r[low3];
+      cycles += core.cyclesIO(address, true);
+      core.writeUint8(address, r[low0]);
+      break;
+    case LDRSB:
+      address = r[low6] + r[low3];
+      cycles += core.cyclesIO(address);
+      r[low0] = (core.readUint8(address) << 24) >> 24;
+      break;
+    case LDR_REG:
+      address = r[low6] + r[low3];
+      cycles += core.cyclesIO(address);
+      r[low0] = core.readUint32(address);
+      break;
+    case LDRH_REG:
+      address = r[low6] + r[low3];
+      cycles += core.cyclesIO(address);
+      r[low0] = core.readUint16(address);
+      break;
+    case LDRB_REG:
+      address = r[low6] + r[low3];
+      cycles += core.cyclesIO(address);
+      r[low0] = core.readUint8(address);
+      break;
+    case LDRSH:
+      address = r[low6] + r[low3];
+      cycles += core.cyclesIO(address);
+      r[low0] = (core.readUint16(address) << 16) >> 16;
+      break;
+    case STR_IMM:
+      address = r[low3] + (imm5 << 2);
+      cycles += core.cyclesIO(address, true);
+      core.writeUint32(address, r[low0]);
+      break;
+    case LDR_IMM:
+      address = r[low3] + (imm5 << 2);
+      cycles += core.cyclesIO(address);
+      r[low0] = core.readUint32(address);
+      break;
+    case STRB_IMM:
+      address = r[low3] + imm5;
+      cycles += core.cyclesIO(address, true);
+      core.writeUint8(address, r[low0]);
+      break;
+    case LDRB_IMM:
+      address = r[low3] + imm5;
+      cycles += core.cyclesIO(address);
+      r[low0] = core.readUint8(address);
+      break;
+    case STRH_IMM:
+      address = r[low3] + (imm5 << 1);
+      cycles += core.cyclesIO(address, true);
+      core.writeUint16(address, r[low0]);
+      break;
+    case LDRH_IMM:
+      address = r[low3] + (imm5 << 1);
+      cycles += core.cyclesIO(address);
+      r[low0] = core.readUint16(address);
+      break;
+    case STR_SP:
+      address = r[13] + (imm8 << 2);
+      cycles += core.cyclesIO(address, true);
+      core.writeUint32(address, r[high8]);
+      break;
+    case LDR_SP:
+      address = r[13] + (imm8 << 2);
+      cycles += core.cyclesIO(address);
+      r[high8] = core.readUint32(address);
+      break;
+    case ADR: r[high8] = (pc & 0xfffffffc) + 4 + (imm8 << 2); break;
+    case ADD_SP_TO_REG: r[high8] = r[13] + (imm8 << 2); break;
+    case ADD_SP: r[13] = (r[13] + ((opcode & 0x7f) << 2)) & ~3; break;
+    case SUB_SP: r[13] = (r[13] - ((opcode & 0x7f) << 2)) & ~3; break;
+    case SXTH: r[low0] = (r[low3] << 16) >> 16; break;
+    case SXTB: r[low0] = (r[low3] << 24) >> 24; break;
+    case UXTH: r[low0] = r[low3] & 0xffff; break;
+    case UXTB: r[low0] = r[low3] & 0xff; break;
+    case B_COND:
+      if (holds(core, (opcode >> 8) & 0xf)) {
+        r[15] += ((imm8 << 24) >> 23) + 2;
+        cycles++;
+      }
+      break;
+    case B:
+      r[15] += (((opcode & 0x7ff) << 21) >> 20) + 2;
+      cycles++;
+      break;
+  }
+  core.cycles += cycles;
+  return cycles;
+}
+
+/** The instructions rp2040js gets wrong, which `execute` computes as the manual does, by mnemonic. */
+export const CORRECTED = ['adcs', 'sbcs', 'lsls', 'lsrs', 'asrs', 'rors'];
