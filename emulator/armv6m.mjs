@@ -32,7 +32,7 @@
 //
 // - PUSH with LR and POP with PC (TRM 3.3, table 3-1: PUSH 1 + N, POP
 //   1 + N, POP and return 3 + N, N the registers in the list): rp2040js
-//   leaves LR and PC out of N, a cycle short each.
+//   leaves LR and PC out of N, a cycle short each (execute.mjs counts them).
 // - Loads and stores on the APB (datasheet 2.1.3, the APB bridge: a read
 //   takes 3 cycles, a write 4): rp2040js charges 4 and 5.
 // - Exception entry: 15 cycles from the interrupt to the handler's first
@@ -76,9 +76,6 @@ export const EXCEPTION_ENTRY_CYCLES = 15;
 /** The exception frame's eight words, loaded a cycle each on return. */
 export const EXCEPTION_RETURN_CYCLES = 8;
 
-const PUSH_WITH_LR = 0xb500;
-const POP_WITH_PC = 0xbd00;
-
 function executeInstruction() {
   if (this.interruptsUpdated && this.checkForInterrupts()) {
     this.waiting = false;
@@ -97,18 +94,13 @@ function executeInstruction() {
     this.slot = wide ? -2 : -1;
     if (wide && ((pc + 2) & ~3) !== this.fetchedWord) fetch(this, (pc + 2) & ~3, this.cycles);
   }
-  let cycles = execute(this, opcode, pc);
+  let cycles = execute(this, opcode, pc, wide ? this.peekInstruction(this.peekContext, pc + 2) : 0);
   if (cycles === 0) {
     // Interrupts were just checked: rp2040js need not look again first.
     const pending = this.interruptsUpdated;
     this.interruptsUpdated = false;
     cycles = executeOriginal.call(this);
     this.interruptsUpdated ||= pending;
-    // LR pushed and PC popped take their cycle, as every other register does.
-    if ((opcode & 0xff00) === PUSH_WITH_LR || (opcode & 0xff00) === POP_WITH_PC) {
-      this.cycles++;
-      cycles++;
-    }
     // A WFI with PRIMASK set does not sleep while an interrupt is pending.
     if (opcode === WFI && this.waiting && this.PM && interruptPending(this)) {
       this.waiting = false;

@@ -16,8 +16,10 @@
 // Reference Manual's pseudocode computes (`addWithCarry`, `shiftCarry`);
 // test/execute.test.mjs checks the rest against rp2040js, opcode by
 // opcode, and test/armv6m.test.mjs all of them against qemu. Anything
-// else (32-bit instructions, PUSH, POP, LDM, STM, BX, BLX, hints, system
-// instructions) is rp2040js's: `execute` returns 0 for it.
+// else (32-bit instructions but BL, BX, BLX, hints, system instructions)
+// is rp2040js's: `execute` returns 0 for it. PUSH with LR and POP with PC
+// take a cycle more than rp2040js counts, as the manual counts them
+// (armv6m.mjs).
 
 /** The manual's AddWithCarry: sets N, Z, C, V and returns the 32-bit result. */
 function addWithCarry(core, x, y, carryIn) {
@@ -141,6 +143,11 @@ const UXTH = 54;
 const UXTB = 55;
 const B_COND = 56;
 const B = 57;
+const PUSH = 58;
+const POP = 59;
+const STM = 60;
+const LDM = 61;
+const BL = 62; // its first halfword; the second says whether it is one
 
 /** The 16-bit data-processing instructions 0100 00oo oo.., by oooo. */
 const DATA_PROCESSING = [ANDS, EORS, LSLS_REG, LSRS_REG, ASRS_REG, ADCS, SBCS, RORS, TST, RSBS, CMP_REG, CMN, ORRS, MULS, BICS, MVNS];
@@ -170,6 +177,11 @@ function decode(opcode) {
   if (opcode >> 8 === 0xb2) return EXTENDS[(opcode >> 6) & 3];
   if (opcode >> 12 === 0xd && ((opcode >> 8) & 0xf) < 0xe) return B_COND;
   if (top5 === 0b11100) return B;
+  if (opcode >> 9 === 0b1011010) return PUSH;
+  if (opcode >> 9 === 0b1011110) return POP;
+  if (top5 === 0b11000) return STM;
+  if (top5 === 0b11001) return LDM;
+  if (top5 === 0b11110) return BL;
   return OTHER;
 }
 
@@ -179,6 +191,13 @@ const KIND = Uint8Array.from({ length: 0x10000 }, (_, opcode) => decode(opcode))
 /** The instructions `execute` takes and rp2040js computes alike (the rest of its own are corrections). */
 export const AS_RP2040JS = (opcode) => KIND[opcode] !== OTHER && !CORRECTED_KINDS.includes(KIND[opcode]);
 const CORRECTED_KINDS = [LSLS_REG, LSRS_REG, ASRS_REG, ADCS, SBCS, RORS];
+
+/** The number of bits set in the byte `bits`. */
+function bitCount(bits) {
+  let n = 0;
+  for (let b = bits; b !== 0; b &= b - 1) n++;
+  return n;
+}
 
 /** Whether condition `cond` (0 to 13) holds for `core`'s flags. */
 function holds(core, cond) {
@@ -195,16 +214,20 @@ function holds(core, cond) {
   return cond & 1 ? !result : result;
 }
 
+/** Whether `second` is the second halfword of a BL (10.1 .... .... ....). */
+const isBl = (second) => (second & 0xd000) === 0xd000;
+
 /**
- * Executes the 16-bit instruction `opcode` at `pc` on `core`, if it is one
- * of those this module takes: fetches it through the core, executes it,
- * counts its cycles and returns them. Returns 0, having done nothing, for
- * any other.
+ * Executes the instruction `opcode` at `pc` on `core` (`second`, its second
+ * halfword if it is a 32-bit one), if it is one of those this module takes:
+ * fetches it through the core, executes it, counts its cycles and returns
+ * them. Returns 0, having done nothing, for any other.
  */
-export function execute(core, opcode, pc) {
+export function execute(core, opcode, pc, second) {
   const kind = KIND[opcode];
-  if (kind === OTHER) return 0;
+  if (kind === OTHER || (kind === BL && !isBl(second))) return 0;
   core.readUint16(pc); // the fetch, for what it costs
+  if (kind === BL) core.readUint16(pc + 2);
   const r = core.registers;
   r[15] += 2;
   const low0 = opcode & 7;
@@ -388,6 +411,79 @@ export function execute(core, opcode, pc) {
       r[15] += (((opcode & 0x7ff) << 21) >> 20) + 2;
       cycles++;
       break;
+    case PUSH: {
+      // Low registers up from the lowest address, LR last; a cycle each (LR's too: armv6m.mjs).
+      const withLr = (opcode >> 8) & 1;
+      let at = r[13] - 4 * (bitCount(imm8) + withLr);
+      for (let i = 0; i < 8; i++) {
+        if (imm8 & (1 << i)) {
+          core.writeUint32(at, r[i]);
+          at += 4;
+          cycles++;
+        }
+      }
+      if (withLr) {
+        core.writeUint32(at, r[14]);
+        cycles++;
+      }
+      r[13] = (r[13] - 4 * (bitCount(imm8) + withLr)) & ~3;
+      break;
+    }
+    case POP: {
+      let at = r[13];
+      for (let i = 0; i < 8; i++) {
+        if (imm8 & (1 << i)) {
+          r[i] = core.readUint32(at);
+          at += 4;
+          cycles++;
+        }
+      }
+      if (opcode & 0x100) {
+        // A return: PC's load takes its cycle (armv6m.mjs), the branch two more.
+        r[13] = (at + 4) & ~3;
+        core.BXWritePC(core.readUint32(at));
+        cycles += 3;
+      } else {
+        r[13] = at & ~3;
+      }
+      break;
+    }
+    case STM: {
+      // Written back unless the base is in the list, as rp2040js does.
+      let at = r[high8];
+      for (let i = 0; i < 8; i++) {
+        if (imm8 & (1 << i)) {
+          core.writeUint32(at, r[i]);
+          at += 4;
+          cycles++;
+        }
+      }
+      if (!(imm8 & (1 << high8))) r[high8] = at;
+      break;
+    }
+    case LDM: {
+      let at = r[high8];
+      for (let i = 0; i < 8; i++) {
+        if (imm8 & (1 << i)) {
+          r[i] = core.readUint32(at);
+          at += 4;
+          cycles++;
+        }
+      }
+      if (!(imm8 & (1 << high8))) r[high8] = at;
+      break;
+    }
+    case BL: {
+      const s = (opcode >> 10) & 1;
+      const i1 = 1 - (s ^ ((second >> 13) & 1));
+      const i2 = 1 - (s ^ ((second >> 11) & 1));
+      const offset = (s ? 0xff000000 : 0) | (i1 << 23) | (i2 << 22) | ((opcode & 0x3ff) << 12) | ((second & 0x7ff) << 1);
+      r[14] = (r[15] + 2) | 1;
+      r[15] += 2 + offset;
+      cycles += 2;
+      core.blTaken(core, false);
+      break;
+    }
   }
   core.cycles += cycles;
   return cycles;
