@@ -117,44 +117,35 @@ const ADD_HIGH = 28;
 const CMP_HIGH = 29;
 const MOV_HIGH = 30;
 const LDR_LITERAL = 31;
-const STR_REG = 32;
-const STRH_REG = 33;
-const STRB_REG = 34;
-const LDRSB = 35;
-const LDR_REG = 36;
-const LDRH_REG = 37;
-const LDRB_REG = 38;
-const LDRSH = 39;
-const STR_IMM = 40;
-const LDR_IMM = 41;
-const STRB_IMM = 42;
-const LDRB_IMM = 43;
-const STRH_IMM = 44;
-const LDRH_IMM = 45;
-const STR_SP = 46;
-const LDR_SP = 47;
-const ADR = 48;
-const ADD_SP_TO_REG = 49;
-const ADD_SP = 50;
-const SUB_SP = 51;
-const SXTH = 52;
-const SXTB = 53;
-const UXTH = 54;
-const UXTB = 55;
-const B_COND = 56;
-const B = 57;
-const PUSH = 58;
-const POP = 59;
-const STM = 60;
-const LDM = 61;
-const BL = 62; // its first halfword; the second says whether it is one
+const TRANSFER_REG = 32; // a load or store at Rn + Rm (`ACCESS` says which)
+const TRANSFER_IMM = 33; // at Rn + imm5 × its width
+const TRANSFER_SP = 34; // at SP + imm8 × 4
+const ADR = 35;
+const ADD_SP_TO_REG = 36;
+const ADD_SP = 37;
+const SUB_SP = 38;
+const SXTH = 39;
+const SXTB = 40;
+const UXTH = 41;
+const UXTB = 42;
+const B_COND = 43;
+const B = 44;
+const PUSH = 45;
+const POP = 46;
+const STM = 47;
+const LDM = 48;
+const BL = 49; // its first halfword; the second says whether it is one
 
 /** The 16-bit data-processing instructions 0100 00oo oo.., by oooo. */
 const DATA_PROCESSING = [ANDS, EORS, LSLS_REG, LSRS_REG, ASRS_REG, ADCS, SBCS, RORS, TST, RSBS, CMP_REG, CMN, ORRS, MULS, BICS, MVNS];
+// A load's or store's access: its width in bytes, whether it stores, and
+// whether it sign-extends what it loads.
+const STORE = 8;
+const SIGNED = 16;
 /** The loads and stores by a register, 0101 ooo.: by ooo. */
-const BY_REGISTER = [STR_REG, STRH_REG, STRB_REG, LDRSB, LDR_REG, LDRH_REG, LDRB_REG, LDRSH];
-/** 011B L... and 100. L...: the loads and stores with an immediate offset, by opcode >> 11. */
-const BY_IMMEDIATE = { 0b01100: STR_IMM, 0b01101: LDR_IMM, 0b01110: STRB_IMM, 0b01111: LDRB_IMM, 0b10000: STRH_IMM, 0b10001: LDRH_IMM, 0b10010: STR_SP, 0b10011: LDR_SP };
+const BY_REGISTER = [4 | STORE, 2 | STORE, 1 | STORE, 1 | SIGNED, 4, 2, 1, 2 | SIGNED];
+/** The loads and stores with an immediate offset, 011B L... and 100. L...: by opcode >> 11. */
+const BY_IMMEDIATE = { 0b01100: 4 | STORE, 0b01101: 4, 0b01110: 1 | STORE, 0b01111: 1, 0b10000: 2 | STORE, 0b10001: 2 };
 const EXTENDS = [SXTH, SXTB, UXTH, UXTB];
 
 /** The instruction `opcode` (its first halfword) is, by the manual's 16-bit Thumb encodings. */
@@ -168,8 +159,9 @@ function decode(opcode) {
   if (opcode >> 8 === 0x45) return CMP_HIGH;
   if (opcode >> 8 === 0x46) return MOV_HIGH;
   if (top5 === 0b01001) return LDR_LITERAL;
-  if (opcode >> 12 === 0b0101) return BY_REGISTER[(opcode >> 9) & 7];
-  if (top5 in BY_IMMEDIATE) return BY_IMMEDIATE[top5];
+  if (opcode >> 12 === 0b0101) return TRANSFER_REG;
+  if (top5 in BY_IMMEDIATE) return TRANSFER_IMM;
+  if (top5 === 0b10010 || top5 === 0b10011) return TRANSFER_SP;
   if (top5 === 0b10100) return ADR;
   if (top5 === 0b10101) return ADD_SP_TO_REG;
   if (opcode >> 7 === 0b101100000) return ADD_SP;
@@ -187,6 +179,42 @@ function decode(opcode) {
 
 /** Each opcode's instruction, decoded once. */
 const KIND = Uint8Array.from({ length: 0x10000 }, (_, opcode) => decode(opcode));
+
+/** A load's or store's access (0 for any other instruction), by opcode. */
+const ACCESS = Uint8Array.from({ length: 0x10000 }, (_, opcode) => {
+  switch (KIND[opcode]) {
+    case TRANSFER_REG: return BY_REGISTER[(opcode >> 9) & 7];
+    case TRANSFER_IMM: return BY_IMMEDIATE[opcode >> 11];
+    case TRANSFER_SP: return opcode & 0x800 ? 4 : 4 | STORE;
+    case LDR_LITERAL: return 4;
+    default: return 0;
+  }
+});
+
+/**
+ * Instruction `opcode`'s load or store at `address`, of or to register
+ * `t`: the cycles it takes beyond the first.
+ */
+function transfer(core, opcode, address, t) {
+  const access = ACCESS[opcode];
+  const r = core.registers;
+  if (access & STORE) {
+    const cycles = core.cyclesIO(address, true);
+    if ((access & 7) === 4) core.writeUint32(address, r[t]);
+    else if ((access & 7) === 2) core.writeUint16(address, r[t]);
+    else core.writeUint8(address, r[t]);
+    return cycles;
+  }
+  const cycles = core.cyclesIO(address);
+  switch (access) {
+    case 4: r[t] = core.readUint32(address); break;
+    case 2: r[t] = core.readUint16(address); break;
+    case 1: r[t] = core.readUint8(address); break;
+    case 2 | SIGNED: r[t] = (core.readUint16(address) << 16) >> 16; break;
+    case 1 | SIGNED: r[t] = (core.readUint8(address) << 24) >> 24; break;
+  }
+  return cycles;
+}
 
 /** The instructions `execute` takes and rp2040js computes alike (the rest of its own are corrections). */
 export const AS_RP2040JS = (opcode) => KIND[opcode] !== OTHER && !CORRECTED_KINDS.includes(KIND[opcode]);
@@ -237,7 +265,6 @@ export function execute(core, opcode, pc, second) {
   const imm5 = (opcode >> 6) & 0x1f;
   const imm8 = opcode & 0xff;
   let cycles = 1;
-  let address;
   switch (kind) {
     case LSLS_IMM: {
       const input = r[low3];
@@ -308,91 +335,10 @@ export function execute(core, opcode, pc, second) {
       }
       break;
     }
-    case LDR_LITERAL:
-      address = ((r[15] + 2) & 0xfffffffc) + (imm8 << 2);
-      cycles += core.cyclesIO(address);
-      r[high8] = core.readUint32(address);
-      break;
-    case STR_REG:
-      address = r[low6] + r[low3];
-      cycles += core.cyclesIO(address, true);
-      core.writeUint32(address, r[low0]);
-      break;
-    case STRH_REG:
-      address = r[low6] + r[low3];
-      cycles += core.cyclesIO(address, true);
-      core.writeUint16(address, r[low0]);
-      break;
-    case STRB_REG:
-      address = r[low6] + r[low3];
-      cycles += core.cyclesIO(address, true);
-      core.writeUint8(address, r[low0]);
-      break;
-    case LDRSB:
-      address = r[low6] + r[low3];
-      cycles += core.cyclesIO(address);
-      r[low0] = (core.readUint8(address) << 24) >> 24;
-      break;
-    case LDR_REG:
-      address = r[low6] + r[low3];
-      cycles += core.cyclesIO(address);
-      r[low0] = core.readUint32(address);
-      break;
-    case LDRH_REG:
-      address = r[low6] + r[low3];
-      cycles += core.cyclesIO(address);
-      r[low0] = core.readUint16(address);
-      break;
-    case LDRB_REG:
-      address = r[low6] + r[low3];
-      cycles += core.cyclesIO(address);
-      r[low0] = core.readUint8(address);
-      break;
-    case LDRSH:
-      address = r[low6] + r[low3];
-      cycles += core.cyclesIO(address);
-      r[low0] = (core.readUint16(address) << 16) >> 16;
-      break;
-    case STR_IMM:
-      address = r[low3] + (imm5 << 2);
-      cycles += core.cyclesIO(address, true);
-      core.writeUint32(address, r[low0]);
-      break;
-    case LDR_IMM:
-      address = r[low3] + (imm5 << 2);
-      cycles += core.cyclesIO(address);
-      r[low0] = core.readUint32(address);
-      break;
-    case STRB_IMM:
-      address = r[low3] + imm5;
-      cycles += core.cyclesIO(address, true);
-      core.writeUint8(address, r[low0]);
-      break;
-    case LDRB_IMM:
-      address = r[low3] + imm5;
-      cycles += core.cyclesIO(address);
-      r[low0] = core.readUint8(address);
-      break;
-    case STRH_IMM:
-      address = r[low3] + (imm5 << 1);
-      cycles += core.cyclesIO(address, true);
-      core.writeUint16(address, r[low0]);
-      break;
-    case LDRH_IMM:
-      address = r[low3] + (imm5 << 1);
-      cycles += core.cyclesIO(address);
-      r[low0] = core.readUint16(address);
-      break;
-    case STR_SP:
-      address = r[13] + (imm8 << 2);
-      cycles += core.cyclesIO(address, true);
-      core.writeUint32(address, r[high8]);
-      break;
-    case LDR_SP:
-      address = r[13] + (imm8 << 2);
-      cycles += core.cyclesIO(address);
-      r[high8] = core.readUint32(address);
-      break;
+    case LDR_LITERAL: cycles += transfer(core, opcode, ((r[15] + 2) & 0xfffffffc) + (imm8 << 2), high8); break;
+    case TRANSFER_REG: cycles += transfer(core, opcode, r[low6] + r[low3], low0); break;
+    case TRANSFER_IMM: cycles += transfer(core, opcode, r[low3] + imm5 * (ACCESS[opcode] & 7), low0); break;
+    case TRANSFER_SP: cycles += transfer(core, opcode, r[13] + (imm8 << 2), high8); break;
     case ADR: r[high8] = (pc & 0xfffffffc) + 4 + (imm8 << 2); break;
     case ADD_SP_TO_REG: r[high8] = r[13] + (imm8 << 2); break;
     case ADD_SP: r[13] = (r[13] + ((opcode & 0x7f) << 2)) & ~3; break;
