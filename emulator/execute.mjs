@@ -220,6 +220,24 @@ function transfer(core, opcode, address, t) {
 export const AS_RP2040JS = (opcode) => KIND[opcode] !== OTHER && !CORRECTED_KINDS.includes(KIND[opcode]);
 const CORRECTED_KINDS = [LSLS_REG, LSRS_REG, ASRS_REG, ADCS, SBCS, RORS];
 
+/** Register `n` as ADD and MOV with high registers read it: the PC as the instruction's address + 4. */
+function readHigh(r, n) {
+  return n === 15 ? r[15] + 2 : r[n];
+}
+
+/**
+ * Writes `value` to register `d` as ADD and MOV with high registers do: to
+ * the PC a branch (a cycle more, returned), to SP word-aligned.
+ */
+function writeHigh(r, d, value) {
+  if (d === 15) {
+    r[15] = value & ~1;
+    return 1;
+  }
+  r[d] = d === 13 ? value & ~3 : value;
+  return 0;
+}
+
 /** The number of bits set in the byte `bits`. */
 function bitCount(bits) {
   let n = 0;
@@ -310,31 +328,12 @@ export function execute(core, opcode, pc, second) {
     case BICS: r[low0] = logical(core, r[low0] & ~r[low3]); break;
     case MVNS: r[low0] = logical(core, ~r[low3]); break;
     case ADD_HIGH: {
-      // The PC reads as the instruction's address + 4; a write to it is a branch.
       const d = ((opcode >> 4) & 8) | low0;
-      const m = (opcode >> 3) & 0xf;
-      const sum = (d === 15 ? r[15] + 2 : r[d]) + (m === 15 ? r[15] + 2 : r[m]);
-      if (d === 15) {
-        r[15] = sum & ~1;
-        cycles++;
-      } else {
-        r[d] = d === 13 ? sum & ~3 : sum;
-      }
+      cycles += writeHigh(r, d, readHigh(r, d) + readHigh(r, (opcode >> 3) & 0xf));
       break;
     }
     case CMP_HIGH: subtract(core, r[((opcode >> 4) & 8) | low0], r[(opcode >> 3) & 0xf]); break;
-    case MOV_HIGH: {
-      const d = ((opcode >> 4) & 8) | low0;
-      const m = (opcode >> 3) & 0xf;
-      const value = m === 15 ? r[15] + 2 : r[m];
-      if (d === 15) {
-        r[15] = value & ~1;
-        cycles++;
-      } else {
-        r[d] = d === 13 ? value & ~3 : value;
-      }
-      break;
-    }
+    case MOV_HIGH: cycles += writeHigh(r, ((opcode >> 4) & 8) | low0, readHigh(r, (opcode >> 3) & 0xf)); break;
     case LDR_LITERAL: cycles += transfer(core, opcode, ((r[15] + 2) & 0xfffffffc) + (imm8 << 2), high8); break;
     case TRANSFER_REG: cycles += transfer(core, opcode, r[low6] + r[low3], low0); break;
     case TRANSFER_IMM: cycles += transfer(core, opcode, r[low3] + imm5 * (ACCESS[opcode] & 7), low0); break;
