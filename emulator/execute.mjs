@@ -217,9 +217,13 @@ function transfer(core, opcode, address, t) {
   return cycles;
 }
 
+/** The instructions rp2040js gets wrong, which `execute` computes as the manual does, by mnemonic. */
+const CORRECTIONS = { adcs: ADCS, sbcs: SBCS, lsls: LSLS_REG, lsrs: LSRS_REG, asrs: ASRS_REG, rors: RORS };
+export const CORRECTED = Object.keys(CORRECTIONS);
+const CORRECTED_KINDS = Object.values(CORRECTIONS);
+
 /** The instructions `execute` takes and rp2040js computes alike (the rest of its own are corrections). */
 export const AS_RP2040JS = (opcode) => KIND[opcode] !== OTHER && !CORRECTED_KINDS.includes(KIND[opcode]);
-const CORRECTED_KINDS = [LSLS_REG, LSRS_REG, ASRS_REG, ADCS, SBCS, RORS];
 
 /** Register `n` as ADD and MOV with high registers read it: the PC as the instruction's address + 4. */
 function readHigh(r, n) {
@@ -237,6 +241,28 @@ function writeHigh(r, d, value) {
   }
   r[d] = d === 13 ? value & ~3 : value;
   return 0;
+}
+
+/** Stores the low registers in `list` from `at` up, a word each: where they end. */
+function storeList(core, list, at) {
+  for (let i = 0; i < 8; i++) {
+    if (list & (1 << i)) {
+      core.writeUint32(at, core.registers[i]);
+      at += 4;
+    }
+  }
+  return at;
+}
+
+/** Loads the low registers in `list` from `at` up, a word each: where they end. */
+function loadList(core, list, at) {
+  for (let i = 0; i < 8; i++) {
+    if (list & (1 << i)) {
+      core.registers[i] = core.readUint32(at);
+      at += 4;
+    }
+  }
+  return at;
 }
 
 /** The number of bits set in the byte `bits`. */
@@ -360,30 +386,16 @@ export function execute(core, opcode, pc, second) {
     case PUSH: {
       // Low registers up from the lowest address, LR last; a cycle each (LR's too: armv6m.mjs).
       const withLr = (opcode >> 8) & 1;
-      let at = r[13] - 4 * (bitCount(imm8) + withLr);
-      for (let i = 0; i < 8; i++) {
-        if (imm8 & (1 << i)) {
-          core.writeUint32(at, r[i]);
-          at += 4;
-          cycles++;
-        }
-      }
-      if (withLr) {
-        core.writeUint32(at, r[14]);
-        cycles++;
-      }
-      r[13] = (r[13] - 4 * (bitCount(imm8) + withLr)) & ~3;
+      const count = bitCount(imm8) + withLr;
+      const at = storeList(core, imm8, r[13] - 4 * count);
+      if (withLr) core.writeUint32(at, r[14]);
+      r[13] = (r[13] - 4 * count) & ~3;
+      cycles += count;
       break;
     }
     case POP: {
-      let at = r[13];
-      for (let i = 0; i < 8; i++) {
-        if (imm8 & (1 << i)) {
-          r[i] = core.readUint32(at);
-          at += 4;
-          cycles++;
-        }
-      }
+      const at = loadList(core, imm8, r[13]);
+      cycles += bitCount(imm8);
       if (opcode & 0x100) {
         // A return: PC's load takes its cycle (armv6m.mjs), the branch two more.
         r[13] = (at + 4) & ~3;
@@ -394,29 +406,12 @@ export function execute(core, opcode, pc, second) {
       }
       break;
     }
-    case STM: {
-      // Written back unless the base is in the list, as rp2040js does.
-      let at = r[high8];
-      for (let i = 0; i < 8; i++) {
-        if (imm8 & (1 << i)) {
-          core.writeUint32(at, r[i]);
-          at += 4;
-          cycles++;
-        }
-      }
-      if (!(imm8 & (1 << high8))) r[high8] = at;
-      break;
-    }
+    case STM:
     case LDM: {
-      let at = r[high8];
-      for (let i = 0; i < 8; i++) {
-        if (imm8 & (1 << i)) {
-          r[i] = core.readUint32(at);
-          at += 4;
-          cycles++;
-        }
-      }
+      // Written back unless the base is in the list, as rp2040js does.
+      const at = kind === STM ? storeList(core, imm8, r[high8]) : loadList(core, imm8, r[high8]);
       if (!(imm8 & (1 << high8))) r[high8] = at;
+      cycles += bitCount(imm8);
       break;
     }
     case BL: {
@@ -434,6 +429,3 @@ export function execute(core, opcode, pc, second) {
   core.cycles += cycles;
   return cycles;
 }
-
-/** The instructions rp2040js gets wrong, which `execute` computes as the manual does, by mnemonic. */
-export const CORRECTED = ['adcs', 'sbcs', 'lsls', 'lsrs', 'asrs', 'rors'];
