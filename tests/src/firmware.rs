@@ -97,6 +97,11 @@ fn peak_stack(output: &str) -> Option<u64> {
     output.lines().find_map(|l| l.strip_prefix("peak stack: ")?.strip_suffix(" bytes")?.parse().ok())
 }
 
+/// Where every firmware build of the tests goes.
+fn boards_target_dir() -> PathBuf {
+    repo().join("target/firmware/boards")
+}
+
 impl Firmware {
     pub fn new(board: Board, scene: &str, width: u32, height: u32, wire: PanelColor) -> Firmware {
         Firmware { board, scene: scene.to_owned(), width, height, wire, dithering: Dithering::default() }
@@ -118,7 +123,7 @@ impl Firmware {
     }
 
     fn target_dir(&self) -> PathBuf {
-        repo().join("target/firmware/boards")
+        boards_target_dir()
     }
 
     /// Where the guest writes its pixels.
@@ -215,14 +220,15 @@ fn rgb565(r: u8, g: u8, b: u8) -> u16 {
 ///   OCTRACE_COLOR=gray4 OCTRACE_OUT=OUT cargo run --release --target thumbv7m-none-eabi
 /// ```
 ///
-/// with its own target directory (`target/firmware/lm3s6965evb-run`), so the
-/// build is cached between test runs. Returns what the run printed; the
+/// in the target directory the other boards' builds share (their
+/// dependencies are built once): the caller runs it when no other build
+/// is under way there. Returns what the run printed; the
 /// panel's screen is in `out`.
 pub fn run_oled_command(scene: &str, out: &Path) -> Result<Run, String> {
     let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
     cargo.current_dir(repo().join("firmware"));
     cargo.args(["run", "--release", "--quiet", "--target", "thumbv7m-none-eabi"]);
-    cargo.arg("--target-dir").arg(repo().join("target/firmware/lm3s6965evb-run"));
+    cargo.arg("--target-dir").arg(boards_target_dir());
     for var in [
         "CARGO_TARGET_DIR",
         "RUSTFLAGS",
