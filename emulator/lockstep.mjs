@@ -282,6 +282,9 @@ export class Lockstep {
   startProfile() {
     this.profile = new Profiler(this.cores, this.functions);
     this.checkEvery = SAMPLE_EVERY;
+    // Started mid-run (from a frame's end): the running stretch ends after
+    // this instruction, so the next one counts to its checks at the new pace.
+    this.woke = true;
   }
 
   /** The `top` functions the profile charged most, with their cycles and share of all it charged. */

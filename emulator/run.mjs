@@ -20,7 +20,9 @@
 // place sampled every 256 instructions, the cycles since charged to the
 // function it is in (the ELF's symbols; inlined code counts as its
 // caller), and the N functions charged most listed after the report (in
-// it, with --json). Not with --serial.
+// it, with --json). Not with --serial. With --frames, --profile-from K
+// charges only frames K on (1: the frames an animation draws after its
+// first, which loads the scene and traces everything).
 //
 // --frames N: for a firmware that draws frames (an animation), runs until
 // N frames are on the panel and writes each as it was then: --out is then
@@ -59,7 +61,7 @@ import { framePattern, watchFrames } from './frames.mjs';
 const USAGE =
   'usage: node run.mjs ELF [--out FILE.png] [--display auto|st7789|ssd1306] [--panel WxH] [--panel-offset X,Y] [--max-seconds S] [--contention on|off] [--json] [--quiet]\n' +
   '       node run.mjs ELF --frames N [--out \'DIR/f%03d.png\'] [the options above]\n' +
-  '       node run.mjs ELF --profile N [the options above, or --frames N]: also where the cycles went, by function\n' +
+  '       node run.mjs ELF --profile N [the options above, or --frames N [--profile-from K]]: also where the cycles went, by function (from frame K on)\n' +
   '       node run.mjs ELF --serial [--out FILE.png] [--display auto|st7789|ssd1306] [--panel WxH] [--panel-offset X,Y] [--contention on|off] [--json]';
 
 function usage(message) {
@@ -89,6 +91,7 @@ try {
       frames: { type: 'string' },
       contention: { type: 'string', default: 'on' },
       profile: { type: 'string' },
+      'profile-from': { type: 'string' },
       json: { type: 'boolean', default: false },
       quiet: { type: 'boolean', default: false },
     },
@@ -135,6 +138,13 @@ const frameCount = values.frames === undefined ? null : Number(values.frames);
 if (frameCount !== null && !(Number.isInteger(frameCount) && frameCount > 0)) {
   usage(`--frames ${values.frames}: expected a whole number of frames, at least 1`);
 }
+const profileFrom = values['profile-from'] === undefined ? 0 : Number(values['profile-from']);
+if (values['profile-from'] !== undefined) {
+  if (profileTop === null || frameCount === null) usage('--profile-from: with --profile and --frames');
+  if (!(Number.isInteger(profileFrom) && profileFrom >= 0 && profileFrom < frameCount)) {
+    usage(`--profile-from ${values['profile-from']}: expected a frame from 0 to ${frameCount - 1}`);
+  }
+}
 const out = values.out ?? (frameCount === null ? 'panel.png' : 'panel%03d.png');
 let frameName = null;
 if (frameCount !== null) {
@@ -153,8 +163,14 @@ try {
   // Each frame's picture as it was when drawn, written once the run has succeeded.
   const pictures = [];
   const picture = () => encodePng(pico.display.width, pico.display.height, pico.display.picture());
-  const frames = frameCount === null ? null : watchFrames(pico, { count: frameCount, onFrame: () => pictures.push(picture()) });
-  if (profileTop !== null) pico.startProfile();
+  // The profile starts with the run, or once frame profileFrom - 1 is drawn.
+  const profileFromHere = () => profileTop !== null && pictures.length === profileFrom && pico.startProfile();
+  const onFrame = () => {
+    pictures.push(picture());
+    profileFromHere();
+  };
+  const frames = frameCount === null ? null : watchFrames(pico, { count: frameCount, onFrame });
+  profileFromHere();
   const ended = pico.run({
     maxSeconds,
     onProgress: progress
@@ -187,7 +203,10 @@ try {
         return { index, out: frameName(index), cycles, seconds, lit, busy, start, end };
       }),
   );
-  if (profileTop !== null) report.profile = pico.profileReport(profileTop);
+  if (profileTop !== null) {
+    report.profile = pico.profileReport(profileTop);
+    report.profileFrom = profileFrom;
+  }
 } catch (error) {
   if (progress) process.stderr.write('\r\x1b[K');
   if (expected(error)) {
@@ -247,7 +266,8 @@ if (values.json) {
         : `the ${report.display} panel's ${report.panel} ${report.frames ? 'frames' : 'picture'}: ${out}`,
       ...(report.profile
         ? [
-            'where the cycles went (sampled every 256 instructions, by function; inlined code counts as its caller):',
+            `where the cycles went${profileFrom > 0 ? ` from frame ${profileFrom} on` : ''} ` +
+              '(sampled every 256 instructions, by function; inlined code counts as its caller):',
             ...report.profile.map(
               ({ name, cycles, share }) => `  ${(100 * share).toFixed(1).padStart(5)} %  ${count(cycles).padStart(13)} cycles  ${name}`,
             ),

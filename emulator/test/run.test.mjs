@@ -206,6 +206,25 @@ test('--frames N: each time the LED goes out a frame is drawn, written, and time
   assert.equal(second.busy[1], 0, 'core 1 stayed asleep in the ROM');
 });
 
+test('--profile-from K charges the frames from K on, and wants --profile and --frames', () => {
+  const whole = run(blinking(3), '--frames', '3', '--profile', '5', '--json');
+  const later = run(blinking(3), '--frames', '3', '--profile', '5', '--profile-from', '1', '--json');
+  assert.equal(whole.status, 0, whole.stderr);
+  assert.equal(later.status, 0, later.stderr);
+  const charged = (report) => report.profile.reduce((sum, { cycles }) => sum + cycles, 0);
+  const [reportWhole, reportLater] = [JSON.parse(whole.stdout), JSON.parse(later.stdout)];
+  const [, second, third] = reportLater.frames;
+  // Frames 1 and 2, within a sample (256 instructions, a loop pass of 3 cycles each).
+  assert.equal(reportLater.profileFrom, 1);
+  assert.ok(Math.abs(charged(reportLater) - (second.cycles + third.cycles)) < 800, `${charged(reportLater)}`);
+  assert.ok(charged(reportWhole) > charged(reportLater) + reportLater.frames[0].cycles - 800, `${charged(reportWhole)}`);
+  for (const args of [['--profile-from', '1'], ['--frames', '3', '--profile-from', '1'], ['--frames', '3', '--profile', '5', '--profile-from', '3']]) {
+    const result = spawnSync(process.execPath, [RUN, 'a.elf', ...args], { encoding: 'utf8' });
+    assert.equal(result.status, 2, `${args.join(' ')}: ${result.stderr}`);
+    assert.match(result.stderr, /--profile-from/);
+  }
+});
+
 test('--frames N with fewer drawn, or a pattern without a number, fails and writes no frame', () => {
   const fewer = run(blinking(3), '--frames', '5');
   assert.equal(fewer.status, 1, fewer.stderr);
