@@ -21,6 +21,7 @@ pub(crate) const GRID_BITS: u32 = 18;
 pub(crate) const WIDENING: i32 = (crate::accel::FILING_MARGIN + crate::accel::RAY_SLACK) as i32 + 2;
 
 use super::path::{Path, Stretch};
+use crate::math::{mul_u32_wide, square_u32_wide};
 
 /// A segment from `p` to `q` on the grid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -55,6 +56,19 @@ fn squared_length(u: [i32; 3]) -> i64 {
     u.iter().map(|&x| i64::from(x.unsigned_abs() * x.unsigned_abs())).sum()
 }
 
+/// Whether the point `w` from the segment's start is within `√k` of the
+/// line along `d`: `|w|²·|d|² − (w·d)² ≤ k·|d|²`, given the dot products.
+/// Those of grid differences, and `k` (a squared radius on the grid), are
+/// below 2^32 in magnitude, so each product is a 32×32→64 one
+/// (`mul_u32_wide`: four one-instruction multiplies on a Cortex-M0, where
+/// an `i64` product is a library call); `|w|²·|d|² ≥ (w·d)²` (Cauchy and
+/// Schwarz, exactly in integers), so the difference never wraps.
+#[inline]
+fn within_line(ww: i64, wd: i64, dd: i64, k: i64) -> bool {
+    let (ww, wd, dd, k) = (ww as u32, wd.unsigned_abs() as u32, dd as u32, k as u32);
+    mul_u32_wide(ww, dd) - square_u32_wide(wd) <= mul_u32_wide(k, dd)
+}
+
 impl Segment {
     /// The segment between raw points `p` and `q`.
     pub(crate) fn new(p: [i64; 3], q: [i64; 3]) -> Segment {
@@ -70,7 +84,11 @@ impl Segment {
     /// segment's ends moves them apart).
     pub(crate) fn near_sphere(&self, center: [i32; 3], radius: i32) -> bool {
         let c = center.map(|v| cell(i64::from(v)));
-        let r = i64::from((radius.saturating_add(WIDENING) >> GRID_BITS) + 3);
+        // Below 2^14 (radii below 2^31), its square below 2^28: one
+        // instruction, in an `i32`.
+        let r = (radius.saturating_add(WIDENING) >> GRID_BITS) + 3;
+        let r2 = i64::from(r * r);
+        let r = i64::from(r);
         if (0..3).any(|a| i64::from(self.hi[a]) < i64::from(c[a]) - r || i64::from(self.lo[a]) > i64::from(c[a]) + r) {
             return false;
         }
@@ -80,13 +98,12 @@ impl Segment {
         let w = [0, 1, 2].map(|a| c[a] - self.p[a]);
         let (dd, wd, ww) = (dot(d, d), dot(w, d), dot(w, w));
         if wd <= 0 || dd == 0 {
-            return ww <= r * r;
+            return ww <= r2;
         }
         if wd >= dd {
-            return squared_length([0, 1, 2].map(|a| w[a] - d[a])) <= r * r;
+            return squared_length([0, 1, 2].map(|a| w[a] - d[a])) <= r2;
         }
-        // The distance to the line, squared, times |d|²: |w|²·|d|² − (w·d)².
-        ww * dd - wd * wd <= r * r * dd
+        within_line(ww, wd, dd, r2)
     }
 
     /// Whether the segment surely passes through the raw sphere of centre
@@ -97,8 +114,11 @@ impl Segment {
     /// sends along the segment meets the sphere between its ends.
     pub(crate) fn through_sphere(&self, center: [i32; 3], radius: i32) -> bool {
         let c = center.map(|v| cell(i64::from(v)));
-        let inner = i64::from((radius.saturating_sub(4 * WIDENING) >> GRID_BITS) - 4);
-        let outer = i64::from((radius.saturating_add(4 * WIDENING) >> GRID_BITS) + 5);
+        // Both below 2^14, their squares in an `i32`.
+        let inner = (radius.saturating_sub(4 * WIDENING) >> GRID_BITS) - 4;
+        let outer = (radius.saturating_add(4 * WIDENING) >> GRID_BITS) + 5;
+        let (inner2, outer2) = (i64::from(inner * inner), i64::from(outer * outer));
+        let inner = i64::from(inner);
         // Passing within `inner` of the centre, the segment's box meets the
         // centre's box of that half-side.
         if inner <= 0
@@ -112,7 +132,7 @@ impl Segment {
         let w = [0, 1, 2].map(|a| c[a] - self.p[a]);
         let e = squared_length([0, 1, 2].map(|a| w[a] - d[a]));
         let (dd, wd, ww) = (dot(d, d), dot(w, d), dot(w, w));
-        ww > outer * outer && e > outer * outer && wd > 0 && wd < dd && ww * dd - wd * wd <= inner * inner * dd
+        ww > outer2 && e > outer2 && wd > 0 && wd < dd && within_line(ww, wd, dd, inner2)
     }
 
     /// Whether the segment comes near the raw box `[lo, hi]`: on the grid,
@@ -468,6 +488,34 @@ mod tests {
             assert!(end(p) >= (r + four) as f64 && end(q) >= (r + four) as f64, "ends: p {p:?} q {q:?} c {c:?} r {r}");
         }
         assert!(through > cases / 50, "{through} of {cases} said through: the cases reach its edges");
+    }
+
+    #[test]
+    fn the_line_test_in_32_bit_products_is_the_wide_one() {
+        // Grid differences up to the extremes (below 2^15), squared radii
+        // up to 2^28, against the inequality in i128.
+        let mut next = crate::test_rng::seeded(0x11e_7e57);
+        let mut difference = || (next() % (1 << 16)) as i32 - (1 << 15) + 1;
+        for case in 0..100_000 {
+            let (w, d) = ([0; 3].map(|_| difference()), [0; 3].map(|_| difference()));
+            let k = i64::from(difference().unsigned_abs()).pow(2) >> (case % 4);
+            let (ww, wd, dd) = (dot(w, w), dot(w, d), dot(d, d));
+            let wide = |x: i64| i128::from(x);
+            let expected = wide(ww) * wide(dd) - wide(wd) * wide(wd) <= wide(k) * wide(dd);
+            assert_eq!(within_line(ww, wd, dd, k), expected, "case {case}: w {w:?} d {d:?} k {k}");
+            // On the line (w = d): within any k, 0 included.
+            assert!(within_line(dd, dd, dd, 0), "case {case}: d {d:?}");
+            // At the edge: the least k that holds, and the one below it.
+            if dd > 0 {
+                let least = (wide(ww) * wide(dd) - wide(wd) * wide(wd) + wide(dd) - 1) / wide(dd);
+                let least = least as i64;
+                assert!(within_line(ww, wd, dd, least), "case {case}: w {w:?} d {d:?} at {least}");
+                assert!(
+                    least == 0 || !within_line(ww, wd, dd, least - 1),
+                    "case {case}: w {w:?} d {d:?} below {least}"
+                );
+            }
+        }
     }
 
     #[test]
