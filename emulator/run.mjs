@@ -164,7 +164,9 @@ try {
   const pictures = [];
   const picture = () => encodePng(pico.display.width, pico.display.height, pico.display.picture());
   // The profile starts with the run, or once frame profileFrom - 1 is drawn.
-  const profileFromHere = () => profileTop !== null && pictures.length === profileFrom && pico.startProfile();
+  const profileFromHere = () => {
+    if (profileTop !== null && pictures.length === profileFrom) pico.startProfile();
+  };
   const onFrame = () => {
     pictures.push(picture());
     profileFromHere();

@@ -493,7 +493,7 @@ mod tests {
     #[test]
     fn the_line_test_in_32_bit_products_is_the_wide_one() {
         // Grid differences up to the extremes (below 2^15), squared radii
-        // up to 2^28, against the inequality in i128.
+        // up to 2^30, against the inequality in i128.
         let mut next = crate::test_rng::seeded(0x11e_7e57);
         let mut difference = || (next() % (1 << 16)) as i32 - (1 << 15) + 1;
         for case in 0..100_000 {
