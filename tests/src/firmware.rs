@@ -122,20 +122,16 @@ impl Firmware {
         }
     }
 
-    fn target_dir(&self) -> PathBuf {
-        boards_target_dir()
-    }
-
     /// Where the guest writes its pixels.
     fn output_file(&self) -> PathBuf {
-        self.target_dir().join(format!("{}.raw", self.slug()))
+        boards_target_dir().join(format!("{}.raw", self.slug()))
     }
 
     /// Builds the firmware (release) and returns the ELF, kept under the
     /// build's name: the next build (which may write the same file) can
     /// then go on while qemu runs this one.
     pub fn build(&self) -> Result<PathBuf, String> {
-        let dir = self.target_dir();
+        let dir = boards_target_dir();
         let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
         // The firmware's .cargo/config.toml (runner, linker script) is found
         // from the working directory.
