@@ -22,6 +22,8 @@
 // take a cycle more than rp2040js counts, as the manual counts them
 // (armv6m.mjs).
 
+import { plainSramFetch } from './bus.mjs';
+
 /** The manual's AddWithCarry: sets N, Z, C, V and returns the 32-bit result. */
 function addWithCarry(core, x, y, carryIn) {
   const unsignedSum = x + y + carryIn;
@@ -299,8 +301,14 @@ const isBl = (second) => (second & 0xd000) === 0xd000;
 export function execute(core, opcode, pc, second) {
   const kind = KIND[opcode];
   if (kind === OTHER || (kind === BL && !isBl(second))) return 0;
-  core.readUint16(pc); // the fetch, for what it costs
-  if (kind === BL) core.readUint16(pc + 2);
+  // The fetch, for what it costs: a plain SRAM read only takes its slots.
+  const halfwords = kind === BL ? 2 : 1;
+  if (plainSramFetch(core, pc, halfwords)) {
+    core.slot += halfwords;
+  } else {
+    core.readUint16(pc);
+    if (kind === BL) core.readUint16(pc + 2);
+  }
   const r = core.registers;
   r[15] += 2;
   const low0 = opcode & 7;

@@ -330,26 +330,27 @@ test('lockstep by cycles: two cores counting the same loop take the same cycles,
   for (const core of pico.coreCycles()) assert.equal(core.busy + core.waiting, pico.time);
 });
 
+/** As rp2040-hal's install_stack_guard: trap if the MPU is set up already, then CTRL, RBAR, RASR (32 bytes at `guard`, no access). */
+function installStackGuard(t, guard) {
+  t.ldrConst(1, 0xe000ed94)
+    .ldr(0, 1)
+    .cmpImm(0, 0)
+    .bcc('eq', 'mpu.free')
+    .udf(0)
+    .label('mpu.free')
+    .movsImm(0, 5)
+    .str(0, 1)
+    .ldrConst(0, guard | 0x10)
+    .str(0, 1, 8)
+    .ldrConst(0, 1 | (7 << 1) | ((0xff ^ 1) << 8) | 0x10000000)
+    .str(0, 1, 12);
+}
+
 test("rp2040-hal's MPU stack guard on core 1: a store into it ends the run as the stack overflow it is", () => {
   const guard = 0x20018000;
-  const installGuard = (t) => {
-    // As rp2040-hal's install_stack_guard: trap if the MPU is set up already, then CTRL, RBAR, RASR.
-    t.ldrConst(1, 0xe000ed94)
-      .ldr(0, 1)
-      .cmpImm(0, 0)
-      .bcc('eq', 'mpu.free')
-      .udf(0)
-      .label('mpu.free')
-      .movsImm(0, 5)
-      .str(0, 1)
-      .ldrConst(0, guard | 0x10)
-      .str(0, 1, 8)
-      .ldrConst(0, 1 | (7 << 1) | ((0xff ^ 1) << 8) | 0x10000000)
-      .str(0, 1, 12);
-  };
   const { pico, records } = launching({
     core1: (t) => {
-      installGuard(t);
+      installStackGuard(t, guard);
       t.ldrConst(1, guard + 0x20).str(0, 1).inline(record, 0); // just above the guard: fine
       t.ldrConst(1, guard + 0x1c).str(0, 1); // into it
       halt(t);
@@ -360,6 +361,21 @@ test("rp2040-hal's MPU stack guard on core 1: a store into it ends the run as th
     /core 1 overflowed its stack: a store to 0x2001801c hit its MPU guard \(0x20018000-0x20018020, no access\)/,
   );
   assert.equal(values(records, 1).length, 1);
+});
+
+test('code in SRAM runs beside the MPU guard, and a fetch from inside the guard is a fault', () => {
+  const guard = 0x20018000;
+  const { pico, records } = launching({
+    core1: (t) => {
+      installStackGuard(t, guard);
+      t.ldrConst(2, (guard + 0x20) | 1).blx(2).inline(record, 0); // code just above the guard: runs
+      t.ldrConst(2, (guard + 0x1c) | 1).blx(2); // code inside it
+      halt(t);
+    },
+    sram: { [guard + 0x1c]: (t) => t.movsImm(0, 7).bxLr(), [guard + 0x20]: (t) => t.movsImm(0, 9).bxLr() },
+  });
+  assert.throws(() => pico.run({ maxSeconds: 1 }), /core 1: a load from 0x2001801c is a fault in MPU region 0x20018000-0x20018020 \(no access\)/);
+  assert.deepEqual(values(records, 1), [9]);
 });
 
 test('a fault, an endless loop or a breakpoint on core 1 ends the run naming core 1', () => {
