@@ -245,7 +245,7 @@ function striped(address) {
  * (the fabric arbitrates the fetch's word, armv6m.mjs); else (flash, the
  * ROM, a fault to raise, or a core without this bus) the fetch is the
  * bus's own read. Half of all reads are fetches: made through the bus,
- * they took a quarter of the emulator's time.
+ * they took about a tenth of the emulator's time.
  */
 export function plainSramFetch(core, pc, halfwords) {
   const sram = core.sramFetch;
