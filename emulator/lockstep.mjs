@@ -280,7 +280,7 @@ export class Lockstep {
    * profiler takes on a board, a little slower to run.
    */
   startProfile() {
-    this.profile = new Profiler(this.cores, this.functions);
+    this.profile = new Profiler(this.cores, this.functions, this.waiting);
     this.checkEvery = SAMPLE_EVERY;
     // Started mid-run (from a frame's end): the running stretch ends after
     // this instruction, so the next one counts to its checks at the new pace.
@@ -294,7 +294,7 @@ export class Lockstep {
 
   check(maxNanos, onProgress) {
     if (this.profile) {
-      this.profile.sample(this.cores);
+      this.profile.sample(this.cores, this.waiting);
       if (this.profile.samples & SAMPLES_PER_CHECK) return;
     }
     for (let k = 0; k < 2; k++) {

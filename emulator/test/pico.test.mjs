@@ -148,3 +148,34 @@ test('a profile charges each function the cycles spent in it', () => {
   assert.ok(Math.abs(most.cycles - 3 * 60000) < 1000, `${most.cycles}`);
   assert.ok(next.cycles >= 3 * 20000 && next.cycles < 3 * 20000 + 8000, `${next.cycles}`);
 });
+
+test('a profile charges no function the cycles a core slept', () => {
+  // Core 0 sleeps in WFI until SysTick's count from 0xffffff runs out
+  // (16.8 M cycles), then spins 60,000 times in another function.
+  const second = CORE0_CODE + 0x200;
+  const handler = FLASH + 0x2000;
+  const image = flashImage({
+    vectors: { 15: handler },
+    programs: {
+      [CORE0_CODE]: (t) => {
+        t.ldrConst(1, 0xe000e010).ldrConst(0, 1000).str(0, 1, 4).movsImm(0, 7).str(0, 1).wfi();
+        t.ldrConst(1, second | 1).blx(1);
+      },
+      [second]: (t) => halt(delay(t, 60000)),
+      [handler]: (t) => t.ldrConst(1, 0xe000e010).movsImm(0, 0).str(0, 1).bxLr(),
+    },
+  });
+  const functions = [
+    { name: '_ZN4demo5first17h0123456789abcdefE', address: CORE0_CODE, size: 0x100 },
+    { name: '_ZN4demo6second17h0123456789abcdefE', address: second, size: 0x100 },
+  ];
+  const { pico } = machine(image, { functions });
+  pico.startProfile();
+  assert.equal(pico.run({ maxSeconds: 20 }), 'idle');
+  assert.ok(pico.coreCycles()[0].waiting > 0xffffff - 1000, 'core 0 slept');
+  const charged = new Map(pico.profileReport(4).map(({ name, cycles }) => [name, cycles]));
+  // As above, a sample's stretch may reach back over the call.
+  const spun = charged.get('demo::second');
+  assert.ok(spun >= 3 * 60000 && spun < 3 * 60000 + 8000, `${spun}`);
+  assert.ok((charged.get('demo::first') ?? 0) < 8000, `the sleep charged to demo::first: ${charged.get('demo::first')}`);
+});
