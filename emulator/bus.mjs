@@ -94,8 +94,7 @@ export function installBus(core, index, { rp2040, xip, sio, ppb, fabric }) {
   };
   // An SRAM address the MPU forbids: a load from a no-access granule, a store to any restricted one.
   const checkLoad = (address) => {
-    const map = ppb.mpuMap;
-    if (map !== null && map[(address - SRAM_BASE) >>> MPU_GRANULE_BITS] === MPU_NO_ACCESS) mpuFault(address, false);
+    if (loadForbidden(ppb, address)) mpuFault(address, false);
   };
   const checkStore = (address) => {
     const map = ppb.mpuMap;
@@ -250,11 +249,14 @@ function striped(address) {
 export function plainSramFetch(core, pc, halfwords) {
   const sram = core.sramFetch;
   if (sram === undefined || pc < SRAM_BASE || pc + 2 * halfwords > sram.end) return false;
-  const map = sram.ppb.mpuMap;
-  if (map === null) return true;
-  const first = (pc - SRAM_BASE) >>> MPU_GRANULE_BITS;
-  const last = (pc + 2 * halfwords - 1 - SRAM_BASE) >>> MPU_GRANULE_BITS;
-  return map[first] !== MPU_NO_ACCESS && map[last] !== MPU_NO_ACCESS;
+  // Each halfword as the bus's read would check it.
+  return !loadForbidden(sram.ppb, pc) && (halfwords === 1 || !loadForbidden(sram.ppb, pc + 2));
+}
+
+/** Whether the MPU of `ppb` forbids a load from the SRAM address `address` (a no-access granule). */
+function loadForbidden(ppb, address) {
+  const map = ppb.mpuMap;
+  return map !== null && map[(address - SRAM_BASE) >>> MPU_GRANULE_BITS] === MPU_NO_ACCESS;
 }
 
 /**
