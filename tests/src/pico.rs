@@ -121,7 +121,10 @@ pub fn build(build: &Build<'_>) -> Result<PathBuf, String> {
     // The template's .cargo/config.toml (target, linker script) is found
     // from the working directory.
     cargo.current_dir(template.dir());
-    cargo.args(["build", "--release", "--quiet"]).arg("--target-dir").arg(&dir);
+    // Only the embedded-scene binary: the ST7789's live firmware embeds no
+    // scene, and rebuilding it for each scene would cost a whole-program
+    // build and replace the ELF the live board's cases may be starting.
+    cargo.args(["build", "--release", "--quiet", "--bin", template.binary()]).arg("--target-dir").arg(&dir);
     for var in [
         "CARGO_TARGET_DIR",
         "RUSTFLAGS",
