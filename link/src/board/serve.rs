@@ -73,6 +73,12 @@ pub const KEEP_ALIVE_US: u64 = 40_000;
 /// pixels are a few tens of KiB a second on a Pico).
 pub const SLOWEST_HOST_BYTES_PER_SECOND: u64 = 16 * 1024;
 
+/// The longest one wait for room in the line lasts ([`Line::wait_for_room`]):
+/// a millisecond, so that a board whose wake-up on the host's taking is
+/// held back (its input full, its USB interrupt masked) still looks at
+/// the line a thousand times a second, 64 KiB a second in USB packets.
+const ROOM_WAIT_US: u64 = 1_000;
+
 /// The board's serial line and the little else of its hardware the loop
 /// needs: what a firmware implements (over its USB serial port's rings, on
 /// a Pico), and a test or fuzz target on a host.
@@ -95,6 +101,15 @@ pub trait Line {
     /// come (a firmware's `wfi`, its watchdog paused), or returns at once.
     /// False when no byte will ever come (a host's test, at its end).
     fn sleep(&mut self) -> bool;
+
+    /// [`Line::write`] had no room: waits until the host may have taken
+    /// some bytes or sent some, for at most `at_most_us` microseconds (the
+    /// loop then looks at its clock again), so that a firmware sleeps
+    /// (`wfi`) instead of spinning while a host is slow or not reading. By
+    /// default returns at once.
+    fn wait_for_room(&mut self, at_most_us: u64) {
+        let _ = at_most_us;
+    }
 
     /// The board is at work: called each time a drawing reads the line (at
     /// most every [`POLL_PERIOD_US`]), at every piece of an answer written
@@ -613,6 +628,9 @@ impl<L: Line> Output<'_, L> {
             }
             self.line.alive();
             while_waiting(self.line);
+            // A host taking bytes wakes the line at once; one that reads
+            // nothing lets it sleep until the allowance is spent.
+            self.line.wait_for_room((allowed - self.waited_us).clamp(1, ROOM_WAIT_US));
         }
     }
 }
@@ -688,6 +706,8 @@ mod tests {
         /// How often the board took its counts: each count is that number
         /// times ten, plus the counter's index.
         counts_taken: u32,
+        /// Each wait for room the board made: how long it let the line sleep.
+        waits_for_room: Vec<u64>,
     }
 
     impl Wire {
@@ -703,6 +723,7 @@ mod tests {
                 clock_us: 0,
                 taken_at_us: 0,
                 counts_taken: 0,
+                waits_for_room: Vec::new(),
             }
         }
 
@@ -801,6 +822,12 @@ mod tests {
 
         fn alive(&mut self) {
             self.polls += 1;
+        }
+
+        fn wait_for_room(&mut self, at_most_us: u64) {
+            // Nothing wakes the board early: it sleeps all it may.
+            self.waits_for_room.push(at_most_us);
+            self.clock_us += at_most_us;
         }
 
         fn counter_names(&self) -> &'static [&'static str] {
@@ -911,6 +938,10 @@ mod tests {
         assert!(wire.ring.is_empty(), "what waited for the host is dropped");
         // Waited a second, not a second a row.
         assert!(wire.clock_us < STALL_GRACE_US + 100_000, "{} µs", wire.clock_us);
+        // Most of it asleep, a millisecond at most at a time, not spinning.
+        let waits = &wire.waits_for_room;
+        assert!(waits.iter().all(|&us| (1..=ROOM_WAIT_US).contains(&us)), "{waits:?}");
+        assert!(waits.iter().sum::<u64>() > STALL_GRACE_US * 9 / 10, "{waits:?}");
         // The host reads again, and asks.
         wire.bytes_per_second = None;
         wire.send(wire.polls, Message::Hello, 2);

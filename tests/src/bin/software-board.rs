@@ -327,7 +327,6 @@ impl Line for Pty {
 
     fn write(&mut self, bytes: &[u8]) -> usize {
         if self.controls.hold.load(Ordering::Relaxed) {
-            self.controls.waiting(|| std::thread::sleep(Duration::from_millis(1)));
             return 0;
         }
         // Non-blocking: a full terminal takes nothing.
@@ -336,13 +335,17 @@ impl Line for Pty {
                 self.controls.last_out.store(self.controls.now_us(), Ordering::Relaxed);
                 n
             }
-            Err(e) if e.kind() == ErrorKind::WouldBlock => {
-                self.controls.waiting(|| std::thread::sleep(Duration::from_millis(1)));
-                0
-            }
+            Err(e) if e.kind() == ErrorKind::WouldBlock => 0,
             // No host has the terminal open: what it would get is lost.
             Err(_) => bytes.len(),
         }
+    }
+
+    fn wait_for_room(&mut self, at_most_us: u64) {
+        // The terminal says nothing when it has room again: a look a
+        // millisecond at most, as a board's USB interrupt would wake it.
+        let wait = Duration::from_micros(at_most_us.min(1_000));
+        self.controls.waiting(|| std::thread::sleep(wait));
     }
 
     fn discard(&mut self) {

@@ -39,6 +39,7 @@ use octrace_core::{ConstStaticCell, Raytracer, RendererRoom};
 use octrace_link::board::{Line, Link, Ring};
 use octrace_link::{Panel, PixelFormat};
 use octrace_pico::animation::{self, Runs};
+use octrace_pico::sleep::Nap;
 use octrace_pico::{board, both_cores};
 use octrace_pico_st7789::measure::{self, Meter};
 use octrace_pico_st7789::panel;
@@ -117,7 +118,7 @@ const WATCHDOG_US: u32 = 8_000_000;
 
 #[entry]
 fn main() -> ! {
-    let board::Board { mut core1, pins, clocks, timer, watchdog, mut resets, peripherals } =
+    let board::Board { mut core1, pins, clocks, mut timer, watchdog, mut resets, peripherals } =
         board::start(CORE1_STACK.take().unwrap());
     let (mut display, _) = panel::init(peripherals.spi1, pins, &mut resets, &clocks, timer, PANEL_BUFFER.take());
 
@@ -141,7 +142,9 @@ fn main() -> ! {
     }
     let raytracer = RAYTRACER.take();
     let room = CORE1_ROOM.take();
-    let mut line = UsbLine { timer, watchdog, meter: Meter::new(timer, peripherals.busctrl) };
+    // Alarm 3, free again once the panel's set-up has slept.
+    let nap = Nap::new(&mut timer).expect("the timer's alarm 3 is free after the panel's set-up");
+    let mut line = UsbLine { timer, watchdog, meter: Meter::new(timer, peripherals.busctrl), nap };
     loop {
         link.serve(&mut line, raytracer, |drawing, rows| {
             let rows = RefCell::new(rows);
@@ -237,6 +240,7 @@ struct UsbLine {
     timer: Timer,
     watchdog: Watchdog,
     meter: Meter,
+    nap: Nap,
 }
 
 impl Line for UsbLine {
@@ -276,6 +280,13 @@ impl Line for UsbLine {
         unsafe { cortex_m::interrupt::enable() };
         self.watchdog.start(hal::fugit::MicrosDurationU32::micros(WATCHDOG_US));
         true
+    }
+
+    fn wait_for_room(&mut self, at_most_us: u64) {
+        // The USB interrupt wakes the core when the host takes a packet
+        // (or sends one); the alarm when the wait is over.
+        let full = || critical_section::with(|cs| OUTPUT.borrow_ref(cs).room() == 0);
+        self.nap.at_most(u32::try_from(at_most_us).unwrap_or(u32::MAX), full);
     }
 
     fn alive(&mut self) {
