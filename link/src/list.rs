@@ -128,10 +128,18 @@ wire_list! {
 pub struct Counter<'a> {
     /// The event counted.
     pub name: &'a str,
-    /// Its count over the load (parse and index), saturated at `u32::MAX`.
+    /// Its count over the load (parse and index); [`Counter::RAN_OVER`]
+    /// for a count that ran over.
     pub load: u32,
-    /// Its count over the render.
+    /// Its count over the render, likewise.
     pub render: u32,
+}
+
+impl Counter<'_> {
+    /// A count that ran over: more events than the board could count (its
+    /// counter filled, or the count passed 32 bits), never a smaller
+    /// number in its place.
+    pub const RAN_OVER: u32 = u32::MAX;
 }
 
 wire_list! {

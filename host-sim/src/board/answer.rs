@@ -6,7 +6,7 @@
 //! characters escaped ([`shown`]).
 
 use crate::terminal::shown;
-use octrace_link::{Panel, Timing};
+use octrace_link::{Counter, Panel, Timing};
 use std::time::Duration;
 
 /// What a board says it is.
@@ -84,8 +84,15 @@ impl BoardTiming {
             parts.push(format!("load {}, render {}", seconds(load), seconds(render)));
         }
         if !self.counters.is_empty() {
-            let counters: Vec<_> =
-                self.counters.iter().map(|(name, load, render)| format!("{name} {load} + {render}")).collect();
+            let count = |n: u32| match n {
+                Counter::RAN_OVER => "(ran over)".to_string(),
+                n => n.to_string(),
+            };
+            let counters: Vec<_> = self
+                .counters
+                .iter()
+                .map(|&(ref name, load, render)| format!("{name} {} + {}", count(load), count(render)))
+                .collect();
             parts.push(counters.join(", "));
         }
         if !parts.is_empty() {
@@ -135,4 +142,25 @@ pub enum Progress<'a> {
     /// The board is still working, though it sent nothing else for a
     /// while: `elapsed` into the request by its clock, if it has one.
     Working { elapsed: Option<Duration> },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_count_that_ran_over_is_said_so_and_not_shown_as_a_number() {
+        let ms = Duration::from_millis;
+        let timing = BoardTiming {
+            elapsed: Some(ms(1850)),
+            load: Some(ms(11)),
+            render: Some(ms(1839)),
+            counters: vec![("sram0_contested".into(), 12, Counter::RAN_OVER), ("sram1_contested".into(), 0, 3456)],
+        };
+        assert_eq!(
+            timing.describe(Duration::ZERO),
+            "in 1.850 s by its clock (load 0.011 s, render 1.839 s; \
+             sram0_contested 12 + (ran over), sram1_contested 0 + 3456)"
+        );
+    }
 }

@@ -291,6 +291,8 @@ impl Line for UsbLine {
 
     fn alive(&mut self) {
         self.watchdog.feed();
+        // At least every millisecond while drawing: the counts never run over.
+        self.meter.fold();
     }
 
     fn counter_names(&self) -> &'static [&'static str] {
