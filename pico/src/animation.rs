@@ -1,6 +1,6 @@
 //! Both cores play an animation (a scene with `FRAMES` and `MOVE`) in a
 //! loop: each frame is loaded, then only the tiles its motion can change
-//! are traced again (octrace-core's [`Coherence`]) and only their runs of
+//! are traced again (octrace-core's [`Coherence`](octrace_core::animation::Coherence)) and only their runs of
 //! pixels drawn, so the panel shows each frame exactly as if drawn whole.
 //! Any panel's colour ([`TracedColor`]): a truecolour panel gets each
 //! pixel converted; a panel of few levels gets ordered (Bayer) dithering,

@@ -5,8 +5,8 @@
 //!
 //! Invariants: the conversation with the board (hello, the scene, its
 //! whole answer) goes on while the board moves it on and ends when it
-//! stops doing so ([`patience`]), or at `--timeout` if given, and what the
-//! board says is checked as [`link`] says; the picture takes memory only as its rows
+//! stops doing so (`patience`), or at `--timeout` if given, and what the
+//! board says is checked as `link` says; the picture takes memory only as its rows
 //! arrive, never for a size the board only claims; `--check` passes only
 //! when every pixel of the panel was compared and each is host-sim's.
 

@@ -1,6 +1,8 @@
 //! octrace's benchmarks: prints the Markdown tables of BENCHMARKS.md.
 //!
-//!     cargo run --release -p host-sim --bin octrace-bench -- [TABLE…]
+//! ```text
+//! cargo run --release -p host-sim --bin octrace-bench -- [TABLE…]
+//! ```
 //!
 //! Tables: `scenes` (every scene, naive), `table51` (the thesis's Table 5.1),
 //! `table52` (Table 5.2), `scaling` (random spheres, N = 10 … 100,000),
