@@ -20,8 +20,9 @@ use rp2040_hal::{pac, Timer};
 /// The counters' events, in BUSCTRL's names: SRAM0 to SRAM3's contested accesses.
 pub const EVENTS: [&str; 4] = ["sram0_contested", "sram1_contested", "sram2_contested", "sram3_contested"];
 
-/// A [`Span`]'s count that ran over: more accesses than it can say.
-pub const RAN_OVER: u32 = u32::MAX;
+/// A [`Span`]'s count that ran over: more accesses than it can say (the
+/// board protocol's own mark, which the live firmware sends as it is).
+pub const RAN_OVER: u32 = octrace_link::Counter::RAN_OVER;
 
 /// What a counter holds once full: it counts no further.
 const COUNTER_FULL: u32 = (1 << 24) - 1;
