@@ -342,10 +342,9 @@ impl Line for Pty {
     }
 
     fn wait_for_room(&mut self, at_most_us: u64) {
-        // The terminal says nothing when it has room again: a look a
-        // millisecond at most, as a board's USB interrupt would wake it.
-        let wait = Duration::from_micros(at_most_us.min(1_000));
-        self.controls.waiting(|| std::thread::sleep(wait));
+        // The terminal says nothing when it has room again: all the wait
+        // the loop allows (a millisecond at most), then a look.
+        self.controls.waiting(|| std::thread::sleep(Duration::from_micros(at_most_us)));
     }
 
     fn discard(&mut self) {
