@@ -175,16 +175,23 @@ impl Segment {
     }
 }
 
-/// A track's objects through the loop: their box at frame 0 (a sphere's
-/// is its centre ± its radius, and then its own test is used at each
+/// A track's objects through the loop: their box at frame 0, for a
+/// sphere its centre and radius there (its own test is then used at each
 /// frame), the box holding them in every frame, and their displacement at
 /// each frame (from frame 0), whose keys cut the loop into monotone
 /// stretches.
 pub(crate) struct Sweep<'m> {
     pub first: [[i32; 3]; 2],
-    pub sphere: bool,
+    pub sphere: Option<([i32; 3], i32)>,
     pub swept: [[i32; 3]; 2],
     pub path: Path<'m>,
+}
+
+/// The centre and (rounded up) radius of the sphere whose box is `[lo, hi]`:
+/// the box is the centre ± the radius, exactly.
+pub(crate) fn sphere_in([lo, hi]: [[i32; 3]; 2]) -> ([i32; 3], i32) {
+    let center = [0, 1, 2].map(|a| lo[a] / 2 + hi[a] / 2 + (lo[a] % 2 + hi[a] % 2) / 2);
+    (center, hi[0] / 2 - lo[0] / 2 + 1)
 }
 
 impl Sweep<'_> {
@@ -196,13 +203,8 @@ impl Sweep<'_> {
     /// A sphere's centre when displaced by `d` and its radius, if the
     /// track is one.
     fn sphere_at(&self, d: [i32; 3]) -> Option<([i32; 3], i32)> {
-        if !self.sphere {
-            return None;
-        }
-        let [lo, hi] = self.first;
-        // The box is the centre ± the radius, exactly.
-        let center = [0, 1, 2].map(|a| (lo[a] / 2 + hi[a] / 2 + (lo[a] % 2 + hi[a] % 2) / 2).saturating_add(d[a]));
-        Some((center, hi[0] / 2 - lo[0] / 2 + 1))
+        let (center, radius) = self.sphere?;
+        Some(([0, 1, 2].map(|a| center[a].saturating_add(d[a])), radius))
     }
 
     /// Whether `segment` comes near the objects at frame `frame`.
@@ -297,7 +299,7 @@ impl Sweep<'_> {
         let mut stack: heapless::Vec<(u32, u32), 64> = heapless::Vec::new();
         let _ = stack.push((ta, tb));
         while let Some((ta, tb)) = stack.pop() {
-            if self.sphere && tb - ta < SCANNED_STEPS {
+            if self.sphere.is_some() && tb - ta < SCANNED_STEPS {
                 if let Some(t) = (ta..=tb).find(|&t| self.meets_displaced(segment, key.after(t))) {
                     return Some(frame_of(t));
                 }

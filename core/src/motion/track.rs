@@ -12,7 +12,7 @@
 //! last, the loop's jump).
 
 use super::path::{write_keys, Key, Path};
-use super::sweep::Sweep;
+use super::sweep::{sphere_in, Sweep};
 use crate::parse::{MotionSink, Moved, Mover};
 use crate::scene::Frames;
 
@@ -162,7 +162,8 @@ impl<'s> Motion<'s> {
     /// How the objects of `track` sweep through the loop, for the tracker.
     pub(crate) fn sweep<'m>(&'m self, track: &'m Track) -> Sweep<'m> {
         let path = Path { keys: self.keys_of(track), frames: self.frames.count, kept: (self.frame, track.now) };
-        Sweep { first: track.first, sphere: track.sphere, swept: track.swept, path }
+        let sphere = track.sphere.then(|| sphere_in(track.first));
+        Sweep { first: track.first, sphere, swept: track.swept, path }
     }
 }
 
