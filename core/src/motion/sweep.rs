@@ -47,6 +47,15 @@ fn cell(v: i64) -> i32 {
     ((v + (1 << (GRID_BITS - 1))) >> GRID_BITS) as i32
 }
 
+/// [`cell`] of a 32-bit coordinate (an object's place) in 32-bit steps:
+/// the floor of `v / 2^GRID_BITS`, plus one when the bit below it is set,
+/// is `v + 2^(GRID_BITS − 1)` rounded down, without its overflow. Cells
+/// of these are within 2^13.
+#[inline]
+fn cell_of_i32(v: i32) -> i32 {
+    (v >> GRID_BITS) + ((v >> (GRID_BITS - 1)) & 1)
+}
+
 /// `u · v` for grid differences (each below 2^15 in magnitude): every
 /// product fits an `i32`, which a Cortex-M0 makes in one instruction
 /// (an `i64` product is a library call there).
@@ -89,13 +98,13 @@ impl Segment {
     /// then by two cells (more than the rounding of the centre and of the
     /// segment's ends moves them apart).
     pub(crate) fn near_sphere(&self, center: [i32; 3], radius: i32) -> bool {
-        let c = center.map(|v| cell(i64::from(v)));
+        let c = center.map(cell_of_i32);
         // Below 2^14 (radii below 2^31), its square below 2^28: one
-        // instruction, in an `i32`.
+        // instruction, in an `i32`; so are the box's sides, `c ± r`
+        // (within 2^15), and the comparisons.
         let r = (radius.saturating_add(WIDENING) >> GRID_BITS) + 3;
         let r2 = i64::from(r * r);
-        let r = i64::from(r);
-        if (0..3).any(|a| i64::from(self.hi[a]) < i64::from(c[a]) - r || i64::from(self.lo[a]) > i64::from(c[a]) + r) {
+        if (0..3).any(|a| self.hi[a] < c[a] - r || self.lo[a] > c[a] + r) {
             return false;
         }
         // Cells are below 2^14: differences below 2^15, their squares and
@@ -119,19 +128,14 @@ impl Segment {
     /// the line, and widened likewise for the ends: any ray the tracer
     /// sends along the segment meets the sphere between its ends.
     pub(crate) fn through_sphere(&self, center: [i32; 3], radius: i32) -> bool {
-        let c = center.map(|v| cell(i64::from(v)));
-        // Both below 2^14, their squares in an `i32`.
+        let c = center.map(cell_of_i32);
+        // Both below 2^14, their squares in an `i32`, as the box's sides.
         let inner = (radius.saturating_sub(4 * WIDENING) >> GRID_BITS) - 4;
         let outer = (radius.saturating_add(4 * WIDENING) >> GRID_BITS) + 5;
         let (inner2, outer2) = (i64::from(inner * inner), i64::from(outer * outer));
-        let inner = i64::from(inner);
         // Passing within `inner` of the centre, the segment's box meets the
         // centre's box of that half-side.
-        if inner <= 0
-            || (0..3).any(|a| {
-                i64::from(self.hi[a]) < i64::from(c[a]) - inner || i64::from(self.lo[a]) > i64::from(c[a]) + inner
-            })
-        {
+        if inner <= 0 || (0..3).any(|a| self.hi[a] < c[a] - inner || self.lo[a] > c[a] + inner) {
             return false;
         }
         let d = [0, 1, 2].map(|a| self.q[a] - self.p[a]);
@@ -331,6 +335,15 @@ mod tests {
 
     fn box_at(c: [i64; 3], half: i64) -> ([i32; 3], [i32; 3]) {
         (c.map(|v| (v - half) as i32), c.map(|v| (v + half) as i32))
+    }
+
+    #[test]
+    fn a_32_bit_coordinates_cell_is_the_wide_rounding() {
+        let mut next = crate::test_rng::seeded(0xce11_0f32);
+        let edges = [i32::MIN, i32::MIN + 1, -(1 << 17) - 1, -(1 << 17), -1, 0, 1, (1 << 17) - 1, 1 << 17, i32::MAX];
+        for v in edges.into_iter().chain((0..100_000).map(|_| next() as i32)) {
+            assert_eq!(cell_of_i32(v), cell(i64::from(v)), "{v}");
+        }
     }
 
     #[test]
