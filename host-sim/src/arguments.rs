@@ -74,19 +74,36 @@ pub(crate) fn output_format(asked: Option<Format>, path: &Path) -> Result<Format
     };
     Format::from_path(path).ok_or_else(|| {
         let names: Vec<&str> = Format::ALL.iter().map(|f| f.name()).collect();
+        let extension = extension.to_string_lossy();
+        let animated = match extension.eq_ignore_ascii_case("gif") {
+            true => " (a GIF is written for a scene with FRAMES)",
+            false => "",
+        };
         CliError::Invalid(format!(
-            "cannot write {}: `.{}` is not a format host-sim writes; it writes {} \
+            "cannot write {}: `.{extension}` is not a format host-sim writes a still image in{animated}; it writes {} \
              (chosen by the extension, or by --format <{}>)",
             path.display(),
-            extension.to_string_lossy(),
             names.join(", "),
             names.join("|"),
         ))
     })
 }
 
+/// Refuses an image path `out` that names the scene file `scene` (itself,
+/// through `..` or through a link): writing it would destroy the scene.
+pub(crate) fn not_the_scene(scene: &Path, out: &Path) -> Result<(), CliError> {
+    if !same_file(scene, out) {
+        return Ok(());
+    }
+    let through = match out == scene {
+        true => String::new(),
+        false => format!(" (which {} names)", out.display()),
+    };
+    Err(CliError::Invalid(format!("refusing to overwrite the scene file {}{through} with the image", scene.display())))
+}
+
 /// Whether two paths name the same existing file.
-pub(crate) fn same_file(a: &Path, b: &Path) -> bool {
+fn same_file(a: &Path, b: &Path) -> bool {
     match (a.canonicalize(), b.canonicalize()) {
         (Ok(x), Ok(y)) => x == y,
         _ => false,

@@ -1,8 +1,8 @@
 //! The `host-sim` command line.
 
 use crate::animation::{animate, is_frame_file, merge_frames, AnimationOptions, Request};
+use crate::arguments::{not_the_scene, parse_size};
 use crate::arguments::{output_format, parse_accel, parse_color, parse_dithering, parse_format, parse_palette};
-use crate::arguments::{parse_size, same_file};
 use crate::options::{all_cores, Partition, RenderOptions};
 use crate::output::{panel_preview, write_atomically, FileSink};
 use crate::parts::{self, MergeError, PartInfo, PartSpec};
@@ -337,7 +337,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         Some(Command::Convert { input, output, format }) => return convert(input, output, *format),
         Some(Command::Merge { output, parts, format }) => {
             return match parts.first().is_some_and(|p| is_frame_file(p)) {
-                true => merge_frames(output, parts),
+                true => merge_frames(output, parts, *format),
                 false => merge(output, parts, *format),
             }
         }
@@ -392,19 +392,16 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
             panels.join("|")
         )));
     }
-    if same_file(scene_path, &out) {
-        return Err(CliError::Invalid(format!(
-            "refusing to overwrite the scene file {} with the image",
-            out.display()
-        )));
-    }
+    not_the_scene(scene_path, &out)?;
     let options = |(w, h)| RenderOptions {
         size: Some((w, h)),
         accel: args.accel,
         octree: OctreeConfig { max_objects: args.max_objects, max_depth: args.max_depth, ..crate::OCTREE },
         threads: args.threads.map_or_else(all_cores, |n| n as usize),
         partition: args.partition,
-        stop: None,
+        // Ctrl-C stops a render before its next ray, a still's or an
+        // animation's frame's, and the run leaves no file (exit 130).
+        stop: Some(ctrl_c()),
     };
     let raster = scene.view().settings.raster;
     let (w, h) = args.size.unwrap_or((raster[0], raster[1]));
@@ -436,9 +433,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         None => (0..h, None),
     };
     let started = Instant::now();
-    // Ctrl-C stops a still before its next ray (an animation's frames are
-    // each written whole, and Ctrl-C ends it as any program).
-    let options = RenderOptions { stop: Some(ctrl_c()), ..options((w, h)) };
+    let options = options((w, h));
     if previewed(args.color) {
         return preview(&mut scene, &options, args, format, &out, stderr);
     }
@@ -503,7 +498,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         }
         let _ = writeln!(
             stderr,
-            "{w}x{h}{} in {:.3} s ({}, {} thread{}, tracing {:.3} s): {} rays, {} shadow rays, {} cells{} -> {}",
+            "{w}x{h}{} in {:.3} s ({}, {} thread{}, tracing {:.3} s{}): {} rays, {} shadow rays, {} cells{} -> {}",
             match args.part {
                 Some(_) => format!(" rows {}..{}", rows.start, rows.end),
                 None => String::new(),
@@ -513,6 +508,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
             options.threads,
             if options.threads == 1 { "" } else { "s" },
             rendered.tracing().as_secs_f64(),
+            if options.threads == 1 { "" } else { " summed over the threads" },
             stats.rays,
             stats.shadow_rays,
             stats.cells,

@@ -382,6 +382,8 @@ fn animation_errors_name_the_place_and_leave_no_file() {
         (&["anim.txt", "x.tga"][..], "--frame K renders one frame"),
         (&["anim.txt", "x.png", "--frame", "8"][..], "has 8 frames, 0 to 7"),
         (&["anim.txt", "x.gif", "--part", "1/2"][..], "--part splits an animation's frames"),
+        (&["anim.txt", "x.gif", "--format", "tga"][..], "is written as an animated GIF"),
+        (&["anim.txt", "x.png", "--format", "ras"][..], "is written as an APNG"),
     ] {
         let (code, err) = host_sim(d, args);
         assert_eq!(code, 2, "{args:?}: {err}");
@@ -396,8 +398,9 @@ fn animation_errors_name_the_place_and_leave_no_file() {
         assert_eq!(code, 2, "{err}");
         // ORIGIN reaches VIEWPOINT within a unit of rounding: no view, or
         // one along UPVECTOR. Found as frame 0 loads, which checks every
-        // frame's camera before any is drawn.
-        assert!(err.contains("lost.txt:9:19: at frame 6, ") && err.contains("(frame 0); nothing rendered"), "{err}");
+        // frame's camera before any is drawn (the message names the frame,
+        // the summary no other).
+        assert!(err.contains("lost.txt:9:19: at frame 6, ") && err.contains("in lost.txt; nothing rendered"), "{err}");
     }
     let mut after = files(d);
     after.retain(|f| f != "lost.txt");

@@ -230,7 +230,16 @@ fn an_output_extension_it_does_not_write_is_refused() {
     let imagefile = dir.path().join("i.txt");
     std::fs::write(&imagefile, format!("IMAGEFILE \"{}\" {SURF}", dir.path().join("x.gif").display())).unwrap();
     let (code, err) = run_args(&[imagefile.as_os_str()]);
-    assert_eq!((code, err.contains("`.gif` is not a format host-sim writes")), (2, true), "{err}");
+    assert_eq!(
+        (
+            code,
+            err.contains(
+                "`.gif` is not a format host-sim writes a still image in (a GIF is written for a scene with FRAMES)"
+            )
+        ),
+        (2, true),
+        "{err}"
+    );
     let png = dir.path().join("a.png");
     assert_eq!(run_args(&[scene.as_os_str(), png.as_os_str()]).0, 0);
     let gif = dir.path().join("a.gif");

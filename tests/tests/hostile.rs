@@ -806,7 +806,10 @@ fn row18_output_equal_to_the_scene_is_refused() {
     for out in [scene.clone(), dir.path().join("sub/../s.txt"), link.clone()] {
         let (code, err) = host_sim(&[scene.as_os_str(), out.as_os_str()]);
         assert_eq!(code, 2, "{}: {err}", out.display());
-        assert!(err.contains("host-sim: refusing to overwrite the scene file"), "{err}");
+        // The scene is named, and the path that led to it.
+        let named = format!("refusing to overwrite the scene file {}", scene.display());
+        assert!(err.contains(&named), "{err}");
+        assert_eq!(err.contains(&format!("(which {} names)", out.display())), out != scene, "{err}");
         assert_eq!(std::fs::read_to_string(&scene).unwrap(), text);
         assert_eq!(listing(dir.path()), ["link.png", "s.txt", "sub"]);
     }

@@ -12,14 +12,31 @@ const HOST_SIM: &str = env!("CARGO_BIN_EXE_host-sim-cli");
 
 #[test]
 fn ctrl_c_ends_a_render_of_seconds_a_pixel_at_once_and_leaves_no_file() {
+    ctrl_c_ends(&wedging_scene(8), "wedge.png", &[]);
+}
+
+#[test]
+fn ctrl_c_ends_an_animations_frame_at_once_and_leaves_no_file() {
+    let animation = format!("FRAMES 3\n{}", wedging_scene(8));
+    // A frame of its tiles (the coherence's), and a frame traced whole.
+    ctrl_c_ends(&animation, "wedge.gif", &[]);
+    ctrl_c_ends(&animation, "wedge.png", &["--no-coherence"]);
+}
+
+/// Renders `scene` to `out` (with `args`) and sends Ctrl-C once its
+/// temporary file is there and it is inside its first pixels: it must end
+/// at once with exit code 130, saying nothing was written, and leave no
+/// file.
+fn ctrl_c_ends(scene_text: &str, out: &str, args: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("wedge.txt");
-    std::fs::write(&scene, wedging_scene(8)).unwrap();
-    let out = dir.path().join("wedge.png");
+    std::fs::write(&scene, scene_text).unwrap();
+    let out = dir.path().join(out);
     let mut child = Command::new(HOST_SIM)
         .arg(&scene)
         .arg(&out)
         .args(["--quiet", "--threads", "2"])
+        .args(args)
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
@@ -48,5 +65,5 @@ fn ctrl_c_ends_a_render_of_seconds_a_pixel_at_once_and_leaves_no_file() {
     assert_eq!(status.code(), Some(host_sim::cli::EXIT_STOPPED), "{status:?}: {stderr}");
     assert!(stderr.contains("host-sim: stopped (Ctrl-C); nothing written"), "{stderr}");
     assert!(elapsed < Duration::from_millis(500), "ended {elapsed:?} after Ctrl-C");
-    assert_eq!(entries(), ["wedge.txt"], "no image and no temporary file left");
+    assert_eq!(entries(), ["wedge.txt"], "{}: no image and no temporary file left", out.display());
 }

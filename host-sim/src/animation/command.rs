@@ -39,7 +39,7 @@ pub struct Request<'a> {
 
 /// Renders the animation `request` asks for and writes it.
 pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliError> {
-    let output = Output::of(request.out).map_err(CliError::Invalid)?;
+    let output = Output::of(request.out, request.format).map_err(CliError::Invalid)?;
     let frames = request.frames;
     let palette =
         match (&output, request.palette) {
@@ -83,10 +83,11 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
     let name = request.scene_path.display().to_string();
     let scene_error = |e: AnimationError| match e {
         AnimationError::Scene { frame, errors } => CliError::Scene {
-            file: format!("{name} (frame {frame})"),
+            file: frame.map_or_else(|| name.clone(), |frame| format!("{name} (frame {frame})")),
             errors: errors.into_iter().map(|e| format!("{name}:{e}")).collect(),
         },
         AnimationError::Setup(message) => CliError::Invalid(message),
+        AnimationError::Stopped => CliError::Stopped,
         AnimationError::Write(e) => CliError::write(request.out, e),
     };
     let mut outcome: Option<Result<AnimationReport, AnimationError>> = None;
@@ -226,9 +227,9 @@ pub fn is_frame_file(path: &Path) -> bool {
 /// `host-sim merge OUT FRAMES…`: frame files rendered apart, assembled into
 /// the animation `output` names, bit for bit what a render straight to it
 /// writes.
-pub fn merge_frames(output: &Path, files: &[PathBuf]) -> Result<(), CliError> {
+pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) -> Result<(), CliError> {
     let refuse = |message: String| CliError::Invalid(format!("merge: {message}; nothing written"));
-    let kind = Output::of(output).map_err(refuse)?;
+    let kind = Output::of(output, format).map_err(refuse)?;
     let mut found: Vec<(FrameInfo, Image)> = Vec::new();
     for path in files {
         let name = path.display();

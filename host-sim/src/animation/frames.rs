@@ -19,7 +19,7 @@ use octrace_core::animation::{AnimationNeeds, HostAnimationRoom};
 use octrace_core::profile::Host;
 use octrace_core::render::PixelSample;
 use octrace_core::shade::Stats;
-use octrace_core::{AnimationError as Refused, Frame, RendererRoom};
+use octrace_core::{AnimationError as Refused, DrawError, Frame, RendererRoom};
 use octrace_images::{RgbImage, SampleImage, NO_OBJECT};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -65,13 +65,17 @@ pub struct AnimationReport {
 /// Why frames could not be rendered.
 #[derive(Debug)]
 pub enum AnimationError {
-    /// The scene has errors at this frame, each `line:col: message`.
-    Scene { frame: u32, errors: Vec<String> },
+    /// The scene has errors at this frame (`None`: found by the check of
+    /// every frame's camera, each message naming its frame), each
+    /// `line:col: message`.
+    Scene { frame: Option<u32>, errors: Vec<String> },
     /// The camera cannot be set up for the size asked, or the animation's
     /// room not made: the message says why.
     Setup(String),
     /// The frames' writer failed.
     Write(std::io::Error),
+    /// The render's stop was set (Ctrl-C): nothing more was traced.
+    Stopped,
 }
 
 /// How to render an animation's frames.
@@ -100,7 +104,7 @@ pub fn render_frames(
     // animation loaded whole once, every frame checked.
     let raster = match load_frame_bytes("", bytes, frames.start, &mut scene) {
         Ok(_) => scene.view().settings.raster,
-        Err(LoadError::Scene(errors)) => return Err(AnimationError::Scene { frame: frames.start, errors }),
+        Err(LoadError::Scene(errors)) => return Err(AnimationError::Scene { frame: Some(frames.start), errors }),
         Err(LoadError::Io(e)) => return Err(AnimationError::Setup(e.to_string())),
     };
     let (w, h) = options.render.size.unwrap_or((raster[0], raster[1]));
@@ -111,11 +115,14 @@ pub fn render_frames(
     let mut errors = Vec::new();
     match animation.load_with(scene.raytracer(), bytes, &mut |e| errors.push(e.to_string())) {
         Ok(first) => first.scene().view().check_camera(w, h).map_err(|e| AnimationError::Setup(e.to_string()))?,
-        Err(Refused::Scene(_)) => return Err(AnimationError::Scene { frame: 0, errors }),
+        Err(Refused::Scene(_)) => return Err(AnimationError::Scene { frame: None, errors }),
         Err(Refused::NoRoom(e)) => return Err(AnimationError::Setup(e.to_string())),
     }
     let mut current: Option<FrameImage> = None;
     for frame in frames {
+        if options.render.stop.is_some_and(|stop| stop.load(Ordering::Relaxed)) {
+            return Err(AnimationError::Stopped);
+        }
         let started = Instant::now();
         let image = current.get_or_insert_with(|| FrameImage {
             image: RgbImage::new(w, h),
@@ -125,7 +132,7 @@ pub fn render_frames(
         let stats = match options.coherence {
             true => {
                 let loaded = animation.load(scene.raytracer(), text, frame).map_err(|e| match e {
-                    Refused::Scene(e) => AnimationError::Scene { frame, errors: vec![e.to_string()] },
+                    Refused::Scene(e) => AnimationError::Scene { frame: Some(frame), errors: vec![e.to_string()] },
                     Refused::NoRoom(e) => AnimationError::Setup(e.to_string()),
                 })?;
                 report.loading += started.elapsed();
@@ -133,7 +140,7 @@ pub fn render_frames(
                 // The first frame can differ anywhere.
                 image.retraced = (report.frames > 0).then(|| loaded.tiles().traced_areas().map(area).collect());
                 report.traced += loaded.tiles().traced_pixels();
-                let stats = draw_frame(&loaded, image, options.render.threads, progress);
+                let stats = draw_frame(&loaded, image, &options.render, progress).ok_or(AnimationError::Stopped)?;
                 report.tracing += traced.elapsed();
                 if report.frames == 0 {
                     report.first_tracing = traced.elapsed();
@@ -143,7 +150,7 @@ pub fn render_frames(
             // Every frame whole, as a still: no watching of the motion.
             false => {
                 load_frame_bytes("", bytes, frame, &mut scene).map_err(|e| match e {
-                    LoadError::Scene(errors) => AnimationError::Scene { frame, errors },
+                    LoadError::Scene(errors) => AnimationError::Scene { frame: Some(frame), errors },
                     LoadError::Io(e) => AnimationError::Setup(e.to_string()),
                 })?;
                 let indexed = scene.index(&options.render);
@@ -163,7 +170,7 @@ pub fn render_frames(
                     Ok((stats, _, _)) => stats,
                     Err(StreamError::Camera(e)) => return Err(AnimationError::Setup(e.to_string())),
                     Err(StreamError::Sink(e)) => return Err(AnimationError::Write(e)),
-                    Err(StreamError::Stopped) => return Err(AnimationError::Setup("stopped".into())),
+                    Err(StreamError::Stopped) => return Err(AnimationError::Stopped),
                 }
             }
         };
@@ -193,15 +200,17 @@ impl RowSink for Whole<'_> {
     }
 }
 
-/// Draws `frame`'s planned tiles into `image` on `threads` threads, each
-/// drawing the next band of tiles not yet taken with a renderer of its
-/// own (as a board's cores do); `progress(pixels)` after each band.
+/// Draws `frame`'s planned tiles into `image` on `options.threads`
+/// threads, each drawing the next band of tiles not yet taken with a
+/// renderer of its own (as a board's cores do); `progress(pixels)` after
+/// each band. `None` once `options.stop` is set: each thread stops before
+/// its next ray.
 fn draw_frame(
     frame: &Frame<'_, '_, Host>,
     image: &mut FrameImage,
-    threads: usize,
+    options: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
-) -> Stats {
+) -> Option<Stats> {
     let (shared, tiles) = (frame.share(), frame.tiles());
     let (width, side) = (image.image.width as usize, tiles.side() as usize);
     // Each band's rows, written by the thread that draws it.
@@ -227,13 +236,23 @@ fn draw_frame(
             band
         };
         let mut target = Bands { bands: &bands, width, side, size: tiles.size() };
-        shared.image::<PixelSample>(&room, tiles.size()).bands(&take).try_draw(&mut target).unwrap_or_default()
+        let image = shared.image::<PixelSample>(&room, tiles.size()).bands(&take);
+        match options.stop {
+            Some(stop) => image.try_draw_until(&mut target, &mut || stop.load(Ordering::Relaxed)),
+            None => image.try_draw(&mut target),
+        }
     };
-    let mut stats = Stats::default();
+    let mut stats = Some(Stats::default());
     std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..threads.max(1)).map(|_| scope.spawn(worker)).collect();
+        let handles: Vec<_> = (0..options.threads.max(1)).map(|_| scope.spawn(worker)).collect();
         for handle in handles {
-            stats.add(&handle.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)));
+            match handle.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)) {
+                Ok(drawn) => stats.iter_mut().for_each(|s| s.add(&drawn)),
+                Err(DrawError::Stopped) => stats = None,
+                // The camera was checked before the first frame, and the
+                // bands' target never fails.
+                Err(_) => {}
+            }
         }
     });
     stats

@@ -27,18 +27,30 @@ pub enum Output {
 }
 
 impl Output {
-    /// The output `path` names, or why it names none.
-    pub fn of(path: &Path) -> Result<Output, String> {
+    /// The output `path` names, written in `format` (`--format`, which
+    /// only frame files choose: a GIF is a GIF, an APNG a PNG), or why it
+    /// names none.
+    pub fn of(path: &Path, format: Option<Format>) -> Result<Output, String> {
         let text = path.to_string_lossy();
         if text.contains('%') {
             return FramePattern::parse(&text).map(Output::Files);
         }
-        match path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).as_deref() {
-            Some("gif") => Ok(Output::Gif),
-            Some("png") => Ok(Output::Apng),
-            _ => Err(format!(
-                "{text}: an animation is written as an animated GIF (.gif), an APNG (.png) or one file a frame \
+        let output = match path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).as_deref() {
+            Some("gif") => Output::Gif,
+            Some("png") => Output::Apng,
+            _ => {
+                return Err(format!(
+                    "{text}: an animation is written as an animated GIF (.gif), an APNG (.png) or one file a frame \
                  (a name with %d, such as 'frames/f%04d.png'); --frame K renders one frame as a still image"
+                ))
+            }
+        };
+        match (format, &output) {
+            (None | Some(Format::Png), Output::Apng) | (None, _) => Ok(output),
+            (Some(format), _) => Err(format!(
+                "--format {}: {text} is written as {}; --format chooses the format of frame files (a name with %d)",
+                format.name(),
+                if output == Output::Gif { "an animated GIF" } else { "an APNG" }
             )),
         }
     }
@@ -174,9 +186,14 @@ mod tests {
         for bad in ["f%4d.png", "f%d%d.png", "f%x.png", "f%%.png", "f%0.png"] {
             assert!(FramePattern::parse(bad).is_err(), "{bad}");
         }
-        assert_eq!(Output::of(Path::new("a.gif")), Ok(Output::Gif));
-        assert_eq!(Output::of(Path::new("a.PNG")), Ok(Output::Apng));
-        assert!(Output::of(Path::new("a.tga")).unwrap_err().contains("--frame K"));
+        assert_eq!(Output::of(Path::new("a.gif"), None), Ok(Output::Gif));
+        assert_eq!(Output::of(Path::new("a.PNG"), None), Ok(Output::Apng));
+        assert!(Output::of(Path::new("a.tga"), None).unwrap_err().contains("--frame K"));
+        // --format chooses frame files' format; an animation's is its own.
+        assert_eq!(Output::of(Path::new("a.png"), Some(Format::Png)), Ok(Output::Apng));
+        assert!(Output::of(Path::new("a.gif"), Some(Format::Tga)).unwrap_err().contains("animated GIF"));
+        assert!(Output::of(Path::new("a.png"), Some(Format::Tga)).unwrap_err().contains("an APNG"));
+        assert!(matches!(Output::of(Path::new("f%d.tga"), Some(Format::Tga)), Ok(Output::Files(_))));
     }
 
     #[test]

@@ -20,7 +20,7 @@ pub use link::{BoardLink, LinkError};
 pub use patience::{LOADING, SILENCE};
 pub use port::{Port, SerialLine};
 
-use crate::arguments::{output_format, parse_format, same_file};
+use crate::arguments::{not_the_scene, output_format, parse_format};
 use crate::exit::CliError;
 use crate::output::panel_preview;
 use crate::terminal::progress_bar;
@@ -155,12 +155,7 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
     }
     // OUT's format, known before the board is asked.
     out.map(|out| output_format(args.format, out)).transpose()?;
-    if let Some(out) = out.filter(|out| same_file(scene, out)) {
-        return Err(CliError::Invalid(format!(
-            "refusing to overwrite the scene file {} with the image",
-            out.display()
-        )));
-    }
+    out.map(|out| not_the_scene(scene, out)).transpose()?;
     let text = std::fs::read(scene).map_err(|e| CliError::read(scene, e))?;
     let file = scene.display().to_string();
     let pixels = out.is_some() || args.check;

@@ -69,8 +69,12 @@ pub fn read(bytes: &[u8]) -> Result<Image, FormatError> {
     } else if bytes.starts_with(&sun_raster::MAGIC.to_be_bytes()) {
         sun_raster::read(bytes)?
     } else {
-        // Targa files have no signature.
-        targa::read(bytes)?
+        // Targa files have no signature: what is not one is no image of
+        // these formats.
+        targa::read(bytes).map_err(|e| match e {
+            FormatError::Io(e) => FormatError::Io(e),
+            e => FormatError::Unsupported(format!("not a PNG, Targa or Sun raster image (as a Targa file: {e})")),
+        })?
     };
     check(&image)?;
     Ok(image)
@@ -135,17 +139,20 @@ pub(crate) mod tests {
     #[test]
     fn malformed_files_give_errors() {
         let message = |bytes: &[u8]| read(bytes).unwrap_err().to_string();
-        assert_eq!(message(&[]), "truncated Targa header");
+        // A file without a PNG's or Sun raster's signature is read as a Targa file.
+        let as_targa = |detail: &str| format!("not a PNG, Targa or Sun raster image (as a Targa file: {detail})");
+        assert_eq!(message(&[]), as_targa("truncated Targa header"));
+        assert_eq!(message(b"GIF89a, a GIF of some kind"), as_targa("Targa image type 70 is not supported"));
         assert_eq!(message(&sun_raster::MAGIC.to_be_bytes()), "truncated Sun raster header");
         assert_eq!(message(png::SIGNATURE), "truncated PNG file");
         let mut tga = encode(&rgb(3, 2), Format::Tga);
         tga[2] = 3;
-        assert_eq!(message(&tga), "Targa image type 3 is not supported");
+        assert_eq!(message(&tga), as_targa("Targa image type 3 is not supported"));
         tga[2] = 2;
         tga[12..16].copy_from_slice(&[0xff; 4]);
-        assert_eq!(message(&tga), "truncated Targa pixels");
+        assert_eq!(message(&tga), as_targa("truncated Targa pixels"));
         tga[2] = 10;
-        assert_eq!(message(&tga), "truncated Targa run-length data");
+        assert_eq!(message(&tga), as_targa("truncated Targa run-length data"));
 
         let mut ras = encode(&indexed(3, 2, 12), Format::Ras);
         ras[32 + 36 + 1] = 12;

@@ -84,9 +84,13 @@ pub(super) fn read(bytes: &[u8]) -> Result<Image, FormatError> {
     let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
     let header = decoder.read_header_info().map_err(decoding_error)?;
     let (width, height) = (header.width, header.height);
+    // An 8-bit gray file (what `write_gray` writes) is read as indices
+    // into the 256 grays.
+    let gray = (header.color_type, header.bit_depth) == (png::ColorType::Grayscale, png::BitDepth::Eight);
     let bits = match (header.color_type, header.bit_depth) {
         (png::ColorType::Rgb, png::BitDepth::Eight) => 24,
         (png::ColorType::Indexed, depth) => depth as u64,
+        _ if gray => 8,
         (colour, depth) => {
             return unsupported(format!("PNG files of {colour:?} colour at {} bits are not supported", depth as u8))
         }
@@ -97,8 +101,10 @@ pub(super) fn read(bytes: &[u8]) -> Result<Image, FormatError> {
         return invalid(format!("a {width}×{height} PNG image cannot fit in {} bytes", bytes.len()));
     }
     let mut reader = decoder.read_info().map_err(decoding_error)?;
-    let palette: Option<Vec<[u8; 3]>> =
-        reader.info().palette.as_ref().map(|p| p.chunks_exact(3).map(|e| [e[0], e[1], e[2]]).collect());
+    let palette: Option<Vec<[u8; 3]>> = match gray {
+        true => Some((0..=255).map(|g| [g; 3]).collect()),
+        false => reader.info().palette.as_ref().map(|p| p.chunks_exact(3).map(|e| [e[0], e[1], e[2]]).collect()),
+    };
     let size = reader.output_buffer_size().ok_or_else(|| FormatError::Invalid("PNG image too large".into()))?;
     let mut buffer = vec![0; size];
     let frame = reader.next_frame(&mut buffer).map_err(decoding_error)?;
@@ -181,5 +187,17 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_gray_png_reads_back_as_indices_into_the_grays() {
+        let grays = [0, 17, 34, 255, 128, 1];
+        let mut bytes = Vec::new();
+        write_gray(3, 2, &grays, &mut bytes).unwrap();
+        let Image::Indexed { width: 3, height: 2, palette, indices } = read(&bytes).unwrap() else {
+            panic!("a gray PNG is read as an indexed image");
+        };
+        assert_eq!(indices, grays);
+        assert!(palette.iter().enumerate().all(|(g, entry)| *entry == [g as u8; 3]) && palette.len() == 256);
     }
 }
