@@ -133,10 +133,9 @@ impl<'m> Lookout<'m> {
     /// stays while a moving sphere surely blocks it).
     fn segment(&mut self, segment: &Segment, shadow: bool) {
         for track in self.motion.tracks_of(Target::Objects) {
-            let sweep = self.motion.sweep(track);
-            if !sweep.ever_meets(segment) {
+            let Some(sweep) = self.motion.sweep_near(track, segment) else {
                 continue;
-            }
+            };
             let clean = if shadow && sweep.blocks_at(segment, self.frame) {
                 // Blocked now, surely: blocked, whatever else moves, until
                 // the first frame the sphere may let it through.

@@ -181,13 +181,11 @@ impl Segment {
 
 /// A track's objects through the loop: their box at frame 0, for a
 /// sphere its centre and radius there (its own test is then used at each
-/// frame), the box holding them in every frame, and their displacement at
-/// each frame (from frame 0), whose keys cut the loop into monotone
-/// stretches.
+/// frame), and their displacement at each frame (from frame 0), whose
+/// keys cut the loop into monotone stretches.
 pub(crate) struct Sweep<'m> {
     pub first: [[i32; 3]; 2],
     pub sphere: Option<([i32; 3], i32)>,
-    pub swept: [[i32; 3]; 2],
     pub path: Path<'m>,
 }
 
@@ -199,11 +197,6 @@ pub(crate) fn sphere_in([lo, hi]: [[i32; 3]; 2]) -> ([i32; 3], i32) {
 }
 
 impl Sweep<'_> {
-    /// Whether `segment` comes near the objects in some frame.
-    pub(crate) fn ever_meets(&self, segment: &Segment) -> bool {
-        segment.meets(self.swept[0], self.swept[1])
-    }
-
     /// A sphere's centre when displaced by `d` and its radius, if the
     /// track is one.
     fn sphere_at(&self, d: [i32; 3]) -> Option<([i32; 3], i32)> {

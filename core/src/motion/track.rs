@@ -12,7 +12,7 @@
 //! last, the loop's jump).
 
 use super::path::{write_keys, Key, Path};
-use super::sweep::{sphere_in, Sweep};
+use super::sweep::{sphere_in, Segment, Sweep};
 use crate::parse::{MotionSink, Moved, Mover};
 use crate::scene::Frames;
 
@@ -42,8 +42,11 @@ pub(crate) struct Track {
     keys: (u32, u32),
     /// Objects: their box at frame 0 (normalised raw units).
     first: [[i32; 3]; 2],
-    /// Objects: a single sphere (tested as one, not as its box).
-    sphere: bool,
+    /// Objects: a single sphere's centre at frame 0 and its radius (as
+    /// [`sphere_in`] makes them from `first`), tested as one, not as its
+    /// box; a radius of 0: not a sphere (a sphere's is at least 1).
+    center: [i32; 3],
+    radius: i32,
     /// Objects: the box holding them in every frame.
     swept: [[i32; 3]; 2],
     /// Objects: their displacement at the motion's frame.
@@ -61,7 +64,8 @@ impl Track {
         target: Target::Camera,
         keys: (0, 0),
         first: [[0; 3]; 2],
-        sphere: false,
+        center: [0; 3],
+        radius: 0,
         swept: [[0; 3]; 2],
         now: [0; 3],
     };
@@ -159,11 +163,16 @@ impl<'s> Motion<'s> {
         self.tracks_of(target).map(|t| self.next_change(t, frame)).min().unwrap_or(NEVER)
     }
 
-    /// How the objects of `track` sweep through the loop, for the tracker.
-    pub(crate) fn sweep<'m>(&'m self, track: &'m Track) -> Sweep<'m> {
+    /// How the objects of `track` sweep through the loop, for the tracker,
+    /// if `segment` comes near them in some frame (`None`: it never does,
+    /// told from the box they sweep, the test most segments end at).
+    pub(crate) fn sweep_near<'m>(&'m self, track: &'m Track, segment: &Segment) -> Option<Sweep<'m>> {
+        if !segment.meets(track.swept[0], track.swept[1]) {
+            return None;
+        }
         let path = Path { keys: self.keys_of(track), frames: self.frames.count, kept: (self.frame, track.now) };
-        let sphere = track.sphere.then(|| sphere_in(track.first));
-        Sweep { first: track.first, sphere, swept: track.swept, path }
+        let sphere = (track.radius > 0).then_some((track.center, track.radius));
+        Some(Sweep { first: track.first, sphere, path })
     }
 }
 
@@ -216,7 +225,10 @@ impl MotionSink for Recorder<'_> {
                     swept[1][a] = swept[1][a].max(hi[a].saturating_add(at[a]));
                 }
             }
-            (track.first, track.swept, track.sphere) = ([lo, hi], swept, objects.sphere);
+            (track.first, track.swept) = ([lo, hi], swept);
+            if objects.sphere {
+                (track.center, track.radius) = sphere_in(track.first);
+            }
         }
         if let Some(slot) = self.tracks.get_mut(self.track_count) {
             *slot = track;
