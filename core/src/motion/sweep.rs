@@ -148,8 +148,12 @@ impl Segment {
     /// Whether the segment comes near the raw box `[lo, hi]`: on the grid,
     /// the box widened and rounded outward, then by a whole cell.
     pub(crate) fn meets(&self, lo: [i32; 3], hi: [i32; 3]) -> bool {
-        let lo = lo.map(|v| ((v.saturating_sub(WIDENING)) >> GRID_BITS) - 1);
-        let hi = hi.map(|v| ((v.saturating_add(WIDENING)) >> GRID_BITS) + 2);
+        self.meets_grid(&GridBox::around([lo, hi]))
+    }
+
+    /// [`Segment::meets`] for a box already on the grid.
+    pub(crate) fn meets_grid(&self, grid: &GridBox) -> bool {
+        let (lo, hi) = (grid.lo, grid.hi);
         if (0..3).any(|a| self.hi[a] < lo[a] || self.lo[a] > hi[a]) {
             return false;
         }
@@ -177,6 +181,27 @@ impl Segment {
         }
         true
     }
+}
+
+/// A raw box on the grid as [`Segment::meets`] takes it: widened and
+/// rounded outward, then by a whole cell. All zero bits for a `const`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct GridBox {
+    lo: [i32; 3],
+    hi: [i32; 3],
+}
+
+impl GridBox {
+    /// The raw box `[lo, hi]` on the grid.
+    pub(crate) fn around([lo, hi]: [[i32; 3]; 2]) -> GridBox {
+        GridBox {
+            lo: lo.map(|v| ((v.saturating_sub(WIDENING)) >> GRID_BITS) - 1),
+            hi: hi.map(|v| ((v.saturating_add(WIDENING)) >> GRID_BITS) + 2),
+        }
+    }
+
+    /// A placeholder to fill storage with.
+    pub(crate) const EMPTY: GridBox = GridBox { lo: [0; 3], hi: [0; 3] };
 }
 
 /// A track's objects through the loop: their box at frame 0, for a

@@ -6,13 +6,13 @@
 //! Invariants: a track's keys say where its objects stand at every frame
 //! relative to frame 0, exactly as the parser places them ([`Path`]);
 //! `first` is the objects' box at frame 0 and `swept` the box holding them
-//! in every frame; `now` is their displacement at the frame the motion was
+//! in every frame (on the tracker's grid); `now` is their displacement at the frame the motion was
 //! last set to ([`Motion::at_frame`]); a key's `changes` says whether its
 //! displacement differs from the key before it (the first key: from the
 //! last, the loop's jump).
 
 use super::path::{write_keys, Key, Path};
-use super::sweep::{sphere_in, Segment, Sweep};
+use super::sweep::{sphere_in, GridBox, Segment, Sweep};
 use crate::parse::{MotionSink, Moved, Mover};
 use crate::scene::Frames;
 
@@ -47,8 +47,9 @@ pub(crate) struct Track {
     /// box; a radius of 0: not a sphere (a sphere's is at least 1).
     center: [i32; 3],
     radius: i32,
-    /// Objects: the box holding them in every frame.
-    swept: [[i32; 3]; 2],
+    /// Objects: the box holding them in every frame, on the tracker's grid
+    /// (made once: every segment of every traced pixel is tested on it).
+    swept: GridBox,
     /// Objects: their displacement at the motion's frame.
     now: [i32; 3],
 }
@@ -66,7 +67,7 @@ impl Track {
         first: [[0; 3]; 2],
         center: [0; 3],
         radius: 0,
-        swept: [[0; 3]; 2],
+        swept: GridBox::EMPTY,
         now: [0; 3],
     };
 }
@@ -167,7 +168,7 @@ impl<'s> Motion<'s> {
     /// if `segment` comes near them in some frame (`None`: it never does,
     /// told from the box they sweep, the test most segments end at).
     pub(crate) fn sweep_near<'m>(&'m self, track: &'m Track, segment: &Segment) -> Option<Sweep<'m>> {
-        if !segment.meets(track.swept[0], track.swept[1]) {
+        if !segment.meets_grid(&track.swept) {
             return None;
         }
         let path = Path { keys: self.keys_of(track), frames: self.frames.count, kept: (self.frame, track.now) };
@@ -225,7 +226,7 @@ impl MotionSink for Recorder<'_> {
                     swept[1][a] = swept[1][a].max(hi[a].saturating_add(at[a]));
                 }
             }
-            (track.first, track.swept) = ([lo, hi], swept);
+            (track.first, track.swept) = ([lo, hi], GridBox::around(swept));
             if objects.sphere {
                 (track.center, track.radius) = sphere_in(track.first);
             }
