@@ -338,8 +338,9 @@ fn into_io(e: FormatError) -> std::io::Error {
     }
 }
 
-/// Writes `path` through a temporary file in the same directory, renamed into
-/// place only when `write` succeeds; on failure no file is left behind.
+/// Writes `path` through a temporary file in the same directory
+/// ([`temporary_beside`]), renamed into place only when `write` succeeds
+/// ([`replace_with`]); on failure no file is left behind.
 pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
@@ -349,18 +350,13 @@ pub fn write_atomically(
     if std::fs::metadata(path).is_ok_and(|m| m.permissions().readonly()) {
         return Err(std::io::Error::new(std::io::ErrorKind::PermissionDenied, "the file is read-only"));
     }
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::InvalidInput, "the output path names no file"))?;
-    let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
+    let (tmp, file) = temporary_beside(path)?;
     let result = (|| {
-        let file = std::fs::File::create(&tmp)?;
         let mut w = std::io::BufWriter::new(file);
         write(&mut w)?;
         w.flush()?;
         w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        std::fs::rename(&tmp, path)
+        replace_with(&tmp, path)
     })();
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
@@ -368,11 +364,100 @@ pub fn write_atomically(
     result
 }
 
+/// A new, empty file beside `path` to write it through: `.NAME.PID.R.tmp`
+/// in its directory, `R` random, created only where nothing is (so never
+/// through a link another user placed there, in a directory they may
+/// write too), with the permissions a new file gets.
+pub(crate) fn temporary_beside(path: &Path) -> std::io::Result<(PathBuf, File)> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::InvalidInput, "the output path names no file"))?
+        .to_string_lossy();
+    create_unguessable(File::options().write(true).create_new(true), || {
+        dir.join(format!(".{name}.{}.{}.tmp", std::process::id(), random_hex()))
+    })
+}
+
+/// A file made with `options` (which create only where nothing is) at the
+/// first of a few of `names()` that is free.
+pub(crate) fn create_unguessable(
+    options: &std::fs::OpenOptions,
+    names: impl Fn() -> PathBuf,
+) -> std::io::Result<(PathBuf, File)> {
+    let mut last = None;
+    for _ in 0..8 {
+        let path = names();
+        match options.open(&path) {
+            Ok(file) => return Ok((path, file)),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => last = Some(e),
+            Err(e) => return Err(e),
+        }
+    }
+    Err(last.unwrap_or_else(|| std::io::Error::other("no new file could be made")))
+}
+
+/// 64 random bits in hex: keys the standard library draws from the
+/// operating system's randomness, a fresh pair each time.
+pub(crate) fn random_hex() -> String {
+    use std::hash::{BuildHasher, Hasher};
+    let mut random = std::collections::hash_map::RandomState::new().build_hasher();
+    random.write_u32(std::process::id());
+    format!("{:016x}", random.finish())
+}
+
+/// Renames the written `tmp` to `path`, giving it first the permissions of
+/// the file it replaces (a private scene stays private).
+pub(crate) fn replace_with(tmp: &Path, path: &Path) -> std::io::Result<()> {
+    if let Ok(replaced) = std::fs::metadata(path) {
+        std::fs::set_permissions(tmp, replaced.permissions())?;
+    }
+    std::fs::rename(tmp, path)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::{RgbImage, RowSink};
     use octrace_images::formats::read;
+
+    /// A directory of its own under the system's temporary one.
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("host-sim-output-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_replaced_file_keeps_its_permissions() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = scratch("mode");
+        let private = dir.join("s.txt");
+        std::fs::write(&private, "old").unwrap();
+        std::fs::set_permissions(&private, std::fs::Permissions::from_mode(0o600)).unwrap();
+        write_atomically(&private, |w| w.write_all(b"new")).unwrap();
+        assert_eq!(std::fs::read(&private).unwrap(), b"new");
+        assert_eq!(std::fs::metadata(&private).unwrap().permissions().mode() & 0o777, 0o600);
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "no temporary file left");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn temporary_files_are_new_and_named_apart() {
+        let dir = scratch("names");
+        let target = dir.join("a.png");
+        let (first, _) = temporary_beside(&target).unwrap();
+        let (second, _) = temporary_beside(&target).unwrap();
+        assert_ne!(first, second);
+        for tmp in [&first, &second] {
+            let name = tmp.file_name().unwrap().to_string_lossy().into_owned();
+            assert!(name.starts_with(".a.png.") && name.ends_with(".tmp"), "{name}");
+            assert_eq!(tmp.parent(), Some(dir.as_path()));
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     /// A gradient with objects in vertical stripes, and what `apply` makes of it.
     fn sample(mode: PaletteMode) -> (RgbImage, Vec<u32>, octrace_images::formats::Image) {

@@ -52,7 +52,13 @@ impl Studio {
     /// `host-sim studio [SCENE] ARGS...`, run in SCENE's directory (so the
     /// page names it as a user would, not by a scratch directory's path).
     fn start_with(scene: Option<&Path>, args: &[&OsStr]) -> Studio {
+        Studio::start_in(scene, args, &[])
+    }
+
+    /// [`Studio::start_with`] with the environment variables `env` set.
+    fn start_in(scene: Option<&Path>, args: &[&OsStr], env: &[(&str, &OsStr)]) -> Studio {
         let mut command = Command::new(HOST_SIM);
+        command.envs(env.iter().copied());
         if let Some(directory) = scene.and_then(Path::parent).filter(|d| !d.as_os_str().is_empty()) {
             command.current_dir(directory);
         }
@@ -531,12 +537,47 @@ fn the_server_keeps_its_security_rules() {
     assert_eq!(http(port, "PUT", &with_token("/secret.txt"), &[("If-Match", "*")], b"x").0, 405);
     assert_eq!(std::fs::read_to_string(dir.path().join("secret.txt")).unwrap(), "secret");
 
+    // A request refused is answered from its head: the body it announces is
+    // never waited for nor held (16 MB announced, none sent, answered at
+    // once; a body read first would have waited 10 s for it and said 400).
+    // A head with a second Host, or token, is refused: the copy checked
+    // could differ from another one read. A HEAD answer has no body.
+    for head in [
+        format!("PUT /scene HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Length: 16000000\r\n\r\n"),
+        format!("GET /scene?{token} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nHost: evil.example\r\n\r\n"),
+        format!(
+            "GET /scene HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nX-Studio-Token: {}\r\nX-Studio-Token: x\r\n\r\n",
+            studio.token
+        ),
+        format!("HEAD /{}/ HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n\r\n", studio.token),
+    ] {
+        let mut stream = std::net::TcpStream::connect(("127.0.0.1", port)).expect("connects");
+        std::io::Write::write_all(&mut stream, head.as_bytes()).expect("sent");
+        let mut answer = Vec::new();
+        std::io::Read::read_to_end(&mut stream, &mut answer).expect("answered");
+        let answer = String::from_utf8_lossy(&answer);
+        let (status_line, body) = answer.split_once("\r\n\r\n").expect("a head");
+        let expected = match head.split(' ').next() {
+            Some("PUT") => "HTTP/1.1 403",
+            Some("HEAD") => "HTTP/1.1 200",
+            _ => "HTTP/1.1 400",
+        };
+        assert!(status_line.starts_with(expected), "{head:?}: {answer}");
+        if head.starts_with("HEAD") {
+            assert!(body.is_empty() && !status_line.contains("Content-Length: 0\r\n"), "{answer}");
+        }
+    }
+
     // Saving: the version loaded, else a conflict; atomically.
     let (status, _) = http(port, "PUT", &with_token("/scene"), &[("If-Match", "\"0000000000000000\"")], b"X");
     assert_eq!(status, 409);
     assert_eq!(std::fs::read_to_string(&scene_path).unwrap(), START);
+    // A private scene stays private.
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&scene_path, std::fs::Permissions::from_mode(0o600)).unwrap();
     assert_eq!(http(port, "PUT", &with_token("/scene"), &[("If-Match", "*")], b"RDEPTH 2\n").0, 200);
     assert_eq!(std::fs::read_to_string(&scene_path).unwrap(), "RDEPTH 2\n");
+    assert_eq!(std::fs::metadata(&scene_path).unwrap().permissions().mode() & 0o777, 0o600);
     let leftovers: Vec<_> =
         std::fs::read_dir(dir.path()).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
     assert_eq!(leftovers.len(), 2, "no temporary file left: {leftovers:?}");
@@ -571,6 +612,45 @@ fn the_server_keeps_its_security_rules() {
     let (status, stderr) = studio.interrupt();
     assert!(status.success(), "{status}: {stderr}");
     assert!(stderr.contains("stopped"), "{stderr}");
+}
+
+/// `--open` has the desktop's opener open a page that sends the browser
+/// on: the token is on no command line (which any user may read), the page
+/// is this user's alone, and it goes once the browser has come.
+#[test]
+fn open_puts_the_token_on_no_command_line() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().expect("a directory");
+    // The opener: what it was given, the page's mode and text.
+    let opener = dir.path().join("xdg-open");
+    let seen = dir.path().join("seen");
+    std::fs::write(
+        &opener,
+        format!(
+            "#!/bin/sh\nprintf '%s\\n' \"$@\" > '{0}/args'\nstat -c %a \"$1\" > '{0}/mode'\ncat \"$1\" > '{0}/page'\ntouch '{1}'\n",
+            dir.path().display(),
+            seen.display()
+        ),
+    )
+    .unwrap();
+    std::fs::set_permissions(&opener, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let path = format!("{}:{}", dir.path().display(), std::env::var("PATH").unwrap_or_default());
+    let studio = Studio::start_in(None, &[OsStr::new("--open")], &[("PATH", OsStr::new(&path))]);
+    let deadline = Instant::now() + HANG_GUARD;
+    while !seen.exists() {
+        assert!(Instant::now() < deadline, "the opener never ran");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let read = |name: &str| std::fs::read_to_string(dir.path().join(name)).expect(name);
+    let (args, page) = (read("args"), read("page"));
+    assert!(!args.contains(&studio.token), "the token on the opener's command line: {args}");
+    assert_eq!(read("mode").trim(), "600", "the page is its user's alone");
+    assert!(page.contains(&studio.url), "the page sends the browser to the address: {page}");
+    // The browser comes: the page goes.
+    let launcher = PathBuf::from(args.trim());
+    assert!(launcher.exists(), "{}", launcher.display());
+    assert_eq!(http(studio.port, "GET", &format!("/?token={}", studio.token), &[], b"").0, 303);
+    assert!(!launcher.exists(), "{} left behind", launcher.display());
 }
 
 #[test]

@@ -11,7 +11,7 @@ use super::frames::{render_frames, AnimationError, AnimationOptions, AnimationRe
 use super::gif::GifWriter;
 use super::writers::{write_frame_file, FrameInfo, Output};
 use crate::exit::CliError;
-use crate::output::write_atomically;
+use crate::output::{replace_with, temporary_beside, write_atomically};
 use crate::parts::{auto_index, band_rows, scene_hash, PartSpec};
 use crate::terminal::progress_bar;
 use octrace_core::scene::Frames;
@@ -144,9 +144,9 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
             let result = render(&mut |k, frame| {
                 let path = pattern.name(k);
                 let shown = palette::apply(&frame.image, &frame.objects, palette);
-                let tmp = temporary(&path);
+                let (tmp, file) = temporary_beside(&path)?;
                 let write = || -> std::io::Result<()> {
-                    let mut file = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
+                    let mut file = std::io::BufWriter::new(file);
                     let info = info(k, frame.image.width, frame.image.height);
                     write_frame_file(&shown, &info, format, &mut file).map_err(into_io)?;
                     file.into_inner().map_err(|e| e.into_error())?.sync_all()
@@ -158,7 +158,7 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
             let mut renamed_paths = Vec::new();
             let renamed = result.and_then(|()| {
                 done.iter().try_for_each(|(tmp, path)| {
-                    std::fs::rename(tmp, path)?;
+                    replace_with(tmp, path)?;
                     renamed_paths.push(path);
                     Ok(())
                 })
@@ -202,13 +202,6 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
         );
     }
     Ok(())
-}
-
-/// A temporary name beside `path`.
-fn temporary(path: &Path) -> PathBuf {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path.file_name().map_or_else(|| "frame".into(), |n| n.to_string_lossy().into_owned());
-    dir.join(format!(".{name}.{}.tmp", std::process::id()))
 }
 
 fn into_io(e: FormatError) -> std::io::Error {

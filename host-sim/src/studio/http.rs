@@ -30,14 +30,20 @@ impl Request {
     }
 }
 
-/// Reads one request; on a malformed or oversized one, the status to
-/// answer with.
-pub(crate) fn read_request(stream: &mut impl Read, max_body: usize) -> Result<Request, u16> {
-    let mut reader = BufReader::new(stream);
+/// Headers a request may give once at most: the ones the security checks
+/// and the body's length are told from (a second copy could say otherwise
+/// than the one checked).
+const SINGLE_HEADERS: [&str; 6] =
+    ["host", "origin", "sec-fetch-site", "x-studio-token", "content-length", "transfer-encoding"];
+
+/// Reads one request's line and headers (its body, if any, is left to
+/// [`read_body`], once the request is admitted); on a malformed or
+/// oversized one, the status to answer with.
+pub(crate) fn read_head(reader: &mut BufReader<impl Read>) -> Result<Request, u16> {
     let mut head = Vec::new();
     loop {
         let before = head.len();
-        let read = (&mut reader)
+        let read = (&mut *reader)
             .take((MAX_HEAD_BYTES + 1 - before) as u64)
             .read_until(b'\n', &mut head)
             .map_err(|_| 400u16)?;
@@ -72,10 +78,20 @@ pub(crate) fn read_request(stream: &mut impl Read, max_body: usize) -> Result<Re
         .filter_map(|pair| pair.split_once('='))
         .map(|(n, v)| (percent_decode(n), percent_decode(v)))
         .collect();
-    let mut request = Request { method: method.to_string(), path: path.to_string(), query, headers, body: Vec::new() };
+    if SINGLE_HEADERS.iter().any(|single| headers.iter().filter(|(name, _)| name == single).count() > 1) {
+        return Err(400);
+    }
+    let request = Request { method: method.to_string(), path: path.to_string(), query, headers, body: Vec::new() };
     if request.header("transfer-encoding").is_some() {
         return Err(411);
     }
+    Ok(request)
+}
+
+/// Reads `request`'s body (by its Content-Length, at most `max_body`
+/// bytes) from `reader`, which read its head; on a malformed or oversized
+/// one, the status to answer with.
+pub(crate) fn read_body(reader: &mut BufReader<impl Read>, request: &mut Request, max_body: usize) -> Result<(), u16> {
     let length = match request.header("content-length") {
         None => 0,
         Some(v) => v.parse::<usize>().map_err(|_| 400u16)?,
@@ -86,7 +102,30 @@ pub(crate) fn read_request(stream: &mut impl Read, max_body: usize) -> Result<Re
     let mut body = vec![0; length];
     reader.read_exact(&mut body).map_err(|_| 400u16)?;
     request.body = body;
-    Ok(request)
+    Ok(())
+}
+
+/// A status's reason phrase.
+pub(crate) fn reason(status: u16) -> &'static str {
+    match status {
+        200 => "OK",
+        303 => "See Other",
+        400 => "Bad Request",
+        403 => "Forbidden",
+        404 => "Not Found",
+        405 => "Method Not Allowed",
+        409 => "Conflict",
+        411 => "Length Required",
+        413 => "Content Too Large",
+        422 => "Unprocessable Content",
+        421 => "Misdirected Request",
+        428 => "Precondition Required",
+        431 => "Request Header Fields Too Large",
+        502 => "Bad Gateway",
+        503 => "Service Unavailable",
+        505 => "HTTP Version Not Supported",
+        _ => "Error",
+    }
 }
 
 fn percent_decode(text: &str) -> String {
@@ -138,26 +177,10 @@ impl Response {
         Response::new(status, "text/plain; charset=utf-8", format!("{message}\n").into_bytes())
     }
 
-    pub(crate) fn write_to(&self, out: &mut impl Write) -> std::io::Result<()> {
-        let reason = match self.status {
-            200 => "OK",
-            303 => "See Other",
-            400 => "Bad Request",
-            403 => "Forbidden",
-            404 => "Not Found",
-            405 => "Method Not Allowed",
-            409 => "Conflict",
-            411 => "Length Required",
-            413 => "Content Too Large",
-            422 => "Unprocessable Content",
-            421 => "Misdirected Request",
-            428 => "Precondition Required",
-            431 => "Request Header Fields Too Large",
-            502 => "Bad Gateway",
-            505 => "HTTP Version Not Supported",
-            _ => "Error",
-        };
-        let mut head = format!("HTTP/1.1 {} {reason}\r\n", self.status);
+    /// Writes the response; `head_only` (a HEAD request): its head alone,
+    /// the body's length still given.
+    pub(crate) fn write_to(&self, out: &mut impl Write, head_only: bool) -> std::io::Result<()> {
+        let mut head = format!("HTTP/1.1 {} {}\r\n", self.status, reason(self.status));
         for (name, value) in &self.headers {
             head.push_str(&format!("{name}: {value}\r\n"));
         }
@@ -173,7 +196,9 @@ impl Response {
             self.body.len()
         ));
         out.write_all(head.as_bytes())?;
-        out.write_all(&self.body)?;
+        if !head_only {
+            out.write_all(&self.body)?;
+        }
         out.flush()
     }
 }
@@ -182,10 +207,18 @@ impl Response {
 mod tests {
     use super::*;
 
+    /// A request's head, then its body, as the studio reads them.
+    fn read_request(mut raw: &[u8], max_body: usize) -> Result<Request, u16> {
+        let mut reader = BufReader::new(&mut raw);
+        let mut request = read_head(&mut reader)?;
+        read_body(&mut reader, &mut request, max_body)?;
+        Ok(request)
+    }
+
     #[test]
     fn requests_are_parsed() {
         let raw = b"PUT /scene?token=a%62c HTTP/1.1\r\nHost: 127.0.0.1:9\r\nContent-Length: 3\r\n\r\nabcdef";
-        let request = read_request(&mut &raw[..], 10).unwrap();
+        let request = read_request(&raw[..], 10).unwrap();
         assert_eq!((request.method.as_str(), request.path.as_str()), ("PUT", "/scene"));
         assert_eq!(request.query("token"), Some("abc"));
         assert_eq!(request.header("host"), Some("127.0.0.1:9"));
@@ -195,11 +228,25 @@ mod tests {
     #[test]
     fn oversized_or_malformed_requests_are_refused() {
         let big = b"PUT / HTTP/1.1\r\nContent-Length: 11\r\n\r\n";
-        assert_eq!(read_request(&mut &big[..], 10).err(), Some(413));
+        assert_eq!(read_request(&big[..], 10).err(), Some(413));
         let long_head = format!("GET / HTTP/1.1\r\nX: {}\r\n\r\n", "a".repeat(MAX_HEAD_BYTES));
-        assert_eq!(read_request(&mut long_head.as_bytes(), 10).err(), Some(431));
-        assert_eq!(read_request(&mut &b"GET /\r\n\r\n"[..], 10).err(), Some(400));
-        assert_eq!(read_request(&mut &b""[..], 10).err(), Some(400));
+        assert_eq!(read_request(long_head.as_bytes(), 10).err(), Some(431));
+        assert_eq!(read_request(&b"GET /\r\n\r\n"[..], 10).err(), Some(400));
+        assert_eq!(read_request(&b""[..], 10).err(), Some(400));
+        // A second Host (or token, or length) could say otherwise than the
+        // one checked: refused.
+        let twice = b"GET / HTTP/1.1\r\nHost: 127.0.0.1:9\r\nhost: evil.com\r\n\r\n";
+        assert_eq!(read_request(&twice[..], 10).err(), Some(400));
+    }
+
+    #[test]
+    fn a_head_answer_has_no_body() {
+        let response = Response::text(200, "hello");
+        let (mut whole, mut head) = (Vec::new(), Vec::new());
+        response.write_to(&mut whole, false).unwrap();
+        response.write_to(&mut head, true).unwrap();
+        assert!(whole.ends_with(b"\r\n\r\nhello\n") && head.ends_with(b"\r\n\r\n"));
+        assert!(String::from_utf8(head).unwrap().contains("Content-Length: 6\r\n"));
     }
 
     #[test]

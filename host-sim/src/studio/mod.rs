@@ -2,7 +2,9 @@
 //! studio page, which runs octrace-core compiled to WebAssembly.
 //!
 //! Invariants (the security rules): the listener is bound to 127.0.0.1
-//! only; a request whose Host is not this address and port is refused (DNS
+//! only, and handles 32 connections at once at most; a request is admitted
+//! from its head alone, its body read only then; a request whose Host is
+//! not this address and port is refused (DNS
 //! rebinding); a request a browser sends for another site's page (its
 //! `Origin` not this server's, or `Sec-Fetch-Site` neither `same-origin`
 //! nor `none`) is refused, and said on stderr; every request carries the
@@ -14,7 +16,8 @@
 //! through `GET`/`PUT /scene`, and every other path is an embedded asset
 //! or 404 — no request path reaches the file system; no `GET` changes
 //! anything; the only serial port opened is the one `--board` names,
-//! through `POST /board`.
+//! through `POST /board`; the token is on no command line (`--open` gives
+//! the desktop's opener a page only this user may read).
 
 mod board;
 mod http;
@@ -24,10 +27,10 @@ use crate::output::write_atomically;
 use crate::terminal::shown;
 use board::BoardSender;
 use http::{Request, Response};
-use std::io::Write;
+use std::io::{BufReader, Read, Write};
 use std::net::{Ipv4Addr, SocketAddr, TcpListener, TcpStream};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -100,6 +103,18 @@ struct Shared {
     saving: Mutex<()>,
     /// The board `--board` names.
     board: Option<BoardSender>,
+    /// The file `--open` had the browser open (see [`open_browser`]),
+    /// until the browser has come.
+    launcher: Mutex<Option<PathBuf>>,
+}
+
+impl Shared {
+    /// Removes the file `--open` gave the browser, if it is still there.
+    fn forget_launcher(&self) {
+        if let Some(path) = self.launcher.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).take() {
+            let _ = std::fs::remove_file(path);
+        }
+    }
 }
 
 /// Runs the studio until Ctrl-C; fails before serving anything if it cannot
@@ -130,6 +145,7 @@ pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) ->
         scene: args.scene.clone(),
         saving: Mutex::new(()),
         board,
+        launcher: Mutex::new(None),
     });
     let _ = writeln!(stdout, "{url}");
     let _ = stdout.flush();
@@ -145,7 +161,7 @@ pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) ->
         let _ = writeln!(stderr, "host-sim studio: \"Send to board\" sends to the board at {}", board.port());
     }
     if args.open {
-        open_browser(&url, stderr);
+        *shared.launcher.lock().unwrap_or_else(|poisoned| poisoned.into_inner()) = open_browser(&url, stderr);
     }
     let stop = Arc::new(AtomicBool::new(false));
     {
@@ -155,6 +171,7 @@ pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) ->
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
     serve(&listener, &shared, &stop);
+    shared.forget_launcher();
     let _ = writeln!(stderr, "host-sim studio: stopped");
     Ok(())
 }
@@ -168,11 +185,20 @@ fn serve(listener: &TcpListener, shared: &Arc<Shared>, stop: &AtomicBool) {
     if listener.set_nonblocking(true).is_err() {
         return;
     }
+    let open = Arc::new(AtomicUsize::new(0));
     while !stop.load(Ordering::SeqCst) {
         match listener.accept() {
+            // Beyond the connections a browser opens at once, closed
+            // unanswered: a local program cannot make the server hold more.
+            Ok((stream, _)) if open.load(Ordering::SeqCst) >= MAX_CONNECTIONS => drop(stream),
             Ok((stream, _)) => {
-                let shared = Arc::clone(shared);
-                std::thread::spawn(move || handle(stream, &shared));
+                let (shared, open) = (Arc::clone(shared), Arc::clone(&open));
+                open.fetch_add(1, Ordering::SeqCst);
+                std::thread::spawn(move || {
+                    // Counted out however the handler ends.
+                    let _counted = Counted(&open);
+                    handle(stream, &shared);
+                });
             }
             Err(_) => std::thread::sleep(Duration::from_millis(20)),
         }
@@ -180,21 +206,74 @@ fn serve(listener: &TcpListener, shared: &Arc<Shared>, stop: &AtomicBool) {
     drop(shared.saving.lock().unwrap_or_else(|poisoned| poisoned.into_inner()));
 }
 
+/// Connections handled at once at most (a browser opens six to a host).
+const MAX_CONNECTIONS: usize = 32;
+
+/// One open connection, counted out when dropped.
+struct Counted<'a>(&'a AtomicUsize);
+
+impl Drop for Counted<'_> {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// Answers one connection's request: its head read and checked first
+/// ([`admit`]), its body read only for a request admitted, so that nobody
+/// without the token makes the server hold more than a head.
 fn handle(stream: TcpStream, shared: &Shared) {
     let _ = stream.set_nonblocking(false);
     let _ = stream.set_read_timeout(Some(Duration::from_secs(10)));
-    let mut stream = stream;
-    let response = match http::read_request(&mut stream, MAX_SCENE_BYTES) {
-        Ok(request) => respond(&request, shared),
-        Err(status) => Response::text(status, "bad request"),
+    let mut reader = BufReader::new(&stream);
+    let (response, head_only) = match http::read_head(&mut reader) {
+        Err(status) => (unreadable(status), false),
+        Ok(mut request) => {
+            let response = match admit(&request, shared) {
+                Err(refusal) => refusal,
+                Ok(route) => match http::read_body(&mut reader, &mut request, MAX_SCENE_BYTES) {
+                    Ok(()) => respond(&request, &route, shared),
+                    Err(status) => unreadable(status),
+                },
+            };
+            (response, request.method == "HEAD")
+        }
     };
-    let _ = response.write_to(&mut stream);
+    let _ = response.write_to(&mut &stream, head_only);
+    // A body left unread (a request refused before it was read) would make
+    // the close a reset, which may cut the answer short at the client:
+    // what is still coming is read and dropped, a little at most.
+    let _ = stream.shutdown(std::net::Shutdown::Write);
+    let _ = stream.set_read_timeout(Some(Duration::from_secs(1)));
+    let _ = std::io::copy(&mut reader.take(DRAINED_BYTES), &mut std::io::sink());
 }
 
-/// The response to `request`: the security checks first, then the route.
-fn respond(request: &Request, shared: &Shared) -> Response {
+/// The most of an unread body dropped before a connection is closed.
+const DRAINED_BYTES: u64 = 1 << 20;
+
+/// The answer to a request that could not be read, saying why.
+fn unreadable(status: u16) -> Response {
+    let why = match status {
+        413 => "the request is too large: a scene may take 16 MiB",
+        431 => "the request's head is too large",
+        411 => "a request's body is sent with Content-Length",
+        505 => "this server speaks HTTP/1.1",
+        _ => "bad request",
+    };
+    Response::text(status, why)
+}
+
+/// Where an admitted request goes: its path without the token (the page
+/// and its assets are under `/TOKEN/`), and whether the token was there.
+struct Route {
+    in_path: bool,
+    path: String,
+}
+
+/// The security checks, on a request's head alone: its route, or the
+/// refusal.
+fn admit(request: &Request, shared: &Shared) -> Result<Route, Response> {
     if !request.header("host").is_some_and(|host| shared.hosts.iter().any(|h| h.eq_ignore_ascii_case(host))) {
-        return Response::text(421, "this server answers only to its own loopback address");
+        return Err(Response::text(421, "this server answers only to its own loopback address"));
     }
     if let Some(site) = another_site(request, shared) {
         // Said, so that the user learns a page tried (its text escaped: it
@@ -205,23 +284,29 @@ fn respond(request: &Request, shared: &Shared) -> Response {
             shown(&request.path),
             shown(&site)
         );
-        return Response::text(403, "this server answers only its own page");
+        return Err(Response::text(403, "this server answers only its own page"));
     }
     // The page and its assets, which the browser loads by address, are
     // under /TOKEN/; every other request names the token itself.
-    let (in_path, route) = match request.path.strip_prefix('/').and_then(|path| path.split_once('/')) {
+    let (in_path, path) = match request.path.strip_prefix('/').and_then(|path| path.split_once('/')) {
         Some((first, _)) if http::same_secret(first, &shared.token) => (true, &request.path[first.len() + 1..]),
         _ => (false, request.path.as_str()),
     };
-    let method = request.method.as_str();
     let named = request.query("token").or_else(|| request.header("x-studio-token"));
     let token_given = named.is_some_and(|t| http::same_secret(t, &shared.token));
-    if !(token_given || (in_path && matches!(method, "GET" | "HEAD"))) {
-        return Response::text(403, "a token is needed: open the address host-sim studio printed");
+    if !(token_given || (in_path && matches!(request.method.as_str(), "GET" | "HEAD"))) {
+        return Err(Response::text(403, "a token is needed: open the address host-sim studio printed"));
     }
-    match (method, route) {
-        // The printed address: the page, under its token.
-        ("GET" | "HEAD", "/") if !in_path => {
+    Ok(Route { in_path, path: path.to_string() })
+}
+
+/// The response to an admitted request.
+fn respond(request: &Request, route: &Route, shared: &Shared) -> Response {
+    match (request.method.as_str(), route.path.as_str()) {
+        // The printed address: the page, under its token (the browser
+        // has it now: the file that led it there goes).
+        ("GET" | "HEAD", "/") if !route.in_path => {
+            shared.forget_launcher();
             let mut response = Response::text(303, "the studio's page");
             response.headers.push(("Location".into(), format!("/{}/", shared.token)));
             response
@@ -233,7 +318,7 @@ fn respond(request: &Request, shared: &Shared) -> Response {
         ("GET" | "HEAD", "/keywords.js") => {
             Response::new(200, "text/javascript; charset=utf-8", keywords_module().into_bytes())
         }
-        ("GET" | "HEAD", _) => match ASSETS.iter().find(|(name, _, _)| *name == route) {
+        ("GET" | "HEAD", route) => match ASSETS.iter().find(|(name, _, _)| *name == route) {
             Some((_, kind, body)) => Response::new(200, kind, body.to_vec()),
             None => Response::text(404, "no such page"),
         },
@@ -363,7 +448,11 @@ fn new_token() -> std::io::Result<String> {
     Ok(bytes.iter().map(|b| format!("{b:02x}")).collect())
 }
 
-fn open_browser(url: &str, stderr: &mut dyn Write) {
+/// Opens `url` in the desktop's browser without putting its token on a
+/// command line (which every user of the machine may read): the browser is
+/// given a page that only this user may read, which sends it on. Returns
+/// that page's path, to remove once the browser has come.
+fn open_browser(url: &str, stderr: &mut dyn Write) -> Option<PathBuf> {
     let opener = if cfg!(target_os = "macos") {
         "open"
     } else if cfg!(windows) {
@@ -371,9 +460,45 @@ fn open_browser(url: &str, stderr: &mut dyn Write) {
     } else {
         "xdg-open"
     };
-    if let Err(e) = std::process::Command::new(opener).arg(url).spawn() {
+    let page = format!(
+        "<!doctype html><meta charset=\"utf-8\"><meta http-equiv=\"refresh\" content=\"0; url={url}\">\
+         <title>octrace studio</title><a href=\"{url}\">octrace studio</a>\n"
+    );
+    let launcher = match private_page(page.as_bytes()) {
+        Ok(path) => path,
+        Err(e) => {
+            let _ = writeln!(
+                stderr,
+                "host-sim studio: cannot write the page for the browser: {e}; open the address above yourself"
+            );
+            return None;
+        }
+    };
+    if let Err(e) = std::process::Command::new(opener).arg(&launcher).spawn() {
         let _ = writeln!(stderr, "host-sim studio: cannot run {opener}: {e}; open the address above yourself");
+        let _ = std::fs::remove_file(&launcher);
+        return None;
     }
+    Some(launcher)
+}
+
+/// A new page in the system's temporary directory holding `contents`,
+/// readable by this user alone from its making.
+fn private_page(contents: &[u8]) -> std::io::Result<PathBuf> {
+    let mut options = std::fs::File::options();
+    options.write(true).create_new(true);
+    #[cfg(unix)]
+    std::os::unix::fs::OpenOptionsExt::mode(&mut options, 0o600);
+    let dir = std::env::temp_dir();
+    let (path, mut file) = crate::output::create_unguessable(&options, || {
+        dir.join(format!("host-sim-studio-{}-{}.html", std::process::id(), crate::output::random_hex()))
+    })?;
+    let written = file.write_all(contents).and_then(|()| file.sync_all());
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&path);
+        return Err(e);
+    }
+    Ok(path)
 }
 
 #[cfg(test)]
