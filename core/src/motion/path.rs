@@ -14,6 +14,8 @@
 //! displacement is between two places of objects in the scene's range, so
 //! within ±2^30, and so is every partial sum here, in an `i32`.
 
+use super::grid::GridBox;
+
 /// Spans shorter than this divide by a multiplication: `⌊y / span⌋ =
 /// (y · ⌈2^24 / span⌉) >> 24` for every `y < span²` (the error `y · e /
 /// 2^24`, `e < span`, stays below `1 / span`; and the product below 2^32).
@@ -22,7 +24,7 @@ const RECIPROCAL_SPANS: u32 = 256;
 /// A key of a moving statement: where it is at a frame, and how it moves
 /// to the next key. Held in an animation's room
 /// ([`AnimationRoom`](crate::animation::AnimationRoom), all zero bits).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Key {
     pub(super) frame: u32,
     /// Whether the displacement differs from the key before (the first
@@ -38,12 +40,24 @@ pub(crate) struct Key {
     span: u32,
     /// `⌈2^24 / span⌉` for a span shorter than [`RECIPROCAL_SPANS`], else 0.
     reciprocal: u32,
+    /// Objects: the box they are in over the span to the next key, on the
+    /// tracker's grid ([`reach_keys`]); a search over the whole stretch
+    /// tests it first.
+    reach: GridBox,
 }
 
 impl Key {
     /// A placeholder to fill storage with (a `const`, for a `static`).
-    pub(crate) const EMPTY: Key =
-        Key { frame: 0, changes: false, at: [0; 3], step: [0; 3], rest: [0; 3], span: 0, reciprocal: 0 };
+    pub(crate) const EMPTY: Key = Key {
+        frame: 0,
+        changes: false,
+        at: [0; 3],
+        step: [0; 3],
+        rest: [0; 3],
+        span: 0,
+        reciprocal: 0,
+        reach: GridBox::EMPTY,
+    };
 
     /// A key at `frame` whose displacement `at` (from frame 0's) moves to
     /// `next`, `span` frames on (`span` 0: the last key).
@@ -59,7 +73,14 @@ impl Key {
             }
         }
         let reciprocal = if span > 0 && span < RECIPROCAL_SPANS { (1u32 << 24).div_ceil(span) } else { 0 };
-        Key { frame, changes, at, step, rest, span, reciprocal }
+        Key { frame, changes, at, step, rest, span, reciprocal, reach: GridBox::EMPTY }
+    }
+
+    /// The objects' box over the span to the next key, on the grid, when
+    /// `ta..=tb` steps after the key are the whole span.
+    #[inline]
+    pub(super) fn reach_over(&self, ta: u32, tb: u32) -> Option<&GridBox> {
+        (ta == 0 && tb == self.span).then_some(&self.reach)
     }
 
     /// Frame `frame` as steps after the key: 0 before it, its span after
@@ -182,6 +203,15 @@ pub(crate) struct Stretch {
     pub from: u32,
     pub to: u32,
     pub key: usize,
+}
+
+/// Sets each of `keys`' reach: the objects whose box is `first` at frame 0,
+/// over the span to the next key, on the grid, as a search would make it
+/// for the whole span ([`Key::within`]).
+pub(crate) fn reach_keys(keys: &mut [Key], first: [[i32; 3]; 2]) {
+    for key in keys {
+        key.reach = GridBox::displaced(first, key.within(0, key.span));
+    }
 }
 
 /// Writes the keys of a statement moved by `values()` (`(frame,

@@ -1,31 +1,21 @@
 //! Where a ray segment meets a moving object: exact integer tests of a
-//! segment against boxes, and the search for the first frame of the loop at
-//! which a track's box meets a segment.
+//! segment against boxes and spheres on the tracker's grid
+//! ([`super::grid`]), and the search for the first frame of the loop at
+//! which a track's objects meet a segment.
 //!
-//! Conservative by construction: coordinates are cut to a coarse grid of
-//! 2^[`GRID_BITS`] raw units with the segment's ends rounded to nearest and
-//! the box rounded outward and widened by a whole cell (more than the
-//! rounding of the ends moves any point of the segment), after a widening
-//! of [`WIDENING`] raw units, more than a hit point strays from its object
-//! plus a shadow ray from its segment (the octree's and the light buffer's
-//! bounds). So "no meeting" means no ray along the segment can meet
-//! anything in the box. On the grid every coordinate is below 2^14 in
-//! magnitude, so the slab test's products fit an `i32`.
+//! Conservative by construction, as the grid is: "no meeting" means no
+//! ray along the segment can meet anything in the box. On the grid every
+//! coordinate is below 2^14 in magnitude, so the slab test's products fit
+//! an `i32`.
 
-/// log2 of the grid's cell, in raw Q16.16 units (4 normalised units: the
-/// scene's range is 2^13 of them each way).
-pub(crate) const GRID_BITS: u32 = 18;
 /// A sphere's search tests ranges of fewer frames than this frame by frame,
 /// by the sphere's own test: below it a range's box, and then its halves',
 /// cost more than the frames' own tests (measured on the Cortex-M0+, the
 /// emulated Pico's anim_fig5_1: 3 against 2 or 6, −2 % a frame, −4 % the
 /// first frame's search of the whole loop, against halving down to one).
 const SCANNED_STEPS: u32 = 3;
-/// How far beyond its bounds an object may be met: the octree's filing
-/// margin and a shadow ray's straying (the light buffer's margin), and a
-/// unit of the end points' own rounding.
-pub(crate) const WIDENING: i32 = (crate::accel::FILING_MARGIN + crate::accel::RAY_SLACK) as i32 + 2;
 
+use super::grid::{cell, cell_of_i32, GridBox, GRID_BITS, WIDENING};
 use super::path::{Path, Stretch};
 use crate::math::{mul_u32_wide, square_u32_wide};
 
@@ -37,23 +27,6 @@ pub(crate) struct Segment {
     /// The segment's own box on the grid, for a quick rejection.
     lo: [i32; 3],
     hi: [i32; 3],
-}
-
-/// A raw coordinate on the grid, rounded to nearest. Raw coordinates are
-/// within 2^32 in magnitude (points in the scene's range, or a miss's far
-/// end 2^31 beyond), so cells are within 2^14.
-#[inline]
-fn cell(v: i64) -> i32 {
-    ((v + (1 << (GRID_BITS - 1))) >> GRID_BITS) as i32
-}
-
-/// [`cell`] of a 32-bit coordinate (an object's place) in 32-bit steps:
-/// the floor of `v / 2^GRID_BITS`, plus one when the bit below it is set,
-/// is `v + 2^(GRID_BITS − 1)` rounded down, without its overflow. Cells
-/// of these are within 2^13.
-#[inline]
-fn cell_of_i32(v: i32) -> i32 {
-    (v >> GRID_BITS) + ((v >> (GRID_BITS - 1)) & 1)
 }
 
 /// `u · v` for grid differences (each below 2^15 in magnitude): every
@@ -145,15 +118,17 @@ impl Segment {
         ww > outer2 && e > outer2 && wd > 0 && wd < dd && within_line(ww, wd, dd, inner2)
     }
 
-    /// Whether the segment comes near the raw box `[lo, hi]`: on the grid,
-    /// the box widened and rounded outward, then by a whole cell.
-    pub(crate) fn meets(&self, lo: [i32; 3], hi: [i32; 3]) -> bool {
+    /// Whether the segment comes near the raw box `[lo, hi]` (for the
+    /// tests: the tracker's boxes are on the grid already).
+    #[cfg(test)]
+    fn meets(&self, lo: [i32; 3], hi: [i32; 3]) -> bool {
         self.meets_grid(&GridBox::around([lo, hi]))
     }
 
-    /// [`Segment::meets`] for a box already on the grid.
+    /// Whether the segment comes near the box `grid`, a raw box on the grid
+    /// (widened and rounded outward, then by a whole cell).
     pub(crate) fn meets_grid(&self, grid: &GridBox) -> bool {
-        let (lo, hi) = (grid.lo, grid.hi);
+        let [lo, hi] = grid.corners();
         if (0..3).any(|a| self.hi[a] < lo[a] || self.lo[a] > hi[a]) {
             return false;
         }
@@ -181,27 +156,6 @@ impl Segment {
         }
         true
     }
-}
-
-/// A raw box on the grid as [`Segment::meets`] takes it: widened and
-/// rounded outward, then by a whole cell. All zero bits for a `const`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct GridBox {
-    lo: [i32; 3],
-    hi: [i32; 3],
-}
-
-impl GridBox {
-    /// The raw box `[lo, hi]` on the grid.
-    pub(crate) fn around([lo, hi]: [[i32; 3]; 2]) -> GridBox {
-        GridBox {
-            lo: lo.map(|v| ((v.saturating_sub(WIDENING)) >> GRID_BITS) - 1),
-            hi: hi.map(|v| ((v.saturating_add(WIDENING)) >> GRID_BITS) + 2),
-        }
-    }
-
-    /// A placeholder to fill storage with.
-    pub(crate) const EMPTY: GridBox = GridBox { lo: [0; 3], hi: [0; 3] };
 }
 
 /// A track's objects through the loop: their box at frame 0, for a
@@ -257,11 +211,8 @@ impl Sweep<'_> {
 
     /// Whether `segment` comes near the objects displaced by any amount
     /// within `lo..=hi` on each axis.
-    fn meets_between(&self, segment: &Segment, (lo, hi): ([i32; 3], [i32; 3])) -> bool {
-        let [first_lo, first_hi] = self.first;
-        let lo = [0, 1, 2].map(|i| first_lo[i].saturating_add(lo[i]));
-        let hi = [0, 1, 2].map(|i| first_hi[i].saturating_add(hi[i]));
-        segment.meets(lo, hi)
+    fn meets_between(&self, segment: &Segment, displacements: ([i32; 3], [i32; 3])) -> bool {
+        segment.meets_grid(&GridBox::displaced(self.first, displacements))
     }
 
     /// The smallest `e` in `1..=limit` such that `segment` comes near the
@@ -317,17 +268,25 @@ impl Sweep<'_> {
         }
         // Moving: a..=b are the key's steps ta..=tb, each a frame.
         let frame_of = |t: u32| a + (t - ta);
+        // The whole stretch: its box on the grid, made once as the motion
+        // was recorded, is the first range's.
+        let mut known_to_meet = match key.reach_over(ta, tb) {
+            Some(reach) if !segment.meets_grid(reach) => return None,
+            Some(_) => true,
+            None => false,
+        };
         // Each step pops one range and pushes two, halving: 2 · 32 levels.
         let mut stack: heapless::Vec<(u32, u32), 64> = heapless::Vec::new();
         let _ = stack.push((ta, tb));
         while let Some((ta, tb)) = stack.pop() {
+            let met = core::mem::take(&mut known_to_meet);
             if self.sphere.is_some() && tb - ta < SCANNED_STEPS {
                 if let Some(t) = (ta..=tb).find(|&t| self.meets_displaced(segment, key.after(t))) {
                     return Some(frame_of(t));
                 }
                 continue;
             }
-            if !self.meets_between(segment, key.within(ta, tb)) {
+            if !met && !self.meets_between(segment, key.within(ta, tb)) {
                 continue;
             }
             if ta == tb {
@@ -353,15 +312,6 @@ mod tests {
 
     fn box_at(c: [i64; 3], half: i64) -> ([i32; 3], [i32; 3]) {
         (c.map(|v| (v - half) as i32), c.map(|v| (v + half) as i32))
-    }
-
-    #[test]
-    fn a_32_bit_coordinates_cell_is_the_wide_rounding() {
-        let mut next = crate::test_rng::seeded(0xce11_0f32);
-        let edges = [i32::MIN, i32::MIN + 1, -(1 << 17) - 1, -(1 << 17), -1, 0, 1, (1 << 17) - 1, 1 << 17, i32::MAX];
-        for v in edges.into_iter().chain((0..100_000).map(|_| next() as i32)) {
-            assert_eq!(cell_of_i32(v), cell(i64::from(v)), "{v}");
-        }
     }
 
     #[test]

@@ -11,8 +11,9 @@
 //! displacement differs from the key before it (the first key: from the
 //! last, the loop's jump).
 
-use super::path::{write_keys, Key, Path};
-use super::sweep::{sphere_in, GridBox, Segment, Sweep};
+use super::grid::GridBox;
+use super::path::{reach_keys, write_keys, Key, Path};
+use super::sweep::{sphere_in, Segment, Sweep};
 use crate::parse::{MotionSink, Moved, Mover};
 use crate::scene::Frames;
 
@@ -227,6 +228,7 @@ impl MotionSink for Recorder<'_> {
                 }
             }
             (track.first, track.swept) = ([lo, hi], GridBox::around(swept));
+            reach_keys(&mut self.keys[first_key..self.key_count], track.first);
             if objects.sphere {
                 (track.center, track.radius) = sphere_in(track.first);
             }
