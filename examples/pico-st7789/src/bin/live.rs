@@ -73,7 +73,7 @@ static RAYTRACER: ConstStaticCell<Raytracer<LiveProfile>> = ConstStaticCell::new
 
 /// What the animations it plays may take: a byte a tile of the 240×240
 /// panel (3,600), and 8 `MOVE`s of 32 keys in all, however many frames
-/// (anim_fig5_1 takes 1 and 6): 5.8 KiB.
+/// (anim_fig5_1 takes 1 and 6): 6.6 KiB.
 const ANIMATION: AnimationNeeds = AnimationNeeds {
     tiles: AnimationNeeds::tiles_for(Size::new(panel::WIDTH as u32, panel::HEIGHT as u32)),
     tracks: 8,
