@@ -6,10 +6,10 @@
 //! Invariants: a track's keys say where its objects stand at every frame
 //! relative to frame 0, exactly as the parser places them ([`Path`]);
 //! `first` is the objects' box at frame 0 and `swept` the box holding them
-//! in every frame (on the tracker's grid); `now` is their displacement at the frame the motion was
-//! last set to ([`Motion::at_frame`]); a key's `changes` says whether its
-//! displacement differs from the key before it (the first key: from the
-//! last, the loop's jump).
+//! in every frame (on the tracker's grid); `now` is their displacement at
+//! the frame the motion was last set to ([`Motion::at_frame`]); a key's
+//! `changes` says whether its displacement differs from the key before it
+//! (the first key: from the last, the loop's jump).
 
 use super::grid::GridBox;
 use super::path::{reach_keys, write_keys, Key, Path};

@@ -106,7 +106,7 @@ pub(crate) fn read_body(reader: &mut BufReader<impl Read>, request: &mut Request
 }
 
 /// A status's reason phrase.
-pub(crate) fn reason(status: u16) -> &'static str {
+fn reason(status: u16) -> &'static str {
     match status {
         200 => "OK",
         303 => "See Other",
@@ -122,7 +122,6 @@ pub(crate) fn reason(status: u16) -> &'static str {
         428 => "Precondition Required",
         431 => "Request Header Fields Too Large",
         502 => "Bad Gateway",
-        503 => "Service Unavailable",
         505 => "HTTP Version Not Supported",
         _ => "Error",
     }

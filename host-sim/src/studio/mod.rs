@@ -253,13 +253,13 @@ const DRAINED_BYTES: u64 = 1 << 20;
 /// The answer to a request that could not be read, saying why.
 fn unreadable(status: u16) -> Response {
     let why = match status {
-        413 => "the request is too large: a scene may take 16 MiB",
-        431 => "the request's head is too large",
-        411 => "a request's body is sent with Content-Length",
-        505 => "this server speaks HTTP/1.1",
-        _ => "bad request",
+        413 => format!("the request is too large: a scene may take {} MiB", MAX_SCENE_BYTES >> 20),
+        431 => "the request's head is too large".into(),
+        411 => "a request's body is sent with Content-Length".into(),
+        505 => "this server speaks HTTP/1.1".into(),
+        _ => "bad request".into(),
     };
-    Response::text(status, why)
+    Response::text(status, &why)
 }
 
 /// Where an admitted request goes: its path without the token (the page
