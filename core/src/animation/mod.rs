@@ -33,7 +33,7 @@
 //! # Memory
 //!
 //! One byte a tile: a 240×240 panel in tiles of [`TILE`] is 3,600 bytes.
-//! The motion: a track (72 bytes) for each `MOVE` and a key (52 bytes) for
+//! The motion: a track (88 bytes) for each `MOVE` and a key (76 bytes) for
 //! each of its keys ([`AnimationNeeds::bytes`]), whatever the number of
 //! frames. Tracing keeps a run of 32 tiles' counts (128 bytes) on the
 //! stack.
