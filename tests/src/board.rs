@@ -31,9 +31,10 @@ use std::sync::mpsc::{self, Receiver};
 use std::time::{Duration, Instant};
 
 /// A scene that wedged the board before it could stop inside a pixel:
-/// two facing mirrors with the eye between them (each sample bounces 4,096
+/// two facing mirrors with the eye between them (a sample bounces up to 4,096
 /// times), `lights` lights (up to eight), 16² samples a pixel: a pixel
-/// takes hours on a Pico, seconds on a PC. The format allows all of it.
+/// takes hours on a Pico (a PC traces it in milliseconds to seconds). The
+/// format allows all of it.
 pub fn wedging_scene(lights: u32) -> String {
     let lights = lights.clamp(1, 8);
     let positions = ["0 1", "0 -1", "1 0", "-1 0", "1 1", "-1 1", "1 -1", "-1 -1"];
