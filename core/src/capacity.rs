@@ -326,11 +326,20 @@ pub struct CapacityError {
     pub profile: &'static str,
 }
 
+/// The name of the desktop's profile (`profile::Host`, feature `alloc`):
+/// its capacities are octrace's most, which no `profile!` raises.
+pub(crate) const HOST_PROFILE: &str = "Host";
+
 impl fmt::Display for CapacityError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "too many {}: the capacity profile {} holds {}", self.kind.what(), self.profile, self.capacity)?;
         if let Some(needed) = self.needed {
             write!(f, " and the scene needs {needed}")?;
+        }
+        if self.profile == HOST_PROFILE {
+            // host-sim's, the studio's: a user of those cannot define a
+            // profile, and no profile holds more.
+            return write!(f, ", the most octrace's desktop build holds: split the scene or simplify it");
         }
         write!(
             f,
@@ -380,6 +389,13 @@ mod tests {
             e.to_string(),
             "too many rectangles: the capacity profile Board16K holds 2 and the scene needs 64; \
              define a profile that holds them with octrace_core::profile! (rectangles: 64, …)"
+        );
+        // The desktop's profile: nothing to define.
+        let e = CapacityError { kind: CapacityKind::Lights, capacity: 4096, needed: Some(4100), profile: HOST_PROFILE };
+        assert_eq!(
+            e.to_string(),
+            "too many lights: the capacity profile Host holds 4096 and the scene needs 4100, \
+             the most octrace's desktop build holds: split the scene or simplify it"
         );
     }
 }

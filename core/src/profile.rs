@@ -533,6 +533,14 @@ mod tests {
         struct Tiny { spheres: 3, lights: 1, surfaces: 1 }
     }
 
+    /// Capacity errors tell the desktop's users that no profile holds more
+    /// by this name.
+    #[cfg(feature = "alloc")]
+    #[test]
+    fn the_host_profile_has_the_name_its_messages_know() {
+        assert_eq!(<Host as SceneCapacities>::NAME, crate::capacity::HOST_PROFILE);
+    }
+
     #[test]
     fn a_profile_holds_exactly_its_counts() {
         assert_eq!(<Tiny as SceneCapacities>::Spheres::CAPACITY, 3);

@@ -139,13 +139,13 @@ fn invalid_utf8() {
 }
 
 #[test]
-fn capacity_names_the_limit_and_how_to_raise_it() {
+fn capacity_names_the_limit_and_that_host_sim_holds_no_more() {
     let lights: String = (0..4097).map(|i| format!("LIGHT 1 {i} 0 0\n")).collect();
     rejected(
         &lights,
         "4097:1",
-        "too many lights: the capacity profile Host holds 4096 and the scene needs 4097; \
-         define a profile that holds them with octrace_core::profile! (lights: 4097, …)",
+        "too many lights: the capacity profile Host holds 4096 and the scene needs 4097, \
+         the most octrace's desktop build holds: split the scene or simplify it",
     );
 }
 
