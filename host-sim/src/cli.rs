@@ -1,7 +1,7 @@
 //! The `host-sim` command line.
 
 use crate::animation::{animate, is_frame_file, merge_frames, AnimationOptions, Request};
-use crate::arguments::{not_the_scene, parse_size};
+use crate::arguments::{not_the_scene, parse_size, same_file};
 use crate::arguments::{output_format, parse_accel, parse_color, parse_dithering, parse_format, parse_palette};
 use crate::options::{all_cores, Partition, RenderOptions};
 use crate::output::{panel_preview, write_atomically, FileSink};
@@ -23,6 +23,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Once;
 use std::time::Instant;
 
+use crate::exit::ShownPath;
 pub use crate::exit::{CliError, EXIT_IO, EXIT_MISMATCH, EXIT_SCENE, EXIT_STOPPED};
 
 /// Render an octrace scene file to an image (PNG, Targa or Sun raster), in
@@ -232,7 +233,7 @@ fn merge(output: &Path, parts: &[PathBuf], format: Option<Format>) -> Result<(),
         }
     })?;
     write_atomically(output, |f| parts::write_merged(&ordered, &header, format, f).map_err(std::io::Error::other))
-        .map_err(|e| CliError::Io(format!("merge: cannot write {}: {e}", output.display())))
+        .map_err(|e| CliError::Io(format!("merge: cannot write {}: {e}", ShownPath(output))))
 }
 
 /// The rows to render and the text to carry for `--part`, checked against the image and the options.
@@ -321,7 +322,7 @@ fn preview(
             stats.rays,
             stats.shadow_rays,
             stats.cells,
-            out.display(),
+            ShownPath(out),
             color.name(),
             match color.panel() {
                 Some(_) => format!(", {}", dithering.name()),
@@ -336,10 +337,16 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     match &args.command {
         Some(Command::Convert { input, output, format }) => return convert(input, output, *format),
         Some(Command::Merge { output, parts, format }) => {
+            if let Some(part) = parts.iter().find(|part| same_file(part, output)) {
+                return Err(CliError::Invalid(format!(
+                    "merge: refusing to write over {}, one of the files it merges; nothing written",
+                    part.display()
+                )));
+            }
             return match parts.first().is_some_and(|p| is_frame_file(p)) {
                 true => merge_frames(output, parts, *format),
                 false => merge(output, parts, *format),
-            }
+            };
         }
         // run() serves the studio and talks to boards (both need stdout)
         // instead of calling this.
@@ -373,6 +380,15 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     }
     let out = match (&args.out, &loaded.imagefile) {
         (Some(o), _) => o.clone(),
+        // Longer than a path can be (Linux's PATH_MAX): refused without
+        // printing it.
+        (None, Some(f)) if f.len() >= 4096 => {
+            return Err(CliError::Invalid(format!(
+                "IMAGEFILE in {} names a path of {} bytes, longer than a path can be: give OUT on the command line",
+                scene_path.display(),
+                f.len()
+            )))
+        }
         (None, Some(f)) => PathBuf::from(f),
         (None, None) => {
             return Err(CliError::Invalid(format!(
@@ -517,7 +533,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
             } else {
                 String::new()
             },
-            out.display()
+            ShownPath(&out)
         );
         if let Some(summary) = summary {
             let _ = writeln!(

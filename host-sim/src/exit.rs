@@ -37,12 +37,12 @@ pub enum CliError {
 impl CliError {
     /// `path` could not be read.
     pub fn read(path: &Path, error: impl fmt::Display) -> CliError {
-        CliError::Io(format!("cannot read {}: {error}", path.display()))
+        CliError::Io(format!("cannot read {}: {error}", ShownPath(path)))
     }
 
     /// `path` could not be written.
     pub fn write(path: &Path, error: impl fmt::Display) -> CliError {
-        CliError::Io(format!("cannot write {}: {error}", path.display()))
+        CliError::Io(format!("cannot write {}: {error}", ShownPath(path)))
     }
 
     /// The process's exit code for this error.
@@ -74,3 +74,20 @@ impl fmt::Display for CliError {
 }
 
 impl std::error::Error for CliError {}
+
+/// A path as a message shows it: its control characters escaped
+/// (`\u{1b}`), so that a name from a scene's IMAGEFILE cannot drive the
+/// terminal.
+pub struct ShownPath<'a>(pub &'a Path);
+
+impl fmt::Display for ShownPath<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for c in self.0.to_string_lossy().chars() {
+            match c.is_control() {
+                true => write!(f, "{}", c.escape_unicode())?,
+                false => write!(f, "{c}")?,
+            }
+        }
+        Ok(())
+    }
+}

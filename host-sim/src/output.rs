@@ -340,16 +340,19 @@ fn into_io(e: FormatError) -> std::io::Error {
 
 /// Writes `path` through a temporary file in the same directory
 /// ([`temporary_beside`]), renamed into place only when `write` succeeds
-/// ([`replace_with`]); on failure no file is left behind.
+/// ([`replace_with`]); on failure no file is left behind. A `path` that is
+/// a device, a pipe or a socket (`/dev/null`, a FIFO) is written into as
+/// a shell's `>` would: a rename would replace the node itself.
 pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
-    // The rename below would replace even a read-only file: refuse it, as
-    // writing to it directly would.
-    if std::fs::metadata(path).is_ok_and(|m| m.permissions().readonly()) {
-        return Err(std::io::Error::new(std::io::ErrorKind::PermissionDenied, "the file is read-only"));
+    if is_stream(path) {
+        let mut w = std::io::BufWriter::new(File::options().write(true).open(path)?);
+        write(&mut w)?;
+        return w.flush();
     }
+    refuse_read_only(path)?;
     let (tmp, file) = temporary_beside(path)?;
     let result = (|| {
         let mut w = std::io::BufWriter::new(file);
@@ -362,6 +365,24 @@ pub fn write_atomically(
         let _ = std::fs::remove_file(&tmp);
     }
     result
+}
+
+/// Whether `path` names something other than a file or a directory: a
+/// device, a pipe or a socket, which output is written into, not renamed
+/// over.
+pub(crate) fn is_stream(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
+}
+
+/// Refuses an existing read-only `path`: a rename would replace it, where
+/// writing to it directly would fail.
+pub(crate) fn refuse_read_only(path: &Path) -> std::io::Result<()> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.permissions().readonly() => {
+            Err(std::io::Error::new(std::io::ErrorKind::PermissionDenied, "the file is read-only"))
+        }
+        _ => Ok(()),
+    }
 }
 
 /// A new, empty file beside `path` to write it through: `.NAME.PID.R.tmp`
@@ -427,6 +448,26 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         dir
+    }
+
+    /// A pipe (as `/dev/null` or `/dev/stdout` would be) is written into:
+    /// renamed over, it would be replaced by a file.
+    #[cfg(unix)]
+    #[test]
+    fn a_pipe_is_written_into_not_replaced() {
+        use std::os::unix::fs::FileTypeExt;
+        let dir = scratch("fifo");
+        let fifo = dir.join("out.png");
+        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read(fifo).unwrap())
+        };
+        write_atomically(&fifo, |w| w.write_all(b"image")).unwrap();
+        assert_eq!(reader.join().unwrap(), b"image");
+        assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo(), "still a pipe");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "no temporary file");
+        std::fs::remove_dir_all(dir).unwrap();
     }
 
     #[cfg(unix)]

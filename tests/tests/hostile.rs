@@ -823,6 +823,101 @@ fn row18_output_equal_to_the_scene_is_refused() {
     assert_eq!(listing(dir.path()), ["link.png", "s.txt", "sub"]);
 }
 
+/// Row 18e: OUT a pipe (or a device: `/dev/null`, `/dev/stdout`) is
+/// written into, as a shell's `>` would; a temporary file renamed over it
+/// would replace the node (as root, `/dev/null` itself).
+#[test]
+fn row18_output_to_a_pipe_is_written_into() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, _) = small_scene(dir.path());
+    let fifo = dir.path().join("o.png");
+    assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read(fifo).unwrap())
+    };
+    let (code, err) = host_sim(&[scene.as_os_str(), fifo.as_os_str(), "-q".as_ref()]);
+    assert_eq!(code, 0, "{err}");
+    let png = reader.join().unwrap();
+    assert_eq!(octrace_images::formats::read(&png).unwrap().to_rgb().width, 4, "a PNG came through the pipe");
+    assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo(), "still a pipe");
+    assert_eq!(listing(dir.path()), ["o.png", "s.txt"]);
+}
+
+/// Row 18f: frame files (`f%d.png`) are each guarded as a still's OUT: the
+/// scene, a read-only file and a directory are refused before anything is
+/// rendered, and a failed run leaves the files that were there before.
+#[test]
+fn row18_frame_files_are_guarded_as_a_stills_file() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!("FRAMES 3 RASTER 4 4 {SURF} SPHERE 1 1 0 0 0");
+    // A scene named as its frame 1 would be.
+    let scene = dir.path().join("f1.png");
+    std::fs::write(&scene, &text).unwrap();
+    let pattern = dir.path().join("f%d.png");
+    let (code, err) = host_sim(&[scene.as_os_str(), pattern.as_os_str()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains(&format!("refusing to overwrite the scene file {}", scene.display())), "{err}");
+    assert_eq!(std::fs::read_to_string(&scene).unwrap(), text);
+    assert_eq!(listing(dir.path()), ["f1.png"]);
+    // Earlier frames, one read-only, then one a directory.
+    let scene = dir.path().join("s.txt");
+    std::fs::write(&scene, &text).unwrap();
+    std::fs::write(dir.path().join("f0.png"), b"old 0").unwrap();
+    std::fs::set_permissions(dir.path().join("f1.png"), std::fs::Permissions::from_mode(0o444)).unwrap();
+    let (code, err) = host_sim(&[scene.as_os_str(), pattern.as_os_str()]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains(&format!("cannot write {}: the file is read-only", dir.path().join("f1.png").display())),
+        "{err}"
+    );
+    std::fs::remove_file(dir.path().join("f1.png")).unwrap();
+    std::fs::create_dir(dir.path().join("f2.png")).unwrap();
+    let (code, err) = host_sim(&[scene.as_os_str(), pattern.as_os_str()]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains(&format!("cannot write {}: not a file", dir.path().join("f2.png").display())), "{err}");
+    assert_eq!(std::fs::read(dir.path().join("f0.png")).unwrap(), b"old 0", "the earlier frame is kept");
+    assert_eq!(listing(dir.path()), ["f0.png", "f2.png", "s.txt"]);
+}
+
+/// Row 18g: an IMAGEFILE name is shown with its control characters
+/// escaped, and one longer than a path can be is refused unprinted.
+#[test]
+fn row18_imagefile_names_cannot_drive_the_terminal() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("s.txt");
+    let name = dir.path().join("\u{1b}[2Jx.png");
+    std::fs::write(&scene, format!("RASTER 4 4 IMAGEFILE \"{}\" {SURF} SPHERE 1 1 0 0 0", name.display())).unwrap();
+    let (code, err) = host_sim(&[scene.as_os_str()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains('\u{1b}') && err.contains("\\u{1b}[2Jx.png"), "{err}");
+    assert!(name.exists());
+    std::fs::write(&scene, format!("RASTER 4 4 IMAGEFILE {} {SURF}", "a".repeat(100_000))).unwrap();
+    let (code, err) = host_sim(&[scene.as_os_str()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.len() < 300 && err.contains("names a path of 100000 bytes"), "{err}");
+}
+
+/// Row 18h: `merge` refuses to write over one of the files it merges.
+#[test]
+fn row18_merge_does_not_write_over_its_parts() {
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, _) = small_scene(dir.path());
+    let parts: Vec<_> = (1..=2).map(|i| dir.path().join(format!("p{i}.png"))).collect();
+    for (i, part) in parts.iter().enumerate() {
+        let spec = format!("{}/2", i + 1);
+        let (code, err) = host_sim(&[scene.as_os_str(), part.as_os_str(), "--part".as_ref(), spec.as_ref()]);
+        assert_eq!(code, 0, "{err}");
+    }
+    let before = std::fs::read(&parts[0]).unwrap();
+    let (code, err) = host_sim(&["merge".as_ref(), parts[0].as_os_str(), parts[0].as_os_str(), parts[1].as_os_str()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("refusing to write over") && err.contains("nothing written"), "{err}");
+    assert_eq!(std::fs::read(&parts[0]).unwrap(), before);
+}
+
 /// Row 19: every line's error in one run. After an error the parser
 /// resynchronises at the next statement (a keyword, or a word opening a
 /// line), so no line's error hides behind the one before.

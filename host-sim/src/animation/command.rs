@@ -10,8 +10,9 @@ use super::apng::ApngWriter;
 use super::frames::{render_frames, AnimationError, AnimationOptions, AnimationReport, FrameImage};
 use super::gif::GifWriter;
 use super::writers::{write_frame_file, FrameInfo, Output};
-use crate::exit::CliError;
-use crate::output::{replace_with, temporary_beside, write_atomically};
+use crate::arguments::not_the_scene;
+use crate::exit::{CliError, ShownPath};
+use crate::output::{is_stream, refuse_read_only, replace_with, temporary_beside, write_atomically};
 use crate::parts::{auto_index, band_rows, scene_hash, PartSpec};
 use crate::terminal::progress_bar;
 use octrace_core::scene::Frames;
@@ -140,36 +141,56 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
                     "frame files are PNG or Targa (a Sun raster has no room for the frame's metadata)".into(),
                 ));
             }
-            let mut done: Vec<(PathBuf, PathBuf)> = Vec::new();
+            // Each frame's file as a still's: not the scene, not a
+            // read-only file, not a directory; refused before anything is
+            // rendered.
+            for k in range.clone() {
+                let path = pattern.name(k);
+                not_the_scene(request.scene_path, &path)?;
+                refuse_read_only(&path).map_err(|e| CliError::write(&path, e))?;
+                if path.is_dir() || is_stream(&path) {
+                    return Err(CliError::write(&path, "not a file a frame can be written to"));
+                }
+            }
+            // Each frame's temporary file, its path, and whether a file was
+            // there before.
+            let mut done: Vec<(PathBuf, PathBuf, bool)> = Vec::new();
+            let named = |path: &Path| {
+                let path = path.display().to_string();
+                move |e: std::io::Error| std::io::Error::new(e.kind(), format!("{path}: {e}"))
+            };
             let result = render(&mut |k, frame| {
                 let path = pattern.name(k);
                 let shown = palette::apply(&frame.image, &frame.objects, palette);
-                let (tmp, file) = temporary_beside(&path)?;
+                let (tmp, file) = temporary_beside(&path).map_err(named(&path))?;
                 let write = || -> std::io::Result<()> {
                     let mut file = std::io::BufWriter::new(file);
                     let info = info(k, frame.image.width, frame.image.height);
                     write_frame_file(&shown, &info, format, &mut file).map_err(into_io)?;
                     file.into_inner().map_err(|e| e.into_error())?.sync_all()
                 };
-                let result = write();
-                done.push((tmp, path));
+                let result = write().map_err(named(&path));
+                let existed = path.exists();
+                done.push((tmp, path, existed));
                 result
             });
-            let mut renamed_paths = Vec::new();
-            let renamed = result.and_then(|()| {
-                done.iter().try_for_each(|(tmp, path)| {
-                    replace_with(tmp, path)?;
-                    renamed_paths.push(path);
+            let mut renamed = Vec::new();
+            let result = result.and_then(|()| {
+                done.iter().try_for_each(|(tmp, path, existed)| {
+                    replace_with(tmp, path).map_err(named(path))?;
+                    renamed.push((path, *existed));
                     Ok(())
                 })
             });
-            if renamed.is_err() {
-                // A failed run leaves no frame: neither those written nor
-                // those already renamed.
-                done.iter().for_each(|(tmp, _)| drop(std::fs::remove_file(tmp)));
-                renamed_paths.iter().for_each(|path| drop(std::fs::remove_file(path)));
+            if result.is_err() {
+                // A failed run leaves no frame of its own: neither those
+                // written nor those already renamed where no file was (a
+                // file it replaced cannot come back; the checks above
+                // make that a race with another program).
+                done.iter().for_each(|(tmp, _, _)| drop(std::fs::remove_file(tmp)));
+                renamed.iter().filter(|(_, existed)| !existed).for_each(|(path, _)| drop(std::fs::remove_file(path)));
             }
-            renamed
+            result
         }
     };
     if let Some(bar) = &bar {
@@ -198,7 +219,7 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
             report.tracing.as_secs_f64(),
             report.stats.rays,
             report.stats.shadow_rays,
-            request.out.display()
+            ShownPath(request.out)
         );
     }
     Ok(())
