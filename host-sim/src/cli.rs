@@ -1,6 +1,6 @@
 //! The `host-sim` command line.
 
-use crate::animation::{animate, is_frame_file, merge_frames, AnimationOptions, Request};
+use crate::animation::{animate, is_frame_file, merge_frames, AnimationOptions, FramePattern, Request};
 use crate::arguments::{not_the_scene, parse_size, same_file};
 use crate::arguments::{output_format, parse_accel, parse_color, parse_dithering, parse_format, parse_palette};
 use crate::options::{all_cores, Partition, RenderOptions};
@@ -218,9 +218,23 @@ where
 fn convert(input: &Path, output: &Path, format: Option<Format>) -> Result<(), CliError> {
     let format = output_format(format, output)?;
     let bytes = std::fs::read(input).map_err(|e| CliError::read(input, e))?;
+    if let Some(frames) = animated_png_frames(&bytes) {
+        return Err(CliError::Invalid(format!(
+            "{}: an animated PNG of {frames} frames; convert takes still images (host-sim writes an animation's \
+             frames one file each with OUT 'f%04d.png')",
+            ShownPath(input)
+        )));
+    }
     let image = formats::read(&bytes).map_err(|e| CliError::Invalid(format!("{}: {e}", input.display())))?;
     write_atomically(output, |f| formats::write(&image, format, f).map_err(std::io::Error::other))
         .map_err(|e| CliError::write(output, e))
+}
+
+/// The frames of an animated PNG (an `acTL` chunk with more than one);
+/// `None` for anything else.
+fn animated_png_frames(bytes: &[u8]) -> Option<u32> {
+    let reader = png::Decoder::new(std::io::Cursor::new(bytes)).read_info().ok()?;
+    reader.info().animation_control().map(|control| control.num_frames).filter(|&frames| frames > 1)
 }
 
 fn merge(output: &Path, parts: &[PathBuf], format: Option<Format>) -> Result<(), CliError> {
@@ -389,6 +403,9 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
                 f.len()
             )))
         }
+        (None, Some(f)) if f.is_empty() => {
+            return Err(CliError::Invalid(format!("IMAGEFILE in {} names no file", scene_path.display())))
+        }
         (None, Some(f)) => PathBuf::from(f),
         (None, None) => {
             return Err(CliError::Invalid(format!(
@@ -397,6 +414,13 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
             )))
         }
     };
+    if let (Some(k), Some(_), Ok(_)) = (args.frame, loaded.frames, FramePattern::parse(&out.to_string_lossy())) {
+        return Err(CliError::Invalid(format!(
+            "--frame {k} writes one still image, and {} is a pattern for one file a frame: name the frame's \
+             file, or leave --frame out to write every frame",
+            ShownPath(&out)
+        )));
+    }
     let palette = args.palette.unwrap_or(PaletteMode::None);
     if args.color != PanelColor::Rgb888 && palette != PaletteMode::None {
         return Err(CliError::Invalid("--color and --palette both choose the pixels: give one".into()));

@@ -918,6 +918,33 @@ fn row18_merge_does_not_write_over_its_parts() {
     assert_eq!(std::fs::read(&parts[0]).unwrap(), before);
 }
 
+/// Row 18i: what a still's command cannot do with an animation is refused
+/// (exit 2, nothing written): `--frame K` to a frame pattern, `convert` of
+/// an animated PNG (it would keep the first frame only); and an empty
+/// IMAGEFILE is the scene's error.
+#[test]
+fn row18_still_commands_refuse_what_is_an_animation() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("a.txt");
+    std::fs::write(&scene, format!("FRAMES 3 RASTER 4 4 {SURF} SPHERE 1 1 0 0 0")).unwrap();
+    let pattern = dir.path().join("f%02d.png");
+    let (code, err) = host_sim(&[scene.as_os_str(), pattern.as_os_str(), "--frame".as_ref(), "1".as_ref()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--frame 1 writes one still image"), "{err}");
+    let apng = dir.path().join("a.png");
+    let (code, err) = host_sim(&[scene.as_os_str(), apng.as_os_str(), "-q".as_ref()]);
+    assert_eq!(code, 0, "{err}");
+    let out = dir.path().join("b.tga");
+    let (code, err) = host_sim(&["convert".as_ref(), apng.as_os_str(), out.as_os_str()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("an animated PNG of 3 frames"), "{err}");
+    std::fs::write(&scene, format!("RASTER 4 4 IMAGEFILE \"\" {SURF}")).unwrap();
+    let (code, err) = host_sim(&[scene.as_os_str()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("IMAGEFILE in") && err.contains("names no file"), "{err}");
+    assert_eq!(listing(dir.path()), ["a.png", "a.txt"]);
+}
+
 /// Row 19: every line's error in one run. After an error the parser
 /// resynchronises at the next statement (a keyword, or a word opening a
 /// line), so no line's error hides behind the one before.
