@@ -3,6 +3,7 @@
 use crate::animation::{animate, is_frame_file, merge_frames, AnimationOptions, FramePattern, Request};
 use crate::arguments::{not_the_scene, parse_size, same_file};
 use crate::arguments::{output_format, parse_accel, parse_color, parse_dithering, parse_format, parse_palette};
+use crate::exit::ShownPath;
 use crate::options::{all_cores, Partition, RenderOptions};
 use crate::output::{panel_preview, write_atomically, FileSink};
 use crate::parts::{self, MergeError, PartInfo, PartSpec};
@@ -23,7 +24,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Once;
 use std::time::Instant;
 
-use crate::exit::ShownPath;
 pub use crate::exit::{CliError, EXIT_IO, EXIT_MISMATCH, EXIT_SCENE, EXIT_STOPPED};
 
 /// Render an octrace scene file to an image (PNG, Targa or Sun raster), in
@@ -354,10 +354,23 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
             if let Some(part) = parts.iter().find(|part| same_file(part, output)) {
                 return Err(CliError::Invalid(format!(
                     "merge: refusing to write over {}, one of the files it merges; nothing written",
-                    part.display()
+                    ShownPath(part)
                 )));
             }
-            return match parts.first().is_some_and(|p| is_frame_file(p)) {
+            // Frame files or band parts, one kind at a time.
+            let frames: Vec<bool> = parts.iter().map(|part| is_frame_file(part)).collect();
+            if let Some(other) = frames.iter().position(|&frame| frame != frames[0]) {
+                let kind = |frame: bool| if frame { "an animation's frame file" } else { "not a frame file" };
+                return Err(CliError::Invalid(format!(
+                    "merge: {} is {} and {} {}: merge a still's band parts or an animation's frame files; nothing \
+                     written",
+                    ShownPath(&parts[0]),
+                    kind(frames[0]),
+                    ShownPath(&parts[other]),
+                    kind(frames[other])
+                )));
+            }
+            return match frames.first() == Some(&true) {
                 true => merge_frames(output, parts, *format),
                 false => merge(output, parts, *format),
             };

@@ -366,8 +366,15 @@ fn frames_rendered_apart_merge_into_the_same_gif() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("frame 2 is missing"), "{err}");
     let (code, err) = host_sim(d, &["merge", "bad.gif", "p0.png", "p0.png", "p1.png"]);
-    assert!(code == 2 && err.contains("frame 0 is twice"), "{err}");
+    assert!(code == 2 && err.contains("frame 0 is given twice"), "{err}");
     assert!(!d.join("bad.gif").exists());
+    // Frames into a still's format, or with a still's band part.
+    let (code, err) = host_sim(d, &["merge", "bad.tga", "p0.png", "p1.png"]);
+    assert!(code == 2 && err.contains("frames merge into an animated GIF (.gif) or an APNG (.png)"), "{err}");
+    assert_eq!(host_sim(d, &["anim.txt", "band.png", "--frame", "0", "--part", "1/2", "-q"]).0, 0);
+    let (code, err) = host_sim(d, &["merge", "bad.png", "p0.png", "band.png"]);
+    assert!(code == 2 && err.contains("p0.png is an animation's frame file and band.png not a frame file"), "{err}");
+    assert!(!d.join("bad.tga").exists() && !d.join("bad.png").exists());
 }
 
 #[test]

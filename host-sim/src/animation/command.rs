@@ -156,7 +156,7 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
             // there before.
             let mut done: Vec<(PathBuf, PathBuf, bool)> = Vec::new();
             let named = |path: &Path| {
-                let path = path.display().to_string();
+                let path = ShownPath(path).to_string();
                 move |e: std::io::Error| std::io::Error::new(e.kind(), format!("{path}: {e}"))
             };
             let result = render(&mut |k, frame| {
@@ -243,7 +243,15 @@ pub fn is_frame_file(path: &Path) -> bool {
 /// writes.
 pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) -> Result<(), CliError> {
     let refuse = |message: String| CliError::Invalid(format!("merge: {message}; nothing written"));
-    let kind = Output::of(output, format).map_err(refuse)?;
+    let kind = match Output::of(output, format) {
+        Ok(Output::Files(_)) | Err(_) => {
+            return Err(refuse(format!(
+                "{}: frames merge into an animated GIF (.gif) or an APNG (.png)",
+                ShownPath(output)
+            )))
+        }
+        Ok(kind) => kind,
+    };
     let mut found: Vec<(FrameInfo, Image)> = Vec::new();
     for path in files {
         let name = path.display();
@@ -286,8 +294,8 @@ pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) ->
     let (frames, (width, height)) = (first.frames, (first.width, first.height));
     for (i, (info, _)) in found.iter().enumerate() {
         if info.frame != i as u32 {
-            let what = if i > 0 && found[i - 1].0.frame == info.frame { "twice" } else { "missing" };
-            let frame = if what == "twice" { info.frame } else { i as u32 };
+            let twice = i > 0 && found[i - 1].0.frame == info.frame;
+            let (frame, what) = if twice { (info.frame, "given twice") } else { (i as u32, "missing") };
             return Err(refuse(format!("frame {frame} is {what}")));
         }
     }
