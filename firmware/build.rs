@@ -12,7 +12,7 @@
 //! | `OCTRACE_ACCEL` | `auto`, `naive`, `octree`, `dda` | `auto` |
 //! | `OCTRACE_COLOR` | `rgb888`, `rgb565`, `dither` (1-byte indices into the 6×6×6 cube), and the panels of few levels, 1 byte a pixel holding the level: `mono` (0, 1), `gray2` (0 to 3), `gray4` (0 to 15), `bwr` (0 black, 1 white, 2 red); only `gray4` on `lm3s6965evb` | `rgb888`; `gray4` on `lm3s6965evb` |
 //! | `OCTRACE_DITHER` | how `mono`, `gray2`, `gray4` and `bwr` are dithered: `fs-pe`, `fs`, `bayer`, `nearest` | `fs-pe` |
-//! | `OCTRACE_TECHNIQUES` | `auto` (every technique whose RAM fits beside the deepest octree that fits, and for a scene walked in an octree the light buffer in flash instead of the shadow shafts), `none`, or a comma list of `first-hits`, `shadow-shafts`, `light-buffer` (built here, kept in flash), `light-buffer-ram` (built by the board, in RAM; each still only where it fits) | `auto` |
+//! | `OCTRACE_TECHNIQUES` | `auto` (every technique whose RAM fits beside the deepest octree that fits, and for a scene walked in an octree the light buffer in flash instead of the shadow shafts, for a few objects their cones in RAM), `none`, or a comma list of `first-hits`, `shadow-shafts`, `light-buffer` (built here, kept in flash), `light-buffer-ram` (built by the board, in RAM; each still only where it fits) | `auto` |
 //! | `OCTRACE_OUT` | host file the pixels are written to; on `lm3s6965evb` the PNG of the panel's screen that the runner grabs | `octrace-out.raw`; `screen.png` on `lm3s6965evb` |
 //!
 //! | board | qemu `-machine` | core | flash | RAM | display |
@@ -196,11 +196,14 @@ fn main() {
     if accel == AccelMode::Naive {
         (wanted.light_buffer, wanted.light_buffer_in_flash) = (0, false);
     }
-    // A handful of objects tested in the naive mode cost about what a
-    // cell's look-up does (fig5_1: 5,380 instructions a pixel without,
-    // 5,414 with): the light buffer only for scenes walked in an octree.
+    // A handful of objects, tested in the naive mode, get cones for a light
+    // buffer (a cube's look-up would cost what testing them all does):
+    // a few words, built by the board in RAM, where checking a copy in
+    // flash would take longer than building it.
+    let wanted_light_buffer = wanted.light_buffer > 0 || wanted.light_buffer_in_flash;
     if accel.resolve(count(&text).objects).traversal().is_none() {
-        (wanted.light_buffer, wanted.light_buffer_in_flash) = (0, false);
+        wanted.light_buffer = if wanted_light_buffer { Techniques::LIGHT_CELLS[0] } else { 0 };
+        wanted.light_buffer_in_flash = false;
     }
     // With every light buffered, nothing would read the shafts.
     if wanted.light_buffer_in_flash {

@@ -150,6 +150,9 @@ macro_rules! profile {
                 const FIRST_HITS: bool = p::given_or(&[$($first_hits)?], false);
                 const COHERENCE: bool = p::given_or(&[$($coherence)?], false);
                 const LIGHT_BUFFER: bool = <$name as $crate::profile::Profile>::COUNTS.light_buffer_lights > 0;
+                const LIGHT_CUBES: bool = <$name as p::Linked>::LIGHT_BUFFER
+                    && <$name as $crate::profile::Profile>::COUNTS.objects > $crate::AccelMode::AUTO_NAIVE_UP_TO;
+                const LIGHT_CONES: bool = <$name as p::Linked>::LIGHT_BUFFER && !<$name as p::Linked>::LIGHT_CUBES;
             }
 
             // 16-bit indices: their top two values are markers.
@@ -299,7 +302,8 @@ pub fn needed_with_light_buffer<'t>(
 /// let mut raytracer = Raytracer::<Spheres>::new();
 /// let mut scene = raytracer.load(text)?;
 /// scene.use_light_buffer(&words)?;
-/// assert_eq!(scene.light_buffer().report().cells_a_side, 16);
+/// // Two spheres: a cone each for the light (a scene of more objects gets a cube).
+/// assert_eq!((scene.light_buffer().report().lights, scene.light_buffer().report().entries), (1, 2));
 /// # Ok::<(), Box<dyn core::error::Error>>(())
 /// ```
 #[cfg(feature = "alloc")]
@@ -509,6 +513,7 @@ mod host {
         const FIRST_HITS: bool = true;
         const COHERENCE: bool = true;
         const LIGHT_BUFFER: bool = true;
+        const LIGHT_CONES: bool = true;
     }
 
     crate::__shape_kinds!(crate::__scene_capacities! { Host, HeapArena });

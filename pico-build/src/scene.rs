@@ -134,11 +134,10 @@ fn scene_source(name: &str, path: &std::path::Path, text: &str) -> Result<(Scene
     let failed = |errors| BuildError::Scene { scene: name.to_owned(), errors };
     // `Raytracer::load` picks the accelerator as `Auto` does, with the
     // octree `profile!` builds by default.
-    let mut needs = needed_by(text, AccelMode::Auto, &OctreeConfig::DEFAULT, &mut report).map_err(failed)?;
-    if needs.octree_boxes > 0 {
-        needs = needed_with_light_buffer(text, AccelMode::Auto, &OctreeConfig::DEFAULT, MAX_CELLS_A_SIDE, &mut report)
-            .map_err(failed)?;
-    }
+    // The shadow rays' light buffer: a cube for a scene walked in an
+    // octree, a cone an object a light for a few objects.
+    let needs = needed_with_light_buffer(text, AccelMode::Auto, &OctreeConfig::DEFAULT, MAX_CELLS_A_SIDE, &mut report)
+        .map_err(failed)?;
     let doc = format!("Exactly what `{name}` needs, its octree included.");
     // Counted once: what the scene is, whether its profile holds motion (a
     // MOVE places its frame 0 even where it is drawn once), and what an
@@ -167,7 +166,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_scene_walked_in_an_octree_gets_a_light_buffer_and_a_few_objects_none() {
+    fn every_scene_gets_a_light_buffer_in_ram_a_few_objects_cones() {
         let spheres: String =
             (0..40).map(|k| format!("SPHERE 1 0.5 {} {} 0\n", k % 7, k / 7)).collect::<String>() + "LIGHT 1 0 10 10\n";
         let path = std::path::Path::new("scene.txt");
@@ -176,7 +175,8 @@ mod tests {
         let (_, few) =
             scene_source("few", path, "SURFACE 1 1 1 1 1 1 1 0 0 0 1 0 0\nSPHERE 1 1 0 0 0\nLIGHT 1 0 10 10\n")
                 .unwrap();
-        assert!(!few.contains("light_buffer"), "{few}");
+        // One light's cone around one sphere: the header and two words.
+        assert!(few.contains("light_buffer_lights: 1, light_buffer_words: 5"), "{few}");
         assert!(few.contains("pub const SCENE_TEXT: &str = include_str!(\"scene.txt\");"), "{few}");
         assert!(few.contains("pub const SCENE_NAME: &str = \"scene\";"), "{few}");
     }

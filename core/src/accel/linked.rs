@@ -34,6 +34,15 @@ pub trait Linked: OctreeCapacities + Sized {
     const COHERENCE: bool = false;
     /// Whether shadow rays may go through a light buffer.
     const LIGHT_BUFFER: bool = false;
+    /// Whether that buffer may be a cube, and whether it may be cones (see
+    /// [`LightBuffer::build`](crate::accel::LightBuffer::build)): a
+    /// `profile!` links one form, cones when it holds no more objects than
+    /// [`AccelMode::AUTO_NAIVE_UP_TO`](crate::AccelMode::AUTO_NAIVE_UP_TO),
+    /// else a cube (then for every scene, few objects or not); the host's
+    /// both, each for the scenes it suits.
+    const LIGHT_CUBES: bool = Self::LIGHT_BUFFER;
+    /// See [`Linked::LIGHT_CUBES`].
+    const LIGHT_CONES: bool = false;
 }
 
 /// Whether builds of `L` mark the mailbox: only an octree's queries do.
@@ -196,8 +205,8 @@ impl<L: Linked> Accelerator for SceneAccelerator<'_, L> {
     ) -> bool {
         match L::LIGHT_BUFFER {
             true => {
-                let query = ShadowQuery { scene, kinds: L::KINDS, ray, t_max, light, start };
-                self.lit.occluded_toward_among(&query, mailbox)
+                let query = ShadowQuery { scene, ray, t_max, light, start };
+                self.lit.occluded_toward_among::<L>(&query, mailbox)
             }
             false => self.lit.accel().occluded_toward(scene, ray, t_max, light, start, mailbox),
         }

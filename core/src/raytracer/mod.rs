@@ -379,7 +379,7 @@ impl<P: Profile> Raytracer<P> {
         both(
             &mut || {
                 if buffered {
-                    light_buffer.build_for(&view, MAX_CELLS_A_SIDE, P::COUNTS.light_buffer_lights);
+                    light_buffer.build_for::<P>(&view, MAX_CELLS_A_SIDE, P::COUNTS.light_buffer_lights);
                     built = true;
                 }
             },
@@ -415,7 +415,7 @@ impl<P: Profile> Raytracer<P> {
     fn scene_indexed(&self) -> LoadedScene<'_, P> {
         let (mode, built, first_hits) = self.indexed;
         let octree = mode.traversal().map(|_| &self.octree);
-        let lights = if built { self.light_buffer.buffer() } else { LightBuffer::NONE };
+        let lights = if built { self.light_buffer.buffer_for::<P>() } else { LightBuffer::NONE };
         let frames = match self.frames {
             [0, _] => None,
             [count, rate] => Some(Frames { count, rate }),

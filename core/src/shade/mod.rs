@@ -422,7 +422,11 @@ impl<'a, L: Linked> Tracer<'a, L> {
         if uses_mailbox::<L>() {
             mailbox.clear();
         }
-        if (*blocker as usize) < self.scene.object_count() {
+        // A scene's cones (a build of few objects, see
+        // `Linked::LIGHT_CUBES`) find its blocker behind a few cheap
+        // rejections: no remembered one is tried first.
+        let cones_only = L::LIGHT_CONES && !L::LIGHT_CUBES;
+        if !cones_only && (*blocker as usize) < self.scene.object_count() {
             let object = ObjectId(*blocker);
             let leaving = RayStart::leaving(Some(start), object);
             if self.scene.shape(object).intersect_among(L::KINDS, shadow, t_max, leaving).is_some() {

@@ -183,6 +183,9 @@ impl<'a> LightBuffer<'a> {
 
     /// The buffer in `words` if its header and sizes are sound.
     pub(super) fn parse(words: &'a [u32]) -> Option<LightBuffer<'a>> {
+        if words.first() == Some(&Words::CONES_MAGIC) {
+            return Self::parse_cones(words);
+        }
         let &[magic, lights, level, cells, _] = words.get(..Words::HEADER)? else { return None };
         let (lights, cells) = (lights as usize, cells as usize);
         let entries = words.len().checked_sub(Words::of(lights, cells, 0))?;
@@ -196,6 +199,7 @@ impl<'a> LightBuffer<'a> {
                 level: level as u8,
                 cells: Words::of(lights, 0, 0),
                 entries: Words::of(lights, cells, 0),
+                cones: false,
             })
     }
 
@@ -227,6 +231,9 @@ impl<'a> LightBuffer<'a> {
     pub fn verified(scene: &SceneView<'_>, words: &'a [u32]) -> Result<LightBuffer<'a>, LightBufferError> {
         use LightBufferError::{Incomplete, Malformed, OtherScene};
         let buffer = Self::parse(words).ok_or(Malformed)?;
+        if buffer.cones {
+            return buffer.verified_cones(scene).map(|()| buffer);
+        }
         let (starts, entries) = words[buffer.cells..].split_at(buffer.entries - buffer.cells);
         if buffer.lights > scene.lights.len() || words[4] as usize != scene.object_count() {
             return Err(OtherScene);

@@ -54,13 +54,15 @@ use super::{Accelerator, Hit, Mailbox, RayStart, FILING_MARGIN};
 use crate::capacity::{Arena, Counts};
 use crate::math::Scalar;
 use crate::scene::{ObjectId, SceneView};
-use crate::shapes::{Ray, ShapeKinds};
+use crate::shapes::Ray;
 
 mod build;
 mod cells;
+mod cones;
 mod query;
 
-pub(crate) use query::ShadowQuery;
+use query::EveryKind;
+pub(crate) use query::{ShadowLinks, ShadowQuery};
 
 /// How far a shadow ray strays from the segment between its origin and its
 /// light, in Q16.16 raw units, at most. The tracer aims it with
@@ -133,6 +135,10 @@ pub struct LightBufferReport {
     pub entries: usize,
     /// Words in all (4 bytes each).
     pub words: usize,
+    /// Whether it is a scene of few objects' cones (see
+    /// [`LightBuffer::build`]): no cube, `cells_a_side` and `cells` 0, an
+    /// entry for each object a light.
+    pub cones: bool,
 }
 
 impl LightBufferReport {
@@ -196,6 +202,8 @@ pub struct LightBuffer<'a> {
     level: u8,
     cells: usize,
     entries: usize,
+    /// Whether the words are cones (`cones.rs`) rather than a cube.
+    cones: bool,
 }
 
 impl core::fmt::Debug for LightBuffer<'_> {
@@ -206,13 +214,19 @@ impl core::fmt::Debug for LightBuffer<'_> {
 
 impl<'a> LightBuffer<'a> {
     /// No light buffered: every shadow ray takes the accelerator.
-    pub const NONE: LightBuffer<'static> = LightBuffer { words: &[], lights: 0, level: 0, cells: 0, entries: 0 };
+    pub const NONE: LightBuffer<'static> =
+        LightBuffer { words: &[], lights: 0, level: 0, cells: 0, entries: 0, cones: false };
 
     /// Builds the buffer over `scene`'s lights and objects in `words` with
     /// at most `cells_a_side` cells a face side (rounded down to a power of
     /// two, at most [`MAX_CELLS_A_SIDE`]): the finest cube whose lists fit
     /// the arena, or, when even one cell a face does not fit, the first
-    /// lights that do.
+    /// lights that do. A scene of
+    /// [`AccelMode::AUTO_NAIVE_UP_TO`](crate::AccelMode::AUTO_NAIVE_UP_TO)
+    /// objects or fewer gets no cube but a cone around each object as each
+    /// light sees it (two words an object a light, for the first lights
+    /// that fit): its shadow rays test only the objects whose cone holds
+    /// their direction, for less than a cell's look-up would cost.
     ///
     /// ```
     /// use octrace_core::accel::LightBuffer;
@@ -220,14 +234,39 @@ impl<'a> LightBuffer<'a> {
     /// use octrace_core::profile::Board64K;
     /// use octrace_core::scene::Scene;
     ///
+    /// let spheres: String = (0..20).map(|k| format!("SPHERE 1 0.2 {} 0 0\n", k)).collect();
+    /// let text = format!("RASTER 8 8\nVIEWPOINT 0 0 9\nLIGHT 10 5 5 5\n{spheres}SURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n");
     /// let mut scene = Scene::<Board64K>::new();
-    /// parse("RASTER 8 8\nVIEWPOINT 0 0 5\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\nSPHERE 1 0.5 1 1 1\nSPHERE 1 0.3 2 2 2\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n", &mut scene, &mut |e| panic!("{e}")).unwrap();
-    /// let mut words = heapless::Vec::<u32, 400>::new();
+    /// parse(&text, &mut scene, &mut |e| panic!("{e}")).unwrap();
+    /// let mut words = heapless::Vec::<u32, 2000>::new();
     /// let buffer = LightBuffer::build(&scene.view(), &mut words, 8);
     /// assert_eq!((buffer.report().lights, buffer.report().cells_a_side), (1, 8));
+    ///
+    /// // Three spheres: a cone each.
+    /// let mut few = Scene::<Board64K>::new();
+    /// parse("LIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\nSPHERE 1 0.5 1 1 1\nSPHERE 1 0.3 2 2 2\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n", &mut few, &mut |e| panic!("{e}")).unwrap();
+    /// let report = LightBuffer::build(&few.view(), &mut words, 8).report();
+    /// assert!(report.cones);
+    /// assert_eq!((report.lights, report.entries, report.words), (1, 3, 3 + 2 * 3));
     /// ```
     pub fn build<W: Arena<u32>>(scene: &SceneView<'_>, words: &'a mut W, cells_a_side: u32) -> LightBuffer<'a> {
-        Self::build_with_margin(scene, words, cells_a_side, usize::MAX, MARGIN)
+        Self::build_for::<EveryKind, W>(scene, words, cells_a_side, usize::MAX)
+    }
+
+    /// [`LightBuffer::build`] for at most the first `lights` lights, in
+    /// the form build `S` links (both: the one that suits the scene), over
+    /// its shapes.
+    fn build_for<S: ShadowLinks, W: Arena<u32>>(
+        scene: &SceneView<'_>,
+        words: &'a mut W,
+        cells_a_side: u32,
+        lights: usize,
+    ) -> LightBuffer<'a> {
+        if S::CONES && (!S::CUBES || scene.object_count() <= crate::AccelMode::AUTO_NAIVE_UP_TO) {
+            words.clear();
+            return Self::build_cones(scene, words, lights);
+        }
+        Self::build_with_margin(scene, words, cells_a_side, lights, MARGIN)
     }
 
     /// The words: what a build script writes out to keep the buffer in
@@ -238,6 +277,16 @@ impl<'a> LightBuffer<'a> {
 
     /// Its size and fineness.
     pub fn report(&self) -> LightBufferReport {
+        if self.cones {
+            let entries = (self.words.len() - Words::CONES_HEADER) / cones::CONE;
+            return LightBufferReport {
+                lights: self.lights,
+                entries,
+                words: self.words.len(),
+                cones: true,
+                ..Default::default()
+            };
+        }
         let cells = self.entries - self.cells;
         LightBufferReport {
             cells_a_side: if self.lights > 0 { 1 << self.level } else { 0 },
@@ -245,6 +294,7 @@ impl<'a> LightBuffer<'a> {
             cells,
             entries: self.words.len() - self.entries,
             words: self.words.len(),
+            cones: false,
         }
     }
 }
@@ -286,17 +336,34 @@ impl<W: Arena<u32>> LightBufferStore<W> {
 
     /// Builds `scene`'s buffer in the store (see [`LightBuffer::build`]).
     pub fn build(&mut self, scene: &SceneView<'_>, cells_a_side: u32) -> LightBuffer<'_> {
-        self.build_for(scene, cells_a_side, usize::MAX)
+        self.build_for::<EveryKind>(scene, cells_a_side, usize::MAX)
     }
 
-    /// [`LightBufferStore::build`] for at most the first `lights` lights.
-    pub(crate) fn build_for(&mut self, scene: &SceneView<'_>, cells_a_side: u32, lights: usize) -> LightBuffer<'_> {
-        LightBuffer::build_with_margin(scene, &mut self.words, cells_a_side, lights, MARGIN)
+    /// [`LightBufferStore::build`] for at most the first `lights` lights,
+    /// over what build `S` links (see [`LightBuffer::build`]).
+    pub(crate) fn build_for<S: ShadowLinks>(
+        &mut self,
+        scene: &SceneView<'_>,
+        cells_a_side: u32,
+        lights: usize,
+    ) -> LightBuffer<'_> {
+        LightBuffer::build_for::<S, W>(scene, &mut self.words, cells_a_side, lights)
     }
 
     /// The buffer last built (none before the first build).
     pub fn buffer(&self) -> LightBuffer<'_> {
-        LightBuffer::parse(self.words.as_slice()).unwrap_or(LightBuffer::NONE)
+        self.buffer_for::<EveryKind>()
+    }
+
+    /// The buffer last built by [`LightBufferStore::build_for`] for `S`.
+    pub(crate) fn buffer_for<S: ShadowLinks>(&self) -> LightBuffer<'_> {
+        let words = self.words.as_slice();
+        match (S::CUBES, S::CONES) {
+            (true, true) => LightBuffer::parse(words),
+            (true, false) => LightBuffer::parse(words).filter(|buffer| !buffer.cones),
+            (false, _) => LightBuffer::parse_cones(words),
+        }
+        .unwrap_or(LightBuffer::NONE)
     }
 }
 
@@ -333,11 +400,15 @@ impl<A: Accelerator> LightBuffered<'_, A> {
     /// the buffer's objects tested over its kinds only (a build's, which
     /// links no other kind's code).
     #[inline]
-    pub(crate) fn occluded_toward_among(&self, query: &ShadowQuery<'_, '_>, mailbox: &mut Mailbox<'_>) -> bool {
-        match self.buffer.occluded(query, mailbox) {
+    pub(crate) fn occluded_toward_among<S: ShadowLinks>(
+        &self,
+        query: &ShadowQuery<'_, '_>,
+        mailbox: &mut Mailbox<'_>,
+    ) -> bool {
+        match self.buffer.occluded::<S>(query, mailbox) {
             Some(blocked) => blocked,
             None => {
-                let ShadowQuery { scene, ray, t_max, light, start, .. } = *query;
+                let ShadowQuery { scene, ray, t_max, light, start } = *query;
                 self.accel.occluded_toward(scene, ray, t_max, light, start, mailbox)
             }
         }
@@ -378,8 +449,8 @@ impl<A: Accelerator> Accelerator for LightBuffered<'_, A> {
         start: Option<RayStart>,
         mailbox: &mut Mailbox<'_>,
     ) -> bool {
-        let query = ShadowQuery { scene, kinds: ShapeKinds::ALL, ray, t_max, light, start };
-        self.occluded_toward_among(&query, mailbox)
+        let query = ShadowQuery { scene, ray, t_max, light, start };
+        self.occluded_toward_among::<EveryKind>(&query, mailbox)
     }
 }
 
@@ -447,11 +518,17 @@ mod tests {
             let naive = Naive.occluded(&view, &ray, t_max, None, &mut Mailbox::none());
             blocked += naive as usize;
             let mut words = Arena::new();
-            let buffer = LightBuffer::build(&view, &mut words, MAX_CELLS_A_SIDE);
+            let buffer = LightBuffer::build_with_margin(&view, &mut words, MAX_CELLS_A_SIDE, usize::MAX, MARGIN);
             assert_eq!(buffer.report().cells_a_side, MAX_CELLS_A_SIDE);
             let lit = LightBuffered::new(&Naive, buffer);
             let answer = lit.occluded_toward(&view, &ray, t_max, 1, None, &mut Mailbox::none());
             assert_eq!(answer, naive, "case {case}: {ray:?} to {t_max:?}\n{text}");
+            let mut cone_words = Arena::new();
+            let cones = LightBuffer::build(&view, &mut cone_words, MAX_CELLS_A_SIDE);
+            assert!(cones.report().cones, "case {case}: one box gets cones");
+            let answer =
+                LightBuffered::new(&Naive, cones).occluded_toward(&view, &ray, t_max, 1, None, &mut Mailbox::none());
+            assert_eq!(answer, naive, "case {case}, cones: {ray:?} to {t_max:?}\n{text}");
             let cut = LightBuffer::build_with_margin(&view, &mut words, MAX_CELLS_A_SIDE, usize::MAX, -4);
             let answer =
                 LightBuffered::new(&Naive, cut).occluded_toward(&view, &ray, t_max, 1, None, &mut Mailbox::none());
@@ -493,12 +570,14 @@ mod tests {
 
     /// Shadow rays from the hits of random rays on random scenes to every
     /// light, aimed as the tracer aims them, leaving their object either
-    /// way: the light buffer (at every fineness, and squeezed into arenas
-    /// too small for every light) gives the naive mode's answer.
+    /// way: the light buffer (cubes at every fineness, cones, each squeezed
+    /// into arenas too small for every light) gives the naive mode's
+    /// answer, and the cones pass a minority of the objects.
     #[test]
     fn shadow_rays_get_the_naive_answer() {
         let mut next = crate::test_rng::seeded(0x5_4ad0_b0ff);
         let (mut rays, mut blocked, mut buffered) = (0u64, 0u64, 0u64);
+        let (mut coned, mut passed) = (0u64, 0u64);
         for _ in 0..150 {
             let scene = random_scene(&mut next);
             let view = scene.view();
@@ -508,7 +587,14 @@ mod tests {
             let cells = 1 << (next() % (MAX_LEVEL as u64 + 1));
             let mut words = Arena::new();
             let mut small = heapless::Vec::<u32, 160>::new();
-            let buffers = [LightBuffer::build(&view, &mut words, cells), LightBuffer::build(&view, &mut small, 64)];
+            let (mut cone_words, mut few_cones) = (Arena::new(), heapless::Vec::<u32, 40>::new());
+            let buffers = [
+                LightBuffer::build_with_margin(&view, &mut words, cells, usize::MAX, MARGIN),
+                LightBuffer::build_with_margin(&view, &mut small, 64, usize::MAX, MARGIN),
+                LightBuffer::build(&view, &mut cone_words, cells),
+                LightBuffer::build(&view, &mut few_cones, cells),
+            ];
+            assert!(buffers[2].report().cones && buffers[2].report().lights == view.lights.len());
             buffered += buffers.iter().map(|b| b.report().lights as u64).sum::<u64>();
             for _ in 0..300 {
                 // From anywhere near the objects towards a point of one's
@@ -530,6 +616,11 @@ mod tests {
                     let naive = Naive.occluded(&view, &shadow, t_max, start, &mut Mailbox::none());
                     rays += 1;
                     blocked += naive as u64;
+                    if let Some(cones) = buffers[2].light_cones(light) {
+                        let toward = shadow.dir.bits().map(|c| -(c >> 16));
+                        coned += view.object_count() as u64;
+                        passed += cones.chunks_exact(cones::CONE).filter(|&c| cones::passes(c, toward)).count() as u64;
+                    }
                     for buffer in buffers {
                         let answer = LightBuffered::new(&Naive, buffer).occluded_toward(
                             &view,
@@ -545,9 +636,10 @@ mod tests {
             }
         }
         assert!(
-            rays > 20_000 && blocked > rays / 10 && buffered > 150,
+            rays > 20_000 && blocked > rays / 10 && buffered > 300,
             "{rays} rays, {blocked} blocked, {buffered} buffered"
         );
+        assert!(passed * 3 < coned, "the cones passed {passed} of {coned} objects");
     }
 
     /// A buffer built for one scene is refused for another, and one with an
@@ -560,7 +652,8 @@ mod tests {
         parse(text, &mut scene, &mut |e| panic!("{e}")).unwrap();
         let view = scene.view();
         let mut arena = Arena::new();
-        let words: Vec<u32> = LightBuffer::build(&view, &mut arena, 16).words().to_vec();
+        let words: Vec<u32> =
+            LightBuffer::build_with_margin(&view, &mut arena, 16, usize::MAX, MARGIN).words().to_vec();
         let buffer = LightBuffer::verified(&view, &words).unwrap();
         assert_eq!(buffer.report().lights, 2);
         let entries = buffer.entries;

@@ -4,17 +4,44 @@
 use super::build::cell_in;
 use super::cells::direction;
 use super::{LightBuffer, Words, DEPTH_SHIFT, OBJECT_BITS, OBJECT_MASK};
-use crate::accel::{Mailbox, RayStart};
+use crate::accel::{Linked, Mailbox, RayStart};
 use crate::math::Scalar;
 use crate::scene::{ObjectId, SceneView};
 use crate::shapes::{Leaving, Ray, ShapeKinds};
 
+/// What a build links of the shadow rays' tests, as constants, so that its
+/// code holds its own shapes' tests only: a profile's ([`Linked`]), or
+/// every kind's ([`EveryKind`]).
+pub(crate) trait ShadowLinks {
+    /// The shape kinds its objects can be.
+    const KINDS: ShapeKinds;
+    /// Whether it links a cube's look-up and build, and the cones' (a
+    /// buffer of a form it does not link is not read: its lights' rays are
+    /// left to the accelerator). At least one of them.
+    const CUBES: bool;
+    const CONES: bool;
+}
+
+impl<L: Linked> ShadowLinks for L {
+    const KINDS: ShapeKinds = L::KINDS;
+    const CUBES: bool = L::LIGHT_CUBES || !L::LIGHT_CONES;
+    const CONES: bool = L::LIGHT_CONES;
+}
+
+/// Every kind and both forms: a [`LightBuffered`](super::LightBuffered)
+/// over any accelerator.
+pub(crate) struct EveryKind;
+
+impl ShadowLinks for EveryKind {
+    const KINDS: ShapeKinds = ShapeKinds::ALL;
+    const CUBES: bool = true;
+    const CONES: bool = true;
+}
+
 /// A shadow ray from its origin towards the scene's light `light` as the
-/// tracer aims it (see [`RAY_SLACK`](super::RAY_SLACK)), up to `t_max`,
-/// its objects tested over `kinds`.
+/// tracer aims it (see [`RAY_SLACK`](super::RAY_SLACK)), up to `t_max`.
 pub(crate) struct ShadowQuery<'q, 'v> {
     pub scene: &'q SceneView<'v>,
-    pub kinds: ShapeKinds,
     pub ray: &'q Ray,
     pub t_max: Scalar,
     pub light: usize,
@@ -26,10 +53,20 @@ impl LightBuffer<'_> {
     /// is left in the mailbox. `None` when the light is not buffered: the
     /// caller asks its accelerator.
     #[inline]
-    pub(crate) fn occluded(&self, query: &ShadowQuery<'_, '_>, mailbox: &mut Mailbox<'_>) -> Option<bool> {
-        let ShadowQuery { scene, kinds, ray, t_max, light, start } = *query;
+    pub(crate) fn occluded<S: ShadowLinks>(
+        &self,
+        query: &ShadowQuery<'_, '_>,
+        mailbox: &mut Mailbox<'_>,
+    ) -> Option<bool> {
+        if self.cones {
+            return if S::CONES { self.occluded_in_cones::<S>(query, mailbox) } else { None };
+        }
+        if !S::CUBES {
+            return None;
+        }
+        let ShadowQuery { scene, ray, t_max, light, start } = *query;
         let ([own, cell], depth) = self.lists(ray.origin.bits(), light)?;
-        let shadow = Shadow { scene, kinds, ray, t_max, start, depth };
+        let shadow = Shadow { scene, kinds: S::KINDS, ray, t_max, start, depth };
         // The light's own list is mostly empty.
         Some((!own.is_empty() && shadow.blocked_by(own, mailbox)) || shadow.blocked_by(cell, mailbox))
     }
