@@ -513,7 +513,6 @@ mod host {
         const FIRST_HITS: bool = true;
         const COHERENCE: bool = true;
         const LIGHT_BUFFER: bool = true;
-        const LIGHT_CONES: bool = true;
     }
 
     crate::__shape_kinds!(crate::__scene_capacities! { Host, HeapArena });
