@@ -47,7 +47,7 @@ use crate::accel::{Mailbox, RayStart};
 use crate::capacity::Arena;
 use crate::math::{leading_zeros_u32, Dir};
 use crate::scene::{ObjectId, SceneView};
-use crate::shapes::{Aabb, Leaving, ShapeRef};
+use crate::shapes::{Aabb, Leaving, ShapeHandle, ShapeRef};
 use crate::AccelMode;
 
 /// Twice what the 16-bit products may lose, in units of 2^-28 (see the
@@ -111,7 +111,8 @@ fn direction_and_length(v: [i32; 3]) -> Option<(Dir, u32, u32)> {
 
 /// The cone of `shape` seen from the light at `light` (Q16.16 bits).
 #[inline(never)]
-fn cone(shape: ShapeRef<'_>, light: [i32; 3]) -> [u32; CONE] {
+fn cone(scene: &SceneView<'_>, handle: ShapeHandle, light: [i32; 3]) -> [u32; CONE] {
+    let shape = scene.shape_of(handle);
     const ALWAYS_TESTED: [u32; CONE] = [0, (ALWAYS as u16 as u32) << 16];
     let Some((center, radius)) = ball(shape) else { return ALWAYS_TESTED };
     let axis = [0, 1, 2].map(|a| center[a] - light[a]);
@@ -155,7 +156,7 @@ impl<'a> LightBuffer<'a> {
         }
         for light in scene.lights.iter().take(lights) {
             for &handle in scene.objects {
-                for word in cone(scene.shape_of(handle), light.position.bits()) {
+                for word in cone(scene, handle, light.position.bits()) {
                     let _ = words.push(word);
                 }
             }
@@ -189,7 +190,7 @@ impl<'a> LightBuffer<'a> {
         }
         for (light, l) in scene.lights[..self.lights].iter().enumerate() {
             for id in scene.object_ids() {
-                if self.cone_of(light, id) != Some(&cone(scene.shape(id), l.position.bits())[..]) {
+                if self.cone_of(light, id) != Some(&cone(scene, scene.objects[id.0 as usize], l.position.bits())[..]) {
                     return Err(LightBufferError::Incomplete { light, object: id });
                 }
             }
@@ -214,21 +215,22 @@ impl<'a> LightBuffer<'a> {
     }
 
     /// Whether anything blocks the shadow ray `query` asks of, testing only
-    /// the objects whose cone its direction is in (the blocker left in the
-    /// mailbox); `None` when the light has no cones.
+    /// the objects whose cone its direction is in (every object when its
+    /// light has no cones); the blocker is left in the mailbox.
     #[inline(never)]
     pub(super) fn occluded_in_cones<S: ShadowLinks>(
         &self,
         query: &ShadowQuery<'_, '_>,
         mailbox: &mut Mailbox<'_>,
-    ) -> Option<bool> {
+    ) -> bool {
         let ShadowQuery { scene, ray, t_max, light, start } = *query;
-        let cones = self.light_cones(light).filter(|cones| cones.len() == CONE * scene.object_count())?;
+        let cones = self.light_cones(light).filter(|cones| cones.len() == CONE * scene.object_count());
+        let mut cones = cones.unwrap_or(&[]).chunks_exact(CONE);
         // From the light towards the ray's origin, in Q2.14: within
         // [−2^14, 2^14 + 1].
         let toward = ray.dir.bits().map(|c| -(c >> 16));
-        for (object, (cone, &handle)) in cones.chunks_exact(CONE).zip(scene.objects.iter()).enumerate() {
-            if !passes(cone, toward) {
+        for (object, &handle) in scene.objects.iter().enumerate() {
+            if cones.next().is_some_and(|cone| !passes(cone, toward)) {
                 continue;
             }
             let leaving = RayStart::leaving(start, ObjectId(object as u32));
@@ -238,10 +240,10 @@ impl<'a> LightBuffer<'a> {
             }
             if scene.intersect_handle(S::KINDS, handle, ray, t_max, leaving).is_some() {
                 mailbox.blocker = object as u32;
-                return Some(true);
+                return true;
             }
         }
-        Some(false)
+        false
     }
 }
 

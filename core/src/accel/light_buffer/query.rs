@@ -50,18 +50,21 @@ pub(crate) struct ShadowQuery<'q, 'v> {
 
 impl LightBuffer<'_> {
     /// Whether anything blocks the shadow ray `query` asks of; the blocker
-    /// is left in the mailbox. `None` when the light is not buffered: the
-    /// caller asks its accelerator.
+    /// is left in the mailbox. `None` when the light is not buffered (in a
+    /// build that links a cube): the caller asks its accelerator.
     #[inline]
     pub(crate) fn occluded<S: ShadowLinks>(
         &self,
         query: &ShadowQuery<'_, '_>,
         mailbox: &mut Mailbox<'_>,
     ) -> Option<bool> {
-        if self.cones {
-            return if S::CONES { self.occluded_in_cones::<S>(query, mailbox) } else { None };
+        // A build of cones alone tests every shadow ray here, against its
+        // light's cones or, for a light without, every object (the
+        // accelerator's answer, with no second loop linked).
+        if !S::CUBES || (S::CONES && self.cones) {
+            return Some(self.occluded_in_cones::<S>(query, mailbox));
         }
-        if !S::CUBES {
+        if self.cones {
             return None;
         }
         let ShadowQuery { scene, ray, t_max, light, start } = *query;
