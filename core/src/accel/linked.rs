@@ -9,11 +9,11 @@
 //! of their code; a scene's own choice (its mode, whether it has a buffer)
 //! is made at load and only narrows these.
 
-use super::light_buffer::ShadowQuery;
+use super::light_buffer::{ShadowLinks, ShadowQuery};
 use super::{naive, Accelerator, Hit, LightBuffer, LightBuffered, Mailbox, OctreeCapacities, OctreeStore, RayStart};
 use crate::math::Scalar;
 use crate::scene::SceneView;
-use crate::shapes::Ray;
+use crate::shapes::{Ray, ShapeKinds};
 use core::fmt;
 
 /// What a build links: every [`Profile`](crate::profile::Profile) is one
@@ -45,6 +45,14 @@ pub trait Linked: OctreeCapacities + Sized {
     const LIGHT_CUBES: bool = Self::LIGHT_BUFFER;
     /// See [`Linked::LIGHT_CUBES`].
     const LIGHT_CONES: bool = false;
+}
+
+/// A build's shadow rays test its own shapes, through the light buffer's
+/// form it links.
+impl<L: Linked> ShadowLinks for L {
+    const KINDS: ShapeKinds = L::KINDS;
+    const CUBES: bool = L::LIGHT_CUBES || !L::LIGHT_CONES;
+    const CONES: bool = L::LIGHT_CONES;
 }
 
 /// Whether builds of `L` mark the mailbox: only an octree's queries do.

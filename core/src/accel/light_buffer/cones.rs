@@ -41,8 +41,8 @@
 //! cones by a shift; the cones of a light are its objects', in order, and
 //! the lights' follow each other.
 
-use super::query::{ShadowLinks, ShadowQuery};
-use super::{LightBuffer, LightBufferError, Words, MARGIN};
+use super::query::ShadowQuery;
+use super::{LightBuffer, LightBufferError, LightBufferReport, ShadowLinks, Words, MARGIN};
 use crate::accel::{Mailbox, RayStart};
 use crate::capacity::Arena;
 use crate::math::{leading_zeros_u32, Dir};
@@ -196,6 +196,12 @@ impl<'a> LightBuffer<'a> {
             }
         }
         Ok(())
+    }
+
+    /// [`LightBuffer::report`] of cones.
+    pub(super) fn cones_report(&self) -> LightBufferReport {
+        let entries = (self.words.len() - Words::CONES_HEADER) / CONE;
+        LightBufferReport { lights: self.lights, entries, words: self.words.len(), cones: true, ..Default::default() }
     }
 
     /// The words of light `light`'s cone around object `id`.

@@ -54,15 +54,14 @@ use super::{Accelerator, Hit, Mailbox, RayStart, FILING_MARGIN};
 use crate::capacity::{Arena, Counts};
 use crate::math::Scalar;
 use crate::scene::{ObjectId, SceneView};
-use crate::shapes::Ray;
+use crate::shapes::{Ray, ShapeKinds};
 
 mod build;
 mod cells;
 mod cones;
 mod query;
 
-use query::EveryKind;
-pub(crate) use query::{ShadowLinks, ShadowQuery};
+pub(crate) use query::ShadowQuery;
 
 /// How far a shadow ray strays from the segment between its origin and its
 /// light, in Q16.16 raw units, at most. The tracer aims it with
@@ -78,6 +77,30 @@ pub(crate) const RAY_SLACK: i64 = 64;
 /// point's rounding (the octree's filing margin) and a shadow ray's
 /// straying.
 pub(crate) const MARGIN: i64 = FILING_MARGIN + RAY_SLACK;
+
+/// What a build links of the shadow rays' tests, as constants, so that its
+/// code holds its own shapes' tests only: a profile's
+/// ([`Linked`](crate::profile::Linked)), or
+/// every kind's ([`EveryKind`]).
+pub(crate) trait ShadowLinks {
+    /// The shape kinds its objects can be.
+    const KINDS: ShapeKinds;
+    /// Whether it links a cube's look-up and build, and the cones' (a
+    /// buffer of a form it does not link is not read: its lights' rays are
+    /// left to the accelerator). At least one of them.
+    const CUBES: bool;
+    const CONES: bool;
+}
+
+/// Every kind and both forms: a [`LightBuffered`](super::LightBuffered)
+/// over any accelerator.
+pub(crate) struct EveryKind;
+
+impl ShadowLinks for EveryKind {
+    const KINDS: ShapeKinds = ShapeKinds::ALL;
+    const CUBES: bool = true;
+    const CONES: bool = true;
+}
 
 /// The most cells a face side has: 2^`MAX_LEVEL`.
 pub const MAX_CELLS_A_SIDE: u32 = 1 << MAX_LEVEL;
@@ -278,14 +301,7 @@ impl<'a> LightBuffer<'a> {
     /// Its size and fineness.
     pub fn report(&self) -> LightBufferReport {
         if self.cones {
-            let entries = (self.words.len() - Words::CONES_HEADER) / cones::CONE;
-            return LightBufferReport {
-                lights: self.lights,
-                entries,
-                words: self.words.len(),
-                cones: true,
-                ..Default::default()
-            };
+            return self.cones_report();
         }
         let cells = self.entries - self.cells;
         LightBufferReport {

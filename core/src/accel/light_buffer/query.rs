@@ -3,40 +3,11 @@
 
 use super::build::cell_in;
 use super::cells::direction;
-use super::{LightBuffer, Words, DEPTH_SHIFT, OBJECT_BITS, OBJECT_MASK};
-use crate::accel::{Linked, Mailbox, RayStart};
+use super::{LightBuffer, ShadowLinks, Words, DEPTH_SHIFT, OBJECT_BITS, OBJECT_MASK};
+use crate::accel::{Mailbox, RayStart};
 use crate::math::Scalar;
 use crate::scene::{ObjectId, SceneView};
 use crate::shapes::{Leaving, Ray, ShapeKinds};
-
-/// What a build links of the shadow rays' tests, as constants, so that its
-/// code holds its own shapes' tests only: a profile's ([`Linked`]), or
-/// every kind's ([`EveryKind`]).
-pub(crate) trait ShadowLinks {
-    /// The shape kinds its objects can be.
-    const KINDS: ShapeKinds;
-    /// Whether it links a cube's look-up and build, and the cones' (a
-    /// buffer of a form it does not link is not read: its lights' rays are
-    /// left to the accelerator). At least one of them.
-    const CUBES: bool;
-    const CONES: bool;
-}
-
-impl<L: Linked> ShadowLinks for L {
-    const KINDS: ShapeKinds = L::KINDS;
-    const CUBES: bool = L::LIGHT_CUBES || !L::LIGHT_CONES;
-    const CONES: bool = L::LIGHT_CONES;
-}
-
-/// Every kind and both forms: a [`LightBuffered`](super::LightBuffered)
-/// over any accelerator.
-pub(crate) struct EveryKind;
-
-impl ShadowLinks for EveryKind {
-    const KINDS: ShapeKinds = ShapeKinds::ALL;
-    const CUBES: bool = true;
-    const CONES: bool = true;
-}
 
 /// A shadow ray from its origin towards the scene's light `light` as the
 /// tracer aims it (see [`RAY_SLACK`](super::RAY_SLACK)), up to `t_max`.
