@@ -2,11 +2,14 @@
 //! around each object as the light sees it, which a shadow ray's direction
 //! is tested against in three 16-bit products before the object's own test.
 //!
-//! A scene of [`AccelMode::AUTO_NAIVE_UP_TO`](crate::AccelMode::AUTO_NAIVE_UP_TO)
-//! objects or fewer, which the `Auto` mode tests one by one, gets this form:
-//! there a cube's look-up (the face, the cell, the list) costs what testing
-//! every object does, where a cone's test costs a fifth of a sphere's
-//! quickest rejection.
+//! A build whose profile holds [`AccelMode::AUTO_NAIVE_UP_TO`] objects or
+//! fewer (scenes the `Auto` mode tests one by one) links this form alone
+//! ([`Linked::LIGHT_CONES`](crate::profile::Linked::LIGHT_CONES)), and
+//! [`LightBuffer::build`] gives it to such a scene: on a Cortex-M0 a cube's
+//! look-up (the face, the cell, the list) costs what testing every object
+//! does, where a cone's test costs a quarter of a sphere's quickest
+//! rejection. Such a build tests every shadow ray in the cone loop, every
+//! object for a light without cones.
 //!
 //! *Cones.* For light `L` and object `k`: the ball of centre `C` and radius
 //! `R` (rounded up) that holds the object widened by [`MARGIN`] (a
@@ -109,12 +112,14 @@ fn direction_and_length(v: [i32; 3]) -> Option<(Dir, u32, u32)> {
     Some((unit, length >> down, ((length + 1) >> down) + 1))
 }
 
-/// The cone of `shape` seen from the light at `light` (Q16.16 bits).
+/// The cone of the object behind `handle` seen from the light at `light`
+/// (Q16.16 bits).
 #[inline(never)]
 fn cone(scene: &SceneView<'_>, handle: ShapeHandle, light: [i32; 3]) -> [u32; CONE] {
-    let shape = scene.shape_of(handle);
     const ALWAYS_TESTED: [u32; CONE] = [0, (ALWAYS as u16 as u32) << 16];
-    let Some((center, radius)) = ball(shape) else { return ALWAYS_TESTED };
+    // The shape from its handle here, not in the caller's loop: a board's
+    // load then calls the scene's one copy of that dispatch.
+    let Some((center, radius)) = ball(scene.shape_of(handle)) else { return ALWAYS_TESTED };
     let axis = [0, 1, 2].map(|a| center[a] - light[a]);
     let Some((unit, distance, _)) = direction_and_length(axis) else { return ALWAYS_TESTED };
     if distance <= radius.saturating_add(NEAR as u32) {
