@@ -89,6 +89,7 @@ pub(crate) trait ShadowLinks {
     /// buffer of a form it does not link is not read: its lights' rays are
     /// left to the accelerator). At least one of them.
     const CUBES: bool;
+    /// See [`ShadowLinks::CUBES`].
     const CONES: bool;
 }
 
@@ -158,9 +159,9 @@ pub struct LightBufferReport {
     pub entries: usize,
     /// Words in all (4 bytes each).
     pub words: usize,
-    /// Whether it is a scene of few objects' cones (see
-    /// [`LightBuffer::build`]): no cube, `cells_a_side` and `cells` 0, an
-    /// entry for each object a light.
+    /// Whether it holds cones rather than a cube (few objects, see
+    /// [`LightBuffer::build`]): then `cells_a_side` and `cells` are 0 and
+    /// there is an entry for each object a light.
     pub cones: bool,
 }
 
