@@ -342,11 +342,14 @@ fn into_io(e: FormatError) -> std::io::Error {
 /// ([`temporary_beside`]), renamed into place only when `write` succeeds
 /// ([`replace_with`]); on failure no file is left behind. A `path` that is
 /// a device, a pipe or a socket (`/dev/null`, a FIFO) is written into as
-/// a shell's `>` would: a rename would replace the node itself.
+/// a shell's `>` would: a rename would replace the node itself. A symbolic
+/// link is written through, as `>` would too: the file it names is
+/// replaced, the link stays.
 pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
+    let path = &through_links(path);
     if is_stream(path) {
         let mut w = std::io::BufWriter::new(File::options().write(true).open(path)?);
         write(&mut w)?;
@@ -365,6 +368,19 @@ pub fn write_atomically(
         let _ = std::fs::remove_file(&tmp);
     }
     result
+}
+
+/// The file `path` names once its symbolic links are followed (a dangling
+/// one, the file it would create), at most 40 deep (the kernel's limit,
+/// past which the path itself, which then fails as the kernel says).
+fn through_links(path: &Path) -> PathBuf {
+    let mut path = path.to_path_buf();
+    for _ in 0..40 {
+        let Ok(target) = std::fs::read_link(&path) else { break };
+        // A relative target is relative to the link's directory.
+        path = path.parent().map_or_else(|| target.clone(), |directory| directory.join(&target));
+    }
+    path
 }
 
 /// Whether `path` names something other than a file or a directory: a

@@ -845,6 +845,30 @@ fn row18_output_to_a_pipe_is_written_into() {
     assert_eq!(listing(dir.path()), ["o.png", "s.txt"]);
 }
 
+/// Row 18e, too: OUT a symbolic link is written through, as a shell's `>`
+/// would: the file it names (relative to the link, through a chain of
+/// links, or not there yet) gets the image, the link stays a link.
+#[test]
+fn row18_output_through_a_symlink_writes_its_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, _) = small_scene(dir.path());
+    std::fs::create_dir(dir.path().join("images")).unwrap();
+    std::fs::write(dir.path().join("images/real.png"), b"old").unwrap();
+    std::os::unix::fs::symlink("images/real.png", dir.path().join("link.png")).unwrap();
+    std::os::unix::fs::symlink("link.png", dir.path().join("chain.png")).unwrap();
+    std::os::unix::fs::symlink("images/new.png", dir.path().join("dangling.png")).unwrap();
+    for (out, file) in [("chain.png", "images/real.png"), ("dangling.png", "images/new.png")] {
+        let (code, err) = host_sim(&[scene.as_os_str(), dir.path().join(out).as_os_str(), "-q".as_ref()]);
+        assert_eq!(code, 0, "{out}: {err}");
+        let png = std::fs::read(dir.path().join(file)).unwrap();
+        assert_eq!(octrace_images::formats::read(&png).unwrap().to_rgb().width, 4, "{out}: the image in {file}");
+    }
+    for link in ["link.png", "chain.png", "dangling.png"] {
+        assert!(std::fs::symlink_metadata(dir.path().join(link)).unwrap().file_type().is_symlink(), "{link}");
+    }
+    assert_eq!(listing(&dir.path().join("images")), ["new.png", "real.png"]);
+}
+
 /// Row 18f: frame files (`f%d.png`) are each guarded as a still's OUT: the
 /// scene, a read-only file and a directory are refused before anything is
 /// rendered, and a failed run leaves the files that were there before.
