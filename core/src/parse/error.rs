@@ -41,6 +41,9 @@ impl fmt::Display for Field {
 pub enum Found<'a> {
     /// This word of the scene text.
     Token(&'a str),
+    /// This quoted string (without its quotes): text where a number was
+    /// expected, however much it looks like one.
+    Quoted(&'a str),
     /// The text ended before the statement did.
     EndOfFile,
 }
@@ -49,6 +52,7 @@ impl fmt::Display for Found<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Found::Token(t) => write!(f, "`{}`", Shown(t)),
+            Found::Quoted(t) => write!(f, "`\"{}\"` (a quoted name, not a number)", Shown(t)),
             Found::EndOfFile => f.write_str("the end of the file"),
         }
     }

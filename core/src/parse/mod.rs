@@ -817,6 +817,10 @@ mod tests {
         check("SPHERE 1 1 0x10 0 0", "found `0x10`");
         check("SPHERE 1 1 0 0", "1:15: expected a number for SPHERE z, found the end of the file");
         check("RASTER 3.5 2", "expected an integer for RASTER width, found `3.5`");
+        // A quoted number is text: the message shows the quotes and says so.
+        let quoted = "expected an integer for RASTER width, found `\"4\"` (a quoted name, not a number)";
+        check("RASTER \"4\" 4", quoted);
+        check("LIGHT 1 \"2\" 0 0", "expected a number for LIGHT x, found `\"2\"` (a quoted name");
         check("SPHERE 1.5 1 0 0 0", "expected an integer for SPHERE surface number");
         check("\n\n  /* open", "3:3: unterminated comment");
         check("IMAGEFILE \"abc", "unterminated string");

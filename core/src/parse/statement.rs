@@ -306,7 +306,7 @@ impl<'a> Cursor<'a> {
         match self.peek()? {
             None => Err(self.end_of_file(ErrorKind::ExpectedNumber { field, found: Found::EndOfFile })),
             Some(t) => match Decimal::parse(t.text).filter(|_| !t.quoted) {
-                None => Err(ParseError::new(t.pos, ErrorKind::ExpectedNumber { field, found: Found::Token(t.text) })),
+                None => Err(ParseError::new(t.pos, ErrorKind::ExpectedNumber { field, found: found(t) })),
                 Some(d) if d.out_of_range() => Err(out_of_range(t, field, Rule::Magnitude)),
                 Some(d) => Ok((d, t)),
             },
@@ -348,7 +348,7 @@ impl<'a> Cursor<'a> {
         };
         let v = parse_integer(t.text)
             .filter(|_| !t.quoted)
-            .ok_or(ParseError::new(t.pos, ErrorKind::ExpectedInteger { field, found: Found::Token(t.text) }))?;
+            .ok_or(ParseError::new(t.pos, ErrorKind::ExpectedInteger { field, found: found(t) }))?;
         if v < lo || v > hi {
             return Err(out_of_range(t, field, Rule::Between(lo, hi)));
         }
@@ -383,6 +383,14 @@ impl<'a> Cursor<'a> {
     fn surface_number(&mut self, keyword: Keyword) -> Result<u32, ParseError<'a>> {
         let field = Field { statement: keyword.name(), name: "surface number" };
         Ok(self.integer(field, 0, super::number::LIMIT as i64)? as u32)
+    }
+}
+
+/// What `t` is, as an error shows it: a quoted string says so.
+fn found(t: Token<'_>) -> Found<'_> {
+    match t.quoted {
+        true => Found::Quoted(t.text),
+        false => Found::Token(t.text),
     }
 }
 
