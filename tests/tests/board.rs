@@ -446,11 +446,13 @@ fn a_board_gone_silent_mid_drawing_is_given_up_saying_what_it_did_last() {
     assert_eq!(board.command("hold"), "ok");
     let run = run.join().expect("host-sim board ends");
     assert_eq!(run.code, 1, "{}", run.stderr);
-    let want = format!(
-        "host-sim: board at {}: the board fell silent: nothing for 8 s after it said it was still working, ",
-        board.port.display()
-    );
-    assert!(run.stderr.starts_with(&want), "{}", run.stderr);
+    let silent = format!("host-sim: board at {}: the board fell silent: nothing for 8 s after ", board.port.display());
+    // What the board did last: its word that it was still working, or the
+    // row it sent just before the hold (a busy machine's host can read the
+    // first row after the board has drawn for 100 ms: the hold then comes
+    // between that row and the board's next word).
+    let last = run.stderr.strip_prefix(&silent).unwrap_or_else(|| panic!("{}", run.stderr));
+    assert!(last.starts_with("it said it was still working, ") || last.starts_with("row "), "{}", run.stderr);
     assert_eq!(board.command("release"), "ok");
     assert!(board.alive());
 }
