@@ -377,8 +377,9 @@ fn through_links(path: &Path) -> PathBuf {
     let mut path = path.to_path_buf();
     for _ in 0..40 {
         let Ok(target) = std::fs::read_link(&path) else { break };
-        // A relative target is relative to the link's directory.
-        path = path.parent().map_or_else(|| target.clone(), |directory| directory.join(&target));
+        // A relative target is relative to the link's directory (joined,
+        // an absolute one replaces it).
+        path = path.parent().unwrap_or(Path::new("")).join(target);
     }
     path
 }

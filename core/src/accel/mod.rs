@@ -23,10 +23,10 @@ pub(crate) mod naive;
 mod octree;
 
 pub use choice::{prepare, Indexing, Prepared};
-pub(crate) use light_buffer::RAY_SLACK;
 pub use light_buffer::{
     LightBuffer, LightBufferError, LightBufferReport, LightBufferStore, LightBuffered, MAX_CELLS_A_SIDE,
 };
+pub(crate) use light_buffer::{ShadowLinks, RAY_SLACK};
 pub(crate) use linked::uses_mailbox;
 pub(crate) use linked::Linked;
 pub use linked::SceneAccelerator;

@@ -20,7 +20,7 @@
 //! is partial, and `Poll::stopped` says so; one not stopped gives the
 //! same bits whether it was asked or not.
 
-use crate::accel::{uses_mailbox, Accelerator, Hit, Linked, Mailbox, RayStart, SceneAccelerator};
+use crate::accel::{uses_mailbox, Accelerator, Hit, Linked, Mailbox, RayStart, SceneAccelerator, ShadowLinks};
 use crate::math::{
     leading_zeros, mul_u32_wide, mul_wide, pow_unit, reciprocal_start, shr_saturating_u32, shr_signed_to_u32, Dir,
     Scalar, Unit, Vec3, UNIT_ONE,
@@ -422,11 +422,10 @@ impl<'a, L: Linked> Tracer<'a, L> {
         if uses_mailbox::<L>() {
             mailbox.clear();
         }
-        // A scene's cones (a build of few objects, see
-        // `Linked::LIGHT_CUBES`) find its blocker behind a few cheap
-        // rejections: no remembered one is tried first.
-        let cones_only = L::LIGHT_CONES && !L::LIGHT_CUBES;
-        if !cones_only && (*blocker as usize) < self.scene.object_count() {
+        // A build of cones alone (few objects, see `Linked::LIGHT_CUBES`)
+        // finds the blocker behind a few cheap rejections: no remembered
+        // one is tried first.
+        if <L as ShadowLinks>::CUBES && (*blocker as usize) < self.scene.object_count() {
             let object = ObjectId(*blocker);
             let leaving = RayStart::leaving(Some(start), object);
             if self.scene.shape(object).intersect_among(L::KINDS, shadow, t_max, leaving).is_some() {

@@ -74,7 +74,6 @@ impl Words {
     pub(super) const CONES_HEADER: usize = 3;
 
     /// Words of the cones of `lights` lights over `objects` objects.
-    #[cfg(test)]
     pub(super) const fn of_cones(lights: usize, objects: usize) -> usize {
         Words::CONES_HEADER + CONE * lights * objects
     }
@@ -177,7 +176,7 @@ impl<'a> LightBuffer<'a> {
         let sound =
             magic == Words::CONES_MAGIC && lights <= u16::MAX as usize && objects <= AccelMode::AUTO_NAIVE_UP_TO;
         let header = Words::CONES_HEADER;
-        (sound && words.len() == header + CONE * lights * objects).then_some(LightBuffer {
+        (sound && words.len() == Words::of_cones(lights, objects)).then_some(LightBuffer {
             words,
             lights,
             level: 0,
