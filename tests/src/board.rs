@@ -24,7 +24,7 @@ use host_sim::board::{BoardDescription, BoardLink};
 use octrace_link::{Decoder, Frame, Refusal};
 use std::collections::VecDeque;
 use std::fs::File;
-use std::io::{self, BufRead, BufReader, Read, Write};
+use std::io::{self, BufRead, BufReader, Write};
 use std::path::PathBuf;
 use std::process::{Child, ChildStdin, Command, Stdio};
 use std::sync::mpsc::{self, Receiver};
@@ -97,12 +97,8 @@ impl RunningBoard {
     /// then serves it until its standard input closes.
     pub fn start(mut command: Command) -> Result<RunningBoard, String> {
         let program = format!("{:?}", command.get_program());
-        let mut child = command
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .map_err(|e| format!("cannot start {program}: {e}"))?;
+        command.stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::inherit());
+        let mut child = crate::children::spawn(&mut command).map_err(|e| format!("cannot start {program}: {e}"))?;
         let stdout = child.stdout.take().ok_or("no standard output")?;
         let commands = child.stdin.take().ok_or("no standard input")?;
         let mut lines = BufReader::new(stdout).lines();
@@ -210,7 +206,10 @@ impl RunningBoard {
     /// What the board says it is.
     pub fn describe(&self) -> BoardDescription {
         let mut link = BoardLink::open(&self.port.to_string_lossy(), None).expect("the port opens");
-        link.hello().expect("the board answers")
+        let description = link.hello().expect("the board answers");
+        drop(link);
+        crate::children::settle_after_closing();
+        description
     }
 
     /// Whether its process still runs.
@@ -295,11 +294,22 @@ pub fn fits(board: &BoardDescription, text: &str) -> bool {
 
 /// A host that writes any bytes to a board and reads its frames.
 pub struct RawHost {
-    port: Box<dyn serialport::SerialPort>,
+    /// Open until dropped.
+    port: Option<Box<dyn serialport::SerialPort>>,
     decoder: Decoder<Vec<u8>>,
     unread: VecDeque<u8>,
     /// Bytes read from the board so far.
     read: u64,
+}
+
+/// Its port closed, no child started meanwhile keeps it locked.
+impl Drop for RawHost {
+    fn drop(&mut self) {
+        // Closed here, not after this with the other fields: the settling
+        // follows the close.
+        self.port = None;
+        crate::children::settle_after_closing();
+    }
 }
 
 impl RawHost {
@@ -310,7 +320,7 @@ impl RawHost {
             .timeout(Duration::from_millis(50))
             .open()
             .unwrap_or_else(|e| panic!("cannot open {}: {e}", port.display()));
-        RawHost { port, decoder: Decoder::for_host(vec![0; 1 << 18]), unread: VecDeque::new(), read: 0 }
+        RawHost { port: Some(port), decoder: Decoder::for_host(vec![0; 1 << 18]), unread: VecDeque::new(), read: 0 }
     }
 
     /// Bytes read from the board so far (up to the end of the last frame
@@ -319,9 +329,13 @@ impl RawHost {
         self.read
     }
 
+    fn line(&mut self) -> &mut dyn serialport::SerialPort {
+        self.port.as_deref_mut().expect("open until dropped")
+    }
+
     pub fn send(&mut self, bytes: &[u8]) {
-        self.port.write_all(bytes).expect("the board's port takes bytes");
-        self.port.flush().expect("the board's port takes bytes");
+        self.line().write_all(bytes).expect("the board's port takes bytes");
+        self.line().flush().expect("the board's port takes bytes");
     }
 
     /// Hands each frame that comes to `each` until it returns true; false
@@ -341,7 +355,7 @@ impl RawHost {
                 return false;
             }
             let mut chunk = [0u8; 4096];
-            match self.port.read(&mut chunk) {
+            match self.line().read(&mut chunk) {
                 Ok(n) => self.unread.extend(&chunk[..n]),
                 Err(e) if e.kind() == io::ErrorKind::TimedOut => {}
                 Err(e) => panic!("reading the board: {e}"),

@@ -3,6 +3,7 @@
 
 pub mod board;
 pub mod budgets;
+pub mod children;
 pub mod firmware;
 pub mod imports;
 pub mod pico;

@@ -94,12 +94,9 @@ impl Browser {
             );
         }
         let port = free_port();
-        let driver = Command::new("/usr/bin/chromedriver")
-            .arg(format!("--port={port}"))
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("chromedriver starts");
+        let mut driver = Command::new("/usr/bin/chromedriver");
+        driver.arg(format!("--port={port}")).stdout(Stdio::null()).stderr(Stdio::null());
+        let driver = crate::children::spawn(&mut driver).expect("chromedriver starts");
         let deadline = Instant::now() + crate::HANG_GUARD;
         while TcpStream::connect(("127.0.0.1", port)).is_err() {
             assert!(Instant::now() < deadline, "chromedriver did not start listening");

@@ -46,6 +46,8 @@ fn host_sim_board(args: &[&OsStr]) -> Run {
     let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
     let args = ["host-sim".as_ref(), "board".as_ref()].into_iter().chain(args.iter().copied());
     let code = host_sim::cli::run(args, &mut stdout, &mut stderr);
+    // host-sim has closed the port, in this process.
+    octrace_tests::children::settle_after_closing();
     let text = |bytes: Vec<u8>| String::from_utf8_lossy(&bytes).into_owned();
     Run { code, stdout: text(stdout), stderr: text(stderr) }
 }

@@ -17,6 +17,7 @@ use octrace_core::panel::Dithering;
 use octrace_images::palette::{self, PaletteMode};
 use octrace_link::{BoardInfo, Capacities, Decoder, Kind, Message, Panel, PixelFormat};
 use octrace_tests::board::{fits, open_pty, wedging_scene, RunningBoard};
+use octrace_tests::children;
 use octrace_tests::webdriver::{http, http_with_head, Browser};
 use octrace_tests::{host_sim_preview, repo, scene_path, scenes, HANG_GUARD};
 use std::ffi::OsStr;
@@ -64,7 +65,7 @@ impl Studio {
         }
         let scene = scene.map(|path| path.file_name().expect("a file"));
         command.arg("studio").args(scene).args(args).stdout(Stdio::piped()).stderr(Stdio::piped());
-        let mut child = command.spawn().expect("host-sim studio starts");
+        let mut child = children::spawn(&mut command).expect("host-sim studio starts");
         let mut first = String::new();
         BufReader::new(child.stdout.take().expect("stdout")).read_line(&mut first).expect("a first line");
         let url = first.trim().to_string();
@@ -101,7 +102,9 @@ impl Studio {
     /// Sends SIGINT (what Ctrl-C sends) and waits for the exit; its status
     /// and all it wrote on its standard error.
     fn interrupt(&mut self) -> (std::process::ExitStatus, String) {
-        let status = Command::new("kill").args(["-INT", &self.child.id().to_string()]).status().expect("kill runs");
+        let status = children::output(Command::new("kill").args(["-INT", &self.child.id().to_string()]))
+            .expect("kill runs")
+            .status;
         assert!(status.success());
         let deadline = Instant::now() + HANG_GUARD;
         loop {
@@ -657,7 +660,7 @@ fn open_puts_the_token_on_no_command_line() {
 fn a_busy_port_is_an_error_not_a_panic() {
     let taken = std::net::TcpListener::bind("127.0.0.1:0").expect("a port");
     let port = taken.local_addr().unwrap().port();
-    let out = Command::new(HOST_SIM).args(["studio", "--port", &port.to_string()]).output().expect("runs");
+    let out = children::output(Command::new(HOST_SIM).args(["studio", "--port", &port.to_string()])).expect("runs");
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot listen"), "{}", String::from_utf8_lossy(&out.stderr));
 }
@@ -1355,7 +1358,7 @@ fn the_board_endpoint_keeps_the_security_rules_and_sends_one_at_a_time() {
 #[test]
 fn a_board_that_is_no_serial_port_is_an_error_at_start() {
     let scene = scene_path("fig5_1");
-    let out = Command::new(HOST_SIM).args(["studio", "--board"]).arg(&scene).output().expect("runs");
+    let out = children::output(Command::new(HOST_SIM).args(["studio", "--board"]).arg(&scene)).expect("runs");
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains(&format!("--board {} is no serial port", scene.display())), "{stderr}");
