@@ -21,7 +21,9 @@ fn image(
     octree: OctreeConfig,
     size: Option<(u32, u32)>,
 ) -> host_sim::RgbImage {
-    render(scene, &RenderOptions { size, accel, octree, ..Default::default() }).expect("renders").image
+    // On every core: the suite's last minutes run few tests beside this one.
+    let threads = std::thread::available_parallelism().map_or(1, usize::from);
+    render(scene, &RenderOptions { size, accel, octree, threads, ..Default::default() }).expect("renders").image
 }
 
 #[test]
