@@ -371,10 +371,14 @@ fn frames_rendered_apart_merge_into_the_same_gif() {
     // Frames into a still's format, or with a still's band part.
     let (code, err) = host_sim(d, &["merge", "bad.tga", "p0.png", "p1.png"]);
     assert!(code == 2 && err.contains("frames merge into an animated GIF (.gif) or an APNG (.png)"), "{err}");
+    // An animation's name with a --format that contradicts it: the --format is named.
+    let (code, err) = host_sim(d, &["merge", "bad.gif", "p0.png", "p1.png", "--format", "tga"]);
+    let want = "--format tga: bad.gif is written as an animated GIF; --format chooses the format of frame files";
+    assert!(code == 2 && err.contains(want), "{err}");
     assert_eq!(host_sim(d, &["anim.txt", "band.png", "--frame", "0", "--part", "1/2", "-q"]).0, 0);
     let (code, err) = host_sim(d, &["merge", "bad.png", "p0.png", "band.png"]);
     assert!(code == 2 && err.contains("p0.png is an animation's frame file and band.png not a frame file"), "{err}");
-    assert!(!d.join("bad.tga").exists() && !d.join("bad.png").exists());
+    assert!(!d.join("bad.tga").exists() && !d.join("bad.png").exists() && !d.join("bad.gif").exists());
 }
 
 #[test]
