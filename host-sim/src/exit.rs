@@ -75,19 +75,33 @@ impl fmt::Display for CliError {
 
 impl std::error::Error for CliError {}
 
-/// A path as a message shows it: its control characters escaped
-/// (`\u{1b}`), so that a name from a scene's IMAGEFILE cannot drive the
-/// terminal.
+/// A path as a message shows it: its control characters and invisible
+/// reordering ones escaped (`\u{1b}`, `\u{202e}`:
+/// [`octrace_core::parse::escaped_in_messages`]), so that a name from a
+/// scene's IMAGEFILE cannot drive the terminal or show another name.
 pub struct ShownPath<'a>(pub &'a Path);
 
 impl fmt::Display for ShownPath<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         for c in self.0.to_string_lossy().chars() {
-            match c.is_control() {
+            match octrace_core::parse::escaped_in_messages(c) {
                 true => write!(f, "{}", c.escape_unicode())?,
                 false => write!(f, "{c}")?,
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_path_is_shown_with_what_would_hide_or_reorder_it_escaped() {
+        let shown = |name: &str| ShownPath(Path::new(name)).to_string();
+        assert_eq!(shown("out\u{1b}[2J.png"), "out\\u{1b}[2J.png");
+        assert_eq!(shown("\u{feff}gnp.\u{202e}exe.png"), "\\u{feff}gnp.\\u{202e}exe.png");
+        assert_eq!(shown("frames/é%04d.png"), "frames/é%04d.png");
     }
 }

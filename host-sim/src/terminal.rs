@@ -6,6 +6,7 @@
 //! move the cursor, recolour the screen or fake a line of host-sim's own.
 
 use indicatif::{ProgressBar, ProgressStyle};
+use octrace_core::parse::escaped_in_messages;
 use std::io::IsTerminal;
 
 /// A progress bar of `total` steps on stderr, if it is a terminal and
@@ -23,12 +24,13 @@ pub(crate) fn progress_bar(total: u64, quiet: bool) -> Option<ProgressBar> {
 }
 
 /// `text` with every control character (a line's end and an escape
-/// included) and byte-order mark written as its Unicode escape (`\u{1b}`),
-/// as octrace-core shows hostile scene text.
+/// included) and every invisible character that reorders or hides text
+/// written as its Unicode escape (`\u{1b}`), as octrace-core shows hostile
+/// scene text ([`escaped_in_messages`]).
 pub(crate) fn shown(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     for c in text.chars() {
-        if c.is_control() || c == '\u{feff}' {
+        if escaped_in_messages(c) {
             out.extend(c.escape_unicode());
         } else {
             out.push(c);
@@ -47,6 +49,8 @@ mod tests {
             shown("red \u{1b}[31mtext\n\rhost-sim: ok\u{7}é"),
             "red \\u{1b}[31mtext\\u{a}\\u{d}host-sim: ok\\u{7}é"
         );
+        // A name that shows reversed, or with a mark no one sees.
+        assert_eq!(shown("scene\u{202e}txt.gpj\u{feff}"), "scene\\u{202e}txt.gpj\\u{feff}");
         assert_eq!(shown("plain"), "plain");
     }
 }

@@ -58,9 +58,41 @@ impl fmt::Display for Found<'_> {
     }
 }
 
-/// Scene text as a message shows it: control characters escaped (a scene
-/// must not be able to send escape sequences to a terminal) and at most
-/// [`Shown::LIMIT`] characters, with the length of the rest.
+/// Whether a message shows `c` as its Unicode escape (`\u{202e}`) rather
+/// than as itself: the control characters, with which text could move a
+/// terminal's cursor, recolour it or fake a line, and the invisible ones
+/// that reorder or hide the text around them (the bidirectional controls,
+/// the zero-width characters, the byte-order mark), with which it could
+/// show one name and hold another.
+///
+/// ```
+/// use octrace_core::parse::escaped_in_messages;
+///
+/// assert!(escaped_in_messages('\u{1b}')); // an escape sequence's start
+/// assert!(escaped_in_messages('\u{202e}')); // right-to-left override
+/// assert!(escaped_in_messages('\u{feff}')); // byte-order mark
+/// assert!(!escaped_in_messages('é'));
+/// ```
+pub fn escaped_in_messages(c: char) -> bool {
+    c.is_control()
+        || matches!(
+            c,
+            '\u{ad}'
+                | '\u{61c}'
+                | '\u{180e}'
+                | '\u{200b}'..='\u{200f}'
+                | '\u{202a}'..='\u{202e}'
+                | '\u{2060}'..='\u{2064}'
+                | '\u{2066}'..='\u{206f}'
+                | '\u{feff}'
+                | '\u{fff9}'..='\u{fffb}'
+        )
+}
+
+/// Scene text as a message shows it: the characters
+/// [`escaped_in_messages`] names escaped (a scene must not be able to send
+/// escape sequences to a terminal) and at most [`Shown::LIMIT`]
+/// characters, with the length of the rest.
 pub struct Shown<'a>(pub &'a str);
 
 impl Shown<'_> {
@@ -70,7 +102,7 @@ impl Shown<'_> {
 impl fmt::Display for Shown<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         for c in self.0.chars().take(Self::LIMIT) {
-            if c.is_control() || c == '\u{feff}' {
+            if escaped_in_messages(c) {
                 write!(f, "{}", c.escape_unicode())?;
             } else {
                 write!(f, "{c}")?;

@@ -24,7 +24,7 @@ mod number;
 mod statement;
 mod statements;
 
-pub use error::{ErrorKind, Field, Found, ParseError, Pos, Rule};
+pub use error::{escaped_in_messages, ErrorKind, Field, Found, ParseError, Pos, Rule};
 pub(crate) use motion::{for_each_move, MotionSink, Moved, Mover};
 
 pub(crate) use statement::{Keys, Statement};
