@@ -76,20 +76,14 @@ impl fmt::Display for CliError {
 impl std::error::Error for CliError {}
 
 /// A path as a message shows it: its control characters and invisible
-/// reordering ones escaped (`\u{1b}`, `\u{202e}`:
-/// [`octrace_core::parse::escaped_in_messages`]), so that a name from a
-/// scene's IMAGEFILE cannot drive the terminal or show another name.
+/// reordering ones escaped (`\u{1b}`, `\u{202e}`), as any text from
+/// outside is shown, so that a name from a scene's IMAGEFILE cannot drive
+/// the terminal or show another name.
 pub struct ShownPath<'a>(pub &'a Path);
 
 impl fmt::Display for ShownPath<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for c in self.0.to_string_lossy().chars() {
-            match octrace_core::parse::escaped_in_messages(c) {
-                true => write!(f, "{}", c.escape_unicode())?,
-                false => write!(f, "{c}")?,
-            }
-        }
-        Ok(())
+        f.write_str(&crate::terminal::shown(&self.0.to_string_lossy()))
     }
 }
 

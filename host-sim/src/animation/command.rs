@@ -243,11 +243,13 @@ pub fn is_frame_file(path: &Path) -> bool {
 /// writes.
 pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) -> Result<(), CliError> {
     let refuse = |message: String| CliError::Invalid(format!("merge: {message}; nothing written"));
-    let kind = match (Output::of(output, None), Output::of(output, format)) {
-        (_, Ok(kind @ (Output::Gif | Output::Apng))) => kind,
+    let kind = match Output::of(output, format) {
+        Ok(kind @ (Output::Gif | Output::Apng)) => kind,
         // An animation's name with a --format that contradicts it: that is
         // what is wrong, not the name.
-        (Ok(Output::Gif | Output::Apng), Err(contradiction)) => return Err(refuse(contradiction)),
+        Err(contradiction) if matches!(Output::of(output, None), Ok(Output::Gif | Output::Apng)) => {
+            return Err(refuse(contradiction))
+        }
         _ => {
             return Err(refuse(format!(
                 "{}: frames merge into an animated GIF (.gif) or an APNG (.png)",
