@@ -1362,6 +1362,12 @@ fn a_board_that_is_no_serial_port_is_an_error_at_start() {
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains(&format!("--board {} is no serial port", scene.display())), "{stderr}");
+    // A device, but no serial line: refused at start too, not at the first Send.
+    let out = children::output(Command::new(HOST_SIM).args(["studio", "--board", "/dev/null"])).expect("runs");
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("studio: --board /dev/null: cannot open it as a serial port"), "{stderr}");
+    assert!(out.stdout.is_empty(), "nothing served: {}", String::from_utf8_lossy(&out.stdout));
 }
 
 /// A page of another program on this machine, served from another port of

@@ -21,9 +21,9 @@ pub use patience::{LOADING, SILENCE};
 pub use port::{Port, SerialLine};
 
 use crate::arguments::{not_the_scene, output_format, parse_format};
-use crate::exit::CliError;
+use crate::exit::{CliError, ShownPath};
 use crate::output::panel_preview;
-use crate::terminal::progress_bar;
+use crate::terminal::{progress_bar, shown};
 use crate::{all_cores, load_frame_bytes, new_scene, render_with_progress, LoadError, RenderOptions, RgbImage};
 use embedded_graphics_core::pixelcolor::RgbColor;
 use octrace_core::panel::Dithering;
@@ -139,7 +139,7 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
         let _ = write_ports(stderr);
         return Err(CliError::Invalid(format!(
             "board: {} is no serial port: give the board's port first (host-sim board PORT SCENE [OUT])",
-            first.display()
+            ShownPath(first)
         )));
     }
     let port = first.display().to_string();
@@ -157,7 +157,7 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
     out.map(|out| output_format(args.format, out)).transpose()?;
     out.map(|out| not_the_scene(scene, out)).transpose()?;
     let text = std::fs::read(scene).map_err(|e| CliError::read(scene, e))?;
-    let file = scene.display().to_string();
+    let file = ShownPath(scene).to_string();
     let pixels = out.is_some() || args.check;
     let started = Instant::now();
     let mut bar = None;
@@ -185,7 +185,7 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
     let (w, h) = (panel.width, panel.height);
     if !args.quiet {
         let time = timing.describe(started.elapsed());
-        let _ = writeln!(stderr, "{w}x{h} {} drawn by the board at {port} {time}", panel.format);
+        let _ = writeln!(stderr, "{w}x{h} {} drawn by the board at {} {time}", panel.format, shown(&port));
     }
     let Some(image) = picture else {
         return match args.check {
@@ -219,7 +219,7 @@ fn write_picture(args: &BoardArgs, image: &RgbImage, stderr: &mut dyn Write) -> 
     })
     .map_err(|e| CliError::write(out, e))?;
     if !args.quiet {
-        let _ = writeln!(stderr, "the board's picture -> {}", out.display());
+        let _ = writeln!(stderr, "the board's picture -> {}", ShownPath(out));
     }
     Ok(())
 }
@@ -240,7 +240,12 @@ fn played(
     for (frame, _) in frames.iter().filter(|_| !args.quiet) {
         let time = frame.elapsed.map_or("".into(), |t| format!(" in {:.3} s by its clock", t.as_secs_f64()));
         let traced = frame.traced;
-        let _ = writeln!(stderr, "frame {} drawn by the board at {port}{time}, {traced} pixels traced", frame.frame);
+        let _ = writeln!(
+            stderr,
+            "frame {} drawn by the board at {}{time}, {traced} pixels traced",
+            frame.frame,
+            shown(port)
+        );
     }
     if let Some((_, Some(last))) = frames.last() {
         write_picture(args, last, stderr)?;
@@ -276,7 +281,7 @@ fn played(
 
 /// A failure to talk to the board at `port`, as host-sim reports it.
 fn link_error(port: &str, e: LinkError) -> CliError {
-    let message = format!("board at {port}: {e}");
+    let message = format!("board at {}: {e}", shown(port));
     match e {
         // The board's own answer to the scene: a scene error in all but name.
         LinkError::Refused(Reason::TooLong { .. }) => CliError::Invalid(message),
@@ -315,8 +320,9 @@ pub(crate) fn send_scene(
     let board = link.hello().map_err(|e| link_error(port, e))?;
     if text.len() > board.max_scene as usize {
         return Err(CliError::Invalid(format!(
-            "{file} is {} bytes; the board at {port} takes scenes of at most {} bytes",
+            "{file} is {} bytes; the board at {} takes scenes of at most {} bytes",
             text.len(),
+            shown(port),
             board.max_scene
         )));
     }
@@ -422,7 +428,7 @@ fn host_render(file: &str, text: &[u8], frame: u32, panel: Panel) -> Result<RgbI
 /// What `host-sim board PORT` prints.
 fn describe(port: &str, board: &BoardDescription, out: &mut dyn Write) -> io::Result<()> {
     let Panel { width, height, format } = board.panel;
-    writeln!(out, "{port}: {} (protocol version {VERSION})", board.firmware)?;
+    writeln!(out, "{}: {} (protocol version {VERSION})", shown(port), board.firmware)?;
     writeln!(out, "panel: {width}x{height} {format}; scenes of at most {} bytes", board.max_scene)?;
     let capacities: Vec<String> = board.capacities.iter().map(|(name, count)| format!("{name} {count}")).collect();
     writeln!(out, "profile {}: {}", board.profile, capacities.join(", "))

@@ -14,6 +14,7 @@
 use super::http::Response;
 use crate::board::{differing_pixels, send_scene, BoardTiming, Progress, Sent};
 use crate::exit::CliError;
+use crate::terminal::shown;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
@@ -86,7 +87,7 @@ impl BoardSender {
                 409,
                 &format!(
                     "busy: the board at {} is still answering an earlier send; send again when it is done",
-                    self.port
+                    shown(&self.port)
                 ),
             );
         }
@@ -156,7 +157,7 @@ impl BoardSender {
                 )
             }
             Ok(Sent::Drawn { picture: None, .. } | Sent::Played { .. }) => {
-                return Response::text(502, &format!("the board at {} drew without its pixels", self.port));
+                return Response::text(502, &format!("the board at {} drew without its pixels", shown(&self.port)));
             }
         };
         Response::new(200, "application/json", body.into_bytes())

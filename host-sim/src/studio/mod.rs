@@ -22,7 +22,7 @@
 mod board;
 mod http;
 
-use crate::exit::CliError;
+use crate::exit::{CliError, ShownPath};
 use crate::output::write_atomically;
 use crate::terminal::shown;
 use board::BoardSender;
@@ -123,14 +123,20 @@ pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) ->
     let board = match &args.board {
         None => None,
         Some(port) if crate::board::is_port(port) => {
-            Some(BoardSender::new(port.display().to_string(), args.board_timeout.map(Duration::from_secs)))
+            let name = port.display().to_string();
+            // Opened once now, as each Send opens it: a device that is no
+            // serial line (`/dev/null`) is refused at start, not at the
+            // first Send.
+            crate::board::BoardLink::open(&name, None)
+                .map_err(|e| CliError::Invalid(format!("studio: --board {}: {e}", shown(&name))))?;
+            Some(BoardSender::new(name, args.board_timeout.map(Duration::from_secs)))
         }
         Some(port) => {
             let _ = writeln!(stderr, "host-sim studio: the serial ports:");
             let _ = crate::board::write_ports(stderr);
             return Err(CliError::Invalid(format!(
                 "studio: --board {} is no serial port: give the port of a board running octrace's live firmware",
-                port.display()
+                ShownPath(port)
             )));
         }
     };
@@ -151,14 +157,14 @@ pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) ->
     let _ = stdout.flush();
     match &args.scene {
         Some(path) => {
-            let _ = writeln!(stderr, "host-sim studio: editing {} (Ctrl-C stops)", path.display());
+            let _ = writeln!(stderr, "host-sim studio: editing {} (Ctrl-C stops)", ShownPath(path));
         }
         None => {
             let _ = writeln!(stderr, "host-sim studio: no scene file given: an example, not saved (Ctrl-C stops)");
         }
     }
     if let Some(board) = &shared.board {
-        let _ = writeln!(stderr, "host-sim studio: \"Send to board\" sends to the board at {}", board.port());
+        let _ = writeln!(stderr, "host-sim studio: \"Send to board\" sends to the board at {}", shown(board.port()));
     }
     if args.open {
         *shared.launcher.lock().unwrap_or_else(|poisoned| poisoned.into_inner()) = open_browser(&url, stderr);
@@ -392,7 +398,7 @@ fn read_scene(path: &Path) -> std::io::Result<Option<Vec<u8>>> {
 
 /// The scene's name in messages: its file, or the example's.
 fn scene_name(shared: &Shared) -> String {
-    shared.scene.as_ref().map_or_else(|| "example.txt".to_string(), |path| path.display().to_string())
+    shared.scene.as_ref().map_or_else(|| "example.txt".to_string(), |path| ShownPath(path).to_string())
 }
 
 fn get_scene(shared: &Shared) -> Response {
@@ -401,7 +407,7 @@ fn get_scene(shared: &Shared) -> Response {
         None => (Some(EXAMPLE_SCENE.as_bytes().to_vec()), false),
         Some(path) => match read_scene(path) {
             Ok(bytes) => (bytes, true),
-            Err(e) => return Response::text(500, &format!("cannot read {}: {e}", path.display())),
+            Err(e) => return Response::text(500, &format!("cannot read {}: {e}", ShownPath(path))),
         },
     };
     let mut response = Response::new(200, "text/plain; charset=utf-8", bytes.clone().unwrap_or_default());
@@ -423,7 +429,7 @@ fn put_scene(request: &Request, shared: &Shared) -> Response {
     let _guard = shared.saving.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     let current = match read_scene(path) {
         Ok(bytes) => version(bytes.as_deref()),
-        Err(e) => return Response::text(500, &format!("cannot read {}: {e}", path.display())),
+        Err(e) => return Response::text(500, &format!("cannot read {}: {e}", ShownPath(path))),
     };
     if expected != "*" && expected != current {
         let mut response = Response::text(409, "the scene file changed on disk since it was loaded");
@@ -436,7 +442,7 @@ fn put_scene(request: &Request, shared: &Shared) -> Response {
             response.headers.push(("ETag".into(), format!("\"{}\"", version(Some(&request.body)))));
             response
         }
-        Err(e) => Response::text(500, &format!("cannot write {}: {e}", path.display())),
+        Err(e) => Response::text(500, &format!("cannot write {}: {e}", ShownPath(path))),
     }
 }
 
