@@ -399,7 +399,18 @@ pub fn write_merged(
     let mut writer = RowWriter::new(format, header, out)
         .map_err(|error| MergeError::Io { path: PathBuf::from("the output"), error })?;
     for (path, info) in parts {
+        // Opened again (a merge of thousands of parts would run out of
+        // descriptors holding them all open): a part replaced since its
+        // check would give rows of another render.
         let mut reader = open(path)?;
+        if reader.header().text.as_deref().and_then(PartInfo::parse).as_ref() != Some(info) {
+            return Err(MergeError::Refused(format!(
+                "{}: changed while the parts were merged (it is no longer part {}/{} of the scene checked): merge again",
+                path.display(),
+                info.index,
+                info.count
+            )));
+        }
         for _ in info.rows.clone() {
             let row = reader.next_row().map_err(|error| MergeError::Io { path: path.clone(), error })?;
             writer.write_row(row).map_err(|error| MergeError::Io { path: PathBuf::from("the output"), error })?;

@@ -175,6 +175,20 @@ fn merged_parts_are_one_render_byte_for_byte() {
 }
 
 #[test]
+fn a_part_replaced_after_its_check_is_refused_not_merged() {
+    let dir = tempfile::tempdir().unwrap();
+    let parts = render_parts(dir.path(), &scene_path("fig5_1"), &["1/2", "2/2"], "png", &[]);
+    let (checked, header) = host_sim::parts::check_parts(&parts).expect("two parts of one render");
+    // Another job writes its part 1 over part 2 between the check and the merge.
+    std::fs::copy(&parts[0], &parts[1]).unwrap();
+    let mut out = Vec::new();
+    let error = host_sim::parts::write_merged(&checked, &header, formats::Format::Png, &mut out)
+        .expect_err("a part changed since its check");
+    let want = format!("{}: changed while the parts were merged (it is no longer part 2/2", parts[1].display());
+    assert!(error.to_string().starts_with(&want), "{error}");
+}
+
+#[test]
 fn merge_refuses_parts_that_do_not_fit_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let (fig5_1, fig5_2) = (scene_path("fig5_1"), scene_path("fig5_2"));
