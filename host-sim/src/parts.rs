@@ -5,6 +5,7 @@
 //! text (PNG `tEXt`, Targa image ID) naming the scene (a hash of its bytes), the whole image's size, the
 //! palette mode and the part's rows; `merge` trusts nothing else and refuses parts that do not fit.
 
+use crate::exit::ShownPath;
 use octrace_images::formats::{Format, FormatError, Header, RowReader, RowWriter};
 use octrace_images::palette::PaletteMode;
 use std::fmt;
@@ -225,7 +226,7 @@ pub enum MergeError {
 impl fmt::Display for MergeError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            MergeError::Io { path, error } => write!(f, "{}: {error}", path.display()),
+            MergeError::Io { path, error } => write!(f, "{}: {error}", ShownPath(path)),
             MergeError::Refused(why) => f.write_str(why),
         }
     }
@@ -237,7 +238,7 @@ fn open(path: &Path) -> Result<RowReader, MergeError> {
     let file = std::fs::File::open(path).map_err(|e| MergeError::Io { path: path.to_owned(), error: e.into() })?;
     RowReader::new(file).map_err(|error| match error {
         FormatError::Io(_) => MergeError::Io { path: path.to_owned(), error },
-        e => MergeError::Refused(format!("{}: not an image host-sim can merge: {e}", path.display())),
+        e => MergeError::Refused(format!("{}: not an image host-sim can merge: {e}", ShownPath(path))),
     })
 }
 
@@ -254,7 +255,7 @@ pub fn check_parts(parts: &[PathBuf]) -> Result<(Vec<(PathBuf, PartInfo)>, Heade
     for path in parts {
         let reader = open(path)?;
         let header = reader.header().clone();
-        let name = path.display();
+        let name = ShownPath(path);
         let info = match header.text.as_deref() {
             None => return Err(MergeError::Refused(format!("{name}: not a part (no octrace part metadata in it)"))),
             Some(text) => PartInfo::parse(text)
@@ -275,7 +276,7 @@ pub fn check_parts(parts: &[PathBuf]) -> Result<(Vec<(PathBuf, PartInfo)>, Heade
             )));
         }
         if let Some((first, first_info, _)) = found.first() {
-            let other = || format!("{name} and {} are not parts of one render:", first.display());
+            let other = || format!("{name} and {} are not parts of one render:", ShownPath(first));
             if info.version != first_info.version {
                 return Err(MergeError::Refused(format!(
                     "{} rendered by host-sim {} and {}, which may give other bits",
@@ -327,11 +328,11 @@ pub fn check_parts(parts: &[PathBuf]) -> Result<(Vec<(PathBuf, PartInfo)>, Heade
             let what = if above_info.rows == info.rows { "the same band" } else { "overlapping bands" };
             return Err(MergeError::Refused(format!(
                 "{} (part {}/{}, {}) and {} (part {}/{}, {}) are {what}",
-                above_path.display(),
+                ShownPath(above_path),
                 above_info.index,
                 above_info.count,
                 rows(&above_info.rows),
-                path.display(),
+                ShownPath(path),
                 info.index,
                 info.count,
                 rows(&info.rows)
@@ -351,8 +352,8 @@ pub fn check_parts(parts: &[PathBuf]) -> Result<(Vec<(PathBuf, PartInfo)>, Heade
         match palettes.iter().find(|(_, p)| !longest.starts_with(p)) {
             Some((other, _)) => Err(MergeError::Refused(format!(
                 "{} and {} have different colour tables: not parts of one render",
-                other.display(),
-                path.display()
+                ShownPath(other),
+                ShownPath(path)
             ))),
             None => Ok((*longest).clone()),
         }
@@ -382,9 +383,9 @@ fn missing(
         message += &format!(" (missing part{} {})", if absent.len() == 1 { "" } else { "s" }, absent.join(", "));
     }
     match (above, below) {
-        (Some(a), Some(b)) => message + &format!(", between {} and {}", a.display(), b.display()),
-        (Some(a), None) => message + &format!(", after {}", a.display()),
-        (None, Some(b)) => message + &format!(", before {}", b.display()),
+        (Some(a), Some(b)) => message + &format!(", between {} and {}", ShownPath(a), ShownPath(b)),
+        (Some(a), None) => message + &format!(", after {}", ShownPath(a)),
+        (None, Some(b)) => message + &format!(", before {}", ShownPath(b)),
         (None, None) => message,
     }
 }
@@ -406,7 +407,7 @@ pub fn write_merged(
         if reader.header().text.as_deref().and_then(PartInfo::parse).as_ref() != Some(info) {
             return Err(MergeError::Refused(format!(
                 "{}: changed while the parts were merged (it is no longer part {}/{} of the scene checked): merge again",
-                path.display(),
+                ShownPath(path),
                 info.index,
                 info.count
             )));
