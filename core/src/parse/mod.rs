@@ -396,7 +396,12 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, '_, C> {
     #[inline(never)]
     fn surface(&mut self, keyword: Keyword, number: u32, pos: Pos) -> Option<u16> {
         let found = self.scene.view().surface_index(number);
-        if found.is_none() && self.reported_capacity & (1 << CapacityKind::Surfaces as u8) == 0 {
+        // The survey stored every SURFACE, wherever it stands, until the
+        // arena was full: with one left out (its capacity error is at the
+        // first SURFACE that did not fit, maybe further down than this
+        // object), a surface not found is likely that, not an error here.
+        let overflowed = self.needed.get(CapacityKind::Surfaces) > Scene::<C>::surfaces_full().capacity;
+        if found.is_none() && !overflowed {
             let keyword = keyword.name();
             self.report(ParseError::new(pos, ErrorKind::UndefinedSurface { keyword, number }));
         }
@@ -999,6 +1004,29 @@ mod tests {
             1,
             "{e:?}"
         );
+    }
+
+    #[test]
+    fn surfaces_beyond_the_capacity_leave_the_objects_before_them_unblamed() {
+        crate::profile! {
+            struct OneSurface { spheres: 4, surfaces: 1, lights: 1 }
+        }
+        let load = |text: &str| {
+            let mut scene = std::boxed::Box::new(Scene::<OneSurface>::new());
+            let mut errors = Vec::new();
+            let r = parse(text, &mut scene, &mut |e| errors.push(e.to_string()));
+            assert_eq!(r, Err(errors.len()), "{errors:?}");
+            errors
+        };
+        // Objects may name a surface defined further down: the one that
+        // did not fit is the error, not the spheres that name it.
+        let surface = |n: u32| SURF.replacen("SURFACE 1", &std::format!("SURFACE {n}"), 1);
+        let e = load(&std::format!("SPHERE 2 1 0 0 0\nSPHERE 1 1 3 0 0\n{}{}", surface(1), surface(2)));
+        assert_eq!(e.len(), 1, "{e:?}");
+        assert!(e[0].starts_with("4:1: too many surfaces: the capacity profile OneSurface holds 1"), "{e:?}");
+        // Within the capacity, a surface no SURFACE defines is one still.
+        let e = load(&std::format!("SPHERE 2 1 0 0 0\n{}", surface(1)));
+        assert_eq!(e, ["1:1: SPHERE uses surface 2, which is never defined"]);
     }
 
     #[test]
