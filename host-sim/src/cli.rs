@@ -258,6 +258,7 @@ fn part_of(
     scene_bytes: &[u8],
     (w, h): (u32, u32),
     format: Format,
+    frame: Option<u32>,
 ) -> Result<(std::ops::Range<u32>, String), CliError> {
     let refuse = |message: String| Err(CliError::Invalid(format!("--part: {message}")));
     if format == Format::Ras {
@@ -293,6 +294,7 @@ fn part_of(
         rows: rows.clone(),
         index,
         count: spec.count,
+        frame,
     };
     Ok((rows, info.to_string()))
 }
@@ -480,7 +482,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     let palette_mode = if args.color == PanelColor::Dither { PaletteMode::Dither } else { palette };
     let (rows, text) = match args.part {
         Some(spec) => {
-            let (rows, text) = part_of(spec, palette_mode, args.color, &scene_bytes, (w, h), format)?;
+            let (rows, text) = part_of(spec, palette_mode, args.color, &scene_bytes, (w, h), format, args.frame)?;
             (rows, Some(text))
         }
         None => (0..h, None),

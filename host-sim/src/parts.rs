@@ -124,6 +124,9 @@ pub struct PartInfo {
     /// Part `index` of `count` (1-based).
     pub index: u32,
     pub count: u32,
+    /// The animation's frame it is a band of (`--frame K`); `None` for a
+    /// still's.
+    pub frame: Option<u32>,
 }
 
 /// The text every part's line starts with (and the version of the line's layout).
@@ -143,7 +146,11 @@ impl fmt::Display for PartInfo {
             self.rows.end,
             self.index,
             self.count
-        )
+        )?;
+        match self.frame {
+            Some(frame) => write!(f, " frame={frame}"),
+            None => Ok(()),
+        }
     }
 }
 
@@ -163,6 +170,11 @@ impl PartInfo {
             rows: start.parse().ok()?..end.parse().ok()?,
             index: index.parse().ok()?,
             count: count.parse().ok()?,
+            // Last, and only in a band of an animation's frame.
+            frame: match fields.0.next() {
+                Some(field) => Some(field.strip_prefix("frame=")?.parse().ok()?),
+                None => None,
+            },
         };
         let valid = info.index >= 1
             && info.index <= info.count
@@ -309,6 +321,15 @@ pub fn check_parts(parts: &[PathBuf]) -> Result<(Vec<(PathBuf, PartInfo)>, Heade
                     other(),
                     info.palette.name(),
                     first_info.palette.name()
+                )));
+            }
+            if info.frame != first_info.frame {
+                let frame = |frame: Option<u32>| frame.map_or("no frame (a still)".into(), |k| format!("frame {k}"));
+                return Err(MergeError::Refused(format!(
+                    "{} another frame of the animation ({}, not {})",
+                    other(),
+                    frame(info.frame),
+                    frame(first_info.frame)
                 )));
             }
         }
@@ -482,9 +503,14 @@ mod tests {
             rows: band_rows(240, 2, 7),
             index: 2,
             count: 7,
+            frame: None,
         };
         let text = info.to_string();
-        assert_eq!(PartInfo::parse(&text), Some(info));
+        assert_eq!(PartInfo::parse(&text), Some(info.clone()));
+        let framed = PartInfo { frame: Some(12), ..info.clone() };
+        assert!(framed.to_string().ends_with(" part=2/7 frame=12"), "{framed}");
+        assert_eq!(PartInfo::parse(&framed.to_string()), Some(framed));
+        assert_eq!(PartInfo::parse(&format!("{text} frame=x")), None);
         assert_eq!(PartInfo::parse(&text.replace("rows=34..68", "rows=34..69")), None);
         assert_eq!(PartInfo::parse(&text.replace("part=2/7", "part=8/7")), None);
         assert_eq!(PartInfo::parse(&format!("{text} more")), None);

@@ -213,6 +213,12 @@ fn merge_refuses_parts_that_do_not_fit_and_writes_nothing() {
     ]);
     let plain = dir.path().join("plain.png");
     ok(&[fig5_1.as_os_str(), plain.as_os_str(), "--size".as_ref(), "40x30".as_ref(), "-q".as_ref()]);
+    // Bands of two frames of one animation: one scene, one size, two pictures.
+    let animation = scene_path("anim_light");
+    let frame_part = |frame: &str, part: &str| {
+        render_parts(&other_dir(&format!("frame-{frame}")), &animation, &[part], "png", &["--frame", frame]).remove(0)
+    };
+    let (frame_3, frame_12) = (frame_part("3", "1/2"), frame_part("12", "2/2"));
     let copy = dir.path().join("copy-of-2.png");
     std::fs::copy(&good[1], &copy).unwrap();
     let absent = dir.path().join("absent.png");
@@ -241,6 +247,11 @@ fn merge_refuses_parts_that_do_not_fit_and_writes_nothing() {
             vec!["another palette (--palette gray, not none)".into(), name(&other_palette)],
         ),
         (vec![one, &plain, three], 2, vec![format!("{}: not a part", name(&plain))]),
+        (
+            vec![&frame_3, &frame_12],
+            2,
+            vec!["another frame of the animation (frame 12, not frame 3)".into(), name(&frame_12), name(&frame_3)],
+        ),
         (vec![one, two, three, &absent], 1, vec![name(&absent)]),
     ];
     let out = dir.path().join("merged.png");
