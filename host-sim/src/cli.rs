@@ -239,15 +239,32 @@ fn animated_png_frames(bytes: &[u8]) -> Option<u32> {
 
 fn merge(output: &Path, parts: &[PathBuf], format: Option<Format>) -> Result<(), CliError> {
     let format = output_format(format, output)?;
-    let (ordered, header) = parts::check_parts(parts).map_err(|e| {
+    let refused = |e: MergeError| {
         let message = format!("merge: {e}; nothing written");
         match e {
-            MergeError::Io { .. } => CliError::Io(message),
             MergeError::Refused(_) => CliError::Invalid(message),
+            MergeError::Io { .. } | MergeError::Output(_) => CliError::Io(message),
         }
-    })?;
-    write_atomically(output, |f| parts::write_merged(&ordered, &header, format, f).map_err(std::io::Error::other))
-        .map_err(|e| CliError::Io(format!("merge: cannot write {}: {e}", ShownPath(output))))
+    };
+    let (ordered, header) = parts::check_parts(parts).map_err(refused)?;
+    // A part that fails while its rows are read is the part's fault, not
+    // the output's: kept aside from the write's own failures.
+    let mut unread = None;
+    let written = write_atomically(output, |f| match parts::write_merged(&ordered, &header, format, f) {
+        Err(MergeError::Output(FormatError::Io(e))) => Err(e),
+        Err(MergeError::Output(e)) => Err(std::io::Error::other(e)),
+        Err(e) => {
+            let message = e.to_string();
+            unread = Some(e);
+            Err(std::io::Error::other(message))
+        }
+        Ok(()) => Ok(()),
+    });
+    match (written, unread) {
+        (_, Some(e)) => Err(refused(e)),
+        (Err(e), None) => Err(CliError::Io(format!("merge: cannot write {}: {e}", ShownPath(output)))),
+        (Ok(()), None) => Ok(()),
+    }
 }
 
 /// The rows to render and the text to carry for `--part`, checked against the image and the options.

@@ -229,10 +229,12 @@ impl<'a> Fields<'a> {
 /// Why parts could not be merged.
 #[derive(Debug)]
 pub enum MergeError {
-    /// A part could not be read, or the output written (exit code 1).
+    /// A part could not be read (exit code 1).
     Io { path: PathBuf, error: FormatError },
     /// The parts do not make one image (exit code 2): the message names the files.
     Refused(String),
+    /// The merged image could not be written (exit code 1).
+    Output(FormatError),
 }
 
 impl fmt::Display for MergeError {
@@ -240,6 +242,7 @@ impl fmt::Display for MergeError {
         match self {
             MergeError::Io { path, error } => write!(f, "{}: {error}", ShownPath(path)),
             MergeError::Refused(why) => f.write_str(why),
+            MergeError::Output(error) => write!(f, "the merged image: {error}"),
         }
     }
 }
@@ -248,10 +251,15 @@ impl std::error::Error for MergeError {}
 
 fn open(path: &Path) -> Result<RowReader, MergeError> {
     let file = std::fs::File::open(path).map_err(|e| MergeError::Io { path: path.to_owned(), error: e.into() })?;
-    RowReader::new(file).map_err(|error| match error {
+    RowReader::new(file).map_err(|error| unreadable(path, error))
+}
+
+/// A part that could not be read: the system's failure, or what is in it.
+fn unreadable(path: &Path, error: FormatError) -> MergeError {
+    match error {
         FormatError::Io(_) => MergeError::Io { path: path.to_owned(), error },
         e => MergeError::Refused(format!("{}: not an image host-sim can merge: {e}", ShownPath(path))),
-    })
+    }
 }
 
 fn rows(r: &Range<u32>) -> String {
@@ -418,8 +426,7 @@ pub fn write_merged(
     format: Format,
     out: &mut dyn std::io::Write,
 ) -> Result<(), MergeError> {
-    let mut writer = RowWriter::new(format, header, out)
-        .map_err(|error| MergeError::Io { path: PathBuf::from("the output"), error })?;
+    let mut writer = RowWriter::new(format, header, out).map_err(MergeError::Output)?;
     for (path, info) in parts {
         // Opened again (a merge of thousands of parts would run out of
         // descriptors holding them all open): a part replaced since its
@@ -434,11 +441,11 @@ pub fn write_merged(
             )));
         }
         for _ in info.rows.clone() {
-            let row = reader.next_row().map_err(|error| MergeError::Io { path: path.clone(), error })?;
-            writer.write_row(row).map_err(|error| MergeError::Io { path: PathBuf::from("the output"), error })?;
+            let row = reader.next_row().map_err(|error| unreadable(path, error))?;
+            writer.write_row(row).map_err(MergeError::Output)?;
         }
     }
-    writer.finish().map_err(|error| MergeError::Io { path: PathBuf::from("the output"), error })
+    writer.finish().map_err(MergeError::Output)
 }
 
 #[cfg(test)]

@@ -219,6 +219,10 @@ fn merge_refuses_parts_that_do_not_fit_and_writes_nothing() {
         render_parts(&other_dir(&format!("frame-{frame}")), &animation, &[part], "png", &["--frame", frame]).remove(0)
     };
     let (frame_3, frame_12) = (frame_part("3", "1/2"), frame_part("12", "2/2"));
+    // A part whose header reads but whose pixels do not (a transfer cut short).
+    let cut = dir.path().join("cut.png");
+    let whole = std::fs::read(&good[2]).unwrap();
+    std::fs::write(&cut, &whole[..whole.len() - 40]).unwrap();
     let copy = dir.path().join("copy-of-2.png");
     std::fs::copy(&good[1], &copy).unwrap();
     let absent = dir.path().join("absent.png");
@@ -247,6 +251,7 @@ fn merge_refuses_parts_that_do_not_fit_and_writes_nothing() {
             vec!["another palette (--palette gray, not none)".into(), name(&other_palette)],
         ),
         (vec![one, &plain, three], 2, vec![format!("{}: not a part", name(&plain))]),
+        (vec![one, two, &cut], 2, vec![format!("{}: not an image host-sim can merge: truncated", name(&cut))]),
         (
             vec![&frame_3, &frame_12],
             2,

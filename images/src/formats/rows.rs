@@ -150,8 +150,11 @@ impl RowReader {
             (header, RowDecoder::Png(Box::new(reader)))
         } else {
             let is_ras = start.starts_with(&sun_raster::MAGIC.to_be_bytes());
-            let header =
-                if is_ras { sun_raster::stream_header(&mut input)? } else { targa::stream_header(&mut input)? };
+            let header = if is_ras {
+                sun_raster::stream_header(&mut input)?
+            } else {
+                targa::stream_header(&mut input).map_err(super::not_targa)?
+            };
             let row_bytes = header.width as usize * header.bytes_per_pixel();
             let pad = if is_ras { sun_raster::row_padding(row_bytes) } else { 0 };
             let (bgr, stored) = (header.palette.is_none(), vec![0; row_bytes + pad]);
