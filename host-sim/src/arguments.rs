@@ -51,11 +51,16 @@ pub(crate) fn parse_name<T: Copy>(text: &str, all: &[T], name: fn(T) -> &'static
 pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WxH (for example 160x128), found `{s}`"))?;
     let dim = |v: &str| -> Result<u32, String> {
-        let n: u32 = v.parse().map_err(|_| format!("`{v}` is not a whole number"))?;
-        if (1..=MAX_SIDE).contains(&n) {
-            Ok(n)
-        } else {
-            Err(format!("{n} is outside 1 to {MAX_SIDE}"))
+        if v.is_empty() {
+            return Err(format!("expected WxH (for example 160x128), found `{s}`: a side is missing"));
+        }
+        if !v.bytes().all(|b| b.is_ascii_digit()) {
+            return Err(format!("`{v}` is not a whole number"));
+        }
+        // Digits alone: too many for a u32 is out of range as well.
+        match v.parse::<u32>() {
+            Ok(n) if (1..=MAX_SIDE).contains(&n) => Ok(n),
+            _ => Err(format!("{v} is outside 1 to {MAX_SIDE}")),
         }
     };
     Ok((dim(w)?, dim(h)?))
@@ -76,7 +81,7 @@ pub(crate) fn output_format(asked: Option<Format>, path: &Path) -> Result<Format
         let names: Vec<&str> = Format::ALL.iter().map(|f| f.name()).collect();
         let extension = extension.to_string_lossy();
         let animated = match extension.eq_ignore_ascii_case("gif") {
-            true => " (a GIF is written for a scene with FRAMES)",
+            true => " (a GIF holds a whole animation: a scene with FRAMES, rendered without --frame, to one file)",
             false => "",
         };
         CliError::Invalid(format!(
@@ -121,5 +126,9 @@ mod tests {
         assert!(parse_size("0x5").is_err());
         assert!(parse_size("12").is_err());
         assert!(parse_size("20000x5").is_err());
+        // A whole number past u32 is out of range too, not "not a whole number".
+        assert_eq!(parse_size("4294967296x1"), Err(format!("4294967296 is outside 1 to {MAX_SIDE}")));
+        assert_eq!(parse_size("3x"), Err("expected WxH (for example 160x128), found `3x`: a side is missing".into()));
+        assert_eq!(parse_size("3x-4"), Err("`-4` is not a whole number".into()));
     }
 }

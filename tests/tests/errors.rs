@@ -234,7 +234,7 @@ fn an_output_extension_it_does_not_write_is_refused() {
         (
             code,
             err.contains(
-                "`.gif` is not a format host-sim writes a still image in (a GIF is written for a scene with FRAMES)"
+                "`.gif` is not a format host-sim writes a still image in (a GIF holds a whole animation: a scene with FRAMES, rendered without --frame, to one file)"
             )
         ),
         (2, true),
