@@ -82,8 +82,10 @@ pub struct Args {
     /// preview; a default VIEWPORT follows the new aspect ratio).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
-    /// Intersection strategy: auto picks the fastest for the scene (naive
-    /// for a handful of objects, else dda). All give the same image.
+    /// Intersection strategy: naive (every object for every ray), octree
+    /// (the octree walked the thesis's way), dda (the octree walked by
+    /// integer 3DDDA), or auto, the fastest for the scene (naive for a
+    /// handful of objects, else dda). All give the same image.
     #[arg(long, value_name = "MODE", default_value = "auto", value_parser = parse_accel)]
     pub accel: AccelMode,
     /// Octree criterion: a box holding more objects than this is subdivided.
