@@ -7,7 +7,7 @@
 //! | variable | values | default |
 //! | --- | --- | --- |
 //! | `OCTRACE_BOARD` | `microbit` (thumbv6m), `mps2-an385` or `lm3s6965evb` (thumbv7m), `mps2-an505` or `mps2-an521` (thumbv8m.main), `virt` (riscv32imc) | from the target: thumbv6m `microbit`, thumbv7m `mps2-an385`, thumbv8m.main `mps2-an505`, riscv32imc `virt` |
-//! | `OCTRACE_SCENE` | a scene in `scenes/` (name without `.txt`) | `fig5_1` |
+//! | `OCTRACE_SCENE` | a scene in `scenes/` by name (without `.txt`), or a scene file's path | `fig5_1` |
 //! | `OCTRACE_SIZE` | `WxH` (on `lm3s6965evb` at most the panel's 128x64, an even width) | `160x128`; `128x64` on `lm3s6965evb` |
 //! | `OCTRACE_ACCEL` | `auto`, `naive`, `octree`, `dda` | `auto` |
 //! | `OCTRACE_COLOR` | `rgb888`, `rgb565`, `dither` (1-byte indices into the 6×6×6 cube), and the panels of few levels, 1 byte a pixel holding the level: `mono` (0, 1), `gray2` (0 to 3), `gray4` (0 to 15), `bwr` (0 black, 1 white, 2 red); only `gray4` on `lm3s6965evb` | `rgb888`; `gray4` on `lm3s6965evb` |
@@ -125,10 +125,17 @@ fn main() {
     println!("cargo:rustc-check-cfg=cfg(board, values(\"microbit\", \"mps2-an385\", \"mps2-an505\", \"mps2-an521\", \"lm3s6965evb\", \"virt\"))");
     println!("cargo:rustc-cfg=board=\"{}\"", board.name);
 
-    let scene = var("OCTRACE_SCENE", "fig5_1");
-    let scene_path = manifest.join("../scenes").join(format!("{scene}.txt"));
+    let given = var("OCTRACE_SCENE", "fig5_1");
+    // A scene of `scenes/` by its name, or any scene file by its path
+    // (relative to `firmware/`, where cargo runs this), named by its stem.
+    let (scene, scene_path) = if given.ends_with(".txt") || given.contains(['/', '\\']) {
+        let path = manifest.join(&given);
+        (path.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned()), path)
+    } else {
+        (given.clone(), manifest.join("../scenes").join(format!("{given}.txt")))
+    };
     let Ok(text) = std::fs::read_to_string(&scene_path) else {
-        fail(format!("OCTRACE_SCENE={scene}: no file {}", scene_path.display()))
+        fail(format!("OCTRACE_SCENE={given}: no file {}", scene_path.display()))
     };
     println!("cargo:rerun-if-changed={}", scene_path.display());
     let size = var("OCTRACE_SIZE", if oled { "128x64" } else { "160x128" });

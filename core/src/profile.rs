@@ -91,7 +91,7 @@ pub trait Profile: SceneCapacities + Linked {
 /// leaves out the hash table only the thesis's walk needs (see
 /// [`Profile::NAMED_WALK`]); a last `first_hits: true` gives camera rays
 /// the screen lists (see [`Linked::FIRST_HITS`]: the same image, for a
-/// [`ScreenBound`] (24 bytes) an object and [`ScreenBound::positions_for`]
+/// [`ScreenBound`] (16 bytes) an object and [`ScreenBound::positions_for`]
 /// them (2 bytes each) of RAM, used in every mode but
 /// [`AccelMode::Naive`](crate::AccelMode::Naive) asked for by name, which
 /// stays the thesis's test of every object); a last `coherence: true` lets

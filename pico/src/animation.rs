@@ -382,7 +382,7 @@ where
         let mut result = drawn.map(|_| ()).map_err(|e| match e {
             DrawError::Camera(_) => Unfinished::Camera,
             DrawError::Stopped => Unfinished::Stopped,
-            DrawError::Target(_) | DrawError::ErrorRow(_) => Unfinished::Panel,
+            DrawError::Target(_) | DrawError::ErrorRow(_) | DrawError::TooLarge { .. } => Unfinished::Panel,
         });
         // The rest of core 1's.
         while result.is_ok() {

@@ -18,7 +18,7 @@ use crate::motion::Lookout;
 use crate::panel::{Dithered, Dithering, TracedColor, IMAGE_ERROR_WORDS};
 use crate::profile::Profile;
 use crate::render::{Halt, Progressive, Renderer};
-use crate::scene::{CameraError, SceneView};
+use crate::scene::{CameraError, SceneView, MAX_SIDE};
 use crate::shade::{Poll, Stats};
 use core::cell::{Cell, RefCell};
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -140,6 +140,11 @@ where
     D: DrawTarget<Color = C>,
     Q: Poll,
 {
+    let (width, height) = (image.size.width, image.size.height);
+    if width > MAX_SIDE || height > MAX_SIDE {
+        // The camera would trace a picture of at most that, clipped.
+        return Err(DrawError::TooLarge { width, height });
+    }
     match image.picture {
         Picture::Bands(playing, next) => match C::PANEL {
             // Ordered dithering, which needs no order: a changed tile

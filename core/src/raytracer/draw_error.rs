@@ -3,7 +3,7 @@
 
 use crate::panel::ErrorRowTooShort;
 use crate::render::Stopped;
-use crate::scene::CameraError;
+use crate::scene::{CameraError, MAX_SIDE};
 use core::fmt;
 
 /// Why a [`TracedImage`](super::TracedImage) was not drawn whole.
@@ -20,6 +20,14 @@ pub enum DrawError<E> {
     Target(E),
     /// The caller's stop said so ([`TracedImage::try_draw_until`](super::TracedImage::try_draw_until)).
     Stopped,
+    /// The image is wider or higher than [`MAX_SIDE`] pixels (a display
+    /// of that size, given to `image_for`): nothing is drawn.
+    TooLarge {
+        /// The image's width, in pixels.
+        width: u32,
+        /// Its height.
+        height: u32,
+    },
 }
 
 impl<E> From<Stopped> for DrawError<E> {
@@ -35,6 +43,9 @@ impl<E: fmt::Display> fmt::Display for DrawError<E> {
             DrawError::ErrorRow(e) => write!(f, "{e}"),
             DrawError::Target(e) => write!(f, "the display failed: {e}"),
             DrawError::Stopped => write!(f, "stopped before the picture's end"),
+            DrawError::TooLarge { width, height } => {
+                write!(f, "an image of {width}×{height} pixels: its sides are at most {MAX_SIDE}")
+            }
         }
     }
 }

@@ -270,9 +270,18 @@ impl<P: Profile, C> OriginDimensions for TracedImage<'_, '_, P, C> {
 impl<P: Profile, C: TracedColor> ImageDrawable for TracedImage<'_, '_, P, C> {
     type Color = C;
 
+    /// Draws the picture, as [`TracedImage::try_draw`] does; but
+    /// embedded-graphics' `draw` can return only the display's error, so
+    /// octrace's own (a camera that cannot be set up, a row of error too
+    /// short for the image's width, an image too large) leave the picture
+    /// undrawn or partial and say nothing. Where that can happen (a scene
+    /// or a display not known when the firmware is built), use `try_draw`.
     fn draw<D: DrawTarget<Color = C>>(&self, target: &mut D) -> Result<(), D::Error> {
         match self.try_draw(target) {
-            Ok(_) | Err(DrawError::Camera(_) | DrawError::ErrorRow(_) | DrawError::Stopped) => Ok(()),
+            Ok(_)
+            | Err(DrawError::Camera(_) | DrawError::ErrorRow(_) | DrawError::Stopped | DrawError::TooLarge { .. }) => {
+                Ok(())
+            }
             Err(DrawError::Target(e)) => Err(e),
         }
     }
@@ -400,6 +409,40 @@ mod tests {
         let rows = RefCell::new([0; 801]);
         image.error_rows(&rows).try_draw(&mut again).unwrap();
         assert!(again.0[0].iter().all(|c| c.is_some()));
+    }
+
+    #[test]
+    fn an_image_wider_than_a_side_can_be_is_refused_not_clipped() {
+        let mut raytracer = Raytracer::<Board16K>::new();
+        let scene = raytracer.load(SCENE).unwrap();
+        let mut drawn = 0;
+        let mut counting = Counting { size: Size::new(70_000, 1), drawn: &mut drawn };
+        let e = scene.image_for(&counting).try_draw(&mut counting).unwrap_err();
+        assert_eq!(e, DrawError::TooLarge { width: 70_000, height: 1 });
+        assert_eq!(e.to_string(), "an image of 70000×1 pixels: its sides are at most 16384");
+        assert_eq!(drawn, 0, "nothing drawn");
+    }
+
+    /// A display of any size that counts the pixels it is given.
+    struct Counting<'a> {
+        size: Size,
+        drawn: &'a mut usize,
+    }
+
+    impl OriginDimensions for Counting<'_> {
+        fn size(&self) -> Size {
+            self.size
+        }
+    }
+
+    impl DrawTarget for Counting<'_> {
+        type Color = Rgb565;
+        type Error = core::convert::Infallible;
+
+        fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
+            *self.drawn += pixels.into_iter().count();
+            Ok(())
+        }
     }
 
     /// A 12×8 gray panel that keeps the last colour drawn at each pixel.
