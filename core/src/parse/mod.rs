@@ -1006,18 +1006,21 @@ mod tests {
         );
     }
 
+    /// The errors of `text`, which has some, loaded with profile `C`.
+    fn errors_in<C: SceneCapacities>(text: &str) -> Vec<String> {
+        let mut scene = std::boxed::Box::new(Scene::<C>::new());
+        let mut errors = Vec::new();
+        let r = parse(text, &mut scene, &mut |e| errors.push(e.to_string()));
+        assert_eq!(r, Err(errors.len()), "{errors:?}");
+        errors
+    }
+
     #[test]
     fn surfaces_beyond_the_capacity_leave_the_objects_before_them_unblamed() {
         crate::profile! {
             struct OneSurface { spheres: 4, surfaces: 1, lights: 1 }
         }
-        let load = |text: &str| {
-            let mut scene = std::boxed::Box::new(Scene::<OneSurface>::new());
-            let mut errors = Vec::new();
-            let r = parse(text, &mut scene, &mut |e| errors.push(e.to_string()));
-            assert_eq!(r, Err(errors.len()), "{errors:?}");
-            errors
-        };
+        let load = errors_in::<OneSurface>;
         // Objects may name a surface defined further down: the one that
         // did not fit is the error, not the spheres that name it.
         let surface = |n: u32| SURF.replacen("SURFACE 1", &std::format!("SURFACE {n}"), 1);
@@ -1034,13 +1037,7 @@ mod tests {
         crate::profile! {
             struct SpheresOnly { spheres: 2, surfaces: 1, lights: 1 }
         }
-        let load = |text: &str| {
-            let mut scene = std::boxed::Box::new(Scene::<SpheresOnly>::new());
-            let mut errors = Vec::new();
-            let r = parse(text, &mut scene, &mut |e| errors.push(e.to_string()));
-            assert_eq!(r, Err(errors.len()), "{errors:?}");
-            errors
-        };
+        let load = errors_in::<SpheresOnly>;
         // A valid rectangle, then one that is not convex: the board skips
         // their checks, and the first one is the capacity error.
         let rectangles = format!(
