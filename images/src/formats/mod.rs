@@ -62,16 +62,6 @@ pub fn write_gray_png(image: &Image, out: &mut dyn Write) -> Result<(), FormatEr
     png::write_gray(*width, *height, &gray, out)
 }
 
-/// What a file without a PNG's or a Sun raster's signature is, when it does
-/// not read as a Targa file either (Targa files have no signature: what is
-/// not one is no image of these formats).
-pub(crate) fn not_targa(e: FormatError) -> FormatError {
-    match e {
-        FormatError::Io(e) => FormatError::Io(e),
-        e => FormatError::Unsupported(format!("not a PNG, Targa or Sun raster image (as a Targa file: {e})")),
-    }
-}
-
 /// Reads an image file of any of the formats, told apart by their content.
 pub fn read(bytes: &[u8]) -> Result<Image, FormatError> {
     let image = if bytes.starts_with(png::SIGNATURE) {
@@ -79,7 +69,7 @@ pub fn read(bytes: &[u8]) -> Result<Image, FormatError> {
     } else if bytes.starts_with(&sun_raster::MAGIC.to_be_bytes()) {
         sun_raster::read(bytes)?
     } else {
-        targa::read(bytes).map_err(not_targa)?
+        targa::read(bytes).map_err(targa::no_image)?
     };
     check(&image)?;
     Ok(image)

@@ -153,7 +153,7 @@ impl RowReader {
             let header = if is_ras {
                 sun_raster::stream_header(&mut input)?
             } else {
-                targa::stream_header(&mut input).map_err(super::not_targa)?
+                targa::stream_header(&mut input).map_err(targa::no_image)?
             };
             let row_bytes = header.width as usize * header.bytes_per_pixel();
             let pad = if is_ras { sun_raster::row_padding(row_bytes) } else { 0 };

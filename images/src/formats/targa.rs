@@ -9,6 +9,16 @@ use super::image::{Header, Image};
 use crate::RgbImage;
 use std::borrow::Cow;
 
+/// What a file without a PNG's or a Sun raster's signature is when it does
+/// not read as a Targa file either: Targa files have no signature, so what
+/// is not one is no image of these formats.
+pub(super) fn no_image(e: FormatError) -> FormatError {
+    match e {
+        FormatError::Io(e) => FormatError::Io(e),
+        e => FormatError::Unsupported(format!("not a PNG, Targa or Sun raster image (as a Targa file: {e})")),
+    }
+}
+
 /// Descriptor bit 5: the first row stored is the top one.
 const TOP_DOWN: u8 = 0x20;
 /// Descriptor bit 4: each row is stored right to left.
