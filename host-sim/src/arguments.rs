@@ -49,10 +49,11 @@ pub(crate) fn parse_name<T: Copy>(text: &str, all: &[T], name: fn(T) -> &'static
 }
 
 pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WxH (for example 160x128), found `{s}`"))?;
+    let expected = format!("expected WxH (for example 160x128), found `{s}`");
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| expected.clone())?;
     let dim = |v: &str| -> Result<u32, String> {
         if v.is_empty() {
-            return Err(format!("expected WxH (for example 160x128), found `{s}`: a side is missing"));
+            return Err(format!("{expected}: a side is missing"));
         }
         if !v.bytes().all(|b| b.is_ascii_digit()) {
             return Err(format!("`{v}` is not a whole number"));
