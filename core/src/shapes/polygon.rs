@@ -28,11 +28,14 @@ pub struct Polygon<const N: usize> {
     pub offset: Scalar,
     /// The axis dropped for the 2-D edge test (the normal's largest).
     drop_axis: u8,
+    /// Whether the normal is exactly ±1 along `drop_axis` and 0 along the
+    /// others (a floor's, a wall's, whatever the corners' shape): the
+    /// plane's products are then one term each (see `intersect`).
+    axis_normal: bool,
     /// Whether every edge runs along an axis (a chessboard's tiles, a
     /// floor's; never a triangle's): the polygon then lies across
-    /// `drop_axis`, its normal is that axis exactly, and it fills its
-    /// bounds in its plane, so the plane's products are one term each and
-    /// the bounds' test is the edges' test (see `intersect`).
+    /// `drop_axis` (so `axis_normal` holds) and fills its bounds in its
+    /// plane, so the bounds' test is the edges' test (see `intersect`).
     along_axes: bool,
 }
 
@@ -48,12 +51,16 @@ impl<const N: usize> Polygon<N> {
         } else {
             2
         };
+        let axis_normal = (0..3).all(|k| {
+            let component = normal.axis(k).to_bits().unsigned_abs();
+            component == if k == drop_axis as usize { 1 << 30 } else { 0 }
+        });
         let along_axes = N == 4
             && (0..N).all(|i| {
                 let (a, b) = (corners[i].bits(), corners[(i + 1) % N].bits());
                 (0..3).filter(|&k| a[k] != b[k]).count() <= 1
             })
-            && normal.axis(drop_axis as usize).to_bits().unsigned_abs() == 1 << 30
+            && axis_normal
             // Its other two corners within the box of the first and the
             // third (which a rectangle along the axes has: the intersection
             // test takes that box for the bounds).
@@ -61,7 +68,7 @@ impl<const N: usize> Polygon<N> {
                 let (a, b, c) = (corners[0].bits(), corners[2 % N].bits(), corners[i % N].bits());
                 (0..3).all(|k| a[k].min(b[k]) <= c[k] && c[k] <= a[k].max(b[k]))
             });
-        Some(Polygon { corners, normal, offset: corners[0].dot_dir(normal), drop_axis, along_axes })
+        Some(Polygon { corners, normal, offset: corners[0].dot_dir(normal), drop_axis, axis_normal, along_axes })
     }
 
     #[inline]
@@ -71,9 +78,9 @@ impl<const N: usize> Polygon<N> {
             return None;
         }
         let along_axes = N == 4 && self.along_axes;
-        let (den, num) = if along_axes {
-            // The normal is ±2^30 on one axis: n·d and n·o have one term,
-            // exactly the sums below would give.
+        let (den, num) = if self.axis_normal {
+            // The normal is ±2^30 on one axis and 0 on the others: n·d and
+            // n·o have one term, exactly what the sums below would give.
             let a = self.drop_axis as usize;
             let positive = self.normal.axis(a).to_bits() > 0;
             let (d, o) = (ray.dir.axis(a).to_bits() as i64, ray.origin.axis(a).to_bits() as i64);
@@ -114,17 +121,25 @@ impl<const N: usize> Polygon<N> {
         // inside the polygon's bounds is representable and worth testing.
         let o = ray.origin.wide();
         let d = ray.dir.bits();
-        let p = [0, 1, 2].map(|a| o[a] + (mul_wide(d[a], t as i32) >> 30));
+        // Across an axis normal's plane, through the first corner's
+        // coordinate `c` on that axis, the point is within [c − 2, c + 1]
+        // (t is the floor of the exact parameter, |d| ≤ 2^30, and the product
+        // is floored once more), so inside the bounds' slack there: that
+        // axis needs neither the product nor the test (the edges' test
+        // drops it too).
+        let across = if self.axis_normal { self.drop_axis as usize } else { 3 };
+        let p = [0, 1, 2].map(|a| if a == across { o[a] } else { o[a] + (mul_wide(d[a], t as i32) >> 30) });
         // Along the axes, the first and third corners span the bounds (see
         // `with_normal`): two corners' box instead of the fold over four.
         let b = if along_axes { Aabb::spanned(self.corners[0], self.corners[2 % N]) } else { self.bounds() };
         let (lo, hi) = (b.min.wide(), b.max.wide());
         let slack = EDGE_TOLERANCE;
-        if (0..3).any(|a| p[a] < lo[a] - slack || p[a] > hi[a] + slack) {
+        if (0..3).any(|a| a != across && (p[a] < lo[a] - slack || p[a] > hi[a] + slack)) {
             return None;
         }
         // Within the bounds, so each coordinate fits an i32: this is
-        // `ray.at(t)`, already computed. A polygon along the axes fills its
+        // `ray.at(t)`, already computed (but across an axis normal, where it
+        // holds the origin's, which the edges' test drops). A polygon along the axes fills its
         // bounds: each edge's test (within its tolerance of the edge) is
         // the bounds' test just made on that side.
         let t = Scalar::from_bits(t as i32);
@@ -270,15 +285,16 @@ mod tests {
     extern crate std;
     use super::*;
 
-    /// Rectangles along the axes, in every axis plane and facing either
-    /// way, hit exactly as the general plane-and-edges test hits them: rays
+    /// Rectangles along the axes, and triangles across an axis, in every
+    /// axis plane and facing either way, hit exactly as the general
+    /// plane-and-edges test hits them: rays
     /// from anywhere, from their plane and a unit off it, towards their
     /// edges and corners within a few units.
     #[test]
     fn along_the_axes_the_short_test_is_the_general_one() {
         let mut next = crate::test_rng::seeded(0xa1_0a9e5);
         let mut coordinate = move |range: u64| (next() % (2 * range + 1)) as i64 - range as i64;
-        let (mut along, mut hits) = (0, 0);
+        let (mut along, mut hits, mut triangle_hits) = (0, 0, 0);
         for _ in 0..20_000 {
             let a = (coordinate(1) + 1) as usize;
             let [u, v] = [(a + 1) % 3, (a + 2) % 3];
@@ -301,7 +317,11 @@ mod tests {
             assert!(fast.along_axes);
             assert_eq!(Aabb::spanned(fast.corners[0], fast.corners[2]), fast.bounds());
             along += 1;
-            let general = Polygon { along_axes: false, ..fast };
+            let general = Polygon { axis_normal: false, along_axes: false, ..fast };
+            // A triangle across the same axis takes the one-term plane too.
+            let fast_triangle = Polygon::with_normal([corners[0], corners[1], corners[2]], normal).unwrap();
+            assert!(fast_triangle.axis_normal && !fast_triangle.along_axes);
+            let general_triangle = Polygon { axis_normal: false, ..fast_triangle };
             let target = [0, 1, 2].map(|k| match k {
                 k if k == a => plane,
                 k if k == u => [u0, u1][coordinate(1).unsigned_abs() as usize % 2] + coordinate(6),
@@ -318,13 +338,18 @@ mod tests {
                 let hit = fast.intersect(&ray, t_max, Leaving::No);
                 assert_eq!(hit, general.intersect(&ray, t_max, Leaving::No), "{ray:?} {fast:?}");
                 hits += hit.is_some() as u32;
+                let hit = fast_triangle.intersect(&ray, t_max, Leaving::No);
+                assert_eq!(hit, general_triangle.intersect(&ray, t_max, Leaving::No), "{ray:?} {fast_triangle:?}");
+                triangle_hits += hit.is_some() as u32;
             }
         }
         assert!(along > 15_000 && hits > 5_000, "{along} along the axes, {hits} hits");
+        assert!(triangle_hits > 2_500, "{triangle_hits} hits of triangles");
         // A tilted one is not along the axes.
         let tilted =
             [[0, 0, 0], [1 << 16, 0, 0], [1 << 16, 1 << 16, 1 << 16], [0, 1 << 16, 1 << 16]].map(Vec3::from_bits);
-        assert!(!Polygon::with_normal(tilted, [0, -1, 1]).unwrap().along_axes);
+        let tilted = Polygon::with_normal(tilted, [0, -1, 1]).unwrap();
+        assert!(!tilted.along_axes && !tilted.axis_normal);
     }
 
     /// The short products' decision agrees with the exact edge test for
