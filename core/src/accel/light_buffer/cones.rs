@@ -46,7 +46,7 @@
 
 use super::query::ShadowQuery;
 use super::{LightBuffer, LightBufferError, LightBufferReport, ShadowLinks, Words, MARGIN};
-use crate::accel::{Mailbox, RayStart};
+use crate::accel::{naive, Mailbox, RayStart};
 use crate::capacity::Arena;
 use crate::math::{leading_zeros_u32, Dir};
 use crate::scene::{ObjectId, SceneView};
@@ -234,26 +234,26 @@ impl<'a> LightBuffer<'a> {
         mailbox: &mut Mailbox<'_>,
     ) -> bool {
         let ShadowQuery { scene, ray, t_max, light, start } = *query;
-        let cones = self.light_cones(light).filter(|cones| cones.len() == CONE * scene.object_count());
-        let mut cones = cones.unwrap_or(&[]).chunks_exact(CONE);
+        let Some(cones) = self.light_cones(light).filter(|cones| cones.len() == CONE * scene.object_count()) else {
+            return naive::occluded(S::KINDS, scene, ray, t_max, start, mailbox);
+        };
         // From the light towards the ray's origin, in Q2.14: within
         // [−2^14, 2^14 + 1].
         let toward = ray.dir.bits().map(|c| -(c >> 16));
-        for (object, &handle) in scene.objects.iter().enumerate() {
-            if cones.next().is_some_and(|cone| !passes(cone, toward)) {
-                continue;
-            }
+        // The cones alone in the loop: an object is looked up only once its
+        // cone holds the ray. The first blocker in file order, as the naive
+        // walk finds it (an object outside its cone blocks nothing).
+        let in_cone = cones.chunks_exact(CONE).enumerate().filter(|(_, cone)| passes(cone, toward));
+        let blocker = in_cone.map(|(object, _)| object).find(|&object| {
             let leaving = RayStart::leaving(start, ObjectId(object as u32));
             // A ray leaving an object outward never meets it again.
-            if leaving == Leaving::Outward {
-                continue;
-            }
-            if scene.intersect_handle(S::KINDS, handle, ray, t_max, leaving).is_some() {
-                mailbox.blocker = object as u32;
-                return true;
-            }
-        }
-        false
+            leaving != Leaving::Outward
+                && scene
+                    .objects
+                    .get(object)
+                    .is_some_and(|&handle| scene.intersect_handle(S::KINDS, handle, ray, t_max, leaving).is_some())
+        });
+        blocker.inspect(|&object| mailbox.blocker = object as u32).is_some()
     }
 }
 
