@@ -232,9 +232,9 @@ impl<'a> FirstHits<'a> {
         })
     }
 
-    /// The nearest hit of `camera`'s ray through sub-cell (`sx`, `sy`) of
-    /// pixel (`x`, `y`), `ray`: the hit every accelerator's `nearest`
-    /// returns for it; `None` where the lists are too long to pay.
+    /// The nearest hit of `camera`'s ray `ray` through a sub-cell of pixel
+    /// (`x`, `y`) (the ray knows its offsets): the hit every accelerator's
+    /// `nearest` returns for it; `None` where the lists are too long to pay.
     #[inline]
     pub fn nearest(
         &mut self,
@@ -242,10 +242,10 @@ impl<'a> FirstHits<'a> {
         kinds: ShapeKinds,
         camera: &Camera,
         ray: &mut CameraRay,
-        [x, y, sx, sy]: [u32; 4],
+        [x, y]: [u32; 2],
     ) -> Option<Option<Hit>> {
         let all = self.all;
-        let (kx, ky) = camera.offsets(x, y, sx, sy);
+        let (kx, ky) = ray.offsets;
         let shift = self.shift;
         let tile = self.tile(camera, x, y)?;
         // A ray's offsets need no clamp ([`window_shift`]): `narrow`'s value.
@@ -428,7 +428,7 @@ mod tests {
                     for (sx, sy) in (0..n * n).map(|s| (s % n, s / n)) {
                         let ray = camera.ray(x, y, sx, sy);
                         let mut lazy = camera.next_ray(&mut RayCursor::default(), x, y, sx, sy);
-                        let listed = hits.nearest(&view, ShapeKinds::ALL, &camera, &mut lazy, [x, y, sx, sy]);
+                        let listed = hits.nearest(&view, ShapeKinds::ALL, &camera, &mut lazy, [x, y]);
                         let naive = Naive.nearest(&view, &ray, None, &mut Mailbox::none());
                         assert_eq!(listed.unwrap_or(naive), naive, "pixel {x} {y}, sample {sx} {sy}");
                         rays += 1;

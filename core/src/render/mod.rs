@@ -223,12 +223,7 @@ impl<'a, L: Linked> Renderer<'a, L> {
     /// The camera ray's hit from the screen lists, if the renderer has them
     /// (filled by the first ray, `poll` asked before each object).
     #[inline]
-    fn first_hit<Q: Poll>(
-        &mut self,
-        ray: &mut CameraRay,
-        [x, y, sx, sy]: [u32; 4],
-        poll: &mut Q,
-    ) -> Option<Option<Hit>> {
+    fn first_hit<Q: Poll>(&mut self, ray: &mut CameraRay, [x, y]: [u32; 2], poll: &mut Q) -> Option<Option<Hit>> {
         // Asked first: for an accelerator that never allows the lists (the
         // naive modes) the whole path folds away, a board's cycles too.
         if !self.tracer.accel().first_hits_by_screen() {
@@ -241,7 +236,7 @@ impl<'a, L: Linked> Renderer<'a, L> {
             }
         }
         let ScreenLists::Lists(hits) = &mut self.first_hits else { return None };
-        hits.nearest(self.tracer.scene(), L::KINDS, &self.camera, ray, [x, y, sx, sy])
+        hits.nearest(self.tracer.scene(), L::KINDS, &self.camera, ray, [x, y])
     }
 
     /// Counters since the renderer was made.
@@ -375,7 +370,7 @@ impl<'a, L: Linked> Renderer<'a, L> {
         poll: &mut Q,
     ) -> Result<(Color, Option<ObjectId>), Q::Stopped> {
         let mut ray = self.camera.next_ray(&mut self.cursor, x, y, sx, sy);
-        let seen = match self.first_hit(&mut ray, [x, y, sx, sy], poll) {
+        let seen = match self.first_hit(&mut ray, [x, y], poll) {
             // Shown by the lists to miss: the ray itself is made only for
             // the lookout.
             Some(None) if poll.go_on() => {

@@ -110,6 +110,9 @@ pub(crate) struct Stride {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct CameraRay {
     direction: [i64; 3],
+    /// The sub-cell's offsets, as [`Camera::offsets`] gives them: the
+    /// screen lists' window test reads them without making them again.
+    pub(crate) offsets: (i32, i32),
     ray: Option<Ray>,
 }
 
@@ -242,7 +245,7 @@ impl Camera {
             _ => self.direction(kx, ky),
         };
         cursor.last = Some((kx, ky, d));
-        CameraRay { direction: d, ray: None }
+        CameraRay { direction: d, offsets: (kx, ky), ray: None }
     }
 
     /// The jump of `pixels` pixels along a row, for [`RayCursor::skip`].
