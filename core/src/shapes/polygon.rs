@@ -139,9 +139,9 @@ impl<const N: usize> Polygon<N> {
         }
         // Within the bounds, so each coordinate fits an i32: this is
         // `ray.at(t)`, already computed (but across an axis normal, where it
-        // holds the origin's, which the edges' test drops). A polygon along the axes fills its
-        // bounds: each edge's test (within its tolerance of the edge) is
-        // the bounds' test just made on that side.
+        // holds the origin's, which the edges' test drops). A polygon along
+        // the axes fills its bounds: each edge's test (within its tolerance
+        // of the edge) is the bounds' test just made on that side.
         let t = Scalar::from_bits(t as i32);
         (along_axes || self.contains(Vec3::from_bits(p.map(|c| c as i32)))).then_some(t)
     }
