@@ -9,6 +9,9 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
+/// How many chromedrivers [`Browser::start`] starts before it gives up.
+const STARTS: usize = 3;
+
 /// A chromedriver process and one headless chromium session, both ended on
 /// drop.
 pub struct Browser {
@@ -37,7 +40,20 @@ pub fn http_with_head(
     headers: &[(&str, &str)],
     body: &[u8],
 ) -> (u16, String, Vec<u8>) {
-    let mut stream = TcpStream::connect(("127.0.0.1", port)).expect("connect");
+    try_http_with_head(port, method, path, headers, body)
+        .unwrap_or_else(|e| panic!("{method} {path} on 127.0.0.1:{port}: {e}"))
+}
+
+/// [`http_with_head`], its failures to connect, send or read returned.
+fn try_http_with_head(
+    port: u16,
+    method: &str,
+    path: &str,
+    headers: &[(&str, &str)],
+    body: &[u8],
+) -> std::io::Result<(u16, String, Vec<u8>)> {
+    let closed = |what: &str| std::io::Error::new(std::io::ErrorKind::UnexpectedEof, what.to_string());
+    let mut stream = TcpStream::connect(("127.0.0.1", port))?;
     stream.set_read_timeout(Some(crate::HANG_GUARD)).ok();
     let mut head = format!("{method} {path} HTTP/1.1\r\nContent-Length: {}\r\nConnection: close\r\n", body.len());
     if !headers.iter().any(|(n, _)| n.eq_ignore_ascii_case("host")) {
@@ -47,8 +63,8 @@ pub fn http_with_head(
         head.push_str(&format!("{n}: {v}\r\n"));
     }
     head.push_str("\r\n");
-    stream.write_all(head.as_bytes()).expect("send");
-    stream.write_all(body).expect("send");
+    stream.write_all(head.as_bytes())?;
+    stream.write_all(body)?;
     // chromedriver keeps the connection open whatever the request says: read
     // the head, then Content-Length bytes (or to the end without one).
     let mut response = Vec::new();
@@ -57,8 +73,10 @@ pub fn http_with_head(
         if let Some(split) = response.windows(4).position(|w| w == b"\r\n\r\n") {
             break split;
         }
-        let n = stream.read(&mut buffer).expect("read");
-        assert!(n > 0, "the connection closed before the response's head ended");
+        let n = stream.read(&mut buffer)?;
+        if n == 0 {
+            return Err(closed("the connection closed before the response's head ended"));
+        }
         response.extend_from_slice(&buffer[..n]);
     };
     let head = String::from_utf8_lossy(&response[..split]).into_owned();
@@ -71,21 +89,27 @@ pub fn http_with_head(
     match length {
         Some(length) => {
             while body.len() < length {
-                let n = stream.read(&mut buffer).expect("read");
-                assert!(n > 0, "the connection closed inside the body");
+                let n = stream.read(&mut buffer)?;
+                if n == 0 {
+                    return Err(closed("the connection closed inside the body"));
+                }
                 body.extend_from_slice(&buffer[..n]);
             }
             body.truncate(length);
         }
         None => {
-            stream.read_to_end(&mut body).expect("read");
+            stream.read_to_end(&mut body)?;
         }
     }
-    (status, head, body)
+    Ok((status, head, body))
 }
 
 impl Browser {
     /// Starts chromedriver and a fresh headless chromium (its own profile).
+    ///
+    /// A chromedriver that fails to make the session (on a loaded machine
+    /// one once reset the connection that asked for it) is ended and a new
+    /// one started on another port, up to [`STARTS`] times in all.
     pub fn start(window: (u32, u32)) -> Browser {
         for tool in ["/usr/bin/chromium", "/usr/bin/chromedriver"] {
             assert!(
@@ -93,6 +117,19 @@ impl Browser {
                 "{tool} is missing: install Debian's chromium and chromium-driver (scripts/test-all does)"
             );
         }
+        let mut failures = Vec::new();
+        for _ in 0..STARTS {
+            match Browser::try_start(window) {
+                Ok(browser) => return browser,
+                Err(failure) => failures.push(failure),
+            }
+        }
+        panic!("chromedriver made no session in {STARTS} starts: {}", failures.join("; "))
+    }
+
+    /// One chromedriver and its session, or why the session was not made
+    /// (the driver is then ended, with the rest, on drop).
+    fn try_start(window: (u32, u32)) -> Result<Browser, String> {
         let port = free_port();
         let mut driver = Command::new("/usr/bin/chromedriver");
         driver.arg(format!("--port={port}")).stdout(Stdio::null()).stderr(Stdio::null());
@@ -116,14 +153,18 @@ impl Browser {
             format!("--window-size={},{}", window.0, window.1),
         ];
         let mut browser = Browser { driver, port, session: String::new(), _profile: profile };
-        let created = browser.command(
-            "POST",
-            "/session",
-            json!({"capabilities": {"alwaysMatch": {"browserName": "chrome", "unhandledPromptBehavior": "ignore",
-                "goog:chromeOptions": {"binary": "/usr/bin/chromium", "args": args}}}}),
-        );
-        browser.session = created["sessionId"].as_str().expect("a session").to_string();
-        browser
+        let request = json!({"capabilities": {"alwaysMatch": {"browserName": "chrome",
+            "unhandledPromptBehavior": "ignore",
+            "goog:chromeOptions": {"binary": "/usr/bin/chromium", "args": args}}}});
+        let json = [("Content-Type", "application/json; charset=utf-8")];
+        let (status, _, response) = try_http_with_head(port, "POST", "/session", &json, request.to_string().as_bytes())
+            .map_err(|e| format!("POST /session: {e}"))?;
+        let created: Value = serde_json::from_slice(&response).unwrap_or(Value::Null);
+        match created["value"]["sessionId"].as_str() {
+            Some(session) if status == 200 => browser.session = session.to_string(),
+            _ => return Err(format!("POST /session: {status} {}", String::from_utf8_lossy(&response))),
+        }
+        Ok(browser)
     }
 
     fn command(&self, method: &str, path: &str, body: Value) -> Value {
