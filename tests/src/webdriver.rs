@@ -156,23 +156,28 @@ impl Browser {
         let request = json!({"capabilities": {"alwaysMatch": {"browserName": "chrome",
             "unhandledPromptBehavior": "ignore",
             "goog:chromeOptions": {"binary": "/usr/bin/chromium", "args": args}}}});
-        let json = [("Content-Type", "application/json; charset=utf-8")];
-        let (status, _, response) = try_http_with_head(port, "POST", "/session", &json, request.to_string().as_bytes())
-            .map_err(|e| format!("POST /session: {e}"))?;
-        let created: Value = serde_json::from_slice(&response).unwrap_or(Value::Null);
+        let (status, created) =
+            browser.request("POST", "/session", request).map_err(|e| format!("POST /session: {e}"))?;
         match created["value"]["sessionId"].as_str() {
             Some(session) if status == 200 => browser.session = session.to_string(),
-            _ => return Err(format!("POST /session: {status} {}", String::from_utf8_lossy(&response))),
+            _ => return Err(format!("POST /session: {status} {created}")),
         }
         Ok(browser)
     }
 
-    fn command(&self, method: &str, path: &str, body: Value) -> Value {
+    /// One WebDriver request to the driver: its status and its JSON (null
+    /// when the body is none), or the failure to connect, send or read.
+    fn request(&self, method: &str, path: &str, body: Value) -> std::io::Result<(u16, Value)> {
         let body = if method == "GET" || method == "DELETE" { Vec::new() } else { body.to_string().into_bytes() };
-        let (status, response) =
-            http(self.port, method, path, &[("Content-Type", "application/json; charset=utf-8")], &body);
-        let value: Value = serde_json::from_slice(&response).unwrap_or(Value::Null);
-        assert!(status == 200, "WebDriver {method} {path}: {status} {}", String::from_utf8_lossy(&response));
+        let json = [("Content-Type", "application/json; charset=utf-8")];
+        let (status, _, response) = try_http_with_head(self.port, method, path, &json, &body)?;
+        Ok((status, serde_json::from_slice(&response).unwrap_or(Value::Null)))
+    }
+
+    fn command(&self, method: &str, path: &str, body: Value) -> Value {
+        let (status, value) =
+            self.request(method, path, body).unwrap_or_else(|e| panic!("WebDriver {method} {path}: {e}"));
+        assert!(status == 200, "WebDriver {method} {path}: {status} {value}");
         value.get("value").cloned().unwrap_or(value)
     }
 
@@ -182,15 +187,9 @@ impl Browser {
 
     /// Tries a command; the error message when it fails.
     fn try_session(&self, method: &str, path: &str, body: Value) -> Result<Value, String> {
-        let body = if method == "GET" || method == "DELETE" { Vec::new() } else { body.to_string().into_bytes() };
-        let (status, response) = http(
-            self.port,
-            method,
-            &format!("/session/{}{path}", self.session),
-            &[("Content-Type", "application/json")],
-            &body,
-        );
-        let value: Value = serde_json::from_slice(&response).unwrap_or(Value::Null);
+        let path = format!("/session/{}{path}", self.session);
+        let (status, value) =
+            self.request(method, &path, body).unwrap_or_else(|e| panic!("WebDriver {method} {path}: {e}"));
         if status == 200 {
             Ok(value["value"].clone())
         } else {

@@ -287,9 +287,9 @@ mod tests {
 
     /// Rectangles along the axes, and triangles across an axis, in every
     /// axis plane and facing either way, hit exactly as the general
-    /// plane-and-edges test hits them: rays
-    /// from anywhere, from their plane and a unit off it, towards their
-    /// edges and corners within a few units.
+    /// plane-and-edges test hits them: rays from anywhere, from their plane
+    /// and a unit off it, towards their edges and corners within a few
+    /// units.
     #[test]
     fn along_the_axes_the_short_test_is_the_general_one() {
         let mut next = crate::test_rng::seeded(0xa1_0a9e5);
