@@ -194,7 +194,7 @@ where
     let args = match Args::try_parse_from(args) {
         Ok(a) => a,
         Err(e) if e.use_stderr() => {
-            let _ = write!(stderr, "{}", e.render());
+            let _ = write!(stderr, "{}", argument_error(&e));
             return EXIT_SCENE;
         }
         Err(e) => {
@@ -215,6 +215,26 @@ where
             e.exit_code()
         }
     }
+}
+
+/// clap's message for arguments it refuses, but for a third positional
+/// argument: clap, which lets subcommands stand where the scene does, takes
+/// it for a subcommand "that cannot be used with <SCENE>", where the user
+/// gave one file too many.
+fn argument_error(e: &clap::Error) -> String {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    use clap::CommandFactory;
+    let extra = match (e.kind(), e.get(ContextKind::InvalidSubcommand)) {
+        (ErrorKind::ArgumentConflict, Some(ContextValue::String(name))) => name,
+        _ => return e.render().to_string(),
+    };
+    if Args::command().get_subcommands().any(|command| command.get_name() == extra) {
+        return e.render().to_string();
+    }
+    format!(
+        "error: unexpected argument '{extra}': host-sim takes a scene file and at most one image file\n\n\
+         Usage: host-sim [OPTIONS] <SCENE> [OUT]\n\nFor more information, try '--help'.\n"
+    )
 }
 
 fn convert(input: &Path, output: &Path, format: Option<Format>) -> Result<(), CliError> {
@@ -712,6 +732,22 @@ mod tests {
     fn dither_without_a_panel_is_refused() {
         let said = refusal(&["--color", "rgb565", "--dither", "bayer"]);
         assert!(said.contains("--color mono|gray2|gray4|bwr"), "{said}");
+    }
+
+    #[test]
+    fn a_third_file_is_named_as_one_too_many() {
+        let said = |args: &[&str]| {
+            let mut stderr = Vec::new();
+            let code = run(["host-sim"].iter().chain(args), &mut Vec::new(), &mut stderr);
+            (code, String::from_utf8_lossy(&stderr).into_owned())
+        };
+        let (code, message) = said(&["a.txt", "b.png", "c.png"]);
+        assert_eq!(code, EXIT_SCENE);
+        assert!(message.starts_with("error: unexpected argument 'c.png': host-sim takes a scene file"), "{message}");
+        // A subcommand after a scene is clap's own conflict.
+        let (code, message) = said(&["a.txt", "b.png", "merge"]);
+        assert_eq!(code, EXIT_SCENE);
+        assert!(message.contains("the subcommand 'merge' cannot be used with"), "{message}");
     }
 
     #[test]
