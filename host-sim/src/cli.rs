@@ -20,8 +20,6 @@ use octrace_images::formats::{self, Format, FormatError, Header, Image};
 use octrace_images::palette::PaletteMode;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Once;
 use std::time::Instant;
 
 pub use crate::exit::{CliError, EXIT_IO, EXIT_MISMATCH, EXIT_SCENE, EXIT_STOPPED};
@@ -32,11 +30,11 @@ pub use crate::exit::{CliError, EXIT_IO, EXIT_MISMATCH, EXIT_SCENE, EXIT_STOPPED
 /// Exit codes: 0 success, 1 a file could not be read or written (or a
 /// board could not be talked to), 2 the scene or the arguments are invalid
 /// (every error is printed as file:line:col), 3 a board's picture differs
-/// from host-sim's (`board --check`), 130 stopped by Ctrl-C.
-/// Nothing is written unless the whole image renders: the image goes to a
-/// temporary file that is renamed into place at the end. Ctrl-C stops a
-/// render before its next ray, even inside a pixel that takes hours, and
-/// leaves no file.
+/// from host-sim's (`board --check`), 130 stopped by Ctrl-C (143 by
+/// SIGTERM, 129 by SIGHUP). Nothing is written unless the whole image
+/// renders: the image goes to a temporary file that is renamed into place
+/// at the end. Ctrl-C, SIGTERM and SIGHUP stop a render before its next ray,
+/// even inside a pixel that takes hours, and leave no file.
 #[derive(Parser, Debug)]
 #[command(
     name = "host-sim",
@@ -355,7 +353,7 @@ fn preview(
     let mut canvas = Canvas::new(w, h);
     let rendered = match render_streamed(scene, options, 0..h, &|_| {}, &mut canvas) {
         Ok(rendered) => rendered,
-        Err(StreamError::Stopped) => return Err(CliError::Stopped),
+        Err(StreamError::Stopped) => return Err(CliError::stopped()),
         // The parser rejects a camera that cannot be set up; a scene built
         // by hand may not.
         Err(e) => return Err(CliError::Invalid(format!("cannot set up the camera: {e}"))),
@@ -493,9 +491,9 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         octree: OctreeConfig { max_objects: args.max_objects, max_depth: args.max_depth, ..crate::OCTREE },
         threads: args.threads.map_or_else(all_cores, |n| n as usize),
         partition: args.partition,
-        // Ctrl-C stops a render before its next ray, a still's or an
-        // animation's frame's, and the run leaves no file (exit 130).
-        stop: Some(ctrl_c()),
+        // Ctrl-C, SIGTERM or SIGHUP stops a render before its next ray, a
+        // still's or an animation's frame's, and the run leaves no file.
+        stop: Some(crate::signals::stop_flag()),
     };
     let raster = scene.view().settings.raster;
     let (w, h) = args.size.unwrap_or((raster[0], raster[1]));
@@ -569,7 +567,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         b.finish_and_clear();
     }
     let rendered = match (outcome, written) {
-        (Some(Err(StreamError::Stopped)), _) => return Err(CliError::Stopped),
+        (Some(Err(StreamError::Stopped)), _) => return Err(CliError::stopped()),
         // The parser rejects a camera that cannot be set up; a scene built
         // by hand may not.
         (Some(Err(e)), _) => return Err(CliError::Invalid(e.to_string())),
@@ -625,21 +623,6 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         }
     }
     Ok(())
-}
-
-/// Set by Ctrl-C, once this process has its handler ([`ctrl_c`]).
-static CTRL_C: AtomicBool = AtomicBool::new(false);
-
-/// The flag Ctrl-C sets, its handler installed on the first call: a render
-/// that asks it stops before its next ray and writes nothing. A process
-/// that has a handler already (the studio's, in a test that ran it) keeps
-/// it, and Ctrl-C ends it as before.
-fn ctrl_c() -> &'static AtomicBool {
-    static INSTALL: Once = Once::new();
-    INSTALL.call_once(|| {
-        let _ = ctrlc::set_handler(|| CTRL_C.store(true, Ordering::SeqCst));
-    });
-    &CTRL_C
 }
 
 #[cfg(test)]

@@ -1,9 +1,11 @@
 //! How a host-sim command fails: [`CliError`], whose exit code is derived in
 //! one place ([`CliError::exit_code`]): 0 done, 1 a file could not be read
 //! or written (or a board talked to), 2 a bad scene or bad arguments, 3 a
-//! board's picture that differs from host-sim's, 130 stopped by Ctrl-C
-//! (128 + SIGINT, as a shell reports a process Ctrl-C ended).
+//! board's picture that differs from host-sim's, 128 + the signal for a
+//! run a signal stopped (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP, as a shell
+//! reports a process the signal ended).
 
+use crate::signals::{self, StopSignal};
 use std::fmt;
 use std::path::Path;
 
@@ -15,7 +17,7 @@ pub const EXIT_IO: i32 = 1;
 /// Exit code for a board's picture that differs from host-sim's
 /// (`host-sim board --check`).
 pub const EXIT_MISMATCH: i32 = 3;
-/// Exit code for a render Ctrl-C stopped.
+/// Exit code for a render Ctrl-C stopped (SIGTERM and SIGHUP: [`StopSignal::exit_code`]).
 pub const EXIT_STOPPED: i32 = 130;
 
 /// Why a command stopped; printed to stderr as it is displayed.
@@ -30,8 +32,9 @@ pub enum CliError {
     Scene { file: String, errors: Vec<String> },
     /// A board's picture is not host-sim's; the message says how.
     Mismatch(String),
-    /// Ctrl-C stopped the render; nothing was written.
-    Stopped,
+    /// A signal (Ctrl-C, SIGTERM, SIGHUP) stopped the render; nothing was
+    /// written.
+    Stopped(StopSignal),
 }
 
 impl CliError {
@@ -45,13 +48,18 @@ impl CliError {
         CliError::Io(format!("cannot write {}: {error}", ShownPath(path)))
     }
 
+    /// A run stopped by the signal that arrived.
+    pub fn stopped() -> CliError {
+        CliError::Stopped(signals::arrived())
+    }
+
     /// The process's exit code for this error.
     pub fn exit_code(&self) -> i32 {
         match self {
             CliError::Io(_) => EXIT_IO,
             CliError::Invalid(_) | CliError::Scene { .. } => EXIT_SCENE,
             CliError::Mismatch(_) => EXIT_MISMATCH,
-            CliError::Stopped => EXIT_STOPPED,
+            CliError::Stopped(signal) => signal.exit_code(),
         }
     }
 }
@@ -68,7 +76,7 @@ impl fmt::Display for CliError {
                 }
                 write!(f, "host-sim: {} error(s) in {file}; nothing rendered", errors.len())
             }
-            CliError::Stopped => f.write_str("host-sim: stopped (Ctrl-C); nothing written"),
+            CliError::Stopped(signal) => write!(f, "host-sim: stopped ({signal}); nothing written"),
         }
     }
 }

@@ -17,6 +17,7 @@ pub mod parts;
 mod render;
 mod rows;
 mod scene;
+pub mod signals;
 pub mod studio;
 mod terminal;
 mod threaded;

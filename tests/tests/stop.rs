@@ -1,6 +1,7 @@
 //! A render can always be stopped, even inside a pixel that takes hours
 //! (issue 41): host-sim's Ctrl-C ends it inside its first pixels and
-//! leaves no file. (The board's side: `board.rs`; the studio's workers:
+//! leaves no file, and so do SIGTERM (`kill`, `timeout`, a job scheduler)
+//! and SIGHUP (a closed terminal). (The board's side: `board.rs`; the studio's workers:
 //! `studio.rs`.)
 //!
 //! No wall-clock bound decides these tests: a pixel of their scene takes
@@ -40,6 +41,13 @@ fn ctrl_c_ends_a_render_of_minutes_a_pixel_inside_it_and_leaves_no_file() {
 }
 
 #[test]
+fn sigterm_and_sighup_end_a_render_inside_a_pixel_and_leave_no_file() {
+    // A part's rows stream into its temporary file as they are traced.
+    signal_ends(Stop::TERM, &minutes_a_pixel(), "wedge.png", &["--part", "1/1"]);
+    signal_ends(Stop::HUP, &format!("FRAMES 3\n{}", minutes_a_pixel()), "wedge.gif", &[]);
+}
+
+#[test]
 fn ctrl_c_ends_an_animations_frame_inside_a_pixel_and_leaves_no_file() {
     let animation = format!("FRAMES 3\n{}", minutes_a_pixel());
     // A frame of its tiles (the coherence's), and a frame traced whole.
@@ -47,12 +55,30 @@ fn ctrl_c_ends_an_animations_frame_inside_a_pixel_and_leaves_no_file() {
     ctrl_c_ends(&animation, "wedge.png", &["--no-coherence"]);
 }
 
-/// Renders `scene` to `out` (with `args`, in the naive mode) and sends
-/// Ctrl-C once its temporary file is there (its handler is installed
-/// before) and, most likely, it is inside its first pixels: it must end
-/// with exit code 130 before any pixel could end, saying nothing was
-/// written, and leave no file.
+/// A signal that stops host-sim: its name for `kill`, host-sim's exit code
+/// and its name in host-sim's message.
+struct Stop {
+    kill: &'static str,
+    exit_code: i32,
+    said: &'static str,
+}
+
+impl Stop {
+    const INT: Stop = Stop { kill: "-INT", exit_code: host_sim::cli::EXIT_STOPPED, said: "Ctrl-C" };
+    const TERM: Stop = Stop { kill: "-TERM", exit_code: 128 + 15, said: "SIGTERM" };
+    const HUP: Stop = Stop { kill: "-HUP", exit_code: 128 + 1, said: "SIGHUP" };
+}
+
 fn ctrl_c_ends(scene_text: &str, out: &str, args: &[&str]) {
+    signal_ends(Stop::INT, scene_text, out, args);
+}
+
+/// Renders `scene` to `out` (with `args`, in the naive mode) and sends
+/// `signal` once its temporary file is there (its handler is installed
+/// before) and, most likely, it is inside its first pixels: it must end
+/// with the signal's exit code before any pixel could end, saying nothing
+/// was written, and leave no file.
+fn signal_ends(signal: Stop, scene_text: &str, out: &str, args: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("wedge.txt");
     std::fs::write(&scene, scene_text).unwrap();
@@ -77,18 +103,22 @@ fn ctrl_c_ends(scene_text: &str, out: &str, args: &[&str]) {
     std::thread::sleep(Duration::from_millis(300));
     assert!(child.try_wait().unwrap().is_none(), "still rendering");
     let sent = Instant::now();
-    let kill = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    let kill = Command::new("kill").args([signal.kill, &child.id().to_string()]).status().unwrap();
     assert!(kill.success());
     let status = loop {
         if let Some(status) = child.try_wait().unwrap() {
             break status;
         }
-        assert!(sent.elapsed() < GUARD, "still running {GUARD:?} after Ctrl-C: it did not stop inside a pixel");
+        assert!(
+            sent.elapsed() < GUARD,
+            "still running {GUARD:?} after {}: it did not stop inside a pixel",
+            signal.said
+        );
         std::thread::sleep(Duration::from_millis(5));
     };
     let mut stderr = String::new();
     std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
-    assert_eq!(status.code(), Some(host_sim::cli::EXIT_STOPPED), "{status:?}: {stderr}");
-    assert!(stderr.contains("host-sim: stopped (Ctrl-C); nothing written"), "{stderr}");
+    assert_eq!(status.code(), Some(signal.exit_code), "{status:?}: {stderr}");
+    assert!(stderr.contains(&format!("host-sim: stopped ({}); nothing written", signal.said)), "{stderr}");
     assert_eq!(entries(), ["wedge.txt"], "{}: no image and no temporary file left", out.display());
 }

@@ -88,7 +88,7 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
             errors: errors.into_iter().map(|e| format!("{name}:{e}")).collect(),
         },
         AnimationError::Setup(message) => CliError::Invalid(message),
-        AnimationError::Stopped => CliError::Stopped,
+        AnimationError::Stopped => CliError::stopped(),
         AnimationError::Write(e) => CliError::write(request.out, e),
     };
     let mut outcome: Option<Result<AnimationReport, AnimationError>> = None;

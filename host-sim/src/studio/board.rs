@@ -169,7 +169,7 @@ fn message(e: CliError) -> String {
     match e {
         CliError::Io(message) | CliError::Invalid(message) | CliError::Mismatch(message) => message,
         CliError::Scene { errors, .. } => errors.join("\n"),
-        CliError::Stopped => "stopped (Ctrl-C)".into(),
+        CliError::Stopped(signal) => format!("stopped ({signal})"),
     }
 }
 

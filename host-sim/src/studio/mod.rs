@@ -169,14 +169,8 @@ pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) ->
     if args.open {
         *shared.launcher.lock().unwrap_or_else(|poisoned| poisoned.into_inner()) = open_browser(&url, stderr);
     }
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = Arc::clone(&stop);
-        // A second handler cannot be installed (tests run the server more
-        // than once in a process); Ctrl-C then simply ends the process.
-        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
-    }
-    serve(&listener, &shared, &stop);
+    // Ctrl-C, SIGTERM or SIGHUP: a save under way ends first.
+    serve(&listener, &shared, crate::signals::stop_flag());
     shared.forget_launcher();
     let _ = writeln!(stderr, "host-sim studio: stopped");
     Ok(())

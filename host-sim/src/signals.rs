@@ -1,0 +1,109 @@
+//! The signals that stop host-sim cleanly: Ctrl-C (SIGINT), SIGTERM (what
+//! `kill`, `timeout` and job schedulers such as Slurm send) and SIGHUP (the
+//! terminal closed). Each sets one flag, which a render, an animation and
+//! the studio ask between rays; the run then ends as it does on any error,
+//! its temporary file removed, with 128 + the signal's number as its exit
+//! code (what a shell reports for a process the signal ended).
+//!
+//! Invariant: the handlers are installed once per process, when the flag
+//! is first asked for; from then on these signals never end the process
+//! mid-write.
+
+use std::fmt;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, OnceLock};
+
+/// A signal that stops a run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StopSignal {
+    /// SIGINT: Ctrl-C in the terminal.
+    Interrupt,
+    /// SIGTERM: `kill`, `timeout`, a job scheduler.
+    Terminate,
+    /// SIGHUP: the terminal closed.
+    HangUp,
+}
+
+impl StopSignal {
+    /// The signals handled where this build runs (Windows has no SIGHUP).
+    const HANDLED: &'static [StopSignal] = &[
+        StopSignal::Interrupt,
+        StopSignal::Terminate,
+        #[cfg(unix)]
+        StopSignal::HangUp,
+    ];
+
+    /// Its number (2, 15, 1 on Linux).
+    pub fn number(self) -> i32 {
+        match self {
+            StopSignal::Interrupt => signal_hook::consts::SIGINT,
+            StopSignal::Terminate => signal_hook::consts::SIGTERM,
+            #[cfg(unix)]
+            StopSignal::HangUp => signal_hook::consts::SIGHUP,
+            #[cfg(not(unix))]
+            StopSignal::HangUp => 1,
+        }
+    }
+
+    /// The exit code of a run it stopped: 128 + its number (130 for Ctrl-C).
+    pub fn exit_code(self) -> i32 {
+        128 + self.number()
+    }
+}
+
+impl fmt::Display for StopSignal {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            StopSignal::Interrupt => "Ctrl-C",
+            StopSignal::Terminate => "SIGTERM",
+            StopSignal::HangUp => "SIGHUP",
+        })
+    }
+}
+
+/// The flag any of the signals sets, and the number of the last one.
+struct Flags {
+    stop: Arc<AtomicBool>,
+    which: Arc<AtomicUsize>,
+}
+
+fn flags() -> &'static Flags {
+    static FLAGS: OnceLock<Flags> = OnceLock::new();
+    FLAGS.get_or_init(|| {
+        let flags = Flags { stop: Arc::new(AtomicBool::new(false)), which: Arc::new(AtomicUsize::new(0)) };
+        for &signal in StopSignal::HANDLED {
+            // Which one first, so that a run that sees the flag finds it. A
+            // signal that cannot be handled here keeps its default action.
+            let number = signal.number();
+            let _ = signal_hook::flag::register_usize(number, Arc::clone(&flags.which), number as usize);
+            let _ = signal_hook::flag::register(number, Arc::clone(&flags.stop));
+        }
+        flags
+    })
+}
+
+/// The flag the stop signals set, their handlers installed on the first
+/// call.
+pub(crate) fn stop_flag() -> &'static AtomicBool {
+    &flags().stop
+}
+
+/// The signal that stopped the run (Ctrl-C when the flag was set another
+/// way).
+pub(crate) fn arrived() -> StopSignal {
+    let number = flags().which.load(Ordering::SeqCst);
+    StopSignal::HANDLED.iter().copied().find(|s| s.number() as usize == number).unwrap_or(StopSignal::Interrupt)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exit_codes_are_the_shells() {
+        assert_eq!(StopSignal::Interrupt.exit_code(), 130);
+        assert_eq!(StopSignal::Terminate.exit_code(), 143);
+        #[cfg(unix)]
+        assert_eq!(StopSignal::HangUp.exit_code(), 129);
+    }
+}
