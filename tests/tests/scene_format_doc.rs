@@ -64,6 +64,8 @@ fn every_statement_has_a_row() {
         .collect();
     assert!(keywords.len() >= 19, "{message}");
     let doc = doc();
+    let counted = format!("**Keywords** are the {} statement names", keywords.len());
+    assert!(doc.contains(&counted), "docs/scene-format.md does not say: {counted}");
     for keyword in keywords {
         assert!(doc.contains(&format!("\n| `{keyword}` |")), "docs/scene-format.md has no statement row for {keyword}");
     }

@@ -194,10 +194,11 @@ fn parse_in<'a, C: SceneCapacities>(
     motion: Option<&mut dyn MotionSink>,
 ) -> Result<Parsed<'a>, usize> {
     scene.clear();
-    let (needed, frames) = survey(text, scene);
+    let Survey { needed, frames, failed } = survey(text, scene);
     let mut build = Build {
         scene,
         needed,
+        failed,
         parsed: Parsed { imagefile: None, frames },
         frame,
         first: [None; Keyword::COUNT],
@@ -210,9 +211,9 @@ fn parse_in<'a, C: SceneCapacities>(
     };
     for_each_paired::<RoomOf<C>>(text, |paired| match paired {
         Paired::Statement { pos, statement, moved } => build.apply(pos, statement, moved),
-        Paired::Error(e) => build.report(e),
+        Paired::Error(e, _) => build.report(e),
         Paired::Stray { pos, after } => match build.parsed.frames {
-            None => build.report(ParseError::new(pos, ErrorKind::MoveWithoutFrames)),
+            None => build.move_without_frames(pos),
             Some(_) => build.report(ParseError::new(pos, ErrorKind::NothingToMove { after })),
         },
     });
@@ -234,7 +235,7 @@ fn parse_in<'a, C: SceneCapacities>(
 /// ```
 pub fn imagefile(text: &str) -> Option<&str> {
     let mut found = None;
-    for_each_statement::<AnyRoom>(text, |_, result| {
+    for_each_statement::<AnyRoom>(text, |_, _, result| {
         if let Ok(Statement::Imagefile(name)) = result {
             found.get_or_insert(name);
         }
@@ -256,7 +257,7 @@ pub fn imagefile(text: &str) -> Option<&str> {
 /// ```
 pub fn count(text: &str) -> Counts {
     let mut counts = Counts::ZERO;
-    for_each_statement::<AnyRoom>(text, |_, result| {
+    for_each_statement::<AnyRoom>(text, |_, _, result| {
         if let Ok(s) = result {
             s.count(&mut counts);
         }
@@ -264,13 +265,25 @@ pub fn count(text: &str) -> Counts {
     counts.with_objects()
 }
 
-/// Pass 1: surfaces (sorted by number), the normalisation and FRAMES;
-/// returns what the scene needs of each capacity, and FRAMES. The extent
-/// is every frame's: a moved statement's box at each of its keys (between
-/// keys it stays within theirs).
-fn survey<C: SceneCapacities>(text: &str, scene: &mut Scene<C>) -> (Counts, Option<Frames>) {
+/// What pass 1 found besides the surfaces and the normalisation it stored.
+struct Survey {
+    /// What the scene needs of each capacity.
+    needed: Counts,
+    /// The scene's FRAMES (its first).
+    frames: Option<Frames>,
+    /// Keywords with a statement in error: what such a statement defines
+    /// (a SURFACE, FRAMES) is missing, and an error for its absence
+    /// elsewhere would only repeat that statement's.
+    failed: [bool; Keyword::COUNT],
+}
+
+/// Pass 1: surfaces (sorted by number), the normalisation and FRAMES. The
+/// extent is every frame's: a moved statement's box at each of its keys
+/// (between keys it stays within theirs).
+fn survey<C: SceneCapacities>(text: &str, scene: &mut Scene<C>) -> Survey {
     let mut counts = Counts::ZERO;
     let mut frames = None;
+    let mut failed = [false; Keyword::COUNT];
     let mut eye: Option<(WorldPoint, Option<Keys<'_>>)> = None;
     let mut extent: Option<Extent> = None;
     let mut add = |lo: WorldPoint, hi: WorldPoint, moved: Option<Keys<'_>>| {
@@ -287,7 +300,14 @@ fn survey<C: SceneCapacities>(text: &str, scene: &mut Scene<C>) -> (Counts, Opti
         }
     };
     for_each_paired::<RoomOf<C>>(text, |paired| {
-        let Paired::Statement { pos, statement, moved } = paired else { return };
+        let (pos, statement, moved) = match paired {
+            Paired::Statement { pos, statement, moved } => (pos, statement, moved),
+            Paired::Error(_, Some(keyword)) => {
+                failed[keyword as usize] = true;
+                return;
+            }
+            _ => return,
+        };
         statement.count(&mut counts);
         let moved = moved.map(|(_, keys)| keys);
         match statement {
@@ -315,7 +335,7 @@ fn survey<C: SceneCapacities>(text: &str, scene: &mut Scene<C>) -> (Counts, Opti
     if let Some(e) = extent {
         scene.normalization = Normalization::fit(e.min, e.max);
     }
-    (counts.with_objects(), frames)
+    Survey { needed: counts.with_objects(), frames, failed }
 }
 
 /// A statement's displacement at the frame being built.
@@ -344,6 +364,8 @@ struct Build<'s, 'a, 'e, 'm, C: SceneCapacities> {
     scene: &'s mut Scene<C>,
     /// What the whole scene needs, for capacity errors.
     needed: Counts,
+    /// Keywords with a statement in error (see [`Survey::failed`]).
+    failed: [bool; Keyword::COUNT],
     parsed: Parsed<'a>,
     /// The frame being built.
     frame: u32,
@@ -391,6 +413,14 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, '_, C> {
         true
     }
 
+    /// A MOVE at `pos` in a scene without FRAMES: an error, unless a FRAMES
+    /// with errors of its own is there.
+    fn move_without_frames(&mut self, pos: Pos) {
+        if !self.failed[Keyword::Frames as usize] {
+            self.report(ParseError::new(pos, ErrorKind::MoveWithoutFrames));
+        }
+    }
+
     /// The surface index for an object, or an error. Not inlined: one copy
     /// for every kind of object that `place` makes.
     #[inline(never)]
@@ -400,8 +430,9 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, '_, C> {
         // arena was full: with one left out (its capacity error is at the
         // first SURFACE that did not fit, maybe further down than this
         // object), a surface not found is likely that, not an error here.
+        // Likewise a SURFACE with errors may be the one meant.
         let overflowed = self.needed.get(CapacityKind::Surfaces) > Scene::<C>::surfaces_full().capacity;
-        if found.is_none() && !overflowed {
+        if found.is_none() && !overflowed && !self.failed[Keyword::Surface as usize] {
             let keyword = keyword.name();
             self.report(ParseError::new(pos, ErrorKind::UndefinedSurface { keyword, number }));
         }
@@ -419,7 +450,7 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, '_, C> {
             return Offset::NONE;
         }
         let Some(frames) = self.parsed.frames else {
-            self.report(ParseError::new(at, ErrorKind::MoveWithoutFrames));
+            self.move_without_frames(at);
             return Offset::NONE;
         };
         let limit = (number::LIMIT as i64) << 32;
@@ -1004,6 +1035,20 @@ mod tests {
             1,
             "{e:?}"
         );
+    }
+
+    #[test]
+    fn a_surface_in_error_is_not_also_never_defined() {
+        // Its objects, before it and after, name it: its error alone.
+        let transparent = SURF.replacen("0.2 0.3", "0.2 1.5", 1);
+        for text in [
+            std::format!("SPHERE 1 1 0 0 0\n{transparent}SPHERE 1 1 3 0 0\n"),
+            "SPHERE 1 1 0 0 0\nSURFACE 1 0 0 0\n".into(),
+        ] {
+            let e = errs(&text);
+            assert_eq!(e.len(), 1, "{e:?}");
+            assert!(e[0].starts_with("2:"), "{e:?}");
+        }
     }
 
     /// The errors of `text`, which has some, loaded with profile `C`.

@@ -10,6 +10,7 @@
 //! a stray, at its position.
 
 use super::error::{ParseError, Pos};
+use super::keyword::Keyword;
 use super::statement::{AnyRoom, Room};
 use super::statement::{Keys, Statement};
 use super::statements::for_each_statement;
@@ -62,8 +63,8 @@ pub(crate) enum Paired<'a> {
     /// A statement that parsed, at `pos`, with the MOVE that follows it
     /// (its position and keys), if any.
     Statement { pos: Pos, statement: Statement<'a>, moved: Option<(Pos, Keys<'a>)> },
-    /// A statement that did not parse.
-    Error(ParseError<'a>),
+    /// A statement that did not parse, and its keyword if it has one.
+    Error(ParseError<'a>, Option<Keyword>),
     /// A MOVE at `pos` that follows nothing it can move: the keyword of
     /// the statement before it, if any.
     Stray { pos: Pos, after: Option<&'static str> },
@@ -82,7 +83,7 @@ enum Before<'a> {
 /// each movable statement with the MOVE that follows it.
 pub(crate) fn for_each_paired<'a, R: Room>(text: &'a str, mut each: impl FnMut(Paired<'a>)) {
     let mut before = Before::Nothing;
-    for_each_statement::<R>(text, |pos, result| {
+    for_each_statement::<R>(text, |pos, keyword, result| {
         if let Ok(Statement::Move(keys)) = result {
             match core::mem::replace(&mut before, Before::Unmovable("MOVE")) {
                 Before::Movable(at, statement) => {
@@ -105,7 +106,7 @@ pub(crate) fn for_each_paired<'a, R: Room>(text: &'a str, mut each: impl FnMut(P
                 Before::Unmovable(keyword)
             }
             Err(e) => {
-                each(Paired::Error(e));
+                each(Paired::Error(e, keyword));
                 Before::Failed
             }
         };
@@ -208,6 +209,12 @@ mod tests {
         let e = frame("LIGHT 1 0 0 0 MOVE 0 1 1 1 LIGHT 1 0 0 0 MOVE 0 1 1 1", 0).unwrap_err();
         assert_eq!(e.len(), 2, "{e:?}");
         assert!(e[0].starts_with("1:15: MOVE in a scene without FRAMES"), "{e:?}");
+        // A FRAMES in error is there all the same: its error alone.
+        for frames in ["FRAMES 4 0", "FRAMES 0", "FRAMES x"] {
+            let e = frame(&format!("{frames}\nLIGHT 1 0 0 0 MOVE 0 1 1 1\nMOVE 1 1 1 1"), 0).unwrap_err();
+            assert_eq!(e.len(), 1, "{frames}: {e:?}");
+            assert!(e[0].starts_with("1:"), "{frames}: {e:?}");
+        }
         // A MOVE after a statement in error adds no error of its own.
         let e = frame("FRAMES 3 LIGHT -1 0 0 0 MOVE 0 1 1 1", 0).unwrap_err();
         assert_eq!(e.len(), 1, "{e:?}");

@@ -10,11 +10,12 @@ use super::lexer;
 use super::number::Decimal;
 use super::statement::{self, Cursor, Room, Statement};
 
-/// Reads every statement of `text`, handing each (or its error) to `each`;
+/// Reads every statement of `text`, handing each (or its error) to `each`
+/// with its keyword (`None` for a word that is none, or a lexical error);
 /// after an error, resynchronises at the next statement (see [`recover`]).
 pub(crate) fn for_each_statement<'a, R: Room>(
     text: &'a str,
-    mut each: impl FnMut(Pos, Result<Statement<'a>, ParseError<'a>>),
+    mut each: impl FnMut(Pos, Option<Keyword>, Result<Statement<'a>, ParseError<'a>>),
 ) {
     let mut cur = Cursor::new(text);
     loop {
@@ -22,18 +23,19 @@ pub(crate) fn for_each_statement<'a, R: Room>(
             Ok(Some(t)) => t,
             Ok(None) => return,
             Err(e) => {
-                each(e.pos, Err(e));
+                each(e.pos, None, Err(e));
                 continue;
             }
         };
-        let result = match Keyword::from_text(token.text).filter(|_| !token.quoted) {
+        let keyword = Keyword::from_text(token.text).filter(|_| !token.quoted);
+        let result = match keyword {
             Some(kw) => statement::statement::<R>(&mut cur, kw, token.pos),
             None => Err(ParseError::new(token.pos, ErrorKind::UnknownKeyword(token.text))),
         };
         let error_at = result.as_ref().err().map(|e| e.pos);
-        each(token.pos, result);
+        each(token.pos, keyword, result);
         if let Some(pos) = error_at {
-            recover(&mut cur, pos, &mut |e| each(e.pos, Err(e)));
+            recover(&mut cur, pos, &mut |e| each(e.pos, None, Err(e)));
         }
     }
 }
