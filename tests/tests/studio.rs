@@ -665,6 +665,17 @@ fn a_busy_port_is_an_error_not_a_panic() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot listen"), "{}", String::from_utf8_lossy(&out.stderr));
 }
 
+#[test]
+fn a_scene_that_cannot_be_read_is_an_error_at_start() {
+    // A directory, as a render refuses it: nothing served.
+    let dir = tempfile::tempdir().unwrap();
+    let out = children::output(Command::new(HOST_SIM).arg("studio").arg(dir.path())).expect("runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains(&format!("studio: cannot read {}: Is a directory", dir.path().display())), "{stderr}");
+    assert!(out.stdout.is_empty(), "nothing served: {}", String::from_utf8_lossy(&out.stdout));
+}
+
 /// Presses `key` (a WebDriver key string) on the page, the focus in none
 /// of its fields (nor in the editor).
 fn press(browser: &Browser, key: &str) {

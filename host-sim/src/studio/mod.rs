@@ -140,6 +140,12 @@ pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) ->
             )));
         }
     };
+    // A scene file that cannot be read (a directory, a file without the
+    // permission) is refused at start, as a render refuses it; one that
+    // does not exist yet is made by the first save.
+    if let Some(path) = &args.scene {
+        read_scene(path).map_err(|e| CliError::Io(format!("studio: cannot read {}: {e}", ShownPath(path))))?;
+    }
     let listener = TcpListener::bind(SocketAddr::from((Ipv4Addr::LOCALHOST, args.port)))
         .map_err(|e| CliError::Io(format!("studio: cannot listen on 127.0.0.1:{}: {e}", args.port)))?;
     let port = listener.local_addr().map_err(|e| CliError::Io(format!("studio: {e}")))?.port();
