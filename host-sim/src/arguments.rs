@@ -7,6 +7,7 @@
 //! without a change here.
 
 use crate::exit::CliError;
+use crate::exit::ShownPath;
 use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
 use octrace_core::scene::MAX_SIDE;
@@ -88,7 +89,7 @@ pub(crate) fn output_format(asked: Option<Format>, path: &Path) -> Result<Format
         CliError::Invalid(format!(
             "cannot write {}: `.{extension}` is not a format host-sim writes a still image in{animated}; it writes {} \
              (chosen by the extension, or by --format <{}>)",
-            path.display(),
+            ShownPath(path),
             names.join(", "),
             names.join("|"),
         ))
@@ -103,9 +104,9 @@ pub(crate) fn not_the_scene(scene: &Path, out: &Path) -> Result<(), CliError> {
     }
     let through = match out == scene {
         true => String::new(),
-        false => format!(" (which {} names)", out.display()),
+        false => format!(" (which {} names)", ShownPath(out)),
     };
-    Err(CliError::Invalid(format!("refusing to overwrite the scene file {}{through} with the image", scene.display())))
+    Err(CliError::Invalid(format!("refusing to overwrite the scene file {}{through} with the image", ShownPath(scene))))
 }
 
 /// Whether two paths name the same existing file.

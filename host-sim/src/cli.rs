@@ -245,7 +245,7 @@ fn convert(input: &Path, output: &Path, format: Option<Format>) -> Result<(), Cl
             ShownPath(input)
         )));
     }
-    let image = formats::read(&bytes).map_err(|e| CliError::Invalid(format!("{}: {e}", input.display())))?;
+    let image = formats::read(&bytes).map_err(|e| CliError::Invalid(format!("{}: {e}", ShownPath(input))))?;
     write_atomically(output, |f| formats::write(&image, format, f).map_err(std::io::Error::other))
         .map_err(|e| CliError::write(output, e))
 }
@@ -425,10 +425,10 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     let mut scene = new_scene();
     let scene_bytes = std::fs::read(scene_path).map_err(|e| CliError::read(scene_path, e))?;
     let frame = args.frame.unwrap_or(0);
-    let name = scene_path.display().to_string();
+    let name = ShownPath(scene_path).to_string();
     let loaded = load_frame_bytes(&name, &scene_bytes, frame, &mut scene).map_err(|e| match e {
         LoadError::Io(e) => CliError::read(scene_path, e),
-        LoadError::Scene(errors) => CliError::Scene { file: scene_path.display().to_string(), errors },
+        LoadError::Scene(errors) => CliError::Scene { file: name.clone(), errors },
     })?;
     match (loaded.frames, args.frame) {
         (None, Some(_)) => {
@@ -450,19 +450,15 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         // printing it.
         (None, Some(f)) if f.len() >= 4096 => {
             return Err(CliError::Invalid(format!(
-                "IMAGEFILE in {} names a path of {} bytes, longer than a path can be: give OUT on the command line",
-                scene_path.display(),
+                "IMAGEFILE in {name} names a path of {} bytes, longer than a path can be: give OUT on the command line",
                 f.len()
             )))
         }
-        (None, Some(f)) if f.is_empty() => {
-            return Err(CliError::Invalid(format!("IMAGEFILE in {} names no file", scene_path.display())))
-        }
+        (None, Some(f)) if f.is_empty() => return Err(CliError::Invalid(format!("IMAGEFILE in {name} names no file"))),
         (None, Some(f)) => PathBuf::from(f),
         (None, None) => {
             return Err(CliError::Invalid(format!(
-                "no output file: give OUT on the command line or IMAGEFILE in {}",
-                scene_path.display()
+                "no output file: give OUT on the command line or IMAGEFILE in {name}"
             )))
         }
     };

@@ -4,6 +4,7 @@
 //! Invariants: a scene with errors leaves nothing loaded; an index is built
 //! anew for each render, each build timed apart.
 
+use crate::exit::ShownPath;
 use crate::options::RenderOptions;
 use octrace_core::accel::{BuildReport, LightBufferReport};
 use octrace_core::parse::{imagefile, ParseError};
@@ -112,5 +113,5 @@ pub fn load_frame_bytes(name: &str, bytes: &[u8], frame: u32, scene: &mut HostSc
 /// Reads and parses the scene file at `path`.
 pub fn load_file(path: &Path, scene: &mut HostScene) -> Result<Loaded, LoadError> {
     let bytes = std::fs::read(path).map_err(LoadError::Io)?;
-    load_bytes(&path.display().to_string(), &bytes, scene)
+    load_bytes(&ShownPath(path).to_string(), &bytes, scene)
 }

@@ -922,6 +922,15 @@ fn row18_imagefile_names_cannot_drive_the_terminal() {
     let (code, err) = host_sim(&[scene.as_os_str()]);
     assert_eq!(code, 2, "{err}");
     assert!(err.len() < 300 && err.contains("names a path of 100000 bytes"), "{err}");
+    // The scene file's own name, in its errors and a still's and an
+    // animation's summary line.
+    for text in ["RASTER 4 4 SPHERE", "FRAMES 2 RASTER 4 4 SPHERE"] {
+        let scene = dir.path().join("\u{1b}[31ms.txt");
+        std::fs::write(&scene, text).unwrap();
+        let (code, err) = host_sim(&[scene.as_os_str(), dir.path().join("o.gif").as_os_str()]);
+        assert_eq!(code, 2, "{err}");
+        assert!(!err.contains('\u{1b}') && err.contains("\\u{1b}[31ms.txt:1:"), "{err}");
+    }
 }
 
 /// Row 18h: `merge` refuses to write over one of the files it merges.

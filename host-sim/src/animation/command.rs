@@ -81,7 +81,7 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
     let started = Instant::now();
     let bar = progress_bar(u64::from(range.len() as u32), request.quiet);
     let progress = |_: u64| {};
-    let name = request.scene_path.display().to_string();
+    let name = ShownPath(request.scene_path).to_string();
     let scene_error = |e: AnimationError| match e {
         AnimationError::Scene { frame, errors } => CliError::Scene {
             file: frame.map_or_else(|| name.clone(), |frame| format!("{name} (frame {frame})")),
@@ -263,7 +263,7 @@ pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) ->
     };
     let mut found: Vec<(FrameInfo, Image)> = Vec::new();
     for path in files {
-        let name = path.display();
+        let name = ShownPath(path);
         let file = std::fs::File::open(path).map_err(|e| CliError::read(path, e))?;
         let mut reader = RowReader::new(file).map_err(|e| refuse(format!("{name}: {e}")))?;
         let header = reader.header().clone();
@@ -292,7 +292,7 @@ pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) ->
                 return Err(refuse(format!(
                     "{name} is not a frame of the animation of {} (another scene, size, palette, FRAMES or \
                      host-sim version)",
-                    files[0].display()
+                    ShownPath(&files[0])
                 )));
             }
         }
@@ -324,5 +324,5 @@ pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) ->
         }),
         Output::Files(_) => return Err(refuse("merge writes one animation (.gif or .png)".into())),
     };
-    written.map_err(|e| CliError::Io(format!("merge: cannot write {}: {e}", output.display())))
+    written.map_err(|e| CliError::Io(format!("merge: cannot write {}: {e}", ShownPath(output))))
 }
