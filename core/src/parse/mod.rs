@@ -657,6 +657,15 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, '_, C> {
         // Both places are within the scene's range: so is their difference.
         let shift = crate::math::Vec3::from_bits([0, 1, 2].map(|a| (offset.normalised[a] - offset.first[a]) as i32));
         match self.scene.push_bspline(order, rows, cols, samples, surface, shift) {
+            // No triangle: a patch whose control points span a plane in the
+            // file, but no longer once placed in the scene's units, is too
+            // small for them, as an object of one is.
+            Ok(0)
+                if !statement::collinear(points.iter())
+                    && statement::collinear(points.iter().map(|p| norm.moved(p, offset.first).wide())) =>
+            {
+                self.report(ParseError::new(pos, ErrorKind::TooSmall { keyword: Keyword::Bspline.name() }))
+            }
             Ok(0) => self.report(ParseError::new(
                 pos,
                 ErrorKind::Degenerate {
@@ -1320,6 +1329,11 @@ mod tests {
         check(&format!("BSPLINE 1 2 3 3 4 4 {} 1e7", &GRID[..GRID.len() - 2]), "control point z must be at most 1e6");
         check(&format!("BSPLINE 7 3 3 3 4 4 {GRID}"), "BSPLINE uses surface 7, which is never defined");
         check("BSPLINE 1 2 2 2 3 3 1 1 1 1 1 1 1 1 1 1 1 1", "BSPLINE is degenerate");
+        // A patch of 1e-9 beside a light 1e6 away: a square in the file, a
+        // point in the scene's units, as a triangle that small is.
+        let tiny = "0 0 0 1e-9 0 0 0 1e-9 0 1e-9 1e-9 0";
+        check(&format!("LIGHT 1 1e6 0 0 BSPLINE 1 2 2 2 2 2 {tiny}"), "1:17: BSPLINE is too small");
+        check("LIGHT 1 1e6 0 0 TRIANGLE 1 0 0 0 1e-9 0 0 0 1e-9 0", "1:17: TRIANGLE is too small");
         // 2 · 5 · 5 = 50 triangles: more than Board64K's 32, said once, up front.
         let e = errs(&format!("BSPLINE 1 3 3 3 6 6 {GRID} BSPLINE 1 3 3 3 6 6 {GRID} {SURF}"));
         assert_eq!(e.len(), 1, "{e:?}");

@@ -547,6 +547,21 @@ pub fn statement<'a, R: Room>(cur: &mut Cursor<'a>, kw: Keyword, at: Pos) -> Res
     })
 }
 
+/// Whether `points` all lie on one line (or are one point), exactly.
+pub(super) fn collinear(mut points: impl Iterator<Item = WorldPoint>) -> bool {
+    let Some(first) = points.next() else { return true };
+    let mut direction = None;
+    for p in points {
+        let along = sub(p, first);
+        match direction {
+            None if along != [0; 3] => direction = Some(along),
+            Some(d) if cross(d, along) != [0; 3] => return false,
+            _ => {}
+        }
+    }
+    true
+}
+
 fn sub(a: WorldPoint, b: WorldPoint) -> [i128; 3] {
     [0, 1, 2].map(|i| a[i] as i128 - b[i] as i128)
 }
