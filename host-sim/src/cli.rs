@@ -25,7 +25,8 @@ use std::time::Instant;
 pub use crate::exit::{CliError, EXIT_IO, EXIT_MISMATCH, EXIT_SCENE, EXIT_STOPPED};
 
 /// Render an octrace scene file to an image (PNG, Targa or Sun raster), in
-/// truecolour or with a 256-entry colour table.
+/// truecolour or with a 256-entry colour table, or a scene that moves to an
+/// animation (GIF, APNG, or a file a frame).
 ///
 /// Exit codes: 0 success, 1 a file could not be read or written (or a
 /// board could not be talked to), 2 the scene or the arguments are invalid
@@ -47,7 +48,7 @@ pub use crate::exit::{CliError, EXIT_IO, EXIT_MISMATCH, EXIT_SCENE, EXIT_STOPPED
 pub struct Args {
     #[command(subcommand)]
     pub command: Option<Command>,
-    /// The scene file (octrace scene format, see the README).
+    /// The scene file (the octrace scene format: docs/scene-format.md).
     #[arg(required = true)]
     pub scene: Option<PathBuf>,
     /// Where to write the image; defaults to the scene's IMAGEFILE (relative
@@ -93,8 +94,8 @@ pub struct Args {
     #[arg(long, value_name = "D", default_value_t = crate::options::OCTREE.max_depth,
           value_parser = clap::value_parser!(u32).range(0..=18))]
     pub max_depth: u32,
-    /// Threads to render on (default: every core). Any number gives the
-    /// same image.
+    /// Threads to render on, 1 to 1024 (default: every core). Any number
+    /// gives the same image.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
     /// How the image is cut between threads: small tiles handed out as
