@@ -87,7 +87,7 @@ pub(crate) fn output_format(asked: Option<Format>, path: &Path) -> Result<Format
             false => "",
         };
         CliError::Invalid(format!(
-            "cannot write {}: `.{extension}` is not a format host-sim writes a still image in{animated}; it writes {} \
+            "{}: `.{extension}` is not a format host-sim writes a still image in{animated}; it writes {} \
              (chosen by the extension, or by --format <{}>)",
             ShownPath(path),
             names.join(", "),

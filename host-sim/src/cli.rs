@@ -14,6 +14,7 @@ use crate::terminal::progress_bar;
 use clap::Parser;
 use octrace_core::accel::OctreeConfig;
 use octrace_core::panel::{Dithering, Panel};
+use octrace_core::parse::Pos;
 use octrace_core::render::PanelColor;
 use octrace_core::AccelMode;
 use octrace_images::formats::{self, Format, FormatError, Header, Image};
@@ -445,18 +446,23 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         }
         _ => {}
     }
+    // What is wrong with the file the scene's IMAGEFILE names is an error
+    // at that statement.
+    let imagefile_error = |pos: Pos, message: String| CliError::Scene {
+        file: name.clone(),
+        errors: vec![format!("{name}:{}:{}: IMAGEFILE {message}", pos.line, pos.column)],
+    };
     let out = match (&args.out, &loaded.imagefile) {
         (Some(o), _) => o.clone(),
         // Longer than a path can be (Linux's PATH_MAX): refused without
         // printing it.
-        (None, Some(f)) if f.len() >= 4096 => {
-            return Err(CliError::Invalid(format!(
-                "IMAGEFILE in {name} names a path of {} bytes, longer than a path can be: give OUT on the command line",
-                f.len()
-            )))
+        (None, Some((f, pos))) if f.len() >= 4096 => {
+            let message =
+                format!("names a path of {} bytes, longer than a path can be: give OUT on the command line", f.len());
+            return Err(imagefile_error(*pos, message));
         }
-        (None, Some(f)) if f.is_empty() => return Err(CliError::Invalid(format!("IMAGEFILE in {name} names no file"))),
-        (None, Some(f)) => PathBuf::from(f),
+        (None, Some((f, pos))) if f.is_empty() => return Err(imagefile_error(*pos, "names no file".into())),
+        (None, Some((f, _))) => PathBuf::from(f),
         (None, None) => {
             return Err(CliError::Invalid(format!(
                 "no output file: give OUT on the command line or IMAGEFILE in {name}"
@@ -512,7 +518,10 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         };
         return animate(&request, stderr);
     }
-    let format = output_format(args.format, &out)?;
+    let format = output_format(args.format, &out).map_err(|e| match (&args.out, &loaded.imagefile, e) {
+        (None, Some((_, pos)), CliError::Invalid(message)) => imagefile_error(*pos, message),
+        (_, _, e) => e,
+    })?;
     let palette_mode = if args.color == PanelColor::Dither { PaletteMode::Dither } else { palette };
     let (rows, text) = match args.part {
         Some(spec) => {

@@ -85,8 +85,8 @@ impl std::fmt::Display for LoadError {
 /// What loading a scene produced besides the scene itself.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Loaded {
-    /// The scene's IMAGEFILE, if any.
-    pub imagefile: Option<String>,
+    /// The scene's IMAGEFILE, if any, and where its statement stands.
+    pub imagefile: Option<(String, octrace_core::parse::Pos)>,
     /// Its FRAMES, if it is an animation.
     pub frames: Option<octrace_core::scene::Frames>,
 }
@@ -106,7 +106,7 @@ pub fn load_frame_bytes(name: &str, bytes: &[u8], frame: u32, scene: &mut HostSc
         Ok(loaded) => loaded.frames(),
         Err(_) => return Err(LoadError::Scene(errors)),
     };
-    let imagefile = std::str::from_utf8(bytes).ok().and_then(imagefile).map(str::to_owned);
+    let imagefile = std::str::from_utf8(bytes).ok().and_then(imagefile).map(|(name, pos)| (name.to_owned(), pos));
     Ok(Loaded { imagefile, frames })
 }
 

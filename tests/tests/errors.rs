@@ -222,20 +222,22 @@ fn an_output_extension_it_does_not_write_is_refused() {
         let out = dir.path().join(name);
         let (code, err) = run_args(&[scene.as_os_str(), out.as_os_str()]);
         assert_eq!(code, 2, "{err}");
-        assert!(err.contains(&format!("cannot write {}", out.display())), "{err}");
+        assert!(err.contains(&format!("host-sim: {}: `.", out.display())), "{err}");
         assert!(err.contains("png, tga, ras") && err.contains("--format"), "{err}");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "{name}: a file was written");
     }
-    // The same through IMAGEFILE, and for `convert`.
+    // The same through IMAGEFILE, at its statement, and for `convert`.
     let imagefile = dir.path().join("i.txt");
-    std::fs::write(&imagefile, format!("IMAGEFILE \"{}\" {SURF}", dir.path().join("x.gif").display())).unwrap();
+    std::fs::write(&imagefile, format!("{SURF}\n IMAGEFILE \"{}\"", dir.path().join("x.gif").display())).unwrap();
     let (code, err) = run_args(&[imagefile.as_os_str()]);
     assert_eq!(
         (
             code,
-            err.contains(
-                "`.gif` is not a format host-sim writes a still image in (a GIF holds a whole animation: a scene with FRAMES, rendered without --frame, to one file)"
-            )
+            err.contains(&format!(
+                "i.txt:3:2: IMAGEFILE {}: `.gif` is not a format host-sim writes a still image in (a GIF holds a whole \
+                 animation: a scene with FRAMES, rendered without --frame, to one file)",
+                dir.path().join("x.gif").display()
+            ))
         ),
         (2, true),
         "{err}"

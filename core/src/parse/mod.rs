@@ -227,17 +227,21 @@ fn parse_in<'a, C: SceneCapacities>(
 }
 
 /// The IMAGEFILE of `text`, if it names one (its first, as the parser
-/// reads it; a scene with errors may name one too).
+/// reads it; a scene with errors may name one too), and where its
+/// statement stands, for a program's errors about the file it names.
 ///
 /// ```
-/// assert_eq!(octrace_core::parse::imagefile("RASTER 8 8 IMAGEFILE ball.png SPHERE 1 1 0 0 0"), Some("ball.png"));
-/// assert_eq!(octrace_core::parse::imagefile("RASTER 8 8"), None);
+/// use octrace_core::parse::{imagefile, Pos};
+///
+/// let text = "RASTER 8 8\nIMAGEFILE ball.png SPHERE 1 1 0 0 0";
+/// assert_eq!(imagefile(text), Some(("ball.png", Pos { line: 2, column: 1 })));
+/// assert_eq!(imagefile("RASTER 8 8"), None);
 /// ```
-pub fn imagefile(text: &str) -> Option<&str> {
+pub fn imagefile(text: &str) -> Option<(&str, Pos)> {
     let mut found = None;
-    for_each_statement::<AnyRoom>(text, |_, _, result| {
+    for_each_statement::<AnyRoom>(text, |pos, _, result| {
         if let Ok(Statement::Imagefile(name)) = result {
-            found.get_or_insert(name);
+            found.get_or_insert((name, pos));
         }
     });
     found
