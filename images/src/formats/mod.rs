@@ -62,12 +62,20 @@ pub fn write_gray_png(image: &Image, out: &mut dyn Write) -> Result<(), FormatEr
     png::write_gray(*width, *height, &gray, out)
 }
 
+/// The signatures of images of other formats, named rather than read as
+/// Targa files (which have none): none of them can begin a Targa file, whose
+/// second byte, the colour map's type, is 0 or 1.
+const OTHER_SIGNATURES: [(&[u8], &str); 5] =
+    [(b"GIF87a", "GIF"), (b"GIF89a", "GIF"), (b"\xff\xd8\xff", "JPEG"), (b"BM", "BMP"), (b"RIFF", "RIFF (WebP)")];
+
 /// Reads an image file of any of the formats, told apart by their content.
 pub fn read(bytes: &[u8]) -> Result<Image, FormatError> {
     let image = if bytes.starts_with(png::SIGNATURE) {
         png::read(bytes)?
     } else if bytes.starts_with(&sun_raster::MAGIC.to_be_bytes()) {
         sun_raster::read(bytes)?
+    } else if let Some(&(_, name)) = OTHER_SIGNATURES.iter().find(|(signature, _)| bytes.starts_with(signature)) {
+        return Err(FormatError::Unsupported(format!("a {name} image, not a PNG, Targa or Sun raster image")));
     } else {
         targa::read(bytes).map_err(targa::no_image)?
     };
@@ -137,7 +145,9 @@ pub(crate) mod tests {
         // A file without a PNG's or Sun raster's signature is read as a Targa file.
         let as_targa = |detail: &str| format!("not a PNG, Targa or Sun raster image (as a Targa file: {detail})");
         assert_eq!(message(&[]), as_targa("truncated Targa header"));
-        assert_eq!(message(b"GIF89a, a GIF of some kind"), as_targa("Targa image type 70 is not supported"));
+        assert_eq!(message(b"GIF89a, a GIF of some kind"), "a GIF image, not a PNG, Targa or Sun raster image");
+        assert_eq!(message(b"\xff\xd8\xff\xe0 JFIF"), "a JPEG image, not a PNG, Targa or Sun raster image");
+        assert_eq!(message(b"GIF90a, of no kind at all"), as_targa("Targa image type 70 is not supported"));
         assert_eq!(message(&sun_raster::MAGIC.to_be_bytes()), "truncated Sun raster header");
         assert_eq!(message(png::SIGNATURE), "truncated PNG file");
         let mut tga = encode(&rgb(3, 2), Format::Tga);
