@@ -21,7 +21,7 @@ use octrace_images::formats::{self, Format, FormatError, Header, Image};
 use octrace_images::palette::PaletteMode;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 pub use crate::exit::{CliError, EXIT_IO, EXIT_MISMATCH, EXIT_SCENE, EXIT_STOPPED};
 
@@ -596,7 +596,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         }
         let _ = writeln!(
             stderr,
-            "{w}x{h}{} in {:.3} s ({}, {} thread{}, tracing {:.3} s{}): {} rays, {} shadow rays, {} cells{} -> {}",
+            "{w}x{h}{} in {:.3} s ({}, {} thread{}, tracing {:.3} s{}{}): {} rays, {} shadow rays, {} cells{} -> {}",
             match args.part {
                 Some(_) => format!(" rows {}..{}", rows.start, rows.end),
                 None => String::new(),
@@ -607,6 +607,12 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
             if options.threads == 1 { "" } else { "s" },
             rendered.tracing().as_secs_f64(),
             if options.threads == 1 { "" } else { " summed over the threads" },
+            // Shown from a millisecond: what a scene of many objects spends
+            // before its first pixel.
+            match rendered.indexing() {
+                indexing if indexing < Duration::from_millis(1) => String::new(),
+                indexing => format!(", {:.3} s of it indexing the scene", indexing.as_secs_f64()),
+            },
             stats.rays,
             stats.shadow_rays,
             stats.cells,

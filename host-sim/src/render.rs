@@ -92,9 +92,15 @@ impl Streamed {
     /// time or idle waits. With one thread this is what POV-Ray calls its
     /// trace time.
     pub fn tracing(&self) -> Duration {
+        self.indexing() + self.busy.iter().sum::<Duration>()
+    }
+
+    /// The part of [`Streamed::tracing`] spent building the octree and the
+    /// light buffer, before any pixel (most of it for a scene of a million
+    /// triangles).
+    pub fn indexing(&self) -> Duration {
         self.build.map_or(Duration::ZERO, |(_, built)| built)
             + self.light_buffer.map_or(Duration::ZERO, |(_, built)| built)
-            + self.busy.iter().sum::<Duration>()
     }
 }
 
