@@ -518,9 +518,14 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         };
         return animate(&request, stderr);
     }
-    let format = output_format(args.format, &out).map_err(|e| match (&args.out, &loaded.imagefile, e) {
-        (None, Some((_, pos)), CliError::Invalid(message)) => imagefile_error(*pos, message),
-        (_, _, e) => e,
+    let format = output_format(args.format, &out).map_err(|e| match (&args.out, &loaded.imagefile, args.frame, e) {
+        // An animation's IMAGEFILE names its GIF or APNG: it is the frame
+        // asked for that wants another file.
+        (None, Some(_), Some(k), CliError::Invalid(message)) => {
+            CliError::Invalid(format!("{message}; --frame {k} writes one still image: give OUT on the command line"))
+        }
+        (None, Some((_, pos)), None, CliError::Invalid(message)) => imagefile_error(*pos, message),
+        (_, _, _, e) => e,
     })?;
     let palette_mode = if args.color == PanelColor::Dither { PaletteMode::Dither } else { palette };
     let (rows, text) = match args.part {

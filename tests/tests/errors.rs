@@ -242,6 +242,13 @@ fn an_output_extension_it_does_not_write_is_refused() {
         (2, true),
         "{err}"
     );
+    // An animation's IMAGEFILE names its GIF: a frame asked for is no
+    // error of the scene's.
+    std::fs::write(&imagefile, format!("FRAMES 2 {SURF}\n IMAGEFILE \"{}\"", dir.path().join("x.gif").display()))
+        .unwrap();
+    let (code, err) = run_args(&[imagefile.as_os_str(), "--frame".as_ref(), "1".as_ref()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.starts_with("host-sim: ") && err.contains("--frame 1 writes one still image: give OUT"), "{err}");
     let png = dir.path().join("a.png");
     assert_eq!(run_args(&[scene.as_os_str(), png.as_os_str()]).0, 0);
     let gif = dir.path().join("a.gif");
