@@ -444,6 +444,7 @@ pub fn write_merged(
             let row = reader.next_row().map_err(|error| unreadable(path, error))?;
             writer.write_row(row).map_err(MergeError::Output)?;
         }
+        reader.finish().map_err(|error| unreadable(path, error))?;
     }
     writer.finish().map_err(MergeError::Output)
 }

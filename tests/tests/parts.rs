@@ -223,6 +223,9 @@ fn merge_refuses_parts_that_do_not_fit_and_writes_nothing() {
     let cut = dir.path().join("cut.png");
     let whole = std::fs::read(&good[2]).unwrap();
     std::fs::write(&cut, &whole[..whole.len() - 40]).unwrap();
+    // Cut after its pixels: its IEND gone.
+    let no_end = dir.path().join("no-end.png");
+    std::fs::write(&no_end, &whole[..whole.len() - 12]).unwrap();
     let copy = dir.path().join("copy-of-2.png");
     std::fs::copy(&good[1], &copy).unwrap();
     let absent = dir.path().join("absent.png");
@@ -252,6 +255,7 @@ fn merge_refuses_parts_that_do_not_fit_and_writes_nothing() {
         ),
         (vec![one, &plain, three], 2, vec![format!("{}: not a part", name(&plain))]),
         (vec![one, two, &cut], 2, vec![format!("{}: not an image host-sim can merge: truncated", name(&cut))]),
+        (vec![one, two, &no_end], 2, vec![format!("{}: not an image host-sim can merge", name(&no_end))]),
         (
             vec![&frame_3, &frame_12],
             2,

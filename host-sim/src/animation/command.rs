@@ -281,6 +281,7 @@ pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) ->
         for _ in 0..header.height {
             data.extend_from_slice(reader.next_row().map_err(|e| refuse(format!("{name}: {e}")))?);
         }
+        reader.finish().map_err(|e| refuse(format!("{name}: {e}")))?;
         let image = match header.palette {
             Some(palette) => Image::Indexed { width: header.width, height: header.height, palette, indices: data },
             None => Image::Rgb(crate::RgbImage { width: header.width, height: header.height, data }),

@@ -197,6 +197,17 @@ impl RowReader {
         }
         Ok(&self.row)
     }
+
+    /// Reads on to the end the format marks, after the last row: a PNG's
+    /// IEND, its chunks' checksums on the way, so that a file cut short
+    /// after its pixels is not taken for whole (Targa and Sun raster files
+    /// end with their pixels).
+    pub fn finish(self) -> Result<(), FormatError> {
+        match self.decoder {
+            RowDecoder::Png(mut reader) => reader.finish().map_err(png::decoding_error),
+            RowDecoder::Raw { .. } => Ok(()),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -231,6 +242,19 @@ mod tests {
                     assert_eq!(reader.next_row().unwrap(), row);
                 }
                 assert!(reader.next_row().is_err());
+                reader.finish().unwrap();
+                // A PNG cut after its pixels, its IEND or its checksum's
+                // last byte gone, is refused at the end.
+                if format == Format::Png {
+                    for cut in [1, 12] {
+                        std::fs::write(&path, &bytes[..bytes.len() - cut]).unwrap();
+                        let mut reader = RowReader::new(std::fs::File::open(&path).unwrap()).unwrap();
+                        for _ in 0..image.height() {
+                            reader.next_row().unwrap();
+                        }
+                        assert!(reader.finish().is_err(), "cut by {cut}");
+                    }
+                }
             }
         }
         let header = Header { width: 1, height: 1, palette: None, text: Some("t".into()) };
