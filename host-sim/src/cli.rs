@@ -143,16 +143,19 @@ pub enum Command {
         format: Option<Format>,
     },
     /// Stack the parts rendered with `--part I/N` into the whole image,
-    /// bit-identical to rendering it at once. Refuses (exit 2, nothing
-    /// written) parts of other scenes, sizes or palettes, and parts that
-    /// leave rows out or hold a row twice.
+    /// bit-identical to rendering it at once; or assemble an animation's
+    /// frame files (`OUT 'f%04d.png'`) into its GIF (OUTPUT.gif) or APNG
+    /// (OUTPUT.png). Refuses (exit 2, nothing written) parts or frames of
+    /// other scenes, sizes or palettes, parts that leave rows out or hold a
+    /// row twice, and frames missing or given twice.
     Merge {
-        /// The image to write.
+        /// The image or animation to write.
         output: PathBuf,
-        /// The part files, in any order.
+        /// The part or frame files, in any order.
         #[arg(required = true)]
         parts: Vec<PathBuf>,
-        /// The output format; by default from OUTPUT's extension, else PNG.
+        /// The output format of parts merged; by default from OUTPUT's
+        /// extension, else PNG (frames: OUTPUT's extension, .gif or .png).
         #[arg(long, value_parser = parse_format)]
         format: Option<Format>,
     },

@@ -261,7 +261,7 @@ pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) ->
             )))
         }
     };
-    let mut found: Vec<(FrameInfo, Image)> = Vec::new();
+    let mut found: Vec<(FrameInfo, Image, &Path)> = Vec::new();
     for path in files {
         let name = ShownPath(path);
         let file = std::fs::File::open(path).map_err(|e| CliError::read(path, e))?;
@@ -286,7 +286,7 @@ pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) ->
             Some(palette) => Image::Indexed { width: header.width, height: header.height, palette, indices: data },
             None => Image::Rgb(crate::RgbImage { width: header.width, height: header.height, data }),
         };
-        if let Some((first, _)) = found.first() {
+        if let Some((first, _, _)) = found.first() {
             let same = (first.version.as_str(), first.scene, first.width, first.height, first.palette, first.frames)
                 == (info.version.as_str(), info.scene, info.width, info.height, info.palette, info.frames);
             if !same {
@@ -297,33 +297,65 @@ pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) ->
                 )));
             }
         }
-        found.push((info, image));
+        found.push((info, image, path));
     }
-    found.sort_by_key(|(info, _)| info.frame);
-    let Some((first, _)) = found.first() else { return Err(refuse("no frames to merge".into())) };
+    found.sort_by_key(|(info, _, _)| info.frame);
+    let Some((first, _, _)) = found.first() else { return Err(refuse("no frames to merge".into())) };
     let (frames, (width, height)) = (first.frames, (first.width, first.height));
-    for (i, (info, _)) in found.iter().enumerate() {
-        if info.frame != i as u32 {
-            let twice = i > 0 && found[i - 1].0.frame == info.frame;
-            let (frame, what) = if twice { (info.frame, "given twice") } else { (i as u32, "missing") };
-            return Err(refuse(format!("frame {frame} is {what}")));
-        }
+    if let Some(pair) = found.windows(2).find(|pair| pair[0].0.frame == pair[1].0.frame) {
+        let (frame, a, b) = (pair[0].0.frame, ShownPath(pair[0].2), ShownPath(pair[1].2));
+        return Err(refuse(format!("frame {frame} is given twice: {a} and {b}")));
     }
-    if found.len() as u32 != frames.count {
-        return Err(refuse(format!("frames {} to {} are missing", found.len(), frames.count - 1)));
+    let missing = missing_frames(found.iter().map(|(info, _, _)| info.frame), frames.count);
+    if !missing.is_empty() {
+        let s = if frames.count == 1 { "" } else { "s" };
+        return Err(refuse(format!("{missing} missing (the animation has {} frame{s})", frames.count)));
     }
     let written = match kind {
         Output::Gif => write_atomically(output, |f| {
             let mut gif = GifWriter::new(f, width, height, frames)?;
-            found.iter().try_for_each(|(_, image)| gif.frame(image, None))?;
+            found.iter().try_for_each(|(_, image, _)| gif.frame(image, None))?;
             gif.finish().map(|_| ())
         }),
         Output::Apng => write_atomically(output, |f| {
             let mut apng = ApngWriter::new(f, width, height, frames)?;
-            found.iter().try_for_each(|(_, image)| apng.frame(&image.to_rgb().data, None))?;
+            found.iter().try_for_each(|(_, image, _)| apng.frame(&image.to_rgb().data, None))?;
             apng.finish()
         }),
         Output::Files(_) => return Err(refuse("merge writes one animation (.gif or .png)".into())),
     };
     written.map_err(|e| CliError::Io(format!("merge: cannot write {}: {e}", ShownPath(output))))
+}
+
+/// The frames of `0..count` that are not in `present` (in order), as one
+/// reads them: `frame 47`, `frames 0 to 3, 12 to 23`; empty when none is.
+fn missing_frames(present: impl Iterator<Item = u32>, count: u32) -> String {
+    let mut ranges = Vec::new();
+    let mut next = 0;
+    for frame in present.filter(|&frame| frame < count).chain([count]) {
+        if frame > next {
+            ranges.push((next, frame - 1));
+        }
+        next = next.max(frame + 1);
+    }
+    let range = |&(from, to): &(u32, u32)| if from == to { from.to_string() } else { format!("{from} to {to}") };
+    match ranges.as_slice() {
+        [] => String::new(),
+        [(from, to)] if from == to => format!("frame {from}"),
+        _ => format!("frames {}", ranges.iter().map(range).collect::<Vec<_>>().join(", ")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn missing_frames_are_listed_as_ranges() {
+        let missing = |present: &[u32], count| missing_frames(present.iter().copied(), count);
+        assert_eq!(missing(&[0, 1, 2], 3), "");
+        assert_eq!(missing(&[0, 1], 3), "frame 2");
+        assert_eq!(missing(&[4, 5, 6, 7, 8, 9, 10, 11, 24, 26], 28), "frames 0 to 3, 12 to 23, 25, 27");
+        assert_eq!(missing(&[], 2), "frames 0 to 1");
+    }
 }
