@@ -130,8 +130,10 @@ pub struct Args {
 /// Other things host-sim does.
 #[derive(clap::Subcommand, Debug)]
 pub enum Command {
-    /// Convert an image between PNG, Targa and Sun raster (truecolour or
-    /// colour-mapped, kept as it is).
+    /// Convert an image between PNG, Targa and Sun raster, its pixels kept:
+    /// truecolour stays truecolour, a colour-mapped or 8-bit gray image is
+    /// written colour-mapped. Reads PNGs of 8-bit RGB, 8-bit gray or
+    /// indexed colour (no alpha).
     Convert {
         /// The image to read (the format is told from its content).
         input: PathBuf,

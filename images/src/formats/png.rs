@@ -79,6 +79,17 @@ pub(super) fn write_gray(width: u32, height: u32, gray: &[u8], out: &mut dyn Wri
     writer.finish().map_err(encoding_error)
 }
 
+/// A PNG colour type as a user knows it.
+fn colour_name(colour: png::ColorType) -> &'static str {
+    match colour {
+        png::ColorType::Grayscale => "gray",
+        png::ColorType::Rgb => "RGB colour",
+        png::ColorType::Indexed => "indexed colour",
+        png::ColorType::GrayscaleAlpha => "gray with alpha",
+        png::ColorType::Rgba => "RGBA colour",
+    }
+}
+
 /// A PNG file read whole.
 pub(super) fn read(bytes: &[u8]) -> Result<Image, FormatError> {
     let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
@@ -92,7 +103,11 @@ pub(super) fn read(bytes: &[u8]) -> Result<Image, FormatError> {
         (png::ColorType::Indexed, depth) => depth as u64,
         _ if gray => 8,
         (colour, depth) => {
-            return unsupported(format!("PNG files of {colour:?} colour at {} bits are not supported", depth as u8))
+            return unsupported(format!(
+                "a PNG of {} at {} bits: host-sim reads PNGs of 8-bit RGB, 8-bit gray or indexed colour (no alpha)",
+                colour_name(colour),
+                depth as u8
+            ))
         }
     };
     // Each row is a filter byte and its pixels, deflated.
@@ -147,7 +162,8 @@ pub(super) fn row_reader(
         }
         (colour, depth, interlaced) => {
             return unsupported(format!(
-                "PNG of {colour:?} colour at {} bits{}: not one host-sim writes",
+                "a PNG of {} at {} bits{}: not one host-sim writes",
+                colour_name(colour),
                 depth as u8,
                 if interlaced { ", interlaced" } else { "" }
             ))
