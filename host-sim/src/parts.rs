@@ -185,6 +185,14 @@ impl PartInfo {
     }
 }
 
+impl PartInfo {
+    /// What it says of the render it is a part of.
+    fn render(&self) -> Render {
+        let (version, scene, palette) = (self.version.clone(), self.scene, self.palette);
+        Render { version, scene, width: self.width, height: self.height, palette }
+    }
+}
+
 /// What every piece of a render split across machines says first: who
 /// rendered what, how large, in which palette.
 pub(crate) struct Render {
@@ -193,6 +201,25 @@ pub(crate) struct Render {
     pub width: u32,
     pub height: u32,
     pub palette: PaletteMode,
+}
+
+impl Render {
+    /// How a file of this render differs from one of `first`, as a merge
+    /// refuses it: another host-sim version, scene, size or palette
+    /// (`None`: none of them).
+    pub(crate) fn difference(&self, first: &Render) -> Option<String> {
+        Some(if self.version != first.version {
+            format!("rendered by host-sim {} and {}, which may give other bits", self.version, first.version)
+        } else if self.scene != first.scene {
+            format!("another scene (scene hash {:016x}, not {:016x})", self.scene, first.scene)
+        } else if (self.width, self.height) != (first.width, first.height) {
+            format!("another size ({}×{}, not {}×{})", self.width, self.height, first.width, first.height)
+        } else if self.palette != first.palette {
+            format!("another palette (--palette {}, not {})", self.palette.name(), first.palette.name())
+        } else {
+            return None;
+        })
+    }
 }
 
 /// The `name=value` fields of a metadata line after its magic words, read
@@ -297,39 +324,8 @@ pub fn check_parts(parts: &[PathBuf]) -> Result<(Vec<(PathBuf, PartInfo)>, Heade
         }
         if let Some((first, first_info, _)) = found.first() {
             let other = || format!("{name} and {} are not parts of one render:", ShownPath(first));
-            if info.version != first_info.version {
-                return Err(MergeError::Refused(format!(
-                    "{} rendered by host-sim {} and {}, which may give other bits",
-                    other(),
-                    info.version,
-                    first_info.version
-                )));
-            }
-            if info.scene != first_info.scene {
-                return Err(MergeError::Refused(format!(
-                    "{} another scene (scene hash {:016x}, not {:016x})",
-                    other(),
-                    info.scene,
-                    first_info.scene
-                )));
-            }
-            if (info.width, info.height) != (first_info.width, first_info.height) {
-                return Err(MergeError::Refused(format!(
-                    "{} another size ({}×{}, not {}×{})",
-                    other(),
-                    info.width,
-                    info.height,
-                    first_info.width,
-                    first_info.height
-                )));
-            }
-            if info.palette != first_info.palette {
-                return Err(MergeError::Refused(format!(
-                    "{} another palette (--palette {}, not {})",
-                    other(),
-                    info.palette.name(),
-                    first_info.palette.name()
-                )));
+            if let Some(difference) = info.render().difference(&first_info.render()) {
+                return Err(MergeError::Refused(format!("{} {difference}", other())));
             }
             if info.frame != first_info.frame {
                 let frame = |frame: Option<u32>| frame.map_or("no frame (a still)".into(), |k| format!("frame {k}"));

@@ -378,6 +378,10 @@ fn frames_rendered_apart_merge_into_the_same_gif() {
     assert_eq!(host_sim(d, &["anim.txt", "band.png", "--frame", "0", "--part", "1/2", "-q"]).0, 0);
     let (code, err) = host_sim(d, &["merge", "bad.png", "p0.png", "band.png"]);
     assert!(code == 2 && err.contains("p0.png is an animation's frame file and band.png not a frame file"), "{err}");
+    // A frame of another render says how it differs.
+    assert_eq!(host_sim(d, &["anim.txt", "small%d.png", "--size", "4x3", "-q"]).0, 0);
+    let (code, err) = host_sim(d, &["merge", "bad.gif", "p0.png", "small1.png"]);
+    assert!(code == 2 && err.contains("small1.png is not a frame of the animation of p0.png: another size"), "{err}");
     assert!(!d.join("bad.tga").exists() && !d.join("bad.png").exists() && !d.join("bad.gif").exists());
 }
 

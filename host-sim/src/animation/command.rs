@@ -286,15 +286,19 @@ pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) ->
             Some(palette) => Image::Indexed { width: header.width, height: header.height, palette, indices: data },
             None => Image::Rgb(crate::RgbImage { width: header.width, height: header.height, data }),
         };
-        if let Some((first, _, _)) = found.first() {
-            let same = (first.version.as_str(), first.scene, first.width, first.height, first.palette, first.frames)
-                == (info.version.as_str(), info.scene, info.width, info.height, info.palette, info.frames);
-            if !same {
-                return Err(refuse(format!(
-                    "{name} is not a frame of the animation of {} (another scene, size, palette, FRAMES or \
-                     host-sim version)",
-                    ShownPath(&files[0])
-                )));
+        if let Some((first, _, first_path)) = found.first() {
+            let (frames, first_frames) = (info.frames, first.frames);
+            let difference = info.render().difference(&first.render()).or_else(|| {
+                (frames != first_frames).then(|| {
+                    format!(
+                        "another FRAMES ({} at {} a second, not {} at {})",
+                        frames.count, frames.rate, first_frames.count, first_frames.rate
+                    )
+                })
+            });
+            if let Some(difference) = difference {
+                let first = ShownPath(first_path);
+                return Err(refuse(format!("{name} is not a frame of the animation of {first}: {difference}")));
             }
         }
         found.push((info, image, path));

@@ -113,6 +113,14 @@ pub struct FrameInfo {
     pub frames: Frames,
 }
 
+impl FrameInfo {
+    /// What it says of the render it is a frame of.
+    pub(crate) fn render(&self) -> Render {
+        let (version, scene, palette) = (self.version.clone(), self.scene, self.palette);
+        Render { version, scene, width: self.width, height: self.height, palette }
+    }
+}
+
 const MAGIC: &str = "octrace-frame 1";
 
 impl fmt::Display for FrameInfo {
