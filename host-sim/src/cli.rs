@@ -319,7 +319,8 @@ fn part_of(
         );
     }
     if spec.count > h {
-        return refuse(format!("{} parts of an image {h} rows high: at most {h}", spec.count));
+        let rows = if h == 1 { "row" } else { "rows" };
+        return refuse(format!("{} parts of an image {h} {rows} high: at most {h}", spec.count));
     }
     let index = match spec.index {
         Some(i) => i,
