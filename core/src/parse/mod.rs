@@ -3,7 +3,8 @@
 //!
 //! It reads the text twice, allocating nothing (the text may live in flash):
 //! 1. the *survey* gathers the surfaces and the world-space extent of objects,
-//!    eye and lights, which fixes the [`Normalization`];
+//!    eye and lights, which fixes the [`Normalization`](crate::scene::Normalization)
+//!    (see `survey.rs`);
 //! 2. the *build* reads every statement again, reports every error, and
 //!    stores the objects in normalised space.
 //!
@@ -23,6 +24,7 @@ mod motion;
 mod number;
 mod statement;
 mod statements;
+mod survey;
 
 pub use error::{escaped_in_messages, ErrorKind, Field, Found, ParseError, Pos, Rule};
 pub(crate) use motion::{for_each_move, MotionSink, Moved, Mover};
@@ -30,14 +32,14 @@ pub(crate) use motion::{for_each_move, MotionSink, Moved, Mover};
 pub(crate) use statement::{Keys, Statement};
 
 use crate::capacity::{CapacityError, CapacityKind, Counts};
-use crate::scene::{displacement_at, Camera, CameraError, Frames, Light, Normalization, Scene, SceneCapacities};
-use crate::scene::{SurfaceEntry, WorldPoint};
+use crate::scene::{displacement_at, Camera, CameraError, Frames, Light, Scene, SceneCapacities, WorldPoint};
 use crate::shapes::{AxisAlignedBox, Rectangle, ShapeKind, Sphere, Superquadric, Triangle};
 
 use keyword::Keyword;
 use motion::{for_each_paired, MovedObjects, Paired};
 use statement::{AnyRoom, Patch, RoomOf};
 use statements::for_each_statement;
+use survey::{survey, Survey};
 
 /// What the parse found besides the scene.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -105,21 +107,6 @@ pub(crate) fn parse_recording<'a, C: SceneCapacities>(
             scene.clear();
             on_error(ParseError::new(lexer::Lexer::end_of(good), ErrorKind::InvalidUtf8));
             Err(1)
-        }
-    }
-}
-
-/// World bounds of everything that matters for the normalisation.
-struct Extent {
-    min: WorldPoint,
-    max: WorldPoint,
-}
-
-impl Extent {
-    fn add(&mut self, lo: WorldPoint, hi: WorldPoint) {
-        for a in 0..3 {
-            self.min[a] = self.min[a].min(lo[a]);
-            self.max[a] = self.max[a].max(hi[a]);
         }
     }
 }
@@ -267,79 +254,6 @@ pub fn count(text: &str) -> Counts {
         }
     });
     counts.with_objects()
-}
-
-/// What pass 1 found besides the surfaces and the normalisation it stored.
-struct Survey {
-    /// What the scene needs of each capacity.
-    needed: Counts,
-    /// The scene's FRAMES (its first).
-    frames: Option<Frames>,
-    /// Keywords with a statement in error: what such a statement defines
-    /// (a SURFACE, FRAMES) is missing, and an error for its absence
-    /// elsewhere would only repeat that statement's.
-    failed: [bool; Keyword::COUNT],
-}
-
-/// Pass 1: surfaces (sorted by number), the normalisation and FRAMES. The
-/// extent is every frame's: a moved statement's box at each of its keys
-/// (between keys it stays within theirs).
-fn survey<C: SceneCapacities>(text: &str, scene: &mut Scene<C>) -> Survey {
-    let mut counts = Counts::ZERO;
-    let mut frames = None;
-    let mut failed = [false; Keyword::COUNT];
-    let mut eye: Option<(WorldPoint, Option<Keys<'_>>)> = None;
-    let mut extent: Option<Extent> = None;
-    let mut add = |lo: WorldPoint, hi: WorldPoint, moved: Option<Keys<'_>>| {
-        let mut at = |d: WorldPoint| {
-            let (lo, hi) = ([0, 1, 2].map(|a| lo[a] + d[a]), [0, 1, 2].map(|a| hi[a] + d[a]));
-            match &mut extent {
-                Some(e) => e.add(lo, hi),
-                None => extent = Some(Extent { min: lo, max: hi }),
-            }
-        };
-        match moved {
-            Some(keys) => keys.offsets().for_each(|(_, d)| at(d)),
-            None => at([0; 3]),
-        }
-    };
-    for_each_paired::<RoomOf<C>>(text, |paired| {
-        let (pos, statement, moved) = match paired {
-            Paired::Statement { pos, statement, moved } => (pos, statement, moved),
-            Paired::Error(_, Some(keyword)) => {
-                failed[keyword as usize] = true;
-                return;
-            }
-            _ => return,
-        };
-        statement.count(&mut counts);
-        let moved = moved.map(|(_, keys)| keys);
-        match statement {
-            Statement::Viewpoint(p) => {
-                eye.get_or_insert((p, moved));
-            }
-            Statement::Light { position, .. } => add(position, position, moved),
-            Statement::Surface { number, surface } => {
-                // A full arena is reported by the build pass.
-                let _ = scene.push_surface(SurfaceEntry { number, line: pos.line, column: pos.column, surface });
-            }
-            Statement::Frames(f) => {
-                frames.get_or_insert(f);
-            }
-            s => {
-                if let Some((lo, hi)) = s.object_bounds() {
-                    add(lo, hi, moved);
-                }
-            }
-        }
-    });
-    let (eye, moved) = eye.unwrap_or((scene.settings.view.eye, None));
-    add(eye, eye, moved);
-    scene.sort_surfaces();
-    if let Some(e) = extent {
-        scene.normalization = Normalization::fit(e.min, e.max);
-    }
-    Survey { needed: counts.with_objects(), frames, failed }
 }
 
 /// A statement's displacement at the frame being built.
