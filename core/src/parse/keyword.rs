@@ -43,6 +43,23 @@ macro_rules! keywords {
     };
 }
 
+/// A set of keywords, a bit each.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct KeywordSet(u32);
+
+impl KeywordSet {
+    pub(crate) fn insert(&mut self, keyword: Keyword) {
+        self.0 |= 1 << keyword as u32;
+    }
+
+    pub(crate) fn contains(self, keyword: Keyword) -> bool {
+        self.0 & 1 << keyword as u32 != 0
+    }
+}
+
+// Every keyword has its bit.
+const _: () = assert!(Keyword::COUNT <= 32);
+
 keywords! {
     Viewpoint = "VIEWPOINT" / 3,
     Origin = "ORIGIN" / 3,

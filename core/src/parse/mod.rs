@@ -35,7 +35,7 @@ use crate::capacity::{CapacityError, CapacityKind, Counts};
 use crate::scene::{displacement_at, Camera, CameraError, Frames, Light, Scene, SceneCapacities, WorldPoint};
 use crate::shapes::{AxisAlignedBox, Rectangle, ShapeKind, Sphere, Superquadric, Triangle};
 
-use keyword::Keyword;
+use keyword::{Keyword, KeywordSet};
 use motion::{for_each_paired, MovedObjects, Paired};
 use statement::{AnyRoom, Patch, RoomOf};
 use statements::for_each_statement;
@@ -283,7 +283,7 @@ struct Build<'s, 'a, 'e, 'm, C: SceneCapacities> {
     /// What the whole scene needs, for capacity errors.
     needed: Counts,
     /// Keywords with a statement in error (see [`Survey::failed`]).
-    failed: [bool; Keyword::COUNT],
+    failed: KeywordSet,
     parsed: Parsed<'a>,
     /// The frame being built.
     frame: u32,
@@ -334,7 +334,7 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, '_, C> {
     /// A MOVE at `pos` in a scene without FRAMES: an error, unless a FRAMES
     /// with errors of its own is there.
     fn move_without_frames(&mut self, pos: Pos) {
-        if !self.failed[Keyword::Frames as usize] {
+        if !self.failed.contains(Keyword::Frames) {
             self.report(ParseError::new(pos, ErrorKind::MoveWithoutFrames));
         }
     }
@@ -350,7 +350,7 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, '_, C> {
         // object), a surface not found is likely that, not an error here.
         // Likewise a SURFACE with errors may be the one meant.
         let overflowed = self.needed.get(CapacityKind::Surfaces) > Scene::<C>::surfaces_full().capacity;
-        if found.is_none() && !overflowed && !self.failed[Keyword::Surface as usize] {
+        if found.is_none() && !overflowed && !self.failed.contains(Keyword::Surface) {
             let keyword = keyword.name();
             self.report(ParseError::new(pos, ErrorKind::UndefinedSurface { keyword, number }));
         }

@@ -5,7 +5,7 @@
 //! Invariant: it reports no error (the build pass reports each once); a
 //! statement in error counts for nothing but its keyword's `failed` mark.
 
-use super::keyword::Keyword;
+use super::keyword::KeywordSet;
 use super::motion::{for_each_paired, Paired};
 use super::statement::{Keys, RoomOf, Statement};
 use crate::capacity::Counts;
@@ -35,7 +35,7 @@ pub(super) struct Survey {
     /// Keywords with a statement in error: what such a statement defines
     /// (a SURFACE, FRAMES) is missing, and an error for its absence
     /// elsewhere would only repeat that statement's.
-    pub failed: [bool; Keyword::COUNT],
+    pub failed: KeywordSet,
 }
 
 /// Pass 1: surfaces (sorted by number), the normalisation and FRAMES. The
@@ -44,7 +44,7 @@ pub(super) struct Survey {
 pub(super) fn survey<C: SceneCapacities>(text: &str, scene: &mut Scene<C>) -> Survey {
     let mut counts = Counts::ZERO;
     let mut frames = None;
-    let mut failed = [false; Keyword::COUNT];
+    let mut failed = KeywordSet::default();
     let mut eye: Option<(WorldPoint, Option<Keys<'_>>)> = None;
     let mut extent: Option<Extent> = None;
     let mut add = |lo: WorldPoint, hi: WorldPoint, moved: Option<Keys<'_>>| {
@@ -64,7 +64,7 @@ pub(super) fn survey<C: SceneCapacities>(text: &str, scene: &mut Scene<C>) -> Su
         let (pos, statement, moved) = match paired {
             Paired::Statement { pos, statement, moved } => (pos, statement, moved),
             Paired::Error(_, Some(keyword)) => {
-                failed[keyword as usize] = true;
+                failed.insert(keyword);
                 return;
             }
             _ => return,
