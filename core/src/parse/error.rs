@@ -163,14 +163,6 @@ pub enum ErrorKind<'a> {
     UnterminatedString,
     /// A word where a statement should start that is no keyword.
     UnknownKeyword(&'a str),
-    /// A number where a statement should start, after a complete statement
-    /// (its keyword given): one argument too many.
-    ExtraNumber {
-        /// The number.
-        found: &'a str,
-        /// The keyword of the statement before it.
-        after: &'static str,
-    },
     /// A parameter that is not a number.
     ExpectedNumber {
         /// The parameter.
@@ -322,11 +314,6 @@ impl fmt::Display for ErrorKind<'_> {
             ErrorKind::UnknownKeyword(k) => {
                 write!(f, "unknown keyword `{}`: expected a statement ({})", Shown(k), Listed)
             }
-            ErrorKind::ExtraNumber { found, after } => write!(
-                f,
-                "expected a statement's keyword after {after}, which takes no more numbers, found the number `{}`",
-                Shown(found)
-            ),
             ErrorKind::ExpectedNumber { field, found } => {
                 write!(f, "expected a number for {field}, found {found}")
             }

@@ -18,8 +18,6 @@ pub(crate) fn for_each_statement<'a, R: Room>(
     mut each: impl FnMut(Pos, Option<Keyword>, Result<Statement<'a>, ParseError<'a>>),
 ) {
     let mut cur = Cursor::new(text);
-    // The keyword of the statement just read whole, for a number after it.
-    let mut complete: Option<Keyword> = None;
     loop {
         let token = match cur.next() {
             Ok(Some(t)) => t,
@@ -30,14 +28,10 @@ pub(crate) fn for_each_statement<'a, R: Room>(
             }
         };
         let keyword = Keyword::from_text(token.text).filter(|_| !token.quoted);
-        let result = match (keyword, complete) {
-            (Some(kw), _) => statement::statement::<R>(&mut cur, kw, token.pos),
-            (None, Some(after)) if !token.quoted && Decimal::parse(token.text).is_some() => {
-                Err(ParseError::new(token.pos, ErrorKind::ExtraNumber { found: token.text, after: after.name() }))
-            }
-            (None, _) => Err(ParseError::new(token.pos, ErrorKind::UnknownKeyword(token.text))),
+        let result = match keyword {
+            Some(kw) => statement::statement::<R>(&mut cur, kw, token.pos),
+            None => Err(ParseError::new(token.pos, ErrorKind::UnknownKeyword(token.text))),
         };
-        complete = keyword.filter(|_| result.is_ok());
         let error_at = result.as_ref().err().map(|e| e.pos);
         each(token.pos, keyword, result);
         if let Some(pos) = error_at {
