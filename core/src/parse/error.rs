@@ -311,6 +311,15 @@ impl fmt::Display for ErrorKind<'_> {
             ErrorKind::InvalidUtf8 => f.write_str("the file is not valid UTF-8 (invalid byte here)"),
             ErrorKind::UnterminatedComment => f.write_str("unterminated comment: this `/*` is never closed"),
             ErrorKind::UnterminatedString => f.write_str("unterminated string: this `\"` is never closed"),
+            // A number where a statement begins: most often one too many
+            // for the statement before it.
+            ErrorKind::UnknownKeyword(k) if super::number::Decimal::parse(k).is_some() => {
+                write!(
+                    f,
+                    "expected a statement's keyword, found the number `{}`, one too many for the statement before it",
+                    Shown(k)
+                )
+            }
             ErrorKind::UnknownKeyword(k) => {
                 write!(f, "unknown keyword `{}`: expected a statement ({})", Shown(k), Listed)
             }

@@ -790,6 +790,10 @@ mod tests {
         check("SPHERE 1 1e400 0 0 0", "SPHERE radius must be at most 1e6 in magnitude, found 1e400");
         check("VIEWPOINT 1000000.5 0 0", "VIEWPOINT x must be at most 1e6 in magnitude");
         check("SPHER 1 1 0 0 0", "unknown keyword `SPHER`");
+        check(
+            &format!("{SURF}SPHERE 1 1 0 0 0 -0.5"),
+            "2:18: expected a statement's keyword, found the number `-0.5`, one too many for the statement before it",
+        );
     }
 
     #[test]
