@@ -330,17 +330,14 @@ fn part_of(
         },
     };
     let rows = parts::band_rows(h, index, spec.count);
-    let info = PartInfo {
+    let render = parts::Render {
         version: env!("CARGO_PKG_VERSION").into(),
         scene: parts::scene_hash(scene_bytes),
         width: w,
         height: h,
         palette: palette_mode,
-        rows: rows.clone(),
-        index,
-        count: spec.count,
-        frame,
     };
+    let info = PartInfo { render, rows: rows.clone(), index, count: spec.count, frame };
     Ok((rows, info.to_string()))
 }
 

@@ -111,14 +111,8 @@ pub fn scene_hash(bytes: &[u8]) -> u64 {
 /// What a part file says about itself.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct PartInfo {
-    /// The host-sim version that rendered it: another version may give other bits.
-    pub version: String,
-    /// [`scene_hash`] of the scene file's bytes.
-    pub scene: u64,
-    /// The whole image's size.
-    pub width: u32,
-    pub height: u32,
-    pub palette: PaletteMode,
+    /// The render it is a part of (its size the whole image's).
+    pub render: Render,
     /// This part's rows of the whole image.
     pub rows: Range<u32>,
     /// Part `index` of `count` (1-based).
@@ -136,16 +130,8 @@ impl fmt::Display for PartInfo {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{MAGIC} version={} scene={:016x} size={}x{} palette={} rows={}..{} part={}/{}",
-            self.version,
-            self.scene,
-            self.width,
-            self.height,
-            self.palette.name(),
-            self.rows.start,
-            self.rows.end,
-            self.index,
-            self.count
+            "{MAGIC} {} rows={}..{} part={}/{}",
+            self.render, self.rows.start, self.rows.end, self.index, self.count
         )?;
         match self.frame {
             Some(frame) => write!(f, " frame={frame}"),
@@ -158,15 +144,11 @@ impl PartInfo {
     /// The text [`PartInfo`]'s `Display` writes, read back; `None` for anything else.
     pub fn parse(text: &str) -> Option<PartInfo> {
         let mut fields = Fields::after(text, MAGIC)?;
-        let Render { version, scene, width, height, palette } = fields.render()?;
+        let render = fields.render()?;
         let (start, end) = fields.next("rows")?.split_once("..")?;
         let (index, count) = fields.next("part")?.split_once('/')?;
         let info = PartInfo {
-            version,
-            scene,
-            width,
-            height,
-            palette,
+            render,
             rows: start.parse().ok()?..end.parse().ok()?,
             index: index.parse().ok()?,
             count: count.parse().ok()?,
@@ -178,29 +160,32 @@ impl PartInfo {
         };
         let valid = info.index >= 1
             && info.index <= info.count
-            && info.rows == band_rows(info.height, info.index, info.count)
+            && info.rows == band_rows(info.render.height, info.index, info.count)
             && !info.rows.is_empty()
-            && info.width > 0;
+            && info.render.width > 0;
         (fields.end() && valid).then_some(info)
-    }
-}
-
-impl PartInfo {
-    /// What it says of the render it is a part of.
-    fn render(&self) -> Render {
-        let (version, scene, palette) = (self.version.clone(), self.scene, self.palette);
-        Render { version, scene, width: self.width, height: self.height, palette }
     }
 }
 
 /// What every piece of a render split across machines says first: who
 /// rendered what, how large, in which palette.
-pub(crate) struct Render {
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Render {
+    /// The host-sim version that rendered it: another version may give other bits.
     pub version: String,
+    /// [`scene_hash`] of the scene file's bytes.
     pub scene: u64,
+    /// The whole image's size.
     pub width: u32,
     pub height: u32,
     pub palette: PaletteMode,
+}
+
+impl fmt::Display for Render {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let Render { version, scene, width, height, palette } = self;
+        write!(f, "version={version} scene={scene:016x} size={width}x{height} palette={}", palette.name())
+    }
 }
 
 impl Render {
@@ -308,23 +293,23 @@ pub fn check_parts(parts: &[PathBuf]) -> Result<(Vec<(PathBuf, PartInfo)>, Heade
             Some(text) => PartInfo::parse(text)
                 .ok_or_else(|| MergeError::Refused(format!("{name}: unreadable part metadata `{text}`")))?,
         };
-        if (header.width, header.height) != (info.width, info.rows.len() as u32)
-            || header.palette.is_some() != (info.palette != PaletteMode::None)
+        if (header.width, header.height) != (info.render.width, info.rows.len() as u32)
+            || header.palette.is_some() != (info.render.palette != PaletteMode::None)
         {
             return Err(MergeError::Refused(format!(
                 "{name}: the image ({}×{}, {}) does not match its metadata ({}×{} for {}, palette {})",
                 header.width,
                 header.height,
                 if header.palette.is_some() { "indexed" } else { "truecolour" },
-                info.width,
+                info.render.width,
                 info.rows.len(),
                 rows(&info.rows),
-                info.palette.name()
+                info.render.palette.name()
             )));
         }
         if let Some((first, first_info, _)) = found.first() {
             let other = || format!("{name} and {} are not parts of one render:", ShownPath(first));
-            if let Some(difference) = info.render().difference(&first_info.render()) {
+            if let Some(difference) = info.render.difference(&first_info.render) {
                 return Err(MergeError::Refused(format!("{} {difference}", other())));
             }
             if info.frame != first_info.frame {
@@ -340,7 +325,7 @@ pub fn check_parts(parts: &[PathBuf]) -> Result<(Vec<(PathBuf, PartInfo)>, Heade
         found.push((path.clone(), info, header));
     }
     found.sort_by_key(|(_, info, _)| (info.rows.start, info.rows.end));
-    let (width, height) = (found[0].1.width, found[0].1.height);
+    let (width, height) = (found[0].1.render.width, found[0].1.render.height);
     // Every row once: each part starts where the one above ended.
     let mut end = 0;
     let mut above: Option<&(PathBuf, PartInfo, Header)> = None;
@@ -400,7 +385,7 @@ fn missing(
     if found.iter().all(|(_, info, _)| info.count == count) {
         let absent: Vec<String> = (1..=count)
             .filter(|&i| {
-                let r = band_rows(found[0].1.height, i, count);
+                let r = band_rows(found[0].1.render.height, i, count);
                 r.start >= gap.start && r.end <= gap.end
             })
             .map(|i| format!("{i}/{count}"))
@@ -498,17 +483,14 @@ mod tests {
 
     #[test]
     fn metadata_round_trips_and_rejects_inconsistent_text() {
-        let info = PartInfo {
+        let render = Render {
             version: "0.1.0".into(),
             scene: 0x0123_4567_89ab_cdef,
             width: 320,
             height: 240,
             palette: PaletteMode::Coarse,
-            rows: band_rows(240, 2, 7),
-            index: 2,
-            count: 7,
-            frame: None,
         };
+        let info = PartInfo { render, rows: band_rows(240, 2, 7), index: 2, count: 7, frame: None };
         let text = info.to_string();
         assert_eq!(PartInfo::parse(&text), Some(info.clone()));
         let framed = PartInfo { frame: Some(12), ..info.clone() };

@@ -13,7 +13,7 @@ use super::writers::{write_frame_file, FrameInfo, Output};
 use crate::arguments::not_the_scene;
 use crate::exit::{CliError, ShownPath};
 use crate::output::{is_stream, refuse_read_only, replace_with, temporary_beside, write_atomically};
-use crate::parts::{auto_index, band_rows, scene_hash, PartSpec};
+use crate::parts::{auto_index, band_rows, scene_hash, PartSpec, Render};
 use crate::terminal::progress_bar;
 use octrace_core::scene::Frames;
 use octrace_images::formats::{Format, FormatError, Image, RowReader};
@@ -108,11 +108,13 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
         }
     };
     let info = |frame: u32, width: u32, height: u32| FrameInfo {
-        version: env!("CARGO_PKG_VERSION").into(),
-        scene: scene_hash(request.bytes),
-        width,
-        height,
-        palette,
+        render: Render {
+            version: env!("CARGO_PKG_VERSION").into(),
+            scene: scene_hash(request.bytes),
+            width,
+            height,
+            palette,
+        },
         frame,
         frames,
     };
@@ -272,8 +274,8 @@ pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) ->
             .as_deref()
             .and_then(FrameInfo::parse)
             .ok_or_else(|| refuse(format!("{name}: not a frame file (no octrace frame metadata in it)")))?;
-        if (header.width, header.height) != (info.width, info.height)
-            || header.palette.is_some() != (info.palette != PaletteMode::None)
+        if (header.width, header.height) != (info.render.width, info.render.height)
+            || header.palette.is_some() != (info.render.palette != PaletteMode::None)
         {
             return Err(refuse(format!("{name}: the image does not match its metadata")));
         }
@@ -288,7 +290,7 @@ pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) ->
         };
         if let Some((first, _, first_path)) = found.first() {
             let (frames, first_frames) = (info.frames, first.frames);
-            let difference = info.render().difference(&first.render()).or_else(|| {
+            let difference = info.render.difference(&first.render).or_else(|| {
                 (frames != first_frames).then(|| {
                     format!(
                         "another FRAMES ({} at {} a second, not {} at {})",
@@ -305,7 +307,7 @@ pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) ->
     }
     found.sort_by_key(|(info, _, _)| info.frame);
     let Some((first, _, _)) = found.first() else { return Err(refuse("no frames to merge".into())) };
-    let (frames, (width, height)) = (first.frames, (first.width, first.height));
+    let (frames, (width, height)) = (first.frames, (first.render.width, first.render.height));
     if let Some(pair) = found.windows(2).find(|pair| pair[0].0.frame == pair[1].0.frame) {
         let (frame, a, b) = (pair[0].0.frame, ShownPath(pair[0].2), ShownPath(pair[1].2));
         return Err(refuse(format!("frame {frame} is given twice: {a} and {b}")));

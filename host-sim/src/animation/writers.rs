@@ -10,7 +10,6 @@
 use crate::parts::{Fields, Render};
 use octrace_core::scene::Frames;
 use octrace_images::formats::{Format, FormatError, Header, Image, RowWriter};
-use octrace_images::palette::PaletteMode;
 use std::fmt;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -101,42 +100,18 @@ impl FramePattern {
 /// What a frame file says about itself, for `host-sim merge`.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct FrameInfo {
-    /// The host-sim version that rendered it.
-    pub version: String,
-    /// The scene's hash ([`crate::parts::scene_hash`]).
-    pub scene: u64,
-    pub width: u32,
-    pub height: u32,
-    pub palette: PaletteMode,
+    /// The render it is a frame of.
+    pub render: Render,
     /// Frame `frame` of the animation's `frames`.
     pub frame: u32,
     pub frames: Frames,
-}
-
-impl FrameInfo {
-    /// What it says of the render it is a frame of.
-    pub(crate) fn render(&self) -> Render {
-        let (version, scene, palette) = (self.version.clone(), self.scene, self.palette);
-        Render { version, scene, width: self.width, height: self.height, palette }
-    }
 }
 
 const MAGIC: &str = "octrace-frame 1";
 
 impl fmt::Display for FrameInfo {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{MAGIC} version={} scene={:016x} size={}x{} palette={} frame={}/{} rate={}",
-            self.version,
-            self.scene,
-            self.width,
-            self.height,
-            self.palette.name(),
-            self.frame,
-            self.frames.count,
-            self.frames.rate
-        )
+        write!(f, "{MAGIC} {} frame={}/{} rate={}", self.render, self.frame, self.frames.count, self.frames.rate)
     }
 }
 
@@ -144,19 +119,12 @@ impl FrameInfo {
     /// The text `Display` writes, read back; `None` for anything else.
     pub fn parse(text: &str) -> Option<FrameInfo> {
         let mut fields = Fields::after(text, MAGIC)?;
-        let Render { version, scene, width, height, palette } = fields.render()?;
+        let render = fields.render()?;
         let (frame, count) = fields.next("frame")?.split_once('/')?;
         let rate = fields.next("rate")?.parse().ok()?;
-        let info = FrameInfo {
-            version,
-            scene,
-            width,
-            height,
-            palette,
-            frame: frame.parse().ok()?,
-            frames: Frames { count: count.parse().ok()?, rate },
-        };
-        let valid = info.frame < info.frames.count && info.width > 0 && info.height > 0;
+        let info =
+            FrameInfo { render, frame: frame.parse().ok()?, frames: Frames { count: count.parse().ok()?, rate } };
+        let valid = info.frame < info.frames.count && info.render.width > 0 && info.render.height > 0;
         (fields.end() && valid).then_some(info)
     }
 }
@@ -172,8 +140,9 @@ pub fn write_frame_file(
         Image::Indexed { palette, indices, .. } => (Some(palette.clone()), indices),
         Image::Rgb(rgb) => (None, &rgb.data),
     };
-    let header = Header { width: info.width, height: info.height, palette, text: Some(info.to_string()) };
-    let row = info.width as usize * header.palette.as_ref().map_or(3, |_| 1);
+    let (width, height) = (info.render.width, info.render.height);
+    let header = Header { width, height, palette, text: Some(info.to_string()) };
+    let row = width as usize * header.palette.as_ref().map_or(3, |_| 1);
     let mut writer = RowWriter::new(format, &header, out)?;
     for chunk in rows.chunks(row) {
         writer.write_row(chunk)?;
@@ -184,6 +153,7 @@ pub fn write_frame_file(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use octrace_images::palette::PaletteMode;
 
     #[test]
     fn patterns() {
@@ -206,15 +176,9 @@ mod tests {
 
     #[test]
     fn frame_info_reads_back() {
-        let info = FrameInfo {
-            version: "0.1.0".into(),
-            scene: 0xabc,
-            width: 4,
-            height: 3,
-            palette: PaletteMode::Dither,
-            frame: 5,
-            frames: Frames { count: 48, rate: 24 },
-        };
+        let render =
+            Render { version: "0.1.0".into(), scene: 0xabc, width: 4, height: 3, palette: PaletteMode::Dither };
+        let info = FrameInfo { render, frame: 5, frames: Frames { count: 48, rate: 24 } };
         assert_eq!(FrameInfo::parse(&info.to_string()), Some(info.clone()));
         assert_eq!(FrameInfo::parse(&info.to_string().replace("5/48", "48/48")), None);
     }
