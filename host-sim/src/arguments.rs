@@ -71,15 +71,26 @@ pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
 /// The format to write `path` in: the one asked for, else the one its
 /// extension names, else (no extension) PNG. Any other extension is refused
 /// before anything is rendered: a PNG named `.bmp` would mislead whatever
-/// opens it.
+/// opens it, and so would a Targa named `.png`: `--format` names the format
+/// of a file whose extension names none, and may not contradict one.
 pub(crate) fn output_format(asked: Option<Format>, path: &Path) -> Result<Format, CliError> {
+    let named = Format::from_path(path);
     if let Some(format) = asked {
-        return Ok(format);
+        return match named {
+            Some(named) if named != format => Err(CliError::Invalid(format!(
+                "--format {}: {} names a {} file; give OUT a .{} name, or leave --format out",
+                format.name(),
+                ShownPath(path),
+                named.name().to_ascii_uppercase(),
+                format.name()
+            ))),
+            _ => Ok(format),
+        };
     }
     let Some(extension) = path.extension() else {
         return Ok(Format::Png);
     };
-    Format::from_path(path).ok_or_else(|| {
+    named.ok_or_else(|| {
         let names: Vec<&str> = Format::ALL.iter().map(|f| f.name()).collect();
         let extension = extension.to_string_lossy();
         let animated = match extension.eq_ignore_ascii_case("gif") {

@@ -75,7 +75,8 @@ pub struct Args {
     #[arg(long, value_name = "METHOD", value_parser = parse_dithering)]
     pub dither: Option<Dithering>,
     /// The file format; by default from OUT's extension (png, tga, ras), or
-    /// PNG when OUT has none. Any other extension is refused without it.
+    /// PNG when OUT has none. Any other extension is refused without it,
+    /// and one that names another format is refused with it.
     #[arg(long, value_parser = parse_format)]
     pub format: Option<Format>,
     /// Render at WxH pixels instead of the scene's RASTER (for a quick
@@ -140,7 +141,8 @@ pub enum Command {
         /// The image to write.
         output: PathBuf,
         /// The output format; by default from OUTPUT's extension (png, tga,
-        /// ras), or PNG when OUTPUT has none.
+        /// ras), or PNG when OUTPUT has none; it may not contradict the
+        /// extension.
         #[arg(long, value_parser = parse_format)]
         format: Option<Format>,
     },
@@ -438,6 +440,12 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     match (loaded.frames, args.frame) {
         (None, Some(_)) => {
             return Err(CliError::Invalid(format!("--frame: {name} is no animation (it has no FRAMES)")))
+        }
+        // Said rather than ignored: a still is always traced whole.
+        (None, None) if args.no_coherence => {
+            return Err(CliError::Invalid(format!(
+                "--no-coherence: {name} is no animation (it has no FRAMES); a still is traced whole"
+            )))
         }
         (Some(frames), Some(k)) if k >= frames.count => {
             return Err(CliError::Invalid(format!(

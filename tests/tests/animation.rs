@@ -399,6 +399,7 @@ fn animation_errors_name_the_place_and_leave_no_file() {
         (&["anim.txt", "x.gif", "--part", "1/2"][..], "--part splits an animation's frames"),
         (&["anim.txt", "x.gif", "--format", "tga"][..], "is written as an animated GIF"),
         (&["anim.txt", "x.png", "--format", "ras"][..], "is written as an APNG"),
+        (&["anim.txt", "f%d.png", "--format", "tga"][..], "--format tga: f0.png names a PNG file"),
     ] {
         let (code, err) = host_sim(d, args);
         assert_eq!(code, 2, "{args:?}: {err}");

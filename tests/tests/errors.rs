@@ -269,7 +269,7 @@ fn the_formats_it_writes_are_told_by_extension_or_format() {
         ("b.Ras", None, ras),
         ("no-extension", None, png),
         ("c.bmp", Some("png"), png),
-        ("d.png", Some("ras"), ras),
+        ("d.img", Some("ras"), ras),
     ];
     for (name, format, magic) in cases {
         let out = dir.path().join(name);
@@ -284,12 +284,34 @@ fn the_formats_it_writes_are_told_by_extension_or_format() {
         let image = octrace_images::formats::read(&bytes).unwrap();
         assert_eq!((image.width(), image.height()), (4, 4));
     }
+    // --format may not contradict the extension: a Sun raster named .png
+    // would mislead whatever opens it. Refused, nothing written.
+    let contradicted = dir.path().join("f.png");
+    let (code, err) = run_args(&[scene.as_os_str(), contradicted.as_os_str(), "--format".as_ref(), "ras".as_ref()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--format ras: ") && err.contains("f.png names a PNG file; give OUT a .ras name"), "{err}");
+    assert!(!contradicted.exists());
     // Targa has no magic number: read back, it is the same image as the PNG.
     let tga = dir.path().join("e.tga");
     assert_eq!(run_args(&[scene.as_os_str(), tga.as_os_str()]).0, 0);
     let from_png = octrace_images::formats::read(&std::fs::read(dir.path().join("a.PNG")).unwrap()).unwrap();
     assert_eq!(octrace_images::formats::read(&std::fs::read(&tga).unwrap()).unwrap(), from_png);
     assert!(!std::fs::read(&tga).unwrap().starts_with(png));
+}
+
+#[test]
+fn an_animations_options_on_a_still_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path());
+    let out = dir.path().join("still.png");
+    for (option, value) in [("--frame", Some("1")), ("--no-coherence", None)] {
+        let mut args = vec![scene.as_os_str(), out.as_os_str(), option.as_ref()];
+        args.extend(value.map(OsStr::new));
+        let (code, err) = run_args(&args);
+        assert_eq!(code, 2, "{option}: {err}");
+        assert!(err.contains(&format!("{option}: ")) && err.contains("is no animation (it has no FRAMES)"), "{err}");
+        assert!(!out.exists(), "{option}");
+    }
 }
 
 #[test]

@@ -137,16 +137,18 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
             apng.finish()
         }),
         Output::Files(pattern) => {
-            let format = crate::arguments::output_format(request.format, &pattern.name(0))
-                .ok()
-                .filter(|&format| format != Format::Ras)
-                .ok_or_else(|| {
-                    CliError::Invalid(format!(
+            let format = match crate::arguments::output_format(request.format, &pattern.name(0)) {
+                Ok(format) if format != Format::Ras => format,
+                // With --format, only a name that contradicts it is refused.
+                Err(contradiction) if request.format.is_some() => return Err(contradiction),
+                _ => {
+                    return Err(CliError::Invalid(format!(
                         "cannot write {}: frame files are PNG or Targa, one file a frame (a Sun raster has no room \
                          for the frame's metadata; a GIF or an APNG of the whole loop is one file: OUT.gif, OUT.png)",
                         ShownPath(&pattern.name(0))
-                    ))
-                })?;
+                    )))
+                }
+            };
             // Each frame's file as a still's: not the scene, not a
             // read-only file, not a directory; refused before anything is
             // rendered.
