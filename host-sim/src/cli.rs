@@ -134,7 +134,8 @@ pub enum Command {
     /// Convert an image between PNG, Targa and Sun raster, its pixels kept:
     /// truecolour stays truecolour, a colour-mapped or 8-bit gray image is
     /// written colour-mapped. Reads PNGs of 8-bit RGB, 8-bit gray or
-    /// indexed colour (no alpha).
+    /// indexed colour, with alpha where every pixel is opaque (a
+    /// transparent pixel is refused: no format here holds it).
     Convert {
         /// The image to read (the format is told from its content).
         input: PathBuf,

@@ -9,9 +9,11 @@
 //!   indices and an RMT_EQUAL_RGB map (all reds, then all greens, then all blues); each row padded to an
 //!   even number of bytes.
 //!
-//! Read, besides everything written: PNG indices of 1, 2 or 4 bits (transparency ignored); Targa images
-//! stored bottom-up or right-to-left, run-length encoded (types 9 and 10), with an image ID, with 32-bit
-//! pixels or map entries (alpha dropped), or truecolour with a colour map (skipped); Sun rasters of type 0
+//! Read, besides everything written: PNG indices of 1, 2 or 4 bits, and 8-bit gray with alpha, RGB with alpha
+//! and indices with a tRNS chunk when every pixel is opaque (a transparent one is a [`FormatError`]: no format
+//! here holds it); Targa images stored bottom-up or right-to-left, run-length encoded (types 9 and 10), with an
+//! image ID, with 32-bit pixels or map entries (opaque, or alpha all zero or not counted by the descriptor, as
+//! writers without alpha leave it), or truecolour with a colour map (skipped); Sun rasters of type 0
 //! (RT_OLD), 2 (sun_raster::RT_BYTE_ENCODED) and 3 (RT_FORMAT_RGB, stored RGB), and with 32-bit pixels (pad byte
 //! dropped). Anything else, and any malformed file, is a [`FormatError`]: reading never panics, and rejects
 //! declared sizes the file is too short to hold (even fully compressed) before allocating for them.

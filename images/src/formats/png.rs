@@ -3,6 +3,7 @@
 //! Invariant: a declared size is checked against what the file's bytes could inflate to before anything
 //! is allocated for it.
 
+use super::bytes::{opaque, pick, RGB};
 use super::error::{invalid, unsupported, FormatError};
 use super::image::{Header, Image, TEXT_KEYWORD};
 use crate::RgbImage;
@@ -98,18 +99,26 @@ pub(super) fn read(bytes: &[u8]) -> Result<Image, FormatError> {
     // An 8-bit gray file (what `write_gray` writes) is read as indices
     // into the 256 grays.
     let gray = (header.color_type, header.bit_depth) == (png::ColorType::Grayscale, png::BitDepth::Eight);
+    // With alpha, 8-bit RGB and gray are read as without, once every
+    // pixel is found opaque.
+    let with_alpha = matches!(header.color_type, png::ColorType::Rgba | png::ColorType::GrayscaleAlpha);
+    let gray = gray || (header.color_type, header.bit_depth) == (png::ColorType::GrayscaleAlpha, png::BitDepth::Eight);
     let bits = match (header.color_type, header.bit_depth) {
         (png::ColorType::Rgb, png::BitDepth::Eight) => 24,
+        (png::ColorType::Rgba, png::BitDepth::Eight) => 32,
         (png::ColorType::Indexed, depth) => depth as u64,
+        (png::ColorType::GrayscaleAlpha, png::BitDepth::Eight) => 16,
         _ if gray => 8,
         (colour, depth) => {
             return unsupported(format!(
-                "a PNG of {} at {} bits: host-sim reads PNGs of 8-bit RGB, 8-bit gray or indexed colour (no alpha)",
+                "a PNG of {} at {} bits: host-sim reads PNGs of 8-bit RGB, 8-bit gray or indexed colour (with \
+                 alpha where every pixel is opaque)",
                 colour_name(colour),
                 depth as u8
             ))
         }
     };
+    let what = format!("a PNG of {}", colour_name(header.color_type));
     // Each row is a filter byte and its pixels, deflated.
     let inflated = u64::from(height) * (1 + (u64::from(width) * bits).div_ceil(8));
     if inflated > bytes.len() as u64 * DEFLATE_MAX_RATIO {
@@ -126,12 +135,19 @@ pub(super) fn read(bytes: &[u8]) -> Result<Image, FormatError> {
     buffer.truncate(frame.buffer_size());
     // Up to IEND, so that a file cut short is not taken for whole.
     reader.finish().map_err(decoding_error)?;
-    if bits == 24 {
-        return Ok(Image::Rgb(RgbImage { width, height, data: buffer }));
+    if with_alpha {
+        let pixel_bytes = bits as usize / 8;
+        opaque(buffer.chunks_exact(pixel_bytes).map(|p| p[pixel_bytes - 1]), width, &what)?;
+    }
+    match bits {
+        24 => return Ok(Image::Rgb(RgbImage { width, height, data: buffer })),
+        32 => return Ok(Image::Rgb(RgbImage { width, height, data: pick(&buffer, 4, RGB) })),
+        _ => {}
     }
     let palette = palette.ok_or_else(|| FormatError::Invalid("indexed PNG file without a PLTE chunk".into()))?;
     let indices = match bits {
         8 => buffer,
+        16 => buffer.chunks_exact(2).map(|p| p[0]).collect(),
         _ => {
             let (bits, per_byte) = (bits as usize, 8 / bits as usize);
             let unpack =
@@ -140,6 +156,10 @@ pub(super) fn read(bytes: &[u8]) -> Result<Image, FormatError> {
             rows.flat_map(|row| (0..width as usize).map(move |x| unpack(row, x))).collect()
         }
     };
+    // A colour table's transparency (tRNS), entry by entry.
+    if let Some(alpha) = reader.info().trns.as_deref().filter(|_| !gray) {
+        opaque(indices.iter().map(|&i| alpha.get(usize::from(i)).copied().unwrap_or(u8::MAX)), width, &what)?;
+    }
     Ok(Image::Indexed { width, height, palette, indices })
 }
 
@@ -215,5 +235,57 @@ mod tests {
         };
         assert_eq!(indices, grays);
         assert!(palette.iter().enumerate().all(|(g, entry)| *entry == [g as u8; 3]) && palette.len() == 256);
+    }
+
+    /// A 3×2 PNG of `colour` made by the png crate, with `trns` if given.
+    fn encoded(colour: png::ColorType, data: &[u8], palette: Option<&[u8]>, trns: Option<&[u8]>) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        let mut encoder = png::Encoder::new(&mut bytes, 3, 2);
+        encoder.set_color(colour);
+        encoder.set_depth(png::BitDepth::Eight);
+        palette.map(|p| encoder.set_palette(p.to_vec()));
+        trns.map(|t| encoder.set_trns(t.to_vec()));
+        encoder.write_header().unwrap().write_image_data(data).unwrap();
+        bytes
+    }
+
+    #[test]
+    fn alpha_is_read_where_every_pixel_is_opaque_and_a_transparent_one_refused() {
+        let rgb: Vec<u8> = (0..18).collect();
+        let rgba: Vec<u8> = rgb.chunks(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();
+        let gray_alpha = [7, 255, 8, 255, 9, 255, 10, 255, 11, 255, 12, 255];
+        let (palette, indices) = ((0..9).collect::<Vec<u8>>(), [0, 1, 2, 2, 1, 0]);
+        let cases = [
+            (png::ColorType::Rgba, &rgba[..], None, None, 4),
+            (png::ColorType::GrayscaleAlpha, &gray_alpha[..], None, None, 2),
+            (png::ColorType::Indexed, &indices[..], Some(&palette[..]), Some(&[255, 255, 255][..]), 1),
+        ];
+        for (colour, data, palette, trns, pixel_bytes) in cases {
+            let opaque = read(&encoded(colour, data, palette, trns)).unwrap();
+            let want = match colour {
+                png::ColorType::Rgba => Image::Rgb(RgbImage { width: 3, height: 2, data: rgb.clone() }),
+                png::ColorType::GrayscaleAlpha => {
+                    let palette = (0..=255).map(|g| [g; 3]).collect();
+                    Image::Indexed { width: 3, height: 2, palette, indices: vec![7, 8, 9, 10, 11, 12] }
+                }
+                _ => Image::Indexed {
+                    width: 3,
+                    height: 2,
+                    palette: vec![[0, 1, 2], [3, 4, 5], [6, 7, 8]],
+                    indices: indices.to_vec(),
+                },
+            };
+            assert_eq!(opaque, want, "{colour:?}");
+            // Pixel (1, 1), the fifth, made transparent: in the pixel's alpha,
+            // or (indexed) in its entry's, index 1.
+            let (mut data, mut trns) = (data.to_vec(), trns.map(<[u8]>::to_vec));
+            match &mut trns {
+                Some(trns) => trns[1] = 254,
+                None => data[5 * pixel_bytes - 1] = 254,
+            }
+            let message = read(&encoded(colour, &data, palette, trns.as_deref())).unwrap_err().to_string();
+            let first = if trns.is_some() { "x 1, y 0" } else { "x 1, y 1" };
+            assert!(message.contains(&format!("with transparent pixels (the first at {first})")), "{message}");
+        }
     }
 }

@@ -3,7 +3,7 @@
 //! Invariant: run-length data is checked to be long enough for the pixels it claims (128 a packet at
 //! most) before they are allocated.
 
-use super::bytes::{pick, read_exactly, take, BGR};
+use super::bytes::{opaque, pick, read_exactly, take, BGR};
 use super::error::{invalid, unsupported, FormatError};
 use super::image::{Header, Image};
 use crate::RgbImage;
@@ -23,6 +23,8 @@ pub(super) fn no_image(e: FormatError) -> FormatError {
 const TOP_DOWN: u8 = 0x20;
 /// Descriptor bit 4: each row is stored right to left.
 const RIGHT_TO_LEFT: u8 = 0x10;
+/// Descriptor bits: how many bits of each pixel are attributes (alpha).
+const ATTRIBUTE_BITS: u8 = 0x0f;
 
 /// The header, image ID and colour map of a top-down, uncompressed Targa file.
 pub(super) fn header_bytes(header: &Header) -> Result<Vec<u8>, FormatError> {
@@ -134,7 +136,11 @@ pub(super) fn read(bytes: &[u8]) -> Result<Image, FormatError> {
     };
     let pixels = orient(&stored, width as usize, pixel_bytes, descriptor);
     let (width, height) = (u32::from(width), u32::from(height));
+    let alpha_of = |colours: &[u8], bytes: usize| alpha(colours, bytes, descriptor);
     if !mapped {
+        if let Some(alpha) = alpha_of(&pixels, pixel_bytes) {
+            opaque(alpha.into_iter(), width, "a Targa image of 32-bit pixels")?;
+        }
         return Ok(Image::Rgb(RgbImage { width, height, data: pick(&pixels, pixel_bytes, BGR) }));
     }
     let palette = map.chunks_exact(map_entry_bytes).map(|e| [e[2], e[1], e[0]]).collect();
@@ -143,8 +149,21 @@ pub(super) fn read(bytes: &[u8]) -> Result<Image, FormatError> {
         Some(index) => Ok(index as u8),
         None => invalid(format!("Targa pixel value {value} is below the colour map's first entry {map_first}")),
     };
-    let indices = pixels.iter().map(index).collect::<Result<_, _>>()?;
+    let indices: Vec<u8> = pixels.iter().map(index).collect::<Result<_, _>>()?;
+    if let Some(alpha) = alpha_of(map, map_entry_bytes) {
+        let used = indices.iter().map(|&i| alpha.get(usize::from(i)).copied().unwrap_or(u8::MAX));
+        opaque(used, width, "a Targa image of 32-bit colour map entries")?;
+    }
     Ok(Image::Indexed { width, height, palette, indices })
+}
+
+/// The alpha of each of `colours` (pixels or map entries of `bytes` bytes),
+/// if they have any: a 32-bit colour's fourth byte is alpha when the
+/// descriptor counts attribute bits, unless it is zero throughout, as
+/// writers without alpha leave it.
+fn alpha(colours: &[u8], bytes: usize, descriptor: u8) -> Option<Vec<u8>> {
+    let alpha: Vec<u8> = colours.chunks_exact(bytes).map(|c| c[bytes - 1]).collect();
+    (bytes == 4 && descriptor & ATTRIBUTE_BITS != 0 && alpha.iter().any(|&a| a != 0)).then_some(alpha)
 }
 
 /// Targa run-length packets expanded to `count` pixels of `pixel_bytes` each.
@@ -256,6 +275,22 @@ mod tests {
             assert_eq!(read(&bytes).unwrap(), image);
             assert_eq!(decoded_by_ffmpeg(&bytes), image.to_rgb().data);
         }
+    }
+
+    #[test]
+    fn a_32_bit_targa_is_read_unless_its_alpha_makes_a_pixel_transparent() {
+        // Two pixels, BGRA, top-down; `attributes` the descriptor's alpha bits.
+        let targa = |attributes: u8, alpha: [u8; 2]| {
+            let mut bytes = vec![0, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 1, 0, 32, TOP_DOWN | attributes];
+            bytes.extend([3, 2, 1, alpha[0], 6, 5, 4, alpha[1]]);
+            bytes
+        };
+        let image = Image::Rgb(RgbImage { width: 2, height: 1, data: vec![1, 2, 3, 4, 5, 6] });
+        for (attributes, alpha) in [(8, [255, 255]), (8, [0, 0]), (0, [255, 128])] {
+            assert_eq!(read(&targa(attributes, alpha)).unwrap(), image, "{attributes} {alpha:?}");
+        }
+        let message = read(&targa(8, [255, 128])).unwrap_err().to_string();
+        assert!(message.contains("32-bit pixels with transparent pixels (the first at x 1, y 0)"), "{message}");
     }
 
     #[test]
