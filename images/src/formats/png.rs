@@ -243,8 +243,12 @@ mod tests {
         let mut encoder = png::Encoder::new(&mut bytes, 3, 2);
         encoder.set_color(colour);
         encoder.set_depth(png::BitDepth::Eight);
-        palette.map(|p| encoder.set_palette(p.to_vec()));
-        trns.map(|t| encoder.set_trns(t.to_vec()));
+        if let Some(palette) = palette {
+            encoder.set_palette(palette.to_vec());
+        }
+        if let Some(trns) = trns {
+            encoder.set_trns(trns.to_vec());
+        }
         encoder.write_header().unwrap().write_image_data(data).unwrap();
         bytes
     }
