@@ -1,6 +1,6 @@
 //! The `host-sim` command line.
 
-use crate::animation::{animate, is_frame_file, merge_frames, AnimationOptions, FramePattern, Request};
+use crate::animation::{animate, is_frame_file, merge_frames, AnimationOptions, FramePattern, Output, Request};
 use crate::arguments::{not_the_scene, parse_size, same_file};
 use crate::arguments::{output_format, parse_accel, parse_color, parse_dithering, parse_format, parse_palette};
 use crate::exit::ShownPath;
@@ -89,13 +89,22 @@ pub struct Args {
     /// handful of objects, else dda). All give the same image.
     #[arg(long, value_name = "MODE", default_value = "auto", value_parser = parse_accel)]
     pub accel: AccelMode,
-    /// Octree criterion: a box holding more objects than this is subdivided.
-    #[arg(long, value_name = "N", default_value_t = crate::options::OCTREE.max_objects)]
-    pub max_objects: usize,
-    /// Octree criterion: boxes are not subdivided below this depth (at most 18).
-    #[arg(long, value_name = "D", default_value_t = crate::options::OCTREE.max_depth,
-          value_parser = clap::value_parser!(u32).range(0..=18))]
-    pub max_depth: u32,
+    /// Octree criterion: a box holding more objects than this is subdivided
+    /// (refused with --accel naive, which builds no octree).
+    #[arg(long, value_name = "N", help = format!(
+        "Octree criterion: a box holding more objects than this is subdivided (refused with --accel naive, which \
+         builds no octree) [default: {}]",
+        crate::options::OCTREE.max_objects
+    ))]
+    pub max_objects: Option<usize>,
+    /// Octree criterion: boxes are not subdivided below this depth (at most
+    /// 18; refused with --accel naive).
+    #[arg(long, value_name = "D", value_parser = clap::value_parser!(u32).range(0..=18), help = format!(
+        "Octree criterion: boxes are not subdivided below this depth (at most 18; refused with --accel naive) \
+         [default: {}]",
+        crate::options::OCTREE.max_depth
+    ))]
+    pub max_depth: Option<u32>,
     /// Threads to render on, 1 to 1024 (default: every core). Any number
     /// gives the same image.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
@@ -248,6 +257,14 @@ fn argument_error(e: &clap::Error) -> String {
 fn convert(input: &Path, output: &Path, format: Option<Format>) -> Result<(), CliError> {
     let format = output_format(format, output)?;
     let bytes = std::fs::read(input).map_err(|e| CliError::read(input, e))?;
+    // Converted in place, a file would lose what only its own format holds
+    // (octrace's metadata, which merge reads) for nothing.
+    if same_file(input, output) {
+        return Err(CliError::Invalid(format!(
+            "convert: refusing to write over {}, the file it converts: name another OUT",
+            ShownPath(input)
+        )));
+    }
     if let Some(frames) = animated_png_frames(&bytes) {
         return Err(CliError::Invalid(format!(
             "{}: an animated PNG of {frames} frames; convert takes still images (host-sim writes an animation's \
@@ -268,7 +285,14 @@ fn animated_png_frames(bytes: &[u8]) -> Option<u32> {
 }
 
 fn merge(output: &Path, parts: &[PathBuf], format: Option<Format>) -> Result<(), CliError> {
-    let format = output_format(format, output)?;
+    let format = output_format(format, output).map_err(|e| match Output::of(output, None) {
+        Ok(Output::Gif) => CliError::Invalid(format!(
+            "merge: {}: a still's band parts merge into a PNG, Targa or Sun raster image, and a GIF is assembled \
+             from an animation's frame files; nothing written",
+            ShownPath(output)
+        )),
+        _ => e,
+    })?;
     let refused = |e: MergeError| {
         let message = format!("merge: {e}; nothing written");
         match e {
@@ -404,6 +428,11 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
                     ShownPath(part)
                 )));
             }
+            // A file that cannot be opened is said so, before it is taken
+            // for a kind of file it is not.
+            for part in parts {
+                std::fs::File::open(part).map_err(|e| CliError::read(part, e))?;
+            }
             // Frame files or band parts, one kind at a time.
             let frames: Vec<bool> = parts.iter().map(|part| is_frame_file(part)).collect();
             if let Some(other) = frames.iter().position(|&frame| frame != frames[0]) {
@@ -418,7 +447,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
                 )));
             }
             return match frames.first() == Some(&true) {
-                true => merge_frames(output, parts, *format),
+                true => merge_frames(output, parts, *format, stderr),
                 false => merge(output, parts, *format),
             };
         }
@@ -442,7 +471,13 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         (None, Some(_)) => {
             return Err(CliError::Invalid(format!("--frame: {name} is no animation (it has no FRAMES)")))
         }
-        // Said rather than ignored: a still is always traced whole.
+        // Said rather than ignored: a still, or a frame alone, is always
+        // traced whole.
+        (Some(_), Some(k)) if args.no_coherence => {
+            return Err(CliError::Invalid(format!(
+                "--no-coherence: --frame {k} traces that frame alone, whole; --no-coherence is for a whole loop"
+            )))
+        }
         (None, None) if args.no_coherence => {
             return Err(CliError::Invalid(format!(
                 "--no-coherence: {name} is no animation (it has no FRAMES); a still is traced whole"
@@ -500,10 +535,20 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         )));
     }
     not_the_scene(scene_path, &out)?;
+    if args.accel == AccelMode::Naive && (args.max_objects.is_some() || args.max_depth.is_some()) {
+        let option = if args.max_objects.is_some() { "--max-objects" } else { "--max-depth" };
+        return Err(CliError::Invalid(format!(
+            "{option} shapes the octree, and --accel naive builds none: give --accel octree or dda"
+        )));
+    }
     let options = |(w, h)| RenderOptions {
         size: Some((w, h)),
         accel: args.accel,
-        octree: OctreeConfig { max_objects: args.max_objects, max_depth: args.max_depth, ..crate::OCTREE },
+        octree: OctreeConfig {
+            max_objects: args.max_objects.unwrap_or(crate::OCTREE.max_objects),
+            max_depth: args.max_depth.unwrap_or(crate::OCTREE.max_depth),
+            ..crate::OCTREE
+        },
         threads: args.threads.map_or_else(all_cores, |n| n as usize),
         partition: args.partition,
         // Ctrl-C, SIGTERM or SIGHUP stops a render before its next ray, a

@@ -257,6 +257,25 @@ fn small_animation(dir: &std::path::Path) -> std::path::PathBuf {
 }
 
 #[test]
+fn a_gif_that_cannot_keep_the_rate_says_so_even_when_quiet() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let text = std::fs::read_to_string(small_animation(d)).unwrap();
+    std::fs::write(d.join("fast.txt"), text.replace("FRAMES 8 12", "FRAMES 8 100")).unwrap();
+    let note = "fast.gif at 100 frames a second plays its loop in 0.16 s, not 0.08 s";
+    let (code, err) = host_sim(d, &["fast.txt", "fast.gif", "-q"]);
+    assert!(code == 0 && err.contains(note), "{err}");
+    // Frames merged into one: the same; at a rate a GIF keeps, nothing.
+    assert_eq!(host_sim(d, &["fast.txt", "f%d.png", "-q"]).0, 0);
+    let frames: Vec<String> = (0..8).map(|k| format!("f{k}.png")).collect();
+    let args: Vec<&str> = ["merge", "fast.gif"].into_iter().chain(frames.iter().map(String::as_str)).collect();
+    let (code, err) = host_sim(d, &args);
+    assert!(code == 0 && err.contains(note), "{err}");
+    let (code, err) = host_sim(d, &["anim.txt", "a.gif", "-q"]);
+    assert!(code == 0 && err.is_empty(), "{err}");
+}
+
+#[test]
 fn host_sim_writes_gif_apng_and_frame_files_identical_to_single_frames() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
@@ -378,6 +397,12 @@ fn frames_rendered_apart_merge_into_the_same_gif() {
     assert_eq!(host_sim(d, &["anim.txt", "band.png", "--frame", "0", "--part", "1/2", "-q"]).0, 0);
     let (code, err) = host_sim(d, &["merge", "bad.png", "p0.png", "band.png"]);
     assert!(code == 2 && err.contains("p0.png is an animation's frame file and band.png not a frame file"), "{err}");
+    // A file that is not there is said so (exit 1), not taken for a kind of
+    // file; a still's band parts are not a GIF's.
+    let (code, err) = host_sim(d, &["merge", "bad.gif", "p0.png", "p1.pgn"]);
+    assert!(code == 1 && err.contains("cannot read p1.pgn: No such file"), "{err}");
+    let (code, err) = host_sim(d, &["merge", "bad.gif", "band.png"]);
+    assert!(code == 2 && err.contains("a still's band parts merge into a PNG, Targa or Sun raster image"), "{err}");
     // A frame of another render says how it differs.
     assert_eq!(host_sim(d, &["anim.txt", "small%d.png", "--size", "4x3", "-q"]).0, 0);
     let (code, err) = host_sim(d, &["merge", "bad.gif", "p0.png", "small1.png"]);
@@ -400,6 +425,8 @@ fn animation_errors_name_the_place_and_leave_no_file() {
         (&["anim.txt", "x.gif", "--format", "tga"][..], "is written as an animated GIF"),
         (&["anim.txt", "x.png", "--format", "ras"][..], "is written as an APNG"),
         (&["anim.txt", "f%d.png", "--format", "tga"][..], "--format tga: f0.png names a PNG file"),
+        (&["anim.txt", "x.png", "--frame", "1", "--no-coherence"][..], "--frame 1 traces that frame alone, whole"),
+        (&["anim.txt", "x.gif", "--accel", "naive", "--max-depth", "3"][..], "--max-depth shapes the octree"),
     ] {
         let (code, err) = host_sim(d, args);
         assert_eq!(code, 2, "{args:?}: {err}");

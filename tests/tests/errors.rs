@@ -226,7 +226,7 @@ fn an_output_extension_it_does_not_write_is_refused() {
         assert!(err.contains("png, tga, ras") && err.contains("--format"), "{err}");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "{name}: a file was written");
     }
-    // The same through IMAGEFILE, at its statement, and for `convert`.
+    // The same through IMAGEFILE, at its file name, and for `convert`.
     let imagefile = dir.path().join("i.txt");
     std::fs::write(&imagefile, format!("{SURF}\n IMAGEFILE \"{}\"", dir.path().join("x.gif").display())).unwrap();
     let (code, err) = run_args(&[imagefile.as_os_str()]);
@@ -234,7 +234,7 @@ fn an_output_extension_it_does_not_write_is_refused() {
         (
             code,
             err.contains(&format!(
-                "i.txt:3:2: IMAGEFILE {}: `.gif` is not a format host-sim writes a still image in (a GIF holds a whole \
+                "i.txt:3:12: IMAGEFILE {}: `.gif` is not a format host-sim writes a still image in (a GIF holds a whole \
                  animation: a scene with FRAMES, rendered without --frame, to one file)",
                 dir.path().join("x.gif").display()
             ))
@@ -300,7 +300,7 @@ fn the_formats_it_writes_are_told_by_extension_or_format() {
 }
 
 #[test]
-fn an_animations_options_on_a_still_are_refused() {
+fn options_that_would_do_nothing_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let scene = small_scene(dir.path());
     let out = dir.path().join("still.png");
@@ -312,6 +312,24 @@ fn an_animations_options_on_a_still_are_refused() {
         assert!(err.contains(&format!("{option}: ")) && err.contains("is no animation (it has no FRAMES)"), "{err}");
         assert!(!out.exists(), "{option}");
     }
+    // Octree options where no octree is built.
+    let args = [
+        scene.as_os_str(),
+        out.as_os_str(),
+        "--accel".as_ref(),
+        "naive".as_ref(),
+        "--max-objects".as_ref(),
+        "2".as_ref(),
+    ];
+    let (code, err) = run_args(&args);
+    assert!(code == 2 && err.contains("--max-objects shapes the octree, and --accel naive builds none"), "{err}");
+    // convert onto its own input: refused, the file as it was.
+    let png = dir.path().join("a.png");
+    assert_eq!(run_args(&[scene.as_os_str(), png.as_os_str()]).0, 0);
+    let before = std::fs::read(&png).unwrap();
+    let (code, err) = run_args(&["convert".as_ref(), png.as_os_str(), png.as_os_str()]);
+    assert!(code == 2 && err.contains("convert: refusing to write over"), "{err}");
+    assert_eq!(std::fs::read(&png).unwrap(), before);
 }
 
 #[test]

@@ -974,7 +974,7 @@ fn row18_still_commands_refuse_what_is_an_animation() {
     std::fs::write(&scene, format!("RASTER 4 4 IMAGEFILE \"\" {SURF}")).unwrap();
     let (code, err) = host_sim(&[scene.as_os_str()]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("a.txt:1:12: IMAGEFILE names no file"), "{err}");
+    assert!(err.contains("a.txt:1:22: IMAGEFILE names no file"), "{err}");
     assert_eq!(listing(dir.path()), ["a.png", "a.txt"]);
 }
 

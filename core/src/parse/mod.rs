@@ -214,20 +214,20 @@ fn parse_in<'a, C: SceneCapacities>(
 }
 
 /// The IMAGEFILE of `text`, if it names one (its first, as the parser
-/// reads it; a scene with errors may name one too), and where its
-/// statement stands, for a program's errors about the file it names.
+/// reads it; a scene with errors may name one too), and where the name is
+/// written, for a program's errors about the file it names.
 ///
 /// ```
 /// use octrace_core::parse::{imagefile, Pos};
 ///
 /// let text = "RASTER 8 8\nIMAGEFILE ball.png SPHERE 1 1 0 0 0";
-/// assert_eq!(imagefile(text), Some(("ball.png", Pos { line: 2, column: 1 })));
+/// assert_eq!(imagefile(text), Some(("ball.png", Pos { line: 2, column: 11 })));
 /// assert_eq!(imagefile("RASTER 8 8"), None);
 /// ```
 pub fn imagefile(text: &str) -> Option<(&str, Pos)> {
     let mut found = None;
-    for_each_statement::<AnyRoom>(text, |pos, _, result| {
-        if let Ok(Statement::Imagefile(name)) = result {
+    for_each_statement::<AnyRoom>(text, |_, _, result| {
+        if let Ok(Statement::Imagefile(name, pos)) = result {
             found.get_or_insert((name, pos));
         }
     });
@@ -452,7 +452,7 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, '_, C> {
             Statement::Raster(r) => settings.raster = r,
             Statement::Viewport(v) => settings.view.viewport = Some(v),
             Statement::Rdepth(d) => settings.rdepth = d,
-            Statement::Imagefile(name) => self.parsed.imagefile = Some(name),
+            Statement::Imagefile(name, _) => self.parsed.imagefile = Some(name),
             Statement::Background(c) => settings.background = c,
             Statement::Gamma(g) => settings.gamma = g,
             Statement::Attenuation(d) => settings.attenuation = d,

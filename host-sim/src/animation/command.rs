@@ -8,7 +8,7 @@
 
 use super::apng::ApngWriter;
 use super::frames::{render_frames, AnimationError, AnimationOptions, AnimationReport, FrameImage};
-use super::gif::GifWriter;
+use super::gif::{gif_delay, GifWriter, GIF_FASTEST};
 use super::writers::{write_frame_file, FrameInfo, Output};
 use crate::arguments::not_the_scene;
 use crate::exit::{CliError, ShownPath};
@@ -210,6 +210,10 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
         (Some(Ok(report)), Ok(())) => report,
         (None, Ok(())) => return Err(CliError::write(request.out, "no frame was rendered")),
     };
+    // Said even with --quiet: the file does not play as the scene asks.
+    if let Some(note) = slower_gif(&output, frames, request.out) {
+        let _ = writeln!(stderr, "{note}");
+    }
     if !request.quiet {
         let share = 100.0 * report.traced as f64 / report.pixels.max(1) as f64;
         let _ = writeln!(
@@ -233,6 +237,24 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
     Ok(())
 }
 
+/// What to tell of a GIF written to `out` that plays slower than `frames`'
+/// rate (faster than [`GIF_FASTEST`] frames a second), if it is one.
+fn slower_gif(output: &Output, frames: Frames, out: &Path) -> Option<String> {
+    if *output != Output::Gif || frames.rate <= GIF_FASTEST {
+        return None;
+    }
+    let played: u32 = frames.all().map(|k| u32::from(gif_delay(frames, k))).sum();
+    Some(format!(
+        "host-sim: note: a GIF shows a frame for {}/100 s at least, so {} at {} frames a second plays its loop in \
+         {:.2} s, not {:.2} s (an APNG, OUT.png, keeps the rate)",
+        100 / GIF_FASTEST,
+        ShownPath(out),
+        frames.rate,
+        f64::from(played) / 100.0,
+        f64::from(frames.count) / f64::from(frames.rate)
+    ))
+}
+
 fn into_io(e: FormatError) -> std::io::Error {
     match e {
         FormatError::Io(e) => e,
@@ -249,7 +271,12 @@ pub fn is_frame_file(path: &Path) -> bool {
 /// `host-sim merge OUT FRAMES…`: frame files rendered apart, assembled into
 /// the animation `output` names, bit for bit what a render straight to it
 /// writes.
-pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) -> Result<(), CliError> {
+pub fn merge_frames(
+    output: &Path,
+    files: &[PathBuf],
+    format: Option<Format>,
+    stderr: &mut dyn Write,
+) -> Result<(), CliError> {
     let refuse = |message: String| CliError::Invalid(format!("merge: {message}; nothing written"));
     let kind = match Output::of(output, format) {
         Ok(kind @ (Output::Gif | Output::Apng)) => kind,
@@ -332,7 +359,11 @@ pub fn merge_frames(output: &Path, files: &[PathBuf], format: Option<Format>) ->
         }),
         Output::Files(_) => return Err(refuse("merge writes one animation (.gif or .png)".into())),
     };
-    written.map_err(|e| CliError::Io(format!("merge: cannot write {}: {e}", ShownPath(output))))
+    written.map_err(|e| CliError::Io(format!("merge: cannot write {}: {e}", ShownPath(output))))?;
+    if let Some(note) = slower_gif(&kind, frames, output) {
+        let _ = writeln!(stderr, "{note}");
+    }
+    Ok(())
 }
 
 /// The frames of `0..count` that are not in `present` (in order), as one

@@ -19,13 +19,17 @@ use octrace_core::scene::Frames;
 use octrace_images::formats::Image;
 use std::io::Write;
 
+/// The most frames a second a GIF plays: browsers show a delay under
+/// 2/100 s as 10/100.
+pub const GIF_FASTEST: u32 = 50;
+
 /// The delay of frame `k` of `frames`, in hundredths of a second: the
 /// rounded time of its end less that of its start (24 frames a second:
 /// 4 or 5), so the loop lasts its length; at least 2 (browsers show a
 /// shorter delay as 10).
 pub fn gif_delay(frames: Frames, k: u32) -> u16 {
     let at = |k: u32| (200 * u64::from(k) + u64::from(frames.rate)) / (2 * u64::from(frames.rate.max(1)));
-    (at(k + 1) - at(k)).clamp(2, u64::from(u16::MAX)) as u16
+    (at(k + 1) - at(k)).clamp(u64::from(100 / GIF_FASTEST), u64::from(u16::MAX)) as u16
 }
 
 /// An animated GIF being written, a frame at a time.
