@@ -227,11 +227,21 @@ fn parse_in<'a, C: SceneCapacities>(
 pub fn imagefile(text: &str) -> Option<(&str, Pos)> {
     let mut found = None;
     for_each_statement::<AnyRoom>(text, |_, _, result| {
-        if let Ok(Statement::Imagefile(name, pos)) = result {
-            found.get_or_insert((name, pos));
+        if let Ok(Statement::Imagefile(name)) = result {
+            found.get_or_insert(name);
         }
     });
-    found
+    // The name is a slice of the text: its token is the one that starts
+    // where it does (found here, on the host's path alone, rather than
+    // carried in every board's statements).
+    let name = found?;
+    let mut lexer = lexer::Lexer::new(text);
+    while let Ok(Some(token)) = lexer.next_token() {
+        if core::ptr::eq(token.text, name) {
+            return Some((name, token.pos));
+        }
+    }
+    None
 }
 
 /// What `text` needs of each capacity, counting its valid statements (a
@@ -452,7 +462,7 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, '_, C> {
             Statement::Raster(r) => settings.raster = r,
             Statement::Viewport(v) => settings.view.viewport = Some(v),
             Statement::Rdepth(d) => settings.rdepth = d,
-            Statement::Imagefile(name, _) => self.parsed.imagefile = Some(name),
+            Statement::Imagefile(name) => self.parsed.imagefile = Some(name),
             Statement::Background(c) => settings.background = c,
             Statement::Gamma(g) => settings.gamma = g,
             Statement::Attenuation(d) => settings.attenuation = d,

@@ -51,46 +51,19 @@ pub enum Statement<'a> {
     Raster([u32; 2]),
     Viewport([WorldValue; 2]),
     Rdepth(u32),
-    /// The file's name, and where it is written (a quoted name: its
-    /// opening quote).
-    Imagefile(&'a str, Pos),
-    Light {
-        brightness: I32F32,
-        position: WorldPoint,
-    },
+    Imagefile(&'a str),
+    Light { brightness: I32F32, position: WorldPoint },
     Background(Color),
     Gamma(I32F32),
     Attenuation(I32F32),
     Samples(u32),
-    Sphere {
-        surface: u32,
-        radius: WorldValue,
-        center: WorldPoint,
-    },
-    Box {
-        surface: u32,
-        center: WorldPoint,
-        half: WorldPoint,
-    },
-    Superquadric {
-        surface: u32,
-        power: I32F32,
-        center: WorldPoint,
-        half: WorldPoint,
-    },
-    Triangle {
-        surface: u32,
-        corners: [WorldPoint; 3],
-    },
-    Rectangle {
-        surface: u32,
-        corners: [WorldPoint; 4],
-    },
+    Sphere { surface: u32, radius: WorldValue, center: WorldPoint },
+    Box { surface: u32, center: WorldPoint, half: WorldPoint },
+    Superquadric { surface: u32, power: I32F32, center: WorldPoint, half: WorldPoint },
+    Triangle { surface: u32, corners: [WorldPoint; 3] },
+    Rectangle { surface: u32, corners: [WorldPoint; 4] },
     Bspline(Patch<'a>),
-    Surface {
-        number: u32,
-        surface: Surface,
-    },
+    Surface { number: u32, surface: Surface },
     Frames(Frames),
     Move(Keys<'a>),
 }
@@ -203,7 +176,7 @@ impl Statement<'_> {
             | Statement::Raster(_)
             | Statement::Viewport(_)
             | Statement::Rdepth(_)
-            | Statement::Imagefile(..)
+            | Statement::Imagefile(_)
             | Statement::Light { .. }
             | Statement::Background(_)
             | Statement::Gamma(_)
@@ -239,7 +212,7 @@ impl Statement<'_> {
             | Statement::Raster(_)
             | Statement::Viewport(_)
             | Statement::Rdepth(_)
-            | Statement::Imagefile(..)
+            | Statement::Imagefile(_)
             | Statement::Background(_)
             | Statement::Gamma(_)
             | Statement::Attenuation(_)
@@ -260,7 +233,7 @@ impl Statement<'_> {
             Statement::Raster(_) => Keyword::Raster,
             Statement::Viewport(_) => Keyword::Viewport,
             Statement::Rdepth(_) => Keyword::Rdepth,
-            Statement::Imagefile(..) => Keyword::Imagefile,
+            Statement::Imagefile(_) => Keyword::Imagefile,
             Statement::Light { .. } => Keyword::Light,
             Statement::Background(_) => Keyword::Background,
             Statement::Gamma(_) => Keyword::Gamma,
@@ -448,7 +421,7 @@ pub fn statement<'a, R: Room>(cur: &mut Cursor<'a>, kw: Keyword, at: Pos) -> Res
         }
         Keyword::Rdepth => Statement::Rdepth(cur.integer(f("depth"), 0, super::number::LIMIT as i64)? as u32),
         Keyword::Imagefile => match cur.next()? {
-            Some(t) => Statement::Imagefile(t.text, t.pos),
+            Some(t) => Statement::Imagefile(t.text),
             None => return Err(cur.end_of_file(ErrorKind::ExpectedName { field: f("file name") })),
         },
         Keyword::Light => Statement::Light {
