@@ -62,7 +62,8 @@ const USAGE =
   'usage: node run.mjs ELF [--out FILE.png] [--display auto|st7789|ssd1306] [--panel WxH] [--panel-offset X,Y] [--max-seconds S] [--contention on|off] [--json] [--quiet]\n' +
   '       node run.mjs ELF --frames N [--out \'DIR/f%03d.png\'] [the options above]\n' +
   '       node run.mjs ELF --profile N [the options above, or --frames N [--profile-from K]]: also where the cycles went, by function (from frame K on)\n' +
-  '       node run.mjs ELF --serial [--out FILE.png] [--display auto|st7789|ssd1306] [--panel WxH] [--panel-offset X,Y] [--contention on|off] [--json]';
+  '       node run.mjs ELF --serial [--out FILE.png] [--display auto|st7789|ssd1306] [--panel WxH] [--panel-offset X,Y] [--contention on|off] [--json]\n' +
+  '       node run.mjs --help';
 
 function usage(message) {
   console.error(`octrace-pico-emulator: ${message}\n${USAGE}`);
@@ -94,12 +95,17 @@ try {
       'profile-from': { type: 'string' },
       json: { type: 'boolean', default: false },
       quiet: { type: 'boolean', default: false },
+      help: { type: 'boolean', short: 'h', default: false },
     },
   });
 } catch (error) {
   usage(error.message);
 }
 const { values, positionals } = args;
+if (values.help) {
+  console.log(`${USAGE}\nWhat each option does, and what the emulator models: README.md beside this file.`);
+  process.exit(0);
+}
 if (positionals.length !== 1) {
   usage(positionals.length === 0 ? 'no ELF given' : `one ELF, not ${positionals.length} arguments`);
 }

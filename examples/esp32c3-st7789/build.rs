@@ -1,6 +1,7 @@
 //! Embeds the scene: the file
 //! `OCTRACE_SCENE` names (a path from this folder; default the thesis's
-//! figure 5.1, `../../scenes/fig5_1.txt`). The scene is checked here, on the
+//! figure 5.1, `scenes/fig5_1.txt` of the octrace checkout the dependencies
+//! come from, `octrace_pico_build::DEFAULT_SCENE`). The scene is checked here, on the
 //! host, with the parser the board runs: its errors fail the build with their
 //! line and column. `SceneProfile` holds exactly what it needs, its octree
 //! included, so the ESP32-C3's RAM holds just this scene (the linker says so if
@@ -15,12 +16,11 @@
 
 use octrace_pico_build::{embed_still_scene, BuildError};
 
-const DEFAULT_SCENE: &str = "../../scenes/fig5_1.txt";
 
 fn main() {
     // The memory map and linker scripts come from esp-hal (linkall.x).
     println!("cargo:rerun-if-changed=build.rs");
-    embed_still_scene(DEFAULT_SCENE).unwrap_or_else(|e| fail(e));
+    embed_still_scene().unwrap_or_else(|e| fail(e));
 }
 
 fn fail(error: BuildError) -> ! {

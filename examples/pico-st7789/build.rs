@@ -1,5 +1,6 @@
 //! Embeds the scene `OCTRACE_SCENE` names (a path from this folder; default
-//! the thesis's figure 5.1), checked with the parser the board runs and with
+//! the thesis's figure 5.1 of the octrace checkout the dependencies come
+//! from), checked with the parser the board runs and with
 //! a capacity profile sized for it; puts the RP2040's memory map where the
 //! linker finds it, with each firmware's code placement (`OCTRACE_CODE_IN`
 //! for the embedded-scene firmware; the live one's arenas fill the RAM, so
@@ -10,12 +11,11 @@
 
 use octrace_pico_build::{embed_scene, link, BuildError, CodePlacement, SceneKind};
 
-const DEFAULT_SCENE: &str = "../../scenes/fig5_1.txt";
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     let placement = CodePlacement::from_env().unwrap_or_else(|e| fail(e));
-    let scene = embed_scene(DEFAULT_SCENE).unwrap_or_else(|e| fail(e));
+    let scene = embed_scene().unwrap_or_else(|e| fail(e));
     link(&[
         ("octrace-pico-st7789", placement, scene),
         ("octrace-pico-live", CodePlacement::RenderInSram, SceneKind::Still),

@@ -1,6 +1,7 @@
 //! Puts `memory.x` where the linker finds it, and embeds the scene: the file
 //! `OCTRACE_SCENE` names (a path from this folder; default the thesis's
-//! figure 5.1, `../../scenes/fig5_1.txt`). The scene is checked here, on the
+//! figure 5.1, `scenes/fig5_1.txt` of the octrace checkout the dependencies
+//! come from, `octrace_pico_build::DEFAULT_SCENE`). The scene is checked here, on the
 //! host, with the parser the board runs: its errors fail the build with their
 //! line and column. `SceneProfile` holds exactly what it needs, its octree
 //! included, so the Pico's RAM holds just this scene (the linker says so if
@@ -17,7 +18,6 @@ use octrace_pico_build::{embed_still_scene, BuildError};
 use std::env;
 use std::path::PathBuf;
 
-const DEFAULT_SCENE: &str = "../../scenes/fig5_1.txt";
 
 fn main() {
     let out = PathBuf::from(env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
@@ -25,7 +25,7 @@ fn main() {
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed=memory.x");
     println!("cargo:rerun-if-changed=build.rs");
-    embed_still_scene(DEFAULT_SCENE).unwrap_or_else(|e| fail(e));
+    embed_still_scene().unwrap_or_else(|e| fail(e));
 }
 
 fn fail(error: BuildError) -> ! {

@@ -33,7 +33,7 @@ mod placement;
 mod scene;
 
 pub use placement::{link, CodePlacement};
-pub use scene::{embed_scene, embed_still_scene, SceneKind};
+pub use scene::{embed_scene, embed_still_scene, SceneKind, DEFAULT_SCENE};
 
 use std::fmt;
 

@@ -35,6 +35,12 @@ use std::path::PathBuf;
 /// The variable a user sets to pick the scene.
 const VARIABLE: &str = "OCTRACE_SCENE";
 
+/// The scene embedded when `OCTRACE_SCENE` is not set: the thesis's figure
+/// 5.1, `scenes/fig5_1.txt` of the octrace checkout this crate is built
+/// from (by path or by `git =`), so that a template copied out of the
+/// repository finds it as well as one built in place.
+pub const DEFAULT_SCENE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/fig5_1.txt");
+
 /// What the embedded scene is: what its firmware does with it, and so
 /// where its code runs ([`link`](crate::link) copies an animation's
 /// tracking into SRAM with the render path).
@@ -47,7 +53,7 @@ pub enum SceneKind {
 }
 
 /// Writes `OUT_DIR/scene.rs`: `SCENE_TEXT`, the scene `OCTRACE_SCENE` names
-/// (a path from the firmware's folder; `default` when it is not set),
+/// (a path from the firmware's folder; [`DEFAULT_SCENE`] when it is not set),
 /// `SCENE_NAME`, its file's name without the extension (what a firmware
 /// reports it drew), and `SceneProfile`, a `profile!` holding exactly what
 /// it needs; `ANIMATED` and `MOTION` (the tracks and keys an animation
@@ -58,8 +64,8 @@ pub enum SceneKind {
 ///     include!(concat!(env!("OUT_DIR"), "/scene.rs"));
 /// }
 /// ```
-pub fn embed_scene(default: &str) -> Result<SceneKind, BuildError> {
-    let (scene, path, text) = read_scene(default)?;
+pub fn embed_scene() -> Result<SceneKind, BuildError> {
+    let (scene, path, text) = read_scene()?;
     let (kind, source) = scene_source(&scene, &path, &text)?;
     write(&out_dir()?.join("scene.rs"), &source)?;
     Ok(kind)
@@ -67,11 +73,11 @@ pub fn embed_scene(default: &str) -> Result<SceneKind, BuildError> {
 
 /// Writes `OUT_DIR/scene.rs` for a firmware that draws one still picture
 /// with the camera rays' first hits alone (no light buffer, no animation):
-/// `SCENE_TEXT`, the scene `OCTRACE_SCENE` names (`default` when it is not
-/// set), and `SceneProfile`, exactly what it needs. The ESP32-C3's and the
+/// `SCENE_TEXT`, the scene `OCTRACE_SCENE` names ([`DEFAULT_SCENE`] when it
+/// is not set), and `SceneProfile`, exactly what it needs. The ESP32-C3's and the
 /// Pico 2's templates take it.
-pub fn embed_still_scene(default: &str) -> Result<(), BuildError> {
-    let (scene, path, text) = read_scene(default)?;
+pub fn embed_still_scene() -> Result<(), BuildError> {
+    let (scene, path, text) = read_scene()?;
     let needs = needed_by(&text, AccelMode::Auto, &OctreeConfig::DEFAULT, &mut |error| eprintln!("{scene}:{error}"))
         .map_err(|errors| BuildError::Scene { scene: scene.clone(), errors })?;
     let doc = format!("Exactly what `{scene}` needs, its octree included.");
@@ -82,18 +88,24 @@ pub fn embed_still_scene(default: &str) -> Result<(), BuildError> {
 }
 
 /// The scene `OCTRACE_SCENE` names (a path from the firmware's folder;
-/// `default` when it is not set): that name, its path and its text, both
-/// announced to cargo.
-fn read_scene(default: &str) -> Result<(String, PathBuf, String), BuildError> {
+/// [`DEFAULT_SCENE`] when it is not set): that name, its path and its
+/// text, both announced to cargo.
+fn read_scene() -> Result<(String, PathBuf, String), BuildError> {
     let manifest: PathBuf = std::env::var_os("CARGO_MANIFEST_DIR")
         .map(Into::into)
         .ok_or(BuildError::NotInBuildScript("CARGO_MANIFEST_DIR"))?;
     println!("cargo:rerun-if-env-changed={VARIABLE}");
-    let scene = std::env::var(VARIABLE).unwrap_or_else(|_| default.to_owned());
+    let given = std::env::var(VARIABLE).ok();
+    let scene = given.clone().unwrap_or_else(|| DEFAULT_SCENE.to_owned());
     let path = manifest.join(&scene);
     println!("cargo:rerun-if-changed={}", path.display());
-    let text = std::fs::read_to_string(&path)
-        .map_err(|error| BuildError::File { path: format!("{VARIABLE}={scene}"), error })?;
+    let text = std::fs::read_to_string(&path).map_err(|error| BuildError::File {
+        path: match given {
+            Some(_) => format!("{VARIABLE}={scene}"),
+            None => format!("the default scene {scene} ({VARIABLE} is not set)"),
+        },
+        error,
+    })?;
     Ok((scene, path, text))
 }
 
