@@ -22,5 +22,5 @@ pub use apng::ApngWriter;
 pub use changes::Area;
 pub use command::{animate, is_frame_file, merge_frames, Request};
 pub use frames::{render_frames, AnimationError, AnimationOptions, AnimationReport, FrameImage, COHERENCE_TILE};
-pub use gif::{gif_delay, GifWriter, GIF_FASTEST};
+pub use gif::{gif_delay, GifWriter};
 pub use writers::{FrameInfo, FramePattern, Output};
