@@ -16,7 +16,6 @@
 
 use octrace_pico_build::{embed_still_scene, BuildError};
 
-
 fn main() {
     // The memory map and linker scripts come from esp-hal (linkall.x).
     println!("cargo:rerun-if-changed=build.rs");

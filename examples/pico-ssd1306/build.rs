@@ -8,7 +8,6 @@
 
 use octrace_pico_build::{embed_scene, link, BuildError, CodePlacement};
 
-
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     let placement = CodePlacement::from_env().unwrap_or_else(|e| fail(e));

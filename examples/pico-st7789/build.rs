@@ -11,7 +11,6 @@
 
 use octrace_pico_build::{embed_scene, link, BuildError, CodePlacement, SceneKind};
 
-
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     let placement = CodePlacement::from_env().unwrap_or_else(|e| fail(e));

@@ -18,7 +18,6 @@ use octrace_pico_build::{embed_still_scene, BuildError};
 use std::env;
 use std::path::PathBuf;
 
-
 fn main() {
     let out = PathBuf::from(env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
     std::fs::copy("memory.x", out.join("memory.x")).expect("copy memory.x into OUT_DIR");
