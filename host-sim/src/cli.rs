@@ -1,16 +1,17 @@
 //! The `host-sim` command line.
 
-use crate::animation::{animate, is_frame_file, merge_frames, AnimationOptions, FramePattern, Output, Request};
-use crate::arguments::{not_the_scene, parse_size, same_file};
+use crate::animation::{animate, AnimationOptions, FramePattern, Request};
+use crate::arguments::{not_the_scene, parse_size};
 use crate::arguments::{output_format, parse_accel, parse_color, parse_dithering, parse_format, parse_palette};
 use crate::exit::ShownPath;
 use crate::options::{all_cores, Partition, RenderOptions};
 use crate::output::{panel_preview, write_atomically, FileSink};
-use crate::parts::{self, MergeError, PartInfo, PartSpec};
+use crate::parts::{self, PartInfo, PartSpec};
 use crate::render::{render_streamed, Streamed};
 use crate::rows::{Canvas, StreamError};
 use crate::scene::{load_frame_bytes, new_scene, HostScene, LoadError};
 use crate::terminal::progress_bar;
+use crate::{convert, merge};
 use clap::Parser;
 use octrace_core::accel::OctreeConfig;
 use octrace_core::panel::{Dithering, Panel};
@@ -254,73 +255,6 @@ fn argument_error(e: &clap::Error) -> String {
     )
 }
 
-fn convert(input: &Path, output: &Path, format: Option<Format>) -> Result<(), CliError> {
-    let format = output_format(format, output)?;
-    let bytes = std::fs::read(input).map_err(|e| CliError::read(input, e))?;
-    // Converted in place, a file would lose what only its own format holds
-    // (octrace's metadata, which merge reads) for nothing.
-    if same_file(input, output) {
-        return Err(CliError::Invalid(format!(
-            "convert: refusing to write over {}, the file it converts: name another OUT",
-            ShownPath(input)
-        )));
-    }
-    if let Some(frames) = animated_png_frames(&bytes) {
-        return Err(CliError::Invalid(format!(
-            "{}: an animated PNG of {frames} frames; convert takes still images (host-sim writes an animation's \
-             frames one file each with OUT 'f%04d.png')",
-            ShownPath(input)
-        )));
-    }
-    let image = formats::read(&bytes).map_err(|e| CliError::Invalid(format!("{}: {e}", ShownPath(input))))?;
-    write_atomically(output, |f| formats::write(&image, format, f).map_err(std::io::Error::other))
-        .map_err(|e| CliError::write(output, e))
-}
-
-/// The frames of an animated PNG (an `acTL` chunk with more than one);
-/// `None` for anything else.
-fn animated_png_frames(bytes: &[u8]) -> Option<u32> {
-    let reader = png::Decoder::new(std::io::Cursor::new(bytes)).read_info().ok()?;
-    reader.info().animation_control().map(|control| control.num_frames).filter(|&frames| frames > 1)
-}
-
-fn merge(output: &Path, parts: &[PathBuf], format: Option<Format>) -> Result<(), CliError> {
-    let format = output_format(format, output).map_err(|e| match Output::of(output, None) {
-        Ok(Output::Gif) => CliError::Invalid(format!(
-            "merge: {}: a still's band parts merge into a PNG, Targa or Sun raster image, and a GIF is assembled \
-             from an animation's frame files; nothing written",
-            ShownPath(output)
-        )),
-        _ => e,
-    })?;
-    let refused = |e: MergeError| {
-        let message = format!("merge: {e}; nothing written");
-        match e {
-            MergeError::Refused(_) => CliError::Invalid(message),
-            MergeError::Io { .. } | MergeError::Output(_) => CliError::Io(message),
-        }
-    };
-    let (ordered, header) = parts::check_parts(parts).map_err(refused)?;
-    // A part that fails while its rows are read is the part's fault, not
-    // the output's: kept aside from the write's own failures.
-    let mut unread = None;
-    let written = write_atomically(output, |f| match parts::write_merged(&ordered, &header, format, f) {
-        Err(MergeError::Output(FormatError::Io(e))) => Err(e),
-        Err(MergeError::Output(e)) => Err(std::io::Error::other(e)),
-        Err(e) => {
-            let message = e.to_string();
-            unread = Some(e);
-            Err(std::io::Error::other(message))
-        }
-        Ok(()) => Ok(()),
-    });
-    match (written, unread) {
-        (_, Some(e)) => Err(refused(e)),
-        (Err(e), None) => Err(CliError::Io(format!("merge: cannot write {}: {e}", ShownPath(output)))),
-        (Ok(()), None) => Ok(()),
-    }
-}
-
 /// The rows to render and the text to carry for `--part`, checked against the image and the options.
 fn part_of(
     spec: PartSpec,
@@ -420,37 +354,8 @@ fn preview(
 
 fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     match &args.command {
-        Some(Command::Convert { input, output, format }) => return convert(input, output, *format),
-        Some(Command::Merge { output, parts, format }) => {
-            if let Some(part) = parts.iter().find(|part| same_file(part, output)) {
-                return Err(CliError::Invalid(format!(
-                    "merge: refusing to write over {}, one of the files it merges; nothing written",
-                    ShownPath(part)
-                )));
-            }
-            // A file that cannot be opened is said so, before it is taken
-            // for a kind of file it is not.
-            for part in parts {
-                std::fs::File::open(part).map_err(|e| CliError::read(part, e))?;
-            }
-            // Frame files or band parts, one kind at a time.
-            let frames: Vec<bool> = parts.iter().map(|part| is_frame_file(part)).collect();
-            if let Some(other) = frames.iter().position(|&frame| frame != frames[0]) {
-                let kind = |frame: bool| if frame { "an animation's frame file" } else { "not a frame file" };
-                return Err(CliError::Invalid(format!(
-                    "merge: {} is {} and {} {}: merge a still's band parts or an animation's frame files; nothing \
-                     written",
-                    ShownPath(&parts[0]),
-                    kind(frames[0]),
-                    ShownPath(&parts[other]),
-                    kind(frames[other])
-                )));
-            }
-            return match frames.first() == Some(&true) {
-                true => merge_frames(output, parts, *format, stderr),
-                false => merge(output, parts, *format),
-            };
-        }
+        Some(Command::Convert { input, output, format }) => return convert::run(input, output, *format),
+        Some(Command::Merge { output, parts, format }) => return merge::run(output, parts, *format, stderr),
         // run() serves the studio and talks to boards (both need stdout)
         // instead of calling this.
         Some(Command::Studio(_) | Command::Board(_)) => return Ok(()),
