@@ -1,6 +1,6 @@
 //! The build-script half of `octrace-pico`: what a Pico template's
 //! `build.rs` does, in three calls. [`embed_scene`] reads the scene
-//! `OCTRACE_SCENE` names, checks it with the parser the board runs and
+//! `OCTRACE_SCENE` names (else [`DEFAULT_SCENE`]), checks it with the parser the board runs and
 //! writes it into `OUT_DIR/scene.rs` with a capacity profile holding
 //! exactly what it needs, and says whether it is a still or an animation
 //! ([`SceneKind`]); [`link`] puts the RP2040's memory map where the
@@ -15,7 +15,7 @@
 //!
 //! fn main() {
 //!     let placement = CodePlacement::from_env().unwrap_or_else(|e| fail(e));
-//!     let scene = embed_scene("../../scenes/fig5_1.txt").unwrap_or_else(|e| fail(e));
+//!     let scene = embed_scene().unwrap_or_else(|e| fail(e));
 //!     link(&[("my-firmware", placement, scene)]).unwrap_or_else(|e| fail(e));
 //! }
 //!
