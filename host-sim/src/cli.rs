@@ -10,7 +10,7 @@ use crate::parts::{self, PartInfo, PartSpec};
 use crate::render::{render_streamed, Streamed};
 use crate::rows::{Canvas, StreamError};
 use crate::scene::{load_frame_bytes, new_scene, HostScene, LoadError};
-use crate::terminal::progress_bar;
+use crate::terminal::{progress_bar, Threads};
 use crate::{convert, merge};
 use clap::Parser;
 use octrace_core::accel::OctreeConfig;
@@ -91,18 +91,18 @@ pub struct Args {
     #[arg(long, value_name = "MODE", default_value = "auto", value_parser = parse_accel)]
     pub accel: AccelMode,
     /// Octree criterion: a box holding more objects than this is subdivided
-    /// (refused with --accel naive, which builds no octree).
+    /// (refused where no octree is built).
     #[arg(long, value_name = "N", help = format!(
-        "Octree criterion: a box holding more objects than this is subdivided (refused with --accel naive, which \
-         builds no octree) [default: {}]",
+        "Octree criterion: a box holding more objects than this is subdivided (refused where no octree is built: \
+         --accel naive, or auto on 16 objects or fewer) [default: {}]",
         crate::options::OCTREE.max_objects
     ))]
     pub max_objects: Option<usize>,
     /// Octree criterion: boxes are not subdivided below this depth (at most
-    /// 18; refused with --accel naive).
+    /// 18; refused where no octree is built).
     #[arg(long, value_name = "D", value_parser = clap::value_parser!(u32).range(0..=18), help = format!(
-        "Octree criterion: boxes are not subdivided below this depth (at most 18; refused with --accel naive) \
-         [default: {}]",
+        "Octree criterion: boxes are not subdivided below this depth (at most 18; refused where no octree is \
+         built) [default: {}]",
         crate::options::OCTREE.max_depth
     ))]
     pub max_depth: Option<u32>,
@@ -159,8 +159,8 @@ pub enum Command {
     },
     /// Stack the parts rendered with `--part I/N` into the whole image,
     /// bit-identical to rendering it at once; or assemble an animation's
-    /// frame files (`OUT 'f%04d.png'`) into its GIF (OUTPUT.gif) or APNG
-    /// (OUTPUT.png). Refuses (exit 2, nothing written) parts or frames of
+    /// frame files (rendered to `OUT 'f%04d.png'`, given as `f*.png`) into
+    /// its GIF (OUTPUT.gif) or APNG (OUTPUT.png). Refuses (exit 2, nothing written) parts or frames of
     /// other scenes, sizes or palettes, parts that leave rows out or hold a
     /// row twice, and frames missing or given twice.
     Merge {
@@ -332,12 +332,12 @@ fn preview(
         let (image, stats) = (&image, rendered.stats);
         let _ = writeln!(
             stderr,
-            "{}x{} in {:.3} s ({}, {} threads): {} rays, {} shadow rays, {} cells -> {} ({} panel{})",
+            "{}x{} in {:.3} s ({}, {}): {} rays, {} shadow rays, {} cells -> {} ({} panel{})",
             image.width,
             image.height,
             started.elapsed().as_secs_f64(),
             rendered.accel.name(),
-            options.threads,
+            Threads(options.threads),
             stats.rays,
             stats.shadow_rays,
             stats.cells,
@@ -440,11 +440,17 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         )));
     }
     not_the_scene(scene_path, &out)?;
-    if args.accel == AccelMode::Naive && (args.max_objects.is_some() || args.max_depth.is_some()) {
+    let objects = scene.view().objects.len();
+    if args.accel.resolve(objects) == AccelMode::Naive && (args.max_objects.is_some() || args.max_depth.is_some()) {
         let option = if args.max_objects.is_some() { "--max-objects" } else { "--max-depth" };
-        return Err(CliError::Invalid(format!(
-            "{option} shapes the octree, and --accel naive builds none: give --accel octree or dda"
-        )));
+        let why = match args.accel {
+            AccelMode::Auto => format!(
+                "--accel auto tests {name}'s {objects} objects without one (up to {})",
+                AccelMode::AUTO_NAIVE_UP_TO
+            ),
+            _ => "--accel naive builds none".into(),
+        };
+        return Err(CliError::Invalid(format!("{option} shapes the octree, and {why}: give --accel octree or dda")));
     }
     let options = |(w, h)| RenderOptions {
         size: Some((w, h)),
@@ -563,15 +569,14 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         }
         let _ = writeln!(
             stderr,
-            "{w}x{h}{} in {:.3} s ({}, {} thread{}, tracing {:.3} s{}{}): {} rays, {} shadow rays, {} cells{} -> {}",
+            "{w}x{h}{} in {:.3} s ({}, {}, tracing {:.3} s{}{}): {} rays, {} shadow rays, {} cells{} -> {}",
             match args.part {
                 Some(_) => format!(" rows {}..{}", rows.start, rows.end),
                 None => String::new(),
             },
             elapsed.as_secs_f64(),
             rendered.accel.name(),
-            options.threads,
-            if options.threads == 1 { "" } else { "s" },
+            Threads(options.threads),
             rendered.tracing().as_secs_f64(),
             if options.threads == 1 { "" } else { " summed over the threads" },
             // Shown from a millisecond: what a scene of many objects spends

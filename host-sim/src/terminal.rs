@@ -9,6 +9,15 @@ use indicatif::{ProgressBar, ProgressStyle};
 use octrace_core::parse::escaped_in_messages;
 use std::io::IsTerminal;
 
+/// A count of threads as a summary line says it: "1 thread", "2 threads".
+pub(crate) struct Threads(pub usize);
+
+impl std::fmt::Display for Threads {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} thread{}", self.0, if self.0 == 1 { "" } else { "s" })
+    }
+}
+
 /// A progress bar of `total` steps on stderr, if it is a terminal and
 /// the run is not `quiet`.
 pub(crate) fn progress_bar(total: u64, quiet: bool) -> Option<ProgressBar> {

@@ -323,6 +323,10 @@ fn options_that_would_do_nothing_are_refused() {
     ];
     let (code, err) = run_args(&args);
     assert!(code == 2 && err.contains("--max-objects shapes the octree, and --accel naive builds none"), "{err}");
+    // auto, which tests a scene of a handful of objects without one, the same.
+    let (code, err) = run_args(&[scene.as_os_str(), out.as_os_str(), "--max-depth".as_ref(), "3".as_ref()]);
+    assert!(code == 2 && err.contains("--max-depth shapes the octree, and --accel auto tests "), "{err}");
+    assert!(err.contains(" objects without one (up to 16): give --accel octree or dda"), "{err}");
     // convert onto its own input: refused, the file as it was.
     let png = dir.path().join("a.png");
     assert_eq!(run_args(&[scene.as_os_str(), png.as_os_str()]).0, 0);

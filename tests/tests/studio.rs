@@ -503,13 +503,13 @@ fn the_server_keeps_its_security_rules() {
     let wrong = "0".repeat(studio.token.len());
     assert_eq!(http(port, "GET", &format!("/?token={wrong}"), &[], b"").0, 403);
     assert_eq!(http(port, "PUT", "/scene", &[("If-Match", "*")], b"x").0, 403);
-    // Without --board there is no board to send to (the rules come first).
+    // Without --board there is no board to send to (the rules come first);
+    // asked which board, the answer is none.
     assert_eq!(http(port, "POST", "/board", &[], START.as_bytes()).0, 403);
-    for method in ["GET", "POST"] {
-        let (status, body) = http(port, method, &with_token("/board"), &[], START.as_bytes());
-        assert_eq!(status, 404, "{method} /board");
-        assert!(String::from_utf8_lossy(&body).contains("without --board"), "{}", String::from_utf8_lossy(&body));
-    }
+    let (status, body) = http(port, "POST", &with_token("/board"), &[], START.as_bytes());
+    assert_eq!(status, 404, "POST /board");
+    assert!(String::from_utf8_lossy(&body).contains("without --board"), "{}", String::from_utf8_lossy(&body));
+    assert_eq!(http(port, "GET", &with_token("/board"), &[], b""), (200, b"{\"port\":null}".to_vec()));
 
     // A foreign Host (DNS rebinding), even with the token.
     for host in [
@@ -543,8 +543,9 @@ fn the_server_keeps_its_security_rules() {
     // A request refused is answered from its head: the body it announces is
     // never waited for nor held (16 MB announced, none sent, answered at
     // once; a body read first would have waited 10 s for it and said 400).
-    // A head with a second Host, or token, is refused: the copy checked
-    // could differ from another one read. A HEAD answer has no body.
+    // A head with a second Host, or token (a header's, the query's, or one
+    // of each), is refused: the copy checked could differ from another one
+    // read. A HEAD answer has no body.
     for head in [
         format!("PUT /scene HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Length: 16000000\r\n\r\n"),
         format!("GET /scene?{token} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nHost: evil.example\r\n\r\n"),
@@ -552,6 +553,8 @@ fn the_server_keeps_its_security_rules() {
             "GET /scene HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nX-Studio-Token: {}\r\nX-Studio-Token: x\r\n\r\n",
             studio.token
         ),
+        format!("GET /scene?{token}&token=x HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n\r\n"),
+        format!("GET /scene?{token} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nX-Studio-Token: x\r\n\r\n"),
         format!("HEAD /{}/ HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n\r\n", studio.token),
     ] {
         let mut stream = std::net::TcpStream::connect(("127.0.0.1", port)).expect("connects");
@@ -876,6 +879,12 @@ fn the_editor_highlights_the_cores_keywords_marks_errors_and_keeps_one_history()
     let typed = scene_text(&browser);
     assert!(typed.starts_with(START) && typed.contains("RDEPTH 2"), "{typed}");
     press(&browser, "\u{E00C}"); // Escape: the scene's panel
+                                 // Its lights are numbered among the lights, not among the statements.
+    let lights = browser.run(
+        "return [...document.querySelectorAll('#panel input')].map((i) => i.dataset.field)
+           .filter((f) => f.startsWith('light'));",
+    );
+    assert_eq!(lights, serde_json::json!(["light 1 brightness"]));
     browser.run(
         "const i = document.querySelector('#panel input[data-field=\"background r\"]');
          i.value = '0.5'; i.dispatchEvent(new Event('change')); return true;",

@@ -14,7 +14,7 @@ use crate::arguments::not_the_scene;
 use crate::exit::{CliError, ShownPath};
 use crate::output::{is_stream, refuse_read_only, replace_with, temporary_beside, write_atomically};
 use crate::parts::{auto_index, band_rows, scene_hash, PartSpec, Render};
-use crate::terminal::progress_bar;
+use crate::terminal::{progress_bar, Threads};
 use octrace_core::scene::Frames;
 use octrace_images::formats::{Format, FormatError, Image, RowReader};
 use octrace_images::palette::{self, PaletteMode};
@@ -218,13 +218,13 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
         let share = 100.0 * report.traced as f64 / report.pixels.max(1) as f64;
         let _ = writeln!(
             stderr,
-            "{} frames of {} ({} a second) in {:.3} s ({} threads, {}): {:.1} % of the pixels traced, \
+            "{} frames of {} ({} a second) in {:.3} s ({}, {}): {:.1} % of the pixels traced, \
              loading {:.3} s, tracing {:.3} s: {} rays, {} shadow rays -> {}",
             report.frames,
             frames.count,
             frames.rate,
             started.elapsed().as_secs_f64(),
-            request.options.render.threads,
+            Threads(request.options.render.threads),
             if request.options.coherence { "coherence" } else { "every frame whole" },
             share,
             report.loading.as_secs_f64(),

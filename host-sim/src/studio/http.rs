@@ -25,8 +25,9 @@ impl Request {
         self.headers.iter().find(|(n, _)| n == name).map(|(_, v)| v.as_str())
     }
 
-    pub(crate) fn query(&self, name: &str) -> Option<&str> {
-        self.query.iter().find(|(n, _)| n == name).map(|(_, v)| v.as_str())
+    /// Every value of `name` in the query, in order.
+    pub(crate) fn queries<'r>(&'r self, name: &'r str) -> impl Iterator<Item = &'r str> + 'r {
+        self.query.iter().filter(move |(n, _)| n == name).map(|(_, v)| v.as_str())
     }
 }
 
@@ -219,7 +220,7 @@ mod tests {
         let raw = b"PUT /scene?token=a%62c HTTP/1.1\r\nHost: 127.0.0.1:9\r\nContent-Length: 3\r\n\r\nabcdef";
         let request = read_request(&raw[..], 10).unwrap();
         assert_eq!((request.method.as_str(), request.path.as_str()), ("PUT", "/scene"));
-        assert_eq!(request.query("token"), Some("abc"));
+        assert_eq!(request.queries("token").collect::<Vec<_>>(), ["abc"]);
         assert_eq!(request.header("host"), Some("127.0.0.1:9"));
         assert_eq!(request.body, b"abc");
     }

@@ -298,7 +298,13 @@ fn admit(request: &Request, shared: &Shared) -> Result<Route, Response> {
         Some((first, _)) if http::same_secret(first, &shared.token) => (true, &request.path[first.len() + 1..]),
         _ => (false, request.path.as_str()),
     };
-    let named = request.query("token").or_else(|| request.header("x-studio-token"));
+    // One copy of the token at most, in the query or the header: the copy
+    // checked could differ from another one read.
+    let mut copies = request.queries("token").chain(request.header("x-studio-token"));
+    let named = copies.next();
+    if copies.next().is_some() {
+        return Err(Response::text(400, "the token is given more than once: give it once"));
+    }
     let token_given = named.is_some_and(|t| http::same_secret(t, &shared.token));
     if !(token_given || (in_path && matches!(request.method.as_str(), "GET" | "HEAD"))) {
         return Err(Response::text(403, "a token is needed: open the address host-sim studio printed"));
@@ -319,6 +325,11 @@ fn respond(request: &Request, route: &Route, shared: &Shared) -> Response {
         }
         ("GET", "/scene") => get_scene(shared),
         ("PUT", "/scene") => put_scene(request, shared),
+        // Asked by the page as it opens: no board is an answer, not an
+        // error (a 404 the browser's console would report).
+        ("GET", "/board") if shared.board.is_none() => {
+            Response::new(200, "application/json", b"{\"port\":null}".to_vec())
+        }
         ("GET", "/board") => with_board(shared, BoardSender::status),
         ("POST", "/board") => with_board(shared, |board| board.send(&scene_name(shared), &request.body)),
         ("GET" | "HEAD", "/keywords.js") => {

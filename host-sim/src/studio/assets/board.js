@@ -18,6 +18,7 @@ export function createBoard(app) {
     const response = await api('/board');
     if (!response.ok) return;
     port = (await response.json()).port;
+    if (port === null) return;
     button.disabled = false;
     button.title = `Send the scene to the board at ${port} (Ctrl+Shift+Enter)`;
   }

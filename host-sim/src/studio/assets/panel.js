@@ -63,8 +63,11 @@ export function createPanel(app) {
       const raster = single('RASTER', [320, 240]);
       panel.append(numberInput('RASTER w', raster[0], (v) => setSingle('RASTER', [Math.round(v), single('RASTER', [320, 240])[1]]), 1));
       panel.append(numberInput('RASTER h', raster[1], (v) => setSingle('RASTER', [single('RASTER', [320, 240])[0], Math.round(v)]), 1));
+      // Lights numbered as the file has them, first to last (i is the
+      // statement's place among all statements).
+      let light = 0;
       model.forEach((l, i) => {
-        if (l.keyword === 'LIGHT') panel.append(numberInput(`light ${i} brightness`, l.args[0], (v) => { const a = l.args.slice(); a[0] = v; replaceStatement(i, 'LIGHT', a); }));
+        if (l.keyword === 'LIGHT') panel.append(numberInput(`light ${++light} brightness`, l.args[0], (v) => { const a = l.args.slice(); a[0] = v; replaceStatement(i, 'LIGHT', a); }));
       });
     }
   }
