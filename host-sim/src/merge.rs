@@ -25,14 +25,15 @@ pub(crate) fn run(
             ShownPath(part)
         )));
     }
-    // A file that cannot be opened is said so, before it is taken
-    // for a kind of file it is not.
-    for part in parts {
-        std::fs::File::open(part)
-            .map_err(|e| CliError::Io(format!("merge: cannot read {}: {e}; nothing written", ShownPath(part))))?;
-    }
-    // Frame files or band parts, one kind at a time.
-    let frames: Vec<bool> = parts.iter().map(|part| is_frame_file(part)).collect();
+    // Frame files or band parts, one kind at a time; a file that cannot be
+    // opened is said so, not taken for a kind of file it is not.
+    let frames = parts
+        .iter()
+        .map(|part| {
+            is_frame_file(part)
+                .map_err(|e| CliError::Io(format!("merge: cannot read {}: {e}; nothing written", ShownPath(part))))
+        })
+        .collect::<Result<Vec<bool>, _>>()?;
     if let Some(other) = frames.iter().position(|&frame| frame != frames[0]) {
         let kind = |frame: bool| if frame { "an animation's frame file" } else { "not a frame file" };
         return Err(CliError::Invalid(format!(

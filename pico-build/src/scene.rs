@@ -96,7 +96,7 @@ fn read_scene() -> Result<(String, PathBuf, String), BuildError> {
         .ok_or(BuildError::NotInBuildScript("CARGO_MANIFEST_DIR"))?;
     println!("cargo:rerun-if-env-changed={VARIABLE}");
     let given = std::env::var(VARIABLE).ok();
-    let scene = given.clone().unwrap_or_else(|| DEFAULT_SCENE.to_owned());
+    let scene = given.as_deref().unwrap_or(DEFAULT_SCENE).to_owned();
     let path = manifest.join(&scene);
     println!("cargo:rerun-if-changed={}", path.display());
     let text = std::fs::read_to_string(&path).map_err(|error| BuildError::File {

@@ -262,10 +262,11 @@ fn into_io(e: FormatError) -> std::io::Error {
     }
 }
 
-/// Whether `path` is a frame file (its metadata says so).
-pub fn is_frame_file(path: &Path) -> bool {
-    let Ok(file) = std::fs::File::open(path) else { return false };
-    RowReader::new(file).is_ok_and(|r| r.header().text.as_deref().and_then(FrameInfo::parse).is_some())
+/// Whether `path` is a frame file (its metadata says so), or why it cannot
+/// be opened.
+pub fn is_frame_file(path: &Path) -> std::io::Result<bool> {
+    let file = std::fs::File::open(path)?;
+    Ok(RowReader::new(file).is_ok_and(|r| r.header().text.as_deref().and_then(FrameInfo::parse).is_some()))
 }
 
 /// `host-sim merge OUT FRAMES…`: frame files rendered apart, assembled into

@@ -97,12 +97,11 @@ pub(super) fn read(bytes: &[u8]) -> Result<Image, FormatError> {
     let header = decoder.read_header_info().map_err(decoding_error)?;
     let (width, height) = (header.width, header.height);
     // An 8-bit gray file (what `write_gray` writes) is read as indices
-    // into the 256 grays.
-    let gray = (header.color_type, header.bit_depth) == (png::ColorType::Grayscale, png::BitDepth::Eight);
-    // With alpha, 8-bit RGB and gray are read as without, once every
-    // pixel is found opaque.
+    // into the 256 grays. With alpha, 8-bit RGB and gray are read as
+    // without, once every pixel is found opaque.
+    let gray = header.bit_depth == png::BitDepth::Eight
+        && matches!(header.color_type, png::ColorType::Grayscale | png::ColorType::GrayscaleAlpha);
     let with_alpha = matches!(header.color_type, png::ColorType::Rgba | png::ColorType::GrayscaleAlpha);
-    let gray = gray || (header.color_type, header.bit_depth) == (png::ColorType::GrayscaleAlpha, png::BitDepth::Eight);
     let bits = match (header.color_type, header.bit_depth) {
         (png::ColorType::Rgb, png::BitDepth::Eight) => 24,
         (png::ColorType::Rgba, png::BitDepth::Eight) => 32,

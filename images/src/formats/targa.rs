@@ -136,9 +136,8 @@ pub(super) fn read(bytes: &[u8]) -> Result<Image, FormatError> {
     };
     let pixels = orient(&stored, width as usize, pixel_bytes, descriptor);
     let (width, height) = (u32::from(width), u32::from(height));
-    let alpha_of = |colours: &[u8], bytes: usize| alpha(colours, bytes, descriptor);
     if !mapped {
-        if let Some(alpha) = alpha_of(&pixels, pixel_bytes) {
+        if let Some(alpha) = alpha(&pixels, pixel_bytes, descriptor) {
             opaque(alpha.into_iter(), width, "a Targa image of 32-bit pixels")?;
         }
         return Ok(Image::Rgb(RgbImage { width, height, data: pick(&pixels, pixel_bytes, BGR) }));
@@ -150,7 +149,7 @@ pub(super) fn read(bytes: &[u8]) -> Result<Image, FormatError> {
         None => invalid(format!("Targa pixel value {value} is below the colour map's first entry {map_first}")),
     };
     let indices: Vec<u8> = pixels.iter().map(index).collect::<Result<_, _>>()?;
-    if let Some(alpha) = alpha_of(map, map_entry_bytes) {
+    if let Some(alpha) = alpha(map, map_entry_bytes, descriptor) {
         let used = indices.iter().map(|&i| alpha.get(usize::from(i)).copied().unwrap_or(u8::MAX));
         opaque(used, width, "a Targa image of 32-bit colour map entries")?;
     }
@@ -162,8 +161,11 @@ pub(super) fn read(bytes: &[u8]) -> Result<Image, FormatError> {
 /// descriptor counts attribute bits, unless it is zero throughout, as
 /// writers without alpha leave it.
 fn alpha(colours: &[u8], bytes: usize, descriptor: u8) -> Option<Vec<u8>> {
-    let alpha: Vec<u8> = colours.chunks_exact(bytes).map(|c| c[bytes - 1]).collect();
-    (bytes == 4 && descriptor & ATTRIBUTE_BITS != 0 && alpha.iter().any(|&a| a != 0)).then_some(alpha)
+    if bytes != 4 || descriptor & ATTRIBUTE_BITS == 0 {
+        return None;
+    }
+    let alpha: Vec<u8> = colours.chunks_exact(bytes).map(|c| c[3]).collect();
+    alpha.iter().any(|&a| a != 0).then_some(alpha)
 }
 
 /// Targa run-length packets expanded to `count` pixels of `pixel_bytes` each.
