@@ -28,9 +28,13 @@ export function wireOled(controller, gpio, now, options = {}) {
     setUpEnd: null,
     ledOn: null,
     ledOff: null,
-    /** The picture's transfer: its first START and last STOP after the LED went out. */
+    /**
+     * The picture's transfer: its first START and last STOP after the LED
+     * went out, before it lit again (an animation's next frame).
+     */
     transferStart: null,
     transferEnd: null,
+    relit: false,
     transfers: 0,
   };
   controller.onBusEvent = (event) => {
@@ -40,13 +44,15 @@ export function wireOled(controller, gpio, now, options = {}) {
       if (events.ledOff !== null && events.transferStart === null) events.transferStart = time;
     } else {
       events.lastStop = time;
-      if (events.ledOff !== null) events.transferEnd = time;
+      if (events.ledOff !== null && !events.relit) events.transferEnd = time;
     }
   };
   gpio[OLED_WIRING.led].addListener((state) => {
     if (state === GPIOPinState.High && events.ledOn === null) {
       events.ledOn = now();
       events.setUpEnd = events.lastStop;
+    } else if (state === GPIOPinState.High && events.ledOff !== null) {
+      events.relit = true;
     } else if (state === GPIOPinState.Low && events.ledOn !== null && events.ledOff === null) {
       events.ledOff = now();
     }
@@ -59,7 +65,8 @@ export function wireOled(controller, gpio, now, options = {}) {
  * set-up and clearing, the last transfer before the LED lit), parse and
  * index (up to the LED: the template lights it as it starts tracing),
  * render (while it is lit), the picture's transfer (its first START to its
- * last STOP after the LED went out), and the first full panel (render and
+ * last STOP after the LED went out, before an animation's next frame lit
+ * it again), and the first full panel (render and
  * transfer: the picture whole on the panel, from the picture's start).
  */
 function phases(events) {
