@@ -1,6 +1,6 @@
 //! The `host-sim` command line.
 
-use crate::animation::{animate, AnimationOptions, FramePattern, Request};
+use crate::animation::{animate, check_frames, AnimationOptions, FramePattern, Request};
 use crate::arguments::{not_the_scene, parse_size};
 use crate::arguments::{output_format, parse_accel, parse_color, parse_dithering, parse_format, parse_palette};
 use crate::exit::ShownPath;
@@ -503,6 +503,11 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         }
         None => (0..h, None),
     };
+    if args.frame.is_some() {
+        // A scene is valid or not whichever frame is asked for: a camera
+        // lost at another frame refuses this one as it refuses the loop.
+        check_frames(scene_path, &scene_bytes, &out)?;
+    }
     let started = Instant::now();
     let options = options((w, h));
     if previewed(args.color) {

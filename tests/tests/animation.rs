@@ -432,18 +432,26 @@ fn animation_errors_name_the_place_and_leave_no_file() {
         assert_eq!(code, 2, "{args:?}: {err}");
         assert!(err.contains(message), "{args:?}: {err}");
     }
-    // A camera lost at frame 3 only: every file of the run goes.
+    // A camera lost at frame 6 only: every file of the run goes. A frame
+    // asked for alone, or a band of one, is refused alike: the scene is
+    // valid or not whichever frame is drawn.
     let text = std::fs::read_to_string(d.join("anim.txt")).unwrap();
     let lost = text.replace("ORIGIN    0 0.6 0", "ORIGIN    0 0.6 0 MOVE 0 0 0 0  6 0 2.6 11");
     std::fs::write(d.join("lost.txt"), lost).unwrap();
-    for out in ["y.gif", "y%d.png"] {
-        let (code, err) = host_sim(d, &["lost.txt", out]);
-        assert_eq!(code, 2, "{err}");
+    for args in [
+        &["lost.txt", "y.gif"][..],
+        &["lost.txt", "y%d.png"],
+        &["lost.txt", "y.png", "--frame", "0"],
+        &["lost.txt", "y.png", "--frame", "0", "--part", "1/2"],
+    ] {
+        let (code, err) = host_sim(d, args);
+        assert_eq!(code, 2, "{args:?}: {err}");
         // ORIGIN reaches VIEWPOINT within a unit of rounding: no view, or
         // one along UPVECTOR. Found as frame 0 loads, which checks every
         // frame's camera before any is drawn (the message names the frame,
         // the summary no other).
-        assert!(err.contains("lost.txt:9:19: at frame 6, ") && err.contains("in lost.txt; nothing rendered"), "{err}");
+        let found = err.contains("lost.txt:9:19: at frame 6, ") && err.contains("in lost.txt; nothing rendered");
+        assert!(found, "{args:?}: {err}");
     }
     let mut after = files(d);
     after.retain(|f| f != "lost.txt");

@@ -7,7 +7,7 @@
 //! `file:line:col` with exit code 2, as for a still.
 
 use super::apng::ApngWriter;
-use super::frames::{render_frames, AnimationError, AnimationOptions, AnimationReport, FrameImage};
+use super::frames::{check_every_frame, render_frames, AnimationError, AnimationOptions, AnimationReport, FrameImage};
 use super::gif::{gif_delay, GifWriter, GIF_FASTEST};
 use super::writers::{write_frame_file, FrameInfo, Output};
 use crate::arguments::not_the_scene;
@@ -36,6 +36,27 @@ pub struct Request<'a> {
     pub size: (u32, u32),
     pub options: AnimationOptions,
     pub quiet: bool,
+}
+
+/// Refuses a frame asked for alone (`--frame K`) of an animation that does
+/// not load at every frame with the error the whole loop's render gives.
+pub fn check_frames(scene_path: &Path, bytes: &[u8], out: &Path) -> Result<(), CliError> {
+    check_every_frame(bytes).map_err(|e| refused(e, scene_path, out))
+}
+
+/// The command line's error for rendering the animation at `scene_path`
+/// into `out`: a scene's errors at `file:line:col`, as for a still.
+fn refused(e: AnimationError, scene_path: &Path, out: &Path) -> CliError {
+    let name = ShownPath(scene_path).to_string();
+    match e {
+        AnimationError::Scene { frame, errors } => CliError::Scene {
+            file: frame.map_or_else(|| name.clone(), |frame| format!("{name} (frame {frame})")),
+            errors: errors.into_iter().map(|e| format!("{name}:{e}")).collect(),
+        },
+        AnimationError::Setup(message) => CliError::Invalid(message),
+        AnimationError::Stopped => CliError::stopped(),
+        AnimationError::Write(e) => CliError::write(out, e),
+    }
 }
 
 /// Renders the animation `request` asks for and writes it.
@@ -81,16 +102,7 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
     let started = Instant::now();
     let bar = progress_bar(u64::from(range.len() as u32), request.quiet);
     let progress = |_: u64| {};
-    let name = ShownPath(request.scene_path).to_string();
-    let scene_error = |e: AnimationError| match e {
-        AnimationError::Scene { frame, errors } => CliError::Scene {
-            file: frame.map_or_else(|| name.clone(), |frame| format!("{name} (frame {frame})")),
-            errors: errors.into_iter().map(|e| format!("{name}:{e}")).collect(),
-        },
-        AnimationError::Setup(message) => CliError::Invalid(message),
-        AnimationError::Stopped => CliError::stopped(),
-        AnimationError::Write(e) => CliError::write(request.out, e),
-    };
+    let scene_error = |e: AnimationError| refused(e, request.scene_path, request.out);
     let mut outcome: Option<Result<AnimationReport, AnimationError>> = None;
     let mut render = |each: &mut dyn FnMut(u32, &FrameImage) -> std::io::Result<()>| {
         let mut counted = |frame: u32, image: &FrameImage| {

@@ -15,11 +15,11 @@ use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{OriginDimensions, Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
-use octrace_core::animation::{AnimationNeeds, HostAnimationRoom};
+use octrace_core::animation::{Animation, AnimationNeeds, HostAnimationRoom};
 use octrace_core::profile::Host;
 use octrace_core::render::PixelSample;
 use octrace_core::shade::Stats;
-use octrace_core::{AnimationError as Refused, DrawError, Frame, RendererRoom};
+use octrace_core::{AnimationError as Refused, DrawError, Frame, Raytracer, RendererRoom};
 use octrace_images::{RgbImage, SampleImage, NO_OBJECT};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -86,6 +86,36 @@ pub struct AnimationOptions {
     pub coherence: bool,
 }
 
+/// Whether the animation `bytes` loads at every frame, its camera
+/// included: the check [`render_frames`] makes as it loads the first, for
+/// a frame asked for alone (a scene is valid or not whichever frame is
+/// drawn).
+pub fn check_every_frame(bytes: &[u8]) -> Result<(), AnimationError> {
+    // Tiles are not traced here: one is room enough.
+    let one = Size::new(1, 1);
+    let needs = std::str::from_utf8(bytes).map_or_else(|_| AnimationNeeds::default(), |t| AnimationNeeds::of(t, one));
+    let mut room = HostAnimationRoom::new(needs);
+    let mut animation = room.animation(one).map_err(|e| AnimationError::Setup(e.to_string()))?;
+    let mut scene = new_scene();
+    load_anew(&mut animation, scene.raytracer(), bytes).map(|_| ())
+}
+
+/// Frame 0 of the animation `bytes` loaded into `animation` anew: its
+/// motion recorded, which checks every frame's camera (an error there
+/// names its frame, so the scene's error has none).
+fn load_anew<'a, 'r>(
+    animation: &'a mut Animation<'_>,
+    raytracer: &'r mut Raytracer<Host>,
+    bytes: &[u8],
+) -> Result<Frame<'a, 'r, Host>, AnimationError> {
+    let mut errors = Vec::new();
+    match animation.load_with(raytracer, bytes, &mut |e| errors.push(e.to_string())) {
+        Ok(first) => Ok(first),
+        Err(Refused::Scene(_)) => Err(AnimationError::Scene { frame: None, errors }),
+        Err(Refused::NoRoom(e)) => Err(AnimationError::Setup(e.to_string())),
+    }
+}
+
 /// Renders frames `frames` of the animation `bytes` (a scene with FRAMES),
 /// handing each to `each` in order; `progress(pixels)`
 /// after each band traced. Every frame's camera is checked before the
@@ -112,12 +142,8 @@ pub fn render_frames(
     let mut room = HostAnimationRoom::new(AnimationNeeds::of(text, size));
     let animation = room.animation(size).map_err(|e| AnimationError::Setup(e.to_string()))?;
     let mut animation = animation.indexed(options.render.indexing());
-    let mut errors = Vec::new();
-    match animation.load_with(scene.raytracer(), bytes, &mut |e| errors.push(e.to_string())) {
-        Ok(first) => first.scene().view().check_camera(w, h).map_err(|e| AnimationError::Setup(e.to_string()))?,
-        Err(Refused::Scene(_)) => return Err(AnimationError::Scene { frame: None, errors }),
-        Err(Refused::NoRoom(e)) => return Err(AnimationError::Setup(e.to_string())),
-    }
+    let first = load_anew(&mut animation, scene.raytracer(), bytes)?;
+    first.scene().view().check_camera(w, h).map_err(|e| AnimationError::Setup(e.to_string()))?;
     let mut current: Option<FrameImage> = None;
     for frame in frames {
         if options.render.stop.is_some_and(|stop| stop.load(Ordering::Relaxed)) {

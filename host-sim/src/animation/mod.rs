@@ -20,7 +20,7 @@ mod writers;
 
 pub use apng::ApngWriter;
 pub use changes::Area;
-pub use command::{animate, is_frame_file, merge_frames, Request};
+pub use command::{animate, check_frames, is_frame_file, merge_frames, Request};
 pub use frames::{render_frames, AnimationError, AnimationOptions, AnimationReport, FrameImage, COHERENCE_TILE};
 pub use gif::{gif_delay, GifWriter};
 pub use writers::{FrameInfo, FramePattern, Output};
