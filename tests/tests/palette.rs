@@ -210,3 +210,24 @@ fn convert_rejects_a_corrupt_file_and_leaves_nothing() {
     assert!(String::from_utf8_lossy(&stderr).contains("bad.ras"), "{}", String::from_utf8_lossy(&stderr));
     assert!(!out.exists());
 }
+
+#[test]
+fn convert_says_a_file_that_is_no_image_is_none() {
+    let dir = tempfile::tempdir().unwrap();
+    // A scene file, given where an image is wanted: no signature, and no
+    // Targa header either, whose image type its third byte would be.
+    let scene = dir.path().join("scene.txt");
+    std::fs::write(&scene, "FRAMES 48 24\nRASTER 240 180\nSPHERE 1 1 0 0 0\n").unwrap();
+    let out = dir.path().join("out.png");
+    let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
+    let code = host_sim::cli::run(
+        ["host-sim".as_ref(), "convert".as_ref(), scene.as_os_str(), out.as_os_str()],
+        &mut stdout,
+        &mut stderr,
+    );
+    let err = String::from_utf8_lossy(&stderr);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("scene.txt: not a PNG, Targa or Sun raster image\n"), "{err}");
+    assert!(!err.contains("Targa file") && !err.contains("image type"), "{err}");
+    assert!(!out.exists());
+}

@@ -34,6 +34,25 @@ impl Format {
             Format::Ras => "ras",
         }
     }
+
+    /// The format's name in prose.
+    pub fn title(self) -> &'static str {
+        match self {
+            Format::Png => "PNG",
+            Format::Tga => "Targa",
+            Format::Ras => "Sun raster",
+        }
+    }
+
+    /// Every format's title, as a sentence lists them ("PNG, Targa or Sun
+    /// raster"), so that a message naming them all follows [`Format::ALL`].
+    pub fn any_title() -> String {
+        let [rest @ .., last] = Format::ALL.map(Format::title);
+        match &rest[..] {
+            [] => last.into(),
+            _ => format!("{} or {last}", rest.join(", ")),
+        }
+    }
 }
 
 /// An image as a file holds it: pixels, or indices into a palette.
@@ -110,6 +129,11 @@ impl Header {
 
 /// The keyword of the PNG `tEXt` chunk that carries [`Header::text`].
 pub const TEXT_KEYWORD: &str = "octrace";
+
+/// Why a file is read as none of the formats: it is not one of them.
+pub(super) fn not_an_image() -> FormatError {
+    FormatError::Unsupported(format!("not a {} image", Format::any_title()))
+}
 
 /// Fails unless `image` is one every format can hold: not empty, the data as long as the size says, at most
 /// 256 palette entries and every index inside the palette.

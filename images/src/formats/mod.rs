@@ -31,7 +31,7 @@ pub use image::{Format, Header, Image, TEXT_KEYWORD};
 pub use rows::{RowReader, RowWriter};
 
 use error::invalid;
-use image::check;
+use image::{check, not_an_image};
 use std::io::Write;
 
 /// Writes `image` to `out` as a `format` file.
@@ -77,9 +77,11 @@ pub fn read(bytes: &[u8]) -> Result<Image, FormatError> {
     } else if bytes.starts_with(&sun_raster::MAGIC.to_be_bytes()) {
         sun_raster::read(bytes)?
     } else if let Some(&(_, name)) = OTHER_SIGNATURES.iter().find(|(signature, _)| bytes.starts_with(signature)) {
-        return Err(FormatError::Unsupported(format!("a {name} image, not a PNG, Targa or Sun raster image")));
-    } else {
+        return Err(FormatError::Unsupported(format!("a {name} image, {}", not_an_image())));
+    } else if targa::could_be(bytes) {
         targa::read(bytes).map_err(targa::no_image)?
+    } else {
+        return Err(not_an_image());
     };
     check(&image)?;
     Ok(image)
@@ -144,12 +146,16 @@ pub(crate) mod tests {
     #[test]
     fn malformed_files_give_errors() {
         let message = |bytes: &[u8]| read(bytes).unwrap_err().to_string();
-        // A file without a PNG's or Sun raster's signature is read as a Targa file.
-        let as_targa = |detail: &str| format!("not a PNG, Targa or Sun raster image (as a Targa file: {detail})");
-        assert_eq!(message(&[]), as_targa("truncated Targa header"));
+        // A file without a PNG's or Sun raster's signature is read as a
+        // Targa file when its header can be one's; otherwise it is no image.
+        let no_image = "not a PNG, Targa or Sun raster image";
+        let as_targa = |detail: &str| format!("{no_image} (as a Targa file: {detail})");
         assert_eq!(message(b"GIF89a, a GIF of some kind"), "a GIF image, not a PNG, Targa or Sun raster image");
         assert_eq!(message(b"\xff\xd8\xff\xe0 JFIF"), "a JPEG image, not a PNG, Targa or Sun raster image");
-        assert_eq!(message(b"GIF90a, of no kind at all"), as_targa("Targa image type 70 is not supported"));
+        assert_eq!(message(b"GIF90a, of no kind at all"), no_image);
+        assert_eq!(message(b"FRAMES 48 24\nRASTER    240 180\n"), no_image, "a text file");
+        assert_eq!(message(&[]), no_image);
+        assert_eq!(message(&encode(&rgb(3, 2), Format::Tga)[..17]), no_image, "shorter than a Targa header");
         assert_eq!(message(&sun_raster::MAGIC.to_be_bytes()), "truncated Sun raster header");
         assert_eq!(message(png::SIGNATURE), "truncated PNG file");
         let mut tga = encode(&rgb(3, 2), Format::Tga);

@@ -6,7 +6,7 @@
 
 use super::bytes::{read_exactly, BGR};
 use super::error::{invalid, unsupported, FormatError};
-use super::image::{check_indices, check_palette_length, check_size, Format, Header};
+use super::image::{check_indices, check_palette_length, check_size, not_an_image, Format, Header};
 use super::{png, sun_raster, targa};
 use std::io::{BufRead, BufReader, Write};
 
@@ -152,8 +152,10 @@ impl RowReader {
             let is_ras = start.starts_with(&sun_raster::MAGIC.to_be_bytes());
             let header = if is_ras {
                 sun_raster::stream_header(&mut input)?
-            } else {
+            } else if targa::could_be(start) {
                 targa::stream_header(&mut input).map_err(targa::no_image)?
+            } else {
+                return Err(not_an_image());
             };
             let row_bytes = header.width as usize * header.bytes_per_pixel();
             let pad = if is_ras { sun_raster::row_padding(row_bytes) } else { 0 };
@@ -262,6 +264,11 @@ mod tests {
         let mut sink = std::io::sink();
         let mut writer = RowWriter::new(Format::Png, &Header { text: None, ..header }, &mut sink).unwrap();
         assert!(writer.write_row(&[0; 4]).is_err(), "a row of the wrong length");
+        // A text file is no image, not a Targa file of some unknown type.
+        let text = dir.join("notes.txt");
+        std::fs::write(&text, "Rows are written top to bottom, each as stored.\n").unwrap();
+        let refused = RowReader::new(std::fs::File::open(&text).unwrap()).err().map(|e| e.to_string());
+        assert_eq!(refused.as_deref(), Some("not a PNG, Targa or Sun raster image"));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -5,17 +5,27 @@
 
 use super::bytes::{opaque, pick, read_exactly, take, BGR};
 use super::error::{invalid, unsupported, FormatError};
-use super::image::{Header, Image};
+use super::image::{not_an_image, Header, Image};
 use crate::RgbImage;
 use std::borrow::Cow;
 
-/// What a file without a PNG's or a Sun raster's signature is when it does
-/// not read as a Targa file either: Targa files have no signature, so what
-/// is not one is no image of these formats.
+/// Whether a file of no other format's signature that starts with `start`
+/// can be a Targa file, which has none: a whole header whose colour map
+/// type, image type and pixel size are ones the format defines. Anything
+/// else (a text file's first bytes, say) is no image at all, and is told
+/// so rather than what of a Targa header it fails.
+pub(super) fn could_be(start: &[u8]) -> bool {
+    let Some(header) = start.first_chunk::<18>() else { return false };
+    let (map_type, image_type, pixel_bits) = (header[1], header[2], header[16]);
+    map_type <= 1 && matches!(image_type, 0..=3 | 9..=11 | 32 | 33) && matches!(pixel_bits, 8 | 15 | 16 | 24 | 32)
+}
+
+/// What a file that [`could_be`] a Targa file is when it does not read as
+/// one: with no signature, it may still be something else.
 pub(super) fn no_image(e: FormatError) -> FormatError {
     match e {
         FormatError::Io(e) => FormatError::Io(e),
-        e => FormatError::Unsupported(format!("not a PNG, Targa or Sun raster image (as a Targa file: {e})")),
+        e => FormatError::Unsupported(format!("{} (as a Targa file: {e})", not_an_image())),
     }
 }
 
