@@ -88,7 +88,7 @@ pub struct Args {
     /// (the octree walked the thesis's way), dda (the octree walked by
     /// integer 3DDDA), or auto, the fastest for the scene (naive for a
     /// handful of objects, else dda). All give the same image.
-    #[arg(long, value_name = "MODE", default_value = "auto", value_parser = parse_accel)]
+    #[arg(long, value_name = "MODE", default_value_t = AccelMode::default(), value_parser = parse_accel)]
     pub accel: AccelMode,
     /// Octree criterion: a box holding more objects than this is subdivided
     /// (refused where no octree is built).

@@ -49,7 +49,7 @@ impl Default for RenderOptions {
     fn default() -> Self {
         RenderOptions {
             size: None,
-            accel: AccelMode::Auto,
+            accel: AccelMode::default(),
             octree: OCTREE,
             threads: 1,
             partition: Partition::Tiles,

@@ -14,6 +14,7 @@
 
 use crate::error::StudioError;
 use crate::studio::{self, Display, Studio};
+use octrace_core::AccelMode;
 use octrace_images::formats::Format;
 use std::cell::RefCell;
 
@@ -72,6 +73,14 @@ pub extern "C" fn studio_load(frame: u32) -> u32 {
         state.output = format!("{w} {h} {objects} {count} {rate}").into_bytes();
         Ok(())
     })
+}
+
+/// The code of the mode the Process menu starts at: the core's default,
+/// which host-sim's `--accel` defaults to too, so that a render in the
+/// studio and one on the command line index a scene alike.
+#[no_mangle]
+pub extern "C" fn studio_default_accel() -> u32 {
+    studio::accel_code(AccelMode::default())
 }
 
 /// Sets the image size and builds the octree for `accel` (0 auto, 1 naive,

@@ -26,6 +26,11 @@ pub fn accel_from_code(code: u32) -> Option<AccelMode> {
     AccelMode::ALL.get(code as usize).copied()
 }
 
+/// The page's code for `mode`, which [`accel_from_code`] reads back.
+pub fn accel_code(mode: AccelMode) -> u32 {
+    AccelMode::ALL.iter().position(|&m| m == mode).unwrap_or_default() as u32
+}
+
 /// How a finished image is shown: truecolour, one of the four 256-colour
 /// modes, a panel's colour depth, or a panel of few levels, dithered.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -89,7 +94,7 @@ impl Default for Studio {
             text: Vec::new(),
             frame: 0,
             frames: None,
-            accel: AccelMode::Auto,
+            accel: AccelMode::default(),
             size: (1, 1),
             player: Player::default(),
         }
@@ -248,6 +253,13 @@ mod tests {
                 let (x, y) = (3 + i as u32 % 4, 2 + i as u32 / 4);
                 assert_eq!(p, image.pixel(x, y), "{accel:?} at {x},{y}");
             }
+        }
+    }
+
+    #[test]
+    fn every_mode_has_the_code_the_page_reads_back() {
+        for mode in AccelMode::ALL {
+            assert_eq!(accel_from_code(accel_code(mode)), Some(mode), "{mode}");
         }
     }
 

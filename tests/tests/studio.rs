@@ -14,6 +14,7 @@
 
 use host_sim::{load_bytes, new_scene, render, RenderOptions, RgbImage};
 use octrace_core::panel::Dithering;
+use octrace_core::AccelMode;
 use octrace_images::palette::{self, PaletteMode};
 use octrace_link::{BoardInfo, Capacities, Decoder, Kind, Message, Panel, PixelFormat};
 use octrace_tests::board::{fits, open_pty, wedging_scene, RunningBoard};
@@ -320,6 +321,11 @@ fn the_canvas_is_host_sims_image_for_every_scene() {
     let send = browser.run("const b = document.getElementById('send-board'); return [b.disabled, b.title];");
     assert_eq!(send[0], true);
     assert!(send[1].as_str().is_some_and(|t| t.contains("--board PORT")), "{send}");
+    // The Process menu starts at host-sim's --accel default (the core's),
+    // its code the mode's place in the core's list.
+    let default = AccelMode::ALL.iter().position(|&m| m == AccelMode::default()).expect("a listed mode");
+    let process = browser.run("return document.getElementById('accel').value;");
+    assert_eq!(process, serde_json::json!(default.to_string()), "the Process menu's first choice");
     // fig5_1 at its own RASTER, the rest small; every process mode.
     let modes = ["naive", "octree", "dda"];
     for (i, (name, path)) in scenes().into_iter().enumerate() {

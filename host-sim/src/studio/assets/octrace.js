@@ -31,6 +31,8 @@ export async function loadOctrace() {
       const [width, height, objects, frames, rate] = out.split(' ').map(Number);
       return { width, height, objects, frames, rate };
     },
+    /** The Process menu's code for the core's default mode (host-sim's). */
+    defaultAccel: () => x.studio_default_accel(),
     prepare: (accel, w, h) => decoder.decode(call(x.studio_prepare, accel, w, h)),
     render: (x0, y0, w, h) => call(x.studio_render, x0, y0, w, h),
     /** The frame loaded, whole (after `prepare`): {traced, data}, the

@@ -301,6 +301,8 @@ function main() {
   (async () => {
     try {
       state.octrace = await loadOctrace();
+      // The core's default mode, host-sim's too: the page keeps no choice of its own.
+      $('accel').value = String(state.octrace.defaultAccel());
       await loadScene(true);
       await app.board.connect();
       setTool('select');
