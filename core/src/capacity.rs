@@ -324,11 +324,11 @@ pub struct CapacityError {
     pub needed: Option<usize>,
     /// The profile's name.
     pub profile: &'static str,
+    /// Whether the profile is the desktop's (its
+    /// [`SceneCapacities::DESKTOP`](crate::scene::SceneCapacities::DESKTOP)):
+    /// then no profile to define holds more.
+    pub desktop: bool,
 }
-
-/// The name of the desktop's profile (`profile::Host`, feature `alloc`):
-/// its capacities are octrace's most, which no `profile!` raises.
-pub(crate) const HOST_PROFILE: &str = "Host";
 
 impl fmt::Display for CapacityError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -336,7 +336,7 @@ impl fmt::Display for CapacityError {
         if let Some(needed) = self.needed {
             write!(f, " and the scene needs {needed}")?;
         }
-        if self.profile == HOST_PROFILE {
+        if self.desktop {
             // host-sim's, the studio's: a user of those cannot define a
             // profile, and no profile holds more.
             return write!(f, ", the most octrace's desktop build holds: split the scene or simplify it");
@@ -384,14 +384,26 @@ mod tests {
 
     #[test]
     fn the_message_says_what_how_many_and_how_to_fix_it() {
-        let e = CapacityError { kind: CapacityKind::Rectangles, capacity: 2, needed: Some(64), profile: "Board16K" };
+        let e = CapacityError {
+            kind: CapacityKind::Rectangles,
+            capacity: 2,
+            needed: Some(64),
+            profile: "Board16K",
+            desktop: false,
+        };
         assert_eq!(
             e.to_string(),
             "too many rectangles: the capacity profile Board16K holds 2 and the scene needs 64; \
              define a profile that holds them with octrace_core::profile! (rectangles: 64, …)"
         );
         // The desktop's profile: nothing to define.
-        let e = CapacityError { kind: CapacityKind::Lights, capacity: 4096, needed: Some(4100), profile: HOST_PROFILE };
+        let e = CapacityError {
+            kind: CapacityKind::Lights,
+            capacity: 4096,
+            needed: Some(4100),
+            profile: "Host",
+            desktop: true,
+        };
         assert_eq!(
             e.to_string(),
             "too many lights: the capacity profile Host holds 4096 and the scene needs 4100, \

@@ -194,7 +194,7 @@ macro_rules! profile {
 macro_rules! __scene_capacities {
     (
         shapes [$($(#[$doc:meta])* $kind:ident($type:ident) in $field:ident: $capacity:ident, $what:literal;)*]
-        $name:ident, $($arena:ident)::+ $(, motion: $motion:expr)?
+        $name:ident, $($arena:ident)::+ $(, motion: $motion:expr)? $(, desktop: $desktop:expr)?
     ) => {
         const _: () = {
             type ArenaOf<T, const N: usize> = $($arena)::+<T, N>;
@@ -207,6 +207,7 @@ macro_rules! __scene_capacities {
                 type Surfaces = ArenaOf<$crate::scene::SurfaceEntry, { <$name as $crate::profile::Profile>::COUNTS.surfaces }>;
                 type Lights = ArenaOf<$crate::scene::Light, { <$name as $crate::profile::Profile>::COUNTS.lights }>;
                 $(const MOTION: bool = $motion;)?
+                $(const DESKTOP: bool = $desktop;)?
             }
         };
     };
@@ -515,7 +516,7 @@ mod host {
         const LIGHT_BUFFER: bool = true;
     }
 
-    crate::__shape_kinds!(crate::__scene_capacities! { Host, HeapArena });
+    crate::__shape_kinds!(crate::__scene_capacities! { Host, HeapArena, desktop: true });
 
     impl OctreeCapacities for Host {
         type Index = u32;
@@ -530,19 +531,42 @@ mod host {
 
 #[cfg(test)]
 mod tests {
+    extern crate std;
     use super::*;
     use crate::capacity::CapacityKind;
+    use crate::scene::Scene;
+    use std::string::ToString;
 
     crate::profile! {
         struct Tiny { spheres: 3, lights: 1, surfaces: 1 }
     }
 
-    /// Capacity errors tell the desktop's users that no profile holds more
-    /// by this name.
-    #[cfg(feature = "alloc")]
+    /// A board's profile that shares the desktop's name.
+    mod board {
+        crate::profile! {
+            pub struct Host { spheres: 1, lights: 1, surfaces: 1 }
+        }
+    }
+
+    /// Capacity errors tell the desktop's users that no profile holds more,
+    /// and a board's, whatever its name, which profile to define.
     #[test]
-    fn the_host_profile_has_the_name_its_messages_know() {
-        assert_eq!(<Host as SceneCapacities>::NAME, crate::capacity::HOST_PROFILE);
+    fn only_the_desktops_profile_has_no_larger_one_to_suggest() {
+        let text = "SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nLIGHT 10 -5 5 5\nSPHERE 1 1 0 0 0\n";
+        let mut scene = Scene::<board::Host>::new();
+        let mut first = None;
+        let _ = crate::parse::parse(text, &mut scene, &mut |e| {
+            first.get_or_insert(e.to_string());
+        });
+        let board = "3:1: too many lights: the capacity profile Host holds 1 and the scene needs 2; \
+                     define a profile that holds them with octrace_core::profile! (lights: 2, …)";
+        assert_eq!(first.as_deref(), Some(board));
+        #[cfg(feature = "alloc")]
+        {
+            let desktop = Scene::<Host>::full(CapacityKind::Lights, 4096).to_string();
+            let no_larger = "the capacity profile Host holds 4096, the most octrace's desktop build holds: split";
+            assert!(desktop.contains(no_larger), "{desktop}");
+        }
     }
 
     #[test]

@@ -78,6 +78,12 @@ macro_rules! scene_arenas {
         pub trait SceneCapacities {
             /// The profile's name, shown in capacity errors.
             const NAME: &'static str;
+            /// Whether it is the desktop's profile
+            /// ([`Host`](crate::profile::Host), feature `alloc`), whose
+            /// capacities are octrace's most: its capacity errors suggest no
+            /// profile to define. Told by the type, not by a name a board's
+            /// `profile!` may share.
+            const DESKTOP: bool = false;
             /// All objects, in file order.
             type Objects: Arena<ShapeHandle>;
             $(#[doc = concat!("The ", $what, ".")] type $capacity: Arena<crate::shapes::$type>;)*
@@ -182,7 +188,7 @@ macro_rules! scene_arenas {
                 const KIND: ShapeKind = ShapeKind::$kind;
 
                 fn push_into<C: SceneCapacities>(self, scene: &mut Scene<C>) -> Result<usize, CapacityError> {
-                    push(&mut scene.$field, self, CapacityKind::$capacity, C::NAME)
+                    Scene::<C>::append(&mut scene.$field, self, CapacityKind::$capacity)
                 }
             }
         )*
@@ -261,21 +267,17 @@ impl<C: SceneCapacities> Default for Scene<C> {
     }
 }
 
-/// Appends `item` to `arena`, or names the capacity that ran out.
-fn push<T, A: Arena<T>>(
-    arena: &mut A,
-    item: T,
-    kind: CapacityKind,
-    profile: &'static str,
-) -> Result<usize, CapacityError> {
-    let index = arena.as_slice().len();
-    arena.push(item).map_err(|_| CapacityError { kind, capacity: A::CAPACITY, needed: None, profile })?;
-    Ok(index)
-}
-
 impl<C: SceneCapacities> Scene<C> {
+    /// Appends `item` to `arena`, one of the scene's, or names the capacity
+    /// that ran out.
+    fn append<T, A: Arena<T>>(arena: &mut A, item: T, kind: CapacityKind) -> Result<usize, CapacityError> {
+        let index = arena.as_slice().len();
+        arena.push(item).map_err(|_| Self::full(kind, A::CAPACITY))?;
+        Ok(index)
+    }
+
     pub(crate) fn full(kind: CapacityKind, capacity: usize) -> CapacityError {
-        CapacityError { kind, capacity, needed: None, profile: C::NAME }
+        CapacityError { kind, capacity, needed: None, profile: C::NAME, desktop: C::DESKTOP }
     }
 
     /// The error for one surface too many.
@@ -301,7 +303,7 @@ impl<C: SceneCapacities> Scene<C> {
     pub(crate) fn push_shape<S: Stored>(&mut self, shape: S) -> Result<(), CapacityError> {
         self.check_room(S::KIND, 1)?;
         let index = shape.push_into(self)?;
-        push(&mut self.objects, ShapeHandle::new(S::KIND, index), CapacityKind::Objects, C::NAME).map(|_| ())
+        Self::append(&mut self.objects, ShapeHandle::new(S::KIND, index), CapacityKind::Objects).map(|_| ())
     }
 
     /// Replaces the control-point scratch with `points`, or names the
@@ -358,7 +360,7 @@ impl<C: SceneCapacities> Scene<C> {
     }
 
     pub(crate) fn push_light(&mut self, l: Light) -> Result<(), CapacityError> {
-        push(&mut self.lights, l, CapacityKind::Lights, C::NAME).map(|_| ())
+        Self::append(&mut self.lights, l, CapacityKind::Lights).map(|_| ())
     }
 
     /// Stores a surface; at most 65,535 whatever the profile (objects refer
@@ -367,7 +369,7 @@ impl<C: SceneCapacities> Scene<C> {
         if self.surfaces.as_slice().len() >= C::Surfaces::CAPACITY.min(u16::MAX as usize) {
             return Err(Self::surfaces_full());
         }
-        push(&mut self.surfaces, s, CapacityKind::Surfaces, C::NAME).map(|_| ())
+        Self::append(&mut self.surfaces, s, CapacityKind::Surfaces).map(|_| ())
     }
 
     /// Sorts the surfaces by number (first definition first), so that
