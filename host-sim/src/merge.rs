@@ -55,9 +55,10 @@ pub(crate) fn run(
 fn merge_parts(output: &Path, parts: &[PathBuf], format: Option<Format>) -> Result<(), CliError> {
     let format = output_format(format, output).map_err(|e| match Output::of(output, None) {
         Ok(Output::Gif) => CliError::Invalid(format!(
-            "merge: {}: a still's band parts merge into a PNG, Targa or Sun raster image, and a GIF is assembled \
-             from an animation's frame files; nothing written",
-            ShownPath(output)
+            "merge: {}: a still's band parts merge into a {} image, and a GIF is assembled from an animation's \
+             frame files; nothing written",
+            ShownPath(output),
+            Format::any_title()
         )),
         _ => e,
     })?;
