@@ -20,7 +20,7 @@
 //! a command's answer) is for an event, and gives up only at its guard
 //! against a hang ([`crate::HANG_GUARD`]).
 
-use host_sim::board::{BoardDescription, BoardLink};
+use host_sim::board::{BoardDescription, BoardLink, Waits};
 use octrace_link::{Decoder, Frame, Refusal};
 use std::collections::VecDeque;
 use std::fs::File;
@@ -64,6 +64,13 @@ pub fn open_pty() -> io::Result<(File, PathBuf)> {
         PathBuf::from(path.into_string().map_err(|_| io::Error::other("a pseudo-terminal's path is not UTF-8"))?);
     Ok((File::from(controller), path))
 }
+
+/// host-sim's `--patience` with a board in the tests that do not test its
+/// waits: its silence allowance (8 s times this) as long as the guard
+/// against a hang, so that a board slowed by a busy machine (the emulated
+/// Pico can run hundreds of times slower than a Pico) is waited for as every
+/// test waits, for the event.
+pub const PATIENCE: u32 = (crate::HANG_GUARD.as_secs() / host_sim::board::SILENCE.as_secs()) as u32;
 
 /// A board serving a serial device, ended when dropped.
 pub struct RunningBoard {
@@ -205,7 +212,8 @@ impl RunningBoard {
 
     /// What the board says it is.
     pub fn describe(&self) -> BoardDescription {
-        let mut link = BoardLink::open(&self.port.to_string_lossy(), None).expect("the port opens");
+        let waits = Waits { cap: None, patience: PATIENCE };
+        let mut link = BoardLink::open(&self.port.to_string_lossy(), waits).expect("the port opens");
         let description = link.hello().expect("the board answers");
         drop(link);
         crate::children::settle_after_closing();

@@ -14,7 +14,9 @@
 //! while the board says it is working, a board gone silent mid-drawing
 //! given up with what it did last, a chatty board ended by its errors'
 //! count. Every wait is for an event (`HANG_GUARD` only guards against a
-//! hang), and every time checked is the board's own clock's.
+//! hang; host-sim is given the patience to match, `PATIENCE`, except in
+//! the tests of its waits, which give a board 800 times slower than a Pico
+//! room), and every time checked is the board's own clock's.
 //!
 //! The board is the software board (`software-board`: the live firmware's
 //! logic, `octrace_link::board`, behind a pseudo-terminal), or the command
@@ -24,7 +26,7 @@
 //! profile, longest scene) and choose their scenes by it.
 
 use octrace_link::{encode_raw, Kind, Message, Panel, Reason, Refusal, VERSION};
-use octrace_tests::board::{dearest_scene, fits, lights, open_pty, wedging_scene, RawHost, RunningBoard};
+use octrace_tests::board::{dearest_scene, fits, lights, open_pty, wedging_scene, RawHost, RunningBoard, PATIENCE};
 use octrace_tests::{host_sim_preview_of, scene_path, HANG_GUARD};
 use std::ffi::OsStr;
 use std::path::Path;
@@ -41,10 +43,17 @@ struct Run {
     stderr: String,
 }
 
-/// `host-sim board ARGS...`, in this process.
+/// `host-sim board ARGS...`, in this process, with `--patience PATIENCE`
+/// unless ARGS give their own (the tests of host-sim's waits).
 fn host_sim_board(args: &[&OsStr]) -> Run {
     let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
-    let args = ["host-sim".as_ref(), "board".as_ref()].into_iter().chain(args.iter().copied());
+    let patience = PATIENCE.to_string();
+    let patient: [&OsStr; 2] = ["--patience".as_ref(), patience.as_ref()];
+    let own = args.contains(&"--patience".as_ref());
+    let args = ["host-sim".as_ref(), "board".as_ref()]
+        .into_iter()
+        .chain(args.iter().copied())
+        .chain(patient.into_iter().filter(|_| !own));
     let code = host_sim::cli::run(args, &mut stdout, &mut stderr);
     // host-sim has closed the port, in this process.
     octrace_tests::children::settle_after_closing();
@@ -399,10 +408,28 @@ fn a_board_that_keeps_sending_errors_is_given_up_by_their_count_or_at_the_timeou
     ends_at_the_cap(&board, &scene, 2);
 }
 
-/// `host-sim board PORT SCENE --timeout SECONDS` to `board` ends at the cap.
-fn ends_at_the_cap(board: &RunningBoard, scene: &Path, seconds: u32) {
-    let seconds = seconds.to_string();
-    let args = [board.port.as_os_str(), scene.as_os_str(), "--timeout".as_ref(), seconds.as_ref()];
+/// host-sim's `--patience` in the tests of its silence allowance: room
+/// for a board 800 times slower than a Pico (one that says it is working
+/// every 40 ms of its clock is heard every 32 s), while a board held silent
+/// is given up within 32 s.
+const WAITS_PATIENCE: u32 = 4;
+
+/// The silence allowance of `host-sim board --patience WAITS_PATIENCE`, in
+/// seconds.
+const WAITS_SILENCE: u64 = host_sim::board::SILENCE.as_secs() * WAITS_PATIENCE as u64;
+
+/// `host-sim board PORT SCENE --timeout SECONDS --patience WAITS_PATIENCE`
+/// to `board` ends at the cap.
+fn ends_at_the_cap(board: &RunningBoard, scene: &Path, seconds: u64) {
+    let (seconds, patience) = (seconds.to_string(), WAITS_PATIENCE.to_string());
+    let args = [
+        board.port.as_os_str(),
+        scene.as_os_str(),
+        "--timeout".as_ref(),
+        seconds.as_ref(),
+        "--patience".as_ref(),
+        patience.as_ref(),
+    ];
     let run = host_sim_board_within(&args, HANG_GUARD).expect("host-sim board ends");
     assert_eq!(run.code, 1, "{}", run.stderr);
     let want = format!(
@@ -422,18 +449,23 @@ fn wedge_file(board: &RunningBoard, dir: &Path) -> std::path::PathBuf {
 #[test]
 fn a_drawing_whose_pixel_outlasts_the_silence_allowance_is_followed_while_the_board_says_it_is_working() {
     // The wedging scene: hours a pixel, so the board sends no row, only its
-    // word that it is still working, for longer than the 8 s host-sim
-    // allows a board to say nothing; host-sim follows it to its cap.
+    // word that it is still working, for longer than host-sim allows a
+    // board to say nothing; host-sim follows it to its cap.
     let board = board();
     let dir = tempfile::tempdir().unwrap();
-    ends_at_the_cap(&board, &wedge_file(&board, dir.path()), 12);
+    ends_at_the_cap(&board, &wedge_file(&board, dir.path()), WAITS_SILENCE + 4);
 }
 
 #[test]
 fn a_board_gone_silent_mid_drawing_is_given_up_saying_what_it_did_last() {
     let mut board = board();
     let dir = tempfile::tempdir().unwrap();
-    let args: Vec<std::ffi::OsString> = vec![board.port.clone().into(), wedge_file(&board, dir.path()).into()];
+    let args: Vec<std::ffi::OsString> = vec![
+        board.port.clone().into(),
+        wedge_file(&board, dir.path()).into(),
+        "--patience".into(),
+        WAITS_PATIENCE.to_string().into(),
+    ];
     let run = std::thread::spawn(move || {
         let args: Vec<&OsStr> = args.iter().map(|a| a.as_os_str()).collect();
         host_sim_board(&args)
@@ -448,7 +480,10 @@ fn a_board_gone_silent_mid_drawing_is_given_up_saying_what_it_did_last() {
     assert_eq!(board.command("hold"), "ok");
     let run = run.join().expect("host-sim board ends");
     assert_eq!(run.code, 1, "{}", run.stderr);
-    let silent = format!("host-sim: board at {}: the board fell silent: nothing for 8 s after ", board.port.display());
+    let silent = format!(
+        "host-sim: board at {}: the board fell silent: nothing for {WAITS_SILENCE} s after ",
+        board.port.display()
+    );
     // What the board did last: its word that it was still working, or the
     // row it sent just before the hold (a busy machine's host can read the
     // first row after the board has drawn for 100 ms: the hold then comes

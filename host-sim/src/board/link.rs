@@ -18,7 +18,7 @@
 //! messages) reaches the caller with its control characters escaped.
 
 use super::answer::{Answer, BoardDescription, BoardSceneError, BoardTiming, PlayedFrame, Progress};
-use super::patience::{Expired, Patience, Step, LOADING, SILENCE};
+use super::patience::{Expired, Patience, Step, Waits, LOADING, SILENCE};
 use super::port::{Port, SerialLine};
 use crate::terminal::shown;
 use octrace_link::{Decoder, Message, Panel, Reason, VERSION};
@@ -153,25 +153,25 @@ pub struct BoardLink<P: Port> {
 }
 
 impl BoardLink<SerialLine> {
-    /// Opens the serial port `path`; the whole conversation ends within
-    /// `cap`, if one is given.
-    pub fn open(path: &str, cap: Option<Duration>) -> Result<Self, LinkError> {
+    /// Opens the serial port `path`, to wait for the board as `waits` says.
+    pub fn open(path: &str, waits: Waits) -> Result<Self, LinkError> {
         let line = SerialLine::open(path)
             .map_err(|e| io::Error::new(e.kind(), format!("cannot open it as a serial port: {e}")))?;
-        Ok(BoardLink::new(line, cap))
+        Ok(BoardLink::new(line, waits))
     }
 }
 
 impl<P: Port> BoardLink<P> {
     /// A link over `port` that waits for the board while it moves the
-    /// conversation on (see `patience.rs`), and ends it within `cap` from
-    /// now (every request sent and every answer received), if one is given.
-    pub fn new(mut port: P, cap: Option<Duration>) -> Self {
+    /// conversation on (see `patience.rs`, times `waits.patience`), and
+    /// ends it within `waits.cap` from now (every request sent and every
+    /// answer received), if one is given.
+    pub fn new(mut port: P, waits: Waits) -> Self {
         // Tags of this run unlike an earlier run's, whose answers may still
         // be on the way.
         let clock = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
         let last_tag = (clock.subsec_nanos() ^ std::process::id()) as u16;
-        let patience = Patience::new(port.now(), cap);
+        let patience = Patience::new(port.now(), waits);
         BoardLink {
             port,
             decoder: Decoder::new(vec![0; MAX_FRAME]),
@@ -748,7 +748,7 @@ mod tests {
     fn played(answer: impl FnMut(u16, Message<'_>) -> Timed) -> (BoardLink<impl Port>, Rc<Cell<Duration>>) {
         let port = played_port(answer);
         let clock = port.clock.clone();
-        (BoardLink::new(port, None), clock)
+        (BoardLink::new(port, Waits::BOARD), clock)
     }
 
     fn frames(messages: &[(Message<'_>, u16)]) -> Vec<u8> {
@@ -910,7 +910,7 @@ mod tests {
         let clock = port.clock.clone();
         let other = frames(&[(board_info(), 0xfff)]);
         *port.chatter.borrow_mut() = Some((other, Duration::from_micros(100), seconds(3600)));
-        let mut link = BoardLink::new(port, None);
+        let mut link = BoardLink::new(port, Waits::BOARD);
         let said = link.hello().unwrap_err().to_string();
         assert!(
             said.ends_with("it sent 10001 frames answering no request of host-sim's before its hello's answer"),
@@ -978,7 +978,7 @@ mod tests {
         });
         port.chatter = chatter;
         let clock = port.clock.clone();
-        let mut link = BoardLink::new(port, None);
+        let mut link = BoardLink::new(port, Waits::BOARD);
         let mut said_working = 0;
         link.hello().unwrap();
         let answer =
@@ -999,7 +999,7 @@ mod tests {
         });
         port.chatter = chatter;
         let clock = port.clock.clone();
-        let mut link = BoardLink::new(port, None);
+        let mut link = BoardLink::new(port, Waits::BOARD);
         link.hello().unwrap();
         let said = link.draw(b"scene", true, 1, &mut |_| {}).unwrap_err().to_string();
         assert_eq!(
@@ -1074,7 +1074,7 @@ mod tests {
         });
         port.chatter = chatter;
         let clock = port.clock.clone();
-        let mut link = BoardLink::new(port, None);
+        let mut link = BoardLink::new(port, Waits::BOARD);
         link.last_tag = 1;
         link.hello().unwrap();
         let said = link.draw(b"scene", true, 1, &mut |_| {}).unwrap_err().to_string();
@@ -1140,7 +1140,7 @@ mod tests {
         });
         port.chatter = chatter;
         let clock = port.clock.clone();
-        (BoardLink::new(port, cap), clock)
+        (BoardLink::new(port, Waits::capped(cap)), clock)
     }
 
     #[test]
@@ -1187,14 +1187,14 @@ mod tests {
         });
         port.byte_every = Duration::from_millis(100);
         let clock = port.clock.clone();
-        let mut link = BoardLink::new(port, None);
+        let mut link = BoardLink::new(port, Waits::BOARD);
         assert!(draw_text(&mut link, &scene).is_ok());
         assert!(clock.get() > seconds(100), "{:?}", clock.get());
         // Nothing read at all: said 8 s after the port opened.
         let mut port = played_port(|tag, _| at_once(frames(&[(board_info(), tag)])));
         port.reads_from = seconds(3600);
         let clock = port.clock.clone();
-        let said = BoardLink::new(port, None).hello().unwrap_err().to_string();
+        let said = BoardLink::new(port, Waits::BOARD).hello().unwrap_err().to_string();
         assert_eq!(
             said,
             "the board took nothing host-sim sent for 8 s, after the port was opened (is octrace's live firmware running there?)"
@@ -1202,7 +1202,7 @@ mod tests {
         assert!(clock.get() >= seconds(8) && clock.get() <= seconds(8) + PORT_WAIT, "{:?}", clock.get());
         // Half read, then nothing.
         let port = played_port(|tag, _| at_once(frames(&[(board_info(), tag)])));
-        let mut link = BoardLink::new(port, None);
+        let mut link = BoardLink::new(port, Waits::BOARD);
         link.hello().unwrap();
         link.port.reads_from = seconds(3600);
         let said = link.draw(scene.as_bytes(), true, 1, &mut |_| {}).unwrap_err().to_string();

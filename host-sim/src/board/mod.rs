@@ -5,7 +5,8 @@
 //!
 //! Invariants: the conversation with the board (hello, the scene, its
 //! whole answer) goes on while the board moves it on and ends when it
-//! stops doing so (`patience`), or at `--timeout` if given, and what the
+//! stops doing so (`patience`, times `--patience`), or at `--timeout` if
+//! given, and what the
 //! board says is checked as `link` says; the picture takes memory only as its rows
 //! arrive, never for a size the board only claims; `--check` passes only
 //! when every pixel of the panel was compared and each is host-sim's.
@@ -17,7 +18,7 @@ mod port;
 
 pub use answer::{Answer, BoardDescription, BoardSceneError, BoardTiming, PlayedFrame, Progress};
 pub use link::{BoardLink, LinkError};
-pub use patience::{LOADING, SILENCE};
+pub use patience::{Waits, LOADING, SILENCE};
 pub use port::{Port, SerialLine};
 
 use crate::arguments::{not_the_scene, output_format, parse_format};
@@ -67,6 +68,11 @@ pub struct BoardArgs {
     /// scene).
     #[arg(long, value_name = "SECONDS", value_parser = clap::value_parser!(u64).range(1..=86_400))]
     pub timeout: Option<u64>,
+    /// Wait N times as long for a board that says nothing (N times 8 s,
+    /// and 120 s while it loads a scene): for a board far slower than a
+    /// Pico, such as the emulated Pico on a busy machine.
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1_000))]
+    pub patience: u32,
     /// Of an animation (a scene with FRAMES), the frames to follow before
     /// stopping the board with a hello: OUT gets the last of them, and
     /// --check compares each with `host-sim SCENE --frame K` at the
@@ -144,9 +150,9 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
     }
     let port = first.display().to_string();
     let out = args.out.as_ref();
-    let timeout = args.timeout.map(Duration::from_secs);
+    let waits = Waits { cap: args.timeout.map(Duration::from_secs), patience: args.patience };
     let Some(scene) = &args.scene else {
-        let mut link = BoardLink::open(&port, timeout).map_err(|e| link_error(&port, e))?;
+        let mut link = BoardLink::open(&port, waits).map_err(|e| link_error(&port, e))?;
         let board = link.hello().map_err(|e| link_error(&port, e))?;
         return describe(&port, &board, stdout).map_err(|e| CliError::Io(format!("board: {e}")));
     };
@@ -161,7 +167,7 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
     let pixels = out.is_some() || args.check;
     let started = Instant::now();
     let mut bar = None;
-    let sent = send_scene(&port, timeout, &file, &text, pixels, args.frames, &mut |step| match step {
+    let sent = send_scene(&port, waits, &file, &text, pixels, args.frames, &mut |step| match step {
         Progress::Drawing(panel) => bar = progress_bar(panel.height.into(), args.quiet),
         Progress::Playing { .. } => bar = progress_bar(args.frames.into(), args.quiet),
         Progress::Row { .. } | Progress::FrameDrawn(_) => {
@@ -305,18 +311,18 @@ pub(crate) enum Sent {
 /// Sends scene `text` (named `file` in errors) to the board at `port`,
 /// after its hello and a check of the scene's length against what it
 /// takes, and follows the drawing (an animation for `follow` frames),
-/// handing each step to `progress`; all of it within `timeout`, if given.
+/// handing each step to `progress`, waiting for the board as `waits` says.
 /// `host-sim board` and the studio send through this.
 pub(crate) fn send_scene(
     port: &str,
-    timeout: Option<Duration>,
+    waits: Waits,
     file: &str,
     text: &[u8],
     pixels: bool,
     follow: u32,
     progress: &mut dyn FnMut(Progress<'_>),
 ) -> Result<Sent, CliError> {
-    let mut link = BoardLink::open(port, timeout).map_err(|e| link_error(port, e))?;
+    let mut link = BoardLink::open(port, waits).map_err(|e| link_error(port, e))?;
     let board = link.hello().map_err(|e| link_error(port, e))?;
     if text.len() > board.max_scene as usize {
         return Err(CliError::Invalid(format!(

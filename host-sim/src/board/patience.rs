@@ -4,7 +4,8 @@
 //! sending rows and runs, saying it is still working) is waited for as
 //! long as it does; one that stops is given up after [`SILENCE`] (or
 //! [`LOADING`] while it may be loading a scene, which it does without a
-//! word), with what it last did.
+//! word), each times the [`Waits::patience`] asked for (`--patience`, for
+//! an emulated board on a busy machine), with what it last did.
 //!
 //! Invariants: only progress restarts the wait, so frames that are not
 //! progress (scene errors, frames skipped, runs after the hello that stops
@@ -28,6 +29,28 @@ pub const SILENCE: Duration = Duration::from_secs(8);
 /// in 5.2 s of its clock, and its watchdog ends a load past 8 s; an
 /// emulated board on a busy machine takes a hundred times longer.
 pub const LOADING: Duration = Duration::from_secs(120);
+
+/// How long host-sim waits for a board: at most `cap` for the whole
+/// conversation (`--timeout`), if set, and `patience` times [`SILENCE`]
+/// and [`LOADING`] for a board that says nothing (`--patience`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Waits {
+    /// The most the whole conversation may take.
+    pub cap: Option<Duration>,
+    /// How many times the allowances a board may say nothing: 1 for a
+    /// board at a real board's speed.
+    pub patience: u32,
+}
+
+impl Waits {
+    /// A real board's: no cap, the allowances as they are.
+    pub const BOARD: Waits = Waits { cap: None, patience: 1 };
+
+    /// [`Waits::BOARD`] with a cap of `cap`.
+    pub fn capped(cap: Option<Duration>) -> Waits {
+        Waits { cap, ..Waits::BOARD }
+    }
+}
 
 /// What the board last did that moved the conversation on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -101,6 +124,8 @@ pub(crate) struct Patience {
     last: Step,
     /// How long it may now say nothing that moves it on.
     allowance: Duration,
+    /// What each allowance is multiplied by.
+    patience: u32,
     /// Frames since then that did not.
     idle: u64,
     /// When the whole conversation must end, if capped, and the cap.
@@ -109,14 +134,24 @@ pub(crate) struct Patience {
 
 impl Patience {
     /// The wait from `now`, the port just opened: [`SILENCE`] for the
-    /// board's first word, and `cap` on the whole, if any.
-    pub(crate) fn new(now: Instant, cap: Option<Duration>) -> Patience {
-        Patience { since: now, last: Step::Opened, allowance: SILENCE, idle: 0, cap: cap.map(|cap| (now + cap, cap)) }
+    /// board's first word (times the patience), and the cap on the whole,
+    /// if any.
+    pub(crate) fn new(now: Instant, waits: Waits) -> Patience {
+        let patience = waits.patience.max(1);
+        Patience {
+            since: now,
+            last: Step::Opened,
+            allowance: SILENCE.saturating_mul(patience),
+            patience,
+            idle: 0,
+            cap: waits.cap.map(|cap| (now + cap, cap)),
+        }
     }
 
     /// The board did `step` at `now`; from then it may say nothing that
-    /// moves the conversation on for `allowance`.
+    /// moves the conversation on for `allowance` (times the patience).
     pub(crate) fn moved(&mut self, now: Instant, step: Step, allowance: Duration) {
+        let allowance = allowance.saturating_mul(self.patience);
         (self.since, self.last, self.allowance, self.idle) = (now, step, allowance, 0);
     }
 
@@ -153,7 +188,7 @@ mod tests {
     fn progress_restarts_the_wait_and_nothing_else_does() {
         let start = Instant::now();
         let at = |ms| start + Duration::from_millis(ms);
-        let mut patience = Patience::new(start, None);
+        let mut patience = Patience::new(start, Waits::BOARD);
         assert_eq!(patience.expired(at(7_999)), None);
         let silent = Expired::Silent { waited: SILENCE, after: Step::Opened, idle: 0 };
         assert_eq!(patience.expired(at(8_000)), Some(silent));
@@ -170,17 +205,30 @@ mod tests {
     }
 
     #[test]
+    fn patience_multiplies_every_allowance() {
+        let start = Instant::now();
+        let at = |s| start + Duration::from_secs(s);
+        let mut patience = Patience::new(start, Waits { cap: None, patience: 5 });
+        assert_eq!(patience.expired(at(39)), None);
+        let silent = Expired::Silent { waited: SILENCE * 5, after: Step::Opened, idle: 0 };
+        assert_eq!(patience.expired(at(40)), Some(silent));
+        patience.moved(at(40), Step::TookScene, LOADING);
+        assert_eq!(patience.expired(at(639)), None);
+        assert!(patience.expired(at(640)).is_some());
+    }
+
+    #[test]
     fn the_cap_ends_the_conversation_however_the_board_moves_it_on() {
         let start = Instant::now();
         let at = |ms| start + Duration::from_millis(ms);
-        let mut patience = Patience::new(start, Some(Duration::from_secs(2)));
+        let mut patience = Patience::new(start, Waits::capped(Some(Duration::from_secs(2))));
         for ms in (0..2_000).step_by(10) {
             patience.moved(at(ms), Step::Row { y: 0, drawn: 1, rows: 2 }, SILENCE);
             assert_eq!(patience.expired(at(ms)), None);
         }
         assert_eq!(patience.expired(at(2_000)), Some(Expired::Capped(Duration::from_secs(2))));
         // Silent before the cap: said as silence.
-        let patience = Patience::new(start, Some(Duration::from_secs(60)));
+        let patience = Patience::new(start, Waits::capped(Some(Duration::from_secs(60))));
         let silent = Expired::Silent { waited: SILENCE, after: Step::Opened, idle: 0 };
         assert_eq!(patience.expired(at(8_000)), Some(silent));
     }

@@ -6,23 +6,24 @@
 //! Invariants: one send at a time (another is refused as busy, never
 //! queued, so two never interleave on the port); a send waits for the
 //! board as `host-sim board` does (as long as it keeps drawing, or says it
-//! is still working; given up when it falls silent; capped only by
+//! is still working; given up when it falls silent, after
+//! `--board-patience` times the usual allowance; capped only by
 //! `--board-timeout`); the errors are the board's, at the line and column
 //! it gave; the verdict is the count of pixels that differ from host-sim's
 //! render at the board's panel size.
 
 use super::http::Response;
-use crate::board::{differing_pixels, send_scene, BoardTiming, Progress, Sent};
+use crate::board::{differing_pixels, send_scene, BoardTiming, Progress, Sent, Waits};
 use crate::exit::CliError;
 use crate::terminal::shown;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// The board the studio sends to, and its send under way.
 pub(crate) struct BoardSender {
     port: String,
-    /// The longest a send may take, answer included, if capped.
-    timeout: Option<Duration>,
+    /// How long a send waits for the board.
+    waits: Waits,
     /// Whether a send is under way; set and cleared by [`Claim`].
     busy: AtomicBool,
     /// The drawing under way (or the last): rows received, of how many.
@@ -46,10 +47,10 @@ impl Drop for Claim<'_> {
 }
 
 impl BoardSender {
-    pub(crate) fn new(port: String, timeout: Option<Duration>) -> BoardSender {
+    pub(crate) fn new(port: String, waits: Waits) -> BoardSender {
         BoardSender {
             port,
-            timeout,
+            waits,
             busy: AtomicBool::new(false),
             rows: AtomicU32::new(0),
             height: AtomicU32::new(0),
@@ -98,7 +99,7 @@ impl BoardSender {
         let started = Instant::now();
         // An animation: its first frame (the scene as a still), then the
         // board is stopped.
-        let sent = send_scene(&self.port, self.timeout, name, text, true, 1, &mut |step| match step {
+        let sent = send_scene(&self.port, self.waits, name, text, true, 1, &mut |step| match step {
             Progress::Drawing(panel) | Progress::Playing { panel, .. } => {
                 self.height.store(panel.height.into(), Ordering::SeqCst)
             }

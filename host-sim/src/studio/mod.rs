@@ -22,6 +22,7 @@
 mod board;
 mod http;
 
+use crate::board::Waits;
 use crate::exit::{CliError, ShownPath};
 use crate::output::write_atomically;
 use crate::terminal::shown;
@@ -60,6 +61,10 @@ pub struct StudioArgs {
     /// loads a scene).
     #[arg(long, value_name = "SECONDS", value_parser = clap::value_parser!(u64).range(1..=86_400))]
     pub board_timeout: Option<u64>,
+    /// As `host-sim board --patience`: wait N times as long for a board
+    /// that says nothing (for the emulated Pico on a busy machine).
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1_000))]
+    pub board_patience: u32,
 }
 
 /// The page, its script and style, and the WebAssembly module, built into
@@ -127,9 +132,10 @@ pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) ->
             // Opened once now, as each Send opens it: a device that is no
             // serial line (`/dev/null`) is refused at start, not at the
             // first Send.
-            crate::board::BoardLink::open(&name, None)
+            let waits = Waits { cap: args.board_timeout.map(Duration::from_secs), patience: args.board_patience };
+            crate::board::BoardLink::open(&name, waits)
                 .map_err(|e| CliError::Invalid(format!("studio: --board {}: {e}", shown(&name))))?;
-            Some(BoardSender::new(name, args.board_timeout.map(Duration::from_secs)))
+            Some(BoardSender::new(name, waits))
         }
         Some(port) => {
             let _ = writeln!(stderr, "host-sim studio: the serial ports:");
