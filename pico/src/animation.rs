@@ -365,8 +365,12 @@ where
         let image = shared.image::<Rgb888>(room, size).bands(&take_next);
         // Core 0 draws into the panel on its main stack, so core 1's runs
         // may take both banks.
+        // Asked through an `Asked`, as core 0 is and a still's rows are,
+        // so that the firmware links one asking tracer.
+        let mut stopped = || stopping.load(Ordering::Acquire);
+        let asked: Asked<'_> = &mut stopped;
         let _ = with_both_banks(|| match ASKED {
-            true => image.try_draw_until(&mut handing, &mut || stopping.load(Ordering::Acquire)),
+            true => image.try_draw_until(&mut handing, &mut { asked }),
             false => image.try_draw(&mut handing),
         });
         handed.store(handing.pieces, Ordering::Release);
