@@ -15,8 +15,7 @@ use octrace_core::accel::{AccelMode, Indexing, OctreeConfig, Traversal};
 use octrace_core::profile::Board64K;
 use octrace_core::render::PixelSample;
 use octrace_core::scene::{ObjectId, Scene};
-use octrace_core::shade::Stats;
-use octrace_core::{LoadedScene, Raytracer};
+use octrace_core::{DrawError, LoadedScene, Raytracer};
 use std::cell::RefCell;
 
 const SIDE: u32 = 8;
@@ -47,13 +46,17 @@ struct Image {
 
 fn render(scene: &LoadedScene<'_, Board64K>) -> Option<Image> {
     // A camera error on a parsed scene is not a panic; host-sim reports it.
+    let mut sink = Sink::new(SIDE, SIDE);
+    let stats = match scene.image_for(&sink).try_draw(&mut sink) {
+        Ok(stats) => stats,
+        Err(DrawError::Camera(_)) => return None,
+        Err(e) => panic!("an 8x8 image into an 8x8 sink: {e}"),
+    };
+    assert_eq!(sink.outside, 0, "pixels drawn outside the image");
+    // The objects seen, through the per-pixel API (same pixels again).
     scene
         .with_renderer(Size::new(SIDE, SIDE), |renderer| {
             assert_eq!((renderer.size().width, renderer.size().height), (SIDE, SIDE));
-            let mut sink = Sink::new(SIDE, SIDE);
-            let Ok(stats): Result<Stats, _> = renderer.render(&mut sink);
-            assert_eq!(sink.outside, 0, "pixels drawn outside the image");
-            // The objects seen, through the per-pixel API (same pixels again).
             let mut objects = Vec::with_capacity((SIDE * SIDE) as usize);
             let mut again = Vec::with_capacity((SIDE * SIDE) as usize);
             for y in 0..SIDE {
@@ -70,7 +73,7 @@ fn render(scene: &LoadedScene<'_, Board64K>) -> Option<Image> {
                     [c.r(), c.g(), c.b()]
                 })
                 .collect();
-            assert_eq!(&sink.pixels[..(SIDE * SIDE) as usize], &again[..], "render() and row() differ");
+            assert_eq!(&sink.pixels[..(SIDE * SIDE) as usize], &again[..], "the image and row() differ");
             Image { colors, objects, rays: stats.rays, shadow_rays: stats.shadow_rays, truncated: stats.truncated }
         })
         .ok()

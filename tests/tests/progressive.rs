@@ -37,10 +37,9 @@ fn every_scene_ends_as_the_direct_picture_on_one_core_and_on_two() {
             let order = Progressive::new(Size::new(w, h), coarsest).with_finest(finest);
             let label = format!("{name}, coarsest {coarsest}, finest {finest}");
 
-            let mut room = RendererRoom::<Host>::new();
-            let mut renderer = shared.renderer(&mut room, Size::new(w, h)).unwrap();
+            let room = RendererRoom::<Host>::new();
             let mut one = RgbImage::new(w, h);
-            let stats = order.render(&mut renderer, &mut one).unwrap();
+            let stats = shared.image(&room, Size::new(w, h)).progressive(&order).try_draw(&mut one).unwrap();
             assert!(one == expected.image, "{label}: one core's picture differs");
             assert_eq!(
                 (stats.rays, stats.shadow_rays),

@@ -1,9 +1,9 @@
-//! What every draw of a loaded scene runs, whichever picture its
-//! [`TracedImage`] asks for: a renderer from the draw's source (the
-//! loading core's room, or another core's), then an area of a still, the
-//! progressive order, or a frame's bands of tiles, into the target
-//! converted or dithered. The one place a change to how pictures and
-//! frames are traced goes.
+//! What every draw of a [`TracedImage`] runs, whichever picture it asks
+//! for: a renderer from the draw's source (the loading core's room, or
+//! another core's), then an area of a still, the progressive order, or a
+//! frame's bands of tiles, into the target converted or dithered. Which
+//! pixels a draw traces, and in what order, is decided here (a pixel's
+//! tracing itself is the renderer's).
 //!
 //! Invariants: one renderer a draw, its counters added to the loaded
 //! scene's; a draw asked to stop ends within a ray, having drawn only

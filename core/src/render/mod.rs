@@ -101,19 +101,19 @@ impl TracedColor for PixelSample {
 /// [`TracedImage`](crate::TracedImage) makes its own.
 ///
 /// ```
-/// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*};
+/// use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 /// use octrace_core::{profile::Board16K, Raytracer};
 ///
 /// let mut raytracer = Raytracer::<Board16K>::new();
 /// let scene = raytracer.load("RASTER 8 8\nVIEWPOINT 0 0 5\nORIGIN 0 0 0\nUPVECTOR 0 1 0\nBACKGROUND 0 0 1\nLIGHT 10 5 5 5\nSPHERE 1 1.5 0 0 0\nSURFACE 1 .1 .1 .1 .8 .2 .2 0 0 0 1 0 0\n")?;
 /// scene.with_renderer(scene.raster(), |renderer| {
-/// let mut display = MockDisplay::<Rgb888>::new();
-/// let stats = renderer.render(&mut display)?;
-/// assert_eq!(stats.rays, 64, "one ray a pixel: nothing reflects");
-/// assert_eq!(display.get_pixel(Point::new(0, 0)), Some(Rgb888::BLUE));
-/// // A single pixel, with the object seen through it.
+/// // A corner sees the background; the centre, the sphere.
+/// assert_eq!(renderer.pixel(0, 0).color, Rgb888::BLUE);
+/// assert!(renderer.pixel(0, 0).object.is_none());
 /// assert!(renderer.pixel(4, 4).object.is_some());
-/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// let row: Vec<_> = renderer.row(4, 0..8).collect();
+/// assert_eq!(row[4], renderer.pixel(4, 4));
+/// assert_eq!(renderer.stats().rays, 12, "a ray a pixel asked: nothing reflects");
 /// })?;
 /// # Ok::<(), Box<dyn core::error::Error>>(())
 /// ```
@@ -448,7 +448,8 @@ impl<'a, L: Linked> Renderer<'a, L> {
     }
 
     /// Renders the whole image.
-    pub fn render<D>(&mut self, target: &mut D) -> Result<Stats, D::Error>
+    #[cfg(test)]
+    pub(crate) fn render<D>(&mut self, target: &mut D) -> Result<Stats, D::Error>
     where
         D: DrawTarget,
         D::Color: TracedColor,
@@ -456,22 +457,9 @@ impl<'a, L: Linked> Renderer<'a, L> {
         self.render_rect(&Rectangle::new(Point::zero(), self.size()), target)
     }
 
-    /// Renders the rows `rows` (clipped to the image).
-    pub fn render_rows<D>(&mut self, rows: Range<u32>, target: &mut D) -> Result<Stats, D::Error>
-    where
-        D: DrawTarget,
-        D::Color: TracedColor,
-    {
-        let h = self.camera.height();
-        let (start, end) = (rows.start.min(h), rows.end.min(h));
-        let rect =
-            Rectangle::new(Point::new(0, start as i32), Size::new(self.camera.width(), end.saturating_sub(start)));
-        self.render_rect(&rect, target)
-    }
-
     /// Renders the pixels of `rect` (clipped to the image), one
     /// `fill_contiguous` per row. Returns the counters of this call.
-    pub fn render_rect<D>(&mut self, rect: &Rectangle, target: &mut D) -> Result<Stats, D::Error>
+    pub(crate) fn render_rect<D>(&mut self, rect: &Rectangle, target: &mut D) -> Result<Stats, D::Error>
     where
         D: DrawTarget,
         D::Color: TracedColor,

@@ -10,9 +10,9 @@
 //! blocks of one pass each), so that several cores can share it: any core
 //! traces a unit's pixels into a colour buffer ([`Unit::trace`]) and the
 //! core that owns the display draws it from there ([`Unit::with_colors`],
-//! [`TracedUnit::draw`]), in order. One core draws it all with
-//! [`Progressive::render`] (or
-//! [`LoadedScene::draw_progressive`](crate::LoadedScene::draw_progressive)),
+//! [`TracedUnit::draw`]), in order. One core draws it all through a
+//! scene's image
+//! ([`TracedImage::progressive`](crate::TracedImage::progressive)),
 //! streaming as the direct order does: no framebuffer.
 //!
 //! Invariants: every pixel of the image is traced once, by exactly one
@@ -243,8 +243,9 @@ impl Progressive {
     /// the order for one core. Blocks drawn alone and single pixels stream
     /// as they are traced; a row of small blocks is traced up to 32 blocks
     /// at a time into a buffer on the stack, then drawn. Returns the
-    /// counters of this call.
-    pub fn render<L, D>(
+    /// counters of this call. (Scenes draw it through a `TracedImage`.)
+    #[cfg(test)]
+    pub(crate) fn render<L, D>(
         &self,
         renderer: &mut Renderer<'_, L>,
         target: &mut D,

@@ -131,10 +131,7 @@ fn main() {
         let all = bus.sent;
         // One core, tracing.
         let mut bus = Bus { size, sent: Sent::default() };
-        let stats = scene
-            .with_renderer(size, |renderer| order.render(renderer, &mut bus))
-            .unwrap_or_else(|e| panic!("{e}"))
-            .unwrap_or_else(|e| panic!("{e}"));
+        let stats = scene.image_for(&bus).progressive(&order).try_draw(&mut bus).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(bus.sent.pixels, all.pixels, "one core sends the same pixels");
         assert!(stats.rays >= size.width as u64 * size.height as u64, "every pixel traced");
         let direct = *direct_ms.get_or_insert(all.bus_ms());
