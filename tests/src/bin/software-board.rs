@@ -3,7 +3,7 @@
 //! on this machine, behind a pseudo-terminal: frames in byte by byte, each
 //! answered, a scene's rows rendered one after the other and sent as they
 //! are drawn, a frame from the host stopping a drawing between two rays.
-//! The tests of `host-sim board` (tests/tests/board.rs) talk to it as they
+//! The tests of `host-sim board` (tests/tests/board/) talk to it as they
 //! will to the emulated Pico.
 //!
 //!     software-board [--profile board16k|board64k|host] [--panel WxH] [--max-scene BYTES]
