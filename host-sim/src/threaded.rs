@@ -1,6 +1,7 @@
 //! The threaded streaming render: worker threads take pieces of the image
 //! (tiles of a band of rows, or the thesis's four rectangles) from a shared
-//! counter, each with its own renderer, and a window of bands collects them
+//! counter, each drawing the scene's image area by area (`areas`: one
+//! renderer a thread, in a room of its own), and a window of bands collects them
 //! so that rows reach the sink in order, holding only a bounded number of
 //! bands in memory.
 //!
@@ -12,15 +13,18 @@
 
 use crate::options::{Partition, RenderOptions, TILE_SIDE};
 use crate::rows::{RowSink, StreamError};
-use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{OriginDimensions, Point, Size};
 use embedded_graphics_core::pixelcolor::RgbColor;
 use embedded_graphics_core::primitives::Rectangle;
+use embedded_graphics_core::Pixel;
 use octrace_core::profile::Host;
-use octrace_core::render::{Renderer, Tiles};
+use octrace_core::render::{PixelSample, Tiles};
 use octrace_core::shade::Stats;
-use octrace_core::{RendererRoom, SharedScene};
+use octrace_core::{DrawError, RendererRoom, SharedScene};
 use octrace_images::NO_OBJECT;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::cell::{Cell, RefCell};
+use std::sync::atomic::Ordering;
 use std::sync::{Condvar, Mutex};
 use std::time::{Duration, Instant};
 
@@ -136,49 +140,69 @@ pub(crate) fn stream_threads(
             }
         }
         let _leaving = Leaving(&lock, &changed);
-        let mut busy = Duration::ZERO;
-        let mut room = RendererRoom::<Host>::new();
-        let Ok(mut renderer) = scene.renderer(&mut room, Size::new(w, h)) else { return (Stats::default(), busy) };
+        let room = RendererRoom::<Host>::new();
+        // The piece being drawn, filled by the draw; handed to its band
+        // when the draw asks for the next (it asks only once a piece is
+        // whole), so that an empty piece is handed too.
+        let tile: RefCell<Option<Tile>> = RefCell::new(None);
+        let waited = Cell::new(Duration::ZERO);
         // Equal4 hands the thesis's rectangles out statically.
-        let mut own_next = thread;
-        loop {
+        let own_next = Cell::new(thread);
+        let next = || -> Option<Rectangle> {
+            let began = Instant::now();
             let mut state = lock();
+            if let Some(done) = tile.borrow_mut().take() {
+                let slot = &mut state.slots[done.band % window];
+                done.copy_into(slot, bands[done.band].start, w);
+                slot.remaining -= 1;
+                if slot.remaining == 0 {
+                    changed.notify_all();
+                }
+                drop(state);
+                progress(done.area.size.width as u64 * done.area.size.height as u64);
+                state = lock();
+            }
             let piece = loop {
                 let index = match options.partition {
                     Partition::Tiles => state.next,
-                    Partition::Equal4 => own_next,
+                    Partition::Equal4 => own_next.get(),
                 };
                 let piece = match pieces.get(index) {
                     Some(p) if !state.abort => *p,
-                    _ => return (renderer.stats(), busy),
+                    _ => break None,
                 };
                 if piece.band < state.written + window {
                     match options.partition {
                         Partition::Tiles => state.next += 1,
-                        Partition::Equal4 => own_next += threads,
+                        Partition::Equal4 => own_next.set(own_next.get() + threads),
                     }
-                    break piece;
+                    break Some(piece);
                 }
                 state = changed.wait(state).unwrap_or_else(|poisoned| poisoned.into_inner());
             };
             drop(state);
-            let began = Instant::now();
-            let tile = Tile::render(&mut renderer, &piece.area, options.stop);
-            busy += began.elapsed();
-            let mut state = lock();
-            let Some(tile) = tile else {
-                state.abort = true;
+            *tile.borrow_mut() = piece.map(Tile::new);
+            waited.set(waited.get() + began.elapsed());
+            piece.map(|p| p.area)
+        };
+        let mut target = TileTarget { tile: &tile, size: Size::new(w, h) };
+        let image = scene.image::<PixelSample>(&room, Size::new(w, h)).areas(&next);
+        let started = Instant::now();
+        let drawn = match options.stop {
+            None => image.try_draw(&mut target),
+            Some(stop) => image.try_draw_until(&mut target, &mut || stop.load(Ordering::Relaxed)),
+        };
+        let busy = started.elapsed().saturating_sub(waited.get());
+        match drawn {
+            Ok(stats) => (stats, busy),
+            // Stopped inside a piece: the others stop at their next ask.
+            Err(DrawError::Stopped) => {
+                lock().abort = true;
                 changed.notify_all();
-                return (renderer.stats(), busy);
-            };
-            let slot = &mut state.slots[piece.band % window];
-            tile.copy_into(slot, bands[piece.band].start, w);
-            slot.remaining -= 1;
-            if slot.remaining == 0 {
-                changed.notify_all();
+                (Stats::default(), busy)
             }
-            drop(state);
-            progress(piece.area.size.width as u64 * piece.area.size.height as u64);
+            // A camera that cannot be set up: the scene's load refused it.
+            Err(_) => (Stats::default(), busy),
         }
     };
     let stopped = || options.stop.is_some_and(|stop| stop.load(Ordering::Relaxed));
@@ -236,30 +260,19 @@ pub(crate) fn stream_threads(
     Ok((stats, wall, results.into_iter().map(|(_, busy)| busy).collect()))
 }
 
-/// A rendered piece of the image: colours and objects, row-major.
+/// A piece of the image as it is drawn: colours and objects, row-major.
 struct Tile {
+    band: usize,
     area: Rectangle,
     colors: Vec<u8>,
     objects: Vec<u32>,
 }
 
 impl Tile {
-    /// The pixels of `area`; None once `stop` is set (asked between rays).
-    fn render(renderer: &mut Renderer<'_, Host>, area: &Rectangle, stop: Option<&AtomicBool>) -> Option<Tile> {
-        let (x0, y0) = (area.top_left.x as u32, area.top_left.y as u32);
-        let count = area.size.width as usize * area.size.height as usize;
-        let mut tile = Tile { area: *area, colors: Vec::with_capacity(3 * count), objects: Vec::with_capacity(count) };
-        for y in y0..y0 + area.size.height {
-            for x in x0..x0 + area.size.width {
-                let p = match stop {
-                    None => renderer.pixel(x, y),
-                    Some(stop) => renderer.pixel_until(x, y, &mut || stop.load(Ordering::Relaxed)).ok()?,
-                };
-                tile.colors.extend([p.color.r(), p.color.g(), p.color.b()]);
-                tile.objects.push(p.object.map_or(NO_OBJECT, |o| o.0));
-            }
-        }
-        Some(tile)
+    /// Room for `piece`'s pixels.
+    fn new(piece: Piece) -> Tile {
+        let count = piece.area.size.width as usize * piece.area.size.height as usize;
+        Tile { band: piece.band, area: piece.area, colors: vec![0; 3 * count], objects: vec![NO_OBJECT; count] }
     }
 
     /// Copies the tile into the band starting at row `top` of an image
@@ -272,5 +285,41 @@ impl Tile {
             slot.colors[3 * at..3 * (at + w)].copy_from_slice(&self.colors[3 * y * w..3 * (y + 1) * w]);
             slot.objects[at..at + w].copy_from_slice(&self.objects[y * w..(y + 1) * w]);
         }
+    }
+}
+
+/// A thread's draw target: each pixel into the tile being drawn (the draw
+/// hands it only the pixels of that tile's area).
+struct TileTarget<'t> {
+    tile: &'t RefCell<Option<Tile>>,
+    size: Size,
+}
+
+impl OriginDimensions for TileTarget<'_> {
+    fn size(&self) -> Size {
+        self.size
+    }
+}
+
+impl DrawTarget for TileTarget<'_> {
+    type Color = PixelSample;
+    type Error = core::convert::Infallible;
+
+    fn draw_iter<I: IntoIterator<Item = Pixel<PixelSample>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
+        let mut tile = self.tile.borrow_mut();
+        let Some(tile) = tile.as_mut() else { return Ok(()) };
+        let (left, top, width) = (tile.area.top_left.x, tile.area.top_left.y, tile.area.size.width as i32);
+        for Pixel(at, sample) in pixels {
+            if tile.area.contains(at) {
+                let index = ((at.y - top) * width + (at.x - left)) as usize;
+                tile.colors[3 * index..3 * index + 3].copy_from_slice(&[
+                    sample.color.r(),
+                    sample.color.g(),
+                    sample.color.b(),
+                ]);
+                tile.objects[index] = sample.object.map_or(NO_OBJECT, |o| o.0);
+            }
+        }
+        Ok(())
     }
 }

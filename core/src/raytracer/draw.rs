@@ -123,6 +123,9 @@ pub(super) enum Picture<'s> {
     Area(Rectangle),
     /// A still whole, in the progressive order.
     Progressive(&'s Progressive),
+    /// A still's areas, the next `next` gives until it gives none, each at
+    /// its place in the image.
+    Areas(&'s dyn Fn() -> Option<Rectangle>),
     /// A frame's planned tiles: every band, or the next band `next` gives
     /// until it gives none.
     Bands(Playing<'s>, Option<&'s dyn Fn() -> Option<u32>>),
@@ -157,6 +160,21 @@ where
                 // Bayer too: the one method a block order keeps.
                 Some(_) => order.render_polled(renderer, &mut Dithered::ordered(target), poll),
                 None => order.render_polled(renderer, target, poll),
+            }))
+        }
+        Picture::Areas(next) => {
+            let whole = Rectangle::new(Point::zero(), image.size);
+            drawn(image.source.with_renderer(image.size, None, |renderer| {
+                let mut stats = Stats::default();
+                while let Some(area) = next() {
+                    let area = area.intersection(&whole);
+                    stats.add(&match C::PANEL {
+                        // Ordered, as a frame's tiles: no order between areas.
+                        Some(_) => rows(renderer, &area, &mut Dithered::ordered(&mut *target), poll)?,
+                        None => rows(renderer, &area, target, poll)?,
+                    });
+                }
+                Ok(stats)
             }))
         }
         Picture::Area(area) => {

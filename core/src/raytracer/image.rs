@@ -25,7 +25,9 @@ use embedded_graphics_core::primitives::Rectangle;
 /// and counts the rays) and [`TracedImage::try_draw_until`] (stopped
 /// inside a pixel); what it draws is set by its options:
 ///
-/// - the whole picture, or an [`area`](TracedImage::area) of it;
+/// - the whole picture, or an [`area`](TracedImage::area) of it, or the
+///   [`areas`](TracedImage::areas) a thread or core takes one after
+///   another;
 /// - the [`progressive`](TracedImage::progressive) order: coarse blocks
 ///   first;
 /// - for a [`Frame`](crate::Frame) of an animation, the tiles its motion
@@ -177,6 +179,41 @@ impl<'s, 'r, P: Profile, C> TracedImage<'s, 'r, P, C> {
         match self.request.picture {
             Picture::Bands(..) => self,
             _ => self.with(Request { picture: Picture::Progressive(order), ..self.request }),
+        }
+    }
+
+    /// A still's areas, the next one `next` gives until it gives none,
+    /// each drawn at its place in the image (clipped to it): where threads
+    /// or cores share a still, each draws the next area none has taken
+    /// yet, through one renderer (its screen lists made once, not an
+    /// area). On a panel of few levels they are dithered by
+    /// [`Dithering::Bayer`], which needs no order. A frame ignores it.
+    ///
+    /// ```
+    /// use core::cell::Cell;
+    /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*, primitives::Rectangle};
+    /// use octrace_core::{profile::Board16K, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
+    /// let mut whole = MockDisplay::<Rgb888>::new();
+    /// scene.image::<Rgb888>(Size::new(16, 16)).try_draw(&mut whole)?;
+    /// // The four quarters, bottom right first, as four threads might take them.
+    /// let quarter = Cell::new(4);
+    /// let next = || {
+    ///     let left = quarter.get();
+    ///     quarter.set(left.max(1) - 1);
+    ///     (left > 0).then(|| Rectangle::new(Point::new(8 * (left - 1) % 16, 8 * ((left - 1) / 2)), Size::new(8, 8)))
+    /// };
+    /// let mut quarters = MockDisplay::<Rgb888>::new();
+    /// scene.image::<Rgb888>(Size::new(16, 16)).areas(&next).try_draw(&mut quarters)?;
+    /// assert_eq!(quarters, whole);
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn areas(self, next: &'s dyn Fn() -> Option<Rectangle>) -> Self {
+        match self.request.picture {
+            Picture::Bands(..) => self,
+            _ => self.with(Request { picture: Picture::Areas(next), ..self.request }),
         }
     }
 
