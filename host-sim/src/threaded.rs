@@ -15,14 +15,13 @@ use crate::options::{Partition, RenderOptions, TILE_SIDE};
 use crate::rows::{RowSink, StreamError};
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{OriginDimensions, Point, Size};
-use embedded_graphics_core::pixelcolor::RgbColor;
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
 use octrace_core::profile::Host;
 use octrace_core::render::{PixelSample, Tiles};
 use octrace_core::shade::Stats;
 use octrace_core::{DrawError, RendererRoom, SharedScene};
-use octrace_images::NO_OBJECT;
+use octrace_images::{SampleImage, NO_OBJECT};
 use std::cell::{Cell, RefCell};
 use std::sync::atomic::Ordering;
 use std::sync::{Condvar, Mutex};
@@ -288,8 +287,8 @@ impl Tile {
     }
 }
 
-/// A thread's draw target: each pixel into the tile being drawn (the draw
-/// hands it only the pixels of that tile's area).
+/// A thread's draw target: each pixel into the tile being drawn, at its
+/// place there (the draw hands it only the pixels of that tile's area).
 struct TileTarget<'t> {
     tile: &'t RefCell<Option<Tile>>,
     size: Size,
@@ -308,18 +307,20 @@ impl DrawTarget for TileTarget<'_> {
     fn draw_iter<I: IntoIterator<Item = Pixel<PixelSample>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
         let mut tile = self.tile.borrow_mut();
         let Some(tile) = tile.as_mut() else { return Ok(()) };
-        let (left, top, width) = (tile.area.top_left.x, tile.area.top_left.y, tile.area.size.width as i32);
-        for Pixel(at, sample) in pixels {
-            if tile.area.contains(at) {
-                let index = ((at.y - top) * width + (at.x - left)) as usize;
-                tile.colors[3 * index..3 * index + 3].copy_from_slice(&[
-                    sample.color.r(),
-                    sample.color.g(),
-                    sample.color.b(),
-                ]);
-                tile.objects[index] = sample.object.map_or(NO_OBJECT, |o| o.0);
-            }
-        }
-        Ok(())
+        let offset = tile.area.top_left;
+        let mut image = SampleImage { colours: &mut tile.colors, objects: &mut tile.objects, size: tile.area.size };
+        image.draw_iter(pixels.into_iter().map(|Pixel(at, sample)| Pixel(at - offset, sample)))
+    }
+
+    fn fill_contiguous<I: IntoIterator<Item = PixelSample>>(
+        &mut self,
+        area: &Rectangle,
+        samples: I,
+    ) -> Result<(), Self::Error> {
+        let mut tile = self.tile.borrow_mut();
+        let Some(tile) = tile.as_mut() else { return Ok(()) };
+        let area = Rectangle::new(area.top_left - tile.area.top_left, area.size);
+        let mut image = SampleImage { colours: &mut tile.colors, objects: &mut tile.objects, size: tile.area.size };
+        image.fill_contiguous(&area, samples)
     }
 }
