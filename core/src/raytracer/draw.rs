@@ -163,19 +163,12 @@ where
             }))
         }
         Picture::Areas(next) => {
-            let whole = Rectangle::new(Point::zero(), image.size);
-            drawn(image.source.with_renderer(image.size, None, |renderer| {
-                let mut stats = Stats::default();
-                while let Some(area) = next() {
-                    let area = area.intersection(&whole);
-                    stats.add(&match C::PANEL {
-                        // Ordered, as a frame's tiles: no order between areas.
-                        Some(_) => rows(renderer, &area, &mut Dithered::ordered(&mut *target), poll)?,
-                        None => rows(renderer, &area, target, poll)?,
-                    });
-                }
-                Ok(stats)
-            }))
+            let mut shifted = Shifted { target, offset: Point::zero() };
+            match C::PANEL {
+                // Ordered, as a frame's tiles: no order between areas.
+                Some(_) => still(image, &mut || next(), &mut Dithered::ordered(&mut shifted), poll),
+                None => still(image, &mut || next(), &mut shifted, poll),
+            }
         }
         Picture::Area(area) => {
             let mut shifted = Shifted { target, offset: Point::zero() - area.top_left };
@@ -183,7 +176,8 @@ where
             let area = area.intersection(&Rectangle::new(Point::zero(), image.size));
             match (C::PANEL, image.rows) {
                 (None, _) => {
-                    drawn(image.source.with_renderer(image.size, None, |r| rows(r, &area, &mut shifted, poll)))
+                    let mut one = Some(area);
+                    still(image, &mut || one.take(), &mut shifted, poll)
                 }
                 (Some(_), Some(given)) => match given.try_borrow_mut() {
                     Ok(mut given) => dithered(image, &area, &mut shifted, &mut given, poll),
@@ -197,6 +191,32 @@ where
             }
         }
     }
+}
+
+/// A still's areas, the next `next` gives until it gives none (each
+/// clipped to the image), into `target`, through one renderer: the one
+/// loop of a still in areas, so that a board links it once whether it
+/// draws one area or many.
+fn still<P, D, Q>(
+    image: &Request<'_, '_, P>,
+    next: &mut dyn FnMut() -> Option<Rectangle>,
+    target: &mut D,
+    poll: &mut Q,
+) -> Result<Stats, DrawError<D::Error>>
+where
+    P: Profile,
+    D: DrawTarget,
+    D::Color: TracedColor,
+    Q: Poll,
+{
+    let whole = Rectangle::new(Point::zero(), image.size);
+    drawn(image.source.with_renderer(image.size, None, |renderer| {
+        let mut stats = Stats::default();
+        while let Some(area) = next() {
+            stats.add(&rows(renderer, &area.intersection(&whole), target, poll)?);
+        }
+        Ok(stats)
+    }))
 }
 
 /// What a renderer's draw ended with, as a draw's result.
