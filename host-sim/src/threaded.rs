@@ -300,16 +300,26 @@ impl OriginDimensions for TileTarget<'_> {
     }
 }
 
+impl TileTarget<'_> {
+    /// Runs `draw` on the tile being drawn, as an image of its own, with
+    /// where its top-left pixel lies in the picture (nothing without one).
+    fn in_tile(&self, draw: impl FnOnce(&mut SampleImage<'_>, Point)) {
+        if let Some(tile) = self.tile.borrow_mut().as_mut() {
+            let at = tile.area.top_left;
+            draw(&mut SampleImage { colours: &mut tile.colors, objects: &mut tile.objects, size: tile.area.size }, at);
+        }
+    }
+}
+
 impl DrawTarget for TileTarget<'_> {
     type Color = PixelSample;
     type Error = core::convert::Infallible;
 
     fn draw_iter<I: IntoIterator<Item = Pixel<PixelSample>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
-        let mut tile = self.tile.borrow_mut();
-        let Some(tile) = tile.as_mut() else { return Ok(()) };
-        let offset = tile.area.top_left;
-        let mut image = SampleImage { colours: &mut tile.colors, objects: &mut tile.objects, size: tile.area.size };
-        image.draw_iter(pixels.into_iter().map(|Pixel(at, sample)| Pixel(at - offset, sample)))
+        self.in_tile(|image, at| {
+            let Ok(()) = image.draw_iter(pixels.into_iter().map(|Pixel(p, sample)| Pixel(p - at, sample)));
+        });
+        Ok(())
     }
 
     fn fill_contiguous<I: IntoIterator<Item = PixelSample>>(
@@ -317,10 +327,9 @@ impl DrawTarget for TileTarget<'_> {
         area: &Rectangle,
         samples: I,
     ) -> Result<(), Self::Error> {
-        let mut tile = self.tile.borrow_mut();
-        let Some(tile) = tile.as_mut() else { return Ok(()) };
-        let area = Rectangle::new(area.top_left - tile.area.top_left, area.size);
-        let mut image = SampleImage { colours: &mut tile.colors, objects: &mut tile.objects, size: tile.area.size };
-        image.fill_contiguous(&area, samples)
+        self.in_tile(|image, at| {
+            let Ok(()) = image.fill_contiguous(&Rectangle::new(area.top_left - at, area.size), samples);
+        });
+        Ok(())
     }
 }
