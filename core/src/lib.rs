@@ -149,6 +149,7 @@ mod sort;
 mod test_rng;
 
 pub use accel::{AccelMode, SceneAccelerator};
+pub use raytracer::picture;
 pub use raytracer::{
     AnimationError, DrawError, Frame, LoadError, LoadedScene, Raytracer, RendererRoom, SharedScene, TracedImage,
 };

@@ -1,7 +1,8 @@
-//! Both Cortex-M33s of the MPS2-AN521 render the picture. Core `c` renders
-//! the rows `interleaved_rows(HEIGHT, c, 2)` with a `Renderer` of its own
-//! (core 0's in its `Raytracer`, core 1's in a `RendererRoom`) over the one
-//! scene, shared with `LoadedScene::share`; core 0 alone writes to the
+//! Both Cortex-M33s of the MPS2-AN521 render the picture. Core `c` draws
+//! the rows `c`, `c + 2`, `c + 4`, … of the scene's image, as its
+//! areas (`TracedImage::areas`), with a renderer of its own (core 0's in
+//! its `Raytracer`, core 1's in a `RendererRoom`) over the one scene,
+//! shared with `LoadedScene::share`; core 0 alone writes to the
 //! display, in row order, taking core 1's rows from a `Handoff` ring: no
 //! heap, no lock. A panel of few levels is dithered as one picture, every
 //! row going through one `Dithered` target in order.
@@ -10,14 +11,16 @@
 //! never touches the scene's `Raytracer` or semihosting).
 
 use crate::config::{self, Profile};
-use core::cell::UnsafeCell;
+use core::cell::{Cell, UnsafeCell};
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::geometry::{OriginDimensions, Point, Size};
+use embedded_graphics_core::pixelcolor::Rgb888;
 use embedded_graphics_core::primitives::Rectangle;
+use embedded_graphics_core::Pixel;
 use octrace_core::panel::{Dithered, TracedColor};
-use octrace_core::render::{interleaved_rows, Handoff};
-use octrace_core::{ConstStaticCell, LoadedScene, RendererRoom, SharedScene};
+use octrace_core::render::Handoff;
+use octrace_core::{ConstStaticCell, DrawError, LoadedScene, RendererRoom, SharedScene};
 
 const WIDTH: usize = config::WIDTH as usize;
 
@@ -86,25 +89,64 @@ where
         INITSVTOR1.write_volatile(&CORE1_VECTORS as *const Vectors as usize as u32);
         CPUWAIT.write_volatile(CPUWAIT.read_volatile() & !0b10);
     }
-    let size = Size::new(config::WIDTH, config::HEIGHT);
+    let next = rows_of(0);
+    let mut interleaving = Interleaving { display: &mut display };
     // The size was checked when core 0 loaded the scene.
-    let drawn = scene.with_renderer(size, |renderer| {
-        for y in 0..size.height {
-            let area = Rectangle::new(Point::new(0, y as i32), Size::new(size.width, 1));
-            if y % 2 == 0 {
-                display.fill_contiguous(&area, renderer.row(y, 0..size.width).map(|p| p.color))?;
-                continue;
-            }
+    let drawn = scene.image::<Rgb888>(SIZE).areas(&next).try_draw(&mut interleaving);
+    let core0_rays = match drawn {
+        Ok(stats) => stats.rays,
+        Err(DrawError::Target(e)) => return Err(e),
+        Err(_) => crate::semihosting::exit(2),
+    };
+    Ok([core0_rays, CORE1_RAYS.load(Ordering::Acquire) as u64])
+}
+
+/// The picture's size.
+const SIZE: Size = Size::new(config::WIDTH, config::HEIGHT);
+
+/// Core `core`'s rows of the picture, every other one from its own, one
+/// after another: its areas.
+fn rows_of(core: u32) -> impl Fn() -> Option<Rectangle> {
+    let next = Cell::new(core);
+    move || {
+        let y = next.get();
+        next.set(y + 2);
+        (y < config::HEIGHT).then(|| Rectangle::new(Point::new(0, y as i32), Size::new(config::WIDTH, 1)))
+    }
+}
+
+/// The display as core 0 draws into it: each of its own rows, then core
+/// 1's row after it, from the ring.
+struct Interleaving<'d, D> {
+    display: &'d mut D,
+}
+
+impl<D: DrawTarget<Color = Rgb888>> OriginDimensions for Interleaving<'_, D> {
+    fn size(&self) -> Size {
+        SIZE
+    }
+}
+
+impl<D: DrawTarget<Color = Rgb888>> DrawTarget for Interleaving<'_, D> {
+    type Color = Rgb888;
+    type Error = D::Error;
+
+    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb888>>>(&mut self, pixels: I) -> Result<(), D::Error> {
+        self.display.draw_iter(pixels)
+    }
+
+    fn fill_contiguous<I: IntoIterator<Item = Rgb888>>(&mut self, row: &Rectangle, colors: I) -> Result<(), D::Error> {
+        self.display.fill_contiguous(row, colors)?;
+        let y = row.top_left.y as u32 + 1;
+        if y < config::HEIGHT {
             octrace_wait_until(y, true);
             // Held, so taken: the row's colours, its slot freed after.
-            if let Some(row) = RING.take(y) {
-                display.fill_contiguous(&area, row)?;
+            if let Some(taken) = RING.take(y) {
+                self.display.fill_contiguous(&Rectangle::new(Point::new(0, y as i32), row.size), taken)?;
             }
         }
-        Ok(renderer.stats().rays)
-    });
-    let Ok(core0_rays) = drawn else { crate::semihosting::exit(2) };
-    Ok([core0_rays?, CORE1_RAYS.load(Ordering::Acquire) as u64])
+        Ok(())
+    }
 }
 
 /// Rays core 1 traced, once it is done.
@@ -121,7 +163,39 @@ pub extern "C" fn octrace_wait_until(y: u32, sent: bool) {
     }
 }
 
-/// Core 1: renders its rows into the ring, then sleeps.
+/// Core 1's rows as it draws them, each into the ring once its slot is
+/// free.
+struct Handing;
+
+impl OriginDimensions for Handing {
+    fn size(&self) -> Size {
+        SIZE
+    }
+}
+
+impl DrawTarget for Handing {
+    type Color = Rgb888;
+    type Error = core::convert::Infallible;
+
+    /// Never called: the image's areas are drawn a row at a time.
+    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb888>>>(&mut self, _: I) -> Result<(), Self::Error> {
+        crate::semihosting::exit(104)
+    }
+
+    fn fill_contiguous<I: IntoIterator<Item = Rgb888>>(
+        &mut self,
+        row: &Rectangle,
+        colors: I,
+    ) -> Result<(), Self::Error> {
+        let y = row.top_left.y as u32;
+        octrace_wait_until(y, false);
+        // Free, so the row is traced as the ring takes it, and published.
+        let _ = RING.send(y, colors);
+        Ok(())
+    }
+}
+
+/// Core 1: draws its rows into the ring, then sleeps.
 extern "C" fn core1_main() -> ! {
     // The FPU, as cortex-m-rt enables it for core 0 (CPACR: CP10, CP11).
     // SAFETY: the architecture's register; enabling it is all this does.
@@ -136,15 +210,11 @@ extern "C" fn core1_main() -> ! {
     }
     // SAFETY: published before `ready`, never written again.
     let Some(shared) = (unsafe { *SHARED.scene.get() }) else { crate::semihosting::exit(104) };
-    let Ok(mut renderer) = shared.renderer(CORE1_ROOM.take(), Size::new(config::WIDTH, config::HEIGHT)) else {
+    let next = rows_of(1);
+    let Ok(stats) = shared.image::<Rgb888>(CORE1_ROOM.take(), SIZE).areas(&next).try_draw(&mut Handing) else {
         crate::semihosting::exit(104)
     };
-    for y in interleaved_rows(config::HEIGHT, 1, 2) {
-        octrace_wait_until(y, false);
-        // Free, so the row is traced and published.
-        let _ = RING.send(y, renderer.row(y, 0..config::WIDTH).map(|p| p.color));
-    }
-    CORE1_RAYS.store(renderer.stats().rays as u32, Ordering::Release);
+    CORE1_RAYS.store(stats.rays as u32, Ordering::Release);
     loop {
         cortex_m::asm::wfi();
     }

@@ -39,7 +39,7 @@ use octrace_core::animation::Animation;
 use octrace_core::panel::{Dithered, TracedColor};
 use octrace_core::profile::Profile;
 use octrace_core::render::Handoff;
-use octrace_core::{DrawError, Frame, Raytracer, RendererRoom};
+use octrace_core::{Frame, Raytracer, RendererRoom};
 use rp2040_hal::Timer;
 
 /// The most bands of tiles a panel may have (a panel up to 512 rows high).
@@ -383,11 +383,7 @@ where
             true => image.try_draw_until(&mut panel, &mut { stop }),
             false => image.try_draw(&mut panel),
         };
-        let mut result = drawn.map(|_| ()).map_err(|e| match e {
-            DrawError::Camera(_) => Unfinished::Camera,
-            DrawError::Stopped => Unfinished::Stopped,
-            DrawError::Target(_) | DrawError::ErrorRow(_) | DrawError::TooLarge { .. } => Unfinished::Panel,
-        });
+        let mut result = drawn.map(|_| ()).map_err(|e| Unfinished::of(e, |_| Unfinished::Panel));
         // The rest of core 1's.
         while result.is_ok() {
             result = panel.show_handed().map_err(|_| Unfinished::Panel);

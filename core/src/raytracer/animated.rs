@@ -7,6 +7,8 @@
 //! tiles are planned for it; a scene with an error at any frame (its
 //! camera included) is refused at its first load, before any frame.
 
+use super::draw::Picture;
+use super::picture::Bands;
 use super::{LoadError, LoadedScene, Raytracer, RunBoth, SharedScene, TracedImage};
 use crate::animation::{Animation, AnimationCapacity, AnimationNeeds, Coherence, NoRoom, Playing};
 use crate::parse::ParseError;
@@ -90,20 +92,20 @@ impl<'a, 'r, P: Profile> Frame<'a, 'r, P> {
     /// its draw traces the planned tiles only, and after the frame before
     /// it in the loop (or at the first frame, everything) the target shows
     /// the frame as a whole draw would.
-    pub fn image<C>(&self) -> TracedImage<'_, 'r, P, C> {
-        TracedImage::new(self.scene.source(), self.playing.coherence.size(), Some(self.playing))
+    pub fn image<C>(&self) -> TracedImage<'_, 'r, P, C, Bands> {
+        TracedImage::new(self.scene.source(), self.playing.coherence.size(), Picture::Bands(self.playing, None))
     }
 
     /// The frame as an image in `target`'s colour (at the animation's
     /// size, which should be the target's).
-    pub fn image_for<D: DrawTarget>(&self, target: &D) -> TracedImage<'_, 'r, P, D::Color> {
+    pub fn image_for<D: DrawTarget>(&self, target: &D) -> TracedImage<'_, 'r, P, D::Color, Bands> {
         let _ = target;
         self.image()
     }
 
     /// What another core needs to draw bands of this frame.
-    pub fn share(&self) -> SharedScene<'_, P> {
-        SharedScene { playing: Some(self.playing), ..self.scene.share() }
+    pub fn share(&self) -> SharedScene<'_, P, Bands> {
+        self.scene.share().frame(self.playing)
     }
 }
 

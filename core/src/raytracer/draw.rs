@@ -11,13 +11,14 @@
 //! mark to be traced); a draw that asks nothing runs the tracer without
 //! any of the asking.
 
+use super::picture::{sealed::Kind, Picture as Drawn};
 use super::{DrawError, RendererRoom, ScreenLists};
 use crate::accel::{Linked, SceneAccelerator};
 use crate::animation::Playing;
 use crate::motion::Lookout;
 use crate::panel::{Dithered, Dithering, TracedColor, IMAGE_ERROR_WORDS};
 use crate::profile::Profile;
-use crate::render::{Halt, Progressive, Renderer};
+use crate::render::{clipped, Halt, Progressive, Renderer};
 use crate::scene::{CameraError, SceneView, MAX_SIDE};
 use crate::shade::{Poll, Stats};
 use core::cell::{Cell, RefCell};
@@ -131,8 +132,9 @@ pub(super) enum Picture<'s> {
     Bands(Playing<'s>, Option<&'s dyn Fn() -> Option<u32>>),
 }
 
-/// Draws what `image` asks into `target`, `poll` asked before every ray.
-pub(super) fn draw<P, C, D, Q>(
+/// Draws what `image` asks into `target`, `poll` asked before every ray:
+/// the picture `K`, whose code alone a draw of it links.
+pub(super) fn draw<P, C, K, D, Q>(
     image: &Request<'_, '_, P>,
     target: &mut D,
     poll: &mut Q,
@@ -140,6 +142,7 @@ pub(super) fn draw<P, C, D, Q>(
 where
     P: Profile,
     C: TracedColor,
+    K: Drawn,
     D: DrawTarget<Color = C>,
     Q: Poll,
 {
@@ -148,21 +151,23 @@ where
         // The camera would trace a picture of at most that, clipped.
         return Err(DrawError::TooLarge { width, height });
     }
-    match image.picture {
-        Picture::Bands(playing, next) => match C::PANEL {
+    // Matched on `K`'s constant first: the other pictures' arms are dead
+    // code in this instance.
+    match (K::KIND, image.picture) {
+        (Kind::Bands, Picture::Bands(playing, next)) => match C::PANEL {
             // Ordered dithering, which needs no order: a changed tile
             // draws the same whatever was drawn around it.
             Some(_) => bands(image, &playing, next, &mut Dithered::ordered(target), poll),
             None => bands(image, &playing, next, target, poll),
         },
-        Picture::Progressive(order) => {
+        (Kind::InOrder, Picture::Progressive(order)) => {
             drawn(image.source.with_renderer(order.size(), None, |renderer| match C::PANEL {
                 // Bayer too: the one method a block order keeps.
                 Some(_) => order.render_polled(renderer, &mut Dithered::ordered(target), poll),
                 None => order.render_polled(renderer, target, poll),
             }))
         }
-        Picture::Areas(next) => {
+        (Kind::Areas, Picture::Areas(next)) => {
             let mut shifted = Shifted { target, offset: Point::zero() };
             match C::PANEL {
                 // Ordered, as a frame's tiles: no order between areas.
@@ -170,10 +175,10 @@ where
                 None => still(image, &mut || next(), &mut shifted, poll),
             }
         }
-        Picture::Area(area) => {
+        (Kind::Still, Picture::Area(area)) => {
             let mut shifted = Shifted { target, offset: Point::zero() - area.top_left };
             // The pixels there are: the rows a ditherer is set up for.
-            let area = area.intersection(&Rectangle::new(Point::zero(), image.size));
+            let area = clipped(&area, image.size);
             match (C::PANEL, image.rows) {
                 (None, _) => {
                     let mut one = Some(area);
@@ -190,6 +195,8 @@ where
                 (Some(_), None) => dithered_on_stack::<IMAGE_ERROR_WORDS, _, _, _, _>(image, &area, &mut shifted, poll),
             }
         }
+        // Never: an image's type and its picture are set together.
+        _ => Ok(Stats::default()),
     }
 }
 
@@ -209,11 +216,10 @@ where
     D::Color: TracedColor,
     Q: Poll,
 {
-    let whole = Rectangle::new(Point::zero(), image.size);
     drawn(image.source.with_renderer(image.size, None, |renderer| {
         let mut stats = Stats::default();
         while let Some(area) = next() {
-            stats.add(&rows(renderer, &area.intersection(&whole), target, poll)?);
+            stats.add(&rows(renderer, &clipped(&area, image.size), target, poll)?);
         }
         Ok(stats)
     }))

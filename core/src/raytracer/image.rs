@@ -2,9 +2,9 @@
 //! embedded-graphics image with options (an area, the progressive order, a
 //! frame's bands, the dithering), drawn whole or stopped inside a pixel.
 
-use super::draw::{self, Picture, Request, Source};
+use super::draw::{self, Request, Source};
+use super::picture::{Areas, Bands, InOrder, Picture, Still};
 use super::DrawError;
-use crate::animation::Playing;
 use crate::panel::{Dithering, TracedColor};
 use crate::profile::Profile;
 use crate::render::{Polling, Progressive, Stop};
@@ -12,7 +12,7 @@ use crate::shade::{Stats, Unpolled};
 use core::cell::RefCell;
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{Dimensions, OriginDimensions, Point, Size};
+use embedded_graphics_core::geometry::{Dimensions, OriginDimensions, Size};
 use embedded_graphics_core::image::ImageDrawable;
 use embedded_graphics_core::primitives::Rectangle;
 
@@ -23,7 +23,9 @@ use embedded_graphics_core::primitives::Rectangle;
 /// embedded-graphics draws any image (`Image::new(&image, point)`), or
 /// with [`TracedImage::try_draw`] (which tells why a picture is not whole
 /// and counts the rays) and [`TracedImage::try_draw_until`] (stopped
-/// inside a pixel); what it draws is set by its options:
+/// inside a pixel); what it draws is set by its options, each of which
+/// gives it the type of its picture (`K`, a [`picture`](crate::picture):
+/// a firmware links the drawing of only the pictures it draws):
 ///
 /// - the whole picture, or an [`area`](TracedImage::area) of it, or the
 ///   [`areas`](TracedImage::areas) a thread or core takes one after
@@ -55,15 +57,15 @@ use embedded_graphics_core::primitives::Rectangle;
 /// Image::new(&scene.image::<Rgb565>(Size::new(4, 2)), Point::zero()).draw(&mut display).unwrap();
 /// display.assert_pattern(&["BBBB", "BBBB"]);
 /// ```
-pub struct TracedImage<'s, 'r, P: Profile, C> {
+pub struct TracedImage<'s, 'r, P: Profile, C, K: Picture = Still> {
     request: Request<'s, 'r, P>,
-    color: core::marker::PhantomData<C>,
+    color: core::marker::PhantomData<(C, K)>,
 }
 
-impl<P: Profile, C> fmt::Debug for TracedImage<'_, '_, P, C> {
+impl<P: Profile, C, K: Picture> fmt::Debug for TracedImage<'_, '_, P, C, K> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let picture = match self.request.picture {
-            Picture::Area(area) => area,
+            draw::Picture::Area(area) => area,
             _ => self.bounding_box(),
         };
         f.debug_struct("TracedImage")
@@ -75,29 +77,25 @@ impl<P: Profile, C> fmt::Debug for TracedImage<'_, '_, P, C> {
     }
 }
 
-impl<P: Profile, C> Clone for TracedImage<'_, '_, P, C> {
+impl<P: Profile, C, K: Picture> Clone for TracedImage<'_, '_, P, C, K> {
     fn clone(&self) -> Self {
         *self
     }
 }
 
-impl<P: Profile, C> Copy for TracedImage<'_, '_, P, C> {}
+impl<P: Profile, C, K: Picture> Copy for TracedImage<'_, '_, P, C, K> {}
 
-impl<'s, 'r, P: Profile, C> TracedImage<'s, 'r, P, C> {
-    /// The image of `size` pixels traced from `source`: a frame's
-    /// planned tiles (`playing`), or the whole still.
-    pub(super) fn new(source: Source<'s, 'r, P>, size: Size, playing: Option<Playing<'s>>) -> Self {
-        let picture = match playing {
-            Some(playing) => Picture::Bands(playing, None),
-            None => Picture::Area(Rectangle::new(Point::zero(), size)),
-        };
+impl<'s, 'r, P: Profile, C, K: Picture> TracedImage<'s, 'r, P, C, K> {
+    /// The image of `size` pixels traced from `source`, drawing `picture`
+    /// (which is `K`'s).
+    pub(super) fn new(source: Source<'s, 'r, P>, size: Size, picture: draw::Picture<'s>) -> Self {
         let request = Request { source, size, dithering: Dithering::default(), picture, rows: None };
         TracedImage { request, color: core::marker::PhantomData }
     }
 
-    /// The image drawing what `request` asks.
-    fn with(self, request: Request<'s, 'r, P>) -> Self {
-        TracedImage { request, ..self }
+    /// The image drawing what `request` asks, as the picture `L`.
+    fn with<L: Picture>(self, request: Request<'s, 'r, P>) -> TracedImage<'s, 'r, P, C, L> {
+        TracedImage { request, color: core::marker::PhantomData }
     }
 
     /// The image dithered by `dithering` on a panel of few levels (a
@@ -123,111 +121,6 @@ impl<'s, 'r, P: Profile, C> TracedImage<'s, 'r, P, C> {
     /// How it is dithered on a panel of few levels.
     pub fn dithering(&self) -> Dithering {
         self.request.dithering
-    }
-
-    /// A still's pixels in `area` only (in the image's coordinates), drawn
-    /// with the area's top-left pixel at the target's origin: what
-    /// [`ImageDrawable::draw_sub_image`] draws. On a panel of few levels the
-    /// area is dithered as an image of its own.
-    ///
-    /// ```
-    /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*, primitives::Rectangle};
-    /// use octrace_core::{profile::Board16K, Raytracer};
-    ///
-    /// let mut raytracer = Raytracer::<Board16K>::new();
-    /// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
-    /// let mut whole = MockDisplay::<Rgb888>::new();
-    /// scene.image::<Rgb888>(Size::new(16, 16)).try_draw(&mut whole)?;
-    /// let mut corner = MockDisplay::<Rgb888>::new();
-    /// let area = Rectangle::new(Point::new(8, 8), Size::new(4, 4));
-    /// scene.image::<Rgb888>(Size::new(16, 16)).area(area).try_draw(&mut corner)?;
-    /// assert_eq!(corner.get_pixel(Point::new(1, 2)), whole.get_pixel(Point::new(9, 10)));
-    /// # Ok::<(), Box<dyn core::error::Error>>(())
-    /// ```
-    pub fn area(self, area: Rectangle) -> Self {
-        match self.request.picture {
-            Picture::Bands(..) => self,
-            _ => self.with(Request { picture: Picture::Area(area), ..self.request }),
-        }
-    }
-
-    /// A still whole in the [`Progressive`] order (at the order's size):
-    /// the whole picture in coarse blocks first, then finer, until it is
-    /// exactly the picture drawn row by row. Every pixel is traced once;
-    /// the drawing streams (no framebuffer), in a few calls a pass. On a
-    /// panel of few levels every pass is dithered by [`Dithering::Bayer`]:
-    /// the last pass is then the image with that method.
-    ///
-    /// ```
-    /// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb565, prelude::*};
-    /// use octrace_core::{profile::Board16K, render::Progressive, Raytracer};
-    ///
-    /// let mut raytracer = Raytracer::<Board16K>::new();
-    /// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
-    /// let mut display = MockDisplay::<Rgb565>::new();
-    /// display.set_allow_overdraw(true); // later passes draw over the coarse blocks
-    /// let order = Progressive::new(display.size(), 16);
-    /// let stats = scene.image_for(&display).progressive(&order).try_draw(&mut display)?;
-    /// assert_eq!(stats.rays, 64 * 64, "every pixel traced once: nothing reflects");
-    ///
-    /// let mut direct = MockDisplay::<Rgb565>::new();
-    /// Image::new(&scene.image_for(&direct), Point::zero()).draw(&mut direct)?;
-    /// assert_eq!(display, direct);
-    /// # Ok::<(), Box<dyn core::error::Error>>(())
-    /// ```
-    pub fn progressive(self, order: &'s Progressive) -> Self {
-        match self.request.picture {
-            Picture::Bands(..) => self,
-            _ => self.with(Request { picture: Picture::Progressive(order), ..self.request }),
-        }
-    }
-
-    /// A still's areas, the next one `next` gives until it gives none,
-    /// each drawn at its place in the image (clipped to it): where threads
-    /// or cores share a still, each draws the next area none has taken
-    /// yet, through one renderer (its screen lists made once, not an
-    /// area). On a panel of few levels they are dithered by
-    /// [`Dithering::Bayer`], which needs no order. A frame ignores it.
-    ///
-    /// ```
-    /// use core::cell::Cell;
-    /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*, primitives::Rectangle};
-    /// use octrace_core::{profile::Board16K, Raytracer};
-    ///
-    /// let mut raytracer = Raytracer::<Board16K>::new();
-    /// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
-    /// let mut whole = MockDisplay::<Rgb888>::new();
-    /// scene.image::<Rgb888>(Size::new(16, 16)).try_draw(&mut whole)?;
-    /// // The four quarters, bottom right first, as four threads might take them.
-    /// let quarter = Cell::new(4);
-    /// let next = || {
-    ///     let left = quarter.get();
-    ///     quarter.set(left.max(1) - 1);
-    ///     (left > 0).then(|| Rectangle::new(Point::new(8 * (left - 1) % 16, 8 * ((left - 1) / 2)), Size::new(8, 8)))
-    /// };
-    /// let mut quarters = MockDisplay::<Rgb888>::new();
-    /// scene.image::<Rgb888>(Size::new(16, 16)).areas(&next).try_draw(&mut quarters)?;
-    /// assert_eq!(quarters, whole);
-    /// # Ok::<(), Box<dyn core::error::Error>>(())
-    /// ```
-    pub fn areas(self, next: &'s dyn Fn() -> Option<Rectangle>) -> Self {
-        match self.request.picture {
-            Picture::Bands(..) => self,
-            _ => self.with(Request { picture: Picture::Areas(next), ..self.request }),
-        }
-    }
-
-    /// A frame's bands of tiles (rows of tiles, [`TILE`](crate::animation::TILE)
-    /// pixels high), the next one `next` gives until it gives none,
-    /// instead of every band: on a board whose cores share a frame, each
-    /// core draws the next band no core has taken yet. A still ignores it.
-    pub fn bands(self, next: &'s dyn Fn() -> Option<u32>) -> Self {
-        match self.request.picture {
-            Picture::Bands(playing, _) => {
-                self.with(Request { picture: Picture::Bands(playing, Some(next)), ..self.request })
-            }
-            _ => self,
-        }
     }
 
     /// Error diffusion's rows in `rows` (at least
@@ -256,14 +149,115 @@ impl<'s, 'r, P: Profile, C> TracedImage<'s, 'r, P, C> {
     }
 }
 
-impl<P: Profile, C: TracedColor> TracedImage<'_, '_, P, C> {
+impl<'s, 'r, P: Profile, C> TracedImage<'s, 'r, P, C, Still> {
+    /// A still's pixels in `area` only (in the image's coordinates), drawn
+    /// with the area's top-left pixel at the target's origin: what
+    /// [`ImageDrawable::draw_sub_image`] draws. On a panel of few levels the
+    /// area is dithered as an image of its own.
+    ///
+    /// ```
+    /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*, primitives::Rectangle};
+    /// use octrace_core::{profile::Board16K, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
+    /// let mut whole = MockDisplay::<Rgb888>::new();
+    /// scene.image::<Rgb888>(Size::new(16, 16)).try_draw(&mut whole)?;
+    /// let mut corner = MockDisplay::<Rgb888>::new();
+    /// let area = Rectangle::new(Point::new(8, 8), Size::new(4, 4));
+    /// scene.image::<Rgb888>(Size::new(16, 16)).area(area).try_draw(&mut corner)?;
+    /// assert_eq!(corner.get_pixel(Point::new(1, 2)), whole.get_pixel(Point::new(9, 10)));
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn area(self, area: Rectangle) -> Self {
+        self.with(Request { picture: draw::Picture::Area(area), ..self.request })
+    }
+
+    /// A still whole in the [`Progressive`] order (at the order's size):
+    /// the whole picture in coarse blocks first, then finer, until it is
+    /// exactly the picture drawn row by row. Every pixel is traced once;
+    /// the drawing streams (no framebuffer), in a few calls a pass. On a
+    /// panel of few levels every pass is dithered by [`Dithering::Bayer`]:
+    /// the last pass is then the image with that method.
+    ///
+    /// ```
+    /// use embedded_graphics::{image::Image, mock_display::MockDisplay, pixelcolor::Rgb565, prelude::*};
+    /// use octrace_core::{profile::Board16K, render::Progressive, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
+    /// let mut display = MockDisplay::<Rgb565>::new();
+    /// display.set_allow_overdraw(true); // later passes draw over the coarse blocks
+    /// let order = Progressive::new(display.size(), 16);
+    /// let stats = scene.image_for(&display).progressive(&order).try_draw(&mut display)?;
+    /// assert_eq!(stats.rays, 64 * 64, "every pixel traced once: nothing reflects");
+    ///
+    /// let mut direct = MockDisplay::<Rgb565>::new();
+    /// Image::new(&scene.image_for(&direct), Point::zero()).draw(&mut direct)?;
+    /// assert_eq!(display, direct);
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn progressive(self, order: &'s Progressive) -> TracedImage<'s, 'r, P, C, InOrder> {
+        self.with(Request { picture: draw::Picture::Progressive(order), ..self.request })
+    }
+
+    /// A still's areas, the next one `next` gives until it gives none,
+    /// each drawn at its place in the image (clipped to it): where threads
+    /// or cores share a still, each draws the next area none has taken
+    /// yet, through one renderer (its screen lists made once, not an
+    /// area). On a panel of few levels they are dithered by
+    /// [`Dithering::Bayer`], which needs no order.
+    ///
+    /// ```
+    /// use core::cell::Cell;
+    /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::Rgb888, prelude::*, primitives::Rectangle};
+    /// use octrace_core::{profile::Board16K, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// let scene = raytracer.load("SURFACE 1 .1 .1 .1 .7 .2 .2 0 0 0 1 0 0\nLIGHT 10 5 5 5\nSPHERE 1 1 0 0 0\n")?;
+    /// let mut whole = MockDisplay::<Rgb888>::new();
+    /// scene.image::<Rgb888>(Size::new(16, 16)).try_draw(&mut whole)?;
+    /// // The four quarters, bottom right first, as four threads might take them.
+    /// let quarter = Cell::new(4);
+    /// let next = || {
+    ///     let left = quarter.get();
+    ///     quarter.set(left.max(1) - 1);
+    ///     (left > 0).then(|| Rectangle::new(Point::new(8 * (left - 1) % 16, 8 * ((left - 1) / 2)), Size::new(8, 8)))
+    /// };
+    /// let mut quarters = MockDisplay::<Rgb888>::new();
+    /// scene.image::<Rgb888>(Size::new(16, 16)).areas(&next).try_draw(&mut quarters)?;
+    /// assert_eq!(quarters, whole);
+    /// # Ok::<(), Box<dyn core::error::Error>>(())
+    /// ```
+    pub fn areas(self, next: &'s dyn Fn() -> Option<Rectangle>) -> TracedImage<'s, 'r, P, C, Areas> {
+        self.with(Request { picture: draw::Picture::Areas(next), ..self.request })
+    }
+}
+
+impl<'s, 'r, P: Profile, C> TracedImage<'s, 'r, P, C, Bands> {
+    /// A frame's bands of tiles (rows of tiles, [`TILE`](crate::animation::TILE)
+    /// pixels high), the next one `next` gives until it gives none,
+    /// instead of every band: on a board whose cores share a frame, each
+    /// core draws the next band no core has taken yet.
+    pub fn bands(self, next: &'s dyn Fn() -> Option<u32>) -> Self {
+        match self.request.picture {
+            draw::Picture::Bands(playing, _) => {
+                self.with(Request { picture: draw::Picture::Bands(playing, Some(next)), ..self.request })
+            }
+            // Never: a frame's image draws its bands.
+            _ => self,
+        }
+    }
+}
+
+impl<P: Profile, C: TracedColor, K: Picture> TracedImage<'_, '_, P, C, K> {
     /// Draws what the image is set to into `target`; returns the counters
     /// of its rays, or why the picture is not whole: a camera that cannot
     /// be set up (a zero size), an image too wide for the error row on the
     /// stack, the display's error ([`ImageDrawable::draw`] tells only the
     /// last).
     pub fn try_draw<D: DrawTarget<Color = C>>(&self, target: &mut D) -> Result<Stats, DrawError<D::Error>> {
-        draw::draw(&self.request, target, &mut Unpolled)
+        draw::draw::<P, C, K, D, _>(&self.request, target, &mut Unpolled)
     }
 
     /// [`TracedImage::try_draw`], asking `stop` before every ray (as
@@ -294,17 +288,17 @@ impl<P: Profile, C: TracedColor> TracedImage<'_, '_, P, C> {
         target: &mut D,
         stop: &mut S,
     ) -> Result<Stats, DrawError<D::Error>> {
-        draw::draw(&self.request, target, &mut Polling { stop, stopped: false })
+        draw::draw::<P, C, K, D, _>(&self.request, target, &mut Polling { stop, stopped: false })
     }
 }
 
-impl<P: Profile, C> OriginDimensions for TracedImage<'_, '_, P, C> {
+impl<P: Profile, C, K: Picture> OriginDimensions for TracedImage<'_, '_, P, C, K> {
     fn size(&self) -> Size {
         self.request.size
     }
 }
 
-impl<P: Profile, C: TracedColor> ImageDrawable for TracedImage<'_, '_, P, C> {
+impl<P: Profile, C: TracedColor, K: Picture> ImageDrawable for TracedImage<'_, '_, P, C, K> {
     type Color = C;
 
     /// Draws the picture, as [`TracedImage::try_draw`] does; but
@@ -324,7 +318,9 @@ impl<P: Profile, C: TracedColor> ImageDrawable for TracedImage<'_, '_, P, C> {
     }
 
     fn draw_sub_image<D: DrawTarget<Color = C>>(&self, target: &mut D, area: &Rectangle) -> Result<(), D::Error> {
-        ImageDrawable::draw(&self.area(*area), target)
+        // A frame's area too: the frame's scene traced there.
+        let still = self.with::<Still>(Request { picture: draw::Picture::Area(*area), ..self.request });
+        ImageDrawable::draw(&still, target)
     }
 }
 
@@ -336,6 +332,7 @@ mod tests {
     use crate::profile::Board16K;
     use crate::render::Progressive;
     use crate::{LoadedScene, Raytracer};
+    use embedded_graphics_core::geometry::Point;
     use embedded_graphics_core::pixelcolor::{BinaryColor, Gray4, Rgb565, Rgb888};
     use embedded_graphics_core::primitives::PointsIter;
     use embedded_graphics_core::Pixel;

@@ -9,9 +9,10 @@ use crate::shade::Stats;
 use core::cell::Cell;
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::Size;
+use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::primitives::Rectangle;
 
-use super::draw::Source;
+use super::draw::{Picture, Source};
 use super::{RendererRoom, SharedScene, TracedImage};
 
 /// A scene ready to trace, borrowed from its [`Raytracer`](super::Raytracer).
@@ -170,7 +171,13 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// What another core needs to render this scene with a [`Renderer`] of
     /// its own: see [`SharedScene`].
     pub fn share(&self) -> SharedScene<'r, P> {
-        SharedScene { view: self.view, accelerator: self.accelerator(), first_hits: self.first_hits, playing: None }
+        SharedScene {
+            view: self.view,
+            accelerator: self.accelerator(),
+            first_hits: self.first_hits,
+            playing: None,
+            picture: core::marker::PhantomData,
+        }
     }
 
     /// Whether camera rays find their hits in the screen lists
@@ -204,7 +211,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// The scene as an image of `size` pixels in the colour `C`: what to
     /// draw of it, and how ([`TracedImage`]).
     pub fn image<C>(&self, size: Size) -> TracedImage<'_, 'r, P, C> {
-        TracedImage::new(self.source(), size, None)
+        TracedImage::new(self.source(), size, Picture::Area(Rectangle::new(Point::zero(), size)))
     }
 
     /// The scene as an image as large as `target`, in its colour: what

@@ -26,6 +26,7 @@ mod draw;
 mod draw_error;
 mod image;
 mod loaded;
+pub mod picture;
 mod shared;
 
 pub use animated::{AnimationError, Frame};

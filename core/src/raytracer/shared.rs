@@ -9,8 +9,11 @@ use crate::scene::{CameraError, SceneView};
 use core::fmt;
 use embedded_graphics_core::geometry::Size;
 
-use super::draw::{renderer_in, Source};
+use super::draw::{renderer_in, Picture as Drawn, Source};
+use super::picture::{sealed::Kind, Bands, Picture, Still};
 use super::{RendererRoom, TracedImage};
+use embedded_graphics_core::geometry::Point;
+use embedded_graphics_core::primitives::Rectangle;
 
 /// What another core needs to render a [`LoadedScene`](super::LoadedScene)
 /// ([`LoadedScene::share`](super::LoadedScene::share)) or a
@@ -50,23 +53,24 @@ use super::{RendererRoom, TracedImage};
 /// }
 /// # Ok::<(), Box<dyn core::error::Error>>(())
 /// ```
-pub struct SharedScene<'r, P: Profile> {
+pub struct SharedScene<'r, P: Profile, K: Picture = Still> {
     pub(super) view: SceneView<'r>,
     pub(super) accelerator: SceneAccelerator<'r, P>,
     pub(super) first_hits: bool,
-    /// A frame's motion and planned tiles.
+    /// A frame's motion and planned tiles (`K` is then [`Bands`]).
     pub(super) playing: Option<Playing<'r>>,
+    pub(super) picture: core::marker::PhantomData<K>,
 }
 
-impl<P: Profile> Clone for SharedScene<'_, P> {
+impl<P: Profile, K: Picture> Clone for SharedScene<'_, P, K> {
     fn clone(&self) -> Self {
         *self
     }
 }
 
-impl<P: Profile> Copy for SharedScene<'_, P> {}
+impl<P: Profile, K: Picture> Copy for SharedScene<'_, P, K> {}
 
-impl<P: Profile> fmt::Debug for SharedScene<'_, P> {
+impl<P: Profile, K: Picture> fmt::Debug for SharedScene<'_, P, K> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("SharedScene")
             .field("objects", &self.view.object_count())
@@ -77,6 +81,14 @@ impl<P: Profile> fmt::Debug for SharedScene<'_, P> {
 }
 
 impl<'r, P: Profile> SharedScene<'r, P> {
+    /// The share of a frame of this scene, `playing`.
+    pub(super) fn frame(self, playing: Playing<'r>) -> SharedScene<'r, P, Bands> {
+        let SharedScene { view, accelerator, first_hits, .. } = self;
+        SharedScene { view, accelerator, first_hits, playing: Some(playing), picture: core::marker::PhantomData }
+    }
+}
+
+impl<'r, P: Profile, K: Picture> SharedScene<'r, P, K> {
     /// The scene's objects, surfaces, lights and settings.
     pub fn view(&self) -> SceneView<'r> {
         self.view
@@ -94,9 +106,13 @@ impl<'r, P: Profile> SharedScene<'r, P> {
     /// as an image of `size` pixels in the colour `C`, drawn in `room`:
     /// another core's draw, as [`LoadedScene::image`](super::LoadedScene::image) is the loading
     /// core's.
-    pub fn image<'s, C>(&'s self, room: &'s RendererRoom<P>, size: Size) -> TracedImage<'s, 'r, P, C> {
+    pub fn image<'s, C>(&'s self, room: &'s RendererRoom<P>, size: Size) -> TracedImage<'s, 'r, P, C, K> {
         let source =
             Source { view: &self.view, accelerator: &self.accelerator, first_hits: self.first_hits, room, stats: None };
-        TracedImage::new(source, size, self.playing)
+        let picture = match (K::KIND, self.playing) {
+            (Kind::Bands, Some(playing)) => Drawn::Bands(playing, None),
+            _ => Drawn::Area(Rectangle::new(Point::zero(), size)),
+        };
+        TracedImage::new(source, size, picture)
     }
 }

@@ -464,8 +464,7 @@ impl<'a, L: Linked> Renderer<'a, L> {
         D: DrawTarget,
         D::Color: TracedColor,
     {
-        let image = Rectangle::new(Point::zero(), self.size());
-        let r = rect.intersection(&image);
+        let r = clipped(rect, self.size());
         let before = self.scratch.stats;
         let x0 = r.top_left.x as u32;
         for y in r.top_left.y as u32..r.top_left.y as u32 + r.size.height {
@@ -474,5 +473,52 @@ impl<'a, L: Linked> Renderer<'a, L> {
             target.fill_contiguous(&line, pixels.map(|p| D::Color::traced(p.color, p.object)))?;
         }
         Ok(self.scratch.stats.since(&before))
+    }
+}
+
+/// The part of `area` inside an image of `size`: what
+/// `Rectangle::intersection` gives for an area that overlaps it (one
+/// that does not gives an empty area), in a tenth of its code, which
+/// every board's draw links.
+pub(crate) fn clipped(area: &Rectangle, size: Size) -> Rectangle {
+    let clip = |start: i32, length: u32, side: u32| {
+        let side = side.min(i32::MAX as u32) as i32;
+        let end = start.saturating_add(length.min(i32::MAX as u32) as i32).clamp(0, side);
+        let start = start.clamp(0, end);
+        (start, (end - start) as u32)
+    };
+    let (x, width) = clip(area.top_left.x, area.size.width, size.width);
+    let (y, height) = clip(area.top_left.y, area.size.height, size.height);
+    Rectangle::new(Point::new(x, y), Size::new(width, height))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clipped_is_the_intersection_with_the_image() {
+        let size = Size::new(12, 8);
+        let image = Rectangle::new(Point::zero(), size);
+        let (starts, lengths) = ([-20, -3, 0, 5, 11, 12, 40], [0, 1, 4, 12, 30]);
+        for x in starts {
+            for y in starts {
+                for w in lengths {
+                    for h in lengths {
+                        let area = Rectangle::new(Point::new(x, y), Size::new(w, h));
+                        let (clip, expected) = (clipped(&area, size), area.intersection(&image));
+                        match expected.is_zero_sized() {
+                            true => assert!(clip.is_zero_sized(), "{area:?}: {clip:?}"),
+                            false => assert_eq!(clip, expected, "{area:?}"),
+                        }
+                    }
+                }
+            }
+        }
+        // Where embedded-graphics' own would overflow: inside, or empty.
+        for (x, w) in [(i32::MIN, u32::MAX), (i32::MAX, u32::MAX), (-1, u32::MAX), (i32::MIN, 5)] {
+            let clip = clipped(&Rectangle::new(Point::new(x, x), Size::new(w, w)), size);
+            assert!(clip.is_zero_sized() || image.contains(clip.bottom_right().unwrap()), "{clip:?}");
+        }
     }
 }
