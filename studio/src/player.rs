@@ -52,19 +52,11 @@ impl Player {
         if let Some(checked) = self.checked.as_ref().filter(|checked| checked.text == text) {
             return checked.errors.clone();
         }
-        let needs = core::str::from_utf8(text).map_or_else(
-            |_| AnimationNeeds::default(),
-            |t| AnimationNeeds { tiles: 1, ..AnimationNeeds::of(t, Size::new(1, 1)) },
-        );
-        let mut room = HostAnimationRoom::new(needs);
         let mut errors = Vec::new();
-        let result = match room.animation(Size::new(1, 1)) {
-            Ok(mut animation) => match animation.load_with(raytracer, text, &mut |e| errors.push(e.to_string())) {
-                Ok(_) => Ok(()),
-                Err(AnimationError::Scene(_)) => Err(errors),
-                Err(AnimationError::NoRoom(e)) => Err(vec![e.to_string()]),
-            },
-            Err(e) => Err(vec![e.to_string()]),
+        let result = match raytracer.check_every_frame(text, &mut |e| errors.push(e.to_string())) {
+            Ok(()) => Ok(()),
+            Err(AnimationError::Scene(_)) => Err(errors),
+            Err(AnimationError::NoRoom(e)) => Err(vec![e.to_string()]),
         };
         self.checked = Some(Checked { text: text.to_vec(), errors: result.clone() });
         result

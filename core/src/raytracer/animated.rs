@@ -195,6 +195,40 @@ impl<'s> Animation<'s> {
     }
 }
 
+#[cfg(feature = "alloc")]
+impl<P: Profile> Raytracer<P> {
+    /// Whether every frame of the animation `text` (bytes; invalid UTF-8
+    /// is an error at its place) loads, its camera included, each error
+    /// handed to `on_error`: frame 0 loaded anew (this raytracer holds it
+    /// after), its motion recorded in a room made for the check (an image
+    /// of one pixel: no tile is traced). What a front-end checks before it
+    /// draws a frame alone (a scene is valid or not whichever frame is
+    /// drawn).
+    ///
+    /// ```
+    /// use octrace_core::{profile::Board16K, AnimationError, Raytracer};
+    ///
+    /// let mut raytracer = Raytracer::<Board16K>::new();
+    /// // The eye reaches the point it looks at in frame 2.
+    /// let text = b"FRAMES 4\nVIEWPOINT 0 0 5 MOVE 0 0 0 0  2 0 0 -5\nORIGIN 0 0 0\n";
+    /// let mut errors = Vec::new();
+    /// let checked = raytracer.check_every_frame(text, &mut |e| errors.push(e.to_string()));
+    /// assert!(matches!(checked, Err(AnimationError::Scene(_))));
+    /// assert_eq!(errors, ["2:17: at frame 2, VIEWPOINT equals ORIGIN: there is no view direction"]);
+    /// ```
+    pub fn check_every_frame<'t>(
+        &mut self,
+        text: &'t [u8],
+        on_error: &mut dyn FnMut(ParseError<'t>),
+    ) -> Result<(), AnimationError<'t>> {
+        let one = embedded_graphics_core::geometry::Size::new(1, 1);
+        let needs = core::str::from_utf8(text).map_or_else(|_| AnimationNeeds::default(), |t| AnimationNeeds::of(t, one));
+        let mut room = crate::animation::HostAnimationRoom::new(needs);
+        let mut animation = room.animation(one).map_err(AnimationError::NoRoom)?;
+        animation.load_with(self, text, on_error).map(|_| ())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     extern crate std;

@@ -91,13 +91,8 @@ pub struct AnimationOptions {
 /// a frame asked for alone (a scene is valid or not whichever frame is
 /// drawn).
 pub fn check_every_frame(bytes: &[u8]) -> Result<(), AnimationError> {
-    // Tiles are not traced here: one is room enough.
-    let one = Size::new(1, 1);
-    let needs = std::str::from_utf8(bytes).map_or_else(|_| AnimationNeeds::default(), |t| AnimationNeeds::of(t, one));
-    let mut room = HostAnimationRoom::new(needs);
-    let mut animation = room.animation(one).map_err(|e| AnimationError::Setup(e.to_string()))?;
-    let mut scene = new_scene();
-    load_anew(&mut animation, scene.raytracer(), bytes).map(|_| ())
+    let mut errors = Vec::new();
+    new_scene().raytracer().check_every_frame(bytes, &mut |e| errors.push(e.to_string())).map_err(|e| refused(e, errors))
 }
 
 /// Frame 0 of the animation `bytes` loaded into `animation` anew: its
@@ -109,10 +104,15 @@ fn load_anew<'a, 'r>(
     bytes: &[u8],
 ) -> Result<Frame<'a, 'r, Host>, AnimationError> {
     let mut errors = Vec::new();
-    match animation.load_with(raytracer, bytes, &mut |e| errors.push(e.to_string())) {
-        Ok(first) => Ok(first),
-        Err(Refused::Scene(_)) => Err(AnimationError::Scene { frame: None, errors }),
-        Err(Refused::NoRoom(e)) => Err(AnimationError::Setup(e.to_string())),
+    animation.load_with(raytracer, bytes, &mut |e| errors.push(e.to_string())).map_err(|e| refused(e, errors))
+}
+
+/// Why frame 0 of an animation was refused, with the scene's `errors`
+/// (each at its line and column; those of a camera name their frame).
+fn refused(e: Refused<'_>, errors: Vec<String>) -> AnimationError {
+    match e {
+        Refused::Scene(_) => AnimationError::Scene { frame: None, errors },
+        Refused::NoRoom(e) => AnimationError::Setup(e.to_string()),
     }
 }
 
