@@ -23,7 +23,7 @@
 //! the motion is recorded once, as frame 0 loads, and serves every frame.
 
 use crate::bank_stack::{on_bank_stack, with_both_banks};
-use crate::both_cores::{Asked, Unfinished};
+use crate::both_cores::{slot_free, Asked, Unfinished};
 use crate::second_core::SecondCore;
 use core::cell::Cell;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -98,11 +98,8 @@ impl<const LEN: usize, const SLOTS: usize> Runs<LEN, SLOTS> {
     /// Core 1: traces `pixels` into piece `piece`'s slot, once it is free,
     /// for `area`; false if `stop` said so first.
     fn send(&self, piece: u32, area: &Rectangle, pixels: impl Iterator<Item = Rgb888>, stop: &AtomicBool) -> bool {
-        while !self.colors.is_free_for(piece) {
-            if stop.load(Ordering::Acquire) {
-                return false;
-            }
-            wfe();
+        if !slot_free(&self.colors, piece, stop) {
+            return false;
         }
         let (x, y, width) = (area.top_left.x as u32, area.top_left.y as u32, area.size.width);
         self.areas[piece as usize % SLOTS].store(x | y << 10 | width << 20, Ordering::Relaxed);

@@ -276,13 +276,8 @@ impl<const LEN: usize, const SLOTS: usize> DrawTarget for HandingRows<'_, LEN, S
         colors: I,
     ) -> Result<(), Unfinished> {
         let y = row.top_left.y as u32;
-        // Its slot is free once core 0 has presented the row SLOTS before
-        // it, which it does without waiting for this core.
-        while !self.ring.is_free_for(y) {
-            if self.stopping.load(Ordering::Acquire) {
-                return Err(Unfinished::Stopped);
-            }
-            wfe();
+        if !slot_free(self.ring, y, self.stopping) {
+            return Err(Unfinished::Stopped);
         }
         // Traced as the ring takes them, on this core's bank stack. Free,
         // so published.
@@ -445,13 +440,8 @@ where
         while !stop.load(Ordering::Acquire) {
             let number = take_next();
             let Some((piece, _)) = pieces.find(|&(_, n)| n == number) else { return };
-            // Its slot is free once core 0 has presented the piece SLOTS
-            // before it, which it does without waiting for this core.
-            while !ring.is_free_for(number) {
-                if stop.load(Ordering::Acquire) {
-                    return;
-                }
-                wfe();
+            if !slot_free(ring, number, &stop) {
+                return;
             }
             // Each ask wakes core 0, which asks its own (it may be waiting
             // for this piece).
@@ -523,6 +513,23 @@ where
         result
     };
     core1.scope(core1_part, core0_part)
+}
+
+/// Core 1: waits until `ring`'s slot for piece `piece` is free (once core
+/// 0 has presented the piece SLOTS before it, which it does without
+/// waiting for core 1); false if core 0 raised `stopping` first.
+pub(crate) fn slot_free<const LEN: usize, const SLOTS: usize>(
+    ring: &Handoff<LEN, SLOTS>,
+    piece: u32,
+    stopping: &AtomicBool,
+) -> bool {
+    while !ring.is_free_for(piece) {
+        if stopping.load(Ordering::Acquire) {
+            return false;
+        }
+        wfe();
+    }
+    true
 }
 
 /// Core 1's piece `number` from `ring` into `colors`, once it is there;

@@ -93,7 +93,8 @@ impl<'a, 'r, P: Profile> Frame<'a, 'r, P> {
     /// it in the loop (or at the first frame, everything) the target shows
     /// the frame as a whole draw would.
     pub fn image<C>(&self) -> TracedImage<'_, 'r, P, C, Bands> {
-        TracedImage::new(self.scene.source(), self.playing.coherence.size(), Picture::Bands(self.playing, None))
+        let size = self.playing.coherence.size();
+        TracedImage::new(self.scene.source(), size, Picture::whole(size, Some(self.playing)))
     }
 
     /// The frame as an image in `target`'s colour (at the animation's
@@ -222,7 +223,8 @@ impl<P: Profile> Raytracer<P> {
         on_error: &mut dyn FnMut(ParseError<'t>),
     ) -> Result<(), AnimationError<'t>> {
         let one = embedded_graphics_core::geometry::Size::new(1, 1);
-        let needs = core::str::from_utf8(text).map_or_else(|_| AnimationNeeds::default(), |t| AnimationNeeds::of(t, one));
+        let needs =
+            core::str::from_utf8(text).map_or_else(|_| AnimationNeeds::default(), |t| AnimationNeeds::of(t, one));
         let mut room = crate::animation::HostAnimationRoom::new(needs);
         let mut animation = room.animation(one).map_err(AnimationError::NoRoom)?;
         animation.load_with(self, text, on_error).map(|_| ())

@@ -132,6 +132,17 @@ pub(super) enum Picture<'s> {
     Bands(Playing<'s>, Option<&'s dyn Fn() -> Option<u32>>),
 }
 
+impl<'s> Picture<'s> {
+    /// What an image of `size` draws at first: a frame's planned tiles
+    /// (`playing`), or the whole still.
+    pub(super) fn whole(size: Size, playing: Option<Playing<'s>>) -> Self {
+        match playing {
+            Some(playing) => Picture::Bands(playing, None),
+            None => Picture::Area(Rectangle::new(Point::zero(), size)),
+        }
+    }
+}
+
 /// Draws what `image` asks into `target`, `poll` asked before every ray:
 /// the picture `K`, whose code alone a draw of it links.
 pub(super) fn draw<P, C, K, D, Q>(

@@ -9,8 +9,7 @@ use crate::shade::Stats;
 use core::cell::Cell;
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{Point, Size};
-use embedded_graphics_core::primitives::Rectangle;
+use embedded_graphics_core::geometry::Size;
 
 use super::draw::{Picture, Source};
 use super::{RendererRoom, SharedScene, TracedImage};
@@ -211,7 +210,7 @@ impl<'r, P: Profile> LoadedScene<'r, P> {
     /// The scene as an image of `size` pixels in the colour `C`: what to
     /// draw of it, and how ([`TracedImage`]).
     pub fn image<C>(&self, size: Size) -> TracedImage<'_, 'r, P, C> {
-        TracedImage::new(self.source(), size, Picture::Area(Rectangle::new(Point::zero(), size)))
+        TracedImage::new(self.source(), size, Picture::whole(size, None))
     }
 
     /// The scene as an image as large as `target`, in its colour: what

@@ -9,11 +9,9 @@ use crate::scene::{CameraError, SceneView};
 use core::fmt;
 use embedded_graphics_core::geometry::Size;
 
-use super::draw::{renderer_in, Picture as Drawn, Source};
-use super::picture::{sealed::Kind, Bands, Picture, Still};
+use super::draw::{renderer_in, Picture, Source};
+use super::picture::{self, Bands, Still};
 use super::{RendererRoom, TracedImage};
-use embedded_graphics_core::geometry::Point;
-use embedded_graphics_core::primitives::Rectangle;
 
 /// What another core needs to render a [`LoadedScene`](super::LoadedScene)
 /// ([`LoadedScene::share`](super::LoadedScene::share)) or a
@@ -53,7 +51,7 @@ use embedded_graphics_core::primitives::Rectangle;
 /// }
 /// # Ok::<(), Box<dyn core::error::Error>>(())
 /// ```
-pub struct SharedScene<'r, P: Profile, K: Picture = Still> {
+pub struct SharedScene<'r, P: Profile, K: picture::Picture = Still> {
     pub(super) view: SceneView<'r>,
     pub(super) accelerator: SceneAccelerator<'r, P>,
     pub(super) first_hits: bool,
@@ -62,15 +60,15 @@ pub struct SharedScene<'r, P: Profile, K: Picture = Still> {
     pub(super) picture: core::marker::PhantomData<K>,
 }
 
-impl<P: Profile, K: Picture> Clone for SharedScene<'_, P, K> {
+impl<P: Profile, K: picture::Picture> Clone for SharedScene<'_, P, K> {
     fn clone(&self) -> Self {
         *self
     }
 }
 
-impl<P: Profile, K: Picture> Copy for SharedScene<'_, P, K> {}
+impl<P: Profile, K: picture::Picture> Copy for SharedScene<'_, P, K> {}
 
-impl<P: Profile, K: Picture> fmt::Debug for SharedScene<'_, P, K> {
+impl<P: Profile, K: picture::Picture> fmt::Debug for SharedScene<'_, P, K> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("SharedScene")
             .field("objects", &self.view.object_count())
@@ -88,7 +86,7 @@ impl<'r, P: Profile> SharedScene<'r, P> {
     }
 }
 
-impl<'r, P: Profile, K: Picture> SharedScene<'r, P, K> {
+impl<'r, P: Profile, K: picture::Picture> SharedScene<'r, P, K> {
     /// The scene's objects, surfaces, lights and settings.
     pub fn view(&self) -> SceneView<'r> {
         self.view
@@ -109,10 +107,6 @@ impl<'r, P: Profile, K: Picture> SharedScene<'r, P, K> {
     pub fn image<'s, C>(&'s self, room: &'s RendererRoom<P>, size: Size) -> TracedImage<'s, 'r, P, C, K> {
         let source =
             Source { view: &self.view, accelerator: &self.accelerator, first_hits: self.first_hits, room, stats: None };
-        let picture = match (K::KIND, self.playing) {
-            (Kind::Bands, Some(playing)) => Drawn::Bands(playing, None),
-            _ => Drawn::Area(Rectangle::new(Point::zero(), size)),
-        };
-        TracedImage::new(source, size, picture)
+        TracedImage::new(source, size, Picture::whole(size, self.playing))
     }
 }

@@ -92,7 +92,10 @@ pub struct AnimationOptions {
 /// drawn).
 pub fn check_every_frame(bytes: &[u8]) -> Result<(), AnimationError> {
     let mut errors = Vec::new();
-    new_scene().raytracer().check_every_frame(bytes, &mut |e| errors.push(e.to_string())).map_err(|e| refused(e, errors))
+    new_scene()
+        .raytracer()
+        .check_every_frame(bytes, &mut |e| errors.push(e.to_string()))
+        .map_err(|e| refused(e, errors))
 }
 
 /// Frame 0 of the animation `bytes` loaded into `animation` anew: its
