@@ -30,7 +30,7 @@
 
 use octrace_core::accel::OctreeConfig;
 use octrace_core::animation::AnimationNeeds;
-use octrace_core::capacity::{CapacityKind, Counts};
+use octrace_core::capacity::Counts;
 use octrace_core::panel::Dithering;
 use octrace_core::parse::{count, parse};
 use octrace_core::profile::Host;
@@ -248,7 +248,7 @@ fn main() {
         fail(format!(
             "{scene} needs about {bytes} bytes of arenas ({}), more than the {} bytes the {} has for them \
              beside its stack and other statics",
-            describe(&counts),
+            counts.described(),
             budget,
             board.name
         ));
@@ -418,13 +418,4 @@ impl Techniques {
                     && t.light_buffer <= self.light_buffer
             })
     }
-}
-
-fn describe(counts: &Counts) -> String {
-    let parts: Vec<String> = CapacityKind::ALL
-        .iter()
-        .filter(|&&k| counts.get(k) > 0)
-        .map(|&k| format!("{} {}", counts.get(k), k.what()))
-        .collect();
-    parts.join(", ")
 }

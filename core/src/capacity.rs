@@ -287,18 +287,31 @@ impl Counts {
     /// assert_eq!(needs.profile_fields().to_string(), "objects: 2, spheres: 2, lights: 1");
     /// ```
     pub fn profile_fields(&self) -> impl fmt::Display + '_ {
-        struct Fields<'a>(&'a Counts);
-        impl fmt::Display for Fields<'_> {
-            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-                let given = CapacityKind::ALL.into_iter().filter(|&kind| self.0.get(kind) > 0);
-                for (i, kind) in given.enumerate() {
-                    let separator = if i == 0 { "" } else { ", " };
-                    write!(f, "{separator}{}: {}", kind.field(), self.0.get(kind))?;
-                }
-                Ok(())
-            }
-        }
-        Fields(self)
+        Listed { counts: self, as_fields: true }
+    }
+
+    /// The counts in words, those that are not 0 (`2 spheres, 1 lights`):
+    /// what a build script says a scene needs when a board cannot hold it.
+    ///
+    /// ```
+    /// use octrace_core::parse::count;
+    ///
+    /// let needs = count("SPHERE 1 1 0 0 0\nSPHERE 1 1 3 0 0\nLIGHT 1 0 9 0\n");
+    /// assert_eq!(needs.described().to_string(), "2 objects, 2 spheres, 1 lights");
+    /// ```
+    pub fn described(&self) -> impl fmt::Display + '_ {
+        Listed { counts: self, as_fields: false }
+    }
+
+    /// The octree's boxes and references a profile holds are below this:
+    /// they are numbered in 16 bits, whose top two values are markers.
+    pub const OCTREE_INDEX_LIMIT: usize = 0xFFFE;
+
+    /// Whether a profile of these counts can number its octree's boxes and
+    /// references ([`Counts::OCTREE_INDEX_LIMIT`]); [`crate::profile!`]
+    /// refuses one that cannot when it is compiled.
+    pub const fn octree_fits_its_index(&self) -> bool {
+        self.octree_boxes < Counts::OCTREE_INDEX_LIMIT && self.octree_references < Counts::OCTREE_INDEX_LIMIT
     }
 
     /// Each count the larger of `self`'s and `other`'s.
@@ -308,6 +321,27 @@ impl Counts {
             *c = (*c).max(other.get(kind));
         }
         self
+    }
+}
+
+/// The counts that are not 0, comma-separated: as a profile's fields
+/// (`spheres: 2`) or in words (`2 spheres`).
+struct Listed<'a> {
+    counts: &'a Counts,
+    as_fields: bool,
+}
+
+impl fmt::Display for Listed<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let given = CapacityKind::ALL.into_iter().filter(|&kind| self.counts.get(kind) > 0);
+        for (i, kind) in given.enumerate() {
+            let (separator, count) = (if i == 0 { "" } else { ", " }, self.counts.get(kind));
+            match self.as_fields {
+                true => write!(f, "{separator}{}: {count}", kind.field())?,
+                false => write!(f, "{separator}{count} {}", kind.what())?,
+            }
+        }
+        Ok(())
     }
 }
 

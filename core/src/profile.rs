@@ -155,11 +155,9 @@ macro_rules! profile {
                 const LIGHT_CONES: bool = <$name as p::Linked>::LIGHT_BUFFER && !<$name as p::Linked>::LIGHT_CUBES;
             }
 
-            // 16-bit indices: their top two values are markers.
             const _: () = assert!(
-                <$name as $crate::profile::Profile>::COUNTS.octree_boxes < 0xFFFE
-                    && <$name as $crate::profile::Profile>::COUNTS.octree_references < 0xFFFE,
-                "profile!: octree_boxes and octree_references must be below 65534"
+                <$name as $crate::profile::Profile>::COUNTS.octree_fits_its_index(),
+                "profile!: octree_boxes and octree_references must be below 65534 (Counts::OCTREE_INDEX_LIMIT)"
             );
             $crate::__shape_kinds!($crate::__scene_capacities! { $name, p::Vec, motion: p::given_or(&[$($motion)?], true) });
 

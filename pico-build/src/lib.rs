@@ -45,6 +45,9 @@ pub enum BuildError {
     /// The scene has errors (each printed with its line and column as it
     /// was found).
     Scene { scene: String, errors: usize },
+    /// The scene needs more than the board can hold: `needs`, its counts
+    /// in words; `limit`, what it passes.
+    TooLarge { scene: String, needs: String, limit: String },
     /// A file could not be read or written.
     File { path: String, error: std::io::Error },
     /// A variable cargo sets for a build script is missing.
@@ -58,6 +61,11 @@ impl fmt::Display for BuildError {
             BuildError::Scene { scene, errors } => {
                 write!(f, "{scene}: {errors} error(s); nothing is built from a scene with errors")
             }
+            BuildError::TooLarge { scene, needs, limit } => write!(
+                f,
+                "{scene} is too large for this board: it needs {needs}; {limit}. host-sim renders it, \
+                 and a scene of fewer objects fits"
+            ),
             BuildError::File { path, error } => write!(f, "{path}: {error}"),
             BuildError::NotInBuildScript(name) => write!(f, "{name} is not set: call this from a build script"),
         }

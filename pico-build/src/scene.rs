@@ -82,6 +82,7 @@ pub fn embed_still_scene() -> Result<(), BuildError> {
         .map_err(|errors| BuildError::Scene { scene: scene.clone(), errors })?;
     let doc = format!("Exactly what `{scene}` needs, its octree included.");
     let profile = profile_text(&doc, &needs, false, AnimationNeeds::of(&text, Default::default()).moves());
+    fits(&scene, &profile, None)?;
     let source =
         format!("/// The scene, from `{scene}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n{profile}");
     write(&out_dir()?.join("scene.rs"), &source)
@@ -127,6 +128,38 @@ fn profile_text<'a>(doc: &'a str, counts: &'a Counts, coherence: bool, motion: b
     }
 }
 
+/// The most RAM a Pico template's arenas can take, in bytes: the 256 KiB
+/// of striped SRAM that statics go in (`memory.x`), less core 0's stack
+/// (the 16 KiB the link requires) and core 1's (a static of 16 KiB). The
+/// rest of the firmware's statics and the code it copies into SRAM come
+/// on top, which the link checks; a scene over this fits no placement.
+const RP2040_ARENA_ROOM: usize = (256 - 16 - 16) * 1024;
+
+/// Refuses, before anything is compiled, a scene whose `profile` the board
+/// cannot hold: an octree its 16-bit indices cannot number, or arenas over
+/// `room` bytes (when the board's RAM is known here).
+fn fits(scene: &str, profile: &ProfileText<'_>, room: Option<usize>) -> Result<(), BuildError> {
+    let too_large = |limit: String| BuildError::TooLarge {
+        scene: scene.to_owned(),
+        needs: profile.counts.described().to_string(),
+        limit,
+    };
+    let bytes = profile.arena_bytes();
+    if let Some(room) = room.filter(|&room| bytes > room) {
+        return Err(too_large(format!(
+            "its arenas take about {bytes} bytes of RAM, more than the {room} a Pico leaves them beside both \
+             cores' stacks"
+        )));
+    }
+    if !profile.counts.octree_fits_its_index() {
+        return Err(too_large(format!(
+            "an octree's boxes and references are numbered in 16 bits, fewer than {} each",
+            Counts::OCTREE_INDEX_LIMIT
+        )));
+    }
+    Ok(())
+}
+
 /// What the scene `text`, whose motion takes `motion`, is: an animation if
 /// it has frames and something moves (a scene of one frame, or where
 /// nothing moves, is drawn once).
@@ -158,6 +191,7 @@ fn scene_source(name: &str, path: &std::path::Path, text: &str) -> Result<(Scene
     let kind = kind_of(text, &motion);
     let animated = kind == SceneKind::Animation;
     let profile = profile_text(&doc, &needs, animated, motion.moves());
+    fits(name, &profile, Some(RP2040_ARENA_ROOM))?;
     let motion = if animated { motion } else { Default::default() };
     let stem = path.file_stem().map_or_else(|| name.to_owned(), |stem| stem.to_string_lossy().into_owned());
     let source = format!(
@@ -217,6 +251,46 @@ mod tests {
         assert!(source.contains("    coherence: true\n    motion: true\n}\n"), "{source}");
         assert!(source.contains("ANIMATED: bool = true"), "{source}");
         assert!(source.contains("tiles: 0, tracks: 1, keys: 2"), "{source}");
+    }
+
+    #[test]
+    fn a_scene_the_pico_cannot_hold_is_refused_before_it_is_compiled() {
+        // 12,000 spheres: some 40 bytes each, over the arenas' room.
+        let spheres: String =
+            (0..12_000).map(|k| format!("SPHERE 1 0.2 {} {} {}\n", k % 20, k / 20 % 20, k / 400)).collect();
+        let text = format!("SURFACE 1 1 1 1 1 1 1 0 0 0 1 0 0\nLIGHT 1 0 10 10\n{spheres}");
+        let error = scene_source("crowd", std::path::Path::new("crowd.txt"), &text).unwrap_err();
+        let message = error.to_string();
+        assert!(matches!(error, BuildError::TooLarge { .. }), "{message}");
+        assert!(
+            message.starts_with("crowd is too large for this board: it needs 12000 objects, 12000 spheres"),
+            "{message}"
+        );
+        assert!(message.contains(&format!("more than the {RP2040_ARENA_ROOM} a Pico leaves them")), "{message}");
+    }
+
+    #[test]
+    fn an_octree_its_indices_cannot_number_is_refused_on_any_board() {
+        let counts =
+            |octree_boxes, octree_references| Counts { spheres: 3, octree_boxes, octree_references, ..Counts::ZERO };
+        let last = Counts::OCTREE_INDEX_LIMIT - 1;
+        for (boxes, references, fits_the_index) in
+            [(last, last, true), (last + 1, 9, false), (9, last + 1, false), (100_000, 200_000, false)]
+        {
+            let counts = counts(boxes, references);
+            let result = fits("big", &profile_text("", &counts, false, false), None);
+            match fits_the_index {
+                true => assert!(result.is_ok(), "{boxes} {references}"),
+                false => {
+                    let message = result.unwrap_err().to_string();
+                    assert!(
+                        message.contains(&format!("{boxes} octree boxes, {references} octree references")),
+                        "{message}"
+                    );
+                    assert!(message.contains("numbered in 16 bits, fewer than 65534 each"), "{message}");
+                }
+            }
+        }
     }
 
     #[test]
