@@ -349,25 +349,54 @@ pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
-    let path = &through_links(path);
-    if is_stream(path) {
-        let mut w = std::io::BufWriter::new(File::options().write(true).open(path)?);
-        write(&mut w)?;
-        return w.flush();
-    }
-    refuse_read_only(path)?;
-    let (tmp, file) = temporary_beside(path)?;
+    let (path, tmp, file) = match destination(path)? {
+        Destination::Stream(path) => {
+            let mut w = std::io::BufWriter::new(File::options().write(true).open(path)?);
+            write(&mut w)?;
+            return w.flush();
+        }
+        Destination::File { path, tmp, file } => (path, tmp, file),
+    };
     let result = (|| {
         let mut w = std::io::BufWriter::new(file);
         write(&mut w)?;
         w.flush()?;
         w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        replace_with(&tmp, path)
+        replace_with(&tmp, &path)
     })();
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
     result
+}
+
+/// Whether [`write_atomically`] could write `path` now (its directory there
+/// and writable, the file not read-only), asked before a long piece of
+/// work whose result would otherwise be lost at the end (a board's
+/// drawing). A stream is not opened: opening a FIFO waits for its reader.
+pub(crate) fn check_writable(path: &Path) -> std::io::Result<()> {
+    match destination(path)? {
+        Destination::Stream(_) => Ok(()),
+        Destination::File { tmp, .. } => std::fs::remove_file(tmp),
+    }
+}
+
+/// Where [`write_atomically`] writes `path`, its symbolic links followed.
+enum Destination {
+    /// A device, a pipe or a socket: written into.
+    Stream(PathBuf),
+    /// A file, replaced by `tmp` (open as `file`) once it is written.
+    File { path: PathBuf, tmp: PathBuf, file: File },
+}
+
+fn destination(path: &Path) -> std::io::Result<Destination> {
+    let path = through_links(path);
+    if is_stream(&path) {
+        return Ok(Destination::Stream(path));
+    }
+    refuse_read_only(&path)?;
+    let (tmp, file) = temporary_beside(&path)?;
+    Ok(Destination::File { path, tmp, file })
 }
 
 /// The file `path` names once its symbolic links are followed (a dangling

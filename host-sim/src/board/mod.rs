@@ -163,6 +163,8 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
     out.map(|out| output_format(args.format, out)).transpose()?;
     out.map(|out| not_the_scene(scene, out)).transpose()?;
     let text = std::fs::read(scene).map_err(|e| CliError::read(scene, e))?;
+    // Before the board draws: a picture it sent could not be kept.
+    out.map(|out| crate::output::check_writable(out).map_err(|e| CliError::write(out, e))).transpose()?;
     let file = ShownPath(scene).to_string();
     let pixels = out.is_some() || args.check;
     let started = Instant::now();

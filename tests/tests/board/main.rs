@@ -139,6 +139,20 @@ fn a_scene_with_errors_is_answered_at_each_line_and_column_and_nothing_is_drawn(
 }
 
 #[test]
+fn an_out_that_cannot_be_written_is_refused_before_the_board_draws() {
+    let mut board = board();
+    let dir = tempfile::tempdir().unwrap();
+    let scene = quick_scene_file(dir.path());
+    let out = dir.path().join("no-such-folder").join("seen.png");
+    let run = host_sim_board(&[board.port.as_os_str(), scene.as_os_str(), out.as_os_str()]);
+    assert_eq!(run.code, 1, "{}", run.stderr);
+    let want = format!("cannot write {}: No such file or directory", out.display());
+    assert!(run.stderr.contains(&want), "want {want:?} in:\n{}", run.stderr);
+    assert!(!run.stderr.contains("drawn by the board"), "the board drew:\n{}", run.stderr);
+    assert!(board.alive());
+}
+
+#[test]
 fn a_scene_over_the_boards_capacity_is_refused_naming_it() {
     let board = board();
     let description = board.describe();
