@@ -43,8 +43,12 @@ impl CliError {
         CliError::Io(format!("cannot read {}: {error}", ShownPath(path)))
     }
 
-    /// `path` could not be written.
+    /// `path` could not be written; a stop signal that arrived meanwhile
+    /// (which cut the wait for a FIFO's reader, say) is reported as such.
     pub fn write(path: &Path, error: impl fmt::Display) -> CliError {
+        if signals::stop_flag().load(std::sync::atomic::Ordering::SeqCst) {
+            return CliError::stopped();
+        }
         CliError::Io(format!("cannot write {}: {error}", ShownPath(path)))
     }
 

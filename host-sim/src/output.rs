@@ -351,7 +351,7 @@ pub fn write_atomically(
 ) -> std::io::Result<()> {
     let (path, tmp, file) = match destination(path)? {
         Destination::Stream(path) => {
-            let mut w = std::io::BufWriter::new(File::options().write(true).open(path)?);
+            let mut w = std::io::BufWriter::new(open_stream(&path)?);
             write(&mut w)?;
             return w.flush();
         }
@@ -379,6 +379,47 @@ pub(crate) fn check_writable(path: &Path) -> std::io::Result<()> {
         Destination::Stream(_) => Ok(()),
         Destination::File { tmp, .. } => std::fs::remove_file(tmp),
     }
+}
+
+/// The stream `path` opened for writing. A FIFO without a reader is
+/// waited for, saying so once, until one comes or a stop signal arrives
+/// (then an `Interrupted` error): open(2) itself would wait on through
+/// the signal, its handler returning into the call.
+fn open_stream(path: &Path) -> std::io::Result<File> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
+        if std::fs::metadata(path).is_ok_and(|m| m.file_type().is_fifo()) {
+            let stop = crate::signals::stop_flag();
+            let mut said = false;
+            let probe = loop {
+                match File::options().write(true).custom_flags(libc::O_NONBLOCK).open(path) {
+                    Ok(probe) => break probe,
+                    // No reader yet.
+                    Err(e) if e.raw_os_error() == Some(libc::ENXIO) => {}
+                    Err(e) => return Err(e),
+                }
+                if stop.load(std::sync::atomic::Ordering::SeqCst) {
+                    return Err(std::io::Error::new(
+                        std::io::ErrorKind::Interrupted,
+                        "stopped while waiting for the FIFO's reader",
+                    ));
+                }
+                if !said {
+                    eprintln!("host-sim: {} is a FIFO: waiting for its reader", crate::exit::ShownPath(path));
+                    said = true;
+                }
+                std::thread::sleep(std::time::Duration::from_millis(20));
+            };
+            // Opened while the probe holds the reader's end: the reader
+            // cannot see an end of file in between, and writes then wait
+            // for it as a shell's `>` would.
+            let file = File::options().write(true).open(path);
+            drop(probe);
+            return file;
+        }
+    }
+    File::options().write(true).open(path)
 }
 
 /// Where [`write_atomically`] writes `path`, its symbolic links followed.

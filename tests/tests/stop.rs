@@ -1,7 +1,8 @@
 //! A render can always be stopped, even inside a pixel that takes hours
 //! (issue 41): host-sim's Ctrl-C ends it inside its first pixels and
 //! leaves no file, and so do SIGTERM (`kill`, `timeout`, a job scheduler)
-//! and SIGHUP (a closed terminal). (The board's side: `board.rs`; the studio's workers:
+//! and SIGHUP (a closed terminal), as they end a wait for the reader of
+//! a FIFO given as the output. (The board's side: `board.rs`; the studio's workers:
 //! `studio.rs`.)
 //!
 //! No wall-clock bound decides these tests: a pixel of their scene takes
@@ -45,6 +46,30 @@ fn sigterm_and_sighup_end_a_render_inside_a_pixel_and_leave_no_file() {
     // A part's rows stream into its temporary file as they are traced.
     signal_ends(Stop::TERM, &minutes_a_pixel(), "wedge.png", &["--part", "1/1"]);
     signal_ends(Stop::HUP, &format!("FRAMES 3\n{}", minutes_a_pixel()), "wedge.gif", &[]);
+}
+
+#[test]
+fn sigterm_ends_the_wait_for_a_fifos_reader() {
+    use std::io::BufRead;
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("s.txt");
+    std::fs::write(&scene, "RASTER 4 3\n").unwrap();
+    let fifo = dir.path().join("o.png");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let mut child = Command::new(HOST_SIM).arg(&scene).arg(&fifo).arg("-q").stderr(Stdio::piped()).spawn().unwrap();
+    // Waiting, with its handlers installed, once it says so.
+    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut said = String::new();
+    stderr.read_line(&mut said).unwrap();
+    assert!(said.ends_with("o.png is a FIFO: waiting for its reader\n"), "{said}");
+    assert!(Command::new("kill").args(["-TERM", &child.id().to_string()]).status().unwrap().success());
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut stderr, &mut rest).unwrap();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(Stop::TERM.exit_code), "{status:?}: {rest}");
+    assert_eq!(rest, "host-sim: stopped (SIGTERM); nothing written\n");
+    assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo(), "still a pipe");
 }
 
 #[test]
