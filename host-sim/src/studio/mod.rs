@@ -2,7 +2,8 @@
 //! studio page, which runs octrace-core compiled to WebAssembly.
 //!
 //! Invariants (the security rules): the listener is bound to 127.0.0.1
-//! only, and handles 32 connections at once at most; a request is admitted
+//! only, and handles 32 connections at once at most (beyond them the one
+//! waiting longest for its request's head is closed); a request is admitted
 //! from its head alone, its body read only then; a request whose Host is
 //! not this address and port is refused (DNS
 //! rebinding); a request a browser sends for another site's page (its
@@ -168,6 +169,13 @@ pub fn run(args: &StudioArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) ->
     let _ = writeln!(stdout, "{url}");
     let _ = stdout.flush();
     match &args.scene {
+        Some(path) if !path.exists() => {
+            let _ = writeln!(
+                stderr,
+                "host-sim studio: editing {}, a new file: created on the first save (Ctrl-C stops)",
+                ShownPath(path)
+            );
+        }
         Some(path) => {
             let _ = writeln!(stderr, "host-sim studio: editing {} (Ctrl-C stops)", ShownPath(path));
         }
@@ -198,18 +206,29 @@ fn serve(listener: &TcpListener, shared: &Arc<Shared>, stop: &AtomicBool) {
         return;
     }
     let open = Arc::new(AtomicUsize::new(0));
+    let waiting = Arc::new(Waiting::default());
+    let mut next = 0;
     while !stop.load(Ordering::SeqCst) {
         match listener.accept() {
-            // Beyond the connections a browser opens at once, closed
-            // unanswered: a local program cannot make the server hold more.
-            Ok((stream, _)) if open.load(Ordering::SeqCst) >= MAX_CONNECTIONS => drop(stream),
             Ok((stream, _)) => {
-                let (shared, open) = (Arc::clone(shared), Arc::clone(&open));
+                // Beyond the connections a browser opens at once, the one
+                // that has waited longest for its request's head is closed
+                // to make room (a local program holding connections idle
+                // cannot lock the page out), or, when every one is being
+                // answered, the new one: the server never holds more.
+                if open.load(Ordering::SeqCst) >= MAX_CONNECTIONS && !waiting.close_oldest() {
+                    drop(stream);
+                    continue;
+                }
+                let (shared, open, waiting) = (Arc::clone(shared), Arc::clone(&open), Arc::clone(&waiting));
+                let id = next;
+                next += 1;
+                waiting.enter(id, &stream);
                 open.fetch_add(1, Ordering::SeqCst);
                 std::thread::spawn(move || {
                     // Counted out however the handler ends.
                     let _counted = Counted(&open);
-                    handle(stream, &shared);
+                    handle(stream, &shared, &|| waiting.leave(id));
                 });
             }
             Err(_) => std::thread::sleep(Duration::from_millis(20)),
@@ -220,6 +239,39 @@ fn serve(listener: &TcpListener, shared: &Arc<Shared>, stop: &AtomicBool) {
 
 /// Connections handled at once at most (a browser opens six to a host).
 const MAX_CONNECTIONS: usize = 32;
+
+/// The connections that have not yet sent their request's head, oldest
+/// first, each with a handle to close it by.
+#[derive(Default)]
+struct Waiting(Mutex<std::collections::VecDeque<(u64, TcpStream)>>);
+
+impl Waiting {
+    fn list(&self) -> std::sync::MutexGuard<'_, std::collections::VecDeque<(u64, TcpStream)>> {
+        self.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    /// Connection `id` waits for its head.
+    fn enter(&self, id: u64, stream: &TcpStream) {
+        if let Ok(handle) = stream.try_clone() {
+            self.list().push_back((id, handle));
+        }
+    }
+
+    /// Connection `id`'s head has come (or it ended).
+    fn leave(&self, id: u64) {
+        self.list().retain(|(waiting, _)| *waiting != id);
+    }
+
+    /// Closes the connection that has waited longest, if one waits: its
+    /// handler's read ends at once.
+    fn close_oldest(&self) -> bool {
+        let oldest = self.list().pop_front();
+        oldest.is_some_and(|(_, stream)| {
+            let _ = stream.shutdown(std::net::Shutdown::Both);
+            true
+        })
+    }
+}
 
 /// One open connection, counted out when dropped.
 struct Counted<'a>(&'a AtomicUsize);
@@ -232,12 +284,15 @@ impl Drop for Counted<'_> {
 
 /// Answers one connection's request: its head read and checked first
 /// ([`admit`]), its body read only for a request admitted, so that nobody
-/// without the token makes the server hold more than a head.
-fn handle(stream: TcpStream, shared: &Shared) {
+/// without the token makes the server hold more than a head; `headed`
+/// once the head is read (or could not be).
+fn handle(stream: TcpStream, shared: &Shared, headed: &dyn Fn()) {
     let _ = stream.set_nonblocking(false);
     let _ = stream.set_read_timeout(Some(Duration::from_secs(10)));
     let mut reader = BufReader::new(&stream);
-    let (response, head_only) = match http::read_head(&mut reader) {
+    let head = http::read_head(&mut reader);
+    headed();
+    let (response, head_only) = match head {
         Err(status) => (unreadable(status), false),
         Ok(mut request) => {
             let response = match admit(&request, shared) {
@@ -497,10 +552,25 @@ fn open_browser(url: &str, stderr: &mut dyn Write) -> Option<PathBuf> {
             return None;
         }
     };
-    if let Err(e) = std::process::Command::new(opener).arg(&launcher).spawn() {
-        let _ = writeln!(stderr, "host-sim studio: cannot run {opener}: {e}; open the address above yourself");
-        let _ = std::fs::remove_file(&launcher);
-        return None;
+    match std::process::Command::new(opener).arg(&launcher).spawn() {
+        Err(e) => {
+            let _ = writeln!(stderr, "host-sim studio: cannot run {opener}: {e}; open the address above yourself");
+            let _ = std::fs::remove_file(&launcher);
+            return None;
+        }
+        // An opener that finds no browser says so in its own words and
+        // exits: said here too, while the server goes on.
+        Ok(mut child) => {
+            std::thread::spawn(move || {
+                if let Ok(status) = child.wait() {
+                    if !status.success() {
+                        eprintln!(
+                            "host-sim studio: {opener} opened no browser ({status}); open the address above yourself"
+                        );
+                    }
+                }
+            });
+        }
     }
     Some(launcher)
 }

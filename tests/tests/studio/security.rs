@@ -209,6 +209,21 @@ fn the_server_keeps_its_security_rules() {
 /// on: the token is on no command line (which any user may read), the page
 /// is this user's alone, and it goes once the browser has come.
 #[test]
+fn idle_connections_cannot_lock_the_page_out() {
+    let dir = tempfile::tempdir().expect("a directory");
+    let scene_path = dir.path().join("s.txt");
+    std::fs::write(&scene_path, START).expect("written");
+    let studio = Studio::start(Some(&scene_path));
+    // Twice the connections the server handles at once, none sending a
+    // byte: each beyond them closes the one that has waited longest.
+    let idle: Vec<_> =
+        (0..64).map(|_| std::net::TcpStream::connect(("127.0.0.1", studio.port)).expect("connects")).collect();
+    let (status, scene) = http(studio.port, "GET", "/scene", &[("X-Studio-Token", &studio.token)], b"");
+    assert_eq!((status, scene.as_slice()), (200, START.as_bytes()));
+    drop(idle);
+}
+
+#[test]
 fn open_puts_the_token_on_no_command_line() {
     use std::os::unix::fs::PermissionsExt;
     let dir = tempfile::tempdir().expect("a directory");

@@ -92,6 +92,32 @@ impl Table {
         }
     }
 
+    /// What it measures, for `--help`.
+    fn what(self) -> &'static str {
+        match self {
+            Table::Scenes => "every scene at its RASTER size, naive mode",
+            Table::Table51 => "the thesis's Table 5.1: naive against the octree",
+            Table::Table52 => "Table 5.2: fig5_4 by the most objects a box holds",
+            Table::Criterion => "the octree's subdivision criterion",
+            Table::Scaling => "random spheres, N = 10 to 100,000",
+            Table::Parallel => "threads and partitions",
+            Table::Palette => "the 256-colour modes",
+            Table::Panels => "every dithering on every panel of few levels",
+            Table::Spheres600 => "naive against dda on 600 random spheres at 800×600",
+            Table::Animation => "frame-to-frame coherence on anim_fig5_1",
+            Table::AnimationFiles => "the animations' GIF and APNG against ffmpeg's GIF (needs ffmpeg)",
+        }
+    }
+
+    /// The command's usage: every table with what it measures.
+    fn usage() -> String {
+        let tables: String = Table::ALL.iter().map(|t| format!("  {:<11} {}\n", t.name(), t.what())).collect();
+        format!(
+            "usage: octrace-bench [TABLE...]\n\nPrints BENCHMARKS.md's tables, measured on this machine (one \
+             thread, best of several runs); with no TABLE, all of them in turn.\n\nTables:\n{tables}"
+        )
+    }
+
     fn from_name(name: &str) -> Result<Table, BenchError> {
         Table::ALL.into_iter().find(|t| t.name() == name).ok_or_else(|| BenchError::UnknownTable {
             name: name.to_owned(),
@@ -468,6 +494,10 @@ fn spheres600(dir: &Path) -> Result<(), BenchError> {
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.iter().any(|a| a == "--help" || a == "-h") {
+        print!("{}", Table::usage());
+        return;
+    }
     let scenes = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes");
     let tables = if args.is_empty() {
         Ok(Table::ALL.to_vec())
@@ -493,6 +523,8 @@ mod tests {
         for table in Table::ALL {
             assert_eq!(Table::from_name(table.name()).ok(), Some(table));
         }
+        let usage = Table::usage();
+        assert!(Table::ALL.iter().all(|t| usage.contains(&format!("  {:<11} {}\n", t.name(), t.what()))), "{usage}");
         let e = Table::from_name("table53").unwrap_err();
         assert_eq!(e.exit_code(), 2);
         assert!(e.to_string().contains("unknown table `table53` (known: scenes, table51"), "{e}");

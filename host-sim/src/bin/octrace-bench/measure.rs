@@ -66,7 +66,11 @@ impl fmt::Display for BenchError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             BenchError::UnknownTable { name, known } => {
-                write!(f, "octrace-bench: unknown table `{name}` (known: {})", known.join(", "))
+                write!(
+                    f,
+                    "octrace-bench: unknown table `{name}` (known: {}; --help says what each measures)",
+                    known.join(", ")
+                )
             }
             BenchError::Scene { path, error: LoadError::Io(e) } => {
                 write!(f, "octrace-bench: cannot read {}: {e}", path.display())
