@@ -244,6 +244,14 @@ fn main() {
         .map(|(techniques, depth)| plan(techniques, depth))
         .find(|&(.., bytes)| bytes <= budget)
         .unwrap_or_else(|| plan(Techniques::NONE, board.config.max_depth));
+    if !counts.octree_fits_its_index() {
+        fail(format!(
+            "{scene}'s octree needs {} boxes and {} references, more than the {} that 16-bit indices number",
+            counts.octree_boxes,
+            counts.octree_references,
+            Counts::OCTREE_INDEX_LIMIT - 1
+        ));
+    }
     if bytes > budget {
         fail(format!(
             "{scene} needs about {bytes} bytes of arenas ({}), more than the {} bytes the {} has for them \

@@ -287,10 +287,10 @@ impl Counts {
     /// assert_eq!(needs.profile_fields().to_string(), "objects: 2, spheres: 2, lights: 1");
     /// ```
     pub fn profile_fields(&self) -> impl fmt::Display + '_ {
-        Listed { counts: self, as_fields: true }
+        Listed { counts: self, form: Listing::Fields }
     }
 
-    /// The counts in words, those that are not 0 (`2 spheres, 1 lights`):
+    /// The counts in words, those that are not 0 (`2 objects, 2 spheres, 1 lights`):
     /// what a build script says a scene needs when a board cannot hold it.
     ///
     /// ```
@@ -300,7 +300,7 @@ impl Counts {
     /// assert_eq!(needs.described().to_string(), "2 objects, 2 spheres, 1 lights");
     /// ```
     pub fn described(&self) -> impl fmt::Display + '_ {
-        Listed { counts: self, as_fields: false }
+        Listed { counts: self, form: Listing::Words }
     }
 
     /// The octree's boxes and references a profile holds are below this:
@@ -324,11 +324,18 @@ impl Counts {
     }
 }
 
-/// The counts that are not 0, comma-separated: as a profile's fields
-/// (`spheres: 2`) or in words (`2 spheres`).
+/// The counts that are not 0, comma-separated, each in `form`.
 struct Listed<'a> {
     counts: &'a Counts,
-    as_fields: bool,
+    form: Listing,
+}
+
+/// How [`Listed`] writes a count.
+enum Listing {
+    /// As a profile's field: `spheres: 2`.
+    Fields,
+    /// In words: `2 spheres`.
+    Words,
 }
 
 impl fmt::Display for Listed<'_> {
@@ -336,9 +343,9 @@ impl fmt::Display for Listed<'_> {
         let given = CapacityKind::ALL.into_iter().filter(|&kind| self.counts.get(kind) > 0);
         for (i, kind) in given.enumerate() {
             let (separator, count) = (if i == 0 { "" } else { ", " }, self.counts.get(kind));
-            match self.as_fields {
-                true => write!(f, "{separator}{}: {count}", kind.field())?,
-                false => write!(f, "{separator}{count} {}", kind.what())?,
+            match self.form {
+                Listing::Fields => write!(f, "{separator}{}: {count}", kind.field())?,
+                Listing::Words => write!(f, "{separator}{count} {}", kind.what())?,
             }
         }
         Ok(())

@@ -46,7 +46,7 @@ impl CliError {
     /// `path` could not be written; a stop signal that arrived meanwhile
     /// (which cut the wait for a FIFO's reader, say) is reported as such.
     pub fn write(path: &Path, error: impl fmt::Display) -> CliError {
-        if signals::stop_flag().load(std::sync::atomic::Ordering::SeqCst) {
+        if signals::stop_requested() {
             return CliError::stopped();
         }
         CliError::Io(format!("cannot write {}: {error}", ShownPath(path)))

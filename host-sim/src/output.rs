@@ -383,8 +383,10 @@ pub(crate) fn check_writable(path: &Path) -> std::io::Result<()> {
 
 /// The stream `path` opened for writing. A FIFO without a reader is
 /// waited for, saying so once, until one comes or a stop signal arrives
-/// (then an `Interrupted` error): open(2) itself would wait on through
-/// the signal, its handler returning into the call.
+/// (then an error): open(2) itself would wait on through the signal, its
+/// handler returning into the call. (A reader gone between the probe and
+/// the open leaves the open waiting: a second signal ends host-sim, see
+/// `signals`.)
 fn open_stream(path: &Path) -> std::io::Result<File> {
     #[cfg(unix)]
     {
@@ -400,10 +402,9 @@ fn open_stream(path: &Path) -> std::io::Result<File> {
                     Err(e) => return Err(e),
                 }
                 if stop.load(std::sync::atomic::Ordering::SeqCst) {
-                    return Err(std::io::Error::new(
-                        std::io::ErrorKind::Interrupted,
-                        "stopped while waiting for the FIFO's reader",
-                    ));
+                    // Not `Interrupted`, which the standard library's
+                    // writers retry.
+                    return Err(std::io::Error::other("stopped while waiting for the FIFO's reader"));
                 }
                 if !said {
                     eprintln!("host-sim: {} is a FIFO: waiting for its reader", crate::exit::ShownPath(path));
@@ -434,6 +435,13 @@ fn destination(path: &Path) -> std::io::Result<Destination> {
     let path = through_links(path);
     if is_stream(&path) {
         return Ok(Destination::Stream(path));
+    }
+    // Refused before anything is written (the rename would refuse it last).
+    if path.is_dir() {
+        #[cfg(unix)]
+        return Err(std::io::Error::from_raw_os_error(libc::EISDIR));
+        #[cfg(not(unix))]
+        return Err(std::io::ErrorKind::IsADirectory.into());
     }
     refuse_read_only(&path)?;
     let (tmp, file) = temporary_beside(&path)?;

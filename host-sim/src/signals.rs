@@ -6,8 +6,9 @@
 //! code (what a shell reports for a process the signal ended).
 //!
 //! Invariant: the handlers are installed once per process, when the flag
-//! is first asked for; from then on these signals never end the process
-//! mid-write.
+//! is first asked for; from then on the first of these signals never ends
+//! the process mid-write. A second one does, at once, with the same exit
+//! code: what a user whose first was not heard (a blocked write) asks.
 
 use std::fmt;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -67,19 +68,32 @@ struct Flags {
     which: Arc<AtomicUsize>,
 }
 
+static FLAGS: OnceLock<Flags> = OnceLock::new();
+
 fn flags() -> &'static Flags {
-    static FLAGS: OnceLock<Flags> = OnceLock::new();
     FLAGS.get_or_init(|| {
         let flags = Flags { stop: Arc::new(AtomicBool::new(false)), which: Arc::new(AtomicUsize::new(0)) };
         for &signal in StopSignal::HANDLED {
-            // Which one first, so that a run that sees the flag finds it. A
-            // signal that cannot be handled here keeps its default action.
+            // A second signal, once the first has set the flag, ends the
+            // process at once (a write blocked on a pipe no one reads, say,
+            // which a handler returns into); registered first, so that the
+            // first signal finds the flag still clear. Then which one, so
+            // that a run that sees the flag finds it. A signal that cannot
+            // be handled here keeps its default action.
             let number = signal.number();
+            let _ =
+                signal_hook::flag::register_conditional_shutdown(number, signal.exit_code(), Arc::clone(&flags.stop));
             let _ = signal_hook::flag::register_usize(number, Arc::clone(&flags.which), number as usize);
             let _ = signal_hook::flag::register(number, Arc::clone(&flags.stop));
         }
         flags
     })
+}
+
+/// Whether a stop signal has arrived, without installing the handlers (a
+/// process that never asked for the flag was never stopped by one).
+pub(crate) fn stop_requested() -> bool {
+    FLAGS.get().is_some_and(|flags| flags.stop.load(Ordering::SeqCst))
 }
 
 /// The flag the stop signals set, their handlers installed on the first

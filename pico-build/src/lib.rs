@@ -45,8 +45,9 @@ pub enum BuildError {
     /// The scene has errors (each printed with its line and column as it
     /// was found).
     Scene { scene: String, errors: usize },
-    /// The scene needs more than the board can hold: `needs`, its counts
-    /// in words; `limit`, what it passes.
+    /// The scene needs more than the board can hold, refused before
+    /// anything is compiled: `needs`, its counts in words; `limit`, which
+    /// of the board's bounds it passes, and by how much.
     TooLarge { scene: String, needs: String, limit: String },
     /// A file could not be read or written.
     File { path: String, error: std::io::Error },

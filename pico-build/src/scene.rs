@@ -57,7 +57,9 @@ pub enum SceneKind {
 /// `SCENE_NAME`, its file's name without the extension (what a firmware
 /// reports it drew), and `SceneProfile`, a `profile!` holding exactly what
 /// it needs; `ANIMATED` and `MOTION` (the tracks and keys an animation
-/// takes, an `AnimationNeeds` without tiles: none for a still). Returns what the scene is. The firmware includes it:
+/// takes, an `AnimationNeeds` without tiles: none for a still). Returns what the scene is; a scene whose arenas
+/// the Pico's RAM cannot hold, or whose octree 16-bit indices cannot number, is refused
+/// ([`BuildError::TooLarge`]). The firmware includes it:
 ///
 /// ```ignore
 /// mod scene {

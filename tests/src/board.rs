@@ -31,10 +31,11 @@ use std::sync::mpsc::{self, Receiver};
 use std::time::{Duration, Instant};
 
 /// A scene that wedged the board before it could stop inside a pixel:
-/// two facing mirrors with the eye between them (a sample bounces up to 4,096
-/// times), `lights` lights (up to eight), 16² samples a pixel: a pixel
-/// takes hours on a Pico (a PC traces it in milliseconds to seconds). The
-/// format allows all of it.
+/// two facing mirrors with the eye between them, so wide that every sample
+/// bounces as often as a sample may (4,096 rays), `lights` lights (up to
+/// eight), 16² samples a pixel: a pixel takes hours on a Pico and seconds
+/// on a PC, a picture minutes at least, so that what waits on a drawing
+/// never sees it end. The format allows all of it.
 pub fn wedging_scene(lights: u32) -> String {
     let lights = lights.clamp(1, 8);
     let positions = ["0 1", "0 -1", "1 0", "-1 0", "1 1", "-1 1", "1 -1", "-1 -1"];
@@ -42,8 +43,8 @@ pub fn wedging_scene(lights: u32) -> String {
     for position in &positions[..lights as usize] {
         text += &format!("LIGHT 1 {position} 0\n");
     }
-    text + "RECTANGLE 1 -5 -5 -3 5 -5 -3 5 5 -3 -5 5 -3\n\
-            RECTANGLE 1 -5 -5 3 -5 5 3 5 5 3 5 -5 3\n\
+    text + "RECTANGLE 1 -1000 -1000 -3 1000 -1000 -3 1000 1000 -3 -1000 1000 -3\n\
+            RECTANGLE 1 -1000 -1000 3 -1000 1000 3 1000 1000 3 1000 -1000 3\n\
             SURFACE 1 0.01 0.01 0.01 0.1 0.1 0.1 0 0 0 0 1 0\n"
 }
 

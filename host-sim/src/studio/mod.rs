@@ -3,7 +3,7 @@
 //!
 //! Invariants (the security rules): the listener is bound to 127.0.0.1
 //! only, and handles 32 connections at once at most (beyond them the one
-//! waiting longest for its request's head is closed); a request is admitted
+//! not yet admitted that came first is closed); a request is admitted
 //! from its head alone, its body read only then; a request whose Host is
 //! not this address and port is refused (DNS
 //! rebinding); a request a browser sends for another site's page (its
@@ -220,14 +220,13 @@ fn serve(listener: &TcpListener, shared: &Arc<Shared>, stop: &AtomicBool) {
                     drop(stream);
                     continue;
                 }
-                let (shared, open, waiting) = (Arc::clone(shared), Arc::clone(&open), Arc::clone(&waiting));
+                let counted = Counted::new(&open);
+                let (shared, waiting) = (Arc::clone(shared), Arc::clone(&waiting));
                 let id = next;
                 next += 1;
-                waiting.enter(id, &stream);
-                open.fetch_add(1, Ordering::SeqCst);
+                waiting.enter(id, &stream, &counted);
                 std::thread::spawn(move || {
-                    // Counted out however the handler ends.
-                    let _counted = Counted(&open);
+                    let _ending = Ending { waiting: &waiting, id, counted };
                     handle(stream, &shared, &|| waiting.leave(id));
                 });
             }
@@ -240,67 +239,99 @@ fn serve(listener: &TcpListener, shared: &Arc<Shared>, stop: &AtomicBool) {
 /// Connections handled at once at most (a browser opens six to a host).
 const MAX_CONNECTIONS: usize = 32;
 
-/// The connections that have not yet sent their request's head, oldest
-/// first, each with a handle to close it by.
+/// The connections not yet admitted (their request's head still coming,
+/// or refused and answered), oldest first: each with a handle to close it
+/// by and its count, released as it is closed.
 #[derive(Default)]
-struct Waiting(Mutex<std::collections::VecDeque<(u64, TcpStream)>>);
+struct Waiting(Mutex<std::collections::VecDeque<(u64, TcpStream, Counted)>>);
 
 impl Waiting {
-    fn list(&self) -> std::sync::MutexGuard<'_, std::collections::VecDeque<(u64, TcpStream)>> {
+    fn list(&self) -> std::sync::MutexGuard<'_, std::collections::VecDeque<(u64, TcpStream, Counted)>> {
         self.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
     }
 
-    /// Connection `id` waits for its head.
-    fn enter(&self, id: u64, stream: &TcpStream) {
+    /// Connection `id`, counted by `counted`, waits to be admitted.
+    fn enter(&self, id: u64, stream: &TcpStream, counted: &Counted) {
         if let Ok(handle) = stream.try_clone() {
-            self.list().push_back((id, handle));
+            self.list().push_back((id, handle, counted.clone()));
         }
     }
 
-    /// Connection `id`'s head has come (or it ended).
+    /// Connection `id` is admitted (or ended).
     fn leave(&self, id: u64) {
-        self.list().retain(|(waiting, _)| *waiting != id);
+        self.list().retain(|(waiting, ..)| *waiting != id);
     }
 
-    /// Closes the connection that has waited longest, if one waits: its
-    /// handler's read ends at once.
+    /// Closes the connection that has waited longest, if one waits (its
+    /// handler's reads and writes end at once), and counts it out now: the
+    /// one accepted in its place does not make the server hold more.
     fn close_oldest(&self) -> bool {
         let oldest = self.list().pop_front();
-        oldest.is_some_and(|(_, stream)| {
+        oldest.is_some_and(|(_, stream, counted)| {
             let _ = stream.shutdown(std::net::Shutdown::Both);
+            counted.release();
             true
         })
     }
 }
 
-/// One open connection, counted out when dropped.
-struct Counted<'a>(&'a AtomicUsize);
+/// A connection's handler ending, however it ends (a panic too): the
+/// connection leaves the waiting list and the server's count.
+struct Ending<'a> {
+    waiting: &'a Waiting,
+    id: u64,
+    counted: Counted,
+}
 
-impl Drop for Counted<'_> {
+impl Drop for Ending<'_> {
     fn drop(&mut self) {
-        self.0.fetch_sub(1, Ordering::SeqCst);
+        self.waiting.leave(self.id);
+        self.counted.release();
+    }
+}
+
+/// One open connection in the server's count: counted out once, when it
+/// is closed to make room or when its handler ends, whichever comes first.
+#[derive(Clone)]
+struct Counted {
+    open: Arc<AtomicUsize>,
+    released: Arc<AtomicBool>,
+}
+
+impl Counted {
+    fn new(open: &Arc<AtomicUsize>) -> Counted {
+        open.fetch_add(1, Ordering::SeqCst);
+        Counted { open: Arc::clone(open), released: Arc::new(AtomicBool::new(false)) }
+    }
+
+    fn release(&self) {
+        if !self.released.swap(true, Ordering::SeqCst) {
+            self.open.fetch_sub(1, Ordering::SeqCst);
+        }
     }
 }
 
 /// Answers one connection's request: its head read and checked first
 /// ([`admit`]), its body read only for a request admitted, so that nobody
-/// without the token makes the server hold more than a head; `headed`
-/// once the head is read (or could not be).
-fn handle(stream: TcpStream, shared: &Shared, headed: &dyn Fn()) {
+/// without the token makes the server hold more than a head; `admitted`
+/// then (until that, the connection may be closed to make room for
+/// another, a refused one too, while its answer goes out).
+fn handle(stream: TcpStream, shared: &Shared, admitted: &dyn Fn()) {
     let _ = stream.set_nonblocking(false);
     let _ = stream.set_read_timeout(Some(Duration::from_secs(10)));
     let mut reader = BufReader::new(&stream);
-    let head = http::read_head(&mut reader);
-    headed();
-    let (response, head_only) = match head {
+    let (response, head_only) = match http::read_head(&mut reader) {
         Err(status) => (unreadable(status), false),
         Ok(mut request) => {
             let response = match admit(&request, shared) {
                 Err(refusal) => refusal,
-                Ok(route) => match http::read_body(&mut reader, &mut request, MAX_SCENE_BYTES) {
-                    Ok(()) => respond(&request, &route, shared),
-                    Err(status) => unreadable(status),
-                },
+                Ok(route) => {
+                    admitted();
+                    match http::read_body(&mut reader, &mut request, MAX_SCENE_BYTES) {
+                        Ok(()) => respond(&request, &route, shared),
+                        Err(status) => unreadable(status),
+                    }
+                }
             };
             (response, request.method == "HEAD")
         }

@@ -205,9 +205,8 @@ fn the_server_keeps_its_security_rules() {
     assert!(stderr.contains("stopped"), "{stderr}");
 }
 
-/// `--open` has the desktop's opener open a page that sends the browser
-/// on: the token is on no command line (which any user may read), the page
-/// is this user's alone, and it goes once the browser has come.
+/// A program without the token holding connections open (twice the 32
+/// the server handles at once, sending nothing) cannot keep the page out.
 #[test]
 fn idle_connections_cannot_lock_the_page_out() {
     let dir = tempfile::tempdir().expect("a directory");
@@ -223,6 +222,9 @@ fn idle_connections_cannot_lock_the_page_out() {
     drop(idle);
 }
 
+/// `--open` has the desktop's opener open a page that sends the browser
+/// on: the token is on no command line (which any user may read), the page
+/// is this user's alone, and it goes once the browser has come.
 #[test]
 fn open_puts_the_token_on_no_command_line() {
     use std::os::unix::fs::PermissionsExt;

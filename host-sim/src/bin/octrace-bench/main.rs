@@ -4,15 +4,7 @@
 //! cargo run --release -p host-sim --bin octrace-bench -- [TABLE…]
 //! ```
 //!
-//! Tables: `scenes` (every scene, naive), `table51` (the thesis's Table 5.1),
-//! `table52` (Table 5.2), `scaling` (random spheres, N = 10 … 100,000),
-//! `criterion` (the octree's subdivision criterion), `parallel` (threads
-//! and partitions), `palette` (the 256-colour modes), `panels` (every
-//! dithering on every panel of few levels, issue 42's measure),
-//! `spheres600` (naive against dda on 600 random spheres at 800×600),
-//! `animation` (frame-to-frame coherence on anim_fig5_1, `animation.rs`),
-//! `animfiles` (the animations' GIF and APNG against ffmpeg's GIF of the
-//! same frames, `animation_files.rs`; needs ffmpeg).
+//! Tables: `octrace-bench --help` lists them, with what each measures.
 //! No argument: all. Times are wall-clock on one thread
 //! (except in `parallel`), the best of several runs; the machine is printed
 //! first so every table says where it came from.
@@ -114,7 +106,7 @@ impl Table {
         let tables: String = Table::ALL.iter().map(|t| format!("  {:<11} {}\n", t.name(), t.what())).collect();
         format!(
             "usage: octrace-bench [TABLE...]\n\nPrints BENCHMARKS.md's tables, measured on this machine (one \
-             thread, best of several runs); with no TABLE, all of them in turn.\n\nTables:\n{tables}"
+             thread but in `parallel`, best of several runs); with no TABLE, all of them in turn.\n\nTables:\n{tables}"
         )
     }
 
