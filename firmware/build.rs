@@ -253,9 +253,27 @@ fn main() {
         ));
     }
     if bytes > budget {
+        // Without an octree the objects alone may fit: said, not chosen
+        // (the naive walk is slower by as much as the octree gains).
+        let naive = needs(&text, AccelMode::Naive, &board.config, 0);
+        let naive_bytes = ProfileText {
+            name: "",
+            doc: "",
+            counts: &naive,
+            octree: None,
+            named_walk: false,
+            first_hits: false,
+            coherence: false,
+            motion,
+        }
+        .arena_bytes();
+        let hint = match accel != AccelMode::Naive && naive_bytes <= budget {
+            true => format!("; without its octree it needs about {naive_bytes}: build it with OCTRACE_ACCEL=naive"),
+            false => String::new(),
+        };
         fail(format!(
             "{scene} needs about {bytes} bytes of arenas ({}), more than the {} bytes the {} has for them \
-             beside its stack and other statics",
+             beside its stack and other statics{hint}",
             counts.described(),
             budget,
             board.name
