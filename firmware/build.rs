@@ -222,7 +222,7 @@ fn main() {
     let budget = board.static_ram - OTHER_STATICS;
     // A scene without a MOVE links none of the interpolation of keys.
     let motion = AnimationNeeds::of(&text, Default::default()).moves();
-    let plan = |techniques: Techniques, max_depth: u32| {
+    let plan = |accel: AccelMode, techniques: Techniques, max_depth: u32| {
         let config = OctreeConfig { max_depth, shadow_shafts: techniques.shadow_shafts, ..board.config };
         let counts = needs(&text, accel, &config, techniques.light_buffer);
         let profile = ProfileText {
@@ -241,9 +241,9 @@ fn main() {
     let (octree, techniques, counts, bytes) = (1..=board.config.max_depth)
         .rev()
         .flat_map(|depth| wanted.subsets().map(move |techniques| (techniques, depth)))
-        .map(|(techniques, depth)| plan(techniques, depth))
+        .map(|(techniques, depth)| plan(accel, techniques, depth))
         .find(|&(.., bytes)| bytes <= budget)
-        .unwrap_or_else(|| plan(Techniques::NONE, board.config.max_depth));
+        .unwrap_or_else(|| plan(accel, Techniques::NONE, board.config.max_depth));
     if !counts.octree_fits_its_index() {
         fail(format!(
             "{scene}'s octree needs {} boxes and {} references, more than the {} that 16-bit indices number",
@@ -255,18 +255,7 @@ fn main() {
     if bytes > budget {
         // Without an octree the objects alone may fit: said, not chosen
         // (the naive walk is slower by as much as the octree gains).
-        let naive = needs(&text, AccelMode::Naive, &board.config, 0);
-        let naive_bytes = ProfileText {
-            name: "",
-            doc: "",
-            counts: &naive,
-            octree: None,
-            named_walk: false,
-            first_hits: false,
-            coherence: false,
-            motion,
-        }
-        .arena_bytes();
+        let (.., naive_bytes) = plan(AccelMode::Naive, Techniques::NONE, board.config.max_depth);
         let hint = match accel != AccelMode::Naive && naive_bytes <= budget {
             true => format!("; without its octree it needs about {naive_bytes}: build it with OCTRACE_ACCEL=naive"),
             false => String::new(),

@@ -146,8 +146,7 @@ fn fits(scene: &str, profile: &ProfileText<'_>, room: Option<usize>) -> Result<(
         needs: profile.counts.described().to_string(),
         limit,
     };
-    let bytes = profile.arena_bytes();
-    if let Some(room) = room.filter(|&room| bytes > room) {
+    if let Some((room, bytes)) = room.map(|room| (room, profile.arena_bytes())).filter(|&(room, bytes)| bytes > room) {
         return Err(too_large(format!(
             "its arenas take about {bytes} bytes of RAM, more than the {room} a Pico leaves them beside both \
              cores' stacks"
