@@ -244,13 +244,8 @@ fn main() {
         .map(|(techniques, depth)| plan(accel, techniques, depth))
         .find(|&(.., bytes)| bytes <= budget)
         .unwrap_or_else(|| plan(accel, Techniques::NONE, board.config.max_depth));
-    if !counts.octree_fits_its_index() {
-        fail(format!(
-            "{scene}'s octree needs {} boxes and {} references, more than the {} that 16-bit indices number",
-            counts.octree_boxes,
-            counts.octree_references,
-            Counts::OCTREE_INDEX_LIMIT - 1
-        ));
+    if let Err(e) = counts.check_octree_index() {
+        fail(format!("{scene} is too large for any board: {e}"));
     }
     if bytes > budget {
         // Without an octree the objects alone may fit: said, not chosen

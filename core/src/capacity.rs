@@ -314,6 +314,27 @@ impl Counts {
         self.octree_boxes < Counts::OCTREE_INDEX_LIMIT && self.octree_references < Counts::OCTREE_INDEX_LIMIT
     }
 
+    /// [`Counts::octree_fits_its_index`] with the reason when it does not:
+    /// what a build script reports for a scene too large for any profile.
+    ///
+    /// ```
+    /// use octrace_core::capacity::Counts;
+    ///
+    /// let counts = Counts { octree_boxes: 70_000, octree_references: 9, ..Counts::ZERO };
+    /// let error = counts.check_octree_index().unwrap_err();
+    /// assert_eq!(
+    ///     error.to_string(),
+    ///     "its octree needs 70000 boxes and 9 references, and 16-bit indices number at most 65533 of each"
+    /// );
+    /// assert!(Counts::ZERO.check_octree_index().is_ok());
+    /// ```
+    pub fn check_octree_index(&self) -> Result<(), OctreeIndexError> {
+        match self.octree_fits_its_index() {
+            true => Ok(()),
+            false => Err(OctreeIndexError { boxes: self.octree_boxes, references: self.octree_references }),
+        }
+    }
+
     /// Each count the larger of `self`'s and `other`'s.
     pub fn max(mut self, other: &Counts) -> Counts {
         for kind in CapacityKind::ALL {
@@ -392,6 +413,30 @@ impl fmt::Display for CapacityError {
 }
 
 impl core::error::Error for CapacityError {}
+
+/// An octree of more boxes or references than its 16-bit indices number
+/// ([`Counts::OCTREE_INDEX_LIMIT`]): no profile can hold it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OctreeIndexError {
+    /// The octree's boxes.
+    pub boxes: usize,
+    /// Its references to objects.
+    pub references: usize,
+}
+
+impl fmt::Display for OctreeIndexError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "its octree needs {} boxes and {} references, and 16-bit indices number at most {} of each",
+            self.boxes,
+            self.references,
+            Counts::OCTREE_INDEX_LIMIT - 1
+        )
+    }
+}
+
+impl core::error::Error for OctreeIndexError {}
 
 #[cfg(test)]
 mod tests {

@@ -152,13 +152,7 @@ fn fits(scene: &str, profile: &ProfileText<'_>, room: Option<usize>) -> Result<(
              cores' stacks"
         )));
     }
-    if !profile.counts.octree_fits_its_index() {
-        return Err(too_large(format!(
-            "an octree's boxes and references are numbered in 16 bits, fewer than {} each",
-            Counts::OCTREE_INDEX_LIMIT
-        )));
-    }
-    Ok(())
+    profile.counts.check_octree_index().map_err(|e| too_large(e.to_string()))
 }
 
 /// What the scene `text`, whose motion takes `motion`, is: an animation if
@@ -288,7 +282,7 @@ mod tests {
                         message.contains(&format!("{boxes} octree boxes, {references} octree references")),
                         "{message}"
                     );
-                    assert!(message.contains("numbered in 16 bits, fewer than 65534 each"), "{message}");
+                    assert!(message.contains("16-bit indices number at most 65533 of each"), "{message}");
                 }
             }
         }
