@@ -15,7 +15,8 @@
 //!
 //! No-panic contract: for any input text, [`parse`] returns (it neither
 //! panics nor loops), in time linear in the text's length plus
-//! O(objects · log surfaces).
+//! O(objects · log surfaces), and for a moving camera (checked at every
+//! frame) O(frames).
 
 mod error;
 mod keyword;
@@ -32,6 +33,7 @@ pub(crate) use motion::{for_each_move, MotionSink, Moved, Mover};
 pub(crate) use statement::{Keys, Statement};
 
 use crate::capacity::{CapacityError, CapacityKind, Counts};
+use crate::scene::motion::KeyWalk;
 use crate::scene::{displacement_at, Camera, CameraError, Frames, Light, Scene, SceneCapacities, WorldPoint};
 use crate::shapes::{AxisAlignedBox, Rectangle, ShapeKind, Sphere, Superquadric, Triangle};
 
@@ -613,10 +615,13 @@ impl<'a, C: SceneCapacities> Build<'_, 'a, '_, '_, C> {
         let (Some(frames), Some(pos), true) = (self.parsed.frames, self.camera_move, C::MOTION) else { return };
         let mut view = self.scene.settings.view;
         let mut last = None;
+        // Each camera key read once over the loop, not once a frame.
+        let mut walks =
+            self.camera_keys.each_ref().map(|moved| moved.as_ref().map(|(w, k)| (*w, KeyWalk::new(k.offsets()))));
         for frame in 0..frames.count {
-            for (i, moved) in self.camera_keys.iter().enumerate() {
-                let Some((written, keys)) = moved else { continue };
-                let d = displacement_at(keys.offsets(), frame);
+            for (i, moved) in walks.iter_mut().enumerate() {
+                let Some((written, walk)) = moved else { continue };
+                let d = walk.at(frame);
                 let point = [0, 1, 2].map(|a| written[a] + d[a]);
                 match i {
                     0 => view.eye = point,
@@ -1337,5 +1342,47 @@ mod tests {
         );
         let e = one_err(&format!("SPHERE 1 -1 0 0 0 {SURF}"));
         assert!(e.contains("SPHERE radius must be > 0, found -1"), "{e}");
+    }
+
+    #[test]
+    fn an_unclosed_comment_or_string_after_a_statement_of_varying_length_is_its_error() {
+        // FRAMES and MOVE look past their last number for another: the
+        // lexer's error there must not end the text without a word.
+        for (text, at) in [
+            ("FRAMES 2 /* open\nSPHERE 1 1 0 0 0\n", "2:10"),
+            ("FRAMES 2 \"open\nSPHERE 1 1 0 0 0\n", "2:10"),
+            ("FRAMES 2 LIGHT 1 1 1 1 MOVE 0 1 1 1 /* open\nSPHERE 1 1 0 0 0\n", "2:37"),
+        ] {
+            // The SURFACE before them is line 1.
+            let e = one_err(&format!("{SURF}{text}"));
+            assert!(e.starts_with(at), "{text}: {e}");
+            assert!(e.contains("never closed"), "{text}: {e}");
+        }
+    }
+
+    #[test]
+    fn range_checks_apply_to_the_value_as_read() {
+        // Negative decimals that read as 0 are 0, as `-0` is; one below the
+        // resolution's half reads as −2^-32 and is refused.
+        let s = ok(&format!(
+            "SURFACE 2 -1e-20 -0 0 0 0 0 0 0 0 -1e-400 1.0000000001 0\nLIGHT -1e-400 1 1 1\nSPHERE 2 1 0 0 0\n{SURF}"
+        ));
+        assert_eq!(s.view().object_count(), 1);
+        let e = one_err(&format!("{SURF}SURFACE 2 -3e-10 0 0 0 0 0 0 0 0 0 0 0\n"));
+        assert!(e.contains("must be between 0 and 1"), "{e}");
+    }
+
+    #[test]
+    fn a_long_thin_rectangle_is_convex() {
+        // Its short sides, cut to nothing at its long sides' scale, still
+        // turn the way they do; as two triangles the same area loads.
+        for corners in [
+            "0 0 0  100 0 0  100 0.000001 0  0 0.000001 0",
+            "0 0 0  0 0.000001 0  100 0.000001 0  100 0 0",
+            "0 0 0  1000000 0 0  1000000 0.01 0  0 0.01 0",
+        ] {
+            let s = ok(&format!("VIEWPOINT 50 0 10 ORIGIN 50 0 0 RECTANGLE 1 {corners}\n{SURF}"));
+            assert_eq!(s.view().object_count(), 1, "{corners}");
+        }
     }
 }

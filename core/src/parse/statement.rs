@@ -319,8 +319,8 @@ impl<'a> Cursor<'a> {
         let v = d.to_q32();
         let ok = match rule {
             Rule::Positive => v > 0,
-            Rule::NonNegative => !d.negative || d.is_zero(),
-            Rule::UnitInterval => (!d.negative || d.is_zero()) && v <= 1 << 32,
+            Rule::NonNegative => v >= 0,
+            Rule::UnitInterval => (0..=1 << 32).contains(&v),
             Rule::BetweenReal(lo, hi) => v >= lo << 32 && v <= hi << 32,
             Rule::Between(..) | Rule::Magnitude | Rule::AboveResolution => true,
         };
@@ -336,8 +336,10 @@ impl<'a> Cursor<'a> {
 
     /// Whether the next token is a number (more of a statement whose
     /// length varies: a rate, a key).
-    fn number_follows(&mut self) -> bool {
-        matches!(self.peek(), Ok(Some(t)) if !t.quoted && Decimal::parse(t.text).is_some())
+    /// The lexer's error there (an unterminated comment or string) is the
+    /// statement's: dropped, it would end the text without a word.
+    fn number_follows(&mut self) -> Result<bool, ParseError<'a>> {
+        Ok(matches!(self.peek()?, Some(t) if !t.quoted && Decimal::parse(t.text).is_some()))
     }
 
     /// An integer from `lo` to `hi`.
@@ -518,7 +520,7 @@ pub fn statement<'a, R: Room>(cur: &mut Cursor<'a>, kw: Keyword, at: Pos) -> Res
         }
         Keyword::Frames => {
             let count = cur.integer(f("count"), 1, Frames::MAX_COUNT as i64)? as u32;
-            let rate = match cur.number_follows() {
+            let rate = match cur.number_follows()? {
                 true => cur.integer(f("rate"), 1, Frames::MAX_RATE as i64)? as u32,
                 false => Frames::DEFAULT_RATE,
             };
@@ -538,7 +540,7 @@ pub fn statement<'a, R: Room>(cur: &mut Cursor<'a>, kw: Keyword, at: Pos) -> Res
                 cur.point(kw, ["dx", "dy", "dz"])?;
                 keys.count += 1;
                 previous = Some(frame);
-                if !cur.number_follows() {
+                if !cur.number_follows()? {
                     break;
                 }
             }
@@ -607,26 +609,35 @@ fn check_quadrilateral(c: &[WorldPoint; 4]) -> Result<(), ErrorKind<'static>> {
     if largest == 0 {
         return Err(ErrorKind::Degenerate { keyword: Keyword::Rectangle.name(), why: "its corners coincide" });
     }
-    let shift = (128 - largest.leading_zeros()).saturating_sub(24);
-    let v = v.map(|e| e.map(|x| x >> shift));
+    let reduced = |e: [i128; 3], largest: u128| {
+        let shift = (128 - largest.leading_zeros()).saturating_sub(24);
+        e.map(|x| x >> shift)
+    };
+    // Each edge at its own scale for the turns: a short side of a long thin
+    // rectangle, cut to nothing at the longest edge's scale, still turns
+    // the way it does (a positive factor an edge keeps each turn's way).
+    let own = v.map(|e| reduced(e, e.iter().map(|x| x.unsigned_abs()).max().unwrap_or(0)));
+    let v = v.map(|e| reduced(e, largest));
     if goes_round_along_axes(&v) {
         return Ok(());
     }
-    check_reduced_edges(&v)
+    check_reduced_edges(&v, &own)
 }
 
-/// [`check_quadrilateral`]'s tests on its edges reduced to 24 bits.
-fn check_reduced_edges(v: &[[i128; 3]; 4]) -> Result<(), ErrorKind<'static>> {
+/// [`check_quadrilateral`]'s tests on its edges reduced to 24 bits: `v` at
+/// the longest edge's scale, `own` each at its own.
+fn check_reduced_edges(v: &[[i128; 3]; 4], own: &[[i128; 3]; 4]) -> Result<(), ErrorKind<'static>> {
     // The turn at each corner; for a strictly convex quadrilateral all four
     // point the same way (counter-clockwise: along the front normal).
-    let turns: [[i128; 3]; 4] = core::array::from_fn(|i| cross(v[i], v[(i + 1) % 4]));
-    let reference = turns.iter().copied().max_by_key(|c| dot(*c, *c)).unwrap_or([0; 3]);
-    if reference == [0; 3] {
+    let turns = |v: &[[i128; 3]; 4]| -> [[i128; 3]; 4] { core::array::from_fn(|i| cross(v[i], v[(i + 1) % 4])) };
+    if turns(v) == [[0; 3]; 4] {
         return Err(ErrorKind::Degenerate {
             keyword: Keyword::Rectangle.name(),
             why: "its corners are collinear (zero area)",
         });
     }
+    let turns = turns(own);
+    let reference = turns.iter().copied().max_by_key(|c| dot(*c, *c)).unwrap_or([0; 3]);
     if turns.iter().any(|c| dot(*c, reference) <= 0) {
         return Err(ErrorKind::NotConvex);
     }
@@ -674,7 +685,7 @@ mod tests {
                 core::array::from_fn(|i| [0, 1, 2].map(|a| corners[(i + 1) % 4][a] - corners[i][a]));
             if goes_round_along_axes(&v) {
                 along += 1;
-                assert_eq!(check_reduced_edges(&v), Ok(()), "{corners:?}");
+                assert_eq!(check_reduced_edges(&v, &v), Ok(()), "{corners:?}");
             }
         }
         assert!(along > 100, "{along} cases along the axes");

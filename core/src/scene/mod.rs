@@ -14,7 +14,7 @@
 //! a `static` costs no flash.
 
 mod camera;
-mod motion;
+pub(crate) mod motion;
 mod normalize;
 mod surface;
 

@@ -58,17 +58,38 @@ impl Frames {
 /// assert_eq!(displacement_at(keys.into_iter(), 9), [10, -10, 3]);
 /// ```
 pub fn displacement_at(keys: impl Iterator<Item = (u32, [i64; 3])>, frame: u32) -> [i64; 3] {
-    let mut before: Option<(u32, [i64; 3])> = None;
-    for (at, value) in keys {
-        if at >= frame {
-            return match before {
-                Some(from) if at > frame => between(from, (at, value), frame),
-                _ => value,
-            };
-        }
-        before = Some((at, value));
+    KeyWalk::new(keys).at(frame)
+}
+
+/// The displacements given by `keys` at frames taken in increasing order,
+/// each key read once: [`displacement_at`] for every frame of a loop in
+/// time linear in the frames and keys together.
+pub(crate) struct KeyWalk<I> {
+    keys: I,
+    /// The last key before the frame asked for last.
+    before: Option<(u32, [i64; 3])>,
+    /// The first key at or after it.
+    after: Option<(u32, [i64; 3])>,
+}
+
+impl<I: Iterator<Item = (u32, [i64; 3])>> KeyWalk<I> {
+    pub(crate) fn new(mut keys: I) -> Self {
+        let after = keys.next();
+        KeyWalk { keys, before: None, after }
     }
-    before.map_or([0; 3], |(_, value)| value)
+
+    /// The displacement at `frame`, not before the frame asked for last.
+    pub(crate) fn at(&mut self, frame: u32) -> [i64; 3] {
+        while let Some(key) = self.after.filter(|&(at, _)| at < frame) {
+            self.before = Some(key);
+            self.after = self.keys.next();
+        }
+        match (self.before, self.after) {
+            (Some(from), Some(to)) if to.0 > frame => between(from, to, frame),
+            (_, Some((_, value))) | (Some((_, value)), None) => value,
+            (None, None) => [0; 3],
+        }
+    }
 }
 
 /// The displacement at `frame`, strictly between the keys `from` and `to`.
@@ -88,6 +109,17 @@ fn between(from: (u32, [i64; 3]), to: (u32, [i64; 3]), frame: u32) -> [i64; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_walk_over_the_frames_gives_each_frame_s_displacement() {
+        let keys = [(2, [0, 100, -7]), (6, [8, 100, 1]), (7, [0, 0, 0]), (11, [-9, 3, 5])];
+        let mut walk = KeyWalk::new(keys.into_iter());
+        for frame in 0..14 {
+            assert_eq!(walk.at(frame), displacement_at(keys.into_iter(), frame), "frame {frame}");
+        }
+        let mut none = KeyWalk::new(core::iter::empty());
+        assert_eq!([none.at(0), none.at(5)], [[0; 3]; 2]);
+    }
 
     #[test]
     fn between_before_and_after_the_keys() {
