@@ -365,7 +365,7 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         return Err(CliError::Invalid("no scene file given".into()));
     };
     let mut scene = new_scene();
-    let scene_bytes = std::fs::read(scene_path).map_err(|e| CliError::read(scene_path, e))?;
+    let scene_bytes = crate::scene::read_scene_file(scene_path).map_err(|e| CliError::read(scene_path, e))?;
     let frame = args.frame.unwrap_or(0);
     let name = ShownPath(scene_path).to_string();
     let loaded = load_frame_bytes(&name, &scene_bytes, frame, &mut scene).map_err(|e| match e {

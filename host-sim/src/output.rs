@@ -357,12 +357,13 @@ pub fn write_atomically(
         }
         Destination::File { path, tmp, file } => (path, tmp, file),
     };
+    let unfinished = crate::signals::Unfinished::new(&tmp);
     let result = (|| {
         let mut w = std::io::BufWriter::new(file);
         write(&mut w)?;
         w.flush()?;
         w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        replace_with(&tmp, &path)
+        unfinished.finish(|| replace_with(&tmp, &path))
     })();
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);

@@ -110,8 +110,28 @@ pub fn load_frame_bytes(name: &str, bytes: &[u8], frame: u32, scene: &mut HostSc
     Ok(Loaded { imagefile, frames })
 }
 
+/// The most host-sim reads of a scene file: five times the fifty megabytes
+/// of comment the hostile-input tests parse in a second or two. A device
+/// read as a scene (`/dev/zero`) ends there, not when memory does.
+pub const MAX_SCENE_FILE_BYTES: usize = 256 << 20;
+
+/// The bytes of the scene file at `path`, refused past
+/// [`MAX_SCENE_FILE_BYTES`].
+pub fn read_scene_file(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?.take(MAX_SCENE_FILE_BYTES as u64 + 1).read_to_end(&mut bytes)?;
+    if bytes.len() > MAX_SCENE_FILE_BYTES {
+        return Err(std::io::Error::other(format!(
+            "it is larger than {} MiB, the most host-sim reads as a scene",
+            MAX_SCENE_FILE_BYTES >> 20
+        )));
+    }
+    Ok(bytes)
+}
+
 /// Reads and parses the scene file at `path`.
 pub fn load_file(path: &Path, scene: &mut HostScene) -> Result<Loaded, LoadError> {
-    let bytes = std::fs::read(path).map_err(LoadError::Io)?;
+    let bytes = read_scene_file(path).map_err(LoadError::Io)?;
     load_bytes(&ShownPath(path).to_string(), &bytes, scene)
 }

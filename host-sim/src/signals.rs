@@ -8,11 +8,16 @@
 //! Invariant: the handlers are installed once per process, when the flag
 //! is first asked for; from then on the first of these signals never ends
 //! the process mid-write. A second one does, at once, with the same exit
-//! code: what a user whose first was not heard (a blocked write) asks.
+//! code (what a user whose first was not heard, a blocked write, asks),
+//! having removed the temporary files being written ([`Unfinished`]): no
+//! partial file is left however many signals come. The same signal sent
+//! twice at once (`timeout` signals host-sim, then its process group)
+//! counts once.
 
 use std::fmt;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{Arc, OnceLock};
+use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 
 /// A signal that stops a run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -74,20 +79,83 @@ fn flags() -> &'static Flags {
     FLAGS.get_or_init(|| {
         let flags = Flags { stop: Arc::new(AtomicBool::new(false)), which: Arc::new(AtomicUsize::new(0)) };
         for &signal in StopSignal::HANDLED {
-            // A second signal, once the first has set the flag, ends the
-            // process at once (a write blocked on a pipe no one reads, say,
-            // which a handler returns into); registered first, so that the
-            // first signal finds the flag still clear. Then which one, so
-            // that a run that sees the flag finds it. A signal that cannot
-            // be handled here keeps its default action.
+            // Which one first, so that a run that sees the flag finds it. A
+            // signal that cannot be handled here keeps its default action.
             let number = signal.number();
-            let _ =
-                signal_hook::flag::register_conditional_shutdown(number, signal.exit_code(), Arc::clone(&flags.stop));
             let _ = signal_hook::flag::register_usize(number, Arc::clone(&flags.which), number as usize);
             let _ = signal_hook::flag::register(number, Arc::clone(&flags.stop));
         }
+        end_at_a_second_signal(&flags.stop);
         flags
     })
+}
+
+/// A second stop signal ends the process at once (a write blocked on a pipe
+/// no one reads, say, which a handler returns into), its unfinished files
+/// removed first: a thread the signals wake, out of the handlers' narrow
+/// rules. Signals not yet taken when it wakes count once.
+#[cfg(unix)]
+fn end_at_a_second_signal(_stop: &Arc<AtomicBool>) {
+    let numbers: Vec<i32> = StopSignal::HANDLED.iter().map(|s| s.number()).collect();
+    let Ok(mut signals) = signal_hook::iterator::Signals::new(&numbers) else { return };
+    let _ = std::thread::Builder::new().name("second-signal".into()).spawn(move || {
+        let mut taken = 0;
+        for number in signals.wait() {
+            taken += 1;
+            if taken < 2 {
+                continue;
+            }
+            let signal = StopSignal::HANDLED.iter().copied().find(|s| s.number() == number);
+            let signal = signal.unwrap_or(StopSignal::Interrupt);
+            // Held to the end: no unfinished file is renamed into place now.
+            let unfinished = unfinished_files();
+            for path in unfinished.iter() {
+                let _ = std::fs::remove_file(path);
+            }
+            eprintln!("host-sim: stopped ({signal}) by a second signal; nothing more written");
+            std::process::exit(signal.exit_code());
+        }
+    });
+}
+
+/// Without a thread to wake (no signal iterator here), the second signal
+/// ends the process from its handler.
+#[cfg(not(unix))]
+fn end_at_a_second_signal(stop: &Arc<AtomicBool>) {
+    for &signal in StopSignal::HANDLED {
+        let _ = signal_hook::flag::register_conditional_shutdown(signal.number(), signal.exit_code(), Arc::clone(stop));
+    }
+}
+
+/// The temporary files being written now.
+static UNFINISHED: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn unfinished_files() -> MutexGuard<'static, Vec<PathBuf>> {
+    UNFINISHED.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// A temporary file being written, which a second stop signal removes
+/// before it ends the process; no longer listed once dropped.
+pub(crate) struct Unfinished(PathBuf);
+
+impl Unfinished {
+    pub(crate) fn new(path: &Path) -> Unfinished {
+        unfinished_files().push(path.to_owned());
+        Unfinished(path.to_owned())
+    }
+
+    /// Runs `finish`, the step that puts the file in its place, where a
+    /// second stop signal cannot remove it midway.
+    pub(crate) fn finish<T>(&self, finish: impl FnOnce() -> T) -> T {
+        let _listed = unfinished_files();
+        finish()
+    }
+}
+
+impl Drop for Unfinished {
+    fn drop(&mut self) {
+        unfinished_files().retain(|path| *path != self.0);
+    }
 }
 
 /// Whether a stop signal has arrived, without installing the handlers (a

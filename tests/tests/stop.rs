@@ -47,6 +47,14 @@ fn sigterm_and_sighup_end_a_render_inside_a_pixel_and_leave_no_file() {
 }
 
 #[test]
+fn a_second_stop_signal_ends_host_sim_at_once_and_leaves_no_file_either() {
+    // Two signals delivered together, SIGTERM then SIGHUP: host-sim stopped
+    // (SIGSTOP) while both are sent, then let go. The second ends it at
+    // once, inside its pixel, whatever the first has done by then.
+    signals_end(Stop::TERM, Some(Stop::HUP), &minutes_a_pixel(), "wedge.png", &["--part", "1/1"]);
+}
+
+#[test]
 fn sigterm_ends_the_wait_for_a_fifos_reader() {
     use std::io::BufRead;
     use std::os::unix::fs::FileTypeExt;
@@ -105,12 +113,23 @@ fn ctrl_c_ends(scene_text: &str, out: &str, args: &[&str]) {
     signal_ends(Stop::INT, scene_text, out, args);
 }
 
+fn signal_ends(signal: Stop, scene_text: &str, out: &str, args: &[&str]) {
+    signals_end(signal, None, scene_text, out, args);
+}
+
+/// Sends `signal` to process `pid`.
+fn send(signal: &str, pid: u32) {
+    assert!(Command::new("kill").args([signal, &pid.to_string()]).status().unwrap().success(), "kill {signal}");
+}
+
 /// Renders `scene` to `out` (with `args`, in the naive mode) and sends
 /// `signal` once its temporary file is there (its handler is installed
-/// before) and, most likely, it is inside its first pixels: it must end
-/// with the signal's exit code before any pixel could end, saying nothing
-/// was written, and leave no file.
-fn signal_ends(signal: Stop, scene_text: &str, out: &str, args: &[&str]) {
+/// before) and, most likely, it is inside its first pixels, with `second`
+/// delivered together with it if given: it must end with the exit code of
+/// one of them before
+/// any pixel could end, saying it stopped (nothing written, for one
+/// signal), and leave no file.
+fn signals_end(signal: Stop, second: Option<Stop>, scene_text: &str, out: &str, args: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("wedge.txt");
     std::fs::write(&scene, scene_text).unwrap();
@@ -135,8 +154,15 @@ fn signal_ends(signal: Stop, scene_text: &str, out: &str, args: &[&str]) {
     std::thread::sleep(Duration::from_millis(300));
     assert!(child.try_wait().unwrap().is_none(), "still rendering");
     let sent = Instant::now();
-    let kill = Command::new("kill").args([signal.kill, &child.id().to_string()]).status().unwrap();
-    assert!(kill.success());
+    match &second {
+        None => send(signal.kill, child.id()),
+        Some(second) => {
+            send("-STOP", child.id());
+            send(signal.kill, child.id());
+            send(second.kill, child.id());
+            send("-CONT", child.id());
+        }
+    }
     let status = loop {
         if let Some(status) = child.try_wait().unwrap() {
             break status;
@@ -150,7 +176,20 @@ fn signal_ends(signal: Stop, scene_text: &str, out: &str, args: &[&str]) {
     };
     let mut stderr = String::new();
     std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
-    assert_eq!(status.code(), Some(signal.exit_code), "{status:?}: {stderr}");
-    assert!(stderr.contains(&format!("host-sim: stopped ({}); nothing written", signal.said)), "{stderr}");
+    let said = match &second {
+        None => {
+            assert_eq!(status.code(), Some(signal.exit_code), "{status:?}: {stderr}");
+            format!("host-sim: stopped ({}); nothing written", signal.said)
+        }
+        Some(second) => {
+            let (code, said) = match status.code() == Some(signal.exit_code) {
+                true => (signal.exit_code, signal.said),
+                false => (second.exit_code, second.said),
+            };
+            assert_eq!(status.code(), Some(code), "{status:?}: {stderr}");
+            format!("host-sim: stopped ({said})")
+        }
+    };
+    assert!(stderr.contains(&said), "{stderr}");
     assert_eq!(entries(), ["wedge.txt"], "{}: no image and no temporary file left", out.display());
 }

@@ -162,7 +162,7 @@ pub fn run(args: &BoardArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> 
     // OUT's format, known before the board is asked.
     out.map(|out| output_format(args.format, out)).transpose()?;
     out.map(|out| not_the_scene(scene, out)).transpose()?;
-    let text = std::fs::read(scene).map_err(|e| CliError::read(scene, e))?;
+    let text = crate::scene::read_scene_file(scene).map_err(|e| CliError::read(scene, e))?;
     // Before the board draws: a picture it sent could not be kept.
     out.map(|out| crate::output::check_writable(out).map_err(|e| CliError::write(out, e))).transpose()?;
     let file = ShownPath(scene).to_string();

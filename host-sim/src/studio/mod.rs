@@ -492,7 +492,7 @@ fn version(bytes: Option<&[u8]>) -> String {
 }
 
 fn read_scene(path: &Path) -> std::io::Result<Option<Vec<u8>>> {
-    match std::fs::read(path) {
+    match crate::scene::read_scene_file(path) {
         Ok(bytes) => Ok(Some(bytes)),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
         Err(e) => Err(e),

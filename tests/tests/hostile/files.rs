@@ -214,11 +214,16 @@ fn row18_output_to_an_unwritable_path() {
     assert!(!listing(Path::new("/proc")).iter().any(|n| n.contains("octrace-hostile")));
 }
 
-/// Row 18c: a scene path that does not exist, or is a directory: exit 1.
+/// Row 18c: a scene path that does not exist, is a directory, or a device
+/// without end (read up to host-sim's limit, not until memory runs out):
+/// exit 1.
 #[test]
 fn row18_scene_that_cannot_be_read() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("o.png");
+    let (code, err) = host_sim(&["/dev/zero".as_ref(), out.as_os_str()]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("host-sim: cannot read /dev/zero: it is larger than 256 MiB"), "{err}");
     for scene in [dir.path().join("nope.txt"), dir.path().to_path_buf()] {
         let (code, err) = host_sim(&[scene.as_os_str(), out.as_os_str()]);
         assert_eq!(code, 1, "{err}");
