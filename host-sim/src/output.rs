@@ -433,10 +433,12 @@ enum Destination {
 }
 
 fn destination(path: &Path) -> std::io::Result<Destination> {
-    let path = through_links(path);
-    if is_stream(&path) {
-        return Ok(Destination::Stream(path));
+    // Asked of the path as given, which open(2) follows: a stream's links
+    // may end where no path does (`/dev/stdout` on a pipe: `pipe:[N]`).
+    if is_stream(path) {
+        return Ok(Destination::Stream(path.to_path_buf()));
     }
+    let path = through_links(path);
     // Refused before anything is written (the rename would refuse it last).
     if path.is_dir() {
         #[cfg(unix)]

@@ -282,6 +282,18 @@ fn row18_output_to_a_pipe_is_written_into() {
     assert_eq!(octrace_images::formats::read(&png).unwrap().to_rgb().width, 4, "a PNG came through the pipe");
     assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo(), "still a pipe");
     assert_eq!(listing(dir.path()), ["o.png", "s.txt"]);
+    // `/dev/stdout` when standard output is a pipe: its links end in
+    // `pipe:[N]`, which names no path, and open(2) follows them.
+    for out in ["/dev/stdout", "/proc/self/fd/1"] {
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_host-sim-cli"))
+            .arg(&scene)
+            .args([out, "-q"])
+            .stdout(std::process::Stdio::piped())
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "{out}: {}", String::from_utf8_lossy(&run.stderr));
+        assert_eq!(octrace_images::formats::read(&run.stdout).unwrap().to_rgb().width, 4, "{out}: a PNG on the pipe");
+    }
 }
 
 /// Row 18e, too: OUT a symbolic link is written through, as a shell's `>`
