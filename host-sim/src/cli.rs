@@ -404,6 +404,16 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
         file: name.clone(),
         errors: vec![format!("{name}:{}:{}: IMAGEFILE {message}", pos.line, pos.column)],
     };
+    let still = loaded.frames.is_none() || args.frame.is_some();
+    if let (Some(_), None, true) = (args.part, &args.out, still) {
+        // Every band would take the IMAGEFILE's name, each over the one
+        // before.
+        return Err(CliError::Invalid(
+            "--part writes one band of the image: give each part an OUT of its own (part-1.png, part-2.png, …), \
+             then `host-sim merge OUT part-*.png`"
+                .into(),
+        ));
+    }
     let out = match (&args.out, &loaded.imagefile) {
         (Some(o), _) => o.clone(),
         // Longer than a path can be (Linux's PATH_MAX): refused without

@@ -439,8 +439,9 @@ fn destination(path: &Path) -> std::io::Result<Destination> {
         return Ok(Destination::Stream(path.to_path_buf()));
     }
     let path = through_links(path);
-    // Refused before anything is written (the rename would refuse it last).
-    if path.is_dir() {
+    // Refused before anything is written (the rename would refuse it last),
+    // as is `DIR/` where there is no DIR (the rename: "Not a directory").
+    if path.is_dir() || path.as_os_str().as_encoded_bytes().ends_with(b"/") {
         #[cfg(unix)]
         return Err(std::io::Error::from_raw_os_error(libc::EISDIR));
         #[cfg(not(unix))]

@@ -351,6 +351,11 @@ fn part_refuses_what_cannot_be_split() {
         assert!(err.contains(message), "{extra:?}: expected `{message}` in: {err}");
         assert!(files(dir.path()).is_empty(), "{extra:?}: {:?}", files(dir.path()));
     }
+    // Without OUT every band would take the scene's IMAGEFILE, each over
+    // the last.
+    let (code, err) = host_sim(&[path.as_os_str(), "--part".as_ref(), "1/2".as_ref()], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--part writes one band of the image: give each part an OUT of its own"), "{err}");
 }
 
 #[test]

@@ -155,8 +155,8 @@ pub fn animate(request: &Request<'_>, stderr: &mut dyn Write) -> Result<(), CliE
                 Err(contradiction) if request.format.is_some() => return Err(contradiction),
                 _ => {
                     return Err(CliError::Invalid(format!(
-                        "cannot write {}: frame files are PNG or Targa, one file a frame (a Sun raster has no room \
-                         for the frame's metadata; a GIF or an APNG of the whole loop is one file: OUT.gif, OUT.png)",
+                        "{}: frame files are PNG or Targa, one file a frame (a Sun raster has no room for the \
+                         frame's metadata; a GIF or an APNG of the whole loop is one file: OUT.gif, OUT.png)",
                         ShownPath(&pattern.name(0))
                     )))
                 }

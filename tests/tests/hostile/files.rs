@@ -151,6 +151,13 @@ fn row18_output_to_a_missing_directory() {
     assert!(sub.is_dir());
     assert_eq!(listing(dir.path()), ["s.txt", "sub"]);
     assert!(listing(&sub).is_empty());
+    // `DIR/` where there is no DIR names a directory too (the rename said
+    // "Not a directory").
+    let slashed = format!("{}/nodir/", dir.path().display());
+    let (code, err) = host_sim(&[scene.as_os_str(), slashed.as_ref()]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains(&format!("cannot write {slashed}: Is a directory")), "{err}");
+    assert_eq!(listing(dir.path()), ["s.txt", "sub"]);
 }
 
 /// Whether this process can create files in a directory without write
