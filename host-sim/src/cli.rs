@@ -479,15 +479,18 @@ fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     let raster = scene.view().settings.raster;
     let (w, h) = args.size.unwrap_or((raster[0], raster[1]));
     if let (Some(frames), None) = (loaded.frames, args.frame) {
-        if args.color != PanelColor::Rgb888 {
-            return Err(CliError::Invalid("--color previews one panel: give --frame K".into()));
-        }
+        // `--color dither` is `--palette dither`, for a loop as for a still.
+        let palette = match args.color {
+            PanelColor::Rgb888 => args.palette,
+            PanelColor::Dither => Some(PaletteMode::Dither),
+            _ => return Err(CliError::Invalid("--color previews one panel: give --frame K".into())),
+        };
         let request = Request {
             scene_path,
             bytes: &scene_bytes,
             frames,
             out: &out,
-            palette: args.palette,
+            palette,
             format: args.format,
             part: args.part,
             size: (w, h),

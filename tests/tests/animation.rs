@@ -367,6 +367,9 @@ fn frames_rendered_apart_merge_into_the_same_gif() {
     let (code, err) = host_sim(d, &args);
     assert_eq!(code, 0, "{err}");
     assert_eq!(std::fs::read(d.join("merged.gif")).unwrap(), std::fs::read(d.join("whole.gif")).unwrap());
+    // `--color dither` is `--palette dither`, for a loop as for a still.
+    assert_eq!(host_sim(d, &["anim.txt", "color.gif", "--color", "dither", "-q"]).0, 0);
+    assert_eq!(std::fs::read(d.join("color.gif")).unwrap(), std::fs::read(d.join("whole.gif")).unwrap());
     // Truecolour frames, merged into a GIF whose colours are chosen for
     // the whole loop: the direct render's file (which knew the tiles each
     // frame re-traced; merge compares the frames).
