@@ -354,7 +354,7 @@ fn preview(
 
 fn execute(args: &Args, stderr: &mut dyn Write) -> Result<(), CliError> {
     match &args.command {
-        Some(Command::Convert { input, output, format }) => return convert::run(input, output, *format),
+        Some(Command::Convert { input, output, format }) => return convert::run(input, output, *format, stderr),
         Some(Command::Merge { output, parts, format }) => return merge::run(output, parts, *format, stderr),
         // run() serves the studio and talks to boards (both need stdout)
         // instead of calling this.

@@ -175,6 +175,24 @@ fn merged_parts_are_one_render_byte_for_byte() {
 }
 
 #[test]
+fn a_part_converted_between_png_and_targa_still_merges() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = scene_path("fig5_1");
+    let parts = render_parts(dir.path(), &path, &["1/2", "2/2"], "png", &[]);
+    let (whole, merged) = (dir.path().join("whole.png"), dir.path().join("merged.png"));
+    ok(&[path.as_os_str(), whole.as_os_str(), "--size".as_ref(), "40x30".as_ref(), "-q".as_ref()]);
+    let converted = dir.path().join("second.tga");
+    ok(&["convert".as_ref(), parts[1].as_os_str(), converted.as_os_str()]);
+    ok(&["merge".as_ref(), merged.as_os_str(), parts[0].as_os_str(), converted.as_os_str()]);
+    assert_eq!(std::fs::read(&merged).unwrap(), std::fs::read(&whole).unwrap());
+    // A Sun raster has no room for the part's metadata: said.
+    let raster = dir.path().join("second.ras");
+    let (code, err) = host_sim(&["convert".as_ref(), parts[1].as_os_str(), raster.as_os_str()], &[]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("which a Sun raster cannot"), "{err}");
+}
+
+#[test]
 fn a_part_replaced_after_its_check_is_refused_not_merged() {
     let dir = tempfile::tempdir().unwrap();
     let parts = render_parts(dir.path(), &scene_path("fig5_1"), &["1/2", "2/2"], "png", &[]);

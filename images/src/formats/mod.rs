@@ -36,12 +36,23 @@ use std::io::Write;
 
 /// Writes `image` to `out` as a `format` file.
 pub fn write(image: &Image, format: Format, out: &mut dyn Write) -> Result<(), FormatError> {
+    write_with_text(image, None, format, out)
+}
+
+/// [`write`], the file carrying `text` as [`Header::text`] says (a Sun
+/// raster cannot: an error).
+pub fn write_with_text(
+    image: &Image,
+    text: Option<String>,
+    format: Format,
+    out: &mut dyn Write,
+) -> Result<(), FormatError> {
     check(image)?;
     let (palette, data) = match image {
         Image::Rgb(rgb) => (None, &rgb.data),
         Image::Indexed { palette, indices, .. } => (Some(palette.clone()), indices),
     };
-    let header = Header { width: image.width(), height: image.height(), palette, text: None };
+    let header = Header { width: image.width(), height: image.height(), palette, text };
     let row_bytes = header.width as usize * header.bytes_per_pixel();
     let mut writer = RowWriter::new(format, &header, out)?;
     for row in data.chunks_exact(row_bytes) {
