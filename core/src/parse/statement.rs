@@ -609,10 +609,6 @@ fn check_quadrilateral(c: &[WorldPoint; 4]) -> Result<(), ErrorKind<'static>> {
     if largest == 0 {
         return Err(ErrorKind::Degenerate { keyword: Keyword::Rectangle.name(), why: "its corners coincide" });
     }
-    let reduced = |e: [i128; 3], largest: u128| {
-        let shift = (128 - largest.leading_zeros()).saturating_sub(24);
-        e.map(|x| x >> shift)
-    };
     // Each edge at its own scale for the turns: a short side of a long thin
     // rectangle, cut to nothing at the longest edge's scale, still turns
     // the way it does (a positive factor an edge keeps each turn's way).
@@ -624,19 +620,32 @@ fn check_quadrilateral(c: &[WorldPoint; 4]) -> Result<(), ErrorKind<'static>> {
     check_reduced_edges(&v, &own)
 }
 
+/// `e` cut to 24 significant bits of `largest`. Not inlined, as
+/// [`corner_turns`]: 128-bit steps are long code on a 32-bit core.
+#[inline(never)]
+fn reduced(e: [i128; 3], largest: u128) -> [i128; 3] {
+    let shift = (128 - largest.leading_zeros()).saturating_sub(24);
+    e.map(|x| x >> shift)
+}
+
+/// The turn at each corner of the quadrilateral of edges `v`.
+#[inline(never)]
+fn corner_turns(v: &[[i128; 3]; 4]) -> [[i128; 3]; 4] {
+    core::array::from_fn(|i| cross(v[i], v[(i + 1) % 4]))
+}
+
 /// [`check_quadrilateral`]'s tests on its edges reduced to 24 bits: `v` at
 /// the longest edge's scale, `own` each at its own.
 fn check_reduced_edges(v: &[[i128; 3]; 4], own: &[[i128; 3]; 4]) -> Result<(), ErrorKind<'static>> {
     // The turn at each corner; for a strictly convex quadrilateral all four
     // point the same way (counter-clockwise: along the front normal).
-    let turns = |v: &[[i128; 3]; 4]| -> [[i128; 3]; 4] { core::array::from_fn(|i| cross(v[i], v[(i + 1) % 4])) };
-    if turns(v) == [[0; 3]; 4] {
+    if corner_turns(v) == [[0; 3]; 4] {
         return Err(ErrorKind::Degenerate {
             keyword: Keyword::Rectangle.name(),
             why: "its corners are collinear (zero area)",
         });
     }
-    let turns = turns(own);
+    let turns = corner_turns(own);
     let reference = turns.iter().copied().max_by_key(|c| dot(*c, *c)).unwrap_or([0; 3]);
     if turns.iter().any(|c| dot(*c, reference) <= 0) {
         return Err(ErrorKind::NotConvex);
