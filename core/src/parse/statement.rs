@@ -628,10 +628,18 @@ fn reduced(e: [i128; 3], largest: u128) -> [i128; 3] {
     e.map(|x| x >> shift)
 }
 
-/// The turn at each corner of the quadrilateral of edges `v`.
+/// The cross product of two vectors of components below 2^26 in
+/// magnitude (sums of two `reduced` edges at most), its products made in 64
+/// bits: 128-bit products are long code on a 32-bit core.
 #[inline(never)]
+fn cross_reduced(a: [i128; 3], b: [i128; 3]) -> [i128; 3] {
+    let (a, b) = (a.map(|x| x as i64), b.map(|x| x as i64));
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]].map(i128::from)
+}
+
+/// The turn at each corner of the quadrilateral of `reduced` edges.
 fn corner_turns(v: &[[i128; 3]; 4]) -> [[i128; 3]; 4] {
-    core::array::from_fn(|i| cross(v[i], v[(i + 1) % 4]))
+    core::array::from_fn(|i| cross_reduced(v[i], v[(i + 1) % 4]))
 }
 
 /// [`check_quadrilateral`]'s tests on its edges reduced to 24 bits: `v` at
@@ -654,7 +662,7 @@ fn check_reduced_edges(v: &[[i128; 3]; 4], own: &[[i128; 3]; 4]) -> Result<(), E
     // against the longest edge L: |(p4 − p1)·n| / |n| ≤ 2^-10 · L.
     let d1 = [0, 1, 2].map(|a| v[0][a] + v[1][a]); // p3 − p1
     let d2 = [0, 1, 2].map(|a| v[1][a] + v[2][a]); // p4 − p2
-    let n = cross(d1, d2);
+    let n = cross_reduced(d1, d2);
     let to4 = [0, 1, 2].map(|a| -v[3][a]); // p4 − p1 = −(p1 − p4)
     let off = dot(to4, n).unsigned_abs();
     // A corner exactly in the plane (every rectangle along the axes) needs
