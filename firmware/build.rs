@@ -134,9 +134,13 @@ fn main() {
     } else {
         (given.clone(), manifest.join("../scenes").join(format!("{given}.txt")))
     };
-    let Ok(text) = std::fs::read_to_string(&scene_path) else {
-        fail(format!("OCTRACE_SCENE={given}: no file {}", scene_path.display()))
-    };
+    let bytes = std::fs::read(&scene_path)
+        .unwrap_or_else(|e| fail(format!("OCTRACE_SCENE={given}: {}: {e}", scene_path.display())));
+    // A scene's other errors the board reports; this one, include_str!
+    // could not embed.
+    let text = octrace_core::parse::scene_text(&bytes)
+        .map(str::to_owned)
+        .unwrap_or_else(|e| fail(format!("{}:{e}", scene_path.display())));
     println!("cargo:rerun-if-changed={}", scene_path.display());
     let size = var("OCTRACE_SIZE", if oled { "128x64" } else { "160x128" });
     let (w, h) = size

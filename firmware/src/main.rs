@@ -129,6 +129,8 @@ fn run(raytracer: &'static mut Raytracer<Profile>) -> u32 {
         hprintln!("the display refused the pixels");
         return 3;
     }
+    #[cfg(not(board = "lm3s6965evb"))]
+    say_where_the_pixels_went();
     // Both cores' renderers count their own (printed by `draw_into`).
     #[cfg(not(board = "mps2-an521"))]
     {
@@ -161,6 +163,21 @@ fn load(raytracer: &'static mut Raytracer<Profile>) -> Option<LoadedScene<'stati
             None
         }
     }
+}
+
+/// Where the pixels went: a host file of rows without a header. Out of
+/// line, so that its arguments do not widen `run`'s frame, under which the
+/// drawing runs.
+#[cfg(not(board = "lm3s6965evb"))]
+#[inline(never)]
+fn say_where_the_pixels_went() {
+    hprintln!(
+        "pixels ({}x{}, {}, rows top to bottom, no header) -> {}",
+        config::WIDTH,
+        config::HEIGHT,
+        config::WIRE.name(),
+        config::OUTPUT.trim_end_matches('\0')
+    );
 }
 
 // The display: a host file on the boards without one (the pixels streamed

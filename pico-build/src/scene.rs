@@ -102,12 +102,16 @@ fn read_scene() -> Result<(String, PathBuf, String), BuildError> {
     let scene = given.as_deref().unwrap_or(DEFAULT_SCENE).to_owned();
     let path = manifest.join(&scene);
     println!("cargo:rerun-if-changed={}", path.display());
-    let text = std::fs::read_to_string(&path).map_err(|error| BuildError::File {
+    let bytes = std::fs::read(&path).map_err(|error| BuildError::File {
         path: match given {
-            Some(_) => format!("{VARIABLE}={scene}"),
+            Some(_) => format!("{VARIABLE}={scene} (a path from {})", manifest.display()),
             None => format!("the default scene {scene} ({VARIABLE} is not set)"),
         },
         error,
+    })?;
+    let text = octrace_core::parse::scene_text(&bytes).map(str::to_owned).map_err(|error| {
+        eprintln!("{scene}:{error}");
+        BuildError::Scene { scene: scene.clone(), errors: 1 }
     })?;
     Ok((scene, path, text))
 }

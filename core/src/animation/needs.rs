@@ -96,6 +96,15 @@ impl AnimationCapacity {
             AnimationCapacity::Keys => "keys",
         }
     }
+
+    /// What a scene has of it, in the format's words, for messages.
+    pub const fn what(self) -> &'static str {
+        match self {
+            AnimationCapacity::Tiles => "tiles of the image (a byte each)",
+            AnimationCapacity::Tracks => "moving statements (one a MOVE)",
+            AnimationCapacity::Keys => "MOVE keys",
+        }
+    }
 }
 
 /// A capacity of an animation's room that a scene needs more of.
@@ -113,7 +122,13 @@ pub struct NoRoom {
 impl fmt::Display for NoRoom {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let NoRoom { what, needed, holds } = self;
-        write!(f, "too many {} to play this animation: the room holds {holds} and it needs {needed}", what.name())
+        write!(
+            f,
+            "too many {} to play this animation: this build's room for it ({}) holds {holds} and the scene needs \
+             {needed}",
+            what.what(),
+            what.name()
+        )
     }
 }
 

@@ -101,16 +101,33 @@ pub(crate) fn parse_recording<'a, C: SceneCapacities>(
     on_error: &mut dyn FnMut(ParseError<'a>),
     motion: Option<&mut dyn MotionSink>,
 ) -> Result<Parsed<'a>, usize> {
-    match core::str::from_utf8(bytes) {
+    match scene_text(bytes) {
         Ok(text) => parse_in(text, scene, frame, on_error, motion),
         Err(e) => {
-            // The valid prefix is UTF-8; its lines end as the lexer's do.
-            let good = core::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or_default();
             scene.clear();
-            on_error(ParseError::new(lexer::Lexer::end_of(good), ErrorKind::InvalidUtf8));
+            on_error(e);
             Err(1)
         }
     }
+}
+
+/// `bytes` as a scene's text, or the error at its first byte that is not
+/// UTF-8 (the format is UTF-8 throughout, comments too): what a build
+/// script that embeds a scene file reports.
+///
+/// ```
+/// use octrace_core::parse::scene_text;
+///
+/// assert_eq!(scene_text(b"RDEPTH 2\n"), Ok("RDEPTH 2\n"));
+/// let error = scene_text(b"RDEPTH 2\n// caf\xe9\n").unwrap_err();
+/// assert_eq!(error.to_string(), "2:7: the file is not valid UTF-8 (invalid byte here)");
+/// ```
+pub fn scene_text(bytes: &[u8]) -> Result<&str, ParseError<'static>> {
+    core::str::from_utf8(bytes).map_err(|e| {
+        // The valid prefix is UTF-8; its lines end as the lexer's do.
+        let good = core::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or_default();
+        ParseError::new(lexer::Lexer::end_of(good), ErrorKind::InvalidUtf8)
+    })
 }
 
 /// Parses `text` into `scene` (cleared first). Every error goes to

@@ -302,7 +302,10 @@ mod tests {
         let mut animation = room.animation(Size::new(8, 8)).unwrap();
         let Err(AnimationError::NoRoom(short)) = animation.load(&mut raytracer, text, 0) else { panic!("room") };
         assert_eq!(short, NoRoom { what: AnimationCapacity::Keys, needed: 5, holds: 4 });
-        assert_eq!(short.to_string(), "too many keys to play this animation: the room holds 4 and it needs 5");
+        assert_eq!(
+            short.to_string(),
+            "too many MOVE keys to play this animation: this build's room for it (keys) holds 4 and the scene needs 5"
+        );
         let mut room = AnimationRoom::<3, 2, 5>::new();
         let e = room.animation(Size::new(8, 8)).unwrap_err();
         assert_eq!(e, NoRoom { what: AnimationCapacity::Tiles, needed: 4, holds: 3 });
