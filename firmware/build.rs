@@ -285,6 +285,7 @@ fn main() {
     if !oled {
         // The guest writes this file; on the OLED board the runner does.
         writeln!(config, "pub const OUTPUT: &str = {:?};", format!("{output}\0")).unwrap();
+        writeln!(config, "pub const OUTPUT_NAME: &str = {output:?};").unwrap();
     }
     // A light buffer in flash serves every light (and takes no RAM).
     let light_buffer = if techniques.light_buffer_in_flash { light_buffer_in_flash(&text) } else { Vec::new() };

@@ -176,7 +176,7 @@ fn say_where_the_pixels_went() {
         config::WIDTH,
         config::HEIGHT,
         config::WIRE.name(),
-        config::OUTPUT.trim_end_matches('\0')
+        config::OUTPUT_NAME
     );
 }
 

@@ -93,14 +93,14 @@ fn flags() -> &'static Flags {
 /// A second stop signal ends the process at once (a write blocked on a pipe
 /// no one reads, say, which a handler returns into), its unfinished files
 /// removed first: a thread the signals wake, out of the handlers' narrow
-/// rules. Signals not yet taken when it wakes count once.
+/// rules. The same signal sent again before it wakes counts once.
 #[cfg(unix)]
 fn end_at_a_second_signal(_stop: &Arc<AtomicBool>) {
     let numbers: Vec<i32> = StopSignal::HANDLED.iter().map(|s| s.number()).collect();
     let Ok(mut signals) = signal_hook::iterator::Signals::new(&numbers) else { return };
     let _ = std::thread::Builder::new().name("second-signal".into()).spawn(move || {
         let mut taken = 0;
-        for number in signals.wait() {
+        for number in signals.forever() {
             taken += 1;
             if taken < 2 {
                 continue;

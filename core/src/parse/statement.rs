@@ -338,6 +338,7 @@ impl<'a> Cursor<'a> {
     /// length varies: a rate, a key).
     /// The lexer's error there (an unterminated comment or string) is the
     /// statement's: dropped, it would end the text without a word.
+    #[inline(never)]
     fn number_follows(&mut self) -> Result<bool, ParseError<'a>> {
         Ok(matches!(self.peek()?, Some(t) if !t.quoted && Decimal::parse(t.text).is_some()))
     }
