@@ -1055,7 +1055,8 @@ mod tests {
             if let Some(Ok(Frame { message: Message::SceneError(e), .. })) = decoder.push(byte) {
                 let need = e.capacity.unwrap();
                 named.push((need.name.to_string(), need.needed, need.holds));
-                assert!(e.message.starts_with(&std::format!("too many {}", need.name)), "{}", e.message);
+                let names = std::format!("room for it ({})", need.name);
+                assert!(e.message.starts_with("too many ") && e.message.contains(&names), "{}", e.message);
             }
         }
         let holds = |name: &str, needed| (name.to_string(), Some(needed), 0);
