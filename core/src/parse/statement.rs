@@ -621,8 +621,8 @@ fn check_quadrilateral(c: &[WorldPoint; 4]) -> Result<(), ErrorKind<'static>> {
     check_reduced_edges(&v, &own)
 }
 
-/// `e` cut to 24 significant bits of `largest`. Not inlined, as
-/// [`corner_turns`]: 128-bit steps are long code on a 32-bit core.
+/// `e` cut to 24 significant bits of `largest`. Not inlined: 128-bit steps
+/// are long code on a 32-bit core.
 #[inline(never)]
 fn reduced(e: [i128; 3], largest: u128) -> [i128; 3] {
     let shift = (128 - largest.leading_zeros()).saturating_sub(24);
