@@ -39,7 +39,7 @@ pub fn write(image: &Image, format: Format, out: &mut dyn Write) -> Result<(), F
     write_with_text(image, None, format, out)
 }
 
-/// [`write`], the file carrying `text` as [`Header::text`] says (a Sun
+/// [`write()`], the file carrying `text` as [`Header::text`] says (a Sun
 /// raster cannot: an error).
 pub fn write_with_text(
     image: &Image,
