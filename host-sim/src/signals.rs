@@ -51,6 +51,12 @@ impl StopSignal {
         }
     }
 
+    /// The handled signal of number `number` (Ctrl-C for any other: the
+    /// stop flag set another way).
+    fn of_number(number: usize) -> StopSignal {
+        StopSignal::HANDLED.iter().copied().find(|s| s.number() as usize == number).unwrap_or(StopSignal::Interrupt)
+    }
+
     /// The exit code of a run it stopped: 128 + its number (130 for Ctrl-C).
     pub fn exit_code(self) -> i32 {
         128 + self.number()
@@ -105,8 +111,7 @@ fn end_at_a_second_signal(_stop: &Arc<AtomicBool>) {
             if taken < 2 {
                 continue;
             }
-            let signal = StopSignal::HANDLED.iter().copied().find(|s| s.number() == number);
-            let signal = signal.unwrap_or(StopSignal::Interrupt);
+            let signal = StopSignal::of_number(number as usize);
             // Held to the end: no unfinished file is renamed into place now.
             let unfinished = unfinished_files();
             for path in unfinished.iter() {
@@ -173,8 +178,7 @@ pub(crate) fn stop_flag() -> &'static AtomicBool {
 /// The signal that stopped the run (Ctrl-C when the flag was set another
 /// way).
 pub(crate) fn arrived() -> StopSignal {
-    let number = flags().which.load(Ordering::SeqCst);
-    StopSignal::HANDLED.iter().copied().find(|s| s.number() as usize == number).unwrap_or(StopSignal::Interrupt)
+    StopSignal::of_number(flags().which.load(Ordering::SeqCst))
 }
 
 #[cfg(test)]
