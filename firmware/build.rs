@@ -236,6 +236,7 @@ fn main() {
             octree: Some(&config),
             named_walk,
             first_hits: techniques.first_hits,
+            mirror_hits: false,
             coherence: false,
             motion,
         };
@@ -301,6 +302,7 @@ fn main() {
         octree: Some(&octree),
         named_walk,
         first_hits: techniques.first_hits,
+        mirror_hits: false,
         coherence: false,
         motion,
     };

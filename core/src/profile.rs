@@ -94,7 +94,9 @@ pub trait Profile: SceneCapacities + Linked {
 /// [`ScreenBound`] (16 bytes) an object and [`ScreenBound::positions_for`]
 /// them (2 bytes each) of RAM, used in every mode but
 /// [`AccelMode::Naive`](crate::AccelMode::Naive) asked for by name, which
-/// stays the thesis's test of every object); a last `coherence: true` lets
+/// stays the thesis's test of every object); a last `mirror_hits: true`
+/// after it gives the reflections of camera rays off a floor the same, for
+/// as much RAM again (see [`Linked::MIRROR_HITS`]); a last `coherence: true` lets
 /// an animation re-trace only what changes (see [`Linked::COHERENCE`]:
 /// without it none of that code is linked, and a board that draws stills
 /// pays nothing for it); a last `motion: false` makes a `MOVE` an error
@@ -117,6 +119,7 @@ macro_rules! profile {
         $(octree: { $($octree_field:ident : $octree_value:expr),* $(,)? })?
         $(named_walk: $named_walk:literal)?
         $(first_hits: $first_hits:literal)?
+        $(mirror_hits: $mirror_hits:literal)?
         $(coherence: $coherence:literal)?
         $(motion: $motion:literal)?
     ) => {
@@ -136,11 +139,11 @@ macro_rules! profile {
                 const NAMED_WALK: bool = p::given_or(&[$($named_walk)?], true);
                 type ScreenBounds = p::Vec<
                     p::ScreenBound,
-                    { p::ScreenBound::if_wanted(<$name as p::Linked>::FIRST_HITS, <$name as $crate::profile::Profile>::COUNTS.objects) },
+                    { p::ScreenBound::if_wanted(<$name as p::Linked>::FIRST_HITS, p::ScreenBound::lists(<$name as p::Linked>::MIRROR_HITS) * <$name as $crate::profile::Profile>::COUNTS.objects) },
                 >;
                 type ScreenPositions = p::Vec<
                     u16,
-                    { p::ScreenBound::if_wanted(<$name as p::Linked>::FIRST_HITS, p::ScreenBound::positions_for(<$name as $crate::profile::Profile>::COUNTS.objects)) },
+                    { p::ScreenBound::if_wanted(<$name as p::Linked>::FIRST_HITS, p::ScreenBound::lists(<$name as p::Linked>::MIRROR_HITS) * p::ScreenBound::positions_for(<$name as $crate::profile::Profile>::COUNTS.objects)) },
                 >;
                 type LightBufferWords = p::Vec<u32, { <$name as $crate::profile::Profile>::COUNTS.light_buffer_words }>;
             }
@@ -148,6 +151,7 @@ macro_rules! profile {
             impl p::Linked for $name {
                 type Octree = p::Octree<$name, { <$name as $crate::profile::Profile>::OCTREE.max_depth as usize + 1 }>;
                 const FIRST_HITS: bool = p::given_or(&[$($first_hits)?], false);
+                const MIRROR_HITS: bool = p::given_or(&[$($mirror_hits)?], false);
                 const COHERENCE: bool = p::given_or(&[$($coherence)?], false);
                 const LIGHT_BUFFER: bool = <$name as $crate::profile::Profile>::COUNTS.light_buffer_lights > 0;
                 const LIGHT_CUBES: bool = <$name as p::Linked>::LIGHT_BUFFER
@@ -338,12 +342,12 @@ fn host_scene<'t>(
 ///
 /// let counts = count("SPHERE 1 1 0 0 0\n");
 /// let octree = OctreeConfig { max_depth: 4, ..OctreeConfig::DEFAULT };
-/// let text = ProfileText { name: "Scene", doc: "One sphere.", counts: &counts, octree: Some(&octree), named_walk: false, first_hits: true, coherence: false, motion: false };
+/// let text = ProfileText { name: "Scene", doc: "One sphere.", counts: &counts, octree: Some(&octree), named_walk: false, first_hits: true, mirror_hits: true, coherence: false, motion: false };
 /// assert_eq!(
 ///     text.to_string(),
 ///     "octrace_core::profile! {\n    /// One sphere.\n    pub struct Scene { objects: 1, spheres: 1 }\n    \
 ///      octree: { max_objects: 4, max_depth: 4, shadow_shafts: false }\n    named_walk: false\n    first_hits: true\n    \
-///      coherence: false\n    motion: false\n}\n",
+///      mirror_hits: true\n    coherence: false\n    motion: false\n}\n",
 /// );
 /// ```
 #[derive(Clone, Copy, Debug)]
@@ -360,6 +364,8 @@ pub struct ProfileText<'a> {
     pub named_walk: bool,
     /// [`Linked::FIRST_HITS`].
     pub first_hits: bool,
+    /// [`Linked::MIRROR_HITS`].
+    pub mirror_hits: bool,
     /// [`Linked::COHERENCE`]: what a firmware that plays animations needs.
     pub coherence: bool,
     /// [`SceneCapacities::MOTION`]:
@@ -379,7 +385,7 @@ impl ProfileText<'_> {
     ///
     /// let one = count("SPHERE 1 1 0 0 0\n");
     /// let two = count("SPHERE 1 1 0 0 0\nSPHERE 1 1 3 0 0\n");
-    /// let text = |counts| ProfileText { name: "Scene", doc: "", counts, octree: None, named_walk: false, first_hits: false, coherence: false, motion: false };
+    /// let text = |counts| ProfileText { name: "Scene", doc: "", counts, octree: None, named_walk: false, first_hits: false, mirror_hits: false, coherence: false, motion: false };
     /// assert!(text(&two).arena_bytes() > text(&one).arena_bytes());
     /// ```
     pub fn arena_bytes(&self) -> usize {
@@ -405,8 +411,12 @@ impl ProfileText<'_> {
             + counts.octree_hash_entries_if(self.named_walk) * size_of::<HashEntry<u16>>()
             + (counts.octree_hash_buckets_if(self.named_walk) + 1) * size_of::<u16>()
             + counts.mailbox_words() * size_of::<u32>()
-            + ScreenBound::if_wanted(self.first_hits, counts.objects) * size_of::<ScreenBound>()
-            + ScreenBound::if_wanted(self.first_hits, ScreenBound::positions_for(counts.objects)) * size_of::<u16>()
+            + ScreenBound::if_wanted(self.first_hits, ScreenBound::lists(self.mirror_hits) * counts.objects)
+                * size_of::<ScreenBound>()
+            + ScreenBound::if_wanted(
+                self.first_hits,
+                ScreenBound::lists(self.mirror_hits) * ScreenBound::positions_for(counts.objects),
+            ) * size_of::<u16>()
             + counts.octree_shadow_shafts_if(shadow_shafts) * size_of::<ShadowShaft>()
             + counts.light_buffer_words * size_of::<u32>()
     }
@@ -426,6 +436,7 @@ impl core::fmt::Display for ProfileText<'_> {
         }
         writeln!(f, "    named_walk: {}", self.named_walk)?;
         writeln!(f, "    first_hits: {}", self.first_hits)?;
+        writeln!(f, "    mirror_hits: {}", self.mirror_hits)?;
         writeln!(f, "    coherence: {}", self.coherence)?;
         writeln!(f, "    motion: {}", self.motion)?;
         writeln!(f, "}}")
@@ -502,14 +513,15 @@ mod host {
         // RAM is plenty: shadow shafts on.
         const OCTREE: OctreeConfig = OctreeConfig { shadow_shafts: true, ..OctreeConfig::DEFAULT };
         type MailboxWords = HeapArena<u32, { Host::COUNTS.mailbox_words() }>;
-        type ScreenBounds = HeapArena<ScreenBound, { Host::COUNTS.objects }>;
-        type ScreenPositions = HeapArena<u16, { ScreenBound::positions_for(Host::COUNTS.objects) }>;
+        type ScreenBounds = HeapArena<ScreenBound, { 2 * Host::COUNTS.objects }>;
+        type ScreenPositions = HeapArena<u16, { 2 * ScreenBound::positions_for(Host::COUNTS.objects) }>;
         type LightBufferWords = HeapArena<u32, { Host::COUNTS.light_buffer_words }>;
     }
 
     impl Linked for Host {
         type Octree = Octree<Host, { MAX_DEPTH as usize + 1 }>;
         const FIRST_HITS: bool = true;
+        const MIRROR_HITS: bool = true;
         const COHERENCE: bool = true;
         const LIGHT_BUFFER: bool = true;
     }

@@ -83,7 +83,8 @@ pub fn embed_still_scene() -> Result<(), BuildError> {
     let needs = needed_by(&text, AccelMode::Auto, &OctreeConfig::DEFAULT, &mut |error| eprintln!("{scene}:{error}"))
         .map_err(|errors| BuildError::Scene { scene: scene.clone(), errors })?;
     let doc = format!("Exactly what `{scene}` needs, its octree included.");
-    let profile = profile_text(&doc, &needs, false, AnimationNeeds::of(&text, Default::default()).moves());
+    let motion = AnimationNeeds::of(&text, Default::default());
+    let profile = profile_text(&doc, &needs, false, motion.moves(), surveyed(&text, &motion).1);
     fits(&scene, &profile, None)?;
     let source =
         format!("/// The scene, from `{scene}`.\npub const SCENE_TEXT: &str = include_str!({path:?});\n{profile}");
@@ -119,9 +120,10 @@ fn read_scene() -> Result<(String, PathBuf, String), BuildError> {
 /// `SceneProfile`, holding `counts`: `Raytracer::load` picks the
 /// accelerator as `Auto` does, with the octree `profile!` builds by
 /// default, and walks it by 3DDDA (no room for the thesis's hash table);
-/// with the camera rays' first hits, `coherence` for an animation, and
+/// with the camera rays' first hits and, for a scene it indexes that has a
+/// `mirror`, their reflections' off it, `coherence` for an animation, and
 /// `motion` for a scene with a `MOVE` (a still's links no interpolation).
-fn profile_text<'a>(doc: &'a str, counts: &'a Counts, coherence: bool, motion: bool) -> ProfileText<'a> {
+fn profile_text<'a>(doc: &'a str, counts: &'a Counts, coherence: bool, motion: bool, mirror: bool) -> ProfileText<'a> {
     ProfileText {
         name: "SceneProfile",
         doc,
@@ -129,6 +131,9 @@ fn profile_text<'a>(doc: &'a str, counts: &'a Counts, coherence: bool, motion: b
         octree: None,
         named_walk: false,
         first_hits: true,
+        // A scene of a few objects is traced naively: a reflection tests
+        // them all for what the lists would cost.
+        mirror_hits: mirror && counts.objects > AccelMode::AUTO_NAIVE_UP_TO,
         coherence,
         motion,
     }
@@ -161,14 +166,16 @@ fn fits(scene: &str, profile: &ProfileText<'_>, room: Option<usize>) -> Result<(
 
 /// What the scene `text`, whose motion takes `motion`, is: an animation if
 /// it has frames and something moves (a scene of one frame, or where
-/// nothing moves, is drawn once).
-fn kind_of(text: &str, motion: &AnimationNeeds) -> SceneKind {
+/// nothing moves, is drawn once); and whether it has a mirror
+/// (`SceneView::has_mirror`).
+fn surveyed(text: &str, motion: &AnimationNeeds) -> (SceneKind, bool) {
     let mut parsed = Box::new(Scene::<Host>::new());
     let frames = parse(text, &mut parsed, &mut |_| {}).ok().and_then(|p| p.frames).map_or(1, |f| f.count);
-    match motion.moves() && frames > 1 {
+    let kind = match motion.moves() && frames > 1 {
         true => SceneKind::Animation,
         false => SceneKind::Still,
-    }
+    };
+    (kind, parsed.view().has_mirror())
 }
 
 /// `scene.rs` for the scene `name`, read from `path` as `text`, and what
@@ -187,9 +194,9 @@ fn scene_source(name: &str, path: &std::path::Path, text: &str) -> Result<(Scene
     // MOVE places its frame 0 even where it is drawn once), and what an
     // animation's motion takes.
     let motion = AnimationNeeds::of(text, Default::default());
-    let kind = kind_of(text, &motion);
+    let (kind, mirror) = surveyed(text, &motion);
     let animated = kind == SceneKind::Animation;
-    let profile = profile_text(&doc, &needs, animated, motion.moves());
+    let profile = profile_text(&doc, &needs, animated, motion.moves(), mirror);
     fits(name, &profile, Some(RP2040_ARENA_ROOM))?;
     let motion = if animated { motion } else { Default::default() };
     let stem = path.file_stem().map_or_else(|| name.to_owned(), |stem| stem.to_string_lossy().into_owned());
@@ -277,7 +284,7 @@ mod tests {
             [(last, last, true), (last + 1, 9, false), (9, last + 1, false), (100_000, 200_000, false)]
         {
             let counts = counts(boxes, references);
-            let result = fits("big", &profile_text("", &counts, false, false), None);
+            let result = fits("big", &profile_text("", &counts, false, false, false), None);
             match fits_the_index {
                 true => assert!(result.is_ok(), "{boxes} {references}"),
                 false => {

@@ -28,6 +28,11 @@ pub trait Linked: OctreeCapacities + Sized {
     /// their pixel (see [`Renderer`](crate::render::Renderer)): the same
     /// image, for RAM.
     const FIRST_HITS: bool = false;
+    /// Whether, with [`Linked::FIRST_HITS`], the reflections of camera rays
+    /// off a mirror along an axis (a floor) find their hits the same way,
+    /// among the objects seen around their pixel from the eye's image in
+    /// it: the same image, for as much RAM again.
+    const MIRROR_HITS: bool = false;
     /// Whether an animation's frames re-trace only what the motion can
     /// change (the tracer watches every ray of a frame against the motion
     /// to come); without it every frame is traced whole, the same pictures.
@@ -121,6 +126,15 @@ impl<'r, L: Linked> SceneAccelerator<'r, L> {
     #[inline]
     pub(crate) fn first_hits_by_screen(&self) -> bool {
         L::FIRST_HITS && self.lit.accel().octree().is_none_or(|octree| octree.walked_by_dda())
+    }
+
+    /// Whether reflections off a mirror may find their hits in screen lists
+    /// too: when the build links them and camera rays use theirs, and
+    /// reflected rays would walk an octree. Without one a reflection tests
+    /// a few objects (the naive mode's), which cost what the lists would.
+    #[inline]
+    pub(crate) fn mirror_hits_by_screen(&self) -> bool {
+        L::MIRROR_HITS && self.first_hits_by_screen() && self.lit.accel().octree().is_some()
     }
 }
 

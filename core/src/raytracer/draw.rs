@@ -91,8 +91,8 @@ pub(super) fn renderer_in<'a, L: Linked>(
     if let Some(words) = mailbox {
         renderer.set_mailbox(words);
     }
-    if let Some((bounds, positions)) = lists {
-        renderer.set_first_hits(bounds, positions);
+    if let Some((lists, mirror)) = lists {
+        renderer.set_first_hits(lists, mirror);
     }
     Ok(renderer)
 }

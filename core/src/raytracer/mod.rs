@@ -15,7 +15,7 @@ use crate::accel::{
 use crate::capacity::Arena;
 use crate::parse::{parse_recording, ErrorKind, MotionSink, ParseError, Pos};
 use crate::profile::Profile;
-use crate::render::ScreenBound;
+use crate::render::{ScreenBound, ScreenRoom};
 use crate::scene::{Frames, Scene, SceneView};
 use crate::shade::Stats;
 use core::cell::{Cell, RefCell};
@@ -102,14 +102,21 @@ impl<P: Profile> RendererRoom<P> {
 
 impl<P: Profile> Room<P> {
     /// The room cleared for a scene of `objects` objects: its mailbox, and
-    /// its screen lists when the scene's camera rays use them.
+    /// its screen lists when the scene's camera rays use them (and as much
+    /// again for a mirror's, when the profile has room for both).
     fn prepare(&mut self, objects: usize, first_hits: bool) -> (&mut [u32], Option<ScreenLists<'_>>) {
         fill(&mut self.mailbox, Mailbox::words_for(objects), 0);
         let listed = if first_hits { objects } else { 0 };
-        fill(&mut self.screen_bounds, listed, ScreenBound::EMPTY);
-        fill(&mut self.screen_positions, ScreenBound::positions_for(listed), 0);
-        let lists = (self.screen_bounds.as_mut_slice(), self.screen_positions.as_mut_slice());
-        (self.mailbox.as_mut_slice(), first_hits.then_some(lists))
+        let copies = if P::MIRROR_HITS { 2 } else { 1 };
+        fill(&mut self.screen_bounds, copies * listed, ScreenBound::EMPTY);
+        fill(&mut self.screen_positions, copies * ScreenBound::positions_for(listed), 0);
+        let bounds = self.screen_bounds.as_mut_slice();
+        let positions = self.screen_positions.as_mut_slice();
+        let (bounds, mirror_bounds) = bounds.split_at_mut(listed.min(bounds.len()));
+        let (positions, mirror_positions) =
+            positions.split_at_mut(ScreenBound::positions_for(listed).min(positions.len()));
+        let mirror = P::MIRROR_HITS.then_some((mirror_bounds, mirror_positions));
+        (self.mailbox.as_mut_slice(), first_hits.then_some(((bounds, positions), mirror)))
     }
 }
 
@@ -125,8 +132,8 @@ impl<P: Profile> fmt::Debug for RendererRoom<P> {
     }
 }
 
-/// A renderer's screen lists: a bound for each object, and their positions.
-pub(super) type ScreenLists<'a> = (&'a mut [ScreenBound], &'a mut [u16]);
+/// A renderer's room for screen lists: its camera's, and a mirror's.
+pub(super) type ScreenLists<'a> = (ScreenRoom<'a>, Option<ScreenRoom<'a>>);
 
 impl<P: Profile> fmt::Debug for Raytracer<P> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

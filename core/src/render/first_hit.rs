@@ -15,6 +15,12 @@
 //! offsets, in order, until the next one's bound is beyond the nearest hit
 //! so far.
 //!
+//! The same lists serve the reflections of camera rays off one mirror
+//! along an axis (a floor's, a chessboard's), made from the eye's mirror
+//! image (see `scene/mirror.rs`): each bound widened by the most such a ray
+//! strays from that camera's ray, its window taken at the camera ray's
+//! offsets, its nearest parameter less the camera ray's.
+//!
 //! Exactness: a hit point strays from its object by less than the filing
 //! margin (the octree relies on the same bound), and a camera ray from its
 //! ideal direction by a few units, so every object a ray can hit has the
@@ -22,11 +28,11 @@
 //! The earlier-object rule for equal parameters is kept by testing every
 //! object whose bound is not beyond the nearest hit.
 
-use crate::accel::{Hit, FILING_MARGIN};
-use crate::math::{isqrt, mul_i64_wide};
-use crate::scene::{Camera, CameraRay, ObjectId, Projection, SceneView};
+use crate::accel::{Hit, RayStart, FILING_MARGIN};
+use crate::math::{isqrt, mul_i64_wide, Scalar};
+use crate::scene::{Camera, CameraRay, MirrorPlane, ObjectId, Projection, SceneView};
 use crate::shade::Poll;
-use crate::shapes::{Leaving, ShapeKinds};
+use crate::shapes::{Leaving, Ray, ShapeKinds};
 
 /// Rows of a band: its objects are chosen once for them all.
 const BAND_ROWS: u32 = 8;
@@ -78,6 +84,16 @@ impl ScreenBound {
         band + tile
     }
 
+    /// How many lists a renderer keeps: the camera's, and with `mirror`
+    /// a mirror's too (see [`Linked::MIRROR_HITS`](crate::profile::Linked::MIRROR_HITS)).
+    pub const fn lists(mirror: bool) -> usize {
+        if mirror {
+            2
+        } else {
+            1
+        }
+    }
+
     /// `count` when `wanted`, else 0: a profile's room for the bounds or
     /// the positions.
     pub const fn if_wanted(wanted: bool, count: usize) -> usize {
@@ -88,12 +104,32 @@ impl ScreenBound {
         }
     }
 
+    /// A window that no offsets are in: an object no listed ray can hit.
+    const UNSEEN: ScreenBound = ScreenBound { near: i32::MAX, object: 0, x: [u16::MAX, 0], y: [u16::MAX, 0] };
+
     #[inline(never)]
-    fn of(scene: &SceneView<'_>, projection: &Projection, shift: u32, id: ObjectId) -> ScreenBound {
+    fn of(
+        scene: &SceneView<'_>,
+        projection: &Projection,
+        shift: u32,
+        id: ObjectId,
+        mirror: Option<MirrorPlane>,
+    ) -> ScreenBound {
         let bounds = scene.shape(id).bounds();
-        let lo = bounds.min.wide().map(|v| v - FILING_MARGIN);
-        let hi = bounds.max.wide().map(|v| v + FILING_MARGIN);
+        let margin = FILING_MARGIN + mirror.map_or(0, |_| MirrorPlane::OFFSET);
+        let lo = bounds.min.wide().map(|v| v - margin);
+        let hi = bounds.max.wide().map(|v| v + margin);
         let eye = projection.eye();
+        // Reflections leave the mirror away from its image of the eye, and
+        // from no further than NEAR behind it: a bound wholly beyond that,
+        // on the image's side, is met by none of them.
+        if let Some(plane) = mirror {
+            let (a, c) = (plane.axis, plane.coordinate as i64);
+            let reach = MirrorPlane::NEAR as i64;
+            if (eye[a] < c && hi[a] < c - reach) || (eye[a] > c && lo[a] > c + reach) {
+                return ScreenBound { object: id.0 as u16, ..ScreenBound::UNSEEN };
+            }
+        }
         let gap2: u128 = (0..3)
             .map(|a| {
                 let gap = (lo[a] - eye[a]).max(eye[a] - hi[a]).max(0);
@@ -197,14 +233,22 @@ impl<'a> FirstHits<'a> {
     /// Projects every object of `scene` seen by `camera` into `bounds`,
     /// asking `poll` before each (an object's projection costs about what
     /// a ray does); false if it said stop.
-    pub fn project<Q: Poll>(scene: &SceneView<'_>, camera: &Camera, bounds: &mut [ScreenBound], poll: &mut Q) -> bool {
+    /// With `mirror`, `camera` is the eye's mirror image in it, and the
+    /// bounds are for the reflections of the real camera's rays.
+    pub fn project<Q: Poll>(
+        scene: &SceneView<'_>,
+        camera: &Camera,
+        bounds: &mut [ScreenBound],
+        poll: &mut Q,
+        mirror: Option<MirrorPlane>,
+    ) -> bool {
         let projection = Projection::new(camera);
         let shift = window_shift(camera);
         for (slot, id) in bounds.iter_mut().zip(scene.object_ids()) {
             if !poll.go_on() {
                 return false;
             }
-            *slot = ScreenBound::of(scene, &projection, shift, id);
+            *slot = ScreenBound::of(scene, &projection, shift, id, mirror);
         }
         true
     }
@@ -244,27 +288,72 @@ impl<'a> FirstHits<'a> {
         ray: &mut CameraRay,
         [x, y]: [u32; 2],
     ) -> Option<Option<Hit>> {
+        let offsets = ray.offsets;
+        self.nearest_of(scene, kinds, camera, offsets, [x, y], &mut Seen { camera, ray })
+    }
+
+    /// The nearest hit of `ray`, the reflection off the lists' mirror of
+    /// the camera ray with `offsets` through pixel (`x`, `y`), which hit the
+    /// mirror at `primary_t`; `camera` is the mirrored one the lists were
+    /// made for. The hit the accelerator's `nearest` returns for it.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn nearest_reflected(
+        &mut self,
+        scene: &SceneView<'_>,
+        kinds: ShapeKinds,
+        camera: &Camera,
+        offsets: (i32, i32),
+        pixel: [u32; 2],
+        ray: &Ray,
+        start: Option<RayStart>,
+        primary_t: Scalar,
+    ) -> Option<Option<Hit>> {
+        self.nearest_of(scene, kinds, camera, offsets, pixel, &mut Reflected { ray, start, primary_t })
+    }
+
+    #[inline]
+    fn nearest_of<R: Listed>(
+        &mut self,
+        scene: &SceneView<'_>,
+        kinds: ShapeKinds,
+        camera: &Camera,
+        (kx, ky): (i32, i32),
+        [x, y]: [u32; 2],
+        ray: &mut R,
+    ) -> Option<Option<Hit>> {
         let all = self.all;
-        let (kx, ky) = ray.offsets;
         let shift = self.shift;
         let tile = self.tile(camera, x, y)?;
         // A ray's offsets need no clamp ([`window_shift`]): `narrow`'s value.
         let ray_offset = |k: i32| ((k >> shift) + 0x8000) as u16;
-        Some(nearest(scene, kinds, all, tile, camera, ray, (ray_offset(kx), ray_offset(ky))))
+        Some(nearest(scene, kinds, all, tile, ray, (ray_offset(kx), ray_offset(ky))))
     }
 
     /// The positions in the bounds of the objects that camera rays of
     /// pixel (`x`, `y`)'s tile may hit, nearest bound first, or `None` when
     /// they are too many.
-    #[inline]
+    #[inline(always)]
     fn tile(&mut self, camera: &Camera, x: u32, y: u32) -> Option<&[u16]> {
         let (band_start, tile_start) = (y - y % BAND_ROWS, x - x % TILE_COLUMNS);
+        if band_start != self.band_start || tile_start != self.tile_start {
+            self.choose(camera, band_start, tile_start);
+        }
+        let band_room = self.all.len().min(MAX_BAND_OBJECTS);
+        self.positions.get(band_room..)?.get(..self.tile?)
+    }
+
+    /// Chooses the objects of the band starting at row `band_start` (if it
+    /// is not the current one) and of its tile starting at column
+    /// `tile_start`. Out of line: once per tile of a band, where the
+    /// look-up is once per ray.
+    #[inline(never)]
+    fn choose(&mut self, camera: &Camera, band_start: u32, tile_start: u32) {
         let last = camera.samples() - 1;
         let all = self.all;
         let (band, tile) = self.positions.split_at_mut(all.len().min(MAX_BAND_OBJECTS));
         if band_start != self.band_start {
             self.band_start = band_start;
-            self.tile_start = u32::MAX;
             // The band's offsets: from its last row's last sub-cells up to
             // its first row's first (shifted as the windows are: a window
             // that meets the band still does).
@@ -273,43 +362,105 @@ impl<'a> FirstHits<'a> {
             // Positions below MAX_OBJECTS: the casts are exact.
             self.band = filter(all, (0..all.len()).map(|p| p as u16), band, |b| b.y[0] <= high && b.y[1] >= low);
         }
-        if tile_start != self.tile_start {
-            self.tile_start = tile_start;
+        self.tile_start = tile_start;
+        // A band of too many objects has no tiles (its rays walk).
+        self.tile = self.band.and_then(|band_len| {
             // The tile's offsets: from its first column's first sub-cells
             // to its last column's last.
             let low = narrow(camera.offsets(tile_start, 0, 0, 0).0, self.shift);
             let high = narrow(camera.offsets(tile_start.saturating_add(TILE_COLUMNS - 1), 0, last, 0).0, self.shift);
-            self.tile = filter(all, band[..self.band?].iter().copied(), tile, |b| b.x[0] <= high && b.x[1] >= low);
-        }
-        Some(&tile[..self.tile?])
+            filter(all, band[..band_len].iter().copied(), tile, |b| b.x[0] <= high && b.x[1] >= low)
+        });
     }
 }
 
-/// The nearest hit of the camera ray with offsets `(kx, ky)` ([`narrow`]ed
-/// as the windows are) among the objects at `tile`'s positions in `all`. The
+/// A ray the lists find the hit of.
+trait Listed {
+    /// The ray (a camera ray's unit vector is made only when asked for).
+    fn ray(&mut self) -> &Ray;
+    /// How it leaves `object`.
+    fn leaving(&self, object: ObjectId) -> Leaving;
+    /// Whether a bound's `near` (from the lists' eye) is beyond every hit
+    /// of parameter `t` on this ray.
+    fn beyond(&self, near: i32, t: Scalar) -> bool;
+}
+
+/// A camera ray, from the lists' own camera.
+struct Seen<'c, 'r> {
+    camera: &'c Camera,
+    ray: &'r mut CameraRay,
+}
+
+impl Listed for Seen<'_, '_> {
+    #[inline(always)]
+    fn ray(&mut self) -> &Ray {
+        self.ray.get(self.camera)
+    }
+
+    #[inline(always)]
+    fn leaving(&self, _: ObjectId) -> Leaving {
+        Leaving::No
+    }
+
+    #[inline(always)]
+    fn beyond(&self, near: i32, t: Scalar) -> bool {
+        near > t.to_bits()
+    }
+}
+
+/// A camera ray's reflection off the lists' mirror.
+struct Reflected<'r> {
+    ray: &'r Ray,
+    start: Option<RayStart>,
+    primary_t: Scalar,
+}
+
+impl Listed for Reflected<'_> {
+    #[inline(always)]
+    fn ray(&mut self) -> &Ray {
+        self.ray
+    }
+
+    #[inline(always)]
+    fn leaving(&self, object: ObjectId) -> Leaving {
+        RayStart::leaving(self.start, object)
+    }
+
+    /// A hit `t` along the reflection is at most `t + primary_t` from the
+    /// mirrored eye, each times `1 + 2^-29` (below 8 units for both, as
+    /// each is below 2^31), plus how far the reflection strays from the
+    /// mirrored camera's ray (below [`MirrorPlane::OFFSET`]).
+    #[inline(always)]
+    fn beyond(&self, near: i32, t: Scalar) -> bool {
+        near as i64 > t.to_bits() as i64 + self.primary_t.to_bits() as i64 + 8 + MirrorPlane::OFFSET
+    }
+}
+
+/// The nearest hit of `ray` with offsets `(kx, ky)` ([`narrow`]ed as the
+/// windows are) among the objects at `tile`'s positions in `all`. A camera
 /// ray is made only when a window holds the offsets.
 #[inline]
-fn nearest(
+fn nearest<R: Listed>(
     scene: &SceneView<'_>,
     kinds: ShapeKinds,
     all: &[ScreenBound],
     tile: &[u16],
-    camera: &Camera,
-    ray: &mut CameraRay,
+    ray: &mut R,
     (kx, ky): (u16, u16),
 ) -> Option<Hit> {
     let mut best = Hit::NONE;
     for bound in tile.iter().filter_map(|&p| all.get(p as usize)) {
-        if bound.near > best.t.to_bits() {
+        if ray.beyond(bound.near, best.t) {
             break;
         }
         if kx < bound.x[0] || kx > bound.x[1] || ky < bound.y[0] || ky > bound.y[1] {
             continue;
         }
-        if let Some(t) =
-            scene.intersect_handle(kinds, scene.objects[bound.object as usize], ray.get(camera), best.t, Leaving::No)
+        let object = ObjectId(bound.object as u32);
+        let leaving = ray.leaving(object);
+        if let Some(t) = scene.intersect_handle(kinds, scene.objects[bound.object as usize], ray.ray(), best.t, leaving)
         {
-            let hit = Hit { t, object: ObjectId(bound.object as u32) };
+            let hit = Hit { t, object };
             if hit.beats(&best) {
                 best = hit;
             }
@@ -338,7 +489,8 @@ mod tests {
         fn coordinate(next: &mut impl FnMut() -> u64, range: u64) -> f64 {
             (next() % (2 * range * 100 + 1)) as f64 / 100.0 - range as f64
         }
-        let mut text = String::from("SURFACE 1 0.1 0.1 0.1 0.5 0.5 0.5 0 0 0 0 0 0\n");
+        // Reflective: flat objects along an axis may be the scene's mirror.
+        let mut text = String::from("SURFACE 1 0.1 0.1 0.1 0.5 0.5 0.5 0 0 0 0 0.5 0\n");
         let eye = [0; 3].map(|_| coordinate(next, 9));
         text += &format!("VIEWPOINT {} {} {}\n", eye[0], eye[1], eye[2]);
         text += &format!("ORIGIN {} {} {}\n", coordinate(next, 2), coordinate(next, 2), coordinate(next, 2));
@@ -417,7 +569,7 @@ mod tests {
             if !FirstHits::fit(&view, &camera, &bounds, &positions) {
                 continue;
             }
-            assert!(FirstHits::project(&view, &camera, &mut bounds, &mut crate::shade::Unpolled));
+            assert!(FirstHits::project(&view, &camera, &mut bounds, &mut crate::shade::Unpolled, None));
             let Some(mut hits) = FirstHits::new(view.object_count(), &camera, &mut bounds, &mut positions) else {
                 continue;
             };
@@ -440,6 +592,72 @@ mod tests {
         }
         std::println!("{rays} rays; tiles left out {skipped} of {naive_tests} objects");
         assert!(rays > 100_000 && skipped * 3 > naive_tests, "the lists must leave objects out");
+    }
+
+    /// Every reflection of a camera ray off the mirror of random scenes
+    /// gets the naive mode's hit from the mirror's lists, while most of
+    /// the objects' tests are skipped.
+    #[test]
+    fn reflections_off_the_mirror_find_the_naive_hit() {
+        let mut next = crate::test_rng::seeded(0x0d1a_7e55);
+        let (mut rays, mut skipped, mut naive_tests, mut mirrors) = (0u64, 0u64, 0u64, 0);
+        for _ in 0..1000 {
+            let scene = random_scene(&mut next);
+            let view = scene.view();
+            let [w, h] = view.settings.raster;
+            if view.object_count() == 0 || w == 0 {
+                continue;
+            }
+            let Some(plane) = view.mirror() else { continue };
+            let camera = Camera::new(&view.settings.view, &view.normalization, w, h, view.settings.samples).unwrap();
+            let Some(image) = camera.mirrored(plane.axis, plane.coordinate) else { continue };
+            let mut bounds = vec![ScreenBound::EMPTY; view.object_count()];
+            let mut positions = vec![0; ScreenBound::positions_for(view.object_count())];
+            if !FirstHits::fit(&view, &camera, &bounds, &positions) {
+                continue;
+            }
+            assert!(FirstHits::project(&view, &image, &mut bounds, &mut crate::shade::Unpolled, Some(plane)));
+            let Some(mut hits) = FirstHits::new(view.object_count(), &image, &mut bounds, &mut positions) else {
+                continue;
+            };
+            mirrors += 1;
+            let n = camera.samples();
+            for (x, y) in (0..w * h).map(|p| (p % w, p / w)) {
+                for (sx, sy) in (0..n * n).map(|s| (s % n, s / n)) {
+                    let primary = camera.ray(x, y, sx, sy);
+                    let Some(hit) = Naive.nearest(&view, &primary, None, &mut Mailbox::none()) else { continue };
+                    let point = primary.at(hit.t);
+                    let geometric = view.shape(hit.object).normal_at(point);
+                    let facing = if geometric.dot_is_positive(primary.dir) { -geometric } else { geometric };
+                    let dir = (-primary.dir).reflect_about(facing);
+                    let reflected = Ray { origin: point, dir };
+                    if !plane.mirrors(&primary, &reflected) {
+                        continue;
+                    }
+                    let leaving = if geometric.dot_is_negative(dir) { Leaving::Inward } else { Leaving::Outward };
+                    let start = Some(RayStart { object: hit.object, leaving });
+                    let offsets = camera.offsets(x, y, sx, sy);
+                    let listed = hits.nearest_reflected(
+                        &view,
+                        ShapeKinds::ALL,
+                        &camera,
+                        offsets,
+                        [x, y],
+                        &reflected,
+                        start,
+                        hit.t,
+                    );
+                    let naive = Naive.nearest(&view, &reflected, start, &mut Mailbox::none());
+                    assert_eq!(listed.unwrap_or(naive), naive, "pixel {x} {y}, sample {sx} {sy}");
+                    let tested = hits.tile(&camera, x, y).map_or(view.object_count(), <[_]>::len) as u64;
+                    rays += 1;
+                    skipped += view.object_count() as u64 - tested;
+                    naive_tests += view.object_count() as u64;
+                }
+            }
+        }
+        std::println!("{mirrors} mirrors, {rays} reflections; tiles left out {skipped} of {naive_tests} objects");
+        assert!(mirrors > 50 && rays > 20_000 && skipped * 3 > naive_tests, "the lists must leave objects out");
     }
 
     /// Every camera offset fits 16 bits once shifted, and a window narrowed

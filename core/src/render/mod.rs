@@ -41,8 +41,11 @@ pub use stop::{Stop, Stopped};
 use crate::accel::{Hit, Linked, Mailbox, SceneAccelerator};
 use crate::motion::{Lookout, RayKind};
 use crate::panel::TracedColor;
-use crate::scene::{Camera, CameraError, CameraRay, Color, ObjectId, RayCursor, SceneView, Stride, MAX_SIDE};
-use crate::shade::{Poll, Scratch, Stats, Tracer, Unpolled};
+use crate::scene::{
+    Camera, CameraError, CameraRay, Color, MirrorPlane, ObjectId, RayCursor, SceneView, Stride, MAX_SIDE,
+};
+use crate::shade::{Mirror, Poll, Scratch, Stats, Tracer, Unpolled};
+use crate::shapes::Ray;
 use core::ops::Range;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
@@ -128,6 +131,82 @@ pub struct Renderer<'a, L: Linked> {
     scratch: Scratch<'a>,
     /// Camera rays' objects by where they are seen, when given storage.
     first_hits: ScreenLists<'a>,
+    /// The same for their reflections off `mirror` (seen from the eye's
+    /// image in it), when given storage and the scene has a mirror.
+    mirror_hits: ScreenLists<'a>,
+    mirror: Option<MirrorPlane>,
+}
+
+/// Room for screen lists: a bound for each object, and their positions.
+pub(crate) type ScreenRoom<'a> = (&'a mut [ScreenBound], &'a mut [u16]);
+
+/// Fills `lists`' room, if that is what it holds, for `camera` (the eye's
+/// image in `mirror`, if given), `poll` asked before each object: false if
+/// it said stop (the room stays, for the next ray to fill).
+#[cold]
+#[inline(never)]
+fn fill<'a, Q: Poll>(
+    lists: &mut ScreenLists<'a>,
+    scene: &SceneView<'_>,
+    camera: &Camera,
+    mirror: Option<MirrorPlane>,
+    poll: &mut Q,
+) -> bool {
+    let ScreenLists::Room(bounds, _) = lists else { return true };
+    if !FirstHits::project(scene, camera, bounds, poll, mirror) {
+        return false;
+    }
+    if let ScreenLists::Room(bounds, positions) = core::mem::replace(lists, ScreenLists::None) {
+        *lists = FirstHits::new(scene.object_count(), camera, bounds, positions)
+            .map_or(ScreenLists::None, ScreenLists::Lists);
+    }
+    true
+}
+
+/// The mirror's lists (or their room, until the first reflection off the
+/// mirror fills it: a frame's run that has none never does), for one
+/// camera ray's reflection; none without a mirror.
+struct ListedMirror<'l, 'a, L> {
+    lists: &'l mut ScreenLists<'a>,
+    linked: core::marker::PhantomData<L>,
+    plane: Option<MirrorPlane>,
+    /// The renderer's camera: its tiles are the mirrored camera's.
+    camera: &'l Camera,
+    offsets: (i32, i32),
+    pixel: [u32; 2],
+}
+
+impl<L: Linked> Mirror for ListedMirror<'_, '_, L> {
+    // A build without the lists links none of the tracer's checks.
+    const LISTS: bool = L::MIRROR_HITS;
+
+    #[inline(always)]
+    fn plane(&self) -> Option<MirrorPlane> {
+        self.plane
+    }
+
+    // Out of line: inlined, the lists' walk would crowd the tracer's loop
+    // (its registers) for every ray, where it serves one reflection.
+    #[inline(never)]
+    fn nearest<Q: Poll>(
+        &mut self,
+        scene: &SceneView<'_>,
+        ray: &Ray,
+        start: Option<crate::accel::RayStart>,
+        primary_t: crate::math::Scalar,
+        poll: &mut Q,
+    ) -> Option<Option<Hit>> {
+        if let ScreenLists::Room(..) = self.lists {
+            let plane = self.plane?;
+            let image = self.camera.mirrored(plane.axis, plane.coordinate)?;
+            // Stopped: the sample is given up at its next ray.
+            if !fill(self.lists, scene, &image, Some(plane), poll) {
+                return None;
+            }
+        }
+        let ScreenLists::Lists(lists) = self.lists else { return None };
+        lists.nearest_reflected(scene, L::KINDS, self.camera, self.offsets, self.pixel, ray, start, primary_t)
+    }
 }
 
 /// A renderer's screen lists: none, their room until the first camera ray
@@ -175,6 +254,8 @@ impl<'a, L: Linked> Renderer<'a, L> {
             last_encoded: [0; 3],
             scratch: Scratch::new(Mailbox::none()),
             first_hits: ScreenLists::None,
+            mirror_hits: ScreenLists::None,
+            mirror: None,
         };
         renderer.gamma.fill(s.gamma);
         Ok(renderer)
@@ -195,11 +276,23 @@ impl<'a, L: Linked> Renderer<'a, L> {
     /// links them, and the scene's octree, if any, is walked by 3DDDA).
     /// The same image, faster; too little room leaves the walk. A
     /// [`RendererRoom`](crate::RendererRoom) holds it.
-    pub(crate) fn set_first_hits(&mut self, bounds: &'a mut [ScreenBound], positions: &'a mut [u16]) {
-        if self.tracer.accel().first_hits_by_screen()
-            && FirstHits::fit(self.tracer.scene(), &self.camera, bounds, positions)
-        {
-            self.first_hits = ScreenLists::Room(bounds, positions);
+    ///
+    /// Room for as many again (`mirror`) lists the hits of the reflections
+    /// of camera rays off the scene's mirror, if it has one
+    /// ([`SceneView::has_mirror`]).
+    pub(crate) fn set_first_hits(&mut self, lists: ScreenRoom<'a>, mirror: Option<ScreenRoom<'a>>) {
+        let (scene, camera) = (self.tracer.scene(), &self.camera);
+        let fits = |(bounds, positions): &ScreenRoom<'a>| FirstHits::fit(scene, camera, bounds, positions);
+        if !self.tracer.accel().first_hits_by_screen() || !fits(&lists) {
+            return;
+        }
+        self.first_hits = ScreenLists::Room(lists.0, lists.1);
+        let mirror = mirror.filter(|_| self.tracer.accel().mirror_hits_by_screen());
+        if let (Some(room), Some(plane)) = (mirror.filter(fits), scene.mirror()) {
+            if camera.mirrored(plane.axis, plane.coordinate).is_some() {
+                self.mirror_hits = ScreenLists::Room(room.0, room.1);
+                self.mirror = Some(plane);
+            }
         }
     }
 
@@ -208,16 +301,7 @@ impl<'a, L: Linked> Renderer<'a, L> {
     #[cold]
     #[inline(never)]
     fn fill_first_hits<Q: Poll>(&mut self, poll: &mut Q) -> bool {
-        let scene = self.tracer.scene();
-        let ScreenLists::Room(bounds, _) = &mut self.first_hits else { return true };
-        if !FirstHits::project(scene, &self.camera, bounds, poll) {
-            return false;
-        }
-        if let ScreenLists::Room(bounds, positions) = core::mem::replace(&mut self.first_hits, ScreenLists::None) {
-            self.first_hits = FirstHits::new(scene.object_count(), &self.camera, bounds, positions)
-                .map_or(ScreenLists::None, ScreenLists::Lists);
-        }
-        true
+        fill(&mut self.first_hits, self.tracer.scene(), &self.camera, None, poll)
     }
 
     /// The camera ray's hit from the screen lists, if the renderer has them
@@ -380,7 +464,19 @@ impl<'a, L: Linked> Renderer<'a, L> {
                 self.tracer.missed(&mut self.scratch)
             }
             Some(None) => (Color::BLACK, None),
-            first => self.tracer.trace(*ray.get(&self.camera), first, &mut self.scratch, poll),
+            first => {
+                // One tracer for scenes with a mirror and without (a second
+                // would take the shading out of line, for every hit).
+                let mut mirror = ListedMirror::<L> {
+                    lists: &mut self.mirror_hits,
+                    linked: core::marker::PhantomData,
+                    plane: self.mirror,
+                    camera: &self.camera,
+                    offsets: ray.offsets,
+                    pixel: [x, y],
+                };
+                self.tracer.trace(*ray.get(&self.camera), first, &mut self.scratch, poll, &mut mirror)
+            }
         };
         // A stopped sample's colour is partial: never used.
         poll.stopped()?;

@@ -853,7 +853,7 @@ mod tests {
             let mut bounds = vec![crate::render::ScreenBound::EMPTY; view.object_count()];
             let mut positions = vec![0; crate::render::ScreenBound::positions_for(view.object_count())];
             let mut listed = Renderer::with_size(view, &octree, w, h).unwrap();
-            listed.set_first_hits(&mut bounds, &mut positions);
+            listed.set_first_hits((&mut bounds, &mut positions), None);
             let mut naive = Renderer::with_size(view, &naive, w, h).unwrap();
             let expected = direct(&mut naive);
             assert_eq!(direct(&mut listed), expected);

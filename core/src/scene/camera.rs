@@ -203,6 +203,26 @@ impl Camera {
         })
     }
 
+    /// The camera's mirror image in the plane across `axis` at `coordinate`
+    /// (Q16.16 bits): each of its rays is this camera's ray of the same
+    /// offsets, mirrored, to the bit (normalising a vector does not see its
+    /// signs). `None` if the mirrored eye is out of normalised range.
+    pub(crate) fn mirrored(&self, axis: usize, coordinate: i32) -> Option<Camera> {
+        let mut eye = self.eye.bits();
+        eye[axis] = i32::try_from(2 * coordinate as i64 - eye[axis] as i64).ok()?;
+        let mirror = |mut v: [i64; 3]| {
+            v[axis] = -v[axis];
+            v
+        };
+        Some(Camera {
+            eye: Vec3::from_bits(eye),
+            forward: mirror(self.forward),
+            step_x: mirror(self.step_x),
+            step_y: mirror(self.step_y),
+            ..*self
+        })
+    }
+
     /// Image width in pixels.
     pub fn width(&self) -> u32 {
         self.width

@@ -14,12 +14,14 @@
 //! a `static` costs no flash.
 
 mod camera;
+mod mirror;
 pub(crate) mod motion;
 mod normalize;
 mod surface;
 
 pub use camera::{Camera, CameraError, View, MAX_SAMPLES, MAX_SIDE};
 pub(crate) use camera::{CameraRay, Projection, RayCursor, Stride};
+pub(crate) use mirror::MirrorPlane;
 pub use motion::{displacement_at, Frames};
 pub use normalize::{Normalization, WorldPoint, WorldValue};
 pub use surface::{Color, Surface, SurfaceEntry};

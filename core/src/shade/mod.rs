@@ -20,6 +20,12 @@
 //! is partial, and `Poll::stopped` says so; one not stopped gives the
 //! same bits whether it was asked or not.
 
+mod mirror;
+
+pub(crate) use mirror::Mirror;
+#[cfg(test)]
+pub(crate) use mirror::NoMirror;
+
 use crate::accel::{uses_mailbox, Accelerator, Hit, Linked, Mailbox, RayStart, SceneAccelerator, ShadowLinks};
 use crate::math::{
     leading_zeros, mul_u32_wide, mul_wide, pow_unit, reciprocal_start, shr_saturating_u32, shr_signed_to_u32, Dir,
@@ -236,21 +242,28 @@ impl<'a, L: Linked> Tracer<'a, L> {
     }
 
     /// The linear colour seen along a primary ray, and the object it hits (as
-    /// written: [`SceneView::written_object`]).
+    /// written: [`SceneView::written_object`]); `first_hit` is the ray's hit
+    /// when the caller knows it, `mirror` where its reflection's may be
+    /// found.
     // Not inlined: a frame of its own keeps the stack of a small board bounded
     // (inlined into the row loop, its locals and the pending rays multiply).
     #[inline(never)]
-    pub fn trace<Q: Poll>(
+    pub fn trace<Q: Poll, M: Mirror>(
         &self,
         ray: Ray,
         mut first_hit: Option<Option<Hit>>,
         scratch: &mut Scratch<'_>,
         poll: &mut Q,
+        mirror: &mut M,
     ) -> (Color, Option<ObjectId>) {
         let mut stack: heapless::Vec<Pending, PENDING_RAYS> = heapless::Vec::new();
         let mut color = Color::BLACK;
         let mut first_object = None;
         let mut traced = 0;
+        // Where the camera ray hit, and whether its reflection is the
+        // mirror's (the one reflected ray of depth 1), for the mirror's lists.
+        let mut primary_t = Scalar::ZERO;
+        let mut mirrored = false;
         // The ray being traced; its first child follows it directly, the
         // other waits on the stack (depth first, as a recursion would go).
         let mut p = Pending { ray, start: None, depth: 0, weight: Scalar::ONE, kind: RayKind::Primary };
@@ -264,7 +277,14 @@ impl<'a, L: Linked> Tracer<'a, L> {
             }
             traced += 1;
             scratch.stats.rays += 1;
-            let hit = match first_hit.take() {
+            let listed = match first_hit.take() {
+                Some(hit) => Some(hit),
+                None if M::LISTS && mirrored && p.depth == 1 && p.kind == RayKind::Reflected => {
+                    mirror.nearest(&self.scene, &p.ray, p.start, primary_t, poll)
+                }
+                None => None,
+            };
+            let hit = match listed {
                 Some(hit) => hit,
                 None => {
                     if uses_mailbox::<L>() {
@@ -284,6 +304,11 @@ impl<'a, L: Linked> Tracer<'a, L> {
                 None => color = color.saturating_add(self.background(p.weight)),
                 Some(hit) => {
                     let children = self.shade(&p, hit, &mut color, scratch, poll);
+                    if M::LISTS && p.depth == 0 {
+                        primary_t = hit.t;
+                        mirrored =
+                            mirror.plane().zip(children[1]).is_some_and(|(plane, r)| plane.mirrors(&p.ray, &r.ray));
+                    }
                     for &child in children.iter().flatten() {
                         if child.weight.to_bits() <= 0 {
                             continue;
@@ -538,7 +563,7 @@ mod shading_tests {
 
     /// What `tracer` sees along `ray`.
     fn traced(tracer: &Tracer<'_, Board64K>, ray: Ray, scratch: &mut Scratch<'_>) -> (Color, Option<ObjectId>) {
-        tracer.trace(ray, None, scratch, &mut Unpolled)
+        tracer.trace(ray, None, scratch, &mut Unpolled, &mut NoMirror)
     }
 
     fn approx(c: Color, rgb: [i32; 3]) {
