@@ -660,6 +660,43 @@ mod tests {
         assert!(mirrors > 50 && rays > 20_000 && skipped * 3 > naive_tests, "the lists must leave objects out");
     }
 
+    /// A band seen through too many objects has no tiles: its rays walk,
+    /// every one of them (none reads the tile list the band before left).
+    #[test]
+    fn a_band_of_too_many_objects_leaves_every_ray_to_the_walk() {
+        crate::profile! { struct Crowd { spheres: 700, surfaces: 1, lights: 1 } }
+        // One sphere seen in the top band's last tile, 600 in a row across
+        // the next band (a pixel is about 0.23 units there).
+        let mut text = String::from("VIEWPOINT 0 0 40\nRASTER 200 64\nSURFACE 1 .1 .1 .1 .5 .5 .5 0 0 0 0 0 0\n");
+        text += "SPHERE 1 0.5 22 6.6 0\n";
+        for i in 0..600 {
+            text += &format!("SPHERE 1 0.2 {} 4.6 0\n", -20.0 + i as f64 / 15.0);
+        }
+        let mut scene: Box<Scene<Crowd>> = Box::default();
+        parse(&text, &mut scene, &mut |e| panic!("{e}")).unwrap();
+        let view = scene.view();
+        let camera = Camera::new(&view.settings.view, &view.normalization, 200, 64, 1).unwrap();
+        let mut bounds = vec![ScreenBound::EMPTY; view.object_count()];
+        let mut positions = vec![0; ScreenBound::positions_for(view.object_count())];
+        assert!(FirstHits::fit(&view, &camera, &bounds, &positions));
+        assert!(FirstHits::project(&view, &camera, &mut bounds, &mut crate::shade::Unpolled, None));
+        let mut hits = FirstHits::new(view.object_count(), &camera, &mut bounds, &mut positions).unwrap();
+        let (mut crowded, mut listed) = (0, 0);
+        for (x, y) in (0..64 * 200).map(|p| (p % 200, p / 200)) {
+            let ray = camera.ray(x, y, 0, 0);
+            let mut lazy = camera.next_ray(&mut RayCursor::default(), x, y, 0, 0);
+            let naive = Naive.nearest(&view, &ray, None, &mut Mailbox::none());
+            match hits.nearest(&view, ShapeKinds::ALL, &camera, &mut lazy, [x, y]) {
+                Some(hit) => {
+                    assert_eq!(hit, naive, "pixel {x} {y}");
+                    listed += 1;
+                }
+                None => crowded += 1,
+            }
+        }
+        assert!(crowded >= 200 && listed >= 200, "{crowded} rays walked, {listed} listed");
+    }
+
     /// Every camera offset fits 16 bits once shifted, and a window narrowed
     /// to 16 bits still holds every offset the full one held, for images
     /// of every size up to the largest.
