@@ -110,13 +110,18 @@ impl<P: Profile> Room<P> {
         let copies = if P::MIRROR_HITS { 2 } else { 1 };
         fill(&mut self.screen_bounds, copies * listed, ScreenBound::EMPTY);
         fill(&mut self.screen_positions, copies * ScreenBound::positions_for(listed), 0);
-        let bounds = self.screen_bounds.as_mut_slice();
-        let positions = self.screen_positions.as_mut_slice();
-        let (bounds, mirror_bounds) = bounds.split_at_mut(listed.min(bounds.len()));
-        let (positions, mirror_positions) =
-            positions.split_at_mut(ScreenBound::positions_for(listed).min(positions.len()));
-        let mirror = P::MIRROR_HITS.then_some((mirror_bounds, mirror_positions));
-        (self.mailbox.as_mut_slice(), first_hits.then_some(((bounds, positions), mirror)))
+        let (bounds, positions) = (self.screen_bounds.as_mut_slice(), self.screen_positions.as_mut_slice());
+        let lists = match P::MIRROR_HITS {
+            // A constant: a profile without the mirror's room links no split.
+            false => ((bounds, positions), None),
+            true => {
+                let (bounds, mirror_bounds) = bounds.split_at_mut(listed.min(bounds.len()));
+                let (positions, mirror_positions) =
+                    positions.split_at_mut(ScreenBound::positions_for(listed).min(positions.len()));
+                ((bounds, positions), Some((mirror_bounds, mirror_positions)))
+            }
+        };
+        (self.mailbox.as_mut_slice(), first_hits.then_some(lists))
     }
 }
 

@@ -107,14 +107,17 @@ impl ScreenBound {
     /// A window that no offsets are in: an object no listed ray can hit.
     const UNSEEN: ScreenBound = ScreenBound { near: i32::MAX, object: 0, x: [u16::MAX, 0], y: [u16::MAX, 0] };
 
+    /// `MIRROR`: whether `mirror` may be given (a build without mirror
+    /// lists links only the camera's form).
     #[inline(never)]
-    fn of(
+    fn of<const MIRROR: bool>(
         scene: &SceneView<'_>,
         projection: &Projection,
         shift: u32,
         id: ObjectId,
         mirror: Option<MirrorPlane>,
     ) -> ScreenBound {
+        let mirror = mirror.filter(|_| MIRROR);
         let bounds = scene.shape(id).bounds();
         let margin = FILING_MARGIN + mirror.map_or(0, |_| MirrorPlane::OFFSET);
         let lo = bounds.min.wide().map(|v| v - margin);
@@ -233,9 +236,10 @@ impl<'a> FirstHits<'a> {
     /// Projects every object of `scene` seen by `camera` into `bounds`,
     /// asking `poll` before each (an object's projection costs about what
     /// a ray does); false if it said stop.
-    /// With `mirror`, `camera` is the eye's mirror image in it, and the
-    /// bounds are for the reflections of the real camera's rays.
-    pub fn project<Q: Poll>(
+    /// With `mirror` (only when `MIRROR`), `camera` is the eye's mirror
+    /// image in it, and the bounds are for the reflections of the real
+    /// camera's rays.
+    pub fn project<Q: Poll, const MIRROR: bool>(
         scene: &SceneView<'_>,
         camera: &Camera,
         bounds: &mut [ScreenBound],
@@ -248,7 +252,7 @@ impl<'a> FirstHits<'a> {
             if !poll.go_on() {
                 return false;
             }
-            *slot = ScreenBound::of(scene, &projection, shift, id, mirror);
+            *slot = ScreenBound::of::<MIRROR>(scene, &projection, shift, id, mirror);
         }
         true
     }
@@ -569,7 +573,7 @@ mod tests {
             if !FirstHits::fit(&view, &camera, &bounds, &positions) {
                 continue;
             }
-            assert!(FirstHits::project(&view, &camera, &mut bounds, &mut crate::shade::Unpolled, None));
+            assert!(FirstHits::project::<_, false>(&view, &camera, &mut bounds, &mut crate::shade::Unpolled, None));
             let Some(mut hits) = FirstHits::new(view.object_count(), &camera, &mut bounds, &mut positions) else {
                 continue;
             };
@@ -616,7 +620,13 @@ mod tests {
             if !FirstHits::fit(&view, &camera, &bounds, &positions) {
                 continue;
             }
-            assert!(FirstHits::project(&view, &image, &mut bounds, &mut crate::shade::Unpolled, Some(plane)));
+            assert!(FirstHits::project::<_, true>(
+                &view,
+                &image,
+                &mut bounds,
+                &mut crate::shade::Unpolled,
+                Some(plane)
+            ));
             let Some(mut hits) = FirstHits::new(view.object_count(), &image, &mut bounds, &mut positions) else {
                 continue;
             };
@@ -679,7 +689,7 @@ mod tests {
         let mut bounds = vec![ScreenBound::EMPTY; view.object_count()];
         let mut positions = vec![0; ScreenBound::positions_for(view.object_count())];
         assert!(FirstHits::fit(&view, &camera, &bounds, &positions));
-        assert!(FirstHits::project(&view, &camera, &mut bounds, &mut crate::shade::Unpolled, None));
+        assert!(FirstHits::project::<_, false>(&view, &camera, &mut bounds, &mut crate::shade::Unpolled, None));
         let mut hits = FirstHits::new(view.object_count(), &camera, &mut bounds, &mut positions).unwrap();
         let (mut crowded, mut listed) = (0, 0);
         for (x, y) in (0..64 * 200).map(|p| (p % 200, p / 200)) {

@@ -141,11 +141,12 @@ pub struct Renderer<'a, L: Linked> {
 pub(crate) type ScreenRoom<'a> = (&'a mut [ScreenBound], &'a mut [u16]);
 
 /// Fills `lists`' room, if that is what it holds, for `camera` (the eye's
-/// image in `mirror`, if given), `poll` asked before each object: false if
-/// it said stop (the room stays, for the next ray to fill).
+/// image in `mirror`, if given: only when `MIRROR`), `poll` asked before
+/// each object: false if it said stop (the room stays, for the next ray to
+/// fill).
 #[cold]
 #[inline(never)]
-fn fill<'a, Q: Poll>(
+fn fill<'a, Q: Poll, const MIRROR: bool>(
     lists: &mut ScreenLists<'a>,
     scene: &SceneView<'_>,
     camera: &Camera,
@@ -153,7 +154,7 @@ fn fill<'a, Q: Poll>(
     poll: &mut Q,
 ) -> bool {
     let ScreenLists::Room(bounds, _) = lists else { return true };
-    if !FirstHits::project(scene, camera, bounds, poll, mirror) {
+    if !FirstHits::project::<Q, MIRROR>(scene, camera, bounds, poll, mirror) {
         return false;
     }
     if let ScreenLists::Room(bounds, positions) = core::mem::replace(lists, ScreenLists::None) {
@@ -200,7 +201,7 @@ impl<L: Linked> Mirror for ListedMirror<'_, '_, L> {
             let plane = self.plane?;
             let image = self.camera.mirrored(plane.axis, plane.coordinate)?;
             // Stopped: the sample is given up at its next ray.
-            if !fill(self.lists, scene, &image, Some(plane), poll) {
+            if !fill::<Q, true>(self.lists, scene, &image, Some(plane), poll) {
                 return None;
             }
         }
@@ -287,12 +288,15 @@ impl<'a, L: Linked> Renderer<'a, L> {
             return;
         }
         self.first_hits = ScreenLists::Room(lists.0, lists.1);
-        let mirror = mirror.filter(|_| self.tracer.accel().mirror_hits_by_screen());
-        if let (Some(room), Some(plane)) = (mirror.filter(fits), scene.mirror()) {
-            if camera.mirrored(plane.axis, plane.coordinate).is_some() {
-                self.mirror_hits = ScreenLists::Room(room.0, room.1);
-                self.mirror = Some(plane);
-            }
+        // Asked first: a build without the lists links none of the rest.
+        if !self.tracer.accel().mirror_hits_by_screen() {
+            return;
+        }
+        let Some(room) = mirror.filter(fits) else { return };
+        let Some(plane) = scene.mirror() else { return };
+        if camera.mirrored(plane.axis, plane.coordinate).is_some() {
+            self.mirror_hits = ScreenLists::Room(room.0, room.1);
+            self.mirror = Some(plane);
         }
     }
 
@@ -301,7 +305,7 @@ impl<'a, L: Linked> Renderer<'a, L> {
     #[cold]
     #[inline(never)]
     fn fill_first_hits<Q: Poll>(&mut self, poll: &mut Q) -> bool {
-        fill(&mut self.first_hits, self.tracer.scene(), &self.camera, None, poll)
+        fill::<Q, false>(&mut self.first_hits, self.tracer.scene(), &self.camera, None, poll)
     }
 
     /// The camera ray's hit from the screen lists, if the renderer has them

@@ -277,20 +277,22 @@ impl<'a, L: Linked> Tracer<'a, L> {
             }
             traced += 1;
             scratch.stats.rays += 1;
-            let listed = match first_hit.take() {
-                Some(hit) => Some(hit),
-                None if M::LISTS && mirrored && p.depth == 1 && p.kind == RayKind::Reflected => {
-                    mirror.nearest(&self.scene, &p.ray, p.start, primary_t, poll)
-                }
-                None => None,
-            };
-            let hit = match listed {
+            let hit = match first_hit.take() {
                 Some(hit) => hit,
                 None => {
-                    if uses_mailbox::<L>() {
-                        scratch.mailbox.clear();
+                    let listed = match M::LISTS && mirrored && p.depth == 1 && p.kind == RayKind::Reflected {
+                        true => mirror.nearest(&self.scene, &p.ray, p.start, primary_t, poll),
+                        false => None,
+                    };
+                    match listed {
+                        Some(hit) => hit,
+                        None => {
+                            if uses_mailbox::<L>() {
+                                scratch.mailbox.clear();
+                            }
+                            self.accel.nearest(&self.scene, &p.ray, p.start, &mut scratch.mailbox)
+                        }
                     }
-                    self.accel.nearest(&self.scene, &p.ray, p.start, &mut scratch.mailbox)
                 }
             };
             if p.depth == 0 {

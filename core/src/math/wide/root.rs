@@ -71,7 +71,10 @@ fn rsqrt_normalised(f: u32) -> u32 {
 }
 
 /// Floor of the square root of a `u64`, without division.
-#[inline]
+// Out of line: long code, and its callers (a sphere's exact test, a cone's
+// and a screen bound's set-up) each had their own copy whenever LLVM
+// chose to inline it (a board's flash +1.4 %).
+#[inline(never)]
 pub fn isqrt(n: u64) -> u64 {
     if n < 2 {
         return n;
