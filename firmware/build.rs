@@ -179,7 +179,7 @@ fn main() {
     let mut linker_script =
         std::fs::read_to_string(&memory).unwrap_or_else(|e| fail(format!("{}: {e}", memory.display())));
     if board.name == "microbit" {
-        let stack = microbit_stack(wire, rdepth(&text));
+        let stack = microbit_stack(wire, surveyed(&text).0);
         board.static_ram = MICROBIT_RAM - stack;
         linker_script = linker_script.replace("STACK_BYTES", &stack.to_string());
     }
@@ -202,6 +202,12 @@ fn main() {
             Techniques::NAMES.join(", ")
         ))
     };
+    // The mirror's lists serve a scene with a mirror walked in an octree
+    // (a few objects, traced naively, cost a reflection what they would);
+    // not on the micro:bit, whose stack is sized for the builds measured
+    // without them (making them from inside a ray's trace overflowed it).
+    let indexed = accel.resolve(count(&text).objects).traversal().is_some();
+    wanted.mirror_hits &= wanted.first_hits && indexed && board.name != "microbit" && surveyed(&text).1;
     // The naive mode asked for by name stays the thesis's test of every
     // object: the board API gives it no light buffer of its own.
     if accel == AccelMode::Naive {
@@ -236,7 +242,7 @@ fn main() {
             octree: Some(&config),
             named_walk,
             first_hits: techniques.first_hits,
-            mirror_hits: false,
+            mirror_hits: techniques.mirror_hits,
             coherence: false,
             motion,
         };
@@ -302,7 +308,7 @@ fn main() {
         octree: Some(&octree),
         named_walk,
         first_hits: techniques.first_hits,
-        mirror_hits: false,
+        mirror_hits: techniques.mirror_hits,
         coherence: false,
         motion,
     };
@@ -355,23 +361,25 @@ fn microbit_stack(wire: PanelColor, rdepth: u32) -> usize {
     }
 }
 
-/// The scene's RDEPTH (the deepest its stack goes); a scene with errors
-/// the deepest there is, and the board then reports its errors.
-fn rdepth(text: &str) -> u32 {
+/// The scene's RDEPTH (the deepest its stack goes; a scene with errors
+/// the deepest there is, and the board then reports its errors) and
+/// whether it has a mirror (`SceneView::has_mirror`).
+fn surveyed(text: &str) -> (u32, bool) {
     let mut scene = Box::new(Scene::<Host>::new());
     match parse(text, &mut scene, &mut |_| {}) {
-        Ok(_) => scene.view().settings.rdepth,
-        Err(_) => u32::MAX,
+        Ok(_) => (scene.view().settings.rdepth, scene.view().has_mirror()),
+        Err(_) => (u32::MAX, false),
     }
 }
 
 /// What a board may spend memory on beyond the scene to render faster
-/// (the same image): the camera rays' screen lists, the octree's shadow
-/// shafts and the shadow rays' light buffer, in RAM or (built here) in
-/// flash.
+/// (the same image): the camera rays' screen lists (and the mirror's), the
+/// octree's shadow shafts and the shadow rays' light buffer, in RAM or
+/// (built here) in flash.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Techniques {
     first_hits: bool,
+    mirror_hits: bool,
     shadow_shafts: bool,
     /// Cells a face side of the light buffer's cubes in RAM (0: none there).
     light_buffer: u32,
@@ -380,19 +388,25 @@ struct Techniques {
 }
 
 impl Techniques {
-    const NONE: Techniques =
-        Techniques { first_hits: false, shadow_shafts: false, light_buffer: 0, light_buffer_in_flash: false };
-    const NAMES: [&str; 4] = ["first-hits", "shadow-shafts", "light-buffer", "light-buffer-ram"];
+    const NONE: Techniques = Techniques {
+        first_hits: false,
+        mirror_hits: false,
+        shadow_shafts: false,
+        light_buffer: 0,
+        light_buffer_in_flash: false,
+    };
+    const NAMES: [&str; 5] = ["first-hits", "shadow-shafts", "light-buffer", "light-buffer-ram", "mirror-hits"];
     /// The light buffer's cubes tried in RAM, finest first.
     const LIGHT_CELLS: [u32; 6] = [32, 16, 8, 4, 2, 1];
 
-    /// `auto` (the screen lists and the shafts where they fit, the light
-    /// buffer in flash), `none`, or a comma list of names.
+    /// `auto` (the screen lists, the mirror's and the shafts where they
+    /// fit, the light buffer in flash), `none`, or a comma list of names.
     fn from_names(names: &str) -> Option<Techniques> {
         match names {
             "auto" => {
                 return Some(Techniques {
                     first_hits: true,
+                    mirror_hits: true,
                     shadow_shafts: true,
                     light_buffer_in_flash: true,
                     ..Techniques::NONE
@@ -407,7 +421,8 @@ impl Techniques {
                 0 => wanted.first_hits = true,
                 1 => wanted.shadow_shafts = true,
                 2 => wanted.light_buffer_in_flash = true,
-                _ => wanted.light_buffer = Techniques::LIGHT_CELLS[0],
+                3 => wanted.light_buffer = Techniques::LIGHT_CELLS[0],
+                _ => wanted.mirror_hits = true,
             }
         }
         Some(wanted)
@@ -420,17 +435,22 @@ impl Techniques {
     /// light.
     fn subsets(self) -> impl Iterator<Item = Techniques> {
         let light_cells = Techniques::LIGHT_CELLS.into_iter().chain([0]);
-        [(true, true), (true, false), (false, true), (false, false)]
+        // The mirror's lists only beside the camera's.
+        let lists = [(true, true), (true, false), (false, false)];
+        lists
             .into_iter()
+            .flat_map(|lists| [true, false].map(move |shafts| (lists, shafts)))
             .flat_map(move |both| light_cells.clone().map(move |cells| (both, cells)))
-            .map(move |((first_hits, shadow_shafts), light_buffer)| Techniques {
+            .map(move |(((first_hits, mirror_hits), shadow_shafts), light_buffer)| Techniques {
                 first_hits,
+                mirror_hits,
                 shadow_shafts,
                 light_buffer,
                 light_buffer_in_flash: self.light_buffer_in_flash,
             })
             .filter(move |t| {
                 (self.first_hits || !t.first_hits)
+                    && (self.mirror_hits || !t.mirror_hits)
                     && (self.shadow_shafts || !t.shadow_shafts)
                     && t.light_buffer <= self.light_buffer
             })
