@@ -71,10 +71,11 @@ fn rsqrt_normalised(f: u32) -> u32 {
 }
 
 /// Floor of the square root of a `u64`, without division.
-// Out of line: long code, and its callers (a sphere's exact test, a cone's
-// and a screen bound's set-up) each had their own copy whenever LLVM
-// chose to inline it (a board's flash +1.4 %).
-#[inline(never)]
+// Out of line on a board: long code, and its callers (a sphere's exact
+// test, a cone's and a screen bound's set-up) each had their own copy
+// whenever LLVM chose to inline it (the RISC-V firmware's flash +1.4 %).
+#[cfg_attr(target_os = "none", inline(never))]
+#[cfg_attr(not(target_os = "none"), inline)]
 pub fn isqrt(n: u64) -> u64 {
     if n < 2 {
         return n;
