@@ -178,8 +178,10 @@ fn main() {
     // this build needs and the statics.
     let mut linker_script =
         std::fs::read_to_string(&memory).unwrap_or_else(|e| fail(format!("{}: {e}", memory.display())));
+    // Parsed once: the stack the micro:bit needs, and the mirror's lists.
+    let (rdepth, has_mirror) = surveyed(&text);
     if board.name == "microbit" {
-        let stack = microbit_stack(wire, surveyed(&text).0);
+        let stack = microbit_stack(wire, rdepth);
         board.static_ram = MICROBIT_RAM - stack;
         linker_script = linker_script.replace("STACK_BYTES", &stack.to_string());
     }
@@ -207,7 +209,7 @@ fn main() {
     // not on the micro:bit, whose stack is sized for the builds measured
     // without them (making them from inside a ray's trace overflowed it).
     let indexed = accel.resolve(count(&text).objects).traversal().is_some();
-    wanted.mirror_hits &= wanted.first_hits && indexed && board.name != "microbit" && surveyed(&text).1;
+    wanted.mirror_hits &= wanted.first_hits && indexed && board.name != "microbit" && has_mirror;
     // The naive mode asked for by name stays the thesis's test of every
     // object: the board API gives it no light buffer of its own.
     if accel == AccelMode::Naive {
@@ -218,7 +220,7 @@ fn main() {
     // a few words, built by the board in RAM, where checking a copy in
     // flash would take longer than building it.
     let wanted_light_buffer = wanted.light_buffer > 0 || wanted.light_buffer_in_flash;
-    if accel.resolve(count(&text).objects).traversal().is_none() {
+    if !indexed {
         wanted.light_buffer = if wanted_light_buffer { Techniques::LIGHT_CELLS[0] } else { 0 };
         wanted.light_buffer_in_flash = false;
     }

@@ -513,8 +513,11 @@ mod host {
         // RAM is plenty: shadow shafts on.
         const OCTREE: OctreeConfig = OctreeConfig { shadow_shafts: true, ..OctreeConfig::DEFAULT };
         type MailboxWords = HeapArena<u32, { Host::COUNTS.mailbox_words() }>;
-        type ScreenBounds = HeapArena<ScreenBound, { 2 * Host::COUNTS.objects }>;
-        type ScreenPositions = HeapArena<u16, { 2 * ScreenBound::positions_for(Host::COUNTS.objects) }>;
+        type ScreenBounds = HeapArena<ScreenBound, { ScreenBound::lists(Host::MIRROR_HITS) * Host::COUNTS.objects }>;
+        type ScreenPositions = HeapArena<
+            u16,
+            { ScreenBound::lists(Host::MIRROR_HITS) * ScreenBound::positions_for(Host::COUNTS.objects) },
+        >;
         type LightBufferWords = HeapArena<u32, { Host::COUNTS.light_buffer_words }>;
     }
 

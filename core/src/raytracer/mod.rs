@@ -107,7 +107,7 @@ impl<P: Profile> Room<P> {
     fn prepare(&mut self, objects: usize, first_hits: bool) -> (&mut [u32], Option<ScreenLists<'_>>) {
         fill(&mut self.mailbox, Mailbox::words_for(objects), 0);
         let listed = if first_hits { objects } else { 0 };
-        let copies = if P::MIRROR_HITS { 2 } else { 1 };
+        let copies = ScreenBound::lists(P::MIRROR_HITS);
         fill(&mut self.screen_bounds, copies * listed, ScreenBound::EMPTY);
         fill(&mut self.screen_positions, copies * ScreenBound::positions_for(listed), 0);
         let (bounds, positions) = (self.screen_bounds.as_mut_slice(), self.screen_positions.as_mut_slice());

@@ -298,8 +298,9 @@ impl<'a> FirstHits<'a> {
 
     /// The nearest hit of `ray`, the reflection off the lists' mirror of
     /// the camera ray with `offsets` through pixel (`x`, `y`), which hit the
-    /// mirror at `primary_t`; `camera` is the mirrored one the lists were
-    /// made for. The hit the accelerator's `nearest` returns for it.
+    /// mirror at `primary_t`; `camera` is that ray's (its tiles are the
+    /// mirrored camera's the lists were made for). The hit the
+    /// accelerator's `nearest` returns for it.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     pub fn nearest_reflected(
@@ -553,6 +554,11 @@ mod tests {
         scene
     }
 
+    /// Room for one set of lists over `view`'s objects.
+    fn room(view: &SceneView<'_>) -> (std::vec::Vec<ScreenBound>, std::vec::Vec<u16>) {
+        (vec![ScreenBound::EMPTY; view.object_count()], vec![0; ScreenBound::positions_for(view.object_count())])
+    }
+
     /// Every camera ray of random scenes gets the naive mode's hit (the
     /// same parameter and object), while most of the objects' tests are
     /// skipped.
@@ -568,8 +574,7 @@ mod tests {
                 continue;
             }
             let camera = Camera::new(&view.settings.view, &view.normalization, w, h, view.settings.samples).unwrap();
-            let mut bounds = vec![ScreenBound::EMPTY; view.object_count()];
-            let mut positions = vec![0; ScreenBound::positions_for(view.object_count())];
+            let (mut bounds, mut positions) = room(&view);
             if !FirstHits::fit(&view, &camera, &bounds, &positions) {
                 continue;
             }
@@ -615,8 +620,7 @@ mod tests {
             let Some(plane) = view.mirror() else { continue };
             let camera = Camera::new(&view.settings.view, &view.normalization, w, h, view.settings.samples).unwrap();
             let Some(image) = camera.mirrored(plane.axis, plane.coordinate) else { continue };
-            let mut bounds = vec![ScreenBound::EMPTY; view.object_count()];
-            let mut positions = vec![0; ScreenBound::positions_for(view.object_count())];
+            let (mut bounds, mut positions) = room(&view);
             if !FirstHits::fit(&view, &camera, &bounds, &positions) {
                 continue;
             }
@@ -686,8 +690,7 @@ mod tests {
         parse(&text, &mut scene, &mut |e| panic!("{e}")).unwrap();
         let view = scene.view();
         let camera = Camera::new(&view.settings.view, &view.normalization, 200, 64, 1).unwrap();
-        let mut bounds = vec![ScreenBound::EMPTY; view.object_count()];
-        let mut positions = vec![0; ScreenBound::positions_for(view.object_count())];
+        let (mut bounds, mut positions) = room(&view);
         assert!(FirstHits::fit(&view, &camera, &bounds, &positions));
         assert!(FirstHits::project::<_, false>(&view, &camera, &mut bounds, &mut crate::shade::Unpolled, None));
         let mut hits = FirstHits::new(view.object_count(), &camera, &mut bounds, &mut positions).unwrap();

@@ -204,9 +204,11 @@ impl Camera {
     }
 
     /// The camera's mirror image in the plane across `axis` at `coordinate`
-    /// (Q16.16 bits): each of its rays is this camera's ray of the same
-    /// offsets, mirrored, to the bit (normalising a vector does not see its
-    /// signs). `None` if the mirrored eye is out of normalised range.
+    /// (Q16.16 bits; a `MirrorPlane`'s fields, taken apart so that this
+    /// file does not import the scene's mirror, which imports the scene):
+    /// each of its rays is this camera's ray of the same offsets, mirrored,
+    /// to the bit (normalising a vector does not see its signs). `None` if
+    /// the mirrored eye is out of normalised range.
     pub(crate) fn mirrored(&self, axis: usize, coordinate: i32) -> Option<Camera> {
         let mut eye = self.eye.bits();
         eye[axis] = i32::try_from(2 * coordinate as i64 - eye[axis] as i64).ok()?;
