@@ -28,6 +28,8 @@ pub struct Budgets {
     section: String,
     table: toml::Table,
     checked: BTreeSet<(String, String)>,
+    /// Every figure checked against a budget, as the run printed it.
+    measured: Vec<String>,
     failures: Vec<String>,
     improved: Vec<String>,
 }
@@ -46,6 +48,7 @@ impl Budgets {
             section: section.to_owned(),
             table,
             checked: BTreeSet::new(),
+            measured: Vec::new(),
             failures: Vec::new(),
             improved: Vec::new(),
         })
@@ -69,6 +72,7 @@ impl Budgets {
             Err(e) => return self.failures.push(e),
         };
         let percent = |v: u64| 100.0 * (v as f64 / budget as f64 - 1.0);
+        self.measured.push(format!("{subject}: {figure} {value} ({:+.2} % against {budget})", percent(value)));
         if value * 100 > budget * (100 + TOLERANCE_PERCENT) {
             self.failures.push(format!(
                 "{subject}: {figure} is {value}, {:+.2} % against its budget {budget} (more than {TOLERANCE_PERCENT} % \
@@ -124,8 +128,12 @@ impl Budgets {
         failures
     }
 
-    /// Prints the improvements, then panics with every failure, if any.
+    /// Prints every figure against its budget and the improvements, then
+    /// panics with every failure, if any.
     pub fn assert_within(&self, subjects: &[String]) {
+        for line in &self.measured {
+            println!("measured: {line}");
+        }
         for line in &self.improved {
             println!("budget: {line}");
         }
@@ -150,6 +158,7 @@ mod tests {
             section: "s".into(),
             table: table["s"].as_table().unwrap().clone(),
             checked: BTreeSet::new(),
+            measured: Vec::new(),
             failures: Vec::new(),
             improved: Vec::new(),
         }

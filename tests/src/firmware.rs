@@ -9,7 +9,7 @@
 //! target: build one configuration at a time (each ELF is then kept under
 //! its configuration's name, and runs while the next builds).
 
-use crate::{repo, scene_path};
+use crate::{board_cargo, repo, scene_path};
 use octrace_core::panel::Dithering;
 use octrace_core::render::PanelColor;
 use octrace_images::formats::Image;
@@ -132,15 +132,9 @@ impl Firmware {
     /// then go on while qemu runs this one.
     pub fn build(&self) -> Result<PathBuf, String> {
         let dir = boards_target_dir();
-        let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
-        // The firmware's .cargo/config.toml (runner, linker script) is found
-        // from the working directory.
-        cargo.current_dir(repo().join("firmware"));
+        let mut cargo = board_cargo(&repo().join("firmware"), self.board.target())?;
         cargo.args(["build", "--release", "--quiet", "--target", self.board.target()]);
         cargo.arg("--target-dir").arg(&dir);
-        for var in ["CARGO_TARGET_DIR", "RUSTFLAGS", "CARGO_ENCODED_RUSTFLAGS", "CARGO_BUILD_TARGET"] {
-            cargo.env_remove(var);
-        }
         cargo.env("OCTRACE_BOARD", self.board.machine());
         cargo.env("OCTRACE_SCENE", &self.scene);
         cargo.env("OCTRACE_SIZE", format!("{}x{}", self.width, self.height));
@@ -221,18 +215,11 @@ fn rgb565(r: u8, g: u8, b: u8) -> u16 {
 /// is under way there. Returns what the run printed; the
 /// panel's screen is in `out`.
 pub fn run_oled_command(scene: &str, out: &Path) -> Result<Run, String> {
-    let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
-    cargo.current_dir(repo().join("firmware"));
-    cargo.args(["run", "--release", "--quiet", "--target", "thumbv7m-none-eabi"]);
+    let target = "thumbv7m-none-eabi";
+    let mut cargo = board_cargo(&repo().join("firmware"), target)?;
+    cargo.args(["run", "--release", "--quiet", "--target", target]);
     cargo.arg("--target-dir").arg(boards_target_dir());
-    for var in [
-        "CARGO_TARGET_DIR",
-        "RUSTFLAGS",
-        "CARGO_ENCODED_RUSTFLAGS",
-        "CARGO_BUILD_TARGET",
-        "OCTRACE_SIZE",
-        "OCTRACE_DITHER",
-    ] {
+    for var in ["OCTRACE_SIZE", "OCTRACE_DITHER"] {
         cargo.env_remove(var);
     }
     cargo.env("OCTRACE_BOARD", "lm3s6965evb");

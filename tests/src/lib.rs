@@ -9,7 +9,8 @@ pub mod imports;
 pub mod pico;
 pub mod webdriver;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::process::Command;
 use std::time::Duration;
 
 /// The longest a test waits for an event (a board's answer, a browser's
@@ -22,6 +23,54 @@ pub const HANG_GUARD: Duration = Duration::from_secs(30 * 60);
 /// The repository root.
 pub fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// Where a board build's sources appear in its firmware: the checkout's
+/// path is written as this (see [`board_cargo`]).
+pub const BUILD_ROOT: &str = "/octrace";
+
+/// `cargo` in the board project `dir` (`firmware/`, a Pico template) for
+/// a build for `target`, as the budgets measure it: the variables that
+/// would change the build (a caller's target directory, flags, target)
+/// are cleared, and the checkout's path is written as [`BUILD_ROOT`].
+///
+/// A panic's location names its source file, and octrace-core (outside
+/// the board project's workspace) is given to rustc by its absolute path:
+/// without the remap a checkout's path would add its length to each such
+/// name in flash, and move the code in the Pico's XIP cache, so that the
+/// figures a clone measures in /check/work/main were not those of one in
+/// /work/main. `scripts/test-all` exports the same variable for every
+/// board target (so that its builds and these share their artifacts); a
+/// different one there fails this build, rather than build twice.
+pub fn board_cargo(dir: &Path, target: &str) -> Result<Command, String> {
+    let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
+    // The project's .cargo/config.toml (runner, linker script) is found
+    // from the working directory.
+    cargo.current_dir(dir);
+    for var in ["CARGO_TARGET_DIR", "RUSTFLAGS", "CARGO_ENCODED_RUSTFLAGS", "CARGO_BUILD_TARGET"] {
+        cargo.env_remove(var);
+    }
+    let root = std::fs::canonicalize(repo()).map_err(|e| format!("{}: {e}", repo().display()))?;
+    // Merged by cargo after the project's own target.TARGET.rustflags;
+    // whitespace separates flags, so a checkout's path must have none.
+    let remap = format!("--remap-path-prefix={}={BUILD_ROOT}", root.display());
+    if remap.contains(char::is_whitespace) {
+        return Err(format!(
+            "the checkout's path has a space, which cargo's flag variables cannot carry: {}",
+            root.display()
+        ));
+    }
+    let var = format!("CARGO_TARGET_{}_RUSTFLAGS", target.to_uppercase().replace(['-', '.'], "_"));
+    match std::env::var(&var) {
+        Ok(exported) if exported != remap => {
+            return Err(format!(
+                "{var} is {exported:?}, where the board builds take {remap:?} (scripts/test-all exports it)"
+            ));
+        }
+        _ => {}
+    }
+    cargo.env(var, remap);
+    Ok(cargo)
 }
 
 /// Scene `name` of `scenes/` (`scenes/NAME.txt`).

@@ -15,7 +15,7 @@
 //! scene at a time; each ELF is copied out under the template's and the
 //! build's name, so runs may overlap.
 
-use crate::{repo, scene_path};
+use crate::{board_cargo, repo, scene_path};
 use std::io::{BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -70,6 +70,9 @@ fn target_dir() -> PathBuf {
     repo().join("target/pico")
 }
 
+/// The RP2040's Rust target, which the templates' .cargo/config.toml set.
+const TARGET: &str = "thumbv6m-none-eabi";
+
 /// The scene the template embeds when `OCTRACE_SCENE` is not set.
 const DEFAULT_SCENE: &str = "fig5_1";
 
@@ -110,30 +113,21 @@ impl<'a> Build<'a> {
 
 /// Builds the template (release) as `build` says and returns its
 /// embedded-scene ELF. The default build is made as a user makes it,
-/// without any variable (and so as `scripts/test-all` built it already).
+/// without any `OCTRACE_` variable, and with the checkout's path remapped
+/// as all board builds ([`board_cargo`]): so `scripts/test-all` built it
+/// already.
 pub fn build(build: &Build<'_>) -> Result<PathBuf, String> {
     let template = build.template;
     if template == Template::Ssd1306 && build.order != "rows" {
         return Err(format!("{}: the SSD1306 template draws rows only, not {}", build.name(), build.order));
     }
     let dir = target_dir();
-    let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
-    // The template's .cargo/config.toml (target, linker script) is found
-    // from the working directory.
-    cargo.current_dir(template.dir());
+    let mut cargo = board_cargo(&template.dir(), TARGET)?;
     // Only the embedded-scene binary: the ST7789's live firmware embeds no
     // scene, and rebuilding it for each scene would cost a whole-program
     // build and replace the ELF the live board's cases may be starting.
     cargo.args(["build", "--release", "--quiet", "--bin", template.binary()]).arg("--target-dir").arg(&dir);
-    for var in [
-        "CARGO_TARGET_DIR",
-        "RUSTFLAGS",
-        "CARGO_ENCODED_RUSTFLAGS",
-        "CARGO_BUILD_TARGET",
-        "OCTRACE_SCENE",
-        "OCTRACE_CODE_IN",
-        "OCTRACE_ORDER",
-    ] {
+    for var in ["OCTRACE_SCENE", "OCTRACE_CODE_IN", "OCTRACE_ORDER"] {
         cargo.env_remove(var);
     }
     if build.scene != DEFAULT_SCENE {
@@ -155,7 +149,7 @@ pub fn build(build: &Build<'_>) -> Result<PathBuf, String> {
         ));
     }
     let elf = dir.join(format!("{}-{}.elf", template.name(), build.name()));
-    std::fs::copy(dir.join("thumbv6m-none-eabi/release").join(template.binary()), &elf)
+    std::fs::copy(dir.join(TARGET).join("release").join(template.binary()), &elf)
         .map_err(|e| format!("cannot copy the ELF to {}: {e}", elf.display()))?;
     Ok(elf)
 }
