@@ -32,7 +32,7 @@ use crate::accel::{Hit, RayStart, FILING_MARGIN};
 use crate::math::{isqrt, mul_i64_wide, Scalar};
 use crate::scene::{Camera, CameraRay, MirrorPlane, ObjectId, Projection, SceneView};
 use crate::shade::Poll;
-use crate::shapes::{Leaving, Ray, ShapeKinds};
+use crate::shapes::{Leaving, Ray, ShapeKind, ShapeKinds};
 
 /// Rows of a band: its objects are chosen once for them all.
 const BAND_ROWS: u32 = 8;
@@ -444,6 +444,18 @@ impl Listed for Reflected<'_> {
 /// The nearest hit of `ray` with offsets `(kx, ky)` ([`narrow`]ed as the
 /// windows are) among the objects at `tile`'s positions in `all`. A camera
 /// ray is made only when a window holds the offsets.
+///
+/// The tile's first box whose window holds the ray is tested after the
+/// others, and only if its bound is not beyond their nearest hit. A box is
+/// its own bound, so a large one (fig5_5's base under its board, a floor,
+/// a wall) comes first by its bound's distance while what stands on it is
+/// hit nearer: tested first, it was a whole slab test and a division for a
+/// hit that lost. Tested last, its hit is bounded, and the box's own test
+/// turns most such rays away at their first slab. Exact: without the box's
+/// hit the loop's nearest is no nearer, so it stops no earlier and tests
+/// every object it tested before; the box is then tested within the
+/// nearest of those, unless its bound (so any hit on it) is beyond it; and
+/// the hit kept is the least by parameter, then object, in any order.
 #[inline]
 fn nearest<R: Listed>(
     scene: &SceneView<'_>,
@@ -454,6 +466,7 @@ fn nearest<R: Listed>(
     (kx, ky): (u16, u16),
 ) -> Option<Hit> {
     let mut best = Hit::NONE;
+    let mut deferred = None;
     for bound in tile.iter().filter_map(|&p| all.get(p as usize)) {
         if ray.beyond(bound.near, best.t) {
             break;
@@ -461,17 +474,34 @@ fn nearest<R: Listed>(
         if kx < bound.x[0] || kx > bound.x[1] || ky < bound.y[0] || ky > bound.y[1] {
             continue;
         }
-        let object = ObjectId(bound.object as u32);
-        let leaving = ray.leaving(object);
-        if let Some(t) = scene.intersect_handle(kinds, scene.objects[bound.object as usize], ray.ray(), best.t, leaving)
+        // The first box is tested last (see the function's doc).
+        if kinds.contains(ShapeKind::Box)
+            && deferred.is_none()
+            && scene.objects[bound.object as usize].kind() == ShapeKind::Box
         {
-            let hit = Hit { t, object };
-            if hit.beats(&best) {
-                best = hit;
-            }
+            deferred = Some(bound);
+            continue;
         }
+        test(scene, kinds, bound, ray, &mut best);
+    }
+    if let Some(bound) = deferred.filter(|bound| !ray.beyond(bound.near, best.t)) {
+        test(scene, kinds, bound, ray, &mut best);
     }
     best.found()
+}
+
+/// Tests the object of `bound` against `ray` within `best`, and keeps its
+/// hit if it wins.
+#[inline(always)]
+fn test<R: Listed>(scene: &SceneView<'_>, kinds: ShapeKinds, bound: &ScreenBound, ray: &mut R, best: &mut Hit) {
+    let object = ObjectId(bound.object as u32);
+    let leaving = ray.leaving(object);
+    if let Some(t) = scene.intersect_handle(kinds, scene.objects[bound.object as usize], ray.ray(), best.t, leaving) {
+        let hit = Hit { t, object };
+        if hit.beats(best) {
+            *best = hit;
+        }
+    }
 }
 
 // f64 appears only here: to write scene text and as the window test's own

@@ -67,6 +67,23 @@ pub(crate) fn slab_span_wide(o: [i64; 3], d: [i64; 3], lo: [i64; 3], hi: [i64; 3
     Some(SlabSpan { enter, exit })
 }
 
+/// Whether a ray not leaving the box enters one of its slabs at a positive
+/// parameter whose rounding is beyond `t_max`. Its entry into the box is
+/// then that far at least (the slabs' latest entry, rounded down alike), so
+/// the span's hit, that entry or none, is not within `t_max`.
+#[inline(always)]
+fn enters_beyond(ray: &Ray, min: Vec3, max: Vec3, t_max: Scalar) -> bool {
+    let (o, d, lo, hi) = (ray.origin.wide(), ray.dir.wide(), min.wide(), max.wide());
+    (0..3).any(|a| {
+        let near = match d[a] {
+            0 => return false,
+            dv if dv > 0 => lo[a] - o[a],
+            _ => o[a] - hi[a],
+        };
+        near > 0 && !Ratio { num: near, den: d[a].abs() }.le_scalar(t_max)
+    })
+}
+
 impl AxisAlignedBox {
     pub fn new(center: Vec3, half: Vec3, surface: u16) -> AxisAlignedBox {
         AxisAlignedBox { min: center - half, max: center + half, surface }
@@ -103,6 +120,12 @@ impl Shape for AxisAlignedBox {
         // behind: its span would end at a parameter ≤ 0.
         let (o, d, lo, hi) = (ray.origin.bits(), ray.dir.bits(), self.min.bits(), self.max.bits());
         if (0..3).any(|a| (o[a] > hi[a] && d[a] >= 0) || (o[a] < lo[a] && d[a] <= 0)) {
+            return None;
+        }
+        // A ray whose hit is bounded (a box tested after what the ray hits
+        // first, see render/first_hit.rs) is often turned away at its
+        // first slab, before the others' ratios and the division.
+        if leaving == Leaving::No && t_max != Scalar::MAX && enters_beyond(ray, self.min, self.max, t_max) {
             return None;
         }
         self.intersect_span(ray, t_max, leaving)
@@ -184,14 +207,15 @@ mod tests {
         assert_eq!(cube().intersect(&r, far(), Leaving::No), None);
     }
 
-    /// Rays from outside a slab moving away from it are rejected before the
-    /// span, with the span's answer: random boxes and rays, many along the
-    /// axes, from outside, inside and on the faces.
+    /// Rays from outside a slab moving away from it, and rays entering a
+    /// slab beyond their bound, are rejected before the span, with the
+    /// span's answer: random boxes and rays, many along the axes, from
+    /// outside, inside and on the faces.
     #[test]
     fn rays_leaving_a_slab_behind_miss_as_the_span_says() {
         let mut next = crate::test_rng::seeded(0xb0c5_1ab5);
         let mut coordinate = move |range: u64| (next() % (2 * range + 1)) as i32 - range as i32;
-        let mut early = 0;
+        let (mut early, mut beyond) = (0, 0);
         for _ in 0..100_000 {
             let c = Vec3::from_bits([0; 3].map(|_| coordinate(1 << 20)));
             let h = Vec3::from_bits([0; 3].map(|_| 1 + coordinate(1 << 18).abs()));
@@ -215,9 +239,20 @@ mod tests {
                     assert!(crossings.map(|c| (c.num << 30) / c.den).any(|q| q == t.to_bits() as i64), "{r:?} {b:?}");
                 }
             }
+            // A bound at the hit's own parameter, and one short of it.
+            if let Some(t) = b.intersect_span(&r, Scalar::MAX, Leaving::No) {
+                for bound in [t, Scalar::from_bits(t.to_bits() - 1)] {
+                    assert_eq!(
+                        b.intersect(&r, bound, Leaving::No),
+                        b.intersect_span(&r, bound, Leaving::No),
+                        "{r:?} {b:?}"
+                    );
+                }
+            }
             let (ob, db) = (o.bits(), dir.bits());
             early += (0..3).any(|a| (ob[a] > hi[a] && db[a] >= 0) || (ob[a] < lo[a] && db[a] <= 0)) as u32;
+            beyond += enters_beyond(&r, b.min, b.max, t_max) as u32;
         }
-        assert!(early > 30_000, "{early} rejected early");
+        assert!(early > 30_000 && beyond > 10_000, "{early} rejected early, {beyond} entering beyond");
     }
 }
