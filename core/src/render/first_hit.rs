@@ -584,6 +584,16 @@ mod tests {
         scene
     }
 
+    /// The camera of `view` at its raster and samples, with the raster's
+    /// width and height; `None` for an empty raster (a scene that did not
+    /// parse).
+    fn raster_camera(view: &SceneView<'_>) -> Option<(Camera, u32, u32)> {
+        let [w, h] = view.settings.raster;
+        let camera =
+            (w > 0).then(|| Camera::new(&view.settings.view, &view.normalization, w, h, view.settings.samples));
+        Some((camera?.unwrap(), w, h))
+    }
+
     /// Room for one set of lists over `view`'s objects.
     fn room(view: &SceneView<'_>) -> (std::vec::Vec<ScreenBound>, std::vec::Vec<u16>) {
         (vec![ScreenBound::EMPTY; view.object_count()], vec![0; ScreenBound::positions_for(view.object_count())])
@@ -599,11 +609,7 @@ mod tests {
         for _ in 0..300 {
             let scene = random_scene(&mut next);
             let view = scene.view();
-            let [w, h] = view.settings.raster;
-            if view.object_count() == 0 || w == 0 {
-                continue;
-            }
-            let camera = Camera::new(&view.settings.view, &view.normalization, w, h, view.settings.samples).unwrap();
+            let Some((camera, w, h)) = raster_camera(&view).filter(|_| view.object_count() > 0) else { continue };
             let (mut bounds, mut positions) = room(&view);
             if !FirstHits::fit(&view, &camera, &bounds, &positions) {
                 continue;
@@ -643,12 +649,8 @@ mod tests {
         for _ in 0..1000 {
             let scene = random_scene(&mut next);
             let view = scene.view();
-            let [w, h] = view.settings.raster;
-            if view.object_count() == 0 || w == 0 {
-                continue;
-            }
+            let Some((camera, w, h)) = raster_camera(&view).filter(|_| view.object_count() > 0) else { continue };
             let Some(plane) = view.mirror() else { continue };
-            let camera = Camera::new(&view.settings.view, &view.normalization, w, h, view.settings.samples).unwrap();
             let Some(image) = camera.mirrored(plane.axis, plane.coordinate) else { continue };
             let (mut bounds, mut positions) = room(&view);
             if !FirstHits::fit(&view, &camera, &bounds, &positions) {
@@ -787,11 +789,7 @@ mod tests {
         for _ in 0..300 {
             let scene = random_scene(&mut next);
             let view = scene.view();
-            let [w, h] = view.settings.raster;
-            if w == 0 {
-                continue;
-            }
-            let camera = Camera::new(&view.settings.view, &view.normalization, w, h, view.settings.samples).unwrap();
+            let Some((camera, _, _)) = raster_camera(&view) else { continue };
             let projection = Projection::new(&camera);
             let f64s = |v: [i64; 3]| v.map(|c| c as f64);
             let (f, x, y) = (f64s(camera.forward), f64s(camera.step_x), f64s(camera.step_y));
