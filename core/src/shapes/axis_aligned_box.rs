@@ -67,20 +67,20 @@ pub(crate) fn slab_span_wide(o: [i64; 3], d: [i64; 3], lo: [i64; 3], hi: [i64; 3
     Some(SlabSpan { enter, exit })
 }
 
-/// Whether a ray not leaving the box enters one of its slabs at a positive
-/// parameter whose rounding is beyond `t_max`. Its entry into the box is
-/// then that far at least (the slabs' latest entry, rounded down alike), so
-/// the span's hit, that entry or none, is not within `t_max`.
+/// Whether a ray (origin `o`, direction `d`) not leaving the box `[lo, hi]`
+/// (raw bits) enters one of its slabs at a positive parameter whose
+/// rounding is beyond `t_max`. Its entry into the box is then that far at
+/// least (the slabs' latest entry, rounded down alike), so the span's hit,
+/// that entry or none, is not within `t_max`.
 #[inline(always)]
-fn enters_beyond(ray: &Ray, min: Vec3, max: Vec3, t_max: Scalar) -> bool {
-    let (o, d, lo, hi) = (ray.origin.wide(), ray.dir.wide(), min.wide(), max.wide());
+fn enters_beyond([o, d, lo, hi]: [[i32; 3]; 4], t_max: Scalar) -> bool {
     (0..3).any(|a| {
         let near = match d[a] {
             0 => return false,
-            dv if dv > 0 => lo[a] - o[a],
-            _ => o[a] - hi[a],
+            dv if dv > 0 => lo[a] as i64 - o[a] as i64,
+            _ => o[a] as i64 - hi[a] as i64,
         };
-        near > 0 && !Ratio { num: near, den: d[a].abs() }.le_scalar(t_max)
+        near > 0 && !Ratio { num: near, den: d[a].unsigned_abs() as i64 }.le_scalar(t_max)
     })
 }
 
@@ -125,7 +125,7 @@ impl Shape for AxisAlignedBox {
         // A ray whose hit is bounded (a box tested after what the ray hits
         // first, see render/first_hit.rs) is often turned away at its
         // first slab, before the others' ratios and the division.
-        if leaving == Leaving::No && t_max != Scalar::MAX && enters_beyond(ray, self.min, self.max, t_max) {
+        if leaving == Leaving::No && t_max != Scalar::MAX && enters_beyond([o, d, lo, hi], t_max) {
             return None;
         }
         self.intersect_span(ray, t_max, leaving)
@@ -251,7 +251,7 @@ mod tests {
             }
             let (ob, db) = (o.bits(), dir.bits());
             early += (0..3).any(|a| (ob[a] > hi[a] && db[a] >= 0) || (ob[a] < lo[a] && db[a] <= 0)) as u32;
-            beyond += enters_beyond(&r, b.min, b.max, t_max) as u32;
+            beyond += enters_beyond([ob, db, lo, hi], t_max) as u32;
         }
         assert!(early > 30_000 && beyond > 10_000, "{early} rejected early, {beyond} entering beyond");
     }
