@@ -6,7 +6,7 @@
 //! nearly so, needs no special case and cannot overflow.
 
 use super::{Aabb, Leaving, Ratio, Ray, Shape};
-use crate::math::{div_saturating, Dir, Scalar, Vec3};
+use crate::math::{div_saturating, mul_wide, part_wise_or, Dir, Scalar, Vec3};
 
 /// A BOX: its corners in normalised space.
 // Public only for `profile!` (arenas of it) and the firmware's RAM
@@ -30,7 +30,125 @@ pub(crate) struct SlabSpan {
 /// Clips `ray` against the box `[min, max]`; `None` when the ray's line misses
 /// it. The span may lie partly or wholly behind the origin.
 pub(crate) fn slab_span(ray: &Ray, min: Vec3, max: Vec3) -> Option<SlabSpan> {
-    slab_span_wide(ray.origin.wide(), ray.dir.wide(), min.wide(), max.wide())
+    let (o, d, lo, hi) = (ray.origin.bits(), ray.dir.bits(), min.bits(), max.bits());
+    match slab_span_narrow(o, d, lo, hi) {
+        Ok(span) => span,
+        Err(NeedsWide) => slab_span_wide(ray.origin.wide(), ray.dir.wide(), min.wide(), max.wide()),
+    }
+}
+
+/// A box's face further from a ray's origin than an `i32` holds, or a
+/// direction's component past a unit's rounding: the slab test takes
+/// 64-bit crossings.
+struct NeedsWide;
+
+/// The largest direction component a [`Crossing`] takes: a unit and the
+/// rounding of an estimated unit vector, with room to spare (`den >> 15`
+/// at most 2^15, as [`coarse_crossing_lt`] needs).
+const MAX_CROSSING_DEN: u32 = (1 << 30) + (1 << 15) - 1;
+
+/// [`slab_span_wide`] in 32-bit crossings, for a box whose faces lie within
+/// an `i32` of the origin on every axis (every box of a normalised scene,
+/// whose points are within ±2^29) and a direction within
+/// [`MAX_CROSSING_DEN`]: the same span, compared as
+/// [`Crossing`]s, where the wide one's `i64` ratios were 64-bit
+/// bookkeeping on a 32-bit core (a quarter of fig5_5's box tests'
+/// cycles on a Cortex-M0+).
+#[inline]
+fn slab_span_narrow(o: [i32; 3], d: [i32; 3], lo: [i32; 3], hi: [i32; 3]) -> Result<Option<SlabSpan>, NeedsWide> {
+    let mut span = NarrowSpan { enter: None, exit: None };
+    // Axis by axis in straight code: a loop kept its index and the arrays
+    // on the stack.
+    for axis in [0, 1, 2] {
+        if !span.clip(o[axis], d[axis], lo[axis], hi[axis])? {
+            return Ok(None);
+        }
+    }
+    if let (Some(e), Some(x)) = (span.enter, span.exit) {
+        if x.lt(e) {
+            return Ok(None);
+        }
+    }
+    Ok(Some(SlabSpan { enter: span.enter.map(Crossing::ratio), exit: span.exit.map(Crossing::ratio) }))
+}
+
+/// The crossings of [`slab_span_narrow`] so far: the latest entry, the
+/// earliest exit.
+struct NarrowSpan {
+    enter: Option<Crossing>,
+    exit: Option<Crossing>,
+}
+
+impl NarrowSpan {
+    /// Clips the span by one axis's slab `[lo, hi]` (the origin's `o`, the
+    /// direction's `d`); `false` when the ray's line misses the slab.
+    #[inline(always)]
+    fn clip(&mut self, o: i32, d: i32, lo: i32, hi: i32) -> Result<bool, NeedsWide> {
+        let gap = |face: i32, from: i32| face.checked_sub(from).ok_or(NeedsWide);
+        let (near, far) = match d {
+            0 => return Ok(lo <= o && o <= hi),
+            d if d > 0 => (gap(lo, o)?, gap(hi, o)?),
+            _ => (gap(o, hi)?, gap(o, lo)?),
+        };
+        let den = d.unsigned_abs();
+        if den > MAX_CROSSING_DEN {
+            return Err(NeedsWide);
+        }
+        let den = den as i32;
+        let (near, far) = (Crossing { num: near, den }, Crossing { num: far, den });
+        if self.enter.is_none_or(|e| e.lt(near)) {
+            self.enter = Some(near);
+        }
+        if self.exit.is_none_or(|x| far.lt(x)) {
+            self.exit = Some(far);
+        }
+        Ok(true)
+    }
+}
+
+/// A ray's parameter at a slab's face, `num / den`: a Q16.16 gap over a
+/// direction's magnitude in Q2.30 (`0 < den ≤ MAX_CROSSING_DEN`), both in
+/// 32 bits.
+#[derive(Clone, Copy, Debug)]
+struct Crossing {
+    num: i32,
+    den: i32,
+}
+
+impl Crossing {
+    /// `self < o`, exactly; on ARMv6-M from 32-bit products of the top
+    /// bits when they decide ([`coarse_crossing_lt`]).
+    #[inline(always)]
+    fn lt(self, o: Crossing) -> bool {
+        part_wise_or(|| coarse_crossing_lt(self, o), || mul_wide(self.num, o.den) < mul_wide(o.num, self.den))
+    }
+
+    fn ratio(self) -> Ratio {
+        Ratio { num: self.num as i64, den: self.den as i64 }
+    }
+}
+
+/// Whether `x < y` (`x.num·y.den < y.num·x.den`) when the products of
+/// their top bits decide it, else `None`.
+///
+/// Why: with `num = h·2^16 + l` (`|h| ≤ 2^15`, `0 ≤ l < 2^16`) and `den =
+/// k·2^15 + m` (`0 ≤ k ≤ 2^15`, `0 ≤ m < 2^15`), `num·den − h·k·2^31 =
+/// h·m·2^16 + l·k·2^15 + l·m` lies in `(−2^46, 2^47 + 2^31)`, so the two
+/// products' difference is within `3·2^46 + 2^31` of `H·2^31`, `H` the
+/// short products' difference (`|H| < 2^31`): `H ≤ −(3·2^15 + 2)` makes
+/// it negative, `H ≥ 3·2^15 + 2` positive.
+#[inline(always)]
+fn coarse_crossing_lt(x: Crossing, y: Crossing) -> Option<bool> {
+    const SURE: i32 = (3 << 15) + 2;
+    let short = |num: i32, den: i32| (num >> 16) * (den >> 15);
+    let h = short(x.num, y.den) - short(y.num, x.den);
+    if h <= -SURE {
+        Some(true)
+    } else if h >= SURE {
+        Some(false)
+    } else {
+        None
+    }
 }
 
 /// [`slab_span`] for a ray and a box given as raw integers (origin and box in
@@ -205,6 +323,81 @@ mod tests {
         assert_eq!(cube().intersect(&r, far(), Leaving::No), Some(s(7)));
         let r = Ray { origin: p(5, 0, -10), dir: Dir::from_bits([-1, 0, 1 << 30]) };
         assert_eq!(cube().intersect(&r, far(), Leaving::No), None);
+    }
+
+    /// The 32-bit span is the wide one, and refuses what it cannot hold:
+    /// random boxes and rays at every scale, faces and directions at their
+    /// extremes.
+    #[test]
+    fn the_narrow_span_is_the_wide_one() {
+        let mut next = crate::test_rng::seeded(0x51ab_5a11);
+        let span_bits = |span: Option<SlabSpan>| span.map(|s| [s.enter, s.exit].map(|r| r.map(|r| (r.num, r.den))));
+        let extremes = [i32::MIN, i32::MIN + 1, -(1 << 30), -1, 0, 1, 1 << 30, i32::MAX - 1, i32::MAX];
+        let (mut narrow, mut wide) = (0, 0);
+        for _ in 0..200_000 {
+            let mut coordinate = || {
+                let v = next();
+                match v % 8 {
+                    0 => extremes[(v >> 3) as usize % extremes.len()],
+                    k => ((v >> 8) as i32) >> (4 * k),
+                }
+            };
+            let (o, a, b) = ([0; 3].map(|_| coordinate()), [0; 3].map(|_| coordinate()), [0; 3].map(|_| coordinate()));
+            let (lo, hi) = ([0, 1, 2].map(|k| a[k].min(b[k])), [0, 1, 2].map(|k| a[k].max(b[k])));
+            let d = [0; 3].map(|_| match next() % 6 {
+                0 => 0,
+                1 => [1 << 30, -(1 << 30), MAX_CROSSING_DEN as i32, -(MAX_CROSSING_DEN as i32), i32::MIN]
+                    [next() as usize % 5],
+                _ => (next() as i32) >> 1,
+            });
+            let expected = slab_span_wide(o.map(i64::from), d.map(i64::from), lo.map(i64::from), hi.map(i64::from));
+            match slab_span_narrow(o, d, lo, hi) {
+                Ok(span) => {
+                    narrow += 1;
+                    assert_eq!(span_bits(span), span_bits(expected), "{o:?} {d:?} {lo:?} {hi:?}");
+                }
+                Err(NeedsWide) => {
+                    wide += 1;
+                    let reach = |x: i32, y: i32| x.checked_sub(y).is_none();
+                    assert!(
+                        (0..3).any(|k| reach(lo[k], o[k])
+                            || reach(hi[k], o[k])
+                            || reach(o[k], lo[k])
+                            || reach(o[k], hi[k]))
+                            || d.iter().any(|&c| c.unsigned_abs() > MAX_CROSSING_DEN),
+                        "{o:?} {d:?} {lo:?} {hi:?}"
+                    );
+                }
+            }
+        }
+        assert!(narrow > 100_000 && wide > 10_000, "{narrow} narrow, {wide} wide");
+    }
+
+    /// The coarse comparison, where it answers, is the exact one: random
+    /// crossings, many at the extremes of their ranges and nearly equal.
+    #[test]
+    fn coarse_crossings_compare_exactly() {
+        let mut next = crate::test_rng::seeded(0xc0a5_e5e5);
+        let mut decided = 0;
+        for _ in 0..500_000 {
+            let mut num = || match next() % 4 {
+                0 => [i32::MIN, i32::MAX, 0, 1, -1][next() as usize % 5],
+                k => (next() as i32) >> (8 * (k - 1)),
+            };
+            let (xn, yn) = (num(), num());
+            let mut den = || match next() % 4 {
+                0 => [1, MAX_CROSSING_DEN, 1 << 30, 1 << 15][next() as usize % 4] as i32,
+                k => 1 + ((next() as u32 % MAX_CROSSING_DEN) >> (8 * (k - 1))) as i32,
+            };
+            let (x, y) = (Crossing { num: xn, den: den() }, Crossing { num: yn, den: den() });
+            let exact = (x.num as i64) * (y.den as i64) < (y.num as i64) * (x.den as i64);
+            if let Some(answer) = coarse_crossing_lt(x, y) {
+                decided += 1;
+                assert_eq!(answer, exact, "{x:?} {y:?}");
+            }
+            assert_eq!(x.lt(y), exact, "{x:?} {y:?}");
+        }
+        assert!(decided > 250_000, "{decided} decided");
     }
 
     /// Rays from outside a slab moving away from it, and rays entering a
