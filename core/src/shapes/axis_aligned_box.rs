@@ -52,8 +52,8 @@ const MAX_CROSSING_DEN: u32 = (1 << 30) + (1 << 15) - 1;
 /// whose points are within ±2^29) and a direction within
 /// [`MAX_CROSSING_DEN`]: the same span, compared as
 /// [`Crossing`]s, where the wide one's `i64` ratios were 64-bit
-/// bookkeeping on a 32-bit core (a quarter of fig5_5's box tests'
-/// cycles on a Cortex-M0+).
+/// bookkeeping on a 32-bit core (the emulated Pico's fig5_5 spent 16.5 M
+/// cycles in the wide span, 8.3 M in this one).
 #[inline]
 fn slab_span_narrow(o: [i32; 3], d: [i32; 3], lo: [i32; 3], hi: [i32; 3]) -> Result<Option<SlabSpan>, NeedsWide> {
     let mut span = NarrowSpan { enter: None, exit: None };
