@@ -2,8 +2,8 @@
 //! the board (parsed there, from the scene text in flash) and the pixels its
 //! display driver receives are bit-identical to host-sim's image. The same
 //! runs count the instructions (qemu-count), which with each firmware's
-//! flash and static RAM are held to their budgets (`budgets.toml`, section
-//! `firmware`).
+//! flash, static RAM and peak stack are held to their budgets
+//! (`budgets.toml`, section `firmware`).
 //!
 //! Needs `qemu-system-arm`, `qemu-system-riscv32` and gcc, which builds
 //! qemu-count's plugin (`firmware/tools/qemu-count`; the test command
@@ -105,6 +105,11 @@ fn boards_render_the_same_bits_as_host_sim() {
             if let Some(measured) = measured {
                 let render = measured.render.unwrap_or_else(|| panic!("{name}: no instructions between the markers"));
                 budgets.check(&subject, "instructions", render);
+                // Exact too where the instructions are (one core: the same
+                // pixels take the same path), and what a micro:bit's stack,
+                // sized by measurement, must keep room for.
+                let stack = run.peak_stack().unwrap_or_else(|| panic!("{name}: no peak stack in\n{}", run.output));
+                budgets.check(&subject, "peak_stack", stack);
             }
             assert_eq!(run.status, 0, "{name}: the board exited with {}:\n{}", run.status, run.output);
             let expected = expected.unwrap_or_else(|e| panic!("{name}: {e}"));
