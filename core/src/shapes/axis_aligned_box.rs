@@ -5,7 +5,7 @@
 //! and divides once, for the crossing it returns: a ray parallel to a face, or
 //! nearly so, needs no special case and cannot overflow.
 
-use super::{Aabb, Leaving, Ratio, Ray, Shape};
+use super::{less_when_sure, Aabb, Leaving, Ratio, Ray, Shape};
 use crate::math::{div_saturating, mul_wide, part_wise_or, Dir, Scalar, Vec3};
 
 /// A BOX: its corners in normalised space.
@@ -141,14 +141,7 @@ impl Crossing {
 fn coarse_crossing_lt(x: Crossing, y: Crossing) -> Option<bool> {
     const SURE: i32 = (3 << 15) + 2;
     let short = |num: i32, den: i32| (num >> 16) * (den >> 15);
-    let h = short(x.num, y.den) - short(y.num, x.den);
-    if h <= -SURE {
-        Some(true)
-    } else if h >= SURE {
-        Some(false)
-    } else {
-        None
-    }
+    less_when_sure(short(x.num, y.den) - short(y.num, x.den), SURE)
 }
 
 /// [`slab_span`] for a ray and a box given as raw integers (origin and box in

@@ -381,10 +381,18 @@ fn coarse_ratio_lt(x: Ratio, y: Ratio) -> Option<bool> {
         return None;
     }
     let short = |n: i64, d: i64| ((n >> 18) as i32) * ((d >> 16) as i32);
-    let h = short(x.num, y.den) - short(y.num, x.den);
-    if h <= -SURE {
+    less_when_sure(short(x.num, y.den) - short(y.num, x.den), SURE)
+}
+
+/// What the difference `h` of two cross products' short forms says of the
+/// ratios' order, when its error bound makes `sure` enough: `Some(true)`
+/// (the first is less) for `h ≤ −sure`, `Some(false)` for `h ≥ sure`,
+/// else `None` (the exact products decide).
+#[inline(always)]
+pub(crate) fn less_when_sure(h: i32, sure: i32) -> Option<bool> {
+    if h <= -sure {
         Some(true)
-    } else if h >= SURE {
+    } else if h >= sure {
         Some(false)
     } else {
         None
