@@ -102,6 +102,8 @@ fn boards_render_the_same_bits_as_host_sim() {
             budgets.check(&subject, "static_ram", sizes.data + sizes.bss);
             let (run, expected) = run.join().unwrap_or_else(|_| panic!("{name}: its run panicked"));
             let (run, measured) = run.unwrap_or_else(|e| panic!("{name}: {e}"));
+            // A board that failed says so before any figure is missed.
+            assert_eq!(run.status, 0, "{name}: the board exited with {}:\n{}", run.status, run.output);
             if let Some(measured) = measured {
                 let render = measured.render.unwrap_or_else(|| panic!("{name}: no instructions between the markers"));
                 budgets.check(&subject, "instructions", render);
@@ -111,7 +113,6 @@ fn boards_render_the_same_bits_as_host_sim() {
                 let stack = run.peak_stack().unwrap_or_else(|| panic!("{name}: no peak stack in\n{}", run.output));
                 budgets.check(&subject, "peak_stack", stack);
             }
-            assert_eq!(run.status, 0, "{name}: the board exited with {}:\n{}", run.status, run.output);
             let expected = expected.unwrap_or_else(|e| panic!("{name}: {e}"));
             assert_eq!(run.pixels.len(), expected.len(), "{name}: byte count\n{}", run.output);
             let differing = run.pixels.iter().zip(&expected).filter(|(a, b)| a != b).count();
