@@ -49,7 +49,7 @@ pub(crate) fn part_wise_or<T>(part_wise: impl FnOnce() -> Option<T>, exact: impl
 }
 
 pub(crate) use wide::{
-    mul_u64_shr24, mul_u64_shr24_clamped, reciprocal_q62, reciprocal_start, shl_u64, shr_saturating_u32,
+    mul_u64_shr24, mul_u64_shr24_clamped, reciprocal_estimate, reciprocal_start, shl_u64, shr_saturating_u32,
     shr_signed_to_u32, shr_u64,
 };
 

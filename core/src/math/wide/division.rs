@@ -1,6 +1,7 @@
 //! Exact division without a divide instruction: a reciprocal from a table
 //! and one Newton step, then a remainder fix-up. The same bits as the
-//! native division on every target.
+//! native division on every target; and the reciprocal alone, for the
+//! 3DDDA.
 
 use super::super::ARMV6M;
 use super::bits::{leading_zeros_u32, shl_u64};
@@ -21,21 +22,16 @@ pub fn div_saturating(n: u64, d: u32) -> u32 {
     }
 }
 
-/// `⌊2^62 / d⌋` for `d > 0` (the 3DDDA's reciprocals). On ARMv6-M, two
-/// divisions with 32-bit quotients by reciprocal instead of the library's
-/// 64-bit division: the same bits.
+/// About 2^63 / (d · 2^shift) and the `shift` that puts `d · 2^shift` in
+/// [2^31, 2^32), for `d > 0` (0 is taken as 1): a reciprocal to 31 bits from
+/// the table and one Newton step, without a division, the same bits on
+/// every target (the 3DDDA's, which only needs it within a bound). It lies
+/// within (−1.07, 1] of the exact quotient: checked once for every one of
+/// the 2^31 normalised divisors; the test below samples them.
 #[inline]
-pub(crate) fn reciprocal_q62(d: u32) -> u64 {
-    let d = d.max(1);
-    if ARMV6M {
-        // Both quotients by the same reciprocal: 2^30 < d·2^32, and the
-        // remainder is below d.
-        let reciprocal = Reciprocal::of(d);
-        let (high, remainder) = reciprocal.quotient_of_2_30();
-        ((high as u64) << 32) | reciprocal.quotient::<2>((remainder as u64) << 32) as u64
-    } else {
-        (1u64 << 62) / d as u64
-    }
+pub(crate) fn reciprocal_estimate(d: u32) -> (u32, u32) {
+    let reciprocal = Reciprocal::of(d.max(1));
+    (reciprocal.r, reciprocal.shift)
 }
 
 /// 2^63 / (m · 2^-8) for m = 256 … 512 (divisors normalised to [1, 2]; the
@@ -65,11 +61,11 @@ pub(crate) fn reciprocal_start(dn: u32) -> u32 {
 /// `⌊n / d⌋` for `0 < d` and `n < d · 2^32`, from a reciprocal.
 #[inline]
 fn div_by_reciprocal(n: u64, d: u32) -> u32 {
-    Reciprocal::of(d).quotient::<0>(n)
+    Reciprocal::of(d).quotient(n)
 }
 
-/// A divisor made ready for exact divisions by products: several quotients
-/// by the same divisor share the normalisation and the Newton step.
+/// A divisor made ready for exact division by products: normalised, with
+/// its reciprocal from the table and one Newton step.
 #[derive(Clone, Copy)]
 struct Reciprocal {
     divisor: u32,
@@ -97,46 +93,21 @@ impl Reciprocal {
 
     /// `⌊n / divisor⌋` for `n < divisor · 2^32`.
     #[inline(always)]
-    fn quotient<const STEPS: usize>(&self, n: u64) -> u32 {
+    fn quotient(&self, n: u64) -> u32 {
         let r = self.r;
         let numerator = shl_u64(n, self.shift); // below dn · 2^32
         let (high, low) = ((numerator >> 32) as u32, numerator as u32);
         let estimate = (mul_u32_wide(high, r) + (mul_u32_wide(low, r) >> 32)) >> 31;
-        self.corrected::<STEPS>(n, estimate.min(u32::MAX as u64) as u32).0
-    }
-
-    /// `⌊2^30 / divisor⌋` and the remainder: the numerator, normalised, is a
-    /// power of two, so the estimate above is a shift of the reciprocal (the
-    /// same value).
-    #[inline(always)]
-    fn quotient_of_2_30(&self) -> (u32, u32) {
-        // (2^(30 + shift) · r) / 2^63, shift ≥ 1 for a divisor below 2^31.
-        let estimate = if self.shift == 0 { 0 } else { self.r >> (33 - self.shift).min(31) };
-        self.corrected::<0>(1 << 30, estimate)
+        self.corrected(n, estimate.min(u32::MAX as u64) as u32)
     }
 
     /// The exact floor of `n / divisor` from an estimate a few off at most,
-    /// stepped on the remainder, and the remainder. `STEPS` steps are
-    /// written out first where the compiler would otherwise turn the
-    /// stepping loop into a 64-bit division (see below).
+    /// stepped on the remainder.
     #[inline(always)]
-    fn corrected<const STEPS: usize>(&self, n: u64, estimate: u32) -> (u32, u32) {
+    fn corrected(&self, n: u64, estimate: u32) -> u32 {
         let d = self.divisor;
         let mut q = estimate;
         let mut remainder = n.wrapping_sub(mul_u32_wide(q, d)) as i64;
-        // Steps written out first: in the 3DDDA's reciprocals the compiler
-        // turned the bare stepping loop into a 64-bit division (a library
-        // call of some 450 instructions on a Cortex-M0), which only a far
-        // estimate needs.
-        for _ in 0..STEPS {
-            if remainder < 0 {
-                q = q.wrapping_sub(1);
-                remainder += d as i64;
-            } else if remainder >= d as i64 {
-                q = q.wrapping_add(1);
-                remainder -= d as i64;
-            }
-        }
         while remainder < 0 {
             q -= 1;
             remainder += d as i64;
@@ -145,7 +116,7 @@ impl Reciprocal {
             q += 1;
             remainder -= d as i64;
         }
-        (q, remainder as u32)
+        q
     }
 }
 
@@ -155,25 +126,23 @@ mod tests {
     use crate::math::wide::tests::spread;
 
     #[test]
-    fn reciprocal_by_two_short_divisions_is_exact() {
-        // The ARMv6-M form: both quotients by one reciprocal.
-        let by_parts = |d: u32| {
-            let reciprocal = Reciprocal::of(d);
-            let (high, rest) = reciprocal.quotient_of_2_30();
-            assert_eq!(high, reciprocal.quotient::<0>(1 << 30), "{d}");
-            let remainder = (1u64 << 30) - mul_u32_wide(high, d);
-            assert_eq!(rest as u64, remainder, "{d}");
-            ((high as u64) << 32) | reciprocal.quotient::<2>(remainder << 32) as u64
+    fn reciprocal_estimates_are_within_their_bound() {
+        // r − 2^63/dn in (−1.07, 1], told exactly: r·dn − 2^63 in
+        // (−1.07·dn, dn].
+        let check = |d: u32| {
+            let (r, shift) = reciprocal_estimate(d);
+            let dn = (d.max(1) as u64) << shift;
+            assert!((1 << 31..1 << 32).contains(&dn), "{d}");
+            let off = r as i128 * dn as i128 - (1i128 << 63);
+            assert!(off * 100 > -107 * dn as i128 && off <= dn as i128, "{d}: {off}");
         };
-        let mut d = 1u32;
-        while d < (1 << 30) + 7 {
-            for e in [d, d + 1, d.saturating_mul(3) / 2] {
-                assert_eq!(by_parts(e), (1u64 << 62) / e as u64, "{e}");
-                assert_eq!(reciprocal_q62(e), (1u64 << 62) / e as u64, "{e}");
-            }
-            d = (d as u64 * 5 / 4 + 1) as u32;
+        let mut next = crate::test_rng::seeded(0x7ec1_9a0c);
+        for d in [0, 1, 2, 3, 1 << 14, (1 << 30) - 1, 1 << 30, (1 << 30) + 1, u32::MAX] {
+            check(d);
         }
-        assert_eq!(reciprocal_q62(0), 1 << 62);
+        for _ in 0..1_000_000 {
+            check((next() as u32) >> (next() % 32));
+        }
     }
 
     #[test]

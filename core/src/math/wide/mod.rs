@@ -16,7 +16,7 @@ mod root;
 pub use bits::{leading_zeros, leading_zeros_u32};
 pub(crate) use bits::{shl_u64, shr_saturating_u32, shr_signed_to_u32, shr_u64};
 pub use division::div_saturating;
-pub(crate) use division::{reciprocal_q62, reciprocal_start};
+pub(crate) use division::{reciprocal_estimate, reciprocal_start};
 pub use product::{mul_i64_i32, mul_i64_i32_wide, mul_i64_wide, mul_u32_wide, mul_wide, square_u32_wide, square_wide};
 pub(crate) use product::{mul_u64_shr24, mul_u64_shr24_clamped};
 pub use root::{isqrt, isqrt_u128};
