@@ -8,6 +8,7 @@
 use super::coherence::Coherence;
 use super::TILE;
 use crate::motion::{Key, MotionNeeds, Track};
+use crate::parse::Pos;
 use core::fmt;
 use embedded_graphics_core::geometry::Size;
 
@@ -117,6 +118,43 @@ pub struct NoRoom {
     pub needed: usize,
     /// How many the room holds.
     pub holds: usize,
+}
+
+impl NoRoom {
+    /// Where in `text` the scene first needs more than the room holds, for
+    /// the error's line and column: the `MOVE` whose track or keys go past
+    /// it; for the tiles (the image's, which the scene needs as an
+    /// animation), its `FRAMES`. `None` when `text` does not go past it.
+    ///
+    /// ```
+    /// use octrace_core::animation::{AnimationCapacity, NoRoom};
+    /// use octrace_core::parse::Pos;
+    ///
+    /// let text = "FRAMES 4\nSPHERE 1 1 0 0 0 MOVE 0 0 0 0  2 1 0 0\nSPHERE 1 1 3 0 0 MOVE 0 0 0 0  2 0 1 0\n";
+    /// let short = NoRoom { what: AnimationCapacity::Tracks, needed: 2, holds: 1 };
+    /// assert_eq!(short.position_in(text), Some(Pos { line: 3, column: 18 }));
+    /// let short = NoRoom { what: AnimationCapacity::Tiles, needed: 3600, holds: 0 };
+    /// assert_eq!(short.position_in(text), Some(Pos { line: 1, column: 1 }));
+    /// ```
+    pub fn position_in(&self, text: &str) -> Option<Pos> {
+        let (mut tracks, mut keys, mut past) = (0, 0, None);
+        let frames = crate::parse::for_each_move(text, |pos, moved| {
+            tracks += 1;
+            keys += moved.iter().count();
+            let count = match self.what {
+                AnimationCapacity::Tiles => return,
+                AnimationCapacity::Tracks => tracks,
+                AnimationCapacity::Keys => keys,
+            };
+            if count > self.holds {
+                past.get_or_insert(pos);
+            }
+        });
+        match self.what {
+            AnimationCapacity::Tiles => frames.map(|(pos, _)| pos),
+            _ => past,
+        }
+    }
 }
 
 impl fmt::Display for NoRoom {

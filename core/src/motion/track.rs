@@ -89,11 +89,11 @@ impl MotionNeeds {
     #[inline(never)]
     pub(crate) fn of(text: &str) -> MotionNeeds {
         let mut needs = MotionNeeds::default();
-        let frames = crate::parse::for_each_move(text, |keys| {
+        let frames = crate::parse::for_each_move(text, |_, keys| {
             needs.tracks += 1;
             needs.keys += keys.iter().count();
         });
-        MotionNeeds { frames: frames.map_or(1, |f| f.count.max(1)), ..needs }
+        MotionNeeds { frames: frames.map_or(1, |(_, f)| f.count.max(1)), ..needs }
     }
 }
 

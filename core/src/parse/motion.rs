@@ -157,15 +157,16 @@ pub(crate) trait MotionSink {
     fn moved(&mut self, moved: &Moved<'_>);
 }
 
-/// The keys of every MOVE of `text` that follows what it can move, in
-/// file order: what an animation's motion takes room for. Returns the
-/// scene's FRAMES, if it says (its first, as the parser reads it).
-pub(crate) fn for_each_move<'a>(text: &'a str, mut each: impl FnMut(Keys<'a>)) -> Option<Frames> {
+/// The position and keys of every MOVE of `text` that follows what it can
+/// move, in file order: what an animation's motion takes room for. Returns
+/// the scene's FRAMES and where it stands, if it says (its first, as the
+/// parser reads it).
+pub(crate) fn for_each_move<'a>(text: &'a str, mut each: impl FnMut(Pos, Keys<'a>)) -> Option<(Pos, Frames)> {
     let mut frames = None;
     for_each_paired::<AnyRoom>(text, |paired| match paired {
-        Paired::Statement { moved: Some((_, keys)), .. } => each(keys),
-        Paired::Statement { statement: Statement::Frames(f), .. } => {
-            frames.get_or_insert(f);
+        Paired::Statement { moved: Some((pos, keys)), .. } => each(pos, keys),
+        Paired::Statement { pos, statement: Statement::Frames(f), .. } => {
+            frames.get_or_insert((pos, f));
         }
         _ => {}
     });

@@ -197,8 +197,8 @@ impl<'a> Board<'a> {
                 Err(AnimationError::Scene(e)) => Err(e.count),
                 // Its room was checked against the scene's needs.
                 Err(AnimationError::NoRoom(short)) => {
-                    let need = play::capacity(&short);
-                    send_error(tag, 0, 0, Some(need), &short, sink)?;
+                    let (line, column) = play::position(&short, text);
+                    send_error(tag, line, column, Some(play::capacity(&short)), &short, sink)?;
                     Err(1)
                 }
             },
@@ -223,7 +223,8 @@ impl<'a> Board<'a> {
             Some(frames) => {
                 let mut errors = 0;
                 for short in shorts.iter().flatten() {
-                    send_error(tag, 0, 0, Some(play::capacity(short)), short, sink)?;
+                    let (line, column) = play::position(short, text);
+                    send_error(tag, line, column, Some(play::capacity(short)), short, sink)?;
                     errors += 1;
                 }
                 if errors > 0 {

@@ -36,6 +36,14 @@ pub(crate) fn capacity(short: &NoRoom) -> CapacityNeed<'static> {
     CapacityNeed { name: short.what.name(), needed: Some(saturate(short.needed)), holds: saturate(short.holds) }
 }
 
+/// Where in `text` a scene goes past the room (`NoRoom::position_in`), as
+/// the protocol's line and column: (0, 0), an error of the whole scene,
+/// where no statement does.
+pub(crate) fn position(short: &NoRoom, text: &[u8]) -> (u32, u32) {
+    let at = core::str::from_utf8(text).ok().and_then(|text| short.position_in(text));
+    at.map_or((0, 0), |pos| (pos.line, pos.column))
+}
+
 /// The frames of `scene`, if it is an animation to play (more than one
 /// frame).
 pub(crate) fn animated<P: Profile>(scene: &LoadedScene<'_, P>) -> Option<Frames> {

@@ -1054,13 +1054,15 @@ mod tests {
         for &byte in &wire.received {
             if let Some(Ok(Frame { message: Message::SceneError(e), .. })) = decoder.push(byte) {
                 let need = e.capacity.unwrap();
-                named.push((need.name.to_string(), need.needed, need.holds));
+                named.push((need.name.to_string(), need.needed, need.holds, (e.line, e.column)));
                 let names = std::format!("room for it ({})", need.name);
                 assert!(e.message.starts_with("too many ") && e.message.contains(&names), "{}", e.message);
             }
         }
-        let holds = |name: &str, needed| (name.to_string(), Some(needed), 0);
-        assert_eq!(named, [holds("tiles", 1), holds("tracks", 1), holds("keys", 2)]);
+        // Each at the statement that goes past it: the tiles at FRAMES, the
+        // track and the keys at the MOVE.
+        let holds = |name: &str, needed, at| (name.to_string(), Some(needed), 0, at);
+        assert_eq!(named, [holds("tiles", 1, (1, 1)), holds("tracks", 1, (5, 21)), holds("keys", 2, (5, 21))]);
         assert_eq!(wire.answers().last(), Some(&(1, Kind::Rejected)));
     }
 
