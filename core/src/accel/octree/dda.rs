@@ -34,8 +34,7 @@ use super::Octree;
 use super::OctreeCapacities;
 use crate::capacity::Arena;
 use crate::math::{
-    leading_zeros_u32, mul_u32_wide, mul_u64_shr24, mul_u64_shr24_clamped, reciprocal_estimate, shl_u64, shr_u64,
-    ARMV6M,
+    leading_zeros_u32, mul_u32_wide, mul_u64_shr24, mul_u64_shr24_clamped, reciprocal_estimate, shl_u64, ARMV6M,
 };
 use crate::shapes::Ray;
 
@@ -71,9 +70,27 @@ impl Setup {
     /// The parameter (Q40.24, saturated) at which the ray crosses the plane
     /// at `plane` (mirrored space, relative to the root) on axis `a`:
     /// (plane − o)·2^38 / |d| through the reciprocal, rounded down.
-    #[inline]
+    // Out of line on ARMv6-M, its wide form apart: the one product's path
+    // then keeps its registers (fig5_3 on the Pico −0.9 %); inlined into
+    // the walk it ran out of them (+0.5 %). Elsewhere the compiler's
+    // choice (forced out of line, the MPS2-AN385's fig5_3 +3.6 %).
+    #[cfg_attr(all(target_arch = "arm", not(target_has_atomic = "32")), inline(never))]
+    #[cfg_attr(not(all(target_arch = "arm", not(target_has_atomic = "32"))), inline)]
     fn crossing(&self, a: usize, plane: i64) -> i64 {
         let gap = plane - self.origin[a];
+        if ARMV6M && self.direction[a] >= STEEP {
+            if let Some(t) = crossing_by_one_product(gap, self.reciprocal[a], self.shift[a]) {
+                return t;
+            }
+        }
+        self.crossing_wide(a, gap)
+    }
+
+    /// [`Setup::crossing`] of a gap `plane − o`, from 64-bit products (on
+    /// ARMv6-M, for what the one product cannot take: rare).
+    #[cfg_attr(all(target_arch = "arm", not(target_has_atomic = "32")), cold, inline(never))]
+    #[cfg_attr(not(all(target_arch = "arm", not(target_has_atomic = "32"))), inline)]
+    fn crossing_wide(&self, a: usize, gap: i64) -> i64 {
         let (reciprocal, shift) = (self.reciprocal[a], self.shift[a]);
         if self.direction[a] >= STEEP {
             // Planes and the origin (i32 points, mirrored about a centre
@@ -81,11 +98,6 @@ impl Setup {
             // reciprocal at most 2^48 (`shift` ≤ 17), so the crossing stays
             // below 2^60 = `LIMIT` without a clamp.
             debug_assert!(gap.unsigned_abs() < 1 << 36 && shift <= 17);
-            if ARMV6M {
-                if let Some(t) = crossing_by_one_product(gap, reciprocal, shift) {
-                    return t;
-                }
-            }
             mul_u64_shr24(gap, shl_u64(reciprocal as u64, shift - 1))
         } else {
             mul_u64_shr24_clamped::<LIMIT>(gap, shl_u64(reciprocal as u64, shift - 1))
@@ -112,14 +124,15 @@ impl Setup {
 fn crossing_by_one_product(gap: i64, reciprocal: u32, shift: u32) -> Option<i64> {
     let magnitude = u32::try_from(gap.unsigned_abs()).ok()?;
     let product = mul_u32_wide(magnitude, reciprocal);
-    let down = 25 - shift;
     // A negative gap rounds towards −∞: its magnitude rounds up (the sum
     // stays below 2^64, as the product is below (2^32 − 1)^2).
-    Some(if gap >= 0 {
-        shr_u64(product, down) as i64
-    } else {
-        -(shr_u64(product + ((1u32 << down) - 1) as u64, down) as i64)
-    })
+    let down = 25 - shift;
+    let product = if gap >= 0 { product } else { product + ((1u32 << down) - 1) as u64 };
+    // Shifted right by 8 to 24 in 32-bit halves (a variable 64-bit shift
+    // is a library call on a 32-bit core).
+    let (high, low) = ((product >> 32) as u32, product as u32);
+    let shifted = (((high >> down) as u64) << 32) | ((high << (32 - down)) | (low >> down)) as u64;
+    Some(if gap >= 0 { shifted as i64 } else { -(shifted as i64) })
 }
 
 #[inline]
