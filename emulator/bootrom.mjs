@@ -39,8 +39,9 @@
 //
 // They cost what the real ROM's (its public source, B2) cost, written here
 // anew: the table in the real one's order (the lookup walks it, 11 cycles
-// a code, and rp2040-hal looks a function up at every call); memset and
-// memcpy reach a word boundary by a byte and a halfword, then fill or copy
+// a code; rp2040-hal looks a function up at every call unless its
+// `rom-func-cache` feature keeps it, as octrace's Pico templates do); memset
+// and memcpy reach a word boundary by a byte and a halfword, then fill or copy
 // 16 bytes a turn with four registers (2 cycles a word filled, 3.25 a word
 // copied) and finish with 8, 4, 2 and 1; memcpy of buffers whose
 // alignments differ, and anything under 8 bytes, go a byte at a time; the
