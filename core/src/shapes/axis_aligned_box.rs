@@ -6,7 +6,7 @@
 //! nearly so, needs no special case and cannot overflow.
 
 use super::{less_when_sure, Aabb, Leaving, Ratio, Ray, Shape};
-use crate::math::{div_saturating, mul_wide, part_wise_or, Dir, Scalar, Vec3};
+use crate::math::{div_saturating, mul_u32_wide, mul_wide, part_wise_or, Dir, Scalar, Vec3};
 
 /// A BOX: its corners in normalised space.
 // Public only for `profile!` (arenas of it) and the firmware's RAM
@@ -248,10 +248,13 @@ impl Shape for AxisAlignedBox {
         let c = [0, 1, 2].map(|a| (self.min.axis(a).to_bits() as i64 + self.max.axis(a).to_bits() as i64) / 2);
         let h = [0, 1, 2].map(|a| (self.max.axis(a).to_bits() as i64 - self.min.axis(a).to_bits() as i64).max(1));
         let off = [0, 1, 2].map(|a| p.axis(a).to_bits() as i64 - c[a]);
-        // Largest |off_a| / h_a by cross multiplication.
+        // Largest |off_a| / h_a by cross multiplication: of i32 points'
+        // differences, below 2^32 each, so 32×32→64 products (the i64 ones
+        // were library calls on a Cortex-M0).
+        let (off_magnitude, h) = (off.map(|o| o.unsigned_abs() as u32), h.map(|h| h as u32));
         let mut best = 0;
         for a in 1..3 {
-            if off[a].abs() * h[best] > off[best].abs() * h[a] {
+            if mul_u32_wide(off_magnitude[a], h[best]) > mul_u32_wide(off_magnitude[best], h[a]) {
                 best = a;
             }
         }
