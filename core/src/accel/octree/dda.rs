@@ -8,15 +8,15 @@
 //! axis and level, are the octants on the way down from the root (Frisken
 //! and Perry 2002). The walk stands in one leaf at a time. Per axis it takes
 //! the parameter (Q40.24) at which the ray crosses the leaf's far plane, one
-//! product with the ray's reciprocal of |d_a| (31 bits, scaled by a power of
-//! two: no division, and one 32×32→64 product on a Cortex-M0), and leaves across the
-//! plane met first (Amanatides and Woo's step). The next point is that plane
-//! exactly on its axis and the ray's position there on the others, held
-//! inside the leaf left and never behind the point before it; the deepest
-//! box holding both points is named by the highest bit in which their
-//! coordinates differ, and the next leaf is found from there down. So a
-//! step costs a few products and the levels between the two leaves, with no
-//! stack: the walk keeps one node index a level.
+//! product with the ray's reciprocal of |d_a| (31 bits scaled by a power of
+//! two: no division, and one 32×32→64 product on a Cortex-M0), and leaves
+//! across the plane met first (Amanatides and Woo's step). The next point is
+//! that plane exactly on its axis and the ray's position there on the
+//! others, held inside the leaf left and never behind the point before it;
+//! the deepest box holding both points is named by the highest bit in which
+//! their coordinates differ, and the next leaf is found from there down. So
+//! a step costs a few products and the levels between the two leaves, with
+//! no stack: the walk keeps one node index a level.
 //!
 //! Every step moves one coordinate forward to a plane and none back, so the
 //! walk ends (after at most 3·2^depth steps). Empty leaves are passed over,
