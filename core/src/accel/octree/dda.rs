@@ -70,10 +70,11 @@ impl Setup {
     /// The parameter (Q40.24, saturated) at which the ray crosses the plane
     /// at `plane` (mirrored space, relative to the root) on axis `a`:
     /// (plane − o)·2^38 / |d| through the reciprocal, rounded down.
-    // Out of line on ARMv6-M, its wide form apart: the one product's path
-    // then keeps its registers (fig5_3 on the Pico −0.9 %); inlined into
-    // the walk it ran out of them (+0.5 %). Elsewhere the compiler's
-    // choice (forced out of line, the MPS2-AN385's fig5_3 +3.6 %).
+    // Out of line on ARMv6-M (the `cfg` of `math::ARMV6M`), its wide form
+    // apart: the one product's path then keeps its registers (fig5_3 on the
+    // Pico −0.9 %); inlined into the walk it ran out of them (+0.5 %).
+    // Elsewhere the compiler's choice (forced out of line, the
+    // MPS2-AN385's fig5_3 +3.6 %).
     #[cfg_attr(all(target_arch = "arm", not(target_has_atomic = "32")), inline(never))]
     #[cfg_attr(not(all(target_arch = "arm", not(target_has_atomic = "32"))), inline)]
     fn crossing(&self, a: usize, plane: i64) -> i64 {

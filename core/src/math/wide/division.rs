@@ -91,22 +91,15 @@ impl Reciprocal {
         Reciprocal { divisor: d, shift, r }
     }
 
-    /// `⌊n / divisor⌋` for `n < divisor · 2^32`.
+    /// `⌊n / divisor⌋` for `n < divisor · 2^32`: the estimate from the
+    /// reciprocal is a few off at most, then stepped on the remainder.
     #[inline(always)]
     fn quotient(&self, n: u64) -> u32 {
-        let r = self.r;
+        let (r, d) = (self.r, self.divisor);
         let numerator = shl_u64(n, self.shift); // below dn · 2^32
         let (high, low) = ((numerator >> 32) as u32, numerator as u32);
         let estimate = (mul_u32_wide(high, r) + (mul_u32_wide(low, r) >> 32)) >> 31;
-        self.corrected(n, estimate.min(u32::MAX as u64) as u32)
-    }
-
-    /// The exact floor of `n / divisor` from an estimate a few off at most,
-    /// stepped on the remainder.
-    #[inline(always)]
-    fn corrected(&self, n: u64, estimate: u32) -> u32 {
-        let d = self.divisor;
-        let mut q = estimate;
+        let mut q = estimate.min(u32::MAX as u64) as u32;
         let mut remainder = n.wrapping_sub(mul_u32_wide(q, d)) as i64;
         while remainder < 0 {
             q -= 1;
